@@ -1,0 +1,64 @@
+//! The library's typed errors. Every variant names the offending value.
+
+use thiserror::Error;
+
+/// What went wrong, with the value that caused it.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum Error {
+    /// A sample value or timestamp is NaN or infinite.
+    #[error("{what} {value} is not finite")]
+    NonFinite {
+        /// `"time"` or `"value"`.
+        what: &'static str,
+        /// The offending number.
+        value: f64,
+    },
+    /// A timestamp is not after the previous one.
+    #[error(
+        "time {time} is not after the previous time {previous}: times must be strictly increasing"
+    )]
+    TimeNotIncreasing {
+        /// The new timestamp.
+        time: f64,
+        /// The previous timestamp.
+        previous: f64,
+    },
+    /// The discount factor is outside `(0, 1)`.
+    #[error("theta {theta} is out of range: it must lie strictly between 0 and 1")]
+    ThetaOutOfRange {
+        /// The rejected θ.
+        theta: f64,
+    },
+    /// The nominal sampling interval is not a positive finite number.
+    #[error("tau {tau} is out of range: it must be a positive finite number")]
+    TauOutOfRange {
+        /// The rejected τ.
+        tau: f64,
+    },
+    /// The degree is larger than the library supports.
+    #[error("degree {degree} is out of range: the largest supported degree is {max}")]
+    DegreeOutOfRange {
+        /// The rejected degree.
+        degree: usize,
+        /// The largest degree accepted.
+        max: usize,
+    },
+    /// Not enough samples to determine the estimate.
+    #[error("too few samples: {got} given, at least {needed} needed")]
+    TooFewSamples {
+        /// Samples required.
+        needed: usize,
+        /// Samples available.
+        got: usize,
+    },
+    /// Some other parameter is out of range.
+    #[error("{name} {value} is invalid: {reason}")]
+    InvalidParameter {
+        /// The parameter.
+        name: &'static str,
+        /// Its value, as text.
+        value: String,
+        /// Why it is rejected.
+        reason: String,
+    },
+}

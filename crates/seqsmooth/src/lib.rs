@@ -1,0 +1,65 @@
+//! # seqsmooth
+//!
+//! Sequential smoothing and prediction: polynomial filters that turn streams of noisy,
+//! timestamped measurements into smoothed estimates, derivatives and predictions with honest
+//! error statistics (Morrison, *Introduction to Sequential Smoothing and Prediction*, 1969;
+//! Reyneke, Morrison, Kourie, de Ridder, 2012).
+//!
+//! ## Conventions (fixed here, once)
+//!
+//! - **Degree** `m`; the state has `m+1` components indexed by **derivative order**
+//!   `k = 0..m` (`0` = the value itself).
+//! - The **public API speaks unscaled derivatives in the caller's time units**:
+//!   [`PolynomialState::derivatives`] is `(x, x', x'', …, x^(m))` at
+//!   [`PolynomialState::time`].
+//! - Internally and in the printed tables, Morrison's **scaled state** `Z` has
+//!   `z_k = τ^k x^(k) / k!` (4.2.14); `X = D(τ) Z` with `D(τ) = diag(k!/τ^k)` (4.2.18). Gains
+//!   ([`polynomial::gains`]) and variance-reduction matrices ([`polynomial::vrf`]) are given for
+//!   `Z` (Tables 9.1, 9.2, 13.1-13.3), and converted at the boundary ([`model`]).
+//! - **Transition matrices**: Morrison's `Φ(h)` acts on `Z` with `h` in samples,
+//!   `[Φ(h)]_ij = C(j,i) h^(j-i)` ([`model::phi`]); Reyneke's `Ψ(ζ)` acts on `d_k = τ^k x^(k)`,
+//!   `[Ψ(ζ)]_ij = ζ^(j-i)/(j-i)!` ([`model::psi`]), which is also the unscaled `Φ_X`. Gains
+//!   relate by `Γ_Ψ[k] = k! Γ_Φ[k]`.
+//! - **Sample index** `n` is 0-based: after the sample with index `n` the filter has seen `n+1`
+//!   samples (Morrison ch. 9: "in all cases n starts at zero").
+//! - **Fading memory**: `θ ∈ (0,1)` is the discount per nominal interval `τ`; a sample of age
+//!   `Δt` weighs `θ^(Δt/τ)` ([`DiscountMode::PerTime`]) or `θ` per later sample
+//!   ([`DiscountMode::PerUpdate`]).
+//!
+//! ## Modules
+//!
+//! - [`calculus`]: factorials, binomials, Stirling and link matrices, polynomials.
+//! - [`basis`]: discrete Legendre and Laguerre polynomials, classical Legendre.
+//! - [`model`]: state scaling, `Φ` and `Ψ`, propagation ([`PolynomialState::at`]).
+//! - [`estimate`]: batch weighted least-squares polynomial fits (QR).
+//! - [`polynomial`]: [`ExpandingMemory`] and [`FadingMemory`] filters, gains, VRFs, switching.
+//! - [`recursive`]: the square-root information (Bayes) recursion the exact engines run on.
+//! - [`scalar`]: the `f64` / exact-rational abstraction every formula is generic over.
+//!
+//! ```
+//! use seqsmooth::{Engine, FadingMemory};
+//! // degree-2 fading-memory filter, θ = 0.9 per second, noise σ = 0.1
+//! let mut f = FadingMemory::new(2, 0.9, 1.0, Engine::Exact).unwrap().with_noise_sigma(0.1).unwrap();
+//! for k in 0..50 {
+//!     let t = k as f64 * 1.0 + 0.1 * ((k * 7 % 5) as f64); // irregular times
+//!     f.update(t, 3.0 + 2.0 * t).unwrap();
+//! }
+//! let s = f.estimate().unwrap();
+//! assert!((s.derivatives[1] - 2.0).abs() < 1e-9);        // exact on a polynomial
+//! assert!(s.std_devs().unwrap()[0] < 0.1);                // smoothed below the noise
+//! ```
+#![warn(missing_docs)]
+
+pub mod basis;
+pub mod calculus;
+pub mod error;
+pub mod estimate;
+pub mod linalg;
+pub mod model;
+pub mod polynomial;
+pub mod recursive;
+pub mod scalar;
+
+pub use error::Error;
+pub use model::PolynomialState;
+pub use polynomial::{DiscountMode, Engine, ExpandingMemory, FadingMemory};

@@ -1,0 +1,108 @@
+//! Small dense linear algebra the library needs beyond nalgebra: exact (field-generic) inversion
+//! for the rational oracles, and triangular solves.
+
+use crate::scalar::Scalar;
+use nalgebra::DMatrix;
+
+/// Inverse of a square matrix over any field by Gauss–Jordan elimination with pivot search on
+/// non-zero entries. Meant for exact rationals (conditioning is irrelevant there); `None` when
+/// the matrix is singular.
+///
+/// ```
+/// use seqsmooth::linalg::inverse_exact;
+/// use seqsmooth::scalar::Rational;
+/// use nalgebra::DMatrix;
+/// let h = DMatrix::from_fn(3, 3, |i, j| Rational::new(1.into(), ((i + j + 1) as i64).into()));
+/// let hi = inverse_exact(&h).unwrap();
+/// assert_eq!(hi[(0, 0)], Rational::from_integer(9.into())); // inverse Hilbert matrix
+/// ```
+pub fn inverse_exact<T: Scalar>(a: &DMatrix<T>) -> Option<DMatrix<T>> {
+    let n = a.nrows();
+    if a.ncols() != n {
+        return None;
+    }
+    let mut m = a.clone();
+    let mut inv = DMatrix::from_fn(n, n, |i, j| if i == j { T::one() } else { T::zero() });
+    for col in 0..n {
+        let pivot = (col..n).find(|&r| !m[(r, col)].is_zero())?;
+        if pivot != col {
+            m.swap_rows(pivot, col);
+            inv.swap_rows(pivot, col);
+        }
+        let p = m[(col, col)].clone();
+        for j in 0..n {
+            m[(col, j)] = m[(col, j)].clone() / p.clone();
+            inv[(col, j)] = inv[(col, j)].clone() / p.clone();
+        }
+        for r in 0..n {
+            if r == col || m[(r, col)].is_zero() {
+                continue;
+            }
+            let f = m[(r, col)].clone();
+            for j in 0..n {
+                m[(r, j)] = m[(r, j)].clone() - f.clone() * m[(col, j)].clone();
+                inv[(r, j)] = inv[(r, j)].clone() - f.clone() * inv[(col, j)].clone();
+            }
+        }
+    }
+    Some(inv)
+}
+
+/// Solves `R x = b` in place for upper-triangular `R` (back substitution). Returns `false`
+/// (leaving `b` partly overwritten) if a diagonal entry is zero.
+pub fn solve_upper_in_place(r: &DMatrix<f64>, b: &mut [f64]) -> bool {
+    let n = b.len();
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for j in i + 1..n {
+            s -= r[(i, j)] * b[j];
+        }
+        let d = r[(i, i)];
+        if d == 0.0 {
+            return false;
+        }
+        b[i] = s / d;
+    }
+    true
+}
+
+/// Solves `Rᵀ x = b` in place for upper-triangular `R` (forward substitution).
+pub fn solve_upper_transpose_in_place(r: &DMatrix<f64>, b: &mut [f64]) -> bool {
+    let n = b.len();
+    for i in 0..n {
+        let mut s = b[i];
+        for j in 0..i {
+            s -= r[(j, i)] * b[j];
+        }
+        let d = r[(i, i)];
+        if d == 0.0 {
+            return false;
+        }
+        b[i] = s / d;
+    }
+    true
+}
+
+/// Matrix product over any field (nalgebra's operators need more trait bounds than exact
+/// rationals and `f64` share through [`Scalar`]).
+///
+/// ```
+/// use seqsmooth::linalg::mul;
+/// use nalgebra::DMatrix;
+/// let a = DMatrix::from_row_slice(1, 2, &[1.0, 2.0]);
+/// let b = DMatrix::from_row_slice(2, 1, &[3.0, 4.0]);
+/// assert_eq!(mul(&a, &b)[(0, 0)], 11.0);
+/// ```
+pub fn mul<T: Scalar>(a: &DMatrix<T>, b: &DMatrix<T>) -> DMatrix<T> {
+    assert_eq!(a.ncols(), b.nrows(), "matrix product dimensions");
+    DMatrix::from_fn(a.nrows(), b.ncols(), |i, j| {
+        (0..a.ncols()).fold(T::zero(), |acc, k| {
+            acc + a[(i, k)].clone() * b[(k, j)].clone()
+        })
+    })
+}
+
+/// `A B Aᵀ` over any field.
+pub fn congruence<T: Scalar>(a: &DMatrix<T>, b: &DMatrix<T>) -> DMatrix<T> {
+    mul(&mul(a, b), &a.transpose())
+}

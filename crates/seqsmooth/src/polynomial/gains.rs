@@ -1,0 +1,204 @@
+//! Gains of the expanding- and fading-memory polynomial filters for any degree, each from one
+//! general formula, generic over [`Scalar`] (exact rationals or `f64`).
+//!
+//! Convention: Morrison's scaled current-estimate gains `h_k` (Tables 9.1 and 13.1; Reyneke's
+//! `Γ_Φ(k, m)`), indexed by derivative order `k = 0..m`, used as
+//! `Z*_{n,n} = Z*_{n,n-1} + H ε_n`. The 1-step-predictor form uses `Φ(1) H`
+//! (Morrison (13.5.35)-(13.5.37)); [`GainForm`] selects between them.
+
+use crate::calculus::{choose, factorial, falling_factorial, link_matrix, stirling1, Polynomial};
+use crate::model::phi;
+use crate::scalar::{Rational, Scalar};
+use nalgebra::DVector;
+
+/// Which recursion the gain vector belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum GainForm {
+    /// `Z*_{n,n} = Z*_{n,n-1} + H ε_n` (current estimate; Tables 9.1, 13.1 gains).
+    #[default]
+    Current,
+    /// `Z*_{n+1,n} = Φ(1) Z*_{n,n-1} + Φ(1) H ε_n` (1-step predictor; gain `Φ(1) H`).
+    Predictor,
+}
+
+/// The expanding-memory gains as rational functions of the sample index `n`:
+/// `h_k(n) = N_k(n) / (n+m+1)^(m+1)` with integer polynomial numerators
+///
+/// `N_k(n) = Σ_{i=k..m} 𝒮_ki Σ_{j=i..m} C(j,i) C(j+i,i) (2j+1) (n-i)^(j-i) (n+m+1)^(m-j)`,
+///
+/// which is Morrison's `H_n = P(n) K(n)` (9.4.28)-(9.4.30) with `P = 𝒮 G` (7.4.15),
+/// `[G]_ij = (-1)^j C(j,i) C(j+i,i)/n^(i)`, `[K]_j = (-1)^j / c(j,n)²`, over the common
+/// denominator. The numerators' coefficients are exact; [`ExpandingGainSchedule`] evaluates them
+/// in `f64`.
+///
+/// ```
+/// use seqsmooth::polynomial::gains::expanding_gain_numerators;
+/// use seqsmooth::scalar::Rational;
+/// let num = expanding_gain_numerators(1);
+/// // h0 = 2(2n+1)/((n+2)(n+1)), h1 = 6/((n+2)(n+1))  (Morrison (9.4.18)-(9.4.19))
+/// assert_eq!(num[0].coeffs, vec![Rational::from_integer(2.into()), Rational::from_integer(4.into())]);
+/// assert_eq!(num[1].coeffs, vec![Rational::from_integer(6.into()), Rational::from_integer(0.into())]);
+/// ```
+pub fn expanding_gain_numerators(m: usize) -> Vec<Polynomial<Rational>> {
+    let sa = link_matrix::<Rational>(m);
+    let one = Rational::from_i64(1);
+    // Linear factor (n + a).
+    let lin = |a: i64| Polynomial::new(vec![Rational::from_i64(a), one.clone()]);
+    let falling_shift = |start: i64, count: usize| {
+        // (n + start)(n + start - 1) … (count factors)
+        let mut p = Polynomial::constant(one.clone());
+        for l in 0..count {
+            p = p.mul(&lin(start - l as i64));
+        }
+        p
+    };
+    (0..=m)
+        .map(|k| {
+            let mut total = Polynomial::new(vec![Rational::from_i64(0); m + 1]);
+            for i in k..=m {
+                let s = sa[(k, i)].clone();
+                if s == Rational::from_i64(0) {
+                    continue;
+                }
+                for j in i..=m {
+                    let c = choose::<Rational>(j, i)
+                        * choose::<Rational>(j + i, i)
+                        * Rational::from_i64(2 * j as i64 + 1)
+                        * s.clone();
+                    let term = falling_shift(-(i as i64), j - i)
+                        .mul(&falling_shift(m as i64 + 1, m - j))
+                        .scale(&c);
+                    total = total.add(&term);
+                }
+            }
+            total.coeffs.resize(m + 1, Rational::from_i64(0));
+            total
+        })
+        .collect()
+}
+
+/// Expanding-memory gains `h_0(n) … h_m(n)` of degree `m` at the 0-based index `n` of the
+/// newest sample, in the field `T` (Morrison Table 9.1; Reyneke §6.3-6.4), current-estimate or
+/// 1-step-predictor form. Finite for every `n ≥ 0`; the filter is exact least squares from
+/// `n = m` on whatever its initial state (Morrison §9.6).
+///
+/// ```
+/// use seqsmooth::polynomial::gains::{expanding_gains, GainForm};
+/// use seqsmooth::scalar::parse_rational;
+/// let g = expanding_gains::<seqsmooth::scalar::Rational>(2, 10, GainForm::Current);
+/// let want: Vec<_> = ["83/143", "63/286", "5/286"].iter().map(|s| parse_rational(s).unwrap()).collect();
+/// assert_eq!(g, want); // Reyneke §6.4 test vector at n = 10
+/// ```
+pub fn expanding_gains<T: Scalar>(m: usize, n: u64, form: GainForm) -> Vec<T> {
+    let num = expanding_gain_numerators(m);
+    let nr = Rational::from_integer((n as i64).into());
+    let den = falling_factorial(nr.clone() + Rational::from_i64(m as i64 + 1), m + 1);
+    let h: Vec<Rational> = num.iter().map(|p| p.eval(&nr) / den.clone()).collect();
+    apply_form(m, h, form)
+        .iter()
+        .map(T::from_rational)
+        .collect()
+}
+
+/// Fading-memory gains `h_0(θ) … h_m(θ)` of degree `m` (Morrison Table 13.1, `H = P(0) L`
+/// (13.5.28)-(13.5.30); Reyneke §6.5-6.6):
+///
+/// `h_k = (1-θ) Σ_{j=k..m} Σ_{v=k..j} C(j,v) θ^(j-v) (1-θ)^v |s(v,k)| / v!`,
+///
+/// a sum of non-negative terms (so accurate in `f64` for every `θ ∈ (0,1)`). `h_0 = 1 - θ^(m+1)`.
+///
+/// ```
+/// use seqsmooth::polynomial::gains::{fading_gains, GainForm};
+/// let g = fading_gains(2, 0.9_f64, GainForm::Current);
+/// assert!((g[0] - 0.271).abs() < 1e-15 && (g[1] - 0.0285).abs() < 1e-15 && (g[2] - 0.0005).abs() < 1e-16);
+/// ```
+pub fn fading_gains<T: Scalar>(m: usize, theta: T, form: GainForm) -> Vec<T> {
+    let s1 = stirling1::<T>(m);
+    let om = T::one() - theta.clone();
+    let h: Vec<T> = (0..=m)
+        .map(|k| {
+            let mut acc = T::zero();
+            for j in k..=m {
+                for v in k..=j {
+                    acc = acc
+                        + choose::<T>(j, v)
+                            * theta.powi_u(j - v)
+                            * om.powi_u(v)
+                            * s1[(v, k)].abs_val()
+                            / factorial::<T>(v);
+                }
+            }
+            om.clone() * acc
+        })
+        .collect();
+    apply_form(m, h, form)
+}
+
+fn apply_form<T: Scalar>(m: usize, h: Vec<T>, form: GainForm) -> Vec<T> {
+    match form {
+        GainForm::Current => h,
+        GainForm::Predictor => {
+            let p = phi(m, T::one());
+            (0..=m)
+                .map(|i| (i..=m).fold(T::zero(), |acc, j| acc + p[(i, j)].clone() * h[j].clone()))
+                .collect()
+        }
+    }
+}
+
+/// Precomputed expanding-memory gain schedule in `f64`: the exact integer numerator coefficients
+/// of [`expanding_gain_numerators`] evaluated by Horner's rule, `O(m)` per gain. The numerator
+/// coefficients are all non-negative (checked at construction for the degree in use), so the
+/// evaluation is accurate to a few ulps for every `n ≥ 0`.
+///
+/// ```
+/// use seqsmooth::polynomial::gains::ExpandingGainSchedule;
+/// let s = ExpandingGainSchedule::new(1);
+/// let mut h = [0.0; 2];
+/// s.gains(3, &mut h);
+/// assert_eq!(h, [0.7, 0.3]); // Morrison T9-01: (7/10, 3/10)
+/// ```
+#[derive(Clone, Debug)]
+pub struct ExpandingGainSchedule {
+    m: usize,
+    numerators: Vec<Vec<f64>>,
+}
+
+impl ExpandingGainSchedule {
+    /// The schedule for degree `m`.
+    pub fn new(m: usize) -> Self {
+        let numerators = expanding_gain_numerators(m)
+            .iter()
+            .map(|p| p.coeffs.iter().map(|c| c.to_f64()).collect())
+            .collect();
+        Self { m, numerators }
+    }
+
+    /// Degree.
+    pub fn degree(&self) -> usize {
+        self.m
+    }
+
+    /// Writes `h_0(n) … h_m(n)` (current-estimate form) into `out`.
+    pub fn gains(&self, n: u64, out: &mut [f64]) {
+        let nf = n as f64;
+        let mut den = 1.0;
+        for l in 1..=self.m + 1 {
+            den *= nf + l as f64;
+        }
+        for (o, num) in out.iter_mut().zip(&self.numerators) {
+            let mut acc = 0.0;
+            for c in num.iter().rev() {
+                acc = acc * nf + c;
+            }
+            *o = acc / den;
+        }
+    }
+
+    /// The gains as a vector.
+    pub fn gains_vec(&self, n: u64) -> DVector<f64> {
+        let mut v = DVector::zeros(self.m + 1);
+        self.gains(n, v.as_mut_slice());
+        v
+    }
+}

@@ -1,0 +1,117 @@
+//! Memory equivalences and the expanding → fading-memory switch (Morrison §13.7-13.8,
+//! Table 13.4; Reyneke et al. §7.2, Table 1).
+//!
+//! A fading-memory filter with discount `θ` smooths about as much as a fixed-memory filter of
+//! `L ≈ c_im / (1-θ)` samples, where `c_im` equates the variance-reduction factors of derivative
+//! `i` near `θ = 1` ([`memory_length_constant`], Table 13.4). The fading-memory filter is not
+//! self-starting; it starts as an expanding-memory filter and switches to its constant gains at a
+//! sample chosen by a [`SwitchRule`].
+
+use super::gains::ExpandingGainSchedule;
+use super::vrf::{fading_vrf, fading_vrf_limit, fixed_memory_vrf_limit, EstimateForm};
+use crate::error::Error;
+use crate::scalar::{Rational, Scalar};
+
+/// Morrison's Table 13.4 constant `c_im = (κ_ii(m)/λ_ii(m))^(1/(2i+1))`: a fading-memory filter
+/// of degree `m` and discount `θ` has the variance reduction in derivative `i` of a fixed-memory
+/// filter with `L = c_im/(1-θ)` (asymptotically, `θ → 1`). Requires `i ≤ m`.
+///
+/// ```
+/// use seqsmooth::polynomial::switching::memory_length_constant;
+/// assert!((memory_length_constant(0, 1) - 3.2).abs() < 1e-15);
+/// assert!((memory_length_constant(1, 1) - 3.6342).abs() < 1e-4);
+/// ```
+pub fn memory_length_constant(i: usize, m: usize) -> f64 {
+    assert!(i <= m, "derivative index {i} exceeds degree {m}");
+    let k = fixed_memory_vrf_limit(m)[(i, i)].to_f64();
+    let l = fading_vrf_limit(m)[(i, i)].to_f64();
+    (k / l).powf(1.0 / (2 * i + 1) as f64)
+}
+
+/// Reyneke's Table 1 switch constant (= Table 13.4 row 0), exactly: `(m+1)² / λ_00(m)`, the
+/// limit ratio of `n·VRF_expanding(n)` to `VRF_fading(θ)/(1-θ)` for the position. Switch at
+/// `n_s = c/(1-θ)`, or choose `θ = 1 - c/n_s` for a planned switch at `n_s`.
+///
+/// ```
+/// use seqsmooth::polynomial::switching::switch_constant;
+/// use seqsmooth::scalar::parse_rational;
+/// assert_eq!(switch_constant(2), parse_rational("48/11").unwrap());
+/// assert_eq!(switch_constant(5), parse_rational("6144/793").unwrap());
+/// ```
+pub fn switch_constant(m: usize) -> Rational {
+    let lam = fading_vrf_limit(m)[(0, 0)].clone();
+    Rational::from_i64(((m + 1) * (m + 1)) as i64) / lam
+}
+
+/// When a fading-memory filter hands over from its expanding-memory start-up (Morrison §13.8).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum SwitchRule {
+    /// At `n = c_0m/(1-θ)`, the position row of Table 13.4 (Reyneke Table 1; Morrison's text
+    /// example (13.8.8): `m = 1, θ = 0.9 → n = 32`). The default.
+    #[default]
+    Position,
+    /// At `n = (mean over i of c_im)/(1-θ)`, the rule behind Morrison's Ex. 13.21 answers.
+    ColumnMean,
+    /// At `n = c_im/(1-θ)` for derivative `i`.
+    Derivative(usize),
+    /// At the first `n` where the expanding-memory position variance of the current estimate
+    /// falls to the fading-memory one: the exact crossover (earlier than the asymptotic rules).
+    ExactCrossover,
+    /// At an explicit 0-based sample index.
+    AtSample(u64),
+}
+
+impl SwitchRule {
+    /// The 0-based index of the first sample processed with the fading-memory gains, for degree
+    /// `m` and discount `θ`. Never less than `m + 1`, so that the expanding-memory start has
+    /// determined the state.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::switching::SwitchRule;
+    /// assert_eq!(SwitchRule::Position.switch_index(1, 0.9).unwrap(), 32);  // Morrison (13.8.8)
+    /// assert_eq!(SwitchRule::ColumnMean.switch_index(2, 0.93).unwrap(), 68); // Ex. 13.21
+    /// assert_eq!(SwitchRule::ExactCrossover.switch_index(0, 0.9).unwrap(), 18);
+    /// ```
+    pub fn switch_index(&self, m: usize, theta: f64) -> Result<u64, Error> {
+        if !(theta > 0.0 && theta < 1.0) {
+            return Err(Error::ThetaOutOfRange { theta });
+        }
+        let scale = |c: f64| (c / (1.0 - theta)).round() as u64;
+        let n = match *self {
+            SwitchRule::Position => scale(memory_length_constant(0, m)),
+            SwitchRule::ColumnMean => {
+                let mean =
+                    (0..=m).map(|i| memory_length_constant(i, m)).sum::<f64>() / (m + 1) as f64;
+                scale(mean)
+            }
+            SwitchRule::Derivative(i) => {
+                if i > m {
+                    return Err(Error::InvalidParameter {
+                        name: "switch derivative",
+                        value: i.to_string(),
+                        reason: format!("must be at most the degree {m}"),
+                    });
+                }
+                scale(memory_length_constant(i, m))
+            }
+            SwitchRule::ExactCrossover => {
+                let target = fading_vrf(m, theta, EstimateForm::Current)?[(0, 0)];
+                let sched = ExpandingGainSchedule::new(m);
+                // The expanding-memory current position VRF equals its position gain h_0(n).
+                let mut n = m as u64;
+                let mut h = vec![0.0; m + 1];
+                loop {
+                    sched.gains(n, &mut h);
+                    // A relative slack of 1e-12 absorbs the rounding of an exact tie
+                    // (m = 0: n* = 2θ/(1-θ) exactly).
+                    if h[0] <= target * (1.0 + 1e-12) {
+                        break n;
+                    }
+                    n += 1;
+                }
+            }
+            SwitchRule::AtSample(n) => n,
+        };
+        Ok(n.max(m as u64 + 1))
+    }
+}
