@@ -192,3 +192,47 @@ impl PolynomialState {
         }
     }
 }
+
+/// Error-free sum: `a + b = s + e` exactly (Knuth's TwoSum).
+#[inline]
+pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    let e = (a - (s - bb)) + (b - bb);
+    (s, e)
+}
+
+/// [`shift_scaled`] in compensated (double-word) arithmetic: the state is `hi + lo` per
+/// component, each product's and sum's rounding error is carried in `lo` (TwoSum and an FMA
+/// for the product error; Graillat–Langlois–Louvet's compensated Horner scheme). The result is
+/// as accurate as if computed in twice the working precision, which matters because the Taylor
+/// coefficients of a polynomial about the end of its data interval are an ill-conditioned
+/// representation (cancellation of order `(1+√2)^(2m)` at degree `m`).
+///
+/// ```
+/// use seqsmooth::model::shift_scaled_compensated;
+/// let mut hi = [1.0, 2.0, 3.0];
+/// let mut lo = [0.0; 3];
+/// shift_scaled_compensated(&mut hi, &mut lo, 1.0);
+/// assert_eq!(hi, [6.0, 8.0, 3.0]);
+/// ```
+pub fn shift_scaled_compensated(hi: &mut [f64], lo: &mut [f64], h: f64) {
+    let n = hi.len();
+    if n < 2 || h == 0.0 {
+        return;
+    }
+    for i in 0..n - 1 {
+        for k in (i..n - 1).rev() {
+            let p = h * hi[k + 1];
+            let pe = h.mul_add(hi[k + 1], -p);
+            let (s, se) = two_sum(hi[k], p);
+            lo[k] += h * lo[k + 1] + pe + se;
+            hi[k] = s;
+        }
+    }
+    for k in 0..n {
+        let (s, e) = two_sum(hi[k], lo[k]);
+        hi[k] = s;
+        lo[k] = e;
+    }
+}

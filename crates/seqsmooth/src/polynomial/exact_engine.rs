@@ -121,7 +121,7 @@ impl ExactEngine {
         };
         let target_c = 0.5 * (start + t);
         let target_s = 0.5 * (t - start);
-        if !(target_s > 0.0) {
+        if target_s.is_nan() || target_s <= 0.0 {
             return;
         }
         let off_centre = (self.centre - target_c).abs() > 0.5 * target_s;

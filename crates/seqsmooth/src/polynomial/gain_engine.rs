@@ -1,23 +1,87 @@
 //! The fixed-gain recursion of Morrison's Tables 9.1 and 13.1 in the variable-step form of
 //! Reyneke et al. §6, with the step scaling that makes it exact on evenly spaced samples for any
 //! step (../shared/spec/others.md §4.8).
+//!
+//! Numerics (measured, see tests/engines.rs): the state — Taylor coefficients about the newest
+//! sample — is an ill-conditioned representation, and the start-up gains `h_k(n)`, `n ≤ m`, are
+//! large. Run in plain `f64` from a zero state, the recursion loses up to 1e-7 relative at
+//! degree 8, almost all of it from rounding the start-up gains. So the engine (1) starts from
+//! the polynomial interpolating the first `m+1` samples, computed in exact rational arithmetic
+//! — the state the recursion reaches from *any* initial state at `n = m` on even spacing
+//! (Morrison §9.6), and the exact least-squares state on any spacing — and (2) carries the
+//! state in compensated (double-word) arithmetic.
 
 use super::gains::{fading_gains, ExpandingGainSchedule, GainForm};
+use super::switching::SwitchRule;
+use super::vrf::{fading_vrf, EstimateForm};
 use super::DiscountMode;
-use crate::model::shift_scaled;
-use nalgebra::DMatrix;
+use crate::calculus::Polynomial;
+use crate::model::{shift_scaled_compensated, two_sum};
+use crate::scalar::{rational_from_f64, Rational, Scalar};
+use nalgebra::{DMatrix, DVector};
 
 #[derive(Clone, Debug)]
 pub(crate) struct FadingGains {
     pub theta: f64,
     pub mode: DiscountMode,
-    /// First 0-based sample index that uses the fading-memory gains.
-    pub switch_at: u64,
-    /// Gains at θ (used whenever the effective discount is θ itself).
-    pub steady: Vec<f64>,
+    pub rule: SwitchRule,
+    /// For the constant rules: switch once `n ≥ c/(1-θ_s)`.
+    pub constant: Option<f64>,
+    /// The sample index at which the fading gains took over.
+    pub switched_at: Option<u64>,
+    /// Cache: the effective discount the gains below belong to.
+    pub theta_eff: f64,
+    pub gains: Vec<f64>,
+    /// Low words of `gains` (double-word gains), exact to ~2⁻¹⁰⁶.
+    pub gains_lo: Vec<f64>,
 }
 
-/// State: Morrison's scaled `Z` (unit `τ`) valid at `t_last`.
+/// The fading-memory gains at `θ` as double words `hi + lo`, from the exact rational formula.
+pub(crate) fn fading_gains_double_word(m: usize, theta: f64) -> (Vec<f64>, Vec<f64>) {
+    let exact = fading_gains::<Rational>(
+        m,
+        rational_from_f64(theta).expect("finite θ"),
+        GainForm::Current,
+    );
+    let hi: Vec<f64> = exact.iter().map(|g| g.to_f64()).collect();
+    let lo = exact
+        .iter()
+        .zip(&hi)
+        .map(|(g, h)| (g.clone() - rational_from_f64(*h).unwrap_or_default()).to_f64())
+        .collect();
+    (hi, lo)
+}
+
+impl FadingGains {
+    pub fn new(m: usize, theta: f64, mode: DiscountMode, rule: SwitchRule) -> Self {
+        let constant = match rule {
+            SwitchRule::Position => Some(super::switching::memory_length_constant(0, m)),
+            SwitchRule::ColumnMean => Some(
+                (0..=m)
+                    .map(|i| super::switching::memory_length_constant(i, m))
+                    .sum::<f64>()
+                    / (m + 1) as f64,
+            ),
+            SwitchRule::Derivative(i) => {
+                Some(super::switching::memory_length_constant(i.min(m), m))
+            }
+            SwitchRule::ExactCrossover | SwitchRule::AtSample(_) => None,
+        };
+        let dw = fading_gains_double_word(m, theta);
+        Self {
+            theta,
+            mode,
+            rule,
+            constant,
+            switched_at: None,
+            theta_eff: theta,
+            gains: dw.0,
+            gains_lo: dw.1,
+        }
+    }
+}
+
+/// State: Morrison's scaled `Z` (unit `τ`) valid at `t_last`, as the double-word `z + z_lo`.
 #[derive(Clone, Debug)]
 pub(crate) struct GainEngine {
     m: usize,
@@ -25,9 +89,14 @@ pub(crate) struct GainEngine {
     fading: Option<FadingGains>,
     schedule: ExpandingGainSchedule,
     z: Vec<f64>,
+    z_lo: Vec<f64>,
+    /// The first `m+1` samples, until the exact start.
+    start: Vec<(f64, f64)>,
+    t_first: f64,
     t_last: f64,
     n: u64,
     k: Vec<f64>,
+    k_lo: Vec<f64>,
     /// Noise variance and the scaled covariance of the estimate's random error.
     cov: Option<(f64, DMatrix<f64>)>,
 }
@@ -40,15 +109,15 @@ impl GainEngine {
             fading,
             schedule: ExpandingGainSchedule::new(m),
             z: vec![0.0; m + 1],
+            z_lo: vec![0.0; m + 1],
+            start: Vec::with_capacity(m + 1),
+            t_first: f64::NAN,
             t_last: f64::NAN,
             n: 0,
             k: vec![0.0; m + 1],
+            k_lo: vec![0.0; m + 1],
             cov: None,
         }
-    }
-
-    pub fn set_initial_scaled(&mut self, z: Vec<f64>) {
-        self.z = z;
     }
 
     pub fn track_covariance(&mut self, sigma: f64) {
@@ -59,60 +128,61 @@ impl GainEngine {
         self.n
     }
 
-    pub fn tau(&self) -> f64 {
-        self.tau
-    }
-
     pub fn last_time(&self) -> f64 {
         self.t_last
     }
 
-    pub fn switch_at(&self) -> Option<u64> {
-        self.fading.as_ref().map(|f| f.switch_at)
+    pub fn switched_at(&self) -> Option<u64> {
+        self.fading.as_ref().and_then(|f| f.switched_at)
     }
 
     /// Processes one sample; `t` must exceed the previous time (checked by the caller).
     pub fn update(&mut self, t: f64, y: f64) {
-        let zeta = if self.n == 0 {
-            1.0
-        } else {
-            (t - self.t_last) / self.tau
-        };
-        if self.n > 0 {
-            shift_scaled(&mut self.z, zeta);
+        if self.n == 0 {
+            self.t_first = t;
         }
-        let e = y - self.z[0];
-        match &self.fading {
-            Some(f) if self.n >= f.switch_at => {
-                let theta_eff = match f.mode {
-                    DiscountMode::PerUpdate => f.theta,
-                    DiscountMode::PerTime => f.theta.powf(zeta),
-                };
-                if theta_eff == f.theta {
-                    self.k.copy_from_slice(&f.steady);
-                } else {
-                    self.k = fading_gains(self.m, theta_eff, GainForm::Current);
-                }
+        if self.n <= self.m as u64 {
+            self.start.push((t, y));
+            self.t_last = t;
+            self.n += 1;
+            if self.n == self.m as u64 + 1 {
+                self.exact_start();
             }
-            _ => self.schedule.gains(self.n, &mut self.k),
+            return;
         }
+        let zeta = (t - self.t_last) / self.tau;
+        shift_scaled_compensated(&mut self.z, &mut self.z_lo, zeta);
+        // e = y - (z0 + z0_lo) as the double-word e + e_lo.
+        let (d, de) = two_sum(y, -self.z[0]);
+        let (e, e_lo) = two_sum(d, de - self.z_lo[0]);
+        self.choose_gains(t, zeta);
         if zeta != 1.0 {
             let mut zk = 1.0;
-            for kk in self.k.iter_mut().skip(1) {
+            for (kk, kl) in self.k.iter_mut().zip(self.k_lo.iter_mut()).skip(1) {
                 zk *= zeta;
                 *kk /= zk;
+                *kl /= zk;
             }
         }
-        for (zi, ki) in self.z.iter_mut().zip(&self.k) {
-            *zi += ki * e;
+        for (((zi, lo), ki), kl) in self
+            .z
+            .iter_mut()
+            .zip(self.z_lo.iter_mut())
+            .zip(&self.k)
+            .zip(&self.k_lo)
+        {
+            let p = ki * e;
+            let pe = ki.mul_add(e, -p);
+            let (s, se) = two_sum(*zi, p);
+            let (s, l) = two_sum(s, *lo + se + pe + ki * e_lo + kl * e);
+            *zi = s;
+            *lo = l;
         }
         if let Some((var, p)) = &mut self.cov {
             // P ← Φ(ζ) P Φ(ζ)ᵀ, then the Joseph form P ← (I - K e0ᵀ) P (I - K e0ᵀ)ᵀ + σ² K Kᵀ:
             // the exact covariance of this linear estimator's random error.
-            if self.n > 0 {
-                let transition = crate::model::phi(self.m, zeta);
-                *p = &transition * &*p * transition.transpose();
-            }
+            let transition = crate::model::phi(self.m, zeta);
+            *p = &transition * &*p * transition.transpose();
             let dim = self.m + 1;
             let a = DMatrix::from_fn(dim, dim, |i, j| {
                 let id = if i == j { 1.0 } else { 0.0 };
@@ -122,18 +192,132 @@ impl GainEngine {
                     id
                 }
             });
-            let kv = nalgebra::DVector::from_column_slice(&self.k);
+            let kv = DVector::from_column_slice(&self.k);
             *p = &a * &*p * a.transpose() + (&kv * kv.transpose()) * *var;
         }
         self.t_last = t;
         self.n += 1;
     }
 
+    /// Writes the current-estimate gains for the sample with index `self.n` into `self.k`.
+    fn choose_gains(&mut self, t: f64, zeta: f64) {
+        let n = self.n;
+        let m = self.m;
+        self.k_lo.iter_mut().for_each(|v| *v = 0.0);
+        let Some(f) = &mut self.fading else {
+            self.schedule.gains(n, &mut self.k);
+            return;
+        };
+        if f.switched_at.is_none() {
+            // The discount per sample so far: θ itself per update, or θ^(mean step/τ).
+            let theta_s = match f.mode {
+                DiscountMode::PerUpdate => f.theta,
+                DiscountMode::PerTime => f.theta.powf((t - self.t_first) / (n as f64 * self.tau)),
+            };
+            let switch = match (f.rule, f.constant) {
+                (SwitchRule::AtSample(k), _) => n >= k,
+                (_, Some(c)) => n as f64 >= (c / (1.0 - theta_s) + 1e-9).floor(),
+                _ => {
+                    // Exact crossover: the expanding-memory position VRF h_0(n) reaches the
+                    // fading-memory one.
+                    self.schedule.gains(n, &mut self.k);
+                    let target = fading_vrf(m, theta_s, EstimateForm::Current)
+                        .map(|s| s[(0, 0)])
+                        .unwrap_or(0.0);
+                    self.k[0] <= target * (1.0 + 1e-12)
+                }
+            };
+            if !switch {
+                self.schedule.gains(n, &mut self.k);
+                return;
+            }
+            f.switched_at = Some(n);
+        }
+        let theta_eff = match f.mode {
+            DiscountMode::PerUpdate => f.theta,
+            DiscountMode::PerTime => f.theta.powf(zeta),
+        };
+        if theta_eff != f.theta_eff {
+            // The steady θ's gains are double words from the exact formula (computed once);
+            // other effective discounts (steps ≠ τ) use the f64 formula, whose terms are all
+            // positive (relative error ~1e-15), cached while the step repeats.
+            f.theta_eff = theta_eff;
+            if theta_eff == f.theta {
+                let (hi, lo) = fading_gains_double_word(m, theta_eff);
+                f.gains = hi;
+                f.gains_lo = lo;
+            } else {
+                f.gains = fading_gains(m, theta_eff, GainForm::Current);
+                f.gains_lo.iter_mut().for_each(|v| *v = 0.0);
+            }
+        }
+        self.k.copy_from_slice(&f.gains);
+        self.k_lo.copy_from_slice(&f.gains_lo);
+    }
+
+    /// The polynomial through the first `m+1` samples, as scaled Taylor coefficients about the
+    /// newest of them, computed exactly (Newton divided differences in rationals), and, when
+    /// tracked, its covariance `σ² L Lᵀ` with `L` the exact interpolation weights.
+    fn exact_start(&mut self) {
+        let m = self.m;
+        let t_ref = self.start[m].0;
+        let tau = rational_from_f64(self.tau).expect("finite tau");
+        let tr = rational_from_f64(t_ref).expect("finite time");
+        let u: Vec<Rational> = self
+            .start
+            .iter()
+            .map(|(t, _)| (rational_from_f64(*t).expect("finite time") - tr.clone()) / tau.clone())
+            .collect();
+        let interpolate = |ys: &[Rational]| -> Vec<Rational> {
+            // Divided differences, then nested multiplication into the power basis in u.
+            let mut c = ys.to_vec();
+            for j in 1..=m {
+                for i in (j..=m).rev() {
+                    c[i] = (c[i].clone() - c[i - 1].clone()) / (u[i].clone() - u[i - j].clone());
+                }
+            }
+            let mut p = Polynomial::constant(c[m].clone());
+            for j in (0..m).rev() {
+                p = p.mul(&Polynomial::new(vec![-u[j].clone(), Rational::from_i64(1)]));
+                p = p.add(&Polynomial::constant(c[j].clone()));
+            }
+            let mut coeffs = p.coeffs;
+            coeffs.resize(m + 1, Rational::from_i64(0));
+            coeffs
+        };
+        let ys: Vec<Rational> = self
+            .start
+            .iter()
+            .map(|(_, y)| rational_from_f64(*y).expect("finite value"))
+            .collect();
+        let z = interpolate(&ys);
+        for (k, zk) in z.iter().enumerate() {
+            let hi = zk.to_f64();
+            self.z[k] = hi;
+            self.z_lo[k] = (zk.clone() - rational_from_f64(hi).unwrap_or_default()).to_f64();
+        }
+        if let Some((var, p)) = &mut self.cov {
+            let mut l = DMatrix::zeros(m + 1, m + 1);
+            for i in 0..=m {
+                let unit: Vec<Rational> = (0..=m)
+                    .map(|j| Rational::from_i64(i64::from(i == j)))
+                    .collect();
+                for (k, v) in interpolate(&unit).iter().enumerate() {
+                    l[(k, i)] = v.to_f64();
+                }
+            }
+            *p = &l * l.transpose() * *var;
+        }
+        self.start.clear();
+    }
+
     /// Unscaled derivatives (and their covariance) of the estimate valid at `t`.
     pub fn estimate_at(&self, t: f64) -> (Vec<f64>, Option<DMatrix<f64>>) {
         let v = (t - self.t_last) / self.tau;
         let mut z = self.z.clone();
-        shift_scaled(&mut z, v);
+        let mut lo = self.z_lo.clone();
+        shift_scaled_compensated(&mut z, &mut lo, v);
+        let z: Vec<f64> = z.iter().zip(&lo).map(|(h, l)| h + l).collect();
         let x = crate::model::scaled_to_derivatives(&z, self.tau);
         let cov = self.cov.as_ref().map(|(_, p)| {
             let j = crate::model::scaling(self.m, self.tau) * crate::model::phi(self.m, v);

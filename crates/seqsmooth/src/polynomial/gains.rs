@@ -91,7 +91,7 @@ pub fn expanding_gain_numerators(m: usize) -> Vec<Polynomial<Rational>> {
 /// ```
 pub fn expanding_gains<T: Scalar>(m: usize, n: u64, form: GainForm) -> Vec<T> {
     let num = expanding_gain_numerators(m);
-    let nr = Rational::from_integer((n as i64).into());
+    let nr = Rational::from_integer(n.into());
     let den = falling_factorial(nr.clone() + Rational::from_i64(m as i64 + 1), m + 1);
     let h: Vec<Rational> = num.iter().map(|p| p.eval(&nr) / den.clone()).collect();
     apply_form(m, h, form)

@@ -36,10 +36,9 @@ pub mod switching;
 pub mod vrf;
 
 use crate::error::Error;
-use crate::model::{derivatives_to_scaled, PolynomialState};
+use crate::model::PolynomialState;
 use exact_engine::{Discount, ExactEngine};
 use gain_engine::{FadingGains, GainEngine};
-use gains::GainForm;
 pub use switching::SwitchRule;
 
 /// The largest degree the filters accept. The exact engine's accuracy against an independent
@@ -209,14 +208,6 @@ impl ExpandingMemory {
         Ok(self)
     }
 
-    /// Sets the gain engine's initial state `X*_{0,-1}` (unscaled derivatives predicted for the
-    /// first sample's time). The filter forgets it after `m+1` samples (Morrison §9.6). The
-    /// exact engine has no initial state, so this is an error there.
-    pub fn with_initial_state(mut self, derivatives: &[f64]) -> Result<Self, Error> {
-        set_initial(&mut self.core, self.m, derivatives)?;
-        Ok(self)
-    }
-
     /// Degree `m`.
     pub fn degree(&self) -> usize {
         self.m
@@ -285,12 +276,7 @@ impl FadingMemory {
             Engine::Gain => Core::Gain(GainEngine::new(
                 m,
                 tau,
-                Some(FadingGains {
-                    theta,
-                    mode,
-                    switch_at: rule.switch_index(m, theta)?,
-                    steady: gains::fading_gains(m, theta, GainForm::Current),
-                }),
+                Some(FadingGains::new(m, theta, mode, rule)),
             )),
         };
         Ok(Self {
@@ -327,12 +313,7 @@ impl FadingMemory {
                 self.core = Core::Gain(GainEngine::new(
                     self.m,
                     self.tau,
-                    Some(FadingGains {
-                        theta: self.theta,
-                        mode: self.mode,
-                        switch_at: self.rule.switch_index(self.m, self.theta)?,
-                        steady: gains::fading_gains(self.m, self.theta, GainForm::Current),
-                    }),
+                    Some(FadingGains::new(self.m, self.theta, self.mode, self.rule)),
                 ));
             }
         }
@@ -368,13 +349,6 @@ impl FadingMemory {
         Ok(self)
     }
 
-    /// Sets the gain engine's initial state (unscaled derivatives predicted for the first
-    /// sample's time). An error on the exact engine, which has none.
-    pub fn with_initial_state(mut self, derivatives: &[f64]) -> Result<Self, Error> {
-        set_initial(&mut self.core, self.m, derivatives)?;
-        Ok(self)
-    }
-
     /// Degree `m`.
     pub fn degree(&self) -> usize {
         self.m
@@ -390,11 +364,11 @@ impl FadingMemory {
         self.tau
     }
 
-    /// The 0-based index of the first sample the gain engine processes with fading gains
-    /// (`None` on the exact engine).
-    pub fn switch_index(&self) -> Option<u64> {
+    /// The 0-based index of the first sample the gain engine processed with the fading-memory
+    /// gains: `None` before the switch and on the exact engine (which needs no start-up).
+    pub fn switched_at(&self) -> Option<u64> {
         match &self.core {
-            Core::Gain(g) => g.switch_at(),
+            Core::Gain(g) => g.switched_at(),
             Core::Exact(_) => None,
         }
     }
@@ -422,34 +396,5 @@ impl FadingMemory {
     /// The estimate valid at any time `t` from the samples so far.
     pub fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
         self.core.estimate_at(self.m, t)
-    }
-}
-
-fn set_initial(core: &mut Core, m: usize, derivatives: &[f64]) -> Result<(), Error> {
-    if derivatives.len() != m + 1 || derivatives.iter().any(|v| !v.is_finite()) {
-        return Err(Error::InvalidParameter {
-            name: "initial state",
-            value: format!("{derivatives:?}"),
-            reason: format!("needs {} finite derivatives", m + 1),
-        });
-    }
-    match core {
-        Core::Gain(g) if g.samples() == 0 => {
-            let tau = g.tau();
-            g.set_initial_scaled(derivatives_to_scaled(derivatives, tau));
-            Ok(())
-        }
-        Core::Gain(_) => Err(Error::InvalidParameter {
-            name: "initial state",
-            value: format!("{derivatives:?}"),
-            reason: "must be set before the first sample".into(),
-        }),
-        Core::Exact(_) => Err(Error::InvalidParameter {
-            name: "initial state",
-            value: format!("{derivatives:?}"),
-            reason:
-                "the exact engine has no initial state: it is least squares from the first sample"
-                    .into(),
-        }),
     }
 }

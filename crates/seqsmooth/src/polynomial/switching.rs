@@ -46,7 +46,7 @@ pub fn switch_constant(m: usize) -> Rational {
 /// When a fading-memory filter hands over from its expanding-memory start-up (Morrison §13.8).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub enum SwitchRule {
-    /// At `n = c_0m/(1-θ)`, the position row of Table 13.4 (Reyneke Table 1; Morrison's text
+    /// At `n = ⌊c_0m/(1-θ)⌋`, the position row of Table 13.4 (Reyneke Table 1; Morrison's text
     /// example (13.8.8): `m = 1, θ = 0.9 → n = 32`). The default.
     #[default]
     Position,
@@ -76,7 +76,9 @@ impl SwitchRule {
         if !(theta > 0.0 && theta < 1.0) {
             return Err(Error::ThetaOutOfRange { theta });
         }
-        let scale = |c: f64| (c / (1.0 - theta)).round() as u64;
+        // Truncated (with a 1e-9 allowance for the rounding of c/(1-θ)): reproduces every switch
+        // time the book gives, (13.8.8) 32, Ex. 13.21 68/32/170, Figs. 13.3/13.5 75/100.
+        let scale = |c: f64| (c / (1.0 - theta) + 1e-9).floor() as u64;
         let n = match *self {
             SwitchRule::Position => scale(memory_length_constant(0, m)),
             SwitchRule::ColumnMean => {

@@ -28,7 +28,9 @@ pub enum EstimateForm {
 /// using `B Bᵀ = diag(c_j²)`). Requires `m ≤ L`.
 ///
 /// For `h ≥ 0` every term of the sums has the same sign, so the `f64` evaluation loses no
-/// digits to cancellation.
+/// digits to cancellation — as long as the intermediate factorial powers stay in range:
+/// `L^(m)` and `c(m,L)² ~ L^(2m+1)/(2m+1)` must not overflow `f64`, which limits the `f64`
+/// path to roughly `L^(2m+1) < 1e300` (e.g. `m = 20`, `L ≲ 1e7`). Use `T = Rational` beyond.
 ///
 /// ```
 /// use seqsmooth::polynomial::vrf::window_covariance;
@@ -37,7 +39,7 @@ pub enum EstimateForm {
 /// assert!((s[(0, 0)] - 0.6).abs() < 1e-15 && (s[(0, 1)] - 0.2).abs() < 1e-15);
 /// ```
 pub fn window_covariance<T: Scalar>(m: usize, span: u64, h: T) -> DMatrix<T> {
-    let b = DiscreteLegendre::new(T::from_i64(span as i64));
+    let b = DiscreteLegendre::new(T::from_rational(&Rational::from_integer(span.into())));
     let q = mul(
         &mul(&phi(m, h), &crate::calculus::link_matrix::<T>(m)),
         &b.end_differences(m),
