@@ -61,5 +61,10 @@ pub mod recursive;
 pub mod scalar;
 
 pub use error::Error;
+
+/// The README's Rust example, compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+pub struct ReadmeDoctests;
 pub use model::PolynomialState;
 pub use polynomial::{DiscountMode, Engine, ExpandingMemory, FadingMemory};

@@ -114,28 +114,11 @@ pub fn exact_ls_derivatives(
             }
         }
     }
-    // Gaussian elimination, exact.
-    for col in 0..p {
-        let piv = (col..p).find(|&r| !a[r][col].is_zero()).expect("singular");
-        a.swap(col, piv);
-        b.swap(col, piv);
-        for r in 0..p {
-            if r != col && !a[r][col].is_zero() {
-                let f = a[r][col].clone() / a[col][col].clone();
-                for j in col..p {
-                    let v = a[col][j].clone() * f.clone();
-                    a[r][j] -= v;
-                }
-                let v = b[col].clone() * f;
-                b[r] -= v;
-            }
-        }
-    }
-    (0..p)
-        .map(|k| {
-            let coeff = b[k].clone() / a[k][k].clone();
-            (coeff * seqsmooth::calculus::factorial::<Rational>(k)).to_f64()
-        })
+    let coeffs = solve_rational(a, b);
+    coeffs
+        .into_iter()
+        .enumerate()
+        .map(|(k, c)| (c * seqsmooth::calculus::factorial::<Rational>(k)).to_f64())
         .collect()
 }
 
@@ -188,32 +171,15 @@ pub fn exact_discounted_even(
             pu *= u[k];
         }
     }
-    let mut a: Vec<Vec<Rational>> = (0..dim)
+    let a: Vec<Vec<Rational>> = (0..dim)
         .map(|i| {
             (0..dim)
                 .map(|j| Rational::from_integer(s[i + j].clone()))
                 .collect()
         })
         .collect();
-    let mut b: Vec<Rational> = t.into_iter().map(Rational::from_integer).collect();
-    for col in 0..dim {
-        let piv = (col..dim)
-            .find(|&r| !a[r][col].is_zero())
-            .expect("singular");
-        a.swap(col, piv);
-        b.swap(col, piv);
-        for r in 0..dim {
-            if r != col && !a[r][col].is_zero() {
-                let f = a[r][col].clone() / a[col][col].clone();
-                for j in col..dim {
-                    let v = a[col][j].clone() * f.clone();
-                    a[r][j] -= v;
-                }
-                let v = b[col].clone() * f;
-                b[r] -= v;
-            }
-        }
-    }
+    let b: Vec<Rational> = t.into_iter().map(Rational::from_integer).collect();
+    let coeffs = solve_rational(a, b);
     (0..dim)
         .map(|k| {
             let c = b[k].clone() / a[k][k].clone();
@@ -222,4 +188,26 @@ pub fn exact_discounted_even(
                 / step.powi(k as i32)
         })
         .collect()
+}
+
+/// Solves the square system `a x = b` exactly (Gauss–Jordan over the rationals).
+pub fn solve_rational(mut a: Vec<Vec<Rational>>, mut b: Vec<Rational>) -> Vec<Rational> {
+    let p = b.len();
+    for col in 0..p {
+        let piv = (col..p).find(|&r| !a[r][col].is_zero()).expect("singular");
+        a.swap(col, piv);
+        b.swap(col, piv);
+        for r in 0..p {
+            if r != col && !a[r][col].is_zero() {
+                let f = a[r][col].clone() / a[col][col].clone();
+                for j in col..p {
+                    let v = a[col][j].clone() * f.clone();
+                    a[r][j] -= v;
+                }
+                let v = b[col].clone() * f;
+                b[r] -= v;
+            }
+        }
+    }
+    (0..p).map(|k| b[k].clone() / a[k][k].clone()).collect()
 }
