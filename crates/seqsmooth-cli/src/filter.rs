@@ -7,7 +7,7 @@
 
 use crate::error::CliError;
 use crate::number::fmt_f64;
-use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialState};
+use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter, PolynomialState};
 use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{self, BufWriter, Read, Write};
@@ -39,33 +39,6 @@ impl From<EngineArg> for Engine {
         match e {
             EngineArg::Exact => Engine::Exact,
             EngineArg::Gain => Engine::Gain,
-        }
-    }
-}
-
-/// Either filter, behind one interface.
-#[derive(Clone, Debug)]
-pub enum AnyFilter {
-    /// An expanding-memory filter.
-    Expanding(ExpandingMemory),
-    /// A fading-memory filter.
-    Fading(FadingMemory),
-}
-
-impl AnyFilter {
-    /// Processes the sample `y` at time `t`.
-    pub fn update(&mut self, t: f64, y: f64) -> Result<(), seqsmooth::Error> {
-        match self {
-            AnyFilter::Expanding(f) => f.update(t, y),
-            AnyFilter::Fading(f) => f.update(t, y),
-        }
-    }
-
-    /// The estimate valid at `t` from the samples so far (`None` before `m+1` samples).
-    pub fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
-        match self {
-            AnyFilter::Expanding(f) => f.estimate_at(t),
-            AnyFilter::Fading(f) => f.estimate_at(t),
         }
     }
 }
@@ -324,11 +297,11 @@ pub fn build_filter(
     tau: f64,
     engine: EngineArg,
     sigma: Option<f64>,
-) -> Result<AnyFilter, seqsmooth::Error> {
-    let filter = match kind {
+) -> Result<Box<dyn PolynomialFilter>, seqsmooth::Error> {
+    let filter: Box<dyn PolynomialFilter> = match kind {
         Kind::Expanding => {
             let f = ExpandingMemory::new(degree, engine.into())?;
-            AnyFilter::Expanding(match sigma {
+            Box::new(match sigma {
                 Some(s) => f.with_noise_sigma(s)?,
                 None => f,
             })
@@ -340,7 +313,7 @@ pub fn build_filter(
                 reason: "a fading-memory filter needs theta".into(),
             })?;
             let f = FadingMemory::new(degree, theta, tau, engine.into())?;
-            AnyFilter::Fading(match sigma {
+            Box::new(match sigma {
                 Some(s) => f.with_noise_sigma(s)?,
                 None => f,
             })

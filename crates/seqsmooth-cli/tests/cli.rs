@@ -6,7 +6,7 @@ use num_rational::BigRational;
 use seqsmooth::polynomial::gains::{expanding_gains, fading_gains, GainForm};
 use seqsmooth::polynomial::vrf::{expanding_vrf, EstimateForm};
 use seqsmooth::scalar::{parse_rational, ratio_to_f64, rational_from_f64, Rational};
-use seqsmooth::{Engine, ExpandingMemory, FadingMemory};
+use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::{Command, Stdio};

@@ -11,7 +11,7 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
-use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialState};
+use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
 
 fn schedule(kind: &str, n: usize, r: &mut StdRng) -> Vec<f64> {
     let mut t = 0.0;
@@ -32,26 +32,6 @@ fn schedule(kind: &str, n: usize, r: &mut StdRng) -> Vec<f64> {
         };
     }
     out
-}
-
-enum F {
-    E(ExpandingMemory),
-    Fa(FadingMemory),
-}
-
-impl F {
-    fn update(&mut self, t: f64, y: f64) {
-        match self {
-            F::E(f) => f.update(t, y).unwrap(),
-            F::Fa(f) => f.update(t, y).unwrap(),
-        }
-    }
-    fn est(&self) -> Option<PolynomialState> {
-        match self {
-            F::E(f) => f.estimate(),
-            F::Fa(f) => f.estimate(),
-        }
-    }
 }
 
 fn main() {
@@ -92,28 +72,30 @@ fn main() {
                             / span;
                         (v, d)
                     };
-                    let make = |engine| match memory {
-                        "expanding" => F::E(
-                            ExpandingMemory::new(m, engine)
-                                .unwrap()
-                                .with_noise_sigma(1.0)
-                                .unwrap(),
-                        ),
-                        _ => F::Fa(
-                            FadingMemory::new(m, 0.9, 1.0, engine)
-                                .unwrap()
-                                .with_noise_sigma(1.0)
-                                .unwrap(),
-                        ),
+                    let make = |engine| -> Box<dyn PolynomialFilter> {
+                        match memory {
+                            "expanding" => Box::new(
+                                ExpandingMemory::new(m, engine)
+                                    .unwrap()
+                                    .with_noise_sigma(1.0)
+                                    .unwrap(),
+                            ),
+                            _ => Box::new(
+                                FadingMemory::new(m, 0.9, 1.0, engine)
+                                    .unwrap()
+                                    .with_noise_sigma(1.0)
+                                    .unwrap(),
+                            ),
+                        }
                     };
                     let (mut g, mut e) = (make(Engine::Gain), make(Engine::Exact));
                     for (k, &t) in times.iter().enumerate() {
                         let noise: f64 = StandardNormal.sample(&mut r);
                         let y = truth(t).0 + noise;
-                        g.update(t, y);
-                        e.update(t, y);
+                        g.update(t, y).unwrap();
+                        e.update(t, y).unwrap();
                         if k >= from {
-                            let (a, b) = (g.est().unwrap(), e.est().unwrap());
+                            let (a, b) = (g.estimate().unwrap(), e.estimate().unwrap());
                             let (v, d) = truth(t);
                             let sd = b.std_devs().unwrap();
                             for (i, tr) in [v, d].iter().enumerate() {

@@ -37,7 +37,7 @@
 //! - [`scalar`]: the `f64` / exact-rational abstraction every formula is generic over.
 //!
 //! ```
-//! use seqsmooth::{Engine, FadingMemory};
+//! use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
 //! // degree-2 fading-memory filter, θ = 0.9 per second, noise σ = 0.1
 //! let mut f = FadingMemory::new(2, 0.9, 1.0, Engine::Exact).unwrap().with_noise_sigma(0.1).unwrap();
 //! for k in 0..50 {
@@ -67,4 +67,4 @@ pub use error::Error;
 #[doc = include_str!("../../../README.md")]
 pub struct ReadmeDoctests;
 pub use model::PolynomialState;
-pub use polynomial::{DiscountMode, Engine, ExpandingMemory, FadingMemory};
+pub use polynomial::{DiscountMode, Engine, ExpandingMemory, FadingMemory, PolynomialFilter};

@@ -12,7 +12,7 @@ use nalgebra::DMatrix;
 use rand_distr::{Distribution, StandardNormal};
 use seqsmooth::model::derivatives_to_scaled;
 use seqsmooth::polynomial::vrf::{expanding_vrf, fading_vrf, EstimateForm};
-use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialState};
+use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter, PolynomialState};
 
 const RUNS: usize = 20_000;
 

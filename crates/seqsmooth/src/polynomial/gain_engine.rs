@@ -94,6 +94,9 @@ pub(crate) struct GainEngine {
     start: Vec<(f64, f64)>,
     t_first: f64,
     t_last: f64,
+    /// The typical step `ζ̄` (in units of `τ`) the gains are scaled for: the mean step so far,
+    /// and after a fading-memory switch an exponentially weighted mean over the memory.
+    step_mean: f64,
     n: u64,
     k: Vec<f64>,
     k_lo: Vec<f64>,
@@ -113,6 +116,7 @@ impl GainEngine {
             start: Vec::with_capacity(m + 1),
             t_first: f64::NAN,
             t_last: f64::NAN,
+            step_mean: 1.0,
             n: 0,
             k: vec![0.0; m + 1],
             k_lo: vec![0.0; m + 1],
@@ -155,11 +159,13 @@ impl GainEngine {
         // e = y - (z0 + z0_lo) as the double-word e + e_lo.
         let (d, de) = two_sum(y, -self.z[0]);
         let (e, e_lo) = two_sum(d, de - self.z_lo[0]);
-        self.choose_gains(t, zeta);
-        if zeta != 1.0 {
+        self.update_step_mean(t, zeta);
+        self.choose_gains(t);
+        let step = self.step_mean;
+        if step != 1.0 {
             let mut zk = 1.0;
             for (kk, kl) in self.k.iter_mut().zip(self.k_lo.iter_mut()).skip(1) {
-                zk *= zeta;
+                zk *= step;
                 *kk /= zk;
                 *kl /= zk;
             }
@@ -199,8 +205,31 @@ impl GainEngine {
         self.n += 1;
     }
 
+    /// The step the gains are scaled for. On even samples it is the step itself, which makes the
+    /// recursion exact for any step (gains `h_k/ζ^k`, `θ_eff = θ^ζ`; others.md §4.8). On
+    /// irregular samples the current step would be the wrong scale — a burst of close samples
+    /// would get gains `h_k/ζ^k` far too large, and the recursion diverges (measured: errors of
+    /// 1e30 on exponential gaps) — so the gains are scaled for the typical step of the memory.
+    fn update_step_mean(&mut self, t: f64, zeta: f64) {
+        let switched = self.fading.as_ref().and_then(|f| f.switched_at).is_some();
+        if !switched {
+            self.step_mean = (t - self.t_first) / (self.n as f64 * self.tau);
+        } else if zeta != self.step_mean {
+            let f = self.fading.as_ref().expect("switched implies fading");
+            let w = match f.mode {
+                DiscountMode::PerUpdate => f.theta,
+                DiscountMode::PerTime => f.theta.powf(self.step_mean),
+            };
+            self.step_mean = w * self.step_mean + (1.0 - w) * zeta;
+        }
+        // Exactly even samples: the mean equals the step up to rounding; use the step itself.
+        if (self.step_mean - zeta).abs() <= 1e-12 * zeta {
+            self.step_mean = zeta;
+        }
+    }
+
     /// Writes the current-estimate gains for the sample with index `self.n` into `self.k`.
-    fn choose_gains(&mut self, t: f64, zeta: f64) {
+    fn choose_gains(&mut self, t: f64) {
         let n = self.n;
         let m = self.m;
         self.k_lo.iter_mut().for_each(|v| *v = 0.0);
@@ -235,7 +264,7 @@ impl GainEngine {
         }
         let theta_eff = match f.mode {
             DiscountMode::PerUpdate => f.theta,
-            DiscountMode::PerTime => f.theta.powf(zeta),
+            DiscountMode::PerTime => f.theta.powf(self.step_mean),
         };
         if theta_eff != f.theta_eff {
             // The steady θ's gains are double words from the exact formula (computed once);

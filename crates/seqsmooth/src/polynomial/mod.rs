@@ -10,15 +10,92 @@
 //!   filter of [`crate::recursive`], in a centred, scaled monomial basis (see
 //!   `exact_engine` docs for why). Determined from the `(m+1)`-th sample on.
 //! - [`Engine::Gain`] — the fixed-gain recursion of Morrison's Tables 9.1/13.1 in Reyneke's
-//!   variable-step form: predict by `Φ(ζ)`, `ζ = Δt/τ`, correct with gains `h_k/ζ^k`. `O(m)` per
-//!   sample after the prediction. Exact least squares on evenly spaced samples for any step; an
-//!   approximation on irregular timestamps (its deviation is tabled in the crate docs).
+//!   variable-step form: predict by `Φ(ζ)`, `ζ = Δt/τ`, correct with gains `h_k/ζ̄^k` scaled for
+//!   the typical step `ζ̄` of the memory (fading: `θ_eff = θ^ζ̄`). `O(m)` per sample after the
+//!   prediction. Exact least squares on evenly spaced samples for any step (there `ζ̄ = ζ`); an
+//!   approximation on irregular timestamps. It starts from the exact interpolating polynomial of
+//!   the first `m+1` samples and carries its state in compensated arithmetic (see
+//!   `gain_engine` for why, with measurements).
+//!
+//! ## Accuracy (measured; `tests/engines.rs`)
+//!
+//! Relative error per derivative against batch QR (Legendre basis) or exact rational least
+//! squares, worst over each run, degrees 0-8: the exact engine ≤ 5e-11 on even, jittered and
+//! Poisson timestamps, expanding and fading (≤ 1e-11 over a 10⁵-sample run at degree 8). On
+//! 2 000 irregular samples: 1.4e-11 at degree 12, 1.3e-9 at 14 and 16, 1.7e-6 at 20, 7e-5 at
+//! 24 — the centred monomial basis is what limits it (asserted bounds: 1e-9 to degree 12, 1e-6
+//! to 16, 1e-3 to [`MAX_DEGREE`]). The gain engine on even samples: ≤ 5e-11 (expanding, 200
+//! samples), ≤ 5e-10 over 10⁵ samples at degree 8, ≤ 5e-12 for fading memory once the switch
+//! transient `θ^n·poly(n)` has decayed.
+//!
+//! ## The gain engine on irregular timestamps
+//!
+//! Measured by `cargo run --release -p seqsmooth --example gain_engine_deviation`: 200 Monte
+//! Carlo runs per row of a degree-`m` polynomial truth plus unit white noise, nominal step 1
+//! (expanding: 100 samples, scored from sample `4(m+1)`; fading: θ = 0.9 per τ = 1, 400
+//! samples, scored from sample 200). "MSE ratio" is the gain engine's mean squared error
+//! against the truth over the exact engine's; the last columns give the largest gain−exact
+//! difference in units of the exact estimate's own 1σ. Jitter ±p% perturbs each step
+//! uniformly; "random" draws exponential steps (a Poisson process); "bursts and gaps" draws
+//! steps from {0.5, 1, 1, 1, 2, 3} × U(0.8, 1.2).
+//!
+//! | memory | schedule | m | MSE ratio x | MSE ratio x' | max abs(gain−exact)/σ x | max abs(gain−exact)/σ x' |
+//! |---|---|---|---|---|---|---|
+//! | expanding | even | 1 | 1.000 | 1.000 | 3.58e-14 | 2.56e-14 |
+//! | expanding | even | 2 | 1.000 | 1.000 | 3.02e-14 | 1.71e-14 |
+//! | expanding | even | 3 | 1.000 | 1.000 | 1.54e-14 | 1.64e-14 |
+//! | expanding | even | 4 | 1.000 | 1.000 | 4.40e-14 | 8.07e-14 |
+//! | expanding | jitter 20% | 1 | 0.999 | 0.994 | 1.66e-1 | 2.61e-1 |
+//! | expanding | jitter 20% | 2 | 0.998 | 0.991 | 2.07e-1 | 2.85e-1 |
+//! | expanding | jitter 20% | 3 | 1.004 | 1.012 | 4.31e-1 | 7.78e-1 |
+//! | expanding | jitter 20% | 4 | 1.009 | 1.012 | 4.25e-1 | 5.87e-1 |
+//! | expanding | jitter 50% | 1 | 1.001 | 1.008 | 4.23e-1 | 9.04e-1 |
+//! | expanding | jitter 50% | 2 | 1.006 | 1.019 | 7.96e-1 | 1.26e0 |
+//! | expanding | jitter 50% | 3 | 1.028 | 1.089 | 1.21e0 | 2.05e0 |
+//! | expanding | jitter 50% | 4 | 1.053 | 1.137 | 2.31e0 | 3.55e0 |
+//! | expanding | random (exponential) | 1 | 2.579 | 7.629 | 1.63e1 | 3.76e1 |
+//! | expanding | random (exponential) | 2 | 135.059 | 670.423 | 2.35e2 | 3.59e2 |
+//! | expanding | random (exponential) | 3 | 262829882.145 | 881303136.471 | 6.08e5 | 7.54e5 |
+//! | expanding | random (exponential) | 4 | 174839869553.543 | 871248753400.558 | 1.38e7 | 2.28e7 |
+//! | expanding | bursts and gaps | 1 | 1.058 | 1.106 | 1.14e0 | 1.63e0 |
+//! | expanding | bursts and gaps | 2 | 1.547 | 3.388 | 1.21e1 | 1.93e1 |
+//! | expanding | bursts and gaps | 3 | 1.821 | 4.818 | 1.37e1 | 2.45e1 |
+//! | expanding | bursts and gaps | 4 | 54.869 | 312.332 | 2.34e2 | 3.39e2 |
+//! | fading θ=0.9 | even | 1 | 1.000 | 1.000 | 3.32e-7 | 8.06e-7 |
+//! | fading θ=0.9 | even | 2 | 1.000 | 1.000 | 1.60e-5 | 3.88e-5 |
+//! | fading θ=0.9 | even | 3 | 1.000 | 1.000 | 4.92e-4 | 1.20e-3 |
+//! | fading θ=0.9 | even | 4 | 1.000 | 1.000 | 4.15e-3 | 1.03e-2 |
+//! | fading θ=0.9 | jitter 20% | 1 | 1.000 | 1.000 | 1.31e-1 | 1.53e-1 |
+//! | fading θ=0.9 | jitter 20% | 2 | 1.000 | 1.001 | 1.49e-1 | 1.52e-1 |
+//! | fading θ=0.9 | jitter 20% | 3 | 1.000 | 1.001 | 1.77e-1 | 1.70e-1 |
+//! | fading θ=0.9 | jitter 20% | 4 | 1.000 | 1.000 | 2.55e-1 | 2.32e-1 |
+//! | fading θ=0.9 | jitter 50% | 1 | 0.997 | 0.999 | 3.13e-1 | 3.91e-1 |
+//! | fading θ=0.9 | jitter 50% | 2 | 0.999 | 1.001 | 3.73e-1 | 3.76e-1 |
+//! | fading θ=0.9 | jitter 50% | 3 | 0.999 | 1.005 | 4.87e-1 | 4.46e-1 |
+//! | fading θ=0.9 | jitter 50% | 4 | 0.999 | 1.005 | 6.59e-1 | 6.41e-1 |
+//! | fading θ=0.9 | random (exponential) | 1 | 0.955 | 0.981 | 1.31e0 | 1.21e0 |
+//! | fading θ=0.9 | random (exponential) | 2 | 0.975 | 1.011 | 1.50e0 | 1.94e0 |
+//! | fading θ=0.9 | random (exponential) | 3 | 0.987 | 1.051 | 1.71e0 | 2.54e0 |
+//! | fading θ=0.9 | random (exponential) | 4 | 1.267 | 2.155 | 3.17e1 | 6.25e1 |
+//! | fading θ=0.9 | bursts and gaps | 1 | 0.972 | 0.987 | 5.80e-1 | 9.68e-1 |
+//! | fading θ=0.9 | bursts and gaps | 2 | 0.983 | 1.002 | 9.89e-1 | 9.93e-1 |
+//! | fading θ=0.9 | bursts and gaps | 3 | 0.983 | 1.012 | 1.22e0 | 1.18e0 |
+//! | fading θ=0.9 | bursts and gaps | 4 | 1.004 | 1.048 | 1.42e0 | 1.51e0 |
+//!
+//! Reading: on even samples the engines agree (the fading rows show the switch transient still
+//! present at sample 200 for m ≥ 3). With moderate jitter the gain engine is within a few
+//! percent of exact least squares; for fading memory this holds on average on every schedule
+//! up to degree 3 (single samples on Poisson arrivals can stray by tens of σ: see the test
+//! `gain_engine_stays_close_to_least_squares_on_irregular_schedules`). The expanding-memory gain engine is **not** usable on strongly irregular
+//! sampling (Poisson arrivals, bursts at degree ≥ 2): its early errors, from gains scheduled
+//! for even spacing, are large and die out only as `1/n`. Use [`Engine::Exact`] (the default)
+//! there.
 //!
 //! The gain-engine fading-memory filter starts as an expanding-memory filter and switches to the
 //! constant gains at the sample chosen by its [`SwitchRule`] (Morrison §13.8).
 //!
 //! ```
-//! use seqsmooth::{Engine, ExpandingMemory};
+//! use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
 //! let mut f = ExpandingMemory::new(2, Engine::Exact).unwrap();
 //! for (t, y) in [(0.0, 1.0), (0.5, 1.75), (1.7, 5.59), (2.0, 7.0)] {
 //!     f.update(t, y).unwrap();
@@ -167,12 +244,76 @@ fn check_theta(theta: f64) -> Result<(), Error> {
     Ok(())
 }
 
+/// What every polynomial filter does: take timestamped samples, give estimates. Implemented by
+/// [`ExpandingMemory`] and [`FadingMemory`], so callers can hold either behind one type.
+///
+/// ```
+/// use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
+/// let mut filters: Vec<Box<dyn PolynomialFilter>> = vec![
+///     Box::new(ExpandingMemory::new(1, Engine::Exact).unwrap()),
+///     Box::new(FadingMemory::new(1, 0.8, 1.0, Engine::Gain).unwrap()),
+/// ];
+/// for f in filters.iter_mut() {
+///     for k in 0..20 {
+///         f.update(k as f64, 3.0 * k as f64).unwrap();
+///     }
+///     assert!((f.estimate().unwrap().derivatives[1] - 3.0).abs() < 1e-12);
+/// }
+/// ```
+pub trait PolynomialFilter: std::fmt::Debug + Send {
+    /// Degree `m`.
+    fn degree(&self) -> usize;
+    /// Number of samples processed.
+    fn samples(&self) -> u64;
+    /// Processes the sample `y` at time `t` (finite, strictly after the previous time). A
+    /// rejected sample leaves the filter unchanged.
+    fn update(&mut self, t: f64, y: f64) -> Result<(), Error>;
+    /// The estimate valid at any time `t` from the samples so far (a prediction after the
+    /// newest sample, a retrodiction before it); `None` until `m+1` samples.
+    fn estimate_at(&self, t: f64) -> Option<PolynomialState>;
+    /// The time of the newest sample.
+    fn last_time(&self) -> Option<f64>;
+    /// The current estimate, valid at the newest sample's time.
+    fn estimate(&self) -> Option<PolynomialState> {
+        self.estimate_at(self.last_time()?)
+    }
+    /// True once the estimate is determined (`m+1` samples).
+    fn is_determined(&self) -> bool {
+        self.samples() > self.degree() as u64
+    }
+}
+
+macro_rules! impl_polynomial_filter {
+    ($ty:ty) => {
+        impl PolynomialFilter for $ty {
+            fn degree(&self) -> usize {
+                self.m
+            }
+            fn samples(&self) -> u64 {
+                self.core.samples()
+            }
+            fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
+                self.core.update(t, y)
+            }
+            fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
+                self.core.estimate_at(self.m, t)
+            }
+            fn last_time(&self) -> Option<f64> {
+                (self.core.samples() > 0).then(|| self.core.last_time())
+            }
+        }
+    };
+}
+
+impl_polynomial_filter!(ExpandingMemory);
+impl_polynomial_filter!(FadingMemory);
+
 /// Expanding-memory polynomial filter of degree `m` (Morrison ch. 9; Reyneke §6.3-6.4): the
 /// least-squares polynomial through all samples so far, with its derivatives, predictions and
 /// (given the noise σ) covariance. Self-starting: determined from the `(m+1)`-th sample.
 ///
 /// ```
-/// use seqsmooth::{Engine, ExpandingMemory};
+/// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
 /// let mut f = ExpandingMemory::new(1, Engine::Gain).unwrap();
 /// for (n, y) in [1.0, 3.0, 2.0, 5.0, 4.0].iter().enumerate() {
 ///     f.update(n as f64, *y).unwrap();
@@ -207,44 +348,13 @@ impl ExpandingMemory {
         self.core.track_covariance(sigma)?;
         Ok(self)
     }
-
-    /// Degree `m`.
-    pub fn degree(&self) -> usize {
-        self.m
-    }
-
-    /// Number of samples processed.
-    pub fn samples(&self) -> u64 {
-        self.core.samples()
-    }
-
-    /// True once the estimate is determined (`m+1` samples).
-    pub fn is_determined(&self) -> bool {
-        self.samples() > self.m as u64
-    }
-
-    /// Processes the sample `y` at time `t` (strictly after the previous one, finite).
-    pub fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
-        self.core.update(t, y)
-    }
-
-    /// The current estimate `X*_{n,n}`, valid at the newest sample's time.
-    pub fn estimate(&self) -> Option<PolynomialState> {
-        self.core.estimate_at(self.m, self.core.last_time())
-    }
-
-    /// The estimate valid at any time `t` from the samples so far: a prediction for `t` after
-    /// the newest sample, a retrodiction before it.
-    pub fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
-        self.core.estimate_at(self.m, t)
-    }
 }
 
 /// Fading-memory polynomial filter of degree `m` and discount `θ` per `τ` (Morrison ch. 13;
 /// Reyneke §6.5-6.6): the polynomial minimising `Σ_k θ^((t_n-t_k)/τ) (y_k - p(t_k))²`.
 ///
 /// ```
-/// use seqsmooth::{Engine, FadingMemory};
+/// use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
 /// let mut f = FadingMemory::new(1, 0.9, 1.0, Engine::Gain).unwrap();
 /// for n in 0..500 {
 ///     f.update(n as f64, 2.0 + 0.5 * n as f64).unwrap();
@@ -349,11 +459,6 @@ impl FadingMemory {
         Ok(self)
     }
 
-    /// Degree `m`.
-    pub fn degree(&self) -> usize {
-        self.m
-    }
-
     /// `θ`.
     pub fn theta(&self) -> f64 {
         self.theta
@@ -371,30 +476,5 @@ impl FadingMemory {
             Core::Gain(g) => g.switched_at(),
             Core::Exact(_) => None,
         }
-    }
-
-    /// Number of samples processed.
-    pub fn samples(&self) -> u64 {
-        self.core.samples()
-    }
-
-    /// True once the estimate is determined (`m+1` samples).
-    pub fn is_determined(&self) -> bool {
-        self.samples() > self.m as u64
-    }
-
-    /// Processes the sample `y` at time `t` (strictly after the previous one, finite).
-    pub fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
-        self.core.update(t, y)
-    }
-
-    /// The current estimate, valid at the newest sample's time.
-    pub fn estimate(&self) -> Option<PolynomialState> {
-        self.core.estimate_at(self.m, self.core.last_time())
-    }
-
-    /// The estimate valid at any time `t` from the samples so far.
-    pub fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
-        self.core.estimate_at(self.m, t)
     }
 }

@@ -44,6 +44,11 @@ pub fn switch_constant(m: usize) -> Rational {
 }
 
 /// When a fading-memory filter hands over from its expanding-memory start-up (Morrison §13.8).
+///
+/// The rules count samples, so they use the discount per sample: `θ` itself with
+/// [`crate::DiscountMode::PerUpdate`], and `θ^(ζ̄)` with [`crate::DiscountMode::PerTime`], where
+/// `ζ̄` is the mean step so far in units of `τ` (the filter re-evaluates the rule at every sample
+/// until it switches; [`SwitchRule::switch_index`] gives the index for a known per-sample `θ`).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub enum SwitchRule {
     /// At `n = ⌊c_0m/(1-θ)⌋`, the position row of Table 13.4 (Reyneke Table 1; Morrison's text

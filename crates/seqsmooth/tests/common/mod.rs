@@ -180,9 +180,10 @@ pub fn exact_discounted_even(
         .collect();
     let b: Vec<Rational> = t.into_iter().map(Rational::from_integer).collect();
     let coeffs = solve_rational(a, b);
-    (0..dim)
-        .map(|k| {
-            let c = b[k].clone() / a[k][k].clone();
+    coeffs
+        .into_iter()
+        .enumerate()
+        .map(|(k, c)| {
             (c * seqsmooth::calculus::factorial::<Rational>(k)).to_f64()
                 / scale
                 / step.powi(k as i32)
