@@ -62,3 +62,31 @@ pub enum Error {
         reason: String,
     },
 }
+
+/// Validates one sample of a stream: finite time and value, and a time strictly after the
+/// previous one (when there is one).
+///
+/// ```
+/// use seqsmooth::error::{check_sample, Error};
+/// assert!(check_sample(1.0, 2.0, Some(0.5)).is_ok());
+/// assert_eq!(check_sample(1.0, 2.0, Some(1.0)), Err(Error::TimeNotIncreasing { time: 1.0, previous: 1.0 }));
+/// assert!(matches!(check_sample(f64::NAN, 2.0, None), Err(Error::NonFinite { what: "time", .. })));
+/// ```
+pub fn check_sample(t: f64, y: f64, previous: Option<f64>) -> Result<(), Error> {
+    if !t.is_finite() {
+        return Err(Error::NonFinite {
+            what: "time",
+            value: t,
+        });
+    }
+    if !y.is_finite() {
+        return Err(Error::NonFinite {
+            what: "value",
+            value: y,
+        });
+    }
+    match previous {
+        Some(previous) if t <= previous => Err(Error::TimeNotIncreasing { time: t, previous }),
+        _ => Ok(()),
+    }
+}

@@ -50,18 +50,7 @@ impl PolynomialFit {
             });
         }
         for (&t, &y) in times.iter().zip(values) {
-            if !t.is_finite() {
-                return Err(Error::NonFinite {
-                    what: "time",
-                    value: t,
-                });
-            }
-            if !y.is_finite() {
-                return Err(Error::NonFinite {
-                    what: "value",
-                    value: y,
-                });
-            }
+            crate::error::check_sample(t, y, None)?;
         }
         let mut sorted: Vec<f64> = times.to_vec();
         sorted.sort_by(f64::total_cmp);
@@ -141,11 +130,11 @@ impl PolynomialFit {
     /// Covariance of [`Self::derivatives_at`] when the weights are inverse variances (or
     /// `σ² ×` it for unit weights and noise variance `σ²`).
     pub fn covariance_at(&self, t: f64) -> DMatrix<f64> {
+        // (J R⁻¹)(J R⁻¹)ᵀ, row by row: (J R⁻¹)ᵀ = R⁻ᵀ Jᵀ by forward substitution.
         let j = self.jacobian(t);
         let p = self.degree + 1;
-        let mut out = DMatrix::zeros(p, p);
-        let mut row = vec![0.0; p];
         let mut jr = DMatrix::zeros(p, p);
+        let mut row = vec![0.0; p];
         for i in 0..p {
             for (c, v) in row.iter_mut().enumerate() {
                 *v = j[(i, c)];
@@ -155,7 +144,6 @@ impl PolynomialFit {
                 jr[(i, c)] = *v;
             }
         }
-        out += &jr * jr.transpose();
-        out
+        &jr * jr.transpose()
     }
 }

@@ -164,24 +164,8 @@ impl Core {
     }
 
     fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
-        if !y.is_finite() {
-            return Err(Error::NonFinite {
-                what: "value",
-                value: y,
-            });
-        }
-        if self.samples() > 0 {
-            let previous = self.last_time();
-            if t <= previous {
-                return Err(Error::TimeNotIncreasing { time: t, previous });
-            }
-        }
+        let previous = (self.samples() > 0).then(|| self.last_time());
+        crate::error::check_sample(t, y, previous)?;
         match self {
             Core::Exact(e) => e.update(t, y),
             Core::Gain(g) => g.update(t, y),
