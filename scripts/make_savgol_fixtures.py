@@ -43,7 +43,7 @@ y = np.sin(1.3 * t) + 0.4 * np.cos(3.1 * t + 0.5) + 0.05 * t * t + 0.1 * rng.sta
 with open(os.path.join(OUT, "input.csv"), "w") as f:
     f.write("t,y\n")
     for ti, yi in zip(t, y):
-        f.write(f"{ti!r},{yi!r}\n")
+        f.write(f"{float(ti)!r},{float(yi)!r}\n")
 with open(os.path.join(OUT, "cases.csv"), "w") as f:
     f.write("degree,window,deriv,index,value\n")
     for degree in range(0, 6):
