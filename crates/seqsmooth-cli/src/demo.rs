@@ -194,10 +194,7 @@ pub fn run(output: Option<&Path>) -> Result<(), CliError> {
             ("-".to_string(), "-".to_string())
         };
         table.push(vec![
-            match r.kind {
-                Kind::Expanding => "expanding".into(),
-                Kind::Fading => "fading".into(),
-            },
+            r.kind.name().into(),
             match r.engine {
                 EngineArg::Exact => "exact".into(),
                 EngineArg::Gain => "gain".into(),

@@ -1,13 +1,18 @@
 //! `seqsmooth filter`: streams a CSV time series through a polynomial filter.
 //!
-//! Reading streams row by row. Only the first [`LOOKAHEAD`] data rows are buffered: they give
-//! the default `τ` (median time step) and decide the too-few-samples check before any output is
-//! written. Every row is validated (number, finite, strictly increasing time) with its 1-based
-//! file line (the header is line 1) and column name.
+//! Reading streams row by row. Only the first [`LOOKAHEAD`] data rows (the first `W` for a
+//! fixed-memory window longer than that) are buffered: they give the default `τ` (median time
+//! step) and decide the too-few-samples check before any output is written. Every row is
+//! validated (number, finite, strictly increasing time) with its 1-based file line (the header
+//! is line 1) and column name.
 
 use crate::error::CliError;
 use crate::number::fmt_f64;
-use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter, PolynomialState};
+use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter};
+use seqsmooth::{
+    Engine, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory, PolynomialFilter,
+    PolynomialState,
+};
 use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{self, BufWriter, Read, Write};
@@ -23,6 +28,23 @@ pub enum Kind {
     Expanding,
     /// Fading memory: samples discounted by θ per τ of age.
     Fading,
+    /// Fixed memory: least squares over the last W samples (--window W).
+    Fixed,
+    /// Automatic: fading memory that starts itself, settles its degree, estimates the noise,
+    /// rejects outliers and flags misfit (--theta T).
+    Auto,
+}
+
+impl Kind {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Expanding => "expanding",
+            Kind::Fading => "fading",
+            Kind::Fixed => "fixed",
+            Kind::Auto => "auto",
+        }
+    }
 }
 
 /// The engine the filter runs on.
@@ -54,10 +76,12 @@ pub struct FilterConfig {
     pub kind: Kind,
     /// Degree `m`.
     pub degree: usize,
-    /// θ (fading memory only), in `(0, 1)`.
+    /// θ (fading memory and automatic only), in `(0, 1)`.
     pub theta: Option<f64>,
     /// τ; `None` = the median step of the first rows.
     pub tau: Option<f64>,
+    /// The window `W` in samples (fixed memory only), at least `degree + 1`.
+    pub window: Option<usize>,
     /// Engine.
     pub engine: EngineArg,
     /// Lead `H`: each row's estimate is valid at `t + H`.
@@ -66,8 +90,48 @@ pub struct FilterConfig {
     pub time_col: String,
     /// Name of the value column.
     pub value_col: String,
-    /// Noise σ for the `s0..sM` columns.
+    /// Noise σ for the `s0..sM` columns (the automatic filter's given noise).
     pub sigma: Option<f64>,
+}
+
+/// The data rows a command needs, and why (for the too-few-samples messages).
+#[derive(Clone, Debug)]
+pub struct Need {
+    /// The number of data rows needed.
+    pub rows: usize,
+    /// What needs them, e.g. `degree 2` or `window 11`.
+    pub why: String,
+}
+
+impl Need {
+    /// A degree-`m` estimate needs `m + 1` rows.
+    pub fn degree(m: usize) -> Self {
+        Self {
+            rows: m + 1,
+            why: format!("degree {m}"),
+        }
+    }
+
+    /// A window of `w` samples needs `w` rows.
+    pub fn window(w: usize) -> Self {
+        Self {
+            rows: w,
+            why: format!("window {w}"),
+        }
+    }
+
+    /// The too-few-samples error when only `got` data rows were read.
+    pub fn check(&self, got: usize) -> Result<(), CliError> {
+        if got < self.rows {
+            return Err(CliError::Data(format!(
+                "too few samples: the input has {got} data row{}, {} needs at least {}",
+                if got == 1 { "" } else { "s" },
+                self.why,
+                self.rows
+            )));
+        }
+        Ok(())
+    }
 }
 
 /// One validated data row.
@@ -155,7 +219,7 @@ pub struct SampleReader<R: Read> {
 
 impl<R: Read> SampleReader<R> {
     /// Reads the header and locates the two columns.
-    pub fn new(input: R, time_col: &str, value_col: &str, degree: usize) -> Result<Self, CliError> {
+    pub fn new(input: R, time_col: &str, value_col: &str, need: &Need) -> Result<Self, CliError> {
         let reader = csv::ReaderBuilder::new()
             .has_headers(true)
             .flexible(false)
@@ -176,9 +240,11 @@ impl<R: Read> SampleReader<R> {
         };
         if headers.is_empty() || (headers.len() == 1 && headers[0].is_empty()) {
             return Err(CliError::Data(format!(
-                "too few samples: the input is empty (no header, no data rows); degree {degree} \
-                 needs at least {} data rows",
-                degree + 1
+                "too few samples: the input is empty (no header, no data rows); {} needs at \
+                 least {} data row{}",
+                need.why,
+                need.rows,
+                if need.rows == 1 { "" } else { "s" }
             )));
         }
         let find = |name: &str| {
@@ -318,27 +384,233 @@ pub fn build_filter(
                 None => f,
             })
         }
+        Kind::Fixed | Kind::Auto => {
+            return Err(seqsmooth::Error::InvalidParameter {
+                name: "kind",
+                value: kind.name().into(),
+                reason: "fixed-memory and automatic filters are built by build_runner".into(),
+            })
+        }
     };
     Ok(filter)
 }
 
-/// Writes the filter's output CSV: header `t,y,d0..dM[,s0..sM]`, one row per sample.
+/// The fixed-memory filter of the command: least squares over the last `W` samples on any
+/// timestamps.
+///
+/// The library's even-spacing engines reject a step that differs from the first; this runs
+/// [`FixedEngine::Sliding`] (`O(m²)` per sample) while the times are evenly spaced, keeping the
+/// newest `W` samples, and at the first uneven step replays them into a
+/// [`FixedEngine::Irregular`] filter (a QR refit of the window per sample) that carries on: the
+/// same least-squares fit either way, up to rounding.
+#[derive(Clone, Debug)]
+pub struct FixedRunner {
+    filter: FixedMemory,
+    degree: usize,
+    window: usize,
+    sigma: Option<f64>,
+    /// The newest `window` samples while the sliding engine runs.
+    recent: VecDeque<(f64, f64)>,
+}
+
+impl FixedRunner {
+    /// A degree-`degree` filter over `window` samples, with noise `sigma` for the covariance.
+    pub fn new(degree: usize, window: usize, sigma: Option<f64>) -> Result<Self, seqsmooth::Error> {
+        Ok(Self {
+            filter: Self::make(degree, window, sigma, FixedEngine::Sliding)?,
+            degree,
+            window,
+            sigma,
+            recent: VecDeque::new(),
+        })
+    }
+
+    fn make(
+        degree: usize,
+        window: usize,
+        sigma: Option<f64>,
+        engine: FixedEngine,
+    ) -> Result<FixedMemory, seqsmooth::Error> {
+        let f = FixedMemory::new(degree, window, engine)?;
+        match sigma {
+            Some(s) => f.with_noise_sigma(s),
+            None => Ok(f),
+        }
+    }
+
+    /// Processes one sample.
+    pub fn update(&mut self, t: f64, y: f64) -> Result<(), seqsmooth::Error> {
+        if self.filter.engine() != FixedEngine::Irregular {
+            if self.filter.update(t, y).is_ok() {
+                self.recent.push_back((t, y));
+                if self.recent.len() > self.window {
+                    self.recent.pop_front();
+                }
+                return Ok(());
+            }
+            // The first uneven step (the input is already checked to be finite and
+            // increasing): the same fit on the irregular engine, from the newest samples.
+            let mut f = Self::make(self.degree, self.window, self.sigma, FixedEngine::Irregular)?;
+            for &(t, y) in &self.recent {
+                f.update(t, y)?;
+            }
+            self.filter = f;
+            self.recent = VecDeque::new();
+        }
+        self.filter.update(t, y)
+    }
+
+    /// The number of samples in the window so far: `W` once full.
+    pub fn filled(&self) -> usize {
+        (self.filter.samples() as usize).min(self.window)
+    }
+
+    /// The estimate at time `t`; `None` until the window is full.
+    pub fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
+        self.filter.estimate_at(t)
+    }
+}
+
+/// A running filter of any kind.
+pub enum Runner {
+    /// Expanding or fading memory.
+    Recursive(Box<dyn PolynomialFilter>),
+    /// Fixed memory.
+    Fixed(Box<FixedRunner>),
+    /// The automatic filter.
+    Auto(Box<AutomaticFilter>),
+}
+
+/// One output row's estimate and trailing cells.
+pub struct Step {
+    /// The estimate at `t + H`, if determined.
+    pub estimate: Option<PolynomialState>,
+    /// The cells of [`Runner::extra_columns`].
+    pub extra: Vec<String>,
+}
+
+impl Runner {
+    /// The columns after `d0..dM` and `s0..sM` this kind writes.
+    pub fn extra_columns(&self) -> &'static [&'static str] {
+        match self {
+            Runner::Recursive(_) => &[],
+            Runner::Fixed(_) => &["window"],
+            Runner::Auto(_) => &["noise", "outlier", "misfit"],
+        }
+    }
+
+    /// Processes the sample `(t, y)` and gives the row's estimate at `t + lead`.
+    pub fn step(&mut self, t: f64, y: f64, lead: f64) -> Result<Step, seqsmooth::Error> {
+        match self {
+            Runner::Recursive(f) => {
+                f.update(t, y)?;
+                Ok(Step {
+                    estimate: f.estimate_at(t + lead),
+                    extra: Vec::new(),
+                })
+            }
+            Runner::Fixed(f) => {
+                f.update(t, y)?;
+                Ok(Step {
+                    estimate: f.estimate_at(t + lead),
+                    extra: vec![f.filled().to_string()],
+                })
+            }
+            Runner::Auto(f) => {
+                let out = f.update(t, y)?;
+                // The output's estimate is at t: the update's own, or across a rejected sample
+                // the prediction; with a lead the active filter's, the same way.
+                let estimate = if lead == 0.0 {
+                    out.estimate
+                } else {
+                    f.estimate_at(t + lead)
+                };
+                let flag = |b: bool| if b { "1" } else { "0" }.to_string();
+                Ok(Step {
+                    estimate,
+                    extra: vec![
+                        out.noise_sigma.map(fmt_f64).unwrap_or_default(),
+                        flag(out.outlier),
+                        flag(out.misfit),
+                    ],
+                })
+            }
+        }
+    }
+}
+
+/// Builds the configured filter of any kind (τ already resolved for fading memory and the
+/// automatic filter).
+pub fn build_runner(cfg: &FilterConfig, tau: f64) -> Result<Runner, seqsmooth::Error> {
+    match cfg.kind {
+        Kind::Expanding | Kind::Fading => Ok(Runner::Recursive(build_filter(
+            cfg.kind, cfg.degree, cfg.theta, tau, cfg.engine, cfg.sigma,
+        )?)),
+        Kind::Fixed => {
+            let window = cfg
+                .window
+                .ok_or_else(|| seqsmooth::Error::InvalidParameter {
+                    name: "window",
+                    value: "(none)".into(),
+                    reason: "a fixed-memory filter needs a window".into(),
+                })?;
+            Ok(Runner::Fixed(Box::new(FixedRunner::new(
+                cfg.degree, window, cfg.sigma,
+            )?)))
+        }
+        Kind::Auto => {
+            let theta = cfg
+                .theta
+                .ok_or_else(|| seqsmooth::Error::InvalidParameter {
+                    name: "theta",
+                    value: "(none)".into(),
+                    reason: "the automatic filter needs theta".into(),
+                })?;
+            let mut config = AutoConfig::new(cfg.degree, theta, tau);
+            config.engine = cfg.engine.into();
+            config.noise_sigma = cfg.sigma;
+            Ok(Runner::Auto(Box::new(AutomaticFilter::new(config)?)))
+        }
+    }
+}
+
+/// Writes the filter's output CSV: header `t,y,d0..dM[,s0..sM][,extra…]`, one row per sample.
 pub struct OutputWriter<W: Write> {
     writer: csv::Writer<W>,
     name: String,
     degree: usize,
     sigma: bool,
+    extra: usize,
+}
+
+/// `width` cells: the values formatted, then empty cells (an estimate of a lower degree than
+/// the columns, or none).
+fn padded(values: Option<&[f64]>, width: usize) -> impl Iterator<Item = String> + '_ {
+    let values = values.unwrap_or(&[]);
+    (0..width).map(move |k| values.get(k).map_or_else(String::new, |&v| fmt_f64(v)))
 }
 
 impl<W: Write> OutputWriter<W> {
     /// Writes the header to `sink`, named `name` in error messages.
     pub fn new(sink: W, name: &str, degree: usize, sigma: bool) -> Result<Self, CliError> {
+        Self::with_extra(sink, name, degree, sigma, &[])
+    }
+
+    /// Writes the header with the trailing columns `extra` to `sink`.
+    pub fn with_extra(
+        sink: W,
+        name: &str,
+        degree: usize,
+        sigma: bool,
+        extra: &[&str],
+    ) -> Result<Self, CliError> {
         let mut writer = csv::WriterBuilder::new().from_writer(sink);
         let mut header = vec!["t".to_string(), "y".to_string()];
         header.extend((0..=degree).map(|k| format!("d{k}")));
         if sigma {
             header.extend((0..=degree).map(|k| format!("s{k}")));
         }
+        header.extend(extra.iter().map(|c| c.to_string()));
         writer
             .write_record(&header)
             .map_err(|e| CliError::write_csv(name, e))?;
@@ -347,6 +619,7 @@ impl<W: Write> OutputWriter<W> {
             name: name.to_string(),
             degree,
             sigma,
+            extra: extra.len(),
         })
     }
 
@@ -357,20 +630,29 @@ impl<W: Write> OutputWriter<W> {
         y_text: &str,
         estimate: Option<&PolynomialState>,
     ) -> Result<(), CliError> {
+        self.row_with(t_text, y_text, estimate, &[])
+    }
+
+    /// Writes one row with the trailing cells `extra` (as many as the header's extra columns).
+    /// Derivatives (and 1σ) beyond the estimate's degree are empty cells.
+    pub fn row_with(
+        &mut self,
+        t_text: &str,
+        y_text: &str,
+        estimate: Option<&PolynomialState>,
+        extra: &[String],
+    ) -> Result<(), CliError> {
+        debug_assert_eq!(extra.len(), self.extra);
         let width = self.degree + 1;
-        let mut cells: Vec<String> = Vec::with_capacity(2 + 2 * width);
+        let mut cells: Vec<String> = Vec::with_capacity(2 + 2 * width + extra.len());
         cells.push(t_text.to_string());
         cells.push(y_text.to_string());
-        match estimate {
-            Some(s) => cells.extend(s.derivatives.iter().map(|&d| fmt_f64(d))),
-            None => cells.extend((0..width).map(|_| String::new())),
-        }
+        cells.extend(padded(estimate.map(|s| s.derivatives.as_slice()), width));
         if self.sigma {
-            match estimate.and_then(PolynomialState::std_devs) {
-                Some(sd) => cells.extend(sd.iter().map(|&d| fmt_f64(d))),
-                None => cells.extend((0..width).map(|_| String::new())),
-            }
+            let sd = estimate.and_then(PolynomialState::std_devs);
+            cells.extend(padded(sd.as_deref(), width));
         }
+        cells.extend(extra.iter().cloned());
         self.writer
             .write_record(&cells)
             .map_err(|e| CliError::write_csv(&self.name, e))
@@ -404,7 +686,8 @@ pub fn open_output(path: Option<&Path>) -> Result<(Box<dyn Write>, String), CliE
     }
 }
 
-fn open_input(path: Option<&Path>) -> Result<Box<dyn Read>, CliError> {
+/// Opens the input: a file, or standard input for `None` or `-`.
+pub fn open_input(path: Option<&Path>) -> Result<Box<dyn Read>, CliError> {
     match path {
         Some(p) if p.as_os_str() != "-" => {
             let file = File::open(p).map_err(|e| {
@@ -417,9 +700,9 @@ fn open_input(path: Option<&Path>) -> Result<Box<dyn Read>, CliError> {
     }
 }
 
-/// Runs `seqsmooth filter`.
-pub fn run(cfg: &FilterConfig) -> Result<(), CliError> {
-    if let (Some(i), Some(o)) = (&cfg.input, &cfg.output) {
+/// Refuses an output file that is the input file.
+pub fn check_distinct(input: Option<&Path>, output: Option<&Path>) -> Result<(), CliError> {
+    if let (Some(i), Some(o)) = (input, output) {
         // Creating the output would truncate the input while it is still being read.
         if let (Ok(a), Ok(b)) = (i.canonicalize(), o.canonicalize()) {
             if a == b {
@@ -430,28 +713,33 @@ pub fn run(cfg: &FilterConfig) -> Result<(), CliError> {
             }
         }
     }
-    let input = open_input(cfg.input.as_deref())?;
-    let mut reader = SampleReader::new(input, &cfg.time_col, &cfg.value_col, cfg.degree)?;
+    Ok(())
+}
 
+/// Runs `seqsmooth filter`.
+pub fn run(cfg: &FilterConfig) -> Result<(), CliError> {
+    check_distinct(cfg.input.as_deref(), cfg.output.as_deref())?;
+    let need = match (cfg.kind, cfg.window) {
+        (Kind::Fixed, Some(w)) => Need::window(w.max(cfg.degree + 1)),
+        _ => Need::degree(cfg.degree),
+    };
+    let input = open_input(cfg.input.as_deref())?;
+    let mut reader = SampleReader::new(input, &cfg.time_col, &cfg.value_col, &need)?;
+
+    // A fixed-memory window longer than LOOKAHEAD is read in full before the first output row:
+    // its rows have no estimate, and an input shorter than the window is an error.
+    let hold = LOOKAHEAD.max(need.rows);
     let mut head = Vec::with_capacity(LOOKAHEAD);
-    while head.len() < LOOKAHEAD {
+    while head.len() < hold {
         match reader.next_sample()? {
             Some(s) => head.push(s),
             None => break,
         }
     }
-    let needed = cfg.degree + 1;
-    if head.len() < needed {
-        return Err(CliError::Data(format!(
-            "too few samples: the input has {} data row{}, degree {} needs at least {needed}",
-            head.len(),
-            if head.len() == 1 { "" } else { "s" },
-            cfg.degree
-        )));
-    }
+    need.check(head.len())?;
     let tau = match (cfg.kind, cfg.tau) {
         (_, Some(tau)) => tau,
-        (Kind::Fading, None) => {
+        (Kind::Fading | Kind::Auto, None) => {
             let tau = median_step(&head);
             if !(tau.is_finite() && tau > 0.0) {
                 return Err(CliError::Data(format!(
@@ -461,19 +749,20 @@ pub fn run(cfg: &FilterConfig) -> Result<(), CliError> {
             }
             tau
         }
-        (Kind::Expanding, None) => 1.0,
+        (Kind::Expanding | Kind::Fixed, None) => 1.0,
     };
-    let mut filter = build_filter(cfg.kind, cfg.degree, cfg.theta, tau, cfg.engine, cfg.sigma)
-        .map_err(|e| CliError::Usage(e.to_string()))?;
+    let mut runner = build_runner(cfg, tau).map_err(|e| CliError::Usage(e.to_string()))?;
 
     let (sink, name) = open_output(cfg.output.as_deref())?;
-    let mut out = OutputWriter::new(sink, &name, cfg.degree, cfg.sigma.is_some())?;
+    // The automatic filter always writes s0..sM (from the given or the estimated noise).
+    let sigma_columns = cfg.sigma.is_some() || cfg.kind == Kind::Auto;
+    let extra = runner.extra_columns();
+    let mut out = OutputWriter::with_extra(sink, &name, cfg.degree, sigma_columns, extra)?;
     let mut step = |s: &Sample| -> Result<(), CliError> {
-        filter
-            .update(s.t, s.y)
+        let row = runner
+            .step(s.t, s.y, cfg.lead)
             .map_err(|e| CliError::Data(format!("line {}: {e}", s.line)))?;
-        let estimate = filter.estimate_at(s.t + cfg.lead);
-        out.row(&s.t_text, &s.y_text, estimate.as_ref())
+        out.row_with(&s.t_text, &s.y_text, row.estimate.as_ref(), &row.extra)
     };
     for s in &head {
         step(s)?;
@@ -499,6 +788,50 @@ mod tests {
         }
     }
 
+    /// The fixed-memory runner falls back from the sliding engine to the irregular one at the
+    /// first uneven step, and its estimates are the irregular engine's from the start (up to
+    /// rounding) on both sides of the switch.
+    #[test]
+    fn fixed_runner_switches_engine_at_first_uneven_step() {
+        let mut runner = FixedRunner::new(2, 6, Some(0.5)).unwrap();
+        let mut reference = FixedMemory::new(2, 6, FixedEngine::Irregular)
+            .unwrap()
+            .with_noise_sigma(0.5)
+            .unwrap();
+        let mut t = 0.0;
+        for k in 0..40 {
+            t += if k < 15 {
+                0.25
+            } else {
+                0.25 + 0.1 * ((k % 3) as f64)
+            };
+            let y = (0.7 * t).sin() + 0.1 * ((k * 7 % 5) as f64);
+            runner.update(t, y).unwrap();
+            reference.update(t, y).unwrap();
+            let engine = runner.filter.engine();
+            assert_eq!(engine == FixedEngine::Irregular, k >= 16, "k = {k}");
+            assert_eq!(runner.filled(), (k + 1).min(6));
+            for lead in [0.0, 0.3, -0.6] {
+                match (
+                    runner.estimate_at(t + lead),
+                    reference.estimate_at(t + lead),
+                ) {
+                    (None, None) => assert!(k < 5),
+                    (Some(a), Some(b)) => {
+                        for (x, y) in a.derivatives.iter().zip(&b.derivatives) {
+                            assert!((x - y).abs() <= 1e-9 * (1.0 + y.abs()), "k = {k}: {x} {y}");
+                        }
+                        let (sa, sb) = (a.std_devs().unwrap(), b.std_devs().unwrap());
+                        for (x, y) in sa.iter().zip(&sb) {
+                            assert!((x - y).abs() <= 1e-9 * (1.0 + y.abs()), "k = {k}: {x} {y}");
+                        }
+                    }
+                    _ => panic!("k = {k}: one estimate is missing"),
+                }
+            }
+        }
+    }
+
     #[test]
     fn median_of_steps() {
         assert_eq!(median_step(&[sample(0.0)]), 1.0);
@@ -512,7 +845,7 @@ mod tests {
     #[test]
     fn reader_lines_and_messages() {
         let text = "t,y\n0,1\n1,2\n\n2,abc\n";
-        let mut r = SampleReader::new(text.as_bytes(), "t", "y", 1).unwrap();
+        let mut r = SampleReader::new(text.as_bytes(), "t", "y", &Need::degree(1)).unwrap();
         assert_eq!(r.next_sample().unwrap().unwrap().line, 2);
         assert_eq!(r.next_sample().unwrap().unwrap().line, 3);
         let e = r.next_sample().unwrap_err().to_string();
@@ -520,7 +853,7 @@ mod tests {
     }
 
     fn lines(text: &str) -> Vec<u64> {
-        let mut r = SampleReader::new(text.as_bytes(), "t", "y", 0).unwrap();
+        let mut r = SampleReader::new(text.as_bytes(), "t", "y", &Need::degree(0)).unwrap();
         let mut v = Vec::new();
         while let Some(s) = r.next_sample().unwrap() {
             v.push(s.line);

@@ -141,6 +141,62 @@ pub fn parse_lead(s: &str) -> Result<f64, String> {
     }
 }
 
+/// Parses `--window`: the number of samples in the window (Morrison's `L+1`), a whole number
+/// from 1 to `i64::MAX`. Whether it suits the degree is checked by the command.
+pub fn parse_window(s: &str) -> Result<usize, String> {
+    let text = s.trim();
+    match text.parse::<i128>() {
+        Ok(w) if (1..=i64::MAX as i128).contains(&w) && w <= usize::MAX as i128 => Ok(w as usize),
+        _ => Err(format!(
+            "window {text} is out of range: it must be a whole number of samples from 1 to {}",
+            i64::MAX
+        )),
+    }
+}
+
+/// A lead in sampling intervals as given on the command line (`seqsmooth vrf --kind fixed`):
+/// exact, and rounded to `f64`.
+#[derive(Clone, Debug)]
+pub struct LeadSteps {
+    /// The lead exactly (`-2.5` is `-5/2`).
+    pub exact: Rational,
+    /// The lead rounded to the nearest `f64`.
+    pub value: f64,
+}
+
+impl Default for LeadSteps {
+    fn default() -> Self {
+        Self {
+            exact: Rational::zero(),
+            value: 0.0,
+        }
+    }
+}
+
+/// Parses `--lead` of `seqsmooth vrf`: `0`, `1`, `-2.5`, `-5/2` or `25e-1`, in samples, exactly;
+/// finite in double precision.
+pub fn parse_lead_steps(s: &str) -> Result<LeadSteps, String> {
+    let text = s.trim();
+    let not_a_number = || format!("lead '{text}' is not a number (write it as -2.5 or -5/2)");
+    let out_of_range = || {
+        format!("lead {text} is out of range: it must be a finite number of samples (|H| < 1e300)")
+    };
+    // An exponent this large would take unbounded time to expand exactly.
+    if let Some((_, e)) = text.split_once(['e', 'E']) {
+        if e.parse::<i64>().is_ok_and(|e| e.unsigned_abs() > 400) {
+            return Err(format!(
+                "lead {text} is out of range: write it with an exponent from -400 to 400"
+            ));
+        }
+    }
+    let exact = parse_rational(text).ok_or_else(not_a_number)?;
+    let value = seqsmooth::scalar::ratio_to_f64(&exact);
+    if !(value.is_finite() && value.abs() < 1e300) {
+        return Err(out_of_range());
+    }
+    Ok(LeadSteps { exact, value })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -218,5 +274,34 @@ mod tests {
         assert!(parse_degree("25").unwrap_err().contains("degree 25"));
         assert!(parse_degree("-1").unwrap_err().contains("degree -1"));
         assert!(parse_degree("x").is_err());
+    }
+
+    #[test]
+    fn window_range() {
+        assert_eq!(parse_window("1"), Ok(1));
+        assert_eq!(parse_window(" 11 "), Ok(11));
+        assert!(parse_window("0")
+            .unwrap_err()
+            .contains("window 0 is out of range"));
+        assert!(parse_window("-3").unwrap_err().contains("window -3"));
+        assert!(parse_window("2.5").is_err());
+    }
+
+    #[test]
+    fn lead_steps_forms() {
+        assert_eq!(parse_lead_steps("-5/2").unwrap().exact.to_string(), "-5/2");
+        assert_eq!(parse_lead_steps("-2.5").unwrap().exact.to_string(), "-5/2");
+        assert_eq!(parse_lead_steps("25e-1").unwrap().value, 2.5);
+        assert_eq!(parse_lead_steps("0").unwrap().value, 0.0);
+        assert!(parse_lead_steps("x")
+            .unwrap_err()
+            .contains("lead 'x' is not a number"));
+        assert!(parse_lead_steps("1e999")
+            .unwrap_err()
+            .contains("out of range"));
+        assert!(parse_lead_steps("1e-99999999")
+            .unwrap_err()
+            .contains("out of range"));
+        assert!(parse_lead_steps("inf").is_err());
     }
 }

@@ -1,8 +1,10 @@
 //! `seqsmooth gains` and `seqsmooth vrf`: Morrison's scaled gain vectors and
-//! variance-reduction matrices, in `f64` or exact rationals.
+//! variance-reduction matrices (expanding, fading and fixed memory), in `f64` or exact
+//! rationals.
 
 use crate::error::CliError;
-use crate::number::{fmt_f64, fmt_rational, Theta};
+use crate::number::{fmt_f64, fmt_rational, LeadSteps, Theta};
+use seqsmooth::polynomial::fixed::covariance;
 use seqsmooth::polynomial::gains::{expanding_gains, fading_gains, GainForm};
 use seqsmooth::polynomial::vrf::{expanding_vrf, fading_vrf, EstimateForm};
 use seqsmooth::scalar::{ratio_to_f64, Rational};
@@ -16,6 +18,26 @@ pub enum Format {
     Csv,
     /// Aligned text for reading.
     Table,
+}
+
+/// The filter kinds of `seqsmooth gains` (and the recursive ones of `seqsmooth vrf`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TableKind {
+    /// Expanding memory (--n N).
+    Expanding,
+    /// Fading memory (--theta T).
+    Fading,
+}
+
+/// The filter kinds with a variance-reduction matrix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum VrfKind {
+    /// Expanding memory (--n N, --form).
+    Expanding,
+    /// Fading memory (--theta T, --form).
+    Fading,
+    /// Fixed memory over W samples (--window W, --lead H).
+    Fixed,
 }
 
 /// Which estimate a variance-reduction matrix describes.
@@ -134,6 +156,36 @@ pub fn vrf(
         }
     };
     // nalgebra iterates column-major; the transpose makes `values` row-major.
+    write_matrix(values, size, format)
+}
+
+/// Runs `seqsmooth vrf --kind fixed`: the scaled covariance per unit input variance
+/// `W(h) W(h)ᵀ` of the fixed-memory estimate over `window = L+1` samples at the lead `h` in
+/// samples after the newest (Morrison (7.5.22)-(7.5.26)); `τ = 1`, so this is also the VRF of
+/// the unscaled derivatives in sample units. Without `exact` the lead is rounded to the nearest
+/// double and the matrix is computed in `f64` (within ~1e-14 relative of the exact one at every
+/// degree: the library evaluates it through the discrete Legendre recursion).
+pub fn fixed_vrf(
+    degree: usize,
+    window: usize,
+    lead: &LeadSteps,
+    exact: bool,
+    format: Format,
+) -> Result<(), CliError> {
+    let span = window as u64 - 1;
+    let lib = |e: seqsmooth::Error| CliError::Usage(e.to_string());
+    let values = if exact {
+        let s = covariance::<Rational>(degree, span, lead.exact.clone()).map_err(lib)?;
+        cells_exact(s.transpose().iter())
+    } else {
+        let s = covariance::<f64>(degree, span, lead.value).map_err(lib)?;
+        cells_f64(s.transpose().iter().copied())
+    };
+    write_matrix(values, degree + 1, format)
+}
+
+/// Writes the row-major `size × size` matrix `values` as `i,j,value` CSV or an aligned table.
+fn write_matrix(values: Vec<String>, size: usize, format: Format) -> Result<(), CliError> {
     match format {
         Format::Csv => {
             let rows: Vec<Vec<String>> = values

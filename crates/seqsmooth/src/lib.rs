@@ -32,7 +32,10 @@
 //! - [`basis`]: discrete Legendre and Laguerre polynomials, classical Legendre.
 //! - [`model`]: state scaling, `Φ` and `Ψ`, propagation ([`PolynomialState::at`]).
 //! - [`estimate`]: batch weighted least-squares polynomial fits (QR).
-//! - [`polynomial`]: [`ExpandingMemory`] and [`FadingMemory`] filters, gains, VRFs, switching.
+//! - [`polynomial`]: [`ExpandingMemory`] and [`FadingMemory`] filters, gains, VRFs, switching;
+//!   the fixed-memory filter and whole-series smoothing ([`polynomial::fixed`]); the automatic
+//!   filter ([`polynomial::automatic`]: start-up, outliers, noise, misfit, degree settling).
+//! - [`stats`]: chi-squared tests, noise estimation, residual calibration.
 //! - [`recursive`]: the square-root information (Bayes) recursion the exact engines run on.
 //! - [`scalar`]: the `f64` / exact-rational abstraction every formula is generic over.
 //!
@@ -59,6 +62,7 @@ pub mod model;
 pub mod polynomial;
 pub mod recursive;
 pub mod scalar;
+pub mod stats;
 
 pub use error::Error;
 
@@ -67,4 +71,5 @@ pub use error::Error;
 #[doc = include_str!("../../../README.md")]
 pub struct ReadmeDoctests;
 pub use model::PolynomialState;
+pub use polynomial::fixed::{FixedEngine, FixedMemory};
 pub use polynomial::{DiscountMode, Engine, ExpandingMemory, FadingMemory, PolynomialFilter};

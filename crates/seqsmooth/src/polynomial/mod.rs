@@ -106,7 +106,9 @@
 //! assert!((s.derivatives[2] - 2.0).abs() < 1e-12);
 //! ```
 
+pub mod automatic;
 mod exact_engine;
+pub mod fixed;
 mod gain_engine;
 pub mod gains;
 pub mod switching;
@@ -114,6 +116,7 @@ pub mod vrf;
 
 use crate::error::Error;
 use crate::model::PolynomialState;
+pub use automatic::{AutoConfig, AutoOutput, AutomaticFilter};
 use exact_engine::{Discount, ExactEngine};
 use gain_engine::{FadingGains, GainEngine};
 pub use switching::SwitchRule;
@@ -253,7 +256,9 @@ pub trait PolynomialFilter: std::fmt::Debug + Send {
     /// rejected sample leaves the filter unchanged.
     fn update(&mut self, t: f64, y: f64) -> Result<(), Error>;
     /// The estimate valid at any time `t` from the samples so far (a prediction after the
-    /// newest sample, a retrodiction before it); `None` until `m+1` samples.
+    /// newest sample, a retrodiction before it); `None` until the estimate is determined
+    /// (`m+1` samples for the expanding- and fading-memory filters, a full window for the
+    /// fixed-memory filter).
     fn estimate_at(&self, t: f64) -> Option<PolynomialState>;
     /// The time of the newest sample.
     fn last_time(&self) -> Option<f64>;

@@ -1,0 +1,283 @@
+//! Random errors of the fixed-memory filter (Morrison §7.5-7.8): exact covariances for any
+//! window and lead, the asymptotic variance-reduction constants of Tables 7.2 and 7.3, and the
+//! design helpers of §7.6.
+
+use super::weights::{inverse_norms, taylor_at};
+use super::{check_finite, check_span, check_tau_scalar, span_scalar, Lead};
+use crate::basis::DiscreteLegendre;
+use crate::calculus::Polynomial;
+use crate::error::Error;
+use crate::linalg::{congruence, mul};
+use crate::model::scaling;
+use crate::scalar::Scalar;
+use nalgebra::DMatrix;
+
+/// Scaled covariance of the fixed-memory estimate per unit input variance,
+/// `S*_{n+h,n}/σ² = W(h) W(h)ᵀ = Q(L+h) Q(L+h)ᵀ` with `[Q(r)]_ij = (1/i!) dⁱφ_j(r)/drⁱ`
+/// (Morrison (7.5.22)-(7.5.23), (7.5.26)), for white errors of equal variance.
+///
+/// This is the same matrix as [`crate::polynomial::vrf::window_covariance`]
+/// (`Φ(h) 𝒮 G C Gᵀ 𝒮ᵀ Φ(h)ᵀ`, equal entry for entry in exact arithmetic; tested), evaluated as
+/// `T(L+h) C T(L+h)ᵀ` with the Legendre derivatives from the recursion (A1.1), so that `f64`
+/// keeps full accuracy also for `h < 0` (the centre, retrodiction), where the shift `Φ(h)`
+/// cancels. Cost `O(m²)`, independent of `L`.
+///
+/// ```
+/// use seqsmooth::polynomial::fixed::covariance;
+/// use seqsmooth::scalar::Rational;
+/// // (7.5.16), m = 1, L = 4, h = 0: [[2(2L+1), 6], [6, 12/L]] / ((L+2)(L+1)) = [[3/5, 1/5], [1/5, 1/10]]
+/// let s = covariance(1, 4, Rational::from_integer(0.into())).unwrap();
+/// assert_eq!(s[(0, 0)], Rational::new(3.into(), 5.into()));
+/// assert_eq!(s[(1, 1)], Rational::new(1.into(), 10.into()));
+/// ```
+pub fn covariance<T: Scalar>(m: usize, span: u64, h: T) -> Result<DMatrix<T>, Error> {
+    check_span(m, span)?;
+    check_finite("lead h", &h)?;
+    let l = span_scalar::<T>(span);
+    let basis = DiscreteLegendre::new(l.clone());
+    let t = taylor_at(m, &basis, &(l + h));
+    let inv = inverse_norms(m, &basis);
+    let c = DMatrix::from_fn(m + 1, m + 1, |i, j| {
+        if i == j {
+            inv[i].clone()
+        } else {
+            T::zero()
+        }
+    });
+    Ok(congruence(&t, &c))
+}
+
+/// Covariance of the unscaled derivatives per unit input variance,
+/// `S_X/σ² = D(τ) W(h) W(h)ᵀ D(τ)` with `D(τ) = diag(k!/τ^k)` (Morrison (7.5.27)-(7.5.28)).
+/// The diagonal holds the variance-reduction factors of `x, x', …, x^(m)`.
+///
+/// ```
+/// use seqsmooth::polynomial::fixed::covariance_unscaled;
+/// // (9.7.8) with n -> L: m = 1, L = 10, 1-step: Var(x') = 12/(τ² (L+2)(L+1)L)
+/// let s = covariance_unscaled(1, 10, 1.0, 0.5).unwrap();
+/// assert!((s[(1, 1)] - 12.0 / (0.25 * 12.0 * 11.0 * 10.0)).abs() < 1e-15);
+/// ```
+pub fn covariance_unscaled<T: Scalar>(
+    m: usize,
+    span: u64,
+    h: T,
+    tau: T,
+) -> Result<DMatrix<T>, Error> {
+    check_tau_scalar(&tau)?;
+    let s = covariance(m, span, h)?;
+    Ok(congruence(&scaling(m, tau), &s))
+}
+
+/// Covariance `W R Wᵀ` of the estimate `W Y` for errors of covariance `R` (Morrison (7.5.4)):
+/// `w` is any weight matrix ([`weights`](super::weights()) or
+/// [`weights_unscaled`](super::weights_unscaled()), `(m+1) × (L+1)`)
+/// and `r` the `(L+1) × (L+1)` covariance of `Y_(n) = (y_n, …, y_{n-L})`, newest first.
+///
+/// ```
+/// use seqsmooth::polynomial::fixed::{correlated_covariance, weights};
+/// use seqsmooth::scalar::Rational;
+/// use nalgebra::DMatrix;
+/// // Ex 7.10 (T7-11): R = tridiag(1, 2, 1), W = W(0), m = 1, L = 4: S = [[46/25, 14/25], [14/25, 7/25]]
+/// let q = |n: i64| Rational::from_integer(n.into());
+/// let r = DMatrix::from_fn(5, 5, |i, j| match i.abs_diff(j) { 0 => q(2), 1 => q(1), _ => q(0) });
+/// let s = correlated_covariance(&weights(1, 4, q(0)).unwrap(), &r).unwrap();
+/// assert_eq!(s[(0, 0)], Rational::new(46.into(), 25.into()));
+/// ```
+pub fn correlated_covariance<T: Scalar>(
+    w: &DMatrix<T>,
+    r: &DMatrix<T>,
+) -> Result<DMatrix<T>, Error> {
+    if r.nrows() != w.ncols() || r.ncols() != w.ncols() {
+        return Err(Error::InvalidParameter {
+            name: "error covariance R",
+            value: format!("{} x {}", r.nrows(), r.ncols()),
+            reason: format!(
+                "must be {n} x {n} to match a weight matrix over {n} samples",
+                n = w.ncols()
+            ),
+        });
+    }
+    Ok(mul(&mul(w, r), &w.transpose()))
+}
+
+/// The classical Legendre polynomials `P_0 … P_m` (Bonnet's recursion), exact in `T`.
+fn classical_legendre<T: Scalar>(m: usize) -> Vec<Polynomial<T>> {
+    let mut p = vec![Polynomial::constant(T::one())];
+    if m >= 1 {
+        p.push(Polynomial::new(vec![T::zero(), T::one()]));
+    }
+    for k in 1..m {
+        let x_pk = Polynomial::new(vec![T::zero(), T::one()]).mul(&p[k]);
+        let a = x_pk.scale(&T::ratio(2 * k as i64 + 1, k as i64 + 1));
+        let b = p[k - 1].scale(&T::ratio(-(k as i64), k as i64 + 1));
+        p.push(a.add(&b));
+    }
+    p
+}
+
+/// The asymptotic (long-window) variance-reduction constants `λ_ij(m, ρ)` of the fixed-memory
+/// filter evaluated at the fraction `ρ = r/L` of the window (`ρ = 1` the newest sample, `ρ = 1/2`
+/// the centre): `[S_X]_ij ≈ σ² λ_ij / (τ^(i+j) L^(i+j+1))` (Morrison (7.6.11)-(7.6.12)), with
+/// the exact generating formula (continuous limit `φ_k ≈ √((2k+1)/L) P_k(1-2ρ)`, Ex 7.22)
+/// `λ_ij(ρ) = (-2)^(i+j) Σ_{k=0..m} (2k+1) P_k^(i)(x) P_k^(j)(x)`, `x = 1 - 2ρ`.
+/// `ρ = 1` gives Table 7.2 (also valid for the one-step prediction; equal to
+/// [`crate::polynomial::vrf::fixed_memory_vrf_limit`]), `ρ = 1/2` Table 7.3.
+///
+/// ```
+/// use seqsmooth::polynomial::fixed::vrf_limit;
+/// use seqsmooth::scalar::Rational;
+/// let half = Rational::new(1.into(), 2.into());
+/// let centre = vrf_limit(4, half).unwrap();
+/// assert_eq!(centre[(2, 2)], Rational::from_integer(8820.into())); // Table 7.3 (not 720: (7.8.5))
+/// assert_eq!(vrf_limit(2, 1.0_f64).unwrap()[(0, 0)], 9.0);         // Table 7.2
+/// ```
+pub fn vrf_limit<T: Scalar>(m: usize, rho: T) -> Result<DMatrix<T>, Error> {
+    super::super::check_degree(m)?;
+    check_finite("window fraction rho", &rho)?;
+    let x = T::one() - T::from_i64(2) * rho;
+    let p = classical_legendre::<T>(m);
+    // d[k][i] = P_k^(i)(x)
+    let d: Vec<Vec<T>> = p
+        .iter()
+        .map(|pk| (0..=m).map(|i| pk.derivative(i).eval(&x)).collect())
+        .collect();
+    Ok(DMatrix::from_fn(m + 1, m + 1, |i, j| {
+        let s = (0..=m).fold(T::zero(), |acc, k| {
+            acc + T::from_i64(2 * k as i64 + 1) * d[k][i].clone() * d[k][j].clone()
+        });
+        T::from_i64(-2).powi_u(i + j) * s
+    }))
+}
+
+/// Largest memory span the design searches consider.
+pub(crate) const MAX_SEARCH_SPAN: u64 = 1 << 40;
+
+/// Variance of the unscaled `derivative` (unit input variance) for span `L` and the lead.
+pub(crate) fn unscaled_variance(
+    m: usize,
+    span: u64,
+    lead: Lead,
+    derivative: usize,
+    tau: f64,
+) -> Result<f64, Error> {
+    let h = lead.steps(span);
+    let s = covariance::<f64>(m, span, h)?;
+    let f = crate::calculus::factorial::<f64>(derivative) / tau.powi(derivative as i32);
+    Ok(s[(derivative, derivative)] * f * f)
+}
+
+fn check_derivative(m: usize, derivative: usize) -> Result<(), Error> {
+    if derivative > m {
+        return Err(Error::InvalidParameter {
+            name: "derivative",
+            value: derivative.to_string(),
+            reason: format!("a degree-{m} filter estimates derivatives 0..={m}"),
+        });
+    }
+    Ok(())
+}
+
+fn check_positive(name: &'static str, v: f64) -> Result<(), Error> {
+    if !(v.is_finite() && v > 0.0) {
+        return Err(Error::InvalidParameter {
+            name,
+            value: v.to_string(),
+            reason: "must be a positive finite number".into(),
+        });
+    }
+    Ok(())
+}
+
+/// The smallest memory span `L` (window of `L+1` samples) for which the 1σ error of the unscaled
+/// `derivative` estimated at `lead` is at most `target_sigma`, for white input noise
+/// `sigma_nu` and sampling interval `tau` (Morrison §7.6, (7.6.1)-(7.6.3), with the exact VRF of
+/// [`covariance_unscaled`], not its large-`L` approximation). The variance decreases with `L`
+/// for the end point, predictions and the centre; the search doubles `L` and then bisects.
+///
+/// ```
+/// use seqsmooth::polynomial::fixed::{min_span_for_sigma, Lead};
+/// // Morrison (7.6.1)-(7.6.2) (T7-16): σ_ν = 10, m = 1, one-step prediction, σ(x) = 3 -> L = 45
+/// assert_eq!(min_span_for_sigma(1, 0, Lead::Steps(1.0), 1.0, 10.0, 3.0).unwrap(), 45);
+/// ```
+pub fn min_span_for_sigma(
+    m: usize,
+    derivative: usize,
+    lead: Lead,
+    tau: f64,
+    sigma_nu: f64,
+    target_sigma: f64,
+) -> Result<u64, Error> {
+    super::super::check_degree(m)?;
+    check_derivative(m, derivative)?;
+    super::super::check_tau(tau)?;
+    check_positive("noise sigma", sigma_nu)?;
+    check_positive("target sigma", target_sigma)?;
+    lead.check()?;
+    let ok = |l: u64| -> Result<bool, Error> {
+        let v = unscaled_variance(m, l, lead, derivative, tau)?;
+        Ok(sigma_nu * v.sqrt() <= target_sigma)
+    };
+    let first = m as u64;
+    if ok(first)? {
+        return Ok(first);
+    }
+    let mut lo = first;
+    let mut hi = first.max(1) * 2;
+    while !ok(hi)? {
+        lo = hi;
+        hi *= 2;
+        if hi > MAX_SEARCH_SPAN {
+            return Err(Error::InvalidParameter {
+                name: "target sigma",
+                value: target_sigma.to_string(),
+                reason: format!("not reached with a window of up to 2^40 samples (degree {m})"),
+            });
+        }
+    }
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if ok(mid)? {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(hi)
+}
+
+/// The sampling interval `τ` at which the unscaled `derivative` (`≥ 1`) of a fixed-memory
+/// filter with span `L` has 1σ error `target_sigma` for white noise `sigma_nu`:
+/// `Var(x^(i)) = σ_ν² (i!)² [W Wᵀ]_ii / τ^(2i)` (Morrison (7.5.28), (7.6.4)-(7.6.5)) solved for `τ`.
+///
+/// ```
+/// use seqsmooth::polynomial::fixed::{tau_for_derivative_sigma, Lead};
+/// // T7-16 / (7.6.4)-(7.6.5): L = 45, m = 1, 1-step, σ_ν = 10, σ(x') = 4 -> τ = 0.0278 s
+/// // (the book prints 0.029; 0.0278 s is the exact value, about 36 samples/s)
+/// let tau = tau_for_derivative_sigma(1, 45, Lead::Steps(1.0), 1, 10.0, 4.0).unwrap();
+/// assert!((tau - 0.02777).abs() < 1e-5);
+/// ```
+pub fn tau_for_derivative_sigma(
+    m: usize,
+    span: u64,
+    lead: Lead,
+    derivative: usize,
+    sigma_nu: f64,
+    target_sigma: f64,
+) -> Result<f64, Error> {
+    check_span(m, span)?;
+    check_derivative(m, derivative)?;
+    if derivative == 0 {
+        return Err(Error::InvalidParameter {
+            name: "derivative",
+            value: "0".into(),
+            reason: "the variance of the value does not depend on τ; choose a derivative ≥ 1"
+                .into(),
+        });
+    }
+    check_positive("noise sigma", sigma_nu)?;
+    check_positive("target sigma", target_sigma)?;
+    lead.check()?;
+    let v = unscaled_variance(m, span, lead, derivative, 1.0)?;
+    let ratio = sigma_nu * sigma_nu * v / (target_sigma * target_sigma);
+    Ok(ratio.powf(1.0 / (2 * derivative) as f64))
+}

@@ -1,0 +1,465 @@
+//! Measurement-noise estimation: from differences of the samples (no model needed) and from the
+//! residuals of a fit (Reyneke et al. §7.1, eq. 39, App. A.5; Morrison §6.10).
+//!
+//! ## Differences
+//!
+//! For white noise of variance `σ²` on a trend, the first difference `y_i − y_{i−1}` has variance
+//! `2σ²` plus the square of the trend's increment. Reyneke's eq. 39,
+//! `R = Σ_{i=2..N} (y_i − y_{i−1})² / (2N − 2)` ([`reyneke_eq39_variance`]), is therefore biased
+//! by any slope (`+ s²/2` for a slope `s` per sample), and `stdd = std(diff y)/√2`
+//! ([`reyneke_stdd`], App. A.5), which subtracts the mean difference, by any curvature. The
+//! `k`-th difference annihilates every polynomial of degree `< k`, and for white noise
+//! `Var(∇^k y) = C(2k,k) σ²` (the weights `(−1)^j C(k,j)` have `Σ C(k,j)² = C(2k,k)`), so
+//! `mean((∇^k y)²)/C(2k,k)` ([`difference_variance`]) is unbiased on a trend of degree `< k`
+//! (others.md §4.7). On irregular timestamps the `k`-th divided difference
+//! `Σ_j w_j y_j`, `w_j = 1/Π_{i≠j}(t_j − t_i)`, annihilates the same polynomials and has
+//! variance `σ² Σ w_j²`, so `d = Σ w_j y_j / √(Σ w_j²)` has variance exactly `σ²`
+//! ([`DifferenceNoise`], running or windowed; on even samples it is `∇^k y/√C(2k,k)`).
+//! What remains is the trend's `k`-th derivative: `E{d²} = σ² + b²` with, on even steps `Δt`,
+//! `b ≈ x^(k) Δt^k / √C(2k,k)`, negligible when `k` exceeds the degree of the local trend. Successive `d` overlap (`k+1` samples each), so the estimate's variance is
+//! `2σ⁴/N · C(4k,2k)/C(2k,k)²` (1.5, 1.94, 2.31 × the independent-sample value for `k = 1, 2,
+//! 3`) rather than `2σ⁴/N`.
+//!
+//! ## Residuals
+//!
+//! After a least-squares fit of `N_X` parameters to `N_O` samples, the residual sum of squares
+//! `e°` has expectation `σ² (N_O − N_X)` (Morrison (6.10.21)), so `σ̂² = e°/(N_O − N_X)`
+//! (6.10.24; [`residual_variance`]). Model mismatch inflates it (6.10.25).
+
+use super::welford::Welford;
+use crate::calculus::choose;
+use crate::error::Error;
+use crate::estimate::PolynomialFit;
+use std::collections::VecDeque;
+
+fn check_values(values: &[f64]) -> Result<(), Error> {
+    if let Some(&v) = values.iter().find(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            what: "value",
+            value: v,
+        });
+    }
+    Ok(())
+}
+
+/// Reyneke's eq. 39 as printed: `R = Σ_{i=2..N} (y_i − y_{i−1})² / (2N − 2)`, the noise variance
+/// from first differences of evenly spaced samples. Unbiased on white noise about a constant;
+/// a slope `s` per sample adds `s²/2` (others.md §4.7: `√R = 1.061` for `σ = 1`, `s = 0.5`).
+/// Needs `N ≥ 2` samples.
+///
+/// ```
+/// use seqsmooth::stats::reyneke_eq39_variance;
+/// // a pure ramp: only the slope bias remains, s²/2
+/// let y: Vec<f64> = (0..100).map(|n| 0.5 * n as f64).collect();
+/// assert!((reyneke_eq39_variance(&y).unwrap() - 0.125).abs() < 1e-12);
+/// ```
+pub fn reyneke_eq39_variance(values: &[f64]) -> Result<f64, Error> {
+    check_values(values)?;
+    let n = values.len();
+    if n < 2 {
+        return Err(Error::TooFewSamples { needed: 2, got: n });
+    }
+    let s: f64 = values.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum();
+    Ok(s / (2 * n - 2) as f64)
+}
+
+/// Reyneke's `stdd` (App. A.5): `σ = std(diff(y))/√2`, with Matlab's `std` (mean removed,
+/// `1/(N−2)` normalisation over the `N−1` differences). Immune to a constant slope, biased by
+/// curvature (others.md §4.7: 1.290 for a `10⁻³ n²` trend, `N = 2000`). Needs `N ≥ 3`.
+///
+/// ```
+/// use seqsmooth::stats::reyneke_stdd;
+/// let y: Vec<f64> = (0..50).map(|n| 3.0 + 0.5 * n as f64).collect();
+/// assert!(reyneke_stdd(&y).unwrap() < 1e-12); // slope removed
+/// ```
+pub fn reyneke_stdd(values: &[f64]) -> Result<f64, Error> {
+    check_values(values)?;
+    let n = values.len();
+    if n < 3 {
+        return Err(Error::TooFewSamples { needed: 3, got: n });
+    }
+    let mut w = Welford::new();
+    for d in values.windows(2) {
+        w.push(d[1] - d[0])?;
+    }
+    Ok((w.sample_variance().unwrap_or(0.0) / 2.0).sqrt())
+}
+
+/// Reyneke's `stddw` (App. A.5): [`reyneke_stdd`] over a centred moving window of `window`
+/// samples, `[i − ⌊w/2⌋, i − ⌊w/2⌋ + w)` clipped to the data, for every sample `i` (the paper
+/// uses `w = 20`). Windows with fewer than 3 samples give 0, as the Matlab code does for a
+/// single sample.
+///
+/// ```
+/// use seqsmooth::stats::reyneke_stddw;
+/// let y: Vec<f64> = (0..30).map(|n| if n % 2 == 0 { 1.0 } else { -1.0 }).collect();
+/// let s = reyneke_stddw(&y, 20).unwrap();
+/// assert_eq!(s.len(), 30);
+/// assert!(s.iter().all(|v| *v > 1.4 && *v < 1.5)); // alternating ±1: √2 · (a little over 1)
+/// ```
+pub fn reyneke_stddw(values: &[f64], window: usize) -> Result<Vec<f64>, Error> {
+    check_values(values)?;
+    if window == 0 {
+        return Err(Error::InvalidParameter {
+            name: "window",
+            value: window.to_string(),
+            reason: "must be at least 1 sample".into(),
+        });
+    }
+    let n = values.len() as i64;
+    let w = window as i64;
+    Ok((0..n)
+        .map(|i| {
+            let lo = (i - w / 2).max(0);
+            let hi = (i - w / 2 + w).min(n);
+            let slice = &values[lo as usize..hi.max(lo) as usize];
+            if slice.len() < 3 {
+                0.0
+            } else {
+                reyneke_stdd(slice).unwrap_or(0.0)
+            }
+        })
+        .collect())
+}
+
+/// The bias-free difference estimator of the noise variance on evenly spaced samples:
+/// `σ̂² = mean((∇^k y)²) / C(2k,k)` over the `N − k` differences of order `k ≥ 1`. Unbiased for
+/// white noise on any polynomial trend of degree `< k` (others.md §4.7, \[DERIVED\]). Needs
+/// `N ≥ k + 1`.
+///
+/// ```
+/// use seqsmooth::stats::difference_variance;
+/// // a quadratic trend is annihilated by the third difference
+/// let y: Vec<f64> = (0..40).map(|n| 1.0 + 2.0 * n as f64 - 0.3 * (n * n) as f64).collect();
+/// assert!(difference_variance(&y, 3).unwrap() < 1e-20);
+/// ```
+pub fn difference_variance(values: &[f64], order: usize) -> Result<f64, Error> {
+    check_order(order)?;
+    check_values(values)?;
+    let n = values.len();
+    if n < order + 1 {
+        return Err(Error::TooFewSamples {
+            needed: order + 1,
+            got: n,
+        });
+    }
+    let mut d = values.to_vec();
+    for _ in 0..order {
+        for i in 0..d.len() - 1 {
+            d[i] = d[i + 1] - d[i];
+        }
+        d.pop();
+    }
+    let c: f64 = choose(2 * order, order);
+    Ok(d.iter().map(|v| v * v).sum::<f64>() / (d.len() as f64 * c))
+}
+
+fn check_order(order: usize) -> Result<(), Error> {
+    if order == 0 || order > crate::polynomial::MAX_DEGREE + 1 {
+        return Err(Error::InvalidParameter {
+            name: "difference order",
+            value: order.to_string(),
+            reason: format!(
+                "must be between 1 and {}",
+                crate::polynomial::MAX_DEGREE + 1
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The noise variance from the residuals of a least-squares fit: `σ̂² = e°/(N_O − N_X)`
+/// (Morrison (6.10.24)), `e°` the residual sum of squares of `N_O` samples fitted with `N_X`
+/// parameters. Requires `N_O > N_X` and a finite `e° ≥ 0`.
+///
+/// ```
+/// use seqsmooth::stats::residual_variance;
+/// assert_eq!(residual_variance(12.0, 10, 2).unwrap(), 1.5);
+/// assert!(residual_variance(1.0, 3, 3).is_err());
+/// ```
+pub fn residual_variance(
+    residual_sq: f64,
+    observations: usize,
+    parameters: usize,
+) -> Result<f64, Error> {
+    if !(residual_sq.is_finite() && residual_sq >= 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "residual sum of squares",
+            value: residual_sq.to_string(),
+            reason: "must be a non-negative finite number".into(),
+        });
+    }
+    if observations <= parameters {
+        return Err(Error::TooFewSamples {
+            needed: parameters + 1,
+            got: observations,
+        });
+    }
+    Ok(residual_sq / (observations - parameters) as f64)
+}
+
+/// [`residual_variance`] of an unweighted [`PolynomialFit`] of degree `m`: `e°/(N − m − 1)`.
+/// (For a weighted fit this is the variance of unit weight.)
+///
+/// ```
+/// use seqsmooth::estimate::PolynomialFit;
+/// use seqsmooth::stats::fit_residual_variance;
+/// let t = [0.0, 1.0, 2.0, 3.0];
+/// let y = [0.0, 1.0, 1.0, 2.0];
+/// let fit = PolynomialFit::new(&t, &y, None, 1).unwrap();
+/// // residuals -0.1, 0.3, -0.3, 0.1: e° = 0.2 over 4 − 2 dof
+/// assert!((fit_residual_variance(&fit).unwrap() - 0.1).abs() < 1e-12);
+/// ```
+pub fn fit_residual_variance(fit: &PolynomialFit) -> Result<f64, Error> {
+    residual_variance(fit.residual_sq(), fit.samples(), fit.degree() + 1)
+}
+
+/// The normalised `k`-th divided difference of `k+1` samples with distinct times:
+/// `Σ w_j y_j / √(Σ w_j²)`, `w_j = 1/Π_{i≠j}(t_j − t_i)` — zero on any polynomial of degree
+/// `< k`, variance `σ²` on white noise. Times are rescaled to the span first (the ratio is
+/// scale-invariant), so no under- or overflow.
+///
+/// ```
+/// use seqsmooth::stats::normalised_divided_difference;
+/// // even steps, k = 1: (y1 − y0)/√2
+/// let d = normalised_divided_difference(&[0.0, 1.0], &[1.0, 3.0]).unwrap();
+/// assert!((d - 2.0 / 2f64.sqrt()).abs() < 1e-15);
+/// // irregular steps: a quadratic is annihilated by the third divided difference
+/// let t = [0.0, 0.3, 1.7, 2.0];
+/// let y: Vec<f64> = t.iter().map(|t| 5.0 - t + 2.0 * t * t).collect();
+/// assert!(normalised_divided_difference(&t, &y).unwrap().abs() < 1e-12);
+/// ```
+pub fn normalised_divided_difference(times: &[f64], values: &[f64]) -> Result<f64, Error> {
+    if times.len() != values.len() || times.len() < 2 {
+        return Err(Error::InvalidParameter {
+            name: "input lengths",
+            value: format!("{} times, {} values", times.len(), values.len()),
+            reason: "need the same number (at least 2) of times and values".into(),
+        });
+    }
+    for &t in times {
+        if !t.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: t,
+            });
+        }
+    }
+    check_values(values)?;
+    for w in times.windows(2) {
+        if w[1] <= w[0] {
+            return Err(Error::TimeNotIncreasing {
+                time: w[1],
+                previous: w[0],
+            });
+        }
+    }
+    Ok(divided_difference_unchecked(times, values))
+}
+
+fn divided_difference_unchecked(times: &[f64], values: &[f64]) -> f64 {
+    divided_difference_with_factors(times, values, &[]).0
+}
+
+/// The normalised divided difference and its variance in units of `σ²` when sample `j` has
+/// variance `f_j σ²` (`factors` empty: all 1).
+fn divided_difference_with_factors(times: &[f64], values: &[f64], factors: &[f64]) -> (f64, f64) {
+    let k = times.len();
+    let span = times[k - 1] - times[0];
+    let mut num = 0.0;
+    let mut norm = 0.0;
+    // Weights relative to the span; the common factor span^(-k+1) cancels in the ratio. Scale
+    // them by the largest to keep the sums in range.
+    let mut w = vec![0.0; k];
+    for j in 0..k {
+        let mut p = 1.0;
+        for i in 0..k {
+            if i != j {
+                p *= (times[j] - times[i]) / span;
+            }
+        }
+        w[j] = 1.0 / p;
+    }
+    let big = w.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let mut weighted = 0.0;
+    for j in 0..k {
+        let wj = w[j] / big;
+        num += wj * values[j];
+        norm += wj * wj;
+        weighted += wj * wj * factors.get(j).copied().unwrap_or(1.0);
+    }
+    (num / norm.sqrt(), weighted / norm)
+}
+
+/// Running noise estimator from normalised divided differences of order `k` on any timestamps
+/// (see the [module docs](self)): unbiased for white noise about any polynomial of degree `< k`.
+/// Cumulative, or over the last `window` differences.
+///
+/// ```
+/// use seqsmooth::stats::DifferenceNoise;
+/// let mut est = DifferenceNoise::new(2, None).unwrap();
+/// // a ramp plus an alternating ±0.1 "noise", on irregular times
+/// for n in 0..200 {
+///     let t = n as f64 + 0.3 * ((n * 7 % 5) as f64) / 5.0;
+///     let y = 4.0 + 3.0 * t + if n % 2 == 0 { 0.1 } else { -0.1 };
+///     est.push(t, y).unwrap();
+/// }
+/// let s = est.sigma().unwrap();
+/// assert!(s > 0.1 && s < 0.2); // the ramp is gone; the rest is the ±0.1 pattern
+/// ```
+#[derive(Clone, Debug)]
+pub struct DifferenceNoise {
+    order: usize,
+    window: Option<usize>,
+    times: VecDeque<f64>,
+    values: VecDeque<f64>,
+    factors: VecDeque<f64>,
+    squares: VecDeque<f64>,
+    sum: f64,
+    count: u64,
+    pushes_since_resum: usize,
+}
+
+impl DifferenceNoise {
+    /// An estimator from differences of order `k ≥ 1` (use `k = m + 1` for a degree-`m` trend),
+    /// over the last `window ≥ 1` differences, or all of them with `None`.
+    pub fn new(order: usize, window: Option<usize>) -> Result<Self, Error> {
+        check_order(order)?;
+        if window == Some(0) {
+            return Err(Error::InvalidParameter {
+                name: "window",
+                value: "0".into(),
+                reason: "must be at least 1 difference".into(),
+            });
+        }
+        Ok(Self {
+            order,
+            window,
+            times: VecDeque::with_capacity(order + 1),
+            values: VecDeque::with_capacity(order + 1),
+            factors: VecDeque::with_capacity(order + 1),
+            squares: VecDeque::new(),
+            sum: 0.0,
+            count: 0,
+            pushes_since_resum: 0,
+        })
+    }
+
+    /// The difference order `k`.
+    pub fn order(&self) -> usize {
+        self.order
+    }
+
+    /// Adds a sample (finite, strictly after the previous time); returns the new normalised
+    /// difference once `k+1` samples are in. On error the estimator is unchanged.
+    pub fn push(&mut self, t: f64, y: f64) -> Result<Option<f64>, Error> {
+        self.push_with_variance_factor(t, y, 1.0)
+    }
+
+    /// [`push`](Self::push) for a sample whose noise variance is `f·σ²` with a known factor
+    /// `f > 0` — e.g. a sample that passed a gate, whose noise is truncated. Each squared
+    /// difference is divided by its expected value in units of `σ²`,
+    /// `Σ w_j² f_j / Σ w_j²`, which keeps the estimate unbiased for `σ²`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::DifferenceNoise;
+    /// let mut est = DifferenceNoise::new(1, None).unwrap();
+    /// est.push_with_variance_factor(0.0, 0.0, 0.5).unwrap();
+    /// est.push_with_variance_factor(1.0, 1.0, 0.5).unwrap();
+    /// // d² = 1/2 with expected value σ²·(0.5 + 0.5)/2: σ̂² = 1
+    /// assert!((est.variance().unwrap() - 1.0).abs() < 1e-15);
+    /// ```
+    pub fn push_with_variance_factor(
+        &mut self,
+        t: f64,
+        y: f64,
+        factor: f64,
+    ) -> Result<Option<f64>, Error> {
+        if !(factor.is_finite() && factor > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "variance factor",
+                value: factor.to_string(),
+                reason: "must be a positive finite number".into(),
+            });
+        }
+        if !t.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: t,
+            });
+        }
+        if !y.is_finite() {
+            return Err(Error::NonFinite {
+                what: "value",
+                value: y,
+            });
+        }
+        if let Some(&prev) = self.times.back() {
+            if t <= prev {
+                return Err(Error::TimeNotIncreasing {
+                    time: t,
+                    previous: prev,
+                });
+            }
+        }
+        self.times.push_back(t);
+        self.values.push_back(y);
+        self.factors.push_back(factor);
+        if self.times.len() > self.order + 1 {
+            self.times.pop_front();
+            self.values.pop_front();
+            self.factors.pop_front();
+        }
+        if self.times.len() < self.order + 1 {
+            return Ok(None);
+        }
+        let ts: Vec<f64> = self.times.iter().copied().collect();
+        let ys: Vec<f64> = self.values.iter().copied().collect();
+        let fs: Vec<f64> = self.factors.iter().copied().collect();
+        let (d, expected) = divided_difference_with_factors(&ts, &ys, &fs);
+        let d2 = d * d / expected;
+        self.count += 1;
+        match self.window {
+            None => self.sum += d2,
+            Some(w) => {
+                if self.squares.len() == w {
+                    let old = self.squares.pop_front().unwrap_or(0.0);
+                    self.sum -= old;
+                }
+                self.squares.push_back(d2);
+                self.sum += d2;
+                self.pushes_since_resum += 1;
+                if self.pushes_since_resum >= 4 * w {
+                    self.sum = self.squares.iter().sum();
+                    self.pushes_since_resum = 0;
+                }
+                self.sum = self.sum.max(0.0);
+            }
+        }
+        Ok(Some(d))
+    }
+
+    /// Differences currently in the estimate.
+    pub fn len(&self) -> usize {
+        match self.window {
+            None => self.count as usize,
+            Some(_) => self.squares.len(),
+        }
+    }
+
+    /// True before the first difference.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The variance estimate `mean(d²)`, once one difference is in.
+    pub fn variance(&self) -> Option<f64> {
+        let n = self.len();
+        (n > 0).then(|| self.sum / n as f64)
+    }
+
+    /// `√variance`.
+    pub fn sigma(&self) -> Option<f64> {
+        self.variance().map(f64::sqrt)
+    }
+}
