@@ -22,6 +22,10 @@ pub enum EstimateForm {
     Predictor,
 }
 
+/// Morrison's product form of the fixed-memory covariance, kept as an independent cross-check
+/// of [`super::fixed::covariance`] (which the filters use: it keeps full `f64` accuracy also for
+/// `h < 0`, where `Φ(h)` here cancels — 5.4e-13 at the centre, `m = 8`, `L = 1000`).
+///
 /// Scaled covariance (per unit input variance) of the least-squares degree-`m` fit over the
 /// `L+1` equally spaced samples `r = 0..L`, evaluated at `r = L + h` (any real lead `h`):
 /// `W(h) Wᵀ = Φ(h) 𝒮 G C Gᵀ 𝒮ᵀ Φ(h)ᵀ` with `C = diag(1/c(j,L)²)` (Morrison (7.4.16), (7.5.x),
@@ -56,7 +60,7 @@ pub fn window_covariance<T: Scalar>(m: usize, span: u64, h: T) -> DMatrix<T> {
 
 /// Expanding-memory variance-reduction matrix at the 0-based index `n` of the newest sample
 /// (`n+1` samples): Morrison §9.7, (9.7.1)-(9.7.4), Table 9.2 (the EMP at `n` is the fixed-memory
-/// fit with `L = n`). Defined for `n ≥ m`.
+/// fit with `L = n`, so this is [`super::fixed::covariance`] at lead 0 or 1). Defined for `n ≥ m`.
 ///
 /// ```
 /// use seqsmooth::polynomial::vrf::{expanding_vrf, EstimateForm};
@@ -74,7 +78,7 @@ pub fn expanding_vrf<T: Scalar>(m: usize, n: u64, form: EstimateForm) -> Result<
         EstimateForm::Current => T::zero(),
         EstimateForm::Predictor => T::one(),
     };
-    Ok(window_covariance(m, n, h))
+    super::fixed::covariance(m, n, h)
 }
 
 /// Fading-memory variance-reduction matrix in the steady state, `S = F(r) A F(r)ᵀ` (Morrison
