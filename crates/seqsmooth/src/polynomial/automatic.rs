@@ -946,23 +946,7 @@ impl AutomaticFilter {
     /// assert_eq!(f.samples(), 1);
     /// ```
     pub fn update(&mut self, t: f64, y: f64) -> Result<AutoOutput, Error> {
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
-        if !y.is_finite() {
-            return Err(Error::NonFinite {
-                what: "value",
-                value: y,
-            });
-        }
-        if let Some(previous) = self.last_time {
-            if t <= previous {
-                return Err(Error::TimeNotIncreasing { time: t, previous });
-            }
-        }
+        crate::error::check_sample(t, y, self.last_time)?;
         // With the input checked, the steps below cannot fail on the data; should an internal
         // step still fail, restore the state so that an error never leaves a half update.
         let backup = self.clone();

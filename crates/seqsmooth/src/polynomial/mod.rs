@@ -107,6 +107,7 @@
 //! ```
 
 pub mod automatic;
+pub mod bank;
 mod exact_engine;
 pub mod fixed;
 mod gain_engine;

@@ -382,26 +382,7 @@ impl DifferenceNoise {
                 reason: "must be a positive finite number".into(),
             });
         }
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
-        if !y.is_finite() {
-            return Err(Error::NonFinite {
-                what: "value",
-                value: y,
-            });
-        }
-        if let Some(&prev) = self.times.back() {
-            if t <= prev {
-                return Err(Error::TimeNotIncreasing {
-                    time: t,
-                    previous: prev,
-                });
-            }
-        }
+        crate::error::check_sample(t, y, self.times.back().copied())?;
         self.times.push_back(t);
         self.values.push_back(y);
         self.factors.push_back(factor);

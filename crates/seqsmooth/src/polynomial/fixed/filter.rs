@@ -543,24 +543,7 @@ impl FixedMemory {
     }
 
     fn check_sample(&self, t: f64, y: f64) -> Result<(), Error> {
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
-        if !y.is_finite() {
-            return Err(Error::NonFinite {
-                what: "value",
-                value: y,
-            });
-        }
-        if self.n > 0 && t <= self.t_last {
-            return Err(Error::TimeNotIncreasing {
-                time: t,
-                previous: self.t_last,
-            });
-        }
+        crate::error::check_sample(t, y, (self.n > 0).then_some(self.t_last))?;
         if let Core::Even(_) = self.core {
             if self.n >= 2 {
                 let step = t - self.t_last;

@@ -18,24 +18,7 @@ pub(crate) fn check_series(times: &[f64], values: &[f64]) -> Result<(), Error> {
         });
     }
     for (k, (&t, &y)) in times.iter().zip(values).enumerate() {
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
-        if !y.is_finite() {
-            return Err(Error::NonFinite {
-                what: "value",
-                value: y,
-            });
-        }
-        if k > 0 && t <= times[k - 1] {
-            return Err(Error::TimeNotIncreasing {
-                time: t,
-                previous: times[k - 1],
-            });
-        }
+        crate::error::check_sample(t, y, k.checked_sub(1).map(|p| times[p]))?;
     }
     Ok(())
 }
