@@ -869,7 +869,6 @@ fn expanding_current_vrf_cross_checks_lear_and_reyneke() {
     }
 }
 
-
 /// κ_ij(m) = Σ_{k=max(i,j)}^{m} (2k+1) (k+i)!(k+j)! / (i! j! (k-i)! (k-j)!) (spec ch07-09.md §1.8,
 /// end-point closed form).
 fn kappa(m: usize, i: usize, j: usize) -> Q {
