@@ -1,0 +1,136 @@
+//! Throughput of the single-stream expanding- and fading-memory filters and of the filter
+//! banks, with the machine's copy bandwidth measured in the same run for reference.
+//!
+//! Run: `cargo bench -p seqsmooth --bench bank` (results in BENCHMARKS.md).
+//!
+//! - `single_stream/<memory>_<engine>/<m>`: one filter (fading: θ = 0.9, τ = 1) already past
+//!   its start-up; each iteration processes a batch of samples; throughput in samples.
+//! - `bank/<serial|parallel>/<K>`: a degree-2 [`FadingBank`] (θ = 0.9) of `K` channels past
+//!   its switch; each iteration is one time step of all channels; throughput in
+//!   channel-updates.
+//! - `copy/256MiB`: `copy_from_slice` of a 256 MiB buffer; throughput counts bytes read plus
+//!   bytes written (STREAM "copy" convention), so it compares directly with the bank's
+//!   traffic of `(m+1)·16 + 8` bytes per channel-update (state read and written, input read).
+
+use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use seqsmooth::polynomial::bank::FadingBank;
+use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
+use std::time::Duration;
+
+/// Deterministic data: a slow sine plus a cheap pseudo-random term.
+fn data(len: usize) -> Vec<f64> {
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    (0..len)
+        .map(|n| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let noise = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            10.0 * (n as f64 * 1e-3).sin() + noise
+        })
+        .collect()
+}
+
+fn single_stream(c: &mut Criterion) {
+    const BATCH: usize = 1_000;
+    let ys = data(1 << 12);
+    let mask = ys.len() - 1;
+    let mut group = c.benchmark_group("single_stream");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2))
+        .throughput(Throughput::Elements(BATCH as u64));
+    for (memory, engine) in [
+        ("fading", Engine::Gain),
+        ("fading", Engine::Exact),
+        ("expanding", Engine::Gain),
+        ("expanding", Engine::Exact),
+    ] {
+        let eng = if engine == Engine::Gain {
+            "gain"
+        } else {
+            "exact"
+        };
+        for m in 0..=5usize {
+            let id = BenchmarkId::new(format!("{memory}_{eng}"), m);
+            group.bench_function(id, |b| {
+                let mut f: Box<dyn PolynomialFilter> = if memory == "fading" {
+                    Box::new(FadingMemory::new(m, 0.9, 1.0, engine).unwrap())
+                } else {
+                    Box::new(ExpandingMemory::new(m, engine).unwrap())
+                };
+                // Past the start-up (the fading switch is at n < 100 for m ≤ 5, θ = 0.9).
+                let mut n = 0usize;
+                while n < 1_000 {
+                    f.update(n as f64, ys[n & mask]).unwrap();
+                    n += 1;
+                }
+                b.iter(|| {
+                    for _ in 0..BATCH {
+                        f.update(n as f64, ys[n & mask]).unwrap();
+                        n += 1;
+                    }
+                    black_box(f.samples())
+                });
+            });
+        }
+    }
+    group.finish();
+}
+
+fn bank(c: &mut Criterion) {
+    let mut group = c.benchmark_group("bank");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2));
+    for k in [10_000usize, 1_000_000] {
+        group.throughput(Throughput::Elements(k as u64));
+        let inputs: Vec<Vec<f64>> = (0..4).map(|s| data(k + s).split_off(s)).collect();
+        for parallel in [false, true] {
+            let mode = if parallel { "parallel" } else { "serial" };
+            group.bench_function(BenchmarkId::new(mode, k), |b| {
+                let mut bank = FadingBank::new(2, 0.9, 1.0, k).unwrap();
+                let mut n = 0usize;
+                while (n as u64) <= bank.switch_index() {
+                    bank.update(&inputs[n % 4]).unwrap();
+                    n += 1;
+                }
+                b.iter(|| {
+                    let y = &inputs[n % 4];
+                    if parallel {
+                        bank.update_par(y).unwrap();
+                    } else {
+                        bank.update(y).unwrap();
+                    }
+                    n += 1;
+                    black_box(bank.samples())
+                });
+            });
+        }
+    }
+    group.finish();
+}
+
+fn copy(c: &mut Criterion) {
+    const LEN: usize = (256 << 20) / 8;
+    let src: Vec<f64> = (0..LEN).map(|i| i as f64).collect();
+    let mut dst = vec![0.0f64; LEN];
+    let mut group = c.benchmark_group("copy");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2))
+        .throughput(Throughput::Bytes(2 * 8 * LEN as u64));
+    group.bench_function("256MiB", |b| {
+        b.iter(|| {
+            dst.copy_from_slice(black_box(&src));
+            black_box(dst[LEN / 2])
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, single_stream, bank, copy);
+criterion_main!(benches);

@@ -1,0 +1,166 @@
+//! The filter banks against the single-stream filters, parallel against serial, bad input.
+
+use seqsmooth::polynomial::bank::{ExpandingBank, FadingBank};
+use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
+
+/// Deterministic data for channel `c` at step `n`: a slow sine of channel-dependent phase and
+/// size, a trend, and a cheap pseudo-random term of unit size.
+fn sample(c: usize, n: usize) -> f64 {
+    let mut s = (c as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ (n as u64).wrapping_mul(0xD1B5_4A32_D192_ED03);
+    s ^= s >> 29;
+    s = s.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    s ^= s >> 32;
+    let noise = (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+    let t = n as f64;
+    (1.0 + c as f64 % 5.0) * (0.01 * t + c as f64).sin() + 0.001 * t + noise
+}
+
+/// Largest difference per derivative, relative to the largest `|x^(k)|` of the single stream
+/// over the run, from step `from` on.
+fn compare_fading(m: usize, theta: f64, tau: f64, k: usize, steps: usize, from: usize) -> Vec<f64> {
+    let mut bank = FadingBank::new(m, theta, tau, k).unwrap();
+    let mut singles: Vec<_> = (0..k)
+        .map(|_| FadingMemory::new(m, theta, tau, Engine::Gain).unwrap())
+        .collect();
+    let mut worst = vec![0.0f64; m + 1];
+    let mut scale = vec![0.0f64; m + 1];
+    let mut y = vec![0.0; k];
+    for n in 0..steps {
+        for (c, v) in y.iter_mut().enumerate() {
+            *v = sample(c, n);
+        }
+        bank.update(&y).unwrap();
+        for (c, f) in singles.iter_mut().enumerate() {
+            f.update(n as f64 * tau, y[c]).unwrap();
+            if n >= m {
+                let want = f.estimate().unwrap().derivatives;
+                let got = bank.estimate(c).unwrap();
+                for d in 0..=m {
+                    scale[d] = scale[d].max(want[d].abs());
+                    if n >= from {
+                        worst[d] = worst[d].max((got[d] - want[d]).abs());
+                    }
+                }
+            } else {
+                assert!(bank.estimate(c).is_none());
+            }
+        }
+    }
+    worst.iter().zip(&scale).map(|(w, s)| w / s).collect()
+}
+
+#[test]
+fn fading_bank_matches_single_streams() {
+    for k in [1, 7, 1000] {
+        for m in 0..=4 {
+            let steps = if k == 1000 { 150 } else { 400 };
+            let rel = compare_fading(m, 0.9, 0.5, k, steps, m);
+            let max = rel.iter().cloned().fold(0.0, f64::max);
+            eprintln!("K = {k}, m = {m}: max relative difference {max:.2e} {rel:?}");
+            assert!(max < 1e-11, "K = {k}, m = {m}: {rel:?}");
+        }
+    }
+}
+
+#[test]
+fn bank_matches_single_stream_over_long_run() {
+    for m in 1..=4 {
+        let rel = compare_fading(m, 0.95, 1.0, 2, 10_000, m);
+        eprintln!("m = {m}, 1e4 steps: {rel:?}");
+        assert!(rel.iter().all(|r| *r < 1e-11), "m = {m}: {rel:?}");
+    }
+}
+
+#[test]
+fn expanding_bank_matches_single_streams() {
+    for m in 0..=4 {
+        let k = 7;
+        let mut bank = ExpandingBank::new(m, 1.0, k).unwrap();
+        let mut singles: Vec<_> = (0..k)
+            .map(|_| ExpandingMemory::new(m, Engine::Gain).unwrap())
+            .collect();
+        let mut y = vec![0.0; k];
+        let mut worst = 0.0f64;
+        for n in 0..300 {
+            for (c, v) in y.iter_mut().enumerate() {
+                *v = sample(c, n);
+            }
+            bank.update(&y).unwrap();
+            for (c, f) in singles.iter_mut().enumerate() {
+                f.update(n as f64, y[c]).unwrap();
+                if n >= m {
+                    let want = f.estimate().unwrap().derivatives;
+                    let got = bank.estimate(c).unwrap();
+                    for d in 0..=m {
+                        worst = worst.max((got[d] - want[d]).abs() / want[0].abs().max(1.0));
+                    }
+                }
+            }
+        }
+        eprintln!("expanding m = {m}: {worst:.2e}");
+        assert!(worst < 1e-10, "m = {m}: {worst}");
+    }
+}
+
+#[test]
+fn parallel_equals_serial_bit_for_bit() {
+    let k = 100_003; // several rayon chunks and a ragged tail
+    for m in [0, 2, 4] {
+        let mut a = FadingBank::new(m, 0.97, 1.0, k).unwrap();
+        let mut b = a.clone();
+        let mut ea = ExpandingBank::new(m, 1.0, k).unwrap();
+        let mut eb = ea.clone();
+        let mut y = vec![0.0; k];
+        for n in 0..80 {
+            for (c, v) in y.iter_mut().enumerate() {
+                *v = sample(c, n);
+            }
+            a.update(&y).unwrap();
+            b.update_par(&y).unwrap();
+            ea.update(&y).unwrap();
+            eb.update_par(&y).unwrap();
+        }
+        for d in 0..=m {
+            let (ra, rb) = (a.scaled_row(d).unwrap(), b.scaled_row(d).unwrap());
+            assert!(ra.iter().zip(rb).all(|(x, y)| x.to_bits() == y.to_bits()));
+            let (ra, rb) = (ea.scaled_row(d).unwrap(), eb.scaled_row(d).unwrap());
+            assert!(ra.iter().zip(rb).all(|(x, y)| x.to_bits() == y.to_bits()));
+        }
+    }
+}
+
+#[test]
+fn bad_input_is_rejected_and_leaves_state_unchanged() {
+    let mut bank = FadingBank::new(2, 0.9, 1.0, 5).unwrap();
+    bank.update(&[1.0, 2.0, 3.0, 4.0, 5.0]).unwrap();
+    bank.update(&[1.5, 2.5, 3.5, 4.5, 5.5]).unwrap();
+    bank.update(&[2.0, 3.0, 4.0, 5.0, 6.0]).unwrap();
+    let before = bank.clone();
+    let err = bank.update(&[1.0, 2.0]).unwrap_err();
+    assert!(err.to_string().contains("input length 2"), "{err}");
+    let err = bank.update(&[1.0, 2.0, f64::NAN, 4.0, 5.0]).unwrap_err();
+    assert!(err.to_string().contains("channel 2"), "{err}");
+    let err = bank
+        .update_par(&[1.0, 2.0, 3.0, f64::INFINITY, 5.0])
+        .unwrap_err();
+    assert!(
+        err.to_string().contains("channel 3") && err.to_string().contains("inf"),
+        "{err}"
+    );
+    assert_eq!(bank.samples(), before.samples());
+    for d in 0..=2 {
+        assert_eq!(bank.scaled_row(d), before.scaled_row(d));
+    }
+    assert!(FadingBank::new(2, 1.0, 1.0, 5).is_err());
+    assert!(FadingBank::new(2, 0.9, 0.0, 5).is_err());
+    assert!(FadingBank::new(2, 0.9, 1.0, 0).is_err());
+    assert!(ExpandingBank::new(99, 1.0, 5).is_err());
+    let mut out = vec![0.0; 4];
+    assert!(bank.derivative_into(1, &mut out).is_err());
+    let mut out = vec![0.0; 5];
+    assert!(bank.derivative_into(3, &mut out).is_err());
+    bank.derivative_into(1, &mut out).unwrap();
+    assert!((out[0] - 0.5).abs() < 1e-12); // slope 0.5 per step
+    assert!(bank.estimate(5).is_none());
+}
