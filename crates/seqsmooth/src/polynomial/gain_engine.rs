@@ -29,8 +29,10 @@ pub(crate) struct FadingGains {
     pub constant: Option<f64>,
     /// The sample index at which the fading gains took over.
     pub switched_at: Option<u64>,
-    /// Cache: the effective discount the gains below belong to.
+    /// Cache: the effective discount the gains below belong to, and the step it was computed
+    /// for (so `θ^ζ̄` is not re-evaluated while the step repeats).
     pub theta_eff: f64,
+    pub step_cached: f64,
     pub gains: Vec<f64>,
     /// Low words of `gains` (double-word gains), exact to ~2⁻¹⁰⁶.
     pub gains_lo: Vec<f64>,
@@ -75,6 +77,7 @@ impl FadingGains {
             constant,
             switched_at: None,
             theta_eff: theta,
+            step_cached: 1.0,
             gains: dw.0,
             gains_lo: dw.1,
         }
@@ -264,7 +267,11 @@ impl GainEngine {
         }
         let theta_eff = match f.mode {
             DiscountMode::PerUpdate => f.theta,
-            DiscountMode::PerTime => f.theta.powf(self.step_mean),
+            DiscountMode::PerTime if self.step_mean == f.step_cached => f.theta_eff,
+            DiscountMode::PerTime => {
+                f.step_cached = self.step_mean;
+                f.theta.powf(self.step_mean)
+            }
         };
         if theta_eff != f.theta_eff {
             // The steady θ's gains are double words from the exact formula (computed once);
