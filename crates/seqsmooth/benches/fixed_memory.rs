@@ -9,24 +9,13 @@
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use seqsmooth::polynomial::fixed::{FixedEngine, FixedMemory};
 use seqsmooth::PolynomialFilter;
+mod common;
+
+use common::data;
 use std::time::Duration;
 
 const SPANS: [usize; 4] = [10, 100, 1_000, 10_000];
 const DEGREE: usize = 2;
-
-/// Deterministic data: a slow sine plus a cheap pseudo-random term.
-fn data(len: usize) -> Vec<f64> {
-    let mut state = 0x2545_F491_4F6C_DD1Du64;
-    (0..len)
-        .map(|n| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let noise = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-            10.0 * (n as f64 * 1e-3).sin() + noise
-        })
-        .collect()
-}
 
 /// A filter with a full window, and the index of the next sample.
 fn primed(engine: FixedEngine, span: usize, ys: &[f64]) -> (FixedMemory, usize) {

@@ -57,6 +57,33 @@ fn check(sample: &DMatrix<f64>, vrf: &DMatrix<f64>, what: &str) {
     }
 }
 
+/// Runs `RUNS` filters made by `make` on `n+1` samples of unit white noise at t = 0..n and
+/// checks the sample moments of the estimate at t_n and of the prediction for t_n + 1 against
+/// the closed-form matrices.
+fn simulate_and_check(
+    r: &mut rand::rngs::StdRng,
+    make: impl Fn() -> Box<dyn PolynomialFilter>,
+    n: usize,
+    current: &DMatrix<f64>,
+    predictor: &DMatrix<f64>,
+    what: &str,
+) {
+    let mut acc = Moments::new(current.nrows());
+    for _ in 0..RUNS {
+        let mut f = make();
+        for k in 0..=n {
+            let y: f64 = StandardNormal.sample(r);
+            f.update(k as f64, y).unwrap();
+        }
+        acc.add(
+            &f.estimate().unwrap(),
+            &f.estimate_at(n as f64 + 1.0).unwrap(),
+        );
+    }
+    check(&acc.current, current, what);
+    check(&acc.predictor, predictor, what);
+}
+
 #[test]
 fn expanding_memory_vrf_matches_monte_carlo() {
     // Morrison §9.7 / Table 9.2: the expanding-memory VRF at n (0-based index of the newest
@@ -65,28 +92,13 @@ fn expanding_memory_vrf_matches_monte_carlo() {
     let mut r = common::rng(20_000);
     for m in 0..=4 {
         for (engine, n) in [(Engine::Gain, m + 3), (Engine::Exact, 25)] {
-            let mut acc = Moments::new(m + 1);
-            for _ in 0..RUNS {
-                let mut f = ExpandingMemory::new(m, engine).unwrap();
-                for k in 0..=n {
-                    let y: f64 = StandardNormal.sample(&mut r);
-                    f.update(k as f64, y).unwrap();
-                }
-                acc.add(
-                    &f.estimate().unwrap(),
-                    &f.estimate_at(n as f64 + 1.0).unwrap(),
-                );
-            }
-            let what = format!("expanding {engine:?} m={m} n={n}");
-            check(
-                &acc.current,
+            simulate_and_check(
+                &mut r,
+                || Box::new(ExpandingMemory::new(m, engine).unwrap()),
+                n,
                 &expanding_vrf(m, n as u64, EstimateForm::Current).unwrap(),
-                &what,
-            );
-            check(
-                &acc.predictor,
                 &expanding_vrf(m, n as u64, EstimateForm::Predictor).unwrap(),
-                &what,
+                &format!("expanding {engine:?} m={m} n={n}"),
             );
         }
     }
@@ -101,28 +113,13 @@ fn fading_memory_vrf_matches_monte_carlo() {
     let n = 250;
     for m in 0..=4 {
         for engine in [Engine::Gain, Engine::Exact] {
-            let mut acc = Moments::new(m + 1);
-            for _ in 0..RUNS {
-                let mut f = FadingMemory::new(m, theta, 1.0, engine).unwrap();
-                for k in 0..=n {
-                    let y: f64 = StandardNormal.sample(&mut r);
-                    f.update(k as f64, y).unwrap();
-                }
-                acc.add(
-                    &f.estimate().unwrap(),
-                    &f.estimate_at(n as f64 + 1.0).unwrap(),
-                );
-            }
-            let what = format!("fading {engine:?} m={m}");
-            check(
-                &acc.current,
+            simulate_and_check(
+                &mut r,
+                || Box::new(FadingMemory::new(m, theta, 1.0, engine).unwrap()),
+                n,
                 &fading_vrf(m, theta, EstimateForm::Current).unwrap(),
-                &what,
-            );
-            check(
-                &acc.predictor,
                 &fading_vrf(m, theta, EstimateForm::Predictor).unwrap(),
-                &what,
+                &format!("fading {engine:?} m={m}"),
             );
         }
     }
