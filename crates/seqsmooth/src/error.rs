@@ -51,6 +51,15 @@ pub enum Error {
         /// Samples available.
         got: usize,
     },
+    /// A sample of a batch ([`PolynomialFilter::update_many`](crate::PolynomialFilter::update_many))
+    /// was rejected; the samples before it were processed, it and the rest were not.
+    #[error("sample {index} of the batch: {source}")]
+    InBatch {
+        /// Position of the rejected sample in the batch.
+        index: usize,
+        /// Why it was rejected.
+        source: Box<Error>,
+    },
     /// Some other parameter is out of range.
     #[error("{name} {value} is invalid: {reason}")]
     InvalidParameter {

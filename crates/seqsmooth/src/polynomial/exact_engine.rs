@@ -15,6 +15,9 @@ use crate::model::shift_scaled;
 use crate::recursive::{InformationFilter, TriangularFactor};
 use nalgebra::DMatrix;
 
+/// When the lazy discount's row scale exceeds this, it is folded into the factors.
+const RENORMALISE: f64 = 1e100;
+
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Discount {
     pub theta: f64,
@@ -37,6 +40,19 @@ pub(crate) struct ExactEngine {
     n: u64,
     row: Vec<f64>,
     sigma: Option<f64>,
+    /// Cache: the last step `Δt` and its discount's square root `√(θ^(Δt/τ))` (per time), so
+    /// the power is evaluated only when the step changes.
+    step_cached: f64,
+    root_cached: f64,
+    /// `-ln θ`, for the effective memory span, and that span `3τ/(-ln θ)` (per time).
+    neg_ln_theta: f64,
+    span_per_time: f64,
+    /// The discount applied lazily: the true factors are the stored ones divided by
+    /// `inv_scale` (the noise factor by `inv_scale²`), and each new row is multiplied by it.
+    /// Solutions and the sandwich covariance do not depend on the common scale.
+    inv_scale: f64,
+    /// The last re-centring `(α, β, A)`.
+    recentre_cache: Option<(f64, f64, DMatrix<f64>)>,
 }
 
 impl ExactEngine {
@@ -53,6 +69,12 @@ impl ExactEngine {
             n: 0,
             row: vec![0.0; m + 1],
             sigma: None,
+            step_cached: f64::NAN,
+            root_cached: 1.0,
+            neg_ln_theta: discount.map_or(0.0, |d| -d.theta.ln()),
+            span_per_time: discount.map_or(0.0, |d| 3.0 * d.tau / -d.theta.ln()),
+            recentre_cache: None,
+            inv_scale: 1.0,
         }
     }
 
@@ -79,25 +101,37 @@ impl ExactEngine {
             self.unit = 1.0;
         } else {
             if let Some(d) = self.discount {
-                let f = match d.mode {
-                    DiscountMode::PerTime => d.theta.powf((t - self.t_last) / d.tau),
-                    DiscountMode::PerUpdate => d.theta,
-                };
-                self.info.discount(f);
-                if let Some(q) = &mut self.noise {
-                    q.discount(f * f);
+                let dt = t - self.t_last;
+                if dt != self.step_cached {
+                    self.step_cached = dt;
+                    self.root_cached = match d.mode {
+                        DiscountMode::PerTime => d.theta.powf(dt / d.tau).sqrt(),
+                        DiscountMode::PerUpdate => d.theta.sqrt(),
+                    };
+                }
+                // Lazily: the factors stay as they are and new rows are scaled up instead.
+                self.inv_scale /= self.root_cached;
+                if self.inv_scale > RENORMALISE {
+                    let s = 1.0 / self.inv_scale;
+                    self.info.discount_root(s);
+                    if let Some(q) = &mut self.noise {
+                        q.discount_root(s * s);
+                    }
+                    self.inv_scale = 1.0;
                 }
             }
             self.maybe_recentre(t);
         }
         let u = (t - self.centre) / self.unit;
-        let mut p = 1.0;
+        let mut p = self.inv_scale;
         for r in self.row.iter_mut() {
             *r = p;
             p *= u;
         }
-        self.info.observe(&self.row, y, 1.0);
+        self.info.observe(&self.row, y * self.inv_scale, 1.0);
         if let Some(q) = &mut self.noise {
+            let w = self.inv_scale;
+            self.row.iter_mut().for_each(|r| *r *= w);
             q.add_row(&self.row, 0.0, 1.0);
         }
         self.t_last = t;
@@ -109,14 +143,13 @@ impl ExactEngine {
             None => self.t_first,
             Some(d) => {
                 // Effective memory: weights fall by e^-3 over this span.
-                let per_unit_time = match d.mode {
-                    DiscountMode::PerTime => -d.theta.ln() / d.tau,
+                let span = match d.mode {
+                    DiscountMode::PerTime => self.span_per_time,
                     DiscountMode::PerUpdate => {
-                        let mean_step = (t - self.t_first) / self.n as f64;
-                        -d.theta.ln() / mean_step
+                        3.0 * (t - self.t_first) / (self.n as f64 * self.neg_ln_theta)
                     }
                 };
-                (t - 3.0 / per_unit_time).max(self.t_first)
+                (t - span).max(self.t_first)
             }
         };
         let target_c = 0.5 * (start + t);
@@ -127,27 +160,39 @@ impl ExactEngine {
         let off_centre = (self.centre - target_c).abs() > 0.5 * target_s;
         let off_scale = self.unit > 4.0 * target_s || self.unit < 0.25 * target_s;
         if off_centre || off_scale {
-            self.recentre(target_c, target_s);
+            // The new unit is the old one times a power of two and the centre moves by a
+            // multiple of unit/8, so `α` and `β` below are exact and on evenly spaced samples
+            // the same change of variables repeats (its matrix is cached).
+            let alpha = if off_scale {
+                (target_s / self.unit).log2().round().exp2()
+            } else {
+                1.0
+            };
+            let beta = ((target_c - self.centre) / self.unit * 8.0).round() / 8.0;
+            self.recentre(alpha, beta);
         }
     }
 
-    fn recentre(&mut self, c_new: f64, s_new: f64) {
-        let alpha = s_new / self.unit;
-        let beta = (c_new - self.centre) / self.unit;
-        let p = self.m + 1;
-        let a = DMatrix::from_fn(p, p, |k, j| {
-            if j < k {
-                0.0
-            } else {
-                choose::<f64>(j, k) * (-beta).powi((j - k) as i32) / alpha.powi(j as i32)
-            }
-        });
-        self.info.change_variables(&a);
-        if let Some(q) = &mut self.noise {
-            q.change_variables(&a);
+    /// Re-centres: `u_old = α u_new + β`, i.e. new centre `c + β·s`, new unit `α·s`.
+    fn recentre(&mut self, alpha: f64, beta: f64) {
+        if self.recentre_cache.as_ref().map(|c| (c.0, c.1)) != Some((alpha, beta)) {
+            let p = self.m + 1;
+            let a = DMatrix::from_fn(p, p, |k, j| {
+                if j < k {
+                    0.0
+                } else {
+                    choose::<f64>(j, k) * (-beta).powi((j - k) as i32) / alpha.powi(j as i32)
+                }
+            });
+            self.recentre_cache = Some((alpha, beta, a));
         }
-        self.centre = c_new;
-        self.unit = s_new;
+        let a = &self.recentre_cache.as_ref().expect("just set").2;
+        self.info.change_variables_upper(a);
+        if let Some(q) = &mut self.noise {
+            q.change_variables_upper(a);
+        }
+        self.centre += beta * self.unit;
+        self.unit *= alpha;
     }
 
     pub fn is_determined(&self) -> bool {

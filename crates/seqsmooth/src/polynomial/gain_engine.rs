@@ -20,6 +20,18 @@ use crate::model::{shift_scaled_compensated, two_sum};
 use crate::scalar::{rational_from_f64, Rational, Scalar};
 use nalgebra::{DMatrix, DVector};
 
+/// How far a step `ζ` (in units of `τ`, ending at time `t`) may differ from the typical step
+/// `ζ̄` and still count as the same step: `1e-12·ζ̄` plus a few rounding units of the timestamp
+/// (`t = k·Δ` computed in `f64` has steps that differ by `ulp(t)`).
+#[inline]
+fn step_tolerance(step: f64, t: f64, tau: f64) -> f64 {
+    1e-12 * step + 8.0 * f64::EPSILON * t.abs() / tau
+}
+
+/// The largest degree whose steady fading recursion [`GainEngine::update_many`] runs in plain
+/// `f64` (see the measurements in [`GainEngine::steady_run`]).
+pub(crate) const PLAIN_KERNEL_MAX_DEGREE: usize = 8;
+
 #[derive(Clone, Debug)]
 pub(crate) struct FadingGains {
     pub theta: f64,
@@ -36,6 +48,8 @@ pub(crate) struct FadingGains {
     pub gains: Vec<f64>,
     /// Low words of `gains` (double-word gains), exact to ~2⁻¹⁰⁶.
     pub gains_lo: Vec<f64>,
+    /// The double-word gains of `θ` itself (computed once).
+    pub steady: (Vec<f64>, Vec<f64>),
 }
 
 /// The fading-memory gains at `θ` as double words `hi + lo`, from the exact rational formula.
@@ -78,8 +92,9 @@ impl FadingGains {
             switched_at: None,
             theta_eff: theta,
             step_cached: 1.0,
-            gains: dw.0,
-            gains_lo: dw.1,
+            gains: dw.0.clone(),
+            gains_lo: dw.1.clone(),
+            steady: dw,
         }
     }
 }
@@ -208,6 +223,88 @@ impl GainEngine {
         self.n += 1;
     }
 
+    /// Processes a batch of checked samples: [`update`](Self::update) on each, except that
+    /// once the fading gains are in force (and no covariance is tracked) runs of steps within
+    /// `1e-12` of the typical step go through [`steady_run`](Self::steady_run).
+    pub fn update_many(&mut self, ts: &[f64], ys: &[f64]) {
+        let mut i = 0;
+        while i < ts.len() {
+            if self.plain_kernel_applies() {
+                i += self.steady_run(&ts[i..], &ys[i..]);
+                if i == ts.len() {
+                    break;
+                }
+            }
+            self.update(ts[i], ys[i]);
+            i += 1;
+        }
+    }
+
+    fn plain_kernel_applies(&self) -> bool {
+        self.cov.is_none()
+            && self.m <= PLAIN_KERNEL_MAX_DEGREE
+            && self
+                .fading
+                .as_ref()
+                .is_some_and(|f| f.switched_at.is_some())
+    }
+
+    /// The steady-state fading recursion on a run of (nearly) even steps in plain `f64`, with
+    /// the state in registers: `Z ← Φ(ζ) Z`, `ε = y − z₀`, `Z ← Z + K ε`, the gains `K` those
+    /// of the typical step. Returns how many samples it took (it stops at the first step that
+    /// differs from the typical one by more than `1e-12`, relative).
+    fn steady_run(&mut self, ts: &[f64], ys: &[f64]) -> usize {
+        match self.m {
+            0 => self.steady_run_n::<1>(ts, ys),
+            1 => self.steady_run_n::<2>(ts, ys),
+            2 => self.steady_run_n::<3>(ts, ys),
+            3 => self.steady_run_n::<4>(ts, ys),
+            4 => self.steady_run_n::<5>(ts, ys),
+            5 => self.steady_run_n::<6>(ts, ys),
+            6 => self.steady_run_n::<7>(ts, ys),
+            7 => self.steady_run_n::<8>(ts, ys),
+            8 => self.steady_run_n::<9>(ts, ys),
+            _ => 0,
+        }
+    }
+
+    fn steady_run_n<const N: usize>(&mut self, ts: &[f64], ys: &[f64]) -> usize {
+        let mut z = [0.0; N];
+        let mut g = [0.0; N];
+        for k in 0..N {
+            z[k] = self.z[k] + self.z_lo[k];
+            g[k] = self.k[k];
+        }
+        let step = self.step_mean;
+        let tol = step_tolerance(step, 0.0, self.tau);
+        let tol_per_time = step_tolerance(0.0, 1.0, self.tau);
+        let tau = self.tau;
+        let mut t_last = self.t_last;
+        let mut done = 0;
+        for (&t, &y) in ts.iter().zip(ys) {
+            let zeta = (t - t_last) / tau;
+            if (zeta - step).abs() > tol + tol_per_time * t.abs() {
+                break;
+            }
+            for i in 0..N - 1 {
+                for k in (i..N - 1).rev() {
+                    z[k] += zeta * z[k + 1];
+                }
+            }
+            let e = y - z[0];
+            for k in 0..N {
+                z[k] += g[k] * e;
+            }
+            t_last = t;
+            done += 1;
+        }
+        self.z.copy_from_slice(&z);
+        self.z_lo.iter_mut().for_each(|v| *v = 0.0);
+        self.t_last = t_last;
+        self.n += done as u64;
+        done
+    }
+
     /// The step the gains are scaled for. On even samples it is the step itself, which makes the
     /// recursion exact for any step (gains `h_k/ζ^k`, `θ_eff = θ^ζ`; others.md §4.8). On
     /// irregular samples the current step would be the wrong scale — a burst of close samples
@@ -217,17 +314,22 @@ impl GainEngine {
         let switched = self.fading.as_ref().and_then(|f| f.switched_at).is_some();
         if !switched {
             self.step_mean = (t - self.t_first) / (self.n as f64 * self.tau);
-        } else if zeta != self.step_mean {
+            // Exactly even samples: the mean equals the step up to rounding; use the step.
+            if (self.step_mean - zeta).abs() <= 1e-12 * zeta {
+                self.step_mean = zeta;
+            }
+        } else if (zeta - self.step_mean).abs() > step_tolerance(self.step_mean, t, self.tau) {
+            // Steps equal to the typical one up to the rounding of the timestamps (even
+            // sampling) keep the gains; the prediction always uses the true step.
             let f = self.fading.as_ref().expect("switched implies fading");
             let w = match f.mode {
                 DiscountMode::PerUpdate => f.theta,
                 DiscountMode::PerTime => f.theta.powf(self.step_mean),
             };
             self.step_mean = w * self.step_mean + (1.0 - w) * zeta;
-        }
-        // Exactly even samples: the mean equals the step up to rounding; use the step itself.
-        if (self.step_mean - zeta).abs() <= 1e-12 * zeta {
-            self.step_mean = zeta;
+            if (self.step_mean - zeta).abs() <= 1e-12 * zeta {
+                self.step_mean = zeta;
+            }
         }
     }
 
@@ -279,9 +381,8 @@ impl GainEngine {
             // positive (relative error ~1e-15), cached while the step repeats.
             f.theta_eff = theta_eff;
             if theta_eff == f.theta {
-                let (hi, lo) = fading_gains_double_word(m, theta_eff);
-                f.gains = hi;
-                f.gains_lo = lo;
+                f.gains.clone_from(&f.steady.0);
+                f.gains_lo.clone_from(&f.steady.1);
             } else {
                 f.gains = fading_gains(m, theta_eff, GainForm::Current);
                 f.gains_lo.iter_mut().for_each(|v| *v = 0.0);

@@ -60,30 +60,85 @@ impl TriangularFactor {
     /// Folds the row `√c·[a | b]` into `[R | d]` by Givens rotations: `O(p²)`.
     pub fn add_row(&mut self, a: &[f64], b: f64, weight: f64) {
         let p = self.dim();
-        debug_assert_eq!(a.len(), p);
-        let sw = weight.sqrt();
+        assert_eq!(a.len(), p, "row of the wrong length");
+        let sw = if weight == 1.0 { 1.0 } else { weight.sqrt() };
+        // Fixed sizes unroll completely (the polynomial filters' common degrees).
+        match p {
+            1 => self.add_row_n::<1>(a, b, sw),
+            2 => self.add_row_n::<2>(a, b, sw),
+            3 => self.add_row_n::<3>(a, b, sw),
+            4 => self.add_row_n::<4>(a, b, sw),
+            5 => self.add_row_n::<5>(a, b, sw),
+            6 => self.add_row_n::<6>(a, b, sw),
+            7 => self.add_row_n::<7>(a, b, sw),
+            8 => self.add_row_n::<8>(a, b, sw),
+            9 => self.add_row_n::<9>(a, b, sw),
+            _ => self.add_row_any(a, b, sw),
+        }
+    }
+
+    #[inline(always)]
+    fn add_row_n<const N: usize>(&mut self, a: &[f64], b: f64, sw: f64) {
+        let mut row = [0.0; N];
+        for (v, x) in row.iter_mut().zip(a) {
+            *v = x * sw;
+        }
+        let mut y = b * sw;
+        // `R` is column-major: entry (i, j) at `i + j·N`.
+        let r: &mut [f64] = &mut self.r.as_mut_slice()[..N * N];
+        let rhs: &mut [f64] = &mut self.rhs.as_mut_slice()[..N];
+        for i in 0..N {
+            let ai = row[i];
+            let rii = r[i + i * N];
+            let h = rotation_norm(rii, ai);
+            // ai = 0 leaves the row as it is (c = 1, s = 0), also when R_ii = 0.
+            let (c, s) = if ai != 0.0 {
+                (rii / h, ai / h)
+            } else {
+                (1.0, 0.0)
+            };
+            r[i + i * N] = if ai != 0.0 { h } else { rii };
+            for j in i + 1..N {
+                let rij = r[i + j * N];
+                let aj = row[j];
+                r[i + j * N] = c * rij + s * aj;
+                row[j] = c * aj - s * rij;
+            }
+            let di = rhs[i];
+            rhs[i] = c * di + s * y;
+            y = c * y - s * di;
+        }
+        self.residual_sq += y * y;
+    }
+
+    fn add_row_any(&mut self, a: &[f64], b: f64, sw: f64) {
+        let p = self.dim();
         self.scratch.clear();
         self.scratch.extend(a.iter().map(|v| v * sw));
         let mut y = b * sw;
+        // `R` is column-major: entry (i, j) at `i + j·p`.
+        let r = self.r.as_mut_slice();
+        let rhs = self.rhs.as_mut_slice();
+        let row = &mut self.scratch[..p];
         for i in 0..p {
-            let ai = self.scratch[i];
+            let ai = row[i];
             if ai == 0.0 {
                 continue;
             }
-            let rii = self.r[(i, i)];
-            let h = rii.hypot(ai);
+            let rii = r[i + i * p];
+            let h = rotation_norm(rii, ai);
             let c = rii / h;
             let s = ai / h;
-            self.r[(i, i)] = h;
-            self.scratch[i] = 0.0;
+            r[i + i * p] = h;
+            row[i] = 0.0;
             for j in i + 1..p {
-                let rij = self.r[(i, j)];
-                let aj = self.scratch[j];
-                self.r[(i, j)] = c * rij + s * aj;
-                self.scratch[j] = c * aj - s * rij;
+                let rij = r[i + j * p];
+                let aj = row[j];
+                r[i + j * p] = c * rij + s * aj;
+                row[j] = c * aj - s * rij;
             }
-            let di = self.rhs[i];
-            self.rhs[i] = c * di + s * y;
+            let di = rhs[i];
+            rhs[i] = c * di + s * y;
             y = c * y - s * di;
         }
         self.residual_sq += y * y;
@@ -91,10 +146,34 @@ impl TriangularFactor {
 
     /// Multiplies the accumulated Gram matrix by `f ≥ 0` (a fading-memory discount).
     pub fn discount(&mut self, f: f64) {
-        let s = f.sqrt();
-        self.r *= s;
-        self.rhs *= s;
-        self.residual_sq *= f;
+        self.discount_root(f.sqrt());
+    }
+
+    /// [`discount`](Self::discount) by `f = s²`, given `s ≥ 0` (saves the square root when the
+    /// caller caches it).
+    pub fn discount_root(&mut self, s: f64) {
+        self.r.as_mut_slice().iter_mut().for_each(|v| *v *= s);
+        self.rhs.as_mut_slice().iter_mut().for_each(|v| *v *= s);
+        self.residual_sq *= s * s;
+    }
+
+    /// [`change_variables`](Self::change_variables) for an upper-triangular `A` (only its upper
+    /// triangle is read): `R ← R A` in place, row by row from the right (entry `(i, j)` needs
+    /// `R_ik` for `i ≤ k ≤ j`, still the old values), `O(p³/6)`, no allocation.
+    pub fn change_variables_upper(&mut self, a: &DMatrix<f64>) {
+        let p = self.dim();
+        assert_eq!(a.shape(), (p, p), "change of variables of the wrong size");
+        let a = a.as_slice();
+        let r = self.r.as_mut_slice();
+        for i in 0..p {
+            for j in (i..p).rev() {
+                let mut acc = 0.0;
+                for k in i..=j {
+                    acc += r[i + k * p] * a[k + j * p];
+                }
+                r[i + j * p] = acc;
+            }
+        }
     }
 
     /// Change of variables `x_old = A x_new`: `R ← R A`. When `A` is upper triangular the result
@@ -102,6 +181,10 @@ impl TriangularFactor {
     /// a Householder QR of `[R A | d]`.
     pub fn change_variables(&mut self, a: &DMatrix<f64>) {
         let p = self.dim();
+        if (0..p).all(|i| (0..i).all(|j| a[(i, j)] == 0.0)) {
+            self.change_variables_upper(a);
+            return;
+        }
         let ra = &self.r * a;
         let upper = (0..p).all(|i| (0..i).all(|j| ra[(i, j)] == 0.0));
         if upper {
@@ -120,6 +203,18 @@ impl TriangularFactor {
                 self.r[(i, j)] = 0.0;
             }
         }
+    }
+}
+
+/// `√(a² + b²)` for a Givens rotation: the plain formula (a few times faster than `hypot`),
+/// falling back to `hypot` when the squares overflow or underflow.
+#[inline]
+fn rotation_norm(a: f64, b: f64) -> f64 {
+    let h = (a * a + b * b).sqrt();
+    if h.is_finite() && h > 1e-150 {
+        h
+    } else {
+        a.hypot(b)
     }
 }
 
@@ -180,9 +275,19 @@ impl InformationFilter {
         self.info.discount(f);
     }
 
+    /// [`discount`](Self::discount) by `f = s²`, given `s`.
+    pub fn discount_root(&mut self, s: f64) {
+        self.info.discount_root(s);
+    }
+
     /// Re-expresses the state in new variables, `x_old = A x_new`.
     pub fn change_variables(&mut self, a: &DMatrix<f64>) {
         self.info.change_variables(a);
+    }
+
+    /// [`change_variables`](Self::change_variables) for an upper-triangular `A`.
+    pub fn change_variables_upper(&mut self, a: &DMatrix<f64>) {
+        self.info.change_variables_upper(a);
     }
 
     /// True when every diagonal entry of `R` is non-zero (the state is determined).

@@ -1,0 +1,223 @@
+//! `PolynomialFilter::update_many` against per-sample `update`: same estimates, same errors,
+//! and the accuracy of the fading-memory gain engine's plain-`f64` steady kernel.
+
+use seqsmooth::{
+    Engine, Error, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory, PolynomialFilter,
+};
+
+/// Deterministic data: a slow sine, a trend and a unit pseudo-random term.
+fn sample(n: usize) -> f64 {
+    let mut s = (n as u64).wrapping_mul(0xD1B5_4A32_D192_ED03) ^ 0x9E37_79B9_7F4A_7C15;
+    s ^= s >> 29;
+    s = s.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    s ^= s >> 32;
+    let noise = (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+    let t = n as f64;
+    100.0 * (0.003 * t).sin() + 0.01 * t + noise
+}
+
+fn filters(m: usize, irregular: bool) -> Vec<(String, Box<dyn PolynomialFilter>)> {
+    let mut v: Vec<(String, Box<dyn PolynomialFilter>)> = Vec::new();
+    for engine in [Engine::Exact, Engine::Gain] {
+        v.push((
+            format!("expanding {engine:?}"),
+            Box::new(ExpandingMemory::new(m, engine).unwrap()),
+        ));
+        v.push((
+            format!("fading {engine:?}"),
+            Box::new(FadingMemory::new(m, 0.9, 0.1, engine).unwrap()),
+        ));
+    }
+    v.push((
+        "fixed".into(),
+        Box::new(
+            FixedMemory::new(
+                m,
+                20 + 2 * m,
+                if irregular {
+                    FixedEngine::Irregular
+                } else {
+                    FixedEngine::Sliding
+                },
+            )
+            .unwrap(),
+        ),
+    ));
+    v
+}
+
+/// Largest difference per derivative between two states, relative to `scale`.
+fn rel_diff(a: &[f64], b: &[f64], scale: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .zip(scale)
+        .map(|((x, y), s)| (x - y).abs() / s.max(1e-300))
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn update_many_equals_update_on_even_and_irregular_times() {
+    for m in [0, 1, 2, 3, 5, 8] {
+        for irregular in [false, true] {
+            // Even: k·0.1 (steps equal up to rounding); irregular: steps 0.1·(1 ± 0.3).
+            let times: Vec<f64> = (0..3000)
+                .map(|k| {
+                    let k = k as f64;
+                    if irregular {
+                        0.1 * k + 0.03 * (1.7 * k).sin()
+                    } else {
+                        0.1 * k
+                    }
+                })
+                .collect();
+            let ys: Vec<f64> = (0..times.len()).map(sample).collect();
+            for ((name, mut one), (_, mut many)) in
+                filters(m, irregular).into_iter().zip(filters(m, irregular))
+            {
+                let mut scale = vec![0.0f64; m + 1];
+                let mut worst = 0.0f64;
+                // Batches of varied lengths, compared at every batch end.
+                let mut i = 0;
+                let mut len = 1;
+                while i < times.len() {
+                    let j = (i + len).min(times.len());
+                    many.update_many(&times[i..j], &ys[i..j]).unwrap();
+                    for k in i..j {
+                        one.update(times[k], ys[k]).unwrap();
+                    }
+                    assert_eq!(one.samples(), many.samples());
+                    match (one.estimate(), many.estimate()) {
+                        (Some(a), Some(b)) => {
+                            for (s, x) in scale.iter_mut().zip(&a.derivatives) {
+                                *s = s.max(x.abs());
+                            }
+                            worst = worst.max(rel_diff(&a.derivatives, &b.derivatives, &scale));
+                        }
+                        (None, None) => {}
+                        (a, b) => panic!("{name}: determined {} vs {}", a.is_some(), b.is_some()),
+                    }
+                    i = j;
+                    len = len % 300 + 37;
+                }
+                eprintln!("m = {m}, irregular = {irregular}, {name}: {worst:.2e}");
+                // Exact and fixed engines run the same code: equal. The gain engine's plain
+                // steady kernel differs from the compensated per-sample path by rounding.
+                let bound = if name.contains("Gain") { 1e-11 } else { 0.0 };
+                assert!(worst <= bound, "m = {m} {name}: {worst:e}");
+            }
+        }
+    }
+}
+
+#[test]
+fn update_many_reports_the_first_bad_sample_and_keeps_the_ones_before() {
+    let bad_cases: Vec<(Vec<f64>, Vec<f64>, usize, &str)> = vec![
+        (vec![1.0, 2.0, 2.0, 3.0], vec![0.0; 4], 2, "not after"),
+        (vec![1.0, 2.0, 3.0, 1.5], vec![0.0; 4], 3, "not after"),
+        (vec![1.0, f64::NAN, 3.0], vec![0.0; 3], 1, "time NaN"),
+        (
+            vec![1.0, 2.0, 3.0],
+            vec![0.0, 1.0, f64::INFINITY],
+            2,
+            "value inf",
+        ),
+    ];
+    for (times, values, index, what) in bad_cases {
+        // Also across the 256-sample blocks of the fast check.
+        for offset in [0usize, 300] {
+            let mut t: Vec<f64> = (0..offset).map(|k| k as f64 * 1e-3 - 1.0).collect();
+            let mut y = vec![0.5; offset];
+            t.extend(&times);
+            y.extend(&values);
+            for (name, mut f) in filters(1, true) {
+                let err = f.update_many(&t, &y).unwrap_err();
+                match &err {
+                    Error::InBatch { index: i, source } => {
+                        assert_eq!(*i, offset + index, "{name} {what}: {err}");
+                        let mut g = filters(1, true)
+                            .into_iter()
+                            .find(|(n, _)| *n == name)
+                            .unwrap()
+                            .1;
+                        for k in 0..offset + index {
+                            g.update(t[k], y[k]).unwrap();
+                        }
+                        // (compared as text: NaN ≠ NaN)
+                        assert_eq!(
+                            source.to_string(),
+                            g.update(t[*i], y[*i]).unwrap_err().to_string()
+                        );
+                    }
+                    other => panic!("{name} {what}: {other}"),
+                }
+                assert_eq!(f.samples(), (offset + index) as u64, "{name} {what}");
+            }
+        }
+    }
+    // Lengths must match; nothing is processed.
+    let mut f = FadingMemory::new(1, 0.9, 1.0, Engine::Gain).unwrap();
+    let err = f.update_many(&[1.0, 2.0], &[1.0]).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            Error::InvalidParameter {
+                name: "batch lengths",
+                ..
+            }
+        ),
+        "{err}"
+    );
+    assert_eq!(f.samples(), 0);
+    // A batch that starts at or before the filter's last time.
+    f.update(5.0, 1.0).unwrap();
+    let err = f.update_many(&[5.0], &[1.0]).unwrap_err();
+    assert!(matches!(err, Error::InBatch { index: 0, .. }), "{err}");
+}
+
+/// The plain-`f64` steady kernel against the compensated per-sample path over long runs, per
+/// degree and θ: worst difference over the second half of the run (every 101st sample),
+/// relative to the largest `|x^(k)|` there, worst over derivatives. Printed with
+/// `--nocapture`; the table is in the `polynomial` module docs.
+#[test]
+fn plain_steady_kernel_accuracy_over_long_runs() {
+    let n = 60_000;
+    let times: Vec<f64> = (0..n).map(|k| k as f64 * 0.1).collect();
+    let ys: Vec<f64> = (0..n).map(sample).collect();
+    for m in 0..=8 {
+        let mut row = Vec::new();
+        for theta in [0.5, 0.9, 0.99, 0.999] {
+            let mut one = FadingMemory::new(m, theta, 0.1, Engine::Gain).unwrap();
+            let mut many = FadingMemory::new(m, theta, 0.1, Engine::Gain).unwrap();
+            let mut scale = vec![0.0f64; m + 1];
+            let mut worst = vec![0.0f64; m + 1];
+            for (tc, yc) in times.chunks(101).zip(ys.chunks(101)) {
+                many.update_many(tc, yc).unwrap();
+                for (t, y) in tc.iter().zip(yc) {
+                    one.update(*t, *y).unwrap();
+                }
+                if one.samples() < n as u64 / 2 {
+                    continue;
+                }
+                let a = one.estimate().unwrap().derivatives;
+                let b = many.estimate().unwrap().derivatives;
+                for k in 0..=m {
+                    scale[k] = scale[k].max(a[k].abs());
+                    worst[k] = worst[k].max((a[k] - b[k]).abs());
+                }
+            }
+            let switched = many.switched_at().expect("switched within the run");
+            assert!(
+                switched < n as u64 / 2,
+                "m = {m}, θ = {theta}: switch at {switched}"
+            );
+            let rel = worst
+                .iter()
+                .zip(&scale)
+                .map(|(w, s)| w / s)
+                .fold(0.0, f64::max);
+            row.push(format!("{rel:.1e}"));
+            assert!(rel < 1e-11, "m = {m}, θ = {theta}: {rel:e}");
+        }
+        eprintln!("| {m} | {} |", row.join(" | "));
+    }
+}
