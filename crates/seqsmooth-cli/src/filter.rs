@@ -206,6 +206,28 @@ impl<R: Read> Read for LineTracker<R> {
     }
 }
 
+/// The error of the CSV parser `e`, with the line `tracker` finds for its position.
+pub fn csv_read_error<R: Read>(tracker: &mut LineTracker<R>, e: csv::Error) -> CliError {
+    let line = e.position().map(|p| tracker.line_at(p.byte()));
+    let at = match line {
+        Some(l) => format!("line {l}: "),
+        None => String::new(),
+    };
+    match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => CliError::Data(format!(
+            "{at}malformed CSV: the row has {len} field{} but the header has {expected_len}",
+            if *len == 1 { "" } else { "s" }
+        )),
+        csv::ErrorKind::Utf8 { .. } => {
+            CliError::Data(format!("{at}malformed CSV: the row is not valid UTF-8"))
+        }
+        csv::ErrorKind::Io(io) => CliError::Data(format!("cannot read the input: {io}")),
+        _ => CliError::Data(format!("{at}malformed CSV: {e}")),
+    }
+}
+
 /// Reads and validates the rows of a CSV time series one at a time.
 pub struct SampleReader<R: Read> {
     reader: csv::Reader<LineTracker<R>>,
@@ -261,26 +283,7 @@ impl<R: Read> SampleReader<R> {
     }
 
     fn csv_error(&mut self, e: csv::Error) -> CliError {
-        let line = e
-            .position()
-            .map(|p| self.reader.get_mut().line_at(p.byte()));
-        let at = match line {
-            Some(l) => format!("line {l}: "),
-            None => String::new(),
-        };
-        match e.kind() {
-            csv::ErrorKind::UnequalLengths {
-                expected_len, len, ..
-            } => CliError::Data(format!(
-                "{at}malformed CSV: the row has {len} field{} but the header has {expected_len}",
-                if *len == 1 { "" } else { "s" }
-            )),
-            csv::ErrorKind::Utf8 { .. } => {
-                CliError::Data(format!("{at}malformed CSV: the row is not valid UTF-8"))
-            }
-            csv::ErrorKind::Io(io) => CliError::Data(format!("cannot read the input: {io}")),
-            _ => CliError::Data(format!("{at}malformed CSV: {e}")),
-        }
+        csv_read_error(self.reader.get_mut(), e)
     }
 
     /// The next data row, validated; `None` at the end of the input.
@@ -320,7 +323,9 @@ impl<R: Read> SampleReader<R> {
     }
 }
 
-fn parse_cell(text: &str, line: u64, column: &str, what: &str) -> Result<f64, CliError> {
+/// Parses the number in the cell `text` (line `line`, column `column`, holding the `what`): a
+/// typed error for an empty cell, a non-number or a non-finite value.
+pub fn parse_cell(text: &str, line: u64, column: &str, what: &str) -> Result<f64, CliError> {
     if text.is_empty() {
         return Err(CliError::Data(format!(
             "line {line}, column '{column}': the cell is empty, expected a number"

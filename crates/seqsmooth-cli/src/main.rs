@@ -4,10 +4,12 @@
 //! matrices, and a demo on built-in data. A thin layer over the `seqsmooth` library: argument
 //! parsing, file formats and messages.
 
+mod chart;
 mod demo;
 mod error;
 mod filter;
 mod number;
+mod plot;
 mod smooth;
 mod tables;
 
@@ -66,10 +68,33 @@ enum Command {
     /// Print the scaled variance-reduction matrix (header i,j,value, row-major)
     #[command(after_help = AFTER_HELP)]
     Vrf(VrfArgs),
-    /// Run the filters on built-in noisy data and print a short summary
+    /// Run the automatic filter on a built-in manoeuvring-target track, print a short summary
+    /// and write a plot (PNG and SVG)
     #[command(after_help = AFTER_HELP)]
     Demo(DemoArgs),
+    /// Plot the output of 'seqsmooth filter' (any kind) as PNG or SVG
+    #[command(after_help = PLOT_AFTER_HELP)]
+    Plot(PlotArgs),
 }
+
+/// Help text after `seqsmooth plot --help`.
+const PLOT_AFTER_HELP: &str = "\
+Reads the CSV written by 'seqsmooth filter' and draws, under a title and a legend: a panel per \
+--derivative K with the estimate dK, its +-3 sigma band from sK (when the output has s \
+columns) and, for K = 0, the samples (rejected ones as red crosses, from the auto filter's \
+outlier column); then a residual panel y - d0 with the estimate's +-3 sigma band about zero \
+and the auto filter's +-3 noise sigma (dashed). The spans where the auto filter's misfit flag \
+is up are shaded in every panel. Empty cells leave gaps. Axis ranges leave out the start-up \
+transients of the estimates; residuals beyond the range are drawn as triangles at its edge.
+
+With --input (the file given to 'seqsmooth filter') the truth column --truth-col is drawn \
+too; the input's times and values must match the output's rows.
+
+Exit status: 0 on success; 1 when the input data or a file is unusable (missing file or \
+columns, malformed CSV, non-numeric cells, unwritable image); 2 for command-line errors \
+(unknown or missing arguments, values out of range, an output name not ending in .png or \
+.svg). Every message goes to stderr and starts with 'error: '; data errors name the file, the \
+1-based line (the header is line 1) and the column.";
 
 /// Help text after `seqsmooth filter --help`.
 const FILTER_AFTER_HELP: &str = "\
@@ -277,9 +302,70 @@ struct VrfArgs {
 /// Arguments of `seqsmooth demo`.
 #[derive(Debug, Args)]
 struct DemoArgs {
-    /// Also write the fading-memory (exact engine) filter's CSV output (t,y,d0..d2,s0..s2) here
+    /// Also write the plain fading-memory (exact engine) filter's CSV output
+    /// (t,y,d0..d2,s0..s2) here
     #[arg(short = 'o', long, value_name = "FILE")]
     output: Option<PathBuf>,
+    /// Path prefix of the plot: writes PREFIX.png and PREFIX.svg
+    #[arg(long, value_name = "PREFIX", default_value = demo::DEFAULT_PLOT)]
+    plot: PathBuf,
+    /// Write no plot
+    #[arg(long, conflicts_with = "plot")]
+    no_plot: bool,
+}
+
+/// Arguments of `seqsmooth plot`.
+#[derive(Debug, Args)]
+struct PlotArgs {
+    /// The output of 'seqsmooth filter' (CSV with header t,y,d0..dM[,s0..sM][,...]); omitted
+    /// or '-' reads standard input
+    #[arg(value_name = "FILTER_OUTPUT")]
+    source: Option<PathBuf>,
+    /// Image file to write, PNG or SVG by its extension (.png, .svg); repeat for both
+    #[arg(short = 'o', long, value_name = "IMAGE", required = true)]
+    output: Vec<PathBuf>,
+    /// Derivative to plot, one panel each, in the order given (0 the value, 1 the rate, ...);
+    /// repeat for several
+    #[arg(long, value_name = "K", default_value = "0", value_parser = parse_degree,
+          allow_hyphen_values = true)]
+    derivative: Vec<usize>,
+    /// Leave out the residual panel
+    #[arg(long)]
+    no_residuals: bool,
+    /// Title [default: the filter kind and the file name]
+    #[arg(long, value_name = "TEXT")]
+    title: Option<String>,
+    /// Image width in pixels
+    #[arg(long, value_name = "PX", default_value_t = 1200,
+          value_parser = clap::value_parser!(u32).range(300..=10000))]
+    width: u32,
+    /// Image height in pixels [default: 330 per derivative panel, 250 for the residuals, 120
+    /// for the title and legend]
+    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(300..=10000))]
+    height: Option<u32>,
+    /// Unit of the times, for the axis labels (e.g. s)
+    #[arg(long, value_name = "UNIT")]
+    time_unit: Option<String>,
+    /// Unit of the values, for the axis labels (e.g. m)
+    #[arg(long, value_name = "UNIT")]
+    value_unit: Option<String>,
+    /// The --lead H the output was made with: the estimates are drawn at t+H (and the residual
+    /// panel, which needs H = 0, is left out)
+    #[arg(long, value_name = "H", default_value = "0", value_parser = parse_lead,
+          allow_hyphen_values = true)]
+    lead: f64,
+    /// The filter's input file, to draw its truth column (--truth-col)
+    #[arg(long, value_name = "FILE")]
+    input: Option<PathBuf>,
+    /// Name of the input's time column
+    #[arg(long, value_name = "NAME", default_value = "t")]
+    time_col: String,
+    /// Name of the input's value column
+    #[arg(long, value_name = "NAME", default_value = "y")]
+    value_col: String,
+    /// Column of the input holding the true values, drawn as a line (needs --input)
+    #[arg(long, value_name = "NAME", requires = "input")]
+    truth_col: Option<String>,
 }
 
 /// Resolves `--n`/`--theta` for the memory kind of a gains or vrf table.
@@ -448,7 +534,26 @@ fn run(cli: Cli) -> Result<(), CliError> {
             tables::gains(a.degree, &mem, a.exact, a.format)
         }
         Command::Vrf(a) => run_vrf(a),
-        Command::Demo(a) => demo::run(a.output.as_deref()),
+        Command::Demo(a) => demo::run(&demo::DemoConfig {
+            output: a.output,
+            plot: (!a.no_plot).then_some(a.plot),
+        }),
+        Command::Plot(a) => plot::run(&plot::PlotConfig {
+            source: a.source,
+            outputs: a.output,
+            derivatives: a.derivative,
+            residuals: !a.no_residuals,
+            title: a.title,
+            width: a.width,
+            height: a.height,
+            time_unit: a.time_unit,
+            value_unit: a.value_unit,
+            lead: a.lead,
+            input: a.input,
+            time_col: a.time_col,
+            value_col: a.value_col,
+            truth_col: a.truth_col,
+        }),
     }
 }
 

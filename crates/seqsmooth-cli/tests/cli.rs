@@ -1647,14 +1647,15 @@ fn error_unknown_argument() {
 /// writes one filter's CSV.
 #[test]
 fn demo_runs() {
-    let out = ok(&["demo"], "");
+    // (the plot itself is tested in tests/plot.rs; keep the crate directory clean)
+    let out = ok(&["demo", "--no-plot"], "");
     assert!(!out.is_empty());
     for word in ["expanding", "fading", "exact", "gain"] {
         assert!(out.contains(word), "{out}");
     }
     let path = tmp("demo.csv");
     let path = path.to_str().unwrap();
-    let again = ok(&["demo", "-o", path], "");
+    let again = ok(&["demo", "--no-plot", "-o", path], "");
     assert_eq!(again, out, "deterministic");
     let csv = std::fs::read_to_string(path).unwrap();
     let (header, rows) = table(&csv);

@@ -1,0 +1,809 @@
+//! The plot of a filter's run, as PNG or SVG: one engine for `seqsmooth demo` and `seqsmooth
+//! plot`.
+//!
+//! A [`Track`] holds one row per sample — time, measured value, the estimated derivatives with
+//! their 1σ where determined — and what the automatic filter adds (rejected samples, the misfit
+//! flag, the noise σ in use, the switch to fading memory, restarts of the memory), plus the
+//! truth when it is known. [`write`] draws, under a title and a legend row:
+//!
+//! - one panel per requested derivative `k`: the estimate `d_k` (line), its ±3σ band (shaded),
+//!   the truth (thin black line) and, for `k = 0`, the samples (grey dots; rejected ones as red
+//!   crosses);
+//! - the residual panel `y − d0`, relative to the estimate: the residuals, the estimate's ±3σ
+//!   band about zero, ±3σ of the noise (dashed) where known, and `truth − d0` where known;
+//! - in every panel, the spans where the misfit flag is up (shaded orange), the switches to
+//!   fading memory (green dashed lines) and the restarts (purple lines).
+//!
+//! Axis ranges ignore the start-up transients of the estimates (the 1st-99th percentile of the
+//! estimates widened by the truth); a residual or band beyond the range is clipped to its edge,
+//! where a clipped residual is drawn as a triangle. Text is drawn with the embedded DejaVu Sans
+//! (no system fonts are read).
+
+use crate::error::CliError;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::{register_font, FontStyle};
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// DejaVu Sans (Bitstream Vera licence, see `assets/LICENSE-DejaVu.txt`).
+static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+/// The family name the embedded font is registered under.
+const FAMILY: &str = "sans-serif";
+
+/// The image formats, chosen by a file's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// Portable Network Graphics (`.png`).
+    Png,
+    /// Scalable Vector Graphics (`.svg`).
+    Svg,
+}
+
+impl Format {
+    /// The format of `path` by its extension (case-insensitive), or `None`.
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "png" => Some(Format::Png),
+            "svg" => Some(Format::Svg),
+            _ => None,
+        }
+    }
+}
+
+/// The rows of a filter run, column by column (every vector has one entry per row).
+#[derive(Clone, Debug, Default)]
+pub struct Track {
+    /// Sample times.
+    pub t: Vec<f64>,
+    /// Measured values.
+    pub y: Vec<f64>,
+    /// `d[k][i]`: the `k`-th derivative estimated at row `i`, where determined.
+    pub d: Vec<Vec<Option<f64>>>,
+    /// `s[k][i]`: its 1σ, where known (`s[k]` may be missing or empty: no band).
+    pub s: Vec<Vec<Option<f64>>>,
+    /// `truth[k][i]`: the true `k`-th derivative (`truth[k]` empty or missing: unknown).
+    pub truth: Vec<Vec<f64>>,
+    /// The noise σ in use at each row (empty: unknown).
+    pub noise: Vec<Option<f64>>,
+    /// Whether each row's sample was rejected as an outlier (empty: no such column).
+    pub rejected: Vec<bool>,
+    /// Whether the misfit flag is up at each row (empty: no such column).
+    pub misfit: Vec<bool>,
+    /// Times at which the output switched from expanding to fading memory.
+    pub switches: Vec<f64>,
+    /// Times at which the memory was restarted on misfit.
+    pub restarts: Vec<f64>,
+    /// The estimates are valid at `t + lead` (the residual panel needs `lead = 0`).
+    pub lead: f64,
+}
+
+/// What to draw and how to label it.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    /// Title at the top.
+    pub title: String,
+    /// A second line under the title (e.g. the filter's parameters); empty for none.
+    pub subtitle: String,
+    /// Label of the time axis, with its unit.
+    pub time_label: String,
+    /// The derivative panels, top to bottom: the derivative order and the axis label.
+    pub panels: Vec<(usize, String)>,
+    /// Label of the residual panel; `None` for no residual panel.
+    pub residual_label: Option<String>,
+    /// Image width and height in pixels.
+    pub size: (u32, u32),
+}
+
+impl Layout {
+    /// The default image height for `panels` derivative panels and an optional residual panel.
+    pub fn default_height(panels: usize, residual: bool) -> u32 {
+        let h = 120 + 330 * panels as u32 + if residual { 250 } else { 0 };
+        h.max(400)
+    }
+}
+
+/// Colours of the plot's elements.
+const DATA: RGBColor = RGBColor(120, 120, 120);
+const REJECTED: RGBColor = RGBColor(215, 25, 28);
+const ESTIMATE: RGBColor = RGBColor(31, 90, 180);
+const TRUTH: RGBColor = RGBColor(0, 0, 0);
+const NOISE: RGBColor = RGBColor(230, 120, 0);
+const SWITCH: RGBColor = RGBColor(0, 140, 70);
+const RESTART: RGBColor = RGBColor(140, 40, 170);
+const MISFIT: RGBColor = RGBColor(255, 170, 60);
+
+fn register() -> Result<(), CliError> {
+    static DONE: OnceLock<bool> = OnceLock::new();
+    let ok = *DONE.get_or_init(|| register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
+    if ok {
+        Ok(())
+    } else {
+        Err(CliError::Data(
+            "the embedded font could not be loaded".into(),
+        ))
+    }
+}
+
+/// Draws `track` as laid out by `layout` into `path`, as PNG or SVG by its extension.
+pub fn write(track: &Track, layout: &Layout, path: &Path) -> Result<(), CliError> {
+    register()?;
+    let format = Format::from_path(path).ok_or_else(|| {
+        CliError::Usage(format!(
+            "cannot tell the image format of '{}': the file name must end in .png or .svg",
+            path.display()
+        ))
+    })?;
+    let fail = |e: String| {
+        CliError::Data(format!(
+            "cannot write the plot to '{}': {e}",
+            path.display()
+        ))
+    };
+    match format {
+        Format::Png => {
+            let root = BitMapBackend::new(path, layout.size).into_drawing_area();
+            draw(&root, track, layout).map_err(fail)?;
+            root.present().map_err(|e| fail(e.to_string()))
+        }
+        Format::Svg => {
+            let root = SVGBackend::new(path, layout.size).into_drawing_area();
+            draw(&root, track, layout).map_err(fail)?;
+            root.present().map_err(|e| fail(e.to_string()))
+        }
+    }
+}
+
+fn font(size: f64) -> TextStyle<'static> {
+    TextStyle::from((FAMILY, size).into_font()).color(&BLACK)
+}
+
+/// The value `p`-quantile of the finite `values` (nearest rank), if any.
+fn quantile(values: &mut [f64], p: f64) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    let k = ((values.len() - 1) as f64 * p).round() as usize;
+    Some(values[k])
+}
+
+/// `[lo, hi]` widened by `pad` of its span on each side (a unit span about a single value).
+fn padded((lo, hi): (f64, f64), pad: f64) -> (f64, f64) {
+    let span = hi - lo;
+    if span > 0.0 {
+        (lo - pad * span, hi + pad * span)
+    } else {
+        let w = if lo == 0.0 { 1.0 } else { 0.05 * lo.abs() };
+        (lo - w, hi + w)
+    }
+}
+
+fn widen(range: &mut Option<(f64, f64)>, v: f64) {
+    if v.is_finite() {
+        *range = Some(match *range {
+            None => (v, v),
+            Some((lo, hi)) => (lo.min(v), hi.max(v)),
+        });
+    }
+}
+
+/// Maximal runs of consecutive indices where `keep` holds.
+fn runs(n: usize, keep: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for i in 0..=n {
+        match (i < n && keep(i), start) {
+            (true, None) => start = Some(i),
+            (false, Some(s)) => {
+                out.push(s..i);
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// Tick label text with the decimals the axis step needs.
+fn tick(v: f64, step: f64) -> String {
+    let decimals = if step > 0.0 && step.is_finite() {
+        (-(step.log10().floor()) as i32).clamp(0, 8) as usize
+    } else {
+        2
+    };
+    let s = format!("{v:.decimals$}");
+    // "-0" and "-0.0" read as noise
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        s.trim_start_matches('-').to_string()
+    } else {
+        s
+    }
+}
+
+/// One panel's y data, relative to the estimate for the residual panel.
+struct PanelData {
+    label: String,
+    /// Points: (time, value, rejected).
+    points: Vec<(f64, f64, bool)>,
+    /// The centre line (the estimate, or zero) by row.
+    line: Vec<Option<f64>>,
+    /// The ±3σ half-width by row.
+    band: Vec<Option<f64>>,
+    /// The truth (or truth − estimate) by row.
+    truth: Vec<Option<f64>>,
+    /// ±3σ noise lines by row.
+    noise: Vec<Option<f64>>,
+    /// The x offset of the line, band and truth (the lead).
+    shift: f64,
+    range: (f64, f64),
+    /// Clip points beyond the range to the edge (residual panel).
+    clip_points: bool,
+}
+
+fn derivative_panel(track: &Track, k: usize, label: &str) -> PanelData {
+    let n = track.t.len();
+    let none = vec![None; n];
+    let line = track.d.get(k).cloned().unwrap_or_else(|| none.clone());
+    let sd = track.s.get(k).filter(|s| s.len() == n);
+    let band: Vec<Option<f64>> = (0..n)
+        .map(|i| sd.and_then(|s| s[i]).map(|s| 3.0 * s))
+        .collect();
+    let truth: Vec<Option<f64>> = match track.truth.get(k) {
+        Some(v) if v.len() == n => v.iter().map(|&x| Some(x)).collect(),
+        _ => none.clone(),
+    };
+    let points: Vec<(f64, f64, bool)> = if k == 0 {
+        (0..n)
+            .map(|i| (track.t[i], track.y[i], track.rejected.get(i) == Some(&true)))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    // Range: every sample, the truth, and the central 98% of the estimates (start-up
+    // transients of the higher derivatives would squash the panel).
+    let mut range = None;
+    for p in &points {
+        widen(&mut range, p.1);
+    }
+    for v in truth.iter().flatten() {
+        widen(&mut range, *v);
+    }
+    let mut est: Vec<f64> = line
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    if let (Some(lo), Some(hi)) = (quantile(&mut est, 0.01), quantile(&mut est, 0.99)) {
+        widen(&mut range, lo);
+        widen(&mut range, hi);
+    }
+    // The band where it is no wider than the spread of the panel (not at start-up).
+    if let Some((lo, hi)) = range {
+        let span = (hi - lo).max(f64::MIN_POSITIVE);
+        let mut half: Vec<f64> = band.iter().flatten().copied().collect();
+        if let Some(h) = quantile(&mut half, 0.9) {
+            if h < 0.25 * span {
+                for (l, b) in line.iter().zip(&band) {
+                    if let (Some(l), Some(b)) = (l, b) {
+                        if *b <= h {
+                            widen(&mut range, l - b);
+                            widen(&mut range, l + b);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    PanelData {
+        label: label.to_string(),
+        points,
+        line,
+        band,
+        truth,
+        noise: none,
+        shift: track.lead,
+        range: padded(range.unwrap_or((0.0, 1.0)), 0.05),
+        clip_points: false,
+    }
+}
+
+fn residual_panel(track: &Track, label: &str) -> PanelData {
+    let n = track.t.len();
+    let d0 = track.d.first().cloned().unwrap_or_else(|| vec![None; n]);
+    let sd = track.s.first().filter(|s| s.len() == n);
+    let points: Vec<(f64, f64, bool)> = (0..n)
+        .filter_map(|i| {
+            d0[i].map(|d| {
+                (
+                    track.t[i],
+                    track.y[i] - d,
+                    track.rejected.get(i) == Some(&true),
+                )
+            })
+        })
+        .collect();
+    let line: Vec<Option<f64>> = d0.iter().map(|d| d.map(|_| 0.0)).collect();
+    let band: Vec<Option<f64>> = (0..n)
+        .map(|i| d0[i].and(sd.and_then(|s| s[i])).map(|s| 3.0 * s))
+        .collect();
+    let truth: Vec<Option<f64>> = match track.truth.first() {
+        Some(x) if x.len() == n => (0..n).map(|i| d0[i].map(|d| x[i] - d)).collect(),
+        _ => vec![None; n],
+    };
+    let noise: Vec<Option<f64>> = if track.noise.len() == n {
+        track.noise.iter().map(|s| s.map(|s| 3.0 * s)).collect()
+    } else {
+        vec![None; n]
+    };
+    // Symmetric range: the 99th percentile of |residual| of the accepted samples, every
+    // rejected one up to twice that, the ±3σ noise and the settled band, the truth's error.
+    let mut accepted: Vec<f64> = points.iter().filter(|p| !p.2).map(|p| p.1.abs()).collect();
+    let mut r = quantile(&mut accepted, 0.99).unwrap_or(0.0);
+    let mut noise3: Vec<f64> = noise.iter().flatten().copied().collect();
+    r = r.max(quantile(&mut noise3, 0.9).unwrap_or(0.0));
+    let mut band3: Vec<f64> = band.iter().flatten().copied().collect();
+    r = r.max(quantile(&mut band3, 0.9).unwrap_or(0.0));
+    let mut err: Vec<f64> = truth.iter().flatten().map(|e| e.abs()).collect();
+    r = r.max(quantile(&mut err, 0.99).unwrap_or(0.0));
+    let cap = 2.0 * r;
+    for p in points.iter().filter(|p| p.2) {
+        r = r.max(p.1.abs().min(cap));
+    }
+    if r <= 0.0 || !r.is_finite() {
+        r = 1.0;
+    }
+    PanelData {
+        label: label.to_string(),
+        points,
+        line,
+        band,
+        truth,
+        noise,
+        shift: 0.0,
+        range: (-1.08 * r, 1.08 * r),
+        clip_points: true,
+    }
+}
+
+/// The legend entries that apply.
+#[derive(Clone, Copy, PartialEq)]
+enum Key {
+    Data,
+    Rejected,
+    Estimate,
+    Band,
+    Truth,
+    Noise,
+    Switch,
+    Restart,
+    Misfit,
+    Clipped,
+}
+
+impl Key {
+    fn label(self) -> &'static str {
+        match self {
+            Key::Data => "samples",
+            Key::Rejected => "rejected (outlier)",
+            Key::Estimate => "estimate",
+            Key::Band => "estimate ±3σ",
+            Key::Truth => "truth",
+            Key::Noise => "noise ±3σ",
+            Key::Switch => "switch to fading memory",
+            Key::Restart => "misfit restart",
+            Key::Misfit => "misfit flagged",
+            Key::Clipped => "beyond the axis",
+        }
+    }
+}
+
+fn legend_keys(panels: &[PanelData], track: &Track) -> Vec<Key> {
+    let mut keys = Vec::new();
+    let any_points = panels.iter().any(|p| p.points.iter().any(|q| !q.2));
+    let any_rejected = panels.iter().any(|p| p.points.iter().any(|q| q.2));
+    let any_clipped = panels
+        .iter()
+        .any(|p| p.clip_points && p.points.iter().any(|q| q.1 < p.range.0 || q.1 > p.range.1));
+    let has = |f: &dyn Fn(&PanelData) -> bool| panels.iter().any(f);
+    if any_points {
+        keys.push(Key::Data);
+    }
+    if any_rejected {
+        keys.push(Key::Rejected);
+    }
+    if any_clipped {
+        keys.push(Key::Clipped);
+    }
+    if has(&|p| p.line.iter().any(Option::is_some)) {
+        keys.push(Key::Estimate);
+    }
+    if has(&|p| p.band.iter().any(Option::is_some)) {
+        keys.push(Key::Band);
+    }
+    if has(&|p| p.truth.iter().any(Option::is_some)) {
+        keys.push(Key::Truth);
+    }
+    if has(&|p| p.noise.iter().any(Option::is_some)) {
+        keys.push(Key::Noise);
+    }
+    if !track.switches.is_empty() {
+        keys.push(Key::Switch);
+    }
+    if !track.restarts.is_empty() {
+        keys.push(Key::Restart);
+    }
+    if track.misfit.iter().any(|&m| m) {
+        keys.push(Key::Misfit);
+    }
+    keys
+}
+
+type Err = String;
+
+fn e<E: std::fmt::Display>(err: E) -> Err {
+    err.to_string()
+}
+
+/// Draws the legend symbol of `key` centred at `(x, y)`.
+fn symbol<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    key: Key,
+    (x, y): (i32, i32),
+) -> Result<(), Err> {
+    let line = |c: RGBColor, w: u32| {
+        area.draw(&PathElement::new(
+            vec![(x - 14, y), (x + 14, y)],
+            c.stroke_width(w),
+        ))
+    };
+    match key {
+        Key::Data => area.draw(&Circle::new((x, y), 3, DATA.filled())),
+        Key::Rejected => area.draw(&Cross::new((x, y), 5, REJECTED.stroke_width(2))),
+        Key::Clipped => area.draw(&TriangleMarker::new((x, y), 5, DATA.filled())),
+        Key::Estimate => line(ESTIMATE, 2),
+        Key::Band => area.draw(&Rectangle::new(
+            [(x - 14, y - 7), (x + 14, y + 7)],
+            ESTIMATE.mix(0.22).filled(),
+        )),
+        Key::Truth => line(TRUTH, 1),
+        Key::Noise => {
+            area.draw(&PathElement::new(
+                vec![(x - 14, y), (x - 4, y)],
+                NOISE.stroke_width(2),
+            ))
+            .map_err(e)?;
+            area.draw(&PathElement::new(
+                vec![(x + 4, y), (x + 14, y)],
+                NOISE.stroke_width(2),
+            ))
+        }
+        Key::Switch => {
+            area.draw(&PathElement::new(
+                vec![(x, y - 8), (x, y - 2)],
+                SWITCH.stroke_width(2),
+            ))
+            .map_err(e)?;
+            area.draw(&PathElement::new(
+                vec![(x, y + 2), (x, y + 8)],
+                SWITCH.stroke_width(2),
+            ))
+        }
+        Key::Restart => area.draw(&PathElement::new(
+            vec![(x, y - 8), (x, y + 8)],
+            RESTART.stroke_width(2),
+        )),
+        Key::Misfit => area.draw(&Rectangle::new(
+            [(x - 14, y - 7), (x + 14, y + 7)],
+            MISFIT.mix(0.3).filled(),
+        )),
+    }
+    .map_err(e)
+}
+
+/// Lays the legend out in rows across `width`; returns the rows of (key, x of its symbol).
+fn legend_rows<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    keys: &[Key],
+    width: i32,
+) -> Result<Vec<Vec<(Key, i32)>>, Err> {
+    let style = font(15.0);
+    let mut rows: Vec<Vec<(Key, i32)>> = vec![Vec::new()];
+    let mut widths = vec![0];
+    for &k in keys {
+        let (tw, _) = area.estimate_text_size(k.label(), &style).map_err(e)?;
+        let item = 32 + tw as i32 + 18;
+        let last = rows.len() - 1;
+        if widths[last] + item > width - 40 && !rows[last].is_empty() {
+            rows.push(Vec::new());
+            widths.push(0);
+        }
+        let last = rows.len() - 1;
+        rows[last].push((k, widths[last]));
+        widths[last] += item;
+    }
+    // centre each row
+    for (row, w) in rows.iter_mut().zip(&widths) {
+        let left = (width - w) / 2;
+        for item in row.iter_mut() {
+            item.1 += left;
+        }
+    }
+    Ok(rows)
+}
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    track: &Track,
+    layout: &Layout,
+) -> Result<(), Err> {
+    root.fill(&WHITE).map_err(e)?;
+    let (width, height) = (layout.size.0 as i32, layout.size.1 as i32);
+
+    let mut panels: Vec<PanelData> = layout
+        .panels
+        .iter()
+        .map(|(k, label)| derivative_panel(track, *k, label))
+        .collect();
+    if let Some(label) = &layout.residual_label {
+        panels.push(residual_panel(track, label));
+    }
+    let keys = legend_keys(&panels, track);
+
+    // Title, subtitle, legend.
+    let mut y = 12;
+    let title = font(24.0).pos(Pos::new(HPos::Center, VPos::Top));
+    root.draw_text(&layout.title, &title, (width / 2, y))
+        .map_err(e)?;
+    y += 32;
+    if !layout.subtitle.is_empty() {
+        let sub = font(15.0)
+            .color(&RGBColor(70, 70, 70))
+            .pos(Pos::new(HPos::Center, VPos::Top));
+        root.draw_text(&layout.subtitle, &sub, (width / 2, y))
+            .map_err(e)?;
+        y += 24;
+    }
+    y += 6;
+    let label_style = font(15.0).pos(Pos::new(HPos::Left, VPos::Center));
+    for row in legend_rows(root, &keys, width)? {
+        let cy = y + 11;
+        for (key, x) in row {
+            symbol(root, key, (x + 14, cy))?;
+            root.draw_text(key.label(), &label_style, (x + 32, cy))
+                .map_err(e)?;
+        }
+        y += 26;
+    }
+    y += 6;
+
+    // Panels: derivative panels weigh 1, the residual panel 0.7; the bottom one carries the
+    // time axis label.
+    let (_, body) = root.split_vertically(y);
+    let weights: Vec<f64> = panels
+        .iter()
+        .map(|p| if p.clip_points { 0.7 } else { 1.0 })
+        .collect();
+    let total: f64 = weights.iter().sum();
+    let axis_extra = 30.0;
+    let usable = (height - y) as f64 - axis_extra;
+    let mut rest = body;
+    let times = track.t.iter().map(|t| (*t, *t + track.lead));
+    let mut xr = None;
+    for (a, b) in times {
+        widen(&mut xr, a);
+        widen(&mut xr, b);
+    }
+    let x_range = padded(xr.unwrap_or((0.0, 1.0)), 0.01);
+    let last = panels.len().saturating_sub(1);
+    for (idx, panel) in panels.iter().enumerate() {
+        let area = if idx == last {
+            rest.clone()
+        } else {
+            let h = (usable * weights[idx] / total).round() as i32;
+            let (top, bottom) = rest.split_vertically(h);
+            rest = bottom;
+            top
+        };
+        draw_panel(
+            &area,
+            track,
+            panel,
+            x_range,
+            idx == last,
+            &layout.time_label,
+        )?;
+    }
+    Ok(())
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    track: &Track,
+    p: &PanelData,
+    (x0, x1): (f64, f64),
+    bottom: bool,
+    time_label: &str,
+) -> Result<(), Err> {
+    let (y0, y1) = p.range;
+    let mut chart = ChartBuilder::on(area)
+        .margin_left(10)
+        .margin_right(25)
+        .margin_top(8)
+        .margin_bottom(if bottom { 8 } else { 4 })
+        .x_label_area_size(if bottom { 55 } else { 28 })
+        .y_label_area_size(95)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(e)?;
+    let x_step = (x1 - x0) / 10.0;
+    let y_step = (y1 - y0) / 6.0;
+    let x_fmt = move |v: &f64| tick(*v, x_step);
+    let y_fmt = move |v: &f64| tick(*v, y_step);
+    let mut mesh = chart.configure_mesh();
+    mesh.x_labels(10)
+        .y_labels(6)
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .label_style(font(14.0))
+        .axis_desc_style(font(16.0))
+        .max_light_lines(2)
+        .light_line_style(RGBColor(242, 242, 242))
+        .bold_line_style(RGBColor(215, 215, 215))
+        .y_desc(p.label.clone());
+    if bottom {
+        mesh.x_desc(time_label);
+    }
+    mesh.draw().map_err(e)?;
+
+    let n = track.t.len();
+    let clamp = |v: f64| v.clamp(y0, y1);
+
+    // Misfit spans: from each flagged row to the next row.
+    if track.misfit.len() == n {
+        for r in runs(n, |i| track.misfit[i]) {
+            let a = track.t[r.start];
+            let b = track.t[r.end.min(n - 1)].max(a);
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(a, y0), (b, y1)],
+                    MISFIT.mix(0.3).filled(),
+                )))
+                .map_err(e)?;
+        }
+    }
+
+    // ±3σ band.
+    for r in runs(n, |i| p.line[i].is_some() && p.band[i].is_some()) {
+        let mut poly: Vec<(f64, f64)> = Vec::with_capacity(2 * r.len());
+        for i in r.clone() {
+            let (l, b) = (p.line[i].unwrap_or(0.0), p.band[i].unwrap_or(0.0));
+            poly.push((track.t[i] + p.shift, clamp(l + b)));
+        }
+        for i in r.rev() {
+            let (l, b) = (p.line[i].unwrap_or(0.0), p.band[i].unwrap_or(0.0));
+            poly.push((track.t[i] + p.shift, clamp(l - b)));
+        }
+        chart
+            .draw_series(std::iter::once(Polygon::new(
+                poly,
+                ESTIMATE.mix(0.22).filled(),
+            )))
+            .map_err(e)?;
+    }
+
+    // ±3σ noise (dashed).
+    for sign in [1.0, -1.0] {
+        for r in runs(n, |i| p.noise[i].is_some()) {
+            let pts: Vec<(f64, f64)> = r
+                .map(|i| (track.t[i], clamp(sign * p.noise[i].unwrap_or(0.0))))
+                .collect();
+            chart
+                .draw_series(DashedLineSeries::new(pts, 7, 5, NOISE.stroke_width(2)))
+                .map_err(e)?;
+        }
+    }
+
+    // Samples.
+    let inside = |v: f64| v >= y0 && v <= y1;
+    chart
+        .draw_series(
+            p.points
+                .iter()
+                .filter(|q| !q.2 && inside(q.1))
+                .map(|q| Circle::new((q.0, q.1), 2, DATA.filled())),
+        )
+        .map_err(e)?;
+    if p.clip_points {
+        chart
+            .draw_series(
+                p.points
+                    .iter()
+                    .filter(|q| !inside(q.1))
+                    .map(|q| TriangleMarker::new((q.0, clamp(q.1)), 5, DATA.filled())),
+            )
+            .map_err(e)?;
+    }
+
+    // Truth, then the estimate over it.
+    for r in runs(n, |i| p.truth[i].is_some()) {
+        let pts: Vec<(f64, f64)> = r
+            .map(|i| (track.t[i] + p.shift, clamp(p.truth[i].unwrap_or(0.0))))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(pts, TRUTH.stroke_width(1)))
+            .map_err(e)?;
+    }
+    for r in runs(n, |i| p.line[i].is_some()) {
+        let pts: Vec<(f64, f64)> = r
+            .map(|i| (track.t[i] + p.shift, clamp(p.line[i].unwrap_or(0.0))))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(pts, ESTIMATE.stroke_width(2)))
+            .map_err(e)?;
+    }
+
+    // Rejected samples on top.
+    chart
+        .draw_series(
+            p.points
+                .iter()
+                .filter(|q| q.2)
+                .map(|q| Cross::new((q.0, clamp(q.1)), 5, REJECTED.stroke_width(2))),
+        )
+        .map_err(e)?;
+
+    // Events.
+    for &t in &track.switches {
+        chart
+            .draw_series(DashedLineSeries::new(
+                vec![(t, y0), (t, y1)],
+                8,
+                6,
+                SWITCH.stroke_width(2),
+            ))
+            .map_err(e)?;
+    }
+    for &t in &track.restarts {
+        chart
+            .draw_series(LineSeries::new(
+                vec![(t, y0), (t, y1)],
+                RESTART.stroke_width(2),
+            ))
+            .map_err(e)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_split_on_gaps() {
+        let v = [true, true, false, true, false, false, true];
+        assert_eq!(runs(v.len(), |i| v[i]), vec![0..2, 3..4, 6..7]);
+        assert!(runs(0, |_| true).is_empty());
+    }
+
+    #[test]
+    fn tick_labels_have_the_step_decimals() {
+        assert_eq!(tick(15000.0, 2500.0), "15000");
+        assert_eq!(tick(0.25, 0.05), "0.25");
+        assert_eq!(tick(-0.0001, 0.5), "0.0");
+        assert_eq!(tick(3.0, 0.5), "3.0");
+    }
+
+    #[test]
+    fn formats_by_extension() {
+        assert_eq!(Format::from_path(Path::new("a/b.PNG")), Some(Format::Png));
+        assert_eq!(Format::from_path(Path::new("b.svg")), Some(Format::Svg));
+        assert_eq!(Format::from_path(Path::new("b.pdf")), None);
+        assert_eq!(Format::from_path(Path::new("b")), None);
+    }
+}

@@ -1,0 +1,375 @@
+//! `seqsmooth plot`: draws the output of `seqsmooth filter` (any kind) as PNG or SVG.
+//!
+//! The output's columns say what there is to draw: `t,y,d0..dM` always, `s0..sM` (the ±3σ
+//! bands) with `--sigma` or `--kind auto`, `noise,outlier,misfit` for `--kind auto` (the ±3σ
+//! noise lines, rejected samples, misfit spans), `window` for `--kind fixed` (not drawn). Empty
+//! cells (no estimate yet, a degree not reached yet) leave gaps. The filter's input file may be
+//! given too, for a truth column. The drawing is [`crate::chart`]'s, the same as the demo's.
+
+use crate::chart::{self, Layout, Track};
+use crate::error::CliError;
+use crate::filter::{csv_read_error, open_input, parse_cell, LineTracker};
+use std::path::{Path, PathBuf};
+
+/// What `seqsmooth plot` does, after argument checking.
+#[derive(Clone, Debug)]
+pub struct PlotConfig {
+    /// The filter output; `None` = standard input.
+    pub source: Option<PathBuf>,
+    /// The image files (each `.png` or `.svg`).
+    pub outputs: Vec<PathBuf>,
+    /// The derivatives to plot, one panel each, top to bottom.
+    pub derivatives: Vec<usize>,
+    /// Draw the residual panel (when `d0` is there and the lead is 0).
+    pub residuals: bool,
+    /// Title; `None` for the default.
+    pub title: Option<String>,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels; `None` for the default for the panels.
+    pub height: Option<u32>,
+    /// Unit of the times, for the axis labels (e.g. `s`).
+    pub time_unit: Option<String>,
+    /// Unit of the values (e.g. `m`).
+    pub value_unit: Option<String>,
+    /// The lead `H` the output was made with: estimates are drawn at `t + H`.
+    pub lead: f64,
+    /// The filter's input file, for the truth column.
+    pub input: Option<PathBuf>,
+    /// Time column of the input file.
+    pub time_col: String,
+    /// Value column of the input file.
+    pub value_col: String,
+    /// Truth column of the input file.
+    pub truth_col: Option<String>,
+}
+
+/// A CSV file read in full: the header and the data rows with their 1-based file lines.
+struct Table {
+    /// The file's name in messages: `'path'` or `standard input`.
+    name: String,
+    header: Vec<String>,
+    rows: Vec<(u64, csv::StringRecord)>,
+}
+
+impl Table {
+    fn read(path: Option<&Path>) -> Result<Table, CliError> {
+        let name = match path {
+            Some(p) if p.as_os_str() != "-" => format!("'{}'", p.display()),
+            _ => "standard input".to_string(),
+        };
+        let input = open_input(path)?;
+        let mut reader = csv::ReaderBuilder::new()
+            .has_headers(true)
+            .flexible(false)
+            .trim(csv::Trim::All)
+            .from_reader(LineTracker::new(input));
+        let at = |e: CliError| CliError::Data(format!("{name}: {e}"));
+        let header: Vec<String> = match reader.headers() {
+            Ok(h) => h.iter().map(str::to_string).collect(),
+            Err(e) => return Err(at(csv_read_error(reader.get_mut(), e))),
+        };
+        let mut rows = Vec::new();
+        let mut record = csv::StringRecord::new();
+        loop {
+            match reader.read_record(&mut record) {
+                Ok(true) => {
+                    let byte = record.position().map_or(0, |p| p.byte());
+                    let line = reader.get_mut().line_at(byte);
+                    rows.push((line, record.clone()));
+                }
+                Ok(false) => break,
+                Err(e) => return Err(at(csv_read_error(reader.get_mut(), e))),
+            }
+        }
+        if header.iter().all(String::is_empty) {
+            return Err(CliError::Data(format!(
+                "{name}: the file is empty (no header, no data rows)"
+            )));
+        }
+        if rows.is_empty() {
+            return Err(CliError::Data(format!("{name}: no data rows to plot")));
+        }
+        Ok(Table { name, header, rows })
+    }
+
+    fn column(&self, col: &str) -> Option<usize> {
+        self.header.iter().position(|h| h == col)
+    }
+
+    fn required(&self, col: &str, why: &str) -> Result<usize, CliError> {
+        self.column(col).ok_or_else(|| {
+            CliError::Data(format!(
+                "{}: column '{col}' not found in the header{why}; columns are: {}",
+                self.name,
+                self.header.join(", ")
+            ))
+        })
+    }
+
+    fn error(&self, e: CliError) -> CliError {
+        CliError::Data(format!("{}: {e}", self.name))
+    }
+
+    /// The numbers of column `idx`; empty cells are `None` when `empty` allows them.
+    fn numbers(&self, idx: usize, what: &str, empty: bool) -> Result<Vec<Option<f64>>, CliError> {
+        let col = &self.header[idx];
+        self.rows
+            .iter()
+            .map(|(line, r)| {
+                let text = &r[idx];
+                if empty && text.is_empty() {
+                    return Ok(None);
+                }
+                parse_cell(text, *line, col, what)
+                    .map(Some)
+                    .map_err(|e| self.error(e))
+            })
+            .collect()
+    }
+
+    /// The numbers of column `idx`, every cell filled.
+    fn filled(&self, idx: usize, what: &str) -> Result<Vec<f64>, CliError> {
+        Ok(self
+            .numbers(idx, what, false)?
+            .into_iter()
+            .map(|v| v.unwrap_or(f64::NAN))
+            .collect())
+    }
+
+    /// Non-negative numbers (standard deviations), empty cells allowed.
+    fn sigmas(&self, idx: usize) -> Result<Vec<Option<f64>>, CliError> {
+        let v = self.numbers(idx, "standard deviation", true)?;
+        for ((line, r), s) in self.rows.iter().zip(&v) {
+            if s.is_some_and(|s| s < 0.0) {
+                return Err(CliError::Data(format!(
+                    "{}: line {line}, column '{}': standard deviation {} is negative",
+                    self.name, self.header[idx], &r[idx]
+                )));
+            }
+        }
+        Ok(v)
+    }
+
+    /// The 0/1 flags of column `idx`.
+    fn flags(&self, idx: usize) -> Result<Vec<bool>, CliError> {
+        let col = &self.header[idx];
+        self.rows
+            .iter()
+            .map(|(line, r)| match &r[idx] {
+                "0" => Ok(false),
+                "1" => Ok(true),
+                other => Err(CliError::Data(format!(
+                    "{}: line {line}, column '{col}': '{other}' is not a flag, expected 0 or 1",
+                    self.name
+                ))),
+            })
+            .collect()
+    }
+}
+
+/// `name (unit)`, or `name` without a unit.
+fn with_unit(name: &str, unit: Option<&str>) -> String {
+    match unit {
+        Some(u) if !u.is_empty() => format!("{name} ({u})"),
+        _ => name.to_string(),
+    }
+}
+
+/// Superscript digits for derivative orders and unit powers.
+fn superscript(k: usize) -> String {
+    const S: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    k.to_string()
+        .chars()
+        .map(|c| S[c.to_digit(10).unwrap_or(0) as usize])
+        .collect()
+}
+
+/// The axis label of derivative `k`: `y`, `dy/dt`, `d²y/dt²`, … with its unit.
+fn derivative_label(k: usize, time_unit: Option<&str>, value_unit: Option<&str>) -> String {
+    let name = match k {
+        0 => "y".to_string(),
+        1 => "dy/dt".to_string(),
+        _ => format!("d{0}y/dt{0}", superscript(k)),
+    };
+    let unit = match (k, value_unit, time_unit) {
+        (0, v, _) => v.map(str::to_string),
+        (_, Some(v), Some(t)) if k == 1 => Some(format!("{v}/{t}")),
+        (_, Some(v), Some(t)) => Some(format!("{v}/{t}{}", superscript(k))),
+        (_, None, Some(t)) if k == 1 => Some(format!("1/{t}")),
+        (_, None, Some(t)) => Some(format!("1/{t}{}", superscript(k))),
+        _ => None,
+    };
+    with_unit(&name, unit.as_deref())
+}
+
+/// Reads the filter output (and input) named in `cfg` into a track.
+fn read_track(cfg: &PlotConfig) -> Result<(Track, String), CliError> {
+    let out = Table::read(cfg.source.as_deref())?;
+    let n = out.rows.len();
+    let t_idx = out.required("t", " (the output of 'seqsmooth filter' has t,y,d0..dM)")?;
+    let y_idx = out.required("y", " (the output of 'seqsmooth filter' has t,y,d0..dM)")?;
+    let t = out.filled(t_idx, "time")?;
+    let y = out.filled(y_idx, "value")?;
+    let top = cfg.derivatives.iter().copied().max().unwrap_or(0);
+    let mut d = vec![vec![None; n]; top + 1];
+    let mut s = vec![Vec::new(); top + 1];
+    for k in 0..=top {
+        let name = format!("d{k}");
+        let idx = if cfg.derivatives.contains(&k) {
+            Some(out.required(
+                &name,
+                &format!(
+                    " (derivative {k} was asked for: the filter's degree must be at least {k})"
+                ),
+            )?)
+        } else {
+            out.column(&name)
+        };
+        if let Some(idx) = idx {
+            d[k] = out.numbers(idx, "derivative", true)?;
+        }
+        if let Some(idx) = out.column(&format!("s{k}")) {
+            s[k] = out.sigmas(idx)?;
+        }
+    }
+    let noise = match out.column("noise") {
+        Some(idx) => out.sigmas(idx)?,
+        None => Vec::new(),
+    };
+    let rejected = match out.column("outlier") {
+        Some(idx) => out.flags(idx)?,
+        None => Vec::new(),
+    };
+    let misfit = match out.column("misfit") {
+        Some(idx) => out.flags(idx)?,
+        None => Vec::new(),
+    };
+    let mut truth = Vec::new();
+    if let Some(path) = &cfg.input {
+        let input = Table::read(Some(path))?;
+        let ti = input.required(&cfg.time_col, " (give its name with --time-col)")?;
+        let yi = input.required(&cfg.value_col, " (give its name with --value-col)")?;
+        let it = input.filled(ti, "time")?;
+        let iy = input.filled(yi, "value")?;
+        if input.rows.len() != n {
+            return Err(CliError::Data(format!(
+                "the input {} has {} data row{} but the filter output {} has {n}: give the \
+                 input the output was made from",
+                input.name,
+                input.rows.len(),
+                if input.rows.len() == 1 { "" } else { "s" },
+                out.name
+            )));
+        }
+        for i in 0..n {
+            if it[i] != t[i] || iy[i] != y[i] {
+                let (col, a, b) = if it[i] != t[i] {
+                    (&cfg.time_col, &input.rows[i].1[ti], &out.rows[i].1[t_idx])
+                } else {
+                    (&cfg.value_col, &input.rows[i].1[yi], &out.rows[i].1[y_idx])
+                };
+                return Err(CliError::Data(format!(
+                    "{}: line {}, column '{col}': {a} differs from {b} on line {} of the filter \
+                     output {}: give the input the output was made from",
+                    input.name, input.rows[i].0, out.rows[i].0, out.name
+                )));
+            }
+        }
+        if let Some(tc) = &cfg.truth_col {
+            let idx = input.required(tc, " (the --truth-col)")?;
+            truth.push(input.filled(idx, "truth")?);
+        }
+    }
+    let kind = if !misfit.is_empty() || !rejected.is_empty() {
+        "automatic filter"
+    } else if out.column("window").is_some() {
+        "fixed-memory filter"
+    } else {
+        "filter"
+    };
+    let file = match cfg.source.as_deref() {
+        Some(p) if p.as_os_str() != "-" => p.file_name().map_or_else(
+            || p.display().to_string(),
+            |f| f.to_string_lossy().into_owned(),
+        ),
+        _ => "standard input".to_string(),
+    };
+    let title = format!("seqsmooth {kind} output: {file}");
+    Ok((
+        Track {
+            t,
+            y,
+            d,
+            s,
+            truth,
+            noise,
+            rejected,
+            misfit,
+            switches: Vec::new(),
+            restarts: Vec::new(),
+            lead: cfg.lead,
+        },
+        title,
+    ))
+}
+
+/// Runs `seqsmooth plot`.
+pub fn run(cfg: &PlotConfig) -> Result<(), CliError> {
+    for p in &cfg.outputs {
+        if chart::Format::from_path(p).is_none() {
+            return Err(CliError::Usage(format!(
+                "cannot tell the image format of '{}': the file name must end in .png or .svg",
+                p.display()
+            )));
+        }
+    }
+    let (track, default_title) = read_track(cfg)?;
+    let tu = cfg.time_unit.as_deref();
+    let vu = cfg.value_unit.as_deref();
+    let residuals = cfg.residuals && cfg.lead == 0.0 && track.d[0].iter().any(Option::is_some);
+    let panels: Vec<(usize, String)> = cfg
+        .derivatives
+        .iter()
+        .map(|&k| (k, derivative_label(k, tu, vu)))
+        .collect();
+    let mut subtitle = Vec::new();
+    if cfg.lead != 0.0 {
+        subtitle.push(format!(
+            "estimates drawn at t + {}{}",
+            crate::number::fmt_f64(cfg.lead),
+            tu.map(|u| format!(" {u}")).unwrap_or_default()
+        ));
+    }
+    let layout = Layout {
+        title: cfg.title.clone().unwrap_or(default_title),
+        subtitle: subtitle.join("; "),
+        time_label: with_unit("time t", tu),
+        residual_label: residuals.then(|| with_unit("residual y − d0", vu)),
+        size: (
+            cfg.width,
+            cfg.height
+                .unwrap_or_else(|| Layout::default_height(panels.len(), residuals)),
+        ),
+        panels,
+    };
+    for p in &cfg.outputs {
+        chart::write(&track, &layout, p)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_carry_units() {
+        assert_eq!(derivative_label(0, Some("s"), Some("m")), "y (m)");
+        assert_eq!(derivative_label(1, Some("s"), Some("m")), "dy/dt (m/s)");
+        assert_eq!(derivative_label(2, Some("s"), Some("m")), "d²y/dt² (m/s²)");
+        assert_eq!(derivative_label(12, None, None), "d¹²y/dt¹²");
+        assert_eq!(derivative_label(1, Some("s"), None), "dy/dt (1/s)");
+        assert_eq!(derivative_label(0, Some("s"), None), "y");
+    }
+}

@@ -1,0 +1,608 @@
+//! End-to-end tests of the plots: `seqsmooth demo` (its summary, PNG and SVG) and `seqsmooth
+//! plot` on the output of every filter kind, and the plot command's errors and exit codes.
+//!
+//! The images are checked by their structure: a PNG's signature, its IHDR dimensions and a size
+//! far above that of a blank image of the same dimensions (a white 1400×1030 PNG compresses to
+//! about 7 KB); an SVG's text (title, axis labels, legend entries) and its element counts.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+/// The outcome of one run of the binary.
+struct Out {
+    code: i32,
+    stdout: String,
+    stderr: String,
+}
+
+/// Runs `seqsmooth args…` in `dir` with `stdin` as standard input.
+fn run_in(dir: &Path, args: &[&str], stdin: &str) -> Out {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_seqsmooth"))
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn seqsmooth");
+    let mut input = child.stdin.take().unwrap();
+    let data = stdin.as_bytes().to_vec();
+    let writer = std::thread::spawn(move || {
+        let _ = input.write_all(&data);
+    });
+    let out = child.wait_with_output().expect("wait for seqsmooth");
+    writer.join().unwrap();
+    Out {
+        code: out.status.code().expect("exit code"),
+        stdout: String::from_utf8(out.stdout).unwrap(),
+        stderr: String::from_utf8(out.stderr).unwrap(),
+    }
+}
+
+fn ok_in(dir: &Path, args: &[&str], stdin: &str) -> String {
+    let o = run_in(dir, args, stdin);
+    assert_eq!(o.code, 0, "seqsmooth {args:?} failed: {}", o.stderr);
+    o.stdout
+}
+
+/// Runs and asserts failure with `code` and every `parts` in stderr.
+fn fails_in(dir: &Path, args: &[&str], stdin: &str, code: i32, parts: &[&str]) {
+    let o = run_in(dir, args, stdin);
+    assert_eq!(o.code, code, "seqsmooth {args:?}: stderr {}", o.stderr);
+    assert!(o.stderr.starts_with("error: "), "{}", o.stderr);
+    for p in parts {
+        assert!(o.stderr.contains(p), "stderr lacks {p:?}: {}", o.stderr);
+    }
+    assert!(!o.stderr.contains("panicked"), "{}", o.stderr);
+}
+
+/// A fresh, empty directory for one test.
+fn fresh_dir(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("plot-tests")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The PNG's width and height from its IHDR chunk, after checking the signature.
+fn png_size(path: &Path) -> (u32, u32) {
+    let b = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(b.len() > 33, "{} is too short for a PNG", path.display());
+    assert_eq!(
+        &b[..8],
+        b"\x89PNG\r\n\x1a\n",
+        "PNG signature of {}",
+        path.display()
+    );
+    assert_eq!(&b[8..16], b"\x00\x00\x00\x0dIHDR", "IHDR first");
+    let be = |i: usize| u32::from_be_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+    (be(16), be(20))
+}
+
+fn file_size(path: &Path) -> u64 {
+    std::fs::metadata(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .len()
+}
+
+fn count(text: &str, what: &str) -> usize {
+    text.matches(what).count()
+}
+
+/// The default image height: 120 for the title and legend, 330 per derivative panel, 250 for
+/// the residual panel (`chart::Layout::default_height`).
+fn default_height(panels: u32, residual: bool) -> u32 {
+    120 + 330 * panels + if residual { 250 } else { 0 }
+}
+
+// ---------------------------------------------------------------------------------------------
+// demo
+
+/// `seqsmooth demo` in an empty directory writes seqsmooth-demo.png and .svg there: a PNG of
+/// 1400 × 1030 (two derivative panels and the residuals) far above a blank image's size, and an
+/// SVG with the title, axis labels, every legend entry the demo's data call for, a dot per
+/// accepted sample and a cross per rejected one. The summary reports what the plot shows.
+#[test]
+fn demo_writes_png_and_svg_in_the_current_directory() {
+    let dir = fresh_dir("demo-default");
+    let o = run_in(&dir, &["demo"], "");
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let png = dir.join("seqsmooth-demo.png");
+    let svg = dir.join("seqsmooth-demo.svg");
+    assert_eq!(png_size(&png), (1400, default_height(2, true)));
+    assert!(
+        file_size(&png) > 60_000,
+        "PNG only {} bytes",
+        file_size(&png)
+    );
+    assert!(o.stderr.contains("seqsmooth-demo.png") && o.stderr.contains("seqsmooth-demo.svg"));
+
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.contains("width=\"1400\""));
+    for label in [
+        "seqsmooth demo: automatic filter on a turning aircraft",
+        "time (s)",
+        "east position (m)",
+        "east velocity (m/s)",
+        "residual y − estimate (m)",
+        "samples",
+        "rejected (outlier)",
+        "estimate ±3σ",
+        "truth",
+        "noise ±3σ",
+        "switch to fading memory",
+        "misfit restart",
+        "misfit flagged",
+    ] {
+        assert!(text.contains(label), "SVG lacks {label:?}");
+    }
+    // Summary: "rejected R samples: C of the N outliers, G good samples".
+    let line = o
+        .stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("rejected "))
+        .unwrap_or_else(|| panic!("no rejected line: {}", o.stdout));
+    let nums: Vec<usize> = line
+        .split(|c: char| !c.is_ascii_digit())
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let (rejected, caught, outliers, good) = (nums[0], nums[1], nums[2], nums[3]);
+    assert_eq!(rejected, caught + good, "{line}");
+    assert!(outliers >= 3 && caught >= outliers - 1, "{line}");
+    // A dot per sample in the position and residual panels (less the clipped and rejected
+    // ones), a cross (two lines) per rejected sample in each of those panels and the legend.
+    let circles = count(&text, "<circle");
+    assert!(circles >= 2 * (400 - rejected) - 40, "{circles} circles");
+    assert!(circles <= 2 * 400 + 1, "{circles} circles");
+    assert!(count(&text, "<polygon") >= 3, "bands");
+    assert!(count(&text, "<polyline") >= 6, "lines");
+    for word in [
+        "switch from expanding to fading memory: t = ",
+        "misfit restarts: ",
+    ] {
+        assert!(o.stdout.contains(word), "{}", o.stdout);
+    }
+    // The automatic filter beats the plain ones on this track (the table's "rms err x").
+    let rms = |name: &str, engine: &str| -> f64 {
+        let row = o
+            .stdout
+            .lines()
+            .find(|l| {
+                let mut w = l.split_whitespace();
+                w.next() == Some(name) && w.next() == Some(engine)
+            })
+            .unwrap_or_else(|| panic!("no {name} {engine} row: {}", o.stdout));
+        row.split_whitespace().nth(2).unwrap().parse().unwrap()
+    };
+    let auto = rms("automatic", "exact");
+    assert!(auto < 20.0, "automatic rms {auto}");
+    for (name, engine) in [
+        ("fading", "exact"),
+        ("expanding", "exact"),
+        ("fading", "gain"),
+    ] {
+        assert!(auto < rms(name, engine) / 3.0, "{name} {engine}");
+    }
+}
+
+/// `--plot PREFIX` writes PREFIX.png and PREFIX.svg (a trailing .png/.svg is dropped), with
+/// `-o` still writing the CSV; `--no-plot` writes no image; the output is deterministic.
+#[test]
+fn demo_plot_prefix_and_no_plot() {
+    let dir = fresh_dir("demo-prefix");
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    let a = ok_in(&dir, &["demo", "--plot", "sub/run", "-o", "d.csv"], "");
+    assert_eq!(png_size(&dir.join("sub/run.png")), (1400, 1030));
+    assert!(file_size(&dir.join("sub/run.svg")) > 50_000);
+    let csv = std::fs::read_to_string(dir.join("d.csv")).unwrap();
+    assert!(csv.starts_with("t,y,d0,d1,d2,s0,s1,s2\n"));
+    assert_eq!(csv.lines().count(), 401);
+
+    let b = ok_in(&dir, &["demo", "--plot", "again.svg"], "");
+    assert_eq!(a, b, "the summary is deterministic");
+    assert!(dir.join("again.png").exists() && dir.join("again.svg").exists());
+    assert_eq!(
+        std::fs::read(dir.join("sub/run.svg")).unwrap(),
+        std::fs::read(dir.join("again.svg")).unwrap(),
+        "the SVG is deterministic"
+    );
+
+    let quiet = fresh_dir("demo-no-plot");
+    ok_in(&quiet, &["demo", "--no-plot"], "");
+    assert_eq!(std::fs::read_dir(&quiet).unwrap().count(), 0);
+    fails_in(
+        &quiet,
+        &["demo", "--no-plot", "--plot", "x"],
+        "",
+        2,
+        &["--plot"],
+    );
+}
+
+/// A plot that cannot be written is a data error naming the file.
+#[test]
+fn demo_plot_to_a_missing_directory_fails() {
+    let dir = fresh_dir("demo-bad-dir");
+    fails_in(
+        &dir,
+        &["demo", "--plot", "no/such/dir/p"],
+        "",
+        1,
+        &["cannot write the plot to 'no/such/dir/p.png'"],
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// plot
+
+/// A test series: a parabola sampled at jittered times with a deterministic ±0.5 noise pattern,
+/// a spike of 30 at row 150 and a truth column.
+fn series() -> String {
+    let mut s = String::from("t,y,truth\n");
+    let mut t = 0.0;
+    for i in 0..300u64 {
+        t += 0.5 + 0.1 * (((i * 7919) % 11) as f64 / 10.0 - 0.5);
+        let truth = 3.0 + 2.0 * t - 0.05 * t * t;
+        let noise = 0.5 * (((i * 37 + 11) % 17) as f64 / 8.0 - 1.0);
+        let spike = if i == 150 { 30.0 } else { 0.0 };
+        s += &format!("{t},{},{truth}\n", truth + noise + spike);
+    }
+    s
+}
+
+/// Runs `seqsmooth filter data.csv ARGS -o NAME.csv` in `dir` and returns NAME.csv's path.
+fn filter_output(dir: &Path, name: &str, args: &[&str]) -> PathBuf {
+    let out = format!("{name}.csv");
+    let mut all = vec!["filter", "data.csv"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["-o", &out]);
+    ok_in(dir, &all, "");
+    dir.join(out)
+}
+
+fn svg_of(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.starts_with("<svg"), "{}", path.display());
+    text
+}
+
+/// One plot case: the output's name, the filter's arguments, what the SVG has and lacks.
+type Case<'a> = (&'a str, &'a [&'a str], &'a [&'a str], &'a [&'a str]);
+
+/// Every filter kind's output plots to PNG and SVG; the legend holds what the columns give:
+/// bands with s columns only, rejected samples, noise lines and misfit spans only for auto.
+#[test]
+fn plot_every_filter_kind() {
+    let dir = fresh_dir("plot-kinds");
+    std::fs::write(dir.join("data.csv"), series()).unwrap();
+    let cases: [Case; 5] = [
+        (
+            "expanding",
+            &["--kind", "expanding", "--degree", "2"],
+            &["samples", "estimate"],
+            &["estimate ±3σ", "rejected", "noise ±3σ", "truth"],
+        ),
+        (
+            "expanding-sigma",
+            &["--kind", "expanding", "--degree", "2", "--sigma", "0.5"],
+            &["estimate ±3σ"],
+            &["rejected", "noise ±3σ"],
+        ),
+        (
+            "fading",
+            &[
+                "--kind", "fading", "--degree", "2", "--theta", "0.9", "--sigma", "0.5",
+            ],
+            &["estimate ±3σ", "seqsmooth filter output: fading.csv"],
+            &["rejected"],
+        ),
+        (
+            "fixed",
+            &[
+                "--kind", "fixed", "--degree", "2", "--window", "21", "--sigma", "0.5",
+            ],
+            &[
+                "estimate ±3σ",
+                "seqsmooth fixed-memory filter output: fixed.csv",
+            ],
+            &["rejected"],
+        ),
+        (
+            "auto",
+            &["--kind", "auto", "--degree", "2", "--theta", "0.9"],
+            &[
+                "estimate ±3σ",
+                "rejected (outlier)",
+                "noise ±3σ",
+                "seqsmooth automatic filter output: auto.csv",
+            ],
+            &["truth"],
+        ),
+    ];
+    for (name, args, has, lacks) in cases {
+        let out = filter_output(&dir, name, args);
+        let png = format!("{name}.png");
+        let svg = format!("{name}.svg");
+        ok_in(
+            &dir,
+            &["plot", out.to_str().unwrap(), "-o", &png, "-o", &svg],
+            "",
+        );
+        assert_eq!(png_size(&dir.join(&png)), (1200, default_height(1, true)));
+        assert!(file_size(&dir.join(&png)) > 30_000, "{name}");
+        let text = svg_of(&dir.join(&svg));
+        for h in has {
+            assert!(text.contains(h), "{name}: SVG lacks {h:?}");
+        }
+        for l in lacks {
+            assert!(!text.contains(l), "{name}: SVG has {l:?}");
+        }
+        for axis in ["time t", "residual y − d0", "\ny\n"] {
+            assert!(text.contains(axis), "{name}: SVG lacks {axis:?}");
+        }
+        // a dot per sample in the value panel and per estimated row in the residual panel
+        assert!(count(&text, "<circle") >= 300 + 250, "{name}");
+    }
+}
+
+/// Two derivative panels with units, a title, a size; standard input as the source; the
+/// input's truth column; a lead drops the residual panel.
+#[test]
+fn plot_options() {
+    let dir = fresh_dir("plot-options");
+    std::fs::write(dir.join("data.csv"), series()).unwrap();
+    let out = filter_output(
+        &dir,
+        "auto",
+        &["--kind", "auto", "--degree", "2", "--theta", "0.9"],
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    ok_in(
+        &dir,
+        &[
+            "plot",
+            "-",
+            "-o",
+            "two.png",
+            "-o",
+            "two.svg",
+            "--derivative",
+            "0",
+            "--derivative",
+            "2",
+            "--time-unit",
+            "s",
+            "--value-unit",
+            "m",
+            "--title",
+            "My title",
+        ],
+        &text,
+    );
+    assert_eq!(
+        png_size(&dir.join("two.png")),
+        (1200, default_height(2, true))
+    );
+    let svg = svg_of(&dir.join("two.svg"));
+    for label in [
+        "My title",
+        "time t (s)",
+        "y (m)",
+        "d²y/dt² (m/s²)",
+        "residual y − d0 (m)",
+    ] {
+        assert!(svg.contains(label), "SVG lacks {label:?}");
+    }
+    assert!(!svg.contains("dy/dt (m/s)"));
+
+    ok_in(
+        &dir,
+        &[
+            "plot",
+            "auto.csv",
+            "-o",
+            "small.png",
+            "--width",
+            "640",
+            "--height",
+            "480",
+        ],
+        "",
+    );
+    assert_eq!(png_size(&dir.join("small.png")), (640, 480));
+
+    ok_in(
+        &dir,
+        &[
+            "plot",
+            "auto.csv",
+            "-o",
+            "truth.svg",
+            "--input",
+            "data.csv",
+            "--truth-col",
+            "truth",
+        ],
+        "",
+    );
+    assert!(svg_of(&dir.join("truth.svg")).contains("truth"));
+
+    let lead = filter_output(
+        &dir,
+        "lead",
+        &[
+            "--kind", "fading", "--degree", "1", "--theta", "0.9", "--lead", "2",
+        ],
+    );
+    ok_in(
+        &dir,
+        &[
+            "plot",
+            lead.to_str().unwrap(),
+            "-o",
+            "lead.svg",
+            "--lead",
+            "2",
+            "--no-residuals",
+        ],
+        "",
+    );
+    let svg = svg_of(&dir.join("lead.svg"));
+    assert!(!svg.contains("residual") && svg.contains("estimates drawn at t + 2"));
+    ok_in(
+        &dir,
+        &["plot", "lead.csv", "-o", "lead2.png", "--lead", "2"],
+        "",
+    );
+    assert_eq!(
+        png_size(&dir.join("lead2.png")),
+        (1200, default_height(1, false))
+    );
+}
+
+/// Bad input is a data error (exit 1) naming the file, line and column; bad arguments are
+/// usage errors (exit 2); no image is written.
+#[test]
+fn plot_errors() {
+    let dir = fresh_dir("plot-errors");
+    let write = |name: &str, text: &str| std::fs::write(dir.join(name), text).unwrap();
+    let good = "t,y,d0,d1,s0,s1,noise,outlier,misfit\n0,1,1,,,,,0,0\n1,2,2,1,0.5,0.2,0.4,0,0\n";
+    write("good.csv", good);
+    write("ragged.csv", "t,y,d0\n0,1,1\n1,2\n");
+    write("nod0.csv", "t,y\n0,1\n1,2\n");
+    write("word.csv", "t,y,d0,d1\n0,1,1,\n1,2,2,1\n\n2,3,3,abc\n");
+    write("flag.csv", "t,y,d0,outlier\n0,1,1,0\n1,2,2,2\n");
+    write("neg.csv", "t,y,d0,s0\n0,1,1,0.1\n1,2,2,-0.1\n");
+    write("inf.csv", "t,y,d0\n0,1,1\n1,inf,2\n");
+    write("emptyt.csv", "t,y,d0\n0,1,1\n,2,2\n");
+    write("header.csv", "t,y,d0\n");
+    write("empty.csv", "");
+    write("in-short.csv", "t,y\n0,1\n");
+    write("in-other.csv", "t,y\n0,1\n1.5,2\n");
+    let cases: [(&[&str], i32, &[&str]); 16] = [
+        (
+            &["plot", "missing.csv", "-o", "x.png"],
+            1,
+            &["cannot open input file 'missing.csv'"],
+        ),
+        (
+            &["plot", "ragged.csv", "-o", "x.png"],
+            1,
+            &["'ragged.csv': line 3: malformed CSV"],
+        ),
+        (
+            &["plot", "nod0.csv", "-o", "x.png"],
+            1,
+            &["'nod0.csv': column 'd0' not found", "t, y"],
+        ),
+        (
+            &["plot", "good.csv", "-o", "x.png", "--derivative", "2"],
+            1,
+            &[
+                "'good.csv': column 'd2' not found",
+                "degree must be at least 2",
+            ],
+        ),
+        (
+            &["plot", "word.csv", "-o", "x.png", "--derivative", "1"],
+            1,
+            &["'word.csv': line 5, column 'd1': 'abc' is not a number"],
+        ),
+        (
+            &["plot", "flag.csv", "-o", "x.png"],
+            1,
+            &["line 3, column 'outlier': '2' is not a flag"],
+        ),
+        (
+            &["plot", "neg.csv", "-o", "x.png"],
+            1,
+            &["line 3, column 's0'", "negative"],
+        ),
+        (
+            &["plot", "inf.csv", "-o", "x.png"],
+            1,
+            &["'inf.csv': line 3, column 'y'", "not finite"],
+        ),
+        (
+            &["plot", "emptyt.csv", "-o", "x.png"],
+            1,
+            &["line 3, column 't': the cell is empty"],
+        ),
+        (
+            &["plot", "header.csv", "-o", "x.png"],
+            1,
+            &["'header.csv': no data rows"],
+        ),
+        (
+            &["plot", "empty.csv", "-o", "x.png"],
+            1,
+            &["'empty.csv': the file is empty"],
+        ),
+        (
+            &["plot", "good.csv", "-o", "x.png", "--input", "in-short.csv"],
+            1,
+            &["'in-short.csv' has 1 data row but", "'good.csv' has 2"],
+        ),
+        (
+            &["plot", "good.csv", "-o", "x.png", "--input", "in-other.csv"],
+            1,
+            &["'in-other.csv': line 3, column 't': 1.5 differs from 1 on line 3"],
+        ),
+        (
+            &["plot", "good.csv", "-o", "x.jpg"],
+            2,
+            &["'x.jpg'", ".png or .svg"],
+        ),
+        (
+            &["plot", "good.csv", "-o", "x.png", "--truth-col", "x"],
+            2,
+            &["--input"],
+        ),
+        (&["plot", "good.csv"], 2, &["--output"]),
+    ];
+    for (args, code, parts) in cases {
+        fails_in(&dir, args, "", code, parts);
+        assert!(!dir.join("x.png").exists(), "{args:?} left an image");
+    }
+    fails_in(
+        &dir,
+        &[
+            "plot",
+            "good.csv",
+            "-o",
+            "x.png",
+            "--input",
+            "good.csv",
+            "--truth-col",
+            "z",
+        ],
+        "",
+        1,
+        &["column 'z' not found"],
+    );
+    fails_in(
+        &dir,
+        &["plot", "good.csv", "-o", "no/dir/x.svg"],
+        "",
+        1,
+        &["cannot write the plot to 'no/dir/x.svg'"],
+    );
+    fails_in(
+        &dir,
+        &["plot", "good.csv", "-o", "x.png", "--width", "10"],
+        "",
+        2,
+        &["10"],
+    );
+    // the good file itself plots
+    ok_in(
+        &dir,
+        &["plot", "good.csv", "-o", "ok.svg", "--derivative", "1"],
+        "",
+    );
+    assert!(svg_of(&dir.join("ok.svg")).contains("dy/dt"));
+}
