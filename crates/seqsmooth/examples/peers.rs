@@ -1,0 +1,279 @@
+//! The seqsmooth side of the peer comparison (`scripts/peers.sh`): runs the library's filters on
+//! the data the script generated, times them, and writes their per-sample estimates for the
+//! script's agreement check against filterpy and scipy.
+//!
+//! Run by the script; by hand: `cargo run --release -p seqsmooth --example peers -- DIR REPS`.
+//!
+//! `DIR/runs.txt` lists one run per line, whitespace-separated:
+//! `name data filter degree [key=value ...]`, with
+//!
+//! - `data`: the data set, read from `DIR/<data>.t.f64` and `DIR/<data>.y.f64` (raw
+//!   little-endian doubles, times and values);
+//! - `filter`: `fading-gain` / `fading-exact` (keys `theta`, `tau`, optional `mode=update` for
+//!   [`DiscountMode::PerUpdate`]), `expanding-gain` / `expanding-exact`, `fixed-sliding`
+//!   (key `window`: the streaming [`FixedMemory`] evaluated at the centre of each window, i.e.
+//!   at the time of the sample `(window-1)/2` before the newest), `smooth` (key `window`: the
+//!   whole-series [`smooth`]).
+//!
+//! For each run it writes `DIR/<name>.est.f64`: `samples × (degree+1)` doubles, row-major, the
+//! estimate `[x, x', …]` after each sample (NaN while undetermined; for `fixed-sliding` row
+//! `n` holds the centred estimate for sample `n`, NaN where no window is centred on it), and
+//! prints one CSV line to stdout:
+//! `name,samples,seconds_update,seconds_update_estimate,switched_at`: the best of `REPS` timed
+//! repetitions of the update loop alone and of the loop that also reads each sample's estimate
+//! (I/O and filter construction excluded), and the fading-memory gain engine's switch sample.
+//!
+//! Each timed loop is one small function per filter family ([`feed`], [`feed_and_read`],
+//! [`feed_fixed_and_read`]), so a batch update API can replace the per-sample loop in one place.
+
+use seqsmooth::polynomial::fixed::smooth;
+use seqsmooth::{
+    DiscountMode, Engine, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory, PolynomialFilter,
+};
+use std::collections::BTreeMap;
+use std::error::Error;
+use std::hint::black_box;
+use std::path::Path;
+use std::time::Instant;
+
+type Res<T> = Result<T, Box<dyn Error>>;
+
+/// One line of `runs.txt`.
+struct Run {
+    name: String,
+    data: String,
+    filter: String,
+    degree: usize,
+    keys: BTreeMap<String, String>,
+}
+
+impl Run {
+    fn parse(line: &str, lineno: usize) -> Res<Self> {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        if f.len() < 4 {
+            return Err(format!("runs.txt line {lineno}: need name data filter degree").into());
+        }
+        let degree = f[3]
+            .parse()
+            .map_err(|e| format!("runs.txt line {lineno}: degree '{}': {e}", f[3]))?;
+        let mut keys = BTreeMap::new();
+        for kv in &f[4..] {
+            let (k, v) = kv
+                .split_once('=')
+                .ok_or_else(|| format!("runs.txt line {lineno}: '{kv}' is not key=value"))?;
+            keys.insert(k.to_string(), v.to_string());
+        }
+        Ok(Self {
+            name: f[0].into(),
+            data: f[1].into(),
+            filter: f[2].into(),
+            degree,
+            keys,
+        })
+    }
+
+    fn key<T: std::str::FromStr>(&self, k: &str) -> Res<T>
+    where
+        T::Err: std::fmt::Display,
+    {
+        let v = self
+            .keys
+            .get(k)
+            .ok_or_else(|| format!("run {}: missing {k}=", self.name))?;
+        v.parse()
+            .map_err(|e| format!("run {}: {k}={v}: {e}", self.name).into())
+    }
+
+    fn fading(&self, engine: Engine) -> Res<FadingMemory> {
+        let f = FadingMemory::new(self.degree, self.key("theta")?, self.key("tau")?, engine)?;
+        Ok(match self.keys.get("mode").map(String::as_str) {
+            None | Some("time") => f,
+            Some("update") => f.with_discount_mode(DiscountMode::PerUpdate)?,
+            Some(other) => return Err(format!("run {}: mode={other}", self.name).into()),
+        })
+    }
+}
+
+fn read_f64s(path: &Path) -> Res<Vec<f64>> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if bytes.len() % 8 != 0 {
+        return Err(format!(
+            "{}: length {} is not a multiple of 8",
+            path.display(),
+            bytes.len()
+        )
+        .into());
+    }
+    Ok(bytes
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+        .collect())
+}
+
+fn write_f64s(path: &Path, v: &[f64]) -> Res<()> {
+    let bytes: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()).into())
+}
+
+/// The timed loop without reading estimates.
+fn feed<F: PolynomialFilter>(f: &mut F, t: &[f64], y: &[f64]) -> Res<()> {
+    for (&ti, &yi) in t.iter().zip(y) {
+        f.update(ti, yi)?;
+    }
+    Ok(())
+}
+
+/// The timed loop that also reads every sample's current estimate into `out`
+/// (`samples × (m+1)`; NaN while undetermined).
+fn feed_and_read<F: PolynomialFilter>(f: &mut F, t: &[f64], y: &[f64], out: &mut [f64]) -> Res<()> {
+    let width = f.degree() + 1;
+    for ((&ti, &yi), row) in t.iter().zip(y).zip(out.chunks_exact_mut(width)) {
+        f.update(ti, yi)?;
+        match f.estimate() {
+            Some(s) => row.copy_from_slice(&s.derivatives),
+            None => row.fill(f64::NAN),
+        }
+    }
+    Ok(())
+}
+
+/// The streaming fixed-memory loop reading the centred estimate: after sample `n` the window
+/// holds samples `n-L..=n`; its fit evaluated at `t[n-L/2]` goes to row `n-L/2`.
+fn feed_fixed_and_read(f: &mut FixedMemory, t: &[f64], y: &[f64], out: &mut [f64]) -> Res<()> {
+    let width = f.degree() + 1;
+    let half = (f.window() - 1) / 2;
+    out.fill(f64::NAN);
+    for (n, (&ti, &yi)) in t.iter().zip(y).enumerate() {
+        f.update(ti, yi)?;
+        if n + 1 >= f.window() {
+            let c = n - half;
+            if let Some(s) = f.estimate_at(t[c]) {
+                out[c * width..(c + 1) * width].copy_from_slice(&s.derivatives);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Best wall-clock seconds of `reps` calls of `body` (each given a fresh setup).
+fn best_of<S>(
+    reps: usize,
+    mut setup: impl FnMut() -> Res<S>,
+    mut body: impl FnMut(&mut S) -> Res<()>,
+) -> Res<f64> {
+    let mut best = f64::INFINITY;
+    for _ in 0..reps {
+        let mut s = setup()?;
+        let start = Instant::now();
+        body(&mut s)?;
+        best = best.min(start.elapsed().as_secs_f64());
+        black_box(&s);
+    }
+    Ok(best)
+}
+
+/// Times a filter that implements [`PolynomialFilter`]: both loops, then one untimed run for
+/// the estimates. Returns (seconds update, seconds update+estimate, estimates, switched_at).
+fn time_filter<F: PolynomialFilter>(
+    reps: usize,
+    make: impl Fn() -> Res<F>,
+    t: &[f64],
+    y: &[f64],
+    switched: impl Fn(&F) -> Option<u64>,
+) -> Res<(f64, f64, Vec<f64>, Option<u64>)> {
+    let width = make()?.degree() + 1;
+    let mut out = vec![0.0; t.len() * width];
+    let plain = best_of(reps, &make, |f| feed(f, t, y))?;
+    let read = best_of(reps, &make, |f| feed_and_read(f, t, y, &mut out))?;
+    let mut f = make()?;
+    feed_and_read(&mut f, t, y, &mut out)?;
+    Ok((plain, read, out, switched(&f)))
+}
+
+fn main() -> Res<()> {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() != 3 {
+        return Err("usage: peers DIR REPS".into());
+    }
+    let dir = Path::new(&args[1]);
+    let reps: usize = args[2]
+        .parse()
+        .map_err(|e| format!("REPS '{}': {e}", args[2]))?;
+    let spec = std::fs::read_to_string(dir.join("runs.txt"))
+        .map_err(|e| format!("{}: {e}", dir.join("runs.txt").display()))?;
+    let mut data: BTreeMap<String, (Vec<f64>, Vec<f64>)> = BTreeMap::new();
+    println!("name,samples,seconds_update,seconds_update_estimate,switched_at");
+    for (i, line) in spec.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let run = Run::parse(line, i + 1)?;
+        if !data.contains_key(&run.data) {
+            let t = read_f64s(&dir.join(format!("{}.t.f64", run.data)))?;
+            let y = read_f64s(&dir.join(format!("{}.y.f64", run.data)))?;
+            if t.len() != y.len() {
+                return Err(
+                    format!("data {}: {} times, {} values", run.data, t.len(), y.len()).into(),
+                );
+            }
+            data.insert(run.data.clone(), (t, y));
+        }
+        let (t, y) = &data[&run.data];
+        let m = run.degree;
+        let (plain, read, out, switched) = match run.filter.as_str() {
+            "fading-gain" => {
+                time_filter(reps, || run.fading(Engine::Gain), t, y, |f| f.switched_at())?
+            }
+            "fading-exact" => time_filter(reps, || run.fading(Engine::Exact), t, y, |_| None)?,
+            "expanding-gain" => time_filter(
+                reps,
+                || Ok(ExpandingMemory::new(m, Engine::Gain)?),
+                t,
+                y,
+                |_| None,
+            )?,
+            "expanding-exact" => time_filter(
+                reps,
+                || Ok(ExpandingMemory::new(m, Engine::Exact)?),
+                t,
+                y,
+                |_| None,
+            )?,
+            "fixed-sliding" => {
+                let window: usize = run.key("window")?;
+                let make = || Ok(FixedMemory::new(m, window, FixedEngine::Sliding)?);
+                let mut out = vec![0.0; t.len() * (m + 1)];
+                let plain = best_of(reps, make, |f| feed(f, t, y))?;
+                let read = best_of(reps, make, |f| feed_fixed_and_read(f, t, y, &mut out))?;
+                feed_fixed_and_read(&mut make()?, t, y, &mut out)?;
+                (plain, read, out, None)
+            }
+            "smooth" => {
+                let window: usize = run.key("window")?;
+                let mut rows = Vec::new();
+                let secs = best_of(
+                    reps,
+                    || Ok(()),
+                    |_| {
+                        rows = smooth(t, y, m, window)?;
+                        Ok(())
+                    },
+                )?;
+                let out: Vec<f64> = rows.concat();
+                (secs, secs, out, None)
+            }
+            other => return Err(format!("run {}: unknown filter '{other}'", run.name).into()),
+        };
+        write_f64s(&dir.join(format!("{}.est.f64", run.name)), &out)?;
+        println!(
+            "{},{},{:e},{:e},{}",
+            run.name,
+            t.len(),
+            plain,
+            read,
+            switched.map(|s| s.to_string()).unwrap_or_default()
+        );
+    }
+    Ok(())
+}

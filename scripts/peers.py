@@ -1,0 +1,439 @@
+#!/usr/bin/env python3
+"""Peer comparison: filterpy and scipy against their seqsmooth counterparts on the same data.
+
+Run:  bash scripts/peers.sh [--n N] [--n-kf N] [--reps R] [--quick]
+(peers.sh builds the Rust side first; this script can also be run directly once
+`cargo build --release --example peers -p seqsmooth` and `cargo build --release -p seqsmooth-cli`
+are done.) It creates (once) a private virtual environment target/peers-venv with the pinned
+PINS below, re-runs itself there, and then
+
+1. generates the data (seed SEED): N evenly spaced samples (step DT) of a slow trajectory plus
+   Gaussian noise, and N_KF irregularly spaced ones (steps DT*U(0.5, 1.5)) for the one peer that
+   takes irregular times (the Kalman filter); writes them as raw doubles and as CSV;
+2. runs `target/release/examples/peers` (crates/seqsmooth/examples/peers.rs): the seqsmooth
+   filters, timed (best of --reps, I/O excluded), with their per-sample estimates;
+3. runs each peer on the same data, timed (best of 2 runs of the update loop for the filterpy
+   memory and least-squares filters, one run for the Kalman filters and savgol), and checks that its
+   per-sample state estimates agree with seqsmooth's within the pair's stated tolerance;
+4. times the `seqsmooth filter` command end to end (CSV in, CSV out) and checks its output;
+5. prints the table (updates/s and ratios) and the agreement figures, and exits non-zero when
+   any pair disagrees beyond its tolerance.
+
+Agreement metric: for each derivative k, max over the compared samples of |peer - ours| divided
+by the largest |ours_k| over those samples (as tests/savgol.rs), the worst k reported; for the
+Savitzky-Golay pairs divided by max|y|·Σ|c_k| instead (see TOL).
+"""
+import argparse
+import json
+import os
+import platform
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+VENV = os.path.join(ROOT, "target", "peers-venv")
+PINS = ["filterpy==2.0.0", "numpy==2.4.6", "scipy==1.17.1"]
+STAMP = os.path.join(VENV, "peers-pins.txt")
+
+
+def in_venv():
+    return os.path.realpath(sys.prefix) == os.path.realpath(VENV)
+
+
+if not in_venv():
+    py = os.path.join(VENV, "bin", "python")
+    have = open(STAMP).read() if os.path.exists(STAMP) else None
+    if have != "\n".join(PINS):
+        if not os.path.exists(py):
+            subprocess.check_call([sys.executable, "-m", "venv", VENV])
+        subprocess.check_call([py, "-m", "pip", "install", "--quiet", "--upgrade", "pip"])
+        subprocess.check_call([py, "-m", "pip", "install", "--quiet"] + PINS)
+        with open(STAMP, "w") as f:
+            f.write("\n".join(PINS))
+    sys.exit(subprocess.call([py, os.path.abspath(__file__)] + sys.argv[1:]))
+
+import numpy as np  # noqa: E402
+import scipy  # noqa: E402
+import filterpy  # noqa: E402
+from scipy.signal import savgol_coeffs, savgol_filter  # noqa: E402
+from filterpy.memory import FadingMemoryFilter  # noqa: E402
+from filterpy.leastsq import LeastSquaresFilter  # noqa: E402
+from filterpy.kalman import KalmanFilter  # noqa: E402
+from math import factorial  # noqa: E402
+from fractions import Fraction  # noqa: E402
+
+SEED = 20260415
+DT = 1e-3
+SIGMA = 0.5
+THETA = 0.9
+SG_WINDOW, SG_DEGREE = 1001, 2
+KF_DEGREES = range(0, 6)
+
+# Agreement tolerances (relative, see the module docstring) and why; checked in compare().
+TOL = {
+    # Same recursion, same gains, from the same state (filterpy's x0 is our estimate just before
+    # our switch to the fading gains): only rounding differs, and the contractive fading
+    # recursion forgets it at the rate θ^n. Plus a term for the timestamps: t = k·dt is rounded,
+    # so the steps the gain engine sees differ from dt (by up to ~ε·max|t|/dt relative: 1.1e-10 at
+    # t = 1000, dt = 0.001; 0 for a binary step such as 2^-10); it schedules its gains for that
+    # (mean) step, a first-order effect, while filterpy assumes dt exactly. main() adds the
+    # measured max |Δt - dt|/dt.
+    "fading": 1e-12,
+    # Same gains; filterpy's plain-f64 state picks up a rounding error at each sample, which the
+    # expanding-memory recursion forgets only slowly (like (k/n)^(j+1)): they add up as a random
+    # walk, ~ε·√n (2e-13 at n = 10⁶); 1e-11 leaves a factor 50.
+    "leastsq": 1e-11,
+    # A covariance-form Kalman filter (P, inv(S), Joseph form; Q = 0, so nothing is forgotten)
+    # against a square-root information filter; both are exact least squares. The KF's error
+    # follows the conditioning of P and grows ~15× per degree (measured 3e-11 at degree 5 over
+    # 10⁵ samples, 1e-10 over 2000); 1e-9 is not derived: 10-30× the worst measured.
+    "kalman": 1e-9,
+    # Relative to max|y|·Σ|c_k(x)| (the size of the terms of the weighted sum, the scale of any
+    # algorithm's rounding), against the convolution with the exact rational coefficients.
+    # Against scipy, scipy's own coefficient error (its lstsq in a monomial basis; e.g. its
+    # deriv=2 coefficients sum to -4e-10, not 0) is added, measured in the same units.
+    "savgol": 1e-12,
+    # The CLI runs the same library code; only the CSV round trip (shortest round-trip text)
+    # lies between them.
+    "cli": 0.0,
+}
+
+
+def rel_diff(peer, ours):
+    """max over k of max_n |peer - ours| / max_n |ours_k| (rows already selected)."""
+    worst = 0.0
+    for k in range(ours.shape[1]):
+        scale = np.max(np.abs(ours[:, k]))
+        d = np.max(np.abs(peer[:, k] - ours[:, k]))
+        worst = max(worst, d / scale if scale > 0 else d)
+    return worst
+
+
+def trajectory(t, rng):
+    truth = 10.0 * np.sin(2 * np.pi * t / 250.0) + 0.5 * t - 4e-4 * t * t
+    return truth + SIGMA * rng.standard_normal(len(t))
+
+
+def sized_diff(peer, ours, size):
+    """max over k of max_n |peer - ours| / size_k."""
+    return max(np.max(np.abs(peer[:, k] - ours[:, k])) / size[k] for k in range(ours.shape[1]))
+
+
+def exact_savgol_coeffs(window, m):
+    """The centred savgol coefficients for derivatives 0..m (unit step), from the exact rational
+    least-squares fit: c_k(x) = k! Σ_j (VᵀV)⁻¹_kj x^j, x = -L/2..L/2."""
+    h = (window - 1) // 2
+    xs = range(-h, h + 1)
+    moments = [sum(Fraction(x) ** p for x in xs) for p in range(2 * m + 1)]
+    g = [[moments[i + j] for j in range(m + 1)] + [Fraction(int(i == j)) for j in range(m + 1)]
+         for i in range(m + 1)]
+    for c in range(m + 1):  # Gauss-Jordan in rationals
+        p = g[c][c]
+        g[c] = [v / p for v in g[c]]
+        for r in range(m + 1):
+            if r != c:
+                f = g[r][c]
+                g[r] = [a - f * b for a, b in zip(g[r], g[c])]
+    inv = [row[m + 1:] for row in g]
+    return [[float(factorial(k) * sum(inv[k][j] * Fraction(x) ** j for j in range(m + 1)))
+             for x in xs] for k in range(m + 1)]
+
+
+def phi(m, h):
+    """Transition of the unscaled derivative state [x, x', ...] over a step h."""
+    F = np.zeros((m + 1, m + 1))
+    for i in range(m + 1):
+        for j in range(i, m + 1):
+            F[i, j] = h ** (j - i) / factorial(j - i)
+    return F
+
+
+def kf_start(t, y, m, theta):
+    """The exact (weighted) least-squares state at sample m from samples 0..m, and its
+    covariance, in a step-scaled basis so the small Vandermonde system is well conditioned."""
+    u = (t[: m + 1] - t[m]) / DT
+    U = np.vander(u, m + 1, increasing=True)  # u^j
+    D = np.array([DT**j / factorial(j) for j in range(m + 1)])  # x_j = z_j j!/DT^j
+    w = theta ** np.arange(m, -1, -1.0) if theta else np.ones(m + 1)
+    z = np.linalg.solve(U, y[: m + 1])
+    info = U.T @ (w[:, None] * U)
+    Pz = np.linalg.inv(info) * SIGMA**2
+    x = z / D
+    P = Pz / np.outer(D, D)
+    return x, P
+
+
+def run_kf(t, y, m, theta):
+    """filterpy.kalman.KalmanFilter, Q = 0, from sample m; alpha = 1/sqrt(θ) for fading memory
+    (P ← α² F P Fᵀ per predict: the information discounted by θ per update)."""
+    kf = KalmanFilter(dim_x=m + 1, dim_z=1)
+    x0, P0 = kf_start(t, y, m, theta)
+    kf.x = x0.reshape(-1, 1)
+    kf.P = P0
+    kf.H = np.zeros((1, m + 1))
+    kf.H[0, 0] = 1.0
+    kf.R = np.array([[SIGMA**2]])
+    kf.Q = np.zeros((m + 1, m + 1))
+    if theta:
+        kf.alpha = 1.0 / np.sqrt(theta)
+    n = len(t)
+    out = np.full((n, m + 1), np.nan)
+    out[m] = x0
+    steps = np.diff(t)
+    start = time.perf_counter()
+    if np.ptp(steps) == 0.0:
+        kf.F = phi(m, steps[0])
+        for i in range(m + 1, n):
+            kf.predict()
+            kf.update(y[i])
+            out[i] = kf.x[:, 0]
+    else:
+        for i in range(m + 1, n):
+            kf.predict(F=phi(m, t[i] - t[i - 1]))
+            kf.update(y[i])
+            out[i] = kf.x[:, 0]
+    secs = time.perf_counter() - start
+    return out, secs, n - m - 1
+
+
+def main():
+    global DT
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--n", type=int, default=1_000_000, help="evenly spaced samples")
+    ap.add_argument("--n-kf", type=int, default=100_000,
+                    help="samples for the Kalman filter pairs (even and irregular)")
+    ap.add_argument("--dt", type=float, default=DT,
+                    help="sampling step of the even data (default 0.001: a decimal step, so "
+                         "t = k*dt carries the timestamps' own rounding)")
+    ap.add_argument("--reps", type=int, default=5, help="repetitions of each seqsmooth timing")
+    ap.add_argument("--quick", action="store_true", help="small smoke run (n 20000, n-kf 2000)")
+    ap.add_argument("--dir", default=os.path.join(ROOT, "target", "peers"),
+                    help="work directory for the data and estimates")
+    a = ap.parse_args()
+    DT = a.dt
+    if a.quick:
+        a.n, a.n_kf = 20_000, 2_000
+    os.makedirs(a.dir, exist_ok=True)
+    exe = os.path.join(ROOT, "target", "release", "examples", "peers")
+    cli = os.path.join(ROOT, "target", "release", "seqsmooth")
+    for p in (exe, cli):
+        if not os.path.exists(p):
+            sys.exit(f"{p} is missing: run scripts/peers.sh (it builds it)")
+
+    # 1. Data.
+    rng = np.random.default_rng(SEED)
+    t_even = np.arange(a.n) * DT
+    y_even = trajectory(t_even, rng)
+    t_irr = np.cumsum(np.concatenate([[0.0], DT * rng.uniform(0.5, 1.5, a.n_kf - 1)]))
+    y_irr = trajectory(t_irr, rng)
+    data = {
+        "even": (t_even, y_even),
+        "kfeven": (t_even[: a.n_kf], y_even[: a.n_kf]),
+        "irregular": (t_irr, y_irr),
+    }
+    for name, (t, y) in data.items():
+        t.astype("<f8").tofile(os.path.join(a.dir, f"{name}.t.f64"))
+        y.astype("<f8").tofile(os.path.join(a.dir, f"{name}.y.f64"))
+    csv_path = os.path.join(a.dir, "even.csv")
+    with open(csv_path, "w") as f:
+        f.write("t,y\n")
+        f.writelines(f"{float(ti)!r},{float(yi)!r}\n" for ti, yi in zip(t_even, y_even))
+
+    runs = []
+    for m in range(3):
+        runs.append((f"fm{m}", "even", "fading-gain", m, f"theta={THETA} tau={DT!r}"))
+        runs.append((f"ls{m}", "even", "expanding-gain", m, ""))
+    for m in KF_DEGREES:
+        for d in ("kfeven", "irregular"):
+            runs.append((f"kfx{m}_{d}", d, "expanding-exact", m, ""))
+            runs.append((f"kff{m}_{d}", d, "fading-exact", m,
+                         f"theta={THETA} tau={DT!r} mode=update"))
+    runs.append(("sg", "even", "smooth", SG_DEGREE, f"window={SG_WINDOW}"))
+    runs.append(("sgs", "even", "fixed-sliding", SG_DEGREE, f"window={SG_WINDOW}"))
+    with open(os.path.join(a.dir, "runs.txt"), "w") as f:
+        for r in runs:
+            f.write(" ".join(str(x) for x in r) + "\n")
+
+    # 2. seqsmooth.
+    print(f"seqsmooth: {len(runs)} runs, best of {a.reps} ...", file=sys.stderr, flush=True)
+    res = subprocess.run([exe, a.dir, str(a.reps)], check=True, capture_output=True, text=True)
+    ours = {}
+    for line in res.stdout.strip().splitlines()[1:]:
+        name, n, s_upd, s_est, sw = line.split(",")
+        ours[name] = {"n": int(n), "upd": float(s_upd), "est": float(s_est),
+                      "switch": int(sw) if sw else None}
+
+    def est(name, m):
+        return np.fromfile(os.path.join(a.dir, f"{name}.est.f64"), dtype="<f8").reshape(-1, m + 1)
+
+    rows, agree, failures = [], [], []
+
+    def record(pair, peer_name, peer_updates, peer_secs, our_name, our_label, err, tol, rows_cmp,
+               metric="max abs(ours_k)"):
+        o = ours[our_name]
+        peer_rate = peer_updates / peer_secs
+        rows.append({
+            "pair": pair, "peer": peer_name, "ours": our_label,
+            "peer_rate": peer_rate,
+            "our_rate": o["n"] / o["upd"], "our_rate_est": o["n"] / o["est"],
+        })
+        agree.append({"pair": f"{pair}: {peer_name} vs {our_label}", "err": err, "tol": tol,
+                      "rows": rows_cmp, "metric": metric})
+        if not err <= tol:
+            failures.append(f"{pair}, {our_label}: difference {err:.2e} > tolerance {tol:.1e}")
+
+    # 3a. FadingMemoryFilter from our state before the switch sample.
+    t, y = data["even"]
+    for m in range(3):
+        name = f"fm{m}"
+        s = ours[name]["switch"]
+        mine = est(name, m)
+        ys = y[s:]
+        secs = float("inf")
+        for _ in range(2):
+            f = FadingMemoryFilter(x0=mine[s - 1].copy(), dt=DT, order=m, beta=THETA)
+            start = time.perf_counter()
+            for z in ys:
+                f.update(z)
+            secs = min(secs, time.perf_counter() - start)
+        f = FadingMemoryFilter(x0=mine[s - 1].copy(), dt=DT, order=m, beta=THETA)
+        out = np.empty((len(ys), m + 1))
+        for i, z in enumerate(ys):
+            f.update(z)
+            out[i] = f.x
+        err = rel_diff(out, mine[s:])
+        tol = TOL["fading"] + np.max(np.abs(np.diff(t) - DT)) / DT
+        record(f"fading memory, degree {m}", "filterpy FadingMemoryFilter", len(ys), secs, name,
+               "FadingMemory (gain engine)", err, tol, f"{s}..{len(y) - 1}")
+
+    # 3b. LeastSquaresFilter from its zero start; exact from sample m on.
+    for m in range(3):
+        name = f"ls{m}"
+        mine = est(name, m)
+        secs = float("inf")
+        for _ in range(2):
+            f = LeastSquaresFilter(dt=DT, order=m)
+            start = time.perf_counter()
+            for z in y:
+                f.update(z)
+            secs = min(secs, time.perf_counter() - start)
+        f = LeastSquaresFilter(dt=DT, order=m)
+        out = np.empty((len(y), m + 1))
+        for i, z in enumerate(y):
+            out[i] = f.update(z)
+        err = rel_diff(out[m:], mine[m:])
+        record(f"expanding memory, degree {m}", "filterpy LeastSquaresFilter", len(y), secs, name,
+               "ExpandingMemory (gain engine)", err, TOL["leastsq"], f"{m}..{len(y) - 1}")
+
+    # 3c. KalmanFilter, Q = 0, polynomial model, started at sample m from the exact fit.
+    for d, label in (("kfeven", "even"), ("irregular", "irregular")):
+        tk, yk = data[d]
+        for m in KF_DEGREES:
+            for theta, kind, our_label in ((None, "x", "ExpandingMemory (exact engine)"),
+                                           (THETA, "f", "FadingMemory (exact, per update)")):
+                name = f"kf{kind}{m}_{d}"
+                mine = est(name, m)
+                out, secs, count = run_kf(tk, yk, m, theta)
+                err = rel_diff(out[m:], mine[m:])
+                memory = "expanding" if theta is None else f"fading θ={theta}"
+                record(f"Kalman {memory}, degree {m}, {label}",
+                       "filterpy KalmanFilter" + (" (alpha)" if theta else ""), count, secs,
+                       name, our_label, err, TOL["kalman"], f"{m}..{len(tk) - 1}")
+
+    # 3d. savgol_filter (all three derivatives) against smooth and the streaming filter, and all
+    # three against the convolution with exact (rational) coefficients.
+    mine = est("sg", SG_DEGREE)
+    start = time.perf_counter()
+    out = np.stack([savgol_filter(y, SG_WINDOW, SG_DEGREE, deriv=k, delta=DT, mode="interp")
+                    for k in range(SG_DEGREE + 1)], axis=1)
+    secs = time.perf_counter() - start
+    half = (SG_WINDOW - 1) // 2
+    inner = slice(half, len(y) - half)
+    exact = exact_savgol_coeffs(SG_WINDOW, SG_DEGREE)
+    ymax = np.max(np.abs(y))
+    oracle, size, scipy_err = [], [], 0.0
+    for k in range(SG_DEGREE + 1):
+        c = np.array(exact[k]) / DT**k
+        oracle.append(np.correlate(y, c, "valid"))
+        size.append(ymax * np.sum(np.abs(c)))
+        theirs = savgol_coeffs(SG_WINDOW, SG_DEGREE, deriv=k, delta=DT, use="dot")
+        scipy_err = max(scipy_err, ymax * np.sum(np.abs(theirs - c)) / size[-1])
+    oracle = np.stack(oracle, axis=1)
+    size = np.array(size)
+    sg_tol = TOL["savgol"] + scipy_err
+    pair = f"Savitzky-Golay, window {SG_WINDOW}, degree {SG_DEGREE}, d0-d2"
+    for name, label, rows_sel, span in (
+            ("sg", "fixed::smooth", slice(None), f"0..{len(y) - 1}"),
+            ("sgs", "FixedMemory (sliding, centred)", inner, f"{half}..{len(y) - 1 - half}")):
+        mine = est(name, SG_DEGREE)
+        err = sized_diff(out[rows_sel], mine[rows_sel], size)
+        record(pair, "scipy savgol_filter (interp)", len(y), secs, name, label, err, sg_tol,
+               span, metric="max abs(y)·Σ abs(c_k)")
+        err = sized_diff(oracle, mine[inner], size)
+        agree.append({"pair": f"{label} vs exact-coefficient convolution", "err": err,
+                      "tol": TOL["savgol"], "rows": f"{half}..{len(y) - 1 - half}",
+                      "metric": "max abs(y)·Σ abs(c_k)"})
+        if not err <= TOL["savgol"]:
+            failures.append(f"{label} vs exact coefficients: {err:.2e} > {TOL['savgol']:.0e}")
+    err = sized_diff(out[inner], oracle, size)
+    agree.append({"pair": "scipy savgol_filter vs exact-coefficient convolution (its own error; "
+                  "not checked)", "err": err, "tol": float("nan"),
+                  "rows": f"{half}..{len(y) - 1 - half}", "metric": "max abs(y)·Σ abs(c_k)"})
+
+    # 4. The CLI end to end, against filterpy FadingMemoryFilter order 2.
+    fm2_peer = next(r["peer_rate"] for r in rows if r["pair"] == "fading memory, degree 2")
+    cli_rows = []
+    for engine in ("gain", "exact"):
+        out_path = os.path.join(a.dir, f"cli_{engine}.csv")
+        cmd = [cli, "filter", "--kind", "fading", "--degree", "2", "--theta", str(THETA),
+               "--tau", repr(DT), "--engine", engine, csv_path, "-o", out_path]
+        best = float("inf")
+        for _ in range(3):
+            start = time.perf_counter()
+            subprocess.run(cmd, check=True)
+            best = min(best, time.perf_counter() - start)
+        shown = ["seqsmooth"] + [os.path.relpath(c, ROOT) if c.startswith(a.dir) else c
+                                 for c in cmd[1:]]
+        cli_rows.append((engine, " ".join(shown), len(y) / best))
+        if engine == "gain":
+            got = np.loadtxt(out_path, delimiter=",", skiprows=3, usecols=(2, 3, 4))
+            err = rel_diff(got, est("fm2", 2)[2:])
+            agree.append({"pair": "CLI filter --kind fading --engine gain vs library",
+                          "err": err, "tol": TOL["cli"], "rows": f"2..{len(y) - 1}",
+                          "metric": "max abs(ours_k)"})
+            if not err <= TOL["cli"]:
+                failures.append(f"CLI vs library: difference {err:.2e} > {TOL['cli']}")
+
+    # 5. Report.
+    print(f"\nPeer comparison: {a.n} even samples (dt {DT}), {a.n_kf} for the Kalman pairs; "
+          f"seqsmooth best of {a.reps}; filterpy memory/leastsq best of 2, Kalman and savgol one run")
+    print(f"python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}"
+          f", filterpy {filterpy.__version__}; {platform.machine()}, "
+          f"{os.cpu_count()} logical CPUs")
+    print("\n| pair | peer | peer updates/s | seqsmooth | ours updates/s (update only) | ratio |"
+          " ours updates/s (update + estimate) | ratio |")
+    print("|---|---|---:|---|---:|---:|---:|---:|")
+    for r in rows:
+        print(f"| {r['pair']} | {r['peer']} | {r['peer_rate']:.3g} | {r['ours']} | "
+              f"{r['our_rate']:.3g} | {r['our_rate'] / r['peer_rate']:.0f}× | "
+              f"{r['our_rate_est']:.3g} | {r['our_rate_est'] / r['peer_rate']:.0f}× |")
+    print("\n| CLI, end to end (CSV in, CSV out) | rows/s | ÷ filterpy FadingMemoryFilter(order 2)"
+          " updates/s |")
+    print("|---|---:|---:|")
+    for engine, cmd, rate in cli_rows:
+        print(f"| `{cmd}` | {rate:.3g} | {rate / fm2_peer:.1f}× |")
+    print("\n| agreement | samples compared | max difference | relative to | tolerance |")
+    print("|---|---|---:|---|---:|")
+    for g in agree:
+        print(f"| {g['pair']} | {g['rows']} | {g['err']:.2e} | {g['metric']} | {g['tol']:.1e} |")
+    with open(os.path.join(a.dir, "results.json"), "w") as f:
+        json.dump({"rows": rows, "cli": cli_rows, "agree": agree}, f, indent=1)
+    if failures:
+        print("\nDISAGREEMENT:\n  " + "\n  ".join(failures), file=sys.stderr)
+        sys.exit(1)
+    print("\nall pairs agree within their tolerances")
+
+
+if __name__ == "__main__":
+    main()
