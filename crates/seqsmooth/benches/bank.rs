@@ -3,9 +3,10 @@
 //!
 //! Run: `cargo bench -p seqsmooth --bench bank` (results in BENCHMARKS.md).
 //!
-//! - `single_stream/<memory>_<engine>[_many]/<m>`: one filter (fading: θ = 0.9, τ = 1) already
-//!   past its start-up; each iteration processes a batch of samples, by `update` per sample or
-//!   (`_many`) by one `update_many` call; throughput in samples.
+//! - `single_stream/<memory>_<engine>[_many|_many_into]/<m>`: one filter (fading: θ = 0.9,
+//!   τ = 1) already past its start-up; each iteration processes a batch of samples, by `update`
+//!   per sample, by one `update_many` call, or by one `update_many_into` call (which also
+//!   writes every sample's estimate); throughput in samples.
 //! - `bank/<serial|parallel>/<K>`: a degree-2 [`FadingBank`] (θ = 0.9) of `K` channels past
 //!   its switch; each iteration is one time step of all channels; throughput in
 //!   channel-updates.
@@ -42,9 +43,9 @@ fn single_stream(c: &mut Criterion) {
         } else {
             "exact"
         };
-        for batch in [false, true] {
+        for api in ["", "_many", "_many_into"] {
+            let batch = !api.is_empty();
             for m in 0..=5usize {
-                let api = if batch { "_many" } else { "" };
                 let id = BenchmarkId::new(format!("{memory}_{eng}{api}"), m);
                 group.bench_function(id, |b| {
                     let mut f: Box<dyn PolynomialFilter> = if memory == "fading" {
@@ -59,6 +60,7 @@ fn single_stream(c: &mut Criterion) {
                         n += 1;
                     }
                     let mut times = vec![0.0; BATCH];
+                    let mut est = vec![0.0; BATCH * (m + 1)];
                     b.iter(|| {
                         if batch {
                             // The times of this batch (filling them costs ≈ 0.3 ns/sample).
@@ -66,7 +68,12 @@ fn single_stream(c: &mut Criterion) {
                                 *t = (n + i) as f64;
                             }
                             let from = (n & mask).min(ys.len() - BATCH);
-                            f.update_many(&times, &ys[from..from + BATCH]).unwrap();
+                            let y = &ys[from..from + BATCH];
+                            if api == "_many" {
+                                f.update_many(&times, y).unwrap();
+                            } else {
+                                f.update_many_into(&times, y, &mut est).unwrap();
+                            }
                             n += BATCH;
                         } else {
                             for _ in 0..BATCH {

@@ -115,25 +115,19 @@ fn write_f64s(path: &Path, v: &[f64]) -> Res<()> {
     std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()).into())
 }
 
-/// The timed loop without reading estimates.
+/// The timed loop without reading estimates: one batch call
+/// ([`PolynomialFilter::update_many`]: the input checked in one pass, then the engine's tight
+/// loop).
 fn feed<F: PolynomialFilter>(f: &mut F, t: &[f64], y: &[f64]) -> Res<()> {
-    for (&ti, &yi) in t.iter().zip(y) {
-        f.update(ti, yi)?;
-    }
+    f.update_many(t, y)?;
     Ok(())
 }
 
 /// The timed loop that also reads every sample's current estimate into `out`
-/// (`samples × (m+1)`; NaN while undetermined).
+/// (`samples × (m+1)`; NaN while undetermined): one
+/// [`PolynomialFilter::update_many_into`] call.
 fn feed_and_read<F: PolynomialFilter>(f: &mut F, t: &[f64], y: &[f64], out: &mut [f64]) -> Res<()> {
-    let width = f.degree() + 1;
-    for ((&ti, &yi), row) in t.iter().zip(y).zip(out.chunks_exact_mut(width)) {
-        f.update(ti, yi)?;
-        match f.estimate() {
-            Some(s) => row.copy_from_slice(&s.derivatives),
-            None => row.fill(f64::NAN),
-        }
-    }
+    f.update_many_into(t, y, out)?;
     Ok(())
 }
 

@@ -210,14 +210,33 @@ impl Core {
         Ok(())
     }
 
-    fn update_many(&mut self, times: &[f64], values: &[f64]) -> Result<(), Error> {
+    fn update_many(
+        &mut self,
+        m: usize,
+        times: &[f64],
+        values: &[f64],
+        estimates: Option<&mut [f64]>,
+    ) -> Result<(), Error> {
         check_batch_lengths(times, values)?;
+        if let Some(out) = &estimates {
+            check_estimates_length(times, m, out)?;
+        }
         let previous = (self.samples() > 0).then(|| self.last_time());
         let valid = first_invalid(times, values, previous);
         let (ts, ys) = (&times[..valid], &values[..valid]);
-        match self {
-            Core::Exact(e) => ts.iter().zip(ys).for_each(|(&t, &y)| e.update(t, y)),
-            Core::Gain(g) => g.update_many(ts, ys),
+        match (&mut *self, estimates) {
+            (Core::Exact(e), None) => ts.iter().zip(ys).for_each(|(&t, &y)| e.update(t, y)),
+            (Core::Exact(e), Some(out)) => {
+                for ((&t, &y), row) in ts.iter().zip(ys).zip(out.chunks_exact_mut(m + 1)) {
+                    e.update(t, y);
+                    match e.estimate_at(t) {
+                        Some((x, _)) => row.copy_from_slice(&x),
+                        None => row.fill(f64::NAN),
+                    }
+                }
+            }
+            (Core::Gain(g), None) => g.update_many(ts, ys),
+            (Core::Gain(g), Some(out)) => g.update_many_into(ts, ys, &mut out[..valid * (m + 1)]),
         }
         if valid < times.len() {
             let previous = (self.samples() > 0).then(|| self.last_time());
@@ -354,6 +373,66 @@ pub trait PolynomialFilter: std::fmt::Debug + Send {
         }
         Ok(())
     }
+    /// [`update_many`](Self::update_many) that also writes the estimate after each sample:
+    /// `estimates[i·(m+1) + k]` is the `k`-th derivative at `times[i]` from the samples up to
+    /// and including sample `i` (NaN while undetermined). `estimates.len()` must be
+    /// `times.len()·(m+1)`. On an invalid sample the rows before it are written, the rest are
+    /// left as they were. The gain engine writes from its batch kernels (no allocation per
+    /// sample); the rows equal [`estimate`](Self::estimate)'s up to a rounding of the last
+    /// conversion `k!/τ^k`.
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
+    /// let mut f = ExpandingMemory::new(1, Engine::Gain).unwrap();
+    /// let t = [0.0, 1.0, 2.0, 3.0];
+    /// let y = [1.0, 3.0, 5.0, 7.0]; // y = 1 + 2t
+    /// let mut est = [0.0; 8];
+    /// f.update_many_into(&t, &y, &mut est).unwrap();
+    /// assert!(est[0].is_nan()); // one sample does not determine a line
+    /// assert!((est[6] - 7.0).abs() < 1e-12 && (est[7] - 2.0).abs() < 1e-12);
+    /// ```
+    fn update_many_into(
+        &mut self,
+        times: &[f64],
+        values: &[f64],
+        estimates: &mut [f64],
+    ) -> Result<(), Error> {
+        check_batch_lengths(times, values)?;
+        let w = self.degree() + 1;
+        check_estimates_length(times, self.degree(), estimates)?;
+        for (index, ((&t, &y), row)) in times
+            .iter()
+            .zip(values)
+            .zip(estimates.chunks_exact_mut(w))
+            .enumerate()
+        {
+            self.update(t, y).map_err(|e| Error::InBatch {
+                index,
+                source: Box::new(e),
+            })?;
+            match self.estimate() {
+                Some(s) => row.copy_from_slice(&s.derivatives),
+                None => row.fill(f64::NAN),
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Checks `estimates.len() = times.len()·(m+1)` for [`PolynomialFilter::update_many_into`].
+fn check_estimates_length(times: &[f64], m: usize, estimates: &[f64]) -> Result<(), Error> {
+    if estimates.len() != times.len() * (m + 1) {
+        return Err(Error::InvalidParameter {
+            name: "estimates length",
+            value: estimates.len().to_string(),
+            reason: format!(
+                "{} samples of degree {m} need {} values (one row of m+1 derivatives per sample)",
+                times.len(),
+                times.len() * (m + 1)
+            ),
+        });
+    }
+    Ok(())
 }
 
 fn check_batch_lengths(times: &[f64], values: &[f64]) -> Result<(), Error> {
@@ -407,7 +486,16 @@ macro_rules! impl_polynomial_filter {
                 self.core.update(t, y)
             }
             fn update_many(&mut self, times: &[f64], values: &[f64]) -> Result<(), Error> {
-                self.core.update_many(times, values)
+                self.core.update_many(self.m, times, values, None)
+            }
+            fn update_many_into(
+                &mut self,
+                times: &[f64],
+                values: &[f64],
+                estimates: &mut [f64],
+            ) -> Result<(), Error> {
+                self.core
+                    .update_many(self.m, times, values, Some(estimates))
             }
             fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
                 self.core.estimate_at(self.m, t)
