@@ -125,15 +125,17 @@ fn smooth_even(
         }
         mu.iter().zip(&inv).map(|(a, b)| a * b).collect()
     };
+    // Row i of the weights in window order (oldest sample first), contiguous: column k of `w`
+    // multiplies y_{newest - k}.
+    let kernels: Vec<Vec<f64>> = (0..=m)
+        .map(|i| (0..window).rev().map(|k| w[(i, k)]).collect())
+        .collect();
     let mut edge_fits: Vec<(usize, Vec<f64>)> = Vec::new();
     for (n, row) in out.iter_mut().enumerate() {
         let s = window_start(n, window, len);
         if n - s == half {
-            // Column k multiplies y_{newest - k}.
-            let newest = s + span;
-            *row = (0..=m)
-                .map(|i| (0..window).map(|k| w[(i, k)] * values[newest - k]).sum())
-                .collect();
+            let ys = &values[s..s + window];
+            *row = kernels.iter().map(|k| dot(k, ys)).collect();
         } else {
             let b = match edge_fits.iter().find(|(st, _)| *st == s) {
                 Some((_, b)) => b.clone(),
@@ -150,6 +152,24 @@ fn smooth_even(
         }
     }
     Ok(out)
+}
+
+/// `Σ a_i b_i` with four partial sums (so the loop vectorises).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        for l in 0..4 {
+            acc[l] += x[l] * y[l];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 fn smooth_irregular(
