@@ -7,7 +7,14 @@
 //! the basis is re-centred by the upper-triangular change of variables
 //! `a_old = A a_new`, `A_kj = C(j,k) (-β)^(j-k) / α^j` (`u_old = α u_new + β`), so `R ← R A`
 //! stays triangular and no re-factorisation is needed. Re-centring happens `O(log n)` times for
-//! expanding memory and about once per quarter memory span for fading memory.
+//! expanding memory and about once per quarter memory span for fading memory; the new unit is
+//! the old one times a power of two and the centre moves by a multiple of unit/8, so `α`, `β`
+//! and `A` are exact, and on evenly spaced samples the same `A` repeats (cached).
+//!
+//! The fading-memory discount is applied lazily: instead of multiplying `[R | d]` by `√θ^ζ` at
+//! every sample, new rows are multiplied by the accumulated `1/√(Π θ^ζ)`, folded back into the
+//! factor when it passes 1e100. The estimate `R⁻¹d` and the sandwich covariance do not depend
+//! on that common scale.
 
 use super::DiscountMode;
 use crate::calculus::choose;
