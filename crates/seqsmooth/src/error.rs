@@ -60,6 +60,17 @@ pub enum Error {
         /// Why it was rejected.
         source: Box<Error>,
     },
+    /// A channel of a bank ([`StreamBank`](crate::polynomial::bank::StreamBank)) rejected its
+    /// input; the other channels were processed.
+    #[error("channel {channel}: {source}{}", also_failed_note(also_failed))]
+    InChannel {
+        /// The (first) failing channel.
+        channel: usize,
+        /// Why it was rejected.
+        source: Box<Error>,
+        /// Other channels of the same call that failed too (each stopped at its bad sample).
+        also_failed: Vec<usize>,
+    },
     /// Some other parameter is out of range.
     #[error("{name} {value} is invalid: {reason}")]
     InvalidParameter {
@@ -70,6 +81,14 @@ pub enum Error {
         /// Why it is rejected.
         reason: String,
     },
+}
+
+fn also_failed_note(others: &[usize]) -> String {
+    if others.is_empty() {
+        String::new()
+    } else {
+        format!(" (channels {others:?} failed as well)")
+    }
 }
 
 /// Validates one sample of a stream: finite time and value, and a time strictly after the
