@@ -1,25 +1,46 @@
-//! `seqsmooth filter`: streams a CSV time series through a polynomial filter.
+//! `seqsmooth filter`: streams a CSV time series — or many, told apart by an id column —
+//! through polynomial filters.
 //!
-//! Reading streams row by row. Only the first [`LOOKAHEAD`] data rows (the first `W` for a
-//! fixed-memory window longer than that) are buffered: they give the default `τ` (median time
-//! step) and decide the too-few-samples check before any output is written. Every row is
-//! validated (number, finite, strictly increasing time) with its 1-based file line (the header
-//! is line 1) and column name.
+//! The command reads, filters and writes chunks of rows ([`CHUNK_ROWS`]): a reader thread
+//! parses and validates the next chunk ([`crate::rows`]) while the current one is run through
+//! the filters of its series, the series in parallel ([`crate::series`]), and written in input
+//! order, formatted in parallel pieces ([`crate::layout`]). Memory is a few chunks plus one
+//! filter per series, whatever the length of the input. The first [`LOOKAHEAD`] data rows (the
+//! first `W` for a fixed-memory window longer than that) decide the default `τ` (median time
+//! step) and the too-few-samples check before any output is written. Every row is validated
+//! (number, finite, strictly increasing time within its series) with its 1-based file line
+//! (the header is line 1) and column name.
+//!
+//! [`SampleReader`] and [`OutputWriter`] are the simpler row-at-a-time reader and writer of the
+//! other commands.
 
 use crate::error::CliError;
+use crate::layout::Layout;
 use crate::number::fmt_f64;
+use crate::progress::{self, Progress};
+use crate::rows::{Chunk, Row, RowReader};
+use crate::series::{run_chunk, Results};
+use rayon::prelude::*;
 use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter};
 use seqsmooth::{
     Engine, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory, PolynomialFilter,
     PolynomialState,
 };
-use std::collections::VecDeque;
+use std::collections::{HashMap, VecDeque};
 use std::fs::File;
 use std::io::{self, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::mpsc;
 
 /// Data rows buffered before output starts: up to 100 time steps for the `τ` median.
 pub const LOOKAHEAD: usize = 101;
+
+/// Rows per chunk of `seqsmooth filter`'s streaming pipeline (read, filter, write).
+pub const CHUNK_ROWS: u32 = 1 << 16;
+
+/// With `--id-col`, the default `τ` is the median of the first 100 steps within series among
+/// this many first rows.
+pub const TAU_SCAN_ROWS: usize = 1 << 16;
 
 /// Which filter the command runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -92,6 +113,12 @@ pub struct FilterConfig {
     pub value_col: String,
     /// Noise σ for the `s0..sM` columns (the automatic filter's given noise).
     pub sigma: Option<f64>,
+    /// The column naming the series (`--id-col`); `None` = one series.
+    pub id_col: Option<String>,
+    /// Never show a progress display (`--no-progress`).
+    pub no_progress: bool,
+    /// Rows per chunk of the streaming pipeline.
+    pub chunk_rows: usize,
 }
 
 /// The data rows a command needs, and why (for the too-few-samples messages).
@@ -138,6 +165,7 @@ impl Need {
 #[derive(Clone, Debug)]
 pub struct Sample {
     /// 1-based file line (header = line 1).
+    #[allow(dead_code)] // No command needs it after validation; the tests check it.
     pub line: u64,
     /// Time.
     pub t: f64,
@@ -156,8 +184,10 @@ pub struct Sample {
 /// offset. Only the bytes read ahead of the current record are kept (the parser's buffer).
 pub struct LineTracker<R: Read> {
     inner: R,
-    /// Bytes read but not yet attributed to a record; `pending[0]` is at offset `base`.
-    pending: VecDeque<u8>,
+    /// Bytes read; `pending[start..]` are not yet attributed to a record, and `pending[start]`
+    /// is at offset `base`. The attributed prefix is dropped at the next read.
+    pending: Vec<u8>,
+    start: usize,
     base: u64,
     /// Line terminators (`\n`, `\r\n` or a lone `\r`) before `base`.
     breaks: u64,
@@ -170,29 +200,44 @@ impl<R: Read> LineTracker<R> {
     pub fn new(inner: R) -> Self {
         Self {
             inner,
-            pending: VecDeque::new(),
+            pending: Vec::new(),
+            start: 0,
             base: 0,
             breaks: 0,
             after_cr: false,
         }
     }
 
+    /// The number of bytes read from the input so far.
+    pub fn bytes_read(&self) -> u64 {
+        self.base + (self.pending.len() - self.start) as u64
+    }
+
     /// The 1-based line of the record the parser reports at byte offset `byte`: the parser's
     /// offset may sit before blank lines or a line terminator it skipped, so those are skipped
     /// here too. Offsets must not decrease between calls.
     pub fn line_at(&mut self, byte: u64) -> u64 {
-        let mut k = (byte.saturating_sub(self.base) as usize).min(self.pending.len());
-        while k < self.pending.len() && matches!(self.pending[k], b'\r' | b'\n') {
+        let rest = &self.pending[self.start..];
+        let mut k = (byte.saturating_sub(self.base) as usize).min(rest.len());
+        while k < rest.len() && matches!(rest[k], b'\r' | b'\n') {
             k += 1;
         }
-        for b in self.pending.drain(..k) {
-            match b {
-                b'\r' => self.breaks += 1,
-                b'\n' if !self.after_cr => self.breaks += 1,
-                _ => {}
+        let span = &rest[..k];
+        // A `\n` right after a `\r` ends the same line; any other `\r` or `\n` ends one.
+        let newlines = span.iter().filter(|&&b| b == b'\n').count() as u64;
+        if !span.contains(&b'\r') {
+            let continued = self.after_cr && span.first() == Some(&b'\n');
+            self.breaks += newlines - u64::from(continued);
+            if k > 0 {
+                self.after_cr = false;
             }
-            self.after_cr = b == b'\r';
+        } else {
+            for &b in span {
+                self.breaks += u64::from(b == b'\r' || (b == b'\n' && !self.after_cr));
+                self.after_cr = b == b'\r';
+            }
         }
+        self.start += k;
         self.base += k as u64;
         self.breaks + 1
     }
@@ -200,8 +245,12 @@ impl<R: Read> LineTracker<R> {
 
 impl<R: Read> Read for LineTracker<R> {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        // The parser asks for more only once it has used up what it had: what is left
+        // unattributed is at most one buffer.
+        self.pending.drain(..self.start);
+        self.start = 0;
         let n = self.inner.read(buf)?;
-        self.pending.extend(&buf[..n]);
+        self.pending.extend_from_slice(&buf[..n]);
         Ok(n)
     }
 }
@@ -347,17 +396,38 @@ pub fn parse_cell(text: &str, line: u64, column: &str, what: &str) -> Result<f64
 /// The median time step of `samples` (the mean of the middle two for an even count), or 1 for
 /// fewer than two samples.
 pub fn median_step(samples: &[Sample]) -> f64 {
-    let mut steps: Vec<f64> = samples.windows(2).map(|w| w[1].t - w[0].t).collect();
-    if steps.is_empty() {
-        return 1.0;
+    median(samples.windows(2).map(|w| w[1].t - w[0].t).collect()).unwrap_or(1.0)
+}
+
+/// The median of `values` (the mean of the middle two for an even count); `None` for none.
+pub fn median(mut values: Vec<f64>) -> Option<f64> {
+    if values.is_empty() {
+        return None;
     }
-    steps.sort_by(f64::total_cmp);
-    let k = steps.len();
-    if k % 2 == 1 {
-        steps[k / 2]
+    values.sort_by(f64::total_cmp);
+    let k = values.len();
+    Some(if k % 2 == 1 {
+        values[k / 2]
     } else {
-        0.5 * steps[k / 2 - 1] + 0.5 * steps[k / 2]
+        0.5 * values[k / 2 - 1] + 0.5 * values[k / 2]
+    })
+}
+
+/// The median of the first `LOOKAHEAD - 1` time steps within the series of `rows` (each
+/// row's time minus the previous time of its series), in input order; `None` when no series
+/// has two rows. For one series, the steps of its first `LOOKAHEAD` rows.
+pub fn median_series_step(rows: &[Row]) -> Option<f64> {
+    let mut last: HashMap<u32, f64> = HashMap::new();
+    let mut steps = Vec::with_capacity(LOOKAHEAD - 1);
+    for r in rows {
+        if let Some(prev) = last.insert(r.series, r.t) {
+            steps.push(r.t - prev);
+            if steps.len() == LOOKAHEAD - 1 {
+                break;
+            }
+        }
     }
+    median(steps)
 }
 
 /// Builds the configured filter (τ already resolved for fading memory).
@@ -476,69 +546,131 @@ impl FixedRunner {
     }
 }
 
-/// A running filter of any kind.
+/// A running filter of any kind. Cloning a new one is how each series gets its filter.
+#[derive(Clone)]
 pub enum Runner {
-    /// Expanding or fading memory.
-    Recursive(Box<dyn PolynomialFilter>),
+    /// Expanding memory.
+    Expanding(Box<ExpandingMemory>),
+    /// Fading memory.
+    Fading(Box<FadingMemory>),
     /// Fixed memory.
     Fixed(Box<FixedRunner>),
     /// The automatic filter.
     Auto(Box<AutomaticFilter>),
 }
 
-/// One output row's estimate and trailing cells.
-pub struct Step {
-    /// The estimate at `t + H`, if determined.
-    pub estimate: Option<PolynomialState>,
-    /// The cells of [`Runner::extra_columns`].
-    pub extra: Vec<String>,
+/// The trailing cells of one output row (after `d0..dM` and `s0..sM`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Extra {
+    /// Expanding and fading memory: none.
+    #[default]
+    None,
+    /// Fixed memory: the number of rows in the window.
+    Window(usize),
+    /// The automatic filter: the noise σ in use, the outlier and misfit flags.
+    Auto {
+        /// The noise σ in use, if any.
+        noise: Option<f64>,
+        /// The sample was rejected as an outlier.
+        outlier: bool,
+        /// The misfit test fired.
+        misfit: bool,
+    },
+}
+
+/// What one output row holds besides its values: how many derivatives and 1σ cells are
+/// filled (the rest are empty) and the trailing cells.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Cells {
+    /// The number of derivatives `d0, d1, …` with a value.
+    pub derivatives: usize,
+    /// The number of 1σ cells `s0, s1, …` with a value.
+    pub std_devs: usize,
+    /// The trailing cells.
+    pub extra: Extra,
+}
+
+/// Copies an estimate into the row slots: derivatives into `values[..m+1]`, and with `sigma`
+/// their 1σ into `values[m+1..]`. The estimate may be of a lower degree than the slots.
+fn store(estimate: Option<&PolynomialState>, sigma: bool, values: &mut [f64]) -> Cells {
+    let Some(s) = estimate else {
+        return Cells::default();
+    };
+    let width = if sigma {
+        values.len() / 2
+    } else {
+        values.len()
+    };
+    let nd = s.derivatives.len().min(width);
+    values[..nd].copy_from_slice(&s.derivatives[..nd]);
+    let ns = match (&s.covariance, sigma) {
+        (Some(c), true) => {
+            let ns = c.nrows().min(width);
+            for (i, v) in values[width..width + ns].iter_mut().enumerate() {
+                *v = c[(i, i)].max(0.0).sqrt();
+            }
+            ns
+        }
+        _ => 0,
+    };
+    Cells {
+        derivatives: nd,
+        std_devs: ns,
+        extra: Extra::None,
+    }
 }
 
 impl Runner {
     /// The columns after `d0..dM` and `s0..sM` this kind writes.
     pub fn extra_columns(&self) -> &'static [&'static str] {
         match self {
-            Runner::Recursive(_) => &[],
+            Runner::Expanding(_) | Runner::Fading(_) => &[],
             Runner::Fixed(_) => &["window"],
             Runner::Auto(_) => &["noise", "outlier", "misfit"],
         }
     }
 
-    /// Processes the sample `(t, y)` and gives the row's estimate at `t + lead`.
-    pub fn step(&mut self, t: f64, y: f64, lead: f64) -> Result<Step, seqsmooth::Error> {
+    /// Processes the sample `(t, y)` and stores the row's estimate at `t + lead` in `values`:
+    /// `m+1` slots for the derivatives, and with `sigma` `m+1` more for their 1σ (taken from
+    /// the covariance). Slots past the returned counts are left as they were.
+    pub fn step_into(
+        &mut self,
+        t: f64,
+        y: f64,
+        lead: f64,
+        sigma: bool,
+        values: &mut [f64],
+    ) -> Result<Cells, seqsmooth::Error> {
         match self {
-            Runner::Recursive(f) => {
+            Runner::Expanding(f) => {
                 f.update(t, y)?;
-                Ok(Step {
-                    estimate: f.estimate_at(t + lead),
-                    extra: Vec::new(),
-                })
+                Ok(store(f.estimate_at(t + lead).as_ref(), sigma, values))
+            }
+            Runner::Fading(f) => {
+                f.update(t, y)?;
+                Ok(store(f.estimate_at(t + lead).as_ref(), sigma, values))
             }
             Runner::Fixed(f) => {
                 f.update(t, y)?;
-                Ok(Step {
-                    estimate: f.estimate_at(t + lead),
-                    extra: vec![f.filled().to_string()],
-                })
+                let mut cells = store(f.estimate_at(t + lead).as_ref(), sigma, values);
+                cells.extra = Extra::Window(f.filled());
+                Ok(cells)
             }
             Runner::Auto(f) => {
                 let out = f.update(t, y)?;
                 // The output's estimate is at t: the update's own, or across a rejected sample
                 // the prediction; with a lead the active filter's, the same way.
-                let estimate = if lead == 0.0 {
-                    out.estimate
+                let mut cells = if lead == 0.0 {
+                    store(out.estimate.as_ref(), sigma, values)
                 } else {
-                    f.estimate_at(t + lead)
+                    store(f.estimate_at(t + lead).as_ref(), sigma, values)
                 };
-                let flag = |b: bool| if b { "1" } else { "0" }.to_string();
-                Ok(Step {
-                    estimate,
-                    extra: vec![
-                        out.noise_sigma.map(fmt_f64).unwrap_or_default(),
-                        flag(out.outlier),
-                        flag(out.misfit),
-                    ],
-                })
+                cells.extra = Extra::Auto {
+                    noise: out.noise_sigma,
+                    outlier: out.outlier,
+                    misfit: out.misfit,
+                };
+                Ok(cells)
             }
         }
     }
@@ -548,9 +680,27 @@ impl Runner {
 /// automatic filter).
 pub fn build_runner(cfg: &FilterConfig, tau: f64) -> Result<Runner, seqsmooth::Error> {
     match cfg.kind {
-        Kind::Expanding | Kind::Fading => Ok(Runner::Recursive(build_filter(
-            cfg.kind, cfg.degree, cfg.theta, tau, cfg.engine, cfg.sigma,
-        )?)),
+        Kind::Expanding => {
+            let f = ExpandingMemory::new(cfg.degree, cfg.engine.into())?;
+            Ok(Runner::Expanding(Box::new(match cfg.sigma {
+                Some(s) => f.with_noise_sigma(s)?,
+                None => f,
+            })))
+        }
+        Kind::Fading => {
+            let theta = cfg
+                .theta
+                .ok_or_else(|| seqsmooth::Error::InvalidParameter {
+                    name: "theta",
+                    value: "(none)".into(),
+                    reason: "a fading-memory filter needs theta".into(),
+                })?;
+            let f = FadingMemory::new(cfg.degree, theta, tau, cfg.engine.into())?;
+            Ok(Runner::Fading(Box::new(match cfg.sigma {
+                Some(s) => f.with_noise_sigma(s)?,
+                None => f,
+            })))
+        }
         Kind::Fixed => {
             let window = cfg
                 .window
@@ -692,7 +842,7 @@ pub fn open_output(path: Option<&Path>) -> Result<(Box<dyn Write>, String), CliE
 }
 
 /// Opens the input: a file, or standard input for `None` or `-`.
-pub fn open_input(path: Option<&Path>) -> Result<Box<dyn Read>, CliError> {
+pub fn open_input(path: Option<&Path>) -> Result<Box<dyn Read + Send>, CliError> {
     match path {
         Some(p) if p.as_os_str() != "-" => {
             let file = File::open(p).map_err(|e| {
@@ -701,7 +851,8 @@ pub fn open_input(path: Option<&Path>) -> Result<Box<dyn Read>, CliError> {
             // The CSV reader buffers; no BufReader needed.
             Ok(Box::new(file))
         }
-        _ => Ok(Box::new(io::stdin().lock())),
+        // Unlocked, so that another thread may read it; the CSV reader reads large blocks.
+        _ => Ok(Box::new(io::stdin())),
     }
 }
 
@@ -722,30 +873,67 @@ pub fn check_distinct(input: Option<&Path>, output: Option<&Path>) -> Result<(),
 }
 
 /// Runs `seqsmooth filter`.
+///
+/// The input is read in chunks of [`FilterConfig::chunk_rows`] rows (the first chunk at least
+/// the `hold` rows that decide τ and the too-few-samples check). Each chunk's rows are run
+/// through their series' filters, the series in parallel, and written in input order; the
+/// memory is one chunk plus one filter per series, whatever the length of the input. An error
+/// in one of the first `hold` rows stops the command before any output; a later one after the
+/// rows before it, of every series, have been written.
 pub fn run(cfg: &FilterConfig) -> Result<(), CliError> {
     check_distinct(cfg.input.as_deref(), cfg.output.as_deref())?;
     let need = match (cfg.kind, cfg.window) {
         (Kind::Fixed, Some(w)) => Need::window(w.max(cfg.degree + 1)),
         _ => Need::degree(cfg.degree),
     };
+    let started = std::time::Instant::now();
+    let size = input_size(cfg.input.as_deref());
     let input = open_input(cfg.input.as_deref())?;
-    let mut reader = SampleReader::new(input, &cfg.time_col, &cfg.value_col, &need)?;
+    let mut reader = RowReader::new(
+        input,
+        &cfg.time_col,
+        &cfg.value_col,
+        cfg.id_col.as_deref(),
+        &need,
+    )?;
 
     // A fixed-memory window longer than LOOKAHEAD is read in full before the first output row:
     // its rows have no estimate, and an input shorter than the window is an error.
     let hold = LOOKAHEAD.max(need.rows);
-    let mut head = Vec::with_capacity(LOOKAHEAD);
-    while head.len() < hold {
-        match reader.next_sample()? {
-            Some(s) => head.push(s),
-            None => break,
+    let chunk_rows = cfg.chunk_rows.max(1);
+    let mut chunk = Chunk::default();
+    // With --id-col, the default τ comes from the steps within series among the first
+    // TAU_SCAN_ROWS rows: they are all in the first chunk, whatever the chunk size.
+    let default_tau = cfg.tau.is_none() && matches!(cfg.kind, Kind::Fading | Kind::Auto);
+    let scan = if default_tau && cfg.id_col.is_some() {
+        TAU_SCAN_ROWS
+    } else {
+        0
+    };
+    reader.read_chunk(&mut chunk, chunk_rows.max(hold).max(scan));
+    let mut reader = Some(reader);
+    if chunk.rows.len() < hold {
+        if let Some(e) = chunk.error.take() {
+            return Err(e);
         }
     }
-    need.check(head.len())?;
+    need.check(chunk.rows.len())?;
     let tau = match (cfg.kind, cfg.tau) {
         (_, Some(tau)) => tau,
         (Kind::Fading | Kind::Auto, None) => {
-            let tau = median_step(&head);
+            let head = &chunk.rows[..chunk.rows.len().min(hold.max(scan))];
+            let tau = match median_series_step(head) {
+                Some(tau) => tau,
+                // One row (per series) in all: τ does not matter.
+                None if chunk.done && chunk.rows.len() <= head.len() => 1.0,
+                None => {
+                    return Err(CliError::Data(format!(
+                        "no series has two rows among the first {} data rows, so there is no \
+                         median time step for the default tau; give --tau",
+                        head.len()
+                    )))
+                }
+            };
             if !(tau.is_finite() && tau > 0.0) {
                 return Err(CliError::Data(format!(
                     "the median time step of the first rows, {}, is not a usable tau; give --tau",
@@ -756,27 +944,207 @@ pub fn run(cfg: &FilterConfig) -> Result<(), CliError> {
         }
         (Kind::Expanding | Kind::Fixed, None) => 1.0,
     };
-    let mut runner = build_runner(cfg, tau).map_err(|e| CliError::Usage(e.to_string()))?;
-
-    let (sink, name) = open_output(cfg.output.as_deref())?;
+    let prototype = build_runner(cfg, tau).map_err(|e| CliError::Usage(e.to_string()))?;
     // The automatic filter always writes s0..sM (from the given or the estimated noise).
-    let sigma_columns = cfg.sigma.is_some() || cfg.kind == Kind::Auto;
-    let extra = runner.extra_columns();
-    let mut out = OutputWriter::with_extra(sink, &name, cfg.degree, sigma_columns, extra)?;
-    let mut step = |s: &Sample| -> Result<(), CliError> {
-        let row = runner
-            .step(s.t, s.y, cfg.lead)
-            .map_err(|e| CliError::Data(format!("line {}: {e}", s.line)))?;
-        out.row_with(&s.t_text, &s.y_text, row.estimate.as_ref(), &row.extra)
+    let layout = Layout {
+        id: cfg.id_col.clone(),
+        degree: cfg.degree,
+        sigma: cfg.sigma.is_some() || cfg.kind == Kind::Auto,
+        extra: prototype.extra_columns(),
     };
-    for s in &head {
-        step(s)?;
+    let stride = layout.stride();
+    let mut runners: Vec<Option<Runner>> = Vec::new();
+    if cfg.id_col.is_none() {
+        runners.push(Some(prototype.clone()));
     }
-    drop(head);
-    while let Some(s) = reader.next_sample()? {
-        step(&s)?;
+    let mut ids: Vec<Vec<u8>> = Vec::new();
+    let mut results = Results::default();
+    let mut bufs = Vec::new();
+    let mut sink: Option<(Box<dyn Write>, String)> = None;
+    let mut progress = Progress::hidden();
+    let mut first = true;
+    let mut pipeline: Option<Pipeline> = None;
+    loop {
+        for id in chunk.new_ids.drain(..) {
+            runners.push(Some(prototype.clone()));
+            ids.push(id);
+        }
+        let failed = run_chunk(
+            &chunk,
+            &mut runners,
+            cfg.lead,
+            layout.sigma,
+            stride,
+            &mut results,
+        );
+        let limit = failed.as_ref().map_or(chunk.rows.len(), |(i, _)| *i);
+        if first && limit < hold {
+            if let Some((_, e)) = failed {
+                return Err(e);
+            }
+        }
+        let (out, name) = match &mut sink {
+            Some(s) => s,
+            None => {
+                let (mut out, name) = open_output(cfg.output.as_deref())?;
+                out.write_all(&layout.header())
+                    .map_err(|e| CliError::write(&name, e))?;
+                sink.insert((out, name))
+            }
+        };
+        let table = Table {
+            chunk: &chunk,
+            results: &results,
+            ids: &ids,
+            layout: &layout,
+            stride,
+        };
+        table.write(out, name, limit, &mut bufs)?;
+        if let Some((_, e)) = failed {
+            out.flush().map_err(|e| CliError::write(name, e))?;
+            return Err(e);
+        }
+        if let Some(e) = chunk.error.take() {
+            out.flush().map_err(|e| CliError::write(name, e))?;
+            return Err(e);
+        }
+        if chunk.done {
+            return out.flush().map_err(|e| CliError::write(name, e));
+        }
+        if first && progress::wanted(cfg.no_progress) {
+            progress = Progress::new(size, started);
+        }
+        progress.update(chunk.bytes_read, chunk.rows_read);
+        first = false;
+        // From the second chunk on, the next chunk is read on a thread of its own while this
+        // one is filtered and written.
+        let next = match &mut pipeline {
+            Some(p) => p,
+            None => {
+                let reader = reader.take().ok_or_else(|| {
+                    CliError::Data("internal error: the input reader is gone".into())
+                })?;
+                pipeline.insert(Pipeline::start(reader, chunk_rows))
+            }
+        };
+        chunk = next.swap(chunk)?;
     }
-    out.finish()
+}
+
+/// A thread that reads the input chunk by chunk ahead of the filtering and writing, passing
+/// full chunks one way and emptied ones back (at most three chunks exist).
+struct Pipeline {
+    full: mpsc::Receiver<Chunk>,
+    empty: mpsc::Sender<Chunk>,
+}
+
+impl Pipeline {
+    /// Starts reading chunks of `rows` rows from `reader` on a new thread. The thread ends
+    /// after the last chunk, or when the pipeline is dropped (the command is ending).
+    fn start<R: Read + Send + 'static>(mut reader: RowReader<R>, rows: usize) -> Self {
+        let (full_tx, full) = mpsc::sync_channel::<Chunk>(1);
+        let (empty, empty_rx) = mpsc::channel::<Chunk>();
+        // Detached: on an early error the command exits without waiting for a pending read.
+        std::thread::spawn(move || loop {
+            let mut chunk = empty_rx.try_recv().unwrap_or_default();
+            reader.read_chunk(&mut chunk, rows);
+            let last = chunk.done || chunk.error.is_some();
+            if full_tx.send(chunk).is_err() || last {
+                return;
+            }
+        });
+        Self { full, empty }
+    }
+
+    /// Hands back a used chunk and takes the next one.
+    fn swap(&mut self, used: Chunk) -> Result<Chunk, CliError> {
+        // The reader may have finished: then the used chunk is simply dropped.
+        let _ = self.empty.send(used);
+        self.full
+            .recv()
+            .map_err(|_| CliError::Data("internal error: the input reader stopped".into()))
+    }
+}
+
+/// The size of the input file, for the progress bar; `None` for standard input or anything
+/// but a regular file.
+fn input_size(path: Option<&Path>) -> Option<u64> {
+    let p = path.filter(|p| p.as_os_str() != "-")?;
+    let meta = std::fs::metadata(p).ok()?;
+    meta.is_file().then_some(meta.len())
+}
+
+/// A chunk's rows with their results, ready to be written in input order.
+struct Table<'a> {
+    chunk: &'a Chunk,
+    results: &'a Results,
+    ids: &'a [Vec<u8>],
+    layout: &'a Layout,
+    stride: usize,
+}
+
+impl Table<'_> {
+    /// Rows formatted per piece (on one thread).
+    const PIECE: usize = 4096;
+
+    /// Appends the text of rows `rows` to `buf`.
+    fn format(&self, rows: std::ops::Range<usize>, buf: &mut Vec<u8>) {
+        for i in rows {
+            let row = &self.chunk.rows[i];
+            let (t, y) = self.chunk.cells(row);
+            let slot = self.results.slot_of(i);
+            let id = self
+                .layout
+                .id
+                .as_ref()
+                .and_then(|_| self.ids.get(row.series as usize))
+                .map(Vec::as_slice);
+            self.layout.row(
+                buf,
+                id,
+                t,
+                y,
+                &self.results.values[slot * self.stride..(slot + 1) * self.stride],
+                &self.results.cells[slot],
+            );
+        }
+    }
+
+    /// Writes the first `limit` rows to `out` (named `name`), formatting pieces of rows in
+    /// parallel into `bufs` and writing them in order.
+    fn write(
+        &self,
+        out: &mut dyn Write,
+        name: &str,
+        limit: usize,
+        bufs: &mut Vec<Vec<u8>>,
+    ) -> Result<(), CliError> {
+        let pieces = limit.div_ceil(Self::PIECE);
+        let batch = rayon::current_num_threads().max(1);
+        if bufs.len() < batch {
+            bufs.resize_with(batch, Vec::new);
+        }
+        for first in (0..pieces).step_by(batch) {
+            let count = batch.min(pieces - first);
+            let piece = |k: usize, buf: &mut Vec<u8>| {
+                buf.clear();
+                let start = (first + k) * Self::PIECE;
+                self.format(start..(start + Self::PIECE).min(limit), buf);
+            };
+            if count == 1 {
+                piece(0, &mut bufs[0]);
+            } else {
+                bufs[..count]
+                    .par_iter_mut()
+                    .enumerate()
+                    .for_each(|(k, buf)| piece(k, buf));
+            }
+            for buf in &bufs[..count] {
+                out.write_all(buf).map_err(|e| CliError::write(name, e))?;
+            }
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]

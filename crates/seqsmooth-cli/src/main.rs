@@ -8,8 +8,13 @@ mod chart;
 mod demo;
 mod error;
 mod filter;
+mod layout;
 mod number;
 mod plot;
+mod progress;
+mod rows;
+mod series;
+mod shortest;
 mod smooth;
 mod tables;
 
@@ -124,9 +129,22 @@ innovation gate (it did not update the filter; the row's estimate is the predict
 else 0. misfit is 1 while the chi-squared test of the last 10 innovations (false-alarm rate 1%) \
 says the model no longer fits, else 0; a strong misfit restarts the memory.
 
-Reading streams: only the first 101 data rows (the first W for a longer fixed window) are held \
-back (for the default tau and the too-few-samples check). An error in a later row stops the \
-command after the rows before it have been written.
+Several series (--id-col NAME): the rows with the same id (any text) form a series, filtered \
+on its own with the same settings; the series may be interleaved in any way, on time grids of \
+their own (times must increase within each series only). The output keeps the input's row \
+order and starts with the id column: NAME,t,y,d0..dM,... A series shorter than the degree \
+needs just has empty cells (the too-few-samples check is on the input as a whole). The default \
+tau is the median of the first 100 time steps within series (among the first 65536 rows).
+
+Reading streams in chunks of 65536 rows, the series of a chunk in parallel; memory stays \
+bounded (one chunk plus one filter per series) however long the input. The first 101 data rows \
+(the first W for a longer fixed window) are held back: an error in one of them stops the \
+command before any output. An error in a later row (a bad cell, a time not after the previous \
+one of its series, ...) stops the command after every row before it, of every series, has been \
+written; the message names the line, the column and, for a time, the series.
+
+Progress: on standard error when it is a terminal and the input is longer than one chunk \
+(bytes of the file read, or rows and rows/s from standard input); --no-progress turns it off.
 
 Exit status: 0 on success; 1 when the input data or a file is unusable (bad numbers, NaN or \
 infinite values, unsorted or duplicate times, missing columns, malformed CSV, too few samples, \
@@ -212,6 +230,18 @@ struct FilterArgs {
     /// Output file [default: standard output]
     #[arg(short = 'o', long, value_name = "OUTPUT")]
     output: Option<PathBuf>,
+    /// Name of a column naming the series: the rows of each id (any text) are a series of
+    /// their own, filtered on its own with the same settings, and the column is written first
+    #[arg(long, value_name = "NAME")]
+    id_col: Option<String>,
+    /// Never show the progress display (shown on standard error only when it is a terminal
+    /// and the input is larger than one chunk of rows)
+    #[arg(long)]
+    no_progress: bool,
+    /// Rows read, filtered and written at a time (testing aid)
+    #[arg(long, value_name = "N", hide = true, default_value_t = filter::CHUNK_ROWS,
+          value_parser = clap::value_parser!(u32).range(1..))]
+    chunk_rows: u32,
 }
 
 /// Arguments of `seqsmooth smooth`.
@@ -435,6 +465,13 @@ fn run_filter(a: FilterArgs) -> Result<(), CliError> {
         (_, Some(_)) => return Err(only("--window", "fixed")),
         (_, None) => {}
     }
+    if let Some(id) = &a.id_col {
+        if *id == a.time_col || *id == a.value_col {
+            return Err(CliError::Usage(format!(
+                "--id-col {id} is the time or the value column; name a column of its own"
+            )));
+        }
+    }
     if kind == Kind::Fixed && a.engine == Some(EngineArg::Gain) {
         return Err(CliError::Usage(
             "--engine gain applies only to --kind expanding, fading and auto: the fixed-memory \
@@ -455,6 +492,9 @@ fn run_filter(a: FilterArgs) -> Result<(), CliError> {
         time_col: a.time_col,
         value_col: a.value_col,
         sigma: a.sigma,
+        id_col: a.id_col,
+        no_progress: a.no_progress,
+        chunk_rows: a.chunk_rows as usize,
     })
 }
 

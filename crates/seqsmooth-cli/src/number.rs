@@ -14,11 +14,21 @@ use seqsmooth::scalar::{parse_rational, Rational};
 /// plain one only avoids an exponent, which would take hundreds of digits far from 1.
 /// Non-finite values print as `NaN`, `inf`, `-inf` (they never occur in valid output).
 pub fn fmt_f64(x: f64) -> String {
+    let mut out = Vec::with_capacity(24);
+    write_f64(&mut out, x);
+    // Only ASCII digits, signs, '.', 'e', "NaN" and "inf" are written.
+    String::from_utf8(out).unwrap_or_default()
+}
+
+/// Appends [`fmt_f64`]`(x)` to `out` without allocating (beyond `out`'s growth): the digits
+/// of [`crate::shortest`], the same as Rust's `{}` and `{:e}`.
+pub fn write_f64(out: &mut Vec<u8>, x: f64) {
     let a = x.abs();
-    if x == 0.0 || !x.is_finite() || (1e-5..1e16).contains(&a) {
-        format!("{x}")
+    if x == 0.0 || !x.is_finite() {
+        // "0", "-0", "NaN", "inf", "-inf".
+        out.extend_from_slice(x.to_string().as_bytes());
     } else {
-        format!("{x:e}")
+        crate::shortest::write(out, x, !(1e-5..1e16).contains(&a));
     }
 }
 
