@@ -206,16 +206,42 @@ impl ExactEngine {
         self.n > self.m as u64 && self.info.is_determined()
     }
 
+    /// Writes the unscaled derivatives of the fit at `t` into `out` (`m+1` values) without
+    /// allocating: `a = R⁻¹d`, shifted to `u(t)`, `x_k = k! a_k / s^k`. False (and `out`
+    /// untouched) while the fit is not determined.
+    pub fn derivatives_into(&self, t: f64, out: &mut [f64]) -> bool {
+        if !self.is_determined() {
+            return false;
+        }
+        let p = self.m + 1;
+        let mut buf = [0.0; super::MAX_DEGREE + 1];
+        let a = &mut buf[..p];
+        a.copy_from_slice(self.info.factor().rhs().as_slice());
+        if !crate::linalg::solve_upper_in_place(self.info.factor().r(), a) {
+            return false;
+        }
+        shift_scaled(a, (t - self.centre) / self.unit);
+        let (mut f, mut sk) = (1.0, 1.0);
+        for (k, (x, z)) in out.iter_mut().zip(a.iter()).enumerate() {
+            if k > 0 {
+                f *= k as f64;
+                sk *= self.unit;
+            }
+            *x = z * f / sk;
+        }
+        true
+    }
+
     /// Unscaled derivatives (and covariance, when tracked) of the fit evaluated at `t`.
     pub fn estimate_at(&self, t: f64) -> Option<(Vec<f64>, Option<DMatrix<f64>>)> {
         if !self.is_determined() {
             return None;
         }
-        let a = self.info.solve()?;
+        let mut x = vec![0.0; self.m + 1];
+        if !self.derivatives_into(t, &mut x) {
+            return None;
+        }
         let v = (t - self.centre) / self.unit;
-        let mut z: Vec<f64> = a.iter().copied().collect();
-        shift_scaled(&mut z, v);
-        let x = crate::model::scaled_to_derivatives(&z, self.unit);
         let cov = match self.sigma {
             None => None,
             Some(sigma) => {

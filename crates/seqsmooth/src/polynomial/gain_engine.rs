@@ -582,11 +582,15 @@ impl GainEngine {
     /// Unscaled derivatives (and their covariance) of the estimate valid at `t`.
     pub fn estimate_at(&self, t: f64) -> (Vec<f64>, Option<DMatrix<f64>>) {
         let v = (t - self.t_last) / self.tau;
-        let mut z = self.z.clone();
-        let mut lo = self.z_lo.clone();
-        shift_scaled_compensated(&mut z, &mut lo, v);
-        let z: Vec<f64> = z.iter().zip(&lo).map(|(h, l)| h + l).collect();
-        let x = crate::model::scaled_to_derivatives(&z, self.tau);
+        let p = self.m + 1;
+        let (mut hi, mut lo) = ([0.0; super::MAX_DEGREE + 1], [0.0; super::MAX_DEGREE + 1]);
+        hi[..p].copy_from_slice(&self.z);
+        lo[..p].copy_from_slice(&self.z_lo);
+        shift_scaled_compensated(&mut hi[..p], &mut lo[..p], v);
+        for (h, l) in hi[..p].iter_mut().zip(&lo[..p]) {
+            *h += l;
+        }
+        let x = crate::model::scaled_to_derivatives(&hi[..p], self.tau);
         let cov = self.cov.as_ref().map(|(_, p)| {
             let j = crate::model::scaling(self.m, self.tau) * crate::model::phi(self.m, v);
             &j * p * j.transpose()

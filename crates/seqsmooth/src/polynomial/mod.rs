@@ -229,9 +229,8 @@ impl Core {
             (Core::Exact(e), Some(out)) => {
                 for ((&t, &y), row) in ts.iter().zip(ys).zip(out.chunks_exact_mut(m + 1)) {
                     e.update(t, y);
-                    match e.estimate_at(t) {
-                        Some((x, _)) => row.copy_from_slice(&x),
-                        None => row.fill(f64::NAN),
+                    if !e.derivatives_into(t, row) {
+                        row.fill(f64::NAN);
                     }
                 }
             }
