@@ -94,9 +94,11 @@ TOL = {
     # Against scipy, scipy's own coefficient error (its lstsq in a monomial basis; e.g. its
     # deriv=2 coefficients sum to -4e-10, not 0) is added, measured in the same units.
     "savgol": 1e-12,
-    # The CLI runs the same library code; only the CSV round trip (shortest round-trip text)
-    # lies between them.
-    "cli": 0.0,
+    # The CLI feeds the library sample by sample (compensated state); the library side here
+    # uses the batch call, whose steady kernel runs in plain f64: crates/seqsmooth/tests/
+    # batch.rs bounds their difference by 1e-11 (measured ≤ 6e-13 at degree 2). The CSV round
+    # trip itself is exact (shortest round-trip text).
+    "cli": 1e-11,
 }
 
 

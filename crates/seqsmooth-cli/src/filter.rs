@@ -621,6 +621,16 @@ fn store(estimate: Option<&PolynomialState>, sigma: bool, values: &mut [f64]) ->
 }
 
 impl Runner {
+    /// The expanding- or fading-memory filter, which takes batches
+    /// ([`PolynomialFilter::update_many_into`]); `None` for the other kinds.
+    pub fn batch_filter(&mut self) -> Option<&mut dyn PolynomialFilter> {
+        match self {
+            Runner::Expanding(f) => Some(f.as_mut()),
+            Runner::Fading(f) => Some(f.as_mut()),
+            Runner::Fixed(_) | Runner::Auto(_) => None,
+        }
+    }
+
     /// The columns after `d0..dM` and `s0..sM` this kind writes.
     pub fn extra_columns(&self) -> &'static [&'static str] {
         match self {

@@ -7,9 +7,10 @@
 //! in input order through the row → slot map.
 
 use crate::error::CliError;
-use crate::filter::{Cells, Runner};
+use crate::filter::{Cells, Extra, Runner};
 use crate::rows::{Chunk, Row};
 use rayon::prelude::*;
+use seqsmooth::PolynomialFilter;
 
 /// The per-chunk results: `values` and `cells` in slot order.
 #[derive(Debug, Default)]
@@ -95,6 +96,11 @@ fn run_group(
     cells: &mut [Cells],
 ) -> Option<(usize, CliError)> {
     let stride = values.len().checked_div(cells.len()).unwrap_or(1).max(1);
+    if !sigma && lead == 0.0 {
+        if let Some(f) = runner.batch_filter() {
+            return run_group_batch(f, chunk, rows, stride, values, cells);
+        }
+    }
     for ((i, v), c) in rows.zip(values.chunks_exact_mut(stride)).zip(cells) {
         let row = &chunk.rows[i];
         match runner.step_into(row.t, row.y, lead, sigma, v) {
@@ -103,6 +109,55 @@ fn run_group(
         }
     }
     None
+}
+
+/// [`run_group`] for the expanding- and fading-memory filters without 1σ columns or lead: the
+/// group's samples in one `update_many_into` call (the library's batch kernels), then the rows'
+/// cells. Same results and errors as row by row (the estimates up to rounding).
+fn run_group_batch(
+    f: &mut dyn PolynomialFilter,
+    chunk: &Chunk,
+    rows: impl Iterator<Item = usize>,
+    stride: usize,
+    values: &mut [f64],
+    cells: &mut [Cells],
+) -> Option<(usize, CliError)> {
+    let idx: Vec<usize> = rows.collect();
+    let ts: Vec<f64> = idx.iter().map(|&i| chunk.rows[i].t).collect();
+    let ys: Vec<f64> = idx.iter().map(|&i| chunk.rows[i].y).collect();
+    let w = f.degree() + 1;
+    let mut est = vec![f64::NAN; idx.len() * w];
+    let result = f.update_many_into(&ts, &ys, &mut est);
+    let (done, error) = match result {
+        Ok(()) => (idx.len(), None),
+        Err(seqsmooth::Error::InBatch { index, source }) => (index, Some((index, *source))),
+        Err(e) => (0, Some((0, e))),
+    };
+    let nd = w.min(stride);
+    for ((e, v), c) in est
+        .chunks_exact(w)
+        .zip(values.chunks_exact_mut(stride))
+        .zip(cells.iter_mut())
+        .take(done)
+    {
+        *c = if e[0].is_nan() {
+            Cells::default()
+        } else {
+            v[..nd].copy_from_slice(&e[..nd]);
+            Cells {
+                derivatives: nd,
+                std_devs: 0,
+                extra: Extra::None,
+            }
+        };
+    }
+    error.map(|(k, e)| {
+        let i = idx[k];
+        (
+            i,
+            CliError::Data(format!("line {}: {e}", chunk.rows[i].line)),
+        )
+    })
 }
 
 /// Runs the rows of `chunk` through the filters of their series (`runners`, by series index,

@@ -275,7 +275,7 @@ impl GainEngine {
                 f *= k as f64;
                 tk *= self.tau;
             }
-            *x = (self.z[k] + self.z_lo[k]) * (f / tk);
+            *x = (self.z[k] + self.z_lo[k]) * f / tk;
         }
     }
 
