@@ -20,6 +20,18 @@ use crate::model::{shift_scaled_compensated, two_sum};
 use crate::scalar::{rational_from_f64, Rational, Scalar};
 use nalgebra::{DMatrix, DVector};
 
+/// Binomial coefficients `C(j, k)` for `j, k < N`.
+fn binomials<const N: usize>() -> [[f64; N]; N] {
+    let mut c = [[0.0; N]; N];
+    for j in 0..N {
+        c[j][0] = 1.0;
+        for k in 1..=j {
+            c[j][k] = c[j - 1][k - 1] + if k < j { c[j - 1][k] } else { 0.0 };
+        }
+    }
+    c
+}
+
 /// How far a step `ζ` (in units of `τ`, ending at time `t`) may differ from the typical step
 /// `ζ̄` and still count as the same step: `1e-12·ζ̄` plus a few rounding units of the timestamp
 /// (`t = k·Δ` computed in `f64` has steps that differ by `ulp(t)`).
@@ -405,20 +417,55 @@ impl GainEngine {
         let tau = self.tau;
         let mut t_last = self.t_last;
         let mut done = 0;
+        // The correction folded into the prediction (so the chain from one sample to the next
+        // is one multiplication and two additions deep): with `d = y − z₀` and the powers
+        // `ζʲ`,
+        //   z₀' = (1 − g₀) z₀ + g₀ y + Σ_{j≥1} (1 − g₀) ζʲ z_j,
+        //   z_k' = Σ_{j≥1} M_kj z_j + g_k d,  M_kj = C(j,k) ζ^(j−k) [j ≥ k] − g_k ζʲ  (k ≥ 1),
+        // which is `Φ(ζ)Z + G(y − [Φ(ζ)Z]₀)` regrouped. `M` is rebuilt only when `ζ` changes.
+        let binom = binomials::<N>();
+        let mut zeta_m = f64::NAN;
+        let mut mk = [[0.0; N]; N];
+        let (g0y, one_minus_g0) = (g[0], 1.0 - g[0]);
         for (&t, &y) in ts.iter().zip(ys) {
             let zeta = (t - t_last) / tau;
             if (zeta - step).abs() > tol + tol_per_time * t.abs() {
                 break;
             }
-            for i in 0..N - 1 {
-                for k in (i..N - 1).rev() {
-                    z[k] += zeta * z[k + 1];
+            if zeta != zeta_m {
+                zeta_m = zeta;
+                let mut pw = [1.0; N];
+                for j in 1..N {
+                    pw[j] = pw[j - 1] * zeta;
+                }
+                for j in 1..N {
+                    mk[0][j] = one_minus_g0 * pw[j];
+                }
+                for k in 1..N {
+                    for j in 1..N {
+                        let phi = if j >= k { binom[j][k] * pw[j - k] } else { 0.0 };
+                        mk[k][j] = phi - g[k] * pw[j];
+                    }
                 }
             }
-            let e = y - z[0];
-            for k in 0..N {
-                z[k] += g[k] * e;
+            let d = y - z[0];
+            let mut next = [0.0; N];
+            next[0] = one_minus_g0 * z[0] + g0y * y;
+            if N > 1 {
+                let mut tail = mk[0][1] * z[1];
+                for j in 2..N {
+                    tail += mk[0][j] * z[j];
+                }
+                next[0] += tail;
+                for k in 1..N {
+                    let mut acc = mk[k][1] * z[1];
+                    for j in 2..N {
+                        acc += mk[k][j] * z[j];
+                    }
+                    next[k] = acc + g[k] * d;
+                }
             }
+            z = next;
             if W {
                 if let Some(row) = rows.next() {
                     for k in 0..N {

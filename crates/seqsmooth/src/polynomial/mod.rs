@@ -101,9 +101,10 @@
 //! engine without per-sample checks. Once the gain engine's fading gains are in force (and no
 //! covariance is tracked), runs of steps equal to the typical step — up to `1e-12` relative
 //! plus the rounding of the timestamps, so `t = k·0.1` counts as even — go through a steady
-//! kernel: `Z ← Φ(ζ) Z`, `ε = y − z₀`, `Z ← Z + K ε` in plain `f64` with the state in
-//! registers (degrees ≤ 8; higher degrees take the per-sample path). Throughput is in
-//! BENCHMARKS.md (degree 2: ≈ 1.2·10⁸ samples/s against ≈ 1.7·10⁷ per sample).
+//! kernel: `Z ← Φ(ζ) Z + K (y − [Φ(ζ) Z]₀)` in plain `f64` with the state in registers,
+//! regrouped as `Z' = M(ζ) Z₁.. + K d` with `d = y − z₀` so that one sample's dependency chain is
+//! a multiplication and two additions (degrees ≤ 8; higher degrees take the per-sample path).
+//! Throughput is in BENCHMARKS.md (degree 2: ≈ 2·10⁸ samples/s against ≈ 1.9·10⁷ per sample).
 //!
 //! The steady recursion is stable (its eigenvalues are all `θ`), so plain arithmetic is enough
 //! there; the compensated state matters in the start-up, where the gains are large. Measured
@@ -114,15 +115,15 @@
 //!
 //! | m | θ = 0.5 | θ = 0.9 | θ = 0.99 | θ = 0.999 |
 //! |---:|---:|---:|---:|---:|
-//! | 0 | 1.6e-16 | 3.3e-16 | 6.6e-16 | 2.6e-15 |
-//! | 1 | 9.1e-14 | 6.7e-14 | 2.3e-14 | 2.8e-14 |
-//! | 2 | 1.4e-13 | 3.9e-13 | 3.5e-14 | 1.7e-14 |
-//! | 3 | 1.2e-13 | 5.3e-13 | 9.5e-14 | 3.3e-14 |
-//! | 4 | 1.3e-13 | 5.9e-13 | 2.5e-13 | 2.6e-14 |
-//! | 5 | 1.3e-13 | 6.1e-13 | 6.5e-13 | 2.9e-14 |
-//! | 6 | 1.1e-13 | 3.6e-13 | 1.4e-12 | 4.2e-14 |
-//! | 7 | 9.8e-14 | 3.7e-13 | 3.6e-12 | 6.5e-14 |
-//! | 8 | 1.1e-13 | 3.5e-13 | 5.1e-12 | 6.6e-14 |
+//! | 0 | 1.6e-16 | 3.3e-16 | 1.3e-15 | 5.0e-15 |
+//! | 1 | 1.3e-13 | 6.6e-14 | 4.1e-14 | 4.5e-13 |
+//! | 2 | 1.7e-13 | 5.5e-13 | 1.0e-13 | 6.3e-14 |
+//! | 3 | 1.3e-13 | 7.0e-13 | 1.4e-13 | 1.6e-13 |
+//! | 4 | 1.4e-13 | 6.7e-13 | 2.9e-13 | 5.0e-14 |
+//! | 5 | 1.5e-13 | 5.0e-13 | 6.9e-13 | 4.8e-14 |
+//! | 6 | 1.1e-13 | 5.0e-13 | 1.6e-12 | 8.5e-14 |
+//! | 7 | 1.5e-13 | 4.3e-13 | 3.8e-12 | 8.7e-14 |
+//! | 8 | 1.1e-13 | 3.9e-13 | 4.9e-12 | 7.2e-14 |
 //!
 //! (asserted: 1e-11). The exact engine and the fixed-memory filter give the same numbers
 //! through either call.
