@@ -12,9 +12,10 @@
 //! and `A` are exact, and on evenly spaced samples the same `A` repeats (cached).
 //!
 //! The fading-memory discount is applied lazily: instead of multiplying `[R | d]` by `√θ^ζ` at
-//! every sample, new rows are multiplied by the accumulated `1/√(Π θ^ζ)`, folded back into the
-//! factor when it passes 1e100. The estimate `R⁻¹d` and the sandwich covariance do not depend
-//! on that common scale.
+//! every sample, new rows get the weight `1/Π θ^ζ`, folded back into the factor when its square
+//! root passes 1e30. The estimate `R⁻¹d` and the sandwich covariance do not depend on that
+//! common scale. The factor itself is kept in Gentleman's square-root-free form
+//! ([`TriangularFactor`]): no square roots per sample.
 
 use super::DiscountMode;
 use crate::calculus::choose;
@@ -22,8 +23,10 @@ use crate::model::shift_scaled;
 use crate::recursive::{InformationFilter, TriangularFactor};
 use nalgebra::DMatrix;
 
-/// When the lazy discount's row scale exceeds this, it is folded into the factors.
-const RENORMALISE: f64 = 1e100;
+/// When the lazy discount's row scale `1/√(Π θ^ζ)` exceeds this, it is folded into the factors
+/// (the rows' weights are its square, the noise factor's its fourth power: ≤ 1e120, far from
+/// overflow in the squares the square-root-free rotations form).
+const RENORMALISE: f64 = 1e30;
 
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Discount {
@@ -55,8 +58,9 @@ pub(crate) struct ExactEngine {
     neg_ln_theta: f64,
     span_per_time: f64,
     /// The discount applied lazily: the true factors are the stored ones divided by
-    /// `inv_scale` (the noise factor by `inv_scale²`), and each new row is multiplied by it.
-    /// Solutions and the sandwich covariance do not depend on the common scale.
+    /// `inv_scale` (the noise factor by `inv_scale²`), and each new row gets the weight
+    /// `inv_scale²` (`inv_scale⁴`). Solutions and the sandwich covariance do not depend on the
+    /// common scale.
     inv_scale: f64,
     /// The last re-centring `(α, β, A)`.
     recentre_cache: Option<(f64, f64, DMatrix<f64>)>,
@@ -116,13 +120,14 @@ impl ExactEngine {
                         DiscountMode::PerUpdate => d.theta.sqrt(),
                     };
                 }
-                // Lazily: the factors stay as they are and new rows are scaled up instead.
+                // Lazily: the factors stay as they are and new rows get the weight
+                // 1/Π θ^ζ instead.
                 self.inv_scale /= self.root_cached;
                 if self.inv_scale > RENORMALISE {
-                    let s = 1.0 / self.inv_scale;
-                    self.info.discount_root(s);
+                    let f = 1.0 / (self.inv_scale * self.inv_scale);
+                    self.info.discount(f);
                     if let Some(q) = &mut self.noise {
-                        q.discount_root(s * s);
+                        q.discount(f * f);
                     }
                     self.inv_scale = 1.0;
                 }
@@ -130,16 +135,15 @@ impl ExactEngine {
             self.maybe_recentre(t);
         }
         let u = (t - self.centre) / self.unit;
-        let mut p = self.inv_scale;
+        let mut p = 1.0;
         for r in self.row.iter_mut() {
             *r = p;
             p *= u;
         }
-        self.info.observe(&self.row, y * self.inv_scale, 1.0);
+        let w = self.inv_scale * self.inv_scale;
+        self.info.observe(&self.row, y, w);
         if let Some(q) = &mut self.noise {
-            let w = self.inv_scale;
-            self.row.iter_mut().for_each(|r| *r *= w);
-            q.add_row(&self.row, 0.0, 1.0);
+            q.add_row(&self.row, 0.0, w * w);
         }
         self.t_last = t;
         self.n += 1;
@@ -216,8 +220,7 @@ impl ExactEngine {
         let p = self.m + 1;
         let mut buf = [0.0; super::MAX_DEGREE + 1];
         let a = &mut buf[..p];
-        a.copy_from_slice(self.info.factor().rhs().as_slice());
-        if !crate::linalg::solve_upper_in_place(self.info.factor().r(), a) {
+        if !self.info.factor().solve_into(a) {
             return false;
         }
         shift_scaled(a, (t - self.centre) / self.unit);
@@ -252,10 +255,10 @@ impl ExactEngine {
                     Some(q) => {
                         // K = J (RᵀR)⁻¹, Kᵀ = R⁻¹ (J R⁻¹)ᵀ; covariance K QᵀQ Kᵀ.
                         let mut kt = jr.transpose();
+                        let r = self.info.factor().r();
                         for mut col in kt.column_iter_mut() {
                             let mut c: Vec<f64> = col.iter().copied().collect();
-                            if !crate::linalg::solve_upper_in_place(self.info.factor().r(), &mut c)
-                            {
+                            if !crate::linalg::solve_upper_in_place(&r, &mut c) {
                                 return None;
                             }
                             col.copy_from_slice(&c);

@@ -22,8 +22,8 @@
 //! Relative error per derivative against batch QR (Legendre basis) or exact rational least
 //! squares, worst over each run, degrees 0-8: the exact engine ≤ 5e-11 on even, jittered and
 //! Poisson timestamps, expanding and fading (≤ 1e-11 over a 10⁵-sample run at degree 8). On
-//! 2 000 irregular samples: 1.4e-11 at degree 12, 1.3e-9 at 14 and 16, 1.7e-6 at 20, 7e-5 at
-//! 24 — the centred monomial basis is what limits it (asserted bounds: 1e-9 to degree 12, 1e-6
+//! 2 000 irregular samples: 5.2e-12 at degree 12, 1.5e-9 at 14, 8.9e-10 at 16, 9.7e-8 at 20,
+//! 7.4e-5 at 24 — the centred monomial basis is what limits it (asserted bounds: 1e-9 to degree 12, 1e-6
 //! to 16, 1e-3 to [`MAX_DEGREE`]). The gain engine on even samples: ≤ 5e-11 (expanding, 200
 //! samples), ≤ 5e-10 over 10⁵ samples at degree 8, ≤ 5e-12 for fading memory once the switch
 //! transient `θ^n·poly(n)` has decayed.

@@ -1,8 +1,16 @@
-use crate::linalg::{solve_upper_in_place, solve_upper_transpose_in_place};
+use crate::linalg::solve_upper_transpose_in_place;
 use nalgebra::{DMatrix, DVector};
 
 /// An upper-triangular factor `R` of an accumulated Gram matrix `RᵀR = Σ_k c_k a_k a_kᵀ`, kept
-/// up to date row by row with Givens rotations, with an optional right-hand column.
+/// up to date row by row, with a right-hand column `d` (`Rᵀd = Σ_k c_k a_k b_k`).
+///
+/// Stored in Gentleman's square-root-free form (W. M. Gentleman, *Least squares computations by
+/// Givens transformations without square roots*, 1973): `R = D^½ U` and `d = D^½ ū` with `U`
+/// unit upper triangular and `D ≥ 0` diagonal. A new row is folded in by the square-root-free
+/// Givens rotations: per pivot `i`, `d_i' = d_i + δ a_i²`, `c̄ = d_i/d_i'`, `s̄ = δ a_i/d_i'`,
+/// `a_j ← a_j − a_i u_ij`, `u_ij ← c̄ u_ij + s̄ a_j`, `δ ← δ c̄` — the same orthogonal
+/// transformations as with square roots, without them, and with the next pivot's row entry
+/// only a multiply-subtract away (a shorter dependency chain). A discount scales `D` alone.
 ///
 /// ```
 /// use seqsmooth::recursive::TriangularFactor;
@@ -11,11 +19,17 @@ use nalgebra::{DMatrix, DVector};
 /// f.add_row(&[1.0, 1.0], 0.0, 1.0);
 /// let g = f.gram();
 /// assert!((g[(0, 0)] - 5.0).abs() < 1e-12 && (g[(1, 1)] - 1.0).abs() < 1e-12);
+/// let r = f.r(); // upper triangular with RᵀR = the Gram matrix
+/// assert!((r[(0, 0)] - 5f64.sqrt()).abs() < 1e-12 && r[(1, 0)] == 0.0);
 /// ```
 #[derive(Clone, Debug)]
 pub struct TriangularFactor {
-    r: DMatrix<f64>,
-    rhs: DVector<f64>,
+    /// `D`, the squares of `R`'s diagonal.
+    d: Vec<f64>,
+    /// `U`, unit upper triangular, row-major (`u[i·p + j]`, `j > i`; the rest unused).
+    u: Vec<f64>,
+    /// `ū = D^-½ d`.
+    ubar: Vec<f64>,
     residual_sq: f64,
     scratch: Vec<f64>,
 }
@@ -24,26 +38,57 @@ impl TriangularFactor {
     /// The zero factor of dimension `p`.
     pub fn new(p: usize) -> Self {
         Self {
-            r: DMatrix::zeros(p, p),
-            rhs: DVector::zeros(p),
+            d: vec![0.0; p],
+            u: vec![0.0; p * p],
+            ubar: vec![0.0; p],
             residual_sq: 0.0,
             scratch: vec![0.0; p],
         }
     }
 
+    /// The factor of a given upper-triangular `R` and right-hand side `rhs` (rows of `R` with a
+    /// zero diagonal carry no information and must be zero).
+    pub fn from_r(r: &DMatrix<f64>, rhs: &DVector<f64>) -> Self {
+        let p = rhs.len();
+        let mut f = Self::new(p);
+        for i in 0..p {
+            let rii = r[(i, i)];
+            if rii == 0.0 {
+                continue;
+            }
+            f.d[i] = rii * rii;
+            f.ubar[i] = rhs[i] / rii;
+            for j in i + 1..p {
+                f.u[i * p + j] = r[(i, j)] / rii;
+            }
+        }
+        f
+    }
+
     /// Dimension `p`.
     pub fn dim(&self) -> usize {
-        self.rhs.len()
+        self.d.len()
     }
 
-    /// The factor `R`.
-    pub fn r(&self) -> &DMatrix<f64> {
-        &self.r
+    /// The factor `R = D^½ U` (computed).
+    pub fn r(&self) -> DMatrix<f64> {
+        let p = self.dim();
+        DMatrix::from_fn(p, p, |i, j| {
+            let s = self.d[i].sqrt();
+            match j.cmp(&i) {
+                std::cmp::Ordering::Less => 0.0,
+                std::cmp::Ordering::Equal => s,
+                std::cmp::Ordering::Greater => s * self.u[i * p + j],
+            }
+        })
     }
 
-    /// The right-hand vector `d` (`Rᵀd = Σ c_k a_k b_k`).
-    pub fn rhs(&self) -> &DVector<f64> {
-        &self.rhs
+    /// The right-hand vector `d = D^½ ū` (`Rᵀd = Σ c_k a_k b_k`; computed).
+    pub fn rhs(&self) -> DVector<f64> {
+        DVector::from_iterator(
+            self.dim(),
+            self.d.iter().zip(&self.ubar).map(|(d, u)| d.sqrt() * u),
+        )
     }
 
     /// The part of `Σ c_k b_k²` that no linear combination of the rows explains: the (weighted)
@@ -52,127 +97,147 @@ impl TriangularFactor {
         self.residual_sq
     }
 
-    /// `RᵀR`.
+    /// `RᵀR = UᵀDU`.
     pub fn gram(&self) -> DMatrix<f64> {
-        self.r.transpose() * &self.r
+        let r = self.r();
+        r.transpose() * &r
     }
 
-    /// Folds the row `√c·[a | b]` into `[R | d]` by Givens rotations: `O(p²)`.
+    /// True when every diagonal entry of `R` is non-zero.
+    pub fn is_determined(&self) -> bool {
+        self.d.iter().all(|&d| d > 0.0)
+    }
+
+    /// Solves `R x = d` into `x` (`U x = ū`, no divisions); false while not determined.
+    pub fn solve_into(&self, x: &mut [f64]) -> bool {
+        if !self.is_determined() {
+            return false;
+        }
+        let p = self.dim();
+        for i in (0..p).rev() {
+            let mut s = self.ubar[i];
+            for j in i + 1..p {
+                s -= self.u[i * p + j] * x[j];
+            }
+            x[i] = s;
+        }
+        true
+    }
+
+    /// Folds the row `√c·[a | b]` into `[R | d]`: `O(p²)`, no square roots.
     pub fn add_row(&mut self, a: &[f64], b: f64, weight: f64) {
         let p = self.dim();
         assert_eq!(a.len(), p, "row of the wrong length");
-        let sw = if weight == 1.0 { 1.0 } else { weight.sqrt() };
         // Fixed sizes unroll completely (the polynomial filters' common degrees).
         match p {
-            1 => self.add_row_n::<1>(a, b, sw),
-            2 => self.add_row_n::<2>(a, b, sw),
-            3 => self.add_row_n::<3>(a, b, sw),
-            4 => self.add_row_n::<4>(a, b, sw),
-            5 => self.add_row_n::<5>(a, b, sw),
-            6 => self.add_row_n::<6>(a, b, sw),
-            7 => self.add_row_n::<7>(a, b, sw),
-            8 => self.add_row_n::<8>(a, b, sw),
-            9 => self.add_row_n::<9>(a, b, sw),
-            _ => self.add_row_any(a, b, sw),
+            1 => self.add_row_n::<1>(a, b, weight),
+            2 => self.add_row_n::<2>(a, b, weight),
+            3 => self.add_row_n::<3>(a, b, weight),
+            4 => self.add_row_n::<4>(a, b, weight),
+            5 => self.add_row_n::<5>(a, b, weight),
+            6 => self.add_row_n::<6>(a, b, weight),
+            7 => self.add_row_n::<7>(a, b, weight),
+            8 => self.add_row_n::<8>(a, b, weight),
+            9 => self.add_row_n::<9>(a, b, weight),
+            _ => self.add_row_any(a, b, weight),
         }
     }
 
     #[inline(always)]
-    fn add_row_n<const N: usize>(&mut self, a: &[f64], b: f64, sw: f64) {
-        let mut row = [0.0; N];
-        for (v, x) in row.iter_mut().zip(a) {
-            *v = x * sw;
-        }
-        let mut y = b * sw;
-        // `R` is column-major: entry (i, j) at `i + j·N`.
-        let r: &mut [f64] = &mut self.r.as_mut_slice()[..N * N];
-        let rhs: &mut [f64] = &mut self.rhs.as_mut_slice()[..N];
+    fn add_row_n<const N: usize>(&mut self, a: &[f64], b: f64, weight: f64) {
+        let mut x = [0.0; N];
+        x.copy_from_slice(&a[..N]);
+        let mut y = b;
+        let mut delta = weight;
+        let d: &mut [f64] = &mut self.d[..N];
+        let u: &mut [f64] = &mut self.u[..N * N];
+        let ubar: &mut [f64] = &mut self.ubar[..N];
         for i in 0..N {
-            let ai = row[i];
-            let rii = r[i + i * N];
-            let h = rotation_norm(rii, ai);
-            // ai = 0 leaves the row as it is (c = 1, s = 0), also when R_ii = 0.
-            let (c, s) = if ai != 0.0 {
-                (rii / h, ai / h)
-            } else {
-                (1.0, 0.0)
-            };
-            r[i + i * N] = if ai != 0.0 { h } else { rii };
-            for j in i + 1..N {
-                let rij = r[i + j * N];
-                let aj = row[j];
-                r[i + j * N] = c * rij + s * aj;
-                row[j] = c * aj - s * rij;
-            }
-            let di = rhs[i];
-            rhs[i] = c * di + s * y;
-            y = c * y - s * di;
-        }
-        self.residual_sq += y * y;
-    }
-
-    fn add_row_any(&mut self, a: &[f64], b: f64, sw: f64) {
-        let p = self.dim();
-        self.scratch.clear();
-        self.scratch.extend(a.iter().map(|v| v * sw));
-        let mut y = b * sw;
-        // `R` is column-major: entry (i, j) at `i + j·p`.
-        let r = self.r.as_mut_slice();
-        let rhs = self.rhs.as_mut_slice();
-        let row = &mut self.scratch[..p];
-        for i in 0..p {
-            let ai = row[i];
-            if ai == 0.0 {
+            let xi = x[i];
+            if xi == 0.0 || delta == 0.0 {
                 continue;
             }
-            let rii = r[i + i * p];
-            let h = rotation_norm(rii, ai);
-            let c = rii / h;
-            let s = ai / h;
-            r[i + i * p] = h;
-            row[i] = 0.0;
-            for j in i + 1..p {
-                let rij = r[i + j * p];
-                let aj = row[j];
-                r[i + j * p] = c * rij + s * aj;
-                row[j] = c * aj - s * rij;
+            let dx = delta * xi;
+            let dp = d[i] + dx * xi;
+            let cbar = d[i] / dp;
+            let sbar = dx / dp;
+            delta *= cbar;
+            d[i] = dp;
+            for j in i + 1..N {
+                let xj = x[j];
+                let uij = u[i * N + j];
+                x[j] = xj - xi * uij;
+                u[i * N + j] = cbar * uij + sbar * xj;
             }
-            let di = rhs[i];
-            rhs[i] = c * di + s * y;
-            y = c * y - s * di;
+            let ui = ubar[i];
+            ubar[i] = cbar * ui + sbar * y;
+            y -= xi * ui;
         }
-        self.residual_sq += y * y;
+        self.residual_sq += delta * y * y;
     }
 
-    /// Multiplies the accumulated Gram matrix by `f ≥ 0` (a fading-memory discount).
+    fn add_row_any(&mut self, a: &[f64], b: f64, weight: f64) {
+        let p = self.dim();
+        self.scratch.clear();
+        self.scratch.extend_from_slice(a);
+        let x = &mut self.scratch[..p];
+        let mut y = b;
+        let mut delta = weight;
+        for i in 0..p {
+            let xi = x[i];
+            if xi == 0.0 || delta == 0.0 {
+                continue;
+            }
+            let dx = delta * xi;
+            let dp = self.d[i] + dx * xi;
+            let cbar = self.d[i] / dp;
+            let sbar = dx / dp;
+            delta *= cbar;
+            self.d[i] = dp;
+            for j in i + 1..p {
+                let xj = x[j];
+                let uij = self.u[i * p + j];
+                x[j] = xj - xi * uij;
+                self.u[i * p + j] = cbar * uij + sbar * xj;
+            }
+            let ui = self.ubar[i];
+            self.ubar[i] = cbar * ui + sbar * y;
+            y -= xi * ui;
+        }
+        self.residual_sq += delta * y * y;
+    }
+
+    /// Multiplies the accumulated Gram matrix by `f ≥ 0` (a fading-memory discount): `D ← fD`.
     pub fn discount(&mut self, f: f64) {
-        self.discount_root(f.sqrt());
+        self.d.iter_mut().for_each(|v| *v *= f);
+        self.residual_sq *= f;
     }
 
-    /// [`discount`](Self::discount) by `f = s²`, given `s ≥ 0` (saves the square root when the
-    /// caller caches it).
+    /// [`discount`](Self::discount) by `f = s²`, given `s ≥ 0`.
     pub fn discount_root(&mut self, s: f64) {
-        self.r.as_mut_slice().iter_mut().for_each(|v| *v *= s);
-        self.rhs.as_mut_slice().iter_mut().for_each(|v| *v *= s);
-        self.residual_sq *= s * s;
+        self.discount(s * s);
     }
 
-    /// [`change_variables`](Self::change_variables) for an upper-triangular `A` (only its upper
-    /// triangle is read): `R ← R A` in place, row by row from the right (entry `(i, j)` needs
-    /// `R_ik` for `i ≤ k ≤ j`, still the old values), `O(p³/6)`, no allocation.
+    /// [`change_variables`](Self::change_variables) for an upper-triangular `A` with a positive
+    /// or negative (non-zero) diagonal (only its upper triangle is read): `U ← diag(A)⁻¹ U A`,
+    /// `D ← D diag(A)²`, `ū ← diag(A)⁻¹ ū`, in place, `O(p³/6)`, no allocation.
     pub fn change_variables_upper(&mut self, a: &DMatrix<f64>) {
         let p = self.dim();
         assert_eq!(a.shape(), (p, p), "change of variables of the wrong size");
         let a = a.as_slice();
-        let r = self.r.as_mut_slice();
         for i in 0..p {
-            for j in (i..p).rev() {
-                let mut acc = 0.0;
-                for k in i..=j {
-                    acc += r[i + k * p] * a[k + j * p];
+            // Row i of U A from the right (entry (i, j) needs U_ik for i ≤ k ≤ j, still old;
+            // U_ii = 1).
+            let aii = a[i + i * p];
+            for j in (i + 1..p).rev() {
+                let mut acc = a[i + j * p];
+                for k in i + 1..=j {
+                    acc += self.u[i * p + k] * a[k + j * p];
                 }
-                r[i + j * p] = acc;
+                self.u[i * p + j] = acc / aii;
             }
+            self.d[i] *= aii * aii;
+            self.ubar[i] /= aii;
         }
     }
 
@@ -181,40 +246,25 @@ impl TriangularFactor {
     /// a Householder QR of `[R A | d]`.
     pub fn change_variables(&mut self, a: &DMatrix<f64>) {
         let p = self.dim();
-        if (0..p).all(|i| (0..i).all(|j| a[(i, j)] == 0.0)) {
+        if (0..p).all(|i| (0..i).all(|j| a[(i, j)] == 0.0) && a[(i, i)] != 0.0) {
             self.change_variables_upper(a);
             return;
         }
-        let ra = &self.r * a;
-        let upper = (0..p).all(|i| (0..i).all(|j| ra[(i, j)] == 0.0));
-        if upper {
-            self.r = ra;
-            return;
-        }
+        let ra = self.r() * a;
         let mut aug = DMatrix::zeros(p, p + 1);
         aug.view_mut((0, 0), (p, p)).copy_from(&ra);
-        aug.set_column(p, &self.rhs);
+        aug.set_column(p, &self.rhs());
         let qr = aug.qr();
         let r = qr.r();
-        self.r = r.view((0, 0), (p, p)).into_owned();
-        self.rhs = r.column(p).into_owned();
+        let mut rr: DMatrix<f64> = r.view((0, 0), (p, p)).into_owned();
         for i in 0..p {
             for j in 0..i {
-                self.r[(i, j)] = 0.0;
+                rr[(i, j)] = 0.0;
             }
         }
-    }
-}
-
-/// `√(a² + b²)` for a Givens rotation: the plain formula (a few times faster than `hypot`),
-/// falling back to `hypot` when the squares overflow or underflow.
-#[inline]
-fn rotation_norm(a: f64, b: f64) -> f64 {
-    let h = (a * a + b * b).sqrt();
-    if h.is_finite() && h > 1e-150 {
-        h
-    } else {
-        a.hypot(b)
+        let residual = self.residual_sq;
+        *self = Self::from_r(&rr, &r.column(p).into_owned());
+        self.residual_sq = residual;
     }
 }
 
@@ -247,11 +297,9 @@ impl InformationFilter {
     /// A Bayes filter with prior estimate `mean` and prior information factor `r_prior`
     /// (`r_priorᵀ r_prior` = inverse prior covariance; upper triangular).
     pub fn with_prior(mean: &DVector<f64>, r_prior: &DMatrix<f64>) -> Self {
-        let p = mean.len();
-        let mut info = TriangularFactor::new(p);
-        info.r = r_prior.clone();
-        info.rhs = r_prior * mean;
-        Self { info }
+        Self {
+            info: TriangularFactor::from_r(r_prior, &(r_prior * mean)),
+        }
     }
 
     /// State dimension.
@@ -292,19 +340,20 @@ impl InformationFilter {
 
     /// True when every diagonal entry of `R` is non-zero (the state is determined).
     pub fn is_determined(&self) -> bool {
-        (0..self.dim()).all(|i| self.info.r[(i, i)] != 0.0)
+        self.info.is_determined()
     }
 
     /// The estimate `R⁻¹ d`, or `None` while the state is not determined.
     pub fn solve(&self) -> Option<DVector<f64>> {
-        let mut x: Vec<f64> = self.info.rhs.iter().copied().collect();
-        solve_upper_in_place(&self.info.r, &mut x).then(|| DVector::from_vec(x))
+        let mut x = vec![0.0; self.dim()];
+        self.info.solve_into(&mut x).then(|| DVector::from_vec(x))
     }
 
     /// `J R⁻¹` for a given `J` (rows are linear functionals of the state): the building block of
     /// covariances `J (RᵀR)⁻¹ Jᵀ = (J R⁻¹)(J R⁻¹)ᵀ`.
     pub fn right_divide(&self, j: &DMatrix<f64>) -> Option<DMatrix<f64>> {
         let p = self.dim();
+        let factor = self.info.r();
         let mut out = DMatrix::zeros(j.nrows(), p);
         let mut row = vec![0.0; p];
         for r in 0..j.nrows() {
@@ -312,7 +361,7 @@ impl InformationFilter {
                 *v = j[(r, c)];
             }
             // (J R⁻¹)ᵀ = R⁻ᵀ Jᵀ: forward substitution with Rᵀ.
-            if !solve_upper_transpose_in_place(&self.info.r, &mut row) {
+            if !solve_upper_transpose_in_place(&factor, &mut row) {
                 return None;
             }
             for (c, v) in row.iter().enumerate() {
