@@ -116,8 +116,8 @@ impl TriangularFactor {
         let p = self.dim();
         for i in (0..p).rev() {
             let mut s = self.ubar[i];
-            for j in i + 1..p {
-                s -= self.u[i * p + j] * x[j];
+            for (uij, xj) in self.u[i * p + i + 1..(i + 1) * p].iter().zip(&x[i + 1..p]) {
+                s -= uij * xj;
             }
             x[i] = s;
         }
@@ -194,11 +194,11 @@ impl TriangularFactor {
             let sbar = dx / dp;
             delta *= cbar;
             self.d[i] = dp;
-            for j in i + 1..p {
-                let xj = x[j];
-                let uij = self.u[i * p + j];
-                x[j] = xj - xi * uij;
-                self.u[i * p + j] = cbar * uij + sbar * xj;
+            let row = &mut self.u[i * p + i + 1..(i + 1) * p];
+            for (xj, uij) in x[i + 1..p].iter_mut().zip(row.iter_mut()) {
+                let (a, u) = (*xj, *uij);
+                *xj = a - xi * u;
+                *uij = cbar * u + sbar * a;
             }
             let ui = self.ubar[i];
             self.ubar[i] = cbar * ui + sbar * y;
