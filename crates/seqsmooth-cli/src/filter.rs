@@ -255,6 +255,30 @@ impl<R: Read> Read for LineTracker<R> {
     }
 }
 
+/// An input without a header (empty) cannot hold the samples `need` asks for.
+pub fn check_header(headers: &[String], need: &Need) -> Result<(), CliError> {
+    if headers.is_empty() || (headers.len() == 1 && headers[0].is_empty()) {
+        return Err(CliError::Data(format!(
+            "too few samples: the input is empty (no header, no data rows); {} needs at \
+             least {} data row{}",
+            need.why,
+            need.rows,
+            if need.rows == 1 { "" } else { "s" }
+        )));
+    }
+    Ok(())
+}
+
+/// The index of the column `name` in the header, or an error listing the columns.
+pub fn find_column(headers: &[String], name: &str) -> Result<usize, CliError> {
+    headers.iter().position(|h| h == name).ok_or_else(|| {
+        CliError::Data(format!(
+            "column '{name}' not found in the header; columns are: {}",
+            headers.join(", ")
+        ))
+    })
+}
+
 /// The error of the CSV parser `e`, with the line `tracker` finds for its position.
 pub fn csv_read_error<R: Read>(tracker: &mut LineTracker<R>, e: csv::Error) -> CliError {
     let line = e.position().map(|p| tracker.line_at(p.byte()));
@@ -309,23 +333,9 @@ impl<R: Read> SampleReader<R> {
             Ok(h) => h.clone(),
             Err(e) => return Err(this.csv_error(e)),
         };
-        if headers.is_empty() || (headers.len() == 1 && headers[0].is_empty()) {
-            return Err(CliError::Data(format!(
-                "too few samples: the input is empty (no header, no data rows); {} needs at \
-                 least {} data row{}",
-                need.why,
-                need.rows,
-                if need.rows == 1 { "" } else { "s" }
-            )));
-        }
-        let find = |name: &str| {
-            headers.iter().position(|h| h == name).ok_or_else(|| {
-                CliError::Data(format!(
-                    "column '{name}' not found in the header; columns are: {}",
-                    headers.iter().collect::<Vec<_>>().join(", ")
-                ))
-            })
-        };
+        let headers: Vec<String> = headers.iter().map(str::to_string).collect();
+        check_header(&headers, need)?;
+        let find = |name: &str| find_column(&headers, name);
         this.time_idx = find(time_col)?;
         this.value_idx = find(value_col)?;
         Ok(this)

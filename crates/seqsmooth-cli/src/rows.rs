@@ -199,23 +199,8 @@ impl<R: Read> RowReader<R> {
             Ok(h) => h.iter().map(|c| c.trim().to_string()).collect(),
             Err(e) => return Err(this.csv_error(e)),
         };
-        if headers.is_empty() || (headers.len() == 1 && headers[0].is_empty()) {
-            return Err(CliError::Data(format!(
-                "too few samples: the input is empty (no header, no data rows); {} needs at \
-                 least {} data row{}",
-                need.why,
-                need.rows,
-                if need.rows == 1 { "" } else { "s" }
-            )));
-        }
-        let find = |name: &str| {
-            headers.iter().position(|h| h == name).ok_or_else(|| {
-                CliError::Data(format!(
-                    "column '{name}' not found in the header; columns are: {}",
-                    headers.join(", ")
-                ))
-            })
-        };
+        crate::filter::check_header(&headers, need)?;
+        let find = |name: &str| crate::filter::find_column(&headers, name);
         this.time_idx = find(time_col)?;
         this.value_idx = find(value_col)?;
         this.id_idx = id_col.map(find).transpose()?;
@@ -231,26 +216,7 @@ impl<R: Read> RowReader<R> {
     }
 
     fn csv_error(&mut self, e: csv::Error) -> CliError {
-        let line = e
-            .position()
-            .map(|p| self.reader.get_mut().line_at(p.byte()));
-        let at = match line {
-            Some(l) => format!("line {l}: "),
-            None => String::new(),
-        };
-        match e.kind() {
-            csv::ErrorKind::UnequalLengths {
-                expected_len, len, ..
-            } => CliError::Data(format!(
-                "{at}malformed CSV: the row has {len} field{} but the header has {expected_len}",
-                if *len == 1 { "" } else { "s" }
-            )),
-            csv::ErrorKind::Utf8 { .. } => {
-                CliError::Data(format!("{at}malformed CSV: the row is not valid UTF-8"))
-            }
-            csv::ErrorKind::Io(io) => CliError::Data(format!("cannot read the input: {io}")),
-            _ => CliError::Data(format!("{at}malformed CSV: {e}")),
-        }
+        crate::filter::csv_read_error(self.reader.get_mut(), e)
     }
 
     /// Reads up to `max_rows` rows into `chunk` (replacing its contents). Reading stops early

@@ -11,40 +11,10 @@ use seqsmooth::scalar::{parse_rational, ratio_to_f64, rational_from_f64, Rationa
 use seqsmooth::{
     Engine, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory, PolynomialFilter,
 };
-use std::io::Write;
 use std::path::PathBuf;
-use std::process::{Command, Stdio};
 
-/// The outcome of one run of the binary.
-struct Out {
-    code: i32,
-    stdout: String,
-    stderr: String,
-}
-
-/// Runs `seqsmooth args…` with `stdin` as standard input.
-fn run(args: &[&str], stdin: &str) -> Out {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_seqsmooth"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn seqsmooth");
-    let mut input = child.stdin.take().unwrap();
-    let data = stdin.as_bytes().to_vec();
-    // Write from a thread: the child may exit (on an error) before reading everything.
-    let writer = std::thread::spawn(move || {
-        let _ = input.write_all(&data);
-    });
-    let out = child.wait_with_output().expect("wait for seqsmooth");
-    writer.join().unwrap();
-    Out {
-        code: out.status.code().expect("exit code"),
-        stdout: String::from_utf8(out.stdout).unwrap(),
-        stderr: String::from_utf8(out.stderr).unwrap(),
-    }
-}
+mod common;
+use common::run;
 
 /// Runs and asserts success.
 fn ok(args: &[&str], stdin: &str) -> String {

@@ -5,39 +5,13 @@
 //! far above that of a blank image of the same dimensions (a white 1400×1030 PNG compresses to
 //! about 7 KB); an SVG's text (title, axis labels, legend entries) and its element counts.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 
-/// The outcome of one run of the binary.
-struct Out {
-    code: i32,
-    stdout: String,
-    stderr: String,
-}
+mod common;
+use common::{run_at, Out};
 
-/// Runs `seqsmooth args…` in `dir` with `stdin` as standard input.
 fn run_in(dir: &Path, args: &[&str], stdin: &str) -> Out {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_seqsmooth"))
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn seqsmooth");
-    let mut input = child.stdin.take().unwrap();
-    let data = stdin.as_bytes().to_vec();
-    let writer = std::thread::spawn(move || {
-        let _ = input.write_all(&data);
-    });
-    let out = child.wait_with_output().expect("wait for seqsmooth");
-    writer.join().unwrap();
-    Out {
-        code: out.status.code().expect("exit code"),
-        stdout: String::from_utf8(out.stdout).unwrap(),
-        stderr: String::from_utf8(out.stderr).unwrap(),
-    }
+    run_at(Some(dir), args, stdin)
 }
 
 fn ok_in(dir: &Path, args: &[&str], stdin: &str) -> String {
