@@ -80,10 +80,28 @@ pub fn scaling<T: Scalar>(m: usize, tau: T) -> DMatrix<T> {
 /// assert_eq!(z, [6.0, 8.0, 3.0]);
 /// ```
 pub fn shift_scaled(z: &mut [f64], h: f64) {
-    let n = z.len();
-    if n < 2 || h == 0.0 {
+    if z.len() < 2 || h == 0.0 {
         return;
     }
+    // Fixed lengths unroll completely (the same operations in the same order).
+    match z.len() {
+        2 => shift_fixed::<2>(z, h),
+        3 => shift_fixed::<3>(z, h),
+        4 => shift_fixed::<4>(z, h),
+        5 => shift_fixed::<5>(z, h),
+        6 => shift_fixed::<6>(z, h),
+        _ => shift_any(z, h),
+    }
+}
+
+#[inline(always)]
+fn shift_fixed<const N: usize>(z: &mut [f64], h: f64) {
+    shift_any(&mut z[..N], h);
+}
+
+#[inline(always)]
+fn shift_any(z: &mut [f64], h: f64) {
+    let n = z.len();
     for i in 0..n - 1 {
         for k in (i..n - 1).rev() {
             z[k] += h * z[k + 1];

@@ -62,6 +62,8 @@ pub(crate) struct ExactEngine {
     /// `inv_scale²` (`inv_scale⁴`). Solutions and the sandwich covariance do not depend on the
     /// common scale.
     inv_scale: f64,
+    /// `k!/s^k` for the unit `s` (unscaled derivatives from the coefficients).
+    unscale: Vec<f64>,
     /// The last re-centring `(α, β, A)`.
     recentre_cache: Option<(f64, f64, DMatrix<f64>)>,
 }
@@ -85,6 +87,7 @@ impl ExactEngine {
             neg_ln_theta: discount.map_or(0.0, |d| -d.theta.ln()),
             span_per_time: discount.map_or(0.0, |d| 3.0 * d.tau / -d.theta.ln()),
             recentre_cache: None,
+            unscale: vec![0.0; m + 1],
             inv_scale: 1.0,
         }
     }
@@ -110,6 +113,7 @@ impl ExactEngine {
             self.t_first = t;
             self.centre = t;
             self.unit = 1.0;
+            self.set_unscale();
         } else {
             if let Some(d) = self.discount {
                 let dt = t - self.t_last;
@@ -184,6 +188,18 @@ impl ExactEngine {
         }
     }
 
+    /// `k!/s^k` for the current unit `s`.
+    fn set_unscale(&mut self) {
+        let (mut f, mut sk) = (1.0, 1.0);
+        for (k, c) in self.unscale.iter_mut().enumerate() {
+            if k > 0 {
+                f *= k as f64;
+                sk *= self.unit;
+            }
+            *c = f / sk;
+        }
+    }
+
     /// Re-centres: `u_old = α u_new + β`, i.e. new centre `c + β·s`, new unit `α·s`.
     fn recentre(&mut self, alpha: f64, beta: f64) {
         if self.recentre_cache.as_ref().map(|c| (c.0, c.1)) != Some((alpha, beta)) {
@@ -204,6 +220,7 @@ impl ExactEngine {
         }
         self.centre += beta * self.unit;
         self.unit *= alpha;
+        self.set_unscale();
     }
 
     pub fn is_determined(&self) -> bool {
@@ -224,13 +241,10 @@ impl ExactEngine {
             return false;
         }
         shift_scaled(a, (t - self.centre) / self.unit);
-        let (mut f, mut sk) = (1.0, 1.0);
-        for (k, (x, z)) in out.iter_mut().zip(a.iter()).enumerate() {
-            if k > 0 {
-                f *= k as f64;
-                sk *= self.unit;
-            }
-            *x = z * f / sk;
+        // `k!/s^k`: the unit `s` is a power of two (re-centring scales it by powers of two
+        // from 1), so this equals `z·k!/s^k` computed with the division, bit for bit.
+        for ((x, z), c) in out.iter_mut().zip(a.iter()).zip(&self.unscale) {
+            *x = z * c;
         }
         true
     }

@@ -8,7 +8,8 @@ use nalgebra::{DMatrix, DVector};
 /// Givens transformations without square roots*, 1973): `R = D^½ U` and `d = D^½ ū` with `U`
 /// unit upper triangular and `D ≥ 0` diagonal. A new row is folded in by the square-root-free
 /// Givens rotations: per pivot `i`, `d_i' = d_i + δ a_i²`, `c̄ = d_i/d_i'`, `s̄ = δ a_i/d_i'`,
-/// `a_j ← a_j − a_i u_ij`, `u_ij ← c̄ u_ij + s̄ a_j`, `δ ← δ c̄` — the same orthogonal
+/// `a_j ← a_j − a_i u_ij`, `u_ij ← c̄ u_ij + s̄ a_j`, `δ ← δ c̄` (a zero pivot `d_i' = 0` leaves
+/// everything as it is) — the same orthogonal
 /// transformations as with square roots, without them, and with the next pivot's row entry
 /// only a multiply-subtract away (a shorter dependency chain). A discount scales `D` alone.
 ///
@@ -110,13 +111,36 @@ impl TriangularFactor {
 
     /// Solves `R x = d` into `x` (`U x = ū`, no divisions); false while not determined.
     pub fn solve_into(&self, x: &mut [f64]) -> bool {
-        if !self.is_determined() {
+        match self.dim() {
+            1 => self.solve_n::<1>(x),
+            2 => self.solve_n::<2>(x),
+            3 => self.solve_n::<3>(x),
+            4 => self.solve_n::<4>(x),
+            5 => self.solve_n::<5>(x),
+            6 => self.solve_n::<6>(x),
+            7 => self.solve_n::<7>(x),
+            8 => self.solve_n::<8>(x),
+            9 => self.solve_n::<9>(x),
+            p => self.solve_any(p, x),
+        }
+    }
+
+    #[inline(always)]
+    fn solve_n<const N: usize>(&self, x: &mut [f64]) -> bool {
+        self.solve_any(N, x)
+    }
+
+    #[inline(always)]
+    fn solve_any(&self, p: usize, x: &mut [f64]) -> bool {
+        if !self.d[..p].iter().all(|&v| v > 0.0) {
             return false;
         }
-        let p = self.dim();
+        let u: &[f64] = &self.u[..p * p];
+        let ubar: &[f64] = &self.ubar[..p];
+        let x: &mut [f64] = &mut x[..p];
         for i in (0..p).rev() {
-            let mut s = self.ubar[i];
-            for (uij, xj) in self.u[i * p + i + 1..(i + 1) * p].iter().zip(&x[i + 1..p]) {
+            let mut s = ubar[i];
+            for (uij, xj) in u[i * p + i + 1..(i + 1) * p].iter().zip(&x[i + 1..]) {
                 s -= uij * xj;
             }
             x[i] = s;
@@ -154,13 +178,14 @@ impl TriangularFactor {
         let ubar: &mut [f64] = &mut self.ubar[..N];
         for i in 0..N {
             let xi = x[i];
-            if xi == 0.0 || delta == 0.0 {
-                continue;
-            }
             let dx = delta * xi;
             let dp = d[i] + dx * xi;
-            let cbar = d[i] / dp;
-            let sbar = dx / dp;
+            // A zero pivot (no information yet and a zero entry) leaves everything as it is.
+            let (cbar, sbar) = if dp > 0.0 {
+                (d[i] / dp, dx / dp)
+            } else {
+                (1.0, 0.0)
+            };
             delta *= cbar;
             d[i] = dp;
             for j in i + 1..N {
@@ -185,13 +210,13 @@ impl TriangularFactor {
         let mut delta = weight;
         for i in 0..p {
             let xi = x[i];
-            if xi == 0.0 || delta == 0.0 {
-                continue;
-            }
             let dx = delta * xi;
             let dp = self.d[i] + dx * xi;
-            let cbar = self.d[i] / dp;
-            let sbar = dx / dp;
+            let (cbar, sbar) = if dp > 0.0 {
+                (self.d[i] / dp, dx / dp)
+            } else {
+                (1.0, 0.0)
+            };
             delta *= cbar;
             self.d[i] = dp;
             let row = &mut self.u[i * p + i + 1..(i + 1) * p];
