@@ -16,6 +16,20 @@ fn sample(n: usize) -> f64 {
     100.0 * (0.003 * t).sin() + 0.01 * t + noise
 }
 
+/// `n` times `k·0.1` (steps equal up to rounding) or, `irregular`, steps `0.1·(1 ± 0.3)`.
+fn grid(n: usize, irregular: bool) -> Vec<f64> {
+    (0..n)
+        .map(|k| {
+            let k = k as f64;
+            if irregular {
+                0.1 * k + 0.03 * (1.7 * k).sin()
+            } else {
+                0.1 * k
+            }
+        })
+        .collect()
+}
+
 fn filters(m: usize, irregular: bool) -> Vec<(String, Box<dyn PolynomialFilter>)> {
     let mut v: Vec<(String, Box<dyn PolynomialFilter>)> = Vec::new();
     for engine in [Engine::Exact, Engine::Gain] {
@@ -59,17 +73,7 @@ fn rel_diff(a: &[f64], b: &[f64], scale: &[f64]) -> f64 {
 fn update_many_equals_update_on_even_and_irregular_times() {
     for m in [0, 1, 2, 3, 5, 8] {
         for irregular in [false, true] {
-            // Even: k·0.1 (steps equal up to rounding); irregular: steps 0.1·(1 ± 0.3).
-            let times: Vec<f64> = (0..3000)
-                .map(|k| {
-                    let k = k as f64;
-                    if irregular {
-                        0.1 * k + 0.03 * (1.7 * k).sin()
-                    } else {
-                        0.1 * k
-                    }
-                })
-                .collect();
+            let times = grid(3000, irregular);
             let ys: Vec<f64> = (0..times.len()).map(sample).collect();
             for ((name, mut one), (_, mut many)) in
                 filters(m, irregular).into_iter().zip(filters(m, irregular))
@@ -181,7 +185,7 @@ fn update_many_reports_the_first_bad_sample_and_keeps_the_ones_before() {
 #[test]
 fn plain_steady_kernel_accuracy_over_long_runs() {
     let n = 60_000;
-    let times: Vec<f64> = (0..n).map(|k| k as f64 * 0.1).collect();
+    let times = grid(n, false);
     let ys: Vec<f64> = (0..n).map(sample).collect();
     for m in 0..=8 {
         let mut row = Vec::new();
@@ -231,16 +235,7 @@ fn plain_steady_kernel_accuracy_over_long_runs() {
 fn plain_expanding_kernel_accuracy_over_long_runs() {
     let n = 60_000;
     for jitter in [false, true] {
-        let times: Vec<f64> = (0..n)
-            .map(|k| {
-                let k = k as f64;
-                if jitter {
-                    0.1 * k + 0.03 * (1.7 * k).sin()
-                } else {
-                    0.1 * k
-                }
-            })
-            .collect();
+        let times = grid(n, jitter);
         let ys: Vec<f64> = (0..n).map(sample).collect();
         let mut row = Vec::new();
         let mut rels = Vec::new();
@@ -290,16 +285,7 @@ fn plain_expanding_kernel_accuracy_over_long_runs() {
 fn update_many_into_writes_every_samples_estimate() {
     for m in [0, 1, 2, 4, 6] {
         for irregular in [false, true] {
-            let times: Vec<f64> = (0..2500)
-                .map(|k| {
-                    let k = k as f64;
-                    if irregular {
-                        0.1 * k + 0.03 * (1.7 * k).sin()
-                    } else {
-                        0.1 * k
-                    }
-                })
-                .collect();
+            let times = grid(2500, irregular);
             let ys: Vec<f64> = (0..times.len()).map(sample).collect();
             for ((name, mut one), (_, mut many)) in
                 filters(m, irregular).into_iter().zip(filters(m, irregular))
