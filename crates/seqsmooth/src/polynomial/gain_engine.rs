@@ -20,6 +20,16 @@ use crate::model::{shift_scaled_compensated, two_sum};
 use crate::scalar::{rational_from_f64, Rational, Scalar};
 use nalgebra::{DMatrix, DVector};
 
+/// A kernel's output row (if any): the unscaled derivatives `x_k = z_k·k!/τ^k`.
+#[inline(always)]
+fn write_row(row: Option<&mut [f64]>, z: &[f64], c: &[f64]) {
+    if let Some(row) = row {
+        for ((x, z), c) in row.iter_mut().zip(z).zip(c) {
+            *x = z * c;
+        }
+    }
+}
+
 /// Binomial coefficients `C(j, k)` for `j, k < N`.
 fn binomials<const N: usize>() -> [[f64; N]; N] {
     let mut c = [[0.0; N]; N];
@@ -335,6 +345,19 @@ impl GainEngine {
         c
     }
 
+    /// The state as plain `f64` (the double word folded), for the kernels below.
+    fn plain_state<const N: usize>(&self) -> [f64; N] {
+        std::array::from_fn(|k| self.z[k] + self.z_lo[k])
+    }
+
+    /// Stores a kernel's state after `done` samples, the newest at `t_last`.
+    fn end_plain_run(&mut self, z: &[f64], t_last: f64, done: usize) {
+        self.z.copy_from_slice(z);
+        self.z_lo.iter_mut().for_each(|v| *v = 0.0);
+        self.t_last = t_last;
+        self.n += done as u64;
+    }
+
     /// The expanding-memory recursion after the exact start in plain `f64`, any steps: the
     /// same operations as [`update`](Self::update) (gains `h_k(n)` of Table 9.1 scaled for the
     /// mean step), without the compensation. Takes every sample; with `W`, writes each
@@ -347,7 +370,7 @@ impl GainEngine {
     ) -> usize {
         let c = self.derivative_factors::<N>();
         let mut rows = out.chunks_exact_mut(N);
-        let mut z: [f64; N] = std::array::from_fn(|k| self.z[k] + self.z_lo[k]);
+        let mut z = self.plain_state::<N>();
         let mut g = [0.0; N];
         let tau = self.tau;
         let t_first = self.t_first;
@@ -378,22 +401,15 @@ impl GainEngine {
                 z[k] += g[k] * e;
             }
             if W {
-                if let Some(row) = rows.next() {
-                    for k in 0..N {
-                        row[k] = z[k] * c[k];
-                    }
-                }
+                write_row(rows.next(), &z, &c);
             }
             t_last = t;
             last_step = step;
             n += 1;
         }
         let done = (n - self.n) as usize;
-        self.z.copy_from_slice(&z);
-        self.z_lo.iter_mut().for_each(|v| *v = 0.0);
-        self.t_last = t_last;
+        self.end_plain_run(&z, t_last, done);
         self.step_mean = last_step;
-        self.n = n;
         done
     }
 
@@ -405,12 +421,8 @@ impl GainEngine {
     ) -> usize {
         let c = self.derivative_factors::<N>();
         let mut rows = out.chunks_exact_mut(N);
-        let mut z = [0.0; N];
-        let mut g = [0.0; N];
-        for k in 0..N {
-            z[k] = self.z[k] + self.z_lo[k];
-            g[k] = self.k[k];
-        }
+        let mut z = self.plain_state::<N>();
+        let g: [f64; N] = std::array::from_fn(|k| self.k[k]);
         let step = self.step_mean;
         let tol = step_tolerance(step, 0.0, self.tau);
         let tol_per_time = step_tolerance(0.0, 1.0, self.tau);
@@ -467,19 +479,12 @@ impl GainEngine {
             }
             z = next;
             if W {
-                if let Some(row) = rows.next() {
-                    for k in 0..N {
-                        row[k] = z[k] * c[k];
-                    }
-                }
+                write_row(rows.next(), &z, &c);
             }
             t_last = t;
             done += 1;
         }
-        self.z.copy_from_slice(&z);
-        self.z_lo.iter_mut().for_each(|v| *v = 0.0);
-        self.t_last = t_last;
-        self.n += done as u64;
+        self.end_plain_run(&z, t_last, done);
         done
     }
 
