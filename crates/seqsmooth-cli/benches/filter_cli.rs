@@ -12,6 +12,8 @@
 //! Throughput is in rows (criterion's elements/s).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -21,24 +23,6 @@ use std::time::Duration;
 /// Rows of each generated input.
 const ROWS: usize = 1_000_000;
 
-/// xorshift64*: deterministic data.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        let mut x = self.0;
-        x ^= x >> 12;
-        x ^= x << 25;
-        x ^= x >> 27;
-        self.0 = x;
-        x.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-
-    fn uniform(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// Writes `ROWS` rows to `path` (once; kept between runs): one series, or `series` series
 /// with an id column.
 fn generate(path: &Path, series: Option<usize>) -> std::io::Result<()> {
@@ -47,13 +31,13 @@ fn generate(path: &Path, series: Option<usize>) -> std::io::Result<()> {
     }
     let tmp = path.with_extension("partial");
     let mut out = BufWriter::new(File::create(&tmp)?);
-    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let mut rng = StdRng::seed_from_u64(0x9E37_79B9_7F4A_7C15);
     match series {
         None => {
             writeln!(out, "t,y")?;
             for k in 0..ROWS {
                 let t = k as f64 * 0.01;
-                writeln!(out, "{t},{}", t.sin() + 0.1 * (rng.uniform() - 0.5))?;
+                writeln!(out, "{t},{}", t.sin() + 0.1 * (rng.gen::<f64>() - 0.5))?;
             }
         }
         Some(n) => {
@@ -62,11 +46,11 @@ fn generate(path: &Path, series: Option<usize>) -> std::io::Result<()> {
             for round in 0..ROWS / n {
                 // A fresh order every round: the series do not alternate regularly.
                 for i in (1..n).rev() {
-                    order.swap(i, (rng.next() % (i as u64 + 1)) as usize);
+                    order.swap(i, rng.gen_range(0..=i));
                 }
                 for &s in &order {
                     let t = round as f64 * 0.01 + s as f64 * 1e-4;
-                    let y = (t + s as f64).sin() + 0.1 * (rng.uniform() - 0.5);
+                    let y = (t + s as f64).sin() + 0.1 * (rng.gen::<f64>() - 0.5);
                     writeln!(out, "s{s},{t},{y}")?;
                 }
             }
