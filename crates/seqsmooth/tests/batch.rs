@@ -363,3 +363,56 @@ fn update_many_into_checks_lengths_and_stops_at_a_bad_sample() {
         assert!(est[40 * 3..].iter().all(|v| *v == -1.0), "{name}");
     }
 }
+
+/// Even runs interrupted by gaps (dropouts) and a changed step: `update_many` (whole blocks as
+/// block maps where it can, the recursion around the breaks) against per-sample `update`,
+/// fading memory, degrees 0-8, both discount modes.
+#[test]
+fn update_many_across_gaps_and_step_changes() {
+    let mut times = Vec::new();
+    let mut t = 0.0;
+    for k in 0..5000 {
+        // dropouts (a missing sample, then a 7-sample gap) and a step change from 0.1 to 0.25
+        let step = if k < 3000 { 0.1 } else { 0.25 };
+        t += if k == 700 || k == 1901 {
+            2.0 * step
+        } else if k == 2500 {
+            8.0 * step
+        } else {
+            step
+        };
+        times.push(t);
+    }
+    let ys: Vec<f64> = (0..times.len()).map(sample).collect();
+    for m in 0..=8 {
+        for mode in [
+            seqsmooth::DiscountMode::PerTime,
+            seqsmooth::DiscountMode::PerUpdate,
+        ] {
+            let make = || {
+                FadingMemory::new(m, 0.95, 0.1, Engine::Gain)
+                    .unwrap()
+                    .with_discount_mode(mode)
+                    .unwrap()
+            };
+            let (mut one, mut many) = (make(), make());
+            // Batches of 997 samples; compared at each batch end, relative to the largest
+            // |x^(k)| so far.
+            let mut scale = vec![0.0f64; m + 1];
+            let mut worst = 0.0f64;
+            for (tc, yc) in times.chunks(997).zip(ys.chunks(997)) {
+                many.update_many(tc, yc).unwrap();
+                for (t, y) in tc.iter().zip(yc) {
+                    one.update(*t, *y).unwrap();
+                }
+                let a = one.estimate().unwrap().derivatives;
+                let b = many.estimate().unwrap().derivatives;
+                for (s, x) in scale.iter_mut().zip(&a) {
+                    *s = s.max(x.abs());
+                }
+                worst = worst.max(rel_diff(&a, &b, &scale));
+            }
+            assert!(worst <= 1e-11, "m = {m}, {mode:?}: {worst:e}");
+        }
+    }
+}
