@@ -364,9 +364,10 @@ fn update_many_into_checks_lengths_and_stops_at_a_bad_sample() {
     }
 }
 
-/// Even runs interrupted by gaps (dropouts) and a changed step: `update_many` (whole blocks as
-/// block maps where it can, the recursion around the breaks) against per-sample `update`,
-/// fading memory, degrees 0-8, both discount modes.
+/// Even runs interrupted by gaps (dropouts) and a changed step: `update_many` (whole blocks of
+/// even steps as block maps or least-squares updates where it can, the recursion around the
+/// breaks) against per-sample `update`,
+/// fading memory (both discount modes) and expanding memory, degrees 0-8.
 #[test]
 fn update_many_across_gaps_and_step_changes() {
     let mut times = Vec::new();
@@ -386,14 +387,20 @@ fn update_many_across_gaps_and_step_changes() {
     let ys: Vec<f64> = (0..times.len()).map(sample).collect();
     for m in 0..=8 {
         for mode in [
-            seqsmooth::DiscountMode::PerTime,
-            seqsmooth::DiscountMode::PerUpdate,
+            Some(seqsmooth::DiscountMode::PerTime),
+            Some(seqsmooth::DiscountMode::PerUpdate),
+            None,
         ] {
-            let make = || {
-                FadingMemory::new(m, 0.95, 0.1, Engine::Gain)
-                    .unwrap()
-                    .with_discount_mode(mode)
-                    .unwrap()
+            let make = || -> Box<dyn PolynomialFilter> {
+                match mode {
+                    Some(mode) => Box::new(
+                        FadingMemory::new(m, 0.95, 0.1, Engine::Gain)
+                            .unwrap()
+                            .with_discount_mode(mode)
+                            .unwrap(),
+                    ),
+                    None => Box::new(ExpandingMemory::new(m, Engine::Gain).unwrap()),
+                }
             };
             let (mut one, mut many) = (make(), make());
             // Batches of 997 samples; compared at each batch end, relative to the largest

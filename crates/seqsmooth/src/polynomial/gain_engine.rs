@@ -68,6 +68,10 @@ const STEADY_BLOCK: usize = 64;
 /// `ε·|t|/(BΔt)`, far below.
 const LINEAR_STEP_DEVIATION: f64 = 1e-9;
 
+/// The largest degree whose expanding-memory `update_many` runs on even runs as a
+/// least-squares update ([`super::expanding_block`]).
+const EXPANDING_BLOCK_MAX_DEGREE: usize = 4;
+
 /// The largest degree whose steady fading recursion `update_many` runs as block maps. Above
 /// it the block map's rounding (weights of mixed sign, `Ā` far from normal) approaches the
 /// tests' bound: against the compensated per-sample path over 6·10⁴ samples, 8.0e-12 against
@@ -512,7 +516,9 @@ impl GainEngine {
     /// differs from the typical one by more than `1e-12`, relative).
     fn steady_run(&mut self, ts: &[f64], ys: &[f64], out: &mut [f64], write: bool) -> usize {
         // Without per-sample outputs, whole blocks of the steady fading recursion first.
-        let blocks = if self.fading.is_some() && !write && self.m <= STEADY_BLOCK_MAX_DEGREE {
+        let blocks = if self.fading.is_none() && !write && self.m <= EXPANDING_BLOCK_MAX_DEGREE {
+            self.expanding_block_run(ts, ys)
+        } else if self.fading.is_some() && !write && self.m <= STEADY_BLOCK_MAX_DEGREE {
             match self.m {
                 0 => self.steady_block_run::<1>(ts, ys),
                 1 => self.steady_block_run::<2>(ts, ys),
@@ -701,6 +707,81 @@ impl GainEngine {
         }
         self.end_plain_run(&z, t_last, done);
         done
+    }
+
+    /// Expanding memory on a run of whole blocks of [`STEADY_BLOCK`] even steps: on an even
+    /// grid the filter's state is the least-squares polynomial through every sample so far
+    /// (Morrison §9.4), so the run is folded in as one least-squares update
+    /// ([`super::expanding_block::advance_even_fit`]) instead of a recursion per sample. The
+    /// grid is the run's own: from the first sample to the run's last at their mean step (the
+    /// old state moved onto it first, by the rounding of the timestamps); within it, the samples'
+    /// own times differ from the grid by their rounding, which the per-sample recursion follows
+    /// and this does not (measured in tests/batch.rs). Returns how many samples it took.
+    fn expanding_block_run(&mut self, ts: &[f64], ys: &[f64]) -> usize {
+        if self.n <= self.m as u64 || ts.is_empty() {
+            return 0;
+        }
+        if self.m == 0 {
+            // Degree 0 is the running mean, whatever the steps.
+            let mut z = [self.z[0] + self.z_lo[0]];
+            super::expanding_block::advance_even_fit(0, self.n, &mut z, ys);
+            self.end_plain_run(&z, ts[ts.len() - 1], ts.len());
+            return ts.len();
+        }
+        // The mean step so far (the one the recursion's gains are scaled for).
+        let step = (self.t_last - self.t_first) / ((self.n - 1) as f64 * self.tau);
+        let tol = step_tolerance(step, 0.0, self.tau);
+        let tol_per_time = step_tolerance(0.0, 1.0, self.tau);
+        let inv_tau = 1.0 / self.tau;
+        let even =
+            |t: f64, p: f64| ((t - p) * inv_tau - step).abs() <= tol + tol_per_time * t.abs();
+        let mut prev = self.t_last;
+        let mut take = 0;
+        for tb in ts.chunks_exact(STEADY_BLOCK) {
+            let uneven = usize::from(!even(tb[0], prev))
+                + tb[1..]
+                    .iter()
+                    .zip(tb)
+                    .map(|(&t, &p)| usize::from(!even(t, p)))
+                    .sum::<usize>();
+            if uneven > 0 {
+                break;
+            }
+            take += STEADY_BLOCK;
+            prev = tb[STEADY_BLOCK - 1];
+        }
+        if take == 0 {
+            return 0;
+        }
+        let (tau, m, n) = (self.tau, self.m, self.n);
+        let t_end = ts[take - 1];
+        // The grid from the first sample to the run's last, in units of its step.
+        let grid = (t_end - self.t_first) / ((n + take as u64 - 1) as f64 * tau);
+        // The old state onto the grid's sample n−1 (a rounding-sized move), then in grid units.
+        let mut z = [0.0; super::MAX_DEGREE + 1];
+        let z = &mut z[..=m];
+        for (zk, (hi, lo)) in z.iter_mut().zip(self.z.iter().zip(&self.z_lo)) {
+            *zk = hi + lo;
+        }
+        let moved = (self.t_first - self.t_last) / tau + (n - 1) as f64 * grid;
+        crate::model::shift_scaled(z, moved);
+        let mut power = 1.0;
+        for zk in z.iter_mut() {
+            *zk *= power;
+            power *= grid;
+        }
+        super::expanding_block::advance_even_fit(m, n, z, &ys[..take]);
+        let mut power = 1.0;
+        for zk in z.iter_mut() {
+            *zk /= power;
+            power *= grid;
+        }
+        self.z.copy_from_slice(z);
+        self.z_lo.iter_mut().for_each(|v| *v = 0.0);
+        self.t_last = t_end;
+        self.n += take as u64;
+        self.step_mean = grid;
+        take
     }
 
     fn steady_run_n<const N: usize, const W: bool>(

@@ -143,6 +143,7 @@
 pub mod automatic;
 pub mod bank;
 mod exact_engine;
+mod expanding_block;
 pub mod fixed;
 mod gain_engine;
 pub mod gains;
