@@ -104,23 +104,35 @@
 //! kernel: `Z ← Φ(ζ) Z + K (y − [Φ(ζ) Z]₀)` in plain `f64` with the state in registers,
 //! regrouped as `Z' = M(ζ) Z₁.. + K d` with `d = y − z₀` so that one sample's dependency chain is
 //! a multiplication and two additions (degrees ≤ 8; higher degrees take the per-sample path).
-//! Throughput is in BENCHMARKS.md (degree 2: ≈ 2·10⁸ samples/s against ≈ 1.9·10⁷ per sample).
+//!
+//! Without per-sample outputs (`update_many`), whole blocks of 64 such steps go faster still:
+//! the steady fading recursion is linear and time-invariant, so a block is one map
+//! `Z ← Āᴮ Z + Σ_j Ā^(B−1−j) K y_j` (`Ā = (I − K e₀ᵀ) Φ(ζ̄)`, tabulated in double words, to
+//! first order in the block's mean-step deviation; degrees ≤ 5), and the expanding-memory
+//! state on an even grid is the least-squares fit through every sample, so a run of blocks is
+//! one least-squares update in the grids' discrete orthogonal polynomials
+//! (degrees ≤ 4; degree 0, the running mean, on any steps). Both take each block's samples on
+//! the grid of its mean step: the timestamps' own rounding (a few units in the last place of
+//! `t`), which the per-sample recursion follows, is the difference between the two paths.
+//! Throughput is in BENCHMARKS.md (degree 2, 10⁶ samples: fading ≈ 4·10⁸, expanding
+//! ≈ 7·10⁸ samples/s, against ≈ 2·10⁷ per sample).
 //!
 //! The steady recursion is stable (its eigenvalues are all `θ`), so plain arithmetic is enough
 //! there; the compensated state matters in the start-up, where the gains are large. Measured
 //! (`cargo test -p seqsmooth --release --test batch plain -- --nocapture`): 60 000 samples at
-//! `t = k·0.1`, `τ = 0.1`, a sine of amplitude 100 plus a trend and unit noise; the largest
+//! `t = k·0.1`, `τ = 0.1`, a sine of amplitude 100 plus a trend and unit noise, in batches of
+//! 101 (a block map and 37 recursion steps each); the largest
 //! difference from the compensated per-sample path over the second half of the run, relative
 //! to the largest `|x^(k)|` there, worst over `k`:
 //!
 //! | m | θ = 0.5 | θ = 0.9 | θ = 0.99 | θ = 0.999 |
 //! |---:|---:|---:|---:|---:|
-//! | 0 | 1.6e-16 | 3.3e-16 | 1.3e-15 | 5.0e-15 |
-//! | 1 | 1.3e-13 | 6.6e-14 | 4.1e-14 | 4.5e-13 |
-//! | 2 | 1.7e-13 | 5.5e-13 | 1.0e-13 | 6.3e-14 |
-//! | 3 | 1.3e-13 | 7.0e-13 | 1.4e-13 | 1.6e-13 |
-//! | 4 | 1.4e-13 | 6.7e-13 | 2.9e-13 | 5.0e-14 |
-//! | 5 | 1.5e-13 | 5.0e-13 | 6.9e-13 | 4.8e-14 |
+//! | 0 | 1.6e-16 | 3.3e-16 | 9.9e-16 | 2.2e-15 |
+//! | 1 | 1.3e-13 | 6.5e-14 | 2.3e-14 | 1.5e-13 |
+//! | 2 | 1.7e-13 | 6.1e-13 | 5.3e-14 | 3.4e-14 |
+//! | 3 | 1.3e-13 | 6.5e-13 | 7.3e-14 | 5.9e-14 |
+//! | 4 | 1.4e-13 | 7.6e-13 | 3.6e-13 | 2.4e-14 |
+//! | 5 | 1.5e-13 | 7.1e-13 | 8.1e-13 | 2.2e-14 |
 //! | 6 | 1.1e-13 | 5.0e-13 | 1.6e-12 | 8.5e-14 |
 //! | 7 | 1.5e-13 | 4.3e-13 | 3.8e-12 | 8.7e-14 |
 //! | 8 | 1.1e-13 | 3.9e-13 | 4.9e-12 | 7.2e-14 |
