@@ -99,6 +99,15 @@ fn shift_fixed<const N: usize>(z: &mut [f64], h: f64) {
     shift_any(&mut z[..N], h);
 }
 
+/// [`shift_scaled`] for a length known at compile time (unrolled where it is inlined; the
+/// same operations in the same order).
+#[inline(always)]
+pub(crate) fn shift_scaled_array<const N: usize>(z: &mut [f64; N], h: f64) {
+    if N >= 2 && h != 0.0 {
+        shift_any(z, h);
+    }
+}
+
 #[inline(always)]
 fn shift_any(z: &mut [f64], h: f64) {
     let n = z.len();

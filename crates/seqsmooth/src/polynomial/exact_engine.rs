@@ -6,20 +6,22 @@
 //! half-width keeps the rows `(1, u, …, u^m)` in `[-1, 1]`-like ranges; when the memory moves
 //! the basis is re-centred by the upper-triangular change of variables
 //! `a_old = A a_new`, `A_kj = C(j,k) (-β)^(j-k) / α^j` (`u_old = α u_new + β`), so `R ← R A`
-//! stays triangular and no re-factorisation is needed. Re-centring happens `O(log n)` times for
+//! stays triangular and no re-factorisation is needed
+//! ([`TriangularFactor::change_variables_polynomial`]: Taylor-shift steps on the columns of
+//! the factor, `O(m³/6)`, without forming `A`). Re-centring happens `O(log n)` times for
 //! expanding memory and about once per quarter memory span for fading memory; the new unit is
 //! the old one times a power of two and the centre moves by a multiple of unit/8, so `α`, `β`
-//! and `A` are exact, and on evenly spaced samples the same `A` repeats (cached).
+//! and the powers of `α` are exact, and `(t - c)/s` is a multiplication by the exact `1/s`.
 //!
 //! The fading-memory discount is applied lazily: instead of multiplying `[R | d]` by `√θ^ζ` at
 //! every sample, new rows get the weight `1/Π θ^ζ`, folded back into the factor when its square
 //! root passes 1e30. The estimate `R⁻¹d` and the sandwich covariance do not depend on that
 //! common scale. The factor itself is kept in Gentleman's square-root-free form
-//! ([`TriangularFactor`]): no square roots per sample.
+//! ([`TriangularFactor`]): no square roots per sample, and once every pivot is positive none
+//! of its `2m+3` divisions per sample waits for another.
 
 use super::DiscountMode;
-use crate::calculus::choose;
-use crate::model::shift_scaled;
+use crate::model::{shift_scaled, shift_scaled_array};
 use crate::recursive::{InformationFilter, TriangularFactor};
 use nalgebra::DMatrix;
 
@@ -45,17 +47,20 @@ pub(crate) struct ExactEngine {
     noise: Option<TriangularFactor>,
     centre: f64,
     unit: f64,
+    /// `1/unit`, exact (the unit is a power of two).
+    inv_unit: f64,
     t_first: f64,
     t_last: f64,
     n: u64,
-    row: Vec<f64>,
     sigma: Option<f64>,
-    /// Cache: the last step `Δt` and its discount's square root `√(θ^(Δt/τ))` (per time), so
-    /// the power is evaluated only when the step changes.
+    /// The last step `Δt` (per time) and the growth `1/√(θ^ζ)` of the lazy row scale per
+    /// sample: constant per update, per time evaluated only when the step changes.
     step_cached: f64,
-    root_cached: f64,
-    /// `-ln θ`, for the effective memory span, and that span `3τ/(-ln θ)` (per time).
-    neg_ln_theta: f64,
+    inv_root: f64,
+    /// `-ln θ / (2τ)`: `1/√(θ^(Δt/τ)) = exp(Δt · that)` (per time).
+    half_rate: f64,
+    /// The effective memory span `3/(-ln θ)`, in updates (per update) or times `τ` (per time).
+    span_updates: f64,
     span_per_time: f64,
     /// The discount applied lazily: the true factors are the stored ones divided by
     /// `inv_scale` (the noise factor by `inv_scale²`), and each new row gets the weight
@@ -64,8 +69,6 @@ pub(crate) struct ExactEngine {
     inv_scale: f64,
     /// `k!/s^k` for the unit `s` (unscaled derivatives from the coefficients).
     unscale: Vec<f64>,
-    /// The last re-centring `(α, β, A)`.
-    recentre_cache: Option<(f64, f64, DMatrix<f64>)>,
 }
 
 impl ExactEngine {
@@ -77,16 +80,16 @@ impl ExactEngine {
             noise: None,
             centre: 0.0,
             unit: 1.0,
+            inv_unit: 1.0,
             t_first: f64::NAN,
             t_last: f64::NAN,
             n: 0,
-            row: vec![0.0; m + 1],
             sigma: None,
             step_cached: f64::NAN,
-            root_cached: 1.0,
-            neg_ln_theta: discount.map_or(0.0, |d| -d.theta.ln()),
+            inv_root: discount.map_or(1.0, |d| 1.0 / d.theta.sqrt()),
+            half_rate: discount.map_or(0.0, |d| -d.theta.ln() / (2.0 * d.tau)),
+            span_updates: discount.map_or(0.0, |d| 3.0 / -d.theta.ln()),
             span_per_time: discount.map_or(0.0, |d| 3.0 * d.tau / -d.theta.ln()),
-            recentre_cache: None,
             unscale: vec![0.0; m + 1],
             inv_scale: 1.0,
         }
@@ -116,17 +119,16 @@ impl ExactEngine {
             self.set_unscale();
         } else {
             if let Some(d) = self.discount {
-                let dt = t - self.t_last;
-                if dt != self.step_cached {
-                    self.step_cached = dt;
-                    self.root_cached = match d.mode {
-                        DiscountMode::PerTime => d.theta.powf(dt / d.tau).sqrt(),
-                        DiscountMode::PerUpdate => d.theta.sqrt(),
-                    };
+                if d.mode == DiscountMode::PerTime {
+                    let dt = t - self.t_last;
+                    if dt != self.step_cached {
+                        self.step_cached = dt;
+                        self.inv_root = (dt * self.half_rate).exp();
+                    }
                 }
                 // Lazily: the factors stay as they are and new rows get the weight
                 // 1/Π θ^ζ instead.
-                self.inv_scale /= self.root_cached;
+                self.inv_scale *= self.inv_root;
                 if self.inv_scale > RENORMALISE {
                     let f = 1.0 / (self.inv_scale * self.inv_scale);
                     self.info.discount(f);
@@ -138,58 +140,61 @@ impl ExactEngine {
             }
             self.maybe_recentre(t);
         }
-        let u = (t - self.centre) / self.unit;
-        let mut p = 1.0;
-        for r in self.row.iter_mut() {
-            *r = p;
-            p *= u;
-        }
+        // The row (1, u, u², …, u^m).
+        let u = (t - self.centre) * self.inv_unit;
         let w = self.inv_scale * self.inv_scale;
-        self.info.observe(&self.row, y, w);
+        self.info.observe_powers(u, y, w);
         if let Some(q) = &mut self.noise {
-            q.add_row(&self.row, 0.0, w * w);
+            q.add_row_powers(u, 0.0, w * w);
         }
         self.t_last = t;
         self.n += 1;
     }
 
+    /// Re-centres when the basis has drifted from the effective memory `[start, t]`: its
+    /// centre off the memory's centre by more than a quarter of the memory, or its unit off the
+    /// half-width by more than a factor 4. The test is division-free: the half-width is
+    /// `s_num/q` (`q = n` for the per-update discount, whose span is `3(t - t_first)/(n·(-ln θ))`,
+    /// else 1) and both sides are multiplied by `q`; the memory's centre is `t` minus its
+    /// half-width.
+    #[inline]
     fn maybe_recentre(&mut self, t: f64) {
-        let start = match self.discount {
-            None => self.t_first,
-            Some(d) => {
-                // Effective memory: weights fall by e^-3 over this span.
-                let span = match d.mode {
-                    DiscountMode::PerTime => self.span_per_time,
-                    DiscountMode::PerUpdate => {
-                        3.0 * (t - self.t_first) / (self.n as f64 * self.neg_ln_theta)
-                    }
-                };
-                (t - span).max(self.t_first)
-            }
+        let elapsed = t - self.t_first;
+        let (s_num, q) = match self.discount {
+            None => (0.5 * elapsed, 1.0),
+            Some(d) => match d.mode {
+                DiscountMode::PerTime => (0.5 * elapsed.min(self.span_per_time), 1.0),
+                DiscountMode::PerUpdate => {
+                    let n = self.n as f64;
+                    (0.5 * elapsed * self.span_updates.min(n), n)
+                }
+            },
         };
-        let target_c = 0.5 * (start + t);
-        let target_s = 0.5 * (t - start);
-        if target_s.is_nan() || target_s <= 0.0 {
+        // NaN or no extent yet: nothing to centre on.
+        if s_num.is_nan() || s_num <= 0.0 {
             return;
         }
-        let off_centre = (self.centre - target_c).abs() > 0.5 * target_s;
-        let off_scale = self.unit > 4.0 * target_s || self.unit < 0.25 * target_s;
+        let off_centre = (q * (self.centre - t) + s_num).abs() > 0.5 * s_num;
+        let unit_q = q * self.unit;
+        let off_scale = unit_q > 4.0 * s_num || unit_q < 0.25 * s_num;
         if off_centre || off_scale {
+            let target_s = s_num / q;
+            let target_c = t - target_s;
             // The new unit is the old one times a power of two and the centre moves by a
-            // multiple of unit/8, so `α` and `β` below are exact and on evenly spaced samples
-            // the same change of variables repeats (its matrix is cached).
+            // multiple of unit/8, so `α` and `β` below are exact.
             let alpha = if off_scale {
-                (target_s / self.unit).log2().round().exp2()
+                (target_s * self.inv_unit).log2().round().exp2()
             } else {
                 1.0
             };
-            let beta = ((target_c - self.centre) / self.unit * 8.0).round() / 8.0;
+            let beta = ((target_c - self.centre) * self.inv_unit * 8.0).round() / 8.0;
             self.recentre(alpha, beta);
         }
     }
 
-    /// `k!/s^k` for the current unit `s`.
+    /// `k!/s^k` and `1/s` for the current unit `s`.
     fn set_unscale(&mut self) {
+        self.inv_unit = 1.0 / self.unit;
         let (mut f, mut sk) = (1.0, 1.0);
         for (k, c) in self.unscale.iter_mut().enumerate() {
             if k > 0 {
@@ -202,25 +207,15 @@ impl ExactEngine {
 
     /// Re-centres: `u_old = α u_new + β`, i.e. new centre `c + β·s`, new unit `α·s`.
     fn recentre(&mut self, alpha: f64, beta: f64) {
-        if self.recentre_cache.as_ref().map(|c| (c.0, c.1)) != Some((alpha, beta)) {
-            let p = self.m + 1;
-            let a = DMatrix::from_fn(p, p, |k, j| {
-                if j < k {
-                    0.0
-                } else {
-                    choose::<f64>(j, k) * (-beta).powi((j - k) as i32) / alpha.powi(j as i32)
-                }
-            });
-            self.recentre_cache = Some((alpha, beta, a));
-        }
-        let a = &self.recentre_cache.as_ref().expect("just set").2;
-        self.info.change_variables_upper(a);
+        self.info.change_variables_polynomial(alpha, beta);
         if let Some(q) = &mut self.noise {
-            q.change_variables_upper(a);
+            q.change_variables_polynomial(alpha, beta);
         }
         self.centre += beta * self.unit;
-        self.unit *= alpha;
-        self.set_unscale();
+        if alpha != 1.0 {
+            self.unit *= alpha;
+            self.set_unscale();
+        }
     }
 
     pub fn is_determined(&self) -> bool {
@@ -231,6 +226,40 @@ impl ExactEngine {
     /// allocating: `a = R⁻¹d`, shifted to `u(t)`, `x_k = k! a_k / s^k`. False (and `out`
     /// untouched) while the fit is not determined.
     pub fn derivatives_into(&self, t: f64, out: &mut [f64]) -> bool {
+        let h = (t - self.centre) * self.inv_unit;
+        // Fixed sizes unroll completely (solve, shift and scaling in one piece).
+        match self.m {
+            0 => self.derivatives_n::<1>(h, out),
+            1 => self.derivatives_n::<2>(h, out),
+            2 => self.derivatives_n::<3>(h, out),
+            3 => self.derivatives_n::<4>(h, out),
+            4 => self.derivatives_n::<5>(h, out),
+            5 => self.derivatives_n::<6>(h, out),
+            6 => self.derivatives_n::<7>(h, out),
+            7 => self.derivatives_n::<8>(h, out),
+            8 => self.derivatives_n::<9>(h, out),
+            _ => self.derivatives_any(h, out),
+        }
+    }
+
+    #[inline(always)]
+    fn derivatives_n<const N: usize>(&self, h: f64, out: &mut [f64]) -> bool {
+        if self.n < N as u64 {
+            return false;
+        }
+        let Some(mut a) = self.info.factor().solve_array::<N>() else {
+            return false;
+        };
+        shift_scaled_array(&mut a, h);
+        // `k!/s^k`: the unit `s` is a power of two (re-centring scales it by powers of two
+        // from 1), so this equals `z·k!/s^k` computed with the division, bit for bit.
+        for ((x, z), c) in out[..N].iter_mut().zip(a).zip(&self.unscale[..N]) {
+            *x = z * c;
+        }
+        true
+    }
+
+    fn derivatives_any(&self, h: f64, out: &mut [f64]) -> bool {
         if !self.is_determined() {
             return false;
         }
@@ -240,9 +269,7 @@ impl ExactEngine {
         if !self.info.factor().solve_into(a) {
             return false;
         }
-        shift_scaled(a, (t - self.centre) / self.unit);
-        // `k!/s^k`: the unit `s` is a power of two (re-centring scales it by powers of two
-        // from 1), so this equals `z·k!/s^k` computed with the division, bit for bit.
+        shift_scaled(a, h);
         for ((x, z), c) in out.iter_mut().zip(a.iter()).zip(&self.unscale) {
             *x = z * c;
         }
@@ -258,7 +285,7 @@ impl ExactEngine {
         if !self.derivatives_into(t, &mut x) {
             return None;
         }
-        let v = (t - self.centre) / self.unit;
+        let v = (t - self.centre) * self.inv_unit;
         let cov = match self.sigma {
             None => None,
             Some(sigma) => {
