@@ -22,8 +22,9 @@
 //! Relative error per derivative against batch QR (Legendre basis) or exact rational least
 //! squares, worst over each run, degrees 0-8: the exact engine ≤ 5e-11 on even, jittered and
 //! Poisson timestamps, expanding and fading (≤ 1e-11 over a 10⁵-sample run at degree 8). On
-//! 2 000 irregular samples: 5.2e-12 at degree 12, 1.5e-9 at 14, 8.9e-10 at 16, 9.7e-8 at 20,
-//! 7.4e-5 at 24 — the centred monomial basis is what limits it (asserted bounds: 1e-9 to degree 12, 1e-6
+//! 2 000 irregular samples (expanding / fading): 3.5e-12 / 5.3e-12 at degree 12, 7.3e-10 /
+//! 1.4e-9 at 14, 1.5e-9 / 1.8e-10 at 16, 1.2e-7 / 2.4e-7 at 20, 8.5e-6 / 3.3e-5 at 24 — the
+//! centred monomial basis is what limits it (asserted bounds: 1e-9 to degree 12, 1e-6
 //! to 16, 1e-3 to [`MAX_DEGREE`]). The gain engine on even samples: ≤ 5e-11 (expanding, 200
 //! samples), ≤ 5e-10 over 10⁵ samples at degree 8, ≤ 5e-12 for fading memory once the switch
 //! transient `θ^n·poly(n)` has decayed.
