@@ -2,10 +2,11 @@
 //! through polynomial filters.
 //!
 //! The command reads, filters and writes chunks of rows ([`CHUNK_ROWS`]): a reader thread
-//! parses and validates the next chunk ([`crate::rows`]) while the current one is run through
-//! the filters of its series, the series in parallel ([`crate::series`]), and written in input
-//! order, formatted in parallel pieces ([`crate::layout`]). Memory is a few chunks plus one
-//! filter per series, whatever the length of the input. The first [`LOOKAHEAD`] data rows (the
+//! splits ([`crate::records`]), parses ([`crate::decimal`]) and validates ([`crate::rows`]) the
+//! next chunk while the current one is run through the filters of its series, the series in
+//! parallel ([`crate::series`]), and, at the same time, the chunk before it is formatted in
+//! parallel pieces ([`crate::layout`]) and written in input order. Memory is a few chunks plus
+//! one filter per series, whatever the length of the input. The first [`LOOKAHEAD`] data rows (the
 //! first `W` for a fixed-memory window longer than that) decide the default `τ` (median time
 //! step) and the too-few-samples check before any output is written. Every row is validated
 //! (number, finite, strictly increasing time within its series) with its 1-based file line
@@ -37,6 +38,10 @@ pub const LOOKAHEAD: usize = 101;
 
 /// Rows per chunk of `seqsmooth filter`'s streaming pipeline (read, filter, write).
 pub const CHUNK_ROWS: u32 = 1 << 16;
+
+/// Rows of the first chunk, unless the first rows held back or scanned need more: the chunks
+/// then double in size up to [`CHUNK_ROWS`], so that filtering starts early.
+pub const FIRST_CHUNK_ROWS: usize = 1 << 12;
 
 /// With `--id-col`, the default `τ` is the median of the first 100 steps within series among
 /// this many first rows.
@@ -206,11 +211,6 @@ impl<R: Read> LineTracker<R> {
             breaks: 0,
             after_cr: false,
         }
-    }
-
-    /// The number of bytes read from the input so far.
-    pub fn bytes_read(&self) -> u64 {
-        self.base + (self.pending.len() - self.start) as u64
     }
 
     /// The 1-based line of the record the parser reports at byte offset `byte`: the parser's
@@ -896,8 +896,9 @@ pub fn check_distinct(input: Option<&Path>, output: Option<&Path>) -> Result<(),
 ///
 /// The input is read in chunks of [`FilterConfig::chunk_rows`] rows (the first chunk at least
 /// the `hold` rows that decide τ and the too-few-samples check). Each chunk's rows are run
-/// through their series' filters, the series in parallel, and written in input order; the
-/// memory is one chunk plus one filter per series, whatever the length of the input. An error
+/// through their series' filters, the series in parallel, while the chunk before is formatted,
+/// and written in input order; the memory is a few chunks plus one filter per series, whatever
+/// the length of the input. An error
 /// in one of the first `hold` rows stops the command before any output; a later one after the
 /// rows before it, of every series, have been written.
 pub fn run(cfg: &FilterConfig) -> Result<(), CliError> {
@@ -930,8 +931,8 @@ pub fn run(cfg: &FilterConfig) -> Result<(), CliError> {
     } else {
         0
     };
-    reader.read_chunk(&mut chunk, chunk_rows.max(hold).max(scan));
-    let mut reader = Some(reader);
+    let first_rows = chunk_rows.min(FIRST_CHUNK_ROWS).max(hold).max(scan);
+    reader.read_chunk(&mut chunk, first_rows);
     if chunk.rows.len() < hold {
         if let Some(e) = chunk.error.take() {
             return Err(e);
@@ -979,24 +980,47 @@ pub fn run(cfg: &FilterConfig) -> Result<(), CliError> {
     }
     let mut ids: Vec<Vec<u8>> = Vec::new();
     let mut results = Results::default();
-    let mut bufs = Vec::new();
+    let mut spare = Results::default();
+    // Formatted output: being filled (from the pending chunk), and waiting to be written.
+    let (mut filling, mut formatted): (Vec<Vec<u8>>, Vec<Vec<u8>>) = Default::default();
+    let mut ready = 0;
     let mut sink: Option<(Box<dyn Write>, String)> = None;
     let mut progress = Progress::hidden();
     let mut first = true;
-    let mut pipeline: Option<Pipeline> = None;
+    // The rest of the input is read on a thread of its own, a chunk ahead.
+    let mut pipeline = (!chunk.done && chunk.error.is_none()).then(|| {
+        let sizes = (1..).map(move |k| first_rows.saturating_mul(1 << k.min(16)));
+        Pipeline::start(reader, sizes.map(move |rows| rows.min(chunk_rows)))
+    });
+    // The chunk before this one, filtered but not yet formatted.
+    let mut pending: Option<(Chunk, Results)> = None;
     loop {
         for id in chunk.new_ids.drain(..) {
             runners.push(Some(prototype.clone()));
             ids.push(id);
         }
-        let failed = run_chunk(
-            &chunk,
-            &mut runners,
-            cfg.lead,
-            layout.sigma,
-            stride,
-            &mut results,
-        );
+        let (ids, layout) = (&ids, &layout);
+        // This chunk is filtered while the one before is formatted and the one before that
+        // written.
+        let (mut failed, mut pieces) = (None, 0);
+        let written = rayon::in_place_scope(|scope| {
+            scope.spawn(|_| {
+                let (lead, sigma) = (cfg.lead, layout.sigma);
+                failed = run_chunk(&chunk, &mut runners, lead, sigma, stride, &mut results);
+            });
+            if let Some((c, r)) = &pending {
+                let table = Table::new(c, r, ids, layout);
+                let (pieces, filling) = (&mut pieces, &mut filling);
+                scope.spawn(move |_| *pieces = table.format_pieces(c.rows.len(), filling));
+            }
+            match &mut sink {
+                Some((out, name)) => write_pieces(out, name, &formatted[..ready]),
+                None => Ok(()),
+            }
+        });
+        written?;
+        std::mem::swap(&mut filling, &mut formatted);
+        ready = pieces;
         let limit = failed.as_ref().map_or(chunk.rows.len(), |(i, _)| *i);
         if first && limit < hold {
             if let Some((_, e)) = failed {
@@ -1012,62 +1036,67 @@ pub fn run(cfg: &FilterConfig) -> Result<(), CliError> {
                 sink.insert((out, name))
             }
         };
-        let table = Table {
-            chunk: &chunk,
-            results: &results,
-            ids: &ids,
-            layout: &layout,
-            stride,
-        };
-        table.write(out, name, limit, &mut bufs)?;
-        if let Some((_, e)) = failed {
+        let used = pending.take().map(|(c, r)| {
+            spare = r;
+            c
+        });
+        if failed.is_some() || chunk.error.is_some() || chunk.done {
+            write_pieces(out, name, &formatted[..ready])?;
+            let table = Table::new(&chunk, &results, ids, layout);
+            let pieces = table.format_pieces(limit, &mut filling);
+            write_pieces(out, name, &filling[..pieces])?;
             out.flush().map_err(|e| CliError::write(name, e))?;
-            return Err(e);
-        }
-        if let Some(e) = chunk.error.take() {
-            out.flush().map_err(|e| CliError::write(name, e))?;
-            return Err(e);
-        }
-        if chunk.done {
-            return out.flush().map_err(|e| CliError::write(name, e));
+            return match (failed, chunk.error.take()) {
+                (Some((_, e)), _) | (None, Some(e)) => Err(e),
+                (None, None) => Ok(()),
+            };
         }
         if first && progress::wanted(cfg.no_progress) {
             progress = Progress::new(size, started);
         }
         progress.update(chunk.bytes_read, chunk.rows_read);
         first = false;
-        // From the second chunk on, the next chunk is read on a thread of its own while this
-        // one is filtered and written.
-        let next = match &mut pipeline {
-            Some(p) => p,
-            None => {
-                let reader = reader.take().ok_or_else(|| {
-                    CliError::Data("internal error: the input reader is gone".into())
-                })?;
-                pipeline.insert(Pipeline::start(reader, chunk_rows))
-            }
-        };
-        chunk = next.swap(chunk)?;
+        let next = pipeline
+            .as_mut()
+            .ok_or_else(|| CliError::Data("internal error: the input reader is gone".into()))?;
+        let filtered = std::mem::replace(&mut chunk, next.swap(used)?);
+        pending = Some((
+            filtered,
+            std::mem::replace(&mut results, std::mem::take(&mut spare)),
+        ));
     }
 }
 
+/// Writes formatted pieces of output to `out` (named `name`), in order.
+fn write_pieces(out: &mut dyn Write, name: &str, pieces: &[Vec<u8>]) -> Result<(), CliError> {
+    for piece in pieces {
+        out.write_all(piece).map_err(|e| CliError::write(name, e))?;
+    }
+    Ok(())
+}
+
 /// A thread that reads the input chunk by chunk ahead of the filtering and writing, passing
-/// full chunks one way and emptied ones back (at most three chunks exist).
+/// full chunks one way and emptied ones back (at most four chunks exist: one read, one
+/// ready, one filtered, one formatted).
 struct Pipeline {
     full: mpsc::Receiver<Chunk>,
     empty: mpsc::Sender<Chunk>,
 }
 
 impl Pipeline {
-    /// Starts reading chunks of `rows` rows from `reader` on a new thread. The thread ends
-    /// after the last chunk, or when the pipeline is dropped (the command is ending).
-    fn start<R: Read + Send + 'static>(mut reader: RowReader<R>, rows: usize) -> Self {
+    /// Starts reading chunks from `reader` on a new thread, of as many rows as `sizes` gives
+    /// in turn. The thread ends after the last chunk, or when the pipeline is dropped (the
+    /// command is ending).
+    fn start<R: Read + Send + 'static>(
+        mut reader: RowReader<R>,
+        mut sizes: impl Iterator<Item = usize> + Send + 'static,
+    ) -> Self {
         let (full_tx, full) = mpsc::sync_channel::<Chunk>(1);
         let (empty, empty_rx) = mpsc::channel::<Chunk>();
         // Detached: on an early error the command exits without waiting for a pending read.
         std::thread::spawn(move || loop {
             let mut chunk = empty_rx.try_recv().unwrap_or_default();
-            reader.read_chunk(&mut chunk, rows);
+            reader.read_chunk(&mut chunk, sizes.next().unwrap_or(CHUNK_ROWS as usize));
             let last = chunk.done || chunk.error.is_some();
             if full_tx.send(chunk).is_err() || last {
                 return;
@@ -1076,10 +1105,12 @@ impl Pipeline {
         Self { full, empty }
     }
 
-    /// Hands back a used chunk and takes the next one.
-    fn swap(&mut self, used: Chunk) -> Result<Chunk, CliError> {
+    /// Hands back a used chunk, if any, and takes the next one.
+    fn swap(&mut self, used: Option<Chunk>) -> Result<Chunk, CliError> {
         // The reader may have finished: then the used chunk is simply dropped.
-        let _ = self.empty.send(used);
+        if let Some(used) = used {
+            let _ = self.empty.send(used);
+        }
         self.full
             .recv()
             .map_err(|_| CliError::Data("internal error: the input reader stopped".into()))
@@ -1103,9 +1134,20 @@ struct Table<'a> {
     stride: usize,
 }
 
-impl Table<'_> {
+impl<'a> Table<'a> {
     /// Rows formatted per piece (on one thread).
     const PIECE: usize = 4096;
+
+    /// The rows of `chunk` with their `results`, the series `ids` and the `layout`.
+    fn new(chunk: &'a Chunk, results: &'a Results, ids: &'a [Vec<u8>], layout: &'a Layout) -> Self {
+        Self {
+            chunk,
+            results,
+            ids,
+            layout,
+            stride: layout.stride(),
+        }
+    }
 
     /// Appends the text of rows `rows` to `buf`.
     fn format(&self, rows: std::ops::Range<usize>, buf: &mut Vec<u8>) {
@@ -1130,40 +1172,22 @@ impl Table<'_> {
         }
     }
 
-    /// Writes the first `limit` rows to `out` (named `name`), formatting pieces of rows in
-    /// parallel into `bufs` and writing them in order.
-    fn write(
-        &self,
-        out: &mut dyn Write,
-        name: &str,
-        limit: usize,
-        bufs: &mut Vec<Vec<u8>>,
-    ) -> Result<(), CliError> {
+    /// Formats the first `limit` rows into `bufs`, one piece of [`Table::PIECE`] rows per
+    /// buffer, the pieces in parallel; returns the number of pieces.
+    fn format_pieces(&self, limit: usize, bufs: &mut Vec<Vec<u8>>) -> usize {
         let pieces = limit.div_ceil(Self::PIECE);
-        let batch = rayon::current_num_threads().max(1);
-        if bufs.len() < batch {
-            bufs.resize_with(batch, Vec::new);
+        if bufs.len() < pieces {
+            bufs.resize_with(pieces, Vec::new);
         }
-        for first in (0..pieces).step_by(batch) {
-            let count = batch.min(pieces - first);
-            let piece = |k: usize, buf: &mut Vec<u8>| {
+        bufs[..pieces]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(k, buf)| {
                 buf.clear();
-                let start = (first + k) * Self::PIECE;
+                let start = k * Self::PIECE;
                 self.format(start..(start + Self::PIECE).min(limit), buf);
-            };
-            if count == 1 {
-                piece(0, &mut bufs[0]);
-            } else {
-                bufs[..count]
-                    .par_iter_mut()
-                    .enumerate()
-                    .for_each(|(k, buf)| piece(k, buf));
-            }
-            for buf in &bufs[..count] {
-                out.write_all(buf).map_err(|e| CliError::write(name, e))?;
-            }
-        }
-        Ok(())
+            });
+        pieces
     }
 }
 

@@ -5,6 +5,7 @@
 //! parsing, file formats and messages.
 
 mod chart;
+mod decimal;
 mod demo;
 mod error;
 mod filter;
@@ -12,6 +13,7 @@ mod layout;
 mod number;
 mod plot;
 mod progress;
+mod records;
 mod rows;
 mod series;
 mod shortest;
@@ -136,9 +138,9 @@ order and starts with the id column: NAME,t,y,d0..dM,... A series shorter than t
 needs just has empty cells (the too-few-samples check is on the input as a whole). The default \
 tau is the median of the first 100 time steps within series (among the first 65536 rows).
 
-Reading streams in chunks of 65536 rows, the series of a chunk in parallel; memory stays \
-bounded (one chunk plus one filter per series) however long the input. The first 101 data rows \
-(the first W for a longer fixed window) are held back: an error in one of them stops the \
+Reading streams in chunks of up to 65536 rows, the series of a chunk in parallel; memory stays \
+bounded (a few chunks plus one filter per series) however long the input. The first 101 data \
+rows (the first W for a longer fixed window) are held back: an error in one of them stops the \
 command before any output. An error in a later row (a bad cell, a time not after the previous \
 one of its series, ...) stops the command after every row before it, of every series, has been \
 written; the message names the line, the column and, for a time, the series.

@@ -22,14 +22,20 @@ pub fn fmt_f64(x: f64) -> String {
 
 /// Appends [`fmt_f64`]`(x)` to `out` without allocating (beyond `out`'s growth): the digits
 /// of [`crate::shortest`], the same as Rust's `{}` and `{:e}`.
+#[inline]
 pub fn write_f64(out: &mut Vec<u8>, x: f64) {
     let a = x.abs();
     if x == 0.0 || !x.is_finite() {
-        // "0", "-0", "NaN", "inf", "-inf".
-        out.extend_from_slice(x.to_string().as_bytes());
+        write_special(out, x);
     } else {
         crate::shortest::write(out, x, !(1e-5..1e16).contains(&a));
     }
+}
+
+/// Appends "0", "-0", "NaN", "inf" or "-inf".
+#[cold]
+fn write_special(out: &mut Vec<u8>, x: f64) {
+    out.extend_from_slice(x.to_string().as_bytes());
 }
 
 /// The rational `r` as `p/q` in lowest terms, or `p` alone when `q = 1`.

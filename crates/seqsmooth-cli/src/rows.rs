@@ -3,13 +3,17 @@
 //!
 //! Every row is validated as it is read — the time and value cells are numbers, finite, and
 //! the time is strictly after the previous time of the same series — with its 1-based file
-//! line (the header is line 1) and column. A chunk holds its rows' numbers and the text of
+//! line (the header is line 1) and column. The records and their lines come from
+//! [`crate::records`], the numbers from [`crate::decimal`] (or `str::parse` for other forms). A chunk holds its rows' numbers and the text of
 //! their time and value cells (echoed to the output) in one buffer, so reading allocates
 //! nothing per row once the buffers have grown. Per series only the id, the newest time (with
-//! its text and line, for the message of a time that goes backwards) and an index are kept.
+//! its line, and its text from chunk to chunk, for the message of a time that goes backwards)
+//! and an index are kept.
 
+use crate::decimal::parse_decimal;
 use crate::error::CliError;
-use crate::filter::{LineTracker, Need};
+use crate::filter::Need;
+use crate::records::Records;
 use std::collections::HashMap;
 use std::io::Read;
 
@@ -77,14 +81,18 @@ impl Chunk {
 struct Newest {
     t: f64,
     line: u64,
-    /// The time cell as written.
-    text: String,
+    /// The row in the chunk being read, whose text is there; `None` when it is in an earlier
+    /// chunk, and its time cell in `text`.
+    row: Option<usize>,
+    /// The time cell as written, when the row is in an earlier chunk.
+    text: Vec<u8>,
 }
 
 /// Reads and validates the data rows of a CSV time series in chunks.
 pub struct RowReader<R: Read> {
-    reader: csv::Reader<LineTracker<R>>,
-    record: csv::ByteRecord,
+    records: Records<R>,
+    /// The number of columns of the header.
+    width: usize,
     time_idx: usize,
     value_idx: usize,
     id_idx: Option<usize>,
@@ -96,6 +104,8 @@ pub struct RowReader<R: Read> {
     ids: Vec<String>,
     /// The newest row of each series, by index.
     newest: Vec<Option<Newest>>,
+    /// The series whose newest row is in the chunk being read.
+    touched: Vec<u32>,
     rows_read: u64,
 }
 
@@ -139,14 +149,21 @@ pub fn csv_field(cell: &[u8]) -> Vec<u8> {
     out
 }
 
-/// Parses a time or value cell (already trimmed) of `line` in `column`: the number and the
-/// cell as text.
-fn parse_cell<'a>(
-    cell: &'a [u8],
-    line: u64,
-    column: &str,
-    what: &str,
-) -> Result<(f64, &'a str), CliError> {
+/// Parses a time or value cell (already trimmed) of `line` in `column`, holding the `what`: a
+/// typed error for an empty cell, a non-number or a non-finite value. Plain decimals take
+/// [`parse_decimal`]'s fast exact path; anything else `str::parse`, with the same result.
+#[inline]
+fn parse_cell(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f64, CliError> {
+    match parse_decimal(cell) {
+        Some(v) => Ok(v),
+        None => parse_cell_text(cell, line, column, what),
+    }
+}
+
+/// [`parse_cell`] through `str::parse`, and its errors.
+#[cold]
+#[inline(never)]
+fn parse_cell_text(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f64, CliError> {
     if cell.is_empty() {
         return Err(CliError::Data(format!(
             "line {line}, column '{column}': the cell is empty, expected a number"
@@ -165,7 +182,35 @@ fn parse_cell<'a>(
             "line {line}, column '{column}': {what} {text} is not finite"
         )));
     }
-    Ok((v, text))
+    Ok(v)
+}
+
+/// The error of a record whose field count differs from the header's.
+fn ragged(line: u64, len: usize, expected: usize) -> CliError {
+    CliError::Data(format!(
+        "line {line}: malformed CSV: the row has {len} field{} but the header has {expected}",
+        if len == 1 { "" } else { "s" }
+    ))
+}
+
+/// The error of a failed read of the input.
+fn read_error(e: std::io::Error) -> CliError {
+    CliError::Data(format!("cannot read the input: {e}"))
+}
+
+/// Reads the header: its cells trimmed, none for an empty input.
+fn read_header<R: Read>(records: &mut Records<R>) -> Result<Vec<String>, CliError> {
+    let Some(line) = records.next_record().map_err(read_error)? else {
+        return Ok(Vec::new());
+    };
+    (0..records.len())
+        .map(|i| match std::str::from_utf8(records.field(i)) {
+            Ok(cell) => Ok(cell.trim().to_string()),
+            Err(_) => Err(CliError::Data(format!(
+                "line {line}: malformed CSV: the row is not valid UTF-8"
+            ))),
+        })
+        .collect()
 }
 
 impl<R: Read> RowReader<R> {
@@ -177,14 +222,11 @@ impl<R: Read> RowReader<R> {
         id_col: Option<&str>,
         need: &Need,
     ) -> Result<Self, CliError> {
-        let reader = csv::ReaderBuilder::new()
-            .has_headers(true)
-            .flexible(false)
-            .buffer_capacity(1 << 16)
-            .from_reader(LineTracker::new(input));
+        let mut records = Records::new(input);
+        let headers = read_header(&mut records)?;
         let mut this = Self {
-            reader,
-            record: csv::ByteRecord::new(),
+            records,
+            width: headers.len(),
             time_idx: 0,
             value_idx: 0,
             id_idx: None,
@@ -193,11 +235,8 @@ impl<R: Read> RowReader<R> {
             index: HashMap::new(),
             ids: Vec::new(),
             newest: Vec::new(),
+            touched: Vec::new(),
             rows_read: 0,
-        };
-        let headers: Vec<String> = match this.reader.headers() {
-            Ok(h) => h.iter().map(|c| c.trim().to_string()).collect(),
-            Err(e) => return Err(this.csv_error(e)),
         };
         crate::filter::check_header(&headers, need)?;
         let find = |name: &str| crate::filter::find_column(&headers, name);
@@ -212,11 +251,7 @@ impl<R: Read> RowReader<R> {
 
     /// The number of bytes read from the input so far.
     pub fn bytes_read(&self) -> u64 {
-        self.reader.get_ref().bytes_read()
-    }
-
-    fn csv_error(&mut self, e: csv::Error) -> CliError {
-        crate::filter::csv_read_error(self.reader.get_mut(), e)
+        self.records.bytes_read()
     }
 
     /// Reads up to `max_rows` rows into `chunk` (replacing its contents). Reading stops early
@@ -237,27 +272,45 @@ impl<R: Read> RowReader<R> {
                 }
             }
         }
+        self.keep_newest_text(chunk);
         chunk.bytes_read = self.bytes_read();
         chunk.rows_read = self.rows_read;
     }
 
+    /// Copies the time cells of the series' newest rows out of `chunk` (read last), for the
+    /// messages of the next chunks: once per series and chunk, not per row.
+    fn keep_newest_text(&mut self, chunk: &Chunk) {
+        for s in self.touched.drain(..) {
+            if let Some(newest) = &mut self.newest[s as usize] {
+                if let Some(i) = newest.row.take() {
+                    let r = &chunk.rows[i];
+                    newest.text.clear();
+                    newest
+                        .text
+                        .extend_from_slice(&chunk.text[r.text..r.text + r.t_len as usize]);
+                }
+            }
+        }
+    }
+
     /// Reads one row into `chunk`; `false` at the end of the input.
     fn next_row(&mut self, chunk: &mut Chunk) -> Result<bool, CliError> {
-        match self.reader.read_byte_record(&mut self.record) {
-            Ok(true) => {}
-            Ok(false) => return Ok(false),
-            Err(e) => return Err(self.csv_error(e)),
+        let line = match self.records.next_record() {
+            Ok(Some(line)) => line,
+            Ok(None) => return Ok(false),
+            Err(e) => return Err(read_error(e)),
+        };
+        if self.records.len() != self.width {
+            return Err(ragged(line, self.records.len(), self.width));
         }
-        let byte = self.record.position().map_or(0, |p| p.byte());
-        let line = self.reader.get_mut().line_at(byte);
-        let t_cell = trim(&self.record[self.time_idx]);
-        let y_cell = trim(&self.record[self.value_idx]);
-        let (t, t_text) = parse_cell(t_cell, line, &self.time_col, "time")?;
-        let (y, _) = parse_cell(y_cell, line, &self.value_col, "value")?;
+        let t_cell = trim(self.records.field(self.time_idx));
+        let y_cell = trim(self.records.field(self.value_idx));
+        let t = parse_cell(t_cell, line, &self.time_col, "time")?;
+        let y = parse_cell(y_cell, line, &self.value_col, "value")?;
         let series = match self.id_idx {
             None => 0,
             Some(i) => {
-                let id = trim(&self.record[i]);
+                let id = trim(self.records.field(i));
                 match self.index.get(id) {
                     Some(&s) => s,
                     None => {
@@ -276,6 +329,7 @@ impl<R: Read> RowReader<R> {
         let too_long = || CliError::Data(format!("line {line}: the cell is too long"));
         let t_len = u32::try_from(t_cell.len()).map_err(|_| too_long())?;
         let y_len = u32::try_from(y_cell.len()).map_err(|_| too_long())?;
+        let row = chunk.rows.len();
         let newest = &mut self.newest[series as usize];
         if let Some(prev) = newest {
             if t <= prev.t {
@@ -288,22 +342,34 @@ impl<R: Read> RowReader<R> {
                     None => String::new(),
                     Some(_) => format!(" of series '{}'", self.ids[series as usize]),
                 };
+                let prev_text = match prev.row {
+                    Some(i) => {
+                        let r = &chunk.rows[i];
+                        &chunk.text[r.text..r.text + r.t_len as usize]
+                    }
+                    None => &prev.text,
+                };
                 return Err(CliError::Data(format!(
-                    "line {line}: time {t_text} is not after the previous time {} (line {}){of}: \
+                    "line {line}: time {} is not after the previous time {} (line {}){of}: \
                      {why}",
-                    prev.text, prev.line
+                    lossy(t_cell),
+                    lossy(prev_text),
+                    prev.line
                 )));
             }
             prev.t = t;
             prev.line = line;
-            prev.text.clear();
-            prev.text.push_str(t_text);
+            if prev.row.replace(row).is_none() {
+                self.touched.push(series);
+            }
         } else {
             *newest = Some(Newest {
                 t,
                 line,
-                text: t_text.to_string(),
+                row: Some(row),
+                text: Vec::new(),
             });
+            self.touched.push(series);
         }
         let text = chunk.text.len();
         chunk.text.extend_from_slice(t_cell);

@@ -27,6 +27,8 @@ pub struct Results {
     groups: Vec<(u32, usize)>,
     /// Per series index: its position in `groups` while grouping, else `u32::MAX`.
     mark: Vec<u32>,
+    /// The batch buffers of a single series.
+    batch: Batch,
 }
 
 impl Results {
@@ -83,6 +85,13 @@ impl Results {
     }
 }
 
+/// What a row's results are: the estimate at `t + lead`, with 1σ columns or not.
+#[derive(Clone, Copy, Debug)]
+struct Step {
+    lead: f64,
+    sigma: bool,
+}
+
 /// Runs the rows `rows` (indices into `chunk.rows`, all of one series) through `runner`,
 /// storing each row's results in `values` (`stride` per row) and `cells`. Stops at the first
 /// error: its row index and message.
@@ -90,15 +99,17 @@ fn run_group(
     runner: &mut Runner,
     chunk: &Chunk,
     rows: impl Iterator<Item = usize>,
-    lead: f64,
-    sigma: bool,
+    Step { lead, sigma }: Step,
     values: &mut [f64],
     cells: &mut [Cells],
+    batch: &mut Batch,
 ) -> Option<(usize, CliError)> {
     let stride = values.len().checked_div(cells.len()).unwrap_or(1).max(1);
     if !sigma && lead == 0.0 {
         if let Some(f) = runner.batch_filter() {
-            return run_group_batch(f, chunk, rows, stride, values, cells);
+            if f.degree() + 1 == stride {
+                return run_group_batch(f, chunk, rows, values, cells, batch);
+            }
         }
     }
     for ((i, v), c) in rows.zip(values.chunks_exact_mut(stride)).zip(cells) {
@@ -111,41 +122,52 @@ fn run_group(
     None
 }
 
+/// The buffers of [`run_group_batch`], kept from chunk to chunk.
+#[derive(Debug, Default)]
+pub struct Batch {
+    /// The group's rows (indices into the chunk).
+    rows: Vec<usize>,
+    /// Their times and values.
+    ts: Vec<f64>,
+    ys: Vec<f64>,
+}
+
 /// [`run_group`] for the expanding- and fading-memory filters without 1σ columns or lead: the
-/// group's samples in one `update_many_into` call (the library's batch kernels), then the rows'
-/// cells. Same results and errors as row by row (the estimates up to rounding).
+/// group's samples in one `update_many_into` call (the library's batch kernels) that writes
+/// the estimates straight into the rows' values, then the rows' cells. Same results and errors
+/// as row by row (the estimates up to rounding).
 fn run_group_batch(
     f: &mut dyn PolynomialFilter,
     chunk: &Chunk,
     rows: impl Iterator<Item = usize>,
-    stride: usize,
     values: &mut [f64],
     cells: &mut [Cells],
+    batch: &mut Batch,
 ) -> Option<(usize, CliError)> {
-    let idx: Vec<usize> = rows.collect();
-    let ts: Vec<f64> = idx.iter().map(|&i| chunk.rows[i].t).collect();
-    let ys: Vec<f64> = idx.iter().map(|&i| chunk.rows[i].y).collect();
+    let Batch { rows: idx, ts, ys } = batch;
+    idx.clear();
+    idx.extend(rows);
+    ts.clear();
+    ts.extend(idx.iter().map(|&i| chunk.rows[i].t));
+    ys.clear();
+    ys.extend(idx.iter().map(|&i| chunk.rows[i].y));
+    // Without 1σ columns a row's values are its d0..dM, the estimate's layout; a row without
+    // an estimate keeps NaN.
     let w = f.degree() + 1;
-    let mut est = vec![f64::NAN; idx.len() * w];
-    let result = f.update_many_into(&ts, &ys, &mut est);
+    let values = &mut values[..idx.len() * w];
+    values.fill(f64::NAN);
+    let result = f.update_many_into(ts, ys, values);
     let (done, error) = match result {
         Ok(()) => (idx.len(), None),
         Err(seqsmooth::Error::InBatch { index, source }) => (index, Some((index, *source))),
         Err(e) => (0, Some((0, e))),
     };
-    let nd = w.min(stride);
-    for ((e, v), c) in est
-        .chunks_exact(w)
-        .zip(values.chunks_exact_mut(stride))
-        .zip(cells.iter_mut())
-        .take(done)
-    {
+    for (e, c) in values.chunks_exact(w).zip(cells.iter_mut()).take(done) {
         *c = if e[0].is_nan() {
             Cells::default()
         } else {
-            v[..nd].copy_from_slice(&e[..nd]);
             Cells {
-                derivatives: nd,
+                derivatives: w,
                 std_devs: 0,
                 extra: Extra::None,
             }
@@ -172,6 +194,7 @@ pub fn run_chunk(
     stride: usize,
     results: &mut Results,
 ) -> Option<(usize, CliError)> {
+    let step = Step { lead, sigma };
     let n = chunk.rows.len();
     results.values.resize(n * stride, 0.0);
     results.cells.resize(n, Cells::default());
@@ -187,10 +210,10 @@ pub fn run_chunk(
             runner,
             chunk,
             0..n,
-            lead,
-            sigma,
+            step,
             &mut results.values,
             &mut results.cells,
+            &mut results.batch,
         );
     }
     // Split the slot arrays into one disjoint piece per group, with the group's filter.
@@ -223,10 +246,10 @@ pub fn run_chunk(
                 runner,
                 chunk,
                 o.iter().map(|&i| i as usize),
-                lead,
-                sigma,
+                step,
                 v,
                 c,
+                &mut Batch::default(),
             ),
             // Every series seen gets its filter before its rows are run.
             None => Some((

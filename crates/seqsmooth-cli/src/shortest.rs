@@ -5,9 +5,12 @@
 //! the interval of reals rounding to `x` (its ends included when `x`'s mantissa is even, as
 //! round-half-even parsing does), and of those the nearest to `x` (the upper one of two equally
 //! near) — the same digits as Rust's own `{}` and `{:e}` (Grisu with a Dragon4 fallback), which
-//! the tests check against. Multiplying by
-//! 5^±q is done with 125-bit approximations of the powers, each computed on first use from exact
-//! big integers.
+//! the tests check against. Multiplying by 5^±q is done with 125-bit approximations of the
+//! powers, each computed on first use from exact big integers.
+//!
+//! Numbers are formatted by the million, so the hot path avoids branches whose outcome varies
+//! from number to number (how many digits are dropped, the sign, a point inside the digits or
+//! `0.` before them): a mispredicted branch costs more than the work it would skip.
 
 use num_bigint::BigUint;
 use num_traits::{One, ToPrimitive};
@@ -71,12 +74,39 @@ fn pow5(i: usize) -> Split {
     })
 }
 
-/// `floor(m · mul / 2^j)` for a 125-bit `mul` and `j >= 64`.
-#[inline]
+/// `floor(m · mul / 2^j)` for a 125-bit `mul` and `j >= 64` (the tests' reference for
+/// [`mul_shift_all`]).
+#[cfg(test)]
 fn mul_shift(m: u64, mul: Split, j: i32) -> u64 {
     let low = (m as u128 * mul.0 as u128) >> 64;
     let high = m as u128 * mul.1 as u128;
     ((low + high) >> (j - 64) as u32) as u64
+}
+
+/// `mul_shift` of `4m`, `4m + 2` and `4m - 1 - mm_shift` (the value and the ends of its
+/// rounding interval) from one product `m · mul`, exact to the bit: 2 multiplications instead
+/// of 6. `m < 2^54`, so `4m · mul` and the ends fit in a (128 + 64)-bit number.
+#[inline]
+fn mul_shift_all(m: u64, mul: Split, j: i32, mm_shift: u64) -> (u64, u64, u64) {
+    let low = u128::from(m) * u128::from(mul.0);
+    let high = u128::from(m) * u128::from(mul.1) + (low >> 64);
+    // 4m · mul as high · 2^64 + low.
+    let high = (high << 2) | u128::from(low as u64 >> 62);
+    let low = (low as u64) << 2;
+    let shift = (j - 64) as u32;
+    let mul = (u128::from(mul.1) << 64) | u128::from(mul.0);
+    // Plus 2 · mul, minus (1 + mm_shift) · mul (both below 2^127).
+    let up = mul << 1;
+    let carry = low.overflowing_add(up as u64).1;
+    let up_high = high + (up >> 64) + u128::from(carry);
+    let down = mul * u128::from(1 + mm_shift);
+    let borrow = low.overflowing_sub(down as u64).1;
+    let down_high = high - (down >> 64) - u128::from(borrow);
+    (
+        (high >> shift) as u64,
+        (up_high >> shift) as u64,
+        (down_high >> shift) as u64,
+    )
 }
 
 /// The exponent of 5 in `v > 0`.
@@ -118,9 +148,7 @@ fn decimal(ieee_mantissa: u64, ieee_exponent: u32) -> (u64, i32) {
         let k = POW5_INV_BITCOUNT + pow5bits(q as i32) - 1;
         let i = -e2 + q as i32 + k;
         let mul = pow5_inv(q as usize);
-        vr = mul_shift(mv, mul, i);
-        vp = mul_shift(mv + 2, mul, i);
-        vm = mul_shift(mv - 1 - mm_shift, mul, i);
+        (vr, vp, vm) = mul_shift_all(m2, mul, i, mm_shift);
         // Only for q <= 21 can the exact quotients be integers; at most one of mv - 1 -
         // mm_shift, mv, mv + 2 is a multiple of 5.
         if q <= 21 && mv % 5 != 0 {
@@ -138,9 +166,7 @@ fn decimal(ieee_mantissa: u64, ieee_exponent: u32) -> (u64, i32) {
         let k = pow5bits(i) - POW5_BITCOUNT;
         let j = q as i32 - k;
         let mul = pow5(i as usize);
-        vr = mul_shift(mv, mul, j);
-        vp = mul_shift(mv + 2, mul, j);
-        vm = mul_shift(mv - 1 - mm_shift, mul, j);
+        (vr, vp, vm) = mul_shift_all(m2, mul, j, mm_shift);
         if q <= 1 {
             // mv has at least q trailing zero bits, so the quotients are exact.
             if accept_bounds {
@@ -174,7 +200,22 @@ fn decimal(ieee_mantissa: u64, ieee_exponent: u32) -> (u64, i32) {
         // takes the upper one: no round-half-even correction.
         vr + u64::from((vr == vm && (!accept_bounds || !vm_trailing_zeros)) || last_removed >= 5)
     } else {
+        // Two digits at once, then one: most numbers lose two or three. Selected without
+        // branches, which the varying counts would mispredict.
         let mut round_up = false;
+        for (step, half) in [(100, 50), (10, 5)] {
+            let (p, m, r) = (vp / step, vm / step, vr / step);
+            let take = p > m;
+            round_up = if take {
+                vr - r * step >= half
+            } else {
+                round_up
+            };
+            vr = if take { r } else { vr };
+            vp = if take { p } else { vp };
+            vm = if take { m } else { vm };
+            removed += if take { step.ilog10() as i32 } else { 0 };
+        }
         while vp / 10 > vm / 10 {
             round_up = vr % 10 >= 5;
             vr /= 10;
@@ -185,6 +226,41 @@ fn decimal(ieee_mantissa: u64, ieee_exponent: u32) -> (u64, i32) {
         vr + u64::from(vr == vm || round_up)
     };
     (output, e10 + removed)
+}
+
+/// `10^k` for `k` in `0..=17`.
+const POW10: [u64; 18] = {
+    let mut t = [1u64; 18];
+    let mut k = 1;
+    while k < 18 {
+        t[k] = t[k - 1] * 10;
+        k += 1;
+    }
+    t
+};
+
+/// The number of decimal digits of `d` (`0 < d < 10^17`).
+#[inline]
+fn digit_count(d: u64) -> usize {
+    // floor(log10(2) · bit length) is the count or one less.
+    let t = (((64 - d.leading_zeros()) * 1233) >> 12) as usize;
+    t + usize::from(d >= POW10[t])
+}
+
+/// The 8 decimal digits of `x < 10^8` as ASCII, the first digit in the lowest byte: the
+/// halves, quarters and digits split in parallel lanes of one word.
+#[inline]
+fn eight_digits(x: u32) -> u64 {
+    let x = u64::from(x);
+    let hi = x / 10_000;
+    // Lanes of 32 bits: the first four digits, then the last four.
+    let quads = hi | ((x - hi * 10_000) << 32);
+    // Lanes of 16 bits: pairs of digits (a quad / 100 is (quad · 10486) >> 20 below 10^4).
+    let top = ((quads * 10_486) >> 20) & 0x0000_007F_0000_007F;
+    let pairs = top | ((quads - top * 100) << 16);
+    // Lanes of 8 bits: digits (a pair / 10 is (pair · 103) >> 10 below 100).
+    let tens = ((pairs * 103) >> 10) & 0x000F_000F_000F_000F;
+    (tens | ((pairs - tens * 10) << 8)) | 0x3030_3030_3030_3030
 }
 
 /// "00", "01", …, "99".
@@ -199,82 +275,125 @@ const PAIRS: [u8; 200] = {
     t
 };
 
-/// Writes the decimal digits of `d` at the end of `buf`; returns where they start. Four
-/// digits per division on the long path, so the chain of dependent divisions stays short.
-fn decimal_digits(mut d: u64, buf: &mut [u8; 20]) -> usize {
-    let pair = |k: u32| &PAIRS[2 * k as usize..2 * k as usize + 2];
-    let mut i = buf.len();
-    while d >= 10_000 {
-        let r = (d % 10_000) as u32;
-        d /= 10_000;
-        buf[i - 4..i - 2].copy_from_slice(pair(r / 100));
-        buf[i - 2..i].copy_from_slice(pair(r % 100));
-        i -= 4;
+/// The 8 decimal digits of `x < 10^8` into `out`, two at a time from [`PAIRS`].
+#[inline]
+fn eight_digits_by_pairs(x: u32, out: &mut [u8]) {
+    let (high, low) = (x / 10_000, x % 10_000);
+    for (k, pair) in [high / 100, high % 100, low / 100, low % 100]
+        .into_iter()
+        .enumerate()
+    {
+        let p = 2 * pair as usize;
+        out[2 * k..2 * k + 2].copy_from_slice(&PAIRS[p..p + 2]);
     }
-    let mut d = d as u32;
-    while d >= 100 {
-        buf[i - 2..i].copy_from_slice(pair(d % 100));
-        d /= 100;
-        i -= 2;
+}
+
+/// The 17 decimal digits of `d < 10^17`, zero-padded on the left, at the start of `buf`. The
+/// two 8-digit halves are converted in different ways: the same way twice, they would be
+/// vectorized into slower SSE code.
+#[inline]
+fn seventeen_digits(d: u64, buf: &mut [u8; DIGITS_BUF]) {
+    let high = d / 100_000_000;
+    let low = (d - high * 100_000_000) as u32;
+    let top = high / 100_000_000;
+    let middle = (high - top * 100_000_000) as u32;
+    buf[0] = b'0' + top as u8;
+    eight_digits_by_pairs(middle, &mut buf[1..9]);
+    buf[9..17].copy_from_slice(&eight_digits(low).to_le_bytes());
+}
+
+/// The digits buffer: 17 digits and room for fixed-size copies past them.
+const DIGITS_BUF: usize = 40;
+/// The text buffer: every number's text is shorter than [`TEXT`] bytes.
+const TEXT: usize = 32;
+
+/// Copies the fixed-size `N` bytes of `from` at `src` to `to` at `dst`.
+#[inline]
+fn copy<const N: usize>(to: &mut [u8], dst: usize, from: &[u8], src: usize) {
+    to[dst..dst + N].copy_from_slice(&from[src..src + N]);
+}
+
+/// Appends the plain text of `digits` with the point after `point` of them, when that needs
+/// more than 4 zeros after the point or more than 16 digits before it (never for the command's
+/// numbers, which are written in scientific notation there).
+fn write_long(out: &mut Vec<u8>, negative: bool, digits: &[u8], point: i32) {
+    if negative {
+        out.push(b'-');
     }
-    if d >= 10 {
-        buf[i - 2..i].copy_from_slice(pair(d));
-        i - 2
+    if point > 0 {
+        out.extend_from_slice(digits);
+        out.resize(out.len() + point as usize - digits.len(), b'0');
     } else {
-        buf[i - 1] = b'0' + d as u8;
-        i - 1
+        out.extend_from_slice(b"0.");
+        out.resize(out.len() + point.unsigned_abs() as usize, b'0');
+        out.extend_from_slice(digits);
     }
 }
 
 /// Appends `x` (finite, nonzero) as Rust's `{}` (`scientific = false`: plain decimal, no
-/// exponent) or `{:e}` (`scientific = true`: `d[.ddd]e[-]x`) would.
+/// exponent) or `{:e}` (`scientific = true`: `d[.ddd]e[-]x`) would. The text is laid out in a
+/// buffer prefilled with `0` by fixed-size copies and appended in one piece; plain text with
+/// more than 4 zeros after the point or 16 digits before it (which the command writes in
+/// scientific notation) is appended piece by piece.
 pub fn write(out: &mut Vec<u8>, x: f64, scientific: bool) {
     let bits = x.to_bits();
-    let (digits, exp) = decimal(
+    let (d, exp) = decimal(
         bits & ((1u64 << MANTISSA_BITS) - 1),
         ((bits >> MANTISSA_BITS) & 0x7ff) as u32,
     );
-    if x.is_sign_negative() {
-        out.push(b'-');
+    let mut digits = [b'0'; DIGITS_BUF];
+    seventeen_digits(d, &mut digits);
+    let n = digit_count(d);
+    let first = 17 - n;
+    let mut text = [b'0'; TEXT + 24];
+    let at = usize::from(x.is_sign_negative());
+    // Without a branch: the signs of numbers vary unpredictably.
+    text[0] = [b'0', b'-'][at];
+    // Where the point goes, counted in digits from the first: 0 or less is "0.000ddd".
+    let point = n as i32 + exp;
+    if !scientific && !(-4..=16).contains(&point) {
+        return write_long(out, at == 1, &digits[first..17], point);
     }
-    let mut buf = [0u8; 20];
-    let start = decimal_digits(digits, &mut buf);
-    let text = &buf[start..];
-    let n = text.len() as i32;
-    if scientific {
-        out.push(text[0]);
-        if n > 1 {
-            out.push(b'.');
-            out.extend_from_slice(&text[1..]);
-        }
-        out.push(b'e');
-        let e = exp + n - 1;
+    let len = if scientific {
+        text[at] = digits[first];
+        text[at + 1] = b'.';
+        copy::<16>(&mut text, at + 2, &digits, first + 1);
+        let mut end = if n > 1 { at + n + 1 } else { at + 1 };
+        text[end] = b'e';
+        end += 1;
+        let e = point - 1;
         if e < 0 {
-            out.push(b'-');
+            text[end] = b'-';
+            end += 1;
         }
         let e = e.unsigned_abs();
-        if e >= 100 {
-            out.push(b'0' + (e / 100) as u8);
+        let width = 1 + usize::from(e >= 10) + usize::from(e >= 100);
+        let mut rest = e;
+        for k in (0..width).rev() {
+            text[end + k] = b'0' + (rest % 10) as u8;
+            rest /= 10;
         }
-        if e >= 10 {
-            out.push(b'0' + (e / 10 % 10) as u8);
-        }
-        out.push(b'0' + (e % 10) as u8);
+        end + width
     } else if exp >= 0 {
-        out.extend_from_slice(text);
-        out.resize(out.len() + exp as usize, b'0');
+        // Digits, then zeros (the digits buffer's padding).
+        copy::<16>(&mut text, at, &digits, first);
+        at + point as usize
     } else {
-        let point = n + exp;
-        if point > 0 {
-            out.extend_from_slice(&text[..point as usize]);
-            out.push(b'.');
-            out.extend_from_slice(&text[point as usize..]);
-        } else {
-            out.extend_from_slice(b"0.");
-            out.resize(out.len() + (-point) as usize, b'0');
-            out.extend_from_slice(text);
-        }
-    }
+        // "ddd.ddd" (point > 0) or "0.000ddd" (point <= 0) by the same three writes at
+        // computed places, without a branch (the two alternate with the numbers' sizes): the
+        // whole part (digits, or the zeros past them), the point, the fraction after its
+        // leading zeros.
+        let whole = point.max(0) as usize;
+        let zeros = (-point).max(0) as usize;
+        let before = whole.max(1);
+        copy::<16>(&mut text, at, &digits, if whole > 0 { first } else { 17 });
+        text[at + before] = b'.';
+        copy::<17>(&mut text, at + before + 1 + zeros, &digits, first + whole);
+        at + before + 1 + zeros + n - whole
+    };
+    let start = out.len();
+    out.extend_from_slice(&text[..TEXT]);
+    out.truncate(start + len);
 }
 
 #[cfg(test)]
@@ -297,10 +416,47 @@ mod tests {
 
     #[test]
     fn digits_of_integers() {
-        for d in (0..100_000u64).chain([u64::MAX, 10u64.pow(19), 99_999_999_999_999_999]) {
-            let mut buf = [0u8; 20];
-            let start = decimal_digits(d, &mut buf);
-            assert_eq!(std::str::from_utf8(&buf[start..]).unwrap(), d.to_string());
+        let mut more = vec![
+            99_999_999_999_999_999,
+            10u64.pow(16),
+            12_345_678_901_234_567,
+        ];
+        more.extend((1..17).flat_map(|k| [10u64.pow(k) - 1, 10u64.pow(k), 10u64.pow(k) + 1]));
+        for d in (1..100_000u64).chain(more) {
+            let mut buf = [0u8; DIGITS_BUF];
+            seventeen_digits(d, &mut buf);
+            assert_eq!(std::str::from_utf8(&buf[..17]).unwrap(), format!("{d:017}"));
+            assert_eq!(digit_count(d), d.to_string().len(), "{d}");
+        }
+        for x in [0, 1, 9, 10, 99, 1234, 9999, 10_000, 12_345_678, 99_999_999] {
+            assert_eq!(eight_digits(x).to_le_bytes(), *format!("{x:08}").as_bytes());
+        }
+    }
+
+    #[test]
+    fn one_product_gives_the_three_shifts() {
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        for q in 0..POW5_TABLE {
+            for _ in 0..200 {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let m = (state >> 10) | 1 << 53;
+                let m = if state % 7 == 0 {
+                    m & ((1 << 53) - 1) | 1
+                } else {
+                    m
+                };
+                let mm_shift = state >> 63;
+                for (mul, j) in [(pow5(q), 64 + (state % 60) as i32), (pow5_inv(q), 120)] {
+                    let want = (
+                        mul_shift(4 * m, mul, j),
+                        mul_shift(4 * m + 2, mul, j),
+                        mul_shift(4 * m - 1 - mm_shift, mul, j),
+                    );
+                    assert_eq!(mul_shift_all(m, mul, j, mm_shift), want, "{m} {q} {j}");
+                }
+            }
         }
     }
 
