@@ -271,6 +271,19 @@ def main():
 
     rows, agree, failures = [], [], []
 
+    def last(name):
+        return np.fromfile(os.path.join(a.dir, f"{name}.last.f64"), dtype="<f8")
+
+    def check_last(pair, peer_name, peer_last, our_name, our_label, scale_rows, tol):
+        """The state after our update-only call (the timed one) against the peer's last."""
+        mine = last(our_name)
+        scale = np.max(np.abs(scale_rows), axis=0)
+        err = float(np.max(np.abs(peer_last - mine) / np.where(scale > 0, scale, 1.0)))
+        agree.append({"pair": f"{pair}: {peer_name}, last state vs {our_label} after update_many",
+                      "err": err, "tol": tol, "rows": "last", "metric": "max abs(ours_k)"})
+        if not err <= tol:
+            failures.append(f"{pair}, {our_label} update_many: difference {err:.2e} > {tol:.1e}")
+
     def record(pair, peer_name, peer_updates, peer_secs, our_name, our_label, err, tol, rows_cmp,
                metric="max abs(ours_k)"):
         o = ours[our_name]
@@ -308,6 +321,8 @@ def main():
         tol = TOL["fading"] + np.max(np.abs(np.diff(t) - DT)) / DT
         record(f"fading memory, degree {m}", "filterpy FadingMemoryFilter", len(ys), secs, name,
                "FadingMemory (gain engine)", err, tol, f"{s}..{len(y) - 1}")
+        check_last(f"fading memory, degree {m}", "filterpy FadingMemoryFilter", out[-1], name,
+                   "FadingMemory (gain engine)", mine[s:], tol)
 
     # 3b. LeastSquaresFilter from its zero start; exact from sample m on.
     for m in range(3):
@@ -327,6 +342,8 @@ def main():
         err = rel_diff(out[m:], mine[m:])
         record(f"expanding memory, degree {m}", "filterpy LeastSquaresFilter", len(y), secs, name,
                "ExpandingMemory (gain engine)", err, TOL["leastsq"], f"{m}..{len(y) - 1}")
+        check_last(f"expanding memory, degree {m}", "filterpy LeastSquaresFilter", out[-1], name,
+                   "ExpandingMemory (gain engine)", mine[m:], TOL["leastsq"])
 
     # 3c. KalmanFilter, Q = 0, polynomial model, started at sample m from the exact fit.
     for d, label in (("kfeven", "even"), ("irregular", "irregular")):
@@ -342,6 +359,9 @@ def main():
                 record(f"Kalman {memory}, degree {m}, {label}",
                        "filterpy KalmanFilter" + (" (alpha)" if theta else ""), count, secs,
                        name, our_label, err, TOL["kalman"], f"{m}..{len(tk) - 1}")
+                check_last(f"Kalman {memory}, degree {m}, {label}",
+                           "filterpy KalmanFilter" + (" (alpha)" if theta else ""), out[-1],
+                           name, our_label, mine[m:], TOL["kalman"])
 
     # 3d. savgol_filter (all three derivatives) against smooth and the streaming filter, and all
     # three against the convolution with exact (rational) coefficients.

@@ -17,7 +17,9 @@
 //!
 //! For each run it writes `DIR/<name>.est.f64`: `samples × (degree+1)` doubles, row-major, the
 //! estimate `[x, x', …]` after each sample (NaN while undetermined; for `fixed-sliding` row
-//! `n` holds the centred estimate for sample `n`, NaN where no window is centred on it), and
+//! `n` holds the centred estimate for sample `n`, NaN where no window is centred on it),
+//! `DIR/<name>.last.f64`: the estimate after the timed update-only call (`degree+1` doubles;
+//! empty for the fixed-memory runs), and
 //! prints one CSV line to stdout:
 //! `name,samples,seconds_update,seconds_update_estimate,switched_at`: the best of `REPS` timed
 //! repetitions of the update loop alone and of the loop that also reads each sample's estimate
@@ -166,22 +168,33 @@ fn best_of<S>(
     Ok(best)
 }
 
-/// Times a filter that implements [`PolynomialFilter`]: both loops, then one untimed run for
-/// the estimates. Returns (seconds update, seconds update+estimate, estimates, switched_at).
+/// What [`time_filter`] returns: seconds of the update loop and of the update + estimate
+/// loop, the per-sample estimates, the final estimate after the update-only loop, and the
+/// switch sample.
+type Timed = (f64, f64, Vec<f64>, Vec<f64>, Option<u64>);
+
+/// Times a filter that implements [`PolynomialFilter`]: both loops, then untimed runs for the
+/// estimates (every sample's through `update_many_into`, and the last one after the
+/// update-only call, so that the script checks what the update-only timing computed).
 fn time_filter<F: PolynomialFilter>(
     reps: usize,
     make: impl Fn() -> Res<F>,
     t: &[f64],
     y: &[f64],
     switched: impl Fn(&F) -> Option<u64>,
-) -> Res<(f64, f64, Vec<f64>, Option<u64>)> {
+) -> Res<Timed> {
     let width = make()?.degree() + 1;
     let mut out = vec![0.0; t.len() * width];
     let plain = best_of(reps, &make, |f| feed(f, t, y))?;
     let read = best_of(reps, &make, |f| feed_and_read(f, t, y, &mut out))?;
     let mut f = make()?;
+    feed(&mut f, t, y)?;
+    let last = f
+        .estimate()
+        .map_or_else(|| vec![f64::NAN; width], |s| s.derivatives);
+    let mut f = make()?;
     feed_and_read(&mut f, t, y, &mut out)?;
-    Ok((plain, read, out, switched(&f)))
+    Ok((plain, read, out, last, switched(&f)))
 }
 
 fn main() -> Res<()> {
@@ -215,7 +228,7 @@ fn main() -> Res<()> {
         }
         let (t, y) = &data[&run.data];
         let m = run.degree;
-        let (plain, read, out, switched) = match run.filter.as_str() {
+        let (plain, read, out, last, switched) = match run.filter.as_str() {
             "fading-gain" => {
                 time_filter(reps, || run.fading(Engine::Gain), t, y, |f| f.switched_at())?
             }
@@ -241,7 +254,7 @@ fn main() -> Res<()> {
                 let plain = best_of(reps, make, |f| feed(f, t, y))?;
                 let read = best_of(reps, make, |f| feed_fixed_and_read(f, t, y, &mut out))?;
                 feed_fixed_and_read(&mut make()?, t, y, &mut out)?;
-                (plain, read, out, None)
+                (plain, read, out, Vec::new(), None)
             }
             "smooth" => {
                 let window: usize = run.key("window")?;
@@ -255,11 +268,12 @@ fn main() -> Res<()> {
                     },
                 )?;
                 let out: Vec<f64> = rows.concat();
-                (secs, secs, out, None)
+                (secs, secs, out, Vec::new(), None)
             }
             other => return Err(format!("run {}: unknown filter '{other}'", run.name).into()),
         };
         write_f64s(&dir.join(format!("{}.est.f64", run.name)), &out)?;
+        write_f64s(&dir.join(format!("{}.last.f64", run.name)), &last)?;
         println!(
             "{},{},{:e},{:e},{}",
             run.name,
