@@ -121,22 +121,24 @@
 //! The steady recursion is stable (its eigenvalues are all `θ`), so plain arithmetic is enough
 //! there; the compensated state matters in the start-up, where the gains are large. Measured
 //! (`cargo test -p seqsmooth --release --test batch plain -- --nocapture`): 60 000 samples at
-//! `t = k·0.1`, `τ = 0.1`, a sine of amplitude 100 plus a trend and unit noise, in batches of
-//! 101 (a block map and 37 recursion steps each); the largest
+//! `t = k·0.1`, `τ = 0.1`, a sine of amplitude 100 plus a trend and unit noise, one batch of
+//! 20 000 then batches of 101 (a block map and 37 recursion steps each; a block map is built for
+//! new gains only in a batch of at least `512·(m+1)²` samples, its cost being that of the
+//! recursion over 2 000 to 30 000 samples); the largest
 //! difference from the compensated per-sample path over the second half of the run, relative
 //! to the largest `|x^(k)|` there, worst over `k`:
 //!
 //! | m | θ = 0.5 | θ = 0.9 | θ = 0.99 | θ = 0.999 |
 //! |---:|---:|---:|---:|---:|
-//! | 0 | 1.6e-16 | 3.3e-16 | 9.9e-16 | 2.2e-15 |
-//! | 1 | 1.3e-13 | 6.5e-14 | 2.3e-14 | 1.5e-13 |
-//! | 2 | 1.7e-13 | 6.1e-13 | 5.3e-14 | 3.4e-14 |
-//! | 3 | 1.3e-13 | 6.5e-13 | 7.3e-14 | 5.9e-14 |
-//! | 4 | 1.4e-13 | 7.6e-13 | 3.6e-13 | 2.4e-14 |
-//! | 5 | 1.5e-13 | 7.1e-13 | 8.1e-13 | 2.2e-14 |
-//! | 6 | 1.1e-13 | 5.0e-13 | 1.6e-12 | 8.5e-14 |
-//! | 7 | 1.5e-13 | 4.3e-13 | 3.8e-12 | 8.7e-14 |
-//! | 8 | 1.1e-13 | 3.9e-13 | 4.9e-12 | 7.2e-14 |
+//! | 0 | 1.6e-16 | 4.9e-16 | 9.9e-16 | 2.2e-15 |
+//! | 1 | 1.8e-13 | 8.7e-14 | 2.4e-14 | 1.6e-13 |
+//! | 2 | 1.7e-13 | 7.6e-13 | 4.7e-14 | 2.9e-14 |
+//! | 3 | 1.9e-13 | 7.7e-13 | 7.5e-14 | 5.8e-14 |
+//! | 4 | 1.9e-13 | 8.1e-13 | 4.2e-13 | 2.1e-14 |
+//! | 5 | 1.4e-13 | 7.7e-13 | 8.1e-13 | 4.8e-14 |
+//! | 6 | 1.1e-13 | 5.9e-13 | 1.5e-12 | 8.5e-14 |
+//! | 7 | 1.1e-13 | 5.2e-13 | 3.6e-12 | 8.8e-14 |
+//! | 8 | 1.1e-13 | 5.6e-13 | 4.8e-12 | 7.2e-14 |
 //!
 //! (asserted: 1e-11). The exact engine and the fixed-memory filter give the same numbers
 //! through either call.
