@@ -1,6 +1,28 @@
 use crate::linalg::solve_upper_transpose_in_place;
 use nalgebra::{DMatrix, DVector};
 
+/// `$call` with the constant `N` equal to the size `$p` for sizes 1 to 9 (fully unrolled code
+/// for the polynomial filters' common degrees), `$other` (with the size bound to `$q`) above.
+macro_rules! unrolled_sizes {
+    ($p:expr, $n:ident => $call:expr, $q:pat => $other:expr) => {
+        match $p {
+            1 => unrolled_sizes!(@at 1, $n, $call),
+            2 => unrolled_sizes!(@at 2, $n, $call),
+            3 => unrolled_sizes!(@at 3, $n, $call),
+            4 => unrolled_sizes!(@at 4, $n, $call),
+            5 => unrolled_sizes!(@at 5, $n, $call),
+            6 => unrolled_sizes!(@at 6, $n, $call),
+            7 => unrolled_sizes!(@at 7, $n, $call),
+            8 => unrolled_sizes!(@at 8, $n, $call),
+            9 => unrolled_sizes!(@at 9, $n, $call),
+            $q => $other,
+        }
+    };
+    (@at $v:literal, $n:ident, $call:expr) => {{
+        const $n: usize = $v;
+        $call
+    }};
+}
 /// An upper-triangular factor `R` of an accumulated Gram matrix `RᵀR = Σ_k c_k a_k a_kᵀ`, kept
 /// up to date row by row, with a right-hand column `d` (`Rᵀd = Σ_k c_k a_k b_k`).
 ///
@@ -155,18 +177,7 @@ impl TriangularFactor {
 
     /// Solves `R x = d` into `x` (`U x = ū`, no divisions); false while not determined.
     pub fn solve_into(&self, x: &mut [f64]) -> bool {
-        match self.dim() {
-            1 => self.solve_n::<1>(x),
-            2 => self.solve_n::<2>(x),
-            3 => self.solve_n::<3>(x),
-            4 => self.solve_n::<4>(x),
-            5 => self.solve_n::<5>(x),
-            6 => self.solve_n::<6>(x),
-            7 => self.solve_n::<7>(x),
-            8 => self.solve_n::<8>(x),
-            9 => self.solve_n::<9>(x),
-            p => self.solve_any(p, x),
-        }
+        unrolled_sizes!(self.dim(), N => self.solve_n::<N>(x), p => self.solve_any(p, x))
     }
 
     #[inline(always)]
@@ -206,22 +217,11 @@ impl TriangularFactor {
         let p = self.dim();
         assert_eq!(a.len(), p, "row of the wrong length");
         // Fixed sizes unroll completely (the polynomial filters' common degrees).
-        match p {
-            1 => self.add_row_n::<1>(row_of(a), b, weight),
-            2 => self.add_row_n::<2>(row_of(a), b, weight),
-            3 => self.add_row_n::<3>(row_of(a), b, weight),
-            4 => self.add_row_n::<4>(row_of(a), b, weight),
-            5 => self.add_row_n::<5>(row_of(a), b, weight),
-            6 => self.add_row_n::<6>(row_of(a), b, weight),
-            7 => self.add_row_n::<7>(row_of(a), b, weight),
-            8 => self.add_row_n::<8>(row_of(a), b, weight),
-            9 => self.add_row_n::<9>(row_of(a), b, weight),
-            _ => {
-                self.scratch.clear();
-                self.scratch.extend_from_slice(a);
-                self.add_row_any(b, weight);
-            }
-        }
+        unrolled_sizes!(p, N => self.add_row_n::<N>(row_of(a), b, weight), _ => {
+            self.scratch.clear();
+            self.scratch.extend_from_slice(a);
+            self.add_row_any(b, weight);
+        })
     }
 
     /// [`add_row`](Self::add_row) with the row of powers `a = (1, v, v², …, v^(p-1))` (a
@@ -237,26 +237,15 @@ impl TriangularFactor {
     /// assert_eq!(f.r(), g.r());
     /// ```
     pub fn add_row_powers(&mut self, v: f64, b: f64, weight: f64) {
-        match self.dim() {
-            1 => self.add_row_n::<1>(powers(v), b, weight),
-            2 => self.add_row_n::<2>(powers(v), b, weight),
-            3 => self.add_row_n::<3>(powers(v), b, weight),
-            4 => self.add_row_n::<4>(powers(v), b, weight),
-            5 => self.add_row_n::<5>(powers(v), b, weight),
-            6 => self.add_row_n::<6>(powers(v), b, weight),
-            7 => self.add_row_n::<7>(powers(v), b, weight),
-            8 => self.add_row_n::<8>(powers(v), b, weight),
-            9 => self.add_row_n::<9>(powers(v), b, weight),
-            p => {
-                self.scratch.clear();
-                let mut pw = 1.0;
-                for _ in 0..p {
-                    self.scratch.push(pw);
-                    pw *= v;
-                }
-                self.add_row_any(b, weight);
+        unrolled_sizes!(self.dim(), N => self.add_row_n::<N>(powers(v), b, weight), p => {
+            self.scratch.clear();
+            let mut pw = 1.0;
+            for _ in 0..p {
+                self.scratch.push(pw);
+                pw *= v;
             }
-        }
+            self.add_row_any(b, weight);
+        })
     }
 
     #[inline(always)]
@@ -485,18 +474,9 @@ impl TriangularFactor {
     /// `U ← diag(A)⁻¹ (U P) diag(α^-j)` is `U_ij ← α^(i-j) (U P)_ij` (`(U P)_ii = 1`),
     /// `D_i ← α^(-2i) D_i` and `ū_i ← α^i ū_i`. With `α` a power of two the scalings are exact.
     pub fn change_variables_polynomial(&mut self, alpha: f64, beta: f64) {
-        match self.dim() {
-            1 => self.change_variables_polynomial_n::<1>(alpha, beta),
-            2 => self.change_variables_polynomial_n::<2>(alpha, beta),
-            3 => self.change_variables_polynomial_n::<3>(alpha, beta),
-            4 => self.change_variables_polynomial_n::<4>(alpha, beta),
-            5 => self.change_variables_polynomial_n::<5>(alpha, beta),
-            6 => self.change_variables_polynomial_n::<6>(alpha, beta),
-            7 => self.change_variables_polynomial_n::<7>(alpha, beta),
-            8 => self.change_variables_polynomial_n::<8>(alpha, beta),
-            9 => self.change_variables_polynomial_n::<9>(alpha, beta),
-            p => self.change_variables_polynomial_any(p, alpha, beta),
-        }
+        unrolled_sizes!(self.dim(), N => self.change_variables_polynomial_n::<N>(alpha, beta), p => {
+            self.change_variables_polynomial_any(p, alpha, beta)
+        })
     }
 
     #[inline(always)]
