@@ -162,6 +162,7 @@ mod expanding_block;
 pub mod fixed;
 mod gain_engine;
 pub mod gains;
+pub mod stream;
 pub mod switching;
 pub mod vrf;
 
