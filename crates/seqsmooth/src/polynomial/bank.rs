@@ -45,7 +45,7 @@
 
 use super::gains::{fading_gains, ExpandingGainSchedule, GainForm};
 use super::switching::SwitchRule;
-use super::{check_degree, check_tau, check_theta};
+use super::options::{check_degree, check_tau, check_theta};
 use crate::error::Error;
 use rayon::prelude::*;
 

@@ -104,6 +104,7 @@ mod filter;
 mod smooth;
 mod trend;
 mod weights;
+mod window_vrf;
 
 pub use bias::{balance_span, bias, dominant_bias, end_point_bias_bound, Balance};
 pub use covariance::{
@@ -114,6 +115,7 @@ pub use filter::{FixedEngine, FixedMemory};
 pub use smooth::smooth;
 pub use trend::{smooth_detrended, Detrended, Nominal};
 pub use weights::{weights, weights_unscaled};
+pub use window_vrf::{fixed_memory_vrf_limit, window_covariance};
 
 use crate::error::Error;
 use crate::scalar::{Rational, Scalar};

@@ -1,25 +1,14 @@
-//! Gains of the expanding- and fading-memory polynomial filters for any degree, each from one
-//! general formula, generic over [`Scalar`] (exact rationals or `f64`).
+//! The expanding-memory gains of any degree (Morrison Table 9.1, (9.4.28)-(9.4.30); Reyneke
+//! et al. §6.3-6.4), generic over [`Scalar`] (exact rationals or `f64`).
 //!
-//! Convention: Morrison's scaled current-estimate gains `h_k` (Tables 9.1 and 13.1; Reyneke's
-//! `Γ_Φ(k, m)`), indexed by derivative order `k = 0..m`, used as
-//! `Z*_{n,n} = Z*_{n,n-1} + H ε_n`. The 1-step-predictor form uses `Φ(1) H`
-//! (Morrison (13.5.35)-(13.5.37)); [`GainForm`] selects between them.
+//! Convention: Morrison's scaled current-estimate gains `h_k` (Reyneke's `Γ_Φ(k, m)`), indexed
+//! by derivative order `k = 0..m`, used as `Z*_{n,n} = Z*_{n,n-1} + H ε_n`; the 1-step-predictor
+//! form uses `Φ(1) H` ([`GainForm`]).
 
-use crate::calculus::{choose, factorial, falling_factorial, link_matrix, stirling1, Polynomial};
-use crate::model::phi;
+use crate::calculus::{choose, falling_factorial, link_matrix, Polynomial};
+use crate::polynomial::form::{apply_form, GainForm};
 use crate::scalar::{Rational, Scalar};
 use nalgebra::DVector;
-
-/// Which recursion the gain vector belongs to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum GainForm {
-    /// `Z*_{n,n} = Z*_{n,n-1} + H ε_n` (current estimate; Tables 9.1, 13.1 gains).
-    #[default]
-    Current,
-    /// `Z*_{n+1,n} = Φ(1) Z*_{n,n-1} + Φ(1) H ε_n` (1-step predictor; gain `Φ(1) H`).
-    Predictor,
-}
 
 /// The expanding-memory gains as rational functions of the sample index `n`:
 /// `h_k(n) = N_k(n) / (n+m+1)^(m+1)` with integer polynomial numerators
@@ -100,52 +89,6 @@ pub fn expanding_gains<T: Scalar>(m: usize, n: u64, form: GainForm) -> Vec<T> {
         .collect()
 }
 
-/// Fading-memory gains `h_0(θ) … h_m(θ)` of degree `m` (Morrison Table 13.1, `H = P(0) L`
-/// (13.5.28)-(13.5.30); Reyneke §6.5-6.6):
-///
-/// `h_k = (1-θ) Σ_{j=k..m} Σ_{v=k..j} C(j,v) θ^(j-v) (1-θ)^v |s(v,k)| / v!`,
-///
-/// a sum of non-negative terms (so accurate in `f64` for every `θ ∈ (0,1)`). `h_0 = 1 - θ^(m+1)`.
-///
-/// ```
-/// use seqsmooth::polynomial::gains::{fading_gains, GainForm};
-/// let g = fading_gains(2, 0.9_f64, GainForm::Current);
-/// assert!((g[0] - 0.271).abs() < 1e-15 && (g[1] - 0.0285).abs() < 1e-15 && (g[2] - 0.0005).abs() < 1e-16);
-/// ```
-pub fn fading_gains<T: Scalar>(m: usize, theta: T, form: GainForm) -> Vec<T> {
-    let s1 = stirling1::<T>(m);
-    let om = T::one() - theta.clone();
-    let h: Vec<T> = (0..=m)
-        .map(|k| {
-            let mut acc = T::zero();
-            for j in k..=m {
-                for v in k..=j {
-                    acc = acc
-                        + choose::<T>(j, v)
-                            * theta.powi_u(j - v)
-                            * om.powi_u(v)
-                            * s1[(v, k)].abs_val()
-                            / factorial::<T>(v);
-                }
-            }
-            om.clone() * acc
-        })
-        .collect();
-    apply_form(m, h, form)
-}
-
-fn apply_form<T: Scalar>(m: usize, h: Vec<T>, form: GainForm) -> Vec<T> {
-    match form {
-        GainForm::Current => h,
-        GainForm::Predictor => {
-            let p = phi(m, T::one());
-            (0..=m)
-                .map(|i| (i..=m).fold(T::zero(), |acc, j| acc + p[(i, j)].clone() * h[j].clone()))
-                .collect()
-        }
-    }
-}
-
 /// Precomputed expanding-memory gain schedule in `f64`: the exact integer numerator coefficients
 /// of [`expanding_gain_numerators`] evaluated by Horner's rule, `O(m)` per gain. The numerator
 /// coefficients are all non-negative (checked at construction for the degree in use), so the
@@ -202,3 +145,4 @@ impl ExpandingGainSchedule {
         v
     }
 }
+

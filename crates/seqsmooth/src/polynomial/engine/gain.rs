@@ -11,10 +11,12 @@
 //! (Morrison §9.6), and the exact least-squares state on any spacing — and (2) carries the
 //! state in compensated (double-word) arithmetic.
 
-use super::gains::{fading_gains, ExpandingGainSchedule, GainForm};
-use super::switching::SwitchRule;
-use super::vrf::{fading_vrf, EstimateForm};
-use super::DiscountMode;
+use crate::polynomial::expanding::gains::ExpandingGainSchedule;
+use crate::polynomial::fading::gains::fading_gains;
+use crate::polynomial::form::{EstimateForm, GainForm};
+use crate::polynomial::fading::switch::{memory_length_constant, SwitchRule};
+use crate::polynomial::fading::vrf::fading_vrf;
+use crate::polynomial::options::{DiscountMode, MAX_DEGREE};
 use crate::calculus::Polynomial;
 use crate::model::{shift_scaled_compensated, two_sum};
 use crate::scalar::{rational_from_f64, Rational, Scalar};
@@ -346,15 +348,15 @@ pub(crate) fn fading_gains_double_word(m: usize, theta: f64) -> (Vec<f64>, Vec<f
 impl FadingGains {
     pub fn new(m: usize, theta: f64, mode: DiscountMode, rule: SwitchRule) -> Self {
         let constant = match rule {
-            SwitchRule::Position => Some(super::switching::memory_length_constant(0, m)),
+            SwitchRule::Position => Some(memory_length_constant(0, m)),
             SwitchRule::ColumnMean => Some(
                 (0..=m)
-                    .map(|i| super::switching::memory_length_constant(i, m))
+                    .map(|i| memory_length_constant(i, m))
                     .sum::<f64>()
                     / (m + 1) as f64,
             ),
             SwitchRule::Derivative(i) => {
-                Some(super::switching::memory_length_constant(i.min(m), m))
+                Some(memory_length_constant(i.min(m), m))
             }
             SwitchRule::ExactCrossover | SwitchRule::AtSample(_) => None,
         };
@@ -804,7 +806,7 @@ impl GainEngine {
         // The grid from the first sample to the run's last, in units of its step.
         let grid = (t_end - self.t_first) / ((n + take as u64 - 1) as f64 * tau);
         // The old state onto the grid's sample n−1 (a rounding-sized move), then in grid units.
-        let mut z = [0.0; super::MAX_DEGREE + 1];
+        let mut z = [0.0; MAX_DEGREE + 1];
         let z = &mut z[..=m];
         for (zk, (hi, lo)) in z.iter_mut().zip(self.z.iter().zip(&self.z_lo)) {
             *zk = hi + lo;
@@ -1052,7 +1054,7 @@ impl GainEngine {
     pub fn estimate_at(&self, t: f64) -> (Vec<f64>, Option<DMatrix<f64>>) {
         let v = (t - self.t_last) / self.tau;
         let p = self.m + 1;
-        let (mut hi, mut lo) = ([0.0; super::MAX_DEGREE + 1], [0.0; super::MAX_DEGREE + 1]);
+        let (mut hi, mut lo) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
         hi[..p].copy_from_slice(&self.z);
         lo[..p].copy_from_slice(&self.z_lo);
         shift_scaled_compensated(&mut hi[..p], &mut lo[..p], v);

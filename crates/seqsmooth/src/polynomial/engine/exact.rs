@@ -20,7 +20,7 @@
 //! ([`TriangularFactor`]): no square roots per sample, and once every pivot is positive none
 //! of its `2m+3` divisions per sample waits for another.
 
-use super::DiscountMode;
+use crate::polynomial::options::{DiscountMode, MAX_DEGREE};
 use crate::model::{shift_scaled, shift_scaled_array};
 use crate::recursive::{InformationFilter, TriangularFactor};
 use nalgebra::DMatrix;
@@ -264,7 +264,7 @@ impl ExactEngine {
             return false;
         }
         let p = self.m + 1;
-        let mut buf = [0.0; super::MAX_DEGREE + 1];
+        let mut buf = [0.0; MAX_DEGREE + 1];
         let a = &mut buf[..p];
         if !self.info.factor().solve_into(a) {
             return false;

@@ -7,8 +7,10 @@
 //! self-starting; it starts as an expanding-memory filter and switches to its constant gains at a
 //! sample chosen by a [`SwitchRule`].
 
-use super::gains::ExpandingGainSchedule;
-use super::vrf::{fading_vrf, fading_vrf_limit, fixed_memory_vrf_limit, EstimateForm};
+use crate::polynomial::expanding::gains::ExpandingGainSchedule;
+use super::vrf::{fading_vrf, fading_vrf_limit};
+use crate::polynomial::fixed::fixed_memory_vrf_limit;
+use crate::polynomial::form::EstimateForm;
 use crate::error::Error;
 use crate::scalar::{Rational, Scalar};
 

@@ -1,0 +1,158 @@
+//! The engines the expanding- and fading-memory filters run on, and [`EngineState`]: the engine
+//! one filter holds (exact or gain), behind the filter's [`PolynomialFilter`] methods.
+//!
+//! - [`exact`]: recursive least squares (the square-root information filter of
+//!   [`crate::recursive`] with the polynomial model).
+//! - [`gain`]: the fixed-gain recursion of Morrison Tables 9.1/13.1 in Reyneke's variable-step
+//!   form, with its batch kernels.
+//! - [`expanding_block`]: runs of even blocks folded into the expanding-memory least-squares fit.
+
+pub(crate) mod exact;
+pub(crate) mod expanding_block;
+pub(crate) mod gain;
+
+use super::filter::{check_batch_lengths, check_estimates_length, first_invalid};
+#[cfg(doc)]
+use super::PolynomialFilter;
+use crate::error::Error;
+use crate::model::PolynomialState;
+pub(crate) use exact::{Discount, ExactEngine};
+pub(crate) use gain::{FadingGains, GainEngine};
+
+#[derive(Clone, Debug)]
+pub(crate) enum EngineState {
+    Exact(ExactEngine),
+    Gain(GainEngine),
+}
+
+impl EngineState {
+    pub(crate) fn samples(&self) -> u64 {
+        match self {
+            EngineState::Exact(e) => e.samples(),
+            EngineState::Gain(g) => g.samples(),
+        }
+    }
+
+    pub(crate) fn last_time(&self) -> f64 {
+        match self {
+            EngineState::Exact(e) => e.last_time(),
+            EngineState::Gain(g) => g.last_time(),
+        }
+    }
+
+    pub(crate) fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
+        let previous = (self.samples() > 0).then(|| self.last_time());
+        crate::error::check_sample(t, y, previous)?;
+        match self {
+            EngineState::Exact(e) => e.update(t, y),
+            EngineState::Gain(g) => g.update(t, y),
+        }
+        Ok(())
+    }
+
+    pub(crate) fn update_many(
+        &mut self,
+        m: usize,
+        times: &[f64],
+        values: &[f64],
+        estimates: Option<&mut [f64]>,
+    ) -> Result<(), Error> {
+        check_batch_lengths(times, values)?;
+        if let Some(out) = &estimates {
+            check_estimates_length(times, m, out)?;
+        }
+        let previous = (self.samples() > 0).then(|| self.last_time());
+        let valid = first_invalid(times, values, previous);
+        let (ts, ys) = (&times[..valid], &values[..valid]);
+        match (&mut *self, estimates) {
+            (EngineState::Exact(e), None) => ts.iter().zip(ys).for_each(|(&t, &y)| e.update(t, y)),
+            (EngineState::Exact(e), Some(out)) => {
+                for ((&t, &y), row) in ts.iter().zip(ys).zip(out.chunks_exact_mut(m + 1)) {
+                    e.update(t, y);
+                    if !e.derivatives_into(t, row) {
+                        row.fill(f64::NAN);
+                    }
+                }
+            }
+            (EngineState::Gain(g), None) => g.update_many(ts, ys),
+            (EngineState::Gain(g), Some(out)) => g.update_many_into(ts, ys, &mut out[..valid * (m + 1)]),
+        }
+        if valid < times.len() {
+            let previous = (self.samples() > 0).then(|| self.last_time());
+            if let Err(e) = crate::error::check_sample(times[valid], values[valid], previous) {
+                return Err(Error::InBatch {
+                    index: valid,
+                    source: Box::new(e),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    pub(crate) fn estimate_at(&self, m: usize, t: f64) -> Option<PolynomialState> {
+        if self.samples() <= m as u64 || !t.is_finite() {
+            return None;
+        }
+        let (derivatives, covariance) = match self {
+            EngineState::Exact(e) => e.estimate_at(t)?,
+            EngineState::Gain(g) => g.estimate_at(t),
+        };
+        Some(PolynomialState {
+            time: t,
+            derivatives,
+            covariance,
+        })
+    }
+
+    pub(crate) fn track_covariance(&mut self, sigma: f64) -> Result<(), Error> {
+        if !(sigma.is_finite() && sigma > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "noise sigma",
+                value: sigma.to_string(),
+                reason: "must be a positive finite number".into(),
+            });
+        }
+        match self {
+            EngineState::Exact(e) => e.track_covariance(sigma),
+            EngineState::Gain(g) => g.track_covariance(sigma),
+        }
+        Ok(())
+    }
+}
+
+/// Implements [`PolynomialFilter`] for a filter type with fields `m` (degree) and `core`
+/// ([`EngineState`]).
+macro_rules! impl_polynomial_filter {
+    ($ty:ty) => {
+        impl PolynomialFilter for $ty {
+            fn degree(&self) -> usize {
+                self.m
+            }
+            fn samples(&self) -> u64 {
+                self.core.samples()
+            }
+            fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
+                self.core.update(t, y)
+            }
+            fn update_many(&mut self, times: &[f64], values: &[f64]) -> Result<(), Error> {
+                self.core.update_many(self.m, times, values, None)
+            }
+            fn update_many_into(
+                &mut self,
+                times: &[f64],
+                values: &[f64],
+                estimates: &mut [f64],
+            ) -> Result<(), Error> {
+                self.core
+                    .update_many(self.m, times, values, Some(estimates))
+            }
+            fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
+                self.core.estimate_at(self.m, t)
+            }
+            fn last_time(&self) -> Option<f64> {
+                (self.core.samples() > 0).then(|| self.core.last_time())
+            }
+        }
+    };
+}
+pub(crate) use impl_polynomial_filter;

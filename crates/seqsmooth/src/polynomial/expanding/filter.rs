@@ -1,0 +1,51 @@
+//! [`ExpandingMemory`]: the expanding-memory polynomial filter (Morrison ch. 9).
+
+use crate::error::Error;
+use crate::model::PolynomialState;
+use crate::polynomial::engine::{impl_polynomial_filter, EngineState, ExactEngine, GainEngine};
+use crate::polynomial::options::{check_degree, Engine};
+use crate::polynomial::PolynomialFilter;
+
+/// Expanding-memory polynomial filter of degree `m` (Morrison ch. 9; Reyneke §6.3-6.4): the
+/// least-squares polynomial through all samples so far, with its derivatives, predictions and
+/// (given the noise σ) covariance. Self-starting: determined from the `(m+1)`-th sample.
+///
+/// ```
+/// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
+/// let mut f = ExpandingMemory::new(1, Engine::Gain).unwrap();
+/// for (n, y) in [1.0, 3.0, 2.0, 5.0, 4.0].iter().enumerate() {
+///     f.update(n as f64, *y).unwrap();
+/// }
+/// // Morrison T9-02: Z*_{4,4} = (23/5, 4/5)
+/// let s = f.estimate().unwrap();
+/// assert!((s.derivatives[0] - 4.6).abs() < 1e-12 && (s.derivatives[1] - 0.8).abs() < 1e-12);
+/// // the 1-step prediction Z*_{5,4} = (27/5, 4/5)
+/// assert!((f.estimate_at(5.0).unwrap().derivatives[0] - 5.4).abs() < 1e-12);
+/// ```
+#[derive(Clone, Debug)]
+pub struct ExpandingMemory {
+    m: usize,
+    core: EngineState,
+}
+
+impl ExpandingMemory {
+    /// A filter of degree `m` on the given engine.
+    pub fn new(m: usize, engine: Engine) -> Result<Self, Error> {
+        check_degree(m)?;
+        let core = match engine {
+            Engine::Exact => EngineState::Exact(ExactEngine::new(m, None)),
+            // The gain engine's output does not depend on τ for expanding memory; τ = 1.
+            Engine::Gain => EngineState::Gain(GainEngine::new(m, 1.0, None)),
+        };
+        Ok(Self { m, core })
+    }
+
+    /// Tracks the covariance of the estimate for white measurement noise of standard deviation
+    /// `sigma`: exact for the engine's estimator on any timestamps.
+    pub fn with_noise_sigma(mut self, sigma: f64) -> Result<Self, Error> {
+        self.core.track_covariance(sigma)?;
+        Ok(self)
+    }
+}
+
+impl_polynomial_filter!(ExpandingMemory);

@@ -1,0 +1,141 @@
+//! [`FadingMemory`]: the fading-memory polynomial filter (Morrison ch. 13).
+
+use super::switch::SwitchRule;
+use crate::error::Error;
+use crate::model::PolynomialState;
+use crate::polynomial::engine::{
+    impl_polynomial_filter, Discount, EngineState, ExactEngine, FadingGains, GainEngine,
+};
+use crate::polynomial::options::{check_degree, check_tau, check_theta, DiscountMode, Engine};
+use crate::polynomial::PolynomialFilter;
+
+/// Fading-memory polynomial filter of degree `m` and discount `θ` per `τ` (Morrison ch. 13;
+/// Reyneke §6.5-6.6): the polynomial minimising `Σ_k θ^((t_n-t_k)/τ) (y_k - p(t_k))²`.
+///
+/// ```
+/// use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
+/// let mut f = FadingMemory::new(1, 0.9, 1.0, Engine::Gain).unwrap();
+/// for n in 0..500 {
+///     f.update(n as f64, 2.0 + 0.5 * n as f64).unwrap();
+/// }
+/// let s = f.estimate().unwrap();
+/// assert!((s.derivatives[0] - 251.5).abs() < 1e-9 && (s.derivatives[1] - 0.5).abs() < 1e-12);
+/// ```
+#[derive(Clone, Debug)]
+pub struct FadingMemory {
+    m: usize,
+    theta: f64,
+    tau: f64,
+    mode: DiscountMode,
+    rule: SwitchRule,
+    sigma: Option<f64>,
+    core: EngineState,
+}
+
+impl FadingMemory {
+    /// A filter of degree `m`, discount `θ ∈ (0,1)` per nominal interval `τ > 0`.
+    pub fn new(m: usize, theta: f64, tau: f64, engine: Engine) -> Result<Self, Error> {
+        check_degree(m)?;
+        check_theta(theta)?;
+        check_tau(tau)?;
+        let mode = DiscountMode::default();
+        let rule = SwitchRule::default();
+        let core = match engine {
+            Engine::Exact => EngineState::Exact(ExactEngine::new(m, Some(Discount { theta, tau, mode }))),
+            Engine::Gain => EngineState::Gain(GainEngine::new(
+                m,
+                tau,
+                Some(FadingGains::new(m, theta, mode, rule)),
+            )),
+        };
+        Ok(Self {
+            m,
+            theta,
+            tau,
+            mode,
+            rule,
+            sigma: None,
+            core,
+        })
+    }
+
+    fn rebuild(&mut self) -> Result<(), Error> {
+        if self.core.samples() > 0 {
+            return Err(Error::InvalidParameter {
+                name: "configuration",
+                value: "change after the first sample".into(),
+                reason: "set the discount mode and switch rule before the first update".into(),
+            });
+        }
+        match &mut self.core {
+            EngineState::Exact(_) => {
+                self.core = EngineState::Exact(ExactEngine::new(
+                    self.m,
+                    Some(Discount {
+                        theta: self.theta,
+                        tau: self.tau,
+                        mode: self.mode,
+                    }),
+                ));
+            }
+            EngineState::Gain(_) => {
+                self.core = EngineState::Gain(GainEngine::new(
+                    self.m,
+                    self.tau,
+                    Some(FadingGains::new(self.m, self.theta, self.mode, self.rule)),
+                ));
+            }
+        }
+        if let Some(sigma) = self.sigma {
+            self.core.track_covariance(sigma)?;
+        }
+        Ok(())
+    }
+
+    /// Chooses how old samples are discounted (default [`DiscountMode::PerTime`]). Must be set
+    /// before the first sample.
+    pub fn with_discount_mode(mut self, mode: DiscountMode) -> Result<Self, Error> {
+        self.mode = mode;
+        self.rebuild()?;
+        Ok(self)
+    }
+
+    /// Chooses when the gain engine switches from its expanding-memory start to the fading
+    /// gains (default [`SwitchRule::Position`]). Must be set before the first sample. The exact
+    /// engine needs no start-up and ignores the rule.
+    pub fn with_switch_rule(mut self, rule: SwitchRule) -> Result<Self, Error> {
+        rule.switch_index(self.m, self.theta)?;
+        self.rule = rule;
+        self.rebuild()?;
+        Ok(self)
+    }
+
+    /// Tracks the covariance of the estimate for white measurement noise of standard deviation
+    /// `sigma` (exact for the engine's estimator, including the start-up).
+    pub fn with_noise_sigma(mut self, sigma: f64) -> Result<Self, Error> {
+        self.core.track_covariance(sigma)?;
+        self.sigma = Some(sigma);
+        Ok(self)
+    }
+
+    /// `θ`.
+    pub fn theta(&self) -> f64 {
+        self.theta
+    }
+
+    /// `τ`.
+    pub fn tau(&self) -> f64 {
+        self.tau
+    }
+
+    /// The 0-based index of the first sample the gain engine processed with the fading-memory
+    /// gains: `None` before the switch and on the exact engine (which needs no start-up).
+    pub fn switched_at(&self) -> Option<u64> {
+        match &self.core {
+            EngineState::Gain(g) => g.switched_at(),
+            EngineState::Exact(_) => None,
+        }
+    }
+}
+
+impl_polynomial_filter!(FadingMemory);
