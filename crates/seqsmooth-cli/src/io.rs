@@ -9,14 +9,49 @@ use std::path::Path;
 
 /// The shortest text that parses back to exactly `x` (the `ryu` crate's digits): plain decimal
 /// for `0` and `1e-5 <= |x| < 1e16`, otherwise scientific (`1e-300`, `2.5e20`). This is Rust's
-/// `{}` and `{:e}` layout with one change: `ryu` writes integers as `1.0`, Rust as `1`, so a
-/// trailing `.0` is dropped. Non-finite values print as `NaN`, `inf`, `-inf` (they never
-/// occur in valid output).
+/// `{}` and `{:e}` text with two changes to `ryu`'s: a trailing `.0` is dropped (`ryu` writes
+/// `1.0`, Rust `1`), and where `x` lies exactly halfway between two shortest candidates `ryu`
+/// takes the even last digit and Rust the one away from zero, so that digit goes up by one
+/// ([`is_tie`]). Non-finite values print as `NaN`, `inf`, `-inf` (never in valid output).
 #[inline]
 pub fn write_f64(out: &mut Vec<u8>, x: f64) {
     let mut buf = ryu::Buffer::new();
     let text = buf.format(x).as_bytes();
-    out.extend_from_slice(text.strip_suffix(b".0").unwrap_or(text));
+    let text = text.strip_suffix(b".0").unwrap_or(text);
+    let start = out.len();
+    out.extend_from_slice(text);
+    // A tie needs 16 or more digits (the exact value has one more, a 5) and an even last one.
+    let mantissa = text.split(|&b| b == b'e').next().unwrap_or(text);
+    if mantissa.len() >= 16 && mantissa.last().is_some_and(|d| d % 2 == 0) && is_tie(x, text) {
+        let last = start + mantissa.len() - 1;
+        out[last] += 1;
+    }
+}
+
+/// Whether `x` is exactly halfway between the decimal `text` (`ryu`'s, `[-]d.ddd[eX]`) and
+/// the next one up in magnitude in its last digit: `2|x| = (2D + 1)·10^p`, `D` the digits and
+/// `10^p` the last one's unit, checked in integers on `|x| = m·2^q`.
+#[cold]
+fn is_tie(x: f64, text: &[u8]) -> bool {
+    let text = std::str::from_utf8(text).unwrap_or("");
+    let (mantissa, exp) = text.split_once('e').unwrap_or((text, "0"));
+    let mantissa = mantissa.trim_start_matches('-');
+    let decimals = mantissa.split_once('.').map_or(0, |(_, f)| f.len() as i32);
+    let (Ok(d), Ok(e)) = (mantissa.replace('.', "").parse::<u128>(), exp.parse::<i32>()) else {
+        return false;
+    };
+    let p = e - decimals;
+    let bits = x.abs().to_bits();
+    let (m, q) = match bits >> 52 {
+        0 => (bits, -1074),
+        b => (bits & ((1 << 52) - 1) | (1 << 52), b as i32 - 1075),
+    };
+    // m·2^(q+1) = (2D+1)·5^p·2^p: the odd parts and the powers of two agree.
+    let (odd, twos) = (m >> m.trailing_zeros(), q + 1 + m.trailing_zeros() as i32);
+    let five = |k: i32| 5u128.checked_pow(k.unsigned_abs());
+    let lhs = if p < 0 { five(p).and_then(|f| f.checked_mul(odd.into())) } else { Some(odd.into()) };
+    let rhs = if p < 0 { Some(2 * d + 1) } else { five(p).and_then(|f| f.checked_mul(2 * d + 1)) };
+    twos == p && lhs.is_some() && lhs == rhs
 }
 
 /// [`write_f64`] as a `String`.
