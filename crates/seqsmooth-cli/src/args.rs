@@ -16,7 +16,6 @@ use std::path::PathBuf;
 /// Rows per chunk of `seqsmooth filter`'s streaming pipeline (read, filter, write).
 pub const CHUNK_ROWS: u32 = 1 << 16;
 
-
 /// Text shown after every `--help`: exit codes and number formats.
 const AFTER_HELP: &str = "\
 Exit status: 0 on success; 1 when the input data or a file is unusable (bad numbers, NaN or \
@@ -492,7 +491,6 @@ pub enum Memory {
         theta: Theta,
     },
 }
-
 
 /// Resolves `--n`/`--theta` for the memory kind of a gains or vrf table.
 pub fn memory(kind: TableKind, n: Option<u64>, theta: Option<Theta>) -> Result<Memory, CliError> {

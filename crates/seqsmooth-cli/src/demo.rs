@@ -10,9 +10,9 @@
 //! step, noise estimated) runs on it; the plain expanding- and fading-memory filters of degree 2
 //! (noise σ given), on both engines, are shown beside it for comparison.
 
+use crate::args::{DemoArgs, EngineArg, Kind};
 use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
-use crate::args::{DemoArgs, EngineArg, Kind};
 use crate::filter::runner::Runner;
 use crate::filter::{median_series_step, LOOKAHEAD};
 use crate::io::{fmt_f64, Output};
@@ -409,9 +409,13 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
         let mut out = Output::create(Some(path))?;
         out.write(b"t,y,d0,d1,d2,s0,s1,s2\n")?;
         for (p, e) in data.iter().zip(&fading_exact.estimates) {
-            let d = e.as_ref().map(|e| (e.derivatives.clone(), e.std_devs().unwrap_or_default()));
+            let d = e
+                .as_ref()
+                .map(|e| (e.derivatives.clone(), e.std_devs().unwrap_or_default()));
             let (d, s) = d.unwrap_or_default();
-            let cells = (0..=DEGREE).map(|k| d.get(k)).chain((0..=DEGREE).map(|k| s.get(k)));
+            let cells = (0..=DEGREE)
+                .map(|k| d.get(k))
+                .chain((0..=DEGREE).map(|k| s.get(k)));
             let mut row = vec![fmt_f64(p.t), fmt_f64(p.y)];
             row.extend(cells.map(|v| v.map_or_else(String::new, |&v| fmt_f64(v))));
             out.row(&row)?;

@@ -20,7 +20,12 @@ pub fn run(a: &GainsArgs) -> Result<(), CliError> {
         }
     };
     let mut rows = vec![vec!["k".to_string(), "gain".to_string()]];
-    rows.extend(values.into_iter().enumerate().map(|(k, g)| vec![k.to_string(), g]));
+    rows.extend(
+        values
+            .into_iter()
+            .enumerate()
+            .map(|(k, g)| vec![k.to_string(), g]),
+    );
     write_table(&rows, a.format)
 }
 

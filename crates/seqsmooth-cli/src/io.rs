@@ -37,7 +37,10 @@ fn is_tie(x: f64, text: &[u8]) -> bool {
     let (mantissa, exp) = text.split_once('e').unwrap_or((text, "0"));
     let mantissa = mantissa.trim_start_matches('-');
     let decimals = mantissa.split_once('.').map_or(0, |(_, f)| f.len() as i32);
-    let (Ok(d), Ok(e)) = (mantissa.replace('.', "").parse::<u128>(), exp.parse::<i32>()) else {
+    let (Ok(d), Ok(e)) = (
+        mantissa.replace('.', "").parse::<u128>(),
+        exp.parse::<i32>(),
+    ) else {
         return false;
     };
     let p = e - decimals;
@@ -49,8 +52,16 @@ fn is_tie(x: f64, text: &[u8]) -> bool {
     // m·2^(q+1) = (2D+1)·5^p·2^p: the odd parts and the powers of two agree.
     let (odd, twos) = (m >> m.trailing_zeros(), q + 1 + m.trailing_zeros() as i32);
     let five = |k: i32| 5u128.checked_pow(k.unsigned_abs());
-    let lhs = if p < 0 { five(p).and_then(|f| f.checked_mul(odd.into())) } else { Some(odd.into()) };
-    let rhs = if p < 0 { Some(2 * d + 1) } else { five(p).and_then(|f| f.checked_mul(2 * d + 1)) };
+    let lhs = if p < 0 {
+        five(p).and_then(|f| f.checked_mul(odd.into()))
+    } else {
+        Some(odd.into())
+    };
+    let rhs = if p < 0 {
+        Some(2 * d + 1)
+    } else {
+        five(p).and_then(|f| f.checked_mul(2 * d + 1))
+    };
     twos == p && lhs.is_some() && lhs == rhs
 }
 
@@ -65,12 +76,19 @@ pub fn fmt_f64(x: f64) -> String {
 /// `cell` as a CSV output field: quoted (with quotes doubled) when it holds a comma, a quote
 /// or a line break.
 pub fn csv_field(cell: &[u8]) -> Vec<u8> {
-    if !cell.iter().any(|b| matches!(b, b',' | b'"' | b'\r' | b'\n')) {
+    if !cell
+        .iter()
+        .any(|b| matches!(b, b',' | b'"' | b'\r' | b'\n'))
+    {
         return cell.to_vec();
     }
     let mut out = vec![b'"'];
     for &b in cell {
-        out.extend_from_slice(if b == b'"' { b"\"\"" } else { std::slice::from_ref(&b) });
+        out.extend_from_slice(if b == b'"' {
+            b"\"\""
+        } else {
+            std::slice::from_ref(&b)
+        });
     }
     out.push(b'"');
     out
@@ -93,7 +111,9 @@ pub fn parse_cell(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f6
 fn parse_cell_text(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f64, CliError> {
     let at = format!("line {line}, column '{column}'");
     if cell.is_empty() {
-        return Err(CliError::Data(format!("{at}: the cell is empty, expected a number")));
+        return Err(CliError::Data(format!(
+            "{at}: the cell is empty, expected a number"
+        )));
     }
     let text = String::from_utf8_lossy(cell);
     let v: f64 = std::str::from_utf8(cell)
@@ -132,12 +152,18 @@ pub struct Need {
 impl Need {
     /// A degree-`m` estimate needs `m + 1` rows.
     pub fn degree(m: usize) -> Self {
-        Self { rows: m + 1, why: format!("degree {m}") }
+        Self {
+            rows: m + 1,
+            why: format!("degree {m}"),
+        }
     }
 
     /// A window of `w` samples needs `w` rows.
     pub fn window(w: usize) -> Self {
-        Self { rows: w, why: format!("window {w}") }
+        Self {
+            rows: w,
+            why: format!("window {w}"),
+        }
     }
 
     /// The too-few-samples error when only `got` data rows were read.
@@ -269,17 +295,29 @@ impl<R: Read> CsvIn<R> {
             breaks: 0,
             after_cr: false,
         };
-        let reader = csv::ReaderBuilder::new().flexible(false).from_reader(tracker);
-        let mut this = Self { reader, record: csv::ByteRecord::new(), header: Vec::new(), line: 1 };
+        let reader = csv::ReaderBuilder::new()
+            .flexible(false)
+            .from_reader(tracker);
+        let mut this = Self {
+            reader,
+            record: csv::ByteRecord::new(),
+            header: Vec::new(),
+            line: 1,
+        };
         let header = match this.reader.byte_headers() {
             Ok(h) => h.clone(),
             Err(e) => return Err(this.error(e)),
         };
-        this.line = this.reader.get_mut().line_at(header.position().map_or(0, |p| p.byte()));
+        this.line = this
+            .reader
+            .get_mut()
+            .line_at(header.position().map_or(0, |p| p.byte()));
         for cell in &header {
             let text = std::str::from_utf8(cell).map_err(|_| {
                 let line = this.line;
-                CliError::Data(format!("line {line}: malformed CSV: the row is not valid UTF-8"))
+                CliError::Data(format!(
+                    "line {line}: malformed CSV: the row is not valid UTF-8"
+                ))
             })?;
             this.header.push(text.trim().to_string());
         }
@@ -312,10 +350,14 @@ impl<R: Read> CsvIn<R> {
 
     /// The error of the CSV parser `e`, with the line of its position.
     fn error(&mut self, e: csv::Error) -> CliError {
-        let line = e.position().map(|p| self.reader.get_mut().line_at(p.byte()));
+        let line = e
+            .position()
+            .map(|p| self.reader.get_mut().line_at(p.byte()));
         let at = line.map_or_else(String::new, |l| format!("line {l}: "));
         match e.kind() {
-            csv::ErrorKind::UnequalLengths { expected_len, len, .. } => CliError::Data(format!(
+            csv::ErrorKind::UnequalLengths {
+                expected_len, len, ..
+            } => CliError::Data(format!(
                 "{at}malformed CSV: the row has {len} field{} but the header has {expected_len}",
                 plural(*len as usize)
             )),
@@ -371,7 +413,10 @@ impl Output {
                 let file = File::create(p).map_err(|e| {
                     CliError::Data(format!("cannot create output file {name}: {e}"))
                 })?;
-                Ok(Self { sink: Box::new(BufWriter::new(file)), name })
+                Ok(Self {
+                    sink: Box::new(BufWriter::new(file)),
+                    name,
+                })
             }
             _ => Ok(Self::stdout()),
         }
@@ -380,17 +425,25 @@ impl Output {
     /// Buffered standard output.
     pub fn stdout() -> Self {
         let sink = Box::new(BufWriter::new(io::stdout().lock()));
-        Self { sink, name: "standard output".to_string() }
+        Self {
+            sink,
+            name: "standard output".to_string(),
+        }
     }
 
     /// Writes `bytes`.
     pub fn write(&mut self, bytes: &[u8]) -> Result<(), CliError> {
-        self.sink.write_all(bytes).map_err(|e| CliError::write(&self.name, e))
+        self.sink
+            .write_all(bytes)
+            .map_err(|e| CliError::write(&self.name, e))
     }
 
     /// Writes a CSV row of `cells` (each quoted where needed).
     pub fn row<S: AsRef<str>>(&mut self, cells: &[S]) -> Result<(), CliError> {
-        let fields: Vec<Vec<u8>> = cells.iter().map(|c| csv_field(c.as_ref().as_bytes())).collect();
+        let fields: Vec<Vec<u8>> = cells
+            .iter()
+            .map(|c| csv_field(c.as_ref().as_bytes()))
+            .collect();
         let mut line = fields.join(&b","[..]);
         line.push(b'\n');
         self.write(&line)
@@ -400,14 +453,24 @@ impl Output {
     /// left-aligned).
     pub fn aligned(&mut self, rows: &[Vec<String>], left: usize) -> Result<(), CliError> {
         let cols = rows.iter().map(Vec::len).max().unwrap_or(0);
-        let width = |c: usize| rows.iter().filter_map(move |r| r.get(c)).map(|s| s.chars().count());
+        let width = |c: usize| {
+            rows.iter()
+                .filter_map(move |r| r.get(c))
+                .map(|s| s.chars().count())
+        };
         let widths: Vec<usize> = (0..cols).map(|c| width(c).max().unwrap_or(0)).collect();
         for r in rows {
             let cells: Vec<String> = r
                 .iter()
                 .zip(&widths)
                 .enumerate()
-                .map(|(c, (s, &w))| if c < left { format!("{s:<w$}") } else { format!("{s:>w$}") })
+                .map(|(c, (s, &w))| {
+                    if c < left {
+                        format!("{s:<w$}")
+                    } else {
+                        format!("{s:>w$}")
+                    }
+                })
                 .collect();
             self.write(format!("{}\n", cells.join("  ").trim_end()).as_bytes())?;
         }
@@ -416,7 +479,9 @@ impl Output {
 
     /// Flushes everything to the sink.
     pub fn finish(mut self) -> Result<(), CliError> {
-        self.sink.flush().map_err(|e| CliError::write(&self.name, e))
+        self.sink
+            .flush()
+            .map_err(|e| CliError::write(&self.name, e))
     }
 }
 
@@ -484,17 +549,49 @@ mod tests {
             cells.push(parse_cell(r.field(1), r.line, "y", "value").map_err(|e| e.to_string()));
         }
         assert_eq!(cells[..2], [Ok(1.0), Ok(2.0)]);
-        assert_eq!(cells[2], Err("line 5, column 'y': 'abc' is not a number".into()));
+        assert_eq!(
+            cells[2],
+            Err("line 5, column 'y': 'abc' is not a number".into())
+        );
     }
 
     /// Every cell parses to the double `str::parse` gives, and is refused where it refuses.
     #[test]
     fn cells_parse_as_str_parse() {
         for text in [
-            "0", "-0", "1", "+7", ".5", "8.", "1e5", "1E+5", "2.5e-300", "1e-400", "1e400", "inf",
-            "-Infinity", "NaN", "nan", "1e", "e5", ".", "+", "-", "1.2.3", "0x10", "1_0", "1,5",
-            "4.9406564584124654e-324", "17976931348623157e292", "0.1000000000000000055511151231",
-            "9007199254740993", "1.", "+.5e1", "  1", "1d", "١",
+            "0",
+            "-0",
+            "1",
+            "+7",
+            ".5",
+            "8.",
+            "1e5",
+            "1E+5",
+            "2.5e-300",
+            "1e-400",
+            "1e400",
+            "inf",
+            "-Infinity",
+            "NaN",
+            "nan",
+            "1e",
+            "e5",
+            ".",
+            "+",
+            "-",
+            "1.2.3",
+            "0x10",
+            "1_0",
+            "1,5",
+            "4.9406564584124654e-324",
+            "17976931348623157e292",
+            "0.1000000000000000055511151231",
+            "9007199254740993",
+            "1.",
+            "+.5e1",
+            "  1",
+            "1d",
+            "١",
         ] {
             let std = text.parse::<f64>().ok().filter(|v| v.is_finite());
             let ours = parse_cell(text.as_bytes(), 1, "y", "value").ok();
@@ -519,9 +616,27 @@ mod tests {
     #[test]
     fn round_trip_special_values() {
         for x in [
-            0.0, -0.0, 1.0, -1.0, 0.1, 0.1 + 0.2, 1e-5, 9.999999999999999e-6, 1e16,
-            9999999999999998.0, 1e-300, -1e-300, 5e-324, f64::MIN_POSITIVE, f64::MAX, f64::MIN,
-            f64::EPSILON, 123456.789, 2.5e20, 1e15, 100.0,
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.1,
+            0.1 + 0.2,
+            1e-5,
+            9.999999999999999e-6,
+            1e16,
+            9999999999999998.0,
+            1e-300,
+            -1e-300,
+            5e-324,
+            f64::MIN_POSITIVE,
+            f64::MAX,
+            f64::MIN,
+            f64::EPSILON,
+            123456.789,
+            2.5e20,
+            1e15,
+            100.0,
         ] {
             check(x);
         }

@@ -6,8 +6,8 @@
 //! cells (no estimate yet, a degree not reached yet) leave gaps. The filter's input file may be
 //! given too, for a truth column. The drawing is [`crate::chart`]'s, the same as the demo's.
 
-use crate::chart::{self, Layout, Track};
 use crate::args::PlotArgs;
+use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
 use crate::io::{find_column, input_name, open_input, parse_cell, CsvIn};
 use std::path::Path;
@@ -32,7 +32,11 @@ impl Table {
             let cells: Result<Vec<String>, _> = (0..header.len())
                 .map(|i| std::str::from_utf8(csv.field(i)).map(str::to_string))
                 .collect();
-            let utf8 = || at(CliError::Data(format!("line {line}: malformed CSV: the row is not valid UTF-8")));
+            let utf8 = || {
+                at(CliError::Data(format!(
+                    "line {line}: malformed CSV: the row is not valid UTF-8"
+                )))
+            };
             rows.push((line, cells.map_err(|_| utf8())?));
         }
         if header.iter().all(String::is_empty) {

@@ -39,9 +39,12 @@ pub fn run(a: &VrfArgs) -> Result<(), CliError> {
     let lib = |e: seqsmooth::Error| CliError::Usage(e.to_string());
     // nalgebra iterates column-major; the transposes make the values row-major.
     let values = match (mem, a.exact) {
-        (Memory::Expanding { n }, true) => {
-            cells(expanding_vrf::<Rational>(m, n, form).map_err(lib)?.transpose().iter())
-        }
+        (Memory::Expanding { n }, true) => cells(
+            expanding_vrf::<Rational>(m, n, form)
+                .map_err(lib)?
+                .transpose()
+                .iter(),
+        ),
         (Memory::Expanding { n }, false) => {
             // Exact, then rounded to nearest: the library's `expanding_vrf::<f64>` overflows in
             // its intermediates for large n at high degree (NaN, or silently wrong: m = 20,
@@ -49,12 +52,20 @@ pub fn run(a: &VrfArgs) -> Result<(), CliError> {
             let s = expanding_vrf::<Rational>(m, n, form).map_err(lib)?;
             cells(&s.transpose().iter().map(ratio_to_f64).collect::<Vec<_>>())
         }
-        (Memory::Fading { theta }, true) => {
-            cells(fading_vrf::<Rational>(m, theta.exact, form).map_err(lib)?.transpose().iter())
-        }
+        (Memory::Fading { theta }, true) => cells(
+            fading_vrf::<Rational>(m, theta.exact, form)
+                .map_err(lib)?
+                .transpose()
+                .iter(),
+        ),
         (Memory::Fading { theta }, false) => {
             let theta = theta.value_f64().map_err(CliError::Usage)?;
-            cells(fading_vrf::<f64>(m, theta, form).map_err(lib)?.transpose().iter())
+            cells(
+                fading_vrf::<f64>(m, theta, form)
+                    .map_err(lib)?
+                    .transpose()
+                    .iter(),
+            )
         }
     };
     write_matrix(values, m + 1, a.format)
@@ -94,9 +105,19 @@ fn fixed(a: &VrfArgs) -> Result<(), CliError> {
     let span = window as u64 - 1;
     let lib = |e: seqsmooth::Error| CliError::Usage(e.to_string());
     let values = if a.exact {
-        cells(covariance::<Rational>(m, span, lead.exact).map_err(lib)?.transpose().iter())
+        cells(
+            covariance::<Rational>(m, span, lead.exact)
+                .map_err(lib)?
+                .transpose()
+                .iter(),
+        )
     } else {
-        cells(covariance::<f64>(m, span, lead.value).map_err(lib)?.transpose().iter())
+        cells(
+            covariance::<f64>(m, span, lead.value)
+                .map_err(lib)?
+                .transpose()
+                .iter(),
+        )
     };
     write_matrix(values, m + 1, a.format)
 }
@@ -106,14 +127,21 @@ fn write_matrix(values: Vec<String>, size: usize, format: Format) -> Result<(), 
     let rows: Vec<Vec<String>> = match format {
         Format::Csv => {
             let mut rows = vec![vec!["i".into(), "j".into(), "value".into()]];
-            let cell = |(k, v): (usize, String)| vec![(k / size).to_string(), (k % size).to_string(), v];
+            let cell =
+                |(k, v): (usize, String)| vec![(k / size).to_string(), (k % size).to_string(), v];
             rows.extend(values.into_iter().enumerate().map(cell));
             rows
         }
         Format::Table => {
-            let mut rows = vec![std::iter::once(String::new()).chain((0..size).map(|j| format!("j={j}"))).collect()];
+            let mut rows = vec![std::iter::once(String::new())
+                .chain((0..size).map(|j| format!("j={j}")))
+                .collect()];
             for (i, chunk) in values.chunks(size).enumerate() {
-                rows.push(std::iter::once(format!("i={i}")).chain(chunk.iter().cloned()).collect());
+                rows.push(
+                    std::iter::once(format!("i={i}"))
+                        .chain(chunk.iter().cloned())
+                        .collect(),
+                );
             }
             rows
         }

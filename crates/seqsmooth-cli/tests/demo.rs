@@ -1,6 +1,5 @@
 //! End-to-end tests of `seqsmooth demo`.
 
-
 mod common;
 use common::*;
 

@@ -1,12 +1,10 @@
 //! End-to-end tests of Error messages and exit codes of every subcommand against the command-line contract,
 //! and the help texts.
 
-
 mod common;
 use common::*;
 
 const EXP1: [&str; 5] = ["filter", "--kind", "expanding", "--degree", "1"];
-
 
 /// A NaN value names the line, the column and the value.
 #[test]

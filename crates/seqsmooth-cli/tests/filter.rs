@@ -11,7 +11,6 @@ use seqsmooth::{
 mod common;
 use common::*;
 
-
 /// Morrison T9-02: the degree-1 expanding-memory estimate after samples 0..4 is
 /// Z*_{4,4} = (23/5, 4/5); the first row (one sample, degree 1) has no estimate yet. Both
 /// engines.
@@ -340,7 +339,6 @@ fn filter_agrees_with_library() {
 }
 
 // filter --kind fixed
-
 
 /// Morrison T7-08, L = 4 (`--window 5`): m = 1, h = 0 gives Z* = (24/5, 9/10); h = 1 (`--lead 1`)
 /// the prediction (57/10, 9/10); h = -2 the centre (3, 9/10); m = 2, h = 0 gives

@@ -27,8 +27,15 @@ fn outputs_are_byte_identical_to_the_golden_files() {
         let (name, args) = line.split_once('|').unwrap();
         let args: Vec<&str> = args.split_whitespace().collect();
         // Cases read the outputs of earlier ones (plot): those are the golden files.
-        let written: Vec<&str> = args.windows(2).filter(|w| w[0] == "-o").map(|w| w[1]).collect();
-        for a in args.iter().filter(|a| a.ends_with(".out") && !written.contains(a)) {
+        let written: Vec<&str> = args
+            .windows(2)
+            .filter(|w| w[0] == "-o")
+            .map(|w| w[1])
+            .collect();
+        for a in args
+            .iter()
+            .filter(|a| a.ends_with(".out") && !written.contains(a))
+        {
             std::fs::copy(dir.join(a), work.join(a)).unwrap();
         }
         for w in &written {
@@ -43,7 +50,11 @@ fn outputs_are_byte_identical_to_the_golden_files() {
         assert_eq!(out.stdout, want("out"), "{name}: standard output");
         assert_eq!(out.stderr, want("err"), "{name}: standard error");
         let code = out.status.code().unwrap().to_string();
-        assert_eq!(code.as_bytes(), want("code").trim_ascii(), "{name}: exit code");
+        assert_eq!(
+            code.as_bytes(),
+            want("code").trim_ascii(),
+            "{name}: exit code"
+        );
         // Files the case writes (-o NAME.out): compared too.
         for w in written {
             let got = std::fs::read(work.join(w)).unwrap_or_default();

@@ -9,7 +9,6 @@ use seqsmooth::scalar::{parse_rational, ratio_to_f64, rational_from_f64, Rationa
 mod common;
 use common::*;
 
-
 /// Reyneke §6.4 test vector: degree-2 expanding-memory gains at n = 10 are
 /// (83/143, 63/286, 5/286).
 #[test]
@@ -137,7 +136,6 @@ fn vrf_expanding_f64_is_rounded_exact() {
     }
     assert!(close(num(&rows[0][2]), 4.41e-13, 1e-3));
 }
-
 
 /// Morrison T9-08: the degree-1 expanding-memory 1-step-prediction VRF at n = 1 is
 /// [[5, 3], [3, 2]], written row-major as i,j,value; exactly with `--exact`.

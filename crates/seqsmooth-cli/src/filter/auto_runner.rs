@@ -16,7 +16,10 @@ pub struct AutoRunner {
 impl AutoRunner {
     /// The automatic filter of `config`.
     pub fn new(config: AutoConfig) -> Result<Self, Error> {
-        Ok(Self { filter: AutomaticFilter::new(config)?, last: None })
+        Ok(Self {
+            filter: AutomaticFilter::new(config)?,
+            last: None,
+        })
     }
 }
 

@@ -45,7 +45,9 @@ const PIECE: usize = 4096;
 fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
     let kind = a.kind;
     let theta = match (kind, &a.theta) {
-        (Kind::Fading | Kind::Auto, Some(theta)) => Some(theta.value_f64().map_err(CliError::Usage)?),
+        (Kind::Fading | Kind::Auto, Some(theta)) => {
+            Some(theta.value_f64().map_err(CliError::Usage)?)
+        }
         (Kind::Fading | Kind::Auto, None) => {
             return Err(CliError::Usage(format!(
                 "--kind {} needs --theta T, the discount per tau (0 < T < 1)",
@@ -159,7 +161,11 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     // With --id-col, the default τ comes from the steps within series among the first
     // TAU_SCAN_ROWS rows: they are all in the first chunk, whatever the chunk size.
     let tau_needed = a.tau.is_none() && matches!(a.kind, Kind::Fading | Kind::Auto);
-    let scan = if tau_needed && a.id_col.is_some() { TAU_SCAN_ROWS } else { 0 };
+    let scan = if tau_needed && a.id_col.is_some() {
+        TAU_SCAN_ROWS
+    } else {
+        0
+    };
     let first_rows = chunk_rows.min(FIRST_CHUNK_ROWS).max(hold).max(scan);
     let mut chunk = Chunk::default();
     reader.read_chunk(&mut chunk, first_rows);
@@ -247,7 +253,8 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         }
         progress.update(chunk.bytes_read, chunk.rows_read);
         let next = pipeline.as_mut();
-        let next = next.ok_or_else(|| CliError::Data("internal error: the input reader is gone".into()))?;
+        let next =
+            next.ok_or_else(|| CliError::Data("internal error: the input reader is gone".into()))?;
         chunk = next.swap(chunk)?;
     }
     Ok(())
@@ -262,7 +269,10 @@ fn row_error(e: seqsmooth::Error, chunk: &Chunk) -> (usize, CliError) {
         },
         other => (0, other),
     };
-    (index, CliError::Data(format!("line {}: {source}", chunk.lines[index])))
+    (
+        index,
+        CliError::Data(format!("line {}: {source}", chunk.lines[index])),
+    )
 }
 
 /// A thread that reads the input chunk by chunk ahead of the filtering and writing, passing
@@ -314,7 +324,10 @@ mod tests {
         assert_eq!(step(&[0.0, 2.0]), 2.0);
         assert_eq!(step(&[0.0, 1.0, 3.0, 3.5]), 1.0); // steps 1, 2, 0.5
         assert_eq!(step(&[0.0, 1.0, 3.0, 3.5, 7.5]), 1.5); // steps 0.5, 1, 2, 4
-        // Within series: a 0, 1; b 10, 13 → steps 1, 3.
-        assert_eq!(median_series_step(&[0.0, 10.0, 1.0, 13.0], &[0, 1, 0, 1]), Some(2.0));
+                                                           // Within series: a 0, 1; b 10, 13 → steps 1, 3.
+        assert_eq!(
+            median_series_step(&[0.0, 10.0, 1.0, 13.0], &[0, 1, 0, 1]),
+            Some(2.0)
+        );
     }
 }

@@ -69,7 +69,14 @@ impl Chunk {
     }
 
     /// Appends the header `[id,]t,y,d0..dM[,s0..sM][,extra…]`.
-    pub fn header(&self, out: &mut Vec<u8>, id: Option<&str>, m: usize, sigma: bool, extra: &[&str]) {
+    pub fn header(
+        &self,
+        out: &mut Vec<u8>,
+        id: Option<&str>,
+        m: usize,
+        sigma: bool,
+        extra: &[&str],
+    ) {
         let mut cells: Vec<Vec<u8>> = id.map(|id| csv_field(id.as_bytes())).into_iter().collect();
         cells.extend([b"t".to_vec(), b"y".to_vec()]);
         cells.extend((0..=m).map(|k| format!("d{k}").into_bytes()));
@@ -82,7 +89,16 @@ impl Chunk {
     }
 
     fn clear(&mut self) {
-        let Chunk { t, y, series, lines, cells, text, new_ids, .. } = self;
+        let Chunk {
+            t,
+            y,
+            series,
+            lines,
+            cells,
+            text,
+            new_ids,
+            ..
+        } = self;
         (t.clear(), y.clear(), series.clear(), lines.clear());
         (cells.clear(), text.clear(), new_ids.clear());
         self.error = None;
@@ -142,7 +158,11 @@ impl<R: Read> RowReader<R> {
             value_col: value_col.to_string(),
             index: HashMap::new(),
             ids: Vec::new(),
-            newest: if id_idx.is_none() { vec![None] } else { Vec::new() },
+            newest: if id_idx.is_none() {
+                vec![None]
+            } else {
+                Vec::new()
+            },
             touched: Vec::new(),
             rows_read: 0,
         })
@@ -201,11 +221,17 @@ impl<R: Read> RowReader<R> {
             return Ok(false);
         }
         let line = self.csv.line;
-        let (t_cell, y_cell) = (self.csv.field(self.time_idx), self.csv.field(self.value_idx));
+        let (t_cell, y_cell) = (
+            self.csv.field(self.time_idx),
+            self.csv.field(self.value_idx),
+        );
         let t = parse_cell(t_cell, line, &self.time_col, "time")?;
         let y = parse_cell(y_cell, line, &self.value_col, "value")?;
         let series = self.series(chunk);
-        let (t_cell, y_cell) = (self.csv.field(self.time_idx), self.csv.field(self.value_idx));
+        let (t_cell, y_cell) = (
+            self.csv.field(self.time_idx),
+            self.csv.field(self.value_idx),
+        );
         let row = chunk.len();
         match &mut self.newest[series] {
             Some(prev) if t <= prev.t => {
@@ -234,11 +260,18 @@ impl<R: Read> RowReader<R> {
                 }
             }
             none => {
-                *none = Some(Newest { t, line, row: Some(row), text: Vec::new() });
+                *none = Some(Newest {
+                    t,
+                    line,
+                    row: Some(row),
+                    text: Vec::new(),
+                });
                 self.touched.push(series);
             }
         }
-        chunk.cells.push((chunk.text.len(), t_cell.len(), y_cell.len()));
+        chunk
+            .cells
+            .push((chunk.text.len(), t_cell.len(), y_cell.len()));
         chunk.text.extend_from_slice(t_cell);
         chunk.text.extend_from_slice(y_cell);
         chunk.t.push(t);
@@ -296,7 +329,10 @@ mod tests {
                 (6, 2, "1,4".into()),
             ]
         );
-        assert_eq!(ids, [b"a".to_vec(), b"\"b,1\"".to_vec(), b"\"c\"\"x\"".to_vec()]);
+        assert_eq!(
+            ids,
+            [b"a".to_vec(), b"\"b,1\"".to_vec(), b"\"c\"\"x\"".to_vec()]
+        );
     }
 
     #[test]

@@ -27,7 +27,11 @@ pub enum Runner {
 
 /// A missing parameter of a filter kind.
 fn needs(name: &'static str, what: &str) -> Error {
-    Error::InvalidParameter { name, value: "(none)".into(), reason: format!("{what} needs {name}") }
+    Error::InvalidParameter {
+        name,
+        value: "(none)".into(),
+        reason: format!("{what} needs {name}"),
+    }
 }
 
 impl Runner {
@@ -42,7 +46,11 @@ impl Runner {
         engine: EngineArg,
         sigma: Option<f64>,
     ) -> Result<Self, Error> {
-        fn noise<F>(f: F, sigma: Option<f64>, with: fn(F, f64) -> Result<F, Error>) -> Result<Box<F>, Error> {
+        fn noise<F>(
+            f: F,
+            sigma: Option<f64>,
+            with: fn(F, f64) -> Result<F, Error>,
+        ) -> Result<Box<F>, Error> {
             Ok(Box::new(match sigma {
                 Some(s) => with(f, s)?,
                 None => f,
@@ -104,15 +112,30 @@ impl Runner {
     /// estimate at `t[i] + lead`, with 1σ when `sigma`) to `out`, `stride` per row. The
     /// expanding- and fading-memory filters without 1σ or lead take the batch kernels
     /// ([`PolynomialFilter::update_many_into`]). An error is [`Error::InBatch`] of its row.
-    pub fn run(&mut self, t: &[f64], y: &[f64], out: &mut [f64], lead: f64, sigma: bool) -> Result<(), Error> {
+    pub fn run(
+        &mut self,
+        t: &[f64],
+        y: &[f64],
+        out: &mut [f64],
+        lead: f64,
+        sigma: bool,
+    ) -> Result<(), Error> {
         out.fill(f64::NAN);
         let w = self.degree() + 1;
         if let (Runner::Expanding(_) | Runner::Fading(_), false, 0.0) = (&*self, sigma, lead) {
             return self.filter_mut().update_many_into(t, y, out);
         }
         let stride = out.len().checked_div(t.len()).unwrap_or(0);
-        for (index, ((&t, &y), row)) in t.iter().zip(y).zip(out.chunks_exact_mut(stride)).enumerate() {
-            self.update(t, y).map_err(|e| Error::InBatch { index, source: Box::new(e) })?;
+        for (index, ((&t, &y), row)) in t
+            .iter()
+            .zip(y)
+            .zip(out.chunks_exact_mut(stride))
+            .enumerate()
+        {
+            self.update(t, y).map_err(|e| Error::InBatch {
+                index,
+                source: Box::new(e),
+            })?;
             let extra = &mut row[w << usize::from(sigma)..];
             let estimate = match &mut *self {
                 Runner::Fixed(f, window) => {
@@ -136,7 +159,11 @@ impl Runner {
                 }
                 other => other.estimate_at(t + lead),
             };
-            store(estimate.as_ref(), sigma, &mut row[..w << usize::from(sigma)]);
+            store(
+                estimate.as_ref(),
+                sigma,
+                &mut row[..w << usize::from(sigma)],
+            );
         }
         Ok(())
     }
@@ -150,7 +177,10 @@ fn store(estimate: Option<&PolynomialState>, sigma: bool, values: &mut [f64]) {
     let nd = s.derivatives.len().min(width);
     values[..nd].copy_from_slice(&s.derivatives[..nd]);
     if let (Some(c), true) = (&s.covariance, sigma) {
-        for (i, v) in values[width..width + c.nrows().min(width)].iter_mut().enumerate() {
+        for (i, v) in values[width..width + c.nrows().min(width)]
+            .iter_mut()
+            .enumerate()
+        {
             *v = c[(i, i)].max(0.0).sqrt();
         }
     }

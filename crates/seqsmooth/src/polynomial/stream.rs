@@ -84,7 +84,10 @@ impl Scratch {
 
 /// The per-channel work of [`StreamBank::update`]: `(filter, times, values, out)` with `out`
 /// holding `stride` values per row; an error in a row is [`Error::InBatch`] with its index.
-pub trait ChannelRun<F>: Fn(&mut F, &[f64], &[f64], &mut [f64]) -> Result<(), Error> + Sync {}
+pub trait ChannelRun<F>:
+    Fn(&mut F, &[f64], &[f64], &mut [f64]) -> Result<(), Error> + Sync
+{
+}
 impl<F, R: Fn(&mut F, &[f64], &[f64], &mut [f64]) -> Result<(), Error> + Sync> ChannelRun<F> for R {}
 
 impl<F: PolynomialFilter + Clone> StreamBank<F> {
@@ -188,7 +191,11 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
         if times.len() != n || values.len() != n || estimates.len() != n * stride {
             return Err(Error::InvalidParameter {
                 name: "chunk lengths",
-                value: format!("{n} channels, {} times, {} values", times.len(), values.len()),
+                value: format!(
+                    "{n} channels, {} times, {} values",
+                    times.len(),
+                    values.len()
+                ),
                 reason: format!("one time, value and {stride} estimates per row"),
             });
         }
@@ -221,7 +228,8 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
         // One disjoint piece of the grouped buffers per channel, with the channel's filter.
         let mut work = Vec::with_capacity(s.groups.len());
         let mut filters: Vec<Option<&mut F>> = self.filters.iter_mut().map(Some).collect();
-        let (mut t, mut y, mut out, mut order) = (&s.times[..], &s.values[..], &mut s.out[..], &s.order[..]);
+        let (mut t, mut y, mut out, mut order) =
+            (&s.times[..], &s.values[..], &mut s.out[..], &s.order[..]);
         for (g, &(c, first)) in s.groups.iter().enumerate() {
             let len = s.groups.get(g + 1).map_or(n, |next| next.1) - first;
             let (tg, ty, (og, rest), rows);
@@ -230,12 +238,22 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
             (out, order) = (rest, rows.1);
             work.push((c, filters[c].take(), tg, ty, og, rows.0));
         }
-        let one = |(c, f, t, y, out, rows): &mut (usize, Option<&mut F>, &[f64], &[f64], &mut [f64], &[usize])| {
+        let one = |(c, f, t, y, out, rows): &mut (
+            usize,
+            Option<&mut F>,
+            &[f64],
+            &[f64],
+            &mut [f64],
+            &[usize],
+        )| {
             let f = f.as_mut()?;
             run(f, t, y, out).err().map(|e| in_row(*c, &|k| rows[k], e))
         };
         let mut failed: Vec<_> = if parallel {
-            work.par_iter_mut().with_min_len(4).filter_map(one).collect()
+            work.par_iter_mut()
+                .with_min_len(4)
+                .filter_map(one)
+                .collect()
         } else {
             work.iter_mut().filter_map(one).collect()
         };
