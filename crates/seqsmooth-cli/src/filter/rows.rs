@@ -89,18 +89,14 @@ impl Chunk {
     }
 
     fn clear(&mut self) {
-        let Chunk {
-            t,
-            y,
-            series,
-            lines,
-            cells,
-            text,
-            new_ids,
-            ..
-        } = self;
-        (t.clear(), y.clear(), series.clear(), lines.clear());
-        (cells.clear(), text.clear(), new_ids.clear());
+        for v in [&mut self.t, &mut self.y] {
+            v.clear();
+        }
+        self.series.clear();
+        self.lines.clear();
+        self.cells.clear();
+        self.text.clear();
+        self.new_ids.clear();
         self.error = None;
         self.done = false;
     }

@@ -82,6 +82,16 @@ impl Scratch {
     }
 }
 
+/// One channel's piece of a chunk: channel, filter, times, values, output, rows.
+type Work<'a, F> = (
+    usize,
+    Option<&'a mut F>,
+    &'a [f64],
+    &'a [f64],
+    &'a mut [f64],
+    &'a [usize],
+);
+
 /// The per-channel work of [`StreamBank::update`]: `(filter, times, values, out)` with `out`
 /// holding `stride` values per row; an error in a row is [`Error::InBatch`] with its index.
 pub trait ChannelRun<F>:
@@ -181,7 +191,7 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
         values: &[f64],
         estimates: &mut [f64],
         stride: usize,
-        run: &(dyn Fn(&mut F, &[f64], &[f64], &mut [f64]) -> Result<(), Error> + Sync),
+        run: &dyn ChannelRun<F>,
         parallel: bool,
     ) -> Result<(), Error>
     where
@@ -238,14 +248,7 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
             (out, order) = (rest, rows.1);
             work.push((c, filters[c].take(), tg, ty, og, rows.0));
         }
-        let one = |(c, f, t, y, out, rows): &mut (
-            usize,
-            Option<&mut F>,
-            &[f64],
-            &[f64],
-            &mut [f64],
-            &[usize],
-        )| {
+        let one = |(c, f, t, y, out, rows): &mut Work<F>| {
             let f = f.as_mut()?;
             run(f, t, y, out).err().map(|e| in_row(*c, &|k| rows[k], e))
         };
