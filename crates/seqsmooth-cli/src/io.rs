@@ -12,7 +12,7 @@ use std::path::Path;
 /// `{}` and `{:e}` text with two changes to `ryu`'s: a trailing `.0` is dropped (`ryu` writes
 /// `1.0`, Rust `1`), and where `x` lies exactly halfway between two shortest candidates `ryu`
 /// takes the even last digit and Rust the one away from zero, so that digit goes up by one
-/// ([`is_tie`]). Non-finite values print as `NaN`, `inf`, `-inf` (never in valid output).
+/// ([`tie_digit`]). Non-finite values print as `NaN`, `inf`, `-inf` (never in valid output).
 #[inline]
 pub fn write_f64(out: &mut Vec<u8>, x: f64) {
     let mut buf = ryu::Buffer::new();
@@ -20,49 +20,63 @@ pub fn write_f64(out: &mut Vec<u8>, x: f64) {
     let text = text.strip_suffix(b".0").unwrap_or(text);
     let start = out.len();
     out.extend_from_slice(text);
-    // A tie needs 16 or more digits (the exact value has one more, a 5) and an even last one.
-    let mantissa = text.split(|&b| b == b'e').next().unwrap_or(text);
-    if mantissa.len() >= 16 && mantissa.last().is_some_and(|d| d % 2 == 0) && is_tie(x, text) {
-        let last = start + mantissa.len() - 1;
-        out[last] += 1;
+    if let Some(last) = tie_digit(x, text) {
+        out[start + last] += 1;
     }
 }
 
-/// Whether `x` is exactly halfway between the decimal `text` (`ryu`'s, `[-]d.ddd[eX]`) and
-/// the next one up in magnitude in its last digit: `2|x| = (2D + 1)·10^p`, `D` the digits and
-/// `10^p` the last one's unit, checked in integers on `|x| = m·2^q`.
-#[cold]
-fn is_tie(x: f64, text: &[u8]) -> bool {
-    let text = std::str::from_utf8(text).unwrap_or("");
-    let (mantissa, exp) = text.split_once('e').unwrap_or((text, "0"));
-    let mantissa = mantissa.trim_start_matches('-');
-    let decimals = mantissa.split_once('.').map_or(0, |(_, f)| f.len() as i32);
-    let (Ok(d), Ok(e)) = (
-        mantissa.replace('.', "").parse::<u128>(),
-        exp.parse::<i32>(),
-    ) else {
-        return false;
-    };
-    let p = e - decimals;
+/// Where `x` lies exactly halfway between the decimal `text` (`ryu`'s, `[-]d.ddd[eX]`, even
+/// last digit) and the next one up in magnitude in its last digit: the index of that digit.
+/// Then `2|x| = (2D + 1)·10^p`, `D` the digits and `10^p` the last one's unit; with
+/// `|x| = o·2^e` (`o` odd) that is `e = p - 1` and `o·5^-p = 2D + 1` for `p < 0`, `o =
+/// (2D+1)·5^p` otherwise, so `x` needs an exact decimal of at most 18 digits: checked on its
+/// bits first, the digits only then.
+#[inline]
+fn tie_digit(x: f64, text: &[u8]) -> Option<usize> {
     let bits = x.abs().to_bits();
     let (m, q) = match bits >> 52 {
         0 => (bits, -1074),
         b => (bits & ((1 << 52) - 1) | (1 << 52), b as i32 - 1075),
     };
-    // m·2^(q+1) = (2D+1)·5^p·2^p: the odd parts and the powers of two agree.
-    let (odd, twos) = (m >> m.trailing_zeros(), q + 1 + m.trailing_zeros() as i32);
-    let five = |k: i32| 5u128.checked_pow(k.unsigned_abs());
-    let lhs = if p < 0 {
-        five(p).and_then(|f| f.checked_mul(odd.into()))
-    } else {
-        Some(odd.into())
+    let (odd, e) = (
+        u128::from(m >> m.trailing_zeros()),
+        q + m.trailing_zeros() as i32,
+    );
+    // A tie has p = e + 1; for p < 0, o·5^-p = 2D + 1 < 2·10^17.
+    let scaled = |p: i32| {
+        5u128
+            .checked_pow(p.unsigned_abs())
+            .and_then(|f| f.checked_mul(odd))
     };
+    if x == 0.0 || (e < -1 && (e < -27 || !scaled(e + 1).is_some_and(|v| v < 2 * 10u128.pow(17)))) {
+        return None;
+    }
+    let (mut d, mut decimals, mut point, mut end) = (0u128, 0i32, false, text.len());
+    for (i, &c) in text.iter().enumerate() {
+        match c {
+            b'0'..=b'9' => {
+                (d, decimals) = (10 * d + u128::from(c - b'0'), decimals + i32::from(point))
+            }
+            b'.' => point = true,
+            b'e' => {
+                end = i;
+                break;
+            }
+            _ => {}
+        }
+    }
+    let exp: i32 = std::str::from_utf8(&text[(end + 1).min(text.len())..])
+        .ok()?
+        .parse()
+        .unwrap_or(0);
+    let p = exp - decimals;
     let rhs = if p < 0 {
         Some(2 * d + 1)
     } else {
-        five(p).and_then(|f| f.checked_mul(2 * d + 1))
+        5u128.checked_pow(p as u32)?.checked_mul(2 * d + 1)
     };
-    twos == p && lhs.is_some() && lhs == rhs
+    let lhs = if p < 0 { scaled(p) } else { Some(odd) };
+    (d % 2 == 0 && e == p - 1 && lhs.is_some() && lhs == rhs).then_some(end - 1)
 }
 
 /// [`write_f64`] as a `String`.
@@ -244,10 +258,9 @@ impl<R: Read> LineTracker<R> {
         }
         let span = &rest[..k];
         // A `\n` right after a `\r` ends the same line; any other `\r` or `\n` ends one.
-        if !span.contains(&b'\r') {
+        if span.iter().filter(|&&b| b == b'\r').count() == 0 {
             let newlines = span.iter().filter(|&&b| b == b'\n').count() as u64;
-            let continued = self.after_cr && span.first() == Some(&b'\n');
-            self.breaks += newlines - u64::from(continued);
+            self.breaks += newlines - u64::from(self.after_cr && span.first() == Some(&b'\n'));
             self.after_cr &= k == 0;
         } else {
             for &b in span {

@@ -224,7 +224,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         let pieces: Vec<Vec<u8>> = (0..limit.div_ceil(PIECE))
             .into_par_iter()
             .map(|k| {
-                let mut buf = Vec::new();
+                let mut buf = Vec::with_capacity(PIECE.min(limit) * (stride + 2) * 20);
                 for i in k * PIECE..((k + 1) * PIECE).min(limit) {
                     chunk.echo(&mut buf, i, id(i));
                     for &v in &values[i * stride..(i + 1) * stride] {
