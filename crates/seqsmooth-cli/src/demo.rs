@@ -10,16 +10,15 @@
 //! step, noise estimated) runs on it; the plain expanding- and fading-memory filters of degree 2
 //! (noise σ given), on both engines, are shown beside it for comparison.
 
+use crate::args::{DemoArgs, EngineArg, Kind};
 use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
-use crate::filter::{
-    build_filter, median_step, open_output, EngineArg, Kind, OutputWriter, Sample,
-};
-use crate::number::fmt_f64;
+use crate::filter::runner::Runner;
+use crate::filter::{median_series_step, LOOKAHEAD};
+use crate::io::{fmt_f64, Output};
 use seqsmooth::polynomial::automatic::{AutoConfig, AutoOutput, AutomaticFilter, Phase};
-use seqsmooth::PolynomialState;
+use seqsmooth::{PolynomialFilter, PolynomialState};
 use std::f64::consts::PI;
-use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 /// Number of samples.
@@ -48,8 +47,6 @@ const DEGREE: usize = 2;
 const THETA: f64 = 0.95;
 /// Samples excluded from the error statistics as start-up.
 const START_UP: usize = 50;
-/// The default path prefix of the plot files.
-pub const DEFAULT_PLOT: &str = "seqsmooth-demo";
 
 /// xorshift64* (Vigna 2016): a tiny deterministic generator, enough for demo noise.
 struct XorShift64Star(u64);
@@ -152,7 +149,7 @@ struct Run {
 }
 
 fn run_plain(data: &[Point], kind: Kind, engine: EngineArg, tau: f64) -> Result<Run, CliError> {
-    let mut f = build_filter(kind, DEGREE, Some(THETA), tau, engine, Some(SIGMA))
+    let mut f = Runner::build(kind, DEGREE, Some(THETA), tau, None, engine, Some(SIGMA))
         .map_err(|e| CliError::Data(e.to_string()))?;
     let mut estimates = Vec::with_capacity(data.len());
     for p in data {
@@ -227,15 +224,6 @@ fn error_row(
         ),
         format!("{:.1} %", 100.0 * inside as f64 / scored.max(1) as f64),
     ]
-}
-
-/// Where the demo writes what.
-#[derive(Clone, Debug)]
-pub struct DemoConfig {
-    /// The plain fading-memory (exact engine) filter's CSV output, if wanted.
-    pub output: Option<PathBuf>,
-    /// The plot files' path prefix (`.png` and `.svg` are appended); `None` for no plot.
-    pub plot: Option<PathBuf>,
 }
 
 /// The plot's two file names for the path prefix `prefix` (a trailing `.png` or `.svg` is
@@ -326,20 +314,10 @@ fn times_list(times: &[f64]) -> String {
 }
 
 /// Runs `seqsmooth demo`.
-pub fn run(cfg: &DemoConfig) -> Result<(), CliError> {
+pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
     let data = generate();
-    let head: Vec<Sample> = data
-        .iter()
-        .take(crate::filter::LOOKAHEAD)
-        .map(|p| Sample {
-            line: 0,
-            t: p.t,
-            y: p.y,
-            t_text: String::new(),
-            y_text: String::new(),
-        })
-        .collect();
-    let tau = median_step(&head);
+    let head: Vec<f64> = data.iter().take(LOOKAHEAD).map(|p| p.t).collect();
+    let tau = median_series_step(&head, &vec![0; head.len()]).unwrap_or(1.0);
 
     let mut auto =
         AutomaticFilter::new(auto_config(tau)).map_err(|e| CliError::Data(e.to_string()))?;
@@ -386,8 +364,7 @@ pub fn run(cfg: &DemoConfig) -> Result<(), CliError> {
     let restarts: Vec<f64> = outs.iter().filter(|o| o.restart).map(|o| o.time).collect();
     let span = data[SAMPLES - 1].t - data[0].t;
 
-    let mut w = BufWriter::new(io::stdout().lock());
-    let name = "standard output";
+    let mut w = Output::stdout();
     let text = format!(
         "seqsmooth demo: the east coordinate of an aircraft through a 180° turn, {SAMPLES} radar \
          samples over {span:.0} s\n  \
@@ -423,47 +400,33 @@ pub fn run(cfg: &DemoConfig) -> Result<(), CliError> {
         auto.noise_sigma().map_or_else(|| "-".to_string(), short),
         SAMPLES - 1
     );
-    w.write_all(text.as_bytes())
-        .map_err(|e| CliError::write(name, e))?;
-    let widths: Vec<usize> = (0..table[0].len())
-        .map(|c| {
-            table
-                .iter()
-                .map(|r| r[c].chars().count())
-                .max()
-                .unwrap_or(0)
-        })
-        .collect();
-    for row in &table {
-        let cells: Vec<String> = row
-            .iter()
-            .zip(&widths)
-            .enumerate()
-            .map(|(c, (s, &width))| {
-                if c < 2 {
-                    format!("{s:<width$}")
-                } else {
-                    format!("{s:>width$}")
-                }
-            })
-            .collect();
-        writeln!(w, "{}", cells.join("  ").trim_end()).map_err(|e| CliError::write(name, e))?;
-    }
-    w.flush().map_err(|e| CliError::write(name, e))?;
+    w.write(text.as_bytes())?;
+    w.aligned(&table, 2)?;
+    w.finish()?;
 
     if let Some(path) = &cfg.output {
         let fading_exact = &runs[2];
-        let (sink, name) = open_output(Some(path))?;
-        let mut out = OutputWriter::new(sink, &name, DEGREE, true)?;
+        let mut out = Output::create(Some(path))?;
+        out.write(b"t,y,d0,d1,d2,s0,s1,s2\n")?;
         for (p, e) in data.iter().zip(&fading_exact.estimates) {
-            out.row(&fmt_f64(p.t), &fmt_f64(p.y), e.as_ref())?;
+            let d = e
+                .as_ref()
+                .map(|e| (e.derivatives.clone(), e.std_devs().unwrap_or_default()));
+            let (d, s) = d.unwrap_or_default();
+            let cells = (0..=DEGREE)
+                .map(|k| d.get(k))
+                .chain((0..=DEGREE).map(|k| s.get(k)));
+            let mut row = vec![fmt_f64(p.t), fmt_f64(p.y)];
+            row.extend(cells.map(|v| v.map_or_else(String::new, |&v| fmt_f64(v))));
+            out.row(&row)?;
         }
+        let name = out.name.clone();
         out.finish()?;
         eprintln!(
             "wrote the fading-memory (exact engine) output to {name}: columns t,y,d0..d2,s0..s2"
         );
     }
-    if let Some(prefix) = &cfg.plot {
+    if let Some(prefix) = Some(&cfg.plot).filter(|_| !cfg.no_plot) {
         let t = track(&data, &outs);
         let l = layout(tau);
         let paths = plot_paths(prefix);

@@ -39,12 +39,4 @@ impl CliError {
             CliError::Data(format!("cannot write to {what}: {e}"))
         }
     }
-
-    /// An error writing CSV output to `what`.
-    pub fn write_csv(what: &str, e: csv::Error) -> Self {
-        match e.into_kind() {
-            csv::ErrorKind::Io(io) => Self::write(what, io),
-            other => CliError::Data(format!("cannot write to {what}: {other:?}")),
-        }
-    }
 }

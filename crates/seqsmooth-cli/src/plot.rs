@@ -6,81 +6,38 @@
 //! cells (no estimate yet, a degree not reached yet) leave gaps. The filter's input file may be
 //! given too, for a truth column. The drawing is [`crate::chart`]'s, the same as the demo's.
 
+use crate::args::PlotArgs;
 use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
-use crate::filter::{csv_read_error, open_input, parse_cell, LineTracker};
-use std::path::{Path, PathBuf};
-
-/// What `seqsmooth plot` does, after argument checking.
-#[derive(Clone, Debug)]
-pub struct PlotConfig {
-    /// The filter output; `None` = standard input.
-    pub source: Option<PathBuf>,
-    /// The image files (each `.png` or `.svg`).
-    pub outputs: Vec<PathBuf>,
-    /// The derivatives to plot, one panel each, top to bottom.
-    pub derivatives: Vec<usize>,
-    /// Draw the residual panel (when `d0` is there and the lead is 0).
-    pub residuals: bool,
-    /// Title; `None` for the default.
-    pub title: Option<String>,
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels; `None` for the default for the panels.
-    pub height: Option<u32>,
-    /// Unit of the times, for the axis labels (e.g. `s`).
-    pub time_unit: Option<String>,
-    /// Unit of the values (e.g. `m`).
-    pub value_unit: Option<String>,
-    /// The lead `H` the output was made with: estimates are drawn at `t + H`.
-    pub lead: f64,
-    /// The filter's input file, for the truth column.
-    pub input: Option<PathBuf>,
-    /// Time column of the input file.
-    pub time_col: String,
-    /// Value column of the input file.
-    pub value_col: String,
-    /// Truth column of the input file.
-    pub truth_col: Option<String>,
-}
+use crate::io::{find_column, input_name, open_input, parse_cell, CsvIn};
+use std::path::Path;
 
 /// A CSV file read in full: the header and the data rows with their 1-based file lines.
 struct Table {
     /// The file's name in messages: `'path'` or `standard input`.
     name: String,
     header: Vec<String>,
-    rows: Vec<(u64, csv::StringRecord)>,
+    rows: Vec<(u64, Vec<String>)>,
 }
 
 impl Table {
     fn read(path: Option<&Path>) -> Result<Table, CliError> {
-        let name = match path {
-            Some(p) if p.as_os_str() != "-" => format!("'{}'", p.display()),
-            _ => "standard input".to_string(),
-        };
-        let input = open_input(path)?;
-        let mut reader = csv::ReaderBuilder::new()
-            .has_headers(true)
-            .flexible(false)
-            .trim(csv::Trim::All)
-            .from_reader(LineTracker::new(input));
+        let name = input_name(path);
         let at = |e: CliError| CliError::Data(format!("{name}: {e}"));
-        let header: Vec<String> = match reader.headers() {
-            Ok(h) => h.iter().map(str::to_string).collect(),
-            Err(e) => return Err(at(csv_read_error(reader.get_mut(), e))),
-        };
+        let mut csv = CsvIn::new(open_input(path)?).map_err(at)?;
+        let header = std::mem::take(&mut csv.header);
         let mut rows = Vec::new();
-        let mut record = csv::StringRecord::new();
-        loop {
-            match reader.read_record(&mut record) {
-                Ok(true) => {
-                    let byte = record.position().map_or(0, |p| p.byte());
-                    let line = reader.get_mut().line_at(byte);
-                    rows.push((line, record.clone()));
-                }
-                Ok(false) => break,
-                Err(e) => return Err(at(csv_read_error(reader.get_mut(), e))),
-            }
+        while csv.next().map_err(at)? {
+            let line = csv.line;
+            let cells: Result<Vec<String>, _> = (0..header.len())
+                .map(|i| std::str::from_utf8(csv.field(i)).map(str::to_string))
+                .collect();
+            let utf8 = || {
+                at(CliError::Data(format!(
+                    "line {line}: malformed CSV: the row is not valid UTF-8"
+                )))
+            };
+            rows.push((line, cells.map_err(|_| utf8())?));
         }
         if header.iter().all(String::is_empty) {
             return Err(CliError::Data(format!(
@@ -98,13 +55,7 @@ impl Table {
     }
 
     fn required(&self, col: &str, why: &str) -> Result<usize, CliError> {
-        self.column(col).ok_or_else(|| {
-            CliError::Data(format!(
-                "{}: column '{col}' not found in the header{why}; columns are: {}",
-                self.name,
-                self.header.join(", ")
-            ))
-        })
+        find_column(&self.header, col, why).map_err(|e| self.error(e))
     }
 
     fn error(&self, e: CliError) -> CliError {
@@ -121,7 +72,7 @@ impl Table {
                 if empty && text.is_empty() {
                     return Ok(None);
                 }
-                parse_cell(text, *line, col, what)
+                parse_cell(text.as_bytes(), *line, col, what)
                     .map(Some)
                     .map_err(|e| self.error(e))
             })
@@ -156,7 +107,7 @@ impl Table {
         let col = &self.header[idx];
         self.rows
             .iter()
-            .map(|(line, r)| match &r[idx] {
+            .map(|(line, r)| match r[idx].as_str() {
                 "0" => Ok(false),
                 "1" => Ok(true),
                 other => Err(CliError::Data(format!(
@@ -204,19 +155,19 @@ fn derivative_label(k: usize, time_unit: Option<&str>, value_unit: Option<&str>)
 }
 
 /// Reads the filter output (and input) named in `cfg` into a track.
-fn read_track(cfg: &PlotConfig) -> Result<(Track, String), CliError> {
+fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
     let out = Table::read(cfg.source.as_deref())?;
     let n = out.rows.len();
     let t_idx = out.required("t", " (the output of 'seqsmooth filter' has t,y,d0..dM)")?;
     let y_idx = out.required("y", " (the output of 'seqsmooth filter' has t,y,d0..dM)")?;
     let t = out.filled(t_idx, "time")?;
     let y = out.filled(y_idx, "value")?;
-    let top = cfg.derivatives.iter().copied().max().unwrap_or(0);
+    let top = cfg.derivative.iter().copied().max().unwrap_or(0);
     let mut d = vec![vec![None; n]; top + 1];
     let mut s = vec![Vec::new(); top + 1];
     for k in 0..=top {
         let name = format!("d{k}");
-        let idx = if cfg.derivatives.contains(&k) {
+        let idx = if cfg.derivative.contains(&k) {
             Some(out.required(
                 &name,
                 &format!(
@@ -315,8 +266,8 @@ fn read_track(cfg: &PlotConfig) -> Result<(Track, String), CliError> {
 }
 
 /// Runs `seqsmooth plot`.
-pub fn run(cfg: &PlotConfig) -> Result<(), CliError> {
-    for p in &cfg.outputs {
+pub fn run(cfg: &PlotArgs) -> Result<(), CliError> {
+    for p in &cfg.output {
         if chart::Format::from_path(p).is_none() {
             return Err(CliError::Usage(format!(
                 "cannot tell the image format of '{}': the file name must end in .png or .svg",
@@ -327,9 +278,9 @@ pub fn run(cfg: &PlotConfig) -> Result<(), CliError> {
     let (track, default_title) = read_track(cfg)?;
     let tu = cfg.time_unit.as_deref();
     let vu = cfg.value_unit.as_deref();
-    let residuals = cfg.residuals && cfg.lead == 0.0 && track.d[0].iter().any(Option::is_some);
+    let residuals = !cfg.no_residuals && cfg.lead == 0.0 && track.d[0].iter().any(Option::is_some);
     let panels: Vec<(usize, String)> = cfg
-        .derivatives
+        .derivative
         .iter()
         .map(|&k| (k, derivative_label(k, tu, vu)))
         .collect();
@@ -337,7 +288,7 @@ pub fn run(cfg: &PlotConfig) -> Result<(), CliError> {
     if cfg.lead != 0.0 {
         subtitle.push(format!(
             "estimates drawn at t + {}{}",
-            crate::number::fmt_f64(cfg.lead),
+            crate::io::fmt_f64(cfg.lead),
             tu.map(|u| format!(" {u}")).unwrap_or_default()
         ));
     }
@@ -353,7 +304,7 @@ pub fn run(cfg: &PlotConfig) -> Result<(), CliError> {
         ),
         panels,
     };
-    for p in &cfg.outputs {
+    for p in &cfg.output {
         chart::write(&track, &layout, p)?;
     }
     Ok(())

@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 /// The outcome of one run of the binary.
@@ -42,3 +42,65 @@ pub fn run_at(dir: Option<&Path>, args: &[&str], stdin: &str) -> Out {
 pub fn run(args: &[&str], stdin: &str) -> Out {
     run_at(None, args, stdin)
 }
+
+/// Runs and asserts success.
+pub fn ok(args: &[&str], stdin: &str) -> String {
+    let o = run(args, stdin);
+    assert_eq!(o.code, 0, "seqsmooth {args:?} failed: {}", o.stderr);
+    o.stdout
+}
+
+/// Runs and asserts failure with `code` and every `parts` in stderr.
+pub fn fails(args: &[&str], stdin: &str, code: i32, parts: &[&str]) {
+    let o = run(args, stdin);
+    assert_eq!(o.code, code, "seqsmooth {args:?}: stderr {}", o.stderr);
+    assert!(
+        o.stderr.starts_with("error: "),
+        "message must start with 'error: ': {}",
+        o.stderr
+    );
+    for p in parts {
+        assert!(o.stderr.contains(p), "stderr lacks {p:?}: {}", o.stderr);
+    }
+    assert!(!o.stderr.contains("panicked"), "{}", o.stderr);
+}
+
+/// Splits CSV output (no quoting occurs in it) into the header and rows of cells.
+pub fn table(text: &str) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut lines = text.lines();
+    let header = lines
+        .next()
+        .expect("header")
+        .split(',')
+        .map(String::from)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    (header, rows)
+}
+
+pub fn num(cell: &str) -> f64 {
+    cell.parse()
+        .unwrap_or_else(|_| panic!("{cell:?} is not a number"))
+}
+
+pub fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * (1.0 + b.abs())
+}
+
+pub fn tmp(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name)
+}
+
+/// The double nearest to the exact number `text` (e.g. `0.9` or `9/10`).
+pub fn exact_f64(text: &str) -> f64 {
+    seqsmooth::scalar::ratio_to_f64(&seqsmooth::scalar::parse_rational(text).unwrap())
+}
+
+/// Morrison's running example (test vector T9-02): samples 1, 3, 2, 5, 4 at n = 0..4.
+pub const T9_02: &str = "t,y\n0,1\n1,3\n2,2\n3,5\n4,4\n";
+
+/// Morrison test vector T7-08: Y = (y_n, …, y_{n-4}) = (5, 3, 4, 2, 1), newest first, so
+/// the CSV (oldest first) is y = 1, 2, 4, 3, 5 at t = 0..4.
+pub const T7_08: &str = "t,y\n0,1\n1,2\n2,4\n3,3\n4,5\n";

@@ -1,0 +1,761 @@
+//! The command line: the subcommands' arguments (clap), their help texts, the parsers of the
+//! numeric arguments and the checks that tie arguments together. Imports no subcommand.
+//!
+//! The argument parsers return `Err(message)`; clap prints it as
+//! `error: invalid value 'V' for '--name <X>': message` and exits with code 2.
+
+use crate::error::CliError;
+use clap::{Args, Parser, Subcommand};
+use num_traits::{One, Zero};
+use seqsmooth::polynomial::vrf::EstimateForm;
+use seqsmooth::polynomial::MAX_DEGREE;
+use seqsmooth::scalar::{parse_rational, Rational};
+use seqsmooth::Engine;
+use std::path::PathBuf;
+
+/// Rows per chunk of `seqsmooth filter`'s streaming pipeline (read, filter, write).
+pub const CHUNK_ROWS: u32 = 1 << 16;
+
+/// Text shown after every `--help`: exit codes and number formats.
+const AFTER_HELP: &str = "\
+Exit status: 0 on success; 1 when the input data or a file is unusable (bad numbers, NaN or \
+infinite values, unsorted or duplicate times, missing columns, malformed CSV, too few samples, \
+unreadable or unwritable files); 2 for command-line errors (unknown or missing arguments, values \
+out of range). Every message goes to stderr and starts with 'error: '; data errors name the \
+1-based file line (the header is line 1), the column and the value.
+
+Numbers are written with round-trip precision: the shortest text that parses back to the same \
+double (plain decimals for 1e-5 <= |x| < 1e16, otherwise scientific notation such as 1e-300). \
+Exact (--exact) values are rationals in lowest terms, 'p/q', or 'p' when the value is an integer.";
+
+/// Top-level command line.
+#[derive(Debug, Parser)]
+#[command(
+    name = "seqsmooth",
+    version,
+    about = "Polynomial smoothing and prediction filters (Morrison 1969; Reyneke et al. 2012)",
+    after_help = AFTER_HELP
+)]
+pub struct Cli {
+    /// The subcommand.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Smooth, differentiate and predict a CSV time series, row by row, with an expanding-,
+    /// fading- or fixed-memory or the automatic polynomial filter
+    #[command(after_help = FILTER_AFTER_HELP)]
+    Filter(FilterArgs),
+    /// Smooth and differentiate a whole CSV time series with centred fixed-memory windows
+    /// (Savitzky-Golay, non-causal; reads the whole input first)
+    #[command(after_help = SMOOTH_AFTER_HELP)]
+    Smooth(SmoothArgs),
+    /// Print Morrison's scaled current-estimate gains h_0..h_m (header k,gain)
+    #[command(after_help = AFTER_HELP)]
+    Gains(GainsArgs),
+    /// Print the scaled variance-reduction matrix (header i,j,value, row-major)
+    #[command(after_help = AFTER_HELP)]
+    Vrf(VrfArgs),
+    /// Run the automatic filter on a built-in manoeuvring-target track, print a short summary
+    /// and write a plot (PNG and SVG)
+    #[command(after_help = AFTER_HELP)]
+    Demo(DemoArgs),
+    /// Plot the output of 'seqsmooth filter' (any kind) as PNG or SVG
+    #[command(after_help = PLOT_AFTER_HELP)]
+    Plot(PlotArgs),
+}
+
+/// Help text after `seqsmooth plot --help`.
+const PLOT_AFTER_HELP: &str = "\
+Reads the CSV written by 'seqsmooth filter' and draws, under a title and a legend: a panel per \
+--derivative K with the estimate dK, its +-3 sigma band from sK (when the output has s \
+columns) and, for K = 0, the samples (rejected ones as red crosses, from the auto filter's \
+outlier column); then a residual panel y - d0 with the estimate's +-3 sigma band about zero \
+and the auto filter's +-3 noise sigma (dashed). The spans where the auto filter's misfit flag \
+is up are shaded in every panel. Empty cells leave gaps. Axis ranges leave out the start-up \
+transients of the estimates; residuals beyond the range are drawn as triangles at its edge.
+
+With --input (the file given to 'seqsmooth filter') the truth column --truth-col is drawn \
+too; the input's times and values must match the output's rows.
+
+Exit status: 0 on success; 1 when the input data or a file is unusable (missing file or \
+columns, malformed CSV, non-numeric cells, unwritable image); 2 for command-line errors \
+(unknown or missing arguments, values out of range, an output name not ending in .png or \
+.svg). Every message goes to stderr and starts with 'error: '; data errors name the file, the \
+1-based line (the header is line 1) and the column.";
+
+/// Help text after `seqsmooth filter --help`.
+const FILTER_AFTER_HELP: &str = "\
+Output: CSV, one row per input row in input order, with the header
+  --kind expanding, fading:  t,y,d0..dM            (and s0..sM with --sigma)
+  --kind fixed:              t,y,d0..dM,window     (t,y,d0..dM,s0..sM,window with --sigma)
+  --kind auto:               t,y,d0..dM,s0..sM,noise,outlier,misfit
+The t and y cells echo the input cells; dk is the k-th time derivative, in the input's time \
+units, of the estimate valid at t+H from the rows up to and including this one, and sk its \
+1-sigma error. Rows before the estimate is determined have empty d and s cells: the first M rows \
+(expanding, fading), the first W-1 rows (fixed); auto estimates from the first row on.
+
+fixed: the least-squares polynomial through the last W rows, on any timestamps (Morrison's \
+sliding O(M^2) recursion while the times are evenly spaced, a refit of the window from the \
+first uneven step on: the same fit). The window cell is the number of rows in the window: \
+1, 2, ..., W-1 on the rows still filling it (whose d and s cells are empty), W on every row \
+with an estimate. On evenly spaced rows, --lead -(W-1)*dt/2 (dt the time step) evaluates each \
+row's window at its centre, where the estimate is most accurate.
+
+auto: the automatic filter (Morrison 13.8, 14.8; Reyneke et al. 7): expanding memory at first, \
+then fading memory with the discount T per TAU; it starts at degree 0 and steps up to M as the \
+data determine each degree (the d and s cells above the degree reached so far are empty). noise \
+is the noise sigma in use: S given with --sigma, otherwise the running estimate from the \
+(M+1)-th differences of the accepted samples (empty until it has 5 terms); s0..sM come from it \
+(empty while there is none). outlier is 1 when the row's sample was rejected by the 3-sigma \
+innovation gate (it did not update the filter; the row's estimate is the prediction across it), \
+else 0. misfit is 1 while the chi-squared test of the last 10 innovations (false-alarm rate 1%) \
+says the model no longer fits, else 0; a strong misfit restarts the memory.
+
+Several series (--id-col NAME): the rows with the same id (any text) form a series, filtered \
+on its own with the same settings; the series may be interleaved in any way, on time grids of \
+their own (times must increase within each series only). The output keeps the input's row \
+order and starts with the id column: NAME,t,y,d0..dM,... A series shorter than the degree \
+needs just has empty cells (the too-few-samples check is on the input as a whole). The default \
+tau is the median of the first 100 time steps within series (among the first 65536 rows).
+
+Reading streams in chunks of up to 65536 rows, the series of a chunk in parallel; memory stays \
+bounded (a few chunks plus one filter per series) however long the input. The first 101 data \
+rows (the first W for a longer fixed window) are held back: an error in one of them stops the \
+command before any output. An error in a later row (a bad cell, a time not after the previous \
+one of its series, ...) stops the command after every row before it, of every series, has been \
+written; the message names the line, the column and, for a time, the series.
+
+Progress: on standard error when it is a terminal and the input is longer than one chunk \
+(bytes of the file read, or rows and rows/s from standard input); --no-progress turns it off.
+
+Exit status: 0 on success; 1 when the input data or a file is unusable (bad numbers, NaN or \
+infinite values, unsorted or duplicate times, missing columns, malformed CSV, too few samples, \
+unreadable or unwritable files); 2 for command-line errors (unknown or missing arguments, values \
+out of range). Every message goes to stderr and starts with 'error: '; data errors name the \
+1-based file line (the header is line 1), the column and the value.
+
+Numbers are written with round-trip precision: the shortest text that parses back to the same \
+double (plain decimals for 1e-5 <= |x| < 1e16, otherwise scientific notation such as 1e-300).";
+
+/// Help text after `seqsmooth smooth --help`.
+const SMOOTH_AFTER_HELP: &str = "\
+Output: CSV with header t,y,d0..dM, one row per input row in input order. The t and y cells \
+echo the input cells; dk is the k-th time derivative, in the input's time units, of the \
+least-squares polynomial of degree M through the W rows most nearly centred on this one \
+(floor((W-1)/2) rows before it), evaluated at its own time; the first and last rows use the \
+first and last full windows. Every row has an estimate.
+
+Evenly spaced times (every step within a relative 1e-9 of the first, allowing for the rounding \
+of the timestamps themselves): for odd W, dk is \
+scipy.signal.savgol_filter(y, W, M, deriv=k, delta=dt, mode='interp') with dt the mean step; \
+for even W each row sits half a step after the centre of its window. Irregular times: the same \
+windows, each fitted by least squares at the actual times.
+
+Reading: the whole input is read and checked before the first output row is written (a row's \
+window reaches rows after it); use 'seqsmooth filter --kind fixed' for a causal, streaming fit.
+
+Exit status: 0 on success; 1 when the input data or a file is unusable (bad numbers, NaN or \
+infinite values, unsorted or duplicate times, missing columns, malformed CSV, fewer rows than \
+the window, unreadable or unwritable files); 2 for command-line errors (unknown or missing \
+arguments, values out of range). Every message goes to stderr and starts with 'error: '; data \
+errors name the 1-based file line (the header is line 1), the column and the value.
+
+Numbers are written with round-trip precision: the shortest text that parses back to the same \
+double (plain decimals for 1e-5 <= |x| < 1e16, otherwise scientific notation such as 1e-300).";
+
+/// Arguments of `seqsmooth filter`.
+#[derive(Debug, Args)]
+pub struct FilterArgs {
+    /// Input CSV with a header row; omitted or '-' reads standard input. Columns other than the
+    /// time and value columns are ignored
+    #[arg(value_name = "INPUT")]
+    pub input: Option<PathBuf>,
+    /// Filter kind
+    #[arg(long, value_enum)]
+    pub kind: Kind,
+    /// Polynomial degree M (0 to 24)
+    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
+    pub degree: usize,
+    /// Fading memory and auto: discount per tau, 0 < T < 1 (e.g. 0.9 or 9/10)
+    #[arg(long, value_name = "T", value_parser = parse_theta, allow_hyphen_values = true)]
+    pub theta: Option<Theta>,
+    /// Fading memory and auto: the time interval theta applies to [default: the median time
+    /// step of the first 101 rows, so theta is the discount per typical sample; 1 for a single
+    /// row]
+    #[arg(long, value_name = "TAU", value_parser = parse_tau, allow_hyphen_values = true)]
+    pub tau: Option<f64>,
+    /// Fixed memory: the number of samples in the window, W >= M+1 (Morrison's L+1, savgol's
+    /// window_length)
+    #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
+    pub window: Option<usize>,
+    /// Engine of the expanding, fading and auto filters: 'exact' is least squares on any
+    /// timestamps; 'gain' is Morrison's fixed-gain recursion, exact on evenly spaced times and
+    /// approximate on irregular ones. The fixed-memory filter is always the exact fit of its
+    /// window [default: exact]
+    #[arg(long, value_enum)]
+    pub engine: Option<EngineArg>,
+    /// Lead H in time units: each row's estimate is valid at t+H (negative = retrodiction)
+    #[arg(long, value_name = "H", default_value = "0", value_parser = parse_lead,
+          allow_hyphen_values = true)]
+    pub lead: f64,
+    /// Name of the time column
+    #[arg(long, value_name = "NAME", default_value = "t")]
+    pub time_col: String,
+    /// Name of the value column
+    #[arg(long, value_name = "NAME", default_value = "y")]
+    pub value_col: String,
+    /// White-noise standard deviation S of the values: adds the columns s0..sM, the 1-sigma
+    /// errors of d0..dM from the filter's covariance. With --kind auto (which always writes
+    /// s0..sM) the noise is taken to be S instead of estimated
+    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
+    pub sigma: Option<f64>,
+    /// Output file [default: standard output]
+    #[arg(short = 'o', long, value_name = "OUTPUT")]
+    pub output: Option<PathBuf>,
+    /// Name of a column naming the series: the rows of each id (any text) are a series of
+    /// their own, filtered on its own with the same settings, and the column is written first
+    #[arg(long, value_name = "NAME")]
+    pub id_col: Option<String>,
+    /// Never show the progress display (shown on standard error only when it is a terminal
+    /// and the input is larger than one chunk of rows)
+    #[arg(long)]
+    pub no_progress: bool,
+    /// Rows read, filtered and written at a time (testing aid)
+    #[arg(long, value_name = "N", hide = true, default_value_t = CHUNK_ROWS,
+          value_parser = clap::value_parser!(u32).range(1..))]
+    pub chunk_rows: u32,
+}
+
+/// Arguments of `seqsmooth smooth`.
+#[derive(Debug, Args)]
+pub struct SmoothArgs {
+    /// Input CSV with a header row; omitted or '-' reads standard input. Columns other than the
+    /// time and value columns are ignored. Read in full before any output is written
+    #[arg(value_name = "INPUT")]
+    pub input: Option<PathBuf>,
+    /// Polynomial degree M (0 to 24)
+    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
+    pub degree: usize,
+    /// The number of samples in each window, M+1 <= W <= the number of rows (savgol's
+    /// window_length, Morrison's L+1); odd W centres every window on its row
+    #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
+    pub window: usize,
+    /// Name of the time column
+    #[arg(long, value_name = "NAME", default_value = "t")]
+    pub time_col: String,
+    /// Name of the value column
+    #[arg(long, value_name = "NAME", default_value = "y")]
+    pub value_col: String,
+    /// Output file [default: standard output]
+    #[arg(short = 'o', long, value_name = "OUTPUT")]
+    pub output: Option<PathBuf>,
+}
+
+/// Arguments of `seqsmooth gains`.
+#[derive(Debug, Args)]
+pub struct GainsArgs {
+    /// Filter kind
+    #[arg(long, value_enum)]
+    pub kind: TableKind,
+    /// Polynomial degree M (0 to 24)
+    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
+    pub degree: usize,
+    /// Expanding memory: 0-based index of the newest sample (n+1 samples seen)
+    #[arg(long, value_name = "N", value_parser = parse_index, allow_hyphen_values = true)]
+    pub n: Option<u64>,
+    /// Fading memory: discount per sample, 0 < T < 1 (e.g. 0.9 or 9/10; exact with --exact)
+    #[arg(long, value_name = "T", value_parser = parse_theta, allow_hyphen_values = true)]
+    pub theta: Option<Theta>,
+    /// Print exact rationals in lowest terms, p/q (an integer as p), instead of doubles.
+    /// Without it θ is rounded to the nearest double before the computation
+    #[arg(long)]
+    pub exact: bool,
+    /// Output format
+    #[arg(long, value_enum, default_value_t = Format::Csv)]
+    pub format: Format,
+}
+
+/// Arguments of `seqsmooth vrf`.
+#[derive(Debug, Args)]
+pub struct VrfArgs {
+    /// Filter kind
+    #[arg(long, value_enum)]
+    pub kind: VrfKind,
+    /// Polynomial degree M (0 to 24)
+    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
+    pub degree: usize,
+    /// Expanding memory: 0-based index of the newest sample, N >= M
+    #[arg(long, value_name = "N", value_parser = parse_index, allow_hyphen_values = true)]
+    pub n: Option<u64>,
+    /// Fading memory: discount per sample, 0 < T < 1 (e.g. 0.9 or 9/10; exact with --exact)
+    #[arg(long, value_name = "T", value_parser = parse_theta, allow_hyphen_values = true)]
+    pub theta: Option<Theta>,
+    /// Fixed memory: the number of samples in the window, W >= M+1 (Morrison's L+1)
+    #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
+    pub window: Option<usize>,
+    /// Fixed memory: the lead H in samples after the newest one: 0 the current estimate
+    /// (default), 1 the 1-step prediction, -(W-1)/2 the centre of the window; any number, e.g.
+    /// -2.5 or -5/2 (exact with --exact)
+    #[arg(long, value_name = "H", value_parser = parse_lead_steps, allow_hyphen_values = true)]
+    pub lead: Option<LeadSteps>,
+    /// Expanding and fading memory: which estimate, the current one (Z*_{n,n}) or the 1-step
+    /// prediction (Z*_{n+1,n}) [default: current]
+    #[arg(long, value_enum)]
+    pub form: Option<FormArg>,
+    /// Print exact rationals in lowest terms, p/q (an integer as p), instead of doubles.
+    /// Without it θ (or H) is rounded to the nearest double before the computation
+    #[arg(long)]
+    pub exact: bool,
+    /// Output format
+    #[arg(long, value_enum, default_value_t = Format::Csv)]
+    pub format: Format,
+}
+
+/// Arguments of `seqsmooth demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Also write the plain fading-memory (exact engine) filter's CSV output
+    /// (t,y,d0..d2,s0..s2) here
+    #[arg(short = 'o', long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Path prefix of the plot: writes PREFIX.png and PREFIX.svg
+    #[arg(long, value_name = "PREFIX", default_value = "seqsmooth-demo")]
+    pub plot: PathBuf,
+    /// Write no plot
+    #[arg(long, conflicts_with = "plot")]
+    pub no_plot: bool,
+}
+
+/// Arguments of `seqsmooth plot`.
+#[derive(Debug, Args)]
+pub struct PlotArgs {
+    /// The output of 'seqsmooth filter' (CSV with header t,y,d0..dM[,s0..sM][,...]); omitted
+    /// or '-' reads standard input
+    #[arg(value_name = "FILTER_OUTPUT")]
+    pub source: Option<PathBuf>,
+    /// Image file to write, PNG or SVG by its extension (.png, .svg); repeat for both
+    #[arg(short = 'o', long, value_name = "IMAGE", required = true)]
+    pub output: Vec<PathBuf>,
+    /// Derivative to plot, one panel each, in the order given (0 the value, 1 the rate, ...);
+    /// repeat for several
+    #[arg(long, value_name = "K", default_value = "0", value_parser = parse_degree,
+          allow_hyphen_values = true)]
+    pub derivative: Vec<usize>,
+    /// Leave out the residual panel
+    #[arg(long)]
+    pub no_residuals: bool,
+    /// Title [default: the filter kind and the file name]
+    #[arg(long, value_name = "TEXT")]
+    pub title: Option<String>,
+    /// Image width in pixels
+    #[arg(long, value_name = "PX", default_value_t = 1200,
+          value_parser = clap::value_parser!(u32).range(300..=10000))]
+    pub width: u32,
+    /// Image height in pixels [default: 330 per derivative panel, 250 for the residuals, 120
+    /// for the title and legend]
+    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(300..=10000))]
+    pub height: Option<u32>,
+    /// Unit of the times, for the axis labels (e.g. s)
+    #[arg(long, value_name = "UNIT")]
+    pub time_unit: Option<String>,
+    /// Unit of the values, for the axis labels (e.g. m)
+    #[arg(long, value_name = "UNIT")]
+    pub value_unit: Option<String>,
+    /// The --lead H the output was made with: the estimates are drawn at t+H (and the residual
+    /// panel, which needs H = 0, is left out)
+    #[arg(long, value_name = "H", default_value = "0", value_parser = parse_lead,
+          allow_hyphen_values = true)]
+    pub lead: f64,
+    /// The filter's input file, to draw its truth column (--truth-col)
+    #[arg(long, value_name = "FILE")]
+    pub input: Option<PathBuf>,
+    /// Name of the input's time column
+    #[arg(long, value_name = "NAME", default_value = "t")]
+    pub time_col: String,
+    /// Name of the input's value column
+    #[arg(long, value_name = "NAME", default_value = "y")]
+    pub value_col: String,
+    /// Column of the input holding the true values, drawn as a line (needs --input)
+    #[arg(long, value_name = "NAME", requires = "input")]
+    pub truth_col: Option<String>,
+}
+
+/// Which filter `seqsmooth filter` runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Kind {
+    /// Expanding memory: least squares over all samples so far.
+    Expanding,
+    /// Fading memory: samples discounted by θ per τ of age.
+    Fading,
+    /// Fixed memory: least squares over the last W samples (--window W).
+    Fixed,
+    /// Automatic: fading memory that starts itself, settles its degree, estimates the noise,
+    /// rejects outliers and flags misfit (--theta T).
+    Auto,
+}
+
+impl Kind {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Expanding => "expanding",
+            Kind::Fading => "fading",
+            Kind::Fixed => "fixed",
+            Kind::Auto => "auto",
+        }
+    }
+}
+
+/// The engine the filter runs on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum EngineArg {
+    /// Recursive least squares, exact on any timestamps.
+    Exact,
+    /// Morrison's fixed-gain recursion: exact on evenly spaced times, approximate otherwise.
+    Gain,
+}
+
+impl From<EngineArg> for Engine {
+    fn from(e: EngineArg) -> Self {
+        match e {
+            EngineArg::Exact => Engine::Exact,
+            EngineArg::Gain => Engine::Gain,
+        }
+    }
+}
+
+/// Output format of the tables.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Format {
+    /// Comma-separated values with a header row.
+    #[default]
+    Csv,
+    /// Aligned text for reading.
+    Table,
+}
+
+/// The filter kinds of `seqsmooth gains` (and the recursive ones of `seqsmooth vrf`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TableKind {
+    /// Expanding memory (--n N).
+    Expanding,
+    /// Fading memory (--theta T).
+    Fading,
+}
+
+/// The filter kinds with a variance-reduction matrix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum VrfKind {
+    /// Expanding memory (--n N, --form).
+    Expanding,
+    /// Fading memory (--theta T, --form).
+    Fading,
+    /// Fixed memory over W samples (--window W, --lead H).
+    Fixed,
+}
+
+/// Which estimate a variance-reduction matrix describes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum FormArg {
+    /// The current estimate Z*_{n,n}.
+    #[default]
+    Current,
+    /// The 1-step prediction Z*_{n+1,n}.
+    Predictor,
+}
+
+impl From<FormArg> for EstimateForm {
+    fn from(f: FormArg) -> Self {
+        match f {
+            FormArg::Current => EstimateForm::Current,
+            FormArg::Predictor => EstimateForm::Predictor,
+        }
+    }
+}
+
+/// The filter memory a table is for, after argument checking.
+#[derive(Clone, Debug)]
+pub enum Memory {
+    /// Expanding memory at the 0-based index `n` of the newest sample.
+    Expanding {
+        /// Sample index.
+        n: u64,
+    },
+    /// Fading memory with discount θ.
+    Fading {
+        /// θ (exact and `f64`).
+        theta: Theta,
+    },
+}
+
+/// Resolves `--n`/`--theta` for the memory kind of a gains or vrf table.
+pub fn memory(kind: TableKind, n: Option<u64>, theta: Option<Theta>) -> Result<Memory, CliError> {
+    match (kind, n, theta) {
+        (TableKind::Expanding, Some(n), None) => Ok(Memory::Expanding { n }),
+        (TableKind::Expanding, None, _) => Err(CliError::Usage(
+            "--kind expanding needs --n N, the 0-based index of the newest sample".into(),
+        )),
+        (TableKind::Expanding, Some(_), Some(_)) => Err(CliError::Usage(
+            "--theta applies only to --kind fading".into(),
+        )),
+        (TableKind::Fading, None, Some(theta)) => Ok(Memory::Fading { theta }),
+        (TableKind::Fading, _, None) => Err(CliError::Usage(
+            "--kind fading needs --theta T, the discount per sample (0 < T < 1)".into(),
+        )),
+        (TableKind::Fading, Some(_), Some(_)) => Err(CliError::Usage(
+            "--n applies only to --kind expanding".into(),
+        )),
+    }
+}
+
+/// The usage error of an argument given to a kind it does not apply to.
+pub fn only(arg: &str, kinds: &str) -> CliError {
+    CliError::Usage(format!("{arg} applies only to --kind {kinds}"))
+}
+
+/// Checks a window against the degree: a degree-M fit needs at least M+1 samples.
+pub fn check_window(window: usize, degree: usize) -> Result<(), CliError> {
+    if window < degree + 1 {
+        return Err(CliError::Usage(format!(
+            "window {window} is too small for degree {degree}: a degree-{degree} fit needs a \
+             window of at least {} samples",
+            degree + 1
+        )));
+    }
+    Ok(())
+}
+
+/// A discount factor θ as given on the command line: exact, and rounded to `f64`.
+#[derive(Clone, Debug)]
+pub struct Theta {
+    /// The text as given (used in messages).
+    pub text: String,
+    /// θ exactly (`0.9` is `9/10`).
+    pub exact: Rational,
+    /// θ rounded to the nearest `f64`.
+    pub value: f64,
+}
+
+impl Theta {
+    /// θ as an `f64` strictly inside `(0, 1)`, for the computations that run in `f64`.
+    pub fn value_f64(&self) -> Result<f64, String> {
+        if self.value > 0.0 && self.value < 1.0 {
+            Ok(self.value)
+        } else {
+            Err(format!(
+                "theta {} is out of range: it rounds to {} in double precision, and the filters \
+                 need 0 < theta < 1 after rounding (--exact tables accept it)",
+                self.text, self.value
+            ))
+        }
+    }
+}
+
+/// Parses `--theta`: `0.9`, `9/10` or `9e-1`, strictly between 0 and 1.
+pub fn parse_theta(s: &str) -> Result<Theta, String> {
+    let text = s.trim();
+    let exact = parse_rational(text)
+        .ok_or_else(|| format!("theta '{text}' is not a number (write it as 0.9 or 9/10)"))?;
+    if !(exact > Rational::zero() && exact < Rational::one()) {
+        return Err(format!(
+            "theta {text} is out of range: it must lie strictly between 0 and 1"
+        ));
+    }
+    let value = seqsmooth::scalar::ratio_to_f64(&exact);
+    Ok(Theta {
+        text: text.to_string(),
+        exact,
+        value,
+    })
+}
+
+/// Parses `--degree`: a whole number from 0 to [`MAX_DEGREE`].
+pub fn parse_degree(s: &str) -> Result<usize, String> {
+    let text = s.trim();
+    let range = format!("it must be a whole number from 0 to {MAX_DEGREE}");
+    match text.parse::<i128>() {
+        Ok(d) if (0..=MAX_DEGREE as i128).contains(&d) => Ok(d as usize),
+        Ok(d) if d > MAX_DEGREE as i128 => Err(format!(
+            "degree {text} is out of range: the largest supported degree is {MAX_DEGREE}"
+        )),
+        _ => Err(format!("degree {text} is out of range: {range}")),
+    }
+}
+
+/// Parses `--n`: the 0-based index of the newest sample, a whole number from 0 to `i64::MAX`.
+pub fn parse_index(s: &str) -> Result<u64, String> {
+    let text = s.trim();
+    match text.parse::<i128>() {
+        Ok(n) if (0..=i64::MAX as i128).contains(&n) => Ok(n as u64),
+        _ => Err(format!(
+            "n {text} is out of range: it must be a whole number from 0 to {}",
+            i64::MAX
+        )),
+    }
+}
+
+fn parse_f64(name: &str, s: &str) -> Result<f64, String> {
+    let text = s.trim();
+    text.parse::<f64>()
+        .map_err(|_| format!("{name} '{text}' is not a number"))
+}
+
+/// Parses `--tau`: a positive finite number.
+pub fn parse_tau(s: &str) -> Result<f64, String> {
+    let v = parse_f64("tau", s)?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!(
+            "tau {} is out of range: it must be a positive finite number",
+            s.trim()
+        ))
+    }
+}
+
+/// Parses `--sigma`: a positive finite number.
+pub fn parse_sigma(s: &str) -> Result<f64, String> {
+    let v = parse_f64("sigma", s)?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!(
+            "sigma {} is out of range: it must be a positive finite number",
+            s.trim()
+        ))
+    }
+}
+
+/// Parses `--lead`: any finite number (negative = retrodiction).
+pub fn parse_lead(s: &str) -> Result<f64, String> {
+    let v = parse_f64("lead", s)?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!(
+            "lead {} is out of range: it must be a finite number",
+            s.trim()
+        ))
+    }
+}
+
+/// Parses `--window`: the number of samples in the window (Morrison's `L+1`), a whole number
+/// from 1 to `i64::MAX`. Whether it suits the degree is checked by the command.
+pub fn parse_window(s: &str) -> Result<usize, String> {
+    let text = s.trim();
+    match text.parse::<i128>() {
+        Ok(w) if (1..=i64::MAX as i128).contains(&w) && w <= usize::MAX as i128 => Ok(w as usize),
+        _ => Err(format!(
+            "window {text} is out of range: it must be a whole number of samples from 1 to {}",
+            i64::MAX
+        )),
+    }
+}
+
+/// A lead in sampling intervals as given on the command line (`seqsmooth vrf --kind fixed`):
+/// exact, and rounded to `f64`.
+#[derive(Clone, Debug)]
+pub struct LeadSteps {
+    /// The lead exactly (`-2.5` is `-5/2`).
+    pub exact: Rational,
+    /// The lead rounded to the nearest `f64`.
+    pub value: f64,
+}
+
+impl Default for LeadSteps {
+    fn default() -> Self {
+        Self {
+            exact: Rational::zero(),
+            value: 0.0,
+        }
+    }
+}
+
+/// Parses `--lead` of `seqsmooth vrf`: `0`, `1`, `-2.5`, `-5/2` or `25e-1`, in samples, exactly;
+/// finite in double precision.
+pub fn parse_lead_steps(s: &str) -> Result<LeadSteps, String> {
+    let text = s.trim();
+    let not_a_number = || format!("lead '{text}' is not a number (write it as -2.5 or -5/2)");
+    let out_of_range = || {
+        format!("lead {text} is out of range: it must be a finite number of samples (|H| < 1e300)")
+    };
+    // An exponent this large would take unbounded time to expand exactly.
+    if let Some((_, e)) = text.split_once(['e', 'E']) {
+        if e.parse::<i64>().is_ok_and(|e| e.unsigned_abs() > 400) {
+            return Err(format!(
+                "lead {text} is out of range: write it with an exponent from -400 to 400"
+            ));
+        }
+    }
+    let exact = parse_rational(text).ok_or_else(not_a_number)?;
+    let value = seqsmooth::scalar::ratio_to_f64(&exact);
+    if !(value.is_finite() && value.abs() < 1e300) {
+        return Err(out_of_range());
+    }
+    Ok(LeadSteps { exact, value })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn clap_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn theta_forms() {
+        assert_eq!(parse_theta("9/10").unwrap().exact.to_string(), "9/10");
+        assert_eq!(parse_theta("0.9").unwrap().exact.to_string(), "9/10");
+        assert_eq!(parse_theta("0.9").unwrap().value, 0.9);
+        assert!(parse_theta("1").is_err());
+        assert!(parse_theta("0").is_err());
+        assert!(parse_theta("nan").is_err());
+        let near_one = parse_theta("0.99999999999999999999").unwrap();
+        assert!(near_one.value_f64().is_err());
+    }
+
+    #[test]
+    fn degree_range() {
+        assert_eq!(parse_degree("0"), Ok(0));
+        assert_eq!(parse_degree("24"), Ok(24));
+        assert!(parse_degree("25").unwrap_err().contains("degree 25"));
+        assert!(parse_degree("-1").unwrap_err().contains("degree -1"));
+        assert!(parse_degree("x").is_err());
+    }
+
+    #[test]
+    fn window_range() {
+        assert_eq!(parse_window("1"), Ok(1));
+        assert_eq!(parse_window(" 11 "), Ok(11));
+        assert!(parse_window("0")
+            .unwrap_err()
+            .contains("window 0 is out of range"));
+        assert!(parse_window("-3").unwrap_err().contains("window -3"));
+        assert!(parse_window("2.5").is_err());
+    }
+
+    #[test]
+    fn lead_steps_forms() {
+        assert_eq!(parse_lead_steps("-5/2").unwrap().exact.to_string(), "-5/2");
+        assert_eq!(parse_lead_steps("-2.5").unwrap().exact.to_string(), "-5/2");
+        assert_eq!(parse_lead_steps("25e-1").unwrap().value, 2.5);
+        assert_eq!(parse_lead_steps("0").unwrap().value, 0.0);
+        assert!(parse_lead_steps("x")
+            .unwrap_err()
+            .contains("lead 'x' is not a number"));
+        assert!(parse_lead_steps("1e999")
+            .unwrap_err()
+            .contains("out of range"));
+        assert!(parse_lead_steps("1e-99999999")
+            .unwrap_err()
+            .contains("out of range"));
+        assert!(parse_lead_steps("inf").is_err());
+    }
+}

@@ -1,0 +1,333 @@
+//! `seqsmooth filter`: streams a CSV time series — or many, told apart by an id column —
+//! through polynomial filters.
+//!
+//! The command reads, filters and writes chunks of rows ([`CHUNK_ROWS`]): a reader thread
+//! reads and validates ([`rows`]) the next chunk while the current one is run through the
+//! filters of its series, the series in parallel (the library's
+//! [`StreamBank`](seqsmooth::polynomial::bank::StreamBank)), then formatted in parallel pieces
+//! and written in input order. Memory is a few chunks plus one filter per series, whatever the
+//! length of the input. The first [`LOOKAHEAD`] data rows (the first `W` for a fixed-memory
+//! window longer than that) decide the default `τ` (median time step) and the too-few-samples
+//! check before any output is written.
+
+mod auto_runner;
+mod fixed_runner;
+pub mod rows;
+pub mod runner;
+
+use crate::args::{check_window, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
+use crate::error::CliError;
+use crate::io::{check_distinct, fmt_f64, input_size, open_input, write_f64, Need, Output};
+use crate::progress::{self, Progress};
+use rayon::prelude::*;
+use rows::{Chunk, RowReader};
+use runner::Runner;
+use seqsmooth::polynomial::bank::StreamBank;
+use std::collections::HashMap;
+use std::io::Read;
+use std::sync::mpsc;
+
+/// Data rows buffered before output starts: up to 100 time steps for the `τ` median.
+pub const LOOKAHEAD: usize = 101;
+
+/// Rows of the first chunk, unless the first rows held back or scanned need more: the chunks
+/// then double in size up to `--chunk-rows`, so that filtering starts early.
+const FIRST_CHUNK_ROWS: usize = 1 << 12;
+
+/// With `--id-col`, the default `τ` is the median of the first 100 steps within series among
+/// this many first rows.
+const TAU_SCAN_ROWS: usize = 1 << 16;
+
+/// Rows formatted per piece (on one thread).
+const PIECE: usize = 4096;
+
+/// Checks the arguments that go together; returns θ (fading memory and auto) in `f64`.
+fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
+    let kind = a.kind;
+    let theta = match (kind, &a.theta) {
+        (Kind::Fading | Kind::Auto, Some(theta)) => {
+            Some(theta.value_f64().map_err(CliError::Usage)?)
+        }
+        (Kind::Fading | Kind::Auto, None) => {
+            return Err(CliError::Usage(format!(
+                "--kind {} needs --theta T, the discount per tau (0 < T < 1)",
+                kind.name()
+            )))
+        }
+        (Kind::Expanding | Kind::Fixed, Some(_)) => return Err(only("--theta", "fading and auto")),
+        (Kind::Expanding | Kind::Fixed, None) => None,
+    };
+    if matches!(kind, Kind::Expanding | Kind::Fixed) && a.tau.is_some() {
+        return Err(only("--tau", "fading and auto"));
+    }
+    match (kind, a.window) {
+        (Kind::Fixed, Some(w)) => check_window(w, a.degree)?,
+        (Kind::Fixed, None) => {
+            return Err(CliError::Usage(format!(
+                "--kind fixed needs --window W, the number of samples in the window (at least \
+                 M+1 = {})",
+                a.degree + 1
+            )))
+        }
+        (_, Some(_)) => return Err(only("--window", "fixed")),
+        (_, None) => {}
+    }
+    if let Some(id) = &a.id_col {
+        if *id == a.time_col || *id == a.value_col {
+            return Err(CliError::Usage(format!(
+                "--id-col {id} is the time or the value column; name a column of its own"
+            )));
+        }
+    }
+    if kind == Kind::Fixed && a.engine == Some(EngineArg::Gain) {
+        return Err(CliError::Usage(
+            "--engine gain applies only to --kind expanding, fading and auto: the fixed-memory \
+             filter is always the exact least-squares fit of its window"
+                .into(),
+        ));
+    }
+    Ok(theta)
+}
+
+/// The median of `values` (the mean of the middle two for an even count); `None` for none.
+pub fn median(mut values: Vec<f64>) -> Option<f64> {
+    values.sort_by(f64::total_cmp);
+    let k = values.len();
+    match k {
+        0 => None,
+        _ if k % 2 == 1 => Some(values[k / 2]),
+        _ => Some(0.5 * values[k / 2 - 1] + 0.5 * values[k / 2]),
+    }
+}
+
+/// The median of the first `LOOKAHEAD - 1` time steps within the series of the first `rows`
+/// rows of `chunk` (each row's time minus the previous time of its series), in input order;
+/// `None` when no series has two rows. For one series, the steps of its first `LOOKAHEAD` rows.
+pub fn median_series_step(times: &[f64], series: &[usize]) -> Option<f64> {
+    let mut last: HashMap<usize, f64> = HashMap::new();
+    let mut steps = Vec::with_capacity(LOOKAHEAD - 1);
+    for (&t, &s) in times.iter().zip(series) {
+        if let Some(prev) = last.insert(s, t) {
+            steps.push(t - prev);
+            if steps.len() == LOOKAHEAD - 1 {
+                break;
+            }
+        }
+    }
+    median(steps)
+}
+
+/// The default `τ`: the median step of the first rows, `head` of them scanned.
+fn default_tau(chunk: &Chunk, head: usize) -> Result<f64, CliError> {
+    let tau = match median_series_step(&chunk.t[..head], &chunk.series[..head]) {
+        Some(tau) => tau,
+        // One row (per series) in all: τ does not matter.
+        None if chunk.done && chunk.len() <= head => 1.0,
+        None => {
+            return Err(CliError::Data(format!(
+                "no series has two rows among the first {head} data rows, so there is no \
+                 median time step for the default tau; give --tau"
+            )))
+        }
+    };
+    if !(tau.is_finite() && tau > 0.0) {
+        return Err(CliError::Data(format!(
+            "the median time step of the first rows, {}, is not a usable tau; give --tau",
+            fmt_f64(tau)
+        )));
+    }
+    Ok(tau)
+}
+
+/// Runs `seqsmooth filter`.
+///
+/// An error in one of the first `hold` rows stops the command before any output; a later one
+/// after the rows before it, of every series, have been written.
+pub fn run(a: &FilterArgs) -> Result<(), CliError> {
+    let theta = check_args(a)?;
+    check_distinct(a.input.as_deref(), a.output.as_deref())?;
+    let need = match (a.kind, a.window) {
+        (Kind::Fixed, Some(w)) => Need::window(w.max(a.degree + 1)),
+        _ => Need::degree(a.degree),
+    };
+    let started = std::time::Instant::now();
+    let size = input_size(a.input.as_deref());
+    let input = open_input(a.input.as_deref())?;
+    let mut reader = RowReader::new(input, &a.time_col, &a.value_col, a.id_col.as_deref(), &need)?;
+    // A fixed-memory window longer than LOOKAHEAD is read in full before the first output row:
+    // its rows have no estimate, and an input shorter than the window is an error.
+    let hold = LOOKAHEAD.max(need.rows);
+    let chunk_rows = a.chunk_rows as usize;
+    // With --id-col, the default τ comes from the steps within series among the first
+    // TAU_SCAN_ROWS rows: they are all in the first chunk, whatever the chunk size.
+    let tau_needed = a.tau.is_none() && matches!(a.kind, Kind::Fading | Kind::Auto);
+    let scan = if tau_needed && a.id_col.is_some() {
+        TAU_SCAN_ROWS
+    } else {
+        0
+    };
+    let first_rows = chunk_rows.min(FIRST_CHUNK_ROWS).max(hold).max(scan);
+    let mut chunk = Chunk::default();
+    reader.read_chunk(&mut chunk, first_rows);
+    if chunk.len() < hold {
+        if let Some(e) = chunk.error.take() {
+            return Err(e);
+        }
+    }
+    need.check(chunk.len())?;
+    let tau = match a.tau {
+        Some(tau) => tau,
+        None if tau_needed => default_tau(&chunk, chunk.len().min(hold.max(scan)))?,
+        None => 1.0,
+    };
+    let engine = a.engine.unwrap_or(EngineArg::Exact);
+    let prototype = Runner::build(a.kind, a.degree, theta, tau, a.window, engine, a.sigma)
+        .map_err(|e| CliError::Usage(e.to_string()))?;
+    // The automatic filter always writes s0..sM (from the given or the estimated noise).
+    let sigma = a.sigma.is_some() || a.kind == Kind::Auto;
+    let extra = prototype.extra_columns();
+    let stride = ((a.degree + 1) << usize::from(sigma)) + extra.len();
+    let mut bank = StreamBank::growing(prototype).map_err(|e| CliError::Usage(e.to_string()))?;
+    let (mut ids, mut values, mut out) = (Vec::new(), Vec::new(), None);
+    let mut progress = Progress::hidden();
+    // The rest of the input is read on a thread of its own, a chunk ahead.
+    let mut pipeline = (!chunk.done && chunk.error.is_none()).then(|| {
+        let sizes = (1..).map(move |k| first_rows.saturating_mul(1 << k.min(16)));
+        Pipeline::start(reader, sizes.map(move |rows| rows.min(chunk_rows)))
+    });
+    let lead = a.lead;
+    for first in std::iter::once(true).chain(std::iter::repeat(false)) {
+        ids.append(&mut chunk.new_ids);
+        values.resize(chunk.len() * stride, 0.0);
+        let run = |f: &mut Runner, t: &[f64], y: &[f64], o: &mut [f64]| f.run(t, y, o, lead, sigma);
+        let failed = bank
+            .update_par(&chunk.series, &chunk.t, &chunk.y, &mut values, stride, run)
+            .err()
+            .map(|e| row_error(e, &chunk));
+        let limit = failed.as_ref().map_or(chunk.len(), |(i, _)| *i);
+        if first && limit < hold {
+            if let Some((_, e)) = failed {
+                return Err(e);
+            }
+        }
+        let sink = match &mut out {
+            Some(sink) => sink,
+            None => {
+                let mut sink = Output::create(a.output.as_deref())?;
+                let mut header = Vec::new();
+                chunk.header(&mut header, a.id_col.as_deref(), a.degree, sigma, extra);
+                sink.write(&header)?;
+                out.insert(sink)
+            }
+        };
+        let id = |i: usize| a.id_col.as_ref().map(|_| ids[chunk.series[i]].as_slice());
+        let pieces: Vec<Vec<u8>> = (0..limit.div_ceil(PIECE))
+            .into_par_iter()
+            .map(|k| {
+                let mut buf = Vec::with_capacity(PIECE.min(limit) * (stride + 2) * 20);
+                for i in k * PIECE..((k + 1) * PIECE).min(limit) {
+                    chunk.echo(&mut buf, i, id(i));
+                    for &v in &values[i * stride..(i + 1) * stride] {
+                        buf.push(b',');
+                        if !v.is_nan() {
+                            write_f64(&mut buf, v);
+                        }
+                    }
+                    buf.push(b'\n');
+                }
+                buf
+            })
+            .collect();
+        for piece in &pieces {
+            sink.write(piece)?;
+        }
+        if failed.is_some() || chunk.error.is_some() || chunk.done {
+            out.take().map_or(Ok(()), Output::finish)?;
+            return match (failed, chunk.error.take()) {
+                (Some((_, e)), _) | (None, Some(e)) => Err(e),
+                (None, None) => Ok(()),
+            };
+        }
+        if first && progress::wanted(a.no_progress) {
+            progress = Progress::new(size, started);
+        }
+        progress.update(chunk.bytes_read, chunk.rows_read);
+        let next = pipeline.as_mut();
+        let next =
+            next.ok_or_else(|| CliError::Data("internal error: the input reader is gone".into()))?;
+        chunk = next.swap(chunk)?;
+    }
+    Ok(())
+}
+
+/// The row and message of the bank's error `e` on `chunk`.
+fn row_error(e: seqsmooth::Error, chunk: &Chunk) -> (usize, CliError) {
+    let (index, source) = match e {
+        seqsmooth::Error::InChannel { source, .. } => match *source {
+            seqsmooth::Error::InBatch { index, source } => (index, *source),
+            other => (0, other),
+        },
+        other => (0, other),
+    };
+    (
+        index,
+        CliError::Data(format!("line {}: {source}", chunk.lines[index])),
+    )
+}
+
+/// A thread that reads the input chunk by chunk ahead of the filtering and writing, passing
+/// full chunks one way and emptied ones back.
+struct Pipeline {
+    full: mpsc::Receiver<Chunk>,
+    empty: mpsc::Sender<Chunk>,
+}
+
+impl Pipeline {
+    /// Starts reading chunks from `reader` on a new thread, of as many rows as `sizes` gives
+    /// in turn. The thread ends after the last chunk, or when the pipeline is dropped.
+    fn start<R: Read + Send + 'static>(
+        mut reader: RowReader<R>,
+        mut sizes: impl Iterator<Item = usize> + Send + 'static,
+    ) -> Self {
+        let (full_tx, full) = mpsc::sync_channel::<Chunk>(1);
+        let (empty, empty_rx) = mpsc::channel::<Chunk>();
+        // Detached: on an early error the command exits without waiting for a pending read.
+        std::thread::spawn(move || loop {
+            let mut chunk = empty_rx.try_recv().unwrap_or_default();
+            reader.read_chunk(&mut chunk, sizes.next().unwrap_or(CHUNK_ROWS as usize));
+            let last = chunk.done || chunk.error.is_some();
+            if full_tx.send(chunk).is_err() || last {
+                return;
+            }
+        });
+        Self { full, empty }
+    }
+
+    /// Hands back a used chunk and takes the next one.
+    fn swap(&mut self, used: Chunk) -> Result<Chunk, CliError> {
+        // The reader may have finished: then the used chunk is simply dropped.
+        let _ = self.empty.send(used);
+        self.full
+            .recv()
+            .map_err(|_| CliError::Data("internal error: the input reader stopped".into()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_steps() {
+        let step = |t: &[f64]| median_series_step(t, &vec![0; t.len()]).unwrap_or(1.0);
+        assert_eq!(step(&[0.0]), 1.0);
+        assert_eq!(step(&[0.0, 2.0]), 2.0);
+        assert_eq!(step(&[0.0, 1.0, 3.0, 3.5]), 1.0); // steps 1, 2, 0.5
+        assert_eq!(step(&[0.0, 1.0, 3.0, 3.5, 7.5]), 1.5); // steps 0.5, 1, 2, 4
+                                                           // Within series: a 0, 1; b 10, 13 → steps 1, 3.
+        assert_eq!(
+            median_series_step(&[0.0, 10.0, 1.0, 13.0], &[0, 1, 0, 1]),
+            Some(2.0)
+        );
+    }
+}

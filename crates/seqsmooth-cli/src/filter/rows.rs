@@ -1,0 +1,360 @@
+//! The rows of a CSV time series, one series or many (`--id-col`), read and validated in
+//! chunks, and echoed to the output.
+//!
+//! Every row is validated as it is read — the time and value cells are numbers, finite, and
+//! the time is strictly after the previous time of the same series — with its 1-based file
+//! line and column. A chunk holds its rows' numbers column by column and the text of their
+//! time and value cells (echoed to the output) in one buffer, so reading allocates nothing per
+//! row once the buffers have grown. Per series only the id, the newest time (with its line,
+//! and its text from chunk to chunk, for the message of a time that goes backwards) are kept.
+
+use crate::error::CliError;
+use crate::io::{csv_field, find_column, parse_cell, CsvIn, Need};
+use std::collections::HashMap;
+use std::io::Read;
+
+/// Consecutive data rows of the input, column by column.
+#[derive(Debug, Default)]
+pub struct Chunk {
+    /// Times.
+    pub t: Vec<f64>,
+    /// Values.
+    pub y: Vec<f64>,
+    /// The series of each row: 0 for a single series, else its id's index in order of
+    /// appearance.
+    pub series: Vec<usize>,
+    /// 1-based file lines (header = line 1).
+    pub lines: Vec<u64>,
+    /// Per row: offset in `text` of the time cell's text, its length, the value cell's length.
+    cells: Vec<(usize, usize, usize)>,
+    /// The time and value cells of the rows, as written (trimmed).
+    text: Vec<u8>,
+    /// The ids of the series first seen in this chunk, in order of their index, as CSV output
+    /// cells (quoted where needed).
+    pub new_ids: Vec<Vec<u8>>,
+    /// Why reading stopped before the chunk was full, other than the end of the input: the
+    /// error of the row after the last one.
+    pub error: Option<CliError>,
+    /// Whether the input ended.
+    pub done: bool,
+    /// Bytes read from the input up to the end of this chunk (for the progress display).
+    pub bytes_read: u64,
+    /// Data rows read up to the end of this chunk.
+    pub rows_read: u64,
+}
+
+impl Chunk {
+    /// The number of rows.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    /// The time cell of row `i`, as written.
+    fn t_text(&self, i: usize) -> &[u8] {
+        let (at, t, _) = self.cells[i];
+        &self.text[at..at + t]
+    }
+
+    /// Appends `[id,]t,y` of row `i`: the id cell (with `--id-col`), and the time and value
+    /// cells as read.
+    pub fn echo(&self, out: &mut Vec<u8>, i: usize, id: Option<&[u8]>) {
+        if let Some(id) = id {
+            out.extend_from_slice(id);
+            out.push(b',');
+        }
+        let (at, t, y) = self.cells[i];
+        out.extend_from_slice(&self.text[at..at + t]);
+        out.push(b',');
+        out.extend_from_slice(&self.text[at + t..at + t + y]);
+    }
+
+    /// Appends the header `[id,]t,y,d0..dM[,s0..sM][,extra…]`.
+    pub fn header(
+        &self,
+        out: &mut Vec<u8>,
+        id: Option<&str>,
+        m: usize,
+        sigma: bool,
+        extra: &[&str],
+    ) {
+        let mut cells: Vec<Vec<u8>> = id.map(|id| csv_field(id.as_bytes())).into_iter().collect();
+        cells.extend([b"t".to_vec(), b"y".to_vec()]);
+        cells.extend((0..=m).map(|k| format!("d{k}").into_bytes()));
+        if sigma {
+            cells.extend((0..=m).map(|k| format!("s{k}").into_bytes()));
+        }
+        cells.extend(extra.iter().map(|c| c.as_bytes().to_vec()));
+        out.extend_from_slice(&cells.join(&b","[..]));
+        out.push(b'\n');
+    }
+
+    fn clear(&mut self) {
+        for v in [&mut self.t, &mut self.y] {
+            v.clear();
+        }
+        self.series.clear();
+        self.lines.clear();
+        self.cells.clear();
+        self.text.clear();
+        self.new_ids.clear();
+        self.error = None;
+        self.done = false;
+    }
+}
+
+/// The newest row of a series.
+#[derive(Debug)]
+struct Newest {
+    t: f64,
+    line: u64,
+    /// The row in the chunk being read, whose text is there; `None` when it is in an earlier
+    /// chunk, and its time cell in `text`.
+    row: Option<usize>,
+    text: Vec<u8>,
+}
+
+/// Reads and validates the data rows of a CSV time series in chunks.
+pub struct RowReader<R: Read> {
+    csv: CsvIn<R>,
+    time_idx: usize,
+    value_idx: usize,
+    id_idx: Option<usize>,
+    time_col: String,
+    value_col: String,
+    /// Series index by id (with `--id-col`), and the ids as written, for messages.
+    index: HashMap<Vec<u8>, usize>,
+    ids: Vec<String>,
+    /// The newest row of each series, by index.
+    newest: Vec<Option<Newest>>,
+    /// The series whose newest row is in the chunk being read.
+    touched: Vec<usize>,
+    rows_read: u64,
+}
+
+impl<R: Read> RowReader<R> {
+    /// Reads the header and locates the time and value columns, and the id column if given.
+    pub fn new(
+        input: R,
+        time_col: &str,
+        value_col: &str,
+        id_col: Option<&str>,
+        need: &Need,
+    ) -> Result<Self, CliError> {
+        let csv = CsvIn::new(input)?;
+        need.check_header(&csv.header)?;
+        let find = |name: &str| find_column(&csv.header, name, "");
+        let (time_idx, value_idx) = (find(time_col)?, find(value_col)?);
+        let id_idx = id_col.map(find).transpose()?;
+        Ok(Self {
+            csv,
+            time_idx,
+            value_idx,
+            id_idx,
+            time_col: time_col.to_string(),
+            value_col: value_col.to_string(),
+            index: HashMap::new(),
+            ids: Vec::new(),
+            newest: if id_idx.is_none() {
+                vec![None]
+            } else {
+                Vec::new()
+            },
+            touched: Vec::new(),
+            rows_read: 0,
+        })
+    }
+
+    /// Reads up to `max_rows` rows into `chunk` (replacing its contents). Reading stops early
+    /// at the end of the input (`chunk.done`) or at a bad row (`chunk.error`; the rows before
+    /// it are in the chunk).
+    pub fn read_chunk(&mut self, chunk: &mut Chunk, max_rows: usize) {
+        chunk.clear();
+        while chunk.len() < max_rows {
+            match self.next_row(chunk) {
+                Ok(true) => {}
+                Ok(false) => {
+                    chunk.done = true;
+                    break;
+                }
+                Err(e) => {
+                    chunk.error = Some(e);
+                    break;
+                }
+            }
+        }
+        // The time cells of the series' newest rows, for the messages of the next chunks:
+        // copied once per series and chunk, not per row.
+        for s in self.touched.drain(..) {
+            if let Some(newest) = &mut self.newest[s] {
+                if let Some(i) = newest.row.take() {
+                    newest.text.clear();
+                    newest.text.extend_from_slice(chunk.t_text(i));
+                }
+            }
+        }
+        chunk.bytes_read = self.csv.bytes_read();
+        chunk.rows_read = self.rows_read;
+    }
+
+    /// The series of the current record: its index, a new one for a new id.
+    fn series(&mut self, chunk: &mut Chunk) -> usize {
+        let Some(i) = self.id_idx else { return 0 };
+        let id = self.csv.field(i);
+        if let Some(&s) = self.index.get(id) {
+            return s;
+        }
+        let s = self.ids.len();
+        self.index.insert(id.to_vec(), s);
+        self.ids.push(String::from_utf8_lossy(id).into_owned());
+        self.newest.push(None);
+        chunk.new_ids.push(csv_field(id));
+        s
+    }
+
+    /// Reads one row into `chunk`; `false` at the end of the input.
+    fn next_row(&mut self, chunk: &mut Chunk) -> Result<bool, CliError> {
+        if !self.csv.next()? {
+            return Ok(false);
+        }
+        let line = self.csv.line;
+        let (t_cell, y_cell) = (
+            self.csv.field(self.time_idx),
+            self.csv.field(self.value_idx),
+        );
+        let t = parse_cell(t_cell, line, &self.time_col, "time")?;
+        let y = parse_cell(y_cell, line, &self.value_col, "value")?;
+        let series = self.series(chunk);
+        let (t_cell, y_cell) = (
+            self.csv.field(self.time_idx),
+            self.csv.field(self.value_idx),
+        );
+        let row = chunk.len();
+        match &mut self.newest[series] {
+            Some(prev) if t <= prev.t => {
+                let why = if t == prev.t {
+                    "duplicate time; times must be strictly increasing"
+                } else {
+                    "times must be strictly increasing"
+                };
+                let of = match self.id_idx {
+                    None => String::new(),
+                    Some(_) => format!(" of series '{}'", self.ids[series]),
+                };
+                let prev_text = prev.row.map_or(&prev.text[..], |i| chunk.t_text(i));
+                return Err(CliError::Data(format!(
+                    "line {line}: time {} is not after the previous time {} (line {}){of}: \
+                     {why}",
+                    String::from_utf8_lossy(t_cell),
+                    String::from_utf8_lossy(prev_text),
+                    prev.line
+                )));
+            }
+            Some(prev) => {
+                (prev.t, prev.line) = (t, line);
+                if prev.row.replace(row).is_none() {
+                    self.touched.push(series);
+                }
+            }
+            none => {
+                *none = Some(Newest {
+                    t,
+                    line,
+                    row: Some(row),
+                    text: Vec::new(),
+                });
+                self.touched.push(series);
+            }
+        }
+        chunk
+            .cells
+            .push((chunk.text.len(), t_cell.len(), y_cell.len()));
+        chunk.text.extend_from_slice(t_cell);
+        chunk.text.extend_from_slice(y_cell);
+        chunk.t.push(t);
+        chunk.y.push(y);
+        chunk.series.push(series);
+        chunk.lines.push(line);
+        self.rows_read += 1;
+        Ok(true)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read_all(text: &str, id: Option<&str>, max: usize) -> (Vec<Chunk>, Vec<Vec<u8>>) {
+        let mut r = RowReader::new(text.as_bytes(), "t", "y", id, &Need::degree(0)).unwrap();
+        let (mut chunks, mut ids) = (Vec::new(), Vec::new());
+        loop {
+            let mut c = Chunk::default();
+            r.read_chunk(&mut c, max);
+            ids.extend(c.new_ids.iter().cloned());
+            let stop = c.done || c.error.is_some();
+            chunks.push(c);
+            if stop {
+                return (chunks, ids);
+            }
+        }
+    }
+
+    #[test]
+    fn chunks_lines_cells_and_series() {
+        let text = "id,t,y\na,0,1\n\"b,1\", 0.5 ,2\n\na,1,3e0\nc\"x,1,4\n";
+        let (chunks, ids) = read_all(text, Some("id"), 2);
+        // Two full chunks, then the end of the input in an empty one.
+        assert_eq!(chunks.len(), 3);
+        assert!(chunks[2].done && chunks[2].error.is_none() && chunks[2].len() == 0);
+        assert_eq!(chunks[1].rows_read, 4);
+        let rows: Vec<(u64, usize, String)> = chunks
+            .iter()
+            .flat_map(|c| {
+                (0..c.len()).map(move |i| {
+                    let mut echo = Vec::new();
+                    c.echo(&mut echo, i, None);
+                    (c.lines[i], c.series[i], String::from_utf8(echo).unwrap())
+                })
+            })
+            .collect();
+        assert_eq!(
+            rows,
+            [
+                (2, 0, "0,1".into()),
+                (3, 1, "0.5,2".into()),
+                (5, 0, "1,3e0".into()),
+                (6, 2, "1,4".into()),
+            ]
+        );
+        assert_eq!(
+            ids,
+            [b"a".to_vec(), b"\"b,1\"".to_vec(), b"\"c\"\"x\"".to_vec()]
+        );
+    }
+
+    #[test]
+    fn time_order_is_per_series() {
+        let text = "id,t,y\na,5,1\nb,1,1\na,6,1\nb,2,1\nb,2,1\n";
+        let (chunks, _) = read_all(text, Some("id"), 100);
+        assert_eq!(chunks[0].len(), 4);
+        let e = chunks[0].error.as_ref().unwrap().to_string();
+        assert_eq!(
+            e,
+            "line 6: time 2 is not after the previous time 2 (line 5) of series 'b': duplicate \
+             time; times must be strictly increasing"
+        );
+        // Across chunks: the previous time's text is kept.
+        let (chunks, _) = read_all("t,y\n0,1\n1.50,1\n1.5,2\n", None, 2);
+        let e = chunks[1].error.as_ref().unwrap().to_string();
+        assert!(e.starts_with("line 4: time 1.5 is not after the previous time 1.50 (line 3)"));
+    }
+
+    #[test]
+    fn bad_cells_stop_the_chunk_with_line_and_column() {
+        let (chunks, _) = read_all("t,y\n0,1\n1,NaN\n2,3\n", None, 100);
+        assert_eq!(chunks[0].len(), 1);
+        assert_eq!(
+            chunks[0].error.as_ref().unwrap().to_string(),
+            "line 3, column 'y': value NaN is not finite"
+        );
+    }
+}

@@ -1,0 +1,205 @@
+//! The filter of one series of `seqsmooth filter`, of any kind, and the values of its output
+//! rows.
+//!
+//! A row's values are `stride` numbers: `d0..dM`, with `--sigma` (always for the automatic
+//! filter) their 1σ `s0..sM` from the covariance, then the kind's trailing cells (fixed memory:
+//! the rows in the window; automatic: the noise σ in use, the outlier and misfit flags as
+//! 0/1). NaN marks an empty cell: a derivative or 1σ not determined yet.
+
+use super::auto_runner::AutoRunner;
+use super::fixed_runner::FixedRunner;
+use crate::args::{EngineArg, Kind};
+use seqsmooth::polynomial::automatic::AutoConfig;
+use seqsmooth::{Error, ExpandingMemory, FadingMemory, PolynomialFilter, PolynomialState};
+
+/// A running filter of any kind. Cloning a new one is how each series gets its filter.
+#[derive(Clone, Debug)]
+pub enum Runner {
+    /// Expanding memory.
+    Expanding(Box<ExpandingMemory>),
+    /// Fading memory.
+    Fading(Box<FadingMemory>),
+    /// Fixed memory over `window` samples.
+    Fixed(Box<FixedRunner>, usize),
+    /// The automatic filter.
+    Auto(Box<AutoRunner>),
+}
+
+/// A missing parameter of a filter kind.
+fn needs(name: &'static str, what: &str) -> Error {
+    Error::InvalidParameter {
+        name,
+        value: "(none)".into(),
+        reason: format!("{what} needs {name}"),
+    }
+}
+
+impl Runner {
+    /// The filter of `kind` (τ already resolved for fading memory and the automatic filter),
+    /// with the noise `sigma` for its covariance (the automatic filter's given noise).
+    pub fn build(
+        kind: Kind,
+        degree: usize,
+        theta: Option<f64>,
+        tau: f64,
+        window: Option<usize>,
+        engine: EngineArg,
+        sigma: Option<f64>,
+    ) -> Result<Self, Error> {
+        fn noise<F>(
+            f: F,
+            sigma: Option<f64>,
+            with: fn(F, f64) -> Result<F, Error>,
+        ) -> Result<Box<F>, Error> {
+            Ok(Box::new(match sigma {
+                Some(s) => with(f, s)?,
+                None => f,
+            }))
+        }
+        let theta = || theta.ok_or_else(|| needs("theta", kind.name()));
+        Ok(match kind {
+            Kind::Expanding => Runner::Expanding(noise(
+                ExpandingMemory::new(degree, engine.into())?,
+                sigma,
+                ExpandingMemory::with_noise_sigma,
+            )?),
+            Kind::Fading => Runner::Fading(noise(
+                FadingMemory::new(degree, theta()?, tau, engine.into())?,
+                sigma,
+                FadingMemory::with_noise_sigma,
+            )?),
+            Kind::Fixed => {
+                let window = window.ok_or_else(|| needs("window", kind.name()))?;
+                Runner::Fixed(Box::new(FixedRunner::new(degree, window, sigma)?), window)
+            }
+            Kind::Auto => {
+                let mut config = AutoConfig::new(degree, theta()?, tau);
+                config.engine = engine.into();
+                config.noise_sigma = sigma;
+                Runner::Auto(Box::new(AutoRunner::new(config)?))
+            }
+        })
+    }
+
+    /// The columns after `d0..dM` and `s0..sM` this kind writes.
+    pub fn extra_columns(&self) -> &'static [&'static str] {
+        match self {
+            Runner::Expanding(_) | Runner::Fading(_) => &[],
+            Runner::Fixed(..) => &["window"],
+            Runner::Auto(_) => &["noise", "outlier", "misfit"],
+        }
+    }
+
+    fn filter(&self) -> &dyn PolynomialFilter {
+        match self {
+            Runner::Expanding(f) => f.as_ref(),
+            Runner::Fading(f) => f.as_ref(),
+            Runner::Fixed(f, _) => f.as_ref(),
+            Runner::Auto(f) => f.as_ref(),
+        }
+    }
+
+    fn filter_mut(&mut self) -> &mut dyn PolynomialFilter {
+        match self {
+            Runner::Expanding(f) => f.as_mut(),
+            Runner::Fading(f) => f.as_mut(),
+            Runner::Fixed(f, _) => f.as_mut(),
+            Runner::Auto(f) => f.as_mut(),
+        }
+    }
+
+    /// Runs the samples `(t[i], y[i])` of one series and writes each row's values (the
+    /// estimate at `t[i] + lead`, with 1σ when `sigma`) to `out`, `stride` per row. The
+    /// expanding- and fading-memory filters without 1σ or lead take the batch kernels
+    /// ([`PolynomialFilter::update_many_into`]). An error is [`Error::InBatch`] of its row.
+    pub fn run(
+        &mut self,
+        t: &[f64],
+        y: &[f64],
+        out: &mut [f64],
+        lead: f64,
+        sigma: bool,
+    ) -> Result<(), Error> {
+        out.fill(f64::NAN);
+        let w = self.degree() + 1;
+        if let (Runner::Expanding(_) | Runner::Fading(_), false, 0.0) = (&*self, sigma, lead) {
+            return self.filter_mut().update_many_into(t, y, out);
+        }
+        let stride = out.len().checked_div(t.len()).unwrap_or(0);
+        for (index, ((&t, &y), row)) in t
+            .iter()
+            .zip(y)
+            .zip(out.chunks_exact_mut(stride))
+            .enumerate()
+        {
+            self.update(t, y).map_err(|e| Error::InBatch {
+                index,
+                source: Box::new(e),
+            })?;
+            let extra = &mut row[w << usize::from(sigma)..];
+            let estimate = match &mut *self {
+                Runner::Fixed(f, window) => {
+                    extra[0] = (f.samples() as usize).min(*window) as f64;
+                    f.estimate_at(t + lead)
+                }
+                Runner::Auto(f) => {
+                    let Some(o) = f.last.take() else { continue };
+                    extra.copy_from_slice(&[
+                        o.noise_sigma.unwrap_or(f64::NAN),
+                        f64::from(u8::from(o.outlier)),
+                        f64::from(u8::from(o.misfit)),
+                    ]);
+                    // The output's estimate is at t: the update's own, or across a rejected
+                    // sample the prediction; with a lead the active filter's, the same way.
+                    if lead == 0.0 {
+                        o.estimate
+                    } else {
+                        f.estimate_at(t + lead)
+                    }
+                }
+                other => other.estimate_at(t + lead),
+            };
+            store(
+                estimate.as_ref(),
+                sigma,
+                &mut row[..w << usize::from(sigma)],
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Copies an estimate into a row's slots: derivatives into `values[..m+1]`, and with `sigma`
+/// their 1σ into `values[m+1..]`. The estimate may be of a lower degree than the slots.
+fn store(estimate: Option<&PolynomialState>, sigma: bool, values: &mut [f64]) {
+    let Some(s) = estimate else { return };
+    let width = values.len() >> usize::from(sigma);
+    let nd = s.derivatives.len().min(width);
+    values[..nd].copy_from_slice(&s.derivatives[..nd]);
+    if let (Some(c), true) = (&s.covariance, sigma) {
+        for (i, v) in values[width..width + c.nrows().min(width)]
+            .iter_mut()
+            .enumerate()
+        {
+            *v = c[(i, i)].max(0.0).sqrt();
+        }
+    }
+}
+
+impl PolynomialFilter for Runner {
+    fn degree(&self) -> usize {
+        self.filter().degree()
+    }
+    fn samples(&self) -> u64 {
+        self.filter().samples()
+    }
+    fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
+        self.filter_mut().update(t, y)
+    }
+    fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
+        self.filter().estimate_at(t)
+    }
+    fn last_time(&self) -> Option<f64> {
+        self.filter().last_time()
+    }
+}

@@ -1,0 +1,685 @@
+//! The command's files: opening inputs and outputs, the one CSV reader (records with their
+//! 1-based file lines, header checks, column lookup, number cells) and the one CSV writer
+//! (cells, numbers with round-trip precision) of every subcommand. Imports no subcommand.
+
+use crate::error::CliError;
+use std::fs::File;
+use std::io::{self, BufWriter, Read, Write};
+use std::path::Path;
+
+/// The shortest text that parses back to exactly `x` (the `ryu` crate's digits): plain decimal
+/// for `0` and `1e-5 <= |x| < 1e16`, otherwise scientific (`1e-300`, `2.5e20`). This is Rust's
+/// `{}` and `{:e}` text with two changes to `ryu`'s: a trailing `.0` is dropped (`ryu` writes
+/// `1.0`, Rust `1`), and where `x` lies exactly halfway between two shortest candidates `ryu`
+/// takes the even last digit and Rust the one away from zero, so that digit goes up by one
+/// ([`tie_digit`]). Non-finite values print as `NaN`, `inf`, `-inf` (never in valid output).
+#[inline]
+pub fn write_f64(out: &mut Vec<u8>, x: f64) {
+    let mut buf = ryu::Buffer::new();
+    let text = buf.format(x).as_bytes();
+    let text = text.strip_suffix(b".0").unwrap_or(text);
+    let start = out.len();
+    out.extend_from_slice(text);
+    if let Some(last) = tie_digit(x, text) {
+        out[start + last] += 1;
+    }
+}
+
+/// Where `x` lies exactly halfway between the decimal `text` (`ryu`'s, `[-]d.ddd[eX]`, even
+/// last digit) and the next one up in magnitude in its last digit: the index of that digit.
+/// Then `2|x| = (2D + 1)·10^p`, `D` the digits and `10^p` the last one's unit; with
+/// `|x| = o·2^e` (`o` odd) that is `e = p - 1` and `o·5^-p = 2D + 1` for `p < 0`, `o =
+/// (2D+1)·5^p` otherwise, so `x` needs an exact decimal of at most 18 digits: checked on its
+/// bits first, the digits only then.
+#[inline]
+fn tie_digit(x: f64, text: &[u8]) -> Option<usize> {
+    let bits = x.abs().to_bits();
+    let (m, q) = match bits >> 52 {
+        0 => (bits, -1074),
+        b => (bits & ((1 << 52) - 1) | (1 << 52), b as i32 - 1075),
+    };
+    let (odd, e) = (
+        u128::from(m >> m.trailing_zeros()),
+        q + m.trailing_zeros() as i32,
+    );
+    // A tie has p = e + 1; for p < 0, o·5^-p = 2D + 1 < 2·10^17.
+    let scaled = |p: i32| {
+        5u128
+            .checked_pow(p.unsigned_abs())
+            .and_then(|f| f.checked_mul(odd))
+    };
+    if x == 0.0 || (e < -1 && (e < -27 || !scaled(e + 1).is_some_and(|v| v < 2 * 10u128.pow(17)))) {
+        return None;
+    }
+    let (mut d, mut decimals, mut point, mut end) = (0u128, 0i32, false, text.len());
+    for (i, &c) in text.iter().enumerate() {
+        match c {
+            b'0'..=b'9' => {
+                (d, decimals) = (10 * d + u128::from(c - b'0'), decimals + i32::from(point))
+            }
+            b'.' => point = true,
+            b'e' => {
+                end = i;
+                break;
+            }
+            _ => {}
+        }
+    }
+    let exp: i32 = std::str::from_utf8(&text[(end + 1).min(text.len())..])
+        .ok()?
+        .parse()
+        .unwrap_or(0);
+    let p = exp - decimals;
+    let rhs = if p < 0 {
+        Some(2 * d + 1)
+    } else {
+        5u128.checked_pow(p as u32)?.checked_mul(2 * d + 1)
+    };
+    let lhs = if p < 0 { scaled(p) } else { Some(odd) };
+    (d % 2 == 0 && e == p - 1 && lhs.is_some() && lhs == rhs).then_some(end - 1)
+}
+
+/// [`write_f64`] as a `String`.
+pub fn fmt_f64(x: f64) -> String {
+    let mut out = Vec::with_capacity(24);
+    write_f64(&mut out, x);
+    // Only ASCII digits, signs, '.', 'e', "NaN" and "inf" are written.
+    String::from_utf8(out).unwrap_or_default()
+}
+
+/// `cell` as a CSV output field: quoted (with quotes doubled) when it holds a comma, a quote
+/// or a line break.
+pub fn csv_field(cell: &[u8]) -> Vec<u8> {
+    if !cell
+        .iter()
+        .any(|b| matches!(b, b',' | b'"' | b'\r' | b'\n'))
+    {
+        return cell.to_vec();
+    }
+    let mut out = vec![b'"'];
+    for &b in cell {
+        out.extend_from_slice(if b == b'"' {
+            b"\"\""
+        } else {
+            std::slice::from_ref(&b)
+        });
+    }
+    out.push(b'"');
+    out
+}
+
+/// Parses the number in the (trimmed) cell of `line` in `column`, holding the `what`: a typed
+/// error for an empty cell, a non-number or a non-finite value. The `fast-float2` crate
+/// parses (correctly rounded, so the same double as `str::parse`); anything it does not take
+/// as a finite number goes through `str::parse` for the same result and messages.
+#[inline]
+pub fn parse_cell(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f64, CliError> {
+    match fast_float2::parse::<f64, _>(cell) {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => parse_cell_text(cell, line, column, what),
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn parse_cell_text(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f64, CliError> {
+    let at = format!("line {line}, column '{column}'");
+    if cell.is_empty() {
+        return Err(CliError::Data(format!(
+            "{at}: the cell is empty, expected a number"
+        )));
+    }
+    let text = String::from_utf8_lossy(cell);
+    let v: f64 = std::str::from_utf8(cell)
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .ok_or_else(|| CliError::Data(format!("{at}: '{text}' is not a number")))?;
+    if !v.is_finite() {
+        return Err(CliError::Data(format!("{at}: {what} {text} is not finite")));
+    }
+    Ok(v)
+}
+
+/// `bytes` without leading and trailing whitespace (Unicode whitespace for UTF-8 text, as
+/// `str::trim`; ASCII whitespace otherwise).
+pub fn trim(bytes: &[u8]) -> &[u8] {
+    let ascii = bytes.trim_ascii();
+    match (ascii.first(), ascii.last()) {
+        // Non-ASCII whitespace starts with a byte >= 0x80 and ends with one.
+        (Some(&a), Some(&b)) if a >= 0x80 || b >= 0x80 => match std::str::from_utf8(ascii) {
+            Ok(s) => s.trim().as_bytes(),
+            Err(_) => ascii,
+        },
+        _ => ascii,
+    }
+}
+
+/// The data rows a command needs, and why (for the too-few-samples messages).
+#[derive(Clone, Debug)]
+pub struct Need {
+    /// The number of data rows needed.
+    pub rows: usize,
+    /// What needs them, e.g. `degree 2` or `window 11`.
+    pub why: String,
+}
+
+impl Need {
+    /// A degree-`m` estimate needs `m + 1` rows.
+    pub fn degree(m: usize) -> Self {
+        Self {
+            rows: m + 1,
+            why: format!("degree {m}"),
+        }
+    }
+
+    /// A window of `w` samples needs `w` rows.
+    pub fn window(w: usize) -> Self {
+        Self {
+            rows: w,
+            why: format!("window {w}"),
+        }
+    }
+
+    /// The too-few-samples error when only `got` data rows were read.
+    pub fn check(&self, got: usize) -> Result<(), CliError> {
+        if got < self.rows {
+            return Err(CliError::Data(format!(
+                "too few samples: the input has {got} data row{}, {} needs at least {}",
+                plural(got),
+                self.why,
+                self.rows
+            )));
+        }
+        Ok(())
+    }
+
+    /// An input without a header (empty) cannot hold the samples needed.
+    pub fn check_header(&self, headers: &[String]) -> Result<(), CliError> {
+        if headers.iter().all(String::is_empty) {
+            return Err(CliError::Data(format!(
+                "too few samples: the input is empty (no header, no data rows); {} needs at \
+                 least {} data row{}",
+                self.why,
+                self.rows,
+                plural(self.rows)
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// `"s"` unless `n` is 1.
+pub fn plural(n: usize) -> &'static str {
+    if n == 1 {
+        ""
+    } else {
+        "s"
+    }
+}
+
+/// The index of the column `name` in the header, or an error listing the columns (`why`
+/// after "the header").
+pub fn find_column(headers: &[String], name: &str, why: &str) -> Result<usize, CliError> {
+    headers.iter().position(|h| h == name).ok_or_else(|| {
+        CliError::Data(format!(
+            "column '{name}' not found in the header{why}; columns are: {}",
+            headers.join(", ")
+        ))
+    })
+}
+
+/// Counts the lines of the bytes the CSV parser consumes.
+///
+/// The `csv` crate's own line numbers are wrong after blank lines and with CRLF line ends, so
+/// the reader passes every byte through here and the line of a record is computed from its byte
+/// offset. Only the bytes read ahead of the current record are kept (the parser's buffer).
+struct LineTracker<R: Read> {
+    inner: R,
+    /// Bytes read; `pending[start..]` are not yet attributed to a record, and `pending[start]`
+    /// is at offset `base`. The attributed prefix is dropped at the next read.
+    pending: Vec<u8>,
+    start: usize,
+    base: u64,
+    /// Line terminators (`\n`, `\r\n` or a lone `\r`) before `base`.
+    breaks: u64,
+    /// Whether the byte before `base` is `\r` (so a `\n` at `base` ends no new line).
+    after_cr: bool,
+}
+
+impl<R: Read> LineTracker<R> {
+    /// The 1-based line of the record the parser reports at byte offset `byte`: the parser's
+    /// offset may sit before blank lines or a line terminator it skipped, so those are skipped
+    /// here too. Offsets must not decrease between calls.
+    fn line_at(&mut self, byte: u64) -> u64 {
+        let rest = &self.pending[self.start..];
+        let mut k = (byte.saturating_sub(self.base) as usize).min(rest.len());
+        while k < rest.len() && matches!(rest[k], b'\r' | b'\n') {
+            k += 1;
+        }
+        let span = &rest[..k];
+        // A `\n` right after a `\r` ends the same line; any other `\r` or `\n` ends one.
+        if span.iter().filter(|&&b| b == b'\r').count() == 0 {
+            let newlines = span.iter().filter(|&&b| b == b'\n').count() as u64;
+            self.breaks += newlines - u64::from(self.after_cr && span.first() == Some(&b'\n'));
+            self.after_cr &= k == 0;
+        } else {
+            for &b in span {
+                self.breaks += u64::from(b == b'\r' || (b == b'\n' && !self.after_cr));
+                self.after_cr = b == b'\r';
+            }
+        }
+        self.start += k;
+        self.base += k as u64;
+        self.breaks + 1
+    }
+}
+
+impl<R: Read> Read for LineTracker<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        // The parser asks for more only once it has used up what it had: what is left
+        // unattributed is at most one buffer.
+        self.pending.drain(..self.start);
+        self.start = 0;
+        let n = self.inner.read(buf)?;
+        self.pending.extend_from_slice(&buf[..n]);
+        Ok(n)
+    }
+}
+
+/// Reads the records of a CSV input with a header row (the `csv` crate's parser), each with
+/// its 1-based file line (the header is line 1 unless blank lines precede it).
+pub struct CsvIn<R: Read> {
+    reader: csv::Reader<LineTracker<R>>,
+    record: csv::ByteRecord,
+    /// The header's cells, trimmed; empty for an empty input.
+    pub header: Vec<String>,
+    /// The line of the current record.
+    pub line: u64,
+}
+
+impl<R: Read> CsvIn<R> {
+    /// Reads the header of `input`.
+    pub fn new(input: R) -> Result<Self, CliError> {
+        let tracker = LineTracker {
+            inner: input,
+            pending: Vec::new(),
+            start: 0,
+            base: 0,
+            breaks: 0,
+            after_cr: false,
+        };
+        let reader = csv::ReaderBuilder::new()
+            .flexible(false)
+            .from_reader(tracker);
+        let mut this = Self {
+            reader,
+            record: csv::ByteRecord::new(),
+            header: Vec::new(),
+            line: 1,
+        };
+        let header = match this.reader.byte_headers() {
+            Ok(h) => h.clone(),
+            Err(e) => return Err(this.error(e)),
+        };
+        this.line = this
+            .reader
+            .get_mut()
+            .line_at(header.position().map_or(0, |p| p.byte()));
+        for cell in &header {
+            let text = std::str::from_utf8(cell).map_err(|_| {
+                let line = this.line;
+                CliError::Data(format!(
+                    "line {line}: malformed CSV: the row is not valid UTF-8"
+                ))
+            })?;
+            this.header.push(text.trim().to_string());
+        }
+        Ok(this)
+    }
+
+    /// Reads the next record; `false` at the end of the input.
+    pub fn next(&mut self) -> Result<bool, CliError> {
+        match self.reader.read_byte_record(&mut self.record) {
+            Ok(true) => {
+                let byte = self.record.position().map_or(0, |p| p.byte());
+                self.line = self.reader.get_mut().line_at(byte);
+                Ok(true)
+            }
+            Ok(false) => Ok(false),
+            Err(e) => Err(self.error(e)),
+        }
+    }
+
+    /// Field `i` of the current record, trimmed.
+    #[inline]
+    pub fn field(&self, i: usize) -> &[u8] {
+        trim(&self.record[i])
+    }
+
+    /// The bytes read from the input so far.
+    pub fn bytes_read(&self) -> u64 {
+        self.reader.position().byte()
+    }
+
+    /// The error of the CSV parser `e`, with the line of its position.
+    fn error(&mut self, e: csv::Error) -> CliError {
+        let line = e
+            .position()
+            .map(|p| self.reader.get_mut().line_at(p.byte()));
+        let at = line.map_or_else(String::new, |l| format!("line {l}: "));
+        match e.kind() {
+            csv::ErrorKind::UnequalLengths {
+                expected_len, len, ..
+            } => CliError::Data(format!(
+                "{at}malformed CSV: the row has {len} field{} but the header has {expected_len}",
+                plural(*len as usize)
+            )),
+            csv::ErrorKind::Io(io) => CliError::Data(format!("cannot read the input: {io}")),
+            _ => CliError::Data(format!("{at}malformed CSV: {e}")),
+        }
+    }
+}
+
+/// Opens the input: a file, or standard input for `None` or `-`.
+pub fn open_input(path: Option<&Path>) -> Result<Box<dyn Read + Send>, CliError> {
+    match path {
+        Some(p) if p.as_os_str() != "-" => {
+            let file = File::open(p).map_err(|e| {
+                CliError::Data(format!("cannot open input file '{}': {e}", p.display()))
+            })?;
+            // The CSV reader buffers; no BufReader needed.
+            Ok(Box::new(file))
+        }
+        // Unlocked, so that another thread may read it; the CSV reader reads large blocks.
+        _ => Ok(Box::new(io::stdin())),
+    }
+}
+
+/// The name of an input in messages: `'path'` or `standard input`.
+pub fn input_name(path: Option<&Path>) -> String {
+    match path {
+        Some(p) if p.as_os_str() != "-" => format!("'{}'", p.display()),
+        _ => "standard input".to_string(),
+    }
+}
+
+/// The size of the input file, for the progress bar; `None` for standard input or anything
+/// but a regular file.
+pub fn input_size(path: Option<&Path>) -> Option<u64> {
+    let meta = std::fs::metadata(path.filter(|p| p.as_os_str() != "-")?).ok()?;
+    meta.is_file().then_some(meta.len())
+}
+
+/// An output: a buffered file or buffered standard output, with its name for messages.
+pub struct Output {
+    sink: Box<dyn Write>,
+    /// `'path'` or `standard output`.
+    pub name: String,
+}
+
+impl Output {
+    /// Creates the output file `path` (standard output for `None` or `-`).
+    pub fn create(path: Option<&Path>) -> Result<Self, CliError> {
+        match path {
+            Some(p) if p.as_os_str() != "-" => {
+                let name = format!("'{}'", p.display());
+                let file = File::create(p).map_err(|e| {
+                    CliError::Data(format!("cannot create output file {name}: {e}"))
+                })?;
+                Ok(Self {
+                    sink: Box::new(BufWriter::new(file)),
+                    name,
+                })
+            }
+            _ => Ok(Self::stdout()),
+        }
+    }
+
+    /// Buffered standard output.
+    pub fn stdout() -> Self {
+        let sink = Box::new(BufWriter::new(io::stdout().lock()));
+        Self {
+            sink,
+            name: "standard output".to_string(),
+        }
+    }
+
+    /// Writes `bytes`.
+    pub fn write(&mut self, bytes: &[u8]) -> Result<(), CliError> {
+        self.sink
+            .write_all(bytes)
+            .map_err(|e| CliError::write(&self.name, e))
+    }
+
+    /// Writes a CSV row of `cells` (each quoted where needed).
+    pub fn row<S: AsRef<str>>(&mut self, cells: &[S]) -> Result<(), CliError> {
+        let fields: Vec<Vec<u8>> = cells
+            .iter()
+            .map(|c| csv_field(c.as_ref().as_bytes()))
+            .collect();
+        let mut line = fields.join(&b","[..]);
+        line.push(b'\n');
+        self.write(&line)
+    }
+
+    /// Writes rows of cells right-aligned in columns two spaces apart (`left` columns first,
+    /// left-aligned).
+    pub fn aligned(&mut self, rows: &[Vec<String>], left: usize) -> Result<(), CliError> {
+        let cols = rows.iter().map(Vec::len).max().unwrap_or(0);
+        let width = |c: usize| {
+            rows.iter()
+                .filter_map(move |r| r.get(c))
+                .map(|s| s.chars().count())
+        };
+        let widths: Vec<usize> = (0..cols).map(|c| width(c).max().unwrap_or(0)).collect();
+        for r in rows {
+            let cells: Vec<String> = r
+                .iter()
+                .zip(&widths)
+                .enumerate()
+                .map(|(c, (s, &w))| {
+                    if c < left {
+                        format!("{s:<w$}")
+                    } else {
+                        format!("{s:>w$}")
+                    }
+                })
+                .collect();
+            self.write(format!("{}\n", cells.join("  ").trim_end()).as_bytes())?;
+        }
+        Ok(())
+    }
+
+    /// Flushes everything to the sink.
+    pub fn finish(mut self) -> Result<(), CliError> {
+        self.sink
+            .flush()
+            .map_err(|e| CliError::write(&self.name, e))
+    }
+}
+
+/// Refuses an output file that is the input file.
+pub fn check_distinct(input: Option<&Path>, output: Option<&Path>) -> Result<(), CliError> {
+    if let (Some(i), Some(o)) = (input, output) {
+        // Creating the output would truncate the input while it is still being read.
+        if let (Ok(a), Ok(b)) = (i.canonicalize(), o.canonicalize()) {
+            if a == b {
+                return Err(CliError::Usage(format!(
+                    "the output file '{}' is the input file; write to another file",
+                    o.display()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lines(text: &str) -> Vec<u64> {
+        let mut r = CsvIn::new(text.as_bytes()).unwrap();
+        let mut v = Vec::new();
+        while r.next().unwrap() {
+            v.push(r.line);
+        }
+        v
+    }
+
+    #[test]
+    fn line_numbers_survive_blank_lines_crlf_and_quotes() {
+        assert_eq!(lines("t,y\n\n\n0,1\n1,2\n"), [4, 5]);
+        assert_eq!(lines("\nt,y\n0,1\n"), [3]);
+        assert_eq!(lines("t,y\r\n0,1\r\n\r\n1,2\r\n"), [2, 4]);
+        assert_eq!(lines("t,y\n0,1\r\n1,2\r2,3\n\r\n4,5"), [2, 3, 4, 6]);
+        assert_eq!(lines("t,y,z\n0,1,\"a\nb\"\n1,2,x\n"), [2, 4]);
+        assert_eq!(lines("t,y\n0,1\n\n\n\n1,2\n"), [2, 6]);
+    }
+
+    #[test]
+    fn line_numbers_across_buffer_refills() {
+        let mut text = String::from("t,y\r\n");
+        let mut want = Vec::new();
+        let mut line = 1;
+        for k in 0..5000 {
+            text += &format!("{k},{k}\r\n");
+            line += 1;
+            want.push(line);
+            if k % 7 == 0 {
+                text += "\r\n";
+                line += 1;
+            }
+        }
+        assert_eq!(lines(&text), want);
+    }
+
+    #[test]
+    fn reader_lines_and_messages() {
+        let mut r = CsvIn::new("t,y\n0,1\n1,2\n\n2,abc\n".as_bytes()).unwrap();
+        let mut cells = Vec::new();
+        while r.next().unwrap() {
+            cells.push(parse_cell(r.field(1), r.line, "y", "value").map_err(|e| e.to_string()));
+        }
+        assert_eq!(cells[..2], [Ok(1.0), Ok(2.0)]);
+        assert_eq!(
+            cells[2],
+            Err("line 5, column 'y': 'abc' is not a number".into())
+        );
+    }
+
+    /// Every cell parses to the double `str::parse` gives, and is refused where it refuses.
+    #[test]
+    fn cells_parse_as_str_parse() {
+        for text in [
+            "0",
+            "-0",
+            "1",
+            "+7",
+            ".5",
+            "8.",
+            "1e5",
+            "1E+5",
+            "2.5e-300",
+            "1e-400",
+            "1e400",
+            "inf",
+            "-Infinity",
+            "NaN",
+            "nan",
+            "1e",
+            "e5",
+            ".",
+            "+",
+            "-",
+            "1.2.3",
+            "0x10",
+            "1_0",
+            "1,5",
+            "4.9406564584124654e-324",
+            "17976931348623157e292",
+            "0.1000000000000000055511151231",
+            "9007199254740993",
+            "1.",
+            "+.5e1",
+            "  1",
+            "1d",
+            "١",
+        ] {
+            let std = text.parse::<f64>().ok().filter(|v| v.is_finite());
+            let ours = parse_cell(text.as_bytes(), 1, "y", "value").ok();
+            assert_eq!(ours.map(f64::to_bits), std.map(f64::to_bits), "{text:?}");
+        }
+    }
+
+    fn check(x: f64) {
+        let s = fmt_f64(x);
+        let back: f64 = s.parse().unwrap();
+        assert_eq!(back.to_bits(), x.to_bits(), "{x:?} printed as {s}");
+        assert!(s.len() <= 24, "{x:?} printed as {s} ({} chars)", s.len());
+        // Rust's layout: `{}` for 1e-5 <= |x| < 1e16 and zero, `{:e}` otherwise.
+        let std = if x == 0.0 || (1e-5..1e16).contains(&x.abs()) {
+            format!("{x}")
+        } else {
+            format!("{x:e}")
+        };
+        assert_eq!(s, std);
+    }
+
+    #[test]
+    fn round_trip_special_values() {
+        for x in [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.1,
+            0.1 + 0.2,
+            1e-5,
+            9.999999999999999e-6,
+            1e16,
+            9999999999999998.0,
+            1e-300,
+            -1e-300,
+            5e-324,
+            f64::MIN_POSITIVE,
+            f64::MAX,
+            f64::MIN,
+            f64::EPSILON,
+            123456.789,
+            2.5e20,
+            1e15,
+            100.0,
+        ] {
+            check(x);
+        }
+        assert_eq!(fmt_f64(1e-300), "1e-300");
+        assert_eq!(fmt_f64(2.5e20), "2.5e20");
+        assert_eq!(fmt_f64(0.1), "0.1");
+        assert_eq!(fmt_f64(4.6), "4.6");
+        assert_eq!(fmt_f64(3.0), "3");
+    }
+
+    #[test]
+    fn round_trip_many_bit_patterns() {
+        // xorshift64 over all exponents: every finite double must survive.
+        let mut state = 0x9E37_79B9_7F4A_7C15_u64;
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let x = f64::from_bits(state);
+            if x.is_finite() {
+                check(x);
+            }
+        }
+    }
+
+    #[test]
+    fn csv_fields_are_quoted_where_needed() {
+        assert_eq!(csv_field(b"abc"), b"abc");
+        assert_eq!(csv_field(b"a,b"), b"\"a,b\"");
+        assert_eq!(csv_field(b"say \"hi\""), b"\"say \"\"hi\"\"\"");
+        assert_eq!(csv_field(b"a\nb"), b"\"a\nb\"");
+    }
+}

@@ -1,0 +1,150 @@
+//! `seqsmooth vrf`: the scaled variance-reduction matrices of the expanding-, fading- and
+//! fixed-memory filters (fading memory: Morrison (13.7.1); fixed memory: Morrison
+//! (7.5.22)-(7.5.26)), in `f64` or exact rationals.
+
+use crate::args::{check_window, memory, only, Format, Memory, TableKind, VrfArgs, VrfKind};
+use crate::error::CliError;
+use crate::gains::{cells, write_table};
+use seqsmooth::polynomial::fixed::covariance;
+use seqsmooth::polynomial::vrf::{expanding_vrf, fading_vrf, EstimateForm};
+use seqsmooth::scalar::{ratio_to_f64, Rational};
+
+/// Runs `seqsmooth vrf`: header `i,j,value`, the `(m+1)×(m+1)` matrix row-major.
+pub fn run(a: &VrfArgs) -> Result<(), CliError> {
+    let kind = match a.kind {
+        VrfKind::Fixed => return fixed(a),
+        VrfKind::Expanding => TableKind::Expanding,
+        VrfKind::Fading => TableKind::Fading,
+    };
+    if a.window.is_some() {
+        return Err(only("--window", "fixed"));
+    }
+    if a.lead.is_some() {
+        return Err(CliError::Usage(
+            "--lead applies only to --kind fixed; expanding and fading take --form".into(),
+        ));
+    }
+    let m = a.degree;
+    let mem = memory(kind, a.n, a.theta.clone())?;
+    if let Memory::Expanding { n } = mem {
+        if n < m as u64 {
+            return Err(CliError::Usage(format!(
+                "n {n} is too small for degree {m}: the expanding-memory variance-reduction \
+                 matrix needs n >= {m} (at least {} samples)",
+                m + 1
+            )));
+        }
+    }
+    let form = EstimateForm::from(a.form.unwrap_or_default());
+    let lib = |e: seqsmooth::Error| CliError::Usage(e.to_string());
+    // nalgebra iterates column-major; the transposes make the values row-major.
+    let values = match (mem, a.exact) {
+        (Memory::Expanding { n }, true) => cells(
+            expanding_vrf::<Rational>(m, n, form)
+                .map_err(lib)?
+                .transpose()
+                .iter(),
+        ),
+        (Memory::Expanding { n }, false) => {
+            // Exact, then rounded to nearest: the library's `expanding_vrf::<f64>` overflows in
+            // its intermediates for large n at high degree (NaN, or silently wrong: m = 20,
+            // n = 10^15 gives 4.0e-13 for the (0,0) entry instead of 4.41e-13).
+            let s = expanding_vrf::<Rational>(m, n, form).map_err(lib)?;
+            cells(&s.transpose().iter().map(ratio_to_f64).collect::<Vec<_>>())
+        }
+        (Memory::Fading { theta }, true) => cells(
+            fading_vrf::<Rational>(m, theta.exact, form)
+                .map_err(lib)?
+                .transpose()
+                .iter(),
+        ),
+        (Memory::Fading { theta }, false) => {
+            let theta = theta.value_f64().map_err(CliError::Usage)?;
+            cells(
+                fading_vrf::<f64>(m, theta, form)
+                    .map_err(lib)?
+                    .transpose()
+                    .iter(),
+            )
+        }
+    };
+    write_matrix(values, m + 1, a.format)
+}
+
+/// `seqsmooth vrf --kind fixed`: the scaled covariance per unit input variance `W(h) W(h)ᵀ` of
+/// the fixed-memory estimate over `window = L+1` samples at the lead `h` in samples after the
+/// newest (Morrison (7.5.22)-(7.5.26)); `τ = 1`, so this is also the VRF of the unscaled
+/// derivatives in sample units. Without `--exact` the lead is rounded to the nearest double
+/// and the matrix is computed in `f64` (the library evaluates it through the discrete Legendre
+/// recursion).
+fn fixed(a: &VrfArgs) -> Result<(), CliError> {
+    if a.n.is_some() {
+        return Err(only("--n", "expanding"));
+    }
+    if a.theta.is_some() {
+        return Err(only("--theta", "fading"));
+    }
+    if a.form.is_some() {
+        return Err(CliError::Usage(
+            "--form applies only to --kind expanding and fading; for --kind fixed give --lead H \
+             in samples (0 the current estimate, 1 the 1-step prediction, -(W-1)/2 the centre \
+             of the window)"
+                .into(),
+        ));
+    }
+    let m = a.degree;
+    let window = a.window.ok_or_else(|| {
+        CliError::Usage(format!(
+            "--kind fixed needs --window W, the number of samples in the window (at least M+1 \
+             = {})",
+            m + 1
+        ))
+    })?;
+    check_window(window, m)?;
+    let lead = a.lead.clone().unwrap_or_default();
+    let span = window as u64 - 1;
+    let lib = |e: seqsmooth::Error| CliError::Usage(e.to_string());
+    let values = if a.exact {
+        cells(
+            covariance::<Rational>(m, span, lead.exact)
+                .map_err(lib)?
+                .transpose()
+                .iter(),
+        )
+    } else {
+        cells(
+            covariance::<f64>(m, span, lead.value)
+                .map_err(lib)?
+                .transpose()
+                .iter(),
+        )
+    };
+    write_matrix(values, m + 1, a.format)
+}
+
+/// Writes the row-major `size × size` matrix `values` as `i,j,value` CSV or an aligned table.
+fn write_matrix(values: Vec<String>, size: usize, format: Format) -> Result<(), CliError> {
+    let rows: Vec<Vec<String>> = match format {
+        Format::Csv => {
+            let mut rows = vec![vec!["i".into(), "j".into(), "value".into()]];
+            let cell =
+                |(k, v): (usize, String)| vec![(k / size).to_string(), (k % size).to_string(), v];
+            rows.extend(values.into_iter().enumerate().map(cell));
+            rows
+        }
+        Format::Table => {
+            let mut rows = vec![std::iter::once(String::new())
+                .chain((0..size).map(|j| format!("j={j}")))
+                .collect()];
+            for (i, chunk) in values.chunks(size).enumerate() {
+                rows.push(
+                    std::iter::once(format!("i={i}"))
+                        .chain(chunk.iter().cloned())
+                        .collect(),
+                );
+            }
+            rows
+        }
+    };
+    write_table(&rows, format)
+}
