@@ -25,31 +25,15 @@
 //! - [PAPER-ERR?] the noise estimate `√(Σr²/N)` = 0.9115 is biased; the unbiased
 //!   `√(Σr²/(N-M-1))` = 1.0689.
 
+mod common;
+
+use common::rational::*;
 use nalgebra::DMatrix;
 use num_traits::{One, Zero};
 use seqsmooth::polynomial::fixed::{
     covariance, covariance_unscaled, min_span_for_sigma, smooth, vrf_limit, weights, Lead,
 };
 use seqsmooth::polynomial::gains::{expanding_gains, GainForm};
-use seqsmooth::scalar::{parse_rational, ratio_to_f64, Rational};
-
-type Q = Rational;
-
-fn z(v: i64) -> Q {
-    Q::from_integer(v.into())
-}
-
-fn fr(n: i64, d: i64) -> Q {
-    Q::new(n.into(), d.into())
-}
-
-fn q(s: &str) -> Q {
-    parse_rational(s).unwrap()
-}
-
-fn f(x: &Q) -> f64 {
-    ratio_to_f64(x)
-}
 
 /// Σ c_k x^k, integer coefficients lowest first.
 fn poly(x: &Q, c: &[i64]) -> Q {
