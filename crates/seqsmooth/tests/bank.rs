@@ -5,41 +5,6 @@ mod common;
 
 use common::bank::*;
 use seqsmooth::polynomial::bank::{ExpandingBank, FadingBank};
-use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
-
-/// Largest difference per derivative, relative to the largest `|x^(k)|` of the single stream
-/// over the run, from step `from` on.
-fn compare_fading(m: usize, theta: f64, tau: f64, k: usize, steps: usize, from: usize) -> Vec<f64> {
-    let mut bank = FadingBank::new(m, theta, tau, k).unwrap();
-    let mut singles: Vec<_> = (0..k)
-        .map(|_| FadingMemory::new(m, theta, tau, Engine::Gain).unwrap())
-        .collect();
-    let mut worst = vec![0.0f64; m + 1];
-    let mut scale = vec![0.0f64; m + 1];
-    let mut y = vec![0.0; k];
-    for n in 0..steps {
-        for (c, v) in y.iter_mut().enumerate() {
-            *v = sample(c, n);
-        }
-        bank.update(&y).unwrap();
-        for (c, f) in singles.iter_mut().enumerate() {
-            f.update(n as f64 * tau, y[c]).unwrap();
-            if n >= m {
-                let want = f.estimate().unwrap().derivatives;
-                let got = bank.estimate(c).unwrap();
-                for d in 0..=m {
-                    scale[d] = scale[d].max(want[d].abs());
-                    if n >= from {
-                        worst[d] = worst[d].max((got[d] - want[d]).abs());
-                    }
-                }
-            } else {
-                assert!(bank.estimate(c).is_none());
-            }
-        }
-    }
-    worst.iter().zip(&scale).map(|(w, s)| w / s).collect()
-}
 
 #[test]
 fn fading_bank_matches_single_streams() {
@@ -48,7 +13,6 @@ fn fading_bank_matches_single_streams() {
             let steps = if k == 1000 { 150 } else { 400 };
             let rel = compare_fading(m, 0.9, 0.5, k, steps, m);
             let max = rel.iter().cloned().fold(0.0, f64::max);
-            eprintln!("K = {k}, m = {m}: max relative difference {max:.2e} {rel:?}");
             assert!(max < 1e-11, "K = {k}, m = {m}: {rel:?}");
         }
     }
@@ -58,7 +22,6 @@ fn fading_bank_matches_single_streams() {
 fn bank_matches_single_stream_over_long_run() {
     for m in 1..=4 {
         let rel = compare_fading(m, 0.95, 1.0, 2, 10_000, m);
-        eprintln!("m = {m}, 1e4 steps: {rel:?}");
         assert!(rel.iter().all(|r| *r < 1e-11), "m = {m}: {rel:?}");
     }
 }
@@ -66,30 +29,7 @@ fn bank_matches_single_stream_over_long_run() {
 #[test]
 fn expanding_bank_matches_single_streams() {
     for m in 0..=4 {
-        let k = 7;
-        let mut bank = ExpandingBank::new(m, 1.0, k).unwrap();
-        let mut singles: Vec<_> = (0..k)
-            .map(|_| ExpandingMemory::new(m, Engine::Gain).unwrap())
-            .collect();
-        let mut y = vec![0.0; k];
-        let mut worst = 0.0f64;
-        for n in 0..300 {
-            for (c, v) in y.iter_mut().enumerate() {
-                *v = sample(c, n);
-            }
-            bank.update(&y).unwrap();
-            for (c, f) in singles.iter_mut().enumerate() {
-                f.update(n as f64, y[c]).unwrap();
-                if n >= m {
-                    let want = f.estimate().unwrap().derivatives;
-                    let got = bank.estimate(c).unwrap();
-                    for d in 0..=m {
-                        worst = worst.max((got[d] - want[d]).abs() / want[0].abs().max(1.0));
-                    }
-                }
-            }
-        }
-        eprintln!("expanding m = {m}: {worst:.2e}");
+        let worst = compare_expanding(m);
         assert!(worst < 1e-10, "m = {m}: {worst}");
     }
 }

@@ -5,6 +5,7 @@
 
 pub mod automatic;
 pub mod bank;
+pub mod batch;
 pub mod book;
 pub mod engine;
 pub mod fixed;
