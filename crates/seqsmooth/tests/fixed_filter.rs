@@ -6,11 +6,8 @@
 mod common;
 
 use common::fixed::*;
-use common::rational::*;
 use common::{dyadic, exact_discounted_even, exact_ls_derivatives, jittered_times, random_times};
 use num_traits::Signed;
-use rand::Rng;
-use seqsmooth::basis::DiscreteLegendre;
 use seqsmooth::polynomial::fixed::{
     balance_span, bias, covariance, covariance_unscaled, dominant_bias, end_point_bias_bound,
     min_span_for_sigma, smooth, tau_for_derivative_sigma, vrf_limit, weights, weights_unscaled,
@@ -89,7 +86,6 @@ fn even_engines_equal_exact_window_least_squares() {
             }
         }
     }
-    println!("even engines vs exact least squares: worst {worst:.2e}");
 }
 
 #[test]
@@ -132,7 +128,6 @@ fn irregular_engine_equals_exact_least_squares_on_irregular_times() {
             }
         }
     }
-    println!("irregular engine vs exact least squares: worst {worst:.2e}");
     // On even times it is the same filter as the even engines, covariance included.
     let mut a = FixedMemory::new(3, 12, FixedEngine::Irregular)
         .unwrap()
@@ -156,53 +151,6 @@ fn irregular_engine_equals_exact_least_squares_on_irregular_times() {
     }
 }
 
-/// `y_n` of the long runs: a slow large sine on an offset plus uniform noise, rounded to
-/// multiples of 2⁻⁴⁰ (so the exact oracle can take them as integers).
-fn long_run_value(n: usize, noise: f64) -> f64 {
-    let y = 100.0 * (n as f64 * 2.0 * std::f64::consts::PI / 5000.0).sin() + 50.0 + noise;
-    (y * 2f64.powi(40)).round() / 2f64.powi(40)
-}
-
-/// Runs the sliding engine over `total` samples; every `every` samples (and over the last
-/// `window` samples) compares its current estimate (scaled: z_i = x^(i)/i!, unit step) with
-/// W(0) applied to the stored window. Returns the worst error relative to the data scale.
-fn sliding_long_run(m: usize, window: usize, total: usize, every: usize, seed: u64) -> f64 {
-    let l = window - 1;
-    let w = weights(m, l as u64, 0.0).unwrap();
-    let mut filt = FixedMemory::new(m, window, FixedEngine::Sliding).unwrap();
-    let mut ring = vec![0.0; window];
-    let mut rng = common::rng(seed);
-    let mut worst = 0.0f64;
-    let mut scale = 0.0f64;
-    let facts: Vec<f64> = (0..=m).map(|i| f(&fact(i))).collect();
-    for n in 0..total {
-        let y = long_run_value(n, rng.gen::<f64>() - 0.5);
-        scale = scale.max(y.abs());
-        filt.update(n as f64, y).unwrap();
-        ring[n % window] = y;
-        if n >= l && (n % every == 0 || n + window >= total) {
-            let s = filt.estimate().unwrap();
-            for i in 0..=m {
-                let zr: f64 = (0..window)
-                    .map(|k| w[(i, k)] * ring[(n - k) % window])
-                    .sum();
-                worst = worst.max((s.derivatives[i] / facts[i] - zr).abs());
-            }
-        }
-    }
-    // Final state against exact least squares (integer arithmetic).
-    let ys: Vec<f64> = (0..window)
-        .map(|k| ring[(total - window + k) % window])
-        .collect();
-    let u: Vec<i64> = (0..window).map(|k| k as i64 - l as i64).collect();
-    let exact = exact_discounted_even(&u, &ys, 1, 1, m, 1.0);
-    let s = filt.estimate().unwrap();
-    for i in 0..=m {
-        worst = worst.max((s.derivatives[i] - exact[i]).abs() / facts[i]);
-    }
-    worst / scale
-}
-
 #[test]
 fn sliding_engine_stays_exact_over_ten_million_samples() {
     // The acceptance run: 10⁷ samples (m = 2, window 1001), the output within 1e-9 of the exact
@@ -210,18 +158,11 @@ fn sliding_engine_stays_exact_over_ten_million_samples() {
     // unrefreshed recursion of `the_naive_sliding_recursion_drifts…` is at 1.9e-8 after only
     // 10⁵ samples). Plus shorter runs at other degrees and windows, every sample checked for
     // the short windows.
-    let e = sliding_long_run(2, 1001, 10_000_000, 9973, 1);
-    println!("sliding engine, m = 2, window 1001, 10^7 samples: {e:.2e}");
+    let (m, window, total, every, seed) = SLIDING_ACCEPTANCE_RUN;
+    let e = sliding_long_run(m, window, total, every, seed);
     assert!(e <= 1e-11);
-    for (m, window, total, every) in [
-        (2usize, 11usize, 1_000_000usize, 1usize),
-        (4, 11, 1_000_000, 1),
-        (8, 101, 300_000, 7),
-        (2, 10001, 1_000_000, 9973),
-        (10, 1001, 300_000, 997),
-    ] {
-        let e = sliding_long_run(m, window, total, every, 2);
-        println!("sliding engine, m = {m}, window {window}, {total} samples: {e:.2e}");
+    for (m, window, total, every, seed) in SLIDING_SHORTER_RUNS {
+        let e = sliding_long_run(m, window, total, every, seed);
         assert!(e <= 1e-11, "m = {m}, window = {window}: {e:.2e}");
     }
 }
@@ -230,9 +171,8 @@ fn sliding_engine_stays_exact_over_ten_million_samples() {
 fn sliding_engine_ten_million_samples_at_higher_degree() {
     // 10⁷ samples at m = 4 with the longest window of the bench (L = 10⁴) and at m = 6
     // (window 101): measured 1.8e-13 and 3.7e-15 (about 3 s in release).
-    for (m, window) in [(4usize, 10001usize), (6, 101)] {
-        let e = sliding_long_run(m, window, 10_000_000, 99991, 3);
-        println!("sliding engine, m = {m}, window {window}, 10^7 samples: {e:.2e}");
+    for (m, window, total, every, seed) in SLIDING_HIGHER_DEGREE_RUNS {
+        let e = sliding_long_run(m, window, total, every, seed);
         assert!(e <= 1e-11);
     }
 }
@@ -243,65 +183,7 @@ fn the_naive_sliding_recursion_drifts_which_is_why_the_engine_refreshes() {
     // has a homogeneous part that never forgets; run without refreshes its error grows (here
     // m = 2, L = 100: measured 1.9e-8 after 10⁵ samples, growing like n^2.5), while the
     // engine with its exact refreshes stays at rounding level on the same data.
-    let (m, l) = (2usize, 100usize);
-    let window = l + 1;
-    let basis = DiscreteLegendre::new(z(l as i64));
-    // M from p_j(x-1) = Σ_l M_jl p_l(x), by exact polynomial algebra.
-    let polys: Vec<_> = (0..=m).map(|j| basis.polynomial(j)).collect();
-    let mut shift = vec![vec![0.0; m + 1]; m + 1];
-    for j in 0..=m {
-        let mut c: Vec<Q> = (0..=j)
-            .map(|i| polys[j].taylor_coefficient(i, &z(-1)))
-            .collect();
-        for k in (0..=j).rev() {
-            let g = c[k].clone() / polys[k].coeffs[k].clone();
-            for (i, ci) in c.iter_mut().enumerate().take(k + 1) {
-                *ci = ci.clone() - g.clone() * polys[k].coeffs[i].clone();
-            }
-            shift[j][k] = f(&g);
-        }
-    }
-    let bf = DiscreteLegendre::new(l as f64);
-    let table: Vec<Vec<f64>> = (0..window)
-        .map(|x| (0..=m).map(|j| bf.value(j, x as f64)).collect())
-        .collect();
-    let t_end = bf.derivatives_by_recursion(m, 0, &(l as f64));
-    let w = weights(m, l as u64, 0.0).unwrap();
-    let mut rng = common::rng(4);
-    let mut ring = vec![0.0; window];
-    let mut mu = vec![0.0; m + 1];
-    let mut filt = FixedMemory::new(m, window, FixedEngine::Sliding).unwrap();
-    let total = 100_000;
-    for n in 0..total {
-        let y = long_run_value(n, rng.gen::<f64>() - 0.5);
-        filt.update(n as f64, y).unwrap();
-        let old = ring[n % window];
-        ring[n % window] = y;
-        if n == l {
-            for x in 0..window {
-                for j in 0..=m {
-                    mu[j] += ring[x] * table[x][j];
-                }
-            }
-        } else if n > l {
-            let s: Vec<f64> = mu.iter().map(|v| v - old).collect();
-            for j in 0..=m {
-                let a: f64 = (0..=j).map(|k| shift[j][k] * s[k]).sum();
-                mu[j] = if j % 2 == 0 { a + y } else { a - y };
-            }
-        }
-    }
-    let n = total - 1;
-    let exact: f64 = (0..window)
-        .map(|k| w[(0, k)] * ring[(n - k) % window])
-        .sum();
-    let naive: f64 = (0..=m).map(|j| t_end[(j, 0)] * mu[j] / bf.norm_sq(j)).sum();
-    let engine = filt.estimate().unwrap().derivatives[0];
-    let (e_naive, e_engine) = (
-        (naive - exact).abs() / 150.0,
-        (engine - exact).abs() / 150.0,
-    );
-    println!("after 1e5 samples: naive sliding {e_naive:.2e}, engine {e_engine:.2e}");
+    let (e_naive, e_engine) = naive_sliding_drift();
     assert!(e_naive > 1e-10 && e_engine < 1e-13);
 }
 
