@@ -13,7 +13,6 @@ use seqsmooth::{DiscountMode, Engine};
 #[test]
 fn gentle_manoeuvre_coverage_outliers_and_misfit() {
     let (s, _) = score(&main_config(), GENTLE);
-    s.print("gentle manoeuvre, degree 2, θ = 0.97, σ known, defaults");
     assert!(s.scored > 180_000);
     assert!(s.coverage() >= 0.99);
     assert!(s.coverage_all() >= 0.99);
@@ -28,7 +27,6 @@ fn gain_engine_and_per_update_discount_run_the_scenario() {
     c.engine = Engine::Gain;
     c.discount = DiscountMode::PerUpdate;
     let (s, _) = score(&c, GENTLE);
-    s.print("gentle manoeuvre, degree 2, θ = 0.97 per update, gain engine");
     assert!(s.coverage() >= 0.97);
     assert!(s.false_alarm_rate() <= 0.01);
 }

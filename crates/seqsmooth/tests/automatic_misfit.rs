@@ -13,20 +13,12 @@ use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter, MisfitResponse, Phase};
 
-const SHARP: Manoeuvre = Manoeuvre {
-    onset: 800.0,
-    end: 900.0,
-    accel: 3.0,
-};
-
 #[test]
 fn sharp_manoeuvre_restarts_keep_the_coverage() {
     let (s, outs) = score(&main_config(), SHARP);
-    s.print("sharp manoeuvre, degree 2, θ = 0.97, σ known, defaults (restart on misfit)");
     let data = track(0, SHARP);
     let onset = index_at(&data, SHARP.onset);
     let restart = outs[onset..].iter().position(|o| o.restart).unwrap();
-    println!("  run 0: restarted {restart} samples after the onset");
     assert!(restart <= DETECTION_BOUND);
     assert!(s.coverage() >= 0.99);
     assert!(s.coverage_all() >= 0.985);
@@ -50,12 +42,10 @@ fn flag_only_response_keeps_the_memory() {
     let mut c = main_config();
     c.misfit_response = MisfitResponse::Flag;
     let (s, outs) = score(&c, SHARP);
-    s.print("sharp manoeuvre, degree 2, θ = 0.97, σ known, flag only");
     assert_eq!(s.restarts, 0);
     let data = track(0, SHARP);
     let onset = index_at(&data, SHARP.onset);
     let up = outs[onset..onset + 100].iter().filter(|o| o.misfit).count();
-    println!("  run 0: misfit up in {up} of the 100 samples after the onset");
     assert!(up > 50);
     assert!(s.coverage_all() < 0.95);
     // On the gentle manoeuvre nothing restarts anyway.
@@ -91,14 +81,6 @@ fn misfit_flags_an_unmodelled_acceleration_within_ten_samples() {
         delays.push(delay.expect("the flag fires"));
     }
     let misfit_rate = rate(straight_misfit, straight);
-    let mean = delays.iter().sum::<usize>() as f64 / delays.len() as f64;
-    println!(
-        "degree 1, θ = 0.95, into a 0.3 σ/τ² acceleration: misfit delay (samples after the \
-         onset) {delays:?}, mean {mean:.1}, max {}; misfit on the straight segment {:.2}% of \
-         {straight}",
-        delays.iter().max().unwrap(),
-        100.0 * misfit_rate
-    );
     assert!(delays.iter().all(|&d| d <= 10));
     assert!(misfit_rate <= 0.02);
 }
@@ -121,7 +103,6 @@ fn ladder_settles_upward_and_steps_up_on_misfit() {
     assert!(degrees.windows(2).all(|w| w[0] <= w[1]));
     let up1 = degrees.iter().position(|&d| d >= 1).unwrap();
     let up2 = degrees.iter().position(|&d| d >= 2).unwrap();
-    println!("constant truth: degree 1 from sample {up1}, degree 2 from sample {up2}");
     // degree 1's current VRF 2(2n+1)/((n+1)(n+2)) ≤ ½ from n = 6; degree 2's from n = 13
     assert!((6..=15).contains(&up1) && (13..=30).contains(&up2));
 
@@ -136,7 +117,6 @@ fn ladder_settles_upward_and_steps_up_on_misfit() {
                 .degree,
         );
     }
-    println!("fast ramp: degrees {degrees:?}");
     assert_eq!(degrees[0], 0);
     assert!(degrees[1..].iter().all(|&d| d == 1));
 }

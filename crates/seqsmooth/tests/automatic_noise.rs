@@ -1,5 +1,5 @@
 //! The automatic filter's noise estimate (differences, innovations) and its outlier gate
-//! (Reyneke et al. (2012) §5): false alarms, rejected samples and runs of rejections.
+//! (Reyneke et al. (2012) §7): false alarms, rejected samples and runs of rejections.
 //!
 //! The scenarios are those of `common::automatic` (a manoeuvring target, jittered times, dropped
 //! samples, outliers; 100 runs of 2200 samples, fixed seeds).
@@ -28,9 +28,6 @@ fn estimated_noise_from_differences_and_innovations() {
         c.noise_sigma = None;
         c.noise_source = source;
         let (s, _) = score(&c, GENTLE);
-        s.print(&format!(
-            "gentle manoeuvre, degree 2, θ = 0.97, σ estimated by {source:?}"
-        ));
         let mut ratios = Vec::new();
         for seed in 0..RUNS {
             let mut f = AutomaticFilter::new(c.clone()).unwrap();
@@ -41,7 +38,6 @@ fn estimated_noise_from_differences_and_innovations() {
         }
         let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
         let worst = ratios.iter().fold(0.0f64, |a, r| a.max((r - 1.0).abs()));
-        println!("  σ̂/σ at the end of the runs: mean {mean:.4}, worst deviation {worst:.4}");
         // ~2150 samples a run: SE(σ̂)/σ ≈ ½√(2·2.31/2150) = 2.3% per run (third differences;
         // less for innovations), 0.23% for the mean of 100 runs (4.5 SE: 1.05%).
         assert!((mean - 1.0).abs() < 0.0105, "{source:?}: mean σ̂/σ {mean}");
@@ -54,7 +50,7 @@ fn estimated_noise_from_differences_and_innovations() {
 
 #[test]
 fn reyneke_gate_false_alarms() {
-    // As printed (k = 1, σ_v(1 + √(2/N))): 10% to 25% of good samples rejected (others.md §4.7).
+    // As printed (k = 1, σ_v(1 + √(2/N))): 10% to 25% of good samples rejected (Reyneke et al. §7).
     let printed = OutlierRule::Reyneke { k: 1.0 };
     for (n, want) in [(5.0, 0.10), (10.0, 0.15), (30.0, 0.21), (100.0, 0.25)] {
         let p = printed.false_alarm_rate(0.0, n).unwrap();
@@ -85,10 +81,6 @@ fn reyneke_gate_false_alarms() {
                 worst = worst.max(rule.false_alarm_rate(v, n).unwrap());
             }
         }
-        println!(
-            "Reyneke k = 3, degree {m}: worst per-sample false-alarm rate {:.3}%",
-            100.0 * worst
-        );
         if m <= 4 {
             assert!(worst <= 0.01);
         } else {
@@ -99,7 +91,6 @@ fn reyneke_gate_false_alarms() {
     let mut c = main_config();
     c.outliers = rule;
     let (s, _) = score(&c, GENTLE);
-    s.print("gentle manoeuvre, degree 2, θ = 0.97, σ known, Reyneke gate k = 3");
     assert!(s.false_alarm_rate() <= 0.01);
     assert!(s.detection() >= 0.9);
 }

@@ -8,7 +8,7 @@ mod common;
 
 use common::automatic::*;
 use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter, OutlierRule, Phase};
-use seqsmooth::polynomial::switching::{memory_length_constant, SwitchRule};
+use seqsmooth::polynomial::switching::SwitchRule;
 use seqsmooth::DiscountMode;
 
 #[test]
@@ -44,14 +44,6 @@ fn switch_happens_at_the_rule_index() {
                     n += 1;
                     t0.get_or_insert(s.t);
                 }
-            }
-            if seed == 0 {
-                println!(
-                    "{rule:?}: switched at accepted sample {} (θ = 0.97 per τ, mean step 1.05τ; \
-                     Table 1 at θ per sample: c/(1−θ) = {:.1})",
-                    seen.unwrap(),
-                    memory_length_constant(0, 2) / 0.03
-                );
             }
             assert!(seen.is_some());
         }

@@ -19,7 +19,7 @@ fn qrow(xs: &[&str]) -> Vec<Q> {
 }
 
 /// Morrison Table 2.1 (signed Stirling numbers of the first kind), rows 0..10, as reconstructed
-/// from (2.4.9) in spec ch02-06.md §1.3 (the printed table is scrambled in the OCR).
+/// from (2.4.9) (the printed table is scrambled in the OCR).
 const TABLE_2_1: [&[i64]; 11] = [
     &[1],
     &[0, 1],
@@ -36,7 +36,7 @@ const TABLE_2_1: [&[i64]; 11] = [
     ],
 ];
 
-/// Morrison Table 2.2 (Stirling numbers of the second kind), rows 0..10 (spec ch02-06.md §1.3).
+/// Morrison Table 2.2 (Stirling numbers of the second kind), rows 0..10.
 const TABLE_2_2: [&[i64]; 11] = [
     &[1],
     &[0, 1],
@@ -57,7 +57,7 @@ fn lower_table(t: &[&[i64]; 11]) -> DMatrix<Q> {
 
 #[test]
 fn table_2_1_stirling_first_kind_rows_0_to_10() {
-    // Source: Morrison Table 2.1 / (2.4.8)-(2.4.10); spec ch02-06.md §1.3 (TV2.2).
+    // Source: Morrison Table 2.1 / (2.4.8)-(2.4.10).
     let want = lower_table(&TABLE_2_1);
     let got = stirling1::<Q>(10);
     assert_eq!(got, want);
@@ -82,7 +82,7 @@ fn table_2_1_stirling_first_kind_rows_0_to_10() {
 
 #[test]
 fn table_2_2_stirling_second_kind_rows_0_to_10() {
-    // Source: Morrison Table 2.2 / (2.4.13)-(2.4.15); spec ch02-06.md §1.3.
+    // Source: Morrison Table 2.2 / (2.4.13)-(2.4.15).
     let want = lower_table(&TABLE_2_2);
     assert_eq!(stirling2::<Q>(10), want);
     let got_f = stirling2::<f64>(10);
@@ -103,7 +103,7 @@ fn table_2_2_stirling_second_kind_rows_0_to_10() {
 
 #[test]
 fn stirling_matrices_are_mutual_inverses() {
-    // Source: Morrison (2.4.13) "S2 = S1^-1"; spec ch02-06.md §1.3 "Sst1 * Sst2 = I (11x11)".
+    // Source: Morrison (2.4.13) "S2 = S1^-1" (11×11).
     // Printed tables: their product is the identity.
     let t1 = lower_table(&TABLE_2_1);
     let t2 = lower_table(&TABLE_2_2);
@@ -120,7 +120,7 @@ fn stirling_matrices_are_mutual_inverses() {
 }
 
 /// Morrison Table 4.1 (link matrix 𝒮), row i lists columns j = i..10 (row 0 lists j = 0..10).
-/// Row 4, column 8 is printed 6169 in the OCR; the correct value is 6769 (spec ch02-06.md §4.3).
+/// Row 4, column 8 is printed 6169 in the OCR; the correct value is 6769 (from (4.4.5)).
 const TABLE_4_1: [&[i64]; 11] = [
     &[1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
     &[1, 1, 2, 6, 24, 120, 720, 5040, 40320, 362880],
@@ -164,7 +164,7 @@ fn upper_table(t: &[&[i64]; 11]) -> DMatrix<Q> {
 
 #[test]
 fn table_4_1_link_matrix_with_6769_correction() {
-    // Source: Morrison Table 4.1 and the Chapter 4 notes; spec ch02-06.md §4.3, T7-27.
+    // Source: Morrison Table 4.1 and the Chapter 4 notes.
     let want = upper_table(&TABLE_4_1);
     let sa = link_matrix::<Q>(10);
     assert_eq!(sa, want);
@@ -198,7 +198,7 @@ fn table_4_1_link_matrix_with_6769_correction() {
 
 #[test]
 fn table_4_2_inverse_link_matrix_and_identity() {
-    // Source: Morrison Table 4.2, (4.4.5), (4.4.9); spec ch02-06.md §4.3, check 5 of §8.
+    // Source: Morrison Table 4.2, (4.4.5), (4.4.9).
     let want = upper_table(&TABLE_4_2);
     assert_eq!(link_matrix_inverse::<Q>(10), want);
     // Formula (4.4.5), evaluated here: [𝒮⁻¹]_ij = (1/i!) Σ_ν (-1)^ν C(i,ν) (-ν)^j (0^0 = 1).
@@ -236,7 +236,7 @@ fn link_matrices_convert_difference_and_derivative_states() {
     let v1 = DMatrix::from_column_slice(4, 1, &[z(8), z(8), z(0), z(8)]);
     let z1 = mm(&link_matrix::<Q>(3), &v1);
     assert_eq!(z1.as_slice(), &[z(8), z(24), z(24), z(8)]);
-    // [DERIVED] x = n^3 at n = 0, τ = 1: V^f = (0,1,3,1), V = (0,1,-3,1), Z = (0,0,0,1) from both.
+    // (derived) x = n^3 at n = 0, τ = 1: V^f = (0,1,3,1), V = (0,1,-3,1), Z = (0,0,0,1) from both.
     let vf = DMatrix::from_column_slice(4, 1, &[z(0), z(1), z(3), z(1)]);
     let v = DMatrix::from_column_slice(4, 1, &[z(0), z(1), z(-3), z(1)]);
     let zz = vec![z(0), z(0), z(0), z(1)];
@@ -269,7 +269,7 @@ fn link_matrices_convert_difference_and_derivative_states() {
 
 #[test]
 fn factorial_function_identities_2_4_19_and_2_4_20() {
-    // Source: Morrison (2.4.1)-(2.4.3), (2.4.19), (2.4.20), Ex 2.10, Ex 2.7a; spec ch02-06.md §1.3.
+    // Source: Morrison (2.4.1)-(2.4.3), (2.4.19), (2.4.20), Ex 2.10, Ex 2.7a.
     let xs = [z(7), z(10), z(-3), z(0), fr(5, 2), fr(-7, 3), fr(1, 10)];
     for x in &xs {
         for m in 0..=9usize {
@@ -323,7 +323,7 @@ fn factorial_function_identities_2_4_19_and_2_4_20() {
 
 #[test]
 fn binomial_coefficients_for_negative_and_real_arguments() {
-    // Source: Morrison (2.5.1)-(2.5.7), Ex 2.11, (2.6.15), Ex 2.18; spec ch02-06.md §1.4-1.5, TV2.5.
+    // Source: Morrison (2.5.1)-(2.5.7), Ex 2.11, (2.6.15), Ex 2.18.
     // Ex 2.11: C(5,3) = C(5,2) = 10, C(5,4) = C(5,1) = 5, C(5,6) = 0, C(-1,j) = (-1)^j.
     assert_eq!(binomial(z(5), 3), z(10));
     assert_eq!(binomial(z(5), 2), z(10));
@@ -401,7 +401,7 @@ fn binomial_coefficients_for_negative_and_real_arguments() {
 
 #[test]
 fn power_sums_at_l_10_and_by_the_stirling_route_2_7_14() {
-    // Source: Morrison (2.7.14), (2.7.17); spec ch02-06.md §1.6 values at L = 10, TV2.6.
+    // Source: Morrison (2.7.14), (2.7.17), values at L = 10.
     let printed: [i64; 11] = [
         11,
         55,

@@ -68,7 +68,7 @@ fn discrete_laguerre_explicit_forms_3_3_9_and_3_3_10() {
 
 #[test]
 fn discrete_laguerre_printed_values_tv3_2() {
-    // Source: spec ch02-06.md TV3.2 [DERIVED from (3.3.10)], x = 0..5.
+    // Source: values derived from Morrison (3.3.10), x = 0..5.
     let cases: [(&str, usize, [&str; 6]); 5] = [
         ("1/2", 1, ["1/2", "0", "-1/2", "-1", "-3/2", "-2"]),
         ("1/2", 2, ["1/4", "-1/4", "-1/2", "-1/2", "-1/4", "1/4"]),
@@ -99,7 +99,7 @@ fn discrete_laguerre_printed_values_tv3_2() {
 #[test]
 fn discrete_laguerre_orthogonality_and_norms_3_3_16() {
     // Source: Morrison (3.3.1), (3.3.12), (3.3.16): Σ_{x>=0} p_i p_j θ^x = δ_ij θ^j/(1-θ);
-    // spec others.md §4.1 (θ = 1/3 and 3/5); TV3.2.
+    // Reyneke et al. eq 24 (θ = 1/3 and 3/5).
     // (a) Exact infinite sums by the closed form of `weighted_series_sum`, j <= 6.
     for (n, d) in THETAS {
         let th = fr(n, d);

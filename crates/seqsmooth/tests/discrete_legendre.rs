@@ -26,7 +26,7 @@ fn sample_points(l: i64) -> Vec<Q> {
 
 #[test]
 fn discrete_legendre_explicit_p0_to_p4_3_2_21() {
-    // Source: Morrison (3.2.21) and the [DERIVED] factored forms of p2, p3 (spec ch02-06.md §2.1).
+    // Source: Morrison (3.2.21) and the (derived) factored forms of p2, p3.
     for l in [4i64, 5, 7, 10, 13] {
         let lq = z(l);
         let b = DiscreteLegendre::new(lq.clone());
@@ -144,7 +144,7 @@ fn discrete_legendre_orthogonality_and_norms_3_2_30() {
 
 #[test]
 fn discrete_legendre_end_values_symmetry_and_leading_coefficient() {
-    // Source: spec ch02-06.md §2.1 [DERIVED, verified]: p_j(0) = 1, p_j(L) = (-1)^j,
+    // Source: derived from Morrison (3.2.20): p_j(0) = 1, p_j(L) = (-1)^j,
     // p_j(L-x) = (-1)^j p_j(x); Morrison (3.2.26) leading coefficient (-1)^j C(2j,j)/L^(j).
     for l in 1..=15i64 {
         let lq = z(l);
@@ -173,7 +173,7 @@ fn discrete_legendre_end_values_symmetry_and_leading_coefficient() {
 
 #[test]
 fn appendix_recursion_a1_1_matches_explicit_derivatives() {
-    // Source: Morrison Appendix I (A1.1)-(A1.6); spec ch02-06.md §3. Oracle: derivatives of the
+    // Source: Morrison Appendix I (A1.1)-(A1.6). Oracle: derivatives of the
     // explicit (3.2.20) polynomial built in this file.
     for l in [z(8), z(9), z(12), z(20), fr(25, 2)] {
         let b = DiscreteLegendre::new(l.clone());
@@ -213,7 +213,7 @@ fn appendix_recursion_a1_1_matches_explicit_derivatives() {
 }
 
 /// Morrison Table 7.1: the integer parts (-1)^j C(j,i) C(j+i,i) of [G]_ij · L^(i), rows i,
-/// columns j = i..10 (spec ch07-09.md §1.4, rebuilt from (7.4.14)).
+/// columns j = i..10 (rebuilt from (7.4.14)).
 const TABLE_7_1: [&[i64]; 11] = [
     &[1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1],
     &[-2, 6, -12, 20, -30, 42, -56, 72, -90, 110],

@@ -7,25 +7,12 @@ mod common;
 use common::engine::*;
 use common::*;
 use seqsmooth::polynomial::MAX_DEGREE;
-use seqsmooth::{DiscountMode, Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
+use seqsmooth::{DiscountMode, Engine, ExpandingMemory, PolynomialFilter};
 
 #[test]
 fn expanding_irregular_exact_engine_equals_batch_qr() {
     for m in 0..=8 {
-        for (label, times) in [
-            ("jittered", jittered_times(150, 0.1, 0.4, 11 + m as u64)),
-            ("random", random_times(150, 0.1, 21 + m as u64)),
-        ] {
-            let ys = noisy_polynomial(&times, m, 15.0, 0.2, 31 + m as u64);
-            let err = compare(
-                Box::new(ExpandingMemory::new(m, Engine::Exact).unwrap()),
-                &times,
-                &ys,
-                m,
-                |_| true,
-                |_| None,
-            );
-            eprintln!("expanding {label} m={m}: {err:.2e}");
+        for (label, err) in expanding_irregular_errors(m) {
             assert!(err < TOL, "m={m} {label} {err:e}");
         }
     }
@@ -59,18 +46,8 @@ fn expanding_irregular_exact_engine_equals_rational_least_squares() {
             .zip(&want)
             .map(|(a, b)| rel_err(a, b, &fl))
             .fold(0.0, f64::max);
-        eprintln!("expanding rational m={m}: {err:.2e}");
         assert!(err < TOL, "m={m} {err:e}");
     }
-}
-
-fn discount_weights(times: &[f64], n: usize, theta: f64, tau: f64, mode: DiscountMode) -> Vec<f64> {
-    (0..=n)
-        .map(|k| match mode {
-            DiscountMode::PerTime => theta.powf((times[n] - times[k]) / tau),
-            DiscountMode::PerUpdate => theta.powi((n - k) as i32),
-        })
-        .collect()
 }
 
 #[test]
@@ -78,23 +55,7 @@ fn fading_irregular_exact_engine_equals_discounted_batch_qr() {
     // Weights θ^((t_n - t_k)/τ) (and θ^(n-k) per update) from the first determinable sample.
     for m in 0..=8 {
         for mode in [DiscountMode::PerTime, DiscountMode::PerUpdate] {
-            let theta = 0.93;
-            let tau = 0.1;
-            let times = jittered_times(400, 0.1, 0.5, 61 + m as u64);
-            let ys = noisy_polynomial(&times, m, 10.0, 0.2, 71 + m as u64);
-            let f = FadingMemory::new(m, theta, tau, Engine::Exact)
-                .unwrap()
-                .with_discount_mode(mode)
-                .unwrap();
-            let err = compare(
-                Box::new(f),
-                &times,
-                &ys,
-                m,
-                |n| n < 60 || n % 7 == 0,
-                |n| Some(discount_weights(&times, n, theta, tau, mode)),
-            );
-            eprintln!("fading irregular {mode:?} m={m}: {err:.2e}");
+            let err = fading_irregular_error(m, mode);
             assert!(err < TOL, "m={m} {mode:?} {err:e}");
         }
     }
@@ -103,38 +64,11 @@ fn fading_irregular_exact_engine_equals_discounted_batch_qr() {
 #[test]
 fn high_degree_exact_engine_accuracy_is_measured() {
     // Conditioning limit of the centred monomial square-root information form, documented in
-    // the crate docs: measured against batch QR in the Legendre basis on 2000 irregular samples.
+    // the crate docs: measured against batch QR in the Legendre basis on 2000 irregular samples
+    // (`cargo run --release -p seqsmooth --example accuracy_engines` prints it).
     // Bounds: 1e-9 to degree 12, 1e-6 to degree 16, 1e-3 to MAX_DEGREE.
     for m in [10, 12, 14, 16, 20, MAX_DEGREE] {
-        let times = jittered_times(2000, 0.01, 0.3, 111 + m as u64);
-        let ys = noisy_polynomial(&times, m, 20.0, 1e-3, 121 + m as u64);
-        let check = [m, m + 5, 100, 500, 1998];
-        let expanding = compare(
-            Box::new(ExpandingMemory::new(m, Engine::Exact).unwrap()),
-            &times,
-            &ys,
-            m,
-            |n| check.contains(&n),
-            |_| None,
-        );
-        let theta = 0.99;
-        let fading = compare(
-            Box::new(FadingMemory::new(m, theta, 0.01, Engine::Exact).unwrap()),
-            &times,
-            &ys,
-            m,
-            |n| check.contains(&n),
-            |n| {
-                Some(discount_weights(
-                    &times,
-                    n,
-                    theta,
-                    0.01,
-                    DiscountMode::PerTime,
-                ))
-            },
-        );
-        eprintln!("high degree m={m}: expanding {expanding:.2e}, fading {fading:.2e}");
+        let (expanding, fading) = high_degree_errors(m);
         let bound = if m <= 12 {
             1e-9
         } else if m <= 16 {

@@ -20,7 +20,7 @@ fn n_values() -> Vec<u64> {
 
 #[test]
 fn expanding_gains_match_morrison_table_9_1() {
-    // Source: Morrison Table 9.1, (9.4.18)-(9.4.19); spec ch07-09.md §3.3 (degrees 0-3).
+    // Source: Morrison Table 9.1, (9.4.18)-(9.4.19) (degrees 0-3).
     for m in 0..=3 {
         for n in n_values() {
             let got = expanding_gains::<Q>(m, n, GainForm::Current);
@@ -39,8 +39,8 @@ fn expanding_gains_match_morrison_table_9_1() {
 
 #[test]
 fn expanding_gains_match_reyneke_section_6_4() {
-    // Source: Reyneke et al. §6.4 (spec others.md §4.3), degrees 0-5; m = 4 also spec ch07-09.md
-    // §3.3 [DERIVED]; top gain (2m+1)!/(m!)² / (n+m+1)^(m+1); h_0(n) = 1 for n <= m.
+    // Source: Reyneke et al. §6.4, degrees 0-5; m = 4 also derived from Morrison
+    // (9.4.18); top gain (2m+1)!/(m!)² / (n+m+1)^(m+1); h_0(n) = 1 for n <= m.
     for m in 0..=5 {
         for n in n_values() {
             let got = expanding_gains::<Q>(m, n, GainForm::Current);
@@ -70,7 +70,7 @@ fn expanding_gains_match_reyneke_section_6_4() {
 
 #[test]
 fn expanding_gains_small_n_t9_01_and_n_10_vector() {
-    // Source: spec ch07-09.md T9-01 (n = 0..4, m = 0..4) and Reyneke §6.4 test vector at n = 10.
+    // Source: Morrison Table 9.1 at n = 0..4, m = 0..4, and Reyneke §6.4 test vector at n = 10.
     let t901: [&[&[&str]]; 5] = [
         &[&["1"], &["1/2"], &["1/3"], &["1/4"], &["1/5"]],
         &[

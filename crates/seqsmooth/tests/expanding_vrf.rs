@@ -12,7 +12,7 @@ use seqsmooth::polynomial::gains::{expanding_gains, GainForm};
 use seqsmooth::polynomial::vrf::{expanding_vrf, unscale, window_covariance, EstimateForm};
 use seqsmooth::{Engine, ExpandingMemory};
 
-/// Morrison Table 9.2 (m = 0..3) and the [DERIVED] m = 4 row (spec ch07-09.md §3.6): diagonal of
+/// Morrison Table 9.2 (m = 0..3) and the derived m = 4 row: diagonal of
 /// the unscaled 1-step-predictor VRF, τ = 1.
 fn table_9_2(m: usize, n: &Q) -> Vec<Q> {
     let p = |cs: &[i64]| poly(cs, n);
@@ -44,7 +44,7 @@ fn table_9_2(m: usize, n: &Q) -> Vec<Q> {
 
 #[test]
 fn expanding_vrf_table_9_2_predictor_diagonal() {
-    // Source: Morrison Table 9.2 (m = 0..3, book), m = 4 [DERIVED] (spec ch07-09.md §3.6);
+    // Source: Morrison Table 9.2 (m = 0..3, book), m = 4 derived;
     // unscaled diagonal = (i!)² × scaled diagonal for τ = 1.
     for m in 0..=4usize {
         for n in m as u64..=40 {
@@ -122,7 +122,7 @@ fn window_covariance_equals_direct_least_squares() {
             assert_eq!(cur, s0);
         }
     }
-    // Ex 7.21 [DERIVED]: L = 4, m = 2: [S]_00(h) = (5h⁴+40h³+107h²+108h+62)/70.
+    // Ex 7.21 (derived): L = 4, m = 2: [S]_00(h) = (5h⁴+40h³+107h²+108h+62)/70.
     for h in [z(0), z(1), z(-2), z(6), z(-10), fr(1, 3)] {
         let s = window_covariance::<Q>(2, 4, h.clone());
         assert_eq!(s[(0, 0)], poly(&[62, 108, 107, 40, 5], &h) / z(70));
@@ -131,7 +131,7 @@ fn window_covariance_equals_direct_least_squares() {
 
 #[test]
 fn expanding_current_vrf_cross_checks_lear_and_reyneke() {
-    // Source: spec others.md §4.6 / §5 (Lear end-point variance = EMP position gain; Reyneke
+    // Source: Lear (1977) and Reyneke et al. §7.2 (Lear end-point variance = EMP position gain; Reyneke
     // current-estimate derivative VRFs and one-step predictor position VRFs, Phi-normalised).
     for m in 0..=6usize {
         for n in m as u64..=40 {

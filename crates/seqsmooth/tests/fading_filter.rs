@@ -4,8 +4,6 @@
 mod common;
 
 use common::engine::*;
-use common::*;
-use seqsmooth::{Engine, FadingMemory};
 
 #[test]
 fn fading_memory_equals_exact_discounted_least_squares_once_the_start_up_has_decayed() {
@@ -13,19 +11,8 @@ fn fading_memory_equals_exact_discounted_least_squares_once_the_start_up_has_dec
     // squares. Gain engine: expanding-memory start, switch (§13.8), then the switch transient
     // decays like θ^n·poly(n) (§13.4); checked from sample 700 on. Exact engine: from the first
     // determinable sample.
-    let theta = (9, 10);
-    let times = even_times(1000, 0.0, 1.0);
     for m in 0..=8 {
-        let ys = dyadic(&wavy(&times, 1.0, 0.01, 81 + m as u64));
-        let mut gain = FadingMemory::new(m, 0.9, 1.0, Engine::Gain).unwrap();
-        let g = compare_fading_exact(&mut gain, &times, &ys, m, theta, &[700, 850, 998]);
-        let mut exact = FadingMemory::new(m, 0.9, 1.0, Engine::Exact).unwrap();
-        let checks: Vec<usize> = [m, m + 1, m + 5, 40, 200, 998]
-            .into_iter()
-            .filter(|&n| n >= m)
-            .collect();
-        let e = compare_fading_exact(&mut exact, &times, &ys, m, theta, &checks);
-        eprintln!("fading even m={m}: gain {g:.2e}, exact {e:.2e}");
+        let (g, e) = fading_even_errors(m);
         assert!(g < TOL && e < TOL, "m={m}: gain {g:e} exact {e:e}");
     }
 }

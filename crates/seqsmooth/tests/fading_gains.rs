@@ -14,7 +14,7 @@ use seqsmooth::scalar::rational_from_f64;
 #[test]
 fn fading_gains_match_table_13_1_and_reyneke_section_6_6() {
     // Source: Morrison Table 13.1 (13.5.26)-(13.5.33) degrees 0-4 (degree 3 reconstructed;
-    // spec ch10-15.md §4.6), Reyneke §6.6 degrees 0-5 (spec others.md §4.4).
+    // reconstructed), Reyneke §6.6 degrees 0-5.
     for th in exact_thetas() {
         for m in 0..=5 {
             let got = fading_gains::<Q>(m, th.clone(), GainForm::Current);
@@ -38,8 +38,8 @@ fn fading_gains_match_table_13_1_and_reyneke_section_6_6() {
 
 #[test]
 fn fading_gain_test_vectors_and_position_gain() {
-    // Source: Reyneke §6.6 test vectors θ = 1/2 (exact) and θ = 0.9 (decimals; spec others.md
-    // §4.4); Morrison Table 13.1 note G0 = 1 - θ^(m+1); spec ch10-15.md §4.7 "H = (0.271, 0.0285,
+    // Source: Reyneke §6.6 test vectors θ = 1/2 (exact) and θ = 0.9 (decimals);
+    // Morrison Table 13.1 note G0 = 1 - θ^(m+1); "H = (0.271, 0.0285,
     // 0.0005)".
     let half: [&[&str]; 6] = [
         &["1/2"],
@@ -107,7 +107,7 @@ fn fading_gain_test_vectors_and_position_gain() {
 fn fading_gains_equal_discounted_least_squares_weights() {
     // Oracle: the steady-state discounted least-squares weight of the newest sample,
     // H = A(θ)⁻¹ e0 with A_ij = Σ_{k>=0} θ^k (-k)^(i+j) summed exactly in closed form
-    // (spec others.md §4.4 check (a); Morrison (13.2.1)). Any degree m <= 10.
+    // (Reyneke et al. §6.6; Morrison (13.2.1)). Any degree m <= 10.
     for th in [fr(1, 2), fr(9, 10), fr(99, 100), fr(1, 3), fr(7, 8)] {
         let moments: Vec<Q> = (0..=20)
             .map(|p| weighted_series_sum(|x| qpow(x, p), p, &th))

@@ -42,7 +42,7 @@ fn lambda_ex_13_15(m: usize) -> DMatrix<Q> {
 
 #[test]
 fn table_13_4_memory_length_constants() {
-    // Source: Morrison Table 13.4, (13.7.9)-(13.7.14); spec ch10-15.md §4.8 (higher-precision
+    // Source: Morrison Table 13.4, (13.7.9)-(13.7.14) (higher-precision
     // rows, column means). Oracle: c_im = (κ_ii/λ_ii)^(1/(2i+1)) from the closed-form κ and the
     // Ex 13.15 λ, both computed here.
     for m in 0..=10usize {
@@ -53,12 +53,12 @@ fn table_13_4_memory_length_constants() {
             assert!(rel_err(c_im, want) < 1e-13, "c({i},{m}) = {c_im} vs {want}");
             let printed = TABLE_13_4[i][m - i];
             if (i, m) == (0, 7) {
-                // Book prints 9.96; the exact constant 64/λ_00(7) = 9.95496 rounds to 9.95 (spec
-                // ch10-15.md §4.8 notes "9.955 (book 9.96)"): a double-rounding in the book.
+                // Book prints 9.96; the exact constant 64/λ_00(7) = 9.95496 rounds to 9.95 (9.955 to
+                // three figures, then 9.96): a double-rounding in the book.
                 assert!((c_im - 9.95496).abs() < 1e-5, "c(0,7) = {c_im}");
                 assert!((c_im - 9.96).abs() <= 0.01);
             } else if (i, m) == (9, 9) {
-                // Book prints 15.8; the exact constant is 15.858 (spec ch10-15.md §4.8): a
+                // Book prints 15.8; the exact constant is 15.858: a
                 // truncation in the printed table, not a rounding.
                 assert!((c_im - 15.858).abs() < 5e-4, "c(9,9) = {c_im}");
                 assert!((c_im - 15.8).abs() > 0.05);
@@ -118,7 +118,7 @@ fn table_13_4_memory_length_constants() {
 
 #[test]
 fn reyneke_table_1_switch_constants() {
-    // Source: Reyneke et al. Table 1 (spec others.md §4.6): N_s(1-θ) = c_E/c_F = 2, 16/5, 48/11,
+    // Source: Reyneke et al. Table 1: N_s(1-θ) = c_E/c_F = 2, 16/5, 48/11,
     // 512/93, 1280/193, 6144/793 with c_E = (m+1)², c_F = 1/2, 5/4, 33/16, 93/32, 965/256,
     // 2379/512; decimals 2, 3.2, 4.3636, 5.5054, 6.6321, 7.7478.
     let table1 = ["2", "16/5", "48/11", "512/93", "1280/193", "6144/793"];
@@ -137,7 +137,7 @@ fn reyneke_table_1_switch_constants() {
 #[test]
 fn switch_rules_position_and_derivative() {
     // Source: Morrison (13.8.8) (m = 1, θ = 0.9 -> n_0 = 32), (13.7.13)-(13.7.14) (velocity ->
-    // 36), Figs. 13.3/13.5 (m = 2, θ = 0.942 -> 75; m = 3, θ = 0.945 -> 100), spec ch10-15.md §4.9.
+    // 36), Figs. 13.3/13.5 (m = 2, θ = 0.942 -> 75; m = 3, θ = 0.945 -> 100).
     assert_eq!(SwitchRule::Position.switch_index(1, 0.9).unwrap(), 32);
     assert_eq!(SwitchRule::default(), SwitchRule::Position);
     assert_eq!(SwitchRule::Derivative(1).switch_index(1, 0.9).unwrap(), 36);
@@ -155,7 +155,7 @@ fn switch_rules_position_and_derivative() {
 #[test]
 fn switch_rule_column_mean_ex_13_21() {
     // Source: Morrison Ex 13.21 a-c: (m, θ) = (2, 0.93) -> 68, (3, 0.81) -> 32, (1, 0.98) -> 170
-    // (spec ch10-15.md §4.9: column means of Table 13.4: 68.4, 32.3, 170.9). The three book
+    // (column means of Table 13.4: 68.4, 32.3, 170.9). The three book
     // answers (and 32, 75, 100 of §13.8) are consistent with truncating c/(1-θ), not rounding.
     assert_eq!(SwitchRule::ColumnMean.switch_index(2, 0.93).unwrap(), 68);
     assert_eq!(SwitchRule::ColumnMean.switch_index(3, 0.81).unwrap(), 32);
@@ -171,7 +171,7 @@ fn switch_rule_column_mean_ex_13_21_a_b() {
 
 #[test]
 fn switch_rule_exact_crossover() {
-    // Definition (spec others.md §4.6 "switch_exact"): the first n >= m with
+    // Definition (Reyneke et al. §7.2): the first n >= m with
     // VRF_EMP,current(n)[0,0] = h_0(n) <= VRF_FMP,current(θ)[0,0], evaluated here exactly with the
     // printed Table 9.1/Reyneke §6.4 h_0(n) and the Reyneke/Table 13.2 current position VRF
     // (1-θ) Q_m(θ)/(1+θ)^(2m+1), at θ = the decimal the caller typed. The library answer is
@@ -204,12 +204,12 @@ fn switch_rule_exact_crossover() {
     }
     // Spec values n* (θ = 0.9: 18.000 / 29.193 / 40.051 / 50.709; 0.95: 38.000 / 61.186 / 83.674 /
     // 105.741; 0.99: 198.000 / 317.181 / 432.755 / 546.156): the first integer n >= n*.
-    let spec: [(f64, [u64; 4]); 3] = [
+    let expected: [(f64, [u64; 4]); 3] = [
         (0.9, [18, 30, 41, 51]),
         (0.95, [38, 62, 84, 106]),
         (0.99, [198, 318, 433, 547]),
     ];
-    for (th, ns) in spec {
+    for (th, ns) in expected {
         for (m, n) in ns.iter().enumerate() {
             assert_eq!(
                 SwitchRule::ExactCrossover.switch_index(m, th).unwrap(),

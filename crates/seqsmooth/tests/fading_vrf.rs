@@ -14,7 +14,7 @@ use seqsmooth::polynomial::vrf::{fading_vrf, fading_vrf_limit, EstimateForm};
 use seqsmooth::scalar::rational_from_f64;
 use seqsmooth::{Engine, FadingMemory};
 
-/// Morrison Table 13.2 (m = 0..2 book; m = 3, 4 computed; spec ch10-15.md §4.7): unscaled
+/// Morrison Table 13.2 (m = 0..2 book; m = 3, 4 computed): unscaled
 /// predictor diagonal with τ = 1, as (constant, numerator coefficients in θ, power of (1-θ));
 /// denominator (1+θ)^(2m+1).
 fn table_13_2(m: usize) -> Vec<(Q, &'static [i64], usize)> {
@@ -49,8 +49,8 @@ fn table_13_2(m: usize) -> Vec<(Q, &'static [i64], usize)> {
 
 #[test]
 fn fading_vrf_table_13_2_predictor_and_current_diagonals() {
-    // Source: Morrison Table 13.2 (spec ch10-15.md §4.7); current estimate = the reversed
-    // numerator polynomial (spec [COMPUTED] observation; Reyneke §7.2 Q_m, spec others.md §4.6).
+    // Source: Morrison Table 13.2; current estimate = the reversed
+    // numerator polynomial (an observation checked here; Reyneke §7.2 Q_m).
     for th in exact_thetas() {
         let om = z(1) - th.clone();
         for m in 0..=4usize {
@@ -87,9 +87,9 @@ fn fading_vrf_table_13_2_predictor_and_current_diagonals() {
 
 #[test]
 fn fading_vrf_full_matrices_13_6_26_13_6_34_and_m2() {
-    // Source: Morrison (13.6.26), (13.6.34) (m = 1), spec ch10-15.md §4.7 [COMPUTED] m = 2;
+    // Source: Morrison (13.6.26), (13.6.34) (m = 1), computed m = 2;
     // independent oracle: Cov = A⁻¹ B A⁻¹ with A_ij = Σ θ^k (-k)^(i+j), B_ij = Σ θ^(2k) (-k)^(i+j)
-    // (spec others.md §4.6 "Method"), shifted by Φ(1) for the predictor, m <= 6.
+    // (Reyneke et al. §7.2), shifted by Φ(1) for the predictor, m <= 6.
     for th in exact_thetas() {
         let om = z(1) - th.clone();
         let op = z(1) + th.clone();
@@ -197,7 +197,7 @@ fn fading_vrf_full_matrices_13_6_26_13_6_34_and_m2() {
 
 #[test]
 fn fading_vrf_numeric_vectors_theta_0_9_and_0_5() {
-    // Source: spec ch10-15.md §4.7 "Numeric FMP test vectors" (scaled z, σ = 1), (13.7.1).
+    // Source: numeric fading-memory vectors computed from Morrison (13.6.x), (13.7.1) (scaled z, σ = 1).
     type Row = (usize, EstimateForm, &'static [&'static str]);
     use EstimateForm::{Current as C, Predictor as P};
     let nine: [Row; 9] = [
@@ -401,9 +401,9 @@ const TABLE_13_3: [&[&str]; 11] = [
 
 #[test]
 fn fading_vrf_limit_table_13_3() {
-    // Source: Morrison Table 13.3 (reconstructed via Ex 13.15d, spec ch10-15.md §4.7), exact
-    // columns m <= 4, Ex 13.15e/13.16 full λ for m = 2, [COMPUTED] m = 3, Reyneke c_F
-    // (spec others.md §4.6); Morrison p. 528 position VRFs 0.5, 1.25, 2.06, 2.9 (×(1-θ)).
+    // Source: Morrison Table 13.3 (reconstructed via Ex 13.15d), exact
+    // columns m <= 4, Ex 13.15e/13.16 full λ for m = 2, computed m = 3, Reyneke c_F
+    // (§7.2); Morrison p. 528 position VRFs 0.5, 1.25, 2.06, 2.9 (×(1-θ)).
     for m in 0..=10usize {
         let l = fading_vrf_limit(m);
         for i in 0..=m {
@@ -492,7 +492,7 @@ fn fading_vrf_approaches_table_13_3_near_theta_one() {
 
 #[test]
 fn fading_vrf_equals_lyapunov_iteration_13_6_41() {
-    // Source: Morrison (13.6.41)-(13.6.51), Ex 13.19; spec ch10-15.md §4.7 method (a):
+    // Source: Morrison (13.6.41)-(13.6.51), Ex 13.19, method (a):
     // J <- B J Bᵀ + G Gᵀ, B = Φ(1)(I - H M), G = Φ(1) H, M = e0ᵀ, from J = 0, converges to the
     // 1-step-predictor VRF. Gains from the printed Table 13.1 / Reyneke §6.6 (transcribed here).
     for (thf, thq) in [(0.5, fr(1, 2)), (0.9, fr(9, 10))] {

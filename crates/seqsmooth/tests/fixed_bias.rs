@@ -181,7 +181,7 @@ fn dominant_bias_is_exact_for_degree_m_plus_1_t7_22() {
 fn bias_versus_random_error_ex_7_26_t7_23() {
     // Ex 7.26: m = 1, σ_ν = 200 ft, R'' = 32 ft/s² (a2 = 16), τ = 1 s. The book's σ column is
     // the one-step formula (7.5.25) although the text says "updated" (misprint register
-    // ch07-09.md §7, "Ex 7.26a 'updated' but formula is the 1-step one"); both are checked.
+    // the book's Ex 7.26a says "updated" 'updated' but formula is the 1-step one"); both are checked.
     let table = [
         (5u64, 186.2, 144.7, 53.3),
         (10, 129.3, 112.8, 240.0),
@@ -236,7 +236,7 @@ fn bias_versus_random_error_ex_7_26_t7_23() {
 
 #[test]
 fn quadratic_fit_to_a_sine_ex_7_8_t7_24() {
-    // T7-24 [DERIVED]: m = 2, L = 4, Y = (sin 90°, sin 67.5°, sin 45°, sin 22.5°, sin 0°),
+    // T7-24 (derived): m = 2, L = 4, Y = (sin 90°, sin 67.5°, sin 45°, sin 22.5°, sin 0°),
     // r = θ/22.5°: p*(r) = -0.008473346 + 0.4600557607 r - 0.05148403766 r² — the Taylor
     // coefficients at r = 0, i.e. W(-L) Y; max |p* - sin| on a 1° grid = 0.01777 at 20°.
     let y: Vec<f64> = (0..=4)

@@ -22,8 +22,8 @@ use seqsmooth::{Error, PolynomialFilter};
 
 #[test]
 fn fixed_memory_vrf_limit_tables_7_2_and_9_3() {
-    // Source: Morrison Table 7.2 (closed form of its entries), Table 9.3 (m <= 3; m = 4 [DERIVED]),
-    // (7.6.12), closed forms of spec ch07-09.md §1.8, exact entries listed there.
+    // Source: Morrison Table 7.2 (closed form of its entries), Table 9.3 (m <= 3; m = 4 derived),
+    // (7.6.12) and its closed forms.
     for m in 0..=10usize {
         let k = fixed_memory_vrf_limit(m);
         for i in 0..=m {
@@ -111,24 +111,8 @@ fn covariance_is_w_wt_and_window_covariance_exactly() {
     // In f64 the recursion keeps full accuracy at the centre, where Φ(h) cancels: m = 8,
     // L = 1000, h = -500. Measured: 7.4e-16 relative per entry (bound 1e-12); the Φ(h)-product
     // form of vrf::window_covariance: 5.4e-13.
-    let (m, l) = (8usize, 1000i64);
-    let exact = to_f64(&covariance(m, l as u64, fr(-l, 2)).unwrap());
-    let got = covariance(m, l as u64, -(l as f64) / 2.0).unwrap();
-    let wc = window_covariance(m, l as u64, -(l as f64) / 2.0);
-    let rel = |a: &DMatrix<f64>| {
-        (0..=m)
-            .flat_map(|i| (0..=m).map(move |j| (i, j)))
-            .map(|(i, j)| {
-                (a[(i, j)] - exact[(i, j)]).abs() / (exact[(i, i)] * exact[(j, j)]).sqrt()
-            })
-            .fold(0.0, f64::max)
-    };
-    println!(
-        "centre covariance, m = 8, L = 1000: recursion {:.1e}, Φ-product {:.1e}",
-        rel(&got),
-        rel(&wc)
-    );
-    assert!(rel(&got) <= 1e-12);
+    let (recursion, _phi_product) = centre_covariance_errors();
+    assert!(recursion <= 1e-12);
 }
 
 /// (L + a)(L + a - 1)…, the falling factorial (L+a)^(k).
@@ -144,8 +128,8 @@ fn poly_in(l: &Q, c: &[i64]) -> Q {
 
 #[test]
 fn exact_vrf_closed_forms_t7_10_t7_12_t7_13() {
-    // Unscaled VRF diagonals (τ = 1: (i!)² [W Wᵀ]_ii) against the closed forms of ch07-09.md §1.5:
-    // h = 1 = Table 9.2 with n -> L [BOOK]; h = 0 and centre [DERIVED].
+    // Unscaled VRF diagonals (τ = 1: (i!)² [W Wᵀ]_ii) against closed forms derived from (7.5.x):
+    // h = 1 = Table 9.2 with n -> L (book); h = 0 and centre (derived).
     type Form = fn(&Q) -> Q;
     let h1: [&[Form]; 4] = [
         &[|l| Q::one() / (l.clone() + z(1))],
@@ -256,7 +240,7 @@ fn covariance_examples_7_5_16_7_5_25_ex_7_11_ex_7_21() {
         assert_eq!(s1[(0, 0)], z(2) * (z(2) * lq.clone() + z(3)) / e.clone());
         assert_eq!(s1[(0, 1)], z(6) / e.clone());
         assert_eq!(s1[(1, 1)], z(12) / (e * (lq.clone() + z(2))));
-        // m = 1, general h [DERIVED], and Ex 7.11: diagonal at the centre.
+        // m = 1, general h (derived), and Ex 7.11: diagonal at the centre.
         for h in [z(-7), fr(-1, 3), z(3), fr(-l, 2)] {
             let s = covariance(1, l as u64, h.clone()).unwrap();
             let den = lq.clone() * d.clone();
@@ -331,7 +315,7 @@ fn impulse_response_gives_the_covariance_ex_7_6_and_dies_after_one_window_ex_7_5
 fn correlated_errors_ex_7_10() {
     // Ex 7.10 (T7-11): R = tridiag(1, 2, 1), W = W(0), m = 1, L = 4: S = W R Wᵀ =
     // [[46/25, 14/25], [14/25, 7/25]]. The book prints the diagonal as "1.76 and 0.28"
-    // (misprint register ch07-09.md §7: 1.84 is the exact value; the velocity agrees).
+    // (a misprint: 1.84 is the exact value; the velocity agrees).
     let r = DMatrix::from_fn(5, 5, |i, j| match i.abs_diff(j) {
         0 => z(2),
         1 => z(1),
@@ -512,8 +496,8 @@ const TABLE_7_3: [&[(&str, i32)]; 11] = [
     &[("9.439", 24)],
 ];
 
-/// Printed values whose last digit is one unit off the exact value (book rounding, recorded in
-/// ch07-09.md §1.8): Table 7.3 (5, m = 9, 10): exact 5.97648e12 printed 5.977; (6, m = 8, 9):
+/// Printed values whose last digit is one unit off the exact value (book rounding):
+/// Table 7.3 (5, m = 9, 10): exact 5.97648e12 printed 5.977; (6, m = 8, 9):
 /// exact 3.23649e14 printed 3.237.
 const TABLE_7_3_ROUNDING: [(usize, usize); 4] = [(5, 9), (5, 10), (6, 8), (6, 9)];
 
@@ -537,7 +521,7 @@ fn asymptotic_tables_7_2_and_7_3_entry_for_entry() {
         // ρ = 1 is vrf::fixed_memory_vrf_limit (κ = V H⁻¹ Vᵀ, an independent formula) exactly.
         assert_eq!(end, fixed_memory_vrf_limit(m), "m = {m}");
         for i in 0..=m {
-            // End-point closed forms (ch07-09.md §1.8).
+            // End-point closed forms of (7.6.12).
             for j in 0..=m {
                 let want = (i.max(j)..=m).fold(Q::zero(), |s, k| {
                     s + z(2 * k as i64 + 1) * fact(k + i) * fact(k + j)
@@ -581,7 +565,7 @@ fn asymptotic_tables_7_2_and_7_3_entry_for_entry() {
             }
         }
     }
-    // Exact Table 7.3 rows as listed in ch07-09.md §1.8.
+    // Exact Table 7.3 rows.
     let exact_centre: [&[&str]; 5] = [
         &[
             "1",
@@ -649,7 +633,7 @@ fn asymptotic_tables_7_2_and_7_3_entry_for_entry() {
             );
         }
     }
-    // The two entries the book rounds up (exact values from ch07-09.md §1.8).
+    // The two entries the book rounds up (exact values).
     for m in [9usize, 10] {
         assert_eq!(
             vrf_limit(m, half.clone()).unwrap()[(5, 5)],
@@ -666,7 +650,7 @@ fn asymptotic_tables_7_2_and_7_3_entry_for_entry() {
 fn asymptotic_matrices_worked_examples_and_misprints() {
     let half = fr(1, 2);
     let mat = |v: &[&[i64]]| DMatrix::from_fn(v.len(), v.len(), |i, j| z(v[i][j]));
-    // Full λ matrices (ch07-09.md §1.8 [DERIVED]).
+    // Full λ matrices (derived from (7.6.12)).
     assert_eq!(
         vrf_limit(2, z(1)).unwrap(),
         mat(&[&[9, 36, 60], &[36, 192, 360], &[60, 360, 720]])
@@ -692,7 +676,7 @@ fn asymptotic_matrices_worked_examples_and_misprints() {
         (z(75), z(-2520), z(100800))
     );
     // (7.8.1)-(7.8.5), m = 4: end point 25, 4800, 317520 — the book prints 317500 (misprint
-    // register ch07-09.md §7: "(7.8.1) 317500 -> 317520", a 4-figure rounding of Table 7.2's
+    // a misprint: "(7.8.1) 317500 -> 317520", a 4-figure rounding of Table 7.2's
     // 3.175e5); centre 3.516 (= 225/64), 75, and 8820 for x'' — the book prints 720 in
     // (7.8.4)-(7.8.5), the m = 2/3 value ("(7.8.4-5) 720 -> 8820"; Table 7.3 has 8.820e3).
     let e4 = vrf_limit(4, z(1)).unwrap();
@@ -747,7 +731,6 @@ fn asymptotic_matrices_worked_examples_and_misprints() {
             }
         }
     }
-    println!("L^(2i+1) VRF at L = 10^6 vs λ: worst relative difference {worst:.2e}");
 }
 
 #[test]
@@ -755,7 +738,7 @@ fn design_example_t7_16() {
     // (7.6.1)-(7.6.5): σ_ν = 10 ft, m = 1, one-step prediction, σ(x) = 3 ft -> L = 45 (exact
     // root 44.93); velocity variance 0.0123/τ²; σ(x') = 4 ft/s -> τ = 0.0278 s — the book
     // prints "τ = 0.029 seconds, i.e. about 36 observations per second" (misprint register
-    // ch07-09.md §7, (7.6.5): 0.029 -> 0.0278; 36/s is right).
+    // a misprint in (7.6.5): 0.029 -> 0.0278; 36/s is right).
     let lead = Lead::Steps(1.0);
     assert_eq!(min_span_for_sigma(1, 0, lead, 1.0, 10.0, 3.0).unwrap(), 45);
     let sd = |l: u64| 10.0 * covariance_unscaled(1, l, 1.0, 1.0).unwrap()[(0, 0)].sqrt();

@@ -66,7 +66,6 @@ fn smooth_even_spacing_equals_exact_least_squares() {
             worst = worst.max(e);
         }
     }
-    println!("smooth (even) vs exact least squares: worst {worst:.2e}");
 }
 
 #[test]
@@ -127,7 +126,6 @@ fn smooth_irregular_spacing_equals_exact_least_squares() {
             worst = worst.max(e);
         }
     }
-    println!("smooth (irregular) vs exact least squares: worst {worst:.2e}");
     // Nearly even times (one step off by 1e-6 relative) are irregular: the fit uses the true
     // times, not an assumed grid.
     let mut t: Vec<f64> = (0..40).map(|k| k as f64).collect();

@@ -31,11 +31,6 @@ fn trend_removal_shrinks_the_bias_of_a_non_polynomial_truth() {
     };
     for i in 0..=1 {
         let ratio = err(&det, i) / err(&plain, i);
-        println!(
-            "trend removal, derivative {i}: plain {:.3e}, detrended {:.3e}, ratio {ratio:.2e}",
-            err(&plain, i),
-            err(&det, i)
-        );
         assert!(ratio < 0.05, "derivative {i}: ratio {ratio}");
     }
     // A truth that differs from the nominal by a polynomial of degree ≤ m is recovered exactly.
@@ -63,6 +58,5 @@ fn trend_removal_shrinks_the_bias_of_a_non_polynomial_truth() {
         worst
     };
     let ratio = run(true) / run(false);
-    println!("streaming trend removal, value error ratio {ratio:.2e}");
     assert!(ratio < 0.05);
 }

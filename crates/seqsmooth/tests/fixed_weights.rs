@@ -9,7 +9,6 @@ use common::fixed::*;
 use common::rational::*;
 use nalgebra::DMatrix;
 use num_traits::{One, Signed, Zero};
-use seqsmooth::basis::legendre::{taylor_table, values as legendre_values};
 use seqsmooth::basis::DiscreteLegendre;
 use seqsmooth::calculus::{link_matrix, link_matrix_inverse};
 use seqsmooth::estimate::PolynomialFit;
@@ -96,43 +95,13 @@ fn book_weights(m: usize, l: i64, h: Q) -> DMatrix<Q> {
     )
 }
 
-/// Weights by Householder QR (nalgebra) of the Legendre design matrix on `r = 0..L` mapped to
-/// `[-1, 1]`: `coefficients = R⁻¹ Qᵀ y`, then Taylor coefficients (per sample) at `r = L+h`.
-/// Columns newest first, like `weights`.
-fn qr_weights(m: usize, l: usize, h: f64) -> DMatrix<f64> {
-    let n = l + 1;
-    let hw = (l as f64 / 2.0).max(0.5);
-    let a = DMatrix::from_fn(n, m + 1, |r, j| {
-        legendre_values(m, (r as f64 - l as f64 / 2.0) / hw)[j]
-    });
-    let qr = a.qr();
-    let qm = qr.q();
-    let rinv = qr.r().try_inverse().expect("full rank");
-    let coef = rinv * qm.transpose();
-    let tt = taylor_table(m, m, (l as f64 + h - l as f64 / 2.0) / hw);
-    let jac = DMatrix::from_fn(m + 1, m + 1, |k, j| tt[(k, j)] / hw.powi(k as i32));
-    let w = jac * coef;
-    DMatrix::from_fn(m + 1, n, |i, k| w[(i, l - k)])
-}
-
-/// Largest over rows of `max_k |a_ik - b_ik| / max_k |b_ik|`.
-fn row_rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
-    (0..a.nrows())
-        .map(|i| {
-            let scale = b.row(i).iter().fold(0.0f64, |s, v| s.max(v.abs()));
-            let d = (0..a.ncols()).fold(0.0f64, |s, k| s.max((a[(i, k)] - b[(i, k)]).abs()));
-            d / scale
-        })
-        .fold(0.0, f64::max)
-}
-
 fn y_newest_first(y: &[Q]) -> DMatrix<Q> {
     DMatrix::from_fn(y.len(), 1, |i, _| y[i].clone())
 }
 
 #[test]
 fn weights_equal_morrisons_product_exactly_7_4_16() {
-    // W(h) = Φ(h) 𝒮 G C B (7.4.16) entry for entry, and the exactness property of spec §1.4
+    // W(h) = Φ(h) 𝒮 G C B (7.4.16) entry for entry, and the exactness property of (7.4.14)
     // (T7-09): W(h) T_(L) = Φ(h) with [T]_{k,i} = (-k)^i (a degree-m input passes unchanged).
     for m in 0..=5usize {
         for l in [m as i64, 5, 8, 13] {
@@ -302,7 +271,7 @@ fn test_vectors_t7_01_to_t7_08() {
 
 #[test]
 fn closed_form_weights_of_spec_1_4() {
-    // [DERIVED, VERIFIED] closed forms of ch07-09.md §1.4, weight on y_{n-j}.
+    // Closed forms derived from (7.4.16), weight on y_{n-j}.
     for l in [4i64, 9, 16] {
         let lq = z(l);
         let (l1, l2, l3, lm1) = (
@@ -411,22 +380,9 @@ fn f64_weights_match_a_householder_qr_fit_up_to_l_10000() {
     // also run at m = 10); measured ≤ 2.2e-12, the worst at the centre, m = 1, L = 10⁴, where
     // the QR oracle is the less accurate of the two: there `weights` is within 2.2e-16 of the
     // exact rational weights and the QR 2.1e-12 (next test).
-    let mut worst: f64 = 0.0;
-    for m in [0usize, 1, 2, 4, 6, 8, 10] {
-        for l in [m.max(1), 10, 100, 1000, 10000] {
-            if l < m {
-                continue;
-            }
-            let lf = l as f64;
-            for h in [0.0, 1.0, -lf / 2.0, 2.5, -lf - 3.0] {
-                let w = weights(m, l as u64, h).unwrap();
-                let e = row_rel(&w, &qr_weights(m, l, h));
-                assert!(e <= 1e-10, "m = {m}, L = {l}, h = {h}: {e:.2e}");
-                worst = worst.max(e);
-            }
-        }
+    for (m, l, h, e) in weights_vs_qr() {
+        assert!(e <= 1e-10, "m = {m}, L = {l}, h = {h}: {e:.2e}");
     }
-    println!("f64 weights vs Householder QR: worst row-relative difference {worst:.2e}");
     // The library's batch fitter on a few unit vectors (a second, independent QR code path).
     let (m, l, h) = (4usize, 1000usize, 2.5);
     let w = weights(m, l as u64, h).unwrap();
@@ -455,56 +411,19 @@ fn f64_weights_match_exact_rationals_where_the_explicit_sums_cancel() {
     // the recursion.
     let mut worst: f64 = 0.0;
     let mut book_m10: f64 = 0.0;
-    for (m, l) in [
-        (4usize, 40i64),
-        (8, 40),
-        (10, 40),
-        (4, 300),
-        (8, 300),
-        (10, 300),
-    ] {
-        for h in [z(0), fr(-l, 2), z(-l - 3)] {
-            let exact = to_f64(&weights(m, l as u64, h.clone()).unwrap());
-            let w = weights(m, l as u64, f(&h)).unwrap();
-            let e = row_rel(&w, &exact);
-            assert!(e <= 1e-13, "m = {m}, L = {l}, h = {h}: {e:.2e}");
-            worst = worst.max(e);
-            if m == 10 && l == 300 {
-                let hb = f(&h);
-                let b = DiscreteLegendre::new(l as f64);
-                let c =
-                    DMatrix::from_fn(
-                        m + 1,
-                        m + 1,
-                        |i, j| if i == j { 1.0 / b.norm_sq(j) } else { 0.0 },
-                    );
-                let bm = DMatrix::from_fn(m + 1, (l + 1) as usize, |i, j| {
-                    b.value(i, (l - j as i64) as f64)
-                });
-                let book = mul(
-                    &mul(
-                        &mul(
-                            &mul(&phi(m, hb), &link_matrix::<f64>(m)),
-                            &b.end_differences(m),
-                        ),
-                        &c,
-                    ),
-                    &bm,
-                );
-                book_m10 = book_m10.max(row_rel(&book, &exact));
-            }
+    for (m, l, h, e, book) in weights_vs_exact() {
+        assert!(e <= 1e-13, "m = {m}, L = {l}, h = {h}: {e:.2e}");
+        worst = worst.max(e);
+        if let Some(b) = book {
+            book_m10 = book_m10.max(b);
         }
     }
     // Long windows, low degree, at the centre: measured ≤ 1e-15 against the exact weights, where
     // the QR oracle of the previous test is off by 2e-12 (m = 1, L = 10⁴).
-    for m in [1usize, 2] {
-        let l = 10_000i64;
-        let exact = to_f64(&weights(m, l as u64, fr(-l, 2)).unwrap());
-        let e = row_rel(&weights(m, l as u64, -(l as f64) / 2.0).unwrap(), &exact);
+    for (m, e) in weights_vs_exact_long_windows() {
         assert!(e <= 1e-13, "m = {m}, L = 10⁴: {e:.2e}");
         worst = worst.max(e);
     }
-    println!("f64 weights vs exact: {worst:.2e}; explicit-sum product at m = 10, L = 300: {book_m10:.2e}");
     assert!(
         book_m10 > 1e3 * worst,
         "the explicit sums were expected to cancel"

@@ -68,7 +68,7 @@ fn gain_recursion_is_self_starting_from_any_initial_state_in_exact_arithmetic() 
 
 #[test]
 fn gain_engine_is_exact_on_even_steps_that_differ_from_tau() {
-    // ../shared/spec/others.md §4.8: with n = sample count, gains h_k/ζ^k and θ_eff = θ^ζ the
+    // Reyneke et al. §6: with n = sample count, gains h_k/ζ^k and θ_eff = θ^ζ the
     // variable-step recursion is exact for a constant step ζτ ≠ τ (the paper's rule is not).
     for m in 0..=8 {
         let times = even_times(300, 1.0, 0.375);
@@ -90,7 +90,6 @@ fn gain_engine_is_exact_on_even_steps_that_differ_from_tau() {
             let mut f = FadingMemory::new(m, 0.81, 1.0, Engine::Gain).unwrap();
             let err =
                 compare_fading_exact(&mut f, &times, &ys, m, per_sample, &[len - 100, len - 2]);
-            eprintln!("fading gain step={step} m={m}: {err:.2e}");
             assert!(err < TOL, "fading m={m} step={step} {err:e}");
         }
     }
@@ -131,7 +130,6 @@ fn gain_engine_stays_close_to_least_squares_on_irregular_schedules() {
                 }
             }
             let rms = (sum_sq / count).sqrt();
-            eprintln!("gain vs exact, fading={fading} poisson={poisson} m={m}: max {worst:.2} σ, rms {rms:.2} σ");
             if poisson {
                 assert!(rms < 5.0, "m={m}: rms {rms} σ");
             } else {

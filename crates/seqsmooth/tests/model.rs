@@ -14,7 +14,7 @@ use seqsmooth::model::{
 
 #[test]
 fn transition_matrix_group_properties_4_2_20_to_4_2_24() {
-    // Source: Morrison (4.2.15), (4.2.20), (4.2.23), (4.2.24); spec ch02-06.md §8 check 3.
+    // Source: Morrison (4.2.15), (4.2.20), (4.2.23), (4.2.24).
     let hs = [z(1), z(-1), fr(1, 2), z(3), fr(-7, 3), z(0)];
     for m in 0..=7usize {
         assert_eq!(phi(m, z(0)), eye(m + 1));
@@ -85,7 +85,7 @@ fn transition_matrix_examples_4_2_17_and_4_2_25() {
 
 #[test]
 fn scaled_and_unscaled_transitions_related_by_scaling_4_2_18() {
-    // Source: Morrison (4.2.5), (4.2.13)-(4.2.19); spec [DERIVED] Φ_Z(h) = D(τ)⁻¹ Φ_X(hτ) D(τ),
+    // Source: Morrison (4.2.5), (4.2.13)-(4.2.19); derived: Φ_Z(h) = D(τ)⁻¹ Φ_X(hτ) D(τ),
     // with Φ_X = psi (Reyneke eq. 7); TV4.5 D(2) = diag(1, 1/2, 1/2, 3/4).
     assert_eq!(
         scaling(3, z(2)),
@@ -158,7 +158,7 @@ fn scaled_and_unscaled_transitions_related_by_scaling_4_2_18() {
 
 #[test]
 fn transition_matrices_are_matrix_exponentials_4_6_24() {
-    // Source: Morrison (4.6.24)-(4.6.28): Φ(ζ) = exp(ζA); spec ch02-06.md §4.5 [DERIVED]:
+    // Source: Morrison (4.6.24)-(4.6.28): Φ(ζ) = exp(ζA); derived:
     // for X, A = superdiagonal of ones (exp(ζA) = psi(ζ)); for Z, N_{i,i+1} = i+1 (exp(hN) = Φ(h)),
     // TV4.9 (Ex 4.11). Both A, N are nilpotent, so the series is finite (m+1 terms).
     let expm = |a: &DMatrix<Q>, t: &Q| {

@@ -1,4 +1,4 @@
-//! `seqsmooth::stats::noise`: Reyneke et al. (2012) §5 difference-based noise estimators (the
+//! `seqsmooth::stats::noise`: Reyneke et al. (2012) §7 difference-based noise estimators (the
 //! trend bias of eq. 39 and stdd, removed by higher differences), windows, irregular samples, bad
 //! input.
 //!
@@ -22,9 +22,9 @@ fn choose(n: u64, k: u64) -> f64 {
     (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64)
 }
 
-/// Reyneke's comparison (others.md §4.7): white noise σ = 1 plus no trend, a 0.5/sample ramp,
+/// Reyneke et al. §7 comparison: white noise σ = 1 plus no trend, a 0.5/sample ramp,
 /// or a 1e-3 n² parabola, N = 2000. Expected values: eq. 39 → √(1 + Σ Δtrend²/(2N−2)) =
-/// 1.000 / 1.061 / 1.915, stdd → √(1 + Var(Δtrend)/2) = 1.000 / 1.000 / 1.291; the spec prints
+/// 1.000 / 1.061 / 1.915, stdd → √(1 + Var(Δtrend)/2) = 1.000 / 1.000 / 1.291; the paper prints
 /// 1.000/1.061/1.914 and 1.000/1.001/1.290.
 #[test]
 fn reyneke_noise_estimators_reproduce_the_trend_bias_and_higher_differences_remove_it() {
@@ -44,17 +44,12 @@ fn reyneke_noise_estimators_reproduce_the_trend_bias_and_higher_differences_remo
     let se =
         |k: u64| 0.5 * (2.0 * choose(4 * k, 2 * k) / choose(2 * k, k).powi(2) / n as f64).sqrt();
     let mut third = Vec::new();
-    println!("trend      eq39   stdd   ∇² est ∇³ est   (printed eq39 / stdd)");
     for (i, (name, trend)) in trends.iter().enumerate() {
         let y: Vec<f64> = (0..n).map(|k| trend(k as f64) + noise[k]).collect();
         let e39 = reyneke_eq39_variance(&y).unwrap().sqrt();
         let stdd = reyneke_stdd(&y).unwrap();
         let d2 = difference_variance(&y, 2).unwrap().sqrt();
         let d3 = difference_variance(&y, 3).unwrap().sqrt();
-        println!(
-            "{name:10} {e39:.3}  {stdd:.3}  {d2:.3}  {d3:.3}   ({:.3} / {:.3})",
-            printed_eq39[i], printed_stdd[i]
-        );
         // the expected (bias) values, exactly
         let d: Vec<f64> = (1..n)
             .map(|k| trend(k as f64) - trend(k as f64 - 1.0))
@@ -129,11 +124,6 @@ fn difference_noise_is_unbiased_on_irregular_samples_with_a_polynomial_trend() {
     }
     let mean = w.mean().unwrap();
     let se = (w.sample_variance().unwrap() / runs as f64).sqrt();
-    println!(
-        "order-4 divided differences: mean σ̂² {mean:.4} (σ² = {:.4}, se {se:.4}); order 1: {:.1}",
-        sigma * sigma,
-        w_first.mean().unwrap()
-    );
     assert!((mean - sigma * sigma).abs() < Z * se);
     assert!(w_first.mean().unwrap() > 10.0 * sigma * sigma); // the first difference is useless here
 }

@@ -41,10 +41,6 @@ fn residual_variance_is_unbiased_and_chi_squared() {
     let mean = w.mean().unwrap();
     let se = sigma * sigma * (2.0 / dof / runs as f64).sqrt();
     let rate = above as f64 / runs as f64;
-    println!(
-        "residual variance: mean {mean:.5} (σ² {:.5}), above χ² 95%: {rate:.4}",
-        sigma * sigma
-    );
     assert!((mean - sigma * sigma).abs() < Z * se);
     assert!((rate - 0.05).abs() < Z * (0.05 * 0.95 / runs as f64).sqrt());
     assert!(residual_variance(-1.0, 10, 2).is_err());

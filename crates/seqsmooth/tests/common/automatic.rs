@@ -42,6 +42,12 @@ pub const GENTLE: Manoeuvre = Manoeuvre {
     accel: 0.01,
 };
 
+pub const SHARP: Manoeuvre = Manoeuvre {
+    onset: 800.0,
+    end: 900.0,
+    accel: 3.0,
+};
+
 #[derive(Clone, Copy, Debug)]
 pub struct Sample {
     pub t: f64,

@@ -139,12 +139,7 @@ pub fn plain_steady_kernel_error(m: usize, theta: f64) -> (f64, u64) {
         if one.samples() < n as u64 / 2 {
             continue;
         }
-        let a = one.estimate().unwrap().derivatives;
-        let b = many.estimate().unwrap().derivatives;
-        for k in 0..=m {
-            scale[k] = scale[k].max(a[k].abs());
-            worst[k] = worst[k].max((a[k] - b[k]).abs());
-        }
+        record_difference(&one, &many, &mut scale, &mut worst);
     }
     let switched = many.switched_at().expect("switched within the run");
     (relative_worst(&worst, &scale), switched)
@@ -170,14 +165,24 @@ pub fn plain_expanding_kernel_error(m: usize, jitter: bool) -> f64 {
         if one.samples() < 10 * (m as u64 + 1) {
             continue;
         }
-        let a = one.estimate().unwrap().derivatives;
-        let b = many.estimate().unwrap().derivatives;
-        for k in 0..=m {
-            scale[k] = scale[k].max(a[k].abs());
-            worst[k] = worst[k].max((a[k] - b[k]).abs());
-        }
+        record_difference(&one, &many, &mut scale, &mut worst);
     }
     relative_worst(&worst, &scale)
+}
+
+/// Updates the running `max |x^(k)|` of `one` and `max |Δx^(k)|` between the two filters.
+fn record_difference(
+    one: &dyn PolynomialFilter,
+    many: &dyn PolynomialFilter,
+    scale: &mut [f64],
+    worst: &mut [f64],
+) {
+    let a = one.estimate().unwrap().derivatives;
+    let b = many.estimate().unwrap().derivatives;
+    for k in 0..a.len() {
+        scale[k] = scale[k].max(a[k].abs());
+        worst[k] = worst[k].max((a[k] - b[k]).abs());
+    }
 }
 
 /// `max_k worst_k / scale_k`.

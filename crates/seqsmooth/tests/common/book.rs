@@ -68,7 +68,7 @@ pub fn emp_book(m: usize, n: &Q) -> Vec<Q> {
     nums.into_iter().map(|v| v / den.clone()).collect()
 }
 
-/// Morrison Table 13.1 (m <= 4; degree 3 reconstructed, spec ch10-15.md §4.6) and Reyneke §6.6
+/// Morrison Table 13.1 (m <= 4; degree 3 reconstructed from (13.5.3)) and Reyneke §6.6
 /// (m <= 5): fading-memory current-estimate gains h_0(θ)..h_m(θ).
 pub fn fmp_book(m: usize, th: &Q) -> Vec<Q> {
     let om = z(1) - th.clone();
@@ -120,7 +120,7 @@ pub fn ls_normal_matrix(m: usize, l: u64) -> DMatrix<Q> {
     })
 }
 
-/// κ_ij(m) = Σ_{k=max(i,j)}^{m} (2k+1) (k+i)!(k+j)! / (i! j! (k-i)! (k-j)!) (spec ch07-09.md §1.8,
+/// κ_ij(m) = Σ_{k=max(i,j)}^{m} (2k+1) (k+i)!(k+j)! / (i! j! (k-i)! (k-j)!) (Morrison (7.6.12),
 /// end-point closed form).
 pub fn kappa(m: usize, i: usize, j: usize) -> Q {
     (i.max(j)..=m).fold(Q::zero(), |s, k| {

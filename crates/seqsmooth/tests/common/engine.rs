@@ -1,10 +1,11 @@
-//! Shared by the engine tests: runs a filter against batch least-squares oracles and reports the
-//! largest relative error.
+//! Shared by the engine tests and the `accuracy_engines` example: runs a filter against batch
+//! least-squares oracles and reports the largest relative error, for the runs the tests assert
+//! and the example prints.
 
 use super::*;
-use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
+use seqsmooth::{DiscountMode, Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
 
-/// Relative tolerance required by the issue.
+/// Relative tolerance required of both engines against least squares, degrees 0-8.
 pub const TOL: f64 = 1e-9;
 
 /// Per-derivative floors for the relative error: 1e-3 of the largest magnitude the oracle
@@ -141,4 +142,151 @@ pub fn test_filter(fading: bool, engine: Engine, m: usize, sigma: Option<f64>) -
                 .unwrap(),
         ),
     }
+}
+
+/// Expanding memory on 200 even samples (`t = 5 + k/4`) of a noisy degree-`m` polynomial, both
+/// engines against batch QR at every sample: `(exact, gain)`.
+pub fn expanding_even_errors(m: usize) -> (f64, f64) {
+    let times = even_times(200, 5.0, 0.25);
+    let ys = noisy_polynomial(&times, m, 50.0, 0.3, 100 + m as u64);
+    let run = |engine| {
+        compare(
+            Box::new(ExpandingMemory::new(m, engine).unwrap()),
+            &times,
+            &ys,
+            m,
+            |_| true,
+            |_| None,
+        )
+    };
+    (run(Engine::Exact), run(Engine::Gain))
+}
+
+/// Expanding memory over 10⁵ even samples, against batch QR at samples 999, 9 999 and 99 999.
+pub fn expanding_long_run_error(m: usize, engine: Engine) -> f64 {
+    let n = 100_001;
+    let times = even_times(n, 0.0, 1e-3);
+    let ys = noisy_polynomial(&times, m, 100.0, 0.1, 7 + m as u64);
+    let checkpoints = [999usize, 9_999, 99_999];
+    compare(
+        Box::new(ExpandingMemory::new(m, engine).unwrap()),
+        &times,
+        &ys,
+        m,
+        |k| checkpoints.contains(&k),
+        |_| None,
+    )
+}
+
+/// The exact expanding-memory engine on 150 jittered (±40 %) and 150 random (Poisson) samples,
+/// against batch QR at every sample: `[(label, error)]`.
+pub fn expanding_irregular_errors(m: usize) -> Vec<(&'static str, f64)> {
+    [
+        ("jittered", jittered_times(150, 0.1, 0.4, 11 + m as u64)),
+        ("random", random_times(150, 0.1, 21 + m as u64)),
+    ]
+    .into_iter()
+    .map(|(label, times)| {
+        let ys = noisy_polynomial(&times, m, 15.0, 0.2, 31 + m as u64);
+        let err = compare(
+            Box::new(ExpandingMemory::new(m, Engine::Exact).unwrap()),
+            &times,
+            &ys,
+            m,
+            |_| true,
+            |_| None,
+        );
+        (label, err)
+    })
+    .collect()
+}
+
+/// Discount weights of samples `0..=n`: `θ^((t_n - t_k)/τ)` per time, `θ^(n-k)` per update.
+pub fn discount_weights(
+    times: &[f64],
+    n: usize,
+    theta: f64,
+    tau: f64,
+    mode: DiscountMode,
+) -> Vec<f64> {
+    (0..=n)
+        .map(|k| match mode {
+            DiscountMode::PerTime => theta.powf((times[n] - times[k]) / tau),
+            DiscountMode::PerUpdate => theta.powi((n - k) as i32),
+        })
+        .collect()
+}
+
+/// The exact fading-memory engine (θ = 0.93 per τ = 0.1) on 400 jittered (±50 %) samples,
+/// against discounted batch QR (samples before 60 and every 7th): the error for `mode`.
+pub fn fading_irregular_error(m: usize, mode: DiscountMode) -> f64 {
+    let theta = 0.93;
+    let tau = 0.1;
+    let times = jittered_times(400, 0.1, 0.5, 61 + m as u64);
+    let ys = noisy_polynomial(&times, m, 10.0, 0.2, 71 + m as u64);
+    let f = FadingMemory::new(m, theta, tau, Engine::Exact)
+        .unwrap()
+        .with_discount_mode(mode)
+        .unwrap();
+    compare(
+        Box::new(f),
+        &times,
+        &ys,
+        m,
+        |n| n < 60 || n % 7 == 0,
+        |n| Some(discount_weights(&times, n, theta, tau, mode)),
+    )
+}
+
+/// Fading memory (θ = 9/10, τ = 1) on 1000 even samples against exact rational discounted
+/// least squares: the gain engine from sample 700 on (after the switch transient), the exact
+/// engine from the first determinable sample. `(gain, exact)`.
+pub fn fading_even_errors(m: usize) -> (f64, f64) {
+    let theta = (9, 10);
+    let times = even_times(1000, 0.0, 1.0);
+    let ys = dyadic(&wavy(&times, 1.0, 0.01, 81 + m as u64));
+    let mut gain = FadingMemory::new(m, 0.9, 1.0, Engine::Gain).unwrap();
+    let g = compare_fading_exact(&mut gain, &times, &ys, m, theta, &[700, 850, 998]);
+    let mut exact = FadingMemory::new(m, 0.9, 1.0, Engine::Exact).unwrap();
+    let checks: Vec<usize> = [m, m + 1, m + 5, 40, 200, 998]
+        .into_iter()
+        .filter(|&n| n >= m)
+        .collect();
+    let e = compare_fading_exact(&mut exact, &times, &ys, m, theta, &checks);
+    (g, e)
+}
+
+/// The exact engine at high degree (the conditioning limit of the centred monomial
+/// square-root information form): 2000 jittered (±30 %) samples, against batch QR in the
+/// Legendre basis at samples m, m+5, 100, 500, 1998. `(expanding, fading θ = 0.99)`.
+pub fn high_degree_errors(m: usize) -> (f64, f64) {
+    let times = jittered_times(2000, 0.01, 0.3, 111 + m as u64);
+    let ys = noisy_polynomial(&times, m, 20.0, 1e-3, 121 + m as u64);
+    let check = [m, m + 5, 100, 500, 1998];
+    let expanding = compare(
+        Box::new(ExpandingMemory::new(m, Engine::Exact).unwrap()),
+        &times,
+        &ys,
+        m,
+        |n| check.contains(&n),
+        |_| None,
+    );
+    let theta = 0.99;
+    let fading = compare(
+        Box::new(FadingMemory::new(m, theta, 0.01, Engine::Exact).unwrap()),
+        &times,
+        &ys,
+        m,
+        |n| check.contains(&n),
+        |n| {
+            Some(discount_weights(
+                &times,
+                n,
+                theta,
+                0.01,
+                DiscountMode::PerTime,
+            ))
+        },
+    );
+    (expanding, fading)
 }

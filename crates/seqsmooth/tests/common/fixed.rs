@@ -5,8 +5,14 @@ use super::rational::*;
 use nalgebra::DMatrix;
 use num_traits::Signed;
 use rand::Rng;
+use seqsmooth::basis::legendre::{taylor_table, values as legendre_values};
 use seqsmooth::basis::DiscreteLegendre;
+use seqsmooth::calculus::link_matrix;
+use seqsmooth::linalg::mul;
+use seqsmooth::model::phi;
+use seqsmooth::polynomial::fixed::covariance;
 use seqsmooth::polynomial::fixed::{weights, FixedEngine, FixedMemory};
+use seqsmooth::polynomial::vrf::window_covariance;
 use seqsmooth::PolynomialFilter;
 
 pub fn rows(r: &[Vec<Q>]) -> DMatrix<Q> {
@@ -157,4 +163,135 @@ pub fn naive_sliding_drift() -> (f64, f64) {
         (naive - exact).abs() / 150.0,
         (engine - exact).abs() / 150.0,
     )
+}
+
+/// Weights by Householder QR (nalgebra) of the Legendre design matrix on `r = 0..L` mapped to
+/// `[-1, 1]`: `coefficients = R⁻¹ Qᵀ y`, then Taylor coefficients (per sample) at `r = L+h`.
+/// Columns newest first, like `weights`.
+pub fn qr_weights(m: usize, l: usize, h: f64) -> DMatrix<f64> {
+    let n = l + 1;
+    let hw = (l as f64 / 2.0).max(0.5);
+    let a = DMatrix::from_fn(n, m + 1, |r, j| {
+        legendre_values(m, (r as f64 - l as f64 / 2.0) / hw)[j]
+    });
+    let qr = a.qr();
+    let qm = qr.q();
+    let rinv = qr.r().try_inverse().expect("full rank");
+    let coef = rinv * qm.transpose();
+    let tt = taylor_table(m, m, (l as f64 + h - l as f64 / 2.0) / hw);
+    let jac = DMatrix::from_fn(m + 1, m + 1, |k, j| tt[(k, j)] / hw.powi(k as i32));
+    let w = jac * coef;
+    DMatrix::from_fn(m + 1, n, |i, k| w[(i, l - k)])
+}
+
+/// Largest over rows of `max_k |a_ik - b_ik| / max_k |b_ik|`.
+pub fn row_rel(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    (0..a.nrows())
+        .map(|i| {
+            let scale = b.row(i).iter().fold(0.0f64, |s, v| s.max(v.abs()));
+            let d = (0..a.ncols()).fold(0.0f64, |s, k| s.max((a[(i, k)] - b[(i, k)]).abs()));
+            d / scale
+        })
+        .fold(0.0, f64::max)
+}
+
+/// `f64` [`weights`] against [`qr_weights`] (Householder QR on a Legendre design matrix), per
+/// degree, window and lead: `(m, L, h, largest row-relative difference)`.
+pub fn weights_vs_qr() -> Vec<(usize, usize, f64, f64)> {
+    let mut out = Vec::new();
+    for m in [0usize, 1, 2, 4, 6, 8, 10] {
+        for l in [m.max(1), 10, 100, 1000, 10000] {
+            if l < m {
+                continue;
+            }
+            let lf = l as f64;
+            for h in [0.0, 1.0, -lf / 2.0, 2.5, -lf - 3.0] {
+                let w = weights(m, l as u64, h).unwrap();
+                out.push((m, l, h, row_rel(&w, &qr_weights(m, l, h))));
+            }
+        }
+    }
+    out
+}
+
+/// `f64` [`weights`] (recursion A1.1) against the exact rational weights:
+/// `(m, L, h, row-relative difference, at m = 10, L = 300 also that of the book's product
+/// Φ(h) 𝒮 G C B (7.4.16) evaluated in f64 with the explicit sums (3.2.20))`.
+pub fn weights_vs_exact() -> Vec<(usize, i64, Q, f64, Option<f64>)> {
+    let mut out = Vec::new();
+    for (m, l) in [
+        (4usize, 40i64),
+        (8, 40),
+        (10, 40),
+        (4, 300),
+        (8, 300),
+        (10, 300),
+    ] {
+        for h in [z(0), fr(-l, 2), z(-l - 3)] {
+            let exact = to_f64(&weights(m, l as u64, h.clone()).unwrap());
+            let w = weights(m, l as u64, f(&h)).unwrap();
+            let e = row_rel(&w, &exact);
+            let book = (m == 10 && l == 300).then(|| {
+                let hb = f(&h);
+                let b = DiscreteLegendre::new(l as f64);
+                let c =
+                    DMatrix::from_fn(
+                        m + 1,
+                        m + 1,
+                        |i, j| if i == j { 1.0 / b.norm_sq(j) } else { 0.0 },
+                    );
+                let bm = DMatrix::from_fn(m + 1, (l + 1) as usize, |i, j| {
+                    b.value(i, (l - j as i64) as f64)
+                });
+                let book = mul(
+                    &mul(
+                        &mul(
+                            &mul(&phi(m, hb), &link_matrix::<f64>(m)),
+                            &b.end_differences(m),
+                        ),
+                        &c,
+                    ),
+                    &bm,
+                );
+                row_rel(&book, &exact)
+            });
+            out.push((m, l, h, e, book));
+        }
+    }
+    out
+}
+
+/// Long windows, low degree, at the centre: `f64` [`weights`] against the exact weights,
+/// `L = 10⁴`: `(m, row-relative difference)`.
+pub fn weights_vs_exact_long_windows() -> Vec<(usize, f64)> {
+    [1usize, 2]
+        .into_iter()
+        .map(|m| {
+            let l = 10_000i64;
+            let exact = to_f64(&weights(m, l as u64, fr(-l, 2)).unwrap());
+            (
+                m,
+                row_rel(&weights(m, l as u64, -(l as f64) / 2.0).unwrap(), &exact),
+            )
+        })
+        .collect()
+}
+
+/// The `f64` covariance at the centre (m = 8, L = 1000, h = -500) against the exact one,
+/// largest entry error relative to `√(S_ii S_jj)`: `(the library's recursion, the Φ(h)-product
+/// form of vrf::window_covariance)`.
+pub fn centre_covariance_errors() -> (f64, f64) {
+    let (m, l) = (8usize, 1000i64);
+    let exact = to_f64(&covariance(m, l as u64, fr(-l, 2)).unwrap());
+    let got = covariance(m, l as u64, -(l as f64) / 2.0).unwrap();
+    let wc = window_covariance(m, l as u64, -(l as f64) / 2.0);
+    let rel = |a: &DMatrix<f64>| {
+        (0..=m)
+            .flat_map(|i| (0..=m).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                (a[(i, j)] - exact[(i, j)]).abs() / (exact[(i, i)] * exact[(j, j)]).sqrt()
+            })
+            .fold(0.0, f64::max)
+    };
+    (rel(&got), rel(&wc))
 }

@@ -11,7 +11,6 @@ use nalgebra::DMatrix;
 use rand_distr::{Distribution, StandardNormal};
 use seqsmooth::model::derivatives_to_scaled;
 use seqsmooth::{PolynomialFilter, PolynomialState};
-#[allow(unused_imports)]
 
 pub const RUNS: usize = 20_000;
 
