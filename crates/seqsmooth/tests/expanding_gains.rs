@@ -18,43 +18,45 @@ fn n_values() -> Vec<u64> {
     v
 }
 
-#[test]
-fn expanding_gains_match_morrison_table_9_1() {
-    // Source: Morrison Table 9.1, (9.4.18)-(9.4.19) (degrees 0-3).
-    for m in 0..=3 {
+/// The exact current-estimate gains of degrees `0..=max_degree` equal the printed formulas
+/// ([`emp_book`]) at every n of [`n_values`].
+fn assert_book_gains(max_degree: usize) {
+    for m in 0..=max_degree {
         for n in n_values() {
             let got = expanding_gains::<Q>(m, n, GainForm::Current);
             assert_eq!(got, emp_book(m, &z(n as i64)), "m = {m}, n = {n}");
         }
     }
-    // Alternative printed factorisation of the m = 3 position gain: 8(2n+1)(n²+n+3).
+}
+
+/// Gain `k` of degree `m` equals `c (2n+1) q(n) / (n+m+1)^(m+1)` for n = 0..60 (`q` lowest
+/// power first): an alternative printed factorisation.
+fn assert_factorised_gain(m: usize, k: usize, c: i64, q: &[i64]) {
     for n in 0..=60i64 {
         let nq = z(n);
         assert_eq!(
-            z(8) * poly(&[1, 2], &nq) * poly(&[3, 1, 1], &nq) / ff(&(nq.clone() + z(4)), 4),
-            expanding_gains::<Q>(3, n as u64, GainForm::Current)[0]
+            z(c) * poly(&[1, 2], &nq) * poly(q, &nq) / ff(&(nq.clone() + z(m as i64 + 1)), m + 1),
+            expanding_gains::<Q>(m, n as u64, GainForm::Current)[k],
+            "m = {m}, k = {k}, n = {n}"
         );
     }
+}
+
+#[test]
+fn expanding_gains_match_morrison_table_9_1() {
+    // Source: Morrison Table 9.1, (9.4.18)-(9.4.19) (degrees 0-3).
+    assert_book_gains(3);
+    // Alternative printed factorisation of the m = 3 position gain: 8(2n+1)(n²+n+3).
+    assert_factorised_gain(3, 0, 8, &[3, 1, 1]);
 }
 
 #[test]
 fn expanding_gains_match_reyneke_section_6_4() {
     // Source: Reyneke et al. §6.4, degrees 0-5; m = 4 also derived from Morrison
     // (9.4.18); top gain (2m+1)!/(m!)² / (n+m+1)^(m+1); h_0(n) = 1 for n <= m.
-    for m in 0..=5 {
-        for n in n_values() {
-            let got = expanding_gains::<Q>(m, n, GainForm::Current);
-            assert_eq!(got, emp_book(m, &z(n as i64)), "m = {m}, n = {n}");
-        }
-    }
+    assert_book_gains(5);
     // Alternative factorisation of the m = 4 velocity gain: 50(2n+1)(3n²+3n+10).
-    for n in 0..=60i64 {
-        let nq = z(n);
-        assert_eq!(
-            z(50) * poly(&[1, 2], &nq) * poly(&[10, 3, 3], &nq) / ff(&(nq.clone() + z(5)), 5),
-            expanding_gains::<Q>(4, n as u64, GainForm::Current)[1]
-        );
-    }
+    assert_factorised_gain(4, 1, 50, &[10, 3, 3]);
     for m in 0..=10usize {
         for n in [0u64, 1, 5, 17, 60, 1000] {
             let g = expanding_gains::<Q>(m, n, GainForm::Current);

@@ -16,13 +16,22 @@ fn savgol_window(n: usize, w: usize, len: usize) -> usize {
     n.saturating_sub((w - 1) / 2).min(len - w)
 }
 
+/// Largest `|got_k[i] - want_k[i]|` over the series, relative to the largest `|want_k[i]|`.
+fn column_error(got: &[Vec<f64>], want: &[Vec<f64>], i: usize) -> f64 {
+    let scale = want.iter().fold(0.0f64, |a, r| a.max(r[i].abs()));
+    got.iter()
+        .zip(want)
+        .map(|(a, b)| (a[i] - b[i]).abs())
+        .fold(0.0, f64::max)
+        / scale
+}
+
 #[test]
 fn smooth_even_spacing_equals_exact_least_squares() {
     // Every sample against the exact fit of its window (integer arithmetic), derivatives 0-2,
     // relative to each derivative's largest magnitude over the series. Measured worst 3.5e-14
     // (bound 1e-12).
     let step = 0.5;
-    let mut worst = 0.0f64;
     for (m, window, len) in [
         (0usize, 1usize, 40usize),
         (0, 7, 60),
@@ -52,18 +61,11 @@ fn smooth_even_spacing_equals_exact_least_squares() {
             })
             .collect();
         for i in 0..=m.min(2) {
-            let scale = want.iter().fold(0.0f64, |a, r| a.max(r[i].abs()));
-            let e = got
-                .iter()
-                .zip(&want)
-                .map(|(a, b)| (a[i] - b[i]).abs())
-                .fold(0.0, f64::max)
-                / scale;
+            let e = column_error(&got, &want, i);
             assert!(
                 e <= 1e-12,
                 "m = {m}, window = {window}, derivative {i}: {e:.2e}"
             );
-            worst = worst.max(e);
         }
     }
 }
@@ -100,7 +102,6 @@ fn smooth_matches_savgol_coefficients() {
 fn smooth_irregular_spacing_equals_exact_least_squares() {
     // Irregular times (detected: a step off by more than 1e-9 relative) use per-sample QR fits.
     // Measured worst 1.3e-13 relative to each derivative's scale (bound 1e-10).
-    let mut worst = 0.0f64;
     let times = jittered_times(120, 0.1, 0.3, 12);
     let ys = common::noisy_polynomial(&times, 4, 3.0, 0.1, 13);
     for (m, window) in [(1usize, 5usize), (2, 9), (3, 15), (4, 31), (2, 120)] {
@@ -112,18 +113,11 @@ fn smooth_irregular_spacing_equals_exact_least_squares() {
             })
             .collect();
         for i in 0..=m.min(2) {
-            let scale = want.iter().fold(0.0f64, |a, r| a.max(r[i].abs()));
-            let e = got
-                .iter()
-                .zip(&want)
-                .map(|(a, b)| (a[i] - b[i]).abs())
-                .fold(0.0, f64::max)
-                / scale;
+            let e = column_error(&got, &want, i);
             assert!(
                 e <= 1e-10,
                 "m = {m}, window = {window}, derivative {i}: {e:.2e}"
             );
-            worst = worst.max(e);
         }
     }
     // Nearly even times (one step off by 1e-6 relative) are irregular: the fit uses the true
