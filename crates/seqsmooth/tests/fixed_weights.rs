@@ -20,24 +20,7 @@ use seqsmooth::polynomial::fixed::{weights, weights_unscaled};
 fn fixed_memory_weights_from_basis_pieces_tv3_5_t7_06() {
     // Source: Morrison (7.4.16)-(7.4.17): W(h) = Φ(h) 𝒮 G C B with [B]_ij = p_i(L-j),
     // C = diag(1/c_j²); TV3.5 / T7-01 / T7-02 (m = 1, L = 4), T7-06 (m = 2, L = 4, ×1/35).
-    let weights = |m: usize, l: i64, h: Q| {
-        let b = DiscreteLegendre::new(z(l));
-        let cm = DMatrix::from_fn(m + 1, m + 1, |i, j| {
-            if i == j {
-                Q::one() / b.norm_sq(j)
-            } else {
-                Q::zero()
-            }
-        });
-        let bm = DMatrix::from_fn(m + 1, (l + 1) as usize, |i, j| b.value(i, z(l - j as i64)));
-        mm(
-            &mm(
-                &mm(&mm(&phi(m, h), &link_matrix::<Q>(m)), &b.end_differences(m)),
-                &cm,
-            ),
-            &bm,
-        )
-    };
+    let weights = book_weights;
     let tenth = |v: &[i64]| v.iter().map(|x| fr(*x, 10)).collect::<Vec<_>>();
     let w1 = weights(1, 4, z(1));
     assert_eq!(
@@ -72,7 +55,7 @@ fn scaled_row(v: &[&str], d: i64) -> Vec<Q> {
 /// Morrison's product `W(h) = Φ(h) 𝒮 G C B` (7.4.16), built in exact rationals from the library's
 /// basis pieces: `G` (A1.7) from `end_differences`, `C = diag(1/c_j²)` (3.2.30), and
 /// `[B]_ij = p_i(L-j)` from the explicit sum (3.2.20) in `DiscreteLegendre::value` — none of them
-/// the recursion (A1.1) that `weights` uses.
+/// the recursion (A1.1) that `weights` uses; the products are this file's own (`mm`).
 fn book_weights(m: usize, l: i64, h: Q) -> DMatrix<Q> {
     let b = DiscreteLegendre::new(z(l));
     let c = DMatrix::from_fn(m + 1, m + 1, |i, j| {
@@ -83,12 +66,9 @@ fn book_weights(m: usize, l: i64, h: Q) -> DMatrix<Q> {
         }
     });
     let bm = DMatrix::from_fn(m + 1, (l + 1) as usize, |i, j| b.value(i, z(l - j as i64)));
-    mul(
-        &mul(
-            &mul(
-                &mul(&phi(m, h), &link_matrix::<Q>(m)),
-                &b.end_differences(m),
-            ),
+    mm(
+        &mm(
+            &mm(&mm(&phi(m, h), &link_matrix::<Q>(m)), &b.end_differences(m)),
             &c,
         ),
         &bm,
