@@ -6,6 +6,7 @@ mod common;
 
 use common::engine::*;
 use common::*;
+use nalgebra::DMatrix;
 use seqsmooth::polynomial::vrf::{expanding_vrf, fading_vrf, unscale, EstimateForm};
 use seqsmooth::polynomial::MAX_DEGREE;
 use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, PolynomialFilter};
@@ -94,58 +95,59 @@ fn every_engine_reports_the_covariance_of_its_own_estimator() {
     }
 }
 
+/// Feeds `f` a constant at `times` (even, step τ) and checks the covariance it reports for the
+/// current estimate at the last sample and the 1-step prediction against `vrf(form)` (to 1e-9).
+fn assert_reports_vrf(
+    mut f: Box<dyn PolynomialFilter>,
+    times: &[f64],
+    tau: f64,
+    vrf: impl Fn(EstimateForm) -> DMatrix<f64>,
+    label: &str,
+) {
+    for &t in times {
+        f.update(t, 1.0).unwrap();
+    }
+    let last = times[times.len() - 1];
+    for (form, at) in [
+        (EstimateForm::Current, last),
+        (EstimateForm::Predictor, last + tau),
+    ] {
+        let got = f.estimate_at(at).unwrap().covariance.unwrap();
+        assert_matrix_close(&got, &vrf(form), 1e-9, &format!("{label} {form:?}"));
+    }
+}
+
 #[test]
 fn covariance_on_even_samples_equals_the_closed_form_vrf() {
     // Morrison (9.7.1)-(9.7.4) expanding at n; (13.6.20) fading steady state; D(τ) S D(τ).
     let sigma = 2.0;
     let tau = 0.5;
     for m in 0..=4 {
-        let times = even_times(30, 0.0, tau);
         for engine in [Engine::Exact, Engine::Gain] {
-            let mut f = ExpandingMemory::new(m, engine)
+            let f = ExpandingMemory::new(m, engine)
                 .unwrap()
                 .with_noise_sigma(sigma)
                 .unwrap();
-            for &t in &times {
-                f.update(t, 1.0).unwrap();
-            }
-            for (form, at) in [
-                (EstimateForm::Current, times[29]),
-                (EstimateForm::Predictor, times[29] + tau),
-            ] {
-                let vrf =
-                    unscale(&expanding_vrf::<f64>(m, 29, form).unwrap(), tau) * (sigma * sigma);
-                let got = f.estimate_at(at).unwrap().covariance.unwrap();
-                assert_matrix_close(
-                    &got,
-                    &vrf,
-                    1e-9,
-                    &format!("expanding {engine:?} m={m} {form:?}"),
-                );
-            }
+            assert_reports_vrf(
+                Box::new(f),
+                &even_times(30, 0.0, tau),
+                tau,
+                |form| unscale(&expanding_vrf::<f64>(m, 29, form).unwrap(), tau) * (sigma * sigma),
+                &format!("expanding {engine:?} m={m}"),
+            );
         }
-        let times = even_times(900, 0.0, tau);
         for engine in [Engine::Exact, Engine::Gain] {
-            let mut f = FadingMemory::new(m, 0.9, tau, engine)
+            let f = FadingMemory::new(m, 0.9, tau, engine)
                 .unwrap()
                 .with_noise_sigma(sigma)
                 .unwrap();
-            for &t in &times {
-                f.update(t, 1.0).unwrap();
-            }
-            for (form, at) in [
-                (EstimateForm::Current, times[899]),
-                (EstimateForm::Predictor, times[899] + tau),
-            ] {
-                let vrf = unscale(&fading_vrf(m, 0.9, form).unwrap(), tau) * (sigma * sigma);
-                let got = f.estimate_at(at).unwrap().covariance.unwrap();
-                assert_matrix_close(
-                    &got,
-                    &vrf,
-                    1e-9,
-                    &format!("fading {engine:?} m={m} {form:?}"),
-                );
-            }
+            assert_reports_vrf(
+                Box::new(f),
+                &even_times(900, 0.0, tau),
+                tau,
+                |form| unscale(&fading_vrf(m, 0.9, form).unwrap(), tau) * (sigma * sigma),
+                &format!("fading {engine:?} m={m}"),
+            );
         }
     }
 }
