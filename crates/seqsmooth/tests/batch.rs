@@ -1,109 +1,16 @@
 //! `PolynomialFilter::update_many` against per-sample `update`: same estimates, same errors,
-//! and the accuracy of the fading-memory gain engine's plain-`f64` steady kernel.
+//! and the accuracy of the gain engines' plain-`f64` kernels.
 
-use seqsmooth::{
-    Engine, Error, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory, PolynomialFilter,
-};
+mod common;
 
-/// Deterministic data: a slow sine, a trend and a unit pseudo-random term.
-fn sample(n: usize) -> f64 {
-    let mut s = (n as u64).wrapping_mul(0xD1B5_4A32_D192_ED03) ^ 0x9E37_79B9_7F4A_7C15;
-    s ^= s >> 29;
-    s = s.wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    s ^= s >> 32;
-    let noise = (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-    let t = n as f64;
-    100.0 * (0.003 * t).sin() + 0.01 * t + noise
-}
-
-/// `n` times `k·0.1` (steps equal up to rounding) or, `irregular`, steps `0.1·(1 ± 0.3)`.
-fn grid(n: usize, irregular: bool) -> Vec<f64> {
-    (0..n)
-        .map(|k| {
-            let k = k as f64;
-            if irregular {
-                0.1 * k + 0.03 * (1.7 * k).sin()
-            } else {
-                0.1 * k
-            }
-        })
-        .collect()
-}
-
-fn filters(m: usize, irregular: bool) -> Vec<(String, Box<dyn PolynomialFilter>)> {
-    let mut v: Vec<(String, Box<dyn PolynomialFilter>)> = Vec::new();
-    for engine in [Engine::Exact, Engine::Gain] {
-        v.push((
-            format!("expanding {engine:?}"),
-            Box::new(ExpandingMemory::new(m, engine).unwrap()),
-        ));
-        v.push((
-            format!("fading {engine:?}"),
-            Box::new(FadingMemory::new(m, 0.9, 0.1, engine).unwrap()),
-        ));
-    }
-    v.push((
-        "fixed".into(),
-        Box::new(
-            FixedMemory::new(
-                m,
-                20 + 2 * m,
-                if irregular {
-                    FixedEngine::Irregular
-                } else {
-                    FixedEngine::Sliding
-                },
-            )
-            .unwrap(),
-        ),
-    ));
-    v
-}
-
-/// Largest difference per derivative between two states, relative to `scale`.
-fn rel_diff(a: &[f64], b: &[f64], scale: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .zip(scale)
-        .map(|((x, y), s)| (x - y).abs() / s.max(1e-300))
-        .fold(0.0, f64::max)
-}
+use common::batch::*;
+use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, PolynomialFilter};
 
 #[test]
 fn update_many_equals_update_on_even_and_irregular_times() {
     for m in [0, 1, 2, 3, 5, 8] {
         for irregular in [false, true] {
-            let times = grid(3000, irregular);
-            let ys: Vec<f64> = (0..times.len()).map(sample).collect();
-            for ((name, mut one), (_, mut many)) in
-                filters(m, irregular).into_iter().zip(filters(m, irregular))
-            {
-                let mut scale = vec![0.0f64; m + 1];
-                let mut worst = 0.0f64;
-                // Batches of varied lengths, compared at every batch end.
-                let mut i = 0;
-                let mut len = 1;
-                while i < times.len() {
-                    let j = (i + len).min(times.len());
-                    many.update_many(&times[i..j], &ys[i..j]).unwrap();
-                    for k in i..j {
-                        one.update(times[k], ys[k]).unwrap();
-                    }
-                    assert_eq!(one.samples(), many.samples());
-                    match (one.estimate(), many.estimate()) {
-                        (Some(a), Some(b)) => {
-                            for (s, x) in scale.iter_mut().zip(&a.derivatives) {
-                                *s = s.max(x.abs());
-                            }
-                            worst = worst.max(rel_diff(&a.derivatives, &b.derivatives, &scale));
-                        }
-                        (None, None) => {}
-                        (a, b) => panic!("{name}: determined {} vs {}", a.is_some(), b.is_some()),
-                    }
-                    i = j;
-                    len = len % 300 + 37;
-                }
-                eprintln!("m = {m}, irregular = {irregular}, {name}: {worst:.2e}");
+            for (name, worst) in update_many_difference(m, irregular) {
                 // Exact and fixed engines run the same code: equal. The gain engine's plain
                 // steady kernel differs from the compensated per-sample path by rounding.
                 let bound = if name.contains("Gain") { 1e-11 } else { 0.0 };
@@ -179,109 +86,35 @@ fn update_many_reports_the_first_bad_sample_and_keeps_the_ones_before() {
 }
 
 /// The plain-`f64` steady kernel against the compensated per-sample path over long runs, per
-/// degree and θ: worst difference over the second half of the run (every 101st sample),
-/// relative to the largest `|x^(k)|` there, worst over derivatives. Printed with
-/// `--nocapture`; the table is in the `polynomial` module docs.
+/// degree and θ (`common::batch::plain_steady_kernel_error`). The measured table:
+/// `cargo run --release -p seqsmooth --example accuracy_batch`.
 #[test]
 fn plain_steady_kernel_accuracy_over_long_runs() {
-    let n = 60_000;
-    let times = grid(n, false);
-    let ys: Vec<f64> = (0..n).map(sample).collect();
-    // One long batch first (long enough for the block map to be built, degrees ≤ 5), then
-    // batches of 101: a block map and 37 recursion steps each.
-    let batches = || {
-        std::iter::once(0..20_000).chain((20_000..n).step_by(101).map(move |i| i..(i + 101).min(n)))
-    };
     for m in 0..=8 {
-        let mut row = Vec::new();
         for theta in [0.5, 0.9, 0.99, 0.999] {
-            let mut one = FadingMemory::new(m, theta, 0.1, Engine::Gain).unwrap();
-            let mut many = FadingMemory::new(m, theta, 0.1, Engine::Gain).unwrap();
-            let mut scale = vec![0.0f64; m + 1];
-            let mut worst = vec![0.0f64; m + 1];
-            for r in batches() {
-                let (tc, yc) = (&times[r.clone()], &ys[r]);
-                many.update_many(tc, yc).unwrap();
-                for (t, y) in tc.iter().zip(yc) {
-                    one.update(*t, *y).unwrap();
-                }
-                if one.samples() < n as u64 / 2 {
-                    continue;
-                }
-                let a = one.estimate().unwrap().derivatives;
-                let b = many.estimate().unwrap().derivatives;
-                for k in 0..=m {
-                    scale[k] = scale[k].max(a[k].abs());
-                    worst[k] = worst[k].max((a[k] - b[k]).abs());
-                }
-            }
-            let switched = many.switched_at().expect("switched within the run");
+            let (rel, switched) = plain_steady_kernel_error(m, theta);
             assert!(
-                switched < n as u64 / 2,
+                switched < LONG_RUN as u64 / 2,
                 "m = {m}, θ = {theta}: switch at {switched}"
             );
-            let rel = worst
-                .iter()
-                .zip(&scale)
-                .map(|(w, s)| w / s)
-                .fold(0.0, f64::max);
-            row.push(format!("{rel:.1e}"));
             assert!(rel < 1e-11, "m = {m}, θ = {theta}: {rel:e}");
         }
-        eprintln!("| {m} | {} |", row.join(" | "));
     }
 }
 
 /// The plain-`f64` expanding-memory kernel (degrees ≤ 4; measured once for all degrees to
 /// choose that bound: 7.2e-12 at 5, 4.3e-11 at 7, 1.1e-9 at 8 on even times, 8.6e-9 at 8
-/// jittered) against the compensated per-sample path: 60 000
-/// samples, even (`t = k·0.1`) and jittered (±30 %) times, worst difference over the run
-/// from sample `10(m+1)` (every 101st sample), relative to the largest `|x^(k)|` there.
+/// jittered) against the compensated per-sample path
+/// (`common::batch::plain_expanding_kernel_error`). The measured table:
+/// `cargo run --release -p seqsmooth --example accuracy_batch`.
 #[test]
 fn plain_expanding_kernel_accuracy_over_long_runs() {
-    let n = 60_000;
     for jitter in [false, true] {
-        let times = grid(n, jitter);
-        let ys: Vec<f64> = (0..n).map(sample).collect();
-        let mut row = Vec::new();
-        let mut rels = Vec::new();
         for m in 0..=8 {
-            let mut one = ExpandingMemory::new(m, Engine::Gain).unwrap();
-            let mut many = ExpandingMemory::new(m, Engine::Gain).unwrap();
-            let mut scale = vec![0.0f64; m + 1];
-            let mut worst = vec![0.0f64; m + 1];
-            for (tc, yc) in times.chunks(101).zip(ys.chunks(101)) {
-                many.update_many(tc, yc).unwrap();
-                for (t, y) in tc.iter().zip(yc) {
-                    one.update(*t, *y).unwrap();
-                }
-                if one.samples() < 10 * (m as u64 + 1) {
-                    continue;
-                }
-                let a = one.estimate().unwrap().derivatives;
-                let b = many.estimate().unwrap().derivatives;
-                for k in 0..=m {
-                    scale[k] = scale[k].max(a[k].abs());
-                    worst[k] = worst[k].max((a[k] - b[k]).abs());
-                }
-            }
-            let rel = worst
-                .iter()
-                .zip(&scale)
-                .map(|(w, s)| w / s)
-                .fold(0.0, f64::max);
-            row.push(format!("{rel:.1e}"));
-            rels.push(rel);
-        }
-        eprintln!(
-            "| {} | {} |",
-            if jitter { "±30 %" } else { "even" },
-            row.join(" | ")
-        );
-        // Degrees ≤ 4 run the plain kernel; above, update_many takes the compensated path.
-        for (m, rel) in rels.iter().enumerate() {
+            let rel = plain_expanding_kernel_error(m, jitter);
+            // Degrees ≤ 4 run the plain kernel; above, update_many takes the compensated path.
             let bound = if m <= 4 { 1e-12 } else { 0.0 };
-            assert!(*rel <= bound, "m = {m}, jitter = {jitter}: {rel:e}");
+            assert!(rel <= bound, "m = {m}, jitter = {jitter}: {rel:e}");
         }
     }
 }
@@ -321,7 +154,6 @@ fn update_many_into_writes_every_samples_estimate() {
                         None => assert!(row.iter().all(|v| v.is_nan()), "{name}: row {k}"),
                     }
                 }
-                eprintln!("m = {m}, irregular = {irregular}, {name}: {worst:.2e}");
                 let bound = if name.contains("Gain") { 1e-11 } else { 0.0 };
                 assert!(worst <= bound, "m = {m} {name}: {worst:e}");
             }

@@ -1,5 +1,17 @@
-//! Shared helpers for the engine tests: reproducible data and independent oracles.
+//! Shared test helpers: reproducible data (time grids, noisy polynomials), independent oracles
+//! (batch least squares by QR, exact rational and integer least squares), and, in the
+//! submodules, the helpers of one group of tests each.
 #![allow(dead_code, clippy::needless_range_loop)]
+
+pub mod automatic;
+pub mod bank;
+pub mod batch;
+pub mod book;
+pub mod engine;
+pub mod fixed;
+pub mod monte_carlo;
+pub mod rational;
+pub mod stats;
 
 use num_traits::{One, Zero};
 use rand::rngs::StdRng;

@@ -1,8 +1,8 @@
 //! Lear (1977), "Least squares polynomial fits and their accuracy" (NASA JSC / TRW), reproduced
 //! through the fixed-memory filter of `seqsmooth::polynomial::fixed`.
 //!
-//! Source: /work/shared/spec/others.md §3 (closed forms eqs 18-51, Tables 1-3, with the notes'
-//! [RECON] reconstructions of the OCR and the one [PAPER-ERR?]).
+//! Source: Lear (1977), closed forms eqs 18-51 and Tables 1-3, with reconstructions where the
+//! scan is unreadable and one apparent error in the paper (below).
 //!
 //! Lear fits `y = a_0 + a_1 n + … + a_M n^M` to `N` evenly spaced samples `n = 1..N`. That is
 //! the fixed-memory fit with `L = N - 1`: sample `n` sits at `r = n - 1` on Morrison's window
@@ -11,7 +11,7 @@
 //! variance of the fit at `n` is `σ² [W(h) W(h)ᵀ]_00` — for derivatives, unscaled with
 //! `τ = ΔT`. All comparisons with closed forms are exact (`BigRational`).
 //!
-//! Lear's misprints and the notes' reconstructions, cited where they matter below:
+//! Lear's misprints and their reconstructions, cited where they matter below:
 //! - the preface corrects eq 13's `n²` coefficient from `C22 + 2C12` to `C22 + 2C13`;
 //! - eq 28 `(PᵀP)⁻¹` of Table 3: the OCR reads "94" and "1301" (exact: 4290 scale, 5174, 130);
 //! - A33 of eq 39: the OCR reads "(2K,-1)", the factor is `(2N+1)`;
@@ -22,34 +22,18 @@
 //!   43, 46, 49, 50;
 //! - Table 3: `Pᵀy*` first entry OCR "61.500" is 61.600 (the data sum to 61.600; only it gives
 //!   a0 = 1.3083); ŷ_5 OCR "3.763" is 3.768; residual 9 OCR "1.08" is 1.108;
-//! - [PAPER-ERR?] the noise estimate `√(Σr²/N)` = 0.9115 is biased; the unbiased
+//! - an apparent error: the noise estimate `√(Σr²/N)` = 0.9115 is biased; the unbiased
 //!   `√(Σr²/(N-M-1))` = 1.0689.
 
+mod common;
+
+use common::rational::*;
 use nalgebra::DMatrix;
 use num_traits::{One, Zero};
 use seqsmooth::polynomial::fixed::{
     covariance, covariance_unscaled, min_span_for_sigma, smooth, vrf_limit, weights, Lead,
 };
 use seqsmooth::polynomial::gains::{expanding_gains, GainForm};
-use seqsmooth::scalar::{parse_rational, ratio_to_f64, Rational};
-
-type Q = Rational;
-
-fn z(v: i64) -> Q {
-    Q::from_integer(v.into())
-}
-
-fn fr(n: i64, d: i64) -> Q {
-    Q::new(n.into(), d.into())
-}
-
-fn q(s: &str) -> Q {
-    parse_rational(s).unwrap()
-}
-
-fn f(x: &Q) -> f64 {
-    ratio_to_f64(x)
-}
 
 /// Σ c_k x^k, integer coefficients lowest first.
 fn poly(x: &Q, c: &[i64]) -> Q {
@@ -321,7 +305,7 @@ fn lear_end_midpoint_and_derivative_variances_eqs_24_to_50() {
             }
         }
     }
-    // Cross-identity (others.md §3.2): Lear's end-point variance with N = n+1 is the
+    // Cross-identity between Lear (1977) and Morrison ch. 9: Lear's end-point variance with N = n+1 is the
     // expanding-memory position gain h_0(n) (the current-estimate VRF).
     for m in 0..=3usize {
         for n in [m as u64 + 1, 10, 33] {
@@ -337,7 +321,7 @@ fn lear_end_midpoint_and_derivative_variances_eqs_24_to_50() {
 
 #[test]
 fn lear_large_n_tables_1_and_2_and_profiles_eqs_36_to_38_51() {
-    // Tables 1 (ends) and 2 (midpoint, [RECON] rebuilt from eqs 25, 31, 34, 43, 46, 49, 50):
+    // Tables 1 (ends) and 2 (midpoint, rebuilt from eqs 25, 31, 34, 43, 46, 49, 50):
     // Var ≈ c σ²/(T^(2d) N) with T = N ΔT, i.e. Morrison's λ_dd(M) at ρ = 1 and ρ = 1/2.
     let table1: [&[i64]; 4] = [&[1], &[4, 12], &[9, 192, 720], &[16, 1200, 25920, 100800]];
     let table2: [&[&str]; 4] = [
@@ -381,7 +365,7 @@ fn lear_large_n_tables_1_and_2_and_profiles_eqs_36_to_38_51() {
     // Eq 36: M = 2, N·E ≈ 9[20x⁴ - 2x² + 1/4], x = n/N - 1/2: the midpoint is a local MAXIMUM
     // 9/4 (eq 37) and the minima 9/5 lie at x² = 1/20 (eq 38). M = 3: N·E ≈ 2800u⁶ - 660u⁴ +
     // 45u² + 9/4: a local minimum 9/4 at the midpoint, maxima 3.2 at u = ±√5/10, minima 2.939 at
-    // u = ±√21/14 (others.md §3.2).
+    // u = ±√21/14 (the large-N profile of Lear eq 41).
     for k in -8..=8i64 {
         let x = fr(k, 16);
         let x2 = x.clone() * x.clone();
@@ -470,7 +454,7 @@ fn lear_table_3_worked_example() {
         );
     }
     // ŷ_n at every n (W(n - N) y*), residuals y* - ŷ and errors ŷ - y, to the printed 3
-    // decimals ([RECON]: ŷ_5 3.768, not the OCR's 3.763; residual 9 1.108, not 1.08).
+    // decimals (reconstructed: ŷ_5 3.768, not the OCR's 3.763; residual 9 1.108, not 1.08).
     let mut resid = Vec::new();
     for i in 1..=n {
         let w = weights(2, 10, z(i as i64 - 11)).unwrap();
@@ -499,7 +483,7 @@ fn lear_table_3_worked_example() {
     }
     // Σ(y* - ŷ) is printed as .001 (rounding of the printed residuals); exactly 0.
     assert!(resid.iter().fold(Q::zero(), |a, r| a + r.clone()).is_zero());
-    // σ̂_q = √(Σr²/N) = 0.9115 ("off by 9%"); [PAPER-ERR?] the unbiased √(Σr²/(N-M-1)) = 1.0689.
+    // σ̂_q = √(Σr²/N) = 0.9115 ("off by 9%"); the unbiased √(Σr²/(N-M-1)) = 1.0689.
     let ss = f(&resid
         .iter()
         .fold(Q::zero(), |a, r| a + r.clone() * r.clone()));
