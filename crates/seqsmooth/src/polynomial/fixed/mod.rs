@@ -100,7 +100,11 @@
 
 mod bias;
 mod covariance;
+mod even;
 mod filter;
+mod irregular;
+mod ring;
+mod sliding;
 mod smooth;
 mod trend;
 mod weights;
