@@ -3,7 +3,7 @@
 
 use super::even::MomentFit;
 use super::irregular::IrregularWindow;
-use super::sliding::{default_refreshes, SlidingMoments};
+use super::sliding::{smoothing_refreshes, SlidingMoments};
 use super::{check_window, steps_agree};
 use crate::error::Error;
 use std::ops::Range;
@@ -170,7 +170,7 @@ pub fn smooth(
         let even = EvenSeries {
             values,
             window,
-            moments: SlidingMoments::new(m, window, default_refreshes(m)),
+            moments: SlidingMoments::new(m, window, smoothing_refreshes(m)),
             fit: MomentFit::new(m, span, span / 2),
             step,
         };
