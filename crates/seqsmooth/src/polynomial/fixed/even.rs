@@ -12,9 +12,9 @@ use nalgebra::DMatrix;
 use std::borrow::Cow;
 
 /// Window fits from their moments: `β_j = μ_j/c_j²`, and at `r` on the window axis the
-/// derivatives `x^(i) = (i!/τ^i) Σ_j T(r)_ij β_j` and their covariance
+/// derivatives `x^(i) = (i!/τ^i) Σ_j [T(r) C]_ij μ_j` and their covariance
 /// `σ² D(τ) T(r) C T(r)ᵀ D(τ)` (7.5.26)-(7.5.28) for samples `τ` apart; `T(r)` (upper
-/// triangular) is kept for one `r`, computed for the others.
+/// triangular) and `T(r) C` are kept for one `r`, computed for the others.
 #[derive(Clone, Debug)]
 pub(super) struct MomentFit {
     m: usize,
@@ -22,19 +22,62 @@ pub(super) struct MomentFit {
     inv_norm: Vec<f64>,
     kept_r: f64,
     kept: DMatrix<f64>,
+    /// `T(kept_r) C`, row-major.
+    kept_tc: Vec<f64>,
 }
 
 impl MomentFit {
     /// Degree `m` over windows of span `L`, keeping `T(kept_r)`.
     pub(super) fn new(m: usize, span: usize, kept_r: usize) -> Self {
         let basis = DiscreteLegendre::new(span as f64);
+        let inv_norm = inverse_norms(m, &basis);
+        let kept = taylor_at(m, &basis, &(kept_r as f64));
         Self {
             m,
-            inv_norm: inverse_norms(m, &basis),
+            kept_tc: Self::times_c(&kept, &inv_norm),
+            inv_norm,
             kept_r: kept_r as f64,
-            kept: taylor_at(m, &basis, &(kept_r as f64)),
+            kept,
             basis,
         }
+    }
+
+    /// `T C`, row-major.
+    fn times_c(t: &DMatrix<f64>, inv_norm: &[f64]) -> Vec<f64> {
+        let p = inv_norm.len();
+        (0..p * p)
+            .map(|k| t[(k / p, k % p)] * inv_norm[k % p])
+            .collect()
+    }
+
+    fn taylor(&self, r: f64) -> Cow<'_, DMatrix<f64>> {
+        if r == self.kept_r {
+            Cow::Borrowed(&self.kept)
+        } else {
+            Cow::Owned(taylor_at(self.m, &self.basis, &r))
+        }
+    }
+
+    /// Unscaled derivatives at `r` of the fit with moments `mu`.
+    pub(super) fn derivatives(&self, mu: &[f64], r: f64, step: f64) -> Vec<f64> {
+        let computed;
+        let tc = if r == self.kept_r {
+            &self.kept_tc
+        } else {
+            computed = Self::times_c(&self.taylor(r), &self.inv_norm);
+            &computed
+        };
+        let p = mu.len();
+        let mut scale = 1.0;
+        (0..p)
+            .map(|i| {
+                if i > 0 {
+                    scale *= i as f64 / step;
+                }
+                let row = &tc[i * p + i..(i + 1) * p];
+                row.iter().zip(&mu[i..]).map(|(a, b)| a * b).sum::<f64>() * scale
+            })
+            .collect()
     }
 
     /// Unscaled derivatives at `r` of the fit with moments `mu` and, given the noise σ, their
@@ -46,24 +89,9 @@ impl MomentFit {
         step: f64,
         sigma: Option<f64>,
     ) -> (Vec<f64>, Option<DMatrix<f64>>) {
-        let t = if r == self.kept_r {
-            Cow::Borrowed(&self.kept)
-        } else {
-            Cow::Owned(taylor_at(self.m, &self.basis, &r))
-        };
-        let mut x = Vec::with_capacity(self.m + 1);
-        let mut scale = 1.0;
-        for i in 0..=self.m {
-            if i > 0 {
-                scale *= i as f64 / step;
-            }
-            let mut acc = 0.0;
-            for j in i..=self.m {
-                acc += t[(i, j)] * mu[j] * self.inv_norm[j];
-            }
-            x.push(acc * scale);
-        }
+        let x = self.derivatives(mu, r, step);
         let cov = sigma.map(|s| {
+            let t = self.taylor(r);
             let scale: Vec<f64> = (0..=self.m)
                 .map(|i| factorial::<f64>(i) / step.powi(i as i32))
                 .collect();
@@ -113,7 +141,7 @@ impl EvenWindow {
                     mu: Vec::new(),
                 }
             }
-            Some(q) => Moments::Sliding(SlidingMoments::new(m, window, q)),
+            Some(q) => Moments::Sliding(SlidingMoments::new(m, window, q, false)),
         };
         Self {
             m,

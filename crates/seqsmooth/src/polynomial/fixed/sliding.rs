@@ -22,12 +22,17 @@ pub(crate) fn default_refreshes(m: usize) -> usize {
     1 << (m.saturating_sub(1) / 2).min(20)
 }
 
-/// The refresh accumulators of whole-series smoothing, `4·q(m)` (an exact refresh every
-/// `⌈(L+1)/(4q)⌉` samples): there every row is reported, derivatives up to `m` each relative to
-/// its own scale, and a shorter carried extrapolation keeps the highest of them within a few
-/// `1e-12` of the exact convolution at `O(q·m)` extra work per sample.
+/// The refresh accumulators of whole-series smoothing: `q(m)` for `m ≤ 2`, `4·q(m)` above (an
+/// exact refresh every `⌈(L+1)/(4q)⌉` samples). There every row is reported, each derivative
+/// up to `m` relative to its own scale; from `m = 3` on the highest of them need the shorter
+/// carried extrapolation to stay within a few `1e-12` of the exact convolution, at `O(q·m)`
+/// extra work per sample.
 pub(crate) fn smoothing_refreshes(m: usize) -> usize {
-    4 * default_refreshes(m)
+    if m <= 2 {
+        default_refreshes(m)
+    } else {
+        4 * default_refreshes(m)
+    }
 }
 
 /// The exact shift matrix `M` with `p_j(x-1) = Σ_l M_jl p_l(x)` (lower triangular, unit
@@ -96,50 +101,50 @@ impl LegendreRecursion {
     }
 }
 
-/// One exact refresh accumulator: the moments `Σ y p_j(x)` of the `L+1` samples of one future
-/// window, collected as they arrive (each at its final position `x`).
-#[derive(Clone, Debug)]
-struct Accumulator {
-    start: u64,
-    count: usize,
-    sums: Vec<f64>,
-}
-
 /// The moments `μ_j = Σ_{x=0..L} y(x) p_j(x)` of the newest `L+1` evenly spaced samples, by the
 /// sliding recursion with `q` staggered exact refreshes.
 #[derive(Clone, Debug)]
 pub(super) struct SlidingMoments {
     window: usize,
     recursion: LegendreRecursion,
+    /// `p_j(x)`, row `x = 0..=L`, when tabulated (else evaluated by the recursion as needed).
+    table: Vec<f64>,
     shift: Vec<f64>,
     mu: Vec<f64>,
     valid: bool,
-    accs: Vec<Accumulator>,
+    /// Refresh accumulator `a` starts at sample `a·period`, holds `counts[a]` samples of its
+    /// window and the sums `Σ y p_j(x)` in `sums[a(m+1)..(a+1)(m+1)]`, each sample added at
+    /// its final position `x`.
+    counts: Vec<usize>,
+    sums: Vec<f64>,
     period: usize,
     scratch: Vec<f64>,
 }
 
 impl SlidingMoments {
     /// Degree `m`, `window = L+1 ≥ m+1` samples, `refreshes` accumulators (clamped to
-    /// `1..=window`).
-    pub(super) fn new(m: usize, window: usize, refreshes: usize) -> Self {
+    /// `1..=window`); `tabulate` keeps the `(L+1)(m+1)` values `p_j(x)` rather than evaluating
+    /// them per sample (the same values: a table for whole series, none for streams).
+    pub(super) fn new(m: usize, window: usize, refreshes: usize, tabulate: bool) -> Self {
         let q = refreshes.clamp(1, window);
-        let period = window.div_ceil(q);
-        let accs = (0..q)
-            .map(|a| Accumulator {
-                start: (a * period) as u64,
-                count: 0,
-                sums: vec![0.0; m + 1],
-            })
-            .collect();
+        let recursion = LegendreRecursion::new(m, window - 1);
+        let mut table = Vec::new();
+        if tabulate {
+            table.resize(window * (m + 1), 0.0);
+            for (x, row) in table.chunks_exact_mut(m + 1).enumerate() {
+                recursion.values(x as f64, row);
+            }
+        }
         Self {
             window,
-            recursion: LegendreRecursion::new(m, window - 1),
+            recursion,
+            table,
             shift: shift_matrix(m, (window - 1) as u64),
             mu: vec![0.0; m + 1],
             valid: false,
-            accs,
-            period,
+            counts: vec![0; q],
+            sums: vec![0.0; q * (m + 1)],
+            period: window.div_ceil(q),
             scratch: vec![0.0; m + 1],
         }
     }
@@ -166,20 +171,26 @@ impl SlidingMoments {
                 self.mu[j] = if j % 2 == 0 { acc + y } else { acc - y };
             }
         }
-        for acc in self.accs.iter_mut() {
-            if n < acc.start {
-                continue;
-            }
-            self.recursion.values(acc.count as f64, &mut self.scratch);
-            for (s, r) in acc.sums.iter_mut().zip(&self.scratch) {
+        let started = (n / self.period as u64 + 1).min(self.counts.len() as u64) as usize;
+        for (count, sums) in self.counts[..started]
+            .iter_mut()
+            .zip(self.sums.chunks_exact_mut(p))
+        {
+            let values = if self.table.is_empty() {
+                self.recursion.values(*count as f64, &mut self.scratch);
+                &self.scratch[..]
+            } else {
+                &self.table[*count * p..(*count + 1) * p]
+            };
+            for (s, r) in sums.iter_mut().zip(values) {
                 *s += y * r;
             }
-            acc.count += 1;
-            if acc.count == self.window {
-                self.mu.copy_from_slice(&acc.sums);
+            *count += 1;
+            if *count == self.window {
+                self.mu.copy_from_slice(sums);
                 self.valid = true;
-                acc.count = 0;
-                acc.sums.iter_mut().for_each(|v| *v = 0.0);
+                *count = 0;
+                sums.iter_mut().for_each(|v| *v = 0.0);
             }
         }
     }

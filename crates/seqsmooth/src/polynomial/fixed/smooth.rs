@@ -93,9 +93,7 @@ impl SeriesWindows for EvenSeries<'_> {
 
     fn row(&self, row: usize, start: usize) -> Vec<f64> {
         let mu = self.moments.moments().expect("the window is full");
-        self.fit
-            .estimate(mu, (row - start) as f64, self.step, None)
-            .0
+        self.fit.derivatives(mu, (row - start) as f64, self.step)
     }
 }
 
@@ -170,7 +168,7 @@ pub fn smooth(
         let even = EvenSeries {
             values,
             window,
-            moments: SlidingMoments::new(m, window, smoothing_refreshes(m)),
+            moments: SlidingMoments::new(m, window, smoothing_refreshes(m), true),
             fit: MomentFit::new(m, span, span / 2),
             step,
         };
