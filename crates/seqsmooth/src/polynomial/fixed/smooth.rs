@@ -120,15 +120,18 @@ impl SeriesWindows for IrregularSeries<'_> {
 /// for every sample, the unscaled derivatives `[x, x', …, x^(m)]` in the caller's time units.
 ///
 /// - **Evenly spaced** times (every step within a relative `1e-9` of the first, plus the
-///   timestamps' own rounding, `2ε|t|`): interior
-///   samples use the centred weights `D(Δt) W(-L/2)` (Morrison (7.4.16) with `h = -L/2`;
-///   `Δt` the mean step) as a convolution; the first and last `⌊L/2⌋` (or `⌈L/2⌉`) samples
-///   take the fit of the first (last) full window evaluated at their own times. For odd
-///   `window` this is exactly `scipy.signal.savgol_filter(y, window, m, deriv=k, delta=Δt,
-///   mode="interp")` for each `k`. (For even `window` each sample sits half a step after the
-///   window centre, `h = -(L+1)/2`; savgol evaluates at the half-sample centre instead.)
+///   timestamps' own rounding, `2ε|t|`): the fit of each window `W(h) Y` with the centred
+///   weights `D(Δt) W(-L/2)` (Morrison (7.4.16) with `h = -L/2`; `Δt` the mean step) at the
+///   sample `⌊L/2⌋` after the window's start, by the sliding engine of [`super::FixedMemory`]
+///   (the window's discrete Legendre moments slid one sample at a time, `O(m²)` per sample at
+///   any window; see the [module docs](super#the-sliding-engine)); the first and last `⌊L/2⌋`
+///   (or `⌈L/2⌉`) samples take the fit of the first (last) full window evaluated at their own
+///   times. For odd `window` this is `scipy.signal.savgol_filter(y, window, m, deriv=k,
+///   delta=Δt, mode="interp")` for each `k`. (For even `window` each sample sits half a step
+///   after the window centre, `h = -(L+1)/2`; savgol evaluates at the half-sample centre
+///   instead.)
 /// - **Irregular** times: the same windows (by sample count), each fitted by Householder QR
-///   in a centred Legendre basis ([`PolynomialFit`]).
+///   in a centred Legendre basis ([`crate::estimate::PolynomialFit`]).
 ///
 /// Errors: `window < m+1`, `window` longer than the series, `m > MAX_DEGREE`, NaN or
 /// infinite input, non-increasing times, mismatched lengths.
