@@ -117,6 +117,8 @@ pub(super) struct SlidingMoments {
     /// its final position `x`.
     counts: Vec<usize>,
     sums: Vec<f64>,
+    /// The accumulators started so far (`⌊n/period⌋ + 1`, at most `q`).
+    started: usize,
     period: usize,
     scratch: Vec<f64>,
 }
@@ -144,6 +146,7 @@ impl SlidingMoments {
             valid: false,
             counts: vec![0; q],
             sums: vec![0.0; q * (m + 1)],
+            started: 0,
             period: window.div_ceil(q),
             scratch: vec![0.0; m + 1],
         }
@@ -154,8 +157,8 @@ impl SlidingMoments {
         self.period
     }
 
-    /// Takes the sample `y` with 0-based index `n`; `old` is the sample leaving the window
-    /// (`None` while the window fills).
+    /// Takes the sample `y` with 0-based index `n` (every sample, in order: `n = 0, 1, …`);
+    /// `old` is the sample leaving the window (`None` while the window fills).
     pub(super) fn push(&mut self, n: u64, y: f64, old: Option<f64>) {
         let p = self.mu.len();
         if let (true, Some(o)) = (self.valid, old) {
@@ -171,8 +174,10 @@ impl SlidingMoments {
                 self.mu[j] = if j % 2 == 0 { acc + y } else { acc - y };
             }
         }
-        let started = (n / self.period as u64 + 1).min(self.counts.len() as u64) as usize;
-        for (count, sums) in self.counts[..started]
+        if self.started < self.counts.len() && n == (self.started * self.period) as u64 {
+            self.started += 1;
+        }
+        for (count, sums) in self.counts[..self.started]
             .iter_mut()
             .zip(self.sums.chunks_exact_mut(p))
         {
