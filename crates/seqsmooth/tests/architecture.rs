@@ -26,7 +26,9 @@ fn layers(krate: &str) -> BTreeMap<String, usize> {
         .find(&start)
         .unwrap_or_else(|| panic!("ARCHITECTURE.md has no `{start}` table"));
     let rest = &doc[begin + start.len()..];
-    let end = rest.find("<!-- /layers -->").expect("the layer table is closed");
+    let end = rest
+        .find("<!-- /layers -->")
+        .expect("the layer table is closed");
     let mut table = BTreeMap::new();
     for line in rest[..end].lines() {
         let cells: Vec<&str> = line.split('|').map(str::trim).collect();
@@ -56,7 +58,10 @@ fn module_of(src: &Path, file: &Path) -> Vec<String> {
         .iter()
         .map(|p| p.to_string_lossy().trim_end_matches(".rs").to_string())
         .collect();
-    if matches!(parts.last().map(String::as_str), Some("mod" | "lib" | "main")) {
+    if matches!(
+        parts.last().map(String::as_str),
+        Some("mod" | "lib" | "main")
+    ) {
         parts.pop();
     }
     parts
@@ -297,7 +302,10 @@ fn the_checker_sees_braced_relative_and_inline_paths() {
          let x = crate::calculus::factorial::<f64>(3); let s = \"crate::in_a_string\";\n\
          use super::super::options::Engine;",
     );
-    let got: Vec<String> = imports(&code, &module).iter().map(|p| p.join("::")).collect();
+    let got: Vec<String> = imports(&code, &module)
+        .iter()
+        .map(|p| p.join("::"))
+        .collect();
     assert_eq!(
         got,
         [
@@ -309,10 +317,13 @@ fn the_checker_sees_braced_relative_and_inline_paths() {
         ]
     );
     // and a violation is found: a low layer naming a higher one
-    let table: BTreeMap<String, usize> = [("calculus".to_string(), 1), ("polynomial".to_string(), 5)]
-        .into_iter()
-        .collect();
+    let table: BTreeMap<String, usize> =
+        [("calculus".to_string(), 1), ("polynomial".to_string(), 5)]
+            .into_iter()
+            .collect();
     let from = level_of(&table, &["calculus".to_string()]).unwrap().1;
-    let to = level_of(&table, &["polynomial".to_string(), "x".to_string()]).unwrap().1;
+    let to = level_of(&table, &["polynomial".to_string(), "x".to_string()])
+        .unwrap()
+        .1;
     assert!(to > from);
 }

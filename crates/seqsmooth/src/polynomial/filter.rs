@@ -1,10 +1,10 @@
 //! [`PolynomialFilter`]: what every polynomial filter does (take timestamped samples, give
 //! estimates), and the one-pass validation of a batch of samples.
 
-use crate::error::Error;
-use crate::model::PolynomialState;
 #[cfg(doc)]
 use super::{ExpandingMemory, FadingMemory};
+use crate::error::Error;
+use crate::model::PolynomialState;
 
 /// What every polynomial filter does: take timestamped samples, give estimates. Implemented by
 /// [`ExpandingMemory`] and [`FadingMemory`], so callers can hold either behind one type.
@@ -121,7 +121,11 @@ pub trait PolynomialFilter: std::fmt::Debug + Send {
 }
 
 /// Checks `estimates.len() = times.len()·(m+1)` for [`PolynomialFilter::update_many_into`].
-pub(crate) fn check_estimates_length(times: &[f64], m: usize, estimates: &[f64]) -> Result<(), Error> {
+pub(crate) fn check_estimates_length(
+    times: &[f64],
+    m: usize,
+    estimates: &[f64],
+) -> Result<(), Error> {
     if estimates.len() != times.len() * (m + 1) {
         return Err(Error::InvalidParameter {
             name: "estimates length",

@@ -155,7 +155,6 @@
 //! assert!((s.derivatives[2] - 2.0).abs() < 1e-12);
 //! ```
 
-
 pub mod automatic;
 pub mod bank;
 mod engine;
@@ -170,12 +169,14 @@ pub use automatic::{AutoConfig, AutoOutput, AutomaticFilter};
 pub use expanding::ExpandingMemory;
 pub use fading::{FadingMemory, SwitchRule};
 pub use filter::PolynomialFilter;
-pub use options::{DiscountMode, Engine, MAX_DEGREE};
 pub(crate) use options::{check_degree, check_tau};
+pub use options::{DiscountMode, Engine, MAX_DEGREE};
 
 /// The gains of both filters (kept at their old path).
 pub mod gains {
-    pub use super::expanding::gains::{expanding_gain_numerators, expanding_gains, ExpandingGainSchedule};
+    pub use super::expanding::gains::{
+        expanding_gain_numerators, expanding_gains, ExpandingGainSchedule,
+    };
     pub use super::fading::gains::fading_gains;
     pub use super::form::GainForm;
 }
@@ -183,8 +184,8 @@ pub mod gains {
 pub mod vrf {
     pub use super::expanding::vrf::expanding_vrf;
     pub use super::fading::vrf::{fading_vrf, fading_vrf_limit};
-    pub use super::form::{unscale, EstimateForm};
     pub use super::fixed::{fixed_memory_vrf_limit, window_covariance};
+    pub use super::form::{unscale, EstimateForm};
 }
 /// The expanding-to-fading switch (kept at its old path).
 pub mod switching {

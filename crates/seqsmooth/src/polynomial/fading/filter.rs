@@ -41,7 +41,9 @@ impl FadingMemory {
         let mode = DiscountMode::default();
         let rule = SwitchRule::default();
         let core = match engine {
-            Engine::Exact => EngineState::Exact(ExactEngine::new(m, Some(Discount { theta, tau, mode }))),
+            Engine::Exact => {
+                EngineState::Exact(ExactEngine::new(m, Some(Discount { theta, tau, mode })))
+            }
             Engine::Gain => EngineState::Gain(GainEngine::new(
                 m,
                 tau,
