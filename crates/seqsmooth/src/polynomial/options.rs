@@ -51,3 +51,16 @@ pub(crate) fn check_theta(theta: f64) -> Result<(), Error> {
     }
     Ok(())
 }
+
+/// Settings are fixed once a filter has taken its first sample: an error naming `what` to set
+/// before the first update when `started`.
+pub(crate) fn check_not_started(started: bool, what: &str) -> Result<(), Error> {
+    if started {
+        return Err(Error::InvalidParameter {
+            name: "configuration",
+            value: "change after the first sample".into(),
+            reason: format!("set {what} before the first update"),
+        });
+    }
+    Ok(())
+}

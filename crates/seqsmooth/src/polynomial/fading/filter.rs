@@ -6,7 +6,9 @@ use crate::model::PolynomialState;
 use crate::polynomial::engine::{
     impl_polynomial_filter, Discount, EngineState, ExactEngine, FadingGains, GainEngine,
 };
-use crate::polynomial::options::{check_degree, check_tau, check_theta, DiscountMode, Engine};
+use crate::polynomial::options::{
+    check_degree, check_not_started, check_tau, check_theta, DiscountMode, Engine,
+};
 use crate::polynomial::PolynomialFilter;
 
 /// Fading-memory polynomial filter of degree `m` and discount `θ` per `τ` (Morrison ch. 13;
@@ -41,7 +43,9 @@ impl FadingMemory {
         let mode = DiscountMode::default();
         let rule = SwitchRule::default();
         let core = match engine {
-            Engine::Exact => EngineState::Exact(ExactEngine::new(m, Some(Discount { theta, tau, mode }))),
+            Engine::Exact => {
+                EngineState::Exact(ExactEngine::new(m, Some(Discount { theta, tau, mode })))
+            }
             Engine::Gain => EngineState::Gain(GainEngine::new(
                 m,
                 tau,
@@ -60,13 +64,7 @@ impl FadingMemory {
     }
 
     fn rebuild(&mut self) -> Result<(), Error> {
-        if self.core.samples() > 0 {
-            return Err(Error::InvalidParameter {
-                name: "configuration",
-                value: "change after the first sample".into(),
-                reason: "set the discount mode and switch rule before the first update".into(),
-            });
-        }
+        check_not_started(self.core.samples() > 0, "the discount mode and switch rule")?;
         match &mut self.core {
             EngineState::Exact(_) => {
                 self.core = EngineState::Exact(ExactEngine::new(
