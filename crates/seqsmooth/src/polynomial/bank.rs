@@ -44,8 +44,8 @@
 //! 300 steps).
 
 use super::gains::{fading_gains, ExpandingGainSchedule, GainForm};
-use super::options::{check_degree, check_tau, check_theta};
 use super::switching::SwitchRule;
+use super::options::{check_degree, check_tau, check_theta};
 use crate::error::Error;
 use rayon::prelude::*;
 

@@ -20,8 +20,8 @@
 //! ([`TriangularFactor`]): no square roots per sample, and once every pivot is positive none
 //! of its `2m+3` divisions per sample waits for another.
 
-use crate::model::{shift_scaled, shift_scaled_array};
 use crate::polynomial::options::{DiscountMode, MAX_DEGREE};
+use crate::model::{shift_scaled, shift_scaled_array};
 use crate::recursive::{InformationFilter, TriangularFactor};
 use nalgebra::DMatrix;
 

@@ -11,14 +11,14 @@
 //! (Morrison §9.6), and the exact least-squares state on any spacing — and (2) carries the
 //! state in compensated (double-word) arithmetic.
 
-use crate::calculus::Polynomial;
-use crate::model::{shift_scaled_compensated, two_sum};
 use crate::polynomial::expanding::gains::ExpandingGainSchedule;
 use crate::polynomial::fading::gains::fading_gains;
+use crate::polynomial::form::{EstimateForm, GainForm};
 use crate::polynomial::fading::switch::{memory_length_constant, SwitchRule};
 use crate::polynomial::fading::vrf::fading_vrf;
-use crate::polynomial::form::{EstimateForm, GainForm};
 use crate::polynomial::options::{DiscountMode, MAX_DEGREE};
+use crate::calculus::Polynomial;
+use crate::model::{shift_scaled_compensated, two_sum};
 use crate::scalar::{rational_from_f64, Rational, Scalar};
 use nalgebra::{DMatrix, DVector};
 
@@ -349,10 +349,15 @@ impl FadingGains {
     pub fn new(m: usize, theta: f64, mode: DiscountMode, rule: SwitchRule) -> Self {
         let constant = match rule {
             SwitchRule::Position => Some(memory_length_constant(0, m)),
-            SwitchRule::ColumnMean => {
-                Some((0..=m).map(|i| memory_length_constant(i, m)).sum::<f64>() / (m + 1) as f64)
+            SwitchRule::ColumnMean => Some(
+                (0..=m)
+                    .map(|i| memory_length_constant(i, m))
+                    .sum::<f64>()
+                    / (m + 1) as f64,
+            ),
+            SwitchRule::Derivative(i) => {
+                Some(memory_length_constant(i.min(m), m))
             }
-            SwitchRule::Derivative(i) => Some(memory_length_constant(i.min(m), m)),
             SwitchRule::ExactCrossover | SwitchRule::AtSample(_) => None,
         };
         let dw = fading_gains_double_word(m, theta);

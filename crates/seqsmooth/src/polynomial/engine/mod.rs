@@ -75,9 +75,7 @@ impl EngineState {
                 }
             }
             (EngineState::Gain(g), None) => g.update_many(ts, ys),
-            (EngineState::Gain(g), Some(out)) => {
-                g.update_many_into(ts, ys, &mut out[..valid * (m + 1)])
-            }
+            (EngineState::Gain(g), Some(out)) => g.update_many_into(ts, ys, &mut out[..valid * (m + 1)]),
         }
         if valid < times.len() {
             let previous = (self.samples() > 0).then(|| self.last_time());

@@ -7,11 +7,11 @@
 //! self-starting; it starts as an expanding-memory filter and switches to its constant gains at a
 //! sample chosen by a [`SwitchRule`].
 
-use super::vrf::{fading_vrf, fading_vrf_limit};
-use crate::error::Error;
 use crate::polynomial::expanding::gains::ExpandingGainSchedule;
+use super::vrf::{fading_vrf, fading_vrf_limit};
 use crate::polynomial::fixed::fixed_memory_vrf_limit;
 use crate::polynomial::form::EstimateForm;
+use crate::error::Error;
 use crate::scalar::{Rational, Scalar};
 
 /// Morrison's Table 13.4 constant `c_im = (κ_ii(m)/λ_ii(m))^(1/(2i+1))`: a fading-memory filter
