@@ -29,6 +29,7 @@ pub mod chi_squared;
 pub mod innovation;
 pub mod noise;
 pub mod welford;
+mod window;
 
 pub use chi_squared::{
     chi_squared_cdf, chi_squared_quantile, chi_squared_sf, normal_quantile, two_sided_tail,
