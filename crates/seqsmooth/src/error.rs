@@ -3,6 +3,13 @@
 use thiserror::Error;
 
 /// What went wrong, with the value that caused it.
+///
+/// ```
+/// use seqsmooth::{Engine, Error, FadingMemory};
+/// let e = FadingMemory::new(1, 1.5, 1.0, Engine::Exact).unwrap_err();
+/// assert_eq!(e, Error::ThetaOutOfRange { theta: 1.5 });
+/// assert_eq!(e.to_string(), "theta 1.5 is out of range: it must lie strictly between 0 and 1");
+/// ```
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum Error {
     /// A sample value or timestamp is NaN or infinite.

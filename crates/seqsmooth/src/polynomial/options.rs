@@ -6,9 +6,26 @@ use crate::error::Error;
 
 /// The largest degree the filters accept. The exact engine's accuracy against an independent
 /// batch QR fit is measured in the tests up to this degree.
+///
+/// ```
+/// use seqsmooth::{Engine, Error, ExpandingMemory, MAX_DEGREE};
+/// assert!(ExpandingMemory::new(MAX_DEGREE, Engine::Exact).is_ok());
+/// assert!(matches!(ExpandingMemory::new(MAX_DEGREE + 1, Engine::Exact), Err(Error::DegreeOutOfRange { .. })));
+/// ```
 pub const MAX_DEGREE: usize = 24;
 
 /// Which computation a filter uses (see the [module docs](self)).
+///
+/// ```
+/// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
+/// assert_eq!(Engine::default(), Engine::Exact);
+/// // on even samples both engines are exact least squares
+/// for engine in [Engine::Exact, Engine::Gain] {
+///     let mut f = ExpandingMemory::new(1, engine).unwrap();
+///     for n in 0..10 { f.update(n as f64, 2.0 * n as f64).unwrap(); }
+///     assert!((f.estimate().unwrap().derivatives[1] - 2.0).abs() < 1e-12);
+/// }
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Engine {
     /// Recursive least squares, exact on any timestamps.
@@ -19,6 +36,16 @@ pub enum Engine {
 }
 
 /// How a fading-memory filter discounts old samples.
+///
+/// ```
+/// use seqsmooth::{DiscountMode, Engine, FadingMemory, PolynomialFilter};
+/// assert_eq!(DiscountMode::default(), DiscountMode::PerTime);
+/// let mut f = FadingMemory::new(0, 0.5, 1.0, Engine::Exact).unwrap()
+///     .with_discount_mode(DiscountMode::PerUpdate).unwrap();
+/// for (t, y) in [(0.0, 0.0), (10.0, 3.0)] { f.update(t, y).unwrap(); }
+/// // weights 1/2 and 1 whatever the gap: (0·½ + 3·1)/(½ + 1) = 2
+/// assert!((f.estimate().unwrap().derivatives[0] - 2.0).abs() < 1e-12);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DiscountMode {
     /// By `θ` per `τ` of elapsed time: weight `θ^((t_n - t_k)/τ)` (`θ_eff = θ^ζ` per update).

@@ -90,6 +90,22 @@ pub(super) fn unit_fading(cfg: &AutoConfig) -> Result<FadingMemory, Error> {
         .with_noise_sigma(1.0)
 }
 
+/// The `with_*` builders of [`AutomaticFilter`]: each changes the fields of its
+/// [`AutoConfig`] given on the right, and checks every setting again (an error after the first
+/// sample).
+macro_rules! builders {
+    ($($(#[$doc:meta])* $name:ident($($arg:ident: $ty:ty),+) => $($field:ident = $value:expr),+;)+) => {
+        $(
+            $(#[$doc])*
+            pub fn $name(self, $($arg: $ty),+) -> Result<Self, Error> {
+                self.reconfigure(|c| {
+                    $(c.$field = $value;)+
+                })
+            }
+        )+
+    };
+}
+
 impl AutomaticFilter {
     /// The filter of a checked configuration.
     fn build(config: AutoConfig) -> Result<Self, Error> {
@@ -184,181 +200,172 @@ impl AutomaticFilter {
         Self::build(config)
     }
 
-    /// The engine of every internal filter (default [`Engine::Exact`], right on irregular
-    /// samples).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// use seqsmooth::Engine;
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_engine(Engine::Gain).unwrap();
-    /// assert_eq!(f.config().engine, Engine::Gain);
-    /// ```
-    pub fn with_engine(self, engine: Engine) -> Result<Self, Error> {
-        self.reconfigure(|c| c.engine = engine)
-    }
+    builders! {
+        /// The engine of every internal filter (default [`Engine::Exact`], right on irregular
+        /// samples).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// use seqsmooth::Engine;
+        /// let mut exact = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(1.0).unwrap();
+        /// let mut gain = exact.clone().with_engine(Engine::Gain).unwrap();
+        /// for n in 0..60 {
+        ///     exact.update(n as f64, 0.5 * n as f64).unwrap();
+        ///     gain.update(n as f64, 0.5 * n as f64).unwrap();
+        /// }
+        /// // on even samples the engines agree
+        /// let (a, b) = (exact.estimate().unwrap(), gain.estimate().unwrap());
+        /// assert!((a.derivatives[1] - b.derivatives[1]).abs() < 1e-9);
+        /// ```
+        with_engine(engine: Engine) => engine = engine;
 
-    /// Discounting by time (default [`DiscountMode::PerTime`]) or by sample.
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// use seqsmooth::DiscountMode;
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap()
-    ///     .with_discount_mode(DiscountMode::PerUpdate).unwrap();
-    /// assert_eq!(f.config().discount, DiscountMode::PerUpdate);
-    /// ```
-    pub fn with_discount_mode(self, mode: DiscountMode) -> Result<Self, Error> {
-        self.reconfigure(|c| c.discount = mode)
-    }
+        /// Discounting by time (default [`DiscountMode::PerTime`]) or by sample.
+        ///
+        /// ```
+        /// # use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// use seqsmooth::DiscountMode;
+        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0)?.with_discount_mode(DiscountMode::PerUpdate)?;
+        /// assert_eq!(f.config().discount, DiscountMode::PerUpdate);
+        /// # Ok::<(), seqsmooth::Error>(())
+        /// ```
+        with_discount_mode(mode: DiscountMode) => discount = mode;
 
-    /// When the final degree moves from expanding to fading memory (default
-    /// [`SwitchRule::Position`]); checked for the degree.
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// use seqsmooth::polynomial::SwitchRule;
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
-    /// assert!(f.clone().with_switch_rule(SwitchRule::Derivative(2)).is_err());
-    /// let mut f = f.with_switch_rule(SwitchRule::AtSample(5)).unwrap().with_noise_sigma(1.0).unwrap();
-    /// for n in 0..10 {
-    ///     f.update(n as f64, n as f64).unwrap();
-    /// }
-    /// assert_eq!(f.switched_at(), Some(5));
-    /// ```
-    pub fn with_switch_rule(self, rule: SwitchRule) -> Result<Self, Error> {
-        self.reconfigure(|c| c.switch_rule = rule)
-    }
+        /// When the final degree moves from expanding to fading memory (default
+        /// [`SwitchRule::Position`]); checked for the degree.
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// use seqsmooth::polynomial::SwitchRule;
+        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// assert!(f.clone().with_switch_rule(SwitchRule::Derivative(2)).is_err());
+        /// let mut f = f.with_switch_rule(SwitchRule::AtSample(5)).unwrap().with_noise_sigma(1.0).unwrap();
+        /// for n in 0..10 {
+        ///     f.update(n as f64, n as f64).unwrap();
+        /// }
+        /// assert_eq!(f.switched_at(), Some(5));
+        /// ```
+        with_switch_rule(rule: SwitchRule) => switch_rule = rule;
 
-    /// The measurement noise `σ > 0`, when known (by default it is estimated, see
-    /// [`with_noise_source`](Self::with_noise_source)).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
-    /// assert!(f.clone().with_noise_sigma(0.0).is_err());
-    /// assert_eq!(f.with_noise_sigma(0.3).unwrap().noise_sigma(), Some(0.3));
-    /// ```
-    pub fn with_noise_sigma(self, sigma: f64) -> Result<Self, Error> {
-        self.reconfigure(|c| c.noise_sigma = Some(sigma))
-    }
+        /// The measurement noise `σ > 0`, when known (by default it is estimated, see
+        /// [`with_noise_source`](Self::with_noise_source)).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// assert!(f.clone().with_noise_sigma(0.0).is_err());
+        /// assert_eq!(f.with_noise_sigma(0.3).unwrap().noise_sigma(), Some(0.3));
+        /// ```
+        with_noise_sigma(sigma: f64) => noise_sigma = Some(sigma);
 
-    /// How `σ` is estimated when not given (default [`NoiseSource::Differences`] over all
-    /// samples).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::{AutomaticFilter, NoiseSource};
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
-    /// assert!(f.clone().with_noise_source(NoiseSource::Differences { window: Some(0) }).is_err());
-    /// let f = f.with_noise_source(NoiseSource::Innovations { window: None }).unwrap();
-    /// assert_eq!(f.config().noise_source, NoiseSource::Innovations { window: None });
-    /// ```
-    pub fn with_noise_source(self, source: NoiseSource) -> Result<Self, Error> {
-        self.reconfigure(|c| c.noise_source = source)
-    }
+        /// How `σ` is estimated when not given (default [`NoiseSource::Differences`] over all
+        /// samples).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::{AutomaticFilter, NoiseSource};
+        /// let source = NoiseSource::Innovations { window: None };
+        /// match AutomaticFilter::with_defaults(1, 0.9, 1.0).and_then(|f| f.with_noise_source(source)) {
+        ///     Ok(f) => assert_eq!(f.config().noise_source, source),
+        ///     Err(e) => panic!("{e}"),
+        /// }
+        /// ```
+        with_noise_source(source: NoiseSource) => noise_source = source;
 
-    /// The outlier gate (default [`OutlierRule::morrison`]).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::{AutomaticFilter, OutlierRule};
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
-    /// assert!(f.clone().with_outlier_rule(OutlierRule::Innovation { k: -1.0 }).is_err());
-    /// let f = f.with_outlier_rule(OutlierRule::Off).unwrap();
-    /// assert_eq!(f.config().outliers, OutlierRule::Off);
-    /// ```
-    pub fn with_outlier_rule(self, rule: OutlierRule) -> Result<Self, Error> {
-        self.reconfigure(|c| c.outliers = rule)
-    }
+        /// The outlier gate (default [`OutlierRule::morrison`]).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::{AutomaticFilter, OutlierRule};
+        /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap()
+        ///     .with_noise_sigma(0.1).unwrap()
+        ///     .with_outlier_rule(OutlierRule::Off).unwrap();
+        /// let flags: Vec<bool> = [1.0, 1.0, 1.0, 50.0].iter().enumerate()
+        ///     .map(|(n, y)| f.update(n as f64, *y).unwrap().outlier)
+        ///     .collect();
+        /// assert_eq!(flags, [false; 4]); // no gate: the spike is taken
+        /// ```
+        with_outlier_rule(rule: OutlierRule) => outliers = rule;
 
-    /// The gate is applied only while the 1-step prediction VRF is at most `v > 0` (default
-    /// [`GATE_MAX_VRF`](super::GATE_MAX_VRF); infinity: always).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
-    /// assert!(f.clone().with_gate_max_vrf(f64::NAN).is_err());
-    /// assert_eq!(f.with_gate_max_vrf(f64::INFINITY).unwrap().config().gate_max_vrf, f64::INFINITY);
-    /// ```
-    pub fn with_gate_max_vrf(self, v: f64) -> Result<Self, Error> {
-        self.reconfigure(|c| c.gate_max_vrf = v)
-    }
+        /// The gate is applied only while the 1-step prediction VRF is at most `v > 0` (default
+        /// [`GATE_MAX_VRF`](super::GATE_MAX_VRF); infinity: always).
+        ///
+        /// ```
+        /// # fn main() -> Result<(), seqsmooth::Error> {
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let always = AutomaticFilter::with_defaults(1, 0.9, 1.0)?.with_gate_max_vrf(f64::INFINITY)?;
+        /// assert!(always.config().gate_max_vrf.is_infinite());
+        /// assert!(always.with_gate_max_vrf(-1.0).is_err());
+        /// # Ok(())
+        /// # }
+        /// ```
+        with_gate_max_vrf(v: f64) => gate_max_vrf = v;
 
-    /// A run of `n` consecutive rejections is a manoeuvre, applied after all (`0`: never;
-    /// default 3).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_max_consecutive_rejections(0).unwrap();
-    /// assert_eq!(f.config().max_consecutive_rejections, 0);
-    /// ```
-    pub fn with_max_consecutive_rejections(self, n: usize) -> Result<Self, Error> {
-        self.reconfigure(|c| c.max_consecutive_rejections = n)
-    }
+        /// A run of `n` consecutive rejections is a manoeuvre, applied after all (`0`: never;
+        /// default 3).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap()
+        ///     .with_max_consecutive_rejections(0).unwrap();
+        /// for n in 0..20 { f.update(n as f64, 0.0).unwrap(); }
+        /// for n in 20..30 { f.update(n as f64, 10.0).unwrap(); } // a step, never accepted
+        /// assert_eq!(f.rejected(), 10);
+        /// ```
+        with_max_consecutive_rejections(n: usize) => max_consecutive_rejections = n;
 
-    /// The innovation chi-squared window `K ≥ 1` (default 10).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
-    /// assert!(f.clone().with_misfit_window(0).is_err());
-    /// assert_eq!(f.with_misfit_window(20).unwrap().config().misfit_window, 20);
-    /// ```
-    pub fn with_misfit_window(self, window: usize) -> Result<Self, Error> {
-        self.reconfigure(|c| c.misfit_window = window)
-    }
+        /// The innovation chi-squared window `K ≥ 1` (default 10).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// for (k, ok) in [(0, false), (1, true), (50, true)] {
+        ///     assert_eq!(AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_misfit_window(k).is_ok(), ok);
+        /// }
+        /// ```
+        with_misfit_window(window: usize) => misfit_window = window;
 
-    /// The per-sample false-alarm rate `α ∈ (0,1)` of the misfit test (default 0.01).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
-    /// assert!(f.clone().with_misfit_alpha(0.0).is_err());
-    /// assert_eq!(f.with_misfit_alpha(0.05).unwrap().config().misfit_alpha, 0.05);
-    /// ```
-    pub fn with_misfit_alpha(self, alpha: f64) -> Result<Self, Error> {
-        self.reconfigure(|c| c.misfit_alpha = alpha)
-    }
+        /// The per-sample false-alarm rate `α ∈ (0,1)` of the misfit test (default 0.01).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// let ok: Vec<bool> = [0.0, 0.05, 1.0].iter().map(|&a| f.clone().with_misfit_alpha(a).is_ok()).collect();
+        /// assert_eq!(ok, [false, true, false]);
+        /// ```
+        with_misfit_alpha(alpha: f64) => misfit_alpha = alpha;
 
-    /// What the filter does when the model no longer fits (default
-    /// [`MisfitResponse::Restart`] at `α = 10⁻⁴`).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::{AutomaticFilter, MisfitResponse};
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
-    /// assert!(f.clone().with_misfit_response(MisfitResponse::Restart { alpha: 1.0 }).is_err());
-    /// let f = f.with_misfit_response(MisfitResponse::Flag).unwrap();
-    /// assert_eq!(f.config().misfit_response, MisfitResponse::Flag);
-    /// ```
-    pub fn with_misfit_response(self, response: MisfitResponse) -> Result<Self, Error> {
-        self.reconfigure(|c| c.misfit_response = response)
-    }
+        /// What the filter does when the model no longer fits (default
+        /// [`MisfitResponse::Restart`] at `α = 10⁻⁴`).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::{AutomaticFilter, MisfitResponse};
+        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// let e = f.clone().with_misfit_response(MisfitResponse::Restart { alpha: 1.0 }).unwrap_err();
+        /// assert!(e.to_string().contains("restart significance"));
+        /// let flag = f.with_misfit_response(MisfitResponse::Flag).unwrap();
+        /// assert_eq!(flag.config().misfit_response, MisfitResponse::Flag);
+        /// ```
+        with_misfit_response(response: MisfitResponse) => misfit_response = response;
 
-    /// The first degree `d₀ ≤ m` of the quick-settling ladder (default 0; `m` disables it).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap();
-    /// assert!(f.clone().with_start_degree(3).is_err());
-    /// assert_eq!(f.with_start_degree(2).unwrap().active_degree(), 2);
-    /// ```
-    pub fn with_start_degree(self, degree: usize) -> Result<Self, Error> {
-        self.reconfigure(|c| c.start_degree = degree)
-    }
+        /// The first degree `d₀ ≤ m` of the quick-settling ladder (default 0; `m` disables it).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap();
+        /// assert!(f.clone().with_start_degree(3).is_err());
+        /// assert_eq!(f.with_start_degree(2).unwrap().active_degree(), 2);
+        /// ```
+        with_start_degree(degree: usize) => start_degree = degree;
 
-    /// The ladder's candidate degree takes over once its current position VRF is at most
-    /// `vrf > 0` (default ½) and its top derivative moved by less than its 1σ at each of
-    /// `stable` updates (default 3).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap();
-    /// assert!(f.clone().with_settling(0.0, 3).is_err());
-    /// let c = f.with_settling(0.25, 5).unwrap().config().clone();
-    /// assert_eq!((c.settle_vrf, c.settle_stable), (0.25, 5));
-    /// ```
-    pub fn with_settling(self, vrf: f64, stable: usize) -> Result<Self, Error> {
-        self.reconfigure(|c| {
-            c.settle_vrf = vrf;
-            c.settle_stable = stable;
-        })
+        /// The ladder's candidate degree takes over once its current position VRF is at most
+        /// `vrf > 0` (default ½) and its top derivative moved by less than its 1σ at each of
+        /// `stable` updates (default 3).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap();
+        /// assert!(f.clone().with_settling(0.0, 3).is_err());
+        /// let c = f.with_settling(0.25, 5).unwrap().config().clone();
+        /// assert_eq!((c.settle_vrf, c.settle_stable), (0.25, 5));
+        /// ```
+        with_settling(vrf: f64, stable: usize) => settle_vrf = vrf, settle_stable = stable;
     }
 
     /// The settings.
@@ -425,17 +432,34 @@ impl AutomaticFilter {
 
     /// Samples rejected as outliers (not counting runs later applied as manoeuvres); see
     /// [`samples`](Self::samples).
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+    /// for n in 0..40 { f.update(n as f64, if n == 30 { 100.0 } else { 1.0 }).unwrap(); }
+    /// assert_eq!(f.rejected(), 1);
+    /// ```
     pub fn rejected(&self) -> u64 {
         self.rejected
     }
 
     /// Restarts of the final-degree memory ([`MisfitResponse::Restart`]); see the example there.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// assert_eq!(AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().restarts(), 0);
+    /// ```
     pub fn restarts(&self) -> u64 {
         self.restarts
     }
 
     /// The index (in accepted samples) of the newest sample when the latest restart happened;
     /// see [`MisfitResponse::Restart`].
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// assert_eq!(AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().last_restart(), None);
+    /// ```
     pub fn last_restart(&self) -> Option<u64> {
         self.last_restart
     }
@@ -476,6 +500,13 @@ impl AutomaticFilter {
     /// The 0-based index, in accepted samples since the first, of the first sample the
     /// fading-memory filter produced the output for (the latest switch, after a restart);
     /// `None` before the switch. See [`Phase`].
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(1.0).unwrap();
+    /// for n in 0..40 { f.update(n as f64, n as f64).unwrap(); }
+    /// assert_eq!(f.switched_at(), Some(32)); // Morrison (13.8.8)
+    /// ```
     pub fn switched_at(&self) -> Option<u64> {
         self.switched_at
     }

@@ -7,6 +7,11 @@ use crate::error::Error;
 use crate::polynomial::PolynomialFilter;
 
 /// What the filter does when its innovations say the model no longer fits (Morrison §14.8).
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::MisfitResponse;
+/// assert_eq!(MisfitResponse::default(), MisfitResponse::Restart { alpha: 1e-4 });
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MisfitResponse {
     /// Raise [`AutoOutput::misfit`](super::AutoOutput::misfit) only: the memory keeps the
