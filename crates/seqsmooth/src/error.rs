@@ -125,3 +125,29 @@ pub fn check_sample(t: f64, y: f64, previous: Option<f64>) -> Result<(), Error> 
         _ => Ok(()),
     }
 }
+
+/// The first non-finite number of `xs` as an [`Error::NonFinite`] naming it `what` (`"time"` or
+/// `"value"`).
+pub(crate) fn check_finite(what: &'static str, xs: &[f64]) -> Result<(), Error> {
+    match xs.iter().find(|x| !x.is_finite()) {
+        Some(&value) => Err(Error::NonFinite { what, value }),
+        None => Ok(()),
+    }
+}
+
+/// One time per value, or an [`Error::InvalidParameter`] called `name` giving `reason`.
+pub(crate) fn check_lengths(
+    name: &'static str,
+    times: &[f64],
+    values: &[f64],
+    reason: &str,
+) -> Result<(), Error> {
+    if times.len() != values.len() {
+        return Err(Error::InvalidParameter {
+            name,
+            value: format!("{} times, {} values", times.len(), values.len()),
+            reason: reason.into(),
+        });
+    }
+    Ok(())
+}

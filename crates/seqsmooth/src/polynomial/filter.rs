@@ -149,20 +149,19 @@ pub(crate) fn check_estimates_length(
     Ok(())
 }
 
+/// One time per value in a batch.
 pub(crate) fn check_batch_lengths(times: &[f64], values: &[f64]) -> Result<(), Error> {
-    if times.len() != values.len() {
-        return Err(Error::InvalidParameter {
-            name: "batch lengths",
-            value: format!("{} times, {} values", times.len(), values.len()),
-            reason: "a batch needs one time per value".into(),
-        });
-    }
-    Ok(())
+    crate::error::check_lengths(
+        "batch lengths",
+        times,
+        values,
+        "a batch needs one time per value",
+    )
 }
 
 /// `x` is neither NaN nor infinite: `x − x` is `0` exactly then (`NaN` otherwise); as
-/// arithmetic it vectorises better in [`first_invalid`] than `f64::is_finite` (measured:
-/// 2.5e9 against 2.0e9 samples/s checked).
+/// arithmetic it vectorises better in [`first_invalid`] than `f64::is_finite` (speed: see
+/// BENCHMARKS.md).
 #[inline(always)]
 #[allow(clippy::eq_op)]
 fn finite(x: f64) -> bool {

@@ -29,18 +29,12 @@
 use super::welford::Welford;
 use super::window::SlidingSum;
 use crate::calculus::choose;
-use crate::error::Error;
+use crate::error::{check_finite, Error};
 use crate::estimate::PolynomialFit;
 use std::collections::VecDeque;
 
 fn check_values(values: &[f64]) -> Result<(), Error> {
-    if let Some(&v) = values.iter().find(|v| !v.is_finite()) {
-        return Err(Error::NonFinite {
-            what: "value",
-            value: v,
-        });
-    }
-    Ok(())
+    check_finite("value", values)
 }
 
 /// Reyneke's eq. 39 as printed: `R = Σ_{i=2..N} (y_i − y_{i−1})² / (2N − 2)`, the noise variance
@@ -240,14 +234,7 @@ pub fn normalised_divided_difference(times: &[f64], values: &[f64]) -> Result<f6
             reason: "need the same number (at least 2) of times and values".into(),
         });
     }
-    for &t in times {
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
-    }
+    check_finite("time", times)?;
     check_values(values)?;
     for w in times.windows(2) {
         if w[1] <= w[0] {
