@@ -48,6 +48,8 @@
 //! - [`recursive`]: the square-root information (Bayes) recursion the exact engines run on.
 //! - [`scalar`]: the `f64` / exact-rational abstraction every formula is generic over.
 //! - [`linalg`]: the small dense linear algebra the formulas share.
+//! - `numeric`: the numerical building blocks of the engines (double-word arithmetic, the
+//!   step tolerance).
 //!
 //! Measured accuracy: see ACCURACY.md; speed: BENCHMARKS.md.
 //!

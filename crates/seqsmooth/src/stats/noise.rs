@@ -151,15 +151,22 @@ pub fn difference_variance(values: &[f64], order: usize) -> Result<f64, Error> {
     Ok(d.iter().map(|v| v * v).sum::<f64>() / (d.len() as f64 * c))
 }
 
+/// The largest difference order the estimators accept: enough for a trend of the filters'
+/// largest degree (`MAX_DEGREE + 1`, checked where the filters define it).
+///
+/// ```
+/// use seqsmooth::stats::{DifferenceNoise, MAX_DIFFERENCE_ORDER};
+/// assert!(DifferenceNoise::new(MAX_DIFFERENCE_ORDER, None).is_ok());
+/// assert!(DifferenceNoise::new(MAX_DIFFERENCE_ORDER + 1, None).is_err());
+/// ```
+pub const MAX_DIFFERENCE_ORDER: usize = 25;
+
 fn check_order(order: usize) -> Result<(), Error> {
-    if order == 0 || order > crate::polynomial::MAX_DEGREE + 1 {
+    if order == 0 || order > MAX_DIFFERENCE_ORDER {
         return Err(Error::InvalidParameter {
             name: "difference order",
             value: order.to_string(),
-            reason: format!(
-                "must be between 1 and {}",
-                crate::polynomial::MAX_DEGREE + 1
-            ),
+            reason: format!("must be between 1 and {MAX_DIFFERENCE_ORDER}"),
         });
     }
     Ok(())
