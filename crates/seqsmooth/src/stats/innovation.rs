@@ -221,7 +221,7 @@ impl InnovationChiSquared {
     /// assert!(!test.is_empty());
     /// ```
     pub fn is_empty(&self) -> bool {
-        self.recent.len() == 0
+        self.recent.is_empty()
     }
 
     /// True when the current window sum exceeds its threshold.

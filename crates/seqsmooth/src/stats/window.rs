@@ -63,6 +63,11 @@ impl SlidingSum {
         }
     }
 
+    /// True when no value is in the window.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
     /// Empties the sum.
     pub(crate) fn clear(&mut self) {
         self.values.clear();
