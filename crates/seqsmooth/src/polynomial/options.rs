@@ -8,7 +8,8 @@ use crate::error::Error;
 /// batch QR fit is measured in the tests up to this degree.
 ///
 /// ```
-/// use seqsmooth::{Engine, Error, ExpandingMemory, MAX_DEGREE};
+/// use seqsmooth::polynomial::MAX_DEGREE;
+/// use seqsmooth::{Engine, Error, ExpandingMemory};
 /// assert!(ExpandingMemory::new(MAX_DEGREE, Engine::Exact).is_ok());
 /// assert!(matches!(ExpandingMemory::new(MAX_DEGREE + 1, Engine::Exact), Err(Error::DegreeOutOfRange { .. })));
 /// ```
