@@ -30,6 +30,13 @@ pub struct ExpandingMemory {
 
 impl ExpandingMemory {
     /// A filter of degree `m` on the given engine.
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, Error, ExpandingMemory, PolynomialFilter};
+    /// let f = ExpandingMemory::new(2, Engine::Exact).unwrap();
+    /// assert_eq!((f.degree(), f.samples()), (2, 0));
+    /// assert!(matches!(ExpandingMemory::new(99, Engine::Exact), Err(Error::DegreeOutOfRange { .. })));
+    /// ```
     pub fn new(m: usize, engine: Engine) -> Result<Self, Error> {
         check_degree(m)?;
         let core = match engine {
@@ -42,6 +49,14 @@ impl ExpandingMemory {
 
     /// Tracks the covariance of the estimate for white measurement noise of standard deviation
     /// `sigma`: exact for the engine's estimator on any timestamps.
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
+    /// let mut f = ExpandingMemory::new(0, Engine::Exact).unwrap().with_noise_sigma(2.0).unwrap();
+    /// for n in 0..4 { f.update(n as f64, 1.0).unwrap(); }
+    /// let var = f.estimate().unwrap().covariance.unwrap()[(0, 0)];
+    /// assert!((var - 1.0).abs() < 1e-12); // σ²/4
+    /// ```
     pub fn with_noise_sigma(mut self, sigma: f64) -> Result<Self, Error> {
         self.core.track_covariance(sigma)?;
         Ok(self)
