@@ -40,9 +40,10 @@ fn layers(krate: &str) -> BTreeMap<String, usize> {
             continue;
         };
         for module in cells[2].split(',') {
-            let module = module.trim().trim_matches('`');
-            if !module.is_empty() {
-                table.insert(module.to_string(), level);
+            // `` is the crate root (lib.rs or main.rs)
+            let module = module.trim();
+            if module.starts_with('`') {
+                table.insert(module.trim_matches('`').to_string(), level);
             }
         }
     }
