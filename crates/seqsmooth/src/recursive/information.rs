@@ -1,28 +1,7 @@
 use crate::linalg::solve_upper_transpose_in_place;
+use crate::numeric::unrolled::unrolled_sizes;
 use nalgebra::{DMatrix, DVector};
 
-/// `$call` with the constant `N` equal to the size `$p` for sizes 1 to 9 (fully unrolled code
-/// for the polynomial filters' common degrees), `$other` (with the size bound to `$q`) above.
-macro_rules! unrolled_sizes {
-    ($p:expr, $n:ident => $call:expr, $q:pat => $other:expr) => {
-        match $p {
-            1 => unrolled_sizes!(@at 1, $n, $call),
-            2 => unrolled_sizes!(@at 2, $n, $call),
-            3 => unrolled_sizes!(@at 3, $n, $call),
-            4 => unrolled_sizes!(@at 4, $n, $call),
-            5 => unrolled_sizes!(@at 5, $n, $call),
-            6 => unrolled_sizes!(@at 6, $n, $call),
-            7 => unrolled_sizes!(@at 7, $n, $call),
-            8 => unrolled_sizes!(@at 8, $n, $call),
-            9 => unrolled_sizes!(@at 9, $n, $call),
-            $q => $other,
-        }
-    };
-    (@at $v:literal, $n:ident, $call:expr) => {{
-        const $n: usize = $v;
-        $call
-    }};
-}
 /// An upper-triangular factor `R` of an accumulated Gram matrix `RᵀR = Σ_k c_k a_k a_kᵀ`, kept
 /// up to date row by row, with a right-hand column `d` (`Rᵀd = Σ_k c_k a_k b_k`).
 ///

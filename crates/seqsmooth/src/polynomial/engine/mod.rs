@@ -6,10 +6,12 @@
 //! - [`gain`]: the fixed-gain recursion of Morrison Tables 9.1/13.1 in Reyneke's variable-step
 //!   form, with its batch kernels.
 //! - [`expanding_block`]: runs of even blocks folded into the expanding-memory least-squares fit.
+//! - [`recursion`]: the gain recursion of one sample, the reference of every fast path.
 
 pub(crate) mod exact;
 pub(crate) mod expanding_block;
 pub(crate) mod gain;
+pub(crate) mod recursion;
 
 use super::filter::{check_batch_lengths, check_estimates_length, first_invalid};
 #[cfg(doc)]
@@ -75,7 +77,9 @@ impl EngineState {
                 }
             }
             (EngineState::Gain(g), None) => g.update_many(ts, ys),
-            (EngineState::Gain(g), Some(out)) => g.update_many_into(ts, ys, &mut out[..valid * (m + 1)]),
+            (EngineState::Gain(g), Some(out)) => {
+                g.update_many_into(ts, ys, &mut out[..valid * (m + 1)])
+            }
         }
         if valid < times.len() {
             let previous = (self.samples() > 0).then(|| self.last_time());
