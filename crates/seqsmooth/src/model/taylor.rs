@@ -116,13 +116,19 @@ pub(crate) fn derivative_scale(tau: f64) -> impl Iterator<Item = f64> {
 /// assert_eq!(d[(2, 2)], 8.0); // 2!/0.5²
 /// ```
 pub fn scaling<T: Scalar>(m: usize, tau: T) -> DMatrix<T> {
-    DMatrix::from_fn(m + 1, m + 1, |i, j| {
-        if i == j {
-            factorial::<T>(i) / tau.powi_u(i)
-        } else {
-            T::zero()
-        }
-    })
+    let d = scaling_diagonal(m, tau);
+    DMatrix::from_fn(
+        m + 1,
+        m + 1,
+        |i, j| if i == j { d[i].clone() } else { T::zero() },
+    )
+}
+
+/// The diagonal of [`scaling`], `k!/τ^k` for `k = 0 … m`, each as `k!` over `τ.powi_u(k)`
+/// (for `f64`: `factorial(k) / τ.powi(k)`, the form of the matrices built from it; the
+/// recursions' read-outs use the running products of [`derivative_scale`]).
+pub(crate) fn scaling_diagonal<T: Scalar>(m: usize, tau: T) -> Vec<T> {
+    (0..=m).map(|k| factorial::<T>(k) / tau.powi_u(k)).collect()
 }
 
 /// Converts Morrison's scaled state `Z` (unit `τ`) to unscaled derivatives `X = D(τ) Z`.

@@ -248,17 +248,7 @@ impl TriangularFactor {
         let ubar: &mut [f64] = &mut self.ubar[..N];
         for i in 0..N {
             let xi = x[i];
-            let dx = delta * xi;
-            let di = d[i].0;
-            let dp = di + dx * xi;
-            // A zero pivot (no information yet and a zero entry) leaves everything as it is.
-            let (cbar, sbar) = if dp > 0.0 {
-                (di / dp, dx / dp)
-            } else {
-                (1.0, 0.0)
-            };
-            delta *= cbar;
-            d[i].0 = dp;
+            let (cbar, sbar) = gentleman_pivot(&mut delta, xi, &mut d[i].0);
             for j in i + 1..N {
                 let xj = x[j];
                 let uij = u[i * N + j];
@@ -340,16 +330,7 @@ impl TriangularFactor {
         let mut delta = weight;
         for i in 0..p {
             let xi = x[i];
-            let dx = delta * xi;
-            let di = self.d[i].0;
-            let dp = di + dx * xi;
-            let (cbar, sbar) = if dp > 0.0 {
-                (di / dp, dx / dp)
-            } else {
-                (1.0, 0.0)
-            };
-            delta *= cbar;
-            self.d[i].0 = dp;
+            let (cbar, sbar) = gentleman_pivot(&mut delta, xi, &mut self.d[i].0);
             let row = &mut self.u[i * p + i + 1..(i + 1) * p];
             for (xj, uij) in x[i + 1..p].iter_mut().zip(row.iter_mut()) {
                 let (a, u) = (*xj, *uij);
@@ -650,6 +631,24 @@ impl InformationFilter {
         let ri = self.right_divide(&DMatrix::identity(p, p))?;
         Some(&ri * ri.transpose())
     }
+}
+
+/// One pivot of Gentleman's rotation for the row entry `x` against the pivot `d`:
+/// `d' = d + δx²`, `c̄ = d/d'`, `s̄ = δx/d'`, `δ ← δc̄`; returns `(c̄, s̄)`. A zero pivot (no
+/// information yet and a zero entry) leaves everything as it is.
+#[inline(always)]
+fn gentleman_pivot(delta: &mut f64, x: f64, d: &mut f64) -> (f64, f64) {
+    let dx = *delta * x;
+    let di = *d;
+    let dp = di + dx * x;
+    let (cbar, sbar) = if dp > 0.0 {
+        (di / dp, dx / dp)
+    } else {
+        (1.0, 0.0)
+    };
+    *delta *= cbar;
+    *d = dp;
+    (cbar, sbar)
 }
 
 /// `a` as an array (its length is checked by the caller).

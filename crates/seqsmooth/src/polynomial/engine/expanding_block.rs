@@ -116,6 +116,29 @@ fn taylor_of_q<const K: usize>(b: &[f64; K], x: f64) -> [[f64; K]; K] {
     t
 }
 
+/// The coefficients `c` in the monic basis `Q_j` of a grid of `count` points (`v` has step
+/// `2/count`) of the polynomial with Taylor coefficients `z_k` in sample steps about the grid
+/// point whose Taylor table ([`taylor_of_q`]) is `r`: with `ζ_k = z_k (count/2)^k`,
+/// `Σ_k ζ_k t^k = Σ_j c_j Q_j(v + t)`, solved by back substitution (`T[j][j] = 1`).
+#[inline(always)]
+fn taylor_to_basis<const K: usize>(z: &[f64], count: f64, r: &[[f64; K]; K]) -> [f64; K] {
+    let mut zeta = [0.0; K];
+    let mut scale = 1.0;
+    for k in 0..K {
+        zeta[k] = z[k] * scale;
+        scale *= 0.5 * count;
+    }
+    let mut c = [0.0; K];
+    for k in (0..K).rev() {
+        let mut v = zeta[k];
+        for j in k + 1..K {
+            v -= c[j] * r[j][k];
+        }
+        c[k] = v;
+    }
+    c
+}
+
 /// `E[i][j]` with `Q^outer_i(δ + α v) = Σ_j E[i][j] Q^inner_j(v)`: the outer basis restricted to
 /// a segment, in the segment's basis (`bo`, `bi` their recurrence coefficients). From
 /// `v Q_j = Q_{j+1} + β_j Q_{j−1}` and the outer recurrence.
@@ -411,20 +434,7 @@ fn advance<const K: usize>(n: u64, z: &mut [f64], ys: &[f64], form: Form) {
         // its moments are μ_j = c_j ‖Q_j‖².
         let bo = betas::<K>(nf);
         let r = taylor_of_q(&bo, (nf - 1.0) / nf);
-        let mut zeta = [0.0; K];
-        let mut scale = 1.0;
-        for k in 0..K {
-            zeta[k] = z[k] * scale;
-            scale *= 0.5 * nf;
-        }
-        let mut c = [0.0; K];
-        for k in (0..K).rev() {
-            let mut v = zeta[k];
-            for j in k + 1..K {
-                v -= c[j] * r[j][k];
-            }
-            c[k] = v;
-        }
+        let c = taylor_to_basis(z, nf, &r);
         let mut mu = [0.0; K];
         let mut norm = nf;
         for j in 0..K {
@@ -485,20 +495,7 @@ fn advance<const K: usize>(n: u64, z: &mut [f64], ys: &[f64], form: Form) {
             let z: &mut [f64; K] = z.try_into().expect("state length checked");
             shift_scaled_array(z, lf);
             // … which is Σ_i a_i Q_i(s_newest + t) with t in units of M/2 steps …
-            let mut zeta = [0.0; K];
-            let mut scale = 1.0;
-            for k in 0..K {
-                zeta[k] = z[k] * scale;
-                scale *= 0.5 * mf;
-            }
-            let mut a = [0.0; K];
-            for k in (0..K).rev() {
-                let mut v = zeta[k];
-                for i in k + 1..K {
-                    v -= a[i] * t[i][k];
-                }
-                a[k] = v;
-            }
+            let a = taylor_to_basis(&z[..], mf, &t);
             // … and whose moments over the run are Σ_j G_ij a_j with the run's Gram matrix
             // G_ij = Σ_run Q_i Q_j = Σ_l E_il E_jl ‖Q^run_l‖² (E: union → run basis).
             let br = betas::<K>(lf);
@@ -539,6 +536,7 @@ fn advance<const K: usize>(n: u64, z: &mut [f64], ys: &[f64], form: Form) {
 mod tests {
     //! Oracles: exact rational least squares (small runs), blocked Householder QR in a Legendre
     //! basis (long runs), and the gain recursion itself, exact or in double-word arithmetic.
+    use super::super::testing::scaled_errors;
     use super::*;
     use crate::linalg::inverse_exact;
     use crate::model::{for_each_shift_step, shift_scaled_compensated};
@@ -549,21 +547,6 @@ mod tests {
     use num_traits::Zero;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
-
-    /// Errors of `z` against `want`, per degree, in units of the span `S`:
-    /// `|Δz_k| S^k / max_j |want_j| S^j`.
-    fn scaled_errors(z: &[f64], want: &[f64], span: f64) -> Vec<f64> {
-        let scale = want
-            .iter()
-            .enumerate()
-            .map(|(j, w)| w.abs() * span.powi(j as i32))
-            .fold(f64::MIN_POSITIVE, f64::max);
-        z.iter()
-            .zip(want)
-            .enumerate()
-            .map(|(k, (a, b))| (a - b).abs() * span.powi(k as i32) / scale)
-            .collect()
-    }
 
     fn max_err(e: &[f64]) -> f64 {
         e.iter().copied().fold(0.0, f64::max)

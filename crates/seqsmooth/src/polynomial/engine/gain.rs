@@ -36,6 +36,27 @@ fn write_row(row: Option<&mut [f64]>, z: &[f64], c: &[f64]) {
     }
 }
 
+/// The gains for the typical step `ζ̄` from those for the unit step: `g_k ← g_k/ζ̄^k`
+/// (Reyneke et al. §6.4), the powers as running products.
+#[inline(always)]
+fn scale_gains_for_step(g: &mut [f64], step: f64) {
+    if step != 1.0 {
+        let mut zk = 1.0;
+        for gk in g.iter_mut().skip(1) {
+            zk *= step;
+            *gk /= zk;
+        }
+    }
+}
+
+/// A plain kernel's result: the state after `done` samples, the newest at `t_last`.
+#[derive(Clone, Copy)]
+struct PlainRun<const N: usize> {
+    z: [f64; N],
+    t_last: f64,
+    done: usize,
+}
+
 /// Binomial coefficients `C(j, k)` for `j, k < N`.
 fn binomials<const N: usize>() -> [[f64; N]; N] {
     let mut c = [[0.0; N]; N];
@@ -360,15 +381,8 @@ impl GainEngine {
         let (e, e_lo) = two_sum(d, de - self.z_lo[0]);
         self.update_step_mean(t, zeta);
         self.choose_gains(t);
-        let step = self.step_mean;
-        if step != 1.0 {
-            let mut zk = 1.0;
-            for (kk, kl) in self.k.iter_mut().zip(self.k_lo.iter_mut()).skip(1) {
-                zk *= step;
-                *kk /= zk;
-                *kl /= zk;
-            }
-        }
+        scale_gains_for_step(&mut self.k, self.step_mean);
+        scale_gains_for_step(&mut self.k_lo, self.step_mean);
         for (((zi, lo), ki), kl) in self
             .z
             .iter_mut()
@@ -473,19 +487,10 @@ impl GainEngine {
         };
         let (ts, ys) = (&ts[blocks..], &ys[blocks..]);
         let steady = self.fading.is_some() && !write;
-        let rest = match (self.fading.is_none(), write) {
-            (true, false) => {
-                unrolled_sizes!(self.m + 1, N => self.expanding_run_n::<N, false>(ts, ys, out), _ => 0)
-            }
-            (true, true) => {
-                unrolled_sizes!(self.m + 1, N => self.expanding_run_n::<N, true>(ts, ys, out), _ => 0)
-            }
-            (false, false) => {
-                unrolled_sizes!(self.m + 1, N => self.steady_run_n::<N, false>(ts, ys, out), _ => 0)
-            }
-            (false, true) => {
-                unrolled_sizes!(self.m + 1, N => self.steady_run_n::<N, true>(ts, ys, out), _ => 0)
-            }
+        let rest = if write {
+            unrolled_sizes!(self.m + 1, N => self.plain_run_n::<N, true>(ts, ys, out), _ => 0)
+        } else {
+            unrolled_sizes!(self.m + 1, N => self.plain_run_n::<N, false>(ts, ys, out), _ => 0)
         };
         if steady {
             self.block_credit = self.block_credit.saturating_add(rest);
@@ -516,51 +521,98 @@ impl GainEngine {
         self.n += done as u64;
     }
 
-    /// The expanding-memory recursion after the exact start in plain `f64`, any steps: the
-    /// same operations as [`update`](Self::update) (gains `h_k(n)` of Table 9.1 scaled for the
-    /// mean step), without the compensation. Takes every sample; with `W`, writes each
-    /// sample's derivatives to `out`.
-    fn expanding_run_n<const N: usize, const W: bool>(
+    /// The plain-`f64` kernels on a run after the exact start, the state in registers, both
+    /// generated from one loop ([`plain_run`](Self::plain_run)) and tested against the
+    /// reference recursion ([`predict_correct`]); with `W`, each sample's derivatives go to
+    /// `out`. Returns how many samples it took.
+    ///
+    /// - Expanding memory, any steps: the same operations as [`update`](Self::update) (gains
+    ///   `h_k(n)` of Table 9.1 scaled for the mean step) without the compensation, the
+    ///   reference recursion itself per sample. Takes every sample.
+    /// - Fading memory after the switch, the gains fixed: the reference recursion regrouped,
+    ///   on a run of steps equal to the typical one ([`StepCheck`]).
+    fn plain_run_n<const N: usize, const W: bool>(
         &mut self,
         ts: &[f64],
         ys: &[f64],
         out: &mut [f64],
     ) -> usize {
-        let c = self.derivative_factors::<N>();
-        let mut rows = out.chunks_exact_mut(N);
-        let mut z = self.plain_state::<N>();
-        let mut g = [0.0; N];
-        let tau = self.tau;
-        let t_first = self.t_first;
-        let mut t_last = self.t_last;
-        let mut n = self.n;
-        let mut last_step = self.step_mean;
-        for (&t, &y) in ts.iter().zip(ys) {
-            let zeta = (t - t_last) / tau;
-            let mut step = (t - t_first) / (n as f64 * tau);
-            if snaps_to(step, zeta) {
-                step = zeta;
-            }
-            self.schedule.gains(n, &mut g);
-            if step != 1.0 {
-                let mut zk = 1.0;
-                for gk in g.iter_mut().skip(1) {
-                    zk *= step;
-                    *gk /= zk;
+        if self.fading.is_none() {
+            let mut g = [0.0; N];
+            let (tau, t_first, schedule) = (self.tau, self.t_first, &self.schedule);
+            let mut n = self.n;
+            let mut last_step = self.step_mean;
+            let run = self.plain_run::<N, W>(ts, ys, out, |z, t, zeta, y| {
+                let mut step = (t - t_first) / (n as f64 * tau);
+                if snaps_to(step, zeta) {
+                    step = zeta;
                 }
-            }
-            predict_correct(&mut z, zeta, &g, y);
-            if W {
-                write_row(rows.next(), &z, &c);
-            }
-            t_last = t;
-            last_step = step;
-            n += 1;
+                schedule.gains(n, &mut g);
+                scale_gains_for_step(&mut g, step);
+                predict_correct(z, zeta, &g, y);
+                last_step = step;
+                n += 1;
+                true
+            });
+            self.end_plain_run(&run.z, run.t_last, run.done);
+            self.step_mean = last_step;
+            run.done
+        } else {
+            let g: [f64; N] = std::array::from_fn(|k| self.k[k]);
+            let check = StepCheck::new(self.step_mean, self.tau);
+            // The correction folded into the prediction (so the chain from one sample to the next
+            // is one multiplication and two additions deep): with `d = y − z₀` and the powers
+            // `ζʲ`,
+            //   z₀' = (1 − g₀) z₀ + g₀ y + Σ_{j≥1} (1 − g₀) ζʲ z_j,
+            //   z_k' = Σ_{j≥1} M_kj z_j + g_k d,  M_kj = C(j,k) ζ^(j−k) [j ≥ k] − g_k ζʲ  (k ≥ 1),
+            // which is `Φ(ζ)Z + G(y − [Φ(ζ)Z]₀)` regrouped. `M` is rebuilt only when `ζ` changes.
+            let binom = binomials::<N>();
+            let mut zeta_m = f64::NAN;
+            let mut mk = [[0.0; N]; N];
+            let (g0y, one_minus_g0) = (g[0], 1.0 - g[0]);
+            let run = self.plain_run::<N, W>(ts, ys, out, |z, t, zeta, y| {
+                if !check.agrees(zeta, t) {
+                    return false;
+                }
+                if zeta != zeta_m {
+                    zeta_m = zeta;
+                    let mut pw = [1.0; N];
+                    for j in 1..N {
+                        pw[j] = pw[j - 1] * zeta;
+                    }
+                    for j in 1..N {
+                        mk[0][j] = one_minus_g0 * pw[j];
+                    }
+                    for k in 1..N {
+                        for j in 1..N {
+                            let phi = if j >= k { binom[j][k] * pw[j - k] } else { 0.0 };
+                            mk[k][j] = phi - g[k] * pw[j];
+                        }
+                    }
+                }
+                let d = y - z[0];
+                let mut next = [0.0; N];
+                next[0] = one_minus_g0 * z[0] + g0y * y;
+                if N > 1 {
+                    let mut tail = mk[0][1] * z[1];
+                    for j in 2..N {
+                        tail += mk[0][j] * z[j];
+                    }
+                    next[0] += tail;
+                    for k in 1..N {
+                        let mut acc = mk[k][1] * z[1];
+                        for j in 2..N {
+                            acc += mk[k][j] * z[j];
+                        }
+                        next[k] = acc + g[k] * d;
+                    }
+                }
+                *z = next;
+                true
+            });
+            self.end_plain_run(&run.z, run.t_last, run.done);
+            run.done
         }
-        let done = (n - self.n) as usize;
-        self.end_plain_run(&z, t_last, done);
-        self.step_mean = last_step;
-        done
     }
 
     /// The steady fading recursion on whole blocks of [`STEADY_BLOCK`] even steps, each as one
@@ -702,78 +754,34 @@ impl GainEngine {
         take
     }
 
-    fn steady_run_n<const N: usize, const W: bool>(
-        &mut self,
+    /// The plain kernels' common loop: from the state folded to `f64`, for each sample the
+    /// step `ζ = (t − t_last)/τ` and `step(z, t, ζ, y)`, which advances `z` over the sample or
+    /// returns false to stop before it; with `W`, the derivatives after each sample go to
+    /// `out`. The caller stores the result ([`end_plain_run`](Self::end_plain_run)).
+    #[inline(always)]
+    fn plain_run<const N: usize, const W: bool>(
+        &self,
         ts: &[f64],
         ys: &[f64],
         out: &mut [f64],
-    ) -> usize {
+        mut step: impl FnMut(&mut [f64; N], f64, f64, f64) -> bool,
+    ) -> PlainRun<N> {
         let c = self.derivative_factors::<N>();
         let mut rows = out.chunks_exact_mut(N);
         let mut z = self.plain_state::<N>();
-        let g: [f64; N] = std::array::from_fn(|k| self.k[k]);
-        let step = self.step_mean;
-        let check = StepCheck::new(step, self.tau);
-        let tau = self.tau;
-        let mut t_last = self.t_last;
-        let mut done = 0;
-        // The correction folded into the prediction (so the chain from one sample to the next
-        // is one multiplication and two additions deep): with `d = y − z₀` and the powers
-        // `ζʲ`,
-        //   z₀' = (1 − g₀) z₀ + g₀ y + Σ_{j≥1} (1 − g₀) ζʲ z_j,
-        //   z_k' = Σ_{j≥1} M_kj z_j + g_k d,  M_kj = C(j,k) ζ^(j−k) [j ≥ k] − g_k ζʲ  (k ≥ 1),
-        // which is `Φ(ζ)Z + G(y − [Φ(ζ)Z]₀)` regrouped. `M` is rebuilt only when `ζ` changes.
-        let binom = binomials::<N>();
-        let mut zeta_m = f64::NAN;
-        let mut mk = [[0.0; N]; N];
-        let (g0y, one_minus_g0) = (g[0], 1.0 - g[0]);
+        let (tau, mut t_last, mut done) = (self.tau, self.t_last, 0);
         for (&t, &y) in ts.iter().zip(ys) {
             let zeta = (t - t_last) / tau;
-            if !check.agrees(zeta, t) {
+            if !step(&mut z, t, zeta, y) {
                 break;
             }
-            if zeta != zeta_m {
-                zeta_m = zeta;
-                let mut pw = [1.0; N];
-                for j in 1..N {
-                    pw[j] = pw[j - 1] * zeta;
-                }
-                for j in 1..N {
-                    mk[0][j] = one_minus_g0 * pw[j];
-                }
-                for k in 1..N {
-                    for j in 1..N {
-                        let phi = if j >= k { binom[j][k] * pw[j - k] } else { 0.0 };
-                        mk[k][j] = phi - g[k] * pw[j];
-                    }
-                }
-            }
-            let d = y - z[0];
-            let mut next = [0.0; N];
-            next[0] = one_minus_g0 * z[0] + g0y * y;
-            if N > 1 {
-                let mut tail = mk[0][1] * z[1];
-                for j in 2..N {
-                    tail += mk[0][j] * z[j];
-                }
-                next[0] += tail;
-                for k in 1..N {
-                    let mut acc = mk[k][1] * z[1];
-                    for j in 2..N {
-                        acc += mk[k][j] * z[j];
-                    }
-                    next[k] = acc + g[k] * d;
-                }
-            }
-            z = next;
             if W {
                 write_row(rows.next(), &z, &c);
             }
             t_last = t;
             done += 1;
         }
-        self.end_plain_run(&z, t_last, done);
-        done
+        PlainRun { z, t_last, done }
     }
 
     /// The step the gains are scaled for. On even samples it is the step itself, which makes the
@@ -943,6 +951,7 @@ impl GainEngine {
 mod tests {
     //! Every fast path of the engine against the reference recursion
     //! ([`predict_correct`]) run from the same state with the same gains, degrees 0 … 8.
+    use super::super::testing::scaled_errors;
     use super::*;
 
     /// Smooth data with a trend of degree `m` and deterministic pseudo-noise.
@@ -956,19 +965,9 @@ mod tests {
             .collect()
     }
 
-    /// `|Δz_k| S^k / max_j |z_j| S^j` with `S` the memory span: the error of the Taylor
-    /// coefficients in units of the span, worst over `k`.
+    /// The worst scaled error ([`scaled_errors`]) with `S` the memory span.
     fn scaled_error(z: &[f64], want: &[f64], span: f64) -> f64 {
-        let scale = want
-            .iter()
-            .enumerate()
-            .map(|(j, w)| w.abs() * span.powi(j as i32))
-            .fold(f64::MIN_POSITIVE, f64::max);
-        z.iter()
-            .zip(want)
-            .enumerate()
-            .map(|(k, (a, b))| (a - b).abs() * span.powi(k as i32) / scale)
-            .fold(0.0, f64::max)
+        scaled_errors(z, want, span).into_iter().fold(0.0, f64::max)
     }
 
     /// The reference from the engine's state over `ts`, `ys` with the gains `h(i)`.
@@ -1019,10 +1018,10 @@ mod tests {
                     let mut e = start.clone();
                     let done = match write {
                         false => {
-                            unrolled_sizes!(m + 1, N => e.steady_run_n::<N, false>(ts, ys, &mut out), _ => 0)
+                            unrolled_sizes!(m + 1, N => e.plain_run_n::<N, false>(ts, ys, &mut out), _ => 0)
                         }
                         true => {
-                            unrolled_sizes!(m + 1, N => e.steady_run_n::<N, true>(ts, ys, &mut out), _ => 0)
+                            unrolled_sizes!(m + 1, N => e.plain_run_n::<N, true>(ts, ys, &mut out), _ => 0)
                         }
                     };
                     assert_eq!(done, ts.len(), "m {m}: the kernel stopped early");
@@ -1033,7 +1032,8 @@ mod tests {
                 for (&t, &y) in ts.iter().zip(ys) {
                     e.update(t, y);
                 }
-                let err = scaled_error(&e.plain_state::<9>()[..=m], &want, span);
+                let folded: Vec<f64> = e.z.iter().zip(&e.z_lo).map(|(a, b)| a + b).collect();
+                let err = scaled_error(&folded, &want, span);
                 assert!(err <= 1e-11, "m {m} θ {theta} compensated: {err:e}");
                 if m <= STEADY_BLOCK_MAX_DEGREE {
                     let mut e = start.clone();
@@ -1075,7 +1075,7 @@ mod tests {
             let span = n as f64;
             let mut e = start.clone();
             let done =
-                unrolled_sizes!(m + 1, N => e.expanding_run_n::<N, false>(ts, ys, &mut []), _ => 0);
+                unrolled_sizes!(m + 1, N => e.plain_run_n::<N, false>(ts, ys, &mut []), _ => 0);
             assert_eq!(done, ts.len());
             let err = scaled_error(&e.z, &want, span);
             assert!(err <= 1e-12, "m {m} per sample: {err:e}");

@@ -160,3 +160,23 @@ macro_rules! impl_polynomial_filter {
     };
 }
 pub(crate) use impl_polynomial_filter;
+
+/// Helpers of the engines' unit tests.
+#[cfg(test)]
+pub(crate) mod testing {
+    /// Errors of `z` against `want`, per degree, in units of the span `S`:
+    /// `|Δz_k| S^k / max_j |want_j| S^j` (the error of Taylor coefficients about the newest
+    /// sample, each in units of the whole span).
+    pub(crate) fn scaled_errors(z: &[f64], want: &[f64], span: f64) -> Vec<f64> {
+        let scale = want
+            .iter()
+            .enumerate()
+            .map(|(j, w)| w.abs() * span.powi(j as i32))
+            .fold(f64::MIN_POSITIVE, f64::max);
+        z.iter()
+            .zip(want)
+            .enumerate()
+            .map(|(k, (a, b))| (a - b).abs() * span.powi(k as i32) / scale)
+            .collect()
+    }
+}
