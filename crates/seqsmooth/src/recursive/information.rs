@@ -66,7 +66,7 @@ pub struct TriangularFactor {
 /// store. In the reciprocal form of [`TriangularFactor::add_row`] the next row's `1/d_i` is
 /// the first thing it computes, while `d_(i+1)` is updated only after `δ_(i+1) = 1/η_(i+1)`,
 /// which depends on `1/d_i`: stored as one pair, `d_i` would wait for `d_(i+1)` and every row
-/// for two divisions of the previous one (measured: 20% of the throughput at `p = 2`). And a
+/// for two divisions of the previous one (measured: see BENCHMARKS.md). And a
 /// 16-byte load spanning two 8-byte stores cannot be forwarded from the store buffer.
 #[derive(Clone, Copy, Debug)]
 #[repr(align(16))]
@@ -676,7 +676,7 @@ fn powers<const N: usize>(v: f64) -> [f64; N] {
 /// what [`TriangularFactor::add_row`] has just stored with stores of the compiler's choosing
 /// (some 8, some 16 bytes wide). A load spanning two stores cannot be forwarded from the store
 /// buffer and waits until both have been written to the cache: measured as a stall of the
-/// whole per-sample pipeline (update plus estimate at degree 5 in half the throughput). An
+/// whole per-sample pipeline (see BENCHMARKS.md). An
 /// 8-byte load is always forwarded from the store containing it; hiding the address from the
 /// optimiser (`black_box`) keeps each load on its own.
 #[inline(always)]

@@ -70,12 +70,12 @@ fn binomials<const N: usize>() -> [[f64; N]; N] {
 }
 
 /// The largest degree whose expanding-memory recursion [`GainEngine::update_many`] runs in
-/// plain `f64`: the expanding recursion accumulates rounding (measured against the compensated
-/// path over 6·10⁴ samples: ≤ 1.1e-13 relative up to degree 4, 4e-11 at 7, 9e-9 at 8).
+/// plain `f64`: above it the expanding recursion accumulates too much rounding against the
+/// compensated path (measured: see ACCURACY.md).
 pub(crate) const PLAIN_EXPANDING_MAX_DEGREE: usize = 4;
 
 /// The largest degree whose steady fading recursion [`GainEngine::update_many`] runs in plain
-/// `f64` (see the measurements in [`GainEngine::steady_run`]).
+/// `f64`: every size with unrolled code ([`crate::numeric::unrolled`]).
 pub(crate) const PLAIN_KERNEL_MAX_DEGREE: usize = UNROLLED_MAX_SIZE - 1;
 
 /// Samples per block of [`GainEngine::steady_block_run`] (a power of two: the block map's
@@ -99,9 +99,8 @@ const EXPANDING_BLOCK_MAX_DEGREE: usize = 4;
 
 /// The largest degree whose steady fading recursion `update_many` runs as block maps. Above
 /// it the block map's rounding (weights of mixed sign, `Ā` far from normal) approaches the
-/// tests' bound: against the compensated per-sample path over 6·10⁴ samples, 8.0e-12 against
-/// the recursion's 4.9e-12 at degree 8, θ = 0.99; 8.1e-13 against 6.9e-13 at degree 5
-/// (tests/batch.rs).
+/// tests' bound against the compensated per-sample path (tests/batch.rs; measured: see
+/// ACCURACY.md).
 const STEADY_BLOCK_MAX_DEGREE: usize = 5;
 
 /// The steady fading recursion `Z ← Ā Z + G y`, `Ā = (I − G e₀ᵀ) Φ(ζ̄)`, over
@@ -128,8 +127,8 @@ impl SteadyBlock {
     /// `f64` gains and step), the weights `Āʲ G` and their derivatives
     /// `(Āʲ G)' = Ā' Āʲ⁻¹ G + Ā (Āʲ⁻¹ G)'` one product at a time, and `Āᴮ`, `(Āᴮ)'` by
     /// repeated squaring (`(A²)' = A' A + A A'`), all in double-word arithmetic, each rounded
-    /// once to `f64`. `Ā` is far from normal at high degree and `θ → 1`: powers formed in plain
-    /// `f64` lose up to 3e-11 relative (measured at degree 8, θ = 0.99).
+    /// once to `f64`. `Ā` is far from normal at high degree and `θ → 1`, so powers formed in
+    /// plain `f64` lose accuracy (measured: see ACCURACY.md).
     fn new(step: f64, gains: &[f64]) -> Self {
         let n = gains.len();
         // ζ̄ʲ in double words, and j·ζ̄^(j−1).
@@ -622,8 +621,8 @@ impl GainEngine {
     /// of decimal timestamps such as `k·0.001` differs from the typical step `ζ̄` by their
     /// rounding); within the block the samples' own times differ from that grid by a few units
     /// in the last place of `t`, which the per-sample recursion follows and the block map does
-    /// not: the two differ by the order of that rounding (≤ 8.1e-13 relative at degree 5 over
-    /// 6·10⁴ samples of `t = k·0.1`, tests/batch.rs). Returns how many samples it took (whole
+    /// not: the two differ by the order of that rounding (tests/batch.rs; measured: see
+    /// ACCURACY.md). Returns how many samples it took (whole
     /// blocks; the first block with an uneven step stops it).
     fn steady_block_run<const N: usize>(&mut self, ts: &[f64], ys: &[f64]) -> usize {
         let step = self.step_mean;
@@ -638,9 +637,10 @@ impl GainEngine {
             None => true,
         };
         if stale {
-            // Building the map costs about as much as the recursion over 2 000 (degree 2) to
-            // 30 000 (degree 5) samples (measured: 17 µs, 0.27 ms): it is built once the
-            // recursion has run that long at this step, or for a batch that long.
+            // Building the map costs about as much as the recursion over thousands of samples
+            // (`O(B m³)` in double words; see BENCHMARKS.md): it is built once the recursion
+            // has run `STEADY_BLOCK_MIN_BUILD_RUN·(m+1)²` samples at this step, or for a batch
+            // that long.
             if self.block_credit_step != step {
                 self.block_credit_step = step;
                 self.block_credit = 0;
@@ -787,8 +787,8 @@ impl GainEngine {
     /// The step the gains are scaled for. On even samples it is the step itself, which makes the
     /// recursion exact for any step (gains `h_k/ζ^k`, `θ_eff = θ^ζ`; Reyneke et al. §6.4). On
     /// irregular samples the current step would be the wrong scale — a burst of close samples
-    /// would get gains `h_k/ζ^k` far too large, and the recursion diverges (measured: errors of
-    /// 1e30 on exponential gaps) — so the gains are scaled for the typical step of the memory.
+    /// would get gains `h_k/ζ^k` far too large, and the recursion diverges (measured on
+    /// exponential gaps: see ACCURACY.md) — so the gains are scaled for the typical step of the memory.
     fn update_step_mean(&mut self, t: f64, zeta: f64) {
         let switched = self.fading.as_ref().and_then(|f| f.switched_at).is_some();
         if !switched {

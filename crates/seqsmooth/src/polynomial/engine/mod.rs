@@ -141,12 +141,8 @@ macro_rules! impl_polynomial_filter {
             fn update_many(&mut self, times: &[f64], values: &[f64]) -> Result<(), Error> {
                 self.core.update_many(self.m, times, values, None)
             }
-            fn update_many_into(
-                &mut self,
-                times: &[f64],
-                values: &[f64],
-                estimates: &mut [f64],
-            ) -> Result<(), Error> {
+            #[rustfmt::skip]
+            fn update_many_into(&mut self, times: &[f64], values: &[f64], estimates: &mut [f64]) -> Result<(), Error> {
                 self.core
                     .update_many(self.m, times, values, Some(estimates))
             }
