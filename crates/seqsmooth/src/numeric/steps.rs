@@ -26,7 +26,34 @@ pub const TIMESTAMP_ROUNDING: f64 = 8.0 * f64::EPSILON;
 /// ```
 #[inline]
 pub fn step_tolerance(step: f64, t: f64, unit: f64) -> f64 {
-    STEP_RELATIVE_TOLERANCE * step + TIMESTAMP_ROUNDING * t.abs() / unit
+    tolerance_within(step, t, unit, STEP_RELATIVE_TOLERANCE, TIMESTAMP_ROUNDING)
+}
+
+/// `relative·|step| + rounding·|t|/unit`: the tolerance with its two constants explicit.
+#[inline(always)]
+fn tolerance_within(step: f64, t: f64, unit: f64, relative: f64, rounding: f64) -> f64 {
+    relative * step.abs() + rounding * t.abs() / unit
+}
+
+/// [`same_step`] with its own relative tolerance and rounding allowance (per unit of
+/// `|t|/unit`): `|ζ − ζ̄| ≤ relative·|ζ̄| + rounding·|t|/unit`. The fixed-memory filters'
+/// even-spacing rule is this with `1e-9` and `2ε` in time units.
+///
+/// ```
+/// use seqsmooth::numeric::steps::same_step_within;
+/// assert!(same_step_within(1.0 + 5e-10, 1.0, 6.0, 1.0, 1e-9, 2.0 * f64::EPSILON));
+/// assert!(!same_step_within(1.0 + 5e-10, 1.0, 6.0, 1.0, 1e-12, 8.0 * f64::EPSILON));
+/// ```
+#[inline]
+pub fn same_step_within(
+    zeta: f64,
+    step: f64,
+    t: f64,
+    unit: f64,
+    relative: f64,
+    rounding: f64,
+) -> bool {
+    (zeta - step).abs() <= tolerance_within(step, t, unit, relative, rounding)
 }
 
 /// Whether `zeta` (a step ending at `t`) is the typical step `step`, all in units of `unit`
