@@ -9,7 +9,7 @@
 //! times computed in `f64` as `t = k·Δ` have steps that differ by `ulp(t)`. The gain engine
 //! scales its gains for the typical step and runs its batch kernels (Morrison Tables 9.1,
 //! 13.1 with the variable-step scaling of Reyneke et al. §6) while the steps agree; the
-//! relative term alone ([`snaps_to`]) decides when a mean step is the step itself.
+//! relative term alone decides when a mean step is the step itself.
 
 /// The relative part of the tolerance.
 pub const STEP_RELATIVE_TOLERANCE: f64 = 1e-12;
