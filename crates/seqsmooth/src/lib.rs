@@ -73,6 +73,7 @@ pub mod error;
 pub mod estimate;
 pub mod linalg;
 pub mod model;
+pub mod numeric;
 pub mod polynomial;
 pub mod recursive;
 pub mod scalar;
