@@ -7,8 +7,8 @@
 //! recursive filters and their test oracle.
 
 use crate::basis::legendre::taylor_table;
-use crate::calculus::factorial;
 use crate::error::Error;
+use crate::model::taylor::scaling_diagonal;
 use nalgebra::{DMatrix, DVector};
 
 /// A weighted least-squares polynomial fit `p(t) = Σ_j c_j P_j((t - c)/w)`.
@@ -142,9 +142,8 @@ impl PolynomialFit {
         // Row k maps the Legendre coefficients to the k-th derivative at t.
         let u = (t - self.centre) / self.half_width;
         let tt = taylor_table(self.degree, self.degree, u);
-        DMatrix::from_fn(self.degree + 1, self.degree + 1, |k, j| {
-            tt[(k, j)] * factorial::<f64>(k) / self.half_width.powi(k as i32)
-        })
+        let d = scaling_diagonal::<f64>(self.degree, self.half_width);
+        DMatrix::from_fn(self.degree + 1, self.degree + 1, |k, j| tt[(k, j)] * d[k])
     }
 
     /// `p(t), p'(t), …, p^(m)(t)` at any `t`.

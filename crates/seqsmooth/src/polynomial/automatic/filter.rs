@@ -8,7 +8,7 @@ use super::misfit::{Kept, MisfitResponse};
 use super::noise::{NoiseSource, NoiseState};
 use super::outlier::OutlierRule;
 use super::output::AutoOutput;
-use super::phase::{switch_constant, Phase};
+use super::phase::Phase;
 use crate::error::Error;
 use crate::model::PolynomialState;
 use crate::polynomial::fading::switch::memory_length_constant;
@@ -133,7 +133,7 @@ impl AutomaticFilter {
         Ok(Self {
             active: config.start_degree,
             memory_constant: memory_length_constant(0, m),
-            switch_constant: switch_constant(config.switch_rule, m),
+            switch_constant: config.switch_rule.asymptotic_constant(m),
             cfg: config,
             ladder,
             expanding,

@@ -162,7 +162,7 @@ pub(crate) fn unscaled_variance(
 ) -> Result<f64, Error> {
     let h = lead.steps(span);
     let s = covariance::<f64>(m, span, h)?;
-    let f = crate::calculus::factorial::<f64>(derivative) / tau.powi(derivative as i32);
+    let f = crate::model::taylor::scaling_diagonal::<f64>(derivative, tau)[derivative];
     Ok(s[(derivative, derivative)] * f * f)
 }
 

@@ -7,7 +7,7 @@ use super::ring::Ring;
 use super::sliding::SlidingMoments;
 use super::weights::{inverse_norms, legendre_values, taylor_at};
 use crate::basis::DiscreteLegendre;
-use crate::calculus::factorial;
+use crate::model::taylor::scaling_diagonal;
 use nalgebra::DMatrix;
 use std::borrow::Cow;
 
@@ -92,9 +92,7 @@ impl MomentFit {
         let x = self.derivatives(mu, r, step);
         let cov = sigma.map(|s| {
             let t = self.taylor(r);
-            let scale: Vec<f64> = (0..=self.m)
-                .map(|i| factorial::<f64>(i) / step.powi(i as i32))
-                .collect();
+            let scale = scaling_diagonal::<f64>(self.m, step);
             DMatrix::from_fn(self.m + 1, self.m + 1, |i, k| {
                 let v: f64 = (0..=self.m)
                     .map(|j| t[(i, j)] * t[(k, j)] * self.inv_norm[j])

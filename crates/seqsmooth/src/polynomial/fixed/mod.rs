@@ -116,7 +116,14 @@ pub(crate) const EVEN_STEP_TOLERANCE: f64 = 1e-9;
 /// the largest time (`t_scale`). Millisecond samples stamped in Unix seconds (`t ≈ 1.7e9`,
 /// resolution `2.4e-7`) thus count as evenly spaced.
 pub(crate) fn steps_agree(step: f64, first: f64, t_scale: f64) -> bool {
-    (step - first).abs() <= EVEN_STEP_TOLERANCE * first.abs() + 2.0 * f64::EPSILON * t_scale
+    crate::numeric::steps::same_step_within(
+        step,
+        first,
+        t_scale,
+        1.0,
+        EVEN_STEP_TOLERANCE,
+        2.0 * f64::EPSILON,
+    )
 }
 
 /// Where in (or beyond) the window an estimate is wanted, for the design helpers.

@@ -10,13 +10,12 @@ use std::ops::Range;
 
 /// Checks lengths, finiteness and strictly increasing times.
 pub(crate) fn check_series(times: &[f64], values: &[f64]) -> Result<(), Error> {
-    if times.len() != values.len() {
-        return Err(Error::InvalidParameter {
-            name: "input lengths",
-            value: format!("{} times, {} values", times.len(), values.len()),
-            reason: "times and values must have the same length".into(),
-        });
-    }
+    crate::error::check_lengths(
+        "input lengths",
+        times,
+        values,
+        "times and values must have the same length",
+    )?;
     for (k, (&t, &y)) in times.iter().zip(values).enumerate() {
         crate::error::check_sample(t, y, k.checked_sub(1).map(|p| times[p]))?;
     }

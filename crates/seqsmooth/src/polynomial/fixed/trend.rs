@@ -55,14 +55,7 @@ fn check_nominal_row(row: &[f64]) -> Result<(), Error> {
             reason: "each nominal row needs at least the value".into(),
         });
     }
-    for &v in row {
-        if !v.is_finite() {
-            return Err(Error::NonFinite {
-                what: "value",
-                value: v,
-            });
-        }
-    }
+    crate::error::check_finite("value", row)?;
     Ok(())
 }
 
