@@ -36,7 +36,7 @@
 //! interpolating polynomial at `n = m` from any initial state, Morrison §9.6), unlike the
 //! single-stream gain engine, which starts exactly and carries a compensated state. Its
 //! agreement with the single-stream `FadingMemory` and `ExpandingMemory` gain engines is
-//! measured in `tests/bank.rs` (run with `--nocapture` to print it; see ACCURACY.md).
+//! asserted in `tests/bank.rs`, printed by `cargo run --release -p seqsmooth --example accuracy_bank` (ACCURACY.md).
 
 use super::expanding::gains::ExpandingGainSchedule;
 use super::fading::gains::fading_gains;

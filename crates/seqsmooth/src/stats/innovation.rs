@@ -13,7 +13,7 @@
 //! (they are the recursive residuals); those of a fading-memory filter are weakly correlated
 //! (each shares the filter's memory), so the window sum has mean `K` but a slightly wider spread
 //! than `χ²_K` and the realised false-alarm rate can exceed `α` somewhat (measured in
-//! `tests/stats.rs`).
+//! `tests/innovation.rs`).
 
 use super::chi_squared::chi_squared_quantile;
 use super::window::SlidingSum;

@@ -23,7 +23,7 @@ pub const MORRISON_K: f64 = 3.0;
 /// the prediction VRF is at most 1 (the default [`AutoConfig::gate_max_vrf`]), the per-sample
 /// false-alarm rate on Gaussian noise stays below 1% up to degree 4 (worst case over the
 /// expanding start and every `θ`); above degree 4 use the innovation gate. The rates are
-/// asserted in `tests/automatic.rs`; measured accuracy: see ACCURACY.md.
+/// asserted in `tests/automatic_noise.rs`; measured accuracy: see ACCURACY.md.
 ///
 /// ```
 /// use seqsmooth::polynomial::automatic::{OutlierRule, REYNEKE_DEFAULT_K};
