@@ -126,6 +126,43 @@ fn code_only(text: &str) -> String {
     out
 }
 
+/// The code without its inline test modules (`#[cfg(test)] mod name { … }`): their `super` is
+/// the file's module, not its parent, and test helpers may reach anywhere.
+fn without_test_modules(code: &str) -> String {
+    let mut out = String::with_capacity(code.len());
+    let mut rest = code;
+    while let Some(k) = rest.find("#[cfg(test)]") {
+        let after = rest[k + "#[cfg(test)]".len()..].trim_start();
+        if !after.starts_with("mod ")
+            || !after[..after.find('\n').unwrap_or(after.len())].contains('{')
+        {
+            out.push_str(&rest[..k + 1]);
+            rest = &rest[k + 1..];
+            continue;
+        }
+        out.push_str(&rest[..k]);
+        let open = rest[k..].find('{').map(|j| k + j).unwrap();
+        let mut depth = 0usize;
+        let mut end = rest.len();
+        for (j, c) in rest[open..].char_indices() {
+            match c {
+                '{' => depth += 1,
+                '}' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        end = open + j + 1;
+                        break;
+                    }
+                }
+                _ => {}
+            }
+        }
+        rest = &rest[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
 /// Every path the code names from `crate::` or `super::`, with braced `use` groups expanded,
 /// resolved to an absolute module path (a list of segments).
 fn imports(code: &str, module: &[String]) -> Vec<Vec<String>> {
@@ -135,8 +172,9 @@ fn imports(code: &str, module: &[String]) -> Vec<Vec<String>> {
     let mut i = 0;
     while i < bytes.len() {
         let at_start = i == 0 || !(is_ident(bytes[i - 1]) || bytes[i - 1] == b':');
-        let rest = &code[i..];
-        if at_start && (rest.starts_with("crate::") || rest.starts_with("super::")) {
+        let starts = |word: &[u8]| bytes[i..].starts_with(word);
+        if at_start && (starts(b"crate::") || starts(b"super::")) {
+            let rest = &code[i..];
             let (len, paths) = parse_path(rest);
             for p in paths {
                 if let Some(abs) = resolve(&p, module) {
@@ -144,9 +182,9 @@ fn imports(code: &str, module: &[String]) -> Vec<Vec<String>> {
                 }
             }
             i += len.max(1);
-        } else {
-            i += 1;
+            continue;
         }
+        i += 1;
     }
     found
 }
@@ -257,7 +295,7 @@ fn check_crate(krate: &str, src: &Path) {
             ));
             continue;
         };
-        let code = code_only(&fs::read_to_string(file).unwrap());
+        let code = without_test_modules(&code_only(&fs::read_to_string(file).unwrap()));
         for target in imports(&code, &module) {
             // Imports from the module's own home (and its children) are inside one layer.
             if target.starts_with(&module) {

@@ -100,7 +100,6 @@ pub use automatic::{AutoConfig, AutoOutput, AutomaticFilter};
 pub use expanding::ExpandingMemory;
 pub use fading::{FadingMemory, SwitchRule};
 pub use filter::PolynomialFilter;
-pub(crate) use options::{check_degree, check_tau};
 pub use options::{DiscountMode, Engine, MAX_DEGREE};
 
 /// The gains of both filters (kept at their old path).

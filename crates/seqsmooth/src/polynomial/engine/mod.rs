@@ -14,10 +14,10 @@ pub(crate) mod gain;
 pub(crate) mod recursion;
 
 use super::filter::{check_batch_lengths, check_estimates_length, first_invalid};
-#[cfg(doc)]
-use super::PolynomialFilter;
 use crate::error::Error;
 use crate::model::PolynomialState;
+#[cfg(doc)]
+use crate::polynomial::filter::PolynomialFilter;
 pub(crate) use exact::{Discount, ExactEngine};
 pub(crate) use gain::{FadingGains, GainEngine};
 

@@ -3,8 +3,8 @@
 use crate::error::Error;
 use crate::model::PolynomialState;
 use crate::polynomial::engine::{impl_polynomial_filter, EngineState, ExactEngine, GainEngine};
+use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::options::{check_degree, Engine};
-use crate::polynomial::PolynomialFilter;
 
 /// Expanding-memory polynomial filter of degree `m` (Morrison ch. 9; Reyneke §6.3-6.4): the
 /// least-squares polynomial through all samples so far, with its derivatives, predictions and

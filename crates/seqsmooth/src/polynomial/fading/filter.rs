@@ -6,10 +6,10 @@ use crate::model::PolynomialState;
 use crate::polynomial::engine::{
     impl_polynomial_filter, Discount, EngineState, ExactEngine, FadingGains, GainEngine,
 };
+use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::options::{
     check_degree, check_not_started, check_tau, check_theta, DiscountMode, Engine,
 };
-use crate::polynomial::PolynomialFilter;
 
 /// Fading-memory polynomial filter of degree `m` and discount `θ` per `τ` (Morrison ch. 13;
 /// Reyneke §6.5-6.6): the polynomial minimising `Σ_k θ^((t_n-t_k)/τ) (y_k - p(t_k))²`.

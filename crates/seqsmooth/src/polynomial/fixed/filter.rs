@@ -8,7 +8,7 @@ use super::sliding::default_refreshes;
 use super::{check_window, steps_agree, EVEN_STEP_TOLERANCE};
 use crate::error::Error;
 use crate::model::PolynomialState;
-use crate::polynomial::PolynomialFilter;
+use crate::polynomial::filter::PolynomialFilter;
 
 /// How a [`FixedMemory`] filter computes its window fit. All give the same estimates on evenly
 /// spaced samples (to rounding); they differ in cost and in the data they accept.

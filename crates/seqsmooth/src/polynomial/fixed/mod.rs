@@ -169,7 +169,7 @@ fn span_scalar<T: Scalar>(span: u64) -> T {
 
 /// Degree within range and at least `m+1` samples (`L ≥ m`).
 fn check_span(m: usize, span: u64) -> Result<(), Error> {
-    super::check_degree(m)?;
+    crate::polynomial::options::check_degree(m)?;
     if span < m as u64 {
         return Err(Error::TooFewSamples {
             needed: m + 1,
@@ -197,7 +197,7 @@ fn check_materialised(span: u64) -> Result<(), Error> {
 
 /// Degree within range and `m+1 ≤ window ≤ MAX_WINDOW`.
 fn check_window(m: usize, window: usize) -> Result<(), Error> {
-    super::check_degree(m)?;
+    crate::polynomial::options::check_degree(m)?;
     if window as u64 > MAX_WINDOW {
         return Err(Error::InvalidParameter {
             name: "window",

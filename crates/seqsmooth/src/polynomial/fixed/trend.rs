@@ -4,7 +4,7 @@
 use super::smooth::{check_series, smooth};
 use crate::error::Error;
 use crate::model::PolynomialState;
-use crate::polynomial::PolynomialFilter;
+use crate::polynomial::filter::PolynomialFilter;
 
 /// A nominal trajectory for [`smooth_detrended`]: the nominal value and derivatives
 /// `[x̄, x̄', …]` (caller's time units) at each sample. Rows shorter than `m+1` mean the
