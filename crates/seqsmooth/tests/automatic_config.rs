@@ -11,18 +11,14 @@ use seqsmooth::Error;
 
 #[test]
 fn bad_configuration_and_input_are_typed_errors() {
-    let base = || AutomaticFilter::with_defaults(2, 0.9, 1.0);
+    let base = || AutomaticFilter::new(2, 0.9, 1.0);
     type Change = fn(AutomaticFilter) -> Result<AutomaticFilter, Error>;
     let bad: Vec<(&str, Change)> = vec![
-        ("degree", |_| AutomaticFilter::with_defaults(99, 0.9, 1.0)),
-        ("θ = 1", |_| AutomaticFilter::with_defaults(2, 1.0, 1.0)),
-        ("θ NaN", |_| {
-            AutomaticFilter::with_defaults(2, f64::NAN, 1.0)
-        }),
-        ("τ = 0", |_| AutomaticFilter::with_defaults(2, 0.9, 0.0)),
-        ("τ inf", |_| {
-            AutomaticFilter::with_defaults(2, 0.9, f64::INFINITY)
-        }),
+        ("degree", |_| AutomaticFilter::new(99, 0.9, 1.0)),
+        ("θ = 1", |_| AutomaticFilter::new(2, 1.0, 1.0)),
+        ("θ NaN", |_| AutomaticFilter::new(2, f64::NAN, 1.0)),
+        ("τ = 0", |_| AutomaticFilter::new(2, 0.9, 0.0)),
+        ("τ inf", |_| AutomaticFilter::new(2, 0.9, f64::INFINITY)),
         ("σ = 0", |f| f.with_noise_sigma(0.0)),
         ("σ NaN", |f| f.with_noise_sigma(f64::NAN)),
         ("noise window", |f| {

@@ -41,7 +41,7 @@ fn scenario(seed: u64) -> (Vec<f64>, Vec<f64>) {
 /// Filters built three ways: known σ, estimated σ from differences, estimated σ from
 /// innovations with Reyneke's gate on the gain engine.
 fn filters() -> Vec<AutomaticFilter> {
-    let base = || AutomaticFilter::with_defaults(2, 0.95, 1.0).unwrap();
+    let base = || AutomaticFilter::new(2, 0.95, 1.0).unwrap();
     vec![
         base().with_noise_sigma(0.5).unwrap(),
         base(),
@@ -155,7 +155,7 @@ fn boxed_beside_the_other_filters() {
     let mut filters: Vec<Box<dyn PolynomialFilter>> = vec![
         Box::new(ExpandingMemory::new(1, Engine::Exact).unwrap()),
         Box::new(
-            AutomaticFilter::with_defaults(1, 0.9, 1.0)
+            AutomaticFilter::new(1, 0.9, 1.0)
                 .unwrap()
                 .with_noise_sigma(0.1)
                 .unwrap(),
@@ -175,7 +175,7 @@ fn boxed_beside_the_other_filters() {
 
 /// Every builder of the scenario's test, applied to degree 2, θ = 0.97 per τ = 0.5.
 fn fully_built() -> AutomaticFilter {
-    AutomaticFilter::with_defaults(2, 0.97, 0.5)
+    AutomaticFilter::new(2, 0.97, 0.5)
         .unwrap()
         .with_engine(Engine::Gain)
         .unwrap()
@@ -249,7 +249,7 @@ fn builders_equal_the_configuration_they_record() {
 #[test]
 fn the_old_style_forward_equals_the_builders() {
     let mut built = fully_built();
-    let mut from_config = AutomaticFilter::new(fully_built_record()).unwrap();
+    let mut from_config = AutomaticFilter::from_config(fully_built_record()).unwrap();
     let (times, values) = scenario(4);
     for (&t, &y) in times.iter().zip(&values) {
         assert_eq!(
@@ -261,17 +261,17 @@ fn the_old_style_forward_equals_the_builders() {
 
 #[test]
 fn builders_reject_what_the_configuration_rejects() {
-    let f = || AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap();
+    let f = || AutomaticFilter::new(2, 0.9, 1.0).unwrap();
     assert!(matches!(
-        AutomaticFilter::with_defaults(99, 0.9, 1.0),
+        AutomaticFilter::new(99, 0.9, 1.0),
         Err(Error::DegreeOutOfRange { .. })
     ));
     assert!(matches!(
-        AutomaticFilter::with_defaults(2, 1.0, 1.0),
+        AutomaticFilter::new(2, 1.0, 1.0),
         Err(Error::ThetaOutOfRange { .. })
     ));
     assert!(matches!(
-        AutomaticFilter::with_defaults(2, 0.9, 0.0),
+        AutomaticFilter::new(2, 0.9, 0.0),
         Err(Error::TauOutOfRange { .. })
     ));
     assert!(f().with_noise_sigma(f64::NAN).is_err());

@@ -63,7 +63,7 @@ fn misfit_flags_an_unmodelled_acceleration_within_ten_samples() {
     for seed in 0..RUNS {
         let data = track(seed, SHARP);
         let onset = index_at(&data, SHARP.onset);
-        let mut f = AutomaticFilter::with_defaults(1, 0.95, 1.0)
+        let mut f = AutomaticFilter::new(1, 0.95, 1.0)
             .unwrap()
             .with_noise_sigma(SIGMA)
             .unwrap();
@@ -91,7 +91,7 @@ fn misfit_flags_an_unmodelled_acceleration_within_ten_samples() {
 fn ladder_settles_upward_and_steps_up_on_misfit() {
     // A constant truth: the degree climbs 0 → 1 → 2 as the candidates' VRFs fall below ½ with
     // stable top coefficients, never down.
-    let c = AutomaticFilter::with_defaults(2, 0.95, 1.0)
+    let c = AutomaticFilter::new(2, 0.95, 1.0)
         .unwrap()
         .with_noise_sigma(1.0)
         .unwrap();

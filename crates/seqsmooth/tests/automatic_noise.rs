@@ -97,7 +97,7 @@ fn innovation_noise_estimate_equals_the_residual_variance_before_the_switch() {
     // Without gating and before the switch, mean(ν²/(1+v)) over the expanding-memory filter's
     // innovations is the batch fit's e°/(N − m − 1) (Morrison (6.10.24)): the recursive
     // residuals sum to the residual sum of squares.
-    let mut f = AutomaticFilter::with_defaults(2, 0.999, 1.0)
+    let mut f = AutomaticFilter::new(2, 0.999, 1.0)
         .unwrap()
         .with_noise_source(NoiseSource::Innovations { window: None })
         .unwrap()
@@ -123,7 +123,7 @@ fn innovation_noise_estimate_equals_the_residual_variance_before_the_switch() {
 
 #[test]
 fn rejected_sample_leaves_the_state_and_predicts_across() {
-    let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0)
+    let mut f = AutomaticFilter::new(1, 0.9, 1.0)
         .unwrap()
         .with_noise_sigma(0.1)
         .unwrap();
@@ -151,7 +151,7 @@ fn rejected_sample_leaves_the_state_and_predicts_across() {
 fn a_run_of_rejections_is_a_manoeuvre() {
     // A persistent 30σ jump: two rejections, then the run is applied, the misfit flag goes up
     // and the memory restarts from the jump.
-    let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0)
+    let mut f = AutomaticFilter::new(1, 0.9, 1.0)
         .unwrap()
         .with_noise_sigma(0.1)
         .unwrap();

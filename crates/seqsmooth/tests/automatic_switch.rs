@@ -64,7 +64,7 @@ fn switch_rules_on_even_samples_match_switch_index() {
         for theta in [0.9, 0.95] {
             for rule in rules {
                 for mode in [DiscountMode::PerTime, DiscountMode::PerUpdate] {
-                    let mut f = AutomaticFilter::with_defaults(m, theta, 1.0)
+                    let mut f = AutomaticFilter::new(m, theta, 1.0)
                         .unwrap()
                         .with_noise_sigma(1.0)
                         .unwrap()

@@ -218,7 +218,7 @@ pub fn score(prototype: &AutomaticFilter, man: Manoeuvre) -> (Score, Vec<AutoOut
 
 /// The scenarios' filter with every default: degree 2, θ = 0.97 per τ = 1 s, σ estimated.
 pub fn main_defaults() -> AutomaticFilter {
-    AutomaticFilter::with_defaults(2, 0.97, 1.0).unwrap()
+    AutomaticFilter::new(2, 0.97, 1.0).unwrap()
 }
 
 /// [`main_defaults`] with the noise known: σ = [`SIGMA`].
