@@ -8,17 +8,19 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use common::automatic::{main_config, score, GENTLE, SHARP};
+use common::automatic::{main_defaults, main_filter, score, GENTLE, SHARP};
 use seqsmooth::polynomial::automatic::{MisfitResponse, NoiseSource, OutlierRule};
 use seqsmooth::{DiscountMode, Engine};
 
 fn main() {
-    let (s, _) = score(&main_config(), GENTLE);
+    let (s, _) = score(&main_filter(), GENTLE);
     s.print("gentle manoeuvre, degree 2, θ = 0.97, σ known, defaults");
 
-    let mut c = main_config();
-    c.engine = Engine::Gain;
-    c.discount = DiscountMode::PerUpdate;
+    let c = main_filter()
+        .with_engine(Engine::Gain)
+        .unwrap()
+        .with_discount_mode(DiscountMode::PerUpdate)
+        .unwrap();
     score(&c, GENTLE)
         .0
         .print("gentle manoeuvre, degree 2, θ = 0.97 per update, gain engine");
@@ -27,26 +29,26 @@ fn main() {
         NoiseSource::Differences { window: None },
         NoiseSource::Innovations { window: None },
     ] {
-        let mut c = main_config();
-        c.noise_sigma = None;
-        c.noise_source = source;
+        let c = main_defaults().with_noise_source(source).unwrap();
         score(&c, GENTLE).0.print(&format!(
             "gentle manoeuvre, degree 2, θ = 0.97, σ estimated by {source:?}"
         ));
     }
 
-    let mut c = main_config();
-    c.outliers = OutlierRule::reyneke();
+    let c = main_filter()
+        .with_outlier_rule(OutlierRule::reyneke())
+        .unwrap();
     score(&c, GENTLE)
         .0
         .print("gentle manoeuvre, degree 2, θ = 0.97, σ known, Reyneke gate k = 3");
 
-    score(&main_config(), SHARP)
+    score(&main_filter(), SHARP)
         .0
         .print("sharp manoeuvre, degree 2, θ = 0.97, σ known, defaults (restart on misfit)");
 
-    let mut c = main_config();
-    c.misfit_response = MisfitResponse::Flag;
+    let c = main_filter()
+        .with_misfit_response(MisfitResponse::Flag)
+        .unwrap();
     score(&c, SHARP)
         .0
         .print("sharp manoeuvre, degree 2, θ = 0.97, σ known, flag only");

@@ -4,59 +4,51 @@
 mod common;
 
 use seqsmooth::polynomial::automatic::{
-    AutoConfig, AutoOutput, AutomaticFilter, MisfitResponse, NoiseSource, OutlierRule,
+    AutoOutput, AutomaticFilter, MisfitResponse, NoiseSource, OutlierRule,
 };
 use seqsmooth::polynomial::switching::SwitchRule;
 use seqsmooth::Error;
 
 #[test]
 fn bad_configuration_and_input_are_typed_errors() {
-    let base = AutoConfig::new(2, 0.9, 1.0);
-    type Change = Box<dyn Fn(&mut AutoConfig)>;
+    let base = || AutomaticFilter::new(2, 0.9, 1.0);
+    type Change = fn(AutomaticFilter) -> Result<AutomaticFilter, Error>;
     let bad: Vec<(&str, Change)> = vec![
-        ("degree", Box::new(|c| c.degree = 99)),
-        ("θ = 1", Box::new(|c| c.theta = 1.0)),
-        ("θ NaN", Box::new(|c| c.theta = f64::NAN)),
-        ("τ = 0", Box::new(|c| c.tau = 0.0)),
-        ("τ inf", Box::new(|c| c.tau = f64::INFINITY)),
-        ("σ = 0", Box::new(|c| c.noise_sigma = Some(0.0))),
-        ("σ NaN", Box::new(|c| c.noise_sigma = Some(f64::NAN))),
-        (
-            "noise window",
-            Box::new(|c| c.noise_source = NoiseSource::Differences { window: Some(0) }),
-        ),
-        (
-            "innovation window",
-            Box::new(|c| c.noise_source = NoiseSource::Innovations { window: Some(0) }),
-        ),
-        (
-            "gate k",
-            Box::new(|c| c.outliers = OutlierRule::Innovation { k: -1.0 }),
-        ),
-        (
-            "Reyneke k",
-            Box::new(|c| c.outliers = OutlierRule::Reyneke { k: f64::NAN }),
-        ),
-        ("misfit window", Box::new(|c| c.misfit_window = 0)),
-        ("misfit α", Box::new(|c| c.misfit_alpha = 0.0)),
-        (
-            "restart α",
-            Box::new(|c| c.misfit_response = MisfitResponse::Restart { alpha: 1.0 }),
-        ),
-        ("start degree", Box::new(|c| c.start_degree = 3)),
-        ("settle VRF", Box::new(|c| c.settle_vrf = 0.0)),
-        ("gate VRF limit", Box::new(|c| c.gate_max_vrf = f64::NAN)),
-        (
-            "switch derivative",
-            Box::new(|c| c.switch_rule = SwitchRule::Derivative(5)),
-        ),
+        ("degree", |_| AutomaticFilter::new(99, 0.9, 1.0)),
+        ("θ = 1", |_| AutomaticFilter::new(2, 1.0, 1.0)),
+        ("θ NaN", |_| AutomaticFilter::new(2, f64::NAN, 1.0)),
+        ("τ = 0", |_| AutomaticFilter::new(2, 0.9, 0.0)),
+        ("τ inf", |_| AutomaticFilter::new(2, 0.9, f64::INFINITY)),
+        ("σ = 0", |f| f.with_noise_sigma(0.0)),
+        ("σ NaN", |f| f.with_noise_sigma(f64::NAN)),
+        ("noise window", |f| {
+            f.with_noise_source(NoiseSource::Differences { window: Some(0) })
+        }),
+        ("innovation window", |f| {
+            f.with_noise_source(NoiseSource::Innovations { window: Some(0) })
+        }),
+        ("gate k", |f| {
+            f.with_outlier_rule(OutlierRule::Innovation { k: -1.0 })
+        }),
+        ("Reyneke k", |f| {
+            f.with_outlier_rule(OutlierRule::Reyneke { k: f64::NAN })
+        }),
+        ("misfit window", |f| f.with_misfit_window(0)),
+        ("misfit α", |f| f.with_misfit_alpha(0.0)),
+        ("restart α", |f| {
+            f.with_misfit_response(MisfitResponse::Restart { alpha: 1.0 })
+        }),
+        ("start degree", |f| f.with_start_degree(3)),
+        ("settle VRF", |f| f.with_settling(0.0, 3)),
+        ("gate VRF limit", |f| f.with_gate_max_vrf(f64::NAN)),
+        ("switch derivative", |f| {
+            f.with_switch_rule(SwitchRule::Derivative(5))
+        }),
     ];
     for (what, change) in bad {
-        let mut c = base.clone();
-        change(&mut c);
-        assert!(AutomaticFilter::new(c).is_err(), "{what} accepted");
+        assert!(change(base().unwrap()).is_err(), "{what} accepted");
     }
-    let mut f = AutomaticFilter::new(base).unwrap();
+    let mut f = base().unwrap();
     for k in 0..20 {
         f.update(k as f64, k as f64).unwrap();
     }

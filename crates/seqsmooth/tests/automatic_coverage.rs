@@ -12,7 +12,7 @@ use seqsmooth::{DiscountMode, Engine};
 
 #[test]
 fn gentle_manoeuvre_coverage_outliers_and_misfit() {
-    let (s, _) = score(&main_config(), GENTLE);
+    let (s, _) = score(&main_filter(), GENTLE);
     assert!(s.scored > 180_000);
     assert!(s.coverage() >= 0.99);
     assert!(s.coverage_all() >= 0.99);
@@ -23,9 +23,11 @@ fn gentle_manoeuvre_coverage_outliers_and_misfit() {
 
 #[test]
 fn gain_engine_and_per_update_discount_run_the_scenario() {
-    let mut c = main_config();
-    c.engine = Engine::Gain;
-    c.discount = DiscountMode::PerUpdate;
+    let c = main_filter()
+        .with_engine(Engine::Gain)
+        .unwrap()
+        .with_discount_mode(DiscountMode::PerUpdate)
+        .unwrap();
     let (s, _) = score(&c, GENTLE);
     assert!(s.coverage() >= 0.97);
     assert!(s.false_alarm_rate() <= 0.01);

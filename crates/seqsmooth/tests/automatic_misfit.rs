@@ -11,11 +11,11 @@ use common::automatic::*;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter, MisfitResponse, Phase};
+use seqsmooth::polynomial::automatic::{AutomaticFilter, MisfitResponse, Phase};
 
 #[test]
 fn sharp_manoeuvre_restarts_keep_the_coverage() {
-    let (s, outs) = score(&main_config(), SHARP);
+    let (s, outs) = score(&main_filter(), SHARP);
     let data = track(0, SHARP);
     let onset = index_at(&data, SHARP.onset);
     let restart = outs[onset..].iter().position(|o| o.restart).unwrap();
@@ -39,8 +39,9 @@ fn sharp_manoeuvre_restarts_keep_the_coverage() {
 fn flag_only_response_keeps_the_memory() {
     // Without the restart the memory carries the sharp manoeuvre: the flag stays up long after
     // the onset, and the coverage over all samples suffers (which is what the restart is for).
-    let mut c = main_config();
-    c.misfit_response = MisfitResponse::Flag;
+    let c = main_filter()
+        .with_misfit_response(MisfitResponse::Flag)
+        .unwrap();
     let (s, outs) = score(&c, SHARP);
     assert_eq!(s.restarts, 0);
     let data = track(0, SHARP);
@@ -50,7 +51,7 @@ fn flag_only_response_keeps_the_memory() {
     assert!(s.coverage_all() < 0.95);
     // On the gentle manoeuvre nothing restarts anyway.
     let (g, _) = score(&c, GENTLE);
-    let (d, _) = score(&main_config(), GENTLE);
+    let (d, _) = score(&main_filter(), GENTLE);
     assert!((g.coverage_all() - d.coverage_all()).abs() < 0.002);
 }
 
@@ -62,9 +63,10 @@ fn misfit_flags_an_unmodelled_acceleration_within_ten_samples() {
     for seed in 0..RUNS {
         let data = track(seed, SHARP);
         let onset = index_at(&data, SHARP.onset);
-        let mut c = AutoConfig::new(1, 0.95, 1.0);
-        c.noise_sigma = Some(SIGMA);
-        let mut f = AutomaticFilter::new(c).unwrap();
+        let mut f = AutomaticFilter::new(1, 0.95, 1.0)
+            .unwrap()
+            .with_noise_sigma(SIGMA)
+            .unwrap();
         let mut started = false;
         let mut delay = None;
         for (i, s) in data.iter().enumerate() {
@@ -89,9 +91,11 @@ fn misfit_flags_an_unmodelled_acceleration_within_ten_samples() {
 fn ladder_settles_upward_and_steps_up_on_misfit() {
     // A constant truth: the degree climbs 0 → 1 → 2 as the candidates' VRFs fall below ½ with
     // stable top coefficients, never down.
-    let mut c = AutoConfig::new(2, 0.95, 1.0);
-    c.noise_sigma = Some(1.0);
-    let mut f = AutomaticFilter::new(c.clone()).unwrap();
+    let c = AutomaticFilter::new(2, 0.95, 1.0)
+        .unwrap()
+        .with_noise_sigma(1.0)
+        .unwrap();
+    let mut f = c.clone();
     let mut r = StdRng::seed_from_u64(8);
     let noise = Normal::new(0.0, 1.0).unwrap();
     let mut degrees = Vec::new();
@@ -108,7 +112,7 @@ fn ladder_settles_upward_and_steps_up_on_misfit() {
 
     // A fast ramp (50σ per sample): the degree-0 filter misfits at the second sample and steps
     // up to degree 1 (whose VRF after two samples is 1), which fits; degree 2 follows by VRF.
-    let mut f = AutomaticFilter::new(c).unwrap();
+    let mut f = c;
     let mut degrees = Vec::new();
     for k in 0..10 {
         degrees.push(

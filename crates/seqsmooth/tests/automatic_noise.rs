@@ -12,7 +12,7 @@ use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
 use seqsmooth::estimate::PolynomialFit;
 use seqsmooth::polynomial::automatic::{
-    AutoConfig, AutomaticFilter, NoiseSource, OutlierRule, REYNEKE_DEFAULT_K,
+    AutomaticFilter, NoiseSource, OutlierRule, REYNEKE_DEFAULT_K,
 };
 use seqsmooth::polynomial::switching::memory_length_constant;
 use seqsmooth::polynomial::vrf::{expanding_vrf, fading_vrf, EstimateForm};
@@ -24,13 +24,11 @@ fn estimated_noise_from_differences_and_innovations() {
         NoiseSource::Differences { window: None },
         NoiseSource::Innovations { window: None },
     ] {
-        let mut c = main_config();
-        c.noise_sigma = None;
-        c.noise_source = source;
+        let c = main_defaults().with_noise_source(source).unwrap();
         let (s, _) = score(&c, GENTLE);
         let mut ratios = Vec::new();
         for seed in 0..RUNS {
-            let mut f = AutomaticFilter::new(c.clone()).unwrap();
+            let mut f = c.clone();
             for d in track(seed, GENTLE) {
                 f.update(d.t, d.y).unwrap();
             }
@@ -88,8 +86,7 @@ fn reyneke_gate_false_alarms() {
         }
     }
     // And on the scenario.
-    let mut c = main_config();
-    c.outliers = rule;
+    let c = main_filter().with_outlier_rule(rule).unwrap();
     let (s, _) = score(&c, GENTLE);
     assert!(s.false_alarm_rate() <= 0.01);
     assert!(s.detection() >= 0.9);
@@ -100,10 +97,12 @@ fn innovation_noise_estimate_equals_the_residual_variance_before_the_switch() {
     // Without gating and before the switch, mean(ν²/(1+v)) over the expanding-memory filter's
     // innovations is the batch fit's e°/(N − m − 1) (Morrison (6.10.24)): the recursive
     // residuals sum to the residual sum of squares.
-    let mut c = AutoConfig::new(2, 0.999, 1.0);
-    c.noise_source = NoiseSource::Innovations { window: None };
-    c.outliers = OutlierRule::Off;
-    let mut f = AutomaticFilter::new(c).unwrap();
+    let mut f = AutomaticFilter::new(2, 0.999, 1.0)
+        .unwrap()
+        .with_noise_source(NoiseSource::Innovations { window: None })
+        .unwrap()
+        .with_outlier_rule(OutlierRule::Off)
+        .unwrap();
     let mut r = StdRng::seed_from_u64(4);
     let noise = Normal::new(0.0, 0.5).unwrap();
     let (mut ts, mut ys) = (Vec::new(), Vec::new());
@@ -124,9 +123,10 @@ fn innovation_noise_estimate_equals_the_residual_variance_before_the_switch() {
 
 #[test]
 fn rejected_sample_leaves_the_state_and_predicts_across() {
-    let mut c = AutoConfig::new(1, 0.9, 1.0);
-    c.noise_sigma = Some(0.1);
-    let mut f = AutomaticFilter::new(c).unwrap();
+    let mut f = AutomaticFilter::new(1, 0.9, 1.0)
+        .unwrap()
+        .with_noise_sigma(0.1)
+        .unwrap();
     let mut r = StdRng::seed_from_u64(3);
     let noise = Normal::new(0.0, 0.1).unwrap();
     for k in 0..100 {
@@ -151,9 +151,10 @@ fn rejected_sample_leaves_the_state_and_predicts_across() {
 fn a_run_of_rejections_is_a_manoeuvre() {
     // A persistent 30σ jump: two rejections, then the run is applied, the misfit flag goes up
     // and the memory restarts from the jump.
-    let mut c = AutoConfig::new(1, 0.9, 1.0);
-    c.noise_sigma = Some(0.1);
-    let mut f = AutomaticFilter::new(c).unwrap();
+    let mut f = AutomaticFilter::new(1, 0.9, 1.0)
+        .unwrap()
+        .with_noise_sigma(0.1)
+        .unwrap();
     for k in 0..100 {
         f.update(k as f64, 0.05 * ((k * 7 % 5) as f64 - 2.0))
             .unwrap();

@@ -7,7 +7,7 @@
 mod common;
 
 use common::automatic::*;
-use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter, OutlierRule, Phase};
+use seqsmooth::polynomial::automatic::{AutomaticFilter, OutlierRule, Phase};
 use seqsmooth::polynomial::switching::SwitchRule;
 use seqsmooth::DiscountMode;
 
@@ -23,9 +23,8 @@ fn switch_happens_at_the_rule_index() {
     ] {
         for seed in 0..5 {
             let data = track(seed, GENTLE);
-            let mut c = main_config();
-            c.switch_rule = rule;
-            let mut f = AutomaticFilter::new(c.clone()).unwrap();
+            let mut f = main_filter().with_switch_rule(rule).unwrap();
+            let c = f.config().clone();
             let (mut n, mut t0, mut expected, mut seen) = (0u64, None, None, None);
             for s in &data {
                 if expected.is_none() && n > c.degree as u64 {
@@ -65,12 +64,16 @@ fn switch_rules_on_even_samples_match_switch_index() {
         for theta in [0.9, 0.95] {
             for rule in rules {
                 for mode in [DiscountMode::PerTime, DiscountMode::PerUpdate] {
-                    let mut c = AutoConfig::new(m, theta, 1.0);
-                    c.noise_sigma = Some(1.0);
-                    c.outliers = OutlierRule::Off;
-                    c.switch_rule = rule;
-                    c.discount = mode;
-                    let mut f = AutomaticFilter::new(c).unwrap();
+                    let mut f = AutomaticFilter::new(m, theta, 1.0)
+                        .unwrap()
+                        .with_noise_sigma(1.0)
+                        .unwrap()
+                        .with_outlier_rule(OutlierRule::Off)
+                        .unwrap()
+                        .with_switch_rule(rule)
+                        .unwrap()
+                        .with_discount_mode(mode)
+                        .unwrap();
                     for k in 0..400 {
                         // PerUpdate ignores the spacing: jitter the times there
                         let t = match mode {

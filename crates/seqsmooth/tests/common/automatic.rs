@@ -19,7 +19,7 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
-use seqsmooth::polynomial::automatic::{AutoConfig, AutoOutput, AutomaticFilter, Phase};
+use seqsmooth::polynomial::automatic::{AutoOutput, AutomaticFilter, Phase};
 
 pub const SIGMA: f64 = 10.0;
 pub const SAMPLES: usize = 2200;
@@ -159,19 +159,19 @@ impl Score {
     }
 }
 
-/// Runs `config` over every run of the scenario and scores it after the start-up. Coverage:
+/// Runs a fresh clone of `prototype` (a filter without samples) over every run of the scenario and scores it after the start-up. Coverage:
 /// the true position inside the reported ±3σ, scored except while the misfit flag is up and
 /// for [`DETECTION_BOUND`] samples after each change of acceleration (and also over all
 /// samples). Straight segments: before the onset and from [`DETECTION_BOUND`] samples after the
 /// end. Returns the score and the outputs of the first run.
-pub fn score(config: &AutoConfig, man: Manoeuvre) -> (Score, Vec<AutoOutput>) {
+pub fn score(prototype: &AutomaticFilter, man: Manoeuvre) -> (Score, Vec<AutoOutput>) {
     let mut total = Score::default();
     let mut first = Vec::new();
     for seed in 0..RUNS {
         let data = track(seed, man);
         let onset = index_at(&data, man.onset);
         let end = index_at(&data, man.end);
-        let mut f = AutomaticFilter::new(config.clone()).unwrap();
+        let mut f = prototype.clone();
         let mut started = false;
         let mut outs = Vec::with_capacity(data.len());
         for (i, s) in data.iter().enumerate() {
@@ -216,8 +216,12 @@ pub fn score(config: &AutoConfig, man: Manoeuvre) -> (Score, Vec<AutoOutput>) {
     (total, first)
 }
 
-pub fn main_config() -> AutoConfig {
-    let mut c = AutoConfig::new(2, 0.97, 1.0);
-    c.noise_sigma = Some(SIGMA);
-    c
+/// The scenarios' filter with every default: degree 2, θ = 0.97 per τ = 1 s, σ estimated.
+pub fn main_defaults() -> AutomaticFilter {
+    AutomaticFilter::new(2, 0.97, 1.0).unwrap()
+}
+
+/// [`main_defaults`] with the noise known: σ = [`SIGMA`].
+pub fn main_filter() -> AutomaticFilter {
+    main_defaults().with_noise_sigma(SIGMA).unwrap()
 }

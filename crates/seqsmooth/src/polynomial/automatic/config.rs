@@ -1,6 +1,6 @@
 //! [`AutoConfig`]: every setting of the [`AutomaticFilter`](super::AutomaticFilter), with its
 //! default and its check. The filter is configured by its builders
-//! ([`AutomaticFilter::with_defaults`](super::AutomaticFilter::with_defaults) and the `with_*`
+//! ([`AutomaticFilter::new`](super::AutomaticFilter::new) and the `with_*`
 //! methods); [`AutomaticFilter::config`](super::AutomaticFilter::config) reads the settings back.
 
 use super::misfit::MisfitResponse;
@@ -15,7 +15,7 @@ use crate::polynomial::{DiscountMode, Engine, SwitchRule};
 ///
 /// ```
 /// use seqsmooth::polynomial::automatic::{AutomaticFilter, GATE_MAX_VRF};
-/// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+/// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
 /// assert_eq!(f.config().gate_max_vrf, GATE_MAX_VRF);
 /// ```
 pub const GATE_MAX_VRF: f64 = 1.0;
@@ -26,7 +26,7 @@ pub const GATE_MAX_VRF: f64 = 1.0;
 /// ```
 /// use seqsmooth::polynomial::automatic::{AutomaticFilter, OutlierRule};
 /// use seqsmooth::polynomial::SwitchRule;
-/// let f = AutomaticFilter::with_defaults(2, 0.97, 0.1) // degree 2, θ = 0.97 per 0.1 s
+/// let f = AutomaticFilter::new(2, 0.97, 0.1) // degree 2, θ = 0.97 per 0.1 s
 ///     .unwrap()
 ///     .with_noise_sigma(5.0)
 ///     .unwrap()
@@ -81,14 +81,14 @@ pub struct AutoConfig {
 }
 
 impl AutoConfig {
-    /// The defaults for degree `m`, discount `θ` per nominal interval `τ` (unchecked; the
-    /// filter checks them). Old style: use
-    /// [`AutomaticFilter::with_defaults`](super::AutomaticFilter::with_defaults) and the
-    /// `with_*` builders.
+    /// The defaults for degree `m`, discount `θ` per nominal interval `τ` (unchecked;
+    /// [`AutomaticFilter::from_config`](super::AutomaticFilter::from_config) checks them). Old
+    /// style, kept for existing callers: use
+    /// [`AutomaticFilter::new`](super::AutomaticFilter::new) and the `with_*` builders.
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter};
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+    /// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
     /// assert_eq!(f.config(), &AutoConfig::new(1, 0.9, 1.0));
     /// ```
     #[doc(hidden)]

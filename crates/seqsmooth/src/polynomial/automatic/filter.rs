@@ -20,13 +20,13 @@ use crate::stats::{ChiSquaredOutcome, InnovationChiSquared};
 use std::collections::VecDeque;
 
 /// The automatic polynomial filter (see the [module docs](crate::polynomial::automatic)).
-/// Configured like the other filters: [`with_defaults`](Self::with_defaults) with the required
+/// Configured like the other filters: [`new`](Self::new) with the required
 /// degree, `θ` and `τ`, then `with_*` builders, each checked. It implements
 /// [`PolynomialFilter`]; the per-sample flags are in [`last_output`](Self::last_output).
 ///
 /// ```
 /// use seqsmooth::polynomial::automatic::{AutomaticFilter, Phase};
-/// let mut f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap(); // σ estimated
+/// let mut f = AutomaticFilter::new(2, 0.9, 1.0).unwrap(); // σ estimated
 /// for n in 0..200 {
 ///     let t = n as f64 * 1.1;
 ///     let noise = 0.2 * (((n * 37 + 11) % 17) as f64 / 8.0 - 1.0);
@@ -157,22 +157,6 @@ impl AutomaticFilter {
         })
     }
 
-    /// A filter with the given configuration. Old style, kept for existing callers: use
-    /// [`with_defaults`](Self::with_defaults) and the `with_*` builders.
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter};
-    /// use seqsmooth::Error;
-    /// assert!(matches!(
-    ///     AutomaticFilter::new(AutoConfig::new(2, 1.5, 1.0)),
-    ///     Err(Error::ThetaOutOfRange { .. })
-    /// ));
-    /// ```
-    #[doc(hidden)]
-    pub fn new(config: AutoConfig) -> Result<Self, Error> {
-        Self::build(config)
-    }
-
     /// A filter of final degree `m`, discount `θ ∈ (0,1)` per nominal interval `τ > 0`, with
     /// every other setting at its default (see [`AutoConfig`]); change them with the `with_*`
     /// builders before the first sample.
@@ -180,15 +164,43 @@ impl AutomaticFilter {
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
     /// use seqsmooth::Error;
-    /// let mut f = AutomaticFilter::with_defaults(2, 0.95, 0.5).unwrap();
+    /// let mut f = AutomaticFilter::new(2, 0.95, 0.5).unwrap();
     /// let out = f.update(0.0, 1.0).unwrap();
     /// assert_eq!(out.degree, 0);                       // the ladder starts at degree 0
     /// assert_eq!(out.derivatives(), Some(&[1.0][..]));
     /// assert!(out.noise_sigma.is_none());               // not estimated yet
-    /// assert!(matches!(AutomaticFilter::with_defaults(2, 1.5, 1.0), Err(Error::ThetaOutOfRange { .. })));
+    /// assert!(matches!(AutomaticFilter::new(2, 1.5, 1.0), Err(Error::ThetaOutOfRange { .. })));
     /// ```
-    pub fn with_defaults(m: usize, theta: f64, tau: f64) -> Result<Self, Error> {
+    pub fn new(m: usize, theta: f64, tau: f64) -> Result<Self, Error> {
         Self::build(AutoConfig::new(m, theta, tau))
+    }
+
+    /// Old name of [`new`](Self::new), kept for existing callers.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap();
+    /// assert_eq!(f.config(), AutomaticFilter::new(2, 0.9, 1.0).unwrap().config());
+    /// ```
+    #[doc(hidden)]
+    pub fn with_defaults(m: usize, theta: f64, tau: f64) -> Result<Self, Error> {
+        Self::new(m, theta, tau)
+    }
+
+    /// A filter with every setting of `config`, checked. Old style, kept for existing callers:
+    /// use [`new`](Self::new) and the `with_*` builders.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter};
+    /// use seqsmooth::Error;
+    /// assert!(matches!(
+    ///     AutomaticFilter::from_config(AutoConfig::new(2, 1.5, 1.0)),
+    ///     Err(Error::ThetaOutOfRange { .. })
+    /// ));
+    /// ```
+    #[doc(hidden)]
+    pub fn from_config(config: AutoConfig) -> Result<Self, Error> {
+        Self::build(config)
     }
 
     /// The same filter with one setting changed and every setting checked again; an error
@@ -207,7 +219,7 @@ impl AutomaticFilter {
         /// ```
         /// use seqsmooth::polynomial::automatic::AutomaticFilter;
         /// use seqsmooth::Engine;
-        /// let mut exact = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(1.0).unwrap();
+        /// let mut exact = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_noise_sigma(1.0).unwrap();
         /// let mut gain = exact.clone().with_engine(Engine::Gain).unwrap();
         /// for n in 0..60 {
         ///     exact.update(n as f64, 0.5 * n as f64).unwrap();
@@ -224,7 +236,7 @@ impl AutomaticFilter {
         /// ```
         /// # use seqsmooth::polynomial::automatic::AutomaticFilter;
         /// use seqsmooth::DiscountMode;
-        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0)?.with_discount_mode(DiscountMode::PerUpdate)?;
+        /// let f = AutomaticFilter::new(1, 0.9, 1.0)?.with_discount_mode(DiscountMode::PerUpdate)?;
         /// assert_eq!(f.config().discount, DiscountMode::PerUpdate);
         /// # Ok::<(), seqsmooth::Error>(())
         /// ```
@@ -236,7 +248,7 @@ impl AutomaticFilter {
         /// ```
         /// use seqsmooth::polynomial::automatic::AutomaticFilter;
         /// use seqsmooth::polynomial::SwitchRule;
-        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
         /// assert!(f.clone().with_switch_rule(SwitchRule::Derivative(2)).is_err());
         /// let mut f = f.with_switch_rule(SwitchRule::AtSample(5)).unwrap().with_noise_sigma(1.0).unwrap();
         /// for n in 0..10 {
@@ -251,7 +263,7 @@ impl AutomaticFilter {
         ///
         /// ```
         /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
         /// assert!(f.clone().with_noise_sigma(0.0).is_err());
         /// assert_eq!(f.with_noise_sigma(0.3).unwrap().noise_sigma(), Some(0.3));
         /// ```
@@ -263,7 +275,7 @@ impl AutomaticFilter {
         /// ```
         /// use seqsmooth::polynomial::automatic::{AutomaticFilter, NoiseSource};
         /// let source = NoiseSource::Innovations { window: None };
-        /// match AutomaticFilter::with_defaults(1, 0.9, 1.0).and_then(|f| f.with_noise_source(source)) {
+        /// match AutomaticFilter::new(1, 0.9, 1.0).and_then(|f| f.with_noise_source(source)) {
         ///     Ok(f) => assert_eq!(f.config().noise_source, source),
         ///     Err(e) => panic!("{e}"),
         /// }
@@ -274,7 +286,7 @@ impl AutomaticFilter {
         ///
         /// ```
         /// use seqsmooth::polynomial::automatic::{AutomaticFilter, OutlierRule};
-        /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap()
+        /// let mut f = AutomaticFilter::new(0, 0.9, 1.0).unwrap()
         ///     .with_noise_sigma(0.1).unwrap()
         ///     .with_outlier_rule(OutlierRule::Off).unwrap();
         /// let flags: Vec<bool> = [1.0, 1.0, 1.0, 50.0].iter().enumerate()
@@ -290,7 +302,7 @@ impl AutomaticFilter {
         /// ```
         /// # fn main() -> Result<(), seqsmooth::Error> {
         /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-        /// let always = AutomaticFilter::with_defaults(1, 0.9, 1.0)?.with_gate_max_vrf(f64::INFINITY)?;
+        /// let always = AutomaticFilter::new(1, 0.9, 1.0)?.with_gate_max_vrf(f64::INFINITY)?;
         /// assert!(always.config().gate_max_vrf.is_infinite());
         /// assert!(always.with_gate_max_vrf(-1.0).is_err());
         /// # Ok(())
@@ -303,7 +315,7 @@ impl AutomaticFilter {
         ///
         /// ```
         /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-        /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap()
+        /// let mut f = AutomaticFilter::new(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap()
         ///     .with_max_consecutive_rejections(0).unwrap();
         /// for n in 0..20 { f.update(n as f64, 0.0).unwrap(); }
         /// for n in 20..30 { f.update(n as f64, 10.0).unwrap(); } // a step, never accepted
@@ -316,7 +328,7 @@ impl AutomaticFilter {
         /// ```
         /// use seqsmooth::polynomial::automatic::AutomaticFilter;
         /// for (k, ok) in [(0, false), (1, true), (50, true)] {
-        ///     assert_eq!(AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_misfit_window(k).is_ok(), ok);
+        ///     assert_eq!(AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_misfit_window(k).is_ok(), ok);
         /// }
         /// ```
         with_misfit_window(window: usize) => misfit_window = window;
@@ -325,7 +337,7 @@ impl AutomaticFilter {
         ///
         /// ```
         /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
         /// let ok: Vec<bool> = [0.0, 0.05, 1.0].iter().map(|&a| f.clone().with_misfit_alpha(a).is_ok()).collect();
         /// assert_eq!(ok, [false, true, false]);
         /// ```
@@ -336,7 +348,7 @@ impl AutomaticFilter {
         ///
         /// ```
         /// use seqsmooth::polynomial::automatic::{AutomaticFilter, MisfitResponse};
-        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
         /// let e = f.clone().with_misfit_response(MisfitResponse::Restart { alpha: 1.0 }).unwrap_err();
         /// assert!(e.to_string().contains("restart significance"));
         /// let flag = f.with_misfit_response(MisfitResponse::Flag).unwrap();
@@ -348,7 +360,7 @@ impl AutomaticFilter {
         ///
         /// ```
         /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-        /// let f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap();
+        /// let f = AutomaticFilter::new(2, 0.9, 1.0).unwrap();
         /// assert!(f.clone().with_start_degree(3).is_err());
         /// assert_eq!(f.with_start_degree(2).unwrap().active_degree(), 2);
         /// ```
@@ -360,7 +372,7 @@ impl AutomaticFilter {
         ///
         /// ```
         /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-        /// let f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap();
+        /// let f = AutomaticFilter::new(2, 0.9, 1.0).unwrap();
         /// assert!(f.clone().with_settling(0.0, 3).is_err());
         /// let c = f.with_settling(0.25, 5).unwrap().config().clone();
         /// assert_eq!((c.settle_vrf, c.settle_stable), (0.25, 5));
@@ -372,7 +384,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let f = AutomaticFilter::with_defaults(2, 0.9, 0.5).unwrap();
+    /// let f = AutomaticFilter::new(2, 0.9, 0.5).unwrap();
     /// assert_eq!((f.config().degree, f.config().theta, f.config().tau), (2, 0.9, 0.5));
     /// ```
     pub fn config(&self) -> &AutoConfig {
@@ -383,7 +395,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// assert_eq!(AutomaticFilter::with_defaults(3, 0.9, 1.0).unwrap().degree(), 3);
+    /// assert_eq!(AutomaticFilter::new(3, 0.9, 1.0).unwrap().degree(), 3);
     /// ```
     pub fn degree(&self) -> usize {
         self.cfg.degree
@@ -393,7 +405,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// assert_eq!(AutomaticFilter::with_defaults(3, 0.9, 1.0).unwrap().active_degree(), 0);
+    /// assert_eq!(AutomaticFilter::new(3, 0.9, 1.0).unwrap().active_degree(), 0);
     /// ```
     pub fn active_degree(&self) -> usize {
         self.active
@@ -403,7 +415,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::{AutomaticFilter, Phase};
-    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_start_degree(1).unwrap();
+    /// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_start_degree(1).unwrap();
     /// assert_eq!(f.phase(), Phase::Expanding);
     /// ```
     pub fn phase(&self) -> Phase {
@@ -420,7 +432,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+    /// let mut f = AutomaticFilter::new(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
     /// for n in 0..40 {
     ///     f.update(n as f64, if n == 30 { 100.0 } else { 1.0 }).unwrap();
     /// }
@@ -435,7 +447,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+    /// let mut f = AutomaticFilter::new(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
     /// for n in 0..40 { f.update(n as f64, if n == 30 { 100.0 } else { 1.0 }).unwrap(); }
     /// assert_eq!(f.rejected(), 1);
     /// ```
@@ -447,7 +459,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// assert_eq!(AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().restarts(), 0);
+    /// assert_eq!(AutomaticFilter::new(1, 0.9, 1.0).unwrap().restarts(), 0);
     /// ```
     pub fn restarts(&self) -> u64 {
         self.restarts
@@ -458,7 +470,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// assert_eq!(AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().last_restart(), None);
+    /// assert_eq!(AutomaticFilter::new(1, 0.9, 1.0).unwrap().last_restart(), None);
     /// ```
     pub fn last_restart(&self) -> Option<u64> {
         self.last_restart
@@ -468,7 +480,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
     /// assert_eq!(f.last_time(), None);
     /// f.update(2.5, 1.0).unwrap();
     /// assert_eq!(f.last_time(), Some(2.5));
@@ -484,7 +496,7 @@ impl AutomaticFilter {
     /// ```
     /// use seqsmooth::polynomial::automatic::{AutomaticFilter, Phase};
     /// use seqsmooth::PolynomialFilter;
-    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
     /// assert!(f.last_output().is_none());
     /// let times: Vec<f64> = (0..60).map(f64::from).collect();
     /// let values: Vec<f64> = times.iter().map(|t| if *t == 50.0 { 9.0 } else { 0.5 * t }).collect();
@@ -503,7 +515,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(1.0).unwrap();
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_noise_sigma(1.0).unwrap();
     /// for n in 0..40 { f.update(n as f64, n as f64).unwrap(); }
     /// assert_eq!(f.switched_at(), Some(32)); // Morrison (13.8.8)
     /// ```
@@ -516,7 +528,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// assert_eq!(AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().noise_sigma(), None);
+    /// assert_eq!(AutomaticFilter::new(1, 0.9, 1.0).unwrap().noise_sigma(), None);
     /// ```
     pub fn noise_sigma(&self) -> Option<f64> {
         self.noise.sigma()
@@ -527,7 +539,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// assert!(!AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().is_misfit());
+    /// assert!(!AutomaticFilter::new(1, 0.9, 1.0).unwrap().is_misfit());
     /// ```
     pub fn is_misfit(&self) -> bool {
         self.chi.is_misfit()
@@ -571,7 +583,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_start_degree(1).unwrap();
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_start_degree(1).unwrap();
     /// f.update(0.0, 1.0).unwrap();
     /// f.update(1.0, 3.0).unwrap();
     /// assert!((f.estimate_at(2.0).unwrap().derivatives[0] - 5.0).abs() < 1e-12);
@@ -584,7 +596,7 @@ impl AutomaticFilter {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
     /// assert!(f.estimate().is_none());
     /// f.update(0.0, 1.0).unwrap();
     /// assert_eq!(f.estimate().unwrap().derivatives, vec![1.0]);
@@ -600,7 +612,7 @@ impl AutomaticFilter {
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
     /// use seqsmooth::Error;
-    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
     /// f.update(0.0, 1.0).unwrap();
     /// assert!(matches!(f.update(0.0, 2.0), Err(Error::TimeNotIncreasing { .. })));
     /// assert!(matches!(f.update(1.0, f64::NAN), Err(Error::NonFinite { .. })));
@@ -773,7 +785,7 @@ impl AutomaticFilter {
 /// ```
 /// use seqsmooth::polynomial::automatic::AutomaticFilter;
 /// use seqsmooth::PolynomialFilter;
-/// let auto = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+/// let auto = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
 /// let mut f: Box<dyn PolynomialFilter> = Box::new(auto);
 /// for n in 0..100 {
 ///     f.update(n as f64, 2.0 + 0.5 * n as f64).unwrap();

@@ -20,7 +20,7 @@ pub enum MisfitResponse {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::{AutomaticFilter, MisfitResponse};
-    /// let mut f = AutomaticFilter::with_defaults(1, 0.95, 1.0).unwrap()
+    /// let mut f = AutomaticFilter::new(1, 0.95, 1.0).unwrap()
     ///     .with_noise_sigma(0.1).unwrap()
     ///     .with_misfit_response(MisfitResponse::Flag).unwrap();
     /// let mut flagged = false;
@@ -45,7 +45,7 @@ pub enum MisfitResponse {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::{AutomaticFilter, MisfitResponse};
-    /// let f = AutomaticFilter::with_defaults(1, 0.95, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+    /// let f = AutomaticFilter::new(1, 0.95, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
     /// assert_eq!(f.config().misfit_response, MisfitResponse::Restart { alpha: 1e-4 });
     /// let mut f = f;
     /// let mut first_restart = None;

@@ -65,7 +65,7 @@
 //!
 //! ## Configuration and use
 //!
-//! Like the other filters: [`AutomaticFilter::with_defaults`] with the required degree `m`,
+//! Like the other filters: [`AutomaticFilter::new`] with the required degree `m`,
 //! discount `θ` and interval `τ`, then checked `with_*` builders ([`AutomaticFilter::with_noise_sigma`],
 //! [`AutomaticFilter::with_outlier_rule`], …; the settings are read back as an [`AutoConfig`]).
 //! It implements [`PolynomialFilter`](crate::PolynomialFilter), so it can stand wherever another
@@ -85,7 +85,7 @@
 //!
 //! ```
 //! use seqsmooth::polynomial::automatic::AutomaticFilter;
-//! let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+//! let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
 //! let mut flagged = Vec::new();
 //! for n in 0..200 {
 //!     let t = n as f64;

@@ -12,7 +12,7 @@ use std::collections::VecDeque;
 ///
 /// ```
 /// use seqsmooth::polynomial::automatic::{AutomaticFilter, MIN_NOISE_TERMS};
-/// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap(); // σ from differences
+/// let mut f = AutomaticFilter::new(0, 0.9, 1.0).unwrap(); // σ from differences
 /// for n in 0..=MIN_NOISE_TERMS {
 ///     assert!(f.noise_sigma().is_none());
 ///     f.update(n as f64, if n % 2 == 0 { 1.0 } else { -1.0 }).unwrap();
@@ -25,7 +25,7 @@ pub const MIN_NOISE_TERMS: usize = 5;
 ///
 /// ```
 /// use seqsmooth::polynomial::automatic::{AutomaticFilter, NoiseSource};
-/// let f = AutomaticFilter::with_defaults(2, 0.95, 1.0).unwrap();
+/// let f = AutomaticFilter::new(2, 0.95, 1.0).unwrap();
 /// assert_eq!(f.config().noise_source, NoiseSource::Differences { window: None });
 /// let mut f = f.with_noise_source(NoiseSource::Innovations { window: Some(200) }).unwrap();
 /// for n in 0..100 {

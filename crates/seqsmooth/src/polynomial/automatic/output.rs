@@ -12,7 +12,7 @@ use crate::stats::ChiSquaredOutcome;
 ///
 /// ```
 /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-/// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(0.5).unwrap();
+/// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_noise_sigma(0.5).unwrap();
 /// let mut out = None;
 /// for n in 0..50 {
 ///     out = Some(f.update(n as f64, 1.0 + 0.1 * n as f64).unwrap());
@@ -63,7 +63,7 @@ impl AutoOutput {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
     /// assert_eq!(f.update(0.0, 4.0).unwrap().derivatives(), Some(&[4.0][..])); // degree 0 first
     /// ```
     pub fn derivatives(&self) -> Option<&[f64]> {
@@ -74,7 +74,7 @@ impl AutoOutput {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap().with_noise_sigma(2.0).unwrap();
+    /// let mut f = AutomaticFilter::new(0, 0.9, 1.0).unwrap().with_noise_sigma(2.0).unwrap();
     /// let sd = f.update(0.0, 4.0).unwrap().std_devs().unwrap();
     /// assert!((sd[0] - 2.0).abs() < 1e-12); // one sample: its own σ
     /// ```
