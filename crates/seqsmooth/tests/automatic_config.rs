@@ -6,7 +6,7 @@ mod common;
 use seqsmooth::polynomial::automatic::{
     AutoOutput, AutomaticFilter, MisfitResponse, NoiseSource, OutlierRule,
 };
-use seqsmooth::polynomial::switching::SwitchRule;
+use seqsmooth::polynomial::fading::switch::SwitchRule;
 use seqsmooth::Error;
 
 #[test]

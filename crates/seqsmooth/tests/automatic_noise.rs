@@ -14,8 +14,10 @@ use seqsmooth::estimate::PolynomialFit;
 use seqsmooth::polynomial::automatic::{
     AutomaticFilter, NoiseSource, OutlierRule, REYNEKE_DEFAULT_K,
 };
-use seqsmooth::polynomial::switching::memory_length_constant;
-use seqsmooth::polynomial::vrf::{expanding_vrf, fading_vrf, EstimateForm};
+use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
+use seqsmooth::polynomial::fading::switch::memory_length_constant;
+use seqsmooth::polynomial::fading::vrf::fading_vrf;
+use seqsmooth::polynomial::form::EstimateForm;
 use seqsmooth::stats::fit_residual_variance;
 
 #[test]

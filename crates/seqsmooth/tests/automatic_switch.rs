@@ -8,7 +8,7 @@ mod common;
 
 use common::automatic::*;
 use seqsmooth::polynomial::automatic::{AutomaticFilter, OutlierRule, Phase};
-use seqsmooth::polynomial::switching::SwitchRule;
+use seqsmooth::polynomial::fading::switch::SwitchRule;
 use seqsmooth::DiscountMode;
 
 #[test]

@@ -7,7 +7,9 @@ mod common;
 use common::engine::*;
 use common::*;
 use nalgebra::DMatrix;
-use seqsmooth::polynomial::vrf::{expanding_vrf, fading_vrf, unscale, EstimateForm};
+use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
+use seqsmooth::polynomial::fading::vrf::fading_vrf;
+use seqsmooth::polynomial::form::{unscale, EstimateForm};
 use seqsmooth::polynomial::MAX_DEGREE;
 use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, PolynomialFilter};
 

@@ -1,4 +1,4 @@
-//! Expanding-memory gains (`seqsmooth::polynomial::gains`, Morrison (1969) ch. 9) against the
+//! Expanding-memory gains (`seqsmooth::polynomial::expanding::gains`, Morrison (1969) ch. 9) against the
 //! printed Table 9.1 ((9.4.18)-(9.4.19)), Reyneke et al. (2012) §6.4 (degrees 4, 5), the small-n
 //! vectors, the printed numerator polynomials and exact least-squares weights; the `f64` gains
 //! against the exact ones.
@@ -8,9 +8,10 @@ mod common;
 use common::book::*;
 use common::rational::*;
 use nalgebra::DMatrix;
-use seqsmooth::polynomial::gains::{
-    expanding_gain_numerators, expanding_gains, ExpandingGainSchedule, GainForm,
+use seqsmooth::polynomial::expanding::gains::{
+    expanding_gain_numerators, expanding_gains, ExpandingGainSchedule,
 };
+use seqsmooth::polynomial::form::GainForm;
 
 fn n_values() -> Vec<u64> {
     let mut v: Vec<u64> = (0..=60).collect();

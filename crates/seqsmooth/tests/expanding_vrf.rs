@@ -1,4 +1,4 @@
-//! Expanding-memory variance-reduction matrices (`seqsmooth::polynomial::vrf`, Morrison (1969)
+//! Expanding-memory variance-reduction matrices (`seqsmooth::polynomial::expanding::vrf`, Morrison (1969)
 //! ch. 9) against the printed Table 9.2, the m = 1 matrix (9.7.5), direct least squares and the
 //! cross-checks with Lear (1977) and Reyneke et al. (2012) §7.2, in exact rationals.
 
@@ -8,8 +8,11 @@ use common::book::*;
 use common::monte_carlo::*;
 use common::rational::*;
 use nalgebra::DMatrix;
-use seqsmooth::polynomial::gains::{expanding_gains, GainForm};
-use seqsmooth::polynomial::vrf::{expanding_vrf, unscale, window_covariance, EstimateForm};
+use seqsmooth::polynomial::expanding::gains::expanding_gains;
+use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
+use seqsmooth::polynomial::fixed::window_covariance;
+use seqsmooth::polynomial::form::GainForm;
+use seqsmooth::polynomial::form::{unscale, EstimateForm};
 use seqsmooth::{Engine, ExpandingMemory};
 
 /// Morrison Table 9.2 (m = 0..3) and the derived m = 4 row: diagonal of

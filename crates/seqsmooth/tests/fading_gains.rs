@@ -1,4 +1,4 @@
-//! Fading-memory gains (`seqsmooth::polynomial::gains`, Morrison (1969) ch. 13) against the
+//! Fading-memory gains (`seqsmooth::polynomial::fading::gains`, Morrison (1969) ch. 13) against the
 //! printed Table 13.1, Reyneke et al. (2012) §6.6, exact discounted least-squares weights, and
 //! the single eigenvalue θ of the recursion (13.5.38); the `f64` gains against the exact ones.
 
@@ -8,7 +8,8 @@ use common::book::*;
 use common::rational::*;
 use nalgebra::DMatrix;
 use num_traits::{One, Zero};
-use seqsmooth::polynomial::gains::{fading_gains, GainForm};
+use seqsmooth::polynomial::fading::gains::fading_gains;
+use seqsmooth::polynomial::form::GainForm;
 use seqsmooth::scalar::rational_from_f64;
 
 #[test]

@@ -1,4 +1,4 @@
-//! Switching from expanding to fading memory (`seqsmooth::polynomial::switching`, Morrison
+//! Switching from expanding to fading memory (`seqsmooth::polynomial::fading::switch`, Morrison
 //! (1969) §13.8): the memory-length constants of Table 13.4, Reyneke et al. (2012) Table 1, the
 //! switch rules of Ex 13.21 and the exact crossover.
 
@@ -7,8 +7,8 @@ mod common;
 use common::book::*;
 use common::rational::*;
 use nalgebra::DMatrix;
-use seqsmooth::polynomial::switching::{memory_length_constant, switch_constant, SwitchRule};
-use seqsmooth::polynomial::vrf::fixed_memory_vrf_limit;
+use seqsmooth::polynomial::fading::switch::{memory_length_constant, switch_constant, SwitchRule};
+use seqsmooth::polynomial::fixed::fixed_memory_vrf_limit;
 
 /// Table 13.4 as printed (rows i, columns m = i..10).
 const TABLE_13_4: [&[&str]; 11] = [

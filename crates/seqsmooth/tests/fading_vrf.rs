@@ -1,4 +1,4 @@
-//! Fading-memory variance-reduction matrices (`seqsmooth::polynomial::vrf`, Morrison (1969)
+//! Fading-memory variance-reduction matrices (`seqsmooth::polynomial::fading::vrf`, Morrison (1969)
 //! §13.6) against the printed Table 13.2, the full matrices (13.6.26), (13.6.34), the numeric
 //! vectors at θ = 0.9 and 0.5, the θ → 1 limits of Table 13.3 and a Lyapunov iteration (13.6.41).
 
@@ -9,8 +9,10 @@ use common::monte_carlo::*;
 use common::rational::*;
 use nalgebra::DMatrix;
 use num_traits::Signed;
-use seqsmooth::polynomial::gains::{fading_gains, GainForm};
-use seqsmooth::polynomial::vrf::{fading_vrf, fading_vrf_limit, EstimateForm};
+use seqsmooth::polynomial::fading::gains::fading_gains;
+use seqsmooth::polynomial::fading::vrf::{fading_vrf, fading_vrf_limit};
+use seqsmooth::polynomial::form::EstimateForm;
+use seqsmooth::polynomial::form::GainForm;
 use seqsmooth::scalar::rational_from_f64;
 use seqsmooth::{Engine, FadingMemory};
 

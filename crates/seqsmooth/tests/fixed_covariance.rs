@@ -11,13 +11,13 @@ use common::rational::*;
 use nalgebra::DMatrix;
 use num_traits::{One, Signed, Zero};
 use seqsmooth::linalg::mul;
+use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
 use seqsmooth::polynomial::fixed::{
     correlated_covariance, covariance, covariance_unscaled, min_span_for_sigma,
     tau_for_derivative_sigma, vrf_limit, weights, FixedEngine, FixedMemory, Lead,
 };
-use seqsmooth::polynomial::vrf::{
-    expanding_vrf, fixed_memory_vrf_limit, window_covariance, EstimateForm,
-};
+use seqsmooth::polynomial::fixed::{fixed_memory_vrf_limit, window_covariance};
+use seqsmooth::polynomial::form::EstimateForm;
 use seqsmooth::{Error, PolynomialFilter};
 
 #[test]

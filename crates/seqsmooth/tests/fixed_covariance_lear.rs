@@ -30,10 +30,11 @@ mod common;
 use common::rational::*;
 use nalgebra::DMatrix;
 use num_traits::{One, Zero};
+use seqsmooth::polynomial::expanding::gains::expanding_gains;
 use seqsmooth::polynomial::fixed::{
     covariance, covariance_unscaled, min_span_for_sigma, smooth, vrf_limit, weights, Lead,
 };
-use seqsmooth::polynomial::gains::{expanding_gains, GainForm};
+use seqsmooth::polynomial::form::GainForm;
 
 /// Σ c_k x^k, integer coefficients lowest first.
 fn poly(x: &Q, c: &[i64]) -> Q {

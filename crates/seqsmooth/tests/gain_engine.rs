@@ -16,7 +16,8 @@ fn gain_recursion_is_self_starting_from_any_initial_state_in_exact_arithmetic() 
     // gain engine starts from exactly that state (computed directly: see its docs) and the
     // tests above check it against batch QR.
     use rand::Rng;
-    use seqsmooth::polynomial::gains::{expanding_gains, GainForm};
+    use seqsmooth::polynomial::expanding::gains::expanding_gains;
+    use seqsmooth::polynomial::form::GainForm;
     use seqsmooth::scalar::{rational_from_f64, Rational};
     let mut r = rng(2024);
     for m in 0..=5 {

@@ -9,7 +9,8 @@ use nalgebra::DMatrix;
 /// Which recursion the gain vector belongs to.
 ///
 /// ```
-/// use seqsmooth::polynomial::gains::{expanding_gains, GainForm};
+/// use seqsmooth::polynomial::expanding::gains::expanding_gains;
+/// use seqsmooth::polynomial::form::GainForm;
 /// let h: Vec<f64> = expanding_gains(1, 3, GainForm::Current);
 /// let p: Vec<f64> = expanding_gains(1, 3, GainForm::Predictor);
 /// assert_eq!(h, vec![0.7, 0.3]);                      // Morrison T9-01
@@ -39,7 +40,8 @@ pub(crate) fn apply_form<T: Scalar>(m: usize, h: Vec<T>, form: GainForm) -> Vec<
 /// Which estimate a variance-reduction matrix describes.
 ///
 /// ```
-/// use seqsmooth::polynomial::vrf::{expanding_vrf, EstimateForm};
+/// use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
+/// use seqsmooth::polynomial::form::EstimateForm;
 /// let cur = expanding_vrf::<f64>(0, 3, EstimateForm::Current).unwrap();
 /// let pred = expanding_vrf::<f64>(0, 3, EstimateForm::Predictor).unwrap();
 /// assert!((cur[(0, 0)] - 0.25).abs() < 1e-15 && (pred[(0, 0)] - 0.25).abs() < 1e-15); // the mean of 4
@@ -57,7 +59,7 @@ pub enum EstimateForm {
 /// (13.6.22)).
 ///
 /// ```
-/// use seqsmooth::polynomial::vrf::unscale;
+/// use seqsmooth::polynomial::form::unscale;
 /// use nalgebra::DMatrix;
 /// let s = unscale(&DMatrix::from_element(2, 2, 1.0), 0.5);
 /// assert_eq!(s[(1, 1)], 4.0);

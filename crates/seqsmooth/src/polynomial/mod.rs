@@ -92,7 +92,7 @@ pub mod expanding;
 pub mod fading;
 mod filter;
 pub mod fixed;
-mod form;
+pub mod form;
 mod options;
 pub mod stream;
 
@@ -101,23 +101,3 @@ pub use expanding::ExpandingMemory;
 pub use fading::{FadingMemory, SwitchRule};
 pub use filter::PolynomialFilter;
 pub use options::{DiscountMode, Engine, MAX_DEGREE};
-
-/// The gains of both filters (kept at their old path).
-pub mod gains {
-    pub use super::expanding::gains::{
-        expanding_gain_numerators, expanding_gains, ExpandingGainSchedule,
-    };
-    pub use super::fading::gains::fading_gains;
-    pub use super::form::GainForm;
-}
-/// The variance-reduction matrices (kept at their old path).
-pub mod vrf {
-    pub use super::expanding::vrf::expanding_vrf;
-    pub use super::fading::vrf::{fading_vrf, fading_vrf_limit};
-    pub use super::fixed::{fixed_memory_vrf_limit, window_covariance};
-    pub use super::form::{unscale, EstimateForm};
-}
-/// The expanding-to-fading switch (kept at its old path).
-pub mod switching {
-    pub use super::fading::switch::{memory_length_constant, switch_constant, SwitchRule};
-}

@@ -11,8 +11,8 @@ use seqsmooth::calculus::link_matrix;
 use seqsmooth::linalg::mul;
 use seqsmooth::model::phi;
 use seqsmooth::polynomial::fixed::covariance;
+use seqsmooth::polynomial::fixed::window_covariance;
 use seqsmooth::polynomial::fixed::{weights, FixedEngine, FixedMemory};
-use seqsmooth::polynomial::vrf::window_covariance;
 use seqsmooth::PolynomialFilter;
 
 pub fn rows(r: &[Vec<Q>]) -> DMatrix<Q> {

@@ -7,8 +7,9 @@ use super::misfit::MisfitResponse;
 use super::noise::NoiseSource;
 use super::outlier::OutlierRule;
 use crate::error::Error;
+use crate::polynomial::fading::switch::SwitchRule;
 use crate::polynomial::options::{check_degree, check_tau, check_theta};
-use crate::polynomial::{DiscountMode, Engine, SwitchRule};
+use crate::polynomial::options::{DiscountMode, Engine};
 
 /// The largest 1-step prediction VRF at which the outlier gate is applied (the default of
 /// [`AutoConfig::gate_max_vrf`]: the prediction is at least as good as a sample).

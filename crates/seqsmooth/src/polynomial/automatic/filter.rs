@@ -11,11 +11,13 @@ use super::output::AutoOutput;
 use super::phase::Phase;
 use crate::error::Error;
 use crate::model::PolynomialState;
+use crate::polynomial::expanding::ExpandingMemory;
 use crate::polynomial::fading::switch::memory_length_constant;
+use crate::polynomial::fading::switch::SwitchRule;
+use crate::polynomial::fading::FadingMemory;
+use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::options::check_not_started;
-use crate::polynomial::{
-    DiscountMode, Engine, ExpandingMemory, FadingMemory, PolynomialFilter, SwitchRule,
-};
+use crate::polynomial::options::{DiscountMode, Engine};
 use crate::stats::{ChiSquaredOutcome, InnovationChiSquared};
 use std::collections::VecDeque;
 

@@ -4,7 +4,7 @@
 
 use super::filter::{unit_expanding, unit_fading, AutomaticFilter};
 use crate::error::Error;
-use crate::polynomial::PolynomialFilter;
+use crate::polynomial::filter::PolynomialFilter;
 
 /// What the filter does when its innovations say the model no longer fits (Morrison §14.8).
 ///

@@ -101,7 +101,11 @@
 //! ```
 
 #[cfg(doc)]
-use crate::polynomial::{DiscountMode, Engine, FadingMemory, SwitchRule};
+use crate::polynomial::fading::switch::SwitchRule;
+#[cfg(doc)]
+use crate::polynomial::fading::FadingMemory;
+#[cfg(doc)]
+use crate::polynomial::options::{DiscountMode, Engine};
 
 mod config;
 mod filter;

@@ -4,16 +4,19 @@
 
 use super::filter::AutomaticFilter;
 use crate::error::Error;
-use crate::polynomial::vrf::{expanding_vrf, fading_vrf, EstimateForm};
+use crate::polynomial::expanding::vrf::expanding_vrf;
 #[cfg(doc)]
-use crate::polynomial::SwitchRule;
-use crate::polynomial::{DiscountMode, PolynomialFilter};
+use crate::polynomial::fading::switch::SwitchRule;
+use crate::polynomial::fading::vrf::fading_vrf;
+use crate::polynomial::filter::PolynomialFilter;
+use crate::polynomial::form::EstimateForm;
+use crate::polynomial::options::DiscountMode;
 
 /// Which filter produced an output.
 ///
 /// ```
 /// use seqsmooth::polynomial::automatic::{AutomaticFilter, Phase};
-/// let mut f = AutomaticFilter::with_defaults(1, 0.8, 1.0).unwrap().with_noise_sigma(1.0).unwrap();
+/// let mut f = AutomaticFilter::new(1, 0.8, 1.0).unwrap().with_noise_sigma(1.0).unwrap();
 /// let phases: Vec<Phase> = (0..30).map(|n| f.update(n as f64, 2.0 * n as f64).unwrap().phase).collect();
 /// assert_eq!(phases[0], Phase::Settling);            // degree 0 first
 /// assert_eq!(phases[29], Phase::Fading);             // switched at ⌊3.2/0.2⌋ = 16

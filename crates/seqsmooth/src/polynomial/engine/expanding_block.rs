@@ -541,7 +541,8 @@ mod tests {
     use crate::linalg::inverse_exact;
     use crate::model::{for_each_shift_step, shift_scaled_compensated};
     use crate::numeric::double_word::{two_prod, two_sum};
-    use crate::polynomial::gains::{expanding_gains, ExpandingGainSchedule, GainForm};
+    use crate::polynomial::expanding::gains::{expanding_gains, ExpandingGainSchedule};
+    use crate::polynomial::form::GainForm;
     use crate::scalar::{rational_from_f64, Rational, Scalar};
     use nalgebra::DMatrix;
     use num_traits::Zero;

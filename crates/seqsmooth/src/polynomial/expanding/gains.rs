@@ -21,7 +21,7 @@ use nalgebra::DVector;
 /// in `f64`.
 ///
 /// ```
-/// use seqsmooth::polynomial::gains::expanding_gain_numerators;
+/// use seqsmooth::polynomial::expanding::gains::expanding_gain_numerators;
 /// use seqsmooth::scalar::Rational;
 /// let num = expanding_gain_numerators(1);
 /// // h0 = 2(2n+1)/((n+2)(n+1)), h1 = 6/((n+2)(n+1))  (Morrison (9.4.18)-(9.4.19))
@@ -72,7 +72,8 @@ pub fn expanding_gain_numerators(m: usize) -> Vec<Polynomial<Rational>> {
 /// `n = m` on whatever its initial state (Morrison §9.6).
 ///
 /// ```
-/// use seqsmooth::polynomial::gains::{expanding_gains, GainForm};
+/// use seqsmooth::polynomial::expanding::gains::expanding_gains;
+/// use seqsmooth::polynomial::form::GainForm;
 /// use seqsmooth::scalar::parse_rational;
 /// let g = expanding_gains::<seqsmooth::scalar::Rational>(2, 10, GainForm::Current);
 /// let want: Vec<_> = ["83/143", "63/286", "5/286"].iter().map(|s| parse_rational(s).unwrap()).collect();
@@ -95,7 +96,7 @@ pub fn expanding_gains<T: Scalar>(m: usize, n: u64, form: GainForm) -> Vec<T> {
 /// evaluation is accurate to a few ulps for every `n ≥ 0`.
 ///
 /// ```
-/// use seqsmooth::polynomial::gains::ExpandingGainSchedule;
+/// use seqsmooth::polynomial::expanding::gains::ExpandingGainSchedule;
 /// let s = ExpandingGainSchedule::new(1);
 /// let mut h = [0.0; 2];
 /// s.gains(3, &mut h);
@@ -111,7 +112,7 @@ impl ExpandingGainSchedule {
     /// The schedule for degree `m`.
     ///
     /// ```
-    /// use seqsmooth::polynomial::gains::ExpandingGainSchedule;
+    /// use seqsmooth::polynomial::expanding::gains::ExpandingGainSchedule;
     /// assert_eq!(ExpandingGainSchedule::new(2).degree(), 2);
     /// ```
     pub fn new(m: usize) -> Self {
@@ -125,7 +126,7 @@ impl ExpandingGainSchedule {
     /// Degree.
     ///
     /// ```
-    /// use seqsmooth::polynomial::gains::ExpandingGainSchedule;
+    /// use seqsmooth::polynomial::expanding::gains::ExpandingGainSchedule;
     /// assert_eq!(ExpandingGainSchedule::new(3).degree(), 3);
     /// ```
     pub fn degree(&self) -> usize {
@@ -135,7 +136,7 @@ impl ExpandingGainSchedule {
     /// Writes `h_0(n) … h_m(n)` (current-estimate form) into `out`.
     ///
     /// ```
-    /// use seqsmooth::polynomial::gains::ExpandingGainSchedule;
+    /// use seqsmooth::polynomial::expanding::gains::ExpandingGainSchedule;
     /// let mut h = [0.0; 1];
     /// ExpandingGainSchedule::new(0).gains(4, &mut h);
     /// assert_eq!(h, [0.2]); // the running mean: 1/(n+1)
@@ -158,7 +159,7 @@ impl ExpandingGainSchedule {
     /// The gains as a vector.
     ///
     /// ```
-    /// use seqsmooth::polynomial::gains::ExpandingGainSchedule;
+    /// use seqsmooth::polynomial::expanding::gains::ExpandingGainSchedule;
     /// assert_eq!(ExpandingGainSchedule::new(1).gains_vec(3).as_slice(), &[0.7, 0.3]);
     /// ```
     pub fn gains_vec(&self, n: u64) -> DVector<f64> {

@@ -11,7 +11,8 @@ use nalgebra::DMatrix;
 /// fit with `L = n`, so this is [`crate::polynomial::fixed::covariance`] at lead 0 or 1). Defined for `n ≥ m`.
 ///
 /// ```
-/// use seqsmooth::polynomial::vrf::{expanding_vrf, EstimateForm};
+/// use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
+/// use seqsmooth::polynomial::form::EstimateForm;
 /// let s = expanding_vrf::<f64>(1, 1, EstimateForm::Predictor).unwrap();
 /// assert!((s[(0, 0)] - 5.0).abs() < 1e-14 && (s[(0, 1)] - 3.0).abs() < 1e-14); // T9-08
 /// ```

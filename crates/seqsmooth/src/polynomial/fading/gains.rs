@@ -13,7 +13,8 @@ use crate::scalar::Scalar;
 /// a sum of non-negative terms (so accurate in `f64` for every `θ ∈ (0,1)`). `h_0 = 1 - θ^(m+1)`.
 ///
 /// ```
-/// use seqsmooth::polynomial::gains::{fading_gains, GainForm};
+/// use seqsmooth::polynomial::fading::gains::fading_gains;
+/// use seqsmooth::polynomial::form::GainForm;
 /// let g = fading_gains(2, 0.9_f64, GainForm::Current);
 /// assert!((g[0] - 0.271).abs() < 1e-15 && (g[1] - 0.0285).abs() < 1e-15 && (g[2] - 0.0005).abs() < 1e-16);
 /// ```

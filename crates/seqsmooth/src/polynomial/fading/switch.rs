@@ -19,7 +19,7 @@ use crate::scalar::{Rational, Scalar};
 /// filter with `L = c_im/(1-θ)` (asymptotically, `θ → 1`). Requires `i ≤ m`.
 ///
 /// ```
-/// use seqsmooth::polynomial::switching::memory_length_constant;
+/// use seqsmooth::polynomial::fading::switch::memory_length_constant;
 /// assert!((memory_length_constant(0, 1) - 3.2).abs() < 1e-15);
 /// assert!((memory_length_constant(1, 1) - 3.6342).abs() < 1e-4);
 /// ```
@@ -35,7 +35,7 @@ pub fn memory_length_constant(i: usize, m: usize) -> f64 {
 /// `n_s = c/(1-θ)`, or choose `θ = 1 - c/n_s` for a planned switch at `n_s`.
 ///
 /// ```
-/// use seqsmooth::polynomial::switching::switch_constant;
+/// use seqsmooth::polynomial::fading::switch::switch_constant;
 /// use seqsmooth::scalar::parse_rational;
 /// assert_eq!(switch_constant(2), parse_rational("48/11").unwrap());
 /// assert_eq!(switch_constant(5), parse_rational("6144/793").unwrap());
@@ -74,7 +74,7 @@ impl SwitchRule {
     /// determined the state.
     ///
     /// ```
-    /// use seqsmooth::polynomial::switching::SwitchRule;
+    /// use seqsmooth::polynomial::fading::switch::SwitchRule;
     /// assert_eq!(SwitchRule::Position.switch_index(1, 0.9).unwrap(), 32);  // Morrison (13.8.8)
     /// assert_eq!(SwitchRule::ColumnMean.switch_index(2, 0.93).unwrap(), 68); // Ex. 13.21
     /// assert_eq!(SwitchRule::ExactCrossover.switch_index(0, 0.9).unwrap(), 18);

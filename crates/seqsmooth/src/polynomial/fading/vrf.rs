@@ -14,7 +14,8 @@ use nalgebra::DMatrix;
 /// 1-step prediction. All terms are non-negative, so `f64` evaluation is accurate for all `θ`.
 ///
 /// ```
-/// use seqsmooth::polynomial::vrf::{fading_vrf, EstimateForm};
+/// use seqsmooth::polynomial::fading::vrf::fading_vrf;
+/// use seqsmooth::polynomial::form::EstimateForm;
 /// let s = fading_vrf(1, 0.9_f64, EstimateForm::Predictor).unwrap();
 /// assert!((s[(0, 0)] - 0.137192010).abs() < 1e-9); // (13.7.1)
 /// ```
@@ -51,7 +52,7 @@ pub fn fading_vrf<T: Scalar>(m: usize, theta: T, form: EstimateForm) -> Result<D
 /// `λ = G B Gᵀ` with `[G]_ij = C(j,i)`, `[B]_ij = C(i+j,i)/2^(i+j+1)` (Ex. 13.15).
 ///
 /// ```
-/// use seqsmooth::polynomial::vrf::fading_vrf_limit;
+/// use seqsmooth::polynomial::fading::vrf::fading_vrf_limit;
 /// use seqsmooth::scalar::parse_rational;
 /// let l = fading_vrf_limit(2);
 /// assert_eq!(l[(0, 0)], parse_rational("33/16").unwrap());

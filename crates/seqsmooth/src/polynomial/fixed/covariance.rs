@@ -16,7 +16,7 @@ use nalgebra::DMatrix;
 /// `S*_{n+h,n}/σ² = W(h) W(h)ᵀ = Q(L+h) Q(L+h)ᵀ` with `[Q(r)]_ij = (1/i!) dⁱφ_j(r)/drⁱ`
 /// (Morrison (7.5.22)-(7.5.23), (7.5.26)), for white errors of equal variance.
 ///
-/// This is the same matrix as [`crate::polynomial::vrf::window_covariance`]
+/// This is the same matrix as [`super::window_covariance`]
 /// (`Φ(h) 𝒮 G C Gᵀ 𝒮ᵀ Φ(h)ᵀ`, equal entry for entry in exact arithmetic; tested), evaluated as
 /// `T(L+h) C T(L+h)ᵀ` with the Legendre derivatives from the recursion (A1.1), so that `f64`
 /// keeps full accuracy also for `h < 0` (the centre, retrodiction), where the shift `Φ(h)`
@@ -121,7 +121,7 @@ fn classical_legendre<T: Scalar>(m: usize) -> Vec<Polynomial<T>> {
 /// the exact generating formula (continuous limit `φ_k ≈ √((2k+1)/L) P_k(1-2ρ)`, Ex 7.22)
 /// `λ_ij(ρ) = (-2)^(i+j) Σ_{k=0..m} (2k+1) P_k^(i)(x) P_k^(j)(x)`, `x = 1 - 2ρ`.
 /// `ρ = 1` gives Table 7.2 (also valid for the one-step prediction; equal to
-/// [`crate::polynomial::vrf::fixed_memory_vrf_limit`]), `ρ = 1/2` Table 7.3.
+/// [`super::fixed_memory_vrf_limit`]), `ρ = 1/2` Table 7.3.
 ///
 /// ```
 /// use seqsmooth::polynomial::fixed::vrf_limit;

@@ -24,7 +24,7 @@ use nalgebra::DMatrix;
 /// path to roughly `L^(2m+1) < 1e300` (e.g. `m = 20`, `L ≲ 1e7`). Use `T = Rational` beyond.
 ///
 /// ```
-/// use seqsmooth::polynomial::vrf::window_covariance;
+/// use seqsmooth::polynomial::fixed::window_covariance;
 /// // m = 1, L = 4, h = 0 (Morrison (7.3.27)): W(0)W(0)ᵀ = [[0.6, 0.2], [0.2, 0.1]]
 /// let s = window_covariance(1, 4, 0.0_f64);
 /// assert!((s[(0, 0)] - 0.6).abs() < 1e-15 && (s[(0, 1)] - 0.2).abs() < 1e-15);
@@ -51,7 +51,7 @@ pub fn window_covariance<T: Scalar>(m: usize, span: u64, h: T) -> DMatrix<T> {
 /// `V_ij = j^(i)` (the derivatives of `s^j` at `s = 1`).
 ///
 /// ```
-/// use seqsmooth::polynomial::vrf::fixed_memory_vrf_limit;
+/// use seqsmooth::polynomial::fixed::fixed_memory_vrf_limit;
 /// use seqsmooth::scalar::Rational;
 /// let k = fixed_memory_vrf_limit(3);
 /// assert_eq!(k[(3, 3)], Rational::from_integer(100800.into())); // Table 9.3, m = 3
