@@ -191,7 +191,7 @@ fn widen(range: &mut Option<(f64, f64)>, v: f64) {
 }
 
 /// Maximal runs of consecutive indices where `keep` holds.
-fn runs(n: usize, keep: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
+pub fn runs(n: usize, keep: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
     let mut out = Vec::new();
     let mut start = None;
     for i in 0..=n {
@@ -208,7 +208,7 @@ fn runs(n: usize, keep: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
 }
 
 /// Tick label text with the decimals the axis step needs.
-fn tick(v: f64, step: f64) -> String {
+pub fn tick(v: f64, step: f64) -> String {
     let decimals = if step > 0.0 && step.is_finite() {
         (-(step.log10().floor()) as i32).clamp(0, 8) as usize
     } else {
@@ -778,32 +778,4 @@ fn draw_panel<DB: DrawingBackend>(
             .map_err(e)?;
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn runs_split_on_gaps() {
-        let v = [true, true, false, true, false, false, true];
-        assert_eq!(runs(v.len(), |i| v[i]), vec![0..2, 3..4, 6..7]);
-        assert!(runs(0, |_| true).is_empty());
-    }
-
-    #[test]
-    fn tick_labels_have_the_step_decimals() {
-        assert_eq!(tick(15000.0, 2500.0), "15000");
-        assert_eq!(tick(0.25, 0.05), "0.25");
-        assert_eq!(tick(-0.0001, 0.5), "0.0");
-        assert_eq!(tick(3.0, 0.5), "3.0");
-    }
-
-    #[test]
-    fn formats_by_extension() {
-        assert_eq!(Format::from_path(Path::new("a/b.PNG")), Some(Format::Png));
-        assert_eq!(Format::from_path(Path::new("b.svg")), Some(Format::Svg));
-        assert_eq!(Format::from_path(Path::new("b.pdf")), None);
-        assert_eq!(Format::from_path(Path::new("b")), None);
-    }
 }
