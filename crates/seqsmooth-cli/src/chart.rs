@@ -142,17 +142,16 @@ pub fn write(track: &Track, layout: &Layout, path: &Path) -> Result<(), CliError
             path.display()
         ))
     };
+    macro_rules! render {
+        ($backend:ident) => {{
+            let root = $backend::new(path, layout.size).into_drawing_area();
+            draw(&root, track, layout).map_err(fail)?;
+            root.present().map_err(|e| fail(e.to_string()))
+        }};
+    }
     match format {
-        Format::Png => {
-            let root = BitMapBackend::new(path, layout.size).into_drawing_area();
-            draw(&root, track, layout).map_err(fail)?;
-            root.present().map_err(|e| fail(e.to_string()))
-        }
-        Format::Svg => {
-            let root = SVGBackend::new(path, layout.size).into_drawing_area();
-            draw(&root, track, layout).map_err(fail)?;
-            root.present().map_err(|e| fail(e.to_string()))
-        }
+        Format::Png => render!(BitMapBackend),
+        Format::Svg => render!(SVGBackend),
     }
 }
 
@@ -161,7 +160,8 @@ fn font(size: f64) -> TextStyle<'static> {
 }
 
 /// The value `p`-quantile of the finite `values` (nearest rank), if any.
-fn quantile(values: &mut [f64], p: f64) -> Option<f64> {
+fn quantile(values: impl IntoIterator<Item = f64>, p: f64) -> Option<f64> {
+    let mut values: Vec<f64> = values.into_iter().collect();
     if values.is_empty() {
         return None;
     }
@@ -274,21 +274,15 @@ fn derivative_panel(track: &Track, k: usize, label: &str) -> PanelData {
     for v in truth.iter().flatten() {
         widen(&mut range, *v);
     }
-    let mut est: Vec<f64> = line
-        .iter()
-        .flatten()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    if let (Some(lo), Some(hi)) = (quantile(&mut est, 0.01), quantile(&mut est, 0.99)) {
+    let est = || line.iter().flatten().copied().filter(|v| v.is_finite());
+    if let (Some(lo), Some(hi)) = (quantile(est(), 0.01), quantile(est(), 0.99)) {
         widen(&mut range, lo);
         widen(&mut range, hi);
     }
     // The band where it is no wider than the spread of the panel (not at start-up).
     if let Some((lo, hi)) = range {
         let span = (hi - lo).max(f64::MIN_POSITIVE);
-        let mut half: Vec<f64> = band.iter().flatten().copied().collect();
-        if let Some(h) = quantile(&mut half, 0.9) {
+        if let Some(h) = quantile(band.iter().flatten().copied(), 0.9) {
             if h < 0.25 * span {
                 for (l, b) in line.iter().zip(&band) {
                     if let (Some(l), Some(b)) = (l, b) {
@@ -344,14 +338,11 @@ fn residual_panel(track: &Track, label: &str) -> PanelData {
     };
     // Symmetric range: the 99th percentile of |residual| of the accepted samples, every
     // rejected one up to twice that, the ±3σ noise and the settled band, the truth's error.
-    let mut accepted: Vec<f64> = points.iter().filter(|p| !p.2).map(|p| p.1.abs()).collect();
-    let mut r = quantile(&mut accepted, 0.99).unwrap_or(0.0);
-    let mut noise3: Vec<f64> = noise.iter().flatten().copied().collect();
-    r = r.max(quantile(&mut noise3, 0.9).unwrap_or(0.0));
-    let mut band3: Vec<f64> = band.iter().flatten().copied().collect();
-    r = r.max(quantile(&mut band3, 0.9).unwrap_or(0.0));
-    let mut err: Vec<f64> = truth.iter().flatten().map(|e| e.abs()).collect();
-    r = r.max(quantile(&mut err, 0.99).unwrap_or(0.0));
+    let q = |v: &mut dyn Iterator<Item = f64>, p| quantile(v, p).unwrap_or(0.0);
+    let mut r = q(&mut points.iter().filter(|p| !p.2).map(|p| p.1.abs()), 0.99)
+        .max(q(&mut noise.iter().flatten().copied(), 0.9))
+        .max(q(&mut band.iter().flatten().copied(), 0.9))
+        .max(q(&mut truth.iter().flatten().map(|e| e.abs()), 0.99));
     let cap = 2.0 * r;
     for p in points.iter().filter(|p| p.2) {
         r = r.max(p.1.abs().min(cap));
@@ -405,44 +396,25 @@ impl Key {
 }
 
 fn legend_keys(panels: &[PanelData], track: &Track) -> Vec<Key> {
-    let mut keys = Vec::new();
-    let any_points = panels.iter().any(|p| p.points.iter().any(|q| !q.2));
-    let any_rejected = panels.iter().any(|p| p.points.iter().any(|q| q.2));
-    let any_clipped = panels
-        .iter()
-        .any(|p| p.clip_points && p.points.iter().any(|q| q.1 < p.range.0 || q.1 > p.range.1));
-    let has = |f: &dyn Fn(&PanelData) -> bool| panels.iter().any(f);
-    if any_points {
-        keys.push(Key::Data);
-    }
-    if any_rejected {
-        keys.push(Key::Rejected);
-    }
-    if any_clipped {
-        keys.push(Key::Clipped);
-    }
-    if has(&|p| p.line.iter().any(Option::is_some)) {
-        keys.push(Key::Estimate);
-    }
-    if has(&|p| p.band.iter().any(Option::is_some)) {
-        keys.push(Key::Band);
-    }
-    if has(&|p| p.truth.iter().any(Option::is_some)) {
-        keys.push(Key::Truth);
-    }
-    if has(&|p| p.noise.iter().any(Option::is_some)) {
-        keys.push(Key::Noise);
-    }
-    if !track.switches.is_empty() {
-        keys.push(Key::Switch);
-    }
-    if !track.restarts.is_empty() {
-        keys.push(Key::Restart);
-    }
-    if track.misfit.iter().any(|&m| m) {
-        keys.push(Key::Misfit);
-    }
-    keys
+    let any = |f: &dyn Fn(&PanelData) -> bool| panels.iter().any(f);
+    let clipped = |p: &PanelData| {
+        p.clip_points && p.points.iter().any(|q| q.1 < p.range.0 || q.1 > p.range.1)
+    };
+    [
+        (any(&|p| p.points.iter().any(|q| !q.2)), Key::Data),
+        (any(&|p| p.points.iter().any(|q| q.2)), Key::Rejected),
+        (any(&clipped), Key::Clipped),
+        (any(&|p| p.line.iter().any(Option::is_some)), Key::Estimate),
+        (any(&|p| p.band.iter().any(Option::is_some)), Key::Band),
+        (any(&|p| p.truth.iter().any(Option::is_some)), Key::Truth),
+        (any(&|p| p.noise.iter().any(Option::is_some)), Key::Noise),
+        (!track.switches.is_empty(), Key::Switch),
+        (!track.restarts.is_empty(), Key::Restart),
+        (track.misfit.iter().any(|&m| m), Key::Misfit),
+    ]
+    .into_iter()
+    .filter_map(|(on, key)| on.then_some(key))
+    .collect()
 }
 
 type Err = String;
@@ -457,52 +429,28 @@ fn symbol<DB: DrawingBackend>(
     key: Key,
     (x, y): (i32, i32),
 ) -> Result<(), Err> {
-    let line = |c: RGBColor, w: u32| {
-        area.draw(&PathElement::new(
-            vec![(x - 14, y), (x + 14, y)],
-            c.stroke_width(w),
+    let seg = |a: (i32, i32), b: (i32, i32), c: RGBColor, w: u32| {
+        area.draw(&PathElement::new(vec![a, b], c.stroke_width(w)))
+    };
+    let rect = |c: RGBAColor| {
+        area.draw(&Rectangle::new(
+            [(x - 14, y - 7), (x + 14, y + 7)],
+            c.filled(),
         ))
     };
     match key {
         Key::Data => area.draw(&Circle::new((x, y), 3, DATA.filled())),
         Key::Rejected => area.draw(&Cross::new((x, y), 5, REJECTED.stroke_width(2))),
         Key::Clipped => area.draw(&TriangleMarker::new((x, y), 5, DATA.filled())),
-        Key::Estimate => line(ESTIMATE, 2),
-        Key::Band => area.draw(&Rectangle::new(
-            [(x - 14, y - 7), (x + 14, y + 7)],
-            ESTIMATE.mix(0.22).filled(),
-        )),
-        Key::Truth => line(TRUTH, 1),
-        Key::Noise => {
-            area.draw(&PathElement::new(
-                vec![(x - 14, y), (x - 4, y)],
-                NOISE.stroke_width(2),
-            ))
-            .map_err(e)?;
-            area.draw(&PathElement::new(
-                vec![(x + 4, y), (x + 14, y)],
-                NOISE.stroke_width(2),
-            ))
-        }
-        Key::Switch => {
-            area.draw(&PathElement::new(
-                vec![(x, y - 8), (x, y - 2)],
-                SWITCH.stroke_width(2),
-            ))
-            .map_err(e)?;
-            area.draw(&PathElement::new(
-                vec![(x, y + 2), (x, y + 8)],
-                SWITCH.stroke_width(2),
-            ))
-        }
-        Key::Restart => area.draw(&PathElement::new(
-            vec![(x, y - 8), (x, y + 8)],
-            RESTART.stroke_width(2),
-        )),
-        Key::Misfit => area.draw(&Rectangle::new(
-            [(x - 14, y - 7), (x + 14, y + 7)],
-            MISFIT.mix(0.3).filled(),
-        )),
+        Key::Estimate => seg((x - 14, y), (x + 14, y), ESTIMATE, 2),
+        Key::Band => rect(ESTIMATE.mix(0.22)),
+        Key::Truth => seg((x - 14, y), (x + 14, y), TRUTH, 1),
+        Key::Noise => seg((x - 14, y), (x - 4, y), NOISE, 2)
+            .and_then(|_| seg((x + 4, y), (x + 14, y), NOISE, 2)),
+        Key::Switch => seg((x, y - 8), (x, y - 2), SWITCH, 2)
+            .and_then(|_| seg((x, y + 2), (x, y + 8), SWITCH, 2)),
+        Key::Restart => seg((x, y - 8), (x, y + 8), RESTART, 2),
+        Key::Misfit => rect(MISFIT.mix(0.3)),
     }
     .map_err(e)
 }
@@ -680,15 +628,13 @@ fn draw_panel<DB: DrawingBackend>(
 
     // ±3σ band.
     for r in runs(n, |i| p.line[i].is_some() && p.band[i].is_some()) {
-        let mut poly: Vec<(f64, f64)> = Vec::with_capacity(2 * r.len());
-        for i in r.clone() {
+        let edge = |i: usize, sign: f64| {
             let (l, b) = (p.line[i].unwrap_or(0.0), p.band[i].unwrap_or(0.0));
-            poly.push((track.t[i] + p.shift, clamp(l + b)));
-        }
-        for i in r.rev() {
-            let (l, b) = (p.line[i].unwrap_or(0.0), p.band[i].unwrap_or(0.0));
-            poly.push((track.t[i] + p.shift, clamp(l - b)));
-        }
+            (track.t[i] + p.shift, clamp(l + sign * b))
+        };
+        let poly: Vec<(f64, f64)> = (r.clone().map(|i| edge(i, 1.0)))
+            .chain(r.rev().map(|i| edge(i, -1.0)))
+            .collect();
         chart
             .draw_series(std::iter::once(Polygon::new(
                 poly,
@@ -697,12 +643,20 @@ fn draw_panel<DB: DrawingBackend>(
             .map_err(e)?;
     }
 
+    // The runs of a row-wise curve, `sign` times its values, at the times moved by `shift`.
+    let curves = |v: &[Option<f64>], shift: f64, sign: f64| -> Vec<Vec<(f64, f64)>> {
+        runs(n, |i| v[i].is_some())
+            .into_iter()
+            .map(|r| {
+                r.map(|i| (track.t[i] + shift, clamp(sign * v[i].unwrap_or(0.0))))
+                    .collect()
+            })
+            .collect()
+    };
+
     // ±3σ noise (dashed).
     for sign in [1.0, -1.0] {
-        for r in runs(n, |i| p.noise[i].is_some()) {
-            let pts: Vec<(f64, f64)> = r
-                .map(|i| (track.t[i], clamp(sign * p.noise[i].unwrap_or(0.0))))
-                .collect();
+        for pts in curves(&p.noise, 0.0, sign) {
             chart
                 .draw_series(DashedLineSeries::new(pts, 7, 5, NOISE.stroke_width(2)))
                 .map_err(e)?;
@@ -731,21 +685,13 @@ fn draw_panel<DB: DrawingBackend>(
     }
 
     // Truth, then the estimate over it.
-    for r in runs(n, |i| p.truth[i].is_some()) {
-        let pts: Vec<(f64, f64)> = r
-            .map(|i| (track.t[i] + p.shift, clamp(p.truth[i].unwrap_or(0.0))))
-            .collect();
-        chart
-            .draw_series(LineSeries::new(pts, TRUTH.stroke_width(1)))
-            .map_err(e)?;
-    }
-    for r in runs(n, |i| p.line[i].is_some()) {
-        let pts: Vec<(f64, f64)> = r
-            .map(|i| (track.t[i] + p.shift, clamp(p.line[i].unwrap_or(0.0))))
-            .collect();
-        chart
-            .draw_series(LineSeries::new(pts, ESTIMATE.stroke_width(2)))
-            .map_err(e)?;
+    for (v, style) in [
+        (&p.truth, TRUTH.stroke_width(1)),
+        (&p.line, ESTIMATE.stroke_width(2)),
+    ] {
+        for pts in curves(v, p.shift, 1.0) {
+            chart.draw_series(LineSeries::new(pts, style)).map_err(e)?;
+        }
     }
 
     // Rejected samples on top.
@@ -758,24 +704,20 @@ fn draw_panel<DB: DrawingBackend>(
         )
         .map_err(e)?;
 
-    // Events.
-    for &t in &track.switches {
-        chart
-            .draw_series(DashedLineSeries::new(
-                vec![(t, y0), (t, y1)],
-                8,
-                6,
-                SWITCH.stroke_width(2),
-            ))
+    // Events: switches to fading memory (dashed), restarts.
+    for (times, dashed, color) in [
+        (&track.switches, true, SWITCH),
+        (&track.restarts, false, RESTART),
+    ] {
+        for &t in times {
+            let (v, style) = (vec![(t, y0), (t, y1)], color.stroke_width(2));
+            if dashed {
+                chart.draw_series(DashedLineSeries::new(v, 8, 6, style))
+            } else {
+                chart.draw_series(LineSeries::new(v, style))
+            }
             .map_err(e)?;
-    }
-    for &t in &track.restarts {
-        chart
-            .draw_series(LineSeries::new(
-                vec![(t, y0), (t, y1)],
-                RESTART.stroke_width(2),
-            ))
-            .map_err(e)?;
+        }
     }
     Ok(())
 }
