@@ -73,7 +73,7 @@ fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
         (_, None) => {}
     }
     if let Some(id) = &a.id_col {
-        if *id == a.time_col || *id == a.value_col {
+        if *id == a.columns.time_col || *id == a.columns.value_col {
             return Err(CliError::Usage(format!(
                 "--id-col {id} is the time or the value column; name a column of its own"
             )));
@@ -153,7 +153,13 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     let started = std::time::Instant::now();
     let size = input_size(a.input.as_deref());
     let input = open_input(a.input.as_deref())?;
-    let mut reader = RowReader::new(input, &a.time_col, &a.value_col, a.id_col.as_deref(), &need)?;
+    let mut reader = RowReader::new(
+        input,
+        &a.columns.time_col,
+        &a.columns.value_col,
+        a.id_col.as_deref(),
+        &need,
+    )?;
     // A fixed-memory window longer than LOOKAHEAD is read in full before the first output row:
     // its rows have no estimate, and an input shorter than the window is an error.
     let hold = LOOKAHEAD.max(need.rows);
