@@ -51,6 +51,16 @@ impl Format {
             _ => None,
         }
     }
+
+    /// The format of `path`, or the usage error that it has none.
+    pub fn of(path: &Path) -> Result<Format, CliError> {
+        Format::from_path(path).ok_or_else(|| {
+            CliError::Usage(format!(
+                "cannot tell the image format of '{}': the file name must end in .png or .svg",
+                path.display()
+            ))
+        })
+    }
 }
 
 /// The rows of a filter run, column by column (every vector has one entry per row).
@@ -130,12 +140,7 @@ fn register() -> Result<(), CliError> {
 /// Draws `track` as laid out by `layout` into `path`, as PNG or SVG by its extension.
 pub fn write(track: &Track, layout: &Layout, path: &Path) -> Result<(), CliError> {
     register()?;
-    let format = Format::from_path(path).ok_or_else(|| {
-        CliError::Usage(format!(
-            "cannot tell the image format of '{}': the file name must end in .png or .svg",
-            path.display()
-        ))
-    })?;
+    let format = Format::of(path)?;
     let fail = |e: String| {
         CliError::Data(format!(
             "cannot write the plot to '{}': {e}",

@@ -159,9 +159,10 @@ fn run_plain(data: &[Point], kind: Kind, engine: EngineArg, tau: f64) -> Result<
     }
     Ok(Run {
         name: kind.name(),
-        engine: match engine {
-            EngineArg::Exact => "exact",
-            EngineArg::Gain => "gain",
+        engine: if engine == EngineArg::Exact {
+            "exact"
+        } else {
+            "gain"
         },
         estimates,
     })
@@ -360,8 +361,8 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
         .map(|(i, (_, p))| (i, p))
         .collect();
     let caught = rejected.iter().filter(|(_, p)| p.outlier).count();
-    let switches = track(&data, &outs).switches;
-    let restarts: Vec<f64> = outs.iter().filter(|o| o.restart).map(|o| o.time).collect();
+    let plot_track = track(&data, &outs);
+    let (switches, restarts) = (&plot_track.switches, &plot_track.restarts);
     let span = data[SAMPLES - 1].t - data[0].t;
 
     let mut w = Output::stdout();
@@ -390,11 +391,11 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
         OUTLIER_SIZE.1,
         rejected.len(),
         rejected.len() - caught,
-        times_list(&switches),
+        times_list(switches),
         if restarts.is_empty() {
             "none".to_string()
         } else {
-            format!("{} at {}", restarts.len(), times_list(&restarts))
+            format!("{} at {}", restarts.len(), times_list(restarts))
         },
         outs.iter().filter(|o| o.misfit).count(),
         auto.noise_sigma().map_or_else(|| "-".to_string(), short),
@@ -427,11 +428,9 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
         );
     }
     if let Some(prefix) = Some(&cfg.plot).filter(|_| !cfg.no_plot) {
-        let t = track(&data, &outs);
-        let l = layout(tau);
-        let paths = plot_paths(prefix);
+        let (l, paths) = (layout(tau), plot_paths(prefix));
         for p in &paths {
-            chart::write(&t, &l, p)?;
+            chart::write(&plot_track, &l, p)?;
         }
         eprintln!(
             "wrote the plot to '{}' and '{}'",
