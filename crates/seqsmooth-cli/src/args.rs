@@ -615,49 +615,40 @@ pub fn parse_index(s: &str) -> Result<u64, String> {
     }
 }
 
-fn parse_f64(name: &str, s: &str) -> Result<f64, String> {
+/// Parses the number `name` that must be `range` (`ok` says whether it is).
+fn parse_f64(name: &str, s: &str, ok: fn(f64) -> bool, range: &str) -> Result<f64, String> {
     let text = s.trim();
-    text.parse::<f64>()
-        .map_err(|_| format!("{name} '{text}' is not a number"))
+    let v = (text.parse::<f64>()).map_err(|_| format!("{name} '{text}' is not a number"))?;
+    if ok(v) {
+        Ok(v)
+    } else {
+        Err(format!("{name} {text} is out of range: it must be {range}"))
+    }
 }
 
 /// Parses `--tau`: a positive finite number.
 pub fn parse_tau(s: &str) -> Result<f64, String> {
-    let v = parse_f64("tau", s)?;
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(format!(
-            "tau {} is out of range: it must be a positive finite number",
-            s.trim()
-        ))
-    }
+    parse_f64(
+        "tau",
+        s,
+        |v| v.is_finite() && v > 0.0,
+        "a positive finite number",
+    )
 }
 
 /// Parses `--sigma`: a positive finite number.
 pub fn parse_sigma(s: &str) -> Result<f64, String> {
-    let v = parse_f64("sigma", s)?;
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(format!(
-            "sigma {} is out of range: it must be a positive finite number",
-            s.trim()
-        ))
-    }
+    parse_f64(
+        "sigma",
+        s,
+        |v| v.is_finite() && v > 0.0,
+        "a positive finite number",
+    )
 }
 
 /// Parses `--lead`: any finite number (negative = retrodiction).
 pub fn parse_lead(s: &str) -> Result<f64, String> {
-    let v = parse_f64("lead", s)?;
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(format!(
-            "lead {} is out of range: it must be a finite number",
-            s.trim()
-        ))
-    }
+    parse_f64("lead", s, f64::is_finite, "a finite number")
 }
 
 /// Parses `--window`: the number of samples in the window (Morrison's `L+1`), a whole number
