@@ -380,10 +380,15 @@ impl<R: Read> CsvIn<R> {
     }
 }
 
+/// The file `path` names, or `None` for standard input or output (`None` or `-`).
+pub fn named(path: Option<&Path>) -> Option<&Path> {
+    path.filter(|p| p.as_os_str() != "-")
+}
+
 /// Opens the input: a file, or standard input for `None` or `-`.
 pub fn open_input(path: Option<&Path>) -> Result<Box<dyn Read + Send>, CliError> {
-    match path {
-        Some(p) if p.as_os_str() != "-" => {
+    match named(path) {
+        Some(p) => {
             let file = File::open(p).map_err(|e| {
                 CliError::Data(format!("cannot open input file '{}': {e}", p.display()))
             })?;
@@ -391,22 +396,19 @@ pub fn open_input(path: Option<&Path>) -> Result<Box<dyn Read + Send>, CliError>
             Ok(Box::new(file))
         }
         // Unlocked, so that another thread may read it; the CSV reader reads large blocks.
-        _ => Ok(Box::new(io::stdin())),
+        None => Ok(Box::new(io::stdin())),
     }
 }
 
 /// The name of an input in messages: `'path'` or `standard input`.
 pub fn input_name(path: Option<&Path>) -> String {
-    match path {
-        Some(p) if p.as_os_str() != "-" => format!("'{}'", p.display()),
-        _ => "standard input".to_string(),
-    }
+    named(path).map_or_else(|| "standard input".into(), |p| format!("'{}'", p.display()))
 }
 
 /// The size of the input file, for the progress bar; `None` for standard input or anything
 /// but a regular file.
 pub fn input_size(path: Option<&Path>) -> Option<u64> {
-    let meta = std::fs::metadata(path.filter(|p| p.as_os_str() != "-")?).ok()?;
+    let meta = std::fs::metadata(named(path)?).ok()?;
     meta.is_file().then_some(meta.len())
 }
 
@@ -420,8 +422,8 @@ pub struct Output {
 impl Output {
     /// Creates the output file `path` (standard output for `None` or `-`).
     pub fn create(path: Option<&Path>) -> Result<Self, CliError> {
-        match path {
-            Some(p) if p.as_os_str() != "-" => {
+        match named(path) {
+            Some(p) => {
                 let name = format!("'{}'", p.display());
                 let file = File::create(p).map_err(|e| {
                     CliError::Data(format!("cannot create output file {name}: {e}"))
@@ -431,7 +433,7 @@ impl Output {
                     name,
                 })
             }
-            _ => Ok(Self::stdout()),
+            None => Ok(Self::stdout()),
         }
     }
 

@@ -9,7 +9,7 @@
 use crate::args::PlotArgs;
 use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
-use crate::io::{find_column, input_name, open_input, parse_cell, plural, CsvIn};
+use crate::io::{find_column, input_name, named, open_input, parse_cell, plural, CsvIn};
 use std::path::Path;
 
 /// A CSV file read in full: the header and the data rows with their 1-based file lines.
@@ -236,12 +236,12 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
     } else {
         "filter"
     };
-    let file = match cfg.source.as_deref() {
-        Some(p) if p.as_os_str() != "-" => p.file_name().map_or_else(
+    let file = match named(cfg.source.as_deref()) {
+        Some(p) => p.file_name().map_or_else(
             || p.display().to_string(),
             |f| f.to_string_lossy().into_owned(),
         ),
-        _ => "standard input".to_string(),
+        None => "standard input".to_string(),
     };
     let title = format!("seqsmooth {kind} output: {file}");
     Ok((
