@@ -338,7 +338,7 @@ impl<R: Read> CsvIn<R> {
     }
 
     /// Reads the next record; `false` at the end of the input.
-    pub fn next(&mut self) -> Result<bool, CliError> {
+    pub fn next_record(&mut self) -> Result<bool, CliError> {
         match self.reader.read_byte_record(&mut self.record) {
             Ok(true) => {
                 let byte = self.record.position().map_or(0, |p| p.byte());

@@ -27,7 +27,7 @@ impl Table {
         let mut csv = CsvIn::new(open_input(path)?).map_err(at)?;
         let header = std::mem::take(&mut csv.header);
         let mut rows = Vec::new();
-        while csv.next().map_err(at)? {
+        while csv.next_record().map_err(at)? {
             let line = csv.line;
             let cells: Result<Vec<String>, _> = (0..header.len())
                 .map(|i| std::str::from_utf8(csv.field(i)).map(str::to_string))

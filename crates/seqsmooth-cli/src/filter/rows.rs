@@ -49,6 +49,11 @@ impl Chunk {
         self.t.len()
     }
 
+    /// Whether the chunk has no rows.
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
     /// The time cell of row `i`, as written.
     fn t_text(&self, i: usize) -> &[u8] {
         let (at, t, _) = self.cells[i];
@@ -213,7 +218,7 @@ impl<R: Read> RowReader<R> {
 
     /// Reads one row into `chunk`; `false` at the end of the input.
     fn next_row(&mut self, chunk: &mut Chunk) -> Result<bool, CliError> {
-        if !self.csv.next()? {
+        if !self.csv.next_record()? {
             return Ok(false);
         }
         let line = self.csv.line;

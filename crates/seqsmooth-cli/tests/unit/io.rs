@@ -5,7 +5,7 @@ use seqsmooth_cli::io::*;
 fn lines(text: &str) -> Vec<u64> {
     let mut r = CsvIn::new(text.as_bytes()).unwrap();
     let mut v = Vec::new();
-    while r.next().unwrap() {
+    while r.next_record().unwrap() {
         v.push(r.line);
     }
     v
@@ -42,7 +42,7 @@ fn line_numbers_across_buffer_refills() {
 fn reader_lines_and_messages() {
     let mut r = CsvIn::new("t,y\n0,1\n1,2\n\n2,abc\n".as_bytes()).unwrap();
     let mut cells = Vec::new();
-    while r.next().unwrap() {
+    while r.next_record().unwrap() {
         cells.push(parse_cell(r.field(1), r.line, "y", "value").map_err(|e| e.to_string()));
     }
     assert_eq!(cells[..2], [Ok(1.0), Ok(2.0)]);
