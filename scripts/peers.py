@@ -20,7 +20,7 @@ PINS below, re-runs itself there, and then
    any pair disagrees beyond its tolerance.
 
 Agreement metric: for each derivative k, max over the compared samples of |peer - ours| divided
-by the largest |ours_k| over those samples (as tests/savgol.rs), the worst k reported; for the
+by the largest |ours_k| over those samples (as tests/fixed_smooth_scipy.rs), the worst k reported; for the
 Savitzky-Golay pairs divided by max|y|·Σ|c_k| instead (see TOL).
 """
 import argparse

@@ -1,5 +1,7 @@
 //! Cost per sample of the streaming fixed-memory filter (degree 2) against the window span L:
-//! the sliding engine (O(m²) per sample, flat in L) and the direct engine (O(L·m)).
+//! the sliding engine (O(m²) per sample, flat in L) and the direct engine (O(L·m)); and of the
+//! whole-series `smooth` (degree 2, derivatives 0..=2, the same sliding engine) against its
+//! window (`smooth/<window>`, throughput in samples of the series).
 //!
 //! Run: `cargo bench -p seqsmooth --bench fixed_memory` (results in BENCHMARKS.md).
 //! Each iteration processes a batch of samples on a filter whose window is already full;
@@ -7,7 +9,7 @@
 //! cost per sample.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use seqsmooth::polynomial::fixed::{FixedEngine, FixedMemory};
+use seqsmooth::polynomial::fixed::{smooth, FixedEngine, FixedMemory};
 use seqsmooth::PolynomialFilter;
 mod common;
 
@@ -72,10 +74,34 @@ fn direct_update(c: &mut Criterion) {
     run(c, "direct_update", FixedEngine::Direct, false, 200);
 }
 
+/// Whole-series smoothing of `SMOOTH_LEN` evenly spaced samples at windows 11 … 10001.
+fn smooth_series(c: &mut Criterion) {
+    const SMOOTH_LEN: usize = 1 << 17;
+    let ys = data(SMOOTH_LEN);
+    let ts: Vec<f64> = (0..SMOOTH_LEN).map(|n| n as f64 * 0.01).collect();
+    let mut group = c.benchmark_group("smooth");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3))
+        .throughput(Throughput::Elements(SMOOTH_LEN as u64));
+    for window in [11usize, 101, 1_001, 10_001] {
+        group.bench_with_input(
+            BenchmarkId::from_parameter(window),
+            &window,
+            |b, &window| {
+                b.iter(|| black_box(smooth(&ts, &ys, DEGREE, window).unwrap()));
+            },
+        );
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
     sliding_update,
     sliding_update_estimate,
-    direct_update
+    direct_update,
+    smooth_series
 );
 criterion_main!(benches);

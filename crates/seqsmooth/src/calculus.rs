@@ -91,13 +91,19 @@ pub fn choose<T: Scalar>(n: usize, k: usize) -> T {
 /// assert_eq!(s[(4, 1)], -6.0);
 /// ```
 pub fn stirling1<T: Scalar>(order: usize) -> DMatrix<T> {
+    stirling_triangle(order, |i, _| -T::from_i64((i - 1) as i64))
+}
+
+/// The triangle `s_00 = 1`, `s_ij = s_(i−1)(j−1) + c(i, j) s_(i−1)j` of both kinds of Stirling
+/// numbers (Morrison (2.4.8), (2.4.15)).
+fn stirling_triangle<T: Scalar>(order: usize, c: impl Fn(usize, usize) -> T) -> DMatrix<T> {
     let mut s = DMatrix::from_element(order + 1, order + 1, T::zero());
     s[(0, 0)] = T::one();
     for i in 1..=order {
         for j in 1..=i {
             let a = s[(i - 1, j - 1)].clone();
-            let b = s[(i - 1, j)].clone() * T::from_i64((i - 1) as i64);
-            s[(i, j)] = a - b;
+            let b = s[(i - 1, j)].clone() * c(i, j);
+            s[(i, j)] = a + b;
         }
     }
     s
@@ -111,16 +117,7 @@ pub fn stirling1<T: Scalar>(order: usize) -> DMatrix<T> {
 /// assert_eq!(stirling2::<f64>(5)[(5, 3)], 25.0);
 /// ```
 pub fn stirling2<T: Scalar>(order: usize) -> DMatrix<T> {
-    let mut s = DMatrix::from_element(order + 1, order + 1, T::zero());
-    s[(0, 0)] = T::one();
-    for i in 1..=order {
-        for j in 1..=i {
-            let a = s[(i - 1, j - 1)].clone();
-            let b = s[(i - 1, j)].clone() * T::from_i64(j as i64);
-            s[(i, j)] = a + b;
-        }
-    }
-    s
+    stirling_triangle(order, |_, j| T::from_i64(j as i64))
 }
 
 /// The link matrix `𝒮` (Morrison's associate Stirling matrix of the first kind, (4.4.8),

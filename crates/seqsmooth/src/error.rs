@@ -3,6 +3,13 @@
 use thiserror::Error;
 
 /// What went wrong, with the value that caused it.
+///
+/// ```
+/// use seqsmooth::{Engine, Error, FadingMemory};
+/// let e = FadingMemory::new(1, 1.5, 1.0, Engine::Exact).unwrap_err();
+/// assert_eq!(e, Error::ThetaOutOfRange { theta: 1.5 });
+/// assert_eq!(e.to_string(), "theta 1.5 is out of range: it must lie strictly between 0 and 1");
+/// ```
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum Error {
     /// A sample value or timestamp is NaN or infinite.
@@ -117,4 +124,30 @@ pub fn check_sample(t: f64, y: f64, previous: Option<f64>) -> Result<(), Error> 
         Some(previous) if t <= previous => Err(Error::TimeNotIncreasing { time: t, previous }),
         _ => Ok(()),
     }
+}
+
+/// The first non-finite number of `xs` as an [`Error::NonFinite`] naming it `what` (`"time"` or
+/// `"value"`).
+pub(crate) fn check_finite(what: &'static str, xs: &[f64]) -> Result<(), Error> {
+    match xs.iter().find(|x| !x.is_finite()) {
+        Some(&value) => Err(Error::NonFinite { what, value }),
+        None => Ok(()),
+    }
+}
+
+/// One time per value, or an [`Error::InvalidParameter`] called `name` giving `reason`.
+pub(crate) fn check_lengths(
+    name: &'static str,
+    times: &[f64],
+    values: &[f64],
+    reason: &str,
+) -> Result<(), Error> {
+    if times.len() != values.len() {
+        return Err(Error::InvalidParameter {
+            name,
+            value: format!("{} times, {} values", times.len(), values.len()),
+            reason: reason.into(),
+        });
+    }
+    Ok(())
 }

@@ -14,8 +14,9 @@
 //!   [`PolynomialState::time`].
 //! - Internally and in the printed tables, Morrison's **scaled state** `Z` has
 //!   `z_k = τ^k x^(k) / k!` (4.2.14); `X = D(τ) Z` with `D(τ) = diag(k!/τ^k)` (4.2.18). Gains
-//!   ([`polynomial::gains`]) and variance-reduction matrices ([`polynomial::vrf`]) are given for
-//!   `Z` (Tables 9.1, 9.2, 13.1-13.3), and converted at the boundary ([`model`]).
+//!   ([`polynomial::expanding::gains`], [`polynomial::fading::gains`]) and variance-reduction
+//!   matrices ([`polynomial::expanding::vrf`], [`polynomial::fading::vrf`]) are given for `Z`
+//!   (Tables 9.1, 9.2, 13.1-13.3), and converted at the boundary ([`model`]).
 //! - **Transition matrices**: Morrison's `Φ(h)` acts on `Z` with `h` in samples,
 //!   `[Φ(h)]_ij = C(j,i) h^(j-i)` ([`model::phi`]); Reyneke's `Ψ(ζ)` acts on `d_k = τ^k x^(k)`,
 //!   `[Ψ(ζ)]_ij = ζ^(j-i)/(j-i)!` ([`model::psi`]), which is also the unscaled `Φ_X`. Gains
@@ -32,12 +33,25 @@
 //! - [`basis`]: discrete Legendre and Laguerre polynomials, classical Legendre.
 //! - [`model`]: state scaling, `Φ` and `Ψ`, propagation ([`PolynomialState::at`]).
 //! - [`estimate`]: batch weighted least-squares polynomial fits (QR).
-//! - [`polynomial`]: [`ExpandingMemory`] and [`FadingMemory`] filters, gains, VRFs, switching;
-//!   the fixed-memory filter and whole-series smoothing ([`polynomial::fixed`]); the automatic
-//!   filter ([`polynomial::automatic`]: start-up, outliers, noise, misfit, degree settling).
+//! - [`polynomial`]: the filters, one module per concept (table in its docs):
+//!   - [`polynomial::expanding`]: [`ExpandingMemory`], its gains and VRF (Morrison ch. 9);
+//!   - [`polynomial::fading`]: [`FadingMemory`], its gains, VRF and the expanding → fading
+//!     switch (Morrison ch. 13);
+//!   - the exact and gain engines both run on (`polynomial::engine`, internal);
+//!   - [`polynomial::fixed`]: [`FixedMemory`] and whole-series smoothing (Morrison ch. 7);
+//!   - [`polynomial::automatic`]: the automatic filter (start-up, outliers, noise, misfit,
+//!     degree settling; Morrison §13.8, §14.8; Reyneke et al. §7);
+//!   - [`polynomial::bank`], [`polynomial::stream`]: many channels at once;
+//!   - every filter implements [`PolynomialFilter`], configured as `Type::new(required)?`
+//!     (the automatic filter: `AutomaticFilter::with_defaults`) then `.with_x(v)?` builders.
 //! - [`stats`]: chi-squared tests, noise estimation, residual calibration.
 //! - [`recursive`]: the square-root information (Bayes) recursion the exact engines run on.
 //! - [`scalar`]: the `f64` / exact-rational abstraction every formula is generic over.
+//! - [`linalg`]: the small dense linear algebra the formulas share.
+//! - `numeric`: the numerical building blocks of the engines (double-word arithmetic, the
+//!   step tolerance).
+//!
+//! Measured accuracy: see ACCURACY.md; speed: BENCHMARKS.md.
 //!
 //! ```
 //! use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
@@ -59,6 +73,7 @@ pub mod error;
 pub mod estimate;
 pub mod linalg;
 pub mod model;
+pub mod numeric;
 pub mod polynomial;
 pub mod recursive;
 pub mod scalar;

@@ -51,28 +51,25 @@ pub fn inverse_exact<T: Scalar>(a: &DMatrix<T>) -> Option<DMatrix<T>> {
 /// Solves `R x = b` in place for upper-triangular `R` (back substitution). Returns `false`
 /// (leaving `b` partly overwritten) if a diagonal entry is zero.
 pub fn solve_upper_in_place(r: &DMatrix<f64>, b: &mut [f64]) -> bool {
-    let n = b.len();
-    for i in (0..n).rev() {
-        let mut s = b[i];
-        for j in i + 1..n {
-            s -= r[(i, j)] * b[j];
-        }
-        let d = r[(i, i)];
-        if d == 0.0 {
-            return false;
-        }
-        b[i] = s / d;
-    }
-    true
+    substitute(r, b, false)
 }
 
 /// Solves `Rᵀ x = b` in place for upper-triangular `R` (forward substitution).
 pub fn solve_upper_transpose_in_place(r: &DMatrix<f64>, b: &mut [f64]) -> bool {
+    substitute(r, b, true)
+}
+
+/// Back substitution with `R` (`transpose` false: `i = n−1 … 0`, `x_i = (b_i − Σ_{j>i} r_ij
+/// x_j)/r_ii`) or forward substitution with `Rᵀ` (`i = 0 … n−1`, `x_i = (b_i − Σ_{j<i} r_ji
+/// x_j)/r_ii`); false at a zero diagonal entry.
+fn substitute(r: &DMatrix<f64>, b: &mut [f64], transpose: bool) -> bool {
     let n = b.len();
-    for i in 0..n {
+    for step in 0..n {
+        let i = if transpose { step } else { n - 1 - step };
+        let others = if transpose { 0..i } else { i + 1..n };
         let mut s = b[i];
-        for j in 0..i {
-            s -= r[(j, i)] * b[j];
+        for j in others {
+            s -= if transpose { r[(j, i)] } else { r[(i, j)] } * b[j];
         }
         let d = r[(i, i)];
         if d == 0.0 {

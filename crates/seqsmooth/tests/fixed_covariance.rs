@@ -34,7 +34,7 @@ fn fixed_memory_vrf_limit_tables_7_2_and_9_3() {
             let diag = fact(m + i + 1) * fact(m + i + 1)
                 / (z(2 * i as i64 + 1) * fact(i) * fact(i) * fact(m - i) * fact(m - i));
             assert_eq!(k[(i, i)], diag);
-            // (The printed decimals of Table 7.2 are checked in tests/fixed_memory.rs, through
+            // (The printed decimals of Table 7.2 are checked in tests/fixed_covariance.rs, through
             // fixed::vrf_limit, which equals this function exactly there.)
         }
     }

@@ -332,7 +332,7 @@ fn closed_form_weights_of_spec_1_4() {
 fn table_7_1_recovered_from_the_weights() {
     // W(0) = 𝒮 G C B and B Bᵀ = C⁻¹ (7.5.8) give G = 𝒮⁻¹ W(0) Bᵀ: the matrix G of Table 7.1
     // comes back out of the weights, exactly. (G itself, (7.4.13)-(7.4.14), is checked entry
-    // for entry against the printed Table 7.1 in tests/foundations.rs.)
+    // for entry against the printed Table 7.1 in tests/discrete_legendre.rs.)
     for l in [10i64, 12, 20] {
         let m = 10;
         let basis = DiscreteLegendre::new(z(l));

@@ -22,16 +22,32 @@ pub struct DiscreteLaguerre<T> {
 
 impl<T: Scalar> DiscreteLaguerre<T> {
     /// The family for the discount factor `θ` (`0 < θ < 1`).
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLaguerre;
+    /// assert_eq!(*DiscreteLaguerre::new(0.9_f64).theta(), 0.9);
+    /// ```
     pub fn new(theta: T) -> Self {
         Self { theta }
     }
 
     /// `θ`.
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLaguerre;
+    /// assert_eq!(*DiscreteLaguerre::new(0.5_f64).theta(), 0.5);
+    /// ```
     pub fn theta(&self) -> &T {
         &self.theta
     }
 
     /// `p(x; j, θ) = Σ_ν (-1)^ν C(j,ν) θ^(j-ν) (1-θ)^ν x^(ν)/ν!` as a polynomial in `x`.
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLaguerre;
+    /// let p = DiscreteLaguerre::new(0.5_f64).polynomial(1);
+    /// assert_eq!(p.coeffs, vec![0.5, -0.5]); // θ − (1−θ)x
+    /// ```
     pub fn polynomial(&self, j: usize) -> Polynomial<T> {
         let one_minus = T::one() - self.theta.clone();
         let mut p = Polynomial::new(vec![T::zero()]);
@@ -45,16 +61,33 @@ impl<T: Scalar> DiscreteLaguerre<T> {
     }
 
     /// `p(x; j, θ)` at any real `x`.
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLaguerre;
+    /// assert_eq!(DiscreteLaguerre::new(0.5_f64).value(2, -1.0), 1.0); // p_j(−1) = 1
+    /// ```
     pub fn value(&self, j: usize, x: T) -> T {
         self.polynomial(j).eval(&x)
     }
 
     /// Taylor coefficient `(1/i!) dⁱp(x; j, θ)/dxⁱ` at `x`.
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLaguerre;
+    /// assert_eq!(DiscreteLaguerre::new(0.5_f64).taylor(1, 1, &0.0), -0.5); // d/dx (θ − (1−θ)x)
+    /// ```
     pub fn taylor(&self, i: usize, j: usize, x: &T) -> T {
         self.polynomial(j).taylor_coefficient(i, x)
     }
 
     /// Squared norm `c(j, θ)² = θ^j / (1-θ)` (Morrison (3.3.16)).
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLaguerre;
+    /// let b = DiscreteLaguerre::new(0.5_f64);
+    /// let direct: f64 = (0..200).map(|x| b.value(1, x as f64).powi(2) * 0.5f64.powi(x)).sum();
+    /// assert!((b.norm_sq(1) - direct).abs() < 1e-12);
+    /// ```
     pub fn norm_sq(&self, j: usize) -> T {
         self.theta.powi_u(j) / (T::one() - self.theta.clone())
     }

@@ -22,16 +22,32 @@ pub struct DiscreteLegendre<T> {
 
 impl<T: Scalar> DiscreteLegendre<T> {
     /// The family on `x = 0..L` (`span = L`, the memory length in samples minus one).
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLegendre;
+    /// assert_eq!(*DiscreteLegendre::new(10.0_f64).span(), 10.0);
+    /// ```
     pub fn new(span: T) -> Self {
         Self { span }
     }
 
     /// `L`.
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLegendre;
+    /// assert_eq!(*DiscreteLegendre::new(4.0_f64).span(), 4.0);
+    /// ```
     pub fn span(&self) -> &T {
         &self.span
     }
 
     /// `p(x; j, L)` as a polynomial in `x` (power basis).
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLegendre;
+    /// let p = DiscreteLegendre::new(4.0_f64).polynomial(1);
+    /// assert_eq!(p.coeffs, vec![1.0, -0.5]); // 1 − 2x/L
+    /// ```
     pub fn polynomial(&self, j: usize) -> Polynomial<T> {
         let mut p = Polynomial::new(vec![T::zero()]);
         for nu in 0..=j {
@@ -44,6 +60,12 @@ impl<T: Scalar> DiscreteLegendre<T> {
     }
 
     /// `p(x; j, L)` at any real `x`.
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLegendre;
+    /// let b = DiscreteLegendre::new(4.0_f64);
+    /// assert_eq!(b.value(2, 0.0), 1.0); // p_j(0) = 1
+    /// ```
     pub fn value(&self, j: usize, x: T) -> T {
         let mut acc = T::zero();
         for nu in 0..=j {
@@ -55,11 +77,24 @@ impl<T: Scalar> DiscreteLegendre<T> {
     }
 
     /// Taylor coefficient `(1/i!) dⁱp(x; j, L)/dxⁱ` at `x` (any order `i`).
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLegendre;
+    /// let b = DiscreteLegendre::new(4.0_f64);
+    /// assert_eq!(b.taylor(1, 1, &2.0), -0.5); // d/dx (1 − 2x/L)
+    /// ```
     pub fn taylor(&self, i: usize, j: usize, x: &T) -> T {
         self.polynomial(j).taylor_coefficient(i, x)
     }
 
     /// Squared norm `c(j, L)² = (L+j+1)^(j+1) / ((2j+1) L^(j))` (Morrison (3.2.30)).
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLegendre;
+    /// let b = DiscreteLegendre::new(4.0_f64);
+    /// let direct: f64 = (0..=4).map(|x| b.value(1, x as f64).powi(2)).sum();
+    /// assert!((b.norm_sq(1) - direct).abs() < 1e-14);
+    /// ```
     pub fn norm_sq(&self, j: usize) -> T {
         falling_factorial(self.span.clone() + T::from_i64(j as i64 + 1), j + 1)
             / (T::from_i64(2 * j as i64 + 1) * falling_factorial(self.span.clone(), j))
@@ -70,6 +105,12 @@ impl<T: Scalar> DiscreteLegendre<T> {
     /// `[G]_ij = (1/i!) ∇ⁱ p_j(L) = (-1)^j C(j,i) C(j+i,i) / L^(i)`, `0 ≤ i, j ≤ m`.
     /// With the link matrix, `P = 𝒮 G` holds the Taylor coefficients `(1/i!) dⁱp_j/dxⁱ` at `x = L`
     /// (7.4.15).
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLegendre;
+    /// let g = DiscreteLegendre::new(4.0_f64).end_differences(1);
+    /// assert_eq!((g[(0, 0)], g[(0, 1)], g[(1, 1)]), (1.0, -1.0, -0.5)); // p1(L) = −1, ∇p1 = −2/L
+    /// ```
     pub fn end_differences(&self, m: usize) -> DMatrix<T> {
         DMatrix::from_fn(m + 1, m + 1, |i, j| {
             if j < i {
@@ -88,6 +129,16 @@ impl<T: Scalar> DiscreteLegendre<T> {
     /// Values of `dⁱp_j/dxⁱ` for `j = 0..=m` at `x` by the three-term recursion of Morrison's
     /// Appendix I (A1.1)-(A1.6), which avoids the cancellation of the explicit sum.
     /// Returns a `(m+1) × (order+1)` matrix: entry `(j, i)` is `dⁱp_j/dxⁱ(x)`. Requires `m ≤ L`.
+    ///
+    /// ```
+    /// use seqsmooth::basis::DiscreteLegendre;
+    /// let b = DiscreteLegendre::new(6.0_f64);
+    /// let d = b.derivatives_by_recursion(3, 2, &2.0);
+    /// for j in 0..=3 {
+    ///     assert!((d[(j, 0)] - b.value(j, 2.0)).abs() < 1e-12);
+    ///     assert!((d[(j, 2)] - 2.0 * b.taylor(2, j, &2.0)).abs() < 1e-12);
+    /// }
+    /// ```
     pub fn derivatives_by_recursion(&self, m: usize, order: usize, x: &T) -> DMatrix<T> {
         let l = self.span.clone();
         let mut d = DMatrix::from_element(m + 1, order + 1, T::zero());

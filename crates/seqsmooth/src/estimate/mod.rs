@@ -7,8 +7,8 @@
 //! recursive filters and their test oracle.
 
 use crate::basis::legendre::taylor_table;
-use crate::calculus::factorial;
 use crate::error::Error;
+use crate::model::taylor::scaling_diagonal;
 use nalgebra::{DMatrix, DVector};
 
 /// A weighted least-squares polynomial fit `p(t) = Σ_j c_j P_j((t - c)/w)`.
@@ -35,6 +35,14 @@ pub struct PolynomialFit {
 impl PolynomialFit {
     /// Fits a degree-`m` polynomial to `(t_k, y_k)` with optional weights `w_k > 0` (minimising
     /// `Σ w_k (y_k - p(t_k))²`). Needs at least `m+1` distinct times.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::PolynomialFit;
+    /// use seqsmooth::Error;
+    /// let fit = PolynomialFit::new(&[0.0, 1.0, 2.0], &[1.0, 2.0, 2.0], Some(&[1.0, 1.0, 4.0]), 1).unwrap();
+    /// assert_eq!(fit.samples(), 3);
+    /// assert!(matches!(PolynomialFit::new(&[0.0, 0.0], &[1.0, 2.0], None, 1), Err(Error::TooFewSamples { .. })));
+    /// ```
     pub fn new(
         times: &[f64],
         values: &[f64],
@@ -99,16 +107,33 @@ impl PolynomialFit {
     }
 
     /// Degree `m`.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::PolynomialFit;
+    /// assert_eq!(PolynomialFit::new(&[0.0, 1.0, 2.0], &[1.0, 2.0, 2.0], None, 2).unwrap().degree(), 2);
+    /// ```
     pub fn degree(&self) -> usize {
         self.degree
     }
 
     /// Weighted residual sum of squares `Σ w_k (y_k - p(t_k))²`.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::PolynomialFit;
+    /// // the best constant through 1, 3 is 2: residuals ±1
+    /// let fit = PolynomialFit::new(&[0.0, 1.0], &[1.0, 3.0], None, 0).unwrap();
+    /// assert!((fit.residual_sq() - 2.0).abs() < 1e-12);
+    /// ```
     pub fn residual_sq(&self) -> f64 {
         self.residual_sq
     }
 
     /// Number of samples fitted.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::PolynomialFit;
+    /// assert_eq!(PolynomialFit::new(&[0.0, 1.0, 2.0, 3.0], &[0.0; 4], None, 1).unwrap().samples(), 4);
+    /// ```
     pub fn samples(&self) -> usize {
         self.samples
     }
@@ -117,18 +142,31 @@ impl PolynomialFit {
         // Row k maps the Legendre coefficients to the k-th derivative at t.
         let u = (t - self.centre) / self.half_width;
         let tt = taylor_table(self.degree, self.degree, u);
-        DMatrix::from_fn(self.degree + 1, self.degree + 1, |k, j| {
-            tt[(k, j)] * factorial::<f64>(k) / self.half_width.powi(k as i32)
-        })
+        let d = scaling_diagonal::<f64>(self.degree, self.half_width);
+        DMatrix::from_fn(self.degree + 1, self.degree + 1, |k, j| tt[(k, j)] * d[k])
     }
 
     /// `p(t), p'(t), …, p^(m)(t)` at any `t`.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::PolynomialFit;
+    /// let fit = PolynomialFit::new(&[0.0, 1.0, 3.0], &[1.0, 3.0, 7.0], None, 1).unwrap(); // y = 1 + 2t
+    /// let d = fit.derivatives_at(10.0);
+    /// assert!((d[0] - 21.0).abs() < 1e-12 && (d[1] - 2.0).abs() < 1e-12);
+    /// ```
     pub fn derivatives_at(&self, t: f64) -> Vec<f64> {
         (self.jacobian(t) * &self.coeffs).iter().copied().collect()
     }
 
     /// Covariance of [`Self::derivatives_at`] when the weights are inverse variances (or
     /// `σ² ×` it for unit weights and noise variance `σ²`).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::PolynomialFit;
+    /// // the mean of n unit-variance samples has variance 1/n
+    /// let fit = PolynomialFit::new(&[0.0, 1.0, 2.0, 3.0], &[1.0, 2.0, 0.0, 1.0], None, 0).unwrap();
+    /// assert!((fit.covariance_at(1.5)[(0, 0)] - 0.25).abs() < 1e-14);
+    /// ```
     pub fn covariance_at(&self, t: f64) -> DMatrix<f64> {
         // (J R⁻¹)(J R⁻¹)ᵀ, row by row: (J R⁻¹)ᵀ = R⁻ᵀ Jᵀ by forward substitution.
         let j = self.jacobian(t);

@@ -24,29 +24,27 @@
 //! operation is a loop over equal-length slices (`zip`, no indexing), which LLVM vectorises:
 //! the release assembly (`cargo rustc --release -p seqsmooth -- --emit asm`) of the block kernel
 //! contains packed `addpd`/`mulpd`/`subpd` on `xmm` registers (SSE2, the default x86-64
-//! target), with scalar code only for the remainders. Measured (`benches/bank.rs`,
-//! BENCHMARKS.md): ≈ 5·10⁸ channel-updates/s at `K = 10⁴`, degree 2, on one core. No fused
-//! multiply-add is used, so results do not depend on the target features. [`FadingBank::update_par`]
-//! splits the channels into blocks of [`PAR_CHUNK`] over rayon; every channel sees exactly the
-//! same operations, so it equals [`FadingBank::update`] bit for bit.
+//! target), with scalar code only for the remainders (throughput: see BENCHMARKS.md). No
+//! fused multiply-add is used, so results do not depend on the target features
+//! ([`crate::numeric::double_word`]). The `_par` updates split the channels into blocks of
+//! [`PAR_CHUNK`] over rayon; every channel sees exactly the same operations, so they equal the
+//! serial updates bit for bit.
 //!
 //! ## Numerics
 //!
 //! The bank runs in plain `f64` from a zero state (the expanding-memory recursion reaches the
 //! interpolating polynomial at `n = m` from any initial state, Morrison §9.6), unlike the
-//! single-stream gain engine, which starts exactly and carries a compensated state. Measured
-//! (tests in `tests/bank.rs`, run with `--nocapture` to print them): over 10⁴ steps of a slow
-//! sine plus unit noise, θ = 0.95, the largest difference from the single-stream
-//! `FadingMemory` gain engine, per derivative `k` relative to the largest `|x^(k)|` of the run,
-//! worst over `k`, is 5.5e-16 (m = 1), 1.9e-15 (m = 2), 2.9e-14 (m = 3) and 2.3e-13 (m = 4);
-//! over 150-400 steps at θ = 0.9 for `K = 1, 7, 1000` it is ≤ 3.8e-13 for m ≤ 4 (asserted:
-//! 1e-11). The expanding bank is within 7.6e-13 of `ExpandingMemory`'s gain engine (m ≤ 4,
-//! 300 steps).
+//! single-stream gain engine, which starts exactly and carries a compensated state. Its
+//! agreement with the single-stream `FadingMemory` and `ExpandingMemory` gain engines is
+//! asserted in `tests/bank.rs`, printed by `cargo run --release -p seqsmooth --example accuracy_bank` (ACCURACY.md).
 
-use super::gains::{fading_gains, ExpandingGainSchedule, GainForm};
-use super::switching::SwitchRule;
+use super::expanding::gains::ExpandingGainSchedule;
+use super::fading::gains::fading_gains;
+use super::fading::switch::SwitchRule;
+use super::form::GainForm;
 use super::options::{check_degree, check_tau, check_theta};
 use crate::error::Error;
+use crate::model::{derivative_scale, for_each_shift_step};
 use rayon::prelude::*;
 
 /// Channels per inner block of an update: the block's rows (`m+1` state rows, input, residual)
@@ -56,9 +54,10 @@ pub const BLOCK: usize = 256;
 /// Channels per rayon task in the parallel updates (a multiple of [`BLOCK`]).
 pub const PAR_CHUNK: usize = 64 * BLOCK;
 
-/// The shared core of the banks: state rows and the sample count.
+/// The channels' states of a bank, structure-of-arrays, and the shared sample count and gain
+/// schedule.
 #[derive(Clone, Debug)]
-struct Core {
+struct BankState {
     m: usize,
     tau: f64,
     channels: usize,
@@ -69,7 +68,7 @@ struct Core {
     gains: Vec<f64>,
 }
 
-impl Core {
+impl BankState {
     fn new(m: usize, tau: f64, channels: usize) -> Result<Self, Error> {
         check_degree(m)?;
         check_tau(tau)?;
@@ -144,16 +143,7 @@ impl Core {
     }
 
     fn derivatives_scale(&self) -> Vec<f64> {
-        let mut s = Vec::with_capacity(self.m + 1);
-        let (mut f, mut tk) = (1.0, 1.0);
-        for k in 0..=self.m {
-            if k > 0 {
-                f *= k as f64;
-                tk *= self.tau;
-            }
-            s.push(f / tk);
-        }
-        s
+        derivative_scale(self.tau).take(self.m + 1).collect()
     }
 
     fn estimate(&self, channel: usize) -> Option<Vec<f64>> {
@@ -208,16 +198,13 @@ fn kernel(z: &mut [&mut [f64]], y: &[f64], h: &[f64]) {
     while start < len {
         let end = (start + BLOCK).min(len);
         let e = &mut e[..end - start];
-        // Predict Z ← Φ(1) Z: Taylor shift by one step as repeated synthetic division,
-        // z_j += z_{j+1} for i = 0..m, j = m-1 down to i.
-        for i in 0..m {
-            for j in (i..m).rev() {
-                let (lo, hi) = z.split_at_mut(j + 1);
-                for (a, b) in lo[j][start..end].iter_mut().zip(&hi[0][start..end]) {
-                    *a += *b;
-                }
+        // Predict Z ← Φ(1) Z: the Taylor shift by one step, row by row.
+        for_each_shift_step(m + 1, |j| {
+            let (lo, hi) = z.split_at_mut(j + 1);
+            for (a, b) in lo[j][start..end].iter_mut().zip(&hi[0][start..end]) {
+                *a += *b;
             }
-        }
+        });
         // ε = y − z₀.
         for ((e, y), z0) in e.iter_mut().zip(&y[start..end]).zip(&z[0][start..end]) {
             *e = y - z0;
@@ -288,6 +275,27 @@ macro_rules! bank_accessors {
             /// # Ok::<(), seqsmooth::Error>(())
             /// ```
             pub fn update_rows(&mut self, matrix: &[f64]) -> Result<(), Error> {
+                self.rows(matrix, false)
+            }
+
+            /// [`update_rows`](Self::update_rows) with each row as
+            /// [`update_par`](Self::update_par): bit-for-bit equal to the serial form.
+            ///
+            /// ```
+            #[doc = concat!("use seqsmooth::polynomial::bank::", stringify!($ty), ";")]
+            #[doc = concat!("let mut a = ", $new, "?;")]
+            /// let mut b = a.clone();
+            /// let m = [0.0, 10.0, 1.0, 8.0, 2.0, 6.0];
+            /// a.update_rows(&m)?;
+            /// b.update_rows_par(&m)?;
+            /// assert_eq!(a.scaled_row(1), b.scaled_row(1));
+            /// # Ok::<(), seqsmooth::Error>(())
+            /// ```
+            pub fn update_rows_par(&mut self, matrix: &[f64]) -> Result<(), Error> {
+                self.rows(matrix, true)
+            }
+
+            fn rows(&mut self, matrix: &[f64], parallel: bool) -> Result<(), Error> {
                 let k = self.core.channels;
                 if matrix.len() % k != 0 {
                     return Err(Error::InvalidParameter {
@@ -297,7 +305,7 @@ macro_rules! bank_accessors {
                     });
                 }
                 for (index, row) in matrix.chunks_exact(k).enumerate() {
-                    self.update(row).map_err(|e| Error::InBatch {
+                    self.step(row, parallel).map_err(|e| Error::InBatch {
                         index,
                         source: Box::new(e),
                     })?;
@@ -328,7 +336,7 @@ macro_rules! bank_accessors {
 /// ```
 #[derive(Clone, Debug)]
 pub struct FadingBank {
-    core: Core,
+    core: BankState,
     theta: f64,
     switch_at: u64,
     fading: Vec<f64>,
@@ -338,7 +346,7 @@ impl FadingBank {
     /// A bank of `channels` filters of degree `m`, discount `θ ∈ (0,1)` per step `τ > 0`.
     pub fn new(m: usize, theta: f64, tau: f64, channels: usize) -> Result<Self, Error> {
         check_theta(theta)?;
-        let core = Core::new(m, tau, channels)?;
+        let core = BankState::new(m, tau, channels)?;
         Ok(Self {
             core,
             theta,
@@ -369,8 +377,12 @@ impl FadingBank {
     /// assert_eq!(bank.samples(), 1);
     /// ```
     pub fn update(&mut self, y: &[f64]) -> Result<(), Error> {
+        self.step(y, false)
+    }
+
+    fn step(&mut self, y: &[f64], parallel: bool) -> Result<(), Error> {
         self.core
-            .update(y, Some((self.switch_at, &self.fading)), false)
+            .update(y, Some((self.switch_at, &self.fading)), parallel)
     }
 
     /// [`update`](Self::update) with the channels split into blocks of [`PAR_CHUNK`] on the
@@ -386,8 +398,7 @@ impl FadingBank {
     /// assert_eq!(a.scaled_row(0), b.scaled_row(0));
     /// ```
     pub fn update_par(&mut self, y: &[f64]) -> Result<(), Error> {
-        self.core
-            .update(y, Some((self.switch_at, &self.fading)), true)
+        self.step(y, true)
     }
 }
 
@@ -408,14 +419,14 @@ bank_accessors!(FadingBank, "FadingBank::new(1, 0.5, 1.0, 2)");
 /// ```
 #[derive(Clone, Debug)]
 pub struct ExpandingBank {
-    core: Core,
+    core: BankState,
 }
 
 impl ExpandingBank {
     /// A bank of `channels` filters of degree `m`, step `τ > 0`.
     pub fn new(m: usize, tau: f64, channels: usize) -> Result<Self, Error> {
         Ok(Self {
-            core: Core::new(m, tau, channels)?,
+            core: BankState::new(m, tau, channels)?,
         })
     }
 
@@ -429,7 +440,11 @@ impl ExpandingBank {
     /// assert_eq!(bank.estimate(1).unwrap(), vec![4.0]);
     /// ```
     pub fn update(&mut self, y: &[f64]) -> Result<(), Error> {
-        self.core.update(y, None, false)
+        self.step(y, false)
+    }
+
+    fn step(&mut self, y: &[f64], parallel: bool) -> Result<(), Error> {
+        self.core.update(y, None, parallel)
     }
 
     /// The parallel update (see [`FadingBank::update_par`]).
@@ -441,10 +456,55 @@ impl ExpandingBank {
     /// assert_eq!(bank.estimate(0).unwrap(), vec![1.0]);
     /// ```
     pub fn update_par(&mut self, y: &[f64]) -> Result<(), Error> {
-        self.core.update(y, None, true)
+        self.step(y, true)
     }
 }
 
 bank_accessors!(ExpandingBank, "ExpandingBank::new(1, 1.0, 2)");
 
 pub use super::stream::StreamBank;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::polynomial::engine::recursion::predict_correct;
+
+    /// The structure-of-arrays kernel is the reference recursion per channel, bit for bit
+    /// (the same operations in the same order), across block boundaries, degrees 0 … 8.
+    #[test]
+    fn kernel_is_the_reference_per_channel() {
+        let channels = BLOCK + 3;
+        for m in 0..=8usize {
+            let h: Vec<f64> = (0..=m).map(|k| 0.7 / (k as f64 + 1.3)).collect();
+            let mut rows: Vec<Vec<f64>> = (0..=m)
+                .map(|k| {
+                    (0..channels)
+                        .map(|c| ((c * 31 + k * 7) % 17) as f64 * 0.1)
+                        .collect()
+                })
+                .collect();
+            let mut want: Vec<Vec<f64>> = (0..channels)
+                .map(|c| (0..=m).map(|k| rows[k][c]).collect())
+                .collect();
+            for step in 0..5 {
+                let y: Vec<f64> = (0..channels)
+                    .map(|c| (c as f64 * 0.37 + step as f64).sin())
+                    .collect();
+                let mut z: Vec<&mut [f64]> = rows.iter_mut().map(|r| r.as_mut_slice()).collect();
+                kernel(&mut z, &y, &h);
+                for (zc, &yc) in want.iter_mut().zip(&y) {
+                    predict_correct(zc, 1.0, &h, yc);
+                }
+            }
+            for (c, zc) in want.iter().enumerate() {
+                for k in 0..=m {
+                    assert_eq!(
+                        rows[k][c].to_bits(),
+                        zc[k].to_bits(),
+                        "m {m} channel {c} k {k}"
+                    );
+                }
+            }
+        }
+    }
+}

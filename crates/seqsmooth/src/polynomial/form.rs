@@ -7,6 +7,14 @@ use crate::scalar::Scalar;
 use nalgebra::DMatrix;
 
 /// Which recursion the gain vector belongs to.
+///
+/// ```
+/// use seqsmooth::polynomial::gains::{expanding_gains, GainForm};
+/// let h: Vec<f64> = expanding_gains(1, 3, GainForm::Current);
+/// let p: Vec<f64> = expanding_gains(1, 3, GainForm::Predictor);
+/// assert_eq!(h, vec![0.7, 0.3]);                      // Morrison T9-01
+/// assert!((p[0] - 1.0).abs() < 1e-15 && (p[1] - 0.3).abs() < 1e-15); // Φ(1) H
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum GainForm {
     /// `Z*_{n,n} = Z*_{n,n-1} + H ε_n` (current estimate; Tables 9.1, 13.1 gains).
@@ -29,6 +37,13 @@ pub(crate) fn apply_form<T: Scalar>(m: usize, h: Vec<T>, form: GainForm) -> Vec<
 }
 
 /// Which estimate a variance-reduction matrix describes.
+///
+/// ```
+/// use seqsmooth::polynomial::vrf::{expanding_vrf, EstimateForm};
+/// let cur = expanding_vrf::<f64>(0, 3, EstimateForm::Current).unwrap();
+/// let pred = expanding_vrf::<f64>(0, 3, EstimateForm::Predictor).unwrap();
+/// assert!((cur[(0, 0)] - 0.25).abs() < 1e-15 && (pred[(0, 0)] - 0.25).abs() < 1e-15); // the mean of 4
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum EstimateForm {
     /// `Z*_{n,n}`: valid at the newest sample.

@@ -6,9 +6,30 @@ use crate::error::Error;
 
 /// The largest degree the filters accept. The exact engine's accuracy against an independent
 /// batch QR fit is measured in the tests up to this degree.
+///
+/// ```
+/// use seqsmooth::polynomial::MAX_DEGREE;
+/// use seqsmooth::{Engine, Error, ExpandingMemory};
+/// assert!(ExpandingMemory::new(MAX_DEGREE, Engine::Exact).is_ok());
+/// assert!(matches!(ExpandingMemory::new(MAX_DEGREE + 1, Engine::Exact), Err(Error::DegreeOutOfRange { .. })));
+/// ```
 pub const MAX_DEGREE: usize = 24;
 
+// The noise estimators take differences of order up to `m + 1` for every degree the filters take.
+const _: () = assert!(crate::stats::MAX_DIFFERENCE_ORDER == MAX_DEGREE + 1);
+
 /// Which computation a filter uses (see the [module docs](self)).
+///
+/// ```
+/// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
+/// assert_eq!(Engine::default(), Engine::Exact);
+/// // on even samples both engines are exact least squares
+/// for engine in [Engine::Exact, Engine::Gain] {
+///     let mut f = ExpandingMemory::new(1, engine).unwrap();
+///     for n in 0..10 { f.update(n as f64, 2.0 * n as f64).unwrap(); }
+///     assert!((f.estimate().unwrap().derivatives[1] - 2.0).abs() < 1e-12);
+/// }
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Engine {
     /// Recursive least squares, exact on any timestamps.
@@ -19,6 +40,16 @@ pub enum Engine {
 }
 
 /// How a fading-memory filter discounts old samples.
+///
+/// ```
+/// use seqsmooth::{DiscountMode, Engine, FadingMemory, PolynomialFilter};
+/// assert_eq!(DiscountMode::default(), DiscountMode::PerTime);
+/// let mut f = FadingMemory::new(0, 0.5, 1.0, Engine::Exact).unwrap()
+///     .with_discount_mode(DiscountMode::PerUpdate).unwrap();
+/// for (t, y) in [(0.0, 0.0), (10.0, 3.0)] { f.update(t, y).unwrap(); }
+/// // weights 1/2 and 1 whatever the gap: (0·½ + 3·1)/(½ + 1) = 2
+/// assert!((f.estimate().unwrap().derivatives[0] - 2.0).abs() < 1e-12);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DiscountMode {
     /// By `θ` per `τ` of elapsed time: weight `θ^((t_n - t_k)/τ)` (`θ_eff = θ^ζ` per update).
@@ -48,6 +79,19 @@ pub(crate) fn check_tau(tau: f64) -> Result<(), Error> {
 pub(crate) fn check_theta(theta: f64) -> Result<(), Error> {
     if !(theta > 0.0 && theta < 1.0) {
         return Err(Error::ThetaOutOfRange { theta });
+    }
+    Ok(())
+}
+
+/// Settings are fixed once a filter has taken its first sample: an error naming `what` to set
+/// before the first update when `started`.
+pub(crate) fn check_not_started(started: bool, what: &str) -> Result<(), Error> {
+    if started {
+        return Err(Error::InvalidParameter {
+            name: "configuration",
+            value: "change after the first sample".into(),
+            reason: format!("set {what} before the first update"),
+        });
     }
     Ok(())
 }

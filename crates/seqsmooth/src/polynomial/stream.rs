@@ -1,8 +1,8 @@
 //! Independent filters of one configuration, one per channel, each on its own timestamps:
 //! [`StreamBank`] (the multi-series engine: any [`PolynomialFilter`] per channel).
 
-use super::PolynomialFilter;
 use crate::error::Error;
+use crate::polynomial::filter::PolynomialFilter;
 use rayon::prelude::*;
 
 /// Independent filters of one configuration, one per channel, each on its own timestamps (the

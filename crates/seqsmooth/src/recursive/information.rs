@@ -1,28 +1,7 @@
 use crate::linalg::solve_upper_transpose_in_place;
+use crate::numeric::unrolled::unrolled_sizes;
 use nalgebra::{DMatrix, DVector};
 
-/// `$call` with the constant `N` equal to the size `$p` for sizes 1 to 9 (fully unrolled code
-/// for the polynomial filters' common degrees), `$other` (with the size bound to `$q`) above.
-macro_rules! unrolled_sizes {
-    ($p:expr, $n:ident => $call:expr, $q:pat => $other:expr) => {
-        match $p {
-            1 => unrolled_sizes!(@at 1, $n, $call),
-            2 => unrolled_sizes!(@at 2, $n, $call),
-            3 => unrolled_sizes!(@at 3, $n, $call),
-            4 => unrolled_sizes!(@at 4, $n, $call),
-            5 => unrolled_sizes!(@at 5, $n, $call),
-            6 => unrolled_sizes!(@at 6, $n, $call),
-            7 => unrolled_sizes!(@at 7, $n, $call),
-            8 => unrolled_sizes!(@at 8, $n, $call),
-            9 => unrolled_sizes!(@at 9, $n, $call),
-            $q => $other,
-        }
-    };
-    (@at $v:literal, $n:ident, $call:expr) => {{
-        const $n: usize = $v;
-        $call
-    }};
-}
 /// An upper-triangular factor `R` of an accumulated Gram matrix `RᵀR = Σ_k c_k a_k a_kᵀ`, kept
 /// up to date row by row, with a right-hand column `d` (`Rᵀd = Σ_k c_k a_k b_k`).
 ///
@@ -87,7 +66,7 @@ pub struct TriangularFactor {
 /// store. In the reciprocal form of [`TriangularFactor::add_row`] the next row's `1/d_i` is
 /// the first thing it computes, while `d_(i+1)` is updated only after `δ_(i+1) = 1/η_(i+1)`,
 /// which depends on `1/d_i`: stored as one pair, `d_i` would wait for `d_(i+1)` and every row
-/// for two divisions of the previous one (measured: 20% of the throughput at `p = 2`). And a
+/// for two divisions of the previous one (measured: see BENCHMARKS.md). And a
 /// 16-byte load spanning two 8-byte stores cannot be forwarded from the store buffer.
 #[derive(Clone, Copy, Debug)]
 #[repr(align(16))]
@@ -269,17 +248,7 @@ impl TriangularFactor {
         let ubar: &mut [f64] = &mut self.ubar[..N];
         for i in 0..N {
             let xi = x[i];
-            let dx = delta * xi;
-            let di = d[i].0;
-            let dp = di + dx * xi;
-            // A zero pivot (no information yet and a zero entry) leaves everything as it is.
-            let (cbar, sbar) = if dp > 0.0 {
-                (di / dp, dx / dp)
-            } else {
-                (1.0, 0.0)
-            };
-            delta *= cbar;
-            d[i].0 = dp;
+            let (cbar, sbar) = gentleman_pivot(&mut delta, xi, &mut d[i].0);
             for j in i + 1..N {
                 let xj = x[j];
                 let uij = u[i * N + j];
@@ -361,16 +330,7 @@ impl TriangularFactor {
         let mut delta = weight;
         for i in 0..p {
             let xi = x[i];
-            let dx = delta * xi;
-            let di = self.d[i].0;
-            let dp = di + dx * xi;
-            let (cbar, sbar) = if dp > 0.0 {
-                (di / dp, dx / dp)
-            } else {
-                (1.0, 0.0)
-            };
-            delta *= cbar;
-            self.d[i].0 = dp;
+            let (cbar, sbar) = gentleman_pivot(&mut delta, xi, &mut self.d[i].0);
             let row = &mut self.u[i * p + i + 1..(i + 1) * p];
             for (xj, uij) in x[i + 1..p].iter_mut().zip(row.iter_mut()) {
                 let (a, u) = (*xj, *uij);
@@ -673,6 +633,24 @@ impl InformationFilter {
     }
 }
 
+/// One pivot of Gentleman's rotation for the row entry `x` against the pivot `d`:
+/// `d' = d + δx²`, `c̄ = d/d'`, `s̄ = δx/d'`, `δ ← δc̄`; returns `(c̄, s̄)`. A zero pivot (no
+/// information yet and a zero entry) leaves everything as it is.
+#[inline(always)]
+fn gentleman_pivot(delta: &mut f64, x: f64, d: &mut f64) -> (f64, f64) {
+    let dx = *delta * x;
+    let di = *d;
+    let dp = di + dx * x;
+    let (cbar, sbar) = if dp > 0.0 {
+        (di / dp, dx / dp)
+    } else {
+        (1.0, 0.0)
+    };
+    *delta *= cbar;
+    *d = dp;
+    (cbar, sbar)
+}
+
 /// `a` as an array (its length is checked by the caller).
 #[inline(always)]
 fn row_of<const N: usize>(a: &[f64]) -> [f64; N] {
@@ -698,7 +676,7 @@ fn powers<const N: usize>(v: f64) -> [f64; N] {
 /// what [`TriangularFactor::add_row`] has just stored with stores of the compiler's choosing
 /// (some 8, some 16 bytes wide). A load spanning two stores cannot be forwarded from the store
 /// buffer and waits until both have been written to the cache: measured as a stall of the
-/// whole per-sample pipeline (update plus estimate at degree 5 in half the throughput). An
+/// whole per-sample pipeline (see BENCHMARKS.md). An
 /// 8-byte load is always forwarded from the store containing it; hiding the address from the
 /// optimiser (`black_box`) keeps each load on its own.
 #[inline(always)]

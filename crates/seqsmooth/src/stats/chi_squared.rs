@@ -201,6 +201,12 @@ pub struct ChiSquaredTest {
 
 impl ChiSquaredTest {
     /// The test with `dof > 0` degrees of freedom and false-alarm rate `α ∈ (0,1)`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::ChiSquaredTest;
+    /// assert!(ChiSquaredTest::new(3.0, 0.01).is_ok());
+    /// assert!(ChiSquaredTest::new(3.0, 1.5).is_err());
+    /// ```
     pub fn new(dof: f64, alpha: f64) -> Result<Self, Error> {
         check_probability("significance", alpha)?;
         let threshold = chi_squared_quantile(dof, 1.0 - alpha)?;
@@ -212,26 +218,55 @@ impl ChiSquaredTest {
     }
 
     /// Degrees of freedom.
+    ///
+    /// ```
+    /// use seqsmooth::stats::ChiSquaredTest;
+    /// assert_eq!(ChiSquaredTest::new(3.0, 0.01).unwrap().dof(), 3.0);
+    /// ```
     pub fn dof(&self) -> f64 {
         self.dof
     }
 
     /// The significance (false-alarm rate) `α`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::ChiSquaredTest;
+    /// assert_eq!(ChiSquaredTest::new(3.0, 0.01).unwrap().alpha(), 0.01);
+    /// ```
     pub fn alpha(&self) -> f64 {
         self.alpha
     }
 
     /// The `(1-α)` quantile the statistic is compared with.
+    ///
+    /// ```
+    /// use seqsmooth::stats::{chi_squared_quantile, ChiSquaredTest};
+    /// let t = ChiSquaredTest::new(4.0, 0.05).unwrap();
+    /// assert_eq!(t.threshold(), chi_squared_quantile(4.0, 0.95).unwrap());
+    /// ```
     pub fn threshold(&self) -> f64 {
         self.threshold
     }
 
     /// True when `statistic` exceeds the threshold (a NaN statistic is rejected).
+    ///
+    /// ```
+    /// use seqsmooth::stats::ChiSquaredTest;
+    /// let t = ChiSquaredTest::new(1.0, 0.05).unwrap(); // threshold 3.84
+    /// assert!(t.rejects(4.0) && !t.rejects(3.0) && t.rejects(f64::NAN));
+    /// ```
     pub fn rejects(&self, statistic: f64) -> bool {
         statistic.is_nan() || statistic > self.threshold
     }
 
     /// The p-value `P(χ²_dof > statistic)`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::ChiSquaredTest;
+    /// let t = ChiSquaredTest::new(2.0, 0.05).unwrap();
+    /// // χ²₂ is exponential with mean 2: P(χ²₂ > x) = e^(−x/2)
+    /// assert!((t.p_value(2.0).unwrap() - (-1.0f64).exp()).abs() < 1e-12);
+    /// ```
     pub fn p_value(&self, statistic: f64) -> Result<f64, Error> {
         chi_squared_sf(self.dof, statistic)
     }

@@ -13,13 +13,21 @@
 //! (they are the recursive residuals); those of a fading-memory filter are weakly correlated
 //! (each shares the filter's memory), so the window sum has mean `K` but a slightly wider spread
 //! than `χ²_K` and the realised false-alarm rate can exceed `α` somewhat (measured in
-//! `tests/stats.rs`).
+//! `tests/innovation.rs`).
 
 use super::chi_squared::chi_squared_quantile;
+use super::window::SlidingSum;
 use crate::error::Error;
-use std::collections::VecDeque;
 
 /// One step of the windowed innovation test.
+///
+/// ```
+/// use seqsmooth::stats::InnovationChiSquared;
+/// let mut test = InnovationChiSquared::new(3, 0.05).unwrap();
+/// let o = test.push(2.0, 4.0).unwrap(); // k² = 2²/4 = 1
+/// assert_eq!((o.normalised, o.statistic, o.dof), (1.0, 1.0, 1));
+/// assert!(!o.misfit && o.threshold > 3.8);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ChiSquaredOutcome {
     /// The normalised squared innovation `k² = ν²/σ_ε²` just added.
@@ -56,13 +64,19 @@ pub struct InnovationChiSquared {
     alpha: f64,
     /// `thresholds[d-1]` = `(1-α)` quantile of `χ²_d`, `d = 1..=window`.
     thresholds: Vec<f64>,
-    recent: VecDeque<f64>,
-    sum: f64,
-    pushes_since_resum: usize,
+    /// The window sum of `k²`.
+    recent: SlidingSum,
 }
 
 impl InnovationChiSquared {
     /// A test over a window of `window ≥ 1` samples at false-alarm rate `α ∈ (0,1)` per sample.
+    ///
+    /// ```
+    /// use seqsmooth::stats::InnovationChiSquared;
+    /// assert!(InnovationChiSquared::new(10, 0.01).is_ok());
+    /// assert!(InnovationChiSquared::new(0, 0.01).is_err());
+    /// assert!(InnovationChiSquared::new(10, 0.0).is_err());
+    /// ```
     pub fn new(window: usize, alpha: f64) -> Result<Self, Error> {
         if window == 0 {
             return Err(Error::InvalidParameter {
@@ -85,23 +99,38 @@ impl InnovationChiSquared {
             window,
             alpha,
             thresholds,
-            recent: VecDeque::with_capacity(window),
-            sum: 0.0,
-            pushes_since_resum: 0,
+            recent: SlidingSum::new(Some(window)),
         })
     }
 
     /// The window length `K`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::InnovationChiSquared;
+    /// assert_eq!(InnovationChiSquared::new(10, 0.01).unwrap().window(), 10);
+    /// ```
     pub fn window(&self) -> usize {
         self.window
     }
 
     /// The false-alarm rate `α`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::InnovationChiSquared;
+    /// assert_eq!(InnovationChiSquared::new(10, 0.01).unwrap().alpha(), 0.01);
+    /// ```
     pub fn alpha(&self) -> f64 {
         self.alpha
     }
 
     /// Adds the innovation `ν` with its predicted variance `σ_ε² > 0` and tests the window.
+    ///
+    /// ```
+    /// use seqsmooth::stats::InnovationChiSquared;
+    /// let mut test = InnovationChiSquared::new(5, 0.01).unwrap();
+    /// assert_eq!(test.push(3.0, 9.0).unwrap().normalised, 1.0);
+    /// assert!(test.push(1.0, 0.0).is_err()); // the variance must be positive
+    /// ```
     pub fn push(&mut self, innovation: f64, variance: f64) -> Result<ChiSquaredOutcome, Error> {
         if !innovation.is_finite() {
             return Err(Error::NonFinite {
@@ -120,6 +149,15 @@ impl InnovationChiSquared {
     }
 
     /// Adds an already normalised squared innovation `k² = ν²/σ_ε² ≥ 0`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::InnovationChiSquared;
+    /// let mut test = InnovationChiSquared::new(2, 0.01).unwrap();
+    /// test.push_normalised(1.0).unwrap();
+    /// test.push_normalised(2.0).unwrap();
+    /// assert_eq!(test.push_normalised(4.0).unwrap().statistic, 6.0); // the first one left
+    /// assert!(test.push_normalised(-1.0).is_err());
+    /// ```
     pub fn push_normalised(&mut self, k2: f64) -> Result<ChiSquaredOutcome, Error> {
         if !(k2.is_finite() && k2 >= 0.0) {
             return Err(Error::InvalidParameter {
@@ -128,19 +166,7 @@ impl InnovationChiSquared {
                 reason: "must be a non-negative finite number".into(),
             });
         }
-        if self.recent.len() == self.window {
-            let old = self.recent.pop_front().unwrap_or(0.0);
-            self.sum -= old;
-        }
-        self.recent.push_back(k2);
-        self.sum += k2;
-        self.pushes_since_resum += 1;
-        // Re-add from scratch now and then, so the running sum cannot drift.
-        if self.pushes_since_resum >= 4 * self.window {
-            self.sum = self.recent.iter().sum();
-            self.pushes_since_resum = 0;
-        }
-        self.sum = self.sum.max(0.0);
+        self.recent.push(k2);
         Ok(self.outcome(k2))
     }
 
@@ -153,38 +179,76 @@ impl InnovationChiSquared {
         };
         ChiSquaredOutcome {
             normalised: k2,
-            statistic: self.sum,
+            statistic: self.recent.sum(),
             dof,
             threshold,
-            misfit: dof > 0 && self.sum > threshold,
+            misfit: dof > 0 && self.recent.sum() > threshold,
         }
     }
 
     /// The current window sum.
+    ///
+    /// ```
+    /// use seqsmooth::stats::InnovationChiSquared;
+    /// let mut test = InnovationChiSquared::new(4, 0.01).unwrap();
+    /// test.push_normalised(0.5).unwrap();
+    /// test.push_normalised(1.5).unwrap();
+    /// assert_eq!(test.statistic(), 2.0);
+    /// ```
     pub fn statistic(&self) -> f64 {
-        self.sum
+        self.recent.sum()
     }
 
     /// Samples currently in the window.
+    ///
+    /// ```
+    /// use seqsmooth::stats::InnovationChiSquared;
+    /// let mut test = InnovationChiSquared::new(2, 0.01).unwrap();
+    /// for _ in 0..5 { test.push_normalised(1.0).unwrap(); }
+    /// assert_eq!(test.len(), 2);
+    /// ```
     pub fn len(&self) -> usize {
         self.recent.len()
     }
 
     /// True when no sample has been added since creation or the last [`reset`](Self::reset).
+    ///
+    /// ```
+    /// use seqsmooth::stats::InnovationChiSquared;
+    /// let mut test = InnovationChiSquared::new(2, 0.01).unwrap();
+    /// assert!(test.is_empty());
+    /// test.push_normalised(1.0).unwrap();
+    /// assert!(!test.is_empty());
+    /// ```
     pub fn is_empty(&self) -> bool {
         self.recent.is_empty()
     }
 
     /// True when the current window sum exceeds its threshold.
+    ///
+    /// ```
+    /// use seqsmooth::stats::InnovationChiSquared;
+    /// let mut test = InnovationChiSquared::new(3, 0.01).unwrap();
+    /// test.push_normalised(1.0).unwrap();
+    /// assert!(!test.is_misfit());
+    /// test.push_normalised(30.0).unwrap(); // above the 99% point of χ²₂ (9.21)
+    /// assert!(test.is_misfit());
+    /// ```
     pub fn is_misfit(&self) -> bool {
         let dof = self.recent.len();
-        dof > 0 && self.sum > self.thresholds[dof - 1]
+        dof > 0 && self.recent.sum() > self.thresholds[dof - 1]
     }
 
     /// Empties the window (e.g. after the model has been changed).
+    ///
+    /// ```
+    /// use seqsmooth::stats::InnovationChiSquared;
+    /// let mut test = InnovationChiSquared::new(3, 0.01).unwrap();
+    /// test.push_normalised(30.0).unwrap();
+    /// test.reset();
+    /// assert!(test.is_empty() && !test.is_misfit() && test.statistic() == 0.0);
+    /// ```
     pub fn reset(&mut self) {
         self.recent.clear();
-        self.sum = 0.0;
-        self.pushes_since_resum = 0;
     }
 }

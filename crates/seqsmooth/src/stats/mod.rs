@@ -29,6 +29,7 @@ pub mod chi_squared;
 pub mod innovation;
 pub mod noise;
 pub mod welford;
+mod window;
 
 pub use chi_squared::{
     chi_squared_cdf, chi_squared_quantile, chi_squared_sf, normal_quantile, two_sided_tail,
@@ -37,6 +38,6 @@ pub use chi_squared::{
 pub use innovation::{ChiSquaredOutcome, InnovationChiSquared};
 pub use noise::{
     difference_variance, fit_residual_variance, normalised_divided_difference, residual_variance,
-    reyneke_eq39_variance, reyneke_stdd, reyneke_stddw, DifferenceNoise,
+    reyneke_eq39_variance, reyneke_stdd, reyneke_stddw, DifferenceNoise, MAX_DIFFERENCE_ORDER,
 };
 pub use welford::Welford;

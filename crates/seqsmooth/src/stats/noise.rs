@@ -10,8 +10,8 @@
 //! ([`reyneke_stdd`], App. A.5), which subtracts the mean difference, by any curvature. The
 //! `k`-th difference annihilates every polynomial of degree `< k`, and for white noise
 //! `Var(∇^k y) = C(2k,k) σ²` (the weights `(−1)^j C(k,j)` have `Σ C(k,j)² = C(2k,k)`), so
-//! `mean((∇^k y)²)/C(2k,k)` ([`difference_variance`]) is unbiased on a trend of degree `< k`
-//! (others.md §4.7). On irregular timestamps the `k`-th divided difference
+//! `mean((∇^k y)²)/C(2k,k)` ([`difference_variance`]) is unbiased on a trend of degree `< k`.
+//! On irregular timestamps the `k`-th divided difference
 //! `Σ_j w_j y_j`, `w_j = 1/Π_{i≠j}(t_j − t_i)`, annihilates the same polynomials and has
 //! variance `σ² Σ w_j²`, so `d = Σ w_j y_j / √(Σ w_j²)` has variance exactly `σ²`
 //! ([`DifferenceNoise`], running or windowed; on even samples it is `∇^k y/√C(2k,k)`).
@@ -27,24 +27,19 @@
 //! (6.10.24; [`residual_variance`]). Model mismatch inflates it (6.10.25).
 
 use super::welford::Welford;
+use super::window::SlidingSum;
 use crate::calculus::choose;
-use crate::error::Error;
+use crate::error::{check_finite, Error};
 use crate::estimate::PolynomialFit;
 use std::collections::VecDeque;
 
 fn check_values(values: &[f64]) -> Result<(), Error> {
-    if let Some(&v) = values.iter().find(|v| !v.is_finite()) {
-        return Err(Error::NonFinite {
-            what: "value",
-            value: v,
-        });
-    }
-    Ok(())
+    check_finite("value", values)
 }
 
 /// Reyneke's eq. 39 as printed: `R = Σ_{i=2..N} (y_i − y_{i−1})² / (2N − 2)`, the noise variance
 /// from first differences of evenly spaced samples. Unbiased on white noise about a constant;
-/// a slope `s` per sample adds `s²/2` (others.md §4.7: `√R = 1.061` for `σ = 1`, `s = 0.5`).
+/// a slope `s` per sample adds `s²/2` (`√R = √(1 + 1/8) = 1.061` for `σ = 1`, `s = 0.5`).
 /// Needs `N ≥ 2` samples.
 ///
 /// ```
@@ -65,7 +60,8 @@ pub fn reyneke_eq39_variance(values: &[f64]) -> Result<f64, Error> {
 
 /// Reyneke's `stdd` (App. A.5): `σ = std(diff(y))/√2`, with Matlab's `std` (mean removed,
 /// `1/(N−2)` normalisation over the `N−1` differences). Immune to a constant slope, biased by
-/// curvature (others.md §4.7: 1.290 for a `10⁻³ n²` trend, `N = 2000`). Needs `N ≥ 3`.
+/// curvature: a trend `c n²` adds about `(2cN)²/24` to `σ̂²` (the differences `2cn` spread
+/// over `N` samples; `σ̂ = 1.290` for `σ = 1`, `c = 10⁻³`, `N = 2000`). Needs `N ≥ 3`.
 ///
 /// ```
 /// use seqsmooth::stats::reyneke_stdd;
@@ -124,7 +120,8 @@ pub fn reyneke_stddw(values: &[f64], window: usize) -> Result<Vec<f64>, Error> {
 
 /// The bias-free difference estimator of the noise variance on evenly spaced samples:
 /// `σ̂² = mean((∇^k y)²) / C(2k,k)` over the `N − k` differences of order `k ≥ 1`. Unbiased for
-/// white noise on any polynomial trend of degree `< k` (others.md §4.7, \[DERIVED\]). Needs
+/// white noise on any polynomial trend of degree `< k` (the weights `(−1)^j C(k,j)` annihilate
+/// it and have `Σ C(k,j)² = C(2k,k)`). Needs
 /// `N ≥ k + 1`.
 ///
 /// ```
@@ -154,15 +151,22 @@ pub fn difference_variance(values: &[f64], order: usize) -> Result<f64, Error> {
     Ok(d.iter().map(|v| v * v).sum::<f64>() / (d.len() as f64 * c))
 }
 
+/// The largest difference order the estimators accept: enough for a trend of the filters'
+/// largest degree (`MAX_DEGREE + 1`, checked where the filters define it).
+///
+/// ```
+/// use seqsmooth::stats::{DifferenceNoise, MAX_DIFFERENCE_ORDER};
+/// assert!(DifferenceNoise::new(MAX_DIFFERENCE_ORDER, None).is_ok());
+/// assert!(DifferenceNoise::new(MAX_DIFFERENCE_ORDER + 1, None).is_err());
+/// ```
+pub const MAX_DIFFERENCE_ORDER: usize = 25;
+
 fn check_order(order: usize) -> Result<(), Error> {
-    if order == 0 || order > crate::polynomial::MAX_DEGREE + 1 {
+    if order == 0 || order > MAX_DIFFERENCE_ORDER {
         return Err(Error::InvalidParameter {
             name: "difference order",
             value: order.to_string(),
-            reason: format!(
-                "must be between 1 and {}",
-                crate::polynomial::MAX_DEGREE + 1
-            ),
+            reason: format!("must be between 1 and {MAX_DIFFERENCE_ORDER}"),
         });
     }
     Ok(())
@@ -237,14 +241,7 @@ pub fn normalised_divided_difference(times: &[f64], values: &[f64]) -> Result<f6
             reason: "need the same number (at least 2) of times and values".into(),
         });
     }
-    for &t in times {
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
-    }
+    check_finite("time", times)?;
     check_values(values)?;
     for w in times.windows(2) {
         if w[1] <= w[0] {
@@ -310,19 +307,23 @@ fn divided_difference_with_factors(times: &[f64], values: &[f64], factors: &[f64
 #[derive(Clone, Debug)]
 pub struct DifferenceNoise {
     order: usize,
-    window: Option<usize>,
     times: VecDeque<f64>,
     values: VecDeque<f64>,
     factors: VecDeque<f64>,
-    squares: VecDeque<f64>,
-    sum: f64,
-    count: u64,
-    pushes_since_resum: usize,
+    /// The sum of the normalised squared differences `d²`.
+    squares: SlidingSum,
 }
 
 impl DifferenceNoise {
     /// An estimator from differences of order `k ≥ 1` (use `k = m + 1` for a degree-`m` trend),
     /// over the last `window ≥ 1` differences, or all of them with `None`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::DifferenceNoise;
+    /// assert!(DifferenceNoise::new(3, Some(100)).is_ok());
+    /// assert!(DifferenceNoise::new(0, None).is_err());
+    /// assert!(DifferenceNoise::new(2, Some(0)).is_err());
+    /// ```
     pub fn new(order: usize, window: Option<usize>) -> Result<Self, Error> {
         check_order(order)?;
         if window == Some(0) {
@@ -334,24 +335,34 @@ impl DifferenceNoise {
         }
         Ok(Self {
             order,
-            window,
             times: VecDeque::with_capacity(order + 1),
             values: VecDeque::with_capacity(order + 1),
             factors: VecDeque::with_capacity(order + 1),
-            squares: VecDeque::new(),
-            sum: 0.0,
-            count: 0,
-            pushes_since_resum: 0,
+            squares: SlidingSum::new(window),
         })
     }
 
     /// The difference order `k`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::DifferenceNoise;
+    /// assert_eq!(DifferenceNoise::new(3, None).unwrap().order(), 3);
+    /// ```
     pub fn order(&self) -> usize {
         self.order
     }
 
     /// Adds a sample (finite, strictly after the previous time); returns the new normalised
     /// difference once `k+1` samples are in. On error the estimator is unchanged.
+    ///
+    /// ```
+    /// use seqsmooth::stats::DifferenceNoise;
+    /// let mut est = DifferenceNoise::new(1, None).unwrap();
+    /// assert_eq!(est.push(0.0, 1.0).unwrap(), None);          // k + 1 = 2 samples needed
+    /// let d = est.push(2.0, 3.0).unwrap().unwrap();            // (3 − 1)/2, normalised by √(2/4)
+    /// assert!((d - 2f64.sqrt()).abs() < 1e-15);
+    /// assert!(est.push(1.0, 0.0).is_err());                    // time not increasing
+    /// ```
     pub fn push(&mut self, t: f64, y: f64) -> Result<Option<f64>, Error> {
         self.push_with_variance_factor(t, y, 1.0)
     }
@@ -399,47 +410,57 @@ impl DifferenceNoise {
         let fs: Vec<f64> = self.factors.iter().copied().collect();
         let (d, expected) = divided_difference_with_factors(&ts, &ys, &fs);
         let d2 = d * d / expected;
-        self.count += 1;
-        match self.window {
-            None => self.sum += d2,
-            Some(w) => {
-                if self.squares.len() == w {
-                    let old = self.squares.pop_front().unwrap_or(0.0);
-                    self.sum -= old;
-                }
-                self.squares.push_back(d2);
-                self.sum += d2;
-                self.pushes_since_resum += 1;
-                if self.pushes_since_resum >= 4 * w {
-                    self.sum = self.squares.iter().sum();
-                    self.pushes_since_resum = 0;
-                }
-                self.sum = self.sum.max(0.0);
-            }
-        }
+        self.squares.push(d2);
         Ok(Some(d))
     }
 
     /// Differences currently in the estimate.
+    ///
+    /// ```
+    /// use seqsmooth::stats::DifferenceNoise;
+    /// let mut est = DifferenceNoise::new(1, Some(2)).unwrap();
+    /// for n in 0..5 { est.push(n as f64, 0.0).unwrap(); }
+    /// assert_eq!(est.len(), 2); // 4 differences, the window keeps 2
+    /// ```
     pub fn len(&self) -> usize {
-        match self.window {
-            None => self.count as usize,
-            Some(_) => self.squares.len(),
-        }
+        self.squares.len()
     }
 
     /// True before the first difference.
+    ///
+    /// ```
+    /// use seqsmooth::stats::DifferenceNoise;
+    /// let mut est = DifferenceNoise::new(1, None).unwrap();
+    /// est.push(0.0, 1.0).unwrap();
+    /// assert!(est.is_empty());
+    /// est.push(1.0, 1.0).unwrap();
+    /// assert!(!est.is_empty());
+    /// ```
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
 
     /// The variance estimate `mean(d²)`, once one difference is in.
+    ///
+    /// ```
+    /// use seqsmooth::stats::DifferenceNoise;
+    /// let mut est = DifferenceNoise::new(1, None).unwrap();
+    /// for (n, y) in [1.0, -1.0, 1.0].iter().enumerate() { est.push(n as f64, *y).unwrap(); }
+    /// assert!((est.variance().unwrap() - 2.0).abs() < 1e-15); // (±2)²/2
+    /// ```
     pub fn variance(&self) -> Option<f64> {
         let n = self.len();
-        (n > 0).then(|| self.sum / n as f64)
+        (n > 0).then(|| self.squares.sum() / n as f64)
     }
 
     /// `√variance`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::DifferenceNoise;
+    /// let mut est = DifferenceNoise::new(1, None).unwrap();
+    /// for (n, y) in [1.0, -1.0, 1.0].iter().enumerate() { est.push(n as f64, *y).unwrap(); }
+    /// assert!((est.sigma().unwrap() - 2f64.sqrt()).abs() < 1e-15);
+    /// ```
     pub fn sigma(&self) -> Option<f64> {
         self.variance().map(f64::sqrt)
     }

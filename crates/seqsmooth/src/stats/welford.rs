@@ -25,11 +25,24 @@ pub struct Welford {
 
 impl Welford {
     /// An empty accumulator.
+    ///
+    /// ```
+    /// use seqsmooth::stats::Welford;
+    /// assert_eq!(Welford::new().count(), 0);
+    /// ```
     pub fn new() -> Self {
         Self::default()
     }
 
     /// Adds a finite value (a non-finite one is refused and leaves the state unchanged).
+    ///
+    /// ```
+    /// use seqsmooth::stats::Welford;
+    /// let mut w = Welford::new();
+    /// w.push(2.0).unwrap();
+    /// assert!(w.push(f64::NAN).is_err());
+    /// assert_eq!(w.count(), 1);
+    /// ```
     pub fn push(&mut self, x: f64) -> Result<(), Error> {
         if !x.is_finite() {
             return Err(Error::NonFinite {
@@ -71,26 +84,64 @@ impl Welford {
     }
 
     /// Number of values.
+    ///
+    /// ```
+    /// use seqsmooth::stats::Welford;
+    /// let mut w = Welford::new();
+    /// for x in [1.0, 2.0, 3.0] { w.push(x).unwrap(); }
+    /// assert_eq!(w.count(), 3);
+    /// ```
     pub fn count(&self) -> u64 {
         self.n
     }
 
     /// The mean, once a value is in.
+    ///
+    /// ```
+    /// use seqsmooth::stats::Welford;
+    /// let mut w = Welford::new();
+    /// assert_eq!(w.mean(), None);
+    /// for x in [1.0, 2.0, 6.0] { w.push(x).unwrap(); }
+    /// assert_eq!(w.mean(), Some(3.0));
+    /// ```
     pub fn mean(&self) -> Option<f64> {
         (self.n > 0).then_some(self.mean)
     }
 
     /// The unbiased sample variance `M_n/(n−1)`, from two values on.
+    ///
+    /// ```
+    /// use seqsmooth::stats::Welford;
+    /// let mut w = Welford::new();
+    /// w.push(1.0).unwrap();
+    /// assert_eq!(w.sample_variance(), None);
+    /// w.push(3.0).unwrap();
+    /// assert_eq!(w.sample_variance(), Some(2.0));
+    /// ```
     pub fn sample_variance(&self) -> Option<f64> {
         (self.n > 1).then(|| self.m2 / (self.n - 1) as f64)
     }
 
     /// The population variance `M_n/n` (the maximum-likelihood value), once a value is in.
+    ///
+    /// ```
+    /// use seqsmooth::stats::Welford;
+    /// let mut w = Welford::new();
+    /// for x in [1.0, 3.0] { w.push(x).unwrap(); }
+    /// assert_eq!(w.population_variance(), Some(1.0));
+    /// ```
     pub fn population_variance(&self) -> Option<f64> {
         (self.n > 0).then(|| self.m2 / self.n as f64)
     }
 
     /// `√sample_variance`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::Welford;
+    /// let mut w = Welford::new();
+    /// for x in [1.0, 3.0] { w.push(x).unwrap(); }
+    /// assert_eq!(w.sample_std_dev(), Some(2f64.sqrt()));
+    /// ```
     pub fn sample_std_dev(&self) -> Option<f64> {
         self.sample_variance().map(f64::sqrt)
     }

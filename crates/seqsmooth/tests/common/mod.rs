@@ -11,6 +11,7 @@ pub mod engine;
 pub mod fixed;
 pub mod monte_carlo;
 pub mod rational;
+pub mod smooth;
 pub mod stats;
 
 use num_traits::{One, Zero};

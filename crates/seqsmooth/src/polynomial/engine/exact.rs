@@ -20,8 +20,9 @@
 //! ([`TriangularFactor`]): no square roots per sample, and once every pivot is positive none
 //! of its `2m+3` divisions per sample waits for another.
 
+use crate::model::{derivative_scale, shift_scaled, shift_scaled_array};
+use crate::numeric::unrolled::unrolled_sizes;
 use crate::polynomial::options::{DiscountMode, MAX_DEGREE};
-use crate::model::{shift_scaled, shift_scaled_array};
 use crate::recursive::{InformationFilter, TriangularFactor};
 use nalgebra::DMatrix;
 
@@ -195,13 +196,8 @@ impl ExactEngine {
     /// `k!/s^k` and `1/s` for the current unit `s`.
     fn set_unscale(&mut self) {
         self.inv_unit = 1.0 / self.unit;
-        let (mut f, mut sk) = (1.0, 1.0);
-        for (k, c) in self.unscale.iter_mut().enumerate() {
-            if k > 0 {
-                f *= k as f64;
-                sk *= self.unit;
-            }
-            *c = f / sk;
+        for (c, d) in self.unscale.iter_mut().zip(derivative_scale(self.unit)) {
+            *c = d;
         }
     }
 
@@ -228,18 +224,7 @@ impl ExactEngine {
     pub fn derivatives_into(&self, t: f64, out: &mut [f64]) -> bool {
         let h = (t - self.centre) * self.inv_unit;
         // Fixed sizes unroll completely (solve, shift and scaling in one piece).
-        match self.m {
-            0 => self.derivatives_n::<1>(h, out),
-            1 => self.derivatives_n::<2>(h, out),
-            2 => self.derivatives_n::<3>(h, out),
-            3 => self.derivatives_n::<4>(h, out),
-            4 => self.derivatives_n::<5>(h, out),
-            5 => self.derivatives_n::<6>(h, out),
-            6 => self.derivatives_n::<7>(h, out),
-            7 => self.derivatives_n::<8>(h, out),
-            8 => self.derivatives_n::<9>(h, out),
-            _ => self.derivatives_any(h, out),
-        }
+        unrolled_sizes!(self.m + 1, N => self.derivatives_n::<N>(h, out), _ => self.derivatives_any(h, out))
     }
 
     #[inline(always)]

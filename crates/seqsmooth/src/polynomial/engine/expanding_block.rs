@@ -41,8 +41,7 @@
 //!   only while `(m+1)·L ≤ n`.
 //! - **Output:** `z_k = f_k (2/M)^k` with `f_k = Σ_i c_i Q_i^(k)(s_newest)/k!` (`M = N+L`).
 //!
-//! Cost: `m+1` multiply-adds per sample, `O(m²)` per block, `O(m³)` per call (about 10 ns at
-//! `m = 0` to 140 ns at `m = 4` for a one-sample run).
+//! Cost: `m+1` multiply-adds per sample, `O(m²)` per block, `O(m³)` per call.
 //!
 //! ## Kernel
 //!
@@ -52,60 +51,29 @@
 //! registers with the mirrored second half, `y_i ± y_{B−1−i}` feed the even/odd moments (the
 //! block sum is a separate forward pass first, which also keeps the hardware prefetcher on a
 //! forward stream when the data come from DRAM). For `m ≤ 1`, one pass per moment over the
-//! L1-resident block is faster. Throughput, 10⁶ samples (8 MB, L3-resident), best of 40, this
-//! 2-core AMD EPYC (Zen 4) VM, baseline x86-64 build; in brackets 10⁷ samples (80 MB, DRAM):
-//!
-//! | m | samples/s |
-//! |---:|---:|
-//! | 0 | 1.0e10 (3.3e9) |
-//! | 1 | 3.8e9 (3.3e9) |
-//! | 2 | 2.3e9 (2.2e9) |
-//! | 3 | 1.9e9 (1.9e9) |
-//! | 4 | 1.5e9 (1.5e9) |
-//! | 5 | 1.3e9 |
-//! | 6 | 8.5e8 |
-//! | 7 | 1.0e9 |
-//! | 8 | 6.4e8 |
+//! L1-resident block is faster. The kernel and lane count per degree are the fastest measured
+//! ([`block_moments`]; throughput: see BENCHMARKS.md).
 //!
 //! ## Accuracy
 //!
-//! Measured by this module's tests. "Error" is the scaled error `|Δz_k|·S^k / max_j |z_j|·S^j`
-//! with `S` the span `N+L−1` of the data (the error of the Taylor coefficients about the newest
-//! sample, each in units of the whole span), worst over `k`, the data and the splits into old
-//! and new samples. Oracles: exact rational least squares from the same (rounded) old state
-//! for `N ≤ 300`; Householder QR in a Legendre basis (tall-skinny, tree-merged) for long runs
-//! with `n ∈ {m+1, N/3, N−1000, N−7, N−1}` old samples; the gain recursion
-//! `z ← Φ(1) z; z_k += h_k(n)(y − z₀)` run exactly (`N = 200`) and in double-word arithmetic
-//! (`N = 10⁵`); and polynomial data (where the answer is `Φ(L) z` exactly) after up to `10¹²`
-//! old samples.
-//!
-//! | m | exact, N ≤ 300 | QR, N = 10⁶ | QR, N = 10⁷ | recursion, exact / double-word | polynomial data |
-//! |---:|---:|---:|---:|---:|---:|
-//! | 0 | 2.0e-16 | 6.4e-16 | 6.6e-16 | 1.4e-16 / 0 | 0 |
-//! | 1 | 3.9e-16 | 5.3e-16 | 7.0e-16 | 0 / 1.9e-16 | 5.0e-16 |
-//! | 2 | 2.4e-15 | 1.7e-15 | 1.6e-15 | 1.0e-15 / 8.4e-16 | 1.4e-15 |
-//! | 3 | 9.3e-15 | 1.1e-14 | 4.6e-15 | 6.8e-15 / 2.5e-15 | 8.4e-15 |
-//! | 4 | 3.4e-14 | 7.2e-15 | 2.8e-15 | 6.9e-15 / 5.5e-15 | 3.3e-14 |
-//! | 5 | 4.2e-14 | 1.3e-14 | 1.7e-15 | | 1.3e-13 |
-//! | 6 | 9.7e-14 | 9.0e-15 | 4.9e-15 | | 1.9e-12 |
-//! | 7 | 9.5e-14 | 7.8e-15 | 9.7e-15 | | 2.7e-12 |
-//! | 8 | 8.1e-13 | 9.2e-15 | 3.6e-15 | | 2.0e-11 |
-//!
-//! Splitting a 10⁵-sample run into ~130 calls of 1 … 1500 samples changes the result by at
-//! most 1.8e-14 (m = 4). The limit is the conditioning of the state itself: Taylor
-//! coefficients about the end of the data are an ill-conditioned representation of the fit
-//! (`(1+√2)^(2m)`), felt on the shortest grids (`N = m+2`) and, in the direct form, when a run
-//! of a few hundred samples follows `~10³` old ones at high degree (the 2e-11 at m = 8). The
-//! QR N = 10⁷ column is from an ignored test (`--ignored`, ~20 s).
+//! Measured by this module's tests against exact rational least squares (`N ≤ 300`),
+//! Householder QR in a Legendre basis (long runs), the gain recursion run exactly and in
+//! double-word arithmetic, and polynomial data (where the answer is `Φ(L) z` exactly); the
+//! measured errors are in ACCURACY.md. The limit is the conditioning of the state itself:
+//! Taylor coefficients about the end of the data are an ill-conditioned representation of the
+//! fit (`(1+√2)^(2m)`), felt on the shortest grids (`N = m+2`) and, in the direct form, when a
+//! run of a few hundred samples follows `~10³` old ones at high degree.
 
 // The small matrix recurrences below index several arrays by the same subscripts.
 #![allow(clippy::needless_range_loop)]
 
-use crate::model::two_sum;
+use crate::model::shift_scaled_array;
+use crate::numeric::double_word::two_sum;
+use crate::numeric::unrolled::{unrolled_sizes, UNROLLED_MAX_SIZE};
 use std::sync::OnceLock;
 
 /// The largest degree [`advance_even_fit`] accepts.
-pub(crate) const MAX_BLOCK_DEGREE: usize = 8;
+pub(crate) const MAX_BLOCK_DEGREE: usize = UNROLLED_MAX_SIZE - 1;
 
 /// `log2` of the block length `B`.
 const BLOCK_LOG2: usize = 9;
@@ -146,6 +114,29 @@ fn taylor_of_q<const K: usize>(b: &[f64; K], x: f64) -> [[f64; K]; K] {
         }
     }
     t
+}
+
+/// The coefficients `c` in the monic basis `Q_j` of a grid of `count` points (`v` has step
+/// `2/count`) of the polynomial with Taylor coefficients `z_k` in sample steps about the grid
+/// point whose Taylor table ([`taylor_of_q`]) is `r`: with `ζ_k = z_k (count/2)^k`,
+/// `Σ_k ζ_k t^k = Σ_j c_j Q_j(v + t)`, solved by back substitution (`T[j][j] = 1`).
+#[inline(always)]
+fn taylor_to_basis<const K: usize>(z: &[f64], count: f64, r: &[[f64; K]; K]) -> [f64; K] {
+    let mut zeta = [0.0; K];
+    let mut scale = 1.0;
+    for k in 0..K {
+        zeta[k] = z[k] * scale;
+        scale *= 0.5 * count;
+    }
+    let mut c = [0.0; K];
+    for k in (0..K).rev() {
+        let mut v = zeta[k];
+        for j in k + 1..K {
+            v -= c[j] * r[j][k];
+        }
+        c[k] = v;
+    }
+    c
 }
 
 /// `E[i][j]` with `Q^outer_i(δ + α v) = Σ_j E[i][j] Q^inner_j(v)`: the outer basis restricted to
@@ -355,8 +346,7 @@ fn moments_by_pass<const K: usize, const LANES: usize>(y: &[f64], w: &[&[f64]; K
 /// `m = 0` is the running mean `z₀ ← (n z₀ + Σy)/(n+L)` (for short runs in the form
 /// `z₀ + (Σy − L z₀)/(n+L)`), `Σy` a blocked, lane-parallel sum compensated across blocks.
 ///
-/// Accuracy and speed: see the [module docs](self) (m ≤ 4: ≤ 3.4e-14 of the fit's scale;
-/// 1.5e9 samples/s at m = 4, 1e10 at m = 0).
+/// Accuracy and speed: see the [module docs](self).
 pub(crate) fn advance_even_fit(m: usize, n: u64, z: &mut [f64], ys: &[f64]) {
     advance_even_fit_in(m, n, z, ys, Form::choose(m, n, ys.len()));
 }
@@ -367,8 +357,7 @@ enum Form {
     /// Refit from the old fit's moments and the run's: `z ← fit(p_old on old, y on new)`.
     /// Accurate while the run carries a fair share of the samples; when it does not, the
     /// conversions of the old state to and from the orthogonal basis cost up to
-    /// `(1+√2)^(2m)`-fold rounding (measured: 2e-13 at m = 4, 4e-10 at m = 8, run of 700 after
-    /// 10¹² samples).
+    /// `(1+√2)^(2m)`-fold rounding (measured: see ACCURACY.md).
     Direct,
     /// Correct the extrapolated old fit: `z ← Φ(L) z + fit(0 on old, y − p_old on new)`. The
     /// correction is small and carries the conversions' rounding only in proportion `L/(n+L)`;
@@ -401,28 +390,27 @@ fn advance_even_fit_in(m: usize, n: u64, z: &mut [f64], ys: &[f64], form: Form) 
     if ys.is_empty() {
         return;
     }
-    // Kernel and lane count per degree: the fastest measured (see the module docs).
-    match m {
-        0 => advance::<1, 16, false>(n, z, ys, form),
-        1 => advance::<2, 8, false>(n, z, ys, form),
-        2 => advance::<3, 4, true>(n, z, ys, form),
-        3 => advance::<4, 4, true>(n, z, ys, form),
-        4 => advance::<5, 2, true>(n, z, ys, form),
-        5 => advance::<6, 2, true>(n, z, ys, form),
-        6 => advance::<7, 8, false>(n, z, ys, form),
-        7 => advance::<8, 2, true>(n, z, ys, form),
-        _ => advance::<9, 8, false>(n, z, ys, form),
+    unrolled_sizes!(m + 1, K => advance::<K>(n, z, ys, form), _ => unreachable!("degree checked"))
+}
+
+/// The block moments of `y` for `K = m+1` components: the kernel ([`moments_symmetric`] or
+/// [`moments_by_pass`]) and lane count per size, the fastest measured (see the module docs).
+#[inline(always)]
+fn block_moments<const K: usize>(y: &[f64], w: &[&[f64]; K]) -> [f64; K] {
+    let pairs = y.len() >= 2;
+    match K {
+        1 => moments_by_pass::<K, 16>(y, w),
+        2 => moments_by_pass::<K, 8>(y, w),
+        3 | 4 if pairs => moments_symmetric::<K, 4>(y, w),
+        3 | 4 => moments_by_pass::<K, 4>(y, w),
+        5 | 6 | 8 if pairs => moments_symmetric::<K, 2>(y, w),
+        5 | 6 | 8 => moments_by_pass::<K, 2>(y, w),
+        _ => moments_by_pass::<K, 8>(y, w),
     }
 }
 
-/// [`advance_even_fit`] for `K = m+1` state components, `LANES` accumulators per moment, and
-/// the block kernel [`moments_symmetric`] (`SYM`) or [`moments_by_pass`].
-fn advance<const K: usize, const LANES: usize, const SYM: bool>(
-    n: u64,
-    z: &mut [f64],
-    ys: &[f64],
-    form: Form,
-) {
+/// [`advance_even_fit`] for `K = m+1` state components.
+fn advance<const K: usize>(n: u64, z: &mut [f64], ys: &[f64], form: Form) {
     let nf = n as f64;
     let lf = ys.len() as f64;
     let mf = (n + ys.len() as u64) as f64;
@@ -446,20 +434,7 @@ fn advance<const K: usize, const LANES: usize, const SYM: bool>(
         // its moments are μ_j = c_j ‖Q_j‖².
         let bo = betas::<K>(nf);
         let r = taylor_of_q(&bo, (nf - 1.0) / nf);
-        let mut zeta = [0.0; K];
-        let mut scale = 1.0;
-        for k in 0..K {
-            zeta[k] = z[k] * scale;
-            scale *= 0.5 * nf;
-        }
-        let mut c = [0.0; K];
-        for k in (0..K).rev() {
-            let mut v = zeta[k];
-            for j in k + 1..K {
-                v -= c[j] * r[j][k];
-            }
-            c[k] = v;
-        }
+        let c = taylor_to_basis(z, nf, &r);
         let mut mu = [0.0; K];
         let mut norm = nf;
         for j in 0..K {
@@ -476,11 +451,7 @@ fn advance<const K: usize, const LANES: usize, const SYM: bool>(
     let segment = |y: &[f64], p: usize, u0: f64, acc: &mut Moments<K>| {
         let count = (1usize << p) as f64;
         let w: [&[f64]; K] = std::array::from_fn(|j| &tabs.weights[p][j][..]);
-        let mut mu = if SYM && y.len() >= 2 {
-            moments_symmetric::<K, LANES>(y, &w)
-        } else {
-            moments_by_pass::<K, LANES>(y, &w)
-        };
+        let mut mu = block_moments::<K>(y, &w);
         for (j, m) in mu.iter_mut().enumerate() {
             if j >= 1usize << p {
                 *m = 0.0; // Q_j vanishes on a grid of fewer than j+1 points
@@ -521,26 +492,10 @@ fn advance<const K: usize, const LANES: usize, const SYM: bool>(
         }
         Form::Residual => {
             // z ← Φ(L) z (Taylor shift by L steps) …
-            for i in 0..K {
-                for k in (i..K - 1).rev() {
-                    z[k] += lf * z[k + 1];
-                }
-            }
+            let z: &mut [f64; K] = z.try_into().expect("state length checked");
+            shift_scaled_array(z, lf);
             // … which is Σ_i a_i Q_i(s_newest + t) with t in units of M/2 steps …
-            let mut zeta = [0.0; K];
-            let mut scale = 1.0;
-            for k in 0..K {
-                zeta[k] = z[k] * scale;
-                scale *= 0.5 * mf;
-            }
-            let mut a = [0.0; K];
-            for k in (0..K).rev() {
-                let mut v = zeta[k];
-                for i in k + 1..K {
-                    v -= a[i] * t[i][k];
-                }
-                a[k] = v;
-            }
+            let a = taylor_to_basis(&z[..], mf, &t);
             // … and whose moments over the run are Σ_j G_ij a_j with the run's Gram matrix
             // G_ij = Σ_run Q_i Q_j = Σ_l E_il E_jl ‖Q^run_l‖² (E: union → run basis).
             let br = betas::<K>(lf);
@@ -581,30 +536,17 @@ fn advance<const K: usize, const LANES: usize, const SYM: bool>(
 mod tests {
     //! Oracles: exact rational least squares (small runs), blocked Householder QR in a Legendre
     //! basis (long runs), and the gain recursion itself, exact or in double-word arithmetic.
+    use super::super::testing::scaled_errors;
     use super::*;
     use crate::linalg::inverse_exact;
-    use crate::model::{shift_scaled_compensated, two_sum};
+    use crate::model::{for_each_shift_step, shift_scaled_compensated};
+    use crate::numeric::double_word::{two_prod, two_sum};
     use crate::polynomial::gains::{expanding_gains, ExpandingGainSchedule, GainForm};
     use crate::scalar::{rational_from_f64, Rational, Scalar};
     use nalgebra::DMatrix;
     use num_traits::Zero;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
-
-    /// Errors of `z` against `want`, per degree, in units of the span `S`:
-    /// `|Δz_k| S^k / max_j |want_j| S^j`.
-    fn scaled_errors(z: &[f64], want: &[f64], span: f64) -> Vec<f64> {
-        let scale = want
-            .iter()
-            .enumerate()
-            .map(|(j, w)| w.abs() * span.powi(j as i32))
-            .fold(f64::MIN_POSITIVE, f64::max);
-        z.iter()
-            .zip(want)
-            .enumerate()
-            .map(|(k, (a, b))| (a - b).abs() * span.powi(k as i32) / scale)
-            .collect()
-    }
 
     fn max_err(e: &[f64]) -> f64 {
         e.iter().copied().fold(0.0, f64::max)
@@ -873,12 +815,10 @@ mod tests {
         let k = m + 1;
         let mut zr: Vec<Rational> = z.iter().map(|&v| rat(v)).collect();
         for (i, &y) in ys.iter().enumerate() {
-            for a in 0..k {
-                for b in (a..k - 1).rev() {
-                    let t = zr[b + 1].clone();
-                    zr[b] += t;
-                }
-            }
+            for_each_shift_step(k, |b| {
+                let t = zr[b + 1].clone();
+                zr[b] += t;
+            });
             let e = rat(y) - &zr[0];
             let h = expanding_gains::<Rational>(m, (n0 + i) as u64, GainForm::Current);
             for (zk, hk) in zr.iter_mut().zip(&h) {
@@ -901,8 +841,8 @@ mod tests {
             let (e, ee) = two_sum(e, ee - lo[0]);
             sched.gains((n0 + i) as u64, &mut h);
             for j in 0..k {
-                let p = h[j] * e;
-                let pe = h[j].mul_add(e, -p) + h[j] * ee;
+                let (p, pe) = two_prod(h[j], e);
+                let pe = pe + h[j] * ee;
                 let (s, se) = two_sum(hi[j], p);
                 let (s, t) = two_sum(s, lo[j] + se + pe);
                 hi[j] = s;

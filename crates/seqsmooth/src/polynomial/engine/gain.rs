@@ -1,24 +1,28 @@
 //! The fixed-gain recursion of Morrison's Tables 9.1 and 13.1 in the variable-step form of
 //! Reyneke et al. §6, with the step scaling that makes it exact on evenly spaced samples for any
-//! step (../shared/spec/others.md §4.8).
+//! step: gains `h_k/ζ̄^k` and `θ_eff = θ^ζ̄` for the typical step `ζ̄` (Reyneke et al. §6.4).
 //!
-//! Numerics (measured, see tests/engines.rs): the state — Taylor coefficients about the newest
-//! sample — is an ill-conditioned representation, and the start-up gains `h_k(n)`, `n ≤ m`, are
-//! large. Run in plain `f64` from a zero state, the recursion loses up to 1e-7 relative at
-//! degree 8, almost all of it from rounding the start-up gains. So the engine (1) starts from
+//! Numerics: the state — Taylor coefficients about the newest sample — is an ill-conditioned
+//! representation, and the start-up gains `h_k(n)`, `n ≤ m`, are large; run in plain `f64`
+//! from a zero state, the recursion loses accuracy at high degree, almost all of it from
+//! rounding the start-up gains (measured accuracy: see ACCURACY.md). So the engine (1) starts from
 //! the polynomial interpolating the first `m+1` samples, computed in exact rational arithmetic
 //! — the state the recursion reaches from *any* initial state at `n = m` on even spacing
 //! (Morrison §9.6), and the exact least-squares state on any spacing — and (2) carries the
 //! state in compensated (double-word) arithmetic.
 
+use super::recursion::predict_correct;
+use crate::calculus::Polynomial;
+use crate::model::{derivative_scale, factorial_powers, shift_scaled, shift_scaled_compensated};
+use crate::numeric::double_word::{self as dw, two_prod, two_sum, DoubleWord};
+use crate::numeric::steps::{same_step, snaps_to, StepCheck};
+use crate::numeric::unrolled::{unrolled_sizes, UNROLLED_MAX_SIZE};
 use crate::polynomial::expanding::gains::ExpandingGainSchedule;
 use crate::polynomial::fading::gains::fading_gains;
-use crate::polynomial::form::{EstimateForm, GainForm};
-use crate::polynomial::fading::switch::{memory_length_constant, SwitchRule};
+use crate::polynomial::fading::switch::SwitchRule;
 use crate::polynomial::fading::vrf::fading_vrf;
+use crate::polynomial::form::{EstimateForm, GainForm};
 use crate::polynomial::options::{DiscountMode, MAX_DEGREE};
-use crate::calculus::Polynomial;
-use crate::model::{shift_scaled_compensated, two_sum};
 use crate::scalar::{rational_from_f64, Rational, Scalar};
 use nalgebra::{DMatrix, DVector};
 
@@ -30,6 +34,27 @@ fn write_row(row: Option<&mut [f64]>, z: &[f64], c: &[f64]) {
             *x = z * c;
         }
     }
+}
+
+/// The gains for the typical step `ζ̄` from those for the unit step: `g_k ← g_k/ζ̄^k`
+/// (Reyneke et al. §6.4), the powers as running products.
+#[inline(always)]
+fn scale_gains_for_step(g: &mut [f64], step: f64) {
+    if step != 1.0 {
+        let mut zk = 1.0;
+        for gk in g.iter_mut().skip(1) {
+            zk *= step;
+            *gk /= zk;
+        }
+    }
+}
+
+/// A plain kernel's result: the state after `done` samples, the newest at `t_last`.
+#[derive(Clone, Copy)]
+struct PlainRun<const N: usize> {
+    z: [f64; N],
+    t_last: f64,
+    done: usize,
 }
 
 /// Binomial coefficients `C(j, k)` for `j, k < N`.
@@ -44,22 +69,14 @@ fn binomials<const N: usize>() -> [[f64; N]; N] {
     c
 }
 
-/// How far a step `ζ` (in units of `τ`, ending at time `t`) may differ from the typical step
-/// `ζ̄` and still count as the same step: `1e-12·ζ̄` plus a few rounding units of the timestamp
-/// (`t = k·Δ` computed in `f64` has steps that differ by `ulp(t)`).
-#[inline]
-fn step_tolerance(step: f64, t: f64, tau: f64) -> f64 {
-    1e-12 * step + 8.0 * f64::EPSILON * t.abs() / tau
-}
-
 /// The largest degree whose expanding-memory recursion [`GainEngine::update_many`] runs in
-/// plain `f64`: the expanding recursion accumulates rounding (measured against the compensated
-/// path over 6·10⁴ samples: ≤ 1.1e-13 relative up to degree 4, 4e-11 at 7, 9e-9 at 8).
+/// plain `f64`: above it the expanding recursion accumulates too much rounding against the
+/// compensated path (measured: see ACCURACY.md).
 pub(crate) const PLAIN_EXPANDING_MAX_DEGREE: usize = 4;
 
 /// The largest degree whose steady fading recursion [`GainEngine::update_many`] runs in plain
-/// `f64` (see the measurements in [`GainEngine::steady_run`]).
-pub(crate) const PLAIN_KERNEL_MAX_DEGREE: usize = 8;
+/// `f64`: every size with unrolled code ([`crate::numeric::unrolled`]).
+pub(crate) const PLAIN_KERNEL_MAX_DEGREE: usize = UNROLLED_MAX_SIZE - 1;
 
 /// Samples per block of [`GainEngine::steady_block_run`] (a power of two: the block map's
 /// power is formed by squaring).
@@ -82,9 +99,8 @@ const EXPANDING_BLOCK_MAX_DEGREE: usize = 4;
 
 /// The largest degree whose steady fading recursion `update_many` runs as block maps. Above
 /// it the block map's rounding (weights of mixed sign, `Ā` far from normal) approaches the
-/// tests' bound: against the compensated per-sample path over 6·10⁴ samples, 8.0e-12 against
-/// the recursion's 4.9e-12 at degree 8, θ = 0.99; 8.1e-13 against 6.9e-13 at degree 5
-/// (tests/batch.rs).
+/// tests' bound against the compensated per-sample path (tests/batch.rs; measured: see
+/// ACCURACY.md).
 const STEADY_BLOCK_MAX_DEGREE: usize = 5;
 
 /// The steady fading recursion `Z ← Ā Z + G y`, `Ā = (I − G e₀ᵀ) Φ(ζ̄)`, over
@@ -105,79 +121,20 @@ struct SteadyBlock {
     weights_d: Vec<f64>,
 }
 
-/// A double word `hi + lo` (|lo| ≤ ulp(hi)/2).
-type DoubleWord = (f64, f64);
-
-/// `a·b = p + e` exactly (Dekker's product with Veltkamp's splitting: no FMA needed, which the
-/// baseline x86-64 target would emulate in software).
-fn two_prod(a: f64, b: f64) -> (f64, f64) {
-    const SPLIT: f64 = 134_217_729.0; // 2^27 + 1
-    let split = |x: f64| {
-        let c = SPLIT * x;
-        let hi = c - (c - x);
-        (hi, x - hi)
-    };
-    let p = a * b;
-    let ((ah, al), (bh, bl)) = (split(a), split(b));
-    (p, ((ah * bh - p) + ah * bl + al * bh) + al * bl)
-}
-
-/// `Σ aᵢ bᵢ` in double-word arithmetic (exact products, TwoSum accumulation).
-fn dot_double_word(a: &[DoubleWord], b: &[DoubleWord]) -> DoubleWord {
-    let (mut hi, mut lo) = (0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        let (p, e) = two_prod(x.0, y.0);
-        let pe = e + (x.0 * y.1 + x.1 * y.0);
-        let (s, se) = two_sum(hi, p);
-        let (s, l) = two_sum(s, se + lo + pe);
-        hi = s;
-        lo = l;
-    }
-    (hi, lo)
-}
-
-/// Double-word `n × n` matrices (row-major) and their products.
-fn mat_mul_double_word(a: &[DoubleWord], b: &[DoubleWord], n: usize) -> Vec<DoubleWord> {
-    let mut col = vec![(0.0, 0.0); n];
-    let mut c = vec![(0.0, 0.0); n * n];
-    for j in 0..n {
-        for (k, ck) in col.iter_mut().enumerate() {
-            *ck = b[k * n + j];
-        }
-        for (i, row) in a.chunks_exact(n).enumerate() {
-            c[i * n + j] = dot_double_word(row, &col);
-        }
-    }
-    c
-}
-
-/// `a + b` for double-word vectors.
-fn add_double_word(a: &[DoubleWord], b: &[DoubleWord]) -> Vec<DoubleWord> {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| {
-            let (s, e) = two_sum(x.0, y.0);
-            let (s, e) = two_sum(s, e + x.1 + y.1);
-            (s, e)
-        })
-        .collect()
-}
-
 impl SteadyBlock {
     /// The block map from the `f64` gains and step, and its derivative with respect to the
     /// step: `Ā = (I − G e₀ᵀ) Φ(ζ̄)` and `Ā' = (I − G e₀ᵀ) Φ'(ζ̄)` in double words (from the
     /// `f64` gains and step), the weights `Āʲ G` and their derivatives
     /// `(Āʲ G)' = Ā' Āʲ⁻¹ G + Ā (Āʲ⁻¹ G)'` one product at a time, and `Āᴮ`, `(Āᴮ)'` by
     /// repeated squaring (`(A²)' = A' A + A A'`), all in double-word arithmetic, each rounded
-    /// once to `f64`. `Ā` is far from normal at high degree and `θ → 1`: powers formed in plain
-    /// `f64` lose up to 3e-11 relative (measured at degree 8, θ = 0.99).
+    /// once to `f64`. `Ā` is far from normal at high degree and `θ → 1`, so powers formed in
+    /// plain `f64` lose accuracy (measured: see ACCURACY.md).
     fn new(step: f64, gains: &[f64]) -> Self {
         let n = gains.len();
         // ζ̄ʲ in double words, and j·ζ̄^(j−1).
         let mut pw = vec![(1.0, 0.0); n];
         for j in 1..n {
-            let (p, e) = two_prod(pw[j - 1].0, step);
-            pw[j] = two_sum(p, e + pw[j - 1].1 * step);
+            pw[j] = dw::mul_f64(pw[j - 1], step);
         }
         let times_int = |x: DoubleWord, c: f64| (x.0 * c, x.1 * c); // exact for small c·2^k
         let entry = |k: usize, j: usize, derivative: bool| -> DoubleWord {
@@ -194,20 +151,13 @@ impl SteadyBlock {
                 }
             };
             let row0 = term(0);
-            let (p, e) = two_prod(gains[k], row0.0);
-            let g_row0 = (p, e + gains[k] * row0.1);
             let phi = if k == 0 { row0 } else { term(k) };
-            let (s, e) = two_sum(phi.0, -g_row0.0);
-            two_sum(s, e + phi.1 - g_row0.1)
+            dw::sub(phi, dw::scale(gains[k], row0))
         };
         let a: Vec<DoubleWord> = (0..n * n).map(|i| entry(i / n, i % n, false)).collect();
         let da: Vec<DoubleWord> = (0..n * n).map(|i| entry(i / n, i % n, true)).collect();
-        let times = |m: &[DoubleWord], v: &[DoubleWord]| -> Vec<DoubleWord> {
-            m.chunks_exact(n)
-                .map(|row| dot_double_word(row, v))
-                .collect()
-        };
-        let round = |v: &DoubleWord| v.0 + v.1;
+        let times = dw::mat_vec;
+        let round = dw::round;
         let (mut weights, mut weights_d) =
             (vec![0.0; n * STEADY_BLOCK], vec![0.0; n * STEADY_BLOCK]);
         let mut w: Vec<DoubleWord> = gains.iter().map(|&g| (g, 0.0)).collect();
@@ -218,18 +168,15 @@ impl SteadyBlock {
                 weights_d[k * STEADY_BLOCK + j] = round(&dw[k]);
             }
             // (w, w') ← (Ā w, Ā' w + Ā w')
-            dw = add_double_word(&times(&da, &w), &times(&a, &dw));
+            dw = dw::add_vectors(&times(&da, &w), &times(&a, &dw));
             w = times(&a, &w);
         }
         // Āᴮ and (Āᴮ)' by squaring (B is a power of two).
         let (mut p, mut dp) = (a, da);
         let mut size = 1;
         while size < STEADY_BLOCK {
-            dp = add_double_word(
-                &mat_mul_double_word(&dp, &p, n),
-                &mat_mul_double_word(&p, &dp, n),
-            );
-            p = mat_mul_double_word(&p, &p, n);
+            dp = dw::add_vectors(&dw::mat_mul(&dp, &p, n), &dw::mat_mul(&p, &dp, n));
+            p = dw::mat_mul(&p, &p, n);
             size *= 2;
         }
         Self {
@@ -264,26 +211,6 @@ fn dot2(a: &[f64], b: &[f64], y: &[f64]) -> (f64, f64) {
         sq += w * v;
     }
     (sp, sq)
-}
-
-/// Whether every step of `ts` (the first from `prev`) is the typical step `step` (in units of
-/// `tau`) within [`step_tolerance`]: the check of the block paths, without an early exit so
-/// that it vectorises.
-fn even_steps(ts: &[f64], prev: f64, step: f64, tau: f64) -> bool {
-    let tol = step_tolerance(step, 0.0, tau);
-    let tol_per_time = step_tolerance(0.0, 1.0, tau);
-    let inv_tau = 1.0 / tau;
-    let even = |t: f64, p: f64| ((t - p) * inv_tau - step).abs() <= tol + tol_per_time * t.abs();
-    let Some((&first, _)) = ts.split_first() else {
-        return true;
-    };
-    let uneven = usize::from(!even(first, prev))
-        + ts[1..]
-            .iter()
-            .zip(ts)
-            .map(|(&t, &p)| usize::from(!even(t, p)))
-            .sum::<usize>();
-    uneven == 0
 }
 
 /// Row `k` of a `(N × STEADY_BLOCK)` row-major table.
@@ -347,19 +274,7 @@ pub(crate) fn fading_gains_double_word(m: usize, theta: f64) -> (Vec<f64>, Vec<f
 
 impl FadingGains {
     pub fn new(m: usize, theta: f64, mode: DiscountMode, rule: SwitchRule) -> Self {
-        let constant = match rule {
-            SwitchRule::Position => Some(memory_length_constant(0, m)),
-            SwitchRule::ColumnMean => Some(
-                (0..=m)
-                    .map(|i| memory_length_constant(i, m))
-                    .sum::<f64>()
-                    / (m + 1) as f64,
-            ),
-            SwitchRule::Derivative(i) => {
-                Some(memory_length_constant(i.min(m), m))
-            }
-            SwitchRule::ExactCrossover | SwitchRule::AtSample(_) => None,
-        };
+        let constant = rule.asymptotic_constant(m);
         let dw = fading_gains_double_word(m, theta);
         Self {
             theta,
@@ -465,15 +380,8 @@ impl GainEngine {
         let (e, e_lo) = two_sum(d, de - self.z_lo[0]);
         self.update_step_mean(t, zeta);
         self.choose_gains(t);
-        let step = self.step_mean;
-        if step != 1.0 {
-            let mut zk = 1.0;
-            for (kk, kl) in self.k.iter_mut().zip(self.k_lo.iter_mut()).skip(1) {
-                zk *= step;
-                *kk /= zk;
-                *kl /= zk;
-            }
-        }
+        scale_gains_for_step(&mut self.k, self.step_mean);
+        scale_gains_for_step(&mut self.k_lo, self.step_mean);
         for (((zi, lo), ki), kl) in self
             .z
             .iter_mut()
@@ -481,8 +389,7 @@ impl GainEngine {
             .zip(&self.k)
             .zip(&self.k_lo)
         {
-            let p = ki * e;
-            let pe = ki.mul_add(e, -p);
+            let (p, pe) = two_prod(*ki, e);
             let (s, se) = two_sum(*zi, p);
             let (s, l) = two_sum(s, *lo + se + pe + ki * e_lo + kl * e);
             *zi = s;
@@ -550,12 +457,7 @@ impl GainEngine {
             row.fill(f64::NAN);
             return;
         }
-        let (mut f, mut tk) = (1.0, 1.0);
-        for (k, x) in row.iter_mut().enumerate() {
-            if k > 0 {
-                f *= k as f64;
-                tk *= self.tau;
-            }
+        for (k, (x, (f, tk))) in row.iter_mut().zip(factorial_powers(self.tau)).enumerate() {
             *x = (self.z[k] + self.z_lo[k]) * f / tk;
         }
     }
@@ -572,40 +474,22 @@ impl GainEngine {
     /// The steady-state fading recursion on a run of (nearly) even steps in plain `f64`, with
     /// the state in registers: `Z ← Φ(ζ) Z`, `ε = y − z₀`, `Z ← Z + K ε`, the gains `K` those
     /// of the typical step. Returns how many samples it took (it stops at the first step that
-    /// differs from the typical one by more than `1e-12`, relative).
+    /// differs from the typical one ([`crate::numeric::steps`]).
     fn steady_run(&mut self, ts: &[f64], ys: &[f64], out: &mut [f64], write: bool) -> usize {
         // Without per-sample outputs, whole blocks of the steady fading recursion first.
         let blocks = if self.fading.is_none() && !write && self.m <= EXPANDING_BLOCK_MAX_DEGREE {
             self.expanding_block_run(ts, ys)
         } else if self.fading.is_some() && !write && self.m <= STEADY_BLOCK_MAX_DEGREE {
-            match self.m {
-                0 => self.steady_block_run::<1>(ts, ys),
-                1 => self.steady_block_run::<2>(ts, ys),
-                2 => self.steady_block_run::<3>(ts, ys),
-                3 => self.steady_block_run::<4>(ts, ys),
-                4 => self.steady_block_run::<5>(ts, ys),
-                5 => self.steady_block_run::<6>(ts, ys),
-                _ => 0,
-            }
+            unrolled_sizes!(self.m + 1, N => self.steady_block_run::<N>(ts, ys), _ => 0)
         } else {
             0
         };
         let (ts, ys) = (&ts[blocks..], &ys[blocks..]);
         let steady = self.fading.is_some() && !write;
-        macro_rules! dispatch {
-            ($run:ident, $($m:literal => $n:literal),*) => {
-                match (self.m, write) {
-                    $(($m, false) => self.$run::<$n, false>(ts, ys, out),
-                      ($m, true) => self.$run::<$n, true>(ts, ys, out),)*
-                    _ => 0,
-                }
-            };
-        }
-        let rest = if self.fading.is_none() {
-            dispatch!(expanding_run_n, 0 => 1, 1 => 2, 2 => 3, 3 => 4, 4 => 5)
+        let rest = if write {
+            unrolled_sizes!(self.m + 1, N => self.plain_run_n::<N, true>(ts, ys, out), _ => 0)
         } else {
-            dispatch!(steady_run_n, 0 => 1, 1 => 2, 2 => 3, 3 => 4, 4 => 5, 5 => 6, 6 => 7,
-                7 => 8, 8 => 9)
+            unrolled_sizes!(self.m + 1, N => self.plain_run_n::<N, false>(ts, ys, out), _ => 0)
         };
         if steady {
             self.block_credit = self.block_credit.saturating_add(rest);
@@ -617,11 +501,8 @@ impl GainEngine {
     /// [`crate::model::scaled_to_derivatives`], rounded once more).
     fn derivative_factors<const N: usize>(&self) -> [f64; N] {
         let mut c = [1.0; N];
-        let (mut f, mut tk) = (1.0, 1.0);
-        for (k, ck) in c.iter_mut().enumerate().skip(1) {
-            f *= k as f64;
-            tk *= self.tau;
-            *ck = f / tk;
+        for (ck, d) in c.iter_mut().zip(derivative_scale(self.tau)) {
+            *ck = d;
         }
         c
     }
@@ -639,59 +520,98 @@ impl GainEngine {
         self.n += done as u64;
     }
 
-    /// The expanding-memory recursion after the exact start in plain `f64`, any steps: the
-    /// same operations as [`update`](Self::update) (gains `h_k(n)` of Table 9.1 scaled for the
-    /// mean step), without the compensation. Takes every sample; with `W`, writes each
-    /// sample's derivatives to `out`.
-    fn expanding_run_n<const N: usize, const W: bool>(
+    /// The plain-`f64` kernels on a run after the exact start, the state in registers, both
+    /// generated from one loop ([`plain_run`](Self::plain_run)) and tested against the
+    /// reference recursion ([`predict_correct`]); with `W`, each sample's derivatives go to
+    /// `out`. Returns how many samples it took.
+    ///
+    /// - Expanding memory, any steps: the same operations as [`update`](Self::update) (gains
+    ///   `h_k(n)` of Table 9.1 scaled for the mean step) without the compensation, the
+    ///   reference recursion itself per sample. Takes every sample.
+    /// - Fading memory after the switch, the gains fixed: the reference recursion regrouped,
+    ///   on a run of steps equal to the typical one ([`StepCheck`]).
+    fn plain_run_n<const N: usize, const W: bool>(
         &mut self,
         ts: &[f64],
         ys: &[f64],
         out: &mut [f64],
     ) -> usize {
-        let c = self.derivative_factors::<N>();
-        let mut rows = out.chunks_exact_mut(N);
-        let mut z = self.plain_state::<N>();
-        let mut g = [0.0; N];
-        let tau = self.tau;
-        let t_first = self.t_first;
-        let mut t_last = self.t_last;
-        let mut n = self.n;
-        let mut last_step = self.step_mean;
-        for (&t, &y) in ts.iter().zip(ys) {
-            let zeta = (t - t_last) / tau;
-            let mut step = (t - t_first) / (n as f64 * tau);
-            if (step - zeta).abs() <= 1e-12 * zeta {
-                step = zeta;
-            }
-            self.schedule.gains(n, &mut g);
-            if step != 1.0 {
-                let mut zk = 1.0;
-                for gk in g.iter_mut().skip(1) {
-                    zk *= step;
-                    *gk /= zk;
+        if self.fading.is_none() {
+            let mut g = [0.0; N];
+            let (tau, t_first, schedule) = (self.tau, self.t_first, &self.schedule);
+            let mut n = self.n;
+            let mut last_step = self.step_mean;
+            let run = self.plain_run::<N, W>(ts, ys, out, |z, t, zeta, y| {
+                let mut step = (t - t_first) / (n as f64 * tau);
+                if snaps_to(step, zeta) {
+                    step = zeta;
                 }
-            }
-            for i in 0..N - 1 {
-                for k in (i..N - 1).rev() {
-                    z[k] += zeta * z[k + 1];
+                schedule.gains(n, &mut g);
+                scale_gains_for_step(&mut g, step);
+                predict_correct(z, zeta, &g, y);
+                last_step = step;
+                n += 1;
+                true
+            });
+            self.end_plain_run(&run.z, run.t_last, run.done);
+            self.step_mean = last_step;
+            run.done
+        } else {
+            let g: [f64; N] = std::array::from_fn(|k| self.k[k]);
+            let check = StepCheck::new(self.step_mean, self.tau);
+            // The correction folded into the prediction (so the chain from one sample to the next
+            // is one multiplication and two additions deep): with `d = y − z₀` and the powers
+            // `ζʲ`,
+            //   z₀' = (1 − g₀) z₀ + g₀ y + Σ_{j≥1} (1 − g₀) ζʲ z_j,
+            //   z_k' = Σ_{j≥1} M_kj z_j + g_k d,  M_kj = C(j,k) ζ^(j−k) [j ≥ k] − g_k ζʲ  (k ≥ 1),
+            // which is `Φ(ζ)Z + G(y − [Φ(ζ)Z]₀)` regrouped. `M` is rebuilt only when `ζ` changes.
+            let binom = binomials::<N>();
+            let mut zeta_m = f64::NAN;
+            let mut mk = [[0.0; N]; N];
+            let (g0y, one_minus_g0) = (g[0], 1.0 - g[0]);
+            let run = self.plain_run::<N, W>(ts, ys, out, |z, t, zeta, y| {
+                if !check.agrees(zeta, t) {
+                    return false;
                 }
-            }
-            let e = y - z[0];
-            for k in 0..N {
-                z[k] += g[k] * e;
-            }
-            if W {
-                write_row(rows.next(), &z, &c);
-            }
-            t_last = t;
-            last_step = step;
-            n += 1;
+                if zeta != zeta_m {
+                    zeta_m = zeta;
+                    let mut pw = [1.0; N];
+                    for j in 1..N {
+                        pw[j] = pw[j - 1] * zeta;
+                    }
+                    for j in 1..N {
+                        mk[0][j] = one_minus_g0 * pw[j];
+                    }
+                    for k in 1..N {
+                        for j in 1..N {
+                            let phi = if j >= k { binom[j][k] * pw[j - k] } else { 0.0 };
+                            mk[k][j] = phi - g[k] * pw[j];
+                        }
+                    }
+                }
+                let d = y - z[0];
+                let mut next = [0.0; N];
+                next[0] = one_minus_g0 * z[0] + g0y * y;
+                if N > 1 {
+                    let mut tail = mk[0][1] * z[1];
+                    for j in 2..N {
+                        tail += mk[0][j] * z[j];
+                    }
+                    next[0] += tail;
+                    for k in 1..N {
+                        let mut acc = mk[k][1] * z[1];
+                        for j in 2..N {
+                            acc += mk[k][j] * z[j];
+                        }
+                        next[k] = acc + g[k] * d;
+                    }
+                }
+                *z = next;
+                true
+            });
+            self.end_plain_run(&run.z, run.t_last, run.done);
+            run.done
         }
-        let done = (n - self.n) as usize;
-        self.end_plain_run(&z, t_last, done);
-        self.step_mean = last_step;
-        done
     }
 
     /// The steady fading recursion on whole blocks of [`STEADY_BLOCK`] even steps, each as one
@@ -701,13 +621,14 @@ impl GainEngine {
     /// of decimal timestamps such as `k·0.001` differs from the typical step `ζ̄` by their
     /// rounding); within the block the samples' own times differ from that grid by a few units
     /// in the last place of `t`, which the per-sample recursion follows and the block map does
-    /// not: the two differ by the order of that rounding (≤ 8.1e-13 relative at degree 5 over
-    /// 6·10⁴ samples of `t = k·0.1`, tests/batch.rs). Returns how many samples it took (whole
+    /// not: the two differ by the order of that rounding (tests/batch.rs; measured: see
+    /// ACCURACY.md). Returns how many samples it took (whole
     /// blocks; the first block with an uneven step stops it).
     fn steady_block_run<const N: usize>(&mut self, ts: &[f64], ys: &[f64]) -> usize {
         let step = self.step_mean;
         let tau = self.tau;
-        let even_block = |tb: &[f64], prev: f64| even_steps(tb, prev, step, tau);
+        let check = StepCheck::new(step, tau);
+        let even_block = |tb: &[f64], prev: f64| check.all_agree(tb, prev, 1.0 / tau);
         if ts.len() < STEADY_BLOCK || !even_block(&ts[..STEADY_BLOCK], self.t_last) {
             return 0;
         }
@@ -716,9 +637,10 @@ impl GainEngine {
             None => true,
         };
         if stale {
-            // Building the map costs about as much as the recursion over 2 000 (degree 2) to
-            // 30 000 (degree 5) samples (measured: 17 µs, 0.27 ms): it is built once the
-            // recursion has run that long at this step, or for a batch that long.
+            // Building the map costs about as much as the recursion over thousands of samples
+            // (`O(B m³)` in double words; see BENCHMARKS.md): it is built once the recursion
+            // has run `STEADY_BLOCK_MIN_BUILD_RUN·(m+1)²` samples at this step, or for a batch
+            // that long.
             if self.block_credit_step != step {
                 self.block_credit_step = step;
                 self.block_credit = 0;
@@ -792,7 +714,7 @@ impl GainEngine {
         let mut prev = self.t_last;
         let mut take = 0;
         for tb in ts.chunks_exact(STEADY_BLOCK) {
-            if !even_steps(tb, prev, step, self.tau) {
+            if !StepCheck::new(step, self.tau).all_agree(tb, prev, 1.0 / self.tau) {
                 break;
             }
             take += STEADY_BLOCK;
@@ -812,7 +734,7 @@ impl GainEngine {
             *zk = hi + lo;
         }
         let moved = (self.t_first - self.t_last) / tau + (n - 1) as f64 * grid;
-        crate::model::shift_scaled(z, moved);
+        shift_scaled(z, moved);
         let mut power = 1.0;
         for zk in z.iter_mut() {
             *zk *= power;
@@ -832,95 +754,50 @@ impl GainEngine {
         take
     }
 
-    fn steady_run_n<const N: usize, const W: bool>(
-        &mut self,
+    /// The plain kernels' common loop: from the state folded to `f64`, for each sample the
+    /// step `ζ = (t − t_last)/τ` and `step(z, t, ζ, y)`, which advances `z` over the sample or
+    /// returns false to stop before it; with `W`, the derivatives after each sample go to
+    /// `out`. The caller stores the result ([`end_plain_run`](Self::end_plain_run)).
+    #[inline(always)]
+    fn plain_run<const N: usize, const W: bool>(
+        &self,
         ts: &[f64],
         ys: &[f64],
         out: &mut [f64],
-    ) -> usize {
+        mut step: impl FnMut(&mut [f64; N], f64, f64, f64) -> bool,
+    ) -> PlainRun<N> {
         let c = self.derivative_factors::<N>();
         let mut rows = out.chunks_exact_mut(N);
         let mut z = self.plain_state::<N>();
-        let g: [f64; N] = std::array::from_fn(|k| self.k[k]);
-        let step = self.step_mean;
-        let tol = step_tolerance(step, 0.0, self.tau);
-        let tol_per_time = step_tolerance(0.0, 1.0, self.tau);
-        let tau = self.tau;
-        let mut t_last = self.t_last;
-        let mut done = 0;
-        // The correction folded into the prediction (so the chain from one sample to the next
-        // is one multiplication and two additions deep): with `d = y − z₀` and the powers
-        // `ζʲ`,
-        //   z₀' = (1 − g₀) z₀ + g₀ y + Σ_{j≥1} (1 − g₀) ζʲ z_j,
-        //   z_k' = Σ_{j≥1} M_kj z_j + g_k d,  M_kj = C(j,k) ζ^(j−k) [j ≥ k] − g_k ζʲ  (k ≥ 1),
-        // which is `Φ(ζ)Z + G(y − [Φ(ζ)Z]₀)` regrouped. `M` is rebuilt only when `ζ` changes.
-        let binom = binomials::<N>();
-        let mut zeta_m = f64::NAN;
-        let mut mk = [[0.0; N]; N];
-        let (g0y, one_minus_g0) = (g[0], 1.0 - g[0]);
+        let (tau, mut t_last, mut done) = (self.tau, self.t_last, 0);
         for (&t, &y) in ts.iter().zip(ys) {
             let zeta = (t - t_last) / tau;
-            if (zeta - step).abs() > tol + tol_per_time * t.abs() {
+            if !step(&mut z, t, zeta, y) {
                 break;
             }
-            if zeta != zeta_m {
-                zeta_m = zeta;
-                let mut pw = [1.0; N];
-                for j in 1..N {
-                    pw[j] = pw[j - 1] * zeta;
-                }
-                for j in 1..N {
-                    mk[0][j] = one_minus_g0 * pw[j];
-                }
-                for k in 1..N {
-                    for j in 1..N {
-                        let phi = if j >= k { binom[j][k] * pw[j - k] } else { 0.0 };
-                        mk[k][j] = phi - g[k] * pw[j];
-                    }
-                }
-            }
-            let d = y - z[0];
-            let mut next = [0.0; N];
-            next[0] = one_minus_g0 * z[0] + g0y * y;
-            if N > 1 {
-                let mut tail = mk[0][1] * z[1];
-                for j in 2..N {
-                    tail += mk[0][j] * z[j];
-                }
-                next[0] += tail;
-                for k in 1..N {
-                    let mut acc = mk[k][1] * z[1];
-                    for j in 2..N {
-                        acc += mk[k][j] * z[j];
-                    }
-                    next[k] = acc + g[k] * d;
-                }
-            }
-            z = next;
             if W {
                 write_row(rows.next(), &z, &c);
             }
             t_last = t;
             done += 1;
         }
-        self.end_plain_run(&z, t_last, done);
-        done
+        PlainRun { z, t_last, done }
     }
 
     /// The step the gains are scaled for. On even samples it is the step itself, which makes the
-    /// recursion exact for any step (gains `h_k/ζ^k`, `θ_eff = θ^ζ`; others.md §4.8). On
+    /// recursion exact for any step (gains `h_k/ζ^k`, `θ_eff = θ^ζ`; Reyneke et al. §6.4). On
     /// irregular samples the current step would be the wrong scale — a burst of close samples
-    /// would get gains `h_k/ζ^k` far too large, and the recursion diverges (measured: errors of
-    /// 1e30 on exponential gaps) — so the gains are scaled for the typical step of the memory.
+    /// would get gains `h_k/ζ^k` far too large, and the recursion diverges (measured on
+    /// exponential gaps: see ACCURACY.md) — so the gains are scaled for the typical step of the memory.
     fn update_step_mean(&mut self, t: f64, zeta: f64) {
         let switched = self.fading.as_ref().and_then(|f| f.switched_at).is_some();
         if !switched {
             self.step_mean = (t - self.t_first) / (self.n as f64 * self.tau);
             // Exactly even samples: the mean equals the step up to rounding; use the step.
-            if (self.step_mean - zeta).abs() <= 1e-12 * zeta {
+            if snaps_to(self.step_mean, zeta) {
                 self.step_mean = zeta;
             }
-        } else if (zeta - self.step_mean).abs() > step_tolerance(self.step_mean, t, self.tau) {
+        } else if !same_step(zeta, self.step_mean, t, self.tau) {
             // Steps equal to the typical one up to the rounding of the timestamps (even
             // sampling) keep the gains; the prediction always uses the true step.
             let f = self.fading.as_ref().expect("switched implies fading");
@@ -929,7 +806,7 @@ impl GainEngine {
                 DiscountMode::PerTime => f.theta.powf(self.step_mean),
             };
             self.step_mean = w * self.step_mean + (1.0 - w) * zeta;
-            if (self.step_mean - zeta).abs() <= 1e-12 * zeta {
+            if snaps_to(self.step_mean, zeta) {
                 self.step_mean = zeta;
             }
         }
@@ -950,19 +827,19 @@ impl GainEngine {
                 DiscountMode::PerUpdate => f.theta,
                 DiscountMode::PerTime => f.theta.powf((t - self.t_first) / (n as f64 * self.tau)),
             };
-            let switch = match (f.rule, f.constant) {
-                (SwitchRule::AtSample(k), _) => n >= k,
-                (_, Some(c)) => n as f64 >= (c / (1.0 - theta_s) + 1e-9).floor(),
-                _ => {
-                    // Exact crossover: the expanding-memory position VRF h_0(n) reaches the
-                    // fading-memory one.
-                    self.schedule.gains(n, &mut self.k);
-                    let target = fading_vrf(m, theta_s, EstimateForm::Current)
-                        .map(|s| s[(0, 0)])
-                        .unwrap_or(0.0);
-                    self.k[0] <= target * (1.0 + 1e-12)
-                }
+            let (schedule, k) = (&self.schedule, &mut self.k);
+            let crossover = || {
+                // The expanding-memory position VRF h_0(n) against the fading-memory one.
+                schedule.gains(n, k);
+                let target = fading_vrf(m, theta_s, EstimateForm::Current)
+                    .map(|s| s[(0, 0)])
+                    .unwrap_or(0.0);
+                Ok::<_, std::convert::Infallible>((k[0], target))
             };
+            let switch = f
+                .rule
+                .switches(m, n, theta_s, f.constant, crossover)
+                .unwrap_or_else(|never| match never {});
             if !switch {
                 self.schedule.gains(n, &mut self.k);
                 return;
@@ -1067,5 +944,149 @@ impl GainEngine {
             &j * p * j.transpose()
         });
         (x, cov)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! Every fast path of the engine against the reference recursion
+    //! ([`predict_correct`]) run from the same state with the same gains, degrees 0 … 8.
+    use super::super::testing::scaled_errors;
+    use super::*;
+
+    /// Smooth data with a trend of degree `m` and deterministic pseudo-noise.
+    fn data(n: usize, m: usize) -> Vec<f64> {
+        (0..n)
+            .map(|k| {
+                let x = k as f64 / n as f64;
+                let trend = (0..=m).fold(0.0, |acc, j| acc * x + 1.0 + 0.5 * j as f64);
+                trend + (7.0 * x).sin() + 0.3 * (((k * 7919) % 101) as f64 / 101.0 - 0.5)
+            })
+            .collect()
+    }
+
+    /// The worst scaled error ([`scaled_errors`]) with `S` the memory span.
+    fn scaled_error(z: &[f64], want: &[f64], span: f64) -> f64 {
+        scaled_errors(z, want, span).into_iter().fold(0.0, f64::max)
+    }
+
+    /// The reference from the engine's state over `ts`, `ys` with the gains `h(i)`.
+    fn reference(
+        e: &GainEngine,
+        ts: &[f64],
+        ys: &[f64],
+        h: impl Fn(usize) -> Vec<f64>,
+    ) -> Vec<f64> {
+        let mut z: Vec<f64> = e.z.iter().zip(&e.z_lo).map(|(a, b)| a + b).collect();
+        let mut t_last = e.t_last;
+        for (i, (&t, &y)) in ts.iter().zip(ys).enumerate() {
+            predict_correct(&mut z, (t - t_last) / e.tau, &h(i), y);
+            t_last = t;
+        }
+        z
+    }
+
+    /// A fading engine fed sample by sample up to its switch; returns it and the samples used.
+    fn switched(m: usize, theta: f64, tau: f64, ts: &[f64], ys: &[f64]) -> (GainEngine, usize) {
+        let fading = FadingGains::new(m, theta, DiscountMode::PerUpdate, SwitchRule::Position);
+        let mut e = GainEngine::new(m, tau, Some(fading));
+        let mut i = 0;
+        while e.switched_at().is_none() {
+            e.update(ts[i], ys[i]);
+            i += 1;
+        }
+        (e, i)
+    }
+
+    /// The steady fading kernels (per sample, with and without outputs; block maps up to
+    /// degree 5) and the compensated update against the reference, within the bound of the
+    /// batch tests (1e-11).
+    #[test]
+    fn steady_fast_paths_match_the_reference() {
+        for m in 0..=PLAIN_KERNEL_MAX_DEGREE {
+            for &(theta, tau) in &[(0.9, 1.0), (0.95, 0.1)] {
+                let n = 512 * (m + 1) * (m + 1) + 4 * STEADY_BLOCK + 1000;
+                let ts: Vec<f64> = (0..n).map(|k| k as f64 * tau).collect();
+                let ys = data(n, m);
+                let (start, i) = switched(m, theta, tau, &ts, &ys);
+                let (ts, ys) = (&ts[i..], &ys[i..]);
+                let gains = start.k.clone();
+                let span = 1.0 / (1.0 - theta);
+                let want = reference(&start, ts, ys, |_| gains.clone());
+                let mut out = vec![0.0; ts.len() * (m + 1)];
+                for write in [false, true] {
+                    let mut e = start.clone();
+                    let done = match write {
+                        false => {
+                            unrolled_sizes!(m + 1, N => e.plain_run_n::<N, false>(ts, ys, &mut out), _ => 0)
+                        }
+                        true => {
+                            unrolled_sizes!(m + 1, N => e.plain_run_n::<N, true>(ts, ys, &mut out), _ => 0)
+                        }
+                    };
+                    assert_eq!(done, ts.len(), "m {m}: the kernel stopped early");
+                    let err = scaled_error(&e.z, &want, span);
+                    assert!(err <= 1e-11, "m {m} θ {theta} write {write}: {err:e}");
+                }
+                let mut e = start.clone();
+                for (&t, &y) in ts.iter().zip(ys) {
+                    e.update(t, y);
+                }
+                let folded: Vec<f64> = e.z.iter().zip(&e.z_lo).map(|(a, b)| a + b).collect();
+                let err = scaled_error(&folded, &want, span);
+                assert!(err <= 1e-11, "m {m} θ {theta} compensated: {err:e}");
+                if m <= STEADY_BLOCK_MAX_DEGREE {
+                    let mut e = start.clone();
+                    let done = unrolled_sizes!(m + 1, N => e.steady_block_run::<N>(ts, ys), _ => 0);
+                    assert!(
+                        done >= ts.len() - STEADY_BLOCK,
+                        "m {m}: {done} of {}",
+                        ts.len()
+                    );
+                    let want = reference(&start, &ts[..done], &ys[..done], |_| gains.clone());
+                    let err = scaled_error(&e.z, &want, span);
+                    assert!(err <= 1e-11, "m {m} θ {theta} block: {err:e}");
+                }
+            }
+        }
+    }
+
+    /// The expanding-memory kernels (per sample for every degree; the least-squares blocks up
+    /// to degree 4) against the reference with the gains `h_k(n)` of Table 9.1 (unit steps, so
+    /// no step scaling), within the bound of the batch tests (1e-12).
+    #[test]
+    fn expanding_fast_paths_match_the_reference() {
+        for m in 0..=PLAIN_KERNEL_MAX_DEGREE {
+            let n = 20 * STEADY_BLOCK + 37;
+            let ts: Vec<f64> = (0..n).map(|k| k as f64).collect();
+            let ys = data(n, m);
+            let mut start = GainEngine::new(m, 1.0, None);
+            for i in 0..=m {
+                start.update(ts[i], ys[i]);
+            }
+            let (ts, ys) = (&ts[m + 1..], &ys[m + 1..]);
+            let schedule = ExpandingGainSchedule::new(m);
+            let gains = |i: usize| {
+                let mut h = vec![0.0; m + 1];
+                schedule.gains((m + 1 + i) as u64, &mut h);
+                h
+            };
+            let want = reference(&start, ts, ys, gains);
+            let span = n as f64;
+            let mut e = start.clone();
+            let done =
+                unrolled_sizes!(m + 1, N => e.plain_run_n::<N, false>(ts, ys, &mut []), _ => 0);
+            assert_eq!(done, ts.len());
+            let err = scaled_error(&e.z, &want, span);
+            assert!(err <= 1e-12, "m {m} per sample: {err:e}");
+            if m <= EXPANDING_BLOCK_MAX_DEGREE {
+                let mut e = start.clone();
+                let done = e.expanding_block_run(ts, ys);
+                assert!(done >= ts.len() - STEADY_BLOCK, "m {m}: {done}");
+                let want = reference(&start, &ts[..done], &ys[..done], gains);
+                let err = scaled_error(&e.z, &want, span);
+                assert!(err <= 1e-12, "m {m} block: {err:e}");
+            }
+        }
     }
 }

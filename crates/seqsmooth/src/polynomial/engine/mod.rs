@@ -6,16 +6,18 @@
 //! - [`gain`]: the fixed-gain recursion of Morrison Tables 9.1/13.1 in Reyneke's variable-step
 //!   form, with its batch kernels.
 //! - [`expanding_block`]: runs of even blocks folded into the expanding-memory least-squares fit.
+//! - [`recursion`]: the gain recursion of one sample, the reference of every fast path.
 
 pub(crate) mod exact;
 pub(crate) mod expanding_block;
 pub(crate) mod gain;
+pub(crate) mod recursion;
 
 use super::filter::{check_batch_lengths, check_estimates_length, first_invalid};
-#[cfg(doc)]
-use super::PolynomialFilter;
 use crate::error::Error;
 use crate::model::PolynomialState;
+#[cfg(doc)]
+use crate::polynomial::filter::PolynomialFilter;
 pub(crate) use exact::{Discount, ExactEngine};
 pub(crate) use gain::{FadingGains, GainEngine};
 
@@ -75,7 +77,9 @@ impl EngineState {
                 }
             }
             (EngineState::Gain(g), None) => g.update_many(ts, ys),
-            (EngineState::Gain(g), Some(out)) => g.update_many_into(ts, ys, &mut out[..valid * (m + 1)]),
+            (EngineState::Gain(g), Some(out)) => {
+                g.update_many_into(ts, ys, &mut out[..valid * (m + 1)])
+            }
         }
         if valid < times.len() {
             let previous = (self.samples() > 0).then(|| self.last_time());
@@ -137,12 +141,8 @@ macro_rules! impl_polynomial_filter {
             fn update_many(&mut self, times: &[f64], values: &[f64]) -> Result<(), Error> {
                 self.core.update_many(self.m, times, values, None)
             }
-            fn update_many_into(
-                &mut self,
-                times: &[f64],
-                values: &[f64],
-                estimates: &mut [f64],
-            ) -> Result<(), Error> {
+            #[rustfmt::skip]
+            fn update_many_into(&mut self, times: &[f64], values: &[f64], estimates: &mut [f64]) -> Result<(), Error> {
                 self.core
                     .update_many(self.m, times, values, Some(estimates))
             }
@@ -156,3 +156,23 @@ macro_rules! impl_polynomial_filter {
     };
 }
 pub(crate) use impl_polynomial_filter;
+
+/// Helpers of the engines' unit tests.
+#[cfg(test)]
+pub(crate) mod testing {
+    /// Errors of `z` against `want`, per degree, in units of the span `S`:
+    /// `|Δz_k| S^k / max_j |want_j| S^j` (the error of Taylor coefficients about the newest
+    /// sample, each in units of the whole span).
+    pub(crate) fn scaled_errors(z: &[f64], want: &[f64], span: f64) -> Vec<f64> {
+        let scale = want
+            .iter()
+            .enumerate()
+            .map(|(j, w)| w.abs() * span.powi(j as i32))
+            .fold(f64::MIN_POSITIVE, f64::max);
+        z.iter()
+            .zip(want)
+            .enumerate()
+            .map(|(k, (a, b))| (a - b).abs() * span.powi(k as i32) / scale)
+            .collect()
+    }
+}

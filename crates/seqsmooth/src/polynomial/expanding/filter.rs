@@ -3,8 +3,8 @@
 use crate::error::Error;
 use crate::model::PolynomialState;
 use crate::polynomial::engine::{impl_polynomial_filter, EngineState, ExactEngine, GainEngine};
+use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::options::{check_degree, Engine};
-use crate::polynomial::PolynomialFilter;
 
 /// Expanding-memory polynomial filter of degree `m` (Morrison ch. 9; Reyneke §6.3-6.4): the
 /// least-squares polynomial through all samples so far, with its derivatives, predictions and
@@ -30,6 +30,13 @@ pub struct ExpandingMemory {
 
 impl ExpandingMemory {
     /// A filter of degree `m` on the given engine.
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, Error, ExpandingMemory, PolynomialFilter};
+    /// let f = ExpandingMemory::new(2, Engine::Exact).unwrap();
+    /// assert_eq!((f.degree(), f.samples()), (2, 0));
+    /// assert!(matches!(ExpandingMemory::new(99, Engine::Exact), Err(Error::DegreeOutOfRange { .. })));
+    /// ```
     pub fn new(m: usize, engine: Engine) -> Result<Self, Error> {
         check_degree(m)?;
         let core = match engine {
@@ -42,6 +49,14 @@ impl ExpandingMemory {
 
     /// Tracks the covariance of the estimate for white measurement noise of standard deviation
     /// `sigma`: exact for the engine's estimator on any timestamps.
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
+    /// let mut f = ExpandingMemory::new(0, Engine::Exact).unwrap().with_noise_sigma(2.0).unwrap();
+    /// for n in 0..4 { f.update(n as f64, 1.0).unwrap(); }
+    /// let var = f.estimate().unwrap().covariance.unwrap()[(0, 0)];
+    /// assert!((var - 1.0).abs() < 1e-12); // σ²/4
+    /// ```
     pub fn with_noise_sigma(mut self, sigma: f64) -> Result<Self, Error> {
         self.core.track_covariance(sigma)?;
         Ok(self)

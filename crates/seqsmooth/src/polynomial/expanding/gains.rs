@@ -109,6 +109,11 @@ pub struct ExpandingGainSchedule {
 
 impl ExpandingGainSchedule {
     /// The schedule for degree `m`.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::gains::ExpandingGainSchedule;
+    /// assert_eq!(ExpandingGainSchedule::new(2).degree(), 2);
+    /// ```
     pub fn new(m: usize) -> Self {
         let numerators = expanding_gain_numerators(m)
             .iter()
@@ -118,11 +123,23 @@ impl ExpandingGainSchedule {
     }
 
     /// Degree.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::gains::ExpandingGainSchedule;
+    /// assert_eq!(ExpandingGainSchedule::new(3).degree(), 3);
+    /// ```
     pub fn degree(&self) -> usize {
         self.m
     }
 
     /// Writes `h_0(n) … h_m(n)` (current-estimate form) into `out`.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::gains::ExpandingGainSchedule;
+    /// let mut h = [0.0; 1];
+    /// ExpandingGainSchedule::new(0).gains(4, &mut h);
+    /// assert_eq!(h, [0.2]); // the running mean: 1/(n+1)
+    /// ```
     pub fn gains(&self, n: u64, out: &mut [f64]) {
         let nf = n as f64;
         let mut den = 1.0;
@@ -139,10 +156,14 @@ impl ExpandingGainSchedule {
     }
 
     /// The gains as a vector.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::gains::ExpandingGainSchedule;
+    /// assert_eq!(ExpandingGainSchedule::new(1).gains_vec(3).as_slice(), &[0.7, 0.3]);
+    /// ```
     pub fn gains_vec(&self, n: u64) -> DVector<f64> {
         let mut v = DVector::zeros(self.m + 1);
         self.gains(n, v.as_mut_slice());
         v
     }
 }
-

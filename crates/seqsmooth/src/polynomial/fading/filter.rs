@@ -6,8 +6,10 @@ use crate::model::PolynomialState;
 use crate::polynomial::engine::{
     impl_polynomial_filter, Discount, EngineState, ExactEngine, FadingGains, GainEngine,
 };
-use crate::polynomial::options::{check_degree, check_tau, check_theta, DiscountMode, Engine};
-use crate::polynomial::PolynomialFilter;
+use crate::polynomial::filter::PolynomialFilter;
+use crate::polynomial::options::{
+    check_degree, check_not_started, check_tau, check_theta, DiscountMode, Engine,
+};
 
 /// Fading-memory polynomial filter of degree `m` and discount `θ` per `τ` (Morrison ch. 13;
 /// Reyneke §6.5-6.6): the polynomial minimising `Σ_k θ^((t_n-t_k)/τ) (y_k - p(t_k))²`.
@@ -34,6 +36,14 @@ pub struct FadingMemory {
 
 impl FadingMemory {
     /// A filter of degree `m`, discount `θ ∈ (0,1)` per nominal interval `τ > 0`.
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, Error, FadingMemory, PolynomialFilter};
+    /// let f = FadingMemory::new(1, 0.9, 0.5, Engine::Gain).unwrap();
+    /// assert_eq!((f.degree(), f.theta(), f.tau()), (1, 0.9, 0.5));
+    /// assert!(matches!(FadingMemory::new(1, 1.0, 1.0, Engine::Gain), Err(Error::ThetaOutOfRange { .. })));
+    /// assert!(matches!(FadingMemory::new(1, 0.9, 0.0, Engine::Gain), Err(Error::TauOutOfRange { .. })));
+    /// ```
     pub fn new(m: usize, theta: f64, tau: f64, engine: Engine) -> Result<Self, Error> {
         check_degree(m)?;
         check_theta(theta)?;
@@ -41,7 +51,9 @@ impl FadingMemory {
         let mode = DiscountMode::default();
         let rule = SwitchRule::default();
         let core = match engine {
-            Engine::Exact => EngineState::Exact(ExactEngine::new(m, Some(Discount { theta, tau, mode }))),
+            Engine::Exact => {
+                EngineState::Exact(ExactEngine::new(m, Some(Discount { theta, tau, mode })))
+            }
             Engine::Gain => EngineState::Gain(GainEngine::new(
                 m,
                 tau,
@@ -60,13 +72,7 @@ impl FadingMemory {
     }
 
     fn rebuild(&mut self) -> Result<(), Error> {
-        if self.core.samples() > 0 {
-            return Err(Error::InvalidParameter {
-                name: "configuration",
-                value: "change after the first sample".into(),
-                reason: "set the discount mode and switch rule before the first update".into(),
-            });
-        }
+        check_not_started(self.core.samples() > 0, "the discount mode and switch rule")?;
         match &mut self.core {
             EngineState::Exact(_) => {
                 self.core = EngineState::Exact(ExactEngine::new(
@@ -94,6 +100,14 @@ impl FadingMemory {
 
     /// Chooses how old samples are discounted (default [`DiscountMode::PerTime`]). Must be set
     /// before the first sample.
+    ///
+    /// ```
+    /// use seqsmooth::{DiscountMode, Engine, FadingMemory, PolynomialFilter};
+    /// let f = FadingMemory::new(1, 0.9, 1.0, Engine::Exact).unwrap();
+    /// let mut g = f.with_discount_mode(DiscountMode::PerUpdate).unwrap();
+    /// g.update(0.0, 1.0).unwrap();
+    /// assert!(g.with_discount_mode(DiscountMode::PerTime).is_err()); // after the first sample
+    /// ```
     pub fn with_discount_mode(mut self, mode: DiscountMode) -> Result<Self, Error> {
         self.mode = mode;
         self.rebuild()?;
@@ -103,6 +117,15 @@ impl FadingMemory {
     /// Chooses when the gain engine switches from its expanding-memory start to the fading
     /// gains (default [`SwitchRule::Position`]). Must be set before the first sample. The exact
     /// engine needs no start-up and ignores the rule.
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
+    /// use seqsmooth::polynomial::SwitchRule;
+    /// let mut f = FadingMemory::new(1, 0.9, 1.0, Engine::Gain).unwrap()
+    ///     .with_switch_rule(SwitchRule::AtSample(10)).unwrap();
+    /// for n in 0..20 { f.update(n as f64, n as f64).unwrap(); }
+    /// assert_eq!(f.switched_at(), Some(10));
+    /// ```
     pub fn with_switch_rule(mut self, rule: SwitchRule) -> Result<Self, Error> {
         rule.switch_index(self.m, self.theta)?;
         self.rule = rule;
@@ -112,6 +135,14 @@ impl FadingMemory {
 
     /// Tracks the covariance of the estimate for white measurement noise of standard deviation
     /// `sigma` (exact for the engine's estimator, including the start-up).
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
+    /// let mut f = FadingMemory::new(0, 0.5, 1.0, Engine::Exact).unwrap().with_noise_sigma(1.0).unwrap();
+    /// for n in 0..200 { f.update(n as f64, 1.0).unwrap(); }
+    /// let var = f.estimate().unwrap().covariance.unwrap()[(0, 0)];
+    /// assert!((var - 1.0 / 3.0).abs() < 1e-12); // (1−θ)/(1+θ)
+    /// ```
     pub fn with_noise_sigma(mut self, sigma: f64) -> Result<Self, Error> {
         self.core.track_covariance(sigma)?;
         self.sigma = Some(sigma);
@@ -119,17 +150,34 @@ impl FadingMemory {
     }
 
     /// `θ`.
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, FadingMemory};
+    /// assert_eq!(FadingMemory::new(1, 0.9, 1.0, Engine::Exact).unwrap().theta(), 0.9);
+    /// ```
     pub fn theta(&self) -> f64 {
         self.theta
     }
 
     /// `τ`.
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, FadingMemory};
+    /// assert_eq!(FadingMemory::new(1, 0.9, 0.25, Engine::Exact).unwrap().tau(), 0.25);
+    /// ```
     pub fn tau(&self) -> f64 {
         self.tau
     }
 
     /// The 0-based index of the first sample the gain engine processed with the fading-memory
     /// gains: `None` before the switch and on the exact engine (which needs no start-up).
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
+    /// let mut f = FadingMemory::new(1, 0.9, 1.0, Engine::Gain).unwrap();
+    /// for n in 0..40 { f.update(n as f64, 0.0).unwrap(); }
+    /// assert_eq!(f.switched_at(), Some(32)); // Morrison (13.8.8)
+    /// ```
     pub fn switched_at(&self) -> Option<u64> {
         match &self.core {
             EngineState::Gain(g) => g.switched_at(),

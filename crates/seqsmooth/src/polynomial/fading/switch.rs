@@ -7,11 +7,11 @@
 //! self-starting; it starts as an expanding-memory filter and switches to its constant gains at a
 //! sample chosen by a [`SwitchRule`].
 
-use crate::polynomial::expanding::gains::ExpandingGainSchedule;
 use super::vrf::{fading_vrf, fading_vrf_limit};
+use crate::error::Error;
+use crate::polynomial::expanding::gains::ExpandingGainSchedule;
 use crate::polynomial::fixed::fixed_memory_vrf_limit;
 use crate::polynomial::form::EstimateForm;
-use crate::error::Error;
 use crate::scalar::{Rational, Scalar};
 
 /// Morrison's Table 13.4 constant `c_im = (κ_ii(m)/λ_ii(m))^(1/(2i+1))`: a fading-memory filter
@@ -83,27 +83,19 @@ impl SwitchRule {
         if !(theta > 0.0 && theta < 1.0) {
             return Err(Error::ThetaOutOfRange { theta });
         }
-        // Truncated (with a 1e-9 allowance for the rounding of c/(1-θ)): reproduces every switch
-        // time the book gives, (13.8.8) 32, Ex. 13.21 68/32/170, Figs. 13.3/13.5 75/100.
-        let scale = |c: f64| (c / (1.0 - theta) + 1e-9).floor() as u64;
-        let n = match *self {
-            SwitchRule::Position => scale(memory_length_constant(0, m)),
-            SwitchRule::ColumnMean => {
-                let mean =
-                    (0..=m).map(|i| memory_length_constant(i, m)).sum::<f64>() / (m + 1) as f64;
-                scale(mean)
+        if let SwitchRule::Derivative(i) = *self {
+            if i > m {
+                return Err(Error::InvalidParameter {
+                    name: "switch derivative",
+                    value: i.to_string(),
+                    reason: format!("must be at most the degree {m}"),
+                });
             }
-            SwitchRule::Derivative(i) => {
-                if i > m {
-                    return Err(Error::InvalidParameter {
-                        name: "switch derivative",
-                        value: i.to_string(),
-                        reason: format!("must be at most the degree {m}"),
-                    });
-                }
-                scale(memory_length_constant(i, m))
-            }
-            SwitchRule::ExactCrossover => {
+        }
+        let n = match (*self, self.asymptotic_constant(m)) {
+            (SwitchRule::AtSample(n), _) => n,
+            (_, Some(c)) => Self::asymptotic_index(c, theta),
+            _ => {
                 let target = fading_vrf(m, theta, EstimateForm::Current)?[(0, 0)];
                 let sched = ExpandingGainSchedule::new(m);
                 // The expanding-memory current position VRF equals its position gain h_0(n).
@@ -111,16 +103,111 @@ impl SwitchRule {
                 let mut h = vec![0.0; m + 1];
                 loop {
                     sched.gains(n, &mut h);
-                    // A relative slack of 1e-12 absorbs the rounding of an exact tie
-                    // (m = 0: n* = 2θ/(1-θ) exactly).
-                    if h[0] <= target * (1.0 + 1e-12) {
+                    if Self::crossover_reached(h[0], target) {
                         break n;
                     }
                     n += 1;
                 }
             }
-            SwitchRule::AtSample(n) => n,
         };
         Ok(n.max(m as u64 + 1))
+    }
+
+    /// The constant `c` of the asymptotic rules (switch at `⌊c/(1−θ)⌋`): `c_0m` for
+    /// [`Position`](Self::Position), the mean of `c_im` over `i` for
+    /// [`ColumnMean`](Self::ColumnMean), `c_im` (`i` clamped to `m`) for
+    /// [`Derivative`](Self::Derivative); `None` for the other rules.
+    pub(crate) fn asymptotic_constant(&self, m: usize) -> Option<f64> {
+        match *self {
+            SwitchRule::Position => Some(memory_length_constant(0, m)),
+            SwitchRule::ColumnMean => {
+                Some((0..=m).map(|i| memory_length_constant(i, m)).sum::<f64>() / (m + 1) as f64)
+            }
+            SwitchRule::Derivative(i) => Some(memory_length_constant(i.min(m), m)),
+            SwitchRule::ExactCrossover | SwitchRule::AtSample(_) => None,
+        }
+    }
+
+    /// `⌊c/(1−θ)⌋`, truncated with a 1e-9 allowance for the rounding of `c/(1−θ)`: reproduces
+    /// every switch time the book gives, (13.8.8) 32, Ex. 13.21 68/32/170, Figs. 13.3/13.5
+    /// 75/100. Saturates at `u64::MAX`.
+    fn asymptotic_index(c: f64, theta: f64) -> u64 {
+        (c / (1.0 - theta) + 1e-9).floor() as u64
+    }
+
+    /// The exact crossover: the expanding-memory position VRF `h0` has fallen to the
+    /// fading-memory one `target`, with a relative slack of 1e-12 that absorbs the rounding
+    /// of an exact tie (`m = 0`: `n* = 2θ/(1−θ)` exactly).
+    fn crossover_reached(h0: f64, target: f64) -> bool {
+        h0 <= target * (1.0 + 1e-12)
+    }
+
+    /// The rule for a filter that evaluates it sample by sample (the gain engine, the automatic
+    /// filter): whether the sample with index `n` is the first with the fading gains, for the
+    /// per-sample discount so far `theta_s`, the rule's [`asymptotic_constant`]
+    /// (`constant`, cached by the caller) and, for [`ExactCrossover`](Self::ExactCrossover)
+    /// only, `crossover()` = (the expanding-memory position VRF at `n`, the fading-memory one
+    /// at `theta_s`). The same rule as [`switch_index`](Self::switch_index): never before
+    /// `n = m + 1`.
+    ///
+    /// [`asymptotic_constant`]: Self::asymptotic_constant
+    pub(crate) fn switches<E>(
+        &self,
+        m: usize,
+        n: u64,
+        theta_s: f64,
+        constant: Option<f64>,
+        crossover: impl FnOnce() -> Result<(f64, f64), E>,
+    ) -> Result<bool, E> {
+        let index = match (*self, constant) {
+            (SwitchRule::AtSample(k), _) => k,
+            (_, Some(c)) => Self::asymptotic_index(c, theta_s),
+            _ => {
+                let (h0, target) = crossover()?;
+                return Ok(n > m as u64 && Self::crossover_reached(h0, target));
+            }
+        };
+        Ok(n >= index.max(m as u64 + 1))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The per-sample rule switches first at the index `switch_index` gives, for every rule
+    /// (the oracle for the constant rules: the book's switch times in the doc examples).
+    #[test]
+    fn per_sample_rule_agrees_with_the_index() {
+        for m in 0..=4usize {
+            for theta in [0.5, 0.9, 0.93, 0.99] {
+                for rule in [
+                    SwitchRule::Position,
+                    SwitchRule::ColumnMean,
+                    SwitchRule::Derivative(1),
+                    SwitchRule::ExactCrossover,
+                    SwitchRule::AtSample(7),
+                ] {
+                    if matches!(rule, SwitchRule::Derivative(1)) && m == 0 {
+                        continue;
+                    }
+                    let index = rule.switch_index(m, theta).unwrap();
+                    let c = rule.asymptotic_constant(m);
+                    let sched = ExpandingGainSchedule::new(m);
+                    let target = fading_vrf(m, theta, EstimateForm::Current).unwrap()[(0, 0)];
+                    let first = (m as u64 + 1..)
+                        .find(|&n| {
+                            rule.switches(m, n, theta, c, || {
+                                let mut h = vec![0.0; m + 1];
+                                sched.gains(n, &mut h);
+                                Ok::<_, Error>((h[0], target))
+                            })
+                            .unwrap()
+                        })
+                        .unwrap();
+                    assert_eq!(first, index, "{rule:?} m {m} θ {theta}");
+                }
+            }
+        }
     }
 }

@@ -205,8 +205,8 @@ pub fn balance_span(
     lead: Lead,
     ratio: f64,
 ) -> Result<Balance, Error> {
-    super::super::check_degree(m)?;
-    super::super::check_tau(tau)?;
+    crate::polynomial::options::check_degree(m)?;
+    crate::polynomial::options::check_tau(tau)?;
     lead.check()?;
     for (name, v) in [
         ("noise sigma", sigma_nu),

@@ -132,7 +132,7 @@ fn classical_legendre<T: Scalar>(m: usize) -> Vec<Polynomial<T>> {
 /// assert_eq!(vrf_limit(2, 1.0_f64).unwrap()[(0, 0)], 9.0);         // Table 7.2
 /// ```
 pub fn vrf_limit<T: Scalar>(m: usize, rho: T) -> Result<DMatrix<T>, Error> {
-    super::super::check_degree(m)?;
+    crate::polynomial::options::check_degree(m)?;
     check_finite("window fraction rho", &rho)?;
     let x = T::one() - T::from_i64(2) * rho;
     let p = classical_legendre::<T>(m);
@@ -162,7 +162,7 @@ pub(crate) fn unscaled_variance(
 ) -> Result<f64, Error> {
     let h = lead.steps(span);
     let s = covariance::<f64>(m, span, h)?;
-    let f = crate::calculus::factorial::<f64>(derivative) / tau.powi(derivative as i32);
+    let f = crate::model::taylor::scaling_diagonal::<f64>(derivative, tau)[derivative];
     Ok(s[(derivative, derivative)] * f * f)
 }
 
@@ -207,9 +207,9 @@ pub fn min_span_for_sigma(
     sigma_nu: f64,
     target_sigma: f64,
 ) -> Result<u64, Error> {
-    super::super::check_degree(m)?;
+    crate::polynomial::options::check_degree(m)?;
     check_derivative(m, derivative)?;
-    super::super::check_tau(tau)?;
+    crate::polynomial::options::check_tau(tau)?;
     check_positive("noise sigma", sigma_nu)?;
     check_positive("target sigma", target_sigma)?;
     lead.check()?;

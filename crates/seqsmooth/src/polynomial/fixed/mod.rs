@@ -26,25 +26,26 @@
 //! | [`bias`], [`dominant_bias`], [`end_point_bias_bound`] | systematic errors | (7.10.17)-(7.10.18), (7.12.14), (7.13.5)-(7.13.10) |
 //! | [`balance_span`] | bias against random error | §7.13 |
 //! | [`smooth_detrended`], [`Detrended`] | trend removal | §7.14 |
-//! | [`FixedMemory`] | streaming filter, three engines | §7.1, §9.5 |
-//! | [`smooth`] | whole-series centred smoothing (savgol `mode="interp"`) | (7.4.16), `h = -L/2` |
+//! | [`FixedMemory`], [`FixedEngine`] | streaming filter: direct, sliding, irregular, adaptive | §7.1, §9.5 |
+//! | [`smooth`] | whole-series centred smoothing (savgol `mode="interp"`), the sliding engine | (7.4.16), `h = -L/2` |
+//! | window moments `μ_j = Σ y(x) p_j(x)`, `β = C μ`, `T(r)` | the even-spacing fit (private `even`) | (7.4.5), (7.4.10), (7.4.15), (7.5.21) |
+//! | sliding moments, shift matrix, refreshes | `O(m²)` per sample (private `sliding`) | (A1.1), §9.5 |
+//! | QR fit of the window | irregular timestamps (private `irregular`) | §6.5 |
 //!
 //! ## The sliding engine
 //!
-//! [`FixedEngine::Sliding`] keeps the window's moments `μ_j = Σ_{x=0..L} y(x) p_j(x)` in the
-//! discrete Legendre basis (`β_j = μ_j/c_j²` are the coefficients of the fit). When the window
-//! slides by one sample the oldest sample leaves, the newest enters, and every retained sample
-//! moves from position `x` to `x-1`: with the exact shift matrix `p_j(x-1) = Σ_l M_jl p_l(x)`,
-//! `μ' = M (μ − y_old 𝟙) + y_new (p_j(L))_j` (`p_j(0) = 1`, `p_j(L) = (-1)^j`): `O(m²)` per
-//! sample, independent of `L`.
+//! [`FixedEngine::Sliding`], the sliding phase of [`FixedEngine::Adaptive`] and [`smooth`] on
+//! evenly spaced samples share one engine. It keeps the window's moments
+//! `μ_j = Σ_{x=0..L} y(x) p_j(x)` in the discrete Legendre basis (`β_j = μ_j/c_j²` are the
+//! coefficients of the fit). When the window slides by one sample the oldest sample leaves, the
+//! newest enters, and every retained sample moves from position `x` to `x-1`: with the exact
+//! shift matrix `p_j(x-1) = Σ_l M_jl p_l(x)`, `μ' = M (μ − y_old 𝟙) + y_new (p_j(L))_j`
+//! (`p_j(0) = 1`, `p_j(L) = (-1)^j`): `O(m²)` per sample, independent of `L`.
 //!
 //! Alone this recursion is unstable (Morrison §9.5, (9.5.3)-(9.5.10)): `M` is unipotent, so its
 //! homogeneous part never forgets — every rounding error persists, and an error injected `k`
 //! samples ago has since been shifted `k` samples, i.e. extrapolated beyond the window it
-//! belonged to, where a degree-`m` error polynomial grows like `p_m` outside `[0, L]`. Measured
-//! without refreshes (error relative to the data scale): `m = 0` random-walks (9e-14 after 10⁷
-//! samples), `m = 2`, `L = 100` reaches 2.5e-5 after 10⁶ and 1.3e-2 after 10⁷ samples, `m = 4`
-//! diverges (3e4 after 10⁶).
+//! belonged to, where a degree-`m` error polynomial grows like `p_m` outside `[0, L]`.
 //!
 //! So the engine also runs `q` staggered **exact refresh accumulators**: each collects
 //! `Σ y p_j(x)` over the `L+1` samples of one future window as they arrive, each sample added
@@ -58,30 +59,12 @@
 //! error is amplified by the growth of `p_m` over the extrapolated distance, which at one full
 //! window is `~|P_m(3)|` (`~10⁶` at `m = 10`); the default `q = 2^⌊(m-1)/2⌋` (1 for `m ≤ 2`, 2 for
 //! `m ≤ 4`, 4 for `m ≤ 6`, 8 for `m ≤ 8`, 16 for `m ≤ 10`, …, at most `L+1`; settable with
-//! [`FixedMemory::with_refreshes`]) keeps that factor near 10. Measured worst error against
-//! the exact window fit, relative to the data scale (`tests/fixed_memory.rs`; `|y| ≤ 150`):
-//!
-//! | m | L | samples | error |
-//! |---|---|---|---|
-//! | 2 | 1000 | 10⁷ | 7.5e-14 |
-//! | 2 | 10 | 10⁶ | 2.6e-15 |
-//! | 2 | 10⁴ | 10⁶ | 8.8e-14 |
-//! | 4 | 10 | 10⁶ | 2.3e-14 |
-//! | 4 | 10⁴ | 10⁷ | 1.8e-13 |
-//! | 6 | 100 | 10⁷ | 3.7e-15 |
-//! | 8 | 100 | 3·10⁵ | 2.1e-14 |
-//! | 10 | 1000 | 3·10⁵ | 1.4e-14 |
+//! [`FixedMemory::with_refreshes`]) keeps that factor near 10. [`smooth`] reports every
+//! derivative up to `m` relative to its own scale and takes `4q` accumulators from `m = 3` on.
 //!
 //! Windows barely longer than the degree (`L ≈ m ≥ 16`) are ill-conditioned for every engine
-//! (the discrete Legendre values themselves lose digits there).
-//!
-//! ## Accuracy of the analytic functions (measured, `tests/fixed_memory.rs`)
-//!
-//! `f64` [`weights`]: ≤ 4e-15 relative to each row's largest weight against the exact rational
-//! weights (`m ≤ 10`, `L ≤ 300`, and `m ≤ 2` at `L = 10⁴`), ≤ 2.2e-12 against a Householder QR
-//! fit up to `L = 10⁴` (the QR's own error). The book's product with the explicit sums, in
-//! `f64`, is off by 7e-10 at `m = 10`, `L = 300`. `f64` [`covariance`] at the centre,
-//! `m = 8`, `L = 1000`: 7e-16 (the `Φ(h)`-product form: 5e-13).
+//! (the discrete Legendre values themselves lose digits there). Measured accuracy of the
+//! engines and of the analytic functions: see ACCURACY.md.
 //!
 //! ```
 //! use seqsmooth::polynomial::fixed::{FixedEngine, FixedMemory};
@@ -100,7 +83,11 @@
 
 mod bias;
 mod covariance;
+mod even;
 mod filter;
+mod irregular;
+mod ring;
+mod sliding;
 mod smooth;
 mod trend;
 mod weights;
@@ -129,7 +116,14 @@ pub(crate) const EVEN_STEP_TOLERANCE: f64 = 1e-9;
 /// the largest time (`t_scale`). Millisecond samples stamped in Unix seconds (`t ≈ 1.7e9`,
 /// resolution `2.4e-7`) thus count as evenly spaced.
 pub(crate) fn steps_agree(step: f64, first: f64, t_scale: f64) -> bool {
-    (step - first).abs() <= EVEN_STEP_TOLERANCE * first.abs() + 2.0 * f64::EPSILON * t_scale
+    crate::numeric::steps::same_step_within(
+        step,
+        first,
+        t_scale,
+        1.0,
+        EVEN_STEP_TOLERANCE,
+        2.0 * f64::EPSILON,
+    )
 }
 
 /// Where in (or beyond) the window an estimate is wanted, for the design helpers.
@@ -175,7 +169,7 @@ fn span_scalar<T: Scalar>(span: u64) -> T {
 
 /// Degree within range and at least `m+1` samples (`L ≥ m`).
 fn check_span(m: usize, span: u64) -> Result<(), Error> {
-    super::check_degree(m)?;
+    crate::polynomial::options::check_degree(m)?;
     if span < m as u64 {
         return Err(Error::TooFewSamples {
             needed: m + 1,
@@ -203,7 +197,7 @@ fn check_materialised(span: u64) -> Result<(), Error> {
 
 /// Degree within range and `m+1 ≤ window ≤ MAX_WINDOW`.
 fn check_window(m: usize, window: usize) -> Result<(), Error> {
-    super::check_degree(m)?;
+    crate::polynomial::options::check_degree(m)?;
     if window as u64 > MAX_WINDOW {
         return Err(Error::InvalidParameter {
             name: "window",

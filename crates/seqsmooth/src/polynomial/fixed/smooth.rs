@@ -1,22 +1,21 @@
 //! Whole-series (non-causal) smoothing with centred fixed-memory windows: the counterpart of
 //! `scipy.signal.savgol_filter(…, mode="interp")`, with derivatives.
 
-use super::weights::{inverse_norms, legendre_values, taylor_at, weights_unscaled};
+use super::even::MomentFit;
+use super::irregular::IrregularWindow;
+use super::sliding::{smoothing_refreshes, SlidingMoments};
 use super::{check_window, steps_agree};
-use crate::basis::DiscreteLegendre;
-use crate::calculus::factorial;
 use crate::error::Error;
-use crate::estimate::PolynomialFit;
+use std::ops::Range;
 
 /// Checks lengths, finiteness and strictly increasing times.
 pub(crate) fn check_series(times: &[f64], values: &[f64]) -> Result<(), Error> {
-    if times.len() != values.len() {
-        return Err(Error::InvalidParameter {
-            name: "input lengths",
-            value: format!("{} times, {} values", times.len(), values.len()),
-            reason: "times and values must have the same length".into(),
-        });
-    }
+    crate::error::check_lengths(
+        "input lengths",
+        times,
+        values,
+        "times and values must have the same length",
+    )?;
     for (k, (&t, &y)) in times.iter().zip(values).enumerate() {
         crate::error::check_sample(t, y, k.checked_sub(1).map(|p| times[p]))?;
     }
@@ -35,11 +34,84 @@ pub(crate) fn is_evenly_spaced(times: &[f64]) -> bool {
         .all(|w| steps_agree(w[1] - w[0], first, t_scale))
 }
 
-/// Index of the first sample of the window used for sample `n`: the window of `window` samples
-/// most nearly centred on `n` (`⌊L/2⌋` samples before it), clamped to the series.
-fn window_start(n: usize, window: usize, len: usize) -> usize {
-    let half = (window - 1) / 2;
-    n.saturating_sub(half).min(len - window)
+/// The samples the full window starting at `start` serves (savgol's "interp" mode): the one
+/// `⌊L/2⌋` after its start and, for the first (last) window, every sample before (after) it.
+fn rows_served(start: usize, window: usize, len: usize) -> Range<usize> {
+    let centre = start + (window - 1) / 2;
+    let first = if start == 0 { 0 } else { centre };
+    let end = if start + window == len {
+        len
+    } else {
+        centre + 1
+    };
+    first..end
+}
+
+/// The window fits of a series, taken window by window.
+trait SeriesWindows {
+    /// Takes sample `n` of the series (the samples arrive in order).
+    fn push(&mut self, n: usize) -> Result<(), Error>;
+    /// The derivatives at sample `row` of the fit of the full window starting at `start` (the
+    /// newest window pushed).
+    fn row(&self, row: usize, start: usize) -> Vec<f64>;
+}
+
+/// Every sample's row, in order, from the fits of the series' `len - window + 1` windows.
+fn centred_rows(
+    len: usize,
+    window: usize,
+    mut fits: impl SeriesWindows,
+) -> Result<Vec<Vec<f64>>, Error> {
+    let mut out = Vec::with_capacity(len);
+    for n in 0..len {
+        fits.push(n)?;
+        if let Some(start) = (n + 1).checked_sub(window) {
+            for row in rows_served(start, window, len) {
+                out.push(fits.row(row, start));
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Evenly spaced samples: the sliding moments of each window, evaluated through `T(r)`.
+struct EvenSeries<'a> {
+    values: &'a [f64],
+    window: usize,
+    moments: SlidingMoments,
+    fit: MomentFit,
+    step: f64,
+}
+
+impl SeriesWindows for EvenSeries<'_> {
+    fn push(&mut self, n: usize) -> Result<(), Error> {
+        let old = n.checked_sub(self.window).map(|k| self.values[k]);
+        self.moments.push(n as u64, self.values[n], old);
+        Ok(())
+    }
+
+    fn row(&self, row: usize, start: usize) -> Vec<f64> {
+        let mu = self.moments.moments().expect("the window is full");
+        self.fit.derivatives(mu, (row - start) as f64, self.step)
+    }
+}
+
+/// Irregular samples: each window's QR fit, evaluated at the sample's time.
+struct IrregularSeries<'a> {
+    times: &'a [f64],
+    values: &'a [f64],
+    fits: IrregularWindow,
+}
+
+impl SeriesWindows for IrregularSeries<'_> {
+    fn push(&mut self, n: usize) -> Result<(), Error> {
+        self.fits.update(self.times[n], self.values[n])
+    }
+
+    fn row(&self, row: usize, _start: usize) -> Vec<f64> {
+        let fit = self.fits.fit().expect("the window is full");
+        fit.derivatives_at(self.times[row])
+    }
 }
 
 /// Smooths a whole series: at each sample, the least-squares polynomial of degree `m` through
@@ -47,15 +119,18 @@ fn window_start(n: usize, window: usize, len: usize) -> usize {
 /// for every sample, the unscaled derivatives `[x, x', …, x^(m)]` in the caller's time units.
 ///
 /// - **Evenly spaced** times (every step within a relative `1e-9` of the first, plus the
-///   timestamps' own rounding, `2ε|t|`): interior
-///   samples use the centred weights `D(Δt) W(-L/2)` (Morrison (7.4.16) with `h = -L/2`;
-///   `Δt` the mean step) as a convolution; the first and last `⌊L/2⌋` (or `⌈L/2⌉`) samples
-///   take the fit of the first (last) full window evaluated at their own times. For odd
-///   `window` this is exactly `scipy.signal.savgol_filter(y, window, m, deriv=k, delta=Δt,
-///   mode="interp")` for each `k`. (For even `window` each sample sits half a step after the
-///   window centre, `h = -(L+1)/2`; savgol evaluates at the half-sample centre instead.)
+///   timestamps' own rounding, `2ε|t|`): the fit of each window `W(h) Y` with the centred
+///   weights `D(Δt) W(-L/2)` (Morrison (7.4.16) with `h = -L/2`; `Δt` the mean step) at the
+///   sample `⌊L/2⌋` after the window's start, by the sliding engine of [`super::FixedMemory`]
+///   (the window's discrete Legendre moments slid one sample at a time, `O(m²)` per sample at
+///   any window; see the [module docs](super#the-sliding-engine)); the first and last `⌊L/2⌋`
+///   (or `⌈L/2⌉`) samples take the fit of the first (last) full window evaluated at their own
+///   times. For odd `window` this is `scipy.signal.savgol_filter(y, window, m, deriv=k,
+///   delta=Δt, mode="interp")` for each `k`. (For even `window` each sample sits half a step
+///   after the window centre, `h = -(L+1)/2`; savgol evaluates at the half-sample centre
+///   instead.)
 /// - **Irregular** times: the same windows (by sample count), each fitted by Householder QR
-///   in a centred Legendre basis ([`PolynomialFit`]).
+///   in a centred Legendre basis ([`crate::estimate::PolynomialFit`]).
 ///
 /// Errors: `window < m+1`, `window` longer than the series, `m > MAX_DEGREE`, NaN or
 /// infinite input, non-increasing times, mismatched lengths.
@@ -86,109 +161,26 @@ pub fn smooth(
         });
     }
     if is_evenly_spaced(times) {
-        smooth_even(times, values, m, window)
-    } else {
-        smooth_irregular(times, values, m, window)
-    }
-}
-
-fn smooth_even(
-    times: &[f64],
-    values: &[f64],
-    m: usize,
-    window: usize,
-) -> Result<Vec<Vec<f64>>, Error> {
-    let len = times.len();
-    let span = window - 1;
-    let step = if len >= 2 {
-        (times[len - 1] - times[0]) / (len - 1) as f64
-    } else {
-        1.0
-    };
-    let half = span / 2;
-    // Interior samples n with start n - half: r = half, h = half - L.
-    let w = weights_unscaled(m, span as u64, half as f64 - span as f64, step)?;
-    let mut out = vec![Vec::new(); len];
-    let basis = DiscreteLegendre::new(span as f64);
-    let inv = inverse_norms(m, &basis);
-    let scale: Vec<f64> = (0..=m)
-        .map(|i| factorial::<f64>(i) / step.powi(i as i32))
-        .collect();
-    // Legendre coefficients β of the window starting at s (x = 0 oldest).
-    let beta = |s: usize| -> Vec<f64> {
-        let mut mu = vec![0.0; m + 1];
-        for x in 0..window {
-            let p = legendre_values(m, &basis, &(x as f64));
-            for j in 0..=m {
-                mu[j] += values[s + x] * p[j];
-            }
-        }
-        mu.iter().zip(&inv).map(|(a, b)| a * b).collect()
-    };
-    // Row i of the weights in window order (oldest sample first), contiguous: column k of `w`
-    // multiplies y_{newest - k}.
-    let kernels: Vec<Vec<f64>> = (0..=m)
-        .map(|i| (0..window).rev().map(|k| w[(i, k)]).collect())
-        .collect();
-    let mut edge_fits: Vec<(usize, Vec<f64>)> = Vec::new();
-    for (n, row) in out.iter_mut().enumerate() {
-        let s = window_start(n, window, len);
-        if n - s == half {
-            let ys = &values[s..s + window];
-            *row = kernels.iter().map(|k| dot(k, ys)).collect();
+        let span = window - 1;
+        let step = if len >= 2 {
+            (times[len - 1] - times[0]) / (len - 1) as f64
         } else {
-            let b = match edge_fits.iter().find(|(st, _)| *st == s) {
-                Some((_, b)) => b.clone(),
-                None => {
-                    let b = beta(s);
-                    edge_fits.push((s, b.clone()));
-                    b
-                }
-            };
-            let t = taylor_at(m, &basis, &((n - s) as f64));
-            *row = (0..=m)
-                .map(|i| (0..=m).map(|j| t[(i, j)] * b[j]).sum::<f64>() * scale[i])
-                .collect();
-        }
+            1.0
+        };
+        let even = EvenSeries {
+            values,
+            window,
+            moments: SlidingMoments::new(m, window, smoothing_refreshes(m), true),
+            fit: MomentFit::new(m, span, span / 2),
+            step,
+        };
+        centred_rows(len, window, even)
+    } else {
+        let irregular = IrregularSeries {
+            times,
+            values,
+            fits: IrregularWindow::new(m, window),
+        };
+        centred_rows(len, window, irregular)
     }
-    Ok(out)
-}
-
-/// `Σ a_i b_i` with four partial sums (so the loop vectorises).
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = ca
-        .remainder()
-        .iter()
-        .zip(cb.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in ca.zip(cb) {
-        for l in 0..4 {
-            acc[l] += x[l] * y[l];
-        }
-    }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
-}
-
-fn smooth_irregular(
-    times: &[f64],
-    values: &[f64],
-    m: usize,
-    window: usize,
-) -> Result<Vec<Vec<f64>>, Error> {
-    let len = times.len();
-    let mut out = Vec::with_capacity(len);
-    let mut cached: Option<(usize, PolynomialFit)> = None;
-    for n in 0..len {
-        let s = window_start(n, window, len);
-        if cached.as_ref().map(|(st, _)| *st) != Some(s) {
-            let fit = PolynomialFit::new(&times[s..s + window], &values[s..s + window], None, m)?;
-            cached = Some((s, fit));
-        }
-        let fit = &cached.as_ref().expect("fitted above").1;
-        out.push(fit.derivatives_at(times[n]));
-    }
-    Ok(out)
 }

@@ -4,7 +4,7 @@
 use super::smooth::{check_series, smooth};
 use crate::error::Error;
 use crate::model::PolynomialState;
-use crate::polynomial::PolynomialFilter;
+use crate::polynomial::filter::PolynomialFilter;
 
 /// A nominal trajectory for [`smooth_detrended`]: the nominal value and derivatives
 /// `[x̄, x̄', …]` (caller's time units) at each sample. Rows shorter than `m+1` mean the
@@ -55,14 +55,7 @@ fn check_nominal_row(row: &[f64]) -> Result<(), Error> {
             reason: "each nominal row needs at least the value".into(),
         });
     }
-    for &v in row {
-        if !v.is_finite() {
-            return Err(Error::NonFinite {
-                what: "value",
-                value: v,
-            });
-        }
-    }
+    crate::error::check_finite("value", row)?;
     Ok(())
 }
 

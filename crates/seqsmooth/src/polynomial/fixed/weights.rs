@@ -40,12 +40,9 @@ pub(crate) fn inverse_norms<T: Scalar>(m: usize, basis: &DiscreteLegendre<T>) ->
 /// `Φ(h) 𝒮 G = T(L+h)`, (7.4.15), (7.5.21)), `C = diag(1/c_j²)` and `[B]_jk = p_j(L-k)` (7.4.6),
 /// every Legendre value and derivative from the three-term recursion (A1.1). With
 /// `T = Rational` the result is exact (and equals the book's product `Φ(h) 𝒮 G C B` entry for
-/// entry); in `f64` it is stable: measured (`tests/fixed_memory.rs`, error relative to each
-/// row's largest weight) ≤ 4e-15 against the exact weights for `m ≤ 10`, `L ≤ 300` and for
-/// `m ≤ 2` at `L = 10⁴`, and within 2.2e-12 of a Householder QR fit for `m ≤ 10`, `L ≤ 10⁴` (the
-/// QR's own error), whereas the book's product with the explicit sums
-/// `Σ_ν C(j,ν) C(j+ν,ν) x^(ν)/L^(ν)` and the shift `Φ(h)` is off by 7e-10 at `m = 10`,
-/// `L = 300` through cancellation. Cost `O(L m²)`.
+/// entry); in `f64` it is stable, whereas the book's product with the explicit sums
+/// `Σ_ν C(j,ν) C(j+ν,ν) x^(ν)/L^(ν)` and the shift `Φ(h)` loses digits through cancellation
+/// (measured accuracy: see ACCURACY.md). Cost `O(L m²)`.
 ///
 /// Errors: `m > MAX_DEGREE`, `L < m` (fewer samples than coefficients), `L ≥ 2³²`,
 /// non-finite `h`.

@@ -1,0 +1,30 @@
+//! The polynomial process model: state conventions, scaling and transition matrices
+//! (Morrison ch. 4; Reyneke et al. §4).
+//!
+//! For a degree-`m` process `x(t)` three state vectors appear in the sources:
+//!
+//! | name | components `k = 0..m` | transition over `h` steps of `τ` |
+//! |---|---|---|
+//! | unscaled `X` | `x^(k)(t)` (the public API) | `Φ_X(hτ)`, `[Φ_X(ζ)]_ij = ζ^(j-i)/(j-i)!` (4.2.5) |
+//! | Morrison's scaled `Z` | `z_k = τ^k x^(k)/k!` | [`phi`]: `[Φ(h)]_ij = C(j,i) h^(j-i)` (4.2.15) |
+//! | Reyneke's `Ψ` state | `d_k = τ^k x^(k) = k! z_k` | [`psi`]: `[Ψ(ζ)]_ij = ζ^(j-i)/(j-i)!` (eq. 7) |
+//!
+//! `X = D(τ) Z` with `D(τ) = diag(k!/τ^k)` ([`scaling`], (4.2.18)). Gains convert as
+//! `Γ_Ψ[k] = k! Γ_Φ[k]` (derivative index `k`; Reyneke et al. §4 against Morrison (4.2.14)).
+//!
+//! - [`transition`]: the matrices `Φ(h)` and `Ψ(ζ)`.
+//! - [`taylor`]: `Φ(h) z` as an in-place Taylor shift (plain and compensated) and `D(τ)`.
+//! - [`state`]: [`PolynomialState`], the public estimate with its propagation.
+
+pub mod state;
+pub mod taylor;
+pub mod transition;
+
+pub use state::PolynomialState;
+pub(crate) use taylor::{
+    derivative_scale, factorial_powers, for_each_shift_step, shift_scaled_array,
+};
+pub use taylor::{
+    derivatives_to_scaled, scaled_to_derivatives, scaling, shift_scaled, shift_scaled_compensated,
+};
+pub use transition::{phi, psi};

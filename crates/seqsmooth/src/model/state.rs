@@ -1,0 +1,65 @@
+//! [`PolynomialState`]: the value and derivatives of an estimate at an instant, with their
+//! covariance, and its propagation `X(t+ζ) = Φ_X(ζ) X(t)` (Morrison (5.5.21)-(5.5.22)).
+
+use super::transition::psi;
+use nalgebra::{DMatrix, DVector};
+
+/// A polynomial state: the value and derivatives `x^(0..=m)` of the estimated process at `time`,
+/// in the caller's time units, with the covariance of their errors when known.
+///
+/// ```
+/// use seqsmooth::model::PolynomialState;
+/// let s = PolynomialState::new(0.0, vec![1.0, 2.0, 2.0]); // 1 + 2t + t²
+/// let p = s.at(1.0);
+/// assert_eq!(p.derivatives, vec![4.0, 4.0, 2.0]);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct PolynomialState {
+    /// The instant the state is valid at.
+    pub time: f64,
+    /// `x, x', x'', …, x^(m)` at `time`.
+    pub derivatives: Vec<f64>,
+    /// Covariance of the errors of `derivatives` (unscaled), when known.
+    pub covariance: Option<DMatrix<f64>>,
+}
+
+impl PolynomialState {
+    /// A state without covariance.
+    pub fn new(time: f64, derivatives: Vec<f64>) -> Self {
+        Self {
+            time,
+            derivatives,
+            covariance: None,
+        }
+    }
+
+    /// Degree `m` of the polynomial model.
+    pub fn degree(&self) -> usize {
+        self.derivatives.len().saturating_sub(1)
+    }
+
+    /// 1σ of each derivative, when the covariance is known.
+    pub fn std_devs(&self) -> Option<Vec<f64>> {
+        self.covariance
+            .as_ref()
+            .map(|c| (0..c.nrows()).map(|i| c[(i, i)].max(0.0).sqrt()).collect())
+    }
+
+    /// The same trajectory propagated to `time` (prediction for a later time, retrodiction for an
+    /// earlier one): `X(t+ζ) = Φ_X(ζ) X(t)`, `S(t+ζ) = Φ_X S Φ_Xᵀ` (Morrison (5.5.21)-(5.5.22)).
+    pub fn at(&self, time: f64) -> PolynomialState {
+        let zeta = time - self.time;
+        let m = self.degree();
+        let transition = psi(m, zeta);
+        let x = &transition * DVector::from_column_slice(&self.derivatives);
+        let covariance = self
+            .covariance
+            .as_ref()
+            .map(|c| &transition * c * transition.transpose());
+        PolynomialState {
+            time,
+            derivatives: x.iter().copied().collect(),
+            covariance,
+        }
+    }
+}

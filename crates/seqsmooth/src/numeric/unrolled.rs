@@ -1,0 +1,49 @@
+//! The one dispatch from a run-time state size `p = m + 1` to code compiled for that size:
+//! sizes `1 ..= UNROLLED_MAX_SIZE` (degrees `0 ..= 8`, the polynomial filters' common degrees)
+//! get a constant `N` and fully unrolled loops; larger sizes take the general path. Every
+//! size-specialised kernel (the information filter's factor, the exact engine's read-out, the
+//! gain engine's batch kernels and block maps, the expanding-memory block fit, the Taylor
+//! shift) goes through [`unrolled_sizes!`].
+
+/// The largest state size `m + 1` with unrolled code.
+pub(crate) const UNROLLED_MAX_SIZE: usize = 9;
+
+/// `unrolled_sizes!(p, N => call, q => other)`: `call` with the constant `N` equal to the
+/// size `p` for `p` in `1 ..= UNROLLED_MAX_SIZE`, `other` (with the size bound to the pattern
+/// `q`) otherwise.
+macro_rules! unrolled_sizes {
+    ($p:expr, $n:ident => $call:expr, $q:pat => $other:expr) => {
+        match $p {
+            1 => $crate::numeric::unrolled::unrolled_sizes!(@at 1, $n, $call),
+            2 => $crate::numeric::unrolled::unrolled_sizes!(@at 2, $n, $call),
+            3 => $crate::numeric::unrolled::unrolled_sizes!(@at 3, $n, $call),
+            4 => $crate::numeric::unrolled::unrolled_sizes!(@at 4, $n, $call),
+            5 => $crate::numeric::unrolled::unrolled_sizes!(@at 5, $n, $call),
+            6 => $crate::numeric::unrolled::unrolled_sizes!(@at 6, $n, $call),
+            7 => $crate::numeric::unrolled::unrolled_sizes!(@at 7, $n, $call),
+            8 => $crate::numeric::unrolled::unrolled_sizes!(@at 8, $n, $call),
+            9 => $crate::numeric::unrolled::unrolled_sizes!(@at 9, $n, $call),
+            $q => $other,
+        }
+    };
+    (@at $v:literal, $n:ident, $call:expr) => {{
+        const $n: usize = $v;
+        $call
+    }};
+}
+pub(crate) use unrolled_sizes;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every size in range gets its own constant; the rest the general arm.
+    #[test]
+    fn dispatch_covers_the_range_once() {
+        for p in 0..=UNROLLED_MAX_SIZE + 3 {
+            let got = unrolled_sizes!(p, N => Some(N), _ => None);
+            let want = (1..=UNROLLED_MAX_SIZE).contains(&p).then_some(p);
+            assert_eq!(got, want);
+        }
+    }
+}

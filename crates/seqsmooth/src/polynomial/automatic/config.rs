@@ -1,0 +1,166 @@
+//! [`AutoConfig`]: every setting of the [`AutomaticFilter`](super::AutomaticFilter), with its
+//! default and its check. The filter is configured by its builders
+//! ([`AutomaticFilter::with_defaults`](super::AutomaticFilter::with_defaults) and the `with_*`
+//! methods); [`AutomaticFilter::config`](super::AutomaticFilter::config) reads the settings back.
+
+use super::misfit::MisfitResponse;
+use super::noise::NoiseSource;
+use super::outlier::OutlierRule;
+use crate::error::Error;
+use crate::polynomial::options::{check_degree, check_tau, check_theta};
+use crate::polynomial::{DiscountMode, Engine, SwitchRule};
+
+/// The largest 1-step prediction VRF at which the outlier gate is applied (the default of
+/// [`AutoConfig::gate_max_vrf`]: the prediction is at least as good as a sample).
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::{AutomaticFilter, GATE_MAX_VRF};
+/// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+/// assert_eq!(f.config().gate_max_vrf, GATE_MAX_VRF);
+/// ```
+pub const GATE_MAX_VRF: f64 = 1.0;
+
+/// Every setting of the [`AutomaticFilter`](super::AutomaticFilter), as its builders set them
+/// (read with [`AutomaticFilter::config`](super::AutomaticFilter::config)).
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::{AutomaticFilter, OutlierRule};
+/// use seqsmooth::polynomial::SwitchRule;
+/// let f = AutomaticFilter::with_defaults(2, 0.97, 0.1) // degree 2, θ = 0.97 per 0.1 s
+///     .unwrap()
+///     .with_noise_sigma(5.0)
+///     .unwrap()
+///     .with_outlier_rule(OutlierRule::reyneke())
+///     .unwrap()
+///     .with_switch_rule(SwitchRule::ExactCrossover)
+///     .unwrap()
+///     .with_start_degree(1)
+///     .unwrap();
+/// assert_eq!((f.degree(), f.active_degree()), (2, 1));
+/// let c = f.config();
+/// assert_eq!((c.noise_sigma, c.outliers, c.misfit_window), (Some(5.0), OutlierRule::reyneke(), 10));
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct AutoConfig {
+    /// Final degree `m ≤ MAX_DEGREE`.
+    pub degree: usize,
+    /// Discount `θ ∈ (0,1)` per `tau`.
+    pub theta: f64,
+    /// Nominal sampling interval `τ > 0` (the time unit of `θ`).
+    pub tau: f64,
+    /// Engine of every internal filter (default [`Engine::Exact`], right on irregular samples).
+    pub engine: Engine,
+    /// Discounting by time (default) or by sample.
+    pub discount: DiscountMode,
+    /// When the final-degree output moves from expanding to fading memory.
+    pub switch_rule: SwitchRule,
+    /// The measurement noise `σ > 0` if known; `None` to estimate it by `noise_source`.
+    pub noise_sigma: Option<f64>,
+    /// How `σ` is estimated when not given.
+    pub noise_source: NoiseSource,
+    /// Outlier gate.
+    pub outliers: OutlierRule,
+    /// The gate is applied only while the 1-step prediction VRF is at most this (default
+    /// [`GATE_MAX_VRF`]).
+    pub gate_max_vrf: f64,
+    /// A run of this many consecutive rejections is a manoeuvre, applied after all (`0`: never).
+    /// Default 3 (three consecutive outliers at a 2% outlier rate: 8·10⁻⁶ per sample).
+    pub max_consecutive_rejections: usize,
+    /// Innovation chi-squared window `K ≥ 1` (default 10).
+    pub misfit_window: usize,
+    /// Per-sample false-alarm rate `α ∈ (0,1)` of the misfit test (default 0.01).
+    pub misfit_alpha: f64,
+    /// What the filter does when the model no longer fits (default: restart at α = 10⁻⁴).
+    pub misfit_response: MisfitResponse,
+    /// First degree of the quick-settling ladder, `≤ degree` (default 0; `degree` disables it).
+    pub start_degree: usize,
+    /// The candidate degree takes over once its current position VRF is at most this (default ½).
+    pub settle_vrf: f64,
+    /// … and its top derivative moved by less than its 1σ at each of this many updates (default 3).
+    pub settle_stable: usize,
+}
+
+impl AutoConfig {
+    /// The defaults for degree `m`, discount `θ` per nominal interval `τ` (unchecked; the
+    /// filter checks them). Old style: use
+    /// [`AutomaticFilter::with_defaults`](super::AutomaticFilter::with_defaults) and the
+    /// `with_*` builders.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter};
+    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+    /// assert_eq!(f.config(), &AutoConfig::new(1, 0.9, 1.0));
+    /// ```
+    #[doc(hidden)]
+    pub fn new(degree: usize, theta: f64, tau: f64) -> Self {
+        Self {
+            degree,
+            theta,
+            tau,
+            engine: Engine::Exact,
+            discount: DiscountMode::PerTime,
+            switch_rule: SwitchRule::Position,
+            noise_sigma: None,
+            noise_source: NoiseSource::default(),
+            outliers: OutlierRule::default(),
+            gate_max_vrf: GATE_MAX_VRF,
+            max_consecutive_rejections: 3,
+            misfit_window: 10,
+            misfit_alpha: 0.01,
+            misfit_response: MisfitResponse::default(),
+            start_degree: 0,
+            settle_vrf: 0.5,
+            settle_stable: 3,
+        }
+    }
+
+    /// Checks every setting: a typed error for the first one out of range (degree, `θ`, `τ`,
+    /// `σ`, noise window, gate, restart significance, switch rule, ladder). The misfit window
+    /// and `α` are checked by [`crate::stats::InnovationChiSquared::new`].
+    pub(super) fn validate(&self) -> Result<(), Error> {
+        check_degree(self.degree)?;
+        check_theta(self.theta)?;
+        check_tau(self.tau)?;
+        if let Some(s) = self.noise_sigma {
+            check_positive("noise sigma", s)?;
+        }
+        if self.noise_source.window() == Some(0) {
+            return Err(Error::InvalidParameter {
+                name: "noise window",
+                value: "0".into(),
+                reason: "must be at least 1".into(),
+            });
+        }
+        self.outliers.validate()?;
+        if self.gate_max_vrf.is_nan() || self.gate_max_vrf <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "gate VRF limit",
+                value: self.gate_max_vrf.to_string(),
+                reason: "must be positive (infinity: always gate)".into(),
+            });
+        }
+        self.misfit_response.validate()?;
+        self.switch_rule.switch_index(self.degree, self.theta)?;
+        if self.start_degree > self.degree {
+            return Err(Error::InvalidParameter {
+                name: "start degree",
+                value: self.start_degree.to_string(),
+                reason: format!("must be at most the degree {}", self.degree),
+            });
+        }
+        check_positive("settle VRF", self.settle_vrf)
+    }
+}
+
+/// `x` is a positive finite number, or an [`Error::InvalidParameter`] naming it.
+pub(super) fn check_positive(name: &'static str, x: f64) -> Result<(), Error> {
+    if x.is_finite() && x > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidParameter {
+            name,
+            value: x.to_string(),
+            reason: "must be a positive finite number".into(),
+        })
+    }
+}

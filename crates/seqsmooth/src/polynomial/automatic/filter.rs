@@ -1,0 +1,806 @@
+//! [`AutomaticFilter`]: the filters it runs, its builders, and one update — prediction,
+//! innovation, gate, acceptance — delegating the gate ([`super::outlier`]), the noise estimate
+//! ([`super::noise`]), the restart ([`super::misfit`]), the degree ladder ([`super::settle`]) and
+//! the switch ([`super::phase`]) to their modules.
+
+use super::config::AutoConfig;
+use super::misfit::{Kept, MisfitResponse};
+use super::noise::{NoiseSource, NoiseState};
+use super::outlier::OutlierRule;
+use super::output::AutoOutput;
+use super::phase::Phase;
+use crate::error::Error;
+use crate::model::PolynomialState;
+use crate::polynomial::fading::switch::memory_length_constant;
+use crate::polynomial::options::check_not_started;
+use crate::polynomial::{
+    DiscountMode, Engine, ExpandingMemory, FadingMemory, PolynomialFilter, SwitchRule,
+};
+use crate::stats::{ChiSquaredOutcome, InnovationChiSquared};
+use std::collections::VecDeque;
+
+/// The automatic polynomial filter (see the [module docs](crate::polynomial::automatic)).
+/// Configured like the other filters: [`with_defaults`](Self::with_defaults) with the required
+/// degree, `θ` and `τ`, then `with_*` builders, each checked. It implements
+/// [`PolynomialFilter`]; the per-sample flags are in [`last_output`](Self::last_output).
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::{AutomaticFilter, Phase};
+/// let mut f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap(); // σ estimated
+/// for n in 0..200 {
+///     let t = n as f64 * 1.1;
+///     let noise = 0.2 * (((n * 37 + 11) % 17) as f64 / 8.0 - 1.0);
+///     f.update(t, 3.0 - t + 0.01 * t * t + noise).unwrap();
+/// }
+/// assert_eq!((f.active_degree(), f.phase()), (2, Phase::Fading));
+/// assert_eq!(f.samples() + f.rejected(), 200);
+/// assert!(f.noise_sigma().unwrap() > 0.05 && f.noise_sigma().unwrap() < 0.2);
+/// let p = f.estimate_at(f.last_time().unwrap() + 1.0).unwrap(); // 1-step prediction
+/// assert_eq!(p.derivatives.len(), 3);
+/// assert!(!f.is_misfit() && f.restarts() == 0 && f.last_restart().is_none());
+/// ```
+#[derive(Clone, Debug)]
+pub struct AutomaticFilter {
+    pub(super) cfg: AutoConfig,
+    /// Expanding-memory filters of the ladder, indexed by degree `< m` (`None` once passed).
+    pub(super) ladder: Vec<Option<ExpandingMemory>>,
+    /// The final-degree expanding-memory filter of the current memory, until the switch.
+    pub(super) expanding: Option<ExpandingMemory>,
+    /// The final-degree fading-memory filter of the current memory.
+    pub(super) fading: FadingMemory,
+    pub(super) active: usize,
+    /// Global index (accepted samples) of the latest expanding → fading switch.
+    switched_at: Option<u64>,
+    /// The current memory has switched to fading.
+    pub(super) switched: bool,
+    /// Time of the first sample of the current final-degree memory.
+    pub(super) memory_t_first: Option<f64>,
+    /// `c` of a constant switch rule (`n_s = ⌊c/(1-θ)⌋`), and `c_0m` for Reyneke's `N`.
+    pub(super) switch_constant: Option<f64>,
+    pub(super) memory_constant: f64,
+    pub(super) accepted: u64,
+    rejected: u64,
+    pub(super) restarts: u64,
+    pub(super) last_restart: Option<u64>,
+    last_time: Option<f64>,
+    noise: NoiseState,
+    pub(super) chi: InnovationChiSquared,
+    pub(super) restart_test: Option<InnovationChiSquared>,
+    /// The newest accepted samples (for a restart).
+    pub(super) recent: VecDeque<Kept>,
+    /// The current run of rejected samples.
+    pending: Vec<Kept>,
+    /// Consecutive updates the candidate's top derivative stayed within its 1σ.
+    pub(super) stable_runs: usize,
+    pub(super) prev_top: Option<f64>,
+    /// The output of the newest update.
+    last_output: Option<AutoOutput>,
+}
+
+/// An expanding-memory filter of degree `m` tracking its covariance for unit noise (its VRF).
+pub(super) fn unit_expanding(m: usize, engine: Engine) -> Result<ExpandingMemory, Error> {
+    ExpandingMemory::new(m, engine)?.with_noise_sigma(1.0)
+}
+
+/// The final-degree fading-memory filter of `cfg`, tracking its VRF.
+pub(super) fn unit_fading(cfg: &AutoConfig) -> Result<FadingMemory, Error> {
+    FadingMemory::new(cfg.degree, cfg.theta, cfg.tau, cfg.engine)?
+        .with_discount_mode(cfg.discount)?
+        .with_switch_rule(cfg.switch_rule)?
+        .with_noise_sigma(1.0)
+}
+
+/// The `with_*` builders of [`AutomaticFilter`]: each changes the fields of its
+/// [`AutoConfig`] given on the right, and checks every setting again (an error after the first
+/// sample).
+macro_rules! builders {
+    ($($(#[$doc:meta])* $name:ident($($arg:ident: $ty:ty),+) => $($field:ident = $value:expr),+;)+) => {
+        $(
+            $(#[$doc])*
+            pub fn $name(self, $($arg: $ty),+) -> Result<Self, Error> {
+                self.reconfigure(|c| {
+                    $(c.$field = $value;)+
+                })
+            }
+        )+
+    };
+}
+
+impl AutomaticFilter {
+    /// The filter of a checked configuration.
+    fn build(config: AutoConfig) -> Result<Self, Error> {
+        config.validate()?;
+        let chi = InnovationChiSquared::new(config.misfit_window, config.misfit_alpha)?;
+        let restart_test = match config.misfit_response {
+            MisfitResponse::Flag => None,
+            MisfitResponse::Restart { alpha } => {
+                Some(InnovationChiSquared::new(config.misfit_window, alpha)?)
+            }
+        };
+        let m = config.degree;
+        let ladder = (0..m)
+            .map(|d| {
+                if d >= config.start_degree {
+                    unit_expanding(d, config.engine).map(Some)
+                } else {
+                    Ok(None)
+                }
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let expanding = Some(unit_expanding(m, config.engine)?);
+        let fading = unit_fading(&config)?;
+        let noise = NoiseState::new(config.noise_sigma, config.noise_source, m)?;
+        Ok(Self {
+            active: config.start_degree,
+            memory_constant: memory_length_constant(0, m),
+            switch_constant: config.switch_rule.asymptotic_constant(m),
+            cfg: config,
+            ladder,
+            expanding,
+            fading,
+            switched_at: None,
+            switched: false,
+            memory_t_first: None,
+            accepted: 0,
+            rejected: 0,
+            restarts: 0,
+            last_restart: None,
+            last_time: None,
+            noise,
+            chi,
+            restart_test,
+            recent: VecDeque::new(),
+            pending: Vec::new(),
+            stable_runs: 0,
+            prev_top: None,
+            last_output: None,
+        })
+    }
+
+    /// A filter with the given configuration. Old style, kept for existing callers: use
+    /// [`with_defaults`](Self::with_defaults) and the `with_*` builders.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter};
+    /// use seqsmooth::Error;
+    /// assert!(matches!(
+    ///     AutomaticFilter::new(AutoConfig::new(2, 1.5, 1.0)),
+    ///     Err(Error::ThetaOutOfRange { .. })
+    /// ));
+    /// ```
+    #[doc(hidden)]
+    pub fn new(config: AutoConfig) -> Result<Self, Error> {
+        Self::build(config)
+    }
+
+    /// A filter of final degree `m`, discount `θ ∈ (0,1)` per nominal interval `τ > 0`, with
+    /// every other setting at its default (see [`AutoConfig`]); change them with the `with_*`
+    /// builders before the first sample.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// use seqsmooth::Error;
+    /// let mut f = AutomaticFilter::with_defaults(2, 0.95, 0.5).unwrap();
+    /// let out = f.update(0.0, 1.0).unwrap();
+    /// assert_eq!(out.degree, 0);                       // the ladder starts at degree 0
+    /// assert_eq!(out.derivatives(), Some(&[1.0][..]));
+    /// assert!(out.noise_sigma.is_none());               // not estimated yet
+    /// assert!(matches!(AutomaticFilter::with_defaults(2, 1.5, 1.0), Err(Error::ThetaOutOfRange { .. })));
+    /// ```
+    pub fn with_defaults(m: usize, theta: f64, tau: f64) -> Result<Self, Error> {
+        Self::build(AutoConfig::new(m, theta, tau))
+    }
+
+    /// The same filter with one setting changed and every setting checked again; an error
+    /// after the first sample.
+    fn reconfigure(self, change: impl FnOnce(&mut AutoConfig)) -> Result<Self, Error> {
+        check_not_started(self.last_time.is_some(), "the automatic filter's settings")?;
+        let mut config = self.cfg;
+        change(&mut config);
+        Self::build(config)
+    }
+
+    builders! {
+        /// The engine of every internal filter (default [`Engine::Exact`], right on irregular
+        /// samples).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// use seqsmooth::Engine;
+        /// let mut exact = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(1.0).unwrap();
+        /// let mut gain = exact.clone().with_engine(Engine::Gain).unwrap();
+        /// for n in 0..60 {
+        ///     exact.update(n as f64, 0.5 * n as f64).unwrap();
+        ///     gain.update(n as f64, 0.5 * n as f64).unwrap();
+        /// }
+        /// // on even samples the engines agree
+        /// let (a, b) = (exact.estimate().unwrap(), gain.estimate().unwrap());
+        /// assert!((a.derivatives[1] - b.derivatives[1]).abs() < 1e-9);
+        /// ```
+        with_engine(engine: Engine) => engine = engine;
+
+        /// Discounting by time (default [`DiscountMode::PerTime`]) or by sample.
+        ///
+        /// ```
+        /// # use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// use seqsmooth::DiscountMode;
+        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0)?.with_discount_mode(DiscountMode::PerUpdate)?;
+        /// assert_eq!(f.config().discount, DiscountMode::PerUpdate);
+        /// # Ok::<(), seqsmooth::Error>(())
+        /// ```
+        with_discount_mode(mode: DiscountMode) => discount = mode;
+
+        /// When the final degree moves from expanding to fading memory (default
+        /// [`SwitchRule::Position`]); checked for the degree.
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// use seqsmooth::polynomial::SwitchRule;
+        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// assert!(f.clone().with_switch_rule(SwitchRule::Derivative(2)).is_err());
+        /// let mut f = f.with_switch_rule(SwitchRule::AtSample(5)).unwrap().with_noise_sigma(1.0).unwrap();
+        /// for n in 0..10 {
+        ///     f.update(n as f64, n as f64).unwrap();
+        /// }
+        /// assert_eq!(f.switched_at(), Some(5));
+        /// ```
+        with_switch_rule(rule: SwitchRule) => switch_rule = rule;
+
+        /// The measurement noise `σ > 0`, when known (by default it is estimated, see
+        /// [`with_noise_source`](Self::with_noise_source)).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// assert!(f.clone().with_noise_sigma(0.0).is_err());
+        /// assert_eq!(f.with_noise_sigma(0.3).unwrap().noise_sigma(), Some(0.3));
+        /// ```
+        with_noise_sigma(sigma: f64) => noise_sigma = Some(sigma);
+
+        /// How `σ` is estimated when not given (default [`NoiseSource::Differences`] over all
+        /// samples).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::{AutomaticFilter, NoiseSource};
+        /// let source = NoiseSource::Innovations { window: None };
+        /// match AutomaticFilter::with_defaults(1, 0.9, 1.0).and_then(|f| f.with_noise_source(source)) {
+        ///     Ok(f) => assert_eq!(f.config().noise_source, source),
+        ///     Err(e) => panic!("{e}"),
+        /// }
+        /// ```
+        with_noise_source(source: NoiseSource) => noise_source = source;
+
+        /// The outlier gate (default [`OutlierRule::morrison`]).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::{AutomaticFilter, OutlierRule};
+        /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap()
+        ///     .with_noise_sigma(0.1).unwrap()
+        ///     .with_outlier_rule(OutlierRule::Off).unwrap();
+        /// let flags: Vec<bool> = [1.0, 1.0, 1.0, 50.0].iter().enumerate()
+        ///     .map(|(n, y)| f.update(n as f64, *y).unwrap().outlier)
+        ///     .collect();
+        /// assert_eq!(flags, [false; 4]); // no gate: the spike is taken
+        /// ```
+        with_outlier_rule(rule: OutlierRule) => outliers = rule;
+
+        /// The gate is applied only while the 1-step prediction VRF is at most `v > 0` (default
+        /// [`GATE_MAX_VRF`](super::GATE_MAX_VRF); infinity: always).
+        ///
+        /// ```
+        /// # fn main() -> Result<(), seqsmooth::Error> {
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let always = AutomaticFilter::with_defaults(1, 0.9, 1.0)?.with_gate_max_vrf(f64::INFINITY)?;
+        /// assert!(always.config().gate_max_vrf.is_infinite());
+        /// assert!(always.with_gate_max_vrf(-1.0).is_err());
+        /// # Ok(())
+        /// # }
+        /// ```
+        with_gate_max_vrf(v: f64) => gate_max_vrf = v;
+
+        /// A run of `n` consecutive rejections is a manoeuvre, applied after all (`0`: never;
+        /// default 3).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap()
+        ///     .with_max_consecutive_rejections(0).unwrap();
+        /// for n in 0..20 { f.update(n as f64, 0.0).unwrap(); }
+        /// for n in 20..30 { f.update(n as f64, 10.0).unwrap(); } // a step, never accepted
+        /// assert_eq!(f.rejected(), 10);
+        /// ```
+        with_max_consecutive_rejections(n: usize) => max_consecutive_rejections = n;
+
+        /// The innovation chi-squared window `K ≥ 1` (default 10).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// for (k, ok) in [(0, false), (1, true), (50, true)] {
+        ///     assert_eq!(AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_misfit_window(k).is_ok(), ok);
+        /// }
+        /// ```
+        with_misfit_window(window: usize) => misfit_window = window;
+
+        /// The per-sample false-alarm rate `α ∈ (0,1)` of the misfit test (default 0.01).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// let ok: Vec<bool> = [0.0, 0.05, 1.0].iter().map(|&a| f.clone().with_misfit_alpha(a).is_ok()).collect();
+        /// assert_eq!(ok, [false, true, false]);
+        /// ```
+        with_misfit_alpha(alpha: f64) => misfit_alpha = alpha;
+
+        /// What the filter does when the model no longer fits (default
+        /// [`MisfitResponse::Restart`] at `α = 10⁻⁴`).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::{AutomaticFilter, MisfitResponse};
+        /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+        /// let e = f.clone().with_misfit_response(MisfitResponse::Restart { alpha: 1.0 }).unwrap_err();
+        /// assert!(e.to_string().contains("restart significance"));
+        /// let flag = f.with_misfit_response(MisfitResponse::Flag).unwrap();
+        /// assert_eq!(flag.config().misfit_response, MisfitResponse::Flag);
+        /// ```
+        with_misfit_response(response: MisfitResponse) => misfit_response = response;
+
+        /// The first degree `d₀ ≤ m` of the quick-settling ladder (default 0; `m` disables it).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap();
+        /// assert!(f.clone().with_start_degree(3).is_err());
+        /// assert_eq!(f.with_start_degree(2).unwrap().active_degree(), 2);
+        /// ```
+        with_start_degree(degree: usize) => start_degree = degree;
+
+        /// The ladder's candidate degree takes over once its current position VRF is at most
+        /// `vrf > 0` (default ½) and its top derivative moved by less than its 1σ at each of
+        /// `stable` updates (default 3).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap();
+        /// assert!(f.clone().with_settling(0.0, 3).is_err());
+        /// let c = f.with_settling(0.25, 5).unwrap().config().clone();
+        /// assert_eq!((c.settle_vrf, c.settle_stable), (0.25, 5));
+        /// ```
+        with_settling(vrf: f64, stable: usize) => settle_vrf = vrf, settle_stable = stable;
+    }
+
+    /// The settings.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let f = AutomaticFilter::with_defaults(2, 0.9, 0.5).unwrap();
+    /// assert_eq!((f.config().degree, f.config().theta, f.config().tau), (2, 0.9, 0.5));
+    /// ```
+    pub fn config(&self) -> &AutoConfig {
+        &self.cfg
+    }
+
+    /// The final degree `m`.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// assert_eq!(AutomaticFilter::with_defaults(3, 0.9, 1.0).unwrap().degree(), 3);
+    /// ```
+    pub fn degree(&self) -> usize {
+        self.cfg.degree
+    }
+
+    /// The active degree (below `m` while the ladder settles).
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// assert_eq!(AutomaticFilter::with_defaults(3, 0.9, 1.0).unwrap().active_degree(), 0);
+    /// ```
+    pub fn active_degree(&self) -> usize {
+        self.active
+    }
+
+    /// Which filter is active.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::{AutomaticFilter, Phase};
+    /// let f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_start_degree(1).unwrap();
+    /// assert_eq!(f.phase(), Phase::Expanding);
+    /// ```
+    pub fn phase(&self) -> Phase {
+        if self.active < self.cfg.degree {
+            Phase::Settling
+        } else if !self.switched {
+            Phase::Expanding
+        } else {
+            Phase::Fading
+        }
+    }
+
+    /// Accepted samples (those that updated the state).
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+    /// for n in 0..40 {
+    ///     f.update(n as f64, if n == 30 { 100.0 } else { 1.0 }).unwrap();
+    /// }
+    /// assert_eq!((f.samples(), f.rejected()), (39, 1)); // the spike at n = 30 was rejected
+    /// ```
+    pub fn samples(&self) -> u64 {
+        self.accepted
+    }
+
+    /// Samples rejected as outliers (not counting runs later applied as manoeuvres); see
+    /// [`samples`](Self::samples).
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+    /// for n in 0..40 { f.update(n as f64, if n == 30 { 100.0 } else { 1.0 }).unwrap(); }
+    /// assert_eq!(f.rejected(), 1);
+    /// ```
+    pub fn rejected(&self) -> u64 {
+        self.rejected
+    }
+
+    /// Restarts of the final-degree memory ([`MisfitResponse::Restart`]); see the example there.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// assert_eq!(AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().restarts(), 0);
+    /// ```
+    pub fn restarts(&self) -> u64 {
+        self.restarts
+    }
+
+    /// The index (in accepted samples) of the newest sample when the latest restart happened;
+    /// see [`MisfitResponse::Restart`].
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// assert_eq!(AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().last_restart(), None);
+    /// ```
+    pub fn last_restart(&self) -> Option<u64> {
+        self.last_restart
+    }
+
+    /// The time of the newest sample seen (accepted or rejected).
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+    /// assert_eq!(f.last_time(), None);
+    /// f.update(2.5, 1.0).unwrap();
+    /// assert_eq!(f.last_time(), Some(2.5));
+    /// ```
+    pub fn last_time(&self) -> Option<f64> {
+        self.last_time
+    }
+
+    /// The output of the newest [`update`](Self::update) (also when it came through
+    /// [`PolynomialFilter`]): the estimate and the per-sample flags (outlier, misfit, noise `σ`
+    /// in use, phase). `None` before the first sample.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::{AutomaticFilter, Phase};
+    /// use seqsmooth::PolynomialFilter;
+    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+    /// assert!(f.last_output().is_none());
+    /// let times: Vec<f64> = (0..60).map(f64::from).collect();
+    /// let values: Vec<f64> = times.iter().map(|t| if *t == 50.0 { 9.0 } else { 0.5 * t }).collect();
+    /// f.update_many(&times[..51], &values[..51]).unwrap(); // through the trait
+    /// let out = f.last_output().unwrap();
+    /// assert!(out.outlier && out.time == 50.0 && out.phase == Phase::Fading);
+    /// assert_eq!(out.noise_sigma, Some(0.1));
+    /// ```
+    pub fn last_output(&self) -> Option<&AutoOutput> {
+        self.last_output.as_ref()
+    }
+
+    /// The 0-based index, in accepted samples since the first, of the first sample the
+    /// fading-memory filter produced the output for (the latest switch, after a restart);
+    /// `None` before the switch. See [`Phase`].
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(1.0).unwrap();
+    /// for n in 0..40 { f.update(n as f64, n as f64).unwrap(); }
+    /// assert_eq!(f.switched_at(), Some(32)); // Morrison (13.8.8)
+    /// ```
+    pub fn switched_at(&self) -> Option<u64> {
+        self.switched_at
+    }
+
+    /// The noise `σ` in use: the given one, or the running estimate once it has
+    /// [`MIN_NOISE_TERMS`](super::MIN_NOISE_TERMS) terms.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// assert_eq!(AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().noise_sigma(), None);
+    /// ```
+    pub fn noise_sigma(&self) -> Option<f64> {
+        self.noise.sigma()
+    }
+
+    /// True while the innovation chi-squared window exceeds its threshold (see
+    /// [`MisfitResponse::Flag`]).
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// assert!(!AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().is_misfit());
+    /// ```
+    pub fn is_misfit(&self) -> bool {
+        self.chi.is_misfit()
+    }
+
+    pub(super) fn final_filter(&self) -> &dyn PolynomialFilter {
+        match (&self.expanding, self.switched) {
+            (Some(e), false) => e,
+            _ => &self.fading,
+        }
+    }
+
+    pub(super) fn filter(&self, degree: usize) -> Option<&dyn PolynomialFilter> {
+        if degree < self.cfg.degree {
+            self.ladder[degree]
+                .as_ref()
+                .map(|f| f as &dyn PolynomialFilter)
+        } else {
+            Some(self.final_filter())
+        }
+    }
+
+    pub(super) fn active_filter(&self) -> &dyn PolynomialFilter {
+        self.filter(self.active)
+            .unwrap_or_else(|| self.final_filter())
+    }
+
+    fn scale(&self, state: PolynomialState) -> PolynomialState {
+        let sigma = self.noise_sigma();
+        PolynomialState {
+            covariance: match (state.covariance, sigma) {
+                (Some(c), Some(s)) => Some(c * (s * s)),
+                _ => None,
+            },
+            ..state
+        }
+    }
+
+    /// The estimate at any time `t` from the active filter (a prediction after the newest
+    /// accepted sample), with covariance `σ²·VRF` when `σ` is available.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_start_degree(1).unwrap();
+    /// f.update(0.0, 1.0).unwrap();
+    /// f.update(1.0, 3.0).unwrap();
+    /// assert!((f.estimate_at(2.0).unwrap().derivatives[0] - 5.0).abs() < 1e-12);
+    /// ```
+    pub fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
+        self.active_filter().estimate_at(t).map(|s| self.scale(s))
+    }
+
+    /// The estimate at the newest accepted sample.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+    /// assert!(f.estimate().is_none());
+    /// f.update(0.0, 1.0).unwrap();
+    /// assert_eq!(f.estimate().unwrap().derivatives, vec![1.0]);
+    /// ```
+    pub fn estimate(&self) -> Option<PolynomialState> {
+        self.active_filter().estimate().map(|s| self.scale(s))
+    }
+
+    /// Processes the sample `y` at time `t` (finite, strictly after the previous sample's time,
+    /// rejected or not) and returns (and keeps, see [`last_output`](Self::last_output)) what it
+    /// did. On error nothing changes.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// use seqsmooth::Error;
+    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+    /// f.update(0.0, 1.0).unwrap();
+    /// assert!(matches!(f.update(0.0, 2.0), Err(Error::TimeNotIncreasing { .. })));
+    /// assert!(matches!(f.update(1.0, f64::NAN), Err(Error::NonFinite { .. })));
+    /// assert_eq!(f.samples(), 1);
+    /// ```
+    pub fn update(&mut self, t: f64, y: f64) -> Result<AutoOutput, Error> {
+        crate::error::check_sample(t, y, self.last_time)?;
+        // With the input checked, the steps below cannot fail on the data; should an internal
+        // step still fail, restore the state so that an error never leaves a half update.
+        let backup = self.clone();
+        match self.step(t, y) {
+            Ok(out) => {
+                self.last_output = Some(out.clone());
+                Ok(out)
+            }
+            Err(e) => {
+                *self = backup;
+                Err(e)
+            }
+        }
+    }
+
+    fn step(&mut self, t: f64, y: f64) -> Result<AutoOutput, Error> {
+        self.last_time = Some(t);
+        let m = self.cfg.degree;
+        if self.switch_due(t)? {
+            self.switched = true;
+            self.switched_at = Some(self.accepted);
+            self.expanding = None;
+        }
+        let sigma = self.noise_sigma();
+        let prediction = self.active_filter().estimate_at(t);
+        let (innovation, vrf) = match &prediction {
+            Some(p) => (
+                Some(y - p.derivatives[0]),
+                p.covariance.as_ref().map(|c| c[(0, 0)].max(0.0)),
+            ),
+            None => (None, None),
+        };
+        let innovation_sigma = match (sigma, vrf) {
+            (Some(s), Some(v)) => Some(s * (1.0 + v).sqrt()),
+            _ => None,
+        };
+        let k2 = match (innovation, innovation_sigma) {
+            (Some(nu), Some(se)) if se > 0.0 => Some((nu / se).powi(2)),
+            _ => None,
+        };
+        let gate = self.gate(sigma, vrf, t);
+        let rejected = match (gate, innovation) {
+            (Some(g), Some(nu)) => nu.abs() > g,
+            _ => false,
+        };
+        let mut manoeuvre = false;
+        let mut restart = false;
+        let mut chi_out = None;
+        if rejected {
+            self.pending.push(Kept { t, y, k2 });
+            let limit = self.cfg.max_consecutive_rejections;
+            if limit > 0 && self.pending.len() >= limit {
+                // A run of rejections: the model, not the samples, is wrong. Apply the run.
+                manoeuvre = true;
+                let run = std::mem::take(&mut self.pending);
+                // The earlier members of the run were counted as rejections; they are not.
+                self.rejected -= (run.len() - 1) as u64;
+                for p in run {
+                    chi_out = self.accept(p, None, true)?.or(chi_out);
+                }
+                if self.restart_test.is_some() && self.active == m {
+                    self.restart()?;
+                    restart = true;
+                }
+            } else {
+                self.rejected += 1;
+            }
+        } else {
+            self.pending.clear();
+            let truncation = match (gate, innovation_sigma, vrf) {
+                (Some(g), Some(se), Some(v)) if se > 0.0 => Some((g / se, v)),
+                _ => None,
+            };
+            chi_out = self.accept(Kept { t, y, k2 }, truncation, false)?;
+            if self.active == m && self.restart_test.as_ref().is_some_and(|r| r.is_misfit()) {
+                self.restart()?;
+                restart = true;
+            }
+        }
+        let outlier = rejected && !manoeuvre;
+        let estimate = if outlier {
+            self.estimate_at(t)
+        } else {
+            self.estimate()
+        };
+        Ok(AutoOutput {
+            time: t,
+            estimate,
+            degree: self.active,
+            phase: self.phase(),
+            noise_sigma: self.noise_sigma(),
+            innovation,
+            innovation_sigma,
+            gate,
+            outlier,
+            misfit: manoeuvre || restart || self.chi.is_misfit(),
+            manoeuvre,
+            restart,
+            chi_squared: chi_out,
+        })
+    }
+
+    /// Applies an accepted sample to every filter, the noise estimate and the misfit window;
+    /// then lets the ladder step up. `truncation` is `(a, v)`, the gate half-width in units of
+    /// `σ_ε` and the prediction VRF, when the gate was active (the noise estimates correct for
+    /// the truncation); `manoeuvre` marks a run of rejections applied after all (left out of the
+    /// innovation noise estimate).
+    fn accept(
+        &mut self,
+        sample: Kept,
+        truncation: Option<(f64, f64)>,
+        manoeuvre: bool,
+    ) -> Result<Option<ChiSquaredOutcome>, Error> {
+        let Kept { t, y, k2 } = sample;
+        // The final-degree filter's own normalised innovation ν²/(1+v), whatever degree is
+        // active (for the innovation noise estimate).
+        let innovation = if self.noise.wants_innovations() {
+            self.final_filter().estimate_at(t).and_then(|p| {
+                let v = p.covariance.as_ref()?[(0, 0)].max(0.0);
+                let nu = y - p.derivatives[0];
+                Some(nu * nu / (1.0 + v))
+            })
+        } else {
+            None
+        };
+        self.noise.push(t, y, innovation, truncation, manoeuvre)?;
+        for f in self.ladder.iter_mut().flatten() {
+            f.update(t, y)?;
+        }
+        if let Some(f) = &mut self.expanding {
+            f.update(t, y)?;
+        }
+        self.fading.update(t, y)?;
+        if self.memory_t_first.is_none() {
+            self.memory_t_first = Some(t);
+        }
+        self.accepted += 1;
+        self.recent.push_back(sample);
+        let keep = self.cfg.misfit_window.max(2 * (self.cfg.degree + 1));
+        while self.recent.len() > keep {
+            self.recent.pop_front();
+        }
+        let chi_out = match k2 {
+            Some(k2) => {
+                if let Some(r) = &mut self.restart_test {
+                    r.push_normalised(k2)?;
+                }
+                Some(self.chi.push_normalised(k2)?)
+            }
+            None => None,
+        };
+        self.settle();
+        Ok(chi_out)
+    }
+}
+
+/// The automatic filter through the common trait: the same estimates as its own methods
+/// ([`AutomaticFilter::estimate`] is the estimate at the newest *accepted* sample), `samples`
+/// counts accepted samples, and the estimates have the active degree's `d+1` derivatives
+/// (fewer than `m+1` while the ladder settles). The flags of each sample are in
+/// [`AutomaticFilter::last_output`].
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::AutomaticFilter;
+/// use seqsmooth::PolynomialFilter;
+/// let auto = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+/// let mut f: Box<dyn PolynomialFilter> = Box::new(auto);
+/// for n in 0..100 {
+///     f.update(n as f64, 2.0 + 0.5 * n as f64).unwrap();
+/// }
+/// let s = f.estimate().unwrap();
+/// assert!((s.derivatives[1] - 0.5).abs() < 1e-9 && f.is_determined() && f.samples() == 100);
+/// ```
+impl PolynomialFilter for AutomaticFilter {
+    fn degree(&self) -> usize {
+        AutomaticFilter::degree(self)
+    }
+    fn samples(&self) -> u64 {
+        AutomaticFilter::samples(self)
+    }
+    fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
+        AutomaticFilter::update(self, t, y).map(drop)
+    }
+    fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
+        AutomaticFilter::estimate_at(self, t)
+    }
+    fn last_time(&self) -> Option<f64> {
+        AutomaticFilter::last_time(self)
+    }
+    fn estimate(&self) -> Option<PolynomialState> {
+        AutomaticFilter::estimate(self)
+    }
+    fn is_determined(&self) -> bool {
+        self.active_filter().is_determined()
+    }
+}

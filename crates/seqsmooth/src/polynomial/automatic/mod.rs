@@ -1,0 +1,121 @@
+//! The automatic polynomial filter: a fading-memory filter that starts itself, settles its
+//! degree, estimates its noise, rejects outliers and says when its model no longer fits
+//! (Morrison §13.8, §14.8; Reyneke et al. §7.2-7.4).
+//!
+//! Per sample `(t, y)` ([`AutomaticFilter::update`]):
+//!
+//! 1. **Prediction and innovation.** The active filter predicts `ŷ(t)` with its own covariance;
+//!    the innovation `ν = y − ŷ(t)` has variance `σ_ε² = σ²(1 + v)`, `v` the 1-step prediction's
+//!    position VRF (Morrison (14.8.4)); `σ` is the given noise or its running estimate.
+//! 2. **Outlier gate** ([`OutlierRule`]): Morrison's `|ν| > k σ_ε` (default `k = 3`, false-alarm
+//!    rate `P(|Z| > 3) = 0.27%`), or Reyneke's `|ν| > k σ (1 + √(2/N))` (§7.4). A rejected sample
+//!    does not touch the state — the estimate is the prediction across it — and is flagged
+//!    [`AutoOutput::outlier`]. A run of [`AutoConfig::max_consecutive_rejections`] rejections is
+//!    taken for a manoeuvre, not outliers: the run is applied after all (in order), and the
+//!    misfit flag goes up. The gate is active only at the final degree, once `σ` is known and the
+//!    prediction VRF `v ≤` [`AutoConfig::gate_max_vrf`] (default 1: the prediction is at least
+//!    as good as a sample; Reyneke's rule, which ignores `v`, needs this to keep its false-alarm
+//!    rate down, see [`REYNEKE_DEFAULT_K`]).
+//! 3. **Misfit** ([`crate::stats::InnovationChiSquared`], Morrison §14.8): the normalised squared
+//!    innovations `ν²/σ_ε²` of accepted samples, summed over a sliding window of `K` samples, are
+//!    `χ²_K` while the model fits; [`AutoOutput::misfit`] is up while the sum exceeds its
+//!    `(1-α)` quantile (defaults `K = 10`, `α = 0.01`). The response ([`MisfitResponse`],
+//!    Morrison: "β can be temporarily reduced until the threshold crossings cease"): by default
+//!    the final-degree memory is restarted from the samples since the estimated onset when the
+//!    same window sum passes the stricter `(1-10⁻⁴)` quantile, and grows back through the
+//!    expanding start; or the flag is only raised ([`MisfitResponse::Flag`]), and the memory
+//!    carries the manoeuvre's bias until it fades (about two memory lengths).
+//! 4. **Update** of every filter the automatic filter runs, with the accepted sample:
+//!    - **Quick-settling degree ladder** (Reyneke §7.3): expanding-memory filters of degrees
+//!      `d₀ … m` (default `d₀ = 0`) run in tandem from the first sample; the active degree `d`
+//!      steps up to `d+1` once the candidate's current position VRF is at most
+//!      [`AutoConfig::settle_vrf`] (default ½) and its top derivative has changed by less than its
+//!      own 1σ at each of the last [`AutoConfig::settle_stable`] updates (default 3); it steps up
+//!      at once when the active degree's misfit flag goes up (the lower degree does not fit). The
+//!      misfit window restarts at each step.
+//!    - **Expanding → fading memory** (Morrison §13.8; Reyneke §7.2, Table 1): at the final
+//!      degree `m` the expanding-memory filter is used until the sample index chosen by the
+//!      [`SwitchRule`] (default [`SwitchRule::Position`], `n = ⌊c_0m/(1-θ)⌋`), and the
+//!      fading-memory filter from then on. The rules count samples, so with
+//!      [`DiscountMode::PerTime`] they use the discount per sample `θ^ζ̄`, `ζ̄` the mean step so far
+//!      in units of `τ`, re-evaluated at each sample until the switch — as the gain engine of
+//!      [`FadingMemory`] does. Indices count *accepted* samples. With the default
+//!      [`Engine::Exact`] the fading-memory filter is exact discounted least squares over all
+//!      accepted samples (weights `θ^((t_n−t_k)/τ)`), run in tandem from the first sample, so
+//!      there is no start-up transient; the expanding start is used because its variance is the
+//!      lower one until the crossover.
+//! 5. **Noise** ([`NoiseSource`]): a given `σ`, or (default) the running estimate from the
+//!    normalised `(m+1)`-th divided differences of the accepted samples
+//!    ([`crate::stats::DifferenceNoise`]): unbiased for white noise about any polynomial of
+//!    degree `≤ m` on any timestamps; biased upward by the trend's `(m+1)`-th derivative
+//!    (`E{d²} = σ² + b²`, `b ≈ x^(m+1) Δt^(m+1)/√C(2m+2,m+1)` — negligible unless the samples
+//!    are sparse on the manoeuvre's time scale) and by outliers that pass the gate (each
+//!    contributes `a²/N` to `σ̂²` for an outlier of size `a`; before the gate is active all samples
+//!    pass). The gate truncates the noise of the samples it passes (for `k = 3`, `σ̂` would be
+//!    1.4% low); each gated sample enters with its expected truncated variance
+//!    `σ²(c(a) + v)/(1 + v)`, `c(a)` the variance of a unit Gaussian cut at `±a = ±g/σ_ε`, which
+//!    removes that bias. Alternatively the innovations of the final-degree filter
+//!    ([`NoiseSource::Innovations`]): `σ̂² = mean(ν²/(1+v))`, corrected for the gate's truncation;
+//!    without gating and before the switch it equals the expanding-memory fit's residual
+//!    variance `e°/(N−m−1)` (Morrison (6.10.24)) exactly, but every unmodelled manoeuvre inflates
+//!    it (by the squared bias of the predictions).
+//!
+//! Every filter inside tracks its covariance for unit noise (the VRF); the reported covariance
+//! is `σ²` times it, with the given or the estimated `σ`.
+//!
+//! ## Configuration and use
+//!
+//! Like the other filters: [`AutomaticFilter::with_defaults`] with the required degree `m`,
+//! discount `θ` and interval `τ`, then checked `with_*` builders ([`AutomaticFilter::with_noise_sigma`],
+//! [`AutomaticFilter::with_outlier_rule`], …; the settings are read back as an [`AutoConfig`]).
+//! It implements [`PolynomialFilter`](crate::PolynomialFilter), so it can stand wherever another
+//! filter does; each sample's flags are in [`AutomaticFilter::last_output`] (or returned by its
+//! own [`AutomaticFilter::update`]).
+//!
+//! | concept | module | source |
+//! |---|---|---|
+//! | settings and their checks: [`AutoConfig`], [`GATE_MAX_VRF`] | `config` | — |
+//! | prediction, innovation, acceptance: [`AutomaticFilter`] | `filter` | Morrison (14.8.1)-(14.8.4) |
+//! | what each sample did: [`AutoOutput`] | `output` | — |
+//! | outlier gate: [`OutlierRule`], [`MORRISON_K`], [`REYNEKE_DEFAULT_K`]; truncated variance | `outlier` | Morrison §14.8, (14.8.4); Reyneke §7.4 |
+//! | noise `σ`: [`NoiseSource`], [`MIN_NOISE_TERMS`] | `noise` | Reyneke §7.1; Morrison (6.10.24), (14.8.4); [`crate::stats::DifferenceNoise`] |
+//! | misfit and restart: [`MisfitResponse`], CUSUM onset | `misfit` | Morrison §14.8, (14.8.5); [`crate::stats::InnovationChiSquared`] |
+//! | degree settling (the ladder) | `settle` | Reyneke §7.3 |
+//! | expanding → fading switch: [`Phase`] | `phase` | Morrison §13.8, (13.8.8), Table 13.4; Reyneke §7.2, Table 1 |
+//!
+//! ```
+//! use seqsmooth::polynomial::automatic::AutomaticFilter;
+//! let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+//! let mut flagged = Vec::new();
+//! for n in 0..200 {
+//!     let t = n as f64;
+//!     let noise = 0.1 * (((n * 37 + 11) % 17) as f64 / 8.0 - 1.0); // a bounded "noise"
+//!     let y = 2.0 + 0.5 * t + noise + if n == 120 { 5.0 } else { 0.0 };
+//!     let out = f.update(t, y).unwrap();
+//!     if out.outlier { flagged.push(n); }
+//! }
+//! assert_eq!(flagged, vec![120]);                 // the 50σ spike, and nothing else
+//! assert_eq!(f.switched_at(), Some(32));          // Morrison (13.8.8): m = 1, θ = 0.9 → 32
+//! let s = f.estimate().unwrap();
+//! assert!((s.derivatives[1] - 0.5).abs() < 0.01);
+//! ```
+
+#[cfg(doc)]
+use crate::polynomial::{DiscountMode, Engine, FadingMemory, SwitchRule};
+
+mod config;
+mod filter;
+mod misfit;
+mod noise;
+mod outlier;
+mod output;
+mod phase;
+mod settle;
+
+pub use config::{AutoConfig, GATE_MAX_VRF};
+pub use filter::AutomaticFilter;
+pub use misfit::MisfitResponse;
+pub use noise::{NoiseSource, MIN_NOISE_TERMS};
+pub use outlier::{OutlierRule, MORRISON_K, REYNEKE_DEFAULT_K};
+pub use output::AutoOutput;
+pub use phase::Phase;

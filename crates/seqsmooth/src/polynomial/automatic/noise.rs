@@ -1,0 +1,220 @@
+//! Where the automatic filter's noise `σ` comes from: given, the normalised `(m+1)`-th divided
+//! differences of the accepted samples (Reyneke et al. §7.1; [`DifferenceNoise`]), or the
+//! normalised innovations of the final-degree filter (Morrison (14.8.4), (6.10.24)), each
+//! corrected for the truncation of the outlier gate.
+
+use super::outlier::truncated_variance;
+use crate::error::Error;
+use crate::stats::DifferenceNoise;
+use std::collections::VecDeque;
+
+/// Noise terms needed before an estimated `σ` is used.
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::{AutomaticFilter, MIN_NOISE_TERMS};
+/// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap(); // σ from differences
+/// for n in 0..=MIN_NOISE_TERMS {
+///     assert!(f.noise_sigma().is_none());
+///     f.update(n as f64, if n % 2 == 0 { 1.0 } else { -1.0 }).unwrap();
+/// }
+/// assert!(f.noise_sigma().is_some()); // 6 samples: MIN_NOISE_TERMS first differences
+/// ```
+pub const MIN_NOISE_TERMS: usize = 5;
+
+/// Where the noise `σ` comes from when it is not given.
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::{AutomaticFilter, NoiseSource};
+/// let f = AutomaticFilter::with_defaults(2, 0.95, 1.0).unwrap();
+/// assert_eq!(f.config().noise_source, NoiseSource::Differences { window: None });
+/// let mut f = f.with_noise_source(NoiseSource::Innovations { window: Some(200) }).unwrap();
+/// for n in 0..100 {
+///     let t = n as f64;
+///     f.update(t, 1.0 + t * t + if n % 2 == 0 { 0.5 } else { -0.5 }).unwrap();
+/// }
+/// assert!(f.noise_sigma().unwrap() > 0.4); // the ±0.5 pattern, the parabola is modelled
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NoiseSource {
+    /// Normalised `(m+1)`-th divided differences of the accepted samples
+    /// ([`crate::stats::DifferenceNoise`]), over the last `window` differences or all of them.
+    /// Model-free, unbiased on any degree-`m` trend. The default (cumulative).
+    Differences {
+        /// Sliding window length in differences; `None` for all.
+        window: Option<usize>,
+    },
+    /// Normalised innovations `ν²/(1+v)` of the final-degree filter (expanding, then fading),
+    /// over the last `window` accepted samples or all; corrected for the gate's truncation.
+    /// Inflated by unmodelled manoeuvres.
+    Innovations {
+        /// Sliding window length in samples; `None` for all.
+        window: Option<usize>,
+    },
+}
+
+impl Default for NoiseSource {
+    fn default() -> Self {
+        NoiseSource::Differences { window: None }
+    }
+}
+
+impl NoiseSource {
+    /// The window length, `None` for all terms.
+    pub(super) fn window(&self) -> Option<usize> {
+        match *self {
+            NoiseSource::Differences { window } | NoiseSource::Innovations { window } => window,
+        }
+    }
+}
+
+/// A running mean over the last `window` values (or all of them), re-summed every `4·window`
+/// pushes so that the rounding of the sliding sum does not accumulate.
+#[derive(Clone, Debug)]
+pub(super) struct WindowedMean {
+    window: Option<usize>,
+    values: VecDeque<f64>,
+    sum: f64,
+    count: usize,
+    pushes: usize,
+}
+
+impl WindowedMean {
+    fn new(window: Option<usize>) -> Self {
+        Self {
+            window,
+            values: VecDeque::new(),
+            sum: 0.0,
+            count: 0,
+            pushes: 0,
+        }
+    }
+
+    fn push(&mut self, x: f64) {
+        self.sum += x;
+        match self.window {
+            None => self.count += 1,
+            Some(w) => {
+                self.values.push_back(x);
+                if self.values.len() > w {
+                    let old = self.values.pop_front().unwrap_or(0.0);
+                    self.sum -= old;
+                }
+                self.count = self.values.len();
+                self.pushes += 1;
+                if self.pushes >= 4 * w {
+                    self.sum = self.values.iter().sum();
+                    self.pushes = 0;
+                }
+                self.sum = self.sum.max(0.0);
+            }
+        }
+    }
+
+    fn mean(&self) -> Option<f64> {
+        (self.count > 0).then(|| self.sum / self.count as f64)
+    }
+}
+
+/// The noise estimate an [`AutomaticFilter`](super::AutomaticFilter) keeps.
+#[derive(Clone, Debug)]
+pub(super) enum NoiseState {
+    Known(f64),
+    Differences(DifferenceNoise),
+    Innovations(WindowedMean),
+}
+
+impl NoiseState {
+    /// The state for a given `σ`, or an estimator of the source for degree `m`.
+    pub(super) fn new(sigma: Option<f64>, source: NoiseSource, m: usize) -> Result<Self, Error> {
+        Ok(match (sigma, source) {
+            (Some(s), _) => NoiseState::Known(s),
+            (None, NoiseSource::Differences { window }) => {
+                NoiseState::Differences(DifferenceNoise::new(m + 1, window)?)
+            }
+            (None, NoiseSource::Innovations { window }) => {
+                NoiseState::Innovations(WindowedMean::new(window))
+            }
+        })
+    }
+
+    /// True when the estimate is built from the final-degree filter's innovations (the caller
+    /// then supplies them to [`push`](Self::push)).
+    pub(super) fn wants_innovations(&self) -> bool {
+        matches!(self, NoiseState::Innovations(_))
+    }
+
+    /// `σ`: the given one, or the running estimate once it has [`MIN_NOISE_TERMS`] terms.
+    pub(super) fn sigma(&self) -> Option<f64> {
+        match self {
+            NoiseState::Known(s) => Some(*s),
+            NoiseState::Differences(d) => {
+                if d.len() >= MIN_NOISE_TERMS {
+                    d.sigma()
+                } else {
+                    None
+                }
+            }
+            NoiseState::Innovations(w) => {
+                if w.count >= MIN_NOISE_TERMS {
+                    w.mean().map(f64::sqrt)
+                } else {
+                    None
+                }
+            }
+        }
+    }
+
+    /// Adds an accepted sample `(t, y)`. `innovation` is the final-degree filter's normalised
+    /// squared innovation `ν²/(1+v)` (used by the innovation estimate); `truncation` is `(a, v)`,
+    /// the gate half-width in units of `σ_ε` and the prediction VRF, when the gate was active;
+    /// `manoeuvre` marks a run of rejections applied after all (left out of the innovation
+    /// estimate).
+    pub(super) fn push(
+        &mut self,
+        t: f64,
+        y: f64,
+        innovation: Option<f64>,
+        truncation: Option<(f64, f64)>,
+        manoeuvre: bool,
+    ) -> Result<(), Error> {
+        match self {
+            NoiseState::Known(_) => {}
+            NoiseState::Innovations(w) => {
+                // Samples the gate could have cut are divided by the truncated variance.
+                if let (Some(term), false) = (innovation, manoeuvre) {
+                    w.push(term / truncation.map_or(1.0, |(a, _)| truncated_variance(a)));
+                }
+            }
+            NoiseState::Differences(d) => {
+                // A gated sample's own noise e has E{e² | |ν| ≤ aσ_ε} = σ²(c(a) + v)/(1 + v),
+                // with c(a) the truncated unit variance (e = ν/(1+v) + an independent part).
+                let factor =
+                    truncation.map_or(1.0, |(a, v)| (truncated_variance(a) + v) / (1.0 + v));
+                d.push_with_variance_factor(t, y, factor)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::WindowedMean;
+
+    /// The sliding mean against a direct mean over the last `w` values, across the re-summing.
+    #[test]
+    fn windowed_mean_equals_the_mean_of_the_window() {
+        let xs: Vec<f64> = (0..50).map(|k| ((k * 13 % 7) as f64) * 0.25).collect();
+        let mut w = WindowedMean::new(Some(4));
+        let mut all = WindowedMean::new(None);
+        for (k, &x) in xs.iter().enumerate() {
+            w.push(x);
+            all.push(x);
+            let lo = (k + 1).saturating_sub(4);
+            let want = xs[lo..=k].iter().sum::<f64>() / (k + 1 - lo) as f64;
+            assert!((w.mean().unwrap() - want).abs() < 1e-12);
+            let want_all = xs[..=k].iter().sum::<f64>() / (k + 1) as f64;
+            assert!((all.mean().unwrap() - want_all).abs() < 1e-12);
+        }
+    }
+}

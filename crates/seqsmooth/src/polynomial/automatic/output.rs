@@ -1,0 +1,84 @@
+//! [`AutoOutput`]: what the automatic filter reports for each sample — the estimate and the
+//! per-sample flags (outlier, misfit, manoeuvre, restart), the noise `σ` in use, the phase and
+//! the innovation statistics.
+
+use super::phase::Phase;
+#[cfg(doc)]
+use super::{AutomaticFilter, MisfitResponse};
+use crate::model::PolynomialState;
+use crate::stats::ChiSquaredOutcome;
+
+/// The result of one [`AutomaticFilter::update`], kept as [`AutomaticFilter::last_output`].
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::AutomaticFilter;
+/// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap().with_noise_sigma(0.5).unwrap();
+/// let mut out = None;
+/// for n in 0..50 {
+///     out = Some(f.update(n as f64, 1.0 + 0.1 * n as f64).unwrap());
+/// }
+/// let out = out.unwrap();
+/// let x = out.derivatives().unwrap();                 // [x, x']
+/// let sd = out.std_devs().unwrap();                   // their 1σ from σ = 0.5
+/// assert!((x[1] - 0.1).abs() < 1e-9 && sd[0] < 0.5);
+/// assert_eq!(out.noise_sigma, Some(0.5));
+/// assert!(!out.outlier && !out.misfit);
+/// assert_eq!(f.last_output(), Some(&out));
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct AutoOutput {
+    /// The sample's time.
+    pub time: f64,
+    /// The estimate at `time`: derivatives `x … x^(d)` of the active degree `d`, with their
+    /// covariance when `σ` is known or estimated. After a rejected sample, the prediction
+    /// across it. `None` until the active filter is determined.
+    pub estimate: Option<PolynomialState>,
+    /// The active degree `d` (the final degree once settled).
+    pub degree: usize,
+    /// Which filter is active.
+    pub phase: Phase,
+    /// The noise `σ` used (given, or the running estimate once it has enough terms).
+    pub noise_sigma: Option<f64>,
+    /// `ν = y − ŷ(t)` against the active filter's prediction (before this sample).
+    pub innovation: Option<f64>,
+    /// `σ_ε = σ √(1 + v)`, the innovation's standard deviation.
+    pub innovation_sigma: Option<f64>,
+    /// The gate half-width applied, when the gate was active.
+    pub gate: Option<f64>,
+    /// The sample was rejected: the state was not updated.
+    pub outlier: bool,
+    /// The innovation chi-squared test says the model no longer fits (or a run of rejections
+    /// was just taken for a manoeuvre).
+    pub misfit: bool,
+    /// A run of consecutive rejections was taken for a manoeuvre and applied at this sample.
+    pub manoeuvre: bool,
+    /// The final-degree memory was restarted at this sample ([`MisfitResponse::Restart`]).
+    pub restart: bool,
+    /// The chi-squared window after this sample (when the sample entered it).
+    pub chi_squared: Option<ChiSquaredOutcome>,
+}
+
+impl AutoOutput {
+    /// The estimated derivatives `x, x', …` (active degree), when determined.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+    /// assert_eq!(f.update(0.0, 4.0).unwrap().derivatives(), Some(&[4.0][..])); // degree 0 first
+    /// ```
+    pub fn derivatives(&self) -> Option<&[f64]> {
+        self.estimate.as_ref().map(|s| s.derivatives.as_slice())
+    }
+
+    /// 1σ of each derivative, when determined and `σ` is available.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// let mut f = AutomaticFilter::with_defaults(0, 0.9, 1.0).unwrap().with_noise_sigma(2.0).unwrap();
+    /// let sd = f.update(0.0, 4.0).unwrap().std_devs().unwrap();
+    /// assert!((sd[0] - 2.0).abs() < 1e-12); // one sample: its own σ
+    /// ```
+    pub fn std_devs(&self) -> Option<Vec<f64>> {
+        self.estimate.as_ref().and_then(|s| s.std_devs())
+    }
+}

@@ -1,0 +1,44 @@
+//! The window's samples: a ring buffer of the newest `capacity` values, oldest first.
+
+/// The newest `capacity` values pushed, in arrival order.
+#[derive(Clone, Debug)]
+pub(super) struct Ring<T> {
+    buf: Vec<T>,
+    head: usize,
+    capacity: usize,
+}
+
+impl<T: Copy> Ring<T> {
+    /// An empty ring holding at most `capacity ≥ 1` values (memory is reserved as it fills).
+    pub(super) fn new(capacity: usize) -> Self {
+        Self {
+            buf: Vec::with_capacity(capacity.min(1 << 16)),
+            head: 0,
+            capacity,
+        }
+    }
+
+    /// Appends `v`; returns the value it displaces once the ring is full.
+    pub(super) fn push(&mut self, v: T) -> Option<T> {
+        if self.buf.len() < self.capacity {
+            self.buf.push(v);
+            return None;
+        }
+        let old = std::mem::replace(&mut self.buf[self.head], v);
+        self.head += 1;
+        if self.head == self.capacity {
+            self.head = 0;
+        }
+        Some(old)
+    }
+
+    pub(super) fn is_full(&self) -> bool {
+        self.buf.len() == self.capacity
+    }
+
+    /// The values, oldest first.
+    pub(super) fn iter(&self) -> impl Iterator<Item = &T> {
+        let (newer, older) = self.buf.split_at(self.head);
+        older.iter().chain(newer)
+    }
+}
