@@ -10,8 +10,6 @@
 //! window longer than that) decide the default `τ` (median time step) and the too-few-samples
 //! check before any output is written.
 
-mod auto_runner;
-pub mod fixed_runner;
 pub mod rows;
 pub mod runner;
 

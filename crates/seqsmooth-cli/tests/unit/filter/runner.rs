@@ -1,14 +1,17 @@
-//! Unit tests of `filter::fixed_runner`: the switch from the sliding to the irregular engine.
+//! Unit tests of `filter::runner`'s fixed-memory filter ([`FixedEngine::Adaptive`], what
+//! `Runner::Fixed` runs): the switch from the sliding to the irregular engine.
 
 use seqsmooth::{FixedEngine, FixedMemory, PolynomialFilter};
-use seqsmooth_cli::filter::fixed_runner::*;
 
-/// The fixed-memory runner falls back from the sliding engine to the irregular one at the
+/// The fixed-memory filter of `Runner::Fixed` falls back from the sliding engine to the irregular one at the
 /// first uneven step, and its estimates are the irregular engine's from the start (up to
 /// rounding) on both sides of the switch.
 #[test]
 fn fixed_runner_switches_engine_at_first_uneven_step() {
-    let mut runner = FixedRunner::new(2, 6, Some(0.5)).unwrap();
+    let mut runner = FixedMemory::new(2, 6, FixedEngine::Adaptive)
+        .unwrap()
+        .with_noise_sigma(0.5)
+        .unwrap();
     let mut reference = FixedMemory::new(2, 6, FixedEngine::Irregular)
         .unwrap()
         .with_noise_sigma(0.5)
