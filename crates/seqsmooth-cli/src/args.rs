@@ -16,17 +16,28 @@ use std::path::PathBuf;
 /// Rows per chunk of `seqsmooth filter`'s streaming pipeline (read, filter, write).
 pub const CHUNK_ROWS: u32 = 1 << 16;
 
-/// Text shown after every `--help`: exit codes and number formats.
-const AFTER_HELP: &str = "\
-Exit status: 0 on success; 1 when the input data or a file is unusable (bad numbers, NaN or \
-infinite values, unsorted or duplicate times, missing columns, malformed CSV, too few samples, \
-unreadable or unwritable files); 2 for command-line errors (unknown or missing arguments, values \
-out of range). Every message goes to stderr and starts with 'error: '; data errors name the \
-1-based file line (the header is line 1), the column and the value.
+/// The exit-status paragraph of the help texts; `$few` names the too-short-input case.
+macro_rules! exit_status {
+    ($few:literal) => {
+        concat!(
+            "Exit status: 0 on success; 1 when the input data or a file is unusable (bad numbers, \
+             NaN or infinite values, unsorted or duplicate times, missing columns, malformed CSV, ",
+            $few,
+            ", unreadable or unwritable files); 2 for command-line errors (unknown or missing \
+             arguments, values out of range). Every message goes to stderr and starts with \
+             'error: '; data errors name the 1-based file line (the header is line 1), the column \
+             and the value.\n\nNumbers are written with round-trip precision: the shortest text \
+             that parses back to the same double (plain decimals for 1e-5 <= |x| < 1e16, \
+             otherwise scientific notation such as 1e-300)."
+        )
+    };
+}
 
-Numbers are written with round-trip precision: the shortest text that parses back to the same \
-double (plain decimals for 1e-5 <= |x| < 1e16, otherwise scientific notation such as 1e-300). \
-Exact (--exact) values are rationals in lowest terms, 'p/q', or 'p' when the value is an integer.";
+/// Text shown after every `--help`: exit codes and number formats.
+const AFTER_HELP: &str = concat!(
+    exit_status!("too few samples"),
+    " Exact (--exact) values are rationals in lowest terms, 'p/q', or 'p' when the value is an integer."
+);
 
 /// Top-level command line.
 #[derive(Debug, Parser)]
@@ -88,7 +99,8 @@ columns, malformed CSV, non-numeric cells, unwritable image); 2 for command-line
 1-based line (the header is line 1) and the column.";
 
 /// Help text after `seqsmooth filter --help`.
-const FILTER_AFTER_HELP: &str = "\
+const FILTER_AFTER_HELP: &str = concat!(
+    "\
 Output: CSV, one row per input row in input order, with the header
   --kind expanding, fading:  t,y,d0..dM            (and s0..sM with --sigma)
   --kind fixed:              t,y,d0..dM,window     (t,y,d0..dM,s0..sM,window with --sigma)
@@ -132,17 +144,13 @@ written; the message names the line, the column and, for a time, the series.
 Progress: on standard error when it is a terminal and the input is longer than one chunk \
 (bytes of the file read, or rows and rows/s from standard input); --no-progress turns it off.
 
-Exit status: 0 on success; 1 when the input data or a file is unusable (bad numbers, NaN or \
-infinite values, unsorted or duplicate times, missing columns, malformed CSV, too few samples, \
-unreadable or unwritable files); 2 for command-line errors (unknown or missing arguments, values \
-out of range). Every message goes to stderr and starts with 'error: '; data errors name the \
-1-based file line (the header is line 1), the column and the value.
-
-Numbers are written with round-trip precision: the shortest text that parses back to the same \
-double (plain decimals for 1e-5 <= |x| < 1e16, otherwise scientific notation such as 1e-300).";
+",
+    exit_status!("too few samples")
+);
 
 /// Help text after `seqsmooth smooth --help`.
-const SMOOTH_AFTER_HELP: &str = "\
+const SMOOTH_AFTER_HELP: &str = concat!(
+    "\
 Output: CSV with header t,y,d0..dM, one row per input row in input order. The t and y cells \
 echo the input cells; dk is the k-th time derivative, in the input's time units, of the \
 least-squares polynomial of degree M through the W rows most nearly centred on this one \
@@ -158,14 +166,9 @@ windows, each fitted by least squares at the actual times.
 Reading: the whole input is read and checked before the first output row is written (a row's \
 window reaches rows after it); use 'seqsmooth filter --kind fixed' for a causal, streaming fit.
 
-Exit status: 0 on success; 1 when the input data or a file is unusable (bad numbers, NaN or \
-infinite values, unsorted or duplicate times, missing columns, malformed CSV, fewer rows than \
-the window, unreadable or unwritable files); 2 for command-line errors (unknown or missing \
-arguments, values out of range). Every message goes to stderr and starts with 'error: '; data \
-errors name the 1-based file line (the header is line 1), the column and the value.
-
-Numbers are written with round-trip precision: the shortest text that parses back to the same \
-double (plain decimals for 1e-5 <= |x| < 1e16, otherwise scientific notation such as 1e-300).";
+",
+    exit_status!("fewer rows than the window")
+);
 
 /// Arguments of `seqsmooth filter`.
 #[derive(Debug, Args)]
@@ -202,12 +205,9 @@ pub struct FilterArgs {
     #[arg(long, value_name = "H", default_value = "0", value_parser = parse_lead,
           allow_hyphen_values = true)]
     pub lead: f64,
-    /// Name of the time column
-    #[arg(long, value_name = "NAME", default_value = "t")]
-    pub time_col: String,
-    /// Name of the value column
-    #[arg(long, value_name = "NAME", default_value = "y")]
-    pub value_col: String,
+    /// The time and value columns.
+    #[command(flatten)]
+    pub columns: Columns,
     /// White-noise standard deviation S of the values: adds the columns s0..sM, the 1-sigma
     /// errors of d0..dM from the filter's covariance. With --kind auto (which always writes
     /// s0..sM) the noise is taken to be S instead of estimated
@@ -244,12 +244,9 @@ pub struct SmoothArgs {
     /// window_length, Morrison's L+1); odd W centres every window on its row
     #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
     pub window: usize,
-    /// Name of the time column
-    #[arg(long, value_name = "NAME", default_value = "t")]
-    pub time_col: String,
-    /// Name of the value column
-    #[arg(long, value_name = "NAME", default_value = "y")]
-    pub value_col: String,
+    /// The time and value columns.
+    #[command(flatten)]
+    pub columns: Columns,
     /// Output file [default: standard output]
     #[arg(short = 'o', long, value_name = "OUTPUT")]
     pub output: Option<PathBuf>,
@@ -261,15 +258,9 @@ pub struct GainsArgs {
     /// Filter kind
     #[arg(long, value_enum)]
     pub kind: TableKind,
-    /// Polynomial degree M (0 to 24)
-    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
-    pub degree: usize,
-    /// Expanding memory: 0-based index of the newest sample (n+1 samples seen)
-    #[arg(long, value_name = "N", value_parser = parse_index, allow_hyphen_values = true)]
-    pub n: Option<u64>,
-    /// Fading memory: discount per sample, 0 < T < 1 (e.g. 0.9 or 9/10; exact with --exact)
-    #[arg(long, value_name = "T", value_parser = parse_theta, allow_hyphen_values = true)]
-    pub theta: Option<Theta>,
+    /// The degree and the memory.
+    #[command(flatten)]
+    pub memory: MemoryArgs,
     /// Print exact rationals in lowest terms, p/q (an integer as p), instead of doubles.
     /// Without it θ is rounded to the nearest double before the computation
     #[arg(long)]
@@ -285,15 +276,9 @@ pub struct VrfArgs {
     /// Filter kind
     #[arg(long, value_enum)]
     pub kind: VrfKind,
-    /// Polynomial degree M (0 to 24)
-    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
-    pub degree: usize,
-    /// Expanding memory: 0-based index of the newest sample, N >= M
-    #[arg(long, value_name = "N", value_parser = parse_index, allow_hyphen_values = true)]
-    pub n: Option<u64>,
-    /// Fading memory: discount per sample, 0 < T < 1 (e.g. 0.9 or 9/10; exact with --exact)
-    #[arg(long, value_name = "T", value_parser = parse_theta, allow_hyphen_values = true)]
-    pub theta: Option<Theta>,
+    /// The degree and the memory.
+    #[command(flatten)]
+    pub memory: MemoryArgs,
     /// Fixed memory: the number of samples in the window, W >= M+1 (Morrison's L+1)
     #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
     pub window: Option<usize>,
@@ -313,6 +298,38 @@ pub struct VrfArgs {
     /// Output format
     #[arg(long, value_enum, default_value_t = Format::Csv)]
     pub format: Format,
+}
+
+/// The time and value columns of an input (`seqsmooth filter`, `seqsmooth smooth`).
+#[derive(Debug, Args)]
+pub struct Columns {
+    /// Name of the time column
+    #[arg(long, value_name = "NAME", default_value = "t")]
+    pub time_col: String,
+    /// Name of the value column
+    #[arg(long, value_name = "NAME", default_value = "y")]
+    pub value_col: String,
+}
+
+/// The degree and memory of a gains or vrf table.
+#[derive(Debug, Args)]
+pub struct MemoryArgs {
+    /// Polynomial degree M (0 to 24)
+    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
+    pub degree: usize,
+    /// Expanding memory: 0-based index of the newest sample (N+1 samples seen; vrf needs N >= M)
+    #[arg(long, value_name = "N", value_parser = parse_index, allow_hyphen_values = true)]
+    pub n: Option<u64>,
+    /// Fading memory: discount per sample, 0 < T < 1 (e.g. 0.9 or 9/10; exact with --exact)
+    #[arg(long, value_name = "T", value_parser = parse_theta, allow_hyphen_values = true)]
+    pub theta: Option<Theta>,
+}
+
+impl MemoryArgs {
+    /// Resolves `--n`/`--theta` for `kind`.
+    pub fn of(&self, kind: TableKind) -> Result<Memory, CliError> {
+        memory(kind, self.n, self.theta.clone())
+    }
 }
 
 /// Arguments of `seqsmooth demo`.
@@ -598,49 +615,40 @@ pub fn parse_index(s: &str) -> Result<u64, String> {
     }
 }
 
-fn parse_f64(name: &str, s: &str) -> Result<f64, String> {
+/// Parses the number `name` that must be `range` (`ok` says whether it is).
+fn parse_f64(name: &str, s: &str, ok: fn(f64) -> bool, range: &str) -> Result<f64, String> {
     let text = s.trim();
-    text.parse::<f64>()
-        .map_err(|_| format!("{name} '{text}' is not a number"))
+    let v = (text.parse::<f64>()).map_err(|_| format!("{name} '{text}' is not a number"))?;
+    if ok(v) {
+        Ok(v)
+    } else {
+        Err(format!("{name} {text} is out of range: it must be {range}"))
+    }
 }
 
 /// Parses `--tau`: a positive finite number.
 pub fn parse_tau(s: &str) -> Result<f64, String> {
-    let v = parse_f64("tau", s)?;
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(format!(
-            "tau {} is out of range: it must be a positive finite number",
-            s.trim()
-        ))
-    }
+    parse_f64(
+        "tau",
+        s,
+        |v| v.is_finite() && v > 0.0,
+        "a positive finite number",
+    )
 }
 
 /// Parses `--sigma`: a positive finite number.
 pub fn parse_sigma(s: &str) -> Result<f64, String> {
-    let v = parse_f64("sigma", s)?;
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(format!(
-            "sigma {} is out of range: it must be a positive finite number",
-            s.trim()
-        ))
-    }
+    parse_f64(
+        "sigma",
+        s,
+        |v| v.is_finite() && v > 0.0,
+        "a positive finite number",
+    )
 }
 
 /// Parses `--lead`: any finite number (negative = retrodiction).
 pub fn parse_lead(s: &str) -> Result<f64, String> {
-    let v = parse_f64("lead", s)?;
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(format!(
-            "lead {} is out of range: it must be a finite number",
-            s.trim()
-        ))
-    }
+    parse_f64("lead", s, f64::is_finite, "a finite number")
 }
 
 /// Parses `--window`: the number of samples in the window (Morrison's `L+1`), a whole number
@@ -697,65 +705,4 @@ pub fn parse_lead_steps(s: &str) -> Result<LeadSteps, String> {
         return Err(out_of_range());
     }
     Ok(LeadSteps { exact, value })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use clap::CommandFactory;
-
-    #[test]
-    fn clap_definition_is_consistent() {
-        Cli::command().debug_assert();
-    }
-
-    #[test]
-    fn theta_forms() {
-        assert_eq!(parse_theta("9/10").unwrap().exact.to_string(), "9/10");
-        assert_eq!(parse_theta("0.9").unwrap().exact.to_string(), "9/10");
-        assert_eq!(parse_theta("0.9").unwrap().value, 0.9);
-        assert!(parse_theta("1").is_err());
-        assert!(parse_theta("0").is_err());
-        assert!(parse_theta("nan").is_err());
-        let near_one = parse_theta("0.99999999999999999999").unwrap();
-        assert!(near_one.value_f64().is_err());
-    }
-
-    #[test]
-    fn degree_range() {
-        assert_eq!(parse_degree("0"), Ok(0));
-        assert_eq!(parse_degree("24"), Ok(24));
-        assert!(parse_degree("25").unwrap_err().contains("degree 25"));
-        assert!(parse_degree("-1").unwrap_err().contains("degree -1"));
-        assert!(parse_degree("x").is_err());
-    }
-
-    #[test]
-    fn window_range() {
-        assert_eq!(parse_window("1"), Ok(1));
-        assert_eq!(parse_window(" 11 "), Ok(11));
-        assert!(parse_window("0")
-            .unwrap_err()
-            .contains("window 0 is out of range"));
-        assert!(parse_window("-3").unwrap_err().contains("window -3"));
-        assert!(parse_window("2.5").is_err());
-    }
-
-    #[test]
-    fn lead_steps_forms() {
-        assert_eq!(parse_lead_steps("-5/2").unwrap().exact.to_string(), "-5/2");
-        assert_eq!(parse_lead_steps("-2.5").unwrap().exact.to_string(), "-5/2");
-        assert_eq!(parse_lead_steps("25e-1").unwrap().value, 2.5);
-        assert_eq!(parse_lead_steps("0").unwrap().value, 0.0);
-        assert!(parse_lead_steps("x")
-            .unwrap_err()
-            .contains("lead 'x' is not a number"));
-        assert!(parse_lead_steps("1e999")
-            .unwrap_err()
-            .contains("out of range"));
-        assert!(parse_lead_steps("1e-99999999")
-            .unwrap_err()
-            .contains("out of range"));
-        assert!(parse_lead_steps("inf").is_err());
-    }
 }

@@ -51,6 +51,16 @@ impl Format {
             _ => None,
         }
     }
+
+    /// The format of `path`, or the usage error that it has none.
+    pub fn of(path: &Path) -> Result<Format, CliError> {
+        Format::from_path(path).ok_or_else(|| {
+            CliError::Usage(format!(
+                "cannot tell the image format of '{}': the file name must end in .png or .svg",
+                path.display()
+            ))
+        })
+    }
 }
 
 /// The rows of a filter run, column by column (every vector has one entry per row).
@@ -130,29 +140,23 @@ fn register() -> Result<(), CliError> {
 /// Draws `track` as laid out by `layout` into `path`, as PNG or SVG by its extension.
 pub fn write(track: &Track, layout: &Layout, path: &Path) -> Result<(), CliError> {
     register()?;
-    let format = Format::from_path(path).ok_or_else(|| {
-        CliError::Usage(format!(
-            "cannot tell the image format of '{}': the file name must end in .png or .svg",
-            path.display()
-        ))
-    })?;
+    let format = Format::of(path)?;
     let fail = |e: String| {
         CliError::Data(format!(
             "cannot write the plot to '{}': {e}",
             path.display()
         ))
     };
+    macro_rules! render {
+        ($backend:ident) => {{
+            let root = $backend::new(path, layout.size).into_drawing_area();
+            draw(&root, track, layout).map_err(fail)?;
+            root.present().map_err(|e| fail(e.to_string()))
+        }};
+    }
     match format {
-        Format::Png => {
-            let root = BitMapBackend::new(path, layout.size).into_drawing_area();
-            draw(&root, track, layout).map_err(fail)?;
-            root.present().map_err(|e| fail(e.to_string()))
-        }
-        Format::Svg => {
-            let root = SVGBackend::new(path, layout.size).into_drawing_area();
-            draw(&root, track, layout).map_err(fail)?;
-            root.present().map_err(|e| fail(e.to_string()))
-        }
+        Format::Png => render!(BitMapBackend),
+        Format::Svg => render!(SVGBackend),
     }
 }
 
@@ -161,7 +165,8 @@ fn font(size: f64) -> TextStyle<'static> {
 }
 
 /// The value `p`-quantile of the finite `values` (nearest rank), if any.
-fn quantile(values: &mut [f64], p: f64) -> Option<f64> {
+fn quantile(values: impl IntoIterator<Item = f64>, p: f64) -> Option<f64> {
+    let mut values: Vec<f64> = values.into_iter().collect();
     if values.is_empty() {
         return None;
     }
@@ -191,7 +196,7 @@ fn widen(range: &mut Option<(f64, f64)>, v: f64) {
 }
 
 /// Maximal runs of consecutive indices where `keep` holds.
-fn runs(n: usize, keep: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
+pub fn runs(n: usize, keep: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
     let mut out = Vec::new();
     let mut start = None;
     for i in 0..=n {
@@ -208,7 +213,7 @@ fn runs(n: usize, keep: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
 }
 
 /// Tick label text with the decimals the axis step needs.
-fn tick(v: f64, step: f64) -> String {
+pub fn tick(v: f64, step: f64) -> String {
     let decimals = if step > 0.0 && step.is_finite() {
         (-(step.log10().floor()) as i32).clamp(0, 8) as usize
     } else {
@@ -274,21 +279,15 @@ fn derivative_panel(track: &Track, k: usize, label: &str) -> PanelData {
     for v in truth.iter().flatten() {
         widen(&mut range, *v);
     }
-    let mut est: Vec<f64> = line
-        .iter()
-        .flatten()
-        .copied()
-        .filter(|v| v.is_finite())
-        .collect();
-    if let (Some(lo), Some(hi)) = (quantile(&mut est, 0.01), quantile(&mut est, 0.99)) {
+    let est = || line.iter().flatten().copied().filter(|v| v.is_finite());
+    if let (Some(lo), Some(hi)) = (quantile(est(), 0.01), quantile(est(), 0.99)) {
         widen(&mut range, lo);
         widen(&mut range, hi);
     }
     // The band where it is no wider than the spread of the panel (not at start-up).
     if let Some((lo, hi)) = range {
         let span = (hi - lo).max(f64::MIN_POSITIVE);
-        let mut half: Vec<f64> = band.iter().flatten().copied().collect();
-        if let Some(h) = quantile(&mut half, 0.9) {
+        if let Some(h) = quantile(band.iter().flatten().copied(), 0.9) {
             if h < 0.25 * span {
                 for (l, b) in line.iter().zip(&band) {
                     if let (Some(l), Some(b)) = (l, b) {
@@ -344,14 +343,11 @@ fn residual_panel(track: &Track, label: &str) -> PanelData {
     };
     // Symmetric range: the 99th percentile of |residual| of the accepted samples, every
     // rejected one up to twice that, the ±3σ noise and the settled band, the truth's error.
-    let mut accepted: Vec<f64> = points.iter().filter(|p| !p.2).map(|p| p.1.abs()).collect();
-    let mut r = quantile(&mut accepted, 0.99).unwrap_or(0.0);
-    let mut noise3: Vec<f64> = noise.iter().flatten().copied().collect();
-    r = r.max(quantile(&mut noise3, 0.9).unwrap_or(0.0));
-    let mut band3: Vec<f64> = band.iter().flatten().copied().collect();
-    r = r.max(quantile(&mut band3, 0.9).unwrap_or(0.0));
-    let mut err: Vec<f64> = truth.iter().flatten().map(|e| e.abs()).collect();
-    r = r.max(quantile(&mut err, 0.99).unwrap_or(0.0));
+    let q = |v: &mut dyn Iterator<Item = f64>, p| quantile(v, p).unwrap_or(0.0);
+    let mut r = q(&mut points.iter().filter(|p| !p.2).map(|p| p.1.abs()), 0.99)
+        .max(q(&mut noise.iter().flatten().copied(), 0.9))
+        .max(q(&mut band.iter().flatten().copied(), 0.9))
+        .max(q(&mut truth.iter().flatten().map(|e| e.abs()), 0.99));
     let cap = 2.0 * r;
     for p in points.iter().filter(|p| p.2) {
         r = r.max(p.1.abs().min(cap));
@@ -405,44 +401,25 @@ impl Key {
 }
 
 fn legend_keys(panels: &[PanelData], track: &Track) -> Vec<Key> {
-    let mut keys = Vec::new();
-    let any_points = panels.iter().any(|p| p.points.iter().any(|q| !q.2));
-    let any_rejected = panels.iter().any(|p| p.points.iter().any(|q| q.2));
-    let any_clipped = panels
-        .iter()
-        .any(|p| p.clip_points && p.points.iter().any(|q| q.1 < p.range.0 || q.1 > p.range.1));
-    let has = |f: &dyn Fn(&PanelData) -> bool| panels.iter().any(f);
-    if any_points {
-        keys.push(Key::Data);
-    }
-    if any_rejected {
-        keys.push(Key::Rejected);
-    }
-    if any_clipped {
-        keys.push(Key::Clipped);
-    }
-    if has(&|p| p.line.iter().any(Option::is_some)) {
-        keys.push(Key::Estimate);
-    }
-    if has(&|p| p.band.iter().any(Option::is_some)) {
-        keys.push(Key::Band);
-    }
-    if has(&|p| p.truth.iter().any(Option::is_some)) {
-        keys.push(Key::Truth);
-    }
-    if has(&|p| p.noise.iter().any(Option::is_some)) {
-        keys.push(Key::Noise);
-    }
-    if !track.switches.is_empty() {
-        keys.push(Key::Switch);
-    }
-    if !track.restarts.is_empty() {
-        keys.push(Key::Restart);
-    }
-    if track.misfit.iter().any(|&m| m) {
-        keys.push(Key::Misfit);
-    }
-    keys
+    let any = |f: &dyn Fn(&PanelData) -> bool| panels.iter().any(f);
+    let clipped = |p: &PanelData| {
+        p.clip_points && p.points.iter().any(|q| q.1 < p.range.0 || q.1 > p.range.1)
+    };
+    [
+        (any(&|p| p.points.iter().any(|q| !q.2)), Key::Data),
+        (any(&|p| p.points.iter().any(|q| q.2)), Key::Rejected),
+        (any(&clipped), Key::Clipped),
+        (any(&|p| p.line.iter().any(Option::is_some)), Key::Estimate),
+        (any(&|p| p.band.iter().any(Option::is_some)), Key::Band),
+        (any(&|p| p.truth.iter().any(Option::is_some)), Key::Truth),
+        (any(&|p| p.noise.iter().any(Option::is_some)), Key::Noise),
+        (!track.switches.is_empty(), Key::Switch),
+        (!track.restarts.is_empty(), Key::Restart),
+        (track.misfit.iter().any(|&m| m), Key::Misfit),
+    ]
+    .into_iter()
+    .filter_map(|(on, key)| on.then_some(key))
+    .collect()
 }
 
 type Err = String;
@@ -457,52 +434,28 @@ fn symbol<DB: DrawingBackend>(
     key: Key,
     (x, y): (i32, i32),
 ) -> Result<(), Err> {
-    let line = |c: RGBColor, w: u32| {
-        area.draw(&PathElement::new(
-            vec![(x - 14, y), (x + 14, y)],
-            c.stroke_width(w),
+    let seg = |a: (i32, i32), b: (i32, i32), c: RGBColor, w: u32| {
+        area.draw(&PathElement::new(vec![a, b], c.stroke_width(w)))
+    };
+    let rect = |c: RGBAColor| {
+        area.draw(&Rectangle::new(
+            [(x - 14, y - 7), (x + 14, y + 7)],
+            c.filled(),
         ))
     };
     match key {
         Key::Data => area.draw(&Circle::new((x, y), 3, DATA.filled())),
         Key::Rejected => area.draw(&Cross::new((x, y), 5, REJECTED.stroke_width(2))),
         Key::Clipped => area.draw(&TriangleMarker::new((x, y), 5, DATA.filled())),
-        Key::Estimate => line(ESTIMATE, 2),
-        Key::Band => area.draw(&Rectangle::new(
-            [(x - 14, y - 7), (x + 14, y + 7)],
-            ESTIMATE.mix(0.22).filled(),
-        )),
-        Key::Truth => line(TRUTH, 1),
-        Key::Noise => {
-            area.draw(&PathElement::new(
-                vec![(x - 14, y), (x - 4, y)],
-                NOISE.stroke_width(2),
-            ))
-            .map_err(e)?;
-            area.draw(&PathElement::new(
-                vec![(x + 4, y), (x + 14, y)],
-                NOISE.stroke_width(2),
-            ))
-        }
-        Key::Switch => {
-            area.draw(&PathElement::new(
-                vec![(x, y - 8), (x, y - 2)],
-                SWITCH.stroke_width(2),
-            ))
-            .map_err(e)?;
-            area.draw(&PathElement::new(
-                vec![(x, y + 2), (x, y + 8)],
-                SWITCH.stroke_width(2),
-            ))
-        }
-        Key::Restart => area.draw(&PathElement::new(
-            vec![(x, y - 8), (x, y + 8)],
-            RESTART.stroke_width(2),
-        )),
-        Key::Misfit => area.draw(&Rectangle::new(
-            [(x - 14, y - 7), (x + 14, y + 7)],
-            MISFIT.mix(0.3).filled(),
-        )),
+        Key::Estimate => seg((x - 14, y), (x + 14, y), ESTIMATE, 2),
+        Key::Band => rect(ESTIMATE.mix(0.22)),
+        Key::Truth => seg((x - 14, y), (x + 14, y), TRUTH, 1),
+        Key::Noise => seg((x - 14, y), (x - 4, y), NOISE, 2)
+            .and_then(|_| seg((x + 4, y), (x + 14, y), NOISE, 2)),
+        Key::Switch => seg((x, y - 8), (x, y - 2), SWITCH, 2)
+            .and_then(|_| seg((x, y + 2), (x, y + 8), SWITCH, 2)),
+        Key::Restart => seg((x, y - 8), (x, y + 8), RESTART, 2),
+        Key::Misfit => rect(MISFIT.mix(0.3)),
     }
     .map_err(e)
 }
@@ -680,15 +633,13 @@ fn draw_panel<DB: DrawingBackend>(
 
     // ±3σ band.
     for r in runs(n, |i| p.line[i].is_some() && p.band[i].is_some()) {
-        let mut poly: Vec<(f64, f64)> = Vec::with_capacity(2 * r.len());
-        for i in r.clone() {
+        let edge = |i: usize, sign: f64| {
             let (l, b) = (p.line[i].unwrap_or(0.0), p.band[i].unwrap_or(0.0));
-            poly.push((track.t[i] + p.shift, clamp(l + b)));
-        }
-        for i in r.rev() {
-            let (l, b) = (p.line[i].unwrap_or(0.0), p.band[i].unwrap_or(0.0));
-            poly.push((track.t[i] + p.shift, clamp(l - b)));
-        }
+            (track.t[i] + p.shift, clamp(l + sign * b))
+        };
+        let poly: Vec<(f64, f64)> = (r.clone().map(|i| edge(i, 1.0)))
+            .chain(r.rev().map(|i| edge(i, -1.0)))
+            .collect();
         chart
             .draw_series(std::iter::once(Polygon::new(
                 poly,
@@ -697,12 +648,20 @@ fn draw_panel<DB: DrawingBackend>(
             .map_err(e)?;
     }
 
+    // The runs of a row-wise curve, `sign` times its values, at the times moved by `shift`.
+    let curves = |v: &[Option<f64>], shift: f64, sign: f64| -> Vec<Vec<(f64, f64)>> {
+        runs(n, |i| v[i].is_some())
+            .into_iter()
+            .map(|r| {
+                r.map(|i| (track.t[i] + shift, clamp(sign * v[i].unwrap_or(0.0))))
+                    .collect()
+            })
+            .collect()
+    };
+
     // ±3σ noise (dashed).
     for sign in [1.0, -1.0] {
-        for r in runs(n, |i| p.noise[i].is_some()) {
-            let pts: Vec<(f64, f64)> = r
-                .map(|i| (track.t[i], clamp(sign * p.noise[i].unwrap_or(0.0))))
-                .collect();
+        for pts in curves(&p.noise, 0.0, sign) {
             chart
                 .draw_series(DashedLineSeries::new(pts, 7, 5, NOISE.stroke_width(2)))
                 .map_err(e)?;
@@ -731,21 +690,13 @@ fn draw_panel<DB: DrawingBackend>(
     }
 
     // Truth, then the estimate over it.
-    for r in runs(n, |i| p.truth[i].is_some()) {
-        let pts: Vec<(f64, f64)> = r
-            .map(|i| (track.t[i] + p.shift, clamp(p.truth[i].unwrap_or(0.0))))
-            .collect();
-        chart
-            .draw_series(LineSeries::new(pts, TRUTH.stroke_width(1)))
-            .map_err(e)?;
-    }
-    for r in runs(n, |i| p.line[i].is_some()) {
-        let pts: Vec<(f64, f64)> = r
-            .map(|i| (track.t[i] + p.shift, clamp(p.line[i].unwrap_or(0.0))))
-            .collect();
-        chart
-            .draw_series(LineSeries::new(pts, ESTIMATE.stroke_width(2)))
-            .map_err(e)?;
+    for (v, style) in [
+        (&p.truth, TRUTH.stroke_width(1)),
+        (&p.line, ESTIMATE.stroke_width(2)),
+    ] {
+        for pts in curves(v, p.shift, 1.0) {
+            chart.draw_series(LineSeries::new(pts, style)).map_err(e)?;
+        }
     }
 
     // Rejected samples on top.
@@ -758,52 +709,20 @@ fn draw_panel<DB: DrawingBackend>(
         )
         .map_err(e)?;
 
-    // Events.
-    for &t in &track.switches {
-        chart
-            .draw_series(DashedLineSeries::new(
-                vec![(t, y0), (t, y1)],
-                8,
-                6,
-                SWITCH.stroke_width(2),
-            ))
+    // Events: switches to fading memory (dashed), restarts.
+    for (times, dashed, color) in [
+        (&track.switches, true, SWITCH),
+        (&track.restarts, false, RESTART),
+    ] {
+        for &t in times {
+            let (v, style) = (vec![(t, y0), (t, y1)], color.stroke_width(2));
+            if dashed {
+                chart.draw_series(DashedLineSeries::new(v, 8, 6, style))
+            } else {
+                chart.draw_series(LineSeries::new(v, style))
+            }
             .map_err(e)?;
-    }
-    for &t in &track.restarts {
-        chart
-            .draw_series(LineSeries::new(
-                vec![(t, y0), (t, y1)],
-                RESTART.stroke_width(2),
-            ))
-            .map_err(e)?;
+        }
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn runs_split_on_gaps() {
-        let v = [true, true, false, true, false, false, true];
-        assert_eq!(runs(v.len(), |i| v[i]), vec![0..2, 3..4, 6..7]);
-        assert!(runs(0, |_| true).is_empty());
-    }
-
-    #[test]
-    fn tick_labels_have_the_step_decimals() {
-        assert_eq!(tick(15000.0, 2500.0), "15000");
-        assert_eq!(tick(0.25, 0.05), "0.25");
-        assert_eq!(tick(-0.0001, 0.5), "0.0");
-        assert_eq!(tick(3.0, 0.5), "3.0");
-    }
-
-    #[test]
-    fn formats_by_extension() {
-        assert_eq!(Format::from_path(Path::new("a/b.PNG")), Some(Format::Png));
-        assert_eq!(Format::from_path(Path::new("b.svg")), Some(Format::Svg));
-        assert_eq!(Format::from_path(Path::new("b.pdf")), None);
-        assert_eq!(Format::from_path(Path::new("b")), None);
-    }
 }

@@ -24,11 +24,11 @@ use std::path::{Path, PathBuf};
 /// Number of samples.
 pub const SAMPLES: usize = 400;
 /// Noise standard deviation, m.
-const SIGMA: f64 = 15.0;
+pub const SIGMA: f64 = 15.0;
 /// Speed, m/s.
 const SPEED: f64 = 120.0;
 /// Start of the turn, s.
-const TURN_START: f64 = 140.0;
+pub const TURN_START: f64 = 140.0;
 /// Turn rate, rad/s (3°/s).
 const TURN_RATE: f64 = PI / 60.0;
 /// Nominal sampling interval, s, and its uniform relative jitter.
@@ -37,10 +37,10 @@ const JITTER: f64 = 0.3;
 /// Probability that a sample is dropped.
 const DROPOUT: f64 = 0.05;
 /// The radar outage: no samples in [start, start + length), s.
-const OUTAGE: (f64, f64) = (262.0, 12.0);
+pub const OUTAGE: (f64, f64) = (262.0, 12.0);
 /// Probability that a sample carries an outlier, and the outlier's size range in σ.
 const OUTLIER_RATE: f64 = 0.02;
-const OUTLIER_SIZE: (f64, f64) = (6.0, 10.0);
+pub const OUTLIER_SIZE: (f64, f64) = (6.0, 10.0);
 /// Filter degree.
 const DEGREE: usize = 2;
 /// Discount per median step, for the automatic and the plain fading-memory filters.
@@ -90,7 +90,7 @@ pub struct Point {
 }
 
 /// The end of the turn, s (half a circle at the turn rate).
-fn turn_end() -> f64 {
+pub fn turn_end() -> f64 {
     TURN_START + PI / TURN_RATE
 }
 
@@ -159,9 +159,10 @@ fn run_plain(data: &[Point], kind: Kind, engine: EngineArg, tau: f64) -> Result<
     }
     Ok(Run {
         name: kind.name(),
-        engine: match engine {
-            EngineArg::Exact => "exact",
-            EngineArg::Gain => "gain",
+        engine: if engine == EngineArg::Exact {
+            "exact"
+        } else {
+            "gain"
         },
         estimates,
     })
@@ -360,8 +361,8 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
         .map(|(i, (_, p))| (i, p))
         .collect();
     let caught = rejected.iter().filter(|(_, p)| p.outlier).count();
-    let switches = track(&data, &outs).switches;
-    let restarts: Vec<f64> = outs.iter().filter(|o| o.restart).map(|o| o.time).collect();
+    let plot_track = track(&data, &outs);
+    let (switches, restarts) = (&plot_track.switches, &plot_track.restarts);
     let span = data[SAMPLES - 1].t - data[0].t;
 
     let mut w = Output::stdout();
@@ -390,11 +391,11 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
         OUTLIER_SIZE.1,
         rejected.len(),
         rejected.len() - caught,
-        times_list(&switches),
+        times_list(switches),
         if restarts.is_empty() {
             "none".to_string()
         } else {
-            format!("{} at {}", restarts.len(), times_list(&restarts))
+            format!("{} at {}", restarts.len(), times_list(restarts))
         },
         outs.iter().filter(|o| o.misfit).count(),
         auto.noise_sigma().map_or_else(|| "-".to_string(), short),
@@ -427,11 +428,9 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
         );
     }
     if let Some(prefix) = Some(&cfg.plot).filter(|_| !cfg.no_plot) {
-        let t = track(&data, &outs);
-        let l = layout(tau);
-        let paths = plot_paths(prefix);
+        let (l, paths) = (layout(tau), plot_paths(prefix));
         for p in &paths {
-            chart::write(&t, &l, p)?;
+            chart::write(&plot_track, &l, p)?;
         }
         eprintln!(
             "wrote the plot to '{}' and '{}'",
@@ -440,55 +439,4 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The track is what the module docs say: 400 samples, increasing times, jittered steps,
-    /// the outage, outliers; the truth is continuous through the turn.
-    #[test]
-    fn the_track_is_as_documented() {
-        let data = generate();
-        assert_eq!(data.len(), SAMPLES);
-        assert!(data.windows(2).all(|w| w[1].t > w[0].t));
-        assert!(!data
-            .iter()
-            .any(|p| p.t >= OUTAGE.0 && p.t < OUTAGE.0 + OUTAGE.1));
-        let outliers = data.iter().filter(|p| p.outlier).count();
-        assert!((3..=20).contains(&outliers), "{outliers}");
-        for p in &data {
-            let e = (p.y - p.x).abs() / SIGMA;
-            if p.outlier {
-                assert!(e > OUTLIER_SIZE.0 - 5.0, "{p:?}");
-            } else {
-                assert!(e < 5.0, "{p:?}");
-            }
-        }
-        for t in [TURN_START, turn_end()] {
-            let (a, b) = (truth(t - 1e-9), truth(t + 1e-9));
-            assert!((a.0 - b.0).abs() < 1e-5 && (a.1 - b.1).abs() < 1e-5);
-        }
-        // the velocity is the derivative of the position
-        for t in [50.0, 150.0, 170.0, 199.0, 300.0] {
-            let h = 1e-4;
-            let num = (truth(t + h).0 - truth(t - h).0) / (2.0 * h);
-            assert!((num - truth(t).1).abs() < 1e-4, "t = {t}");
-        }
-        assert_eq!(generate()[123].y, data[123].y, "deterministic");
-    }
-
-    #[test]
-    fn plot_paths_append_the_extensions() {
-        let [a, b] = plot_paths(Path::new("out/run"));
-        assert_eq!(
-            (a.to_str(), b.to_str()),
-            (Some("out/run.png"), Some("out/run.svg"))
-        );
-        let [a, b] = plot_paths(Path::new("x.svg"));
-        assert_eq!((a.to_str(), b.to_str()), (Some("x.png"), Some("x.svg")));
-        let [a, _] = plot_paths(Path::new("v1.2"));
-        assert_eq!(a.to_str(), Some("v1.2.png"));
-    }
 }

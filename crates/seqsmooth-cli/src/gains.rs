@@ -1,7 +1,7 @@
 //! `seqsmooth gains`: Morrison's scaled current-estimate gains `h_0..h_m` of the expanding-
 //! and fading-memory filters (Reyneke et al. §6.4, §6.6), in `f64` or exact rationals.
 
-use crate::args::{memory, Format, GainsArgs, Memory};
+use crate::args::{Format, GainsArgs, Memory};
 use crate::error::CliError;
 use crate::io::{fmt_f64, Output};
 use seqsmooth::polynomial::gains::{expanding_gains, fading_gains, GainForm};
@@ -9,8 +9,8 @@ use seqsmooth::scalar::Rational;
 
 /// Runs `seqsmooth gains`: header `k,gain`, one row per derivative order `k = 0..m`.
 pub fn run(a: &GainsArgs) -> Result<(), CliError> {
-    let (m, form) = (a.degree, GainForm::Current);
-    let values: Vec<String> = match (memory(a.kind, a.n, a.theta.clone())?, a.exact) {
+    let (m, form) = (a.memory.degree, GainForm::Current);
+    let values: Vec<String> = match (a.memory.of(a.kind)?, a.exact) {
         (Memory::Expanding { n }, true) => cells(&expanding_gains::<Rational>(m, n, form)),
         (Memory::Expanding { n }, false) => cells(&expanding_gains::<f64>(m, n, form)),
         (Memory::Fading { theta }, true) => cells(&fading_gains::<Rational>(m, theta.exact, form)),

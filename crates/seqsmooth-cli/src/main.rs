@@ -1,24 +1,10 @@
-//! The `seqsmooth` command: polynomial smoothing and prediction filters (Morrison 1969;
-//! Reyneke et al. 2012) on CSV time series — expanding, fading and fixed memory, the automatic
-//! filter, and whole-series (Savitzky–Golay) smoothing — their gains and variance-reduction
-//! matrices, and a demo on built-in data. A thin layer over the `seqsmooth` library: argument
-//! parsing ([`args`]), files ([`io`]), one module per subcommand, and messages ([`error`]).
+//! The `seqsmooth` command's entry point: parses the command line and runs the subcommand
+//! (the work is in the `seqsmooth_cli` library).
 
-mod args;
-mod chart;
-mod demo;
-mod error;
-mod filter;
-mod gains;
-mod io;
-mod plot;
-mod progress;
-mod smooth;
-mod vrf;
-
-use args::{Cli, Command};
 use clap::Parser;
-use error::CliError;
+use seqsmooth_cli::args::{Cli, Command};
+use seqsmooth_cli::error::CliError;
+use seqsmooth_cli::{demo, filter, gains, plot, smooth, vrf};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {

@@ -9,7 +9,7 @@
 use crate::args::PlotArgs;
 use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
-use crate::io::{find_column, input_name, open_input, parse_cell, CsvIn};
+use crate::io::{find_column, input_name, named, open_input, parse_cell, plural, CsvIn};
 use std::path::Path;
 
 /// A CSV file read in full: the header and the data rows with their 1-based file lines.
@@ -27,7 +27,7 @@ impl Table {
         let mut csv = CsvIn::new(open_input(path)?).map_err(at)?;
         let header = std::mem::take(&mut csv.header);
         let mut rows = Vec::new();
-        while csv.next().map_err(at)? {
+        while csv.next_record().map_err(at)? {
             let line = csv.line;
             let cells: Result<Vec<String>, _> = (0..header.len())
                 .map(|i| std::str::from_utf8(csv.field(i)).map(str::to_string))
@@ -137,18 +137,19 @@ fn superscript(k: usize) -> String {
 }
 
 /// The axis label of derivative `k`: `y`, `dy/dt`, `d²y/dt²`, … with its unit.
-fn derivative_label(k: usize, time_unit: Option<&str>, value_unit: Option<&str>) -> String {
+pub fn derivative_label(k: usize, time_unit: Option<&str>, value_unit: Option<&str>) -> String {
+    let power = if k == 1 {
+        String::new()
+    } else {
+        superscript(k)
+    };
     let name = match k {
         0 => "y".to_string(),
-        1 => "dy/dt".to_string(),
-        _ => format!("d{0}y/dt{0}", superscript(k)),
+        _ => format!("d{power}y/dt{power}"),
     };
     let unit = match (k, value_unit, time_unit) {
         (0, v, _) => v.map(str::to_string),
-        (_, Some(v), Some(t)) if k == 1 => Some(format!("{v}/{t}")),
-        (_, Some(v), Some(t)) => Some(format!("{v}/{t}{}", superscript(k))),
-        (_, None, Some(t)) if k == 1 => Some(format!("1/{t}")),
-        (_, None, Some(t)) => Some(format!("1/{t}{}", superscript(k))),
+        (_, v, Some(t)) => Some(format!("{}/{t}{power}", v.unwrap_or("1"))),
         _ => None,
     };
     with_unit(&name, unit.as_deref())
@@ -184,18 +185,14 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
             s[k] = out.sigmas(idx)?;
         }
     }
-    let noise = match out.column("noise") {
-        Some(idx) => out.sigmas(idx)?,
-        None => Vec::new(),
-    };
-    let rejected = match out.column("outlier") {
-        Some(idx) => out.flags(idx)?,
-        None => Vec::new(),
-    };
-    let misfit = match out.column("misfit") {
-        Some(idx) => out.flags(idx)?,
-        None => Vec::new(),
-    };
+    let noise = out.column("noise").map(|i| out.sigmas(i)).transpose()?;
+    let rejected = out.column("outlier").map(|i| out.flags(i)).transpose()?;
+    let misfit = out.column("misfit").map(|i| out.flags(i)).transpose()?;
+    let (noise, rejected, misfit) = (
+        noise.unwrap_or_default(),
+        rejected.unwrap_or_default(),
+        misfit.unwrap_or_default(),
+    );
     let mut truth = Vec::new();
     if let Some(path) = &cfg.input {
         let input = Table::read(Some(path))?;
@@ -209,7 +206,7 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
                  input the output was made from",
                 input.name,
                 input.rows.len(),
-                if input.rows.len() == 1 { "" } else { "s" },
+                plural(input.rows.len()),
                 out.name
             )));
         }
@@ -239,12 +236,12 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
     } else {
         "filter"
     };
-    let file = match cfg.source.as_deref() {
-        Some(p) if p.as_os_str() != "-" => p.file_name().map_or_else(
+    let file = match named(cfg.source.as_deref()) {
+        Some(p) => p.file_name().map_or_else(
             || p.display().to_string(),
             |f| f.to_string_lossy().into_owned(),
         ),
-        _ => "standard input".to_string(),
+        None => "standard input".to_string(),
     };
     let title = format!("seqsmooth {kind} output: {file}");
     Ok((
@@ -257,9 +254,8 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
             noise,
             rejected,
             misfit,
-            switches: Vec::new(),
-            restarts: Vec::new(),
             lead: cfg.lead,
+            ..Track::default()
         },
         title,
     ))
@@ -268,12 +264,7 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
 /// Runs `seqsmooth plot`.
 pub fn run(cfg: &PlotArgs) -> Result<(), CliError> {
     for p in &cfg.output {
-        if chart::Format::from_path(p).is_none() {
-            return Err(CliError::Usage(format!(
-                "cannot tell the image format of '{}': the file name must end in .png or .svg",
-                p.display()
-            )));
-        }
+        chart::Format::of(p)?;
     }
     let (track, default_title) = read_track(cfg)?;
     let tu = cfg.time_unit.as_deref();
@@ -308,19 +299,4 @@ pub fn run(cfg: &PlotArgs) -> Result<(), CliError> {
         chart::write(&track, &layout, p)?;
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn labels_carry_units() {
-        assert_eq!(derivative_label(0, Some("s"), Some("m")), "y (m)");
-        assert_eq!(derivative_label(1, Some("s"), Some("m")), "dy/dt (m/s)");
-        assert_eq!(derivative_label(2, Some("s"), Some("m")), "d²y/dt² (m/s²)");
-        assert_eq!(derivative_label(12, None, None), "d¹²y/dt¹²");
-        assert_eq!(derivative_label(1, Some("s"), None), "dy/dt (1/s)");
-        assert_eq!(derivative_label(0, Some("s"), None), "y");
-    }
 }

@@ -17,7 +17,13 @@ pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
     check_distinct(a.input.as_deref(), a.output.as_deref())?;
     let need = Need::window(a.window.max(a.degree + 1));
     let input = open_input(a.input.as_deref())?;
-    let mut reader = RowReader::new(input, &a.time_col, &a.value_col, None, &need)?;
+    let mut reader = RowReader::new(
+        input,
+        &a.columns.time_col,
+        &a.columns.value_col,
+        None,
+        &need,
+    )?;
     let mut rows = Chunk::default();
     reader.read_chunk(&mut rows, usize::MAX);
     if let Some(e) = rows.error.take() {

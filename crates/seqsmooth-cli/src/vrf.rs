@@ -2,7 +2,7 @@
 //! fixed-memory filters (fading memory: Morrison (13.7.1); fixed memory: Morrison
 //! (7.5.22)-(7.5.26)), in `f64` or exact rationals.
 
-use crate::args::{check_window, memory, only, Format, Memory, TableKind, VrfArgs, VrfKind};
+use crate::args::{check_window, only, Format, Memory, TableKind, VrfArgs, VrfKind};
 use crate::error::CliError;
 use crate::gains::{cells, write_table};
 use seqsmooth::polynomial::fixed::covariance;
@@ -24,8 +24,8 @@ pub fn run(a: &VrfArgs) -> Result<(), CliError> {
             "--lead applies only to --kind fixed; expanding and fading take --form".into(),
         ));
     }
-    let m = a.degree;
-    let mem = memory(kind, a.n, a.theta.clone())?;
+    let m = a.memory.degree;
+    let mem = a.memory.of(kind)?;
     if let Memory::Expanding { n } = mem {
         if n < m as u64 {
             return Err(CliError::Usage(format!(
@@ -78,10 +78,10 @@ pub fn run(a: &VrfArgs) -> Result<(), CliError> {
 /// and the matrix is computed in `f64` (the library evaluates it through the discrete Legendre
 /// recursion).
 fn fixed(a: &VrfArgs) -> Result<(), CliError> {
-    if a.n.is_some() {
+    if a.memory.n.is_some() {
         return Err(only("--n", "expanding"));
     }
-    if a.theta.is_some() {
+    if a.memory.theta.is_some() {
         return Err(only("--theta", "fading"));
     }
     if a.form.is_some() {
@@ -92,7 +92,7 @@ fn fixed(a: &VrfArgs) -> Result<(), CliError> {
                 .into(),
         ));
     }
-    let m = a.degree;
+    let m = a.memory.degree;
     let window = a.window.ok_or_else(|| {
         CliError::Usage(format!(
             "--kind fixed needs --window W, the number of samples in the window (at least M+1 \

@@ -10,8 +10,6 @@
 //! window longer than that) decide the default `τ` (median time step) and the too-few-samples
 //! check before any output is written.
 
-mod auto_runner;
-mod fixed_runner;
 pub mod rows;
 pub mod runner;
 
@@ -73,7 +71,7 @@ fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
         (_, None) => {}
     }
     if let Some(id) = &a.id_col {
-        if *id == a.time_col || *id == a.value_col {
+        if *id == a.columns.time_col || *id == a.columns.value_col {
             return Err(CliError::Usage(format!(
                 "--id-col {id} is the time or the value column; name a column of its own"
             )));
@@ -153,7 +151,13 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     let started = std::time::Instant::now();
     let size = input_size(a.input.as_deref());
     let input = open_input(a.input.as_deref())?;
-    let mut reader = RowReader::new(input, &a.time_col, &a.value_col, a.id_col.as_deref(), &need)?;
+    let mut reader = RowReader::new(
+        input,
+        &a.columns.time_col,
+        &a.columns.value_col,
+        a.id_col.as_deref(),
+        &need,
+    )?;
     // A fixed-memory window longer than LOOKAHEAD is read in full before the first output row:
     // its rows have no estimate, and an input shorter than the window is an error.
     let hold = LOOKAHEAD.max(need.rows);
@@ -310,24 +314,5 @@ impl Pipeline {
         self.full
             .recv()
             .map_err(|_| CliError::Data("internal error: the input reader stopped".into()))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn median_of_steps() {
-        let step = |t: &[f64]| median_series_step(t, &vec![0; t.len()]).unwrap_or(1.0);
-        assert_eq!(step(&[0.0]), 1.0);
-        assert_eq!(step(&[0.0, 2.0]), 2.0);
-        assert_eq!(step(&[0.0, 1.0, 3.0, 3.5]), 1.0); // steps 1, 2, 0.5
-        assert_eq!(step(&[0.0, 1.0, 3.0, 3.5, 7.5]), 1.5); // steps 0.5, 1, 2, 4
-                                                           // Within series: a 0, 1; b 10, 13 → steps 1, 3.
-        assert_eq!(
-            median_series_step(&[0.0, 10.0, 1.0, 13.0], &[0, 1, 0, 1]),
-            Some(2.0)
-        );
     }
 }

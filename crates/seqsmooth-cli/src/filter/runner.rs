@@ -6,11 +6,10 @@
 //! the rows in the window; automatic: the noise σ in use, the outlier and misfit flags as
 //! 0/1). NaN marks an empty cell: a derivative or 1σ not determined yet.
 
-use super::auto_runner::AutoRunner;
-use super::fixed_runner::FixedRunner;
 use crate::args::{EngineArg, Kind};
-use seqsmooth::polynomial::automatic::AutoConfig;
-use seqsmooth::{Error, ExpandingMemory, FadingMemory, PolynomialFilter, PolynomialState};
+use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter};
+use seqsmooth::{Error, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory};
+use seqsmooth::{PolynomialFilter, PolynomialState};
 
 /// A running filter of any kind. Cloning a new one is how each series gets its filter.
 #[derive(Clone, Debug)]
@@ -19,10 +18,10 @@ pub enum Runner {
     Expanding(Box<ExpandingMemory>),
     /// Fading memory.
     Fading(Box<FadingMemory>),
-    /// Fixed memory over `window` samples.
-    Fixed(Box<FixedRunner>, usize),
-    /// The automatic filter.
-    Auto(Box<AutoRunner>),
+    /// Fixed memory over `window` samples, on any timestamps ([`FixedEngine::Adaptive`]).
+    Fixed(Box<FixedMemory>, usize),
+    /// The automatic filter (its last update's flags in [`AutomaticFilter::last_output`]).
+    Auto(Box<AutomaticFilter>),
 }
 
 /// A missing parameter of a filter kind.
@@ -70,13 +69,14 @@ impl Runner {
             )?),
             Kind::Fixed => {
                 let window = window.ok_or_else(|| needs("window", kind.name()))?;
-                Runner::Fixed(Box::new(FixedRunner::new(degree, window, sigma)?), window)
+                let f = FixedMemory::new(degree, window, FixedEngine::Adaptive)?;
+                Runner::Fixed(noise(f, sigma, FixedMemory::with_noise_sigma)?, window)
             }
             Kind::Auto => {
                 let mut config = AutoConfig::new(degree, theta()?, tau);
                 config.engine = engine.into();
                 config.noise_sigma = sigma;
-                Runner::Auto(Box::new(AutoRunner::new(config)?))
+                Runner::Auto(Box::new(AutomaticFilter::new(config)?))
             }
         })
     }
@@ -143,7 +143,7 @@ impl Runner {
                     f.estimate_at(t + lead)
                 }
                 Runner::Auto(f) => {
-                    let Some(o) = f.last.take() else { continue };
+                    let Some(o) = f.last_output() else { continue };
                     extra.copy_from_slice(&[
                         o.noise_sigma.unwrap_or(f64::NAN),
                         f64::from(u8::from(o.outlier)),
@@ -152,7 +152,7 @@ impl Runner {
                     // The output's estimate is at t: the update's own, or across a rejected
                     // sample the prediction; with a lead the active filter's, the same way.
                     if lead == 0.0 {
-                        o.estimate
+                        o.estimate.clone()
                     } else {
                         f.estimate_at(t + lead)
                     }

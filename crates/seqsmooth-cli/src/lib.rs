@@ -1,0 +1,17 @@
+//! The `seqsmooth` command: polynomial smoothing and prediction filters (Morrison 1969;
+//! Reyneke et al. 2012) on CSV time series — expanding, fading and fixed memory, the automatic
+//! filter, and whole-series (Savitzky–Golay) smoothing — their gains and variance-reduction
+//! matrices, and a demo on built-in data. The library behind the binary (`src/main.rs` only dispatches), a thin layer over the `seqsmooth` library: argument
+//! parsing ([`args`]), files ([`io`]), one module per subcommand, and messages ([`error`]).
+
+pub mod args;
+pub mod chart;
+pub mod demo;
+pub mod error;
+pub mod filter;
+pub mod gains;
+pub mod io;
+pub mod plot;
+pub mod progress;
+pub mod smooth;
+pub mod vrf;

@@ -1,0 +1,5 @@
+//! Unit tests of `filter` and its submodules.
+
+mod median;
+mod rows;
+mod runner;
