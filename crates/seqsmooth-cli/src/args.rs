@@ -7,7 +7,7 @@
 use crate::error::CliError;
 use clap::{Args, Parser, Subcommand};
 use num_traits::{One, Zero};
-use seqsmooth::polynomial::vrf::EstimateForm;
+use seqsmooth::polynomial::form::EstimateForm;
 use seqsmooth::polynomial::MAX_DEGREE;
 use seqsmooth::scalar::{parse_rational, Rational};
 use seqsmooth::Engine;

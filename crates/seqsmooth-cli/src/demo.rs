@@ -16,7 +16,7 @@ use crate::error::CliError;
 use crate::filter::runner::Runner;
 use crate::filter::{median_series_step, LOOKAHEAD};
 use crate::io::{fmt_f64, Output};
-use seqsmooth::polynomial::automatic::{AutoConfig, AutoOutput, AutomaticFilter, Phase};
+use seqsmooth::polynomial::automatic::{AutoOutput, AutomaticFilter, Phase};
 use seqsmooth::{PolynomialFilter, PolynomialState};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
@@ -168,9 +168,9 @@ fn run_plain(data: &[Point], kind: Kind, engine: EngineArg, tau: f64) -> Result<
     })
 }
 
-/// The automatic filter's configuration in the demo.
-fn auto_config(tau: f64) -> AutoConfig {
-    AutoConfig::new(DEGREE, THETA, tau)
+/// The automatic filter of the demo.
+fn auto_filter(tau: f64) -> Result<AutomaticFilter, seqsmooth::Error> {
+    AutomaticFilter::new(DEGREE, THETA, tau)
 }
 
 /// Three significant digits, scientific below 0.001 or from 10⁵ on.
@@ -320,8 +320,7 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
     let head: Vec<f64> = data.iter().take(LOOKAHEAD).map(|p| p.t).collect();
     let tau = median_series_step(&head, &vec![0; head.len()]).unwrap_or(1.0);
 
-    let mut auto =
-        AutomaticFilter::new(auto_config(tau)).map_err(|e| CliError::Data(e.to_string()))?;
+    let mut auto = auto_filter(tau).map_err(|e| CliError::Data(e.to_string()))?;
     let mut outs = Vec::with_capacity(data.len());
     for p in &data {
         outs.push(

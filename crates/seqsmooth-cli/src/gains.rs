@@ -4,7 +4,9 @@
 use crate::args::{Format, GainsArgs, Memory};
 use crate::error::CliError;
 use crate::io::{fmt_f64, Output};
-use seqsmooth::polynomial::gains::{expanding_gains, fading_gains, GainForm};
+use seqsmooth::polynomial::expanding::gains::expanding_gains;
+use seqsmooth::polynomial::fading::gains::fading_gains;
+use seqsmooth::polynomial::form::GainForm;
 use seqsmooth::scalar::Rational;
 
 /// Runs `seqsmooth gains`: header `k,gain`, one row per derivative order `k = 0..m`.

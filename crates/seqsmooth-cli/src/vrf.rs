@@ -5,8 +5,10 @@
 use crate::args::{check_window, only, Format, Memory, TableKind, VrfArgs, VrfKind};
 use crate::error::CliError;
 use crate::gains::{cells, write_table};
+use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
+use seqsmooth::polynomial::fading::vrf::fading_vrf;
 use seqsmooth::polynomial::fixed::covariance;
-use seqsmooth::polynomial::vrf::{expanding_vrf, fading_vrf, EstimateForm};
+use seqsmooth::polynomial::form::EstimateForm;
 use seqsmooth::scalar::{ratio_to_f64, Rational};
 
 /// Runs `seqsmooth vrf`: header `i,j,value`, the `(m+1)×(m+1)` matrix row-major.

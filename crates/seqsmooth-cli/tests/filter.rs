@@ -2,8 +2,9 @@
 //! 2012) and the library.
 
 use seqsmooth::polynomial::automatic::AutomaticFilter;
+use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
 use seqsmooth::polynomial::fixed::covariance_unscaled;
-use seqsmooth::polynomial::vrf::{expanding_vrf, EstimateForm};
+use seqsmooth::polynomial::form::EstimateForm;
 use seqsmooth::{
     Engine, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory, PolynomialFilter,
 };
@@ -578,7 +579,7 @@ fn filter_auto_flags_outlier() {
     assert!((num(&rows[120][2]) - 62.0).abs() < 0.3, "{:?}", rows[120]);
     assert!(rows[199][4..7].iter().all(|c| num(c) > 0.0));
 
-    let mut f = AutomaticFilter::with_defaults(1, 0.9, 1.0).unwrap();
+    let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
     for (row, &(t, y)) in rows.iter().zip(&samples) {
         let o = f.update(t, y).unwrap();
         let d = o.derivatives().unwrap_or(&[]);
@@ -630,9 +631,10 @@ fn filter_auto_given_sigma_and_misfit() {
         rows.iter().all(|r| r[6] == "0.2"),
         "noise column is the given sigma"
     );
-    let mut config = seqsmooth::polynomial::automatic::AutoConfig::new(1, 0.9, 1.0);
-    config.noise_sigma = Some(0.2);
-    let mut f = AutomaticFilter::new(config).unwrap();
+    let mut f = AutomaticFilter::new(1, 0.9, 1.0)
+        .unwrap()
+        .with_noise_sigma(0.2)
+        .unwrap();
     for (row, &(t, y)) in rows.iter().zip(&samples) {
         let o = f.update(t, y).unwrap();
         assert_eq!(row[7], if o.outlier { "1" } else { "0" }, "{row:?}");

@@ -2,8 +2,10 @@
 //! and exact rationals.
 
 use num_rational::BigRational;
+use seqsmooth::polynomial::expanding::gains::expanding_gains;
+use seqsmooth::polynomial::fading::gains::fading_gains;
 use seqsmooth::polynomial::fixed::covariance;
-use seqsmooth::polynomial::gains::{expanding_gains, fading_gains, GainForm};
+use seqsmooth::polynomial::form::GainForm;
 use seqsmooth::scalar::{parse_rational, ratio_to_f64, rational_from_f64, Rational};
 
 mod common;

@@ -43,7 +43,7 @@
 //!     degree settling; Morrison §13.8, §14.8; Reyneke et al. §7);
 //!   - [`polynomial::bank`], [`polynomial::stream`]: many channels at once;
 //!   - every filter implements [`PolynomialFilter`], configured as `Type::new(required)?`
-//!     (the automatic filter: `AutomaticFilter::with_defaults`) then `.with_x(v)?` builders.
+//!     (the automatic filter: `AutomaticFilter::new(m, θ, τ)`) then `.with_x(v)?` builders.
 //! - [`stats`]: chi-squared tests, noise estimation, residual calibration.
 //! - [`recursive`]: the square-root information (Bayes) recursion the exact engines run on.
 //! - [`scalar`]: the `f64` / exact-rational abstraction every formula is generic over.

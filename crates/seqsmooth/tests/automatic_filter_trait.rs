@@ -244,21 +244,6 @@ fn builders_equal_the_configuration_they_record() {
     ));
 }
 
-/// The hidden old-style entry point (kept until the CLI is migrated): a filter from the
-/// record is the filter of the builders, update for update.
-#[test]
-fn the_old_style_forward_equals_the_builders() {
-    let mut built = fully_built();
-    let mut from_config = AutomaticFilter::from_config(fully_built_record()).unwrap();
-    let (times, values) = scenario(4);
-    for (&t, &y) in times.iter().zip(&values) {
-        assert_eq!(
-            built.update(t, y).unwrap(),
-            from_config.update(t, y).unwrap()
-        );
-    }
-}
-
 #[test]
 fn builders_reject_what_the_configuration_rejects() {
     let f = || AutomaticFilter::new(2, 0.9, 1.0).unwrap();

@@ -7,7 +7,7 @@
 //! 0/1). NaN marks an empty cell: a derivative or 1σ not determined yet.
 
 use crate::args::{EngineArg, Kind};
-use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter};
+use seqsmooth::polynomial::automatic::AutomaticFilter;
 use seqsmooth::{Error, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory};
 use seqsmooth::{PolynomialFilter, PolynomialState};
 
@@ -73,10 +73,8 @@ impl Runner {
                 Runner::Fixed(noise(f, sigma, FixedMemory::with_noise_sigma)?, window)
             }
             Kind::Auto => {
-                let mut config = AutoConfig::new(degree, theta()?, tau);
-                config.engine = engine.into();
-                config.noise_sigma = sigma;
-                Runner::Auto(Box::new(AutomaticFilter::new(config)?))
+                let f = AutomaticFilter::new(degree, theta()?, tau)?.with_engine(engine.into())?;
+                Runner::Auto(noise(f, sigma, AutomaticFilter::with_noise_sigma)?)
             }
         })
     }

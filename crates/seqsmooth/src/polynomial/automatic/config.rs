@@ -82,18 +82,9 @@ pub struct AutoConfig {
 }
 
 impl AutoConfig {
-    /// The defaults for degree `m`, discount `θ` per nominal interval `τ` (unchecked;
-    /// [`AutomaticFilter::from_config`](super::AutomaticFilter::from_config) checks them). Old
-    /// style, kept for existing callers: use
-    /// [`AutomaticFilter::new`](super::AutomaticFilter::new) and the `with_*` builders.
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter};
-    /// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
-    /// assert_eq!(f.config(), &AutoConfig::new(1, 0.9, 1.0));
-    /// ```
-    #[doc(hidden)]
-    pub fn new(degree: usize, theta: f64, tau: f64) -> Self {
+    /// The defaults for degree `m`, discount `θ` per nominal interval `τ` (unchecked:
+    /// [`AutomaticFilter::new`](super::AutomaticFilter::new) checks them).
+    pub(super) fn new(degree: usize, theta: f64, tau: f64) -> Self {
         Self {
             degree,
             theta,

@@ -177,34 +177,6 @@ impl AutomaticFilter {
         Self::build(AutoConfig::new(m, theta, tau))
     }
 
-    /// Old name of [`new`](Self::new), kept for existing callers.
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let f = AutomaticFilter::with_defaults(2, 0.9, 1.0).unwrap();
-    /// assert_eq!(f.config(), AutomaticFilter::new(2, 0.9, 1.0).unwrap().config());
-    /// ```
-    #[doc(hidden)]
-    pub fn with_defaults(m: usize, theta: f64, tau: f64) -> Result<Self, Error> {
-        Self::new(m, theta, tau)
-    }
-
-    /// A filter with every setting of `config`, checked. Old style, kept for existing callers:
-    /// use [`new`](Self::new) and the `with_*` builders.
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::{AutoConfig, AutomaticFilter};
-    /// use seqsmooth::Error;
-    /// assert!(matches!(
-    ///     AutomaticFilter::from_config(AutoConfig::new(2, 1.5, 1.0)),
-    ///     Err(Error::ThetaOutOfRange { .. })
-    /// ));
-    /// ```
-    #[doc(hidden)]
-    pub fn from_config(config: AutoConfig) -> Result<Self, Error> {
-        Self::build(config)
-    }
-
     /// The same filter with one setting changed and every setting checked again; an error
     /// after the first sample.
     fn reconfigure(self, change: impl FnOnce(&mut AutoConfig)) -> Result<Self, Error> {
