@@ -3,9 +3,9 @@
 //!
 //! If `z` holds the coefficients of `f(u) = Σ z_k u^k`, `Φ(h) z` holds those of `f(u + h)`:
 //! repeated synthetic division, `z_k += h·z_{k+1}` for `i = 0 … m−1` and `k = m−1` down to
-//! `i` (`O(m²)`, [`for_each_shift_step`] gives that order once for every variant: plain,
+//! `i` (`O(m²)`, `for_each_shift_step` gives that order once for every variant: plain,
 //! compensated, on arrays, on the rows of a bank). The factors `k!/τ^k` are running products
-//! `k! = (k−1)!·k`, `τ^k = τ^(k−1)·τ` ([`factorial_powers`]), the same operations wherever
+//! `k! = (k−1)!·k`, `τ^k = τ^(k−1)·τ` (`factorial_powers`), the same operations wherever
 //! they are used.
 
 use crate::calculus::factorial;

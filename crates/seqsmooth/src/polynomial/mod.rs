@@ -8,15 +8,13 @@
 //! |---|---|---|
 //! | what every filter does: [`PolynomialFilter`]; batch checks | `filter` | — |
 //! | engines, discounting, largest degree: [`Engine`], [`DiscountMode`], [`MAX_DEGREE`] | `options` | — |
-//! | current / predictor form of gains and VRFs: [`gains::GainForm`], [`vrf::EstimateForm`], [`vrf::unscale`] | `form` | Morrison (9.7.4), (13.6.22) |
+//! | current / predictor form of gains and VRFs: [`form::GainForm`], [`form::EstimateForm`], [`form::unscale`] | [`form`] | Morrison (9.7.4), (13.6.22) |
 //! | expanding memory: [`ExpandingMemory`], gains, VRF | [`expanding`] | Morrison ch. 9, Tables 9.1-9.2; Reyneke §6.3-6.4 |
 //! | fading memory: [`FadingMemory`], gains, VRF, the switch [`SwitchRule`] | [`fading`] | Morrison ch. 13, Tables 13.1-13.4, §13.8; Reyneke §6.5-6.6, Table 1 |
 //! | the exact and gain engines | `engine` | Morrison §9.6, Tables 9.1/13.1; Reyneke §6 |
 //! | fixed memory and whole-series smoothing | [`fixed`] | Morrison ch. 7, §9.5 |
 //! | the automatic filter: [`AutomaticFilter`] | [`automatic`] | Morrison §13.8, §14.8; Reyneke §7 |
 //! | many channels at once | [`bank`], [`stream`] | — |
-//!
-//! The old paths [`gains`], [`vrf`] and [`switching`] re-export the formulas of both memories.
 //!
 //! ## Engines
 //!

@@ -18,7 +18,7 @@ pub const MAX_DEGREE: usize = 24;
 // The noise estimators take differences of order up to `m + 1` for every degree the filters take.
 const _: () = assert!(crate::stats::MAX_DIFFERENCE_ORDER == MAX_DEGREE + 1);
 
-/// Which computation a filter uses (see the [module docs](self)).
+/// Which computation a filter uses (see the [module docs](crate::polynomial)).
 ///
 /// ```
 /// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
