@@ -3,7 +3,7 @@
 //! interleaved series, series that start late or pause, and chunks of 1, 3 and 64 rows, serial
 //! and on rayon; errors name the first failing row and its channel.
 
-use seqsmooth::polynomial::bank::StreamBank;
+use seqsmooth::polynomial::stream::{Chunk, StreamBank};
 use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, PolynomialFilter};
 
 /// Rows `(channel, t, y)`: channel 0 throughout, channel 1 from row 40 on, channel 2 paused
@@ -81,9 +81,29 @@ fn banked<F: PolynomialFilter + Clone + Send>(
             Ok(())
         };
         if parallel {
-            bank.update_par(&ch, &t, &y, est, w, run).unwrap();
+            bank.update_par(
+                Chunk {
+                    channels: &ch,
+                    times: &t,
+                    values: &y,
+                    estimates: est,
+                    stride: w,
+                },
+                run,
+            )
+            .unwrap();
         } else {
-            bank.update(&ch, &t, &y, est, w, run).unwrap();
+            bank.update(
+                Chunk {
+                    channels: &ch,
+                    times: &t,
+                    values: &y,
+                    estimates: est,
+                    stride: w,
+                },
+                run,
+            )
+            .unwrap();
         }
     }
     assert_eq!(bank.channels(), 4);
@@ -153,9 +173,27 @@ fn errors_name_the_first_failing_row_and_channel() {
     for parallel in [false, true] {
         let mut b = bank.clone();
         let e = if parallel {
-            b.update_par(&ch, &t, &y, &mut est, 1, run)
+            b.update_par(
+                Chunk {
+                    channels: &ch,
+                    times: &t,
+                    values: &y,
+                    estimates: &mut est,
+                    stride: 1,
+                },
+                run,
+            )
         } else {
-            b.update(&ch, &t, &y, &mut est, 1, run)
+            b.update(
+                Chunk {
+                    channels: &ch,
+                    times: &t,
+                    values: &y,
+                    estimates: &mut est,
+                    stride: 1,
+                },
+                run,
+            )
         };
         match e.unwrap_err() {
             Error::InChannel {
@@ -175,6 +213,17 @@ fn errors_name_the_first_failing_row_and_channel() {
         assert_eq!(b.channel(2).unwrap().samples(), 1);
     }
     // Wrong lengths are refused before anything runs.
-    assert!(bank.update(&ch, &t[..6], &y, &mut est, 1, run).is_err());
+    assert!(bank
+        .update(
+            Chunk {
+                channels: &ch,
+                times: &t[..6],
+                values: &y,
+                estimates: &mut est,
+                stride: 1
+            },
+            run
+        )
+        .is_err());
     assert_eq!(bank.channels(), 0);
 }

@@ -20,7 +20,7 @@ use crate::progress::{self, Progress};
 use rayon::prelude::*;
 use rows::{Chunk, RowReader};
 use runner::Runner;
-use seqsmooth::polynomial::bank::StreamBank;
+use seqsmooth::polynomial::stream::{self, StreamBank};
 use std::collections::HashMap;
 use std::io::Read;
 use std::sync::mpsc;
@@ -205,7 +205,16 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         values.resize(chunk.len() * stride, 0.0);
         let run = |f: &mut Runner, t: &[f64], y: &[f64], o: &mut [f64]| f.run(t, y, o, lead, sigma);
         let failed = bank
-            .update_par(&chunk.series, &chunk.t, &chunk.y, &mut values, stride, run)
+            .update_par(
+                stream::Chunk {
+                    channels: &chunk.series,
+                    times: &chunk.t,
+                    values: &chunk.y,
+                    estimates: &mut values,
+                    stride,
+                },
+                run,
+            )
             .err()
             .map(|e| row_error(e, &chunk));
         let limit = failed.as_ref().map_or(chunk.len(), |(i, _)| *i);

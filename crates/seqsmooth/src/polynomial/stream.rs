@@ -82,6 +82,23 @@ impl Scratch {
     }
 }
 
+/// Rows of many channels for [`StreamBank::update`]: row `i` is the sample
+/// `(times[i], values[i])` of channel `channels[i]`, and its results go to
+/// `estimates[i·stride..(i+1)·stride]`.
+#[derive(Debug)]
+pub struct Chunk<'a> {
+    /// The channel of each row.
+    pub channels: &'a [usize],
+    /// The time of each row.
+    pub times: &'a [f64],
+    /// The value of each row.
+    pub values: &'a [f64],
+    /// `stride` results per row, written by the per-channel run.
+    pub estimates: &'a mut [f64],
+    /// Results per row.
+    pub stride: usize,
+}
+
 /// One channel's piece of a chunk: channel, filter, times, values, output, rows.
 type Work<'a, F> = (
     usize,
@@ -135,7 +152,8 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
     /// let (ch, t) = ([0, 1, 0, 1, 1], [0.0, 0.0, 1.0, 1.0, 2.0]);
     /// let y = [0.0, 0.0, 1.0, 2.0, 4.0];
     /// let mut est = [0.0; 10]; // d0, d1 per row, in row order
-    /// bank.update_par(&ch, &t, &y, &mut est, 2, |f, t, y, out| f.update_many_into(t, y, out))?;
+    /// let chunk = Chunk { channels: &ch, times: &t, values: &y, estimates: &mut est, stride: 2 };
+    /// bank.update_par(chunk, |f, t, y, out| f.update_many_into(t, y, out))?;
     /// assert_eq!(bank.channels(), 2);
     /// assert!(est[0].is_nan() && (est[9] - 2.0).abs() < 1e-12); // row 4: slope 2
     /// # Ok::<(), seqsmooth::Error>(())
@@ -146,8 +164,7 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
         Ok(bank)
     }
 
-    /// Runs a chunk of rows: row `i` is the sample `(times[i], values[i])` of channel
-    /// `channels[i]` (a channel not seen yet starts from the prototype). Each channel's rows,
+    /// Runs a [`Chunk`] of rows (a channel not seen yet starts from the prototype). Each channel's rows,
     /// in order, go to `run(filter, times, values, out)` as one batch, `out` holding `stride`
     /// values per row; they come back in `estimates[i·stride..(i+1)·stride]`. The channels run
     /// one after the other; [`update_par`](Self::update_par) runs them on the rayon pool, with
@@ -155,48 +172,34 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
     /// the error is [`Error::InChannel`] of the channel whose bad row comes first, its source
     /// [`Error::InBatch`] with that row's index in the chunk (the rows before it, of every
     /// channel, are done).
-    pub fn update(
-        &mut self,
-        channels: &[usize],
-        times: &[f64],
-        values: &[f64],
-        estimates: &mut [f64],
-        stride: usize,
-        run: impl ChannelRun<F>,
-    ) -> Result<(), Error> {
-        self.run_chunk(channels, times, values, estimates, stride, &run, false)
+    pub fn update(&mut self, chunk: Chunk<'_>, run: impl ChannelRun<F>) -> Result<(), Error> {
+        self.run_chunk(chunk, &run, false)
     }
 
     /// [`update`](Self::update) with the channels on the rayon pool.
-    pub fn update_par(
-        &mut self,
-        channels: &[usize],
-        times: &[f64],
-        values: &[f64],
-        estimates: &mut [f64],
-        stride: usize,
-        run: impl ChannelRun<F>,
-    ) -> Result<(), Error>
+    pub fn update_par(&mut self, chunk: Chunk<'_>, run: impl ChannelRun<F>) -> Result<(), Error>
     where
         F: Send,
     {
-        self.run_chunk(channels, times, values, estimates, stride, &run, true)
+        self.run_chunk(chunk, &run, true)
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn run_chunk(
         &mut self,
-        channels: &[usize],
-        times: &[f64],
-        values: &[f64],
-        estimates: &mut [f64],
-        stride: usize,
+        chunk: Chunk<'_>,
         run: &dyn ChannelRun<F>,
         parallel: bool,
     ) -> Result<(), Error>
     where
         F: Send,
     {
+        let Chunk {
+            channels,
+            times,
+            values,
+            estimates,
+            stride,
+        } = chunk;
         let n = channels.len();
         if times.len() != n || values.len() != n || estimates.len() != n * stride {
             return Err(Error::InvalidParameter {
@@ -304,13 +307,8 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
     /// others.
     pub fn update_all(&mut self, batches: &[(&[f64], &[f64])]) -> Result<(), Error> {
         self.check_batches(batches)?;
-        let results: Vec<Result<(), Error>> = self
-            .filters
-            .iter_mut()
-            .zip(batches)
-            .map(|(f, (t, y))| f.update_many(t, y))
-            .collect();
-        first_failure(results)
+        let each = |(f, (t, y)): (&mut F, &(&[f64], &[f64]))| f.update_many(t, y);
+        first_failure(self.filters.iter_mut().zip(batches).map(each).collect())
     }
 
     /// [`update_all`](Self::update_all) with the channels on the rayon pool.
@@ -319,13 +317,8 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
         F: Send,
     {
         self.check_batches(batches)?;
-        let results: Vec<Result<(), Error>> = self
-            .filters
-            .par_iter_mut()
-            .zip(batches.par_iter())
-            .map(|(f, (t, y))| f.update_many(t, y))
-            .collect();
-        first_failure(results)
+        let each = |(f, (t, y)): (&mut F, &(&[f64], &[f64]))| f.update_many(t, y);
+        first_failure(self.filters.par_iter_mut().zip(batches).map(each).collect())
     }
 
     fn check_batches(&self, batches: &[(&[f64], &[f64])]) -> Result<(), Error> {
