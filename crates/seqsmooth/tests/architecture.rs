@@ -271,9 +271,11 @@ fn resolve(path: &[String], module: &[String]) -> Option<Vec<String>> {
     Some(abs)
 }
 
-/// The level of a module path: the longest table entry that prefixes it.
+/// The level of a module path: the longest table entry that prefixes it (the crate root, ``,
+/// only for the root itself, so that a module missing from the table is found).
 fn level_of(table: &BTreeMap<String, usize>, path: &[String]) -> Option<(String, usize)> {
-    (0..=path.len()).rev().find_map(|n| {
+    let shortest = usize::from(!path.is_empty());
+    (shortest..=path.len()).rev().find_map(|n| {
         let key = path[..n].join("::");
         table.get(&key).map(|&l| (key, l))
     })

@@ -145,13 +145,13 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
     /// must not have seen any sample) for each new channel, as its rows come.
     ///
     /// ```
-    /// use seqsmooth::polynomial::bank::StreamBank;
+    /// use seqsmooth::polynomial::stream::{Chunk, StreamBank};
     /// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
     /// let mut bank = StreamBank::growing(ExpandingMemory::new(1, Engine::Exact)?)?;
     /// // Rows of channels 0 and 1, interleaved; y = t on channel 0, y = 2t on channel 1.
     /// let (ch, t) = ([0, 1, 0, 1, 1], [0.0, 0.0, 1.0, 1.0, 2.0]);
     /// let y = [0.0, 0.0, 1.0, 2.0, 4.0];
-    /// let mut est = [0.0; 10]; // d0, d1 per row, in row order
+    /// let mut est = [0.0f64; 10]; // d0, d1 per row, in row order
     /// let chunk = Chunk { channels: &ch, times: &t, values: &y, estimates: &mut est, stride: 2 };
     /// bank.update_par(chunk, |f, t, y, out| f.update_many_into(t, y, out))?;
     /// assert_eq!(bank.channels(), 2);
