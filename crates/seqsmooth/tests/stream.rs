@@ -80,30 +80,17 @@ fn banked<F: PolynomialFilter + Clone + Send>(
             }
             Ok(())
         };
+        let chunk = Chunk {
+            channels: &ch,
+            times: &t,
+            values: &y,
+            estimates: est,
+            stride: w,
+        };
         if parallel {
-            bank.update_par(
-                Chunk {
-                    channels: &ch,
-                    times: &t,
-                    values: &y,
-                    estimates: est,
-                    stride: w,
-                },
-                run,
-            )
-            .unwrap();
+            bank.update_par(chunk, run).unwrap();
         } else {
-            bank.update(
-                Chunk {
-                    channels: &ch,
-                    times: &t,
-                    values: &y,
-                    estimates: est,
-                    stride: w,
-                },
-                run,
-            )
-            .unwrap();
+            bank.update(chunk, run).unwrap();
         }
     }
     assert_eq!(bank.channels(), 4);
@@ -172,28 +159,17 @@ fn errors_name_the_first_failing_row_and_channel() {
         |f: &mut ExpandingMemory, t: &[f64], y: &[f64], o: &mut [f64]| f.update_many_into(t, y, o);
     for parallel in [false, true] {
         let mut b = bank.clone();
+        let chunk = Chunk {
+            channels: &ch,
+            times: &t,
+            values: &y,
+            estimates: &mut est,
+            stride: 1,
+        };
         let e = if parallel {
-            b.update_par(
-                Chunk {
-                    channels: &ch,
-                    times: &t,
-                    values: &y,
-                    estimates: &mut est,
-                    stride: 1,
-                },
-                run,
-            )
+            b.update_par(chunk, run)
         } else {
-            b.update(
-                Chunk {
-                    channels: &ch,
-                    times: &t,
-                    values: &y,
-                    estimates: &mut est,
-                    stride: 1,
-                },
-                run,
-            )
+            b.update(chunk, run)
         };
         match e.unwrap_err() {
             Error::InChannel {
