@@ -9,7 +9,7 @@
 //! cost per sample.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use seqsmooth::polynomial::fixed::{smooth, FixedEngine, FixedMemory};
+use seqsmooth::polynomial::fixed::{smooth, smooth_into, FixedEngine, FixedMemory};
 use seqsmooth::PolynomialFilter;
 mod common;
 
@@ -74,7 +74,8 @@ fn direct_update(c: &mut Criterion) {
     run(c, "direct_update", FixedEngine::Direct, false, 200);
 }
 
-/// Whole-series smoothing of `SMOOTH_LEN` evenly spaced samples at windows 11 … 10001.
+/// Whole-series smoothing of `SMOOTH_LEN` evenly spaced samples at windows 11 … 10001: rows
+/// as vectors (`smooth`) and into one flat buffer (`smooth_into`).
 fn smooth_series(c: &mut Criterion) {
     const SMOOTH_LEN: usize = 1 << 17;
     let ys = data(SMOOTH_LEN);
@@ -91,6 +92,23 @@ fn smooth_series(c: &mut Criterion) {
             &window,
             |b, &window| {
                 b.iter(|| black_box(smooth(&ts, &ys, DEGREE, window).unwrap()));
+            },
+        );
+    }
+    group.finish();
+    let mut group = c.benchmark_group("smooth_into");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3))
+        .throughput(Throughput::Elements(SMOOTH_LEN as u64));
+    let mut out = vec![0.0; SMOOTH_LEN * (DEGREE + 1)];
+    for window in [11usize, 101, 1_001, 10_001] {
+        group.bench_with_input(
+            BenchmarkId::from_parameter(window),
+            &window,
+            |b, &window| {
+                b.iter(|| smooth_into(&ts, &ys, DEGREE, window, black_box(&mut out)).unwrap());
             },
         );
     }

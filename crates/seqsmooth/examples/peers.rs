@@ -13,7 +13,7 @@
 //!   [`DiscountMode::PerUpdate`]), `expanding-gain` / `expanding-exact`, `fixed-sliding`
 //!   (key `window`: the streaming [`FixedMemory`] evaluated at the centre of each window, i.e.
 //!   at the time of the sample `(window-1)/2` before the newest), `smooth` (key `window`: the
-//!   whole-series [`smooth`]).
+//!   whole-series [`smooth_into`]).
 //!
 //! For each run it writes `DIR/<name>.est.f64`: `samples × (degree+1)` doubles, row-major, the
 //! estimate `[x, x', …]` after each sample (NaN while undetermined; for `fixed-sliding` row
@@ -28,7 +28,7 @@
 //! Each timed loop is one small function per filter family ([`feed`], [`feed_and_read`],
 //! [`feed_fixed_and_read`]), so a batch update API can replace the per-sample loop in one place.
 
-use seqsmooth::polynomial::fixed::smooth;
+use seqsmooth::polynomial::fixed::smooth_into;
 use seqsmooth::{
     DiscountMode, Engine, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory, PolynomialFilter,
 };
@@ -258,16 +258,12 @@ fn main() -> Res<()> {
             }
             "smooth" => {
                 let window: usize = run.key("window")?;
-                let mut rows = Vec::new();
+                let mut out = vec![0.0; t.len() * (m + 1)];
                 let secs = best_of(
                     reps,
                     || Ok(()),
-                    |_| {
-                        rows = smooth(t, y, m, window)?;
-                        Ok(())
-                    },
+                    |_| Ok(smooth_into(t, y, m, window, &mut out)?),
                 )?;
-                let out: Vec<f64> = rows.concat();
                 (secs, secs, out, Vec::new(), None)
             }
             other => return Err(format!("run {}: unknown filter '{other}'", run.name).into()),

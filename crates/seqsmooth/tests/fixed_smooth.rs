@@ -6,7 +6,9 @@ mod common;
 use common::fixed::*;
 use common::{dyadic, exact_discounted_even, exact_ls_derivatives, jittered_times};
 use rand::Rng;
-use seqsmooth::polynomial::fixed::{smooth, smooth_detrended, weights_unscaled, Nominal};
+use seqsmooth::polynomial::fixed::{
+    smooth, smooth_detrended, smooth_into, weights_unscaled, Nominal,
+};
 use seqsmooth::polynomial::MAX_DEGREE;
 use seqsmooth::Error;
 
@@ -162,4 +164,62 @@ fn smooth_rejects_bad_input() {
     assert!(smooth_detrended(&t, &y, 1, 3, Nominal::Samples(&rows)).is_err());
     let bad = |_: f64| vec![f64::NAN];
     assert!(smooth_detrended(&t, &y, 1, 3, Nominal::Function(&bad)).is_err());
+}
+
+#[test]
+fn smooth_into_writes_the_rows_of_smooth() {
+    // The flat form is the same computation: bit for bit the rows of `smooth`, on even and on
+    // irregular times, degrees 0-10.
+    let mut rng = common::rng(11);
+    for m in 0..=10usize {
+        let window = 2 * m + 5;
+        let len = 3 * window;
+        let even: Vec<f64> = (0..len).map(|k| 0.25 * k as f64).collect();
+        let uneven = jittered_times(len, 0.25, 0.3, 5 + m as u64);
+        let y: Vec<f64> = (0..len).map(|_| rng.gen_range(-1.0..1.0)).collect();
+        for t in [&even, &uneven] {
+            let rows = smooth(t, &y, m, window).unwrap();
+            let mut flat = vec![f64::NAN; len * (m + 1)];
+            smooth_into(t, &y, m, window, &mut flat).unwrap();
+            assert_eq!(flat, rows.concat(), "m = {m}");
+        }
+    }
+}
+
+#[test]
+fn smooth_rejects_bad_input_anywhere_in_long_series() {
+    // The first bad sample is the error, wherever it is (the check runs over blocks).
+    let len = 2000;
+    let t: Vec<f64> = (0..len).map(|k| k as f64).collect();
+    let y = vec![1.0; len];
+    for k in [0, 1, 255, 256, 257, 1999] {
+        let mut yb = y.clone();
+        yb[k] = f64::INFINITY;
+        assert_eq!(
+            smooth(&t, &yb, 2, 11),
+            Err(Error::NonFinite {
+                what: "value",
+                value: f64::INFINITY
+            })
+        );
+        if k > 0 {
+            let mut tb = t.clone();
+            tb[k] = tb[k - 1];
+            assert_eq!(
+                smooth(&tb, &y, 2, 11),
+                Err(Error::TimeNotIncreasing {
+                    time: tb[k],
+                    previous: tb[k - 1]
+                })
+            );
+        }
+    }
+    let mut short = vec![0.0; len * 3 - 1];
+    assert!(matches!(
+        smooth_into(&t, &y, 2, 11, &mut short),
+        Err(Error::InvalidParameter {
+            name: "estimates length",
+            ..
+        })
+    ));
 }

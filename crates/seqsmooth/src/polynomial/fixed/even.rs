@@ -7,7 +7,8 @@ use super::ring::Ring;
 use super::sliding::SlidingMoments;
 use super::weights::{inverse_norms, legendre_values, taylor_at};
 use crate::basis::DiscreteLegendre;
-use crate::model::taylor::scaling_diagonal;
+use crate::model::taylor::{derivative_scale, scaling_diagonal};
+use crate::numeric::unrolled::unrolled_sizes;
 use nalgebra::DMatrix;
 use std::borrow::Cow;
 
@@ -67,16 +68,23 @@ impl MomentFit {
             computed = Self::times_c(&self.taylor(r), &self.inv_norm);
             &computed
         };
-        let p = mu.len();
-        let mut scale = 1.0;
-        (0..p)
-            .map(|i| {
-                if i > 0 {
-                    scale *= i as f64 / step;
-                }
-                let row = &tc[i * p + i..(i + 1) * p];
-                row.iter().zip(&mu[i..]).map(|(a, b)| a * b).sum::<f64>() * scale
-            })
+        let mut out = vec![0.0; mu.len()];
+        apply_upper(tc, mu, &mut out);
+        for (o, s) in out.iter_mut().zip(derivative_scale(step)) {
+            *o *= s;
+        }
+        out
+    }
+
+    /// `D(τ) T(r) C` row-major, `τ = step`: the map from the moments to the unscaled
+    /// derivatives at `r` ([`apply_upper`] applies it).
+    pub(super) fn evaluator(&self, r: f64, step: f64) -> Vec<f64> {
+        let tc = Self::times_c(&self.taylor(r), &self.inv_norm);
+        let scale: Vec<f64> = derivative_scale(step).take(self.m + 1).collect();
+        let p = self.m + 1;
+        tc.iter()
+            .enumerate()
+            .map(|(k, v)| v * scale[k / p])
             .collect()
     }
 
@@ -101,6 +109,23 @@ impl MomentFit {
             })
         });
         (x, cov)
+    }
+}
+
+/// `out_i = Σ_{j≥i} a_ij μ_j` for the upper-triangular, row-major `a` (`p × p`, `p` the
+/// length of `mu`).
+#[inline]
+pub(super) fn apply_upper(a: &[f64], mu: &[f64], out: &mut [f64]) {
+    unrolled_sizes!(mu.len(), N => apply_upper_sized(N, a, mu, out), p => apply_upper_sized(p, a, mu, out));
+}
+
+/// [`apply_upper`] for `p` (a constant where the dispatch makes it one).
+#[inline(always)]
+fn apply_upper_sized(p: usize, a: &[f64], mu: &[f64], out: &mut [f64]) {
+    let (mu, out) = (&mu[..p], &mut out[..p]);
+    for (i, o) in out.iter_mut().enumerate() {
+        let row = &a[i * p + i..(i + 1) * p];
+        *o = row.iter().zip(&mu[i..]).map(|(a, b)| a * b).sum::<f64>();
     }
 }
 

@@ -27,7 +27,7 @@
 //! | [`balance_span`] | bias against random error | §7.13 |
 //! | [`smooth_detrended`], [`Detrended`] | trend removal | §7.14 |
 //! | [`FixedMemory`], [`FixedEngine`] | streaming filter: direct, sliding, irregular, adaptive | §7.1, §9.5 |
-//! | [`smooth`] | whole-series centred smoothing (savgol `mode="interp"`), the sliding engine | (7.4.16), `h = -L/2` |
+//! | [`smooth`], [`smooth_into`] | whole-series centred smoothing (savgol `mode="interp"`), the sliding engine | (7.4.16), `h = -L/2` |
 //! | window moments `μ_j = Σ y(x) p_j(x)`, `β = C μ`, `T(r)` | the even-spacing fit (private `even`) | (7.4.5), (7.4.10), (7.4.15), (7.5.21) |
 //! | sliding moments, shift matrix, refreshes | `O(m²)` per sample (private `sliding`) | (A1.1), §9.5 |
 //! | QR fit of the window | irregular timestamps (private `irregular`) | §6.5 |
@@ -99,7 +99,7 @@ pub use covariance::{
     tau_for_derivative_sigma, vrf_limit,
 };
 pub use filter::{FixedEngine, FixedMemory};
-pub use smooth::smooth;
+pub use smooth::{smooth, smooth_into};
 pub use trend::{smooth_detrended, Detrended, Nominal};
 pub use weights::{weights, weights_unscaled};
 pub use window_vrf::{fixed_memory_vrf_limit, window_covariance};

@@ -13,6 +13,7 @@
 //! window is complete, so no error is carried through more than `⌈(L+1)/q⌉` shifts.
 
 use crate::basis::DiscreteLegendre;
+use crate::numeric::unrolled::unrolled_sizes;
 use crate::scalar::{Rational, Scalar};
 
 /// The default number of staggered refresh accumulators for degree `m` (an exact refresh every
@@ -160,18 +161,25 @@ impl SlidingMoments {
     /// Takes the sample `y` with 0-based index `n` (every sample, in order: `n = 0, 1, …`);
     /// `old` is the sample leaving the window (`None` while the window fills).
     pub(super) fn push(&mut self, n: u64, y: f64, old: Option<f64>) {
-        let p = self.mu.len();
+        unrolled_sizes!(self.mu.len(), N => self.push_sized(N, n, y, old), p => self.push_sized(p, n, y, old));
+    }
+
+    /// [`Self::push`] for `p = m+1` (a constant where the dispatch makes it one).
+    #[inline(always)]
+    fn push_sized(&mut self, p: usize, n: u64, y: f64, old: Option<f64>) {
+        let mu = &mut self.mu[..p];
+        let scratch = &mut self.scratch[..p];
         if let (true, Some(o)) = (self.valid, old) {
-            for (s, m) in self.scratch.iter_mut().zip(&self.mu) {
+            for (s, m) in scratch.iter_mut().zip(mu.iter()) {
                 *s = m - o;
             }
-            for j in 0..p {
+            for (j, mj) in mu.iter_mut().enumerate() {
                 let row = &self.shift[j * p..j * p + j + 1];
                 let mut acc = 0.0;
-                for (r, s) in row.iter().zip(&self.scratch) {
+                for (r, s) in row.iter().zip(scratch.iter()) {
                     acc += r * s;
                 }
-                self.mu[j] = if j % 2 == 0 { acc + y } else { acc - y };
+                *mj = if j % 2 == 0 { acc + y } else { acc - y };
             }
         }
         if self.started < self.counts.len() && n == (self.started * self.period) as u64 {
@@ -182,8 +190,8 @@ impl SlidingMoments {
             .zip(self.sums.chunks_exact_mut(p))
         {
             let values = if self.table.is_empty() {
-                self.recursion.values(*count as f64, &mut self.scratch);
-                &self.scratch[..]
+                self.recursion.values(*count as f64, scratch);
+                &scratch[..]
             } else {
                 &self.table[*count * p..(*count + 1) * p]
             };
@@ -192,7 +200,7 @@ impl SlidingMoments {
             }
             *count += 1;
             if *count == self.window {
-                self.mu.copy_from_slice(sums);
+                mu.copy_from_slice(sums);
                 self.valid = true;
                 *count = 0;
                 sums.iter_mut().for_each(|v| *v = 0.0);

@@ -1,14 +1,16 @@
 //! Whole-series (non-causal) smoothing with centred fixed-memory windows: the counterpart of
 //! `scipy.signal.savgol_filter(…, mode="interp")`, with derivatives.
 
-use super::even::MomentFit;
+use super::even::{apply_upper, MomentFit};
 use super::irregular::IrregularWindow;
 use super::sliding::{smoothing_refreshes, SlidingMoments};
 use super::{check_window, steps_agree};
 use crate::error::Error;
+use crate::polynomial::filter::{check_estimates_length, first_invalid};
 use std::ops::Range;
 
-/// Checks lengths, finiteness and strictly increasing times.
+/// Checks lengths, finiteness and strictly increasing times: the first sample that
+/// [`crate::error::check_sample`] rejects is the error.
 pub(crate) fn check_series(times: &[f64], values: &[f64]) -> Result<(), Error> {
     crate::error::check_lengths(
         "input lengths",
@@ -16,10 +18,11 @@ pub(crate) fn check_series(times: &[f64], values: &[f64]) -> Result<(), Error> {
         values,
         "times and values must have the same length",
     )?;
-    for (k, (&t, &y)) in times.iter().zip(values).enumerate() {
-        crate::error::check_sample(t, y, k.checked_sub(1).map(|p| times[p]))?;
+    let k = first_invalid(times, values, None);
+    match times.get(k) {
+        Some(&t) => crate::error::check_sample(t, values[k], k.checked_sub(1).map(|p| times[p])),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// True when every step equals the first (the rule of [`steps_agree`]).
@@ -51,36 +54,40 @@ fn rows_served(start: usize, window: usize, len: usize) -> Range<usize> {
 trait SeriesWindows {
     /// Takes sample `n` of the series (the samples arrive in order).
     fn push(&mut self, n: usize) -> Result<(), Error>;
-    /// The derivatives at sample `row` of the fit of the full window starting at `start` (the
-    /// newest window pushed).
-    fn row(&self, row: usize, start: usize) -> Vec<f64>;
+    /// Writes the derivatives at sample `row` of the fit of the full window starting at `start`
+    /// (the newest window pushed).
+    fn row(&self, row: usize, start: usize, out: &mut [f64]);
 }
 
-/// Every sample's row, in order, from the fits of the series' `len - window + 1` windows.
+/// Every sample's row, in order, from the fits of the series' `len - window + 1` windows, into
+/// `out` (`len` rows of `p` values).
 fn centred_rows(
     len: usize,
     window: usize,
     mut fits: impl SeriesWindows,
-) -> Result<Vec<Vec<f64>>, Error> {
-    let mut out = Vec::with_capacity(len);
+    out: &mut [f64],
+) -> Result<(), Error> {
+    let p = out.len() / len;
     for n in 0..len {
         fits.push(n)?;
         if let Some(start) = (n + 1).checked_sub(window) {
             for row in rows_served(start, window, len) {
-                out.push(fits.row(row, start));
+                fits.row(row, start, &mut out[row * p..(row + 1) * p]);
             }
         }
     }
-    Ok(out)
+    Ok(())
 }
 
-/// Evenly spaced samples: the sliding moments of each window, evaluated through `T(r)`.
+/// Evenly spaced samples: the sliding moments of each window, evaluated through `D(τ) T(r) C`
+/// (kept for the centre row, computed for the edge rows).
 struct EvenSeries<'a> {
     values: &'a [f64],
     window: usize,
     moments: SlidingMoments,
     fit: MomentFit,
     step: f64,
+    centre: Vec<f64>,
 }
 
 impl SeriesWindows for EvenSeries<'_> {
@@ -90,9 +97,14 @@ impl SeriesWindows for EvenSeries<'_> {
         Ok(())
     }
 
-    fn row(&self, row: usize, start: usize) -> Vec<f64> {
+    fn row(&self, row: usize, start: usize, out: &mut [f64]) {
         let mu = self.moments.moments().expect("the window is full");
-        self.fit.derivatives(mu, (row - start) as f64, self.step)
+        let r = row - start;
+        if r == (self.window - 1) / 2 {
+            apply_upper(&self.centre, mu, out);
+        } else {
+            apply_upper(&self.fit.evaluator(r as f64, self.step), mu, out);
+        }
     }
 }
 
@@ -108,9 +120,9 @@ impl SeriesWindows for IrregularSeries<'_> {
         self.fits.update(self.times[n], self.values[n])
     }
 
-    fn row(&self, row: usize, _start: usize) -> Vec<f64> {
+    fn row(&self, row: usize, _start: usize, out: &mut [f64]) {
         let fit = self.fits.fit().expect("the window is full");
-        fit.derivatives_at(self.times[row])
+        out.copy_from_slice(&fit.derivatives_at(self.times[row]));
     }
 }
 
@@ -152,6 +164,34 @@ pub fn smooth(
     window: usize,
 ) -> Result<Vec<Vec<f64>>, Error> {
     check_window(m, window)?;
+    let mut out = vec![0.0; times.len() * (m + 1)];
+    smooth_into(times, values, m, window, &mut out)?;
+    Ok(out.chunks_exact(m + 1).map(<[f64]>::to_vec).collect())
+}
+
+/// [`smooth`] into `estimates`, one row of `m+1` derivatives per sample (row-major, the
+/// layout of [`crate::PolynomialFilter::update_many_into`] and of numpy's `(len, m+1)`
+/// arrays), without allocating per sample.
+///
+/// Errors: those of [`smooth`], and `estimates.len() ≠ times.len()·(m+1)`.
+///
+/// ```
+/// use seqsmooth::polynomial::fixed::{smooth, smooth_into};
+/// let t: Vec<f64> = (0..9).map(|k| 0.5 * k as f64).collect();
+/// let y = [2.0, 1.0, 3.0, 2.0, 4.0, 6.0, 5.0, 7.0, 6.0];
+/// let mut flat = vec![0.0; 9 * 3];
+/// smooth_into(&t, &y, 2, 5, &mut flat).unwrap();
+/// assert_eq!(flat.chunks(3).map(<[f64]>::to_vec).collect::<Vec<_>>(), smooth(&t, &y, 2, 5).unwrap());
+/// assert!(smooth_into(&t, &y, 2, 5, &mut flat[..26]).is_err());
+/// ```
+pub fn smooth_into(
+    times: &[f64],
+    values: &[f64],
+    m: usize,
+    window: usize,
+    estimates: &mut [f64],
+) -> Result<(), Error> {
+    check_window(m, window)?;
     check_series(times, values)?;
     let len = times.len();
     if window > len {
@@ -160,6 +200,7 @@ pub fn smooth(
             got: len,
         });
     }
+    check_estimates_length(times, m, estimates)?;
     if is_evenly_spaced(times) {
         let span = window - 1;
         let step = if len >= 2 {
@@ -167,20 +208,22 @@ pub fn smooth(
         } else {
             1.0
         };
+        let fit = MomentFit::new(m, span, span / 2);
         let even = EvenSeries {
             values,
             window,
             moments: SlidingMoments::new(m, window, smoothing_refreshes(m), true),
-            fit: MomentFit::new(m, span, span / 2),
+            centre: fit.evaluator((span / 2) as f64, step),
+            fit,
             step,
         };
-        centred_rows(len, window, even)
+        centred_rows(len, window, even, estimates)
     } else {
         let irregular = IrregularSeries {
             times,
             values,
             fits: IrregularWindow::new(m, window),
         };
-        centred_rows(len, window, irregular)
+        centred_rows(len, window, irregular, estimates)
     }
 }
