@@ -1,6 +1,6 @@
 //! The fixed-memory bias (`seqsmooth::polynomial::fixed::bias`; Morrison (1969) §7.7-7.8): the
 //! bias of a truth of degree m+1 and beyond by the weights and by the power-series route
-//! (7.12.14), the dominant-bias bound, bias against random error (Ex 7.26) and the quadratic fit
+//! (7.12.14), the dominant-bias bound and the book's Ex 7.26 table (the balance: `fixed_design.rs`), the quadratic fit
 //! to a sine (Ex 7.8).
 
 mod common;
@@ -13,10 +13,8 @@ use rand::Rng;
 use seqsmooth::basis::DiscreteLegendre;
 use seqsmooth::linalg::mul;
 use seqsmooth::polynomial::fixed::{
-    balance_span, bias, covariance_unscaled, dominant_bias, end_point_bias_bound, weights,
-    weights_unscaled, Lead,
+    bias, covariance_unscaled, dominant_bias, end_point_bias_bound, weights, weights_unscaled,
 };
-use seqsmooth::Error;
 
 /// Bias as truth minus estimate (7.10.1), computed here from the weights: the truth's
 /// derivatives at r = L+h minus W(h, τ) applied to its error-free samples (an independent route
@@ -199,39 +197,6 @@ fn bias_versus_random_error_ex_7_26_t7_23() {
     // "Equality near L ≈ 8 (L = 8: σ 145.3 vs bias 149.3)".
     assert!((sd(8, 1.0) - 145.3).abs() < 0.05);
     assert!((end_point_bias_bound(1, 8, 1.0, 16.0).unwrap() - 149.3).abs() < 0.05);
-    // balance_span at the end point (σ and bias both at h = 0): L = 7 (σ 129.1 ≥ bias 112.0;
-    // L = 8: σ 122.9 < bias 149.3).
-    let b = balance_span(1, 200.0, 16.0, 1.0, Lead::Steps(0.0), 1.0).unwrap();
-    assert_eq!(b.span, 7);
-    assert!((b.random_sigma - 129.1).abs() < 0.05 && (b.bias - 112.0).abs() < 1e-9);
-    // The defining property, for other leads, degrees and ratios: the bias is within ratio·σ at
-    // the returned L and not at L+1.
-    for (m, lead, ratio) in [
-        (1usize, Lead::Steps(1.0), 1.0),
-        (1, Lead::Centre, 1.0),
-        (2, Lead::Steps(0.0), 0.1),
-        (3, Lead::Centre, 0.5),
-    ] {
-        let b = balance_span(m, 1.0, 1e-4, 1.0, lead, ratio).unwrap();
-        let at = |l: u64| {
-            let s = covariance_unscaled(m, l, lead.steps(l), 1.0).unwrap()[(0, 0)].sqrt();
-            let bias = dominant_bias(m, l, lead.steps(l), 1.0, 1e-4).unwrap()[0].abs();
-            (s, bias)
-        };
-        let (s0, b0) = at(b.span);
-        let (s1, b1) = at(b.span + 1);
-        assert!(
-            b0 <= ratio * s0 && b1 > ratio * s1,
-            "m = {m}, {lead:?}: L = {}",
-            b.span
-        );
-        assert_eq!((b.random_sigma, b.bias), (s0, b0));
-    }
-    // At the centre the dominant bias vanishes for even m: nothing to balance.
-    assert!(matches!(
-        balance_span(2, 1.0, 1.0, 1.0, Lead::Centre, 1.0),
-        Err(Error::InvalidParameter { name: "lead", .. })
-    ));
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! The fixed-memory covariance (`seqsmooth::polynomial::fixed::covariance`; Morrison (1969)
 //! §7.5-7.6, §9.3): `W Wᵀ` and the window covariance in exact rationals, the closed-form VRFs,
 //! the worked examples (7.5.16), (7.5.25), correlated errors (Ex 7.10), the asymptotic
-//! Tables 7.2, 7.3 and 9.3 entry for entry, and the design example.
+//! Tables 7.2, 7.3 and 9.3 entry for entry (the design example: `fixed_design.rs`).
 
 mod common;
 
@@ -13,8 +13,8 @@ use num_traits::{One, Signed, Zero};
 use seqsmooth::linalg::mul;
 use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
 use seqsmooth::polynomial::fixed::{
-    correlated_covariance, covariance, covariance_unscaled, min_span_for_sigma,
-    tau_for_derivative_sigma, vrf_limit, weights, FixedEngine, FixedMemory, Lead,
+    correlated_covariance, covariance, covariance_unscaled, vrf_limit, weights, FixedEngine,
+    FixedMemory,
 };
 use seqsmooth::polynomial::fixed::{fixed_memory_vrf_limit, window_covariance};
 use seqsmooth::polynomial::form::EstimateForm;
@@ -730,44 +730,5 @@ fn asymptotic_matrices_worked_examples_and_misprints() {
                 worst = worst.max(((got - want) / want).abs());
             }
         }
-    }
-}
-
-#[test]
-fn design_example_t7_16() {
-    // (7.6.1)-(7.6.5): σ_ν = 10 ft, m = 1, one-step prediction, σ(x) = 3 ft -> L = 45 (exact
-    // root 44.93); velocity variance 0.0123/τ²; σ(x') = 4 ft/s -> τ = 0.0278 s — the book
-    // prints "τ = 0.029 seconds, i.e. about 36 observations per second" (misprint register
-    // a misprint in (7.6.5): 0.029 -> 0.0278; 36/s is right).
-    let lead = Lead::Steps(1.0);
-    assert_eq!(min_span_for_sigma(1, 0, lead, 1.0, 10.0, 3.0).unwrap(), 45);
-    let sd = |l: u64| 10.0 * covariance_unscaled(1, l, 1.0, 1.0).unwrap()[(0, 0)].sqrt();
-    assert!(sd(45) <= 3.0 && sd(44) > 3.0);
-    let var_v = 100.0 * covariance_unscaled(1, 45, 1.0, 1.0).unwrap()[(1, 1)];
-    assert!((var_v - 0.012334).abs() < 1e-6, "{var_v}");
-    let tau = tau_for_derivative_sigma(1, 45, lead, 1, 10.0, 4.0).unwrap();
-    assert!((tau - (var_v / 16.0).sqrt()).abs() < 1e-15);
-    assert!((tau - 0.02777).abs() < 1e-5 && (1.0 / tau - 36.0).abs() < 0.1);
-    assert!((tau - 0.029).abs() > 1e-3);
-    // At that τ the velocity 1σ is 4 ft/s.
-    let s = covariance_unscaled(1, 45, 1.0, tau).unwrap();
-    assert!((10.0 * s[(1, 1)].sqrt() - 4.0).abs() < 1e-12);
-    // The search is exact on both sides for other leads and derivatives.
-    for (m, i, lead, tau, target) in [
-        (2usize, 0usize, Lead::Centre, 1.0, 0.3),
-        (2, 1, Lead::Steps(0.0), 0.1, 0.5),
-        (3, 2, Lead::Centre, 0.5, 0.05),
-        (0, 0, Lead::Steps(0.0), 1.0, 1.0),
-    ] {
-        let l = min_span_for_sigma(m, i, lead, tau, 1.0, target).unwrap();
-        let sd = |l: u64| {
-            let s = covariance_unscaled(m, l, lead.steps(l), tau).unwrap();
-            s[(i, i)].sqrt()
-        };
-        assert!(sd(l) <= target, "m = {m}");
-        assert!(
-            l == m as u64 || sd(l - 1) > target,
-            "m = {m}: L = {l} is not the smallest"
-        );
     }
 }

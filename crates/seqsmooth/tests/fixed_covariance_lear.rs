@@ -32,7 +32,7 @@ use nalgebra::DMatrix;
 use num_traits::{One, Zero};
 use seqsmooth::polynomial::expanding::gains::expanding_gains;
 use seqsmooth::polynomial::fixed::{
-    covariance, covariance_unscaled, min_span_for_sigma, smooth, vrf_limit, weights, Lead,
+    covariance, covariance_unscaled, smooth, vrf_limit, weights, Design, Lead,
 };
 use seqsmooth::polynomial::form::GainForm;
 
@@ -497,7 +497,14 @@ fn lear_table_3_worked_example() {
     // "A 10x sd reduction at the ends needs 9/N = 0.01, so N ~ 900": exactly eq 30 needs N = 896
     // (L = 895).
     assert_eq!(
-        min_span_for_sigma(2, 0, Lead::Steps(0.0), 1.0, 1.0, 0.1).unwrap(),
+        Design {
+            degree: 2,
+            lead: Lead::Steps(0.0),
+            tau: 1.0,
+            sigma_nu: 1.0
+        }
+        .min_span_for_sigma(0, 0.1)
+        .unwrap(),
         895
     );
 }

@@ -9,9 +9,9 @@ use common::fixed::*;
 use common::{dyadic, exact_discounted_even, exact_ls_derivatives, jittered_times, random_times};
 use num_traits::Signed;
 use seqsmooth::polynomial::fixed::{
-    balance_span, bias, covariance, covariance_unscaled, dominant_bias, end_point_bias_bound,
-    min_span_for_sigma, smooth, tau_for_derivative_sigma, vrf_limit, weights, weights_unscaled,
-    FixedEngine, FixedMemory, Lead,
+    bias, covariance, covariance_unscaled, dominant_bias, end_point_bias_bound, smooth,
+    tau_for_derivative_sigma, vrf_limit, weights, weights_unscaled, Design, FixedEngine,
+    FixedMemory, Lead,
 };
 use seqsmooth::polynomial::MAX_DEGREE;
 use seqsmooth::{Error, PolynomialFilter};
@@ -294,11 +294,39 @@ fn filters_say_so_before_the_window_fills_and_reject_bad_input() {
     assert!(bias(1, 4, 0.0, 1.0, &[0.0, f64::NAN, 1.0]).is_err());
     assert!(dominant_bias(1, 0, 0.0, 1.0, 1.0).is_err());
     assert!(end_point_bias_bound(2, 1, 1.0, 1.0).is_err());
-    assert!(min_span_for_sigma(1, 2, Lead::Centre, 1.0, 1.0, 1.0).is_err());
-    assert!(min_span_for_sigma(1, 0, Lead::Steps(f64::NAN), 1.0, 1.0, 1.0).is_err());
-    assert!(min_span_for_sigma(1, 0, Lead::Centre, 1.0, 1.0, 0.0).is_err());
+    assert!(Design {
+        degree: 1,
+        lead: Lead::Centre,
+        tau: 1.0,
+        sigma_nu: 1.0
+    }
+    .min_span_for_sigma(2, 1.0)
+    .is_err());
+    assert!(Design {
+        degree: 1,
+        lead: Lead::Steps(f64::NAN),
+        tau: 1.0,
+        sigma_nu: 1.0
+    }
+    .min_span_for_sigma(0, 1.0)
+    .is_err());
+    assert!(Design {
+        degree: 1,
+        lead: Lead::Centre,
+        tau: 1.0,
+        sigma_nu: 1.0
+    }
+    .min_span_for_sigma(0, 0.0)
+    .is_err());
     assert!(tau_for_derivative_sigma(1, 10, Lead::Centre, 0, 1.0, 1.0).is_err());
-    assert!(balance_span(1, 1.0, 0.0, 1.0, Lead::Centre, 1.0).is_err());
+    assert!(Design {
+        degree: 1,
+        lead: Lead::Centre,
+        tau: 1.0,
+        sigma_nu: 1.0
+    }
+    .balance_span(0.0, 1.0)
+    .is_err());
 }
 
 #[test]

@@ -1,9 +1,8 @@
 //! Systematic errors of the fixed-memory filter (Morrison §7.10-7.13): the bias for a truth of
 //! any degree, the dominant-term form, the end-point bound, and the bias/variance balance.
 
-use super::covariance::{unscaled_variance, MAX_SEARCH_SPAN};
 use super::weights::weights_unscaled;
-use super::{check_finite, check_span, check_tau_scalar, span_scalar, Lead};
+use super::{check_finite, check_span, check_tau_scalar, span_scalar};
 use crate::basis::DiscreteLegendre;
 use crate::calculus::{choose, falling_factorial, stirling2, Polynomial};
 use crate::error::Error;
@@ -162,123 +161,4 @@ pub fn end_point_bias_bound<T: Scalar>(m: usize, span: u64, tau: T, a_max: T) ->
         a_max.abs_val() * tau.powi_u(m + 1) * falling_factorial(l, m + 1)
             / choose::<T>(2 * m + 2, m + 1),
     )
-}
-
-/// The result of [`balance_span`]: the span and, at it, the random and systematic errors of the
-/// value at the lead.
-///
-/// ```
-/// use seqsmooth::polynomial::fixed::{balance_span, Lead};
-/// let b = balance_span(2, 0.5, 1e-6, 1.0, Lead::Steps(0.0), 1.0).unwrap();
-/// assert!(b.bias <= b.random_sigma && b.span > 2);
-/// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Balance {
-    /// The memory span `L` (window of `L+1` samples).
-    pub span: u64,
-    /// 1σ random error of the value at the lead for this span.
-    pub random_sigma: f64,
-    /// Magnitude of the dominant-term bias of the value at the lead for this span.
-    pub bias: f64,
-}
-
-/// Balances systematic against random error (Morrison §7.13, (7.13.8)-(7.13.10)): the largest
-/// span `L` for which the dominant-term bias of the value at `lead`,
-/// `|a_{m+1}| τ^(m+1) L^(m+1) |p_{m+1}(L+h)| / C(2m+2, m+1)`, is at most `ratio` times its random
-/// 1σ error `σ_ν √VRF(L)` (exact VRF; the book balances at `ratio = 1`, Ex 9.19b uses 0.1).
-/// The bias grows and the random error falls with `L` at the end point, for predictions and at
-/// the centre; the search doubles `L` and then bisects. At the centre the dominant bias vanishes
-/// for even `m` (`p_{m+1}(L/2) = 0`), so there is nothing to balance: an error.
-///
-/// ```
-/// use seqsmooth::polynomial::fixed::{balance_span, Lead};
-/// // Ex 7.26 (T7-23): m = 1, σ_ν = 200 ft, R'' = 32 ft/s² (a2 = 16), τ = 1 s, end point: L = 7
-/// // (L = 7: σ 129.1, bias 112.0; L = 8: σ 122.9 < bias 149.3)
-/// let b = balance_span(1, 200.0, 16.0, 1.0, Lead::Steps(0.0), 1.0).unwrap();
-/// assert_eq!(b.span, 7);
-/// ```
-pub fn balance_span(
-    m: usize,
-    sigma_nu: f64,
-    a_next: f64,
-    tau: f64,
-    lead: Lead,
-    ratio: f64,
-) -> Result<Balance, Error> {
-    crate::polynomial::options::check_degree(m)?;
-    crate::polynomial::options::check_tau(tau)?;
-    lead.check()?;
-    for (name, v) in [
-        ("noise sigma", sigma_nu),
-        ("a_next", a_next.abs()),
-        ("ratio", ratio),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Error::InvalidParameter {
-                name,
-                value: v.to_string(),
-                reason: "must be a non-zero finite number (positive for sigma and ratio)".into(),
-            });
-        }
-    }
-    if matches!(lead, Lead::Centre) && m % 2 == 0 {
-        return Err(Error::InvalidParameter {
-            name: "lead",
-            value: "centre".into(),
-            reason: format!(
-                "the dominant bias p_{}(L/2) vanishes at the centre for even degree {m}",
-                m + 1
-            ),
-        });
-    }
-    let eval = |l: u64| -> Result<Balance, Error> {
-        let h = lead.steps(l);
-        let var = unscaled_variance(m, l, lead, 0, tau)?;
-        let b = dominant_bias::<f64>(m, l, h, tau, a_next)?[0].abs();
-        Ok(Balance {
-            span: l,
-            random_sigma: sigma_nu * var.sqrt(),
-            bias: b,
-        })
-    };
-    let ok = |b: &Balance| b.bias <= ratio * b.random_sigma;
-    let first = eval(m as u64)?;
-    if !ok(&first) {
-        return Err(Error::InvalidParameter {
-            name: "a_next",
-            value: a_next.to_string(),
-            reason: format!(
-                "even the shortest window (L = {m}) has bias {} above {ratio} × σ = {}",
-                first.bias,
-                ratio * first.random_sigma
-            ),
-        });
-    }
-    let mut lo = first;
-    let mut hi = (m as u64).max(1) * 2;
-    loop {
-        let b = eval(hi)?;
-        if !ok(&b) {
-            break;
-        }
-        lo = b;
-        hi *= 2;
-        if hi > MAX_SEARCH_SPAN {
-            return Err(Error::InvalidParameter {
-                name: "a_next",
-                value: a_next.to_string(),
-                reason: "the bias stays below the random error up to 2^40 samples".into(),
-            });
-        }
-    }
-    while hi - lo.span > 1 {
-        let mid = lo.span + (hi - lo.span) / 2;
-        let b = eval(mid)?;
-        if ok(&b) {
-            lo = b;
-        } else {
-            hi = mid;
-        }
-    }
-    Ok(lo)
 }

@@ -22,9 +22,9 @@
 //! | [`weights`], [`weights_unscaled`] | `W(h) = Φ(h) 𝒮 G C B`, `D(τ) W(h)` | (7.4.9)-(7.4.16) |
 //! | [`covariance`], [`covariance_unscaled`], [`correlated_covariance`] | `W Wᵀ`, `D W Wᵀ D`, `W R Wᵀ` | (7.5.4), (7.5.22)-(7.5.28) |
 //! | [`vrf_limit`] | `λ_ij(m, ρ)`: Tables 7.2 (`ρ = 1`) and 7.3 (`ρ = 1/2`) | (7.6.11)-(7.6.12), §7.8 |
-//! | [`min_span_for_sigma`], [`tau_for_derivative_sigma`] | design for a target 1σ | (7.6.1)-(7.6.5) |
+//! | [`Design::min_span_for_sigma`], [`tau_for_derivative_sigma`] | design for a target 1σ | (7.6.1)-(7.6.5) |
 //! | [`bias`], [`dominant_bias`], [`end_point_bias_bound`] | systematic errors | (7.10.17)-(7.10.18), (7.12.14), (7.13.5)-(7.13.10) |
-//! | [`balance_span`] | bias against random error | §7.13 |
+//! | [`Design::balance_span`] | bias against random error | §7.13 |
 //! | [`smooth_detrended`], [`Detrended`] | trend removal | §7.14 |
 //! | [`FixedMemory`], [`FixedEngine`] | streaming filter: direct, sliding, irregular, adaptive | §7.1, §9.5 |
 //! | [`smooth`], [`smooth_into`] | whole-series centred smoothing (savgol `mode="interp"`), the sliding engine | (7.4.16), `h = -L/2` |
@@ -83,6 +83,7 @@
 
 mod bias;
 mod covariance;
+mod design;
 mod even;
 mod filter;
 mod irregular;
@@ -93,11 +94,9 @@ mod trend;
 mod weights;
 mod window_vrf;
 
-pub use bias::{balance_span, bias, dominant_bias, end_point_bias_bound, Balance};
-pub use covariance::{
-    correlated_covariance, covariance, covariance_unscaled, min_span_for_sigma,
-    tau_for_derivative_sigma, vrf_limit,
-};
+pub use bias::{bias, dominant_bias, end_point_bias_bound};
+pub use covariance::{correlated_covariance, covariance, covariance_unscaled, vrf_limit};
+pub use design::{tau_for_derivative_sigma, Balance, Design};
 pub use filter::{FixedEngine, FixedMemory};
 pub use smooth::{smooth, smooth_into};
 pub use trend::{smooth_detrended, Detrended, Nominal};
