@@ -19,6 +19,11 @@ fn line_numbers_survive_blank_lines_crlf_and_quotes() {
     assert_eq!(lines("t,y\n0,1\r\n1,2\r2,3\n\r\n4,5"), [2, 3, 4, 6]);
     assert_eq!(lines("t,y,z\n0,1,\"a\nb\"\n1,2,x\n"), [2, 4]);
     assert_eq!(lines("t,y\n0,1\n\n\n\n1,2\n"), [2, 6]);
+    // Breaks are counted in chunks of 255 bytes: quoted cells longer than that, LF and CRLF.
+    let long_lf = format!("t,y,z\n0,1,\"{}\"\n1,2,x\n", "\n".repeat(600));
+    assert_eq!(lines(&long_lf), [2, 603]);
+    let long_crlf = format!("t,y,z\r\n0,1,\"{}\"\r\n1,2,x\r\n", "a\r\n".repeat(300));
+    assert_eq!(lines(&long_crlf), [2, 303]);
 }
 
 #[test]
