@@ -13,11 +13,11 @@ use seqsmooth::scalar::Rational;
 pub fn run(a: &GainsArgs) -> Result<(), CliError> {
     let (m, form) = (a.memory.degree, GainForm::Current);
     let values: Vec<String> = match (a.memory.of(a.kind)?, a.exact) {
-        (Memory::Expanding { n }, true) => cells(&expanding_gains::<Rational>(m, n, form)),
-        (Memory::Expanding { n }, false) => cells(&expanding_gains::<f64>(m, n, form)),
-        (Memory::Fading { theta }, true) => cells(&fading_gains::<Rational>(m, theta.exact, form)),
-        (Memory::Fading { theta }, false) => {
-            let theta = theta.value_f64().map_err(CliError::Usage)?;
+        (Memory::Expanding(n), true) => cells(&expanding_gains::<Rational>(m, n, form)),
+        (Memory::Expanding(n), false) => cells(&expanding_gains::<f64>(m, n, form)),
+        (Memory::Fading(theta), true) => cells(&fading_gains::<Rational>(m, theta.exact, form)),
+        (Memory::Fading(theta), false) => {
+            let theta = theta.value_f64()?;
             cells(&fading_gains::<f64>(m, theta, form))
         }
     };

@@ -13,7 +13,7 @@ use seqsmooth::polynomial::fixed::smooth;
 
 /// Runs `seqsmooth smooth`: header `t,y,d0..dM`, one row per input row in input order.
 pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
-    check_window(a.window, a.degree)?;
+    check_window(Some(a.window), a.degree)?;
     check_distinct(a.input.as_deref(), a.output.as_deref())?;
     let need = Need::window(a.window.max(a.degree + 1));
     let input = open_input(a.input.as_deref())?;

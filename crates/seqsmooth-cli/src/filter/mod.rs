@@ -43,9 +43,7 @@ const PIECE: usize = 4096;
 fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
     let kind = a.kind;
     let theta = match (kind, &a.theta) {
-        (Kind::Fading | Kind::Auto, Some(theta)) => {
-            Some(theta.value_f64().map_err(CliError::Usage)?)
-        }
+        (Kind::Fading | Kind::Auto, Some(theta)) => Some(theta.value_f64()?),
         (Kind::Fading | Kind::Auto, None) => {
             return Err(CliError::Usage(format!(
                 "--kind {} needs --theta T, the discount per tau (0 < T < 1)",
@@ -59,14 +57,7 @@ fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
         return Err(only("--tau", "fading and auto"));
     }
     match (kind, a.window) {
-        (Kind::Fixed, Some(w)) => check_window(w, a.degree)?,
-        (Kind::Fixed, None) => {
-            return Err(CliError::Usage(format!(
-                "--kind fixed needs --window W, the number of samples in the window (at least \
-                 M+1 = {})",
-                a.degree + 1
-            )))
-        }
+        (Kind::Fixed, w) => _ = check_window(w, a.degree)?,
         (_, Some(_)) => return Err(only("--window", "fixed")),
         (_, None) => {}
     }
