@@ -392,16 +392,11 @@ pub enum Kind {
     Auto,
 }
 
-impl Kind {
-    /// The name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Kind::Expanding => "expanding",
-            Kind::Fading => "fading",
-            Kind::Fixed => "fixed",
-            Kind::Auto => "auto",
-        }
-    }
+/// The name of `value` on the command line (e.g. `fading` for [`Kind::Fading`]).
+pub fn name(value: impl clap::ValueEnum) -> String {
+    value
+        .to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_string())
 }
 
 /// The engine the filter runs on.

@@ -10,7 +10,7 @@
 //! step, noise estimated) runs on it; the plain expanding- and fading-memory filters of degree 2
 //! (noise σ given), on both engines, are shown beside it for comparison.
 
-use crate::args::{DemoArgs, EngineArg, Kind};
+use crate::args::{name, DemoArgs, EngineArg, Kind};
 use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
 use crate::filter::runner::Runner;
@@ -21,7 +21,6 @@ use seqsmooth::{PolynomialFilter, PolynomialState};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
-/// Number of samples.
 pub const SAMPLES: usize = 400;
 /// Noise standard deviation, m.
 pub const SIGMA: f64 = 15.0;
@@ -41,7 +40,6 @@ pub const OUTAGE: (f64, f64) = (262.0, 12.0);
 /// Probability that a sample carries an outlier, and the outlier's size range in σ.
 const OUTLIER_RATE: f64 = 0.02;
 pub const OUTLIER_SIZE: (f64, f64) = (6.0, 10.0);
-/// Filter degree.
 const DEGREE: usize = 2;
 /// Discount per median step, for the automatic and the plain fading-memory filters.
 const THETA: f64 = 0.95;
@@ -143,8 +141,8 @@ pub fn generate() -> Vec<Point> {
 
 /// The estimates of one filter at every sample.
 struct Run {
-    name: &'static str,
-    engine: &'static str,
+    name: String,
+    engine: String,
     estimates: Vec<Option<PolynomialState>>,
 }
 
@@ -158,19 +156,10 @@ fn run_plain(data: &[Point], kind: Kind, engine: EngineArg, tau: f64) -> Result<
         estimates.push(f.estimate_at(p.t));
     }
     Ok(Run {
-        name: kind.name(),
-        engine: if engine == EngineArg::Exact {
-            "exact"
-        } else {
-            "gain"
-        },
+        name: name(kind),
+        engine: name(engine),
         estimates,
     })
-}
-
-/// The automatic filter of the demo.
-fn auto_filter(tau: f64) -> Result<AutomaticFilter, seqsmooth::Error> {
-    AutomaticFilter::new(DEGREE, THETA, tau)
 }
 
 /// Three significant digits, scientific below 0.001 or from 10⁵ on.
@@ -320,7 +309,8 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
     let head: Vec<f64> = data.iter().take(LOOKAHEAD).map(|p| p.t).collect();
     let tau = median_series_step(&head, &vec![0; head.len()]).unwrap_or(1.0);
 
-    let mut auto = auto_filter(tau).map_err(|e| CliError::Data(e.to_string()))?;
+    let mut auto =
+        AutomaticFilter::new(DEGREE, THETA, tau).map_err(|e| CliError::Data(e.to_string()))?;
     let mut outs = Vec::with_capacity(data.len());
     for p in &data {
         outs.push(
@@ -338,28 +328,25 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
         }
     }
 
-    let mut table = vec![vec![
-        "filter".to_string(),
-        "engine".into(),
-        "rms err x".into(),
-        "rms err x'".into(),
-        "max |err x|".into(),
-        "x within ±3σ".into(),
-    ]];
+    let header = [
+        "filter",
+        "engine",
+        "rms err x",
+        "rms err x'",
+        "max |err x|",
+        "x within ±3σ",
+    ];
+    let mut table = vec![header.map(String::from).to_vec()];
     table.push(error_row("automatic", "exact", &auto_estimates, &data));
     for r in &runs {
-        table.push(error_row(r.name, r.engine, &r.estimates, &data));
+        table.push(error_row(&r.name, &r.engine, &r.estimates, &data));
     }
 
     let outliers = data.iter().filter(|p| p.outlier).count();
-    let rejected: Vec<(usize, &Point)> = outs
-        .iter()
-        .zip(&data)
-        .enumerate()
-        .filter(|(_, (o, _))| o.outlier)
-        .map(|(i, (_, p))| (i, p))
-        .collect();
-    let caught = rejected.iter().filter(|(_, p)| p.outlier).count();
+    let rejected = outs.iter().filter(|o| o.outlier).count();
+    let caught = (outs.iter().zip(&data))
+        .filter(|(o, p)| o.outlier && p.outlier)
+        .count();
     let plot_track = track(&data, &outs);
     let (switches, restarts) = (&plot_track.switches, &plot_track.restarts);
     let span = data[SAMPLES - 1].t - data[0].t;
@@ -388,8 +375,8 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
         OUTAGE.0,
         OUTLIER_SIZE.0,
         OUTLIER_SIZE.1,
-        rejected.len(),
-        rejected.len() - caught,
+        rejected,
+        rejected - caught,
         times_list(switches),
         if restarts.is_empty() {
             "none".to_string()

@@ -13,7 +13,7 @@
 pub mod rows;
 pub mod runner;
 
-use crate::args::{check_window, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
+use crate::args::{check_window, name, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
 use crate::error::CliError;
 use crate::io::{check_distinct, fmt_f64, input_size, open_input, write_f64, Need, Output};
 use crate::progress::{self, Progress};
@@ -47,7 +47,7 @@ fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
         (Kind::Fading | Kind::Auto, None) => {
             return Err(CliError::Usage(format!(
                 "--kind {} needs --theta T, the discount per tau (0 < T < 1)",
-                kind.name()
+                name(kind)
             )))
         }
         (Kind::Expanding | Kind::Fixed, Some(_)) => return Err(only("--theta", "fading and auto")),
