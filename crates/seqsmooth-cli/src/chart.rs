@@ -128,13 +128,8 @@ const MISFIT: RGBColor = RGBColor(255, 170, 60);
 fn register() -> Result<(), CliError> {
     static DONE: OnceLock<bool> = OnceLock::new();
     let ok = *DONE.get_or_init(|| register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
-    if ok {
-        Ok(())
-    } else {
-        Err(CliError::Data(
-            "the embedded font could not be loaded".into(),
-        ))
-    }
+    let failed = || CliError::Data("the embedded font could not be loaded".into());
+    ok.then_some(()).ok_or_else(failed)
 }
 
 /// Draws `track` as laid out by `layout` into `path`, as PNG or SVG by its extension.
@@ -437,28 +432,28 @@ fn legend_rows<DB: DrawingBackend<ErrorType: 'static>>(
     width: i32,
 ) -> Result<Vec<Vec<(Key, i32)>>, Err> {
     let style = font(15.0);
-    let mut rows: Vec<Vec<(Key, i32)>> = vec![Vec::new()];
-    let mut widths = vec![0];
+    // Each row's items (key, x from the row's start) and width.
+    let mut rows: Vec<(Vec<(Key, i32)>, i32)> = vec![(Vec::new(), 0)];
     for &k in keys {
-        let (tw, _) = area.estimate_text_size(k.label(), &style)?;
-        let item = 32 + tw as i32 + 18;
-        let last = rows.len() - 1;
-        if widths[last] + item > width - 40 && !rows[last].is_empty() {
-            rows.push(Vec::new());
-            widths.push(0);
+        let item = 32 + area.estimate_text_size(k.label(), &style)?.0 as i32 + 18;
+        if rows
+            .last()
+            .is_some_and(|(row, w)| w + item > width - 40 && !row.is_empty())
+        {
+            rows.push((Vec::new(), 0));
         }
-        let last = rows.len() - 1;
-        rows[last].push((k, widths[last]));
-        widths[last] += item;
+        if let Some((row, w)) = rows.last_mut() {
+            row.push((k, *w));
+            *w += item;
+        }
     }
     // centre each row
-    for (row, w) in rows.iter_mut().zip(&widths) {
-        let left = (width - w) / 2;
-        for item in row.iter_mut() {
-            item.1 += left;
-        }
-    }
-    Ok(rows)
+    let centred = |(row, w): (Vec<(Key, i32)>, i32)| {
+        row.into_iter()
+            .map(move |(k, x)| (k, x + (width - w) / 2))
+            .collect()
+    };
+    Ok(rows.into_iter().map(centred).collect())
 }
 
 fn draw<DB: DrawingBackend<ErrorType: 'static>>(
@@ -609,21 +604,22 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         }
     }
 
-    // Samples.
+    // Samples: the points `$keep` picks, as `$shape`s at their values clamped to the range.
     let inside = |v: f64| v >= y0 && v <= y1;
-    chart.draw_series(
-        p.points
-            .iter()
-            .filter(|q| !q.2 && inside(q.1))
-            .map(|q| Circle::new((q.0, q.1), 2, DATA.filled())),
-    )?;
-    if p.clip_points {
-        chart.draw_series(
-            p.points
+    macro_rules! points {
+        ($keep:expr, $shape:ident, $size:expr, $style:expr) => {
+            let at = |q: &(f64, f64, bool)| (q.0, clamp(q.1));
+            let shapes = p
+                .points
                 .iter()
-                .filter(|q| !inside(q.1))
-                .map(|q| TriangleMarker::new((q.0, clamp(q.1)), 5, DATA.filled())),
-        )?;
+                .filter($keep)
+                .map(|q| $shape::new(at(q), $size, $style));
+            chart.draw_series(shapes)?;
+        };
+    }
+    points!(|q| !q.2 && inside(q.1), Circle, 2, DATA.filled());
+    if p.clip_points {
+        points!(|q| !inside(q.1), TriangleMarker, 5, DATA.filled());
     }
 
     // Truth, then the estimate over it.
@@ -637,26 +633,15 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     }
 
     // Rejected samples on top.
-    chart.draw_series(
-        p.points
-            .iter()
-            .filter(|q| q.2)
-            .map(|q| Cross::new((q.0, clamp(q.1)), 5, REJECTED.stroke_width(2))),
-    )?;
+    points!(|q| q.2, Cross, 5, REJECTED.stroke_width(2));
 
     // Events: switches to fading memory (dashed), restarts.
-    for (times, dashed, color) in [
-        (&track.switches, true, SWITCH),
-        (&track.restarts, false, RESTART),
-    ] {
-        for &t in times {
-            let (v, style) = (vec![(t, y0), (t, y1)], color.stroke_width(2));
-            if dashed {
-                chart.draw_series(DashedLineSeries::new(v, 8, 6, style))
-            } else {
-                chart.draw_series(LineSeries::new(v, style))
-            }?;
-        }
+    let edge = |t: f64| vec![(t, y0), (t, y1)];
+    for &t in &track.switches {
+        chart.draw_series(DashedLineSeries::new(edge(t), 8, 6, SWITCH.stroke_width(2)))?;
+    }
+    for &t in &track.restarts {
+        chart.draw_series(LineSeries::new(edge(t), RESTART.stroke_width(2)))?;
     }
     Ok(())
 }
