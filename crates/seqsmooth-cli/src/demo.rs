@@ -234,36 +234,23 @@ pub fn plot_paths(prefix: &Path) -> [PathBuf; 2] {
 
 /// The automatic filter's run as a plot track.
 fn track(data: &[Point], outs: &[AutoOutput]) -> Track {
-    let n = data.len();
-    let mut d = vec![vec![None; n]; DEGREE + 1];
-    let mut s = vec![vec![None; n]; DEGREE + 1];
-    for (i, o) in outs.iter().enumerate() {
-        if let Some(e) = &o.estimate {
-            let sd = e.std_devs();
-            for k in 0..e.derivatives.len().min(DEGREE + 1) {
-                d[k][i] = Some(e.derivatives[k]);
-                s[k][i] = sd.as_ref().map(|s| s[k]);
-            }
-        }
-    }
-    let mut switches = Vec::new();
-    let mut restarts = Vec::new();
-    let mut fading = false;
-    for o in outs {
-        if o.restart {
-            restarts.push(o.time);
-        }
-        let now = o.phase == Phase::Fading;
-        if now && !fading {
-            switches.push(o.time);
-        }
-        fading = now;
-    }
+    // Row by row, `f` of the estimate where there is one.
+    let rows = |f: &dyn Fn(&PolynomialState) -> Option<f64>| -> Vec<Option<f64>> {
+        outs.iter()
+            .map(|o| o.estimate.as_ref().and_then(f))
+            .collect()
+    };
+    let fading = |i: usize| outs[i].phase == Phase::Fading;
+    let switches = (0..outs.len()).filter(|&i| fading(i) && (i == 0 || !fading(i - 1)));
     Track {
         t: data.iter().map(|p| p.t).collect(),
         y: data.iter().map(|p| p.y).collect(),
-        d,
-        s,
+        d: (0..=DEGREE)
+            .map(|k| rows(&|e| e.derivatives.get(k).copied()))
+            .collect(),
+        s: (0..=DEGREE)
+            .map(|k| rows(&|e| e.std_devs()?.get(k).copied()))
+            .collect(),
         truth: vec![
             data.iter().map(|p| p.x).collect(),
             data.iter().map(|p| p.v).collect(),
@@ -271,8 +258,8 @@ fn track(data: &[Point], outs: &[AutoOutput]) -> Track {
         noise: outs.iter().map(|o| o.noise_sigma).collect(),
         rejected: outs.iter().map(|o| o.outlier).collect(),
         misfit: outs.iter().map(|o| o.misfit).collect(),
-        switches,
-        restarts,
+        switches: switches.map(|i| outs[i].time).collect(),
+        restarts: outs.iter().filter(|o| o.restart).map(|o| o.time).collect(),
         lead: 0.0,
     }
 }

@@ -96,16 +96,8 @@ pub fn csv_field(cell: &[u8]) -> Vec<u8> {
     {
         return cell.to_vec();
     }
-    let mut out = vec![b'"'];
-    for &b in cell {
-        out.extend_from_slice(if b == b'"' {
-            b"\"\""
-        } else {
-            std::slice::from_ref(&b)
-        });
-    }
-    out.push(b'"');
-    out
+    let parts: Vec<&[u8]> = cell.split(|&b| b == b'"').collect();
+    [&b"\""[..], &parts.join(&b"\"\""[..]), b"\""].concat()
 }
 
 /// Parses the number in the (trimmed) cell of `line` in `column`, holding the `what`: a typed

@@ -159,11 +159,7 @@ impl<R: Read> RowReader<R> {
             value_col: value_col.to_string(),
             index: HashMap::new(),
             ids: Vec::new(),
-            newest: if id_idx.is_none() {
-                vec![None]
-            } else {
-                Vec::new()
-            },
+            newest: id_idx.map_or_else(|| vec![None], |_| Vec::new()),
             touched: Vec::new(),
             rows_read: 0,
         })
