@@ -214,11 +214,9 @@ pub fn tick(v: f64, step: f64) -> String {
     };
     let s = format!("{v:.decimals$}");
     // "-0" and "-0.0" read as noise
-    if s.trim_start_matches('-')
-        .chars()
-        .all(|c| c == '0' || c == '.')
-    {
-        s.trim_start_matches('-').to_string()
+    let unsigned = s.trim_start_matches('-');
+    if unsigned.chars().all(|c| c == '0' || c == '.') {
+        unsigned.to_string()
     } else {
         s
     }

@@ -139,14 +139,15 @@ pub fn generate() -> Vec<Point> {
     out
 }
 
-/// The estimates of one filter at every sample.
-struct Run {
-    name: String,
-    engine: String,
-    estimates: Vec<Option<PolynomialState>>,
-}
+/// The estimates of a plain filter (noise σ given) at every sample.
+type Estimates = Vec<Option<PolynomialState>>;
 
-fn run_plain(data: &[Point], kind: Kind, engine: EngineArg, tau: f64) -> Result<Run, CliError> {
+fn run_plain(
+    data: &[Point],
+    kind: Kind,
+    engine: EngineArg,
+    tau: f64,
+) -> Result<Estimates, CliError> {
     let mut f = Runner::build(kind, DEGREE, Some(THETA), tau, None, engine, Some(SIGMA))
         .map_err(|e| CliError::Data(e.to_string()))?;
     let mut estimates = Vec::with_capacity(data.len());
@@ -155,11 +156,7 @@ fn run_plain(data: &[Point], kind: Kind, engine: EngineArg, tau: f64) -> Result<
             .map_err(|e| CliError::Data(e.to_string()))?;
         estimates.push(f.estimate_at(p.t));
     }
-    Ok(Run {
-        name: name(kind),
-        engine: name(engine),
-        estimates,
-    })
+    Ok(estimates)
 }
 
 /// Three significant digits, scientific below 0.001 or from 10⁵ on.
@@ -305,16 +302,7 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
                 .map_err(|e| CliError::Data(e.to_string()))?,
         );
     }
-    let auto_estimates: Vec<Option<PolynomialState>> =
-        outs.iter().map(|o| o.estimate.clone()).collect();
-
-    let mut runs = Vec::new();
-    for kind in [Kind::Expanding, Kind::Fading] {
-        for engine in [EngineArg::Exact, EngineArg::Gain] {
-            runs.push(run_plain(&data, kind, engine, tau)?);
-        }
-    }
-
+    let auto_estimates: Estimates = outs.iter().map(|o| o.estimate.clone()).collect();
     let header = [
         "filter",
         "engine",
@@ -325,8 +313,15 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
     ];
     let mut table = vec![header.map(String::from).to_vec()];
     table.push(error_row("automatic", "exact", &auto_estimates, &data));
-    for r in &runs {
-        table.push(error_row(&r.name, &r.engine, &r.estimates, &data));
+    let mut fading_exact = Vec::new();
+    for kind in [Kind::Expanding, Kind::Fading] {
+        for engine in [EngineArg::Exact, EngineArg::Gain] {
+            let estimates = run_plain(&data, kind, engine, tau)?;
+            table.push(error_row(&name(kind), &name(engine), &estimates, &data));
+            if (kind, engine) == (Kind::Fading, EngineArg::Exact) {
+                fading_exact = estimates;
+            }
+        }
     }
 
     let outliers = data.iter().filter(|p| p.outlier).count();
@@ -379,10 +374,9 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
     w.finish()?;
 
     if let Some(path) = &cfg.output {
-        let fading_exact = &runs[2];
         let mut out = Output::create(Some(path))?;
         out.write(b"t,y,d0,d1,d2,s0,s1,s2\n")?;
-        for (p, e) in data.iter().zip(&fading_exact.estimates) {
+        for (p, e) in data.iter().zip(&fading_exact) {
             let d = e
                 .as_ref()
                 .map(|e| (e.derivatives.clone(), e.std_devs().unwrap_or_default()));
