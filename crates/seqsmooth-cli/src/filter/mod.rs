@@ -164,10 +164,9 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     let first_rows = chunk_rows.min(FIRST_CHUNK_ROWS).max(hold).max(scan);
     let mut chunk = Chunk::default();
     reader.read_chunk(&mut chunk, first_rows);
-    if chunk.len() < hold {
-        if let Some(e) = chunk.error.take() {
-            return Err(e);
-        }
+    let early = chunk.len() < hold;
+    if let Some(e) = chunk.error.take_if(|_| early) {
+        return Err(e);
     }
     need.check(chunk.len())?;
     let tau = match a.tau {
@@ -195,24 +194,18 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         ids.append(&mut chunk.new_ids);
         values.resize(chunk.len() * stride, 0.0);
         let run = |f: &mut Runner, t: &[f64], y: &[f64], o: &mut [f64]| f.run(t, y, o, lead, sigma);
-        let failed = bank
-            .update_par(
-                stream::Chunk {
-                    channels: &chunk.series,
-                    times: &chunk.t,
-                    values: &chunk.y,
-                    estimates: &mut values,
-                    stride,
-                },
-                run,
-            )
-            .err()
-            .map(|e| row_error(e, &chunk));
+        let rows = stream::Chunk {
+            channels: &chunk.series,
+            times: &chunk.t,
+            values: &chunk.y,
+            estimates: &mut values,
+            stride,
+        };
+        let failed = bank.update_par(rows, run).err();
+        let mut failed = failed.map(|e| row_error(e, &chunk));
         let limit = failed.as_ref().map_or(chunk.len(), |(i, _)| *i);
-        if first && limit < hold {
-            if let Some((_, e)) = failed {
-                return Err(e);
-            }
+        if let Some((_, e)) = failed.take_if(|_| first && limit < hold) {
+            return Err(e);
         }
         let sink = match &mut out {
             Some(sink) => sink,
