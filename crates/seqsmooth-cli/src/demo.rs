@@ -261,7 +261,6 @@ fn track(data: &[Point], outs: &[AutoOutput]) -> Track {
     }
 }
 
-/// The demo plot's layout.
 fn layout(tau: f64) -> Layout {
     Layout {
         title: "seqsmooth demo: automatic filter on a turning aircraft (east coordinate)".into(),
@@ -287,7 +286,6 @@ fn times_list(times: &[f64]) -> String {
     format!("t = {} s", list.join(", "))
 }
 
-/// Runs `seqsmooth demo`.
 pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
     let data = generate();
     let head: Vec<f64> = data.iter().take(LOOKAHEAD).map(|p| p.t).collect();

@@ -22,7 +22,6 @@ pub enum CliError {
 }
 
 impl CliError {
-    /// The process exit code for this error.
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::Usage(_) => EXIT_USAGE,

@@ -33,7 +33,6 @@ pub fn run(a: &GainsArgs) -> Result<(), CliError> {
 
 /// A number's cell: an exact rational `p/q` (or `p`), or an `f64` with round-trip precision.
 pub trait Cell {
-    /// The cell's text.
     fn cell(&self) -> String;
 }
 
@@ -49,7 +48,6 @@ impl Cell for Rational {
     }
 }
 
-/// The cells of `values`.
 pub fn cells<'a, T: Cell + 'a>(values: impl IntoIterator<Item = &'a T>) -> Vec<String> {
     values.into_iter().map(Cell::cell).collect()
 }

@@ -348,7 +348,6 @@ impl<R: Read> CsvIn<R> {
         trim(&self.record[i])
     }
 
-    /// The bytes read from the input so far.
     pub fn bytes_read(&self) -> u64 {
         self.reader.position().byte()
     }
@@ -438,7 +437,6 @@ impl Output {
         }
     }
 
-    /// Writes `bytes`.
     pub fn write(&mut self, bytes: &[u8]) -> Result<(), CliError> {
         self.sink
             .write_all(bytes)

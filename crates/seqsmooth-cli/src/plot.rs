@@ -257,7 +257,6 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
     ))
 }
 
-/// Runs `seqsmooth plot`.
 pub fn run(cfg: &PlotArgs) -> Result<(), CliError> {
     for p in &cfg.output {
         chart::Format::of(p)?;

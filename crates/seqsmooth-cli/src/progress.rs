@@ -22,7 +22,6 @@ pub struct Progress {
 }
 
 impl Progress {
-    /// No display.
     pub fn hidden() -> Self {
         Self {
             bar: ProgressBar::hidden(),

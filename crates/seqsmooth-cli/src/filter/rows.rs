@@ -44,12 +44,10 @@ pub struct Chunk {
 }
 
 impl Chunk {
-    /// The number of rows.
     pub fn len(&self) -> usize {
         self.t.len()
     }
 
-    /// Whether the chunk has no rows.
     pub fn is_empty(&self) -> bool {
         self.t.is_empty()
     }

@@ -14,9 +14,7 @@ use seqsmooth::{PolynomialFilter, PolynomialState};
 /// A running filter of any kind. Cloning a new one is how each series gets its filter.
 #[derive(Clone, Debug)]
 pub enum Runner {
-    /// Expanding memory.
     Expanding(Box<ExpandingMemory>),
-    /// Fading memory.
     Fading(Box<FadingMemory>),
     /// Fixed memory over `window` samples, on any timestamps ([`FixedEngine::Adaptive`]).
     Fixed(Box<FixedMemory>, usize),
