@@ -446,12 +446,10 @@ fn legend_rows<DB: DrawingBackend<ErrorType: 'static>>(
         }
     }
     // centre each row
-    let centred = |(row, w): (Vec<(Key, i32)>, i32)| {
-        row.into_iter()
-            .map(move |(k, x)| (k, x + (width - w) / 2))
-            .collect()
-    };
-    Ok(rows.into_iter().map(centred).collect())
+    for (row, w) in &mut rows {
+        row.iter_mut().for_each(|item| item.1 += (width - *w) / 2);
+    }
+    Ok(rows.into_iter().map(|(row, _)| row).collect())
 }
 
 fn draw<DB: DrawingBackend<ErrorType: 'static>>(
