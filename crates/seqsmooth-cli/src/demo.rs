@@ -192,23 +192,19 @@ fn error_row(
             .filter_map(|(e, p)| e.as_ref().map(|e| (e, p)))
             .filter(|(e, _)| e.derivatives.len() > 1)
     };
-    let scored = after().count();
-    let inside = after()
-        .filter(|(e, p)| {
-            e.std_devs()
-                .is_some_and(|s| (e.derivatives[0] - p.x).abs() <= 3.0 * s[0])
-        })
-        .count();
+    type Scored<'a> = (&'a PolynomialState, &'a Point);
+    let x_err = |(e, p): Scored| e.derivatives[0] - p.x;
+    let within = |&(e, p): &Scored| {
+        e.std_devs()
+            .is_some_and(|s| x_err((e, p)).abs() <= 3.0 * s[0])
+    };
+    let (scored, inside) = (after().count(), after().filter(within).count());
     vec![
         name.to_string(),
         engine.to_string(),
-        short(rms(after().map(|(e, p)| e.derivatives[0] - p.x))),
+        short(rms(after().map(x_err))),
         short(rms(after().map(|(e, p)| e.derivatives[1] - p.v))),
-        short(
-            after()
-                .map(|(e, p)| (e.derivatives[0] - p.x).abs())
-                .fold(0.0, f64::max),
-        ),
+        short(after().map(|q| x_err(q).abs()).fold(0.0, f64::max)),
         format!("{:.1} %", 100.0 * inside as f64 / scored.max(1) as f64),
     ]
 }

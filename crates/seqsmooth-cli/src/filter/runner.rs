@@ -48,10 +48,7 @@ impl Runner {
             sigma: Option<f64>,
             with: fn(F, f64) -> Result<F, Error>,
         ) -> Result<Box<F>, Error> {
-            Ok(Box::new(match sigma {
-                Some(s) => with(f, s)?,
-                None => f,
-            }))
+            Ok(Box::new(if let Some(s) = sigma { with(f, s)? } else { f }))
         }
         let theta = || theta.ok_or_else(|| needs("theta", &name(kind)));
         Ok(match kind {
