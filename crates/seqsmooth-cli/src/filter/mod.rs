@@ -15,7 +15,7 @@ pub mod runner;
 
 use crate::args::{check_window, name, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
 use crate::error::CliError;
-use crate::io::{check_distinct, fmt_f64, input_size, open_input, write_f64, Need, Output};
+use crate::io::{check_distinct, fmt_f64, input_size, open_input, Need, Output};
 use crate::progress::{self, Progress};
 use rayon::prelude::*;
 use rows::{Chunk, RowReader};
@@ -223,14 +223,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             .map(|k| {
                 let mut buf = Vec::with_capacity(PIECE.min(limit) * (stride + 2) * 20);
                 for i in k * PIECE..((k + 1) * PIECE).min(limit) {
-                    chunk.echo(&mut buf, i, id(i));
-                    for &v in &values[i * stride..(i + 1) * stride] {
-                        buf.push(b',');
-                        if !v.is_nan() {
-                            write_f64(&mut buf, v);
-                        }
-                    }
-                    buf.push(b'\n');
+                    chunk.row(&mut buf, i, id(i), &values[i * stride..(i + 1) * stride]);
                 }
                 buf
             })

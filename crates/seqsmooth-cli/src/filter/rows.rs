@@ -9,7 +9,7 @@
 //! and its text from chunk to chunk, for the message of a time that goes backwards) are kept.
 
 use crate::error::CliError;
-use crate::io::{csv_field, find_column, parse_cell, CsvIn, Need};
+use crate::io::{csv_field, find_column, parse_cell, write_f64, CsvIn, Need};
 use std::collections::HashMap;
 use std::io::Read;
 
@@ -69,6 +69,20 @@ impl Chunk {
         out.extend_from_slice(&self.text[at..at + t]);
         out.push(b',');
         out.extend_from_slice(&self.text[at + t..at + t + y]);
+    }
+
+    /// Appends the output row of row `i`: [`echo`](Self::echo), then `values` (NaN an empty
+    /// cell) and the line end.
+    #[inline]
+    pub fn row(&self, out: &mut Vec<u8>, i: usize, id: Option<&[u8]>, values: &[f64]) {
+        self.echo(out, i, id);
+        for &v in values {
+            out.push(b',');
+            if !v.is_nan() {
+                write_f64(out, v);
+            }
+        }
+        out.push(b'\n');
     }
 
     /// Appends the header `[id,]t,y,d0..dM[,s0..sM][,extra…]`.
