@@ -496,12 +496,11 @@ fn draw<DB: DrawingBackend<ErrorType: 'static>>(
 
     // Panels: derivative panels weigh 1, the residual panel 0.7; the bottom one carries the
     // time axis label.
-    let (_, body) = root.split_vertically(y);
+    let (_, mut rest) = root.split_vertically(y);
     let weight = |p: &PanelData| if p.clip_points { 0.7 } else { 1.0 };
     let total: f64 = panels.iter().map(weight).sum();
-    let axis_extra = 30.0;
-    let usable = (height - y) as f64 - axis_extra;
-    let mut rest = body;
+    // The height less the bottom panel's time axis.
+    let usable = (height - y) as f64 - 30.0;
     let mut xr = None;
     widen(&mut xr, track.t.iter().flat_map(|&t| [t, t + track.lead]));
     let x_range = padded(xr.unwrap_or((0.0, 1.0)), 0.01);
