@@ -259,10 +259,8 @@ fn row_error(e: seqsmooth::Error, chunk: &Chunk) -> (usize, CliError) {
         },
         other => (0, other),
     };
-    (
-        index,
-        CliError::Data(format!("line {}: {source}", chunk.lines[index])),
-    )
+    let line = chunk.lines[index];
+    (index, CliError::Data(format!("line {line}: {source}")))
 }
 
 /// A thread that reads the input chunk by chunk ahead of the filtering and writing, passing

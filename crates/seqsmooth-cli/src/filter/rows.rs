@@ -106,9 +106,8 @@ impl Chunk {
     }
 
     fn clear(&mut self) {
-        for v in [&mut self.t, &mut self.y] {
-            v.clear();
-        }
+        self.t.clear();
+        self.y.clear();
         self.series.clear();
         self.lines.clear();
         self.cells.clear();
