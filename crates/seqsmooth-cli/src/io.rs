@@ -309,21 +309,12 @@ impl<R: Read> CsvIn<R> {
             header: Vec::new(),
             line: 1,
         };
-        let header = match this.reader.byte_headers() {
-            Ok(h) => h.clone(),
-            Err(e) => return Err(this.error(e)),
-        };
-        this.line = this
-            .reader
-            .get_mut()
-            .line_at(header.position().map_or(0, |p| p.byte()));
+        let header = this.reader.byte_headers().cloned();
+        let header = header.map_err(|e| this.error(e))?;
+        let byte = header.position().map_or(0, |p| p.byte());
+        this.line = this.reader.get_mut().line_at(byte);
         for cell in &header {
-            let text = std::str::from_utf8(cell).map_err(|_| {
-                let line = this.line;
-                CliError::Data(format!(
-                    "line {line}: malformed CSV: the row is not valid UTF-8"
-                ))
-            })?;
+            let text = std::str::from_utf8(cell).map_err(|_| not_utf8(this.line))?;
             this.header.push(text.trim().to_string());
         }
         Ok(this)
@@ -369,6 +360,13 @@ impl<R: Read> CsvIn<R> {
             _ => CliError::Data(format!("{at}malformed CSV: {e}")),
         }
     }
+}
+
+/// The error of a row on `line` that is not UTF-8 text.
+pub fn not_utf8(line: u64) -> CliError {
+    CliError::Data(format!(
+        "line {line}: malformed CSV: the row is not valid UTF-8"
+    ))
 }
 
 /// The file `path` names, or `None` for standard input or output (`None` or `-`).

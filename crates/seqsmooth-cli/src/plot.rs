@@ -9,7 +9,7 @@
 use crate::args::PlotArgs;
 use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
-use crate::io::{find_column, input_name, named, open_input, parse_cell, plural, CsvIn};
+use crate::io::{find_column, input_name, named, not_utf8, open_input, parse_cell, plural, CsvIn};
 use std::path::Path;
 
 /// The cells of a column, or why they are unusable.
@@ -35,12 +35,7 @@ impl Table {
             let cells: Result<Vec<String>, _> = (0..header.len())
                 .map(|i| std::str::from_utf8(csv.field(i)).map(str::to_string))
                 .collect();
-            let utf8 = || {
-                at(CliError::Data(format!(
-                    "line {line}: malformed CSV: the row is not valid UTF-8"
-                )))
-            };
-            rows.push((line, cells.map_err(|_| utf8())?));
+            rows.push((line, cells.map_err(|_| at(not_utf8(line)))?));
         }
         if header.iter().all(String::is_empty) {
             return Err(CliError::Data(format!(
