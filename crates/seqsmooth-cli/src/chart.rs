@@ -400,12 +400,8 @@ fn symbol<DB: DrawingBackend<ErrorType: 'static>>(
     let seg = |a: (i32, i32), b: (i32, i32), c: RGBColor, w: u32| {
         area.draw(&PathElement::new(vec![a, b], c.stroke_width(w)))
     };
-    let rect = |c: RGBAColor| {
-        area.draw(&Rectangle::new(
-            [(x - 14, y - 7), (x + 14, y + 7)],
-            c.filled(),
-        ))
-    };
+    let corners = [(x - 14, y - 7), (x + 14, y + 7)];
+    let rect = |c: RGBAColor| area.draw(&Rectangle::new(corners, c.filled()));
     match key {
         Key::Data => area.draw(&Circle::new((x, y), 3, DATA.filled())),
         Key::Rejected => area.draw(&Cross::new((x, y), 5, REJECTED.stroke_width(2))),
@@ -460,25 +456,22 @@ fn draw<DB: DrawingBackend<ErrorType: 'static>>(
     root.fill(&WHITE)?;
     let (width, height) = (layout.size.0 as i32, layout.size.1 as i32);
 
-    let mut panels: Vec<PanelData> = layout
-        .panels
-        .iter()
-        .map(|(k, label)| panel(track, Some(*k), label))
+    // The derivative panels, then the residual panel.
+    let derivatives = layout.panels.iter().map(|(k, label)| (Some(*k), label));
+    let residuals = layout.residual_label.iter().map(|label| (None, label));
+    let panels: Vec<PanelData> = derivatives
+        .chain(residuals)
+        .map(|(k, label)| panel(track, k, label))
         .collect();
-    if let Some(label) = &layout.residual_label {
-        panels.push(panel(track, None, label));
-    }
     let keys = legend_keys(&panels, track);
 
     // Title, subtitle, legend.
     let mut y = 12;
-    let title = font(24.0).pos(Pos::new(HPos::Center, VPos::Top));
-    root.draw_text(&layout.title, &title, (width / 2, y))?;
+    let top = Pos::new(HPos::Center, VPos::Top);
+    root.draw_text(&layout.title, &font(24.0).pos(top), (width / 2, y))?;
     y += 32;
     if !layout.subtitle.is_empty() {
-        let sub = font(15.0)
-            .color(&RGBColor(70, 70, 70))
-            .pos(Pos::new(HPos::Center, VPos::Top));
+        let sub = font(15.0).color(&RGBColor(70, 70, 70)).pos(top);
         root.draw_text(&layout.subtitle, &sub, (width / 2, y))?;
         y += 24;
     }

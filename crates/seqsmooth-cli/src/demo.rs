@@ -320,7 +320,9 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
 
     let outliers = data.iter().filter(|p| p.outlier).count();
     let rejected = outs.iter().filter(|o| o.outlier).count();
-    let caught = (outs.iter().zip(&data))
+    let caught = outs
+        .iter()
+        .zip(&data)
         .filter(|(o, p)| o.outlier && p.outlier)
         .count();
     let plot_track = track(&data, &outs);
