@@ -16,18 +16,11 @@ pub fn run(a: &GainsArgs) -> Result<(), CliError> {
         (Memory::Expanding(n), true) => cells(&expanding_gains::<Rational>(m, n, form)),
         (Memory::Expanding(n), false) => cells(&expanding_gains::<f64>(m, n, form)),
         (Memory::Fading(theta), true) => cells(&fading_gains::<Rational>(m, theta.exact, form)),
-        (Memory::Fading(theta), false) => {
-            let theta = theta.value_f64()?;
-            cells(&fading_gains::<f64>(m, theta, form))
-        }
+        (Memory::Fading(theta), false) => cells(&fading_gains(m, theta.value_f64()?, form)),
     };
     let mut rows = vec![vec!["k".to_string(), "gain".to_string()]];
-    rows.extend(
-        values
-            .into_iter()
-            .enumerate()
-            .map(|(k, g)| vec![k.to_string(), g]),
-    );
+    let row = |(k, g): (usize, String)| vec![k.to_string(), g];
+    rows.extend(values.into_iter().enumerate().map(row));
     write_table(&rows, a.format)
 }
 

@@ -108,15 +108,11 @@ fn write_matrix(values: Vec<String>, size: usize, format: Format) -> Result<(), 
             rows
         }
         Format::Table => {
-            let mut rows = vec![std::iter::once(String::new())
-                .chain((0..size).map(|j| format!("j={j}")))
-                .collect()];
+            let mut header = vec![String::new()];
+            header.extend((0..size).map(|j| format!("j={j}")));
+            let mut rows = vec![header];
             for (i, chunk) in values.chunks(size).enumerate() {
-                rows.push(
-                    std::iter::once(format!("i={i}"))
-                        .chain(chunk.iter().cloned())
-                        .collect(),
-                );
+                rows.push([vec![format!("i={i}")], chunk.to_vec()].concat());
             }
             rows
         }
