@@ -90,10 +90,8 @@ pub fn fmt_f64(x: f64) -> String {
 /// `cell` as a CSV output field: quoted (with quotes doubled) when it holds a comma, a quote
 /// or a line break.
 pub fn csv_field(cell: &[u8]) -> Vec<u8> {
-    if !cell
-        .iter()
-        .any(|b| matches!(b, b',' | b'"' | b'\r' | b'\n'))
-    {
+    let special = |b: &u8| matches!(b, b',' | b'"' | b'\r' | b'\n');
+    if !cell.iter().any(special) {
         return cell.to_vec();
     }
     let parts: Vec<&[u8]> = cell.split(|&b| b == b'"').collect();

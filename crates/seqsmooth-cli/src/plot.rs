@@ -9,7 +9,9 @@
 use crate::args::PlotArgs;
 use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
-use crate::io::{find_column, input_name, named, not_utf8, open_input, parse_cell, plural, CsvIn};
+use crate::io::{
+    find_column, fmt_f64, input_name, named, not_utf8, open_input, parse_cell, plural, CsvIn,
+};
 use std::path::Path;
 
 /// The cells of a column, or why they are unusable.
@@ -257,32 +259,22 @@ pub fn run(cfg: &PlotArgs) -> Result<(), CliError> {
         chart::Format::of(p)?;
     }
     let (track, default_title) = read_track(cfg)?;
-    let tu = cfg.time_unit.as_deref();
-    let vu = cfg.value_unit.as_deref();
+    let (tu, vu) = (cfg.time_unit.as_deref(), cfg.value_unit.as_deref());
     let residuals = !cfg.no_residuals && cfg.lead == 0.0 && track.d[0].iter().any(Option::is_some);
     let panels: Vec<(usize, String)> = cfg
         .derivative
         .iter()
         .map(|&k| (k, derivative_label(k, tu, vu)))
         .collect();
-    let mut subtitle = Vec::new();
-    if cfg.lead != 0.0 {
-        subtitle.push(format!(
-            "estimates drawn at t + {}{}",
-            crate::io::fmt_f64(cfg.lead),
-            tu.map(|u| format!(" {u}")).unwrap_or_default()
-        ));
-    }
+    let unit = tu.map(|u| format!(" {u}")).unwrap_or_default();
+    let lead = format!("estimates drawn at t + {}{unit}", fmt_f64(cfg.lead));
+    let default_height = Layout::default_height(cfg.derivative.len(), residuals);
     let layout = Layout {
         title: cfg.title.clone().unwrap_or(default_title),
-        subtitle: subtitle.join("; "),
+        subtitle: if cfg.lead != 0.0 { lead } else { String::new() },
         time_label: with_unit("time t", tu),
         residual_label: residuals.then(|| with_unit("residual y − d0", vu)),
-        size: (
-            cfg.width,
-            cfg.height
-                .unwrap_or_else(|| Layout::default_height(panels.len(), residuals)),
-        ),
+        size: (cfg.width, cfg.height.unwrap_or(default_height)),
         panels,
     };
     for p in &cfg.output {
