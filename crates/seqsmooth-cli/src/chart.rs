@@ -136,12 +136,8 @@ fn register() -> Result<(), CliError> {
 pub fn write(track: &Track, layout: &Layout, path: &Path) -> Result<(), CliError> {
     register()?;
     let format = Format::of(path)?;
-    let fail = |e: Err| {
-        CliError::Data(format!(
-            "cannot write the plot to '{}': {e}",
-            path.display()
-        ))
-    };
+    let name = path.display();
+    let fail = |e: Err| CliError::Data(format!("cannot write the plot to '{name}': {e}"));
     macro_rules! render {
         ($backend:ident) => {{
             let root = $backend::new(path, layout.size).into_drawing_area();
@@ -162,12 +158,9 @@ fn font(size: f64) -> TextStyle<'static> {
 /// The value `p`-quantile of the finite `values` (nearest rank), if any.
 fn quantile(values: impl IntoIterator<Item = f64>, p: f64) -> Option<f64> {
     let mut values: Vec<f64> = values.into_iter().collect();
-    if values.is_empty() {
-        return None;
-    }
     values.sort_by(f64::total_cmp);
-    let k = ((values.len() - 1) as f64 * p).round() as usize;
-    Some(values[k])
+    let k = (values.len().saturating_sub(1) as f64 * p).round() as usize;
+    values.get(k).copied()
 }
 
 /// `[lo, hi]` widened by `pad` of its span on each side (a unit span about a single value).
