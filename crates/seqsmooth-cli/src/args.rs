@@ -39,7 +39,6 @@ const AFTER_HELP: &str = concat!(
     " Exact (--exact) values are rationals in lowest terms, 'p/q', or 'p' when the value is an integer."
 );
 
-/// Top-level command line.
 #[derive(Debug, Parser)]
 #[command(
     name = "seqsmooth",
@@ -48,12 +47,10 @@ const AFTER_HELP: &str = concat!(
     after_help = AFTER_HELP
 )]
 pub struct Cli {
-    /// The subcommand.
     #[command(subcommand)]
     pub command: Command,
 }
 
-/// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Smooth, differentiate and predict a CSV time series, row by row, with an expanding-,
@@ -79,7 +76,6 @@ pub enum Command {
     Plot(PlotArgs),
 }
 
-/// Help text after `seqsmooth plot --help`.
 const PLOT_AFTER_HELP: &str = "\
 Reads the CSV written by 'seqsmooth filter' and draws, under a title and a legend: a panel per \
 --derivative K with the estimate dK, its +-3 sigma band from sK (when the output has s \
@@ -98,7 +94,6 @@ columns, malformed CSV, non-numeric cells, unwritable image); 2 for command-line
 .svg). Every message goes to stderr and starts with 'error: '; data errors name the file, the \
 1-based line (the header is line 1) and the column.";
 
-/// Help text after `seqsmooth filter --help`.
 const FILTER_AFTER_HELP: &str = concat!(
     "\
 Output: CSV, one row per input row in input order, with the header
@@ -148,7 +143,6 @@ Progress: on standard error when it is a terminal and the input is longer than o
     exit_status!("too few samples")
 );
 
-/// Help text after `seqsmooth smooth --help`.
 const SMOOTH_AFTER_HELP: &str = concat!(
     "\
 Output: CSV with header t,y,d0..dM, one row per input row in input order. The t and y cells \
@@ -170,7 +164,6 @@ window reaches rows after it); use 'seqsmooth filter --kind fixed' for a causal,
     exit_status!("fewer rows than the window")
 );
 
-/// Arguments of `seqsmooth filter`.
 #[derive(Debug, Args)]
 pub struct FilterArgs {
     /// Input CSV with a header row; omitted or '-' reads standard input. Columns other than the
@@ -205,7 +198,6 @@ pub struct FilterArgs {
     #[arg(long, value_name = "H", default_value = "0", value_parser = parse_lead,
           allow_hyphen_values = true)]
     pub lead: f64,
-    /// The time and value columns.
     #[command(flatten)]
     pub columns: Columns,
     /// White-noise standard deviation S of the values: adds the columns s0..sM, the 1-sigma
@@ -230,7 +222,6 @@ pub struct FilterArgs {
     pub chunk_rows: u32,
 }
 
-/// Arguments of `seqsmooth smooth`.
 #[derive(Debug, Args)]
 pub struct SmoothArgs {
     /// Input CSV with a header row; omitted or '-' reads standard input. Columns other than the
@@ -244,7 +235,6 @@ pub struct SmoothArgs {
     /// window_length, Morrison's L+1); odd W centres every window on its row
     #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
     pub window: usize,
-    /// The time and value columns.
     #[command(flatten)]
     pub columns: Columns,
     /// Output file [default: standard output]
@@ -252,13 +242,11 @@ pub struct SmoothArgs {
     pub output: Option<PathBuf>,
 }
 
-/// Arguments of `seqsmooth gains`.
 #[derive(Debug, Args)]
 pub struct GainsArgs {
     /// Filter kind
     #[arg(long, value_enum)]
     pub kind: TableKind,
-    /// The degree and the memory.
     #[command(flatten)]
     pub memory: MemoryArgs,
     /// Print exact rationals in lowest terms, p/q (an integer as p), instead of doubles.
@@ -270,13 +258,11 @@ pub struct GainsArgs {
     pub format: Format,
 }
 
-/// Arguments of `seqsmooth vrf`.
 #[derive(Debug, Args)]
 pub struct VrfArgs {
     /// Filter kind
     #[arg(long, value_enum)]
     pub kind: VrfKind,
-    /// The degree and the memory.
     #[command(flatten)]
     pub memory: MemoryArgs,
     /// Fixed memory: the number of samples in the window, W >= M+1 (Morrison's L+1)
@@ -325,14 +311,6 @@ pub struct MemoryArgs {
     pub theta: Option<Theta>,
 }
 
-impl MemoryArgs {
-    /// Resolves `--n`/`--theta` for `kind`.
-    pub fn of(&self, kind: TableKind) -> Result<Memory, CliError> {
-        memory(kind, self.n, self.theta.clone())
-    }
-}
-
-/// Arguments of `seqsmooth demo`.
 #[derive(Debug, Args)]
 pub struct DemoArgs {
     /// Also write the plain fading-memory (exact engine) filter's CSV output
@@ -347,7 +325,6 @@ pub struct DemoArgs {
     pub no_plot: bool,
 }
 
-/// Arguments of `seqsmooth plot`.
 #[derive(Debug, Args)]
 pub struct PlotArgs {
     /// The output of 'seqsmooth filter' (CSV with header t,y,d0..dM[,s0..sM][,...]); omitted
@@ -415,16 +392,11 @@ pub enum Kind {
     Auto,
 }
 
-impl Kind {
-    /// The name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Kind::Expanding => "expanding",
-            Kind::Fading => "fading",
-            Kind::Fixed => "fixed",
-            Kind::Auto => "auto",
-        }
-    }
+/// The name of `value` on the command line (e.g. `fading` for [`Kind::Fading`]).
+pub fn name(value: impl clap::ValueEnum) -> String {
+    value
+        .to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_string())
 }
 
 /// The engine the filter runs on.
@@ -494,38 +466,29 @@ impl From<FormArg> for EstimateForm {
     }
 }
 
-/// The filter memory a table is for, after argument checking.
+/// The filter memory a table is for, after argument checking: expanding memory at the 0-based
+/// index `n` of the newest sample, or fading memory with discount θ.
 #[derive(Clone, Debug)]
 pub enum Memory {
-    /// Expanding memory at the 0-based index `n` of the newest sample.
-    Expanding {
-        /// Sample index.
-        n: u64,
-    },
-    /// Fading memory with discount θ.
-    Fading {
-        /// θ (exact and `f64`).
-        theta: Theta,
-    },
+    Expanding(u64),
+    Fading(Theta),
 }
 
-/// Resolves `--n`/`--theta` for the memory kind of a gains or vrf table.
-pub fn memory(kind: TableKind, n: Option<u64>, theta: Option<Theta>) -> Result<Memory, CliError> {
-    match (kind, n, theta) {
-        (TableKind::Expanding, Some(n), None) => Ok(Memory::Expanding { n }),
-        (TableKind::Expanding, None, _) => Err(CliError::Usage(
-            "--kind expanding needs --n N, the 0-based index of the newest sample".into(),
-        )),
-        (TableKind::Expanding, Some(_), Some(_)) => Err(CliError::Usage(
-            "--theta applies only to --kind fading".into(),
-        )),
-        (TableKind::Fading, None, Some(theta)) => Ok(Memory::Fading { theta }),
-        (TableKind::Fading, _, None) => Err(CliError::Usage(
-            "--kind fading needs --theta T, the discount per sample (0 < T < 1)".into(),
-        )),
-        (TableKind::Fading, Some(_), Some(_)) => Err(CliError::Usage(
-            "--n applies only to --kind expanding".into(),
-        )),
+impl MemoryArgs {
+    /// Resolves `--n`/`--theta` for the memory kind of a gains or vrf table.
+    pub fn of(&self, kind: TableKind) -> Result<Memory, CliError> {
+        match (kind, self.n, self.theta.clone()) {
+            (TableKind::Expanding, Some(n), None) => Ok(Memory::Expanding(n)),
+            (TableKind::Expanding, None, _) => Err(CliError::Usage(
+                "--kind expanding needs --n N, the 0-based index of the newest sample".into(),
+            )),
+            (TableKind::Expanding, Some(_), Some(_)) => Err(only("--theta", "fading")),
+            (TableKind::Fading, None, Some(theta)) => Ok(Memory::Fading(theta)),
+            (TableKind::Fading, _, None) => Err(CliError::Usage(
+                "--kind fading needs --theta T, the discount per sample (0 < T < 1)".into(),
+            )),
+            (TableKind::Fading, Some(_), Some(_)) => Err(only("--n", "expanding")),
+        }
     }
 }
 
@@ -534,16 +497,21 @@ pub fn only(arg: &str, kinds: &str) -> CliError {
     CliError::Usage(format!("{arg} applies only to --kind {kinds}"))
 }
 
-/// Checks a window against the degree: a degree-M fit needs at least M+1 samples.
-pub fn check_window(window: usize, degree: usize) -> Result<(), CliError> {
-    if window < degree + 1 {
-        return Err(CliError::Usage(format!(
-            "window {window} is too small for degree {degree}: a degree-{degree} fit needs a \
-             window of at least {} samples",
-            degree + 1
-        )));
+/// The `--window` of a fixed-memory fit, checked against the degree: given, and at least the
+/// M+1 samples a degree-M fit needs.
+pub fn check_window(window: Option<usize>, degree: usize) -> Result<usize, CliError> {
+    let need = degree + 1;
+    match window {
+        None => Err(CliError::Usage(format!(
+            "--kind fixed needs --window W, the number of samples in the window (at least M+1 \
+             = {need})"
+        ))),
+        Some(w) if w < need => Err(CliError::Usage(format!(
+            "window {w} is too small for degree {degree}: a degree-{degree} fit needs a window \
+             of at least {need} samples"
+        ))),
+        Some(w) => Ok(w),
     }
-    Ok(())
 }
 
 /// A discount factor θ as given on the command line: exact, and rounded to `f64`.
@@ -559,15 +527,15 @@ pub struct Theta {
 
 impl Theta {
     /// θ as an `f64` strictly inside `(0, 1)`, for the computations that run in `f64`.
-    pub fn value_f64(&self) -> Result<f64, String> {
+    pub fn value_f64(&self) -> Result<f64, CliError> {
         if self.value > 0.0 && self.value < 1.0 {
             Ok(self.value)
         } else {
-            Err(format!(
+            Err(CliError::Usage(format!(
                 "theta {} is out of range: it rounds to {} in double precision, and the filters \
                  need 0 < theta < 1 after rounding (--exact tables accept it)",
                 self.text, self.value
-            ))
+            )))
         }
     }
 }
@@ -590,33 +558,39 @@ pub fn parse_theta(s: &str) -> Result<Theta, String> {
     })
 }
 
+/// Parses the whole number `name` of `unit` (e.g. " of samples") from `lo` to `hi`.
+fn parse_whole(name: &str, s: &str, unit: &str, lo: i128, hi: i128) -> Result<i128, String> {
+    let text = s.trim();
+    match text.parse::<i128>() {
+        Ok(v) if (lo..=hi).contains(&v) => Ok(v),
+        _ => Err(format!(
+            "{name} {text} is out of range: it must be a whole number{unit} from {lo} to {hi}"
+        )),
+    }
+}
+
 /// Parses `--degree`: a whole number from 0 to [`MAX_DEGREE`].
 pub fn parse_degree(s: &str) -> Result<usize, String> {
-    let text = s.trim();
-    let range = format!("it must be a whole number from 0 to {MAX_DEGREE}");
-    match text.parse::<i128>() {
-        Ok(d) if (0..=MAX_DEGREE as i128).contains(&d) => Ok(d as usize),
+    match s.trim().parse::<i128>() {
         Ok(d) if d > MAX_DEGREE as i128 => Err(format!(
-            "degree {text} is out of range: the largest supported degree is {MAX_DEGREE}"
+            "degree {} is out of range: the largest supported degree is {MAX_DEGREE}",
+            s.trim()
         )),
-        _ => Err(format!("degree {text} is out of range: {range}")),
+        _ => parse_whole("degree", s, "", 0, MAX_DEGREE as i128).map(|d| d as usize),
     }
 }
 
 /// Parses `--n`: the 0-based index of the newest sample, a whole number from 0 to `i64::MAX`.
 pub fn parse_index(s: &str) -> Result<u64, String> {
-    let text = s.trim();
-    match text.parse::<i128>() {
-        Ok(n) if (0..=i64::MAX as i128).contains(&n) => Ok(n as u64),
-        _ => Err(format!(
-            "n {text} is out of range: it must be a whole number from 0 to {}",
-            i64::MAX
-        )),
-    }
+    parse_whole("n", s, "", 0, i64::MAX.into()).map(|n| n as u64)
 }
 
+/// A positive finite number (`--tau`, `--sigma`).
+const POSITIVE: (fn(f64) -> bool, &str) =
+    (|v| v.is_finite() && v > 0.0, "a positive finite number");
+
 /// Parses the number `name` that must be `range` (`ok` says whether it is).
-fn parse_f64(name: &str, s: &str, ok: fn(f64) -> bool, range: &str) -> Result<f64, String> {
+fn parse_f64(name: &str, s: &str, (ok, range): (fn(f64) -> bool, &str)) -> Result<f64, String> {
     let text = s.trim();
     let v = (text.parse::<f64>()).map_err(|_| format!("{name} '{text}' is not a number"))?;
     if ok(v) {
@@ -628,59 +602,34 @@ fn parse_f64(name: &str, s: &str, ok: fn(f64) -> bool, range: &str) -> Result<f6
 
 /// Parses `--tau`: a positive finite number.
 pub fn parse_tau(s: &str) -> Result<f64, String> {
-    parse_f64(
-        "tau",
-        s,
-        |v| v.is_finite() && v > 0.0,
-        "a positive finite number",
-    )
+    parse_f64("tau", s, POSITIVE)
 }
 
 /// Parses `--sigma`: a positive finite number.
 pub fn parse_sigma(s: &str) -> Result<f64, String> {
-    parse_f64(
-        "sigma",
-        s,
-        |v| v.is_finite() && v > 0.0,
-        "a positive finite number",
-    )
+    parse_f64("sigma", s, POSITIVE)
 }
 
 /// Parses `--lead`: any finite number (negative = retrodiction).
 pub fn parse_lead(s: &str) -> Result<f64, String> {
-    parse_f64("lead", s, f64::is_finite, "a finite number")
+    parse_f64("lead", s, (f64::is_finite, "a finite number"))
 }
 
 /// Parses `--window`: the number of samples in the window (Morrison's `L+1`), a whole number
 /// from 1 to `i64::MAX`. Whether it suits the degree is checked by the command.
 pub fn parse_window(s: &str) -> Result<usize, String> {
-    let text = s.trim();
-    match text.parse::<i128>() {
-        Ok(w) if (1..=i64::MAX as i128).contains(&w) && w <= usize::MAX as i128 => Ok(w as usize),
-        _ => Err(format!(
-            "window {text} is out of range: it must be a whole number of samples from 1 to {}",
-            i64::MAX
-        )),
-    }
+    let max = i128::from(i64::MAX).min(usize::MAX as i128);
+    parse_whole("window", s, " of samples", 1, max).map(|w| w as usize)
 }
 
 /// A lead in sampling intervals as given on the command line (`seqsmooth vrf --kind fixed`):
-/// exact, and rounded to `f64`.
-#[derive(Clone, Debug)]
+/// exact, and rounded to `f64`; zero by default.
+#[derive(Clone, Debug, Default)]
 pub struct LeadSteps {
     /// The lead exactly (`-2.5` is `-5/2`).
     pub exact: Rational,
     /// The lead rounded to the nearest `f64`.
     pub value: f64,
-}
-
-impl Default for LeadSteps {
-    fn default() -> Self {
-        Self {
-            exact: Rational::zero(),
-            value: 0.0,
-        }
-    }
 }
 
 /// Parses `--lead` of `seqsmooth vrf`: `0`, `1`, `-2.5`, `-5/2` or `25e-1`, in samples, exactly;

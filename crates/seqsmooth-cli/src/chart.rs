@@ -128,30 +128,21 @@ const MISFIT: RGBColor = RGBColor(255, 170, 60);
 fn register() -> Result<(), CliError> {
     static DONE: OnceLock<bool> = OnceLock::new();
     let ok = *DONE.get_or_init(|| register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
-    if ok {
-        Ok(())
-    } else {
-        Err(CliError::Data(
-            "the embedded font could not be loaded".into(),
-        ))
-    }
+    let failed = || CliError::Data("the embedded font could not be loaded".into());
+    ok.then_some(()).ok_or_else(failed)
 }
 
 /// Draws `track` as laid out by `layout` into `path`, as PNG or SVG by its extension.
 pub fn write(track: &Track, layout: &Layout, path: &Path) -> Result<(), CliError> {
     register()?;
     let format = Format::of(path)?;
-    let fail = |e: String| {
-        CliError::Data(format!(
-            "cannot write the plot to '{}': {e}",
-            path.display()
-        ))
-    };
+    let name = path.display();
+    let fail = |e: Err| CliError::Data(format!("cannot write the plot to '{name}': {e}"));
     macro_rules! render {
         ($backend:ident) => {{
             let root = $backend::new(path, layout.size).into_drawing_area();
             draw(&root, track, layout).map_err(fail)?;
-            root.present().map_err(|e| fail(e.to_string()))
+            root.present().map_err(|e| fail(e.into()))
         }};
     }
     match format {
@@ -167,12 +158,9 @@ fn font(size: f64) -> TextStyle<'static> {
 /// The value `p`-quantile of the finite `values` (nearest rank), if any.
 fn quantile(values: impl IntoIterator<Item = f64>, p: f64) -> Option<f64> {
     let mut values: Vec<f64> = values.into_iter().collect();
-    if values.is_empty() {
-        return None;
-    }
     values.sort_by(f64::total_cmp);
-    let k = ((values.len() - 1) as f64 * p).round() as usize;
-    Some(values[k])
+    let k = (values.len().saturating_sub(1) as f64 * p).round() as usize;
+    values.get(k).copied()
 }
 
 /// `[lo, hi]` widened by `pad` of its span on each side (a unit span about a single value).
@@ -186,12 +174,10 @@ fn padded((lo, hi): (f64, f64), pad: f64) -> (f64, f64) {
     }
 }
 
-fn widen(range: &mut Option<(f64, f64)>, v: f64) {
-    if v.is_finite() {
-        *range = Some(match *range {
-            None => (v, v),
-            Some((lo, hi)) => (lo.min(v), hi.max(v)),
-        });
+/// `range` widened to take in the finite `values`.
+fn widen(range: &mut Option<(f64, f64)>, values: impl IntoIterator<Item = f64>) {
+    for v in values.into_iter().filter(|v| v.is_finite()) {
+        *range = Some(range.map_or((v, v), |(lo, hi)| (lo.min(v), hi.max(v))));
     }
 }
 
@@ -221,11 +207,9 @@ pub fn tick(v: f64, step: f64) -> String {
     };
     let s = format!("{v:.decimals$}");
     // "-0" and "-0.0" read as noise
-    if s.trim_start_matches('-')
-        .chars()
-        .all(|c| c == '0' || c == '.')
-    {
-        s.trim_start_matches('-').to_string()
+    let unsigned = s.trim_start_matches('-');
+    if unsigned.chars().all(|c| c == '0' || c == '.') {
+        unsigned.to_string()
     } else {
         s
     }
@@ -251,120 +235,95 @@ struct PanelData {
     clip_points: bool,
 }
 
-fn derivative_panel(track: &Track, k: usize, label: &str) -> PanelData {
-    let n = track.t.len();
-    let none = vec![None; n];
-    let line = track.d.get(k).cloned().unwrap_or_else(|| none.clone());
-    let sd = track.s.get(k).filter(|s| s.len() == n);
-    let band: Vec<Option<f64>> = (0..n)
-        .map(|i| sd.and_then(|s| s[i]).map(|s| 3.0 * s))
+/// The panel of derivative `k`, or for `k = None` the residual panel, whose values are
+/// relative to the estimate `d0` (the rows without one are left out).
+fn panel(track: &Track, k: Option<usize>, label: &str) -> PanelData {
+    let (n, j) = (track.t.len(), k.unwrap_or(0));
+    let cell = |v: &[Vec<Option<f64>>], i: usize| v.get(j).and_then(|v| v.get(i)).copied()?;
+    let base = |i: usize| k.map_or_else(|| cell(&track.d, i), |_| Some(0.0));
+    let rejected = |i: usize| track.rejected.get(i) == Some(&true);
+    let points = (0..n)
+        .filter(|_| k.unwrap_or(0) == 0)
+        .filter_map(|i| base(i).map(|b| (track.t[i], track.y[i] - b, rejected(i))))
         .collect();
-    let truth: Vec<Option<f64>> = match track.truth.get(k) {
-        Some(v) if v.len() == n => v.iter().map(|&x| Some(x)).collect(),
-        _ => none.clone(),
+    let rows = |f: &dyn Fn(usize, f64) -> Option<f64>| -> Vec<Option<f64>> {
+        (0..n).map(|i| base(i).and_then(|b| f(i, b))).collect()
     };
-    let points: Vec<(f64, f64, bool)> = if k == 0 {
-        (0..n)
-            .map(|i| (track.t[i], track.y[i], track.rejected.get(i) == Some(&true)))
-            .collect()
+    let truth = |i: usize| track.truth.get(j).and_then(|x| x.get(i)).copied();
+    let noise = |i: usize| {
+        track
+            .noise
+            .get(i)
+            .copied()
+            .flatten()
+            .filter(|_| k.is_none())
+    };
+    let mut p = PanelData {
+        label: label.to_string(),
+        points,
+        line: rows(&|i, b| cell(&track.d, i).map(|d| d - b)),
+        band: rows(&|i, _| cell(&track.s, i).map(|s| 3.0 * s)),
+        truth: rows(&|i, b| truth(i).map(|x| x - b)),
+        noise: (0..n).map(|i| noise(i).map(|s| 3.0 * s)).collect(),
+        shift: if k.is_some() { track.lead } else { 0.0 },
+        range: (0.0, 1.0),
+        clip_points: k.is_none(),
+    };
+    p.range = if p.clip_points {
+        p.residual_range()
     } else {
-        Vec::new()
+        p.derivative_range()
     };
-    // Range: every sample, the truth, and the central 98% of the estimates (start-up
-    // transients of the higher derivatives would squash the panel).
-    let mut range = None;
-    for p in &points {
-        widen(&mut range, p.1);
-    }
-    for v in truth.iter().flatten() {
-        widen(&mut range, *v);
-    }
-    let est = || line.iter().flatten().copied().filter(|v| v.is_finite());
-    if let (Some(lo), Some(hi)) = (quantile(est(), 0.01), quantile(est(), 0.99)) {
-        widen(&mut range, lo);
-        widen(&mut range, hi);
-    }
-    // The band where it is no wider than the spread of the panel (not at start-up).
-    if let Some((lo, hi)) = range {
-        let span = (hi - lo).max(f64::MIN_POSITIVE);
-        if let Some(h) = quantile(band.iter().flatten().copied(), 0.9) {
-            if h < 0.25 * span {
-                for (l, b) in line.iter().zip(&band) {
-                    if let (Some(l), Some(b)) = (l, b) {
-                        if *b <= h {
-                            widen(&mut range, l - b);
-                            widen(&mut range, l + b);
+    p
+}
+
+impl PanelData {
+    /// Every sample, the truth, and the central 98% of the estimates (start-up transients of
+    /// the higher derivatives would squash the panel).
+    fn derivative_range(&self) -> (f64, f64) {
+        let (line, band) = (&self.line, &self.band);
+        let mut range = None;
+        widen(&mut range, self.points.iter().map(|p| p.1));
+        widen(&mut range, self.truth.iter().flatten().copied());
+        let est = || line.iter().flatten().copied().filter(|v| v.is_finite());
+        if let (Some(lo), Some(hi)) = (quantile(est(), 0.01), quantile(est(), 0.99)) {
+            widen(&mut range, [lo, hi]);
+        }
+        // The band where it is no wider than the spread of the panel (not at start-up).
+        if let Some((lo, hi)) = range {
+            let span = (hi - lo).max(f64::MIN_POSITIVE);
+            if let Some(h) = quantile(band.iter().flatten().copied(), 0.9) {
+                if h < 0.25 * span {
+                    for (l, b) in line.iter().zip(band) {
+                        if let (Some(l), Some(b)) = (l, b) {
+                            if *b <= h {
+                                widen(&mut range, [l - b, l + b]);
+                            }
                         }
                     }
                 }
             }
         }
+        padded(range.unwrap_or((0.0, 1.0)), 0.05)
     }
-    PanelData {
-        label: label.to_string(),
-        points,
-        line,
-        band,
-        truth,
-        noise: none,
-        shift: track.lead,
-        range: padded(range.unwrap_or((0.0, 1.0)), 0.05),
-        clip_points: false,
-    }
-}
 
-fn residual_panel(track: &Track, label: &str) -> PanelData {
-    let n = track.t.len();
-    let d0 = track.d.first().cloned().unwrap_or_else(|| vec![None; n]);
-    let sd = track.s.first().filter(|s| s.len() == n);
-    let points: Vec<(f64, f64, bool)> = (0..n)
-        .filter_map(|i| {
-            d0[i].map(|d| {
-                (
-                    track.t[i],
-                    track.y[i] - d,
-                    track.rejected.get(i) == Some(&true),
-                )
-            })
-        })
-        .collect();
-    let line: Vec<Option<f64>> = d0.iter().map(|d| d.map(|_| 0.0)).collect();
-    let band: Vec<Option<f64>> = (0..n)
-        .map(|i| d0[i].and(sd.and_then(|s| s[i])).map(|s| 3.0 * s))
-        .collect();
-    let truth: Vec<Option<f64>> = match track.truth.first() {
-        Some(x) if x.len() == n => (0..n).map(|i| d0[i].map(|d| x[i] - d)).collect(),
-        _ => vec![None; n],
-    };
-    let noise: Vec<Option<f64>> = if track.noise.len() == n {
-        track.noise.iter().map(|s| s.map(|s| 3.0 * s)).collect()
-    } else {
-        vec![None; n]
-    };
-    // Symmetric range: the 99th percentile of |residual| of the accepted samples, every
-    // rejected one up to twice that, the ±3σ noise and the settled band, the truth's error.
-    let q = |v: &mut dyn Iterator<Item = f64>, p| quantile(v, p).unwrap_or(0.0);
-    let mut r = q(&mut points.iter().filter(|p| !p.2).map(|p| p.1.abs()), 0.99)
-        .max(q(&mut noise.iter().flatten().copied(), 0.9))
-        .max(q(&mut band.iter().flatten().copied(), 0.9))
-        .max(q(&mut truth.iter().flatten().map(|e| e.abs()), 0.99));
-    let cap = 2.0 * r;
-    for p in points.iter().filter(|p| p.2) {
-        r = r.max(p.1.abs().min(cap));
-    }
-    if r <= 0.0 || !r.is_finite() {
-        r = 1.0;
-    }
-    PanelData {
-        label: label.to_string(),
-        points,
-        line,
-        band,
-        truth,
-        noise,
-        shift: 0.0,
-        range: (-1.08 * r, 1.08 * r),
-        clip_points: true,
+    /// Symmetric: the 99th percentile of |residual| of the accepted samples, every rejected one
+    /// up to twice that, the ±3σ noise and the settled band, the truth's error.
+    fn residual_range(&self) -> (f64, f64) {
+        let points = &self.points;
+        let q = |v: &mut dyn Iterator<Item = f64>, p| quantile(v, p).unwrap_or(0.0);
+        let mut r = q(&mut points.iter().filter(|p| !p.2).map(|p| p.1.abs()), 0.99)
+            .max(q(&mut self.noise.iter().flatten().copied(), 0.9))
+            .max(q(&mut self.band.iter().flatten().copied(), 0.9))
+            .max(q(&mut self.truth.iter().flatten().map(|e| e.abs()), 0.99));
+        let cap = 2.0 * r;
+        for p in points.iter().filter(|p| p.2) {
+            r = r.max(p.1.abs().min(cap));
+        }
+        if r <= 0.0 || !r.is_finite() {
+            r = 1.0;
+        }
+        (-1.08 * r, 1.08 * r)
     }
 }
 
@@ -422,14 +381,11 @@ fn legend_keys(panels: &[PanelData], track: &Track) -> Vec<Key> {
     .collect()
 }
 
-type Err = String;
-
-fn e<E: std::fmt::Display>(err: E) -> Err {
-    err.to_string()
-}
+/// A drawing error of either backend.
+type Err = Box<dyn std::error::Error>;
 
 /// Draws the legend symbol of `key` centred at `(x, y)`.
-fn symbol<DB: DrawingBackend>(
+fn symbol<DB: DrawingBackend<ErrorType: 'static>>(
     area: &DrawingArea<DB, Shift>,
     key: Key,
     (x, y): (i32, i32),
@@ -437,12 +393,8 @@ fn symbol<DB: DrawingBackend>(
     let seg = |a: (i32, i32), b: (i32, i32), c: RGBColor, w: u32| {
         area.draw(&PathElement::new(vec![a, b], c.stroke_width(w)))
     };
-    let rect = |c: RGBAColor| {
-        area.draw(&Rectangle::new(
-            [(x - 14, y - 7), (x + 14, y + 7)],
-            c.filled(),
-        ))
-    };
+    let corners = [(x - 14, y - 7), (x + 14, y + 7)];
+    let rect = |c: RGBAColor| area.draw(&Rectangle::new(corners, c.filled()));
     match key {
         Key::Data => area.draw(&Circle::new((x, y), 3, DATA.filled())),
         Key::Rejected => area.draw(&Cross::new((x, y), 5, REJECTED.stroke_width(2))),
@@ -456,71 +408,64 @@ fn symbol<DB: DrawingBackend>(
             .and_then(|_| seg((x, y + 2), (x, y + 8), SWITCH, 2)),
         Key::Restart => seg((x, y - 8), (x, y + 8), RESTART, 2),
         Key::Misfit => rect(MISFIT.mix(0.3)),
-    }
-    .map_err(e)
+    }?;
+    Ok(())
 }
 
 /// Lays the legend out in rows across `width`; returns the rows of (key, x of its symbol).
-fn legend_rows<DB: DrawingBackend>(
+fn legend_rows<DB: DrawingBackend<ErrorType: 'static>>(
     area: &DrawingArea<DB, Shift>,
     keys: &[Key],
     width: i32,
 ) -> Result<Vec<Vec<(Key, i32)>>, Err> {
     let style = font(15.0);
-    let mut rows: Vec<Vec<(Key, i32)>> = vec![Vec::new()];
-    let mut widths = vec![0];
+    // Each row's items (key, x from the row's start) and width.
+    let mut rows: Vec<(Vec<(Key, i32)>, i32)> = vec![(Vec::new(), 0)];
     for &k in keys {
-        let (tw, _) = area.estimate_text_size(k.label(), &style).map_err(e)?;
-        let item = 32 + tw as i32 + 18;
-        let last = rows.len() - 1;
-        if widths[last] + item > width - 40 && !rows[last].is_empty() {
-            rows.push(Vec::new());
-            widths.push(0);
+        let item = 32 + area.estimate_text_size(k.label(), &style)?.0 as i32 + 18;
+        if rows
+            .last()
+            .is_some_and(|(row, w)| w + item > width - 40 && !row.is_empty())
+        {
+            rows.push((Vec::new(), 0));
         }
-        let last = rows.len() - 1;
-        rows[last].push((k, widths[last]));
-        widths[last] += item;
+        if let Some((row, w)) = rows.last_mut() {
+            row.push((k, *w));
+            *w += item;
+        }
     }
     // centre each row
-    for (row, w) in rows.iter_mut().zip(&widths) {
-        let left = (width - w) / 2;
-        for item in row.iter_mut() {
-            item.1 += left;
-        }
+    for (row, w) in &mut rows {
+        row.iter_mut().for_each(|item| item.1 += (width - *w) / 2);
     }
-    Ok(rows)
+    Ok(rows.into_iter().map(|(row, _)| row).collect())
 }
 
-fn draw<DB: DrawingBackend>(
+fn draw<DB: DrawingBackend<ErrorType: 'static>>(
     root: &DrawingArea<DB, Shift>,
     track: &Track,
     layout: &Layout,
 ) -> Result<(), Err> {
-    root.fill(&WHITE).map_err(e)?;
+    root.fill(&WHITE)?;
     let (width, height) = (layout.size.0 as i32, layout.size.1 as i32);
 
-    let mut panels: Vec<PanelData> = layout
-        .panels
-        .iter()
-        .map(|(k, label)| derivative_panel(track, *k, label))
+    // The derivative panels, then the residual panel.
+    let derivatives = layout.panels.iter().map(|(k, label)| (Some(*k), label));
+    let residuals = layout.residual_label.iter().map(|label| (None, label));
+    let panels: Vec<PanelData> = derivatives
+        .chain(residuals)
+        .map(|(k, label)| panel(track, k, label))
         .collect();
-    if let Some(label) = &layout.residual_label {
-        panels.push(residual_panel(track, label));
-    }
     let keys = legend_keys(&panels, track);
 
     // Title, subtitle, legend.
     let mut y = 12;
-    let title = font(24.0).pos(Pos::new(HPos::Center, VPos::Top));
-    root.draw_text(&layout.title, &title, (width / 2, y))
-        .map_err(e)?;
+    let top = Pos::new(HPos::Center, VPos::Top);
+    root.draw_text(&layout.title, &font(24.0).pos(top), (width / 2, y))?;
     y += 32;
     if !layout.subtitle.is_empty() {
-        let sub = font(15.0)
-            .color(&RGBColor(70, 70, 70))
-            .pos(Pos::new(HPos::Center, VPos::Top));
-        root.draw_text(&layout.subtitle, &sub, (width / 2, y))
-            .map_err(e)?;
+        let sub = font(15.0).color(&RGBColor(70, 70, 70)).pos(top);
+        root.draw_text(&layout.subtitle, &sub, (width / 2, y))?;
         y += 24;
     }
     y += 6;
@@ -529,8 +474,7 @@ fn draw<DB: DrawingBackend>(
         let cy = y + 11;
         for (key, x) in row {
             symbol(root, key, (x + 14, cy))?;
-            root.draw_text(key.label(), &label_style, (x + 32, cy))
-                .map_err(e)?;
+            root.draw_text(key.label(), &label_style, (x + 32, cy))?;
         }
         y += 26;
     }
@@ -538,52 +482,38 @@ fn draw<DB: DrawingBackend>(
 
     // Panels: derivative panels weigh 1, the residual panel 0.7; the bottom one carries the
     // time axis label.
-    let (_, body) = root.split_vertically(y);
-    let weights: Vec<f64> = panels
-        .iter()
-        .map(|p| if p.clip_points { 0.7 } else { 1.0 })
-        .collect();
-    let total: f64 = weights.iter().sum();
-    let axis_extra = 30.0;
-    let usable = (height - y) as f64 - axis_extra;
-    let mut rest = body;
-    let times = track.t.iter().map(|t| (*t, *t + track.lead));
+    let (_, mut rest) = root.split_vertically(y);
+    let weight = |p: &PanelData| if p.clip_points { 0.7 } else { 1.0 };
+    let total: f64 = panels.iter().map(weight).sum();
+    // The height less the bottom panel's time axis.
+    let usable = (height - y) as f64 - 30.0;
     let mut xr = None;
-    for (a, b) in times {
-        widen(&mut xr, a);
-        widen(&mut xr, b);
-    }
+    widen(&mut xr, track.t.iter().flat_map(|&t| [t, t + track.lead]));
     let x_range = padded(xr.unwrap_or((0.0, 1.0)), 0.01);
     let last = panels.len().saturating_sub(1);
     for (idx, panel) in panels.iter().enumerate() {
         let area = if idx == last {
             rest.clone()
         } else {
-            let h = (usable * weights[idx] / total).round() as i32;
+            let h = (usable * weight(panel) / total).round() as i32;
             let (top, bottom) = rest.split_vertically(h);
             rest = bottom;
             top
         };
-        draw_panel(
-            &area,
-            track,
-            panel,
-            x_range,
-            idx == last,
-            &layout.time_label,
-        )?;
+        let x_desc = (idx == last).then_some(layout.time_label.as_str());
+        draw_panel(&area, track, panel, x_range, x_desc)?;
     }
     Ok(())
 }
 
-fn draw_panel<DB: DrawingBackend>(
+fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     area: &DrawingArea<DB, Shift>,
     track: &Track,
     p: &PanelData,
     (x0, x1): (f64, f64),
-    bottom: bool,
-    time_label: &str,
+    x_desc: Option<&str>,
 ) -> Result<(), Err> {
+    let bottom = x_desc.is_some();
     let (y0, y1) = p.range;
     let mut chart = ChartBuilder::on(area)
         .margin_left(10)
@@ -592,10 +522,8 @@ fn draw_panel<DB: DrawingBackend>(
         .margin_bottom(if bottom { 8 } else { 4 })
         .x_label_area_size(if bottom { 55 } else { 28 })
         .y_label_area_size(95)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(e)?;
-    let x_step = (x1 - x0) / 10.0;
-    let y_step = (y1 - y0) / 6.0;
+        .build_cartesian_2d(x0..x1, y0..y1)?;
+    let (x_step, y_step) = ((x1 - x0) / 10.0, (y1 - y0) / 6.0);
     let x_fmt = move |v: &f64| tick(*v, x_step);
     let y_fmt = move |v: &f64| tick(*v, y_step);
     let mut mesh = chart.configure_mesh();
@@ -609,10 +537,10 @@ fn draw_panel<DB: DrawingBackend>(
         .light_line_style(RGBColor(242, 242, 242))
         .bold_line_style(RGBColor(215, 215, 215))
         .y_desc(p.label.clone());
-    if bottom {
-        mesh.x_desc(time_label);
+    if let Some(desc) = x_desc {
+        mesh.x_desc(desc);
     }
-    mesh.draw().map_err(e)?;
+    mesh.draw()?;
 
     let n = track.t.len();
     let clamp = |v: f64| v.clamp(y0, y1);
@@ -622,12 +550,8 @@ fn draw_panel<DB: DrawingBackend>(
         for r in runs(n, |i| track.misfit[i]) {
             let a = track.t[r.start];
             let b = track.t[r.end.min(n - 1)].max(a);
-            chart
-                .draw_series(std::iter::once(Rectangle::new(
-                    [(a, y0), (b, y1)],
-                    MISFIT.mix(0.3).filled(),
-                )))
-                .map_err(e)?;
+            let span = Rectangle::new([(a, y0), (b, y1)], MISFIT.mix(0.3).filled());
+            chart.draw_series([span])?;
         }
     }
 
@@ -640,12 +564,7 @@ fn draw_panel<DB: DrawingBackend>(
         let poly: Vec<(f64, f64)> = (r.clone().map(|i| edge(i, 1.0)))
             .chain(r.rev().map(|i| edge(i, -1.0)))
             .collect();
-        chart
-            .draw_series(std::iter::once(Polygon::new(
-                poly,
-                ESTIMATE.mix(0.22).filled(),
-            )))
-            .map_err(e)?;
+        chart.draw_series([Polygon::new(poly, ESTIMATE.mix(0.22).filled())])?;
     }
 
     // The runs of a row-wise curve, `sign` times its values, at the times moved by `shift`.
@@ -662,31 +581,26 @@ fn draw_panel<DB: DrawingBackend>(
     // ±3σ noise (dashed).
     for sign in [1.0, -1.0] {
         for pts in curves(&p.noise, 0.0, sign) {
-            chart
-                .draw_series(DashedLineSeries::new(pts, 7, 5, NOISE.stroke_width(2)))
-                .map_err(e)?;
+            chart.draw_series(DashedLineSeries::new(pts, 7, 5, NOISE.stroke_width(2)))?;
         }
     }
 
-    // Samples.
+    // Samples: the points `$keep` picks, as `$shape`s at their values clamped to the range.
     let inside = |v: f64| v >= y0 && v <= y1;
-    chart
-        .draw_series(
-            p.points
+    macro_rules! points {
+        ($keep:expr, $shape:ident, $size:expr, $style:expr) => {
+            let at = |q: &(f64, f64, bool)| (q.0, clamp(q.1));
+            let shapes = p
+                .points
                 .iter()
-                .filter(|q| !q.2 && inside(q.1))
-                .map(|q| Circle::new((q.0, q.1), 2, DATA.filled())),
-        )
-        .map_err(e)?;
+                .filter($keep)
+                .map(|q| $shape::new(at(q), $size, $style));
+            chart.draw_series(shapes)?;
+        };
+    }
+    points!(|q| !q.2 && inside(q.1), Circle, 2, DATA.filled());
     if p.clip_points {
-        chart
-            .draw_series(
-                p.points
-                    .iter()
-                    .filter(|q| !inside(q.1))
-                    .map(|q| TriangleMarker::new((q.0, clamp(q.1)), 5, DATA.filled())),
-            )
-            .map_err(e)?;
+        points!(|q| !inside(q.1), TriangleMarker, 5, DATA.filled());
     }
 
     // Truth, then the estimate over it.
@@ -695,34 +609,20 @@ fn draw_panel<DB: DrawingBackend>(
         (&p.line, ESTIMATE.stroke_width(2)),
     ] {
         for pts in curves(v, p.shift, 1.0) {
-            chart.draw_series(LineSeries::new(pts, style)).map_err(e)?;
+            chart.draw_series(LineSeries::new(pts, style))?;
         }
     }
 
     // Rejected samples on top.
-    chart
-        .draw_series(
-            p.points
-                .iter()
-                .filter(|q| q.2)
-                .map(|q| Cross::new((q.0, clamp(q.1)), 5, REJECTED.stroke_width(2))),
-        )
-        .map_err(e)?;
+    points!(|q| q.2, Cross, 5, REJECTED.stroke_width(2));
 
     // Events: switches to fading memory (dashed), restarts.
-    for (times, dashed, color) in [
-        (&track.switches, true, SWITCH),
-        (&track.restarts, false, RESTART),
-    ] {
-        for &t in times {
-            let (v, style) = (vec![(t, y0), (t, y1)], color.stroke_width(2));
-            if dashed {
-                chart.draw_series(DashedLineSeries::new(v, 8, 6, style))
-            } else {
-                chart.draw_series(LineSeries::new(v, style))
-            }
-            .map_err(e)?;
-        }
+    let edge = |t: f64| vec![(t, y0), (t, y1)];
+    for &t in &track.switches {
+        chart.draw_series(DashedLineSeries::new(edge(t), 8, 6, SWITCH.stroke_width(2)))?;
+    }
+    for &t in &track.restarts {
+        chart.draw_series(LineSeries::new(edge(t), RESTART.stroke_width(2)))?;
     }
     Ok(())
 }

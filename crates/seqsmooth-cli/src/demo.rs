@@ -10,7 +10,7 @@
 //! step, noise estimated) runs on it; the plain expanding- and fading-memory filters of degree 2
 //! (noise σ given), on both engines, are shown beside it for comparison.
 
-use crate::args::{DemoArgs, EngineArg, Kind};
+use crate::args::{name, DemoArgs, EngineArg, Kind};
 use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
 use crate::filter::runner::Runner;
@@ -21,7 +21,6 @@ use seqsmooth::{PolynomialFilter, PolynomialState};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
-/// Number of samples.
 pub const SAMPLES: usize = 400;
 /// Noise standard deviation, m.
 pub const SIGMA: f64 = 15.0;
@@ -41,7 +40,6 @@ pub const OUTAGE: (f64, f64) = (262.0, 12.0);
 /// Probability that a sample carries an outlier, and the outlier's size range in σ.
 const OUTLIER_RATE: f64 = 0.02;
 pub const OUTLIER_SIZE: (f64, f64) = (6.0, 10.0);
-/// Filter degree.
 const DEGREE: usize = 2;
 /// Discount per median step, for the automatic and the plain fading-memory filters.
 const THETA: f64 = 0.95;
@@ -141,14 +139,15 @@ pub fn generate() -> Vec<Point> {
     out
 }
 
-/// The estimates of one filter at every sample.
-struct Run {
-    name: &'static str,
-    engine: &'static str,
-    estimates: Vec<Option<PolynomialState>>,
-}
+/// The estimates of a plain filter (noise σ given) at every sample.
+type Estimates = Vec<Option<PolynomialState>>;
 
-fn run_plain(data: &[Point], kind: Kind, engine: EngineArg, tau: f64) -> Result<Run, CliError> {
+fn run_plain(
+    data: &[Point],
+    kind: Kind,
+    engine: EngineArg,
+    tau: f64,
+) -> Result<Estimates, CliError> {
     let mut f = Runner::build(kind, DEGREE, Some(THETA), tau, None, engine, Some(SIGMA))
         .map_err(|e| CliError::Data(e.to_string()))?;
     let mut estimates = Vec::with_capacity(data.len());
@@ -157,20 +156,7 @@ fn run_plain(data: &[Point], kind: Kind, engine: EngineArg, tau: f64) -> Result<
             .map_err(|e| CliError::Data(e.to_string()))?;
         estimates.push(f.estimate_at(p.t));
     }
-    Ok(Run {
-        name: kind.name(),
-        engine: if engine == EngineArg::Exact {
-            "exact"
-        } else {
-            "gain"
-        },
-        estimates,
-    })
-}
-
-/// The automatic filter of the demo.
-fn auto_filter(tau: f64) -> Result<AutomaticFilter, seqsmooth::Error> {
-    AutomaticFilter::new(DEGREE, THETA, tau)
+    Ok(estimates)
 }
 
 /// Three significant digits, scientific below 0.001 or from 10⁵ on.
@@ -206,23 +192,19 @@ fn error_row(
             .filter_map(|(e, p)| e.as_ref().map(|e| (e, p)))
             .filter(|(e, _)| e.derivatives.len() > 1)
     };
-    let scored = after().count();
-    let inside = after()
-        .filter(|(e, p)| {
-            e.std_devs()
-                .is_some_and(|s| (e.derivatives[0] - p.x).abs() <= 3.0 * s[0])
-        })
-        .count();
+    type Scored<'a> = (&'a PolynomialState, &'a Point);
+    let x_err = |(e, p): Scored| e.derivatives[0] - p.x;
+    let within = |&(e, p): &Scored| {
+        e.std_devs()
+            .is_some_and(|s| x_err((e, p)).abs() <= 3.0 * s[0])
+    };
+    let (scored, inside) = (after().count(), after().filter(within).count());
     vec![
         name.to_string(),
         engine.to_string(),
-        short(rms(after().map(|(e, p)| e.derivatives[0] - p.x))),
+        short(rms(after().map(x_err))),
         short(rms(after().map(|(e, p)| e.derivatives[1] - p.v))),
-        short(
-            after()
-                .map(|(e, p)| (e.derivatives[0] - p.x).abs())
-                .fold(0.0, f64::max),
-        ),
+        short(after().map(|q| x_err(q).abs()).fold(0.0, f64::max)),
         format!("{:.1} %", 100.0 * inside as f64 / scored.max(1) as f64),
     ]
 }
@@ -245,36 +227,23 @@ pub fn plot_paths(prefix: &Path) -> [PathBuf; 2] {
 
 /// The automatic filter's run as a plot track.
 fn track(data: &[Point], outs: &[AutoOutput]) -> Track {
-    let n = data.len();
-    let mut d = vec![vec![None; n]; DEGREE + 1];
-    let mut s = vec![vec![None; n]; DEGREE + 1];
-    for (i, o) in outs.iter().enumerate() {
-        if let Some(e) = &o.estimate {
-            let sd = e.std_devs();
-            for k in 0..e.derivatives.len().min(DEGREE + 1) {
-                d[k][i] = Some(e.derivatives[k]);
-                s[k][i] = sd.as_ref().map(|s| s[k]);
-            }
-        }
-    }
-    let mut switches = Vec::new();
-    let mut restarts = Vec::new();
-    let mut fading = false;
-    for o in outs {
-        if o.restart {
-            restarts.push(o.time);
-        }
-        let now = o.phase == Phase::Fading;
-        if now && !fading {
-            switches.push(o.time);
-        }
-        fading = now;
-    }
+    // Row by row, `f` of the estimate where there is one.
+    let rows = |f: &dyn Fn(&PolynomialState) -> Option<f64>| -> Vec<Option<f64>> {
+        outs.iter()
+            .map(|o| o.estimate.as_ref().and_then(f))
+            .collect()
+    };
+    let fading = |i: usize| outs[i].phase == Phase::Fading;
+    let switches = (0..outs.len()).filter(|&i| fading(i) && (i == 0 || !fading(i - 1)));
     Track {
         t: data.iter().map(|p| p.t).collect(),
         y: data.iter().map(|p| p.y).collect(),
-        d,
-        s,
+        d: (0..=DEGREE)
+            .map(|k| rows(&|e| e.derivatives.get(k).copied()))
+            .collect(),
+        s: (0..=DEGREE)
+            .map(|k| rows(&|e| e.std_devs()?.get(k).copied()))
+            .collect(),
         truth: vec![
             data.iter().map(|p| p.x).collect(),
             data.iter().map(|p| p.v).collect(),
@@ -282,13 +251,12 @@ fn track(data: &[Point], outs: &[AutoOutput]) -> Track {
         noise: outs.iter().map(|o| o.noise_sigma).collect(),
         rejected: outs.iter().map(|o| o.outlier).collect(),
         misfit: outs.iter().map(|o| o.misfit).collect(),
-        switches,
-        restarts,
+        switches: switches.map(|i| outs[i].time).collect(),
+        restarts: outs.iter().filter(|o| o.restart).map(|o| o.time).collect(),
         lead: 0.0,
     }
 }
 
-/// The demo plot's layout.
 fn layout(tau: f64) -> Layout {
     Layout {
         title: "seqsmooth demo: automatic filter on a turning aircraft (east coordinate)".into(),
@@ -314,13 +282,13 @@ fn times_list(times: &[f64]) -> String {
     format!("t = {} s", list.join(", "))
 }
 
-/// Runs `seqsmooth demo`.
 pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
     let data = generate();
     let head: Vec<f64> = data.iter().take(LOOKAHEAD).map(|p| p.t).collect();
     let tau = median_series_step(&head, &vec![0; head.len()]).unwrap_or(1.0);
 
-    let mut auto = auto_filter(tau).map_err(|e| CliError::Data(e.to_string()))?;
+    let mut auto =
+        AutomaticFilter::new(DEGREE, THETA, tau).map_err(|e| CliError::Data(e.to_string()))?;
     let mut outs = Vec::with_capacity(data.len());
     for p in &data {
         outs.push(
@@ -328,38 +296,35 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
                 .map_err(|e| CliError::Data(e.to_string()))?,
         );
     }
-    let auto_estimates: Vec<Option<PolynomialState>> =
-        outs.iter().map(|o| o.estimate.clone()).collect();
-
-    let mut runs = Vec::new();
+    let auto_estimates: Estimates = outs.iter().map(|o| o.estimate.clone()).collect();
+    let header = [
+        "filter",
+        "engine",
+        "rms err x",
+        "rms err x'",
+        "max |err x|",
+        "x within ±3σ",
+    ];
+    let mut table = vec![header.map(String::from).to_vec()];
+    table.push(error_row("automatic", "exact", &auto_estimates, &data));
+    let mut fading_exact = Vec::new();
     for kind in [Kind::Expanding, Kind::Fading] {
         for engine in [EngineArg::Exact, EngineArg::Gain] {
-            runs.push(run_plain(&data, kind, engine, tau)?);
+            let estimates = run_plain(&data, kind, engine, tau)?;
+            table.push(error_row(&name(kind), &name(engine), &estimates, &data));
+            if (kind, engine) == (Kind::Fading, EngineArg::Exact) {
+                fading_exact = estimates;
+            }
         }
     }
 
-    let mut table = vec![vec![
-        "filter".to_string(),
-        "engine".into(),
-        "rms err x".into(),
-        "rms err x'".into(),
-        "max |err x|".into(),
-        "x within ±3σ".into(),
-    ]];
-    table.push(error_row("automatic", "exact", &auto_estimates, &data));
-    for r in &runs {
-        table.push(error_row(r.name, r.engine, &r.estimates, &data));
-    }
-
     let outliers = data.iter().filter(|p| p.outlier).count();
-    let rejected: Vec<(usize, &Point)> = outs
+    let rejected = outs.iter().filter(|o| o.outlier).count();
+    let caught = outs
         .iter()
         .zip(&data)
-        .enumerate()
-        .filter(|(_, (o, _))| o.outlier)
-        .map(|(i, (_, p))| (i, p))
-        .collect();
-    let caught = rejected.iter().filter(|(_, p)| p.outlier).count();
+        .filter(|(o, p)| o.outlier && p.outlier)
+        .count();
     let plot_track = track(&data, &outs);
     let (switches, restarts) = (&plot_track.switches, &plot_track.restarts);
     let span = data[SAMPLES - 1].t - data[0].t;
@@ -388,8 +353,8 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
         OUTAGE.0,
         OUTLIER_SIZE.0,
         OUTLIER_SIZE.1,
-        rejected.len(),
-        rejected.len() - caught,
+        rejected,
+        rejected - caught,
         times_list(switches),
         if restarts.is_empty() {
             "none".to_string()
@@ -405,10 +370,9 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
     w.finish()?;
 
     if let Some(path) = &cfg.output {
-        let fading_exact = &runs[2];
         let mut out = Output::create(Some(path))?;
         out.write(b"t,y,d0,d1,d2,s0,s1,s2\n")?;
-        for (p, e) in data.iter().zip(&fading_exact.estimates) {
+        for (p, e) in data.iter().zip(&fading_exact) {
             let d = e
                 .as_ref()
                 .map(|e| (e.derivatives.clone(), e.std_devs().unwrap_or_default()));

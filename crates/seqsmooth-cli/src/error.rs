@@ -2,15 +2,10 @@
 
 use thiserror::Error;
 
-/// Exit code of a command-line (argument) error; clap uses the same code for its own.
-pub const EXIT_USAGE: u8 = 2;
-/// Exit code of an input-data or file error.
-pub const EXIT_DATA: u8 = 1;
-
 /// Why a command failed. The message is printed after `error: ` on stderr.
 #[derive(Debug, Error)]
 pub enum CliError {
-    /// The arguments are inconsistent or out of range (exit code 2).
+    /// The arguments are inconsistent or out of range (exit code 2, clap's for its own errors).
     #[error("{0}")]
     Usage(String),
     /// The input data or a file is unusable (exit code 1).
@@ -22,11 +17,10 @@ pub enum CliError {
 }
 
 impl CliError {
-    /// The process exit code for this error.
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Usage(_) => EXIT_USAGE,
-            CliError::Data(_) => EXIT_DATA,
+            CliError::Usage(_) => 2,
+            CliError::Data(_) => 1,
             CliError::BrokenPipe => 0,
         }
     }

@@ -13,27 +13,19 @@ use seqsmooth::scalar::Rational;
 pub fn run(a: &GainsArgs) -> Result<(), CliError> {
     let (m, form) = (a.memory.degree, GainForm::Current);
     let values: Vec<String> = match (a.memory.of(a.kind)?, a.exact) {
-        (Memory::Expanding { n }, true) => cells(&expanding_gains::<Rational>(m, n, form)),
-        (Memory::Expanding { n }, false) => cells(&expanding_gains::<f64>(m, n, form)),
-        (Memory::Fading { theta }, true) => cells(&fading_gains::<Rational>(m, theta.exact, form)),
-        (Memory::Fading { theta }, false) => {
-            let theta = theta.value_f64().map_err(CliError::Usage)?;
-            cells(&fading_gains::<f64>(m, theta, form))
-        }
+        (Memory::Expanding(n), true) => cells(&expanding_gains::<Rational>(m, n, form)),
+        (Memory::Expanding(n), false) => cells(&expanding_gains::<f64>(m, n, form)),
+        (Memory::Fading(theta), true) => cells(&fading_gains::<Rational>(m, theta.exact, form)),
+        (Memory::Fading(theta), false) => cells(&fading_gains(m, theta.value_f64()?, form)),
     };
     let mut rows = vec![vec!["k".to_string(), "gain".to_string()]];
-    rows.extend(
-        values
-            .into_iter()
-            .enumerate()
-            .map(|(k, g)| vec![k.to_string(), g]),
-    );
+    let row = |(k, g): (usize, String)| vec![k.to_string(), g];
+    rows.extend(values.into_iter().enumerate().map(row));
     write_table(&rows, a.format)
 }
 
 /// A number's cell: an exact rational `p/q` (or `p`), or an `f64` with round-trip precision.
 pub trait Cell {
-    /// The cell's text.
     fn cell(&self) -> String;
 }
 
@@ -49,7 +41,6 @@ impl Cell for Rational {
     }
 }
 
-/// The cells of `values`.
 pub fn cells<'a, T: Cell + 'a>(values: impl IntoIterator<Item = &'a T>) -> Vec<String> {
     values.into_iter().map(Cell::cell).collect()
 }

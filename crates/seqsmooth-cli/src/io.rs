@@ -90,22 +90,12 @@ pub fn fmt_f64(x: f64) -> String {
 /// `cell` as a CSV output field: quoted (with quotes doubled) when it holds a comma, a quote
 /// or a line break.
 pub fn csv_field(cell: &[u8]) -> Vec<u8> {
-    if !cell
-        .iter()
-        .any(|b| matches!(b, b',' | b'"' | b'\r' | b'\n'))
-    {
+    let special = |b: &u8| matches!(b, b',' | b'"' | b'\r' | b'\n');
+    if !cell.iter().any(special) {
         return cell.to_vec();
     }
-    let mut out = vec![b'"'];
-    for &b in cell {
-        out.extend_from_slice(if b == b'"' {
-            b"\"\""
-        } else {
-            std::slice::from_ref(&b)
-        });
-    }
-    out.push(b'"');
-    out
+    let parts: Vec<&[u8]> = cell.split(|&b| b == b'"').collect();
+    [&b"\""[..], &parts.join(&b"\"\""[..]), b"\""].concat()
 }
 
 /// Parses the number in the (trimmed) cell of `line` in `column`, holding the `what`: a typed
@@ -328,21 +318,12 @@ impl<R: Read> CsvIn<R> {
             header: Vec::new(),
             line: 1,
         };
-        let header = match this.reader.byte_headers() {
-            Ok(h) => h.clone(),
-            Err(e) => return Err(this.error(e)),
-        };
-        this.line = this
-            .reader
-            .get_mut()
-            .line_at(header.position().map_or(0, |p| p.byte()));
+        let header = this.reader.byte_headers().cloned();
+        let header = header.map_err(|e| this.error(e))?;
+        let byte = header.position().map_or(0, |p| p.byte());
+        this.line = this.reader.get_mut().line_at(byte);
         for cell in &header {
-            let text = std::str::from_utf8(cell).map_err(|_| {
-                let line = this.line;
-                CliError::Data(format!(
-                    "line {line}: malformed CSV: the row is not valid UTF-8"
-                ))
-            })?;
+            let text = std::str::from_utf8(cell).map_err(|_| not_utf8(this.line))?;
             this.header.push(text.trim().to_string());
         }
         Ok(this)
@@ -367,7 +348,6 @@ impl<R: Read> CsvIn<R> {
         trim(&self.record[i])
     }
 
-    /// The bytes read from the input so far.
     pub fn bytes_read(&self) -> u64 {
         self.reader.position().byte()
     }
@@ -389,6 +369,13 @@ impl<R: Read> CsvIn<R> {
             _ => CliError::Data(format!("{at}malformed CSV: {e}")),
         }
     }
+}
+
+/// The error of a row on `line` that is not UTF-8 text.
+pub fn not_utf8(line: u64) -> CliError {
+    CliError::Data(format!(
+        "line {line}: malformed CSV: the row is not valid UTF-8"
+    ))
 }
 
 /// The file `path` names, or `None` for standard input or output (`None` or `-`).
@@ -457,7 +444,6 @@ impl Output {
         }
     }
 
-    /// Writes `bytes`.
     pub fn write(&mut self, bytes: &[u8]) -> Result<(), CliError> {
         self.sink
             .write_all(bytes)

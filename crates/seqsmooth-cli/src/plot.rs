@@ -9,8 +9,13 @@
 use crate::args::PlotArgs;
 use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
-use crate::io::{find_column, input_name, named, open_input, parse_cell, plural, CsvIn};
+use crate::io::{
+    find_column, fmt_f64, input_name, named, not_utf8, open_input, parse_cell, plural, CsvIn,
+};
 use std::path::Path;
+
+/// The cells of a column, or why they are unusable.
+type Column<T> = Result<Vec<T>, CliError>;
 
 /// A CSV file read in full: the header and the data rows with their 1-based file lines.
 struct Table {
@@ -32,12 +37,7 @@ impl Table {
             let cells: Result<Vec<String>, _> = (0..header.len())
                 .map(|i| std::str::from_utf8(csv.field(i)).map(str::to_string))
                 .collect();
-            let utf8 = || {
-                at(CliError::Data(format!(
-                    "line {line}: malformed CSV: the row is not valid UTF-8"
-                )))
-            };
-            rows.push((line, cells.map_err(|_| utf8())?));
+            rows.push((line, cells.map_err(|_| at(not_utf8(line)))?));
         }
         if header.iter().all(String::is_empty) {
             return Err(CliError::Data(format!(
@@ -63,7 +63,7 @@ impl Table {
     }
 
     /// The numbers of column `idx`; empty cells are `None` when `empty` allows them.
-    fn numbers(&self, idx: usize, what: &str, empty: bool) -> Result<Vec<Option<f64>>, CliError> {
+    fn numbers(&self, idx: usize, what: &str, empty: bool) -> Column<Option<f64>> {
         let col = &self.header[idx];
         self.rows
             .iter()
@@ -80,16 +80,18 @@ impl Table {
     }
 
     /// The numbers of column `idx`, every cell filled.
-    fn filled(&self, idx: usize, what: &str) -> Result<Vec<f64>, CliError> {
-        Ok(self
-            .numbers(idx, what, false)?
-            .into_iter()
-            .map(|v| v.unwrap_or(f64::NAN))
-            .collect())
+    fn filled(&self, idx: usize, what: &str) -> Column<f64> {
+        let v = self.numbers(idx, what, false)?;
+        Ok(v.into_iter().flatten().collect())
+    }
+
+    /// `read` of the column `col`, empty when there is none.
+    fn optional<T>(&self, col: &str, read: fn(&Self, usize) -> Column<T>) -> Column<T> {
+        self.column(col).map_or(Ok(Vec::new()), |i| read(self, i))
     }
 
     /// Non-negative numbers (standard deviations), empty cells allowed.
-    fn sigmas(&self, idx: usize) -> Result<Vec<Option<f64>>, CliError> {
+    fn sigmas(&self, idx: usize) -> Column<Option<f64>> {
         let v = self.numbers(idx, "standard deviation", true)?;
         for ((line, r), s) in self.rows.iter().zip(&v) {
             if s.is_some_and(|s| s < 0.0) {
@@ -103,7 +105,7 @@ impl Table {
     }
 
     /// The 0/1 flags of column `idx`.
-    fn flags(&self, idx: usize) -> Result<Vec<bool>, CliError> {
+    fn flags(&self, idx: usize) -> Column<bool> {
         let col = &self.header[idx];
         self.rows
             .iter()
@@ -159,8 +161,8 @@ pub fn derivative_label(k: usize, time_unit: Option<&str>, value_unit: Option<&s
 fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
     let out = Table::read(cfg.source.as_deref())?;
     let n = out.rows.len();
-    let t_idx = out.required("t", " (the output of 'seqsmooth filter' has t,y,d0..dM)")?;
-    let y_idx = out.required("y", " (the output of 'seqsmooth filter' has t,y,d0..dM)")?;
+    let why = " (the output of 'seqsmooth filter' has t,y,d0..dM)";
+    let (t_idx, y_idx) = (out.required("t", why)?, out.required("y", why)?);
     let t = out.filled(t_idx, "time")?;
     let y = out.filled(y_idx, "value")?;
     let top = cfg.derivative.iter().copied().max().unwrap_or(0);
@@ -181,18 +183,11 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
         if let Some(idx) = idx {
             d[k] = out.numbers(idx, "derivative", true)?;
         }
-        if let Some(idx) = out.column(&format!("s{k}")) {
-            s[k] = out.sigmas(idx)?;
-        }
+        s[k] = out.optional(&format!("s{k}"), Table::sigmas)?;
     }
-    let noise = out.column("noise").map(|i| out.sigmas(i)).transpose()?;
-    let rejected = out.column("outlier").map(|i| out.flags(i)).transpose()?;
-    let misfit = out.column("misfit").map(|i| out.flags(i)).transpose()?;
-    let (noise, rejected, misfit) = (
-        noise.unwrap_or_default(),
-        rejected.unwrap_or_default(),
-        misfit.unwrap_or_default(),
-    );
+    let noise = out.optional("noise", Table::sigmas)?;
+    let rejected = out.optional("outlier", Table::flags)?;
+    let misfit = out.optional("misfit", Table::flags)?;
     let mut truth = Vec::new();
     if let Some(path) = &cfg.input {
         let input = Table::read(Some(path))?;
@@ -210,19 +205,17 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
                 out.name
             )));
         }
-        for i in 0..n {
-            if it[i] != t[i] || iy[i] != y[i] {
-                let (col, a, b) = if it[i] != t[i] {
-                    (&cfg.time_col, &input.rows[i].1[ti], &out.rows[i].1[t_idx])
-                } else {
-                    (&cfg.value_col, &input.rows[i].1[yi], &out.rows[i].1[y_idx])
-                };
-                return Err(CliError::Data(format!(
-                    "{}: line {}, column '{col}': {a} differs from {b} on line {} of the filter \
-                     output {}: give the input the output was made from",
-                    input.name, input.rows[i].0, out.rows[i].0, out.name
-                )));
-            }
+        if let Some(i) = (0..n).find(|&i| it[i] != t[i] || iy[i] != y[i]) {
+            let (col, a, b) = if it[i] != t[i] {
+                (&cfg.time_col, &input.rows[i].1[ti], &out.rows[i].1[t_idx])
+            } else {
+                (&cfg.value_col, &input.rows[i].1[yi], &out.rows[i].1[y_idx])
+            };
+            return Err(CliError::Data(format!(
+                "{}: line {}, column '{col}': {a} differs from {b} on line {} of the filter \
+                 output {}: give the input the output was made from",
+                input.name, input.rows[i].0, out.rows[i].0, out.name
+            )));
         }
         if let Some(tc) = &cfg.truth_col {
             let idx = input.required(tc, " (the --truth-col)")?;
@@ -261,38 +254,27 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
     ))
 }
 
-/// Runs `seqsmooth plot`.
 pub fn run(cfg: &PlotArgs) -> Result<(), CliError> {
     for p in &cfg.output {
         chart::Format::of(p)?;
     }
     let (track, default_title) = read_track(cfg)?;
-    let tu = cfg.time_unit.as_deref();
-    let vu = cfg.value_unit.as_deref();
+    let (tu, vu) = (cfg.time_unit.as_deref(), cfg.value_unit.as_deref());
     let residuals = !cfg.no_residuals && cfg.lead == 0.0 && track.d[0].iter().any(Option::is_some);
     let panels: Vec<(usize, String)> = cfg
         .derivative
         .iter()
         .map(|&k| (k, derivative_label(k, tu, vu)))
         .collect();
-    let mut subtitle = Vec::new();
-    if cfg.lead != 0.0 {
-        subtitle.push(format!(
-            "estimates drawn at t + {}{}",
-            crate::io::fmt_f64(cfg.lead),
-            tu.map(|u| format!(" {u}")).unwrap_or_default()
-        ));
-    }
+    let unit = tu.map(|u| format!(" {u}")).unwrap_or_default();
+    let lead = format!("estimates drawn at t + {}{unit}", fmt_f64(cfg.lead));
+    let default_height = Layout::default_height(cfg.derivative.len(), residuals);
     let layout = Layout {
         title: cfg.title.clone().unwrap_or(default_title),
-        subtitle: subtitle.join("; "),
+        subtitle: if cfg.lead != 0.0 { lead } else { String::new() },
         time_label: with_unit("time t", tu),
         residual_label: residuals.then(|| with_unit("residual y − d0", vu)),
-        size: (
-            cfg.width,
-            cfg.height
-                .unwrap_or_else(|| Layout::default_height(panels.len(), residuals)),
-        ),
+        size: (cfg.width, cfg.height.unwrap_or(default_height)),
         panels,
     };
     for p in &cfg.output {

@@ -15,17 +15,16 @@ pub fn wanted(no_progress: bool) -> bool {
     !no_progress && std::io::stderr().is_terminal()
 }
 
-/// A progress bar or spinner, or nothing.
+/// A progress bar or spinner, or a hidden one.
 pub struct Progress {
-    bar: Option<ProgressBar>,
+    bar: ProgressBar,
     start: Instant,
 }
 
 impl Progress {
-    /// No display.
     pub fn hidden() -> Self {
         Self {
-            bar: None,
+            bar: ProgressBar::hidden(),
             start: Instant::now(),
         }
     }
@@ -33,46 +32,41 @@ impl Progress {
     /// A bar of `total` bytes (a file of known size) or a spinner counting rows; rates are
     /// counted from `start`.
     pub fn new(total: Option<u64>, start: Instant) -> Self {
-        let (bar, template) = match total {
-            Some(len) => (
-                ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr()),
-                "{bytes}/{total_bytes} [{wide_bar}] {percent}%  {msg}  eta {eta}",
-            ),
-            None => (
-                ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr()),
-                "{spinner} {msg}",
-            ),
+        let template = match total {
+            Some(_) => "{bytes}/{total_bytes} [{wide_bar}] {percent}%  {msg}  eta {eta}",
+            None => "{spinner} {msg}",
         };
         let style = ProgressStyle::with_template(template)
             .unwrap_or_else(|_| ProgressStyle::default_bar())
             .progress_chars("=> ");
+        let bar = ProgressBar::with_draw_target(total, ProgressDrawTarget::stderr());
         Self {
-            bar: Some(bar.with_style(style)),
+            bar: bar.with_style(style),
             start,
         }
     }
 
     /// Reports `bytes` read and `rows` done.
     pub fn update(&self, bytes: u64, rows: u64) {
-        let Some(bar) = &self.bar else { return };
+        if self.bar.is_hidden() {
+            return;
+        }
         let secs = self.start.elapsed().as_secs_f64().max(1e-3);
-        bar.set_message(format!(
+        self.bar.set_message(format!(
             "{} rows, {} rows/s",
             HumanCount(rows),
             HumanCount((rows as f64 / secs) as u64)
         ));
-        if bar.length().is_some() {
-            bar.set_position(bytes);
+        if self.bar.length().is_some() {
+            self.bar.set_position(bytes);
         } else {
-            bar.tick();
+            self.bar.tick();
         }
     }
 }
 
 impl Drop for Progress {
     fn drop(&mut self) {
-        if let Some(bar) = &self.bar {
-            bar.finish_and_clear();
-        }
+        self.bar.finish_and_clear();
     }
 }

@@ -8,12 +8,12 @@
 use crate::args::{check_window, SmoothArgs};
 use crate::error::CliError;
 use crate::filter::rows::{Chunk, RowReader};
-use crate::io::{check_distinct, open_input, write_f64, Need, Output};
+use crate::io::{check_distinct, open_input, Need, Output};
 use seqsmooth::polynomial::fixed::smooth;
 
 /// Runs `seqsmooth smooth`: header `t,y,d0..dM`, one row per input row in input order.
 pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
-    check_window(a.window, a.degree)?;
+    check_window(Some(a.window), a.degree)?;
     check_distinct(a.input.as_deref(), a.output.as_deref())?;
     let need = Need::window(a.window.max(a.degree + 1));
     let input = open_input(a.input.as_deref())?;
@@ -38,12 +38,7 @@ pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
     let mut text = Vec::new();
     rows.header(&mut text, None, a.degree, false, &[]);
     for (i, d) in fits.iter().enumerate() {
-        rows.echo(&mut text, i, None);
-        for &v in d {
-            text.push(b',');
-            write_f64(&mut text, v);
-        }
-        text.push(b'\n');
+        rows.row(&mut text, i, None, d);
     }
     out.write(&text)?;
     out.finish()

@@ -11,6 +11,18 @@ use seqsmooth::polynomial::fixed::covariance;
 use seqsmooth::polynomial::form::EstimateForm;
 use seqsmooth::scalar::{ratio_to_f64, Rational};
 
+/// The cells of the library's matrix result, row-major (nalgebra iterates column-major).
+macro_rules! row_major {
+    ($matrix:expr) => {
+        cells(
+            $matrix
+                .map_err(|e| CliError::Usage(e.to_string()))?
+                .transpose()
+                .iter(),
+        )
+    };
+}
+
 /// Runs `seqsmooth vrf`: header `i,j,value`, the `(m+1)×(m+1)` matrix row-major.
 pub fn run(a: &VrfArgs) -> Result<(), CliError> {
     let kind = match a.kind {
@@ -28,7 +40,7 @@ pub fn run(a: &VrfArgs) -> Result<(), CliError> {
     }
     let m = a.memory.degree;
     let mem = a.memory.of(kind)?;
-    if let Memory::Expanding { n } = mem {
+    if let Memory::Expanding(n) = mem {
         if n < m as u64 {
             return Err(CliError::Usage(format!(
                 "n {n} is too small for degree {m}: the expanding-memory variance-reduction \
@@ -38,37 +50,17 @@ pub fn run(a: &VrfArgs) -> Result<(), CliError> {
         }
     }
     let form = EstimateForm::from(a.form.unwrap_or_default());
-    let lib = |e: seqsmooth::Error| CliError::Usage(e.to_string());
-    // nalgebra iterates column-major; the transposes make the values row-major.
     let values = match (mem, a.exact) {
-        (Memory::Expanding { n }, true) => cells(
-            expanding_vrf::<Rational>(m, n, form)
-                .map_err(lib)?
-                .transpose()
-                .iter(),
-        ),
-        (Memory::Expanding { n }, false) => {
-            // Exact, then rounded to nearest: the library's `expanding_vrf::<f64>` overflows in
-            // its intermediates for large n at high degree (NaN, or silently wrong: m = 20,
-            // n = 10^15 gives 4.0e-13 for the (0,0) entry instead of 4.41e-13).
-            let s = expanding_vrf::<Rational>(m, n, form).map_err(lib)?;
-            cells(&s.transpose().iter().map(ratio_to_f64).collect::<Vec<_>>())
+        (Memory::Expanding(n), true) => row_major!(expanding_vrf::<Rational>(m, n, form)),
+        // Exact, then rounded to nearest: the library's `expanding_vrf::<f64>` overflows in its
+        // intermediates for large n at high degree (NaN, or silently wrong: m = 20, n = 10^15
+        // gives 4.0e-13 for the (0,0) entry instead of 4.41e-13).
+        (Memory::Expanding(n), false) => {
+            let s = expanding_vrf::<Rational>(m, n, form);
+            row_major!(s.map(|s| s.map(|v| ratio_to_f64(&v))))
         }
-        (Memory::Fading { theta }, true) => cells(
-            fading_vrf::<Rational>(m, theta.exact, form)
-                .map_err(lib)?
-                .transpose()
-                .iter(),
-        ),
-        (Memory::Fading { theta }, false) => {
-            let theta = theta.value_f64().map_err(CliError::Usage)?;
-            cells(
-                fading_vrf::<f64>(m, theta, form)
-                    .map_err(lib)?
-                    .transpose()
-                    .iter(),
-            )
-        }
+        (Memory::Fading(theta), true) => row_major!(fading_vrf::<Rational>(m, theta.exact, form)),
+        (Memory::Fading(theta), false) => row_major!(fading_vrf(m, theta.value_f64()?, form)),
     };
     write_matrix(values, m + 1, a.format)
 }
@@ -95,31 +87,12 @@ fn fixed(a: &VrfArgs) -> Result<(), CliError> {
         ));
     }
     let m = a.memory.degree;
-    let window = a.window.ok_or_else(|| {
-        CliError::Usage(format!(
-            "--kind fixed needs --window W, the number of samples in the window (at least M+1 \
-             = {})",
-            m + 1
-        ))
-    })?;
-    check_window(window, m)?;
+    let span = check_window(a.window, m)? as u64 - 1;
     let lead = a.lead.clone().unwrap_or_default();
-    let span = window as u64 - 1;
-    let lib = |e: seqsmooth::Error| CliError::Usage(e.to_string());
     let values = if a.exact {
-        cells(
-            covariance::<Rational>(m, span, lead.exact)
-                .map_err(lib)?
-                .transpose()
-                .iter(),
-        )
+        row_major!(covariance::<Rational>(m, span, lead.exact))
     } else {
-        cells(
-            covariance::<f64>(m, span, lead.value)
-                .map_err(lib)?
-                .transpose()
-                .iter(),
-        )
+        row_major!(covariance::<f64>(m, span, lead.value))
     };
     write_matrix(values, m + 1, a.format)
 }
@@ -135,15 +108,11 @@ fn write_matrix(values: Vec<String>, size: usize, format: Format) -> Result<(), 
             rows
         }
         Format::Table => {
-            let mut rows = vec![std::iter::once(String::new())
-                .chain((0..size).map(|j| format!("j={j}")))
-                .collect()];
+            let mut header = vec![String::new()];
+            header.extend((0..size).map(|j| format!("j={j}")));
+            let mut rows = vec![header];
             for (i, chunk) in values.chunks(size).enumerate() {
-                rows.push(
-                    std::iter::once(format!("i={i}"))
-                        .chain(chunk.iter().cloned())
-                        .collect(),
-                );
+                rows.push([vec![format!("i={i}")], chunk.to_vec()].concat());
             }
             rows
         }

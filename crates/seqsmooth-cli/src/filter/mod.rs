@@ -13,9 +13,9 @@
 pub mod rows;
 pub mod runner;
 
-use crate::args::{check_window, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
+use crate::args::{check_window, name, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
 use crate::error::CliError;
-use crate::io::{check_distinct, fmt_f64, input_size, open_input, write_f64, Need, Output};
+use crate::io::{check_distinct, fmt_f64, input_size, open_input, Need, Output};
 use crate::progress::{self, Progress};
 use rayon::prelude::*;
 use rows::{Chunk, RowReader};
@@ -43,13 +43,11 @@ const PIECE: usize = 4096;
 fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
     let kind = a.kind;
     let theta = match (kind, &a.theta) {
-        (Kind::Fading | Kind::Auto, Some(theta)) => {
-            Some(theta.value_f64().map_err(CliError::Usage)?)
-        }
+        (Kind::Fading | Kind::Auto, Some(theta)) => Some(theta.value_f64()?),
         (Kind::Fading | Kind::Auto, None) => {
             return Err(CliError::Usage(format!(
                 "--kind {} needs --theta T, the discount per tau (0 < T < 1)",
-                kind.name()
+                name(kind)
             )))
         }
         (Kind::Expanding | Kind::Fixed, Some(_)) => return Err(only("--theta", "fading and auto")),
@@ -59,14 +57,7 @@ fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
         return Err(only("--tau", "fading and auto"));
     }
     match (kind, a.window) {
-        (Kind::Fixed, Some(w)) => check_window(w, a.degree)?,
-        (Kind::Fixed, None) => {
-            return Err(CliError::Usage(format!(
-                "--kind fixed needs --window W, the number of samples in the window (at least \
-                 M+1 = {})",
-                a.degree + 1
-            )))
-        }
+        (Kind::Fixed, w) => _ = check_window(w, a.degree)?,
         (_, Some(_)) => return Err(only("--window", "fixed")),
         (_, None) => {}
     }
@@ -173,10 +164,9 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     let first_rows = chunk_rows.min(FIRST_CHUNK_ROWS).max(hold).max(scan);
     let mut chunk = Chunk::default();
     reader.read_chunk(&mut chunk, first_rows);
-    if chunk.len() < hold {
-        if let Some(e) = chunk.error.take() {
-            return Err(e);
-        }
+    let early = chunk.len() < hold;
+    if let Some(e) = chunk.error.take_if(|_| early) {
+        return Err(e);
     }
     need.check(chunk.len())?;
     let tau = match a.tau {
@@ -204,24 +194,18 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         ids.append(&mut chunk.new_ids);
         values.resize(chunk.len() * stride, 0.0);
         let run = |f: &mut Runner, t: &[f64], y: &[f64], o: &mut [f64]| f.run(t, y, o, lead, sigma);
-        let failed = bank
-            .update_par(
-                stream::Chunk {
-                    channels: &chunk.series,
-                    times: &chunk.t,
-                    values: &chunk.y,
-                    estimates: &mut values,
-                    stride,
-                },
-                run,
-            )
-            .err()
-            .map(|e| row_error(e, &chunk));
+        let rows = stream::Chunk {
+            channels: &chunk.series,
+            times: &chunk.t,
+            values: &chunk.y,
+            estimates: &mut values,
+            stride,
+        };
+        let failed = bank.update_par(rows, run).err();
+        let mut failed = failed.map(|e| row_error(e, &chunk));
         let limit = failed.as_ref().map_or(chunk.len(), |(i, _)| *i);
-        if first && limit < hold {
-            if let Some((_, e)) = failed {
-                return Err(e);
-            }
+        if let Some((_, e)) = failed.take_if(|_| first && limit < hold) {
+            return Err(e);
         }
         let sink = match &mut out {
             Some(sink) => sink,
@@ -239,14 +223,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             .map(|k| {
                 let mut buf = Vec::with_capacity(PIECE.min(limit) * (stride + 2) * 20);
                 for i in k * PIECE..((k + 1) * PIECE).min(limit) {
-                    chunk.echo(&mut buf, i, id(i));
-                    for &v in &values[i * stride..(i + 1) * stride] {
-                        buf.push(b',');
-                        if !v.is_nan() {
-                            write_f64(&mut buf, v);
-                        }
-                    }
-                    buf.push(b'\n');
+                    chunk.row(&mut buf, i, id(i), &values[i * stride..(i + 1) * stride]);
                 }
                 buf
             })
@@ -282,10 +259,8 @@ fn row_error(e: seqsmooth::Error, chunk: &Chunk) -> (usize, CliError) {
         },
         other => (0, other),
     };
-    (
-        index,
-        CliError::Data(format!("line {}: {source}", chunk.lines[index])),
-    )
+    let line = chunk.lines[index];
+    (index, CliError::Data(format!("line {line}: {source}")))
 }
 
 /// A thread that reads the input chunk by chunk ahead of the filtering and writing, passing

@@ -9,7 +9,7 @@
 //! and its text from chunk to chunk, for the message of a time that goes backwards) are kept.
 
 use crate::error::CliError;
-use crate::io::{csv_field, find_column, parse_cell, CsvIn, Need};
+use crate::io::{csv_field, find_column, parse_cell, write_f64, CsvIn, Need};
 use std::collections::HashMap;
 use std::io::Read;
 
@@ -44,12 +44,10 @@ pub struct Chunk {
 }
 
 impl Chunk {
-    /// The number of rows.
     pub fn len(&self) -> usize {
         self.t.len()
     }
 
-    /// Whether the chunk has no rows.
     pub fn is_empty(&self) -> bool {
         self.t.is_empty()
     }
@@ -73,6 +71,20 @@ impl Chunk {
         out.extend_from_slice(&self.text[at + t..at + t + y]);
     }
 
+    /// Appends the output row of row `i`: [`echo`](Self::echo), then `values` (NaN an empty
+    /// cell) and the line end.
+    #[inline]
+    pub fn row(&self, out: &mut Vec<u8>, i: usize, id: Option<&[u8]>, values: &[f64]) {
+        self.echo(out, i, id);
+        for &v in values {
+            out.push(b',');
+            if !v.is_nan() {
+                write_f64(out, v);
+            }
+        }
+        out.push(b'\n');
+    }
+
     /// Appends the header `[id,]t,y,d0..dM[,s0..sM][,extra…]`.
     pub fn header(
         &self,
@@ -94,9 +106,8 @@ impl Chunk {
     }
 
     fn clear(&mut self) {
-        for v in [&mut self.t, &mut self.y] {
-            v.clear();
-        }
+        self.t.clear();
+        self.y.clear();
         self.series.clear();
         self.lines.clear();
         self.cells.clear();
@@ -159,11 +170,7 @@ impl<R: Read> RowReader<R> {
             value_col: value_col.to_string(),
             index: HashMap::new(),
             ids: Vec::new(),
-            newest: if id_idx.is_none() {
-                vec![None]
-            } else {
-                Vec::new()
-            },
+            newest: id_idx.map_or_else(|| vec![None], |_| Vec::new()),
             touched: Vec::new(),
             rows_read: 0,
         })

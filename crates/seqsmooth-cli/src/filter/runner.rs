@@ -6,7 +6,7 @@
 //! the rows in the window; automatic: the noise σ in use, the outlier and misfit flags as
 //! 0/1). NaN marks an empty cell: a derivative or 1σ not determined yet.
 
-use crate::args::{EngineArg, Kind};
+use crate::args::{name, EngineArg, Kind};
 use seqsmooth::polynomial::automatic::AutomaticFilter;
 use seqsmooth::{Error, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory};
 use seqsmooth::{PolynomialFilter, PolynomialState};
@@ -14,9 +14,7 @@ use seqsmooth::{PolynomialFilter, PolynomialState};
 /// A running filter of any kind. Cloning a new one is how each series gets its filter.
 #[derive(Clone, Debug)]
 pub enum Runner {
-    /// Expanding memory.
     Expanding(Box<ExpandingMemory>),
-    /// Fading memory.
     Fading(Box<FadingMemory>),
     /// Fixed memory over `window` samples, on any timestamps ([`FixedEngine::Adaptive`]).
     Fixed(Box<FixedMemory>, usize),
@@ -50,12 +48,9 @@ impl Runner {
             sigma: Option<f64>,
             with: fn(F, f64) -> Result<F, Error>,
         ) -> Result<Box<F>, Error> {
-            Ok(Box::new(match sigma {
-                Some(s) => with(f, s)?,
-                None => f,
-            }))
+            Ok(Box::new(if let Some(s) = sigma { with(f, s)? } else { f }))
         }
-        let theta = || theta.ok_or_else(|| needs("theta", kind.name()));
+        let theta = || theta.ok_or_else(|| needs("theta", &name(kind)));
         Ok(match kind {
             Kind::Expanding => Runner::Expanding(noise(
                 ExpandingMemory::new(degree, engine.into())?,
@@ -68,7 +63,7 @@ impl Runner {
                 FadingMemory::with_noise_sigma,
             )?),
             Kind::Fixed => {
-                let window = window.ok_or_else(|| needs("window", kind.name()))?;
+                let window = window.ok_or_else(|| needs("window", &name(kind)))?;
                 let f = FixedMemory::new(degree, window, FixedEngine::Adaptive)?;
                 Runner::Fixed(noise(f, sigma, FixedMemory::with_noise_sigma)?, window)
             }
