@@ -329,6 +329,8 @@ pub struct DemoArgs {
 pub struct PlotArgs {
     /// The output of 'seqsmooth filter' (CSV with header t,y,d0..dM[,s0..sM][,...]); omitted
     /// or '-' reads standard input
+    // The brackets are --help text, not links.
+    #[allow(rustdoc::broken_intra_doc_links)]
     #[arg(value_name = "FILTER_OUTPUT")]
     pub source: Option<PathBuf>,
     /// Image file to write, PNG or SVG by its extension (.png, .svg); repeat for both

@@ -4,7 +4,7 @@
 //! A [`Track`] holds one row per sample — time, measured value, the estimated derivatives with
 //! their 1σ where determined — and what the automatic filter adds (rejected samples, the misfit
 //! flag, the noise σ in use, the switch to fading memory, restarts of the memory), plus the
-//! truth when it is known. [`write`] draws, under a title and a legend row:
+//! truth when it is known. [`write()`] draws, under a title and a legend row:
 //!
 //! - one panel per requested derivative `k`: the estimate `d_k` (line), its ±3σ band (shaded),
 //!   the truth (thin black line) and, for `k = 0`, the samples (grey dots; rejected ones as red

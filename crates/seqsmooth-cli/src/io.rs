@@ -12,7 +12,7 @@ use std::path::Path;
 /// `{}` and `{:e}` text with two changes to `ryu`'s: a trailing `.0` is dropped (`ryu` writes
 /// `1.0`, Rust `1`), and where `x` lies exactly halfway between two shortest candidates `ryu`
 /// takes the even last digit and Rust the one away from zero, so that digit goes up by one
-/// ([`tie_digit`]). Non-finite values print as `NaN`, `inf`, `-inf` (never in valid output).
+/// (`tie_digit`). Non-finite values print as `NaN`, `inf`, `-inf` (never in valid output).
 #[inline]
 pub fn write_f64(out: &mut Vec<u8>, x: f64) {
     let mut buf = ryu::Buffer::new();

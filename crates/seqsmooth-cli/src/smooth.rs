@@ -9,7 +9,7 @@ use crate::args::{check_window, SmoothArgs};
 use crate::error::CliError;
 use crate::filter::rows::{Chunk, RowReader};
 use crate::io::{check_distinct, open_input, Need, Output};
-use seqsmooth::polynomial::fixed::smooth;
+use seqsmooth::polynomial::fixed::smooth_into;
 
 /// Runs `seqsmooth smooth`: header `t,y,d0..dM`, one row per input row in input order.
 pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
@@ -32,12 +32,13 @@ pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
     need.check(rows.len())?;
     // The arguments and the rows are checked already (degree, window, finite and increasing
     // values, enough of them): an error left here is about the data as a whole.
-    let fits = smooth(&rows.t, &rows.y, a.degree, a.window)
+    let mut fits = vec![0.0; rows.len() * (a.degree + 1)];
+    smooth_into(&rows.t, &rows.y, a.degree, a.window, &mut fits)
         .map_err(|e| CliError::Data(format!("cannot smooth the input: {e}")))?;
     let mut out = Output::create(a.output.as_deref())?;
     let mut text = Vec::new();
     rows.header(&mut text, None, a.degree, false, &[]);
-    for (i, d) in fits.iter().enumerate() {
+    for (i, d) in fits.chunks_exact(a.degree + 1).enumerate() {
         rows.row(&mut text, i, None, d);
     }
     out.write(&text)?;

@@ -4,7 +4,7 @@
 //! The command reads, filters and writes chunks of rows ([`CHUNK_ROWS`]): a reader thread
 //! reads and validates ([`rows`]) the next chunk while the current one is run through the
 //! filters of its series, the series in parallel (the library's
-//! [`StreamBank`](seqsmooth::polynomial::bank::StreamBank)), then formatted in parallel pieces
+//! [`seqsmooth::polynomial::bank::StreamBank`]), then formatted in parallel pieces
 //! and written in input order. Memory is a few chunks plus one filter per series, whatever the
 //! length of the input. The first [`LOOKAHEAD`] data rows (the first `W` for a fixed-memory
 //! window longer than that) decide the default `τ` (median time step) and the too-few-samples
