@@ -386,7 +386,7 @@ def main():
     sg_tol = TOL["savgol"] + scipy_err
     pair = f"Savitzky-Golay, window {SG_WINDOW}, degree {SG_DEGREE}, d0-d2"
     for name, label, rows_sel, span in (
-            ("sg", "fixed::smooth", slice(None), f"0..{len(y) - 1}"),
+            ("sg", "fixed::smooth_into", slice(None), f"0..{len(y) - 1}"),
             ("sgs", "FixedMemory (sliding, centred)", inner, f"{half}..{len(y) - 1 - half}")):
         mine = est(name, SG_DEGREE)
         err = sized_diff(out[rows_sel], mine[rows_sel], size)
