@@ -80,39 +80,31 @@ fn smooth_series(c: &mut Criterion) {
     const SMOOTH_LEN: usize = 1 << 17;
     let ys = data(SMOOTH_LEN);
     let ts: Vec<f64> = (0..SMOOTH_LEN).map(|n| n as f64 * 0.01).collect();
-    let mut group = c.benchmark_group("smooth");
-    group
-        .sample_size(10)
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(3))
-        .throughput(Throughput::Elements(SMOOTH_LEN as u64));
-    for window in [11usize, 101, 1_001, 10_001] {
-        group.bench_with_input(
-            BenchmarkId::from_parameter(window),
-            &window,
-            |b, &window| {
-                b.iter(|| black_box(smooth(&ts, &ys, DEGREE, window).unwrap()));
-            },
-        );
-    }
-    group.finish();
-    let mut group = c.benchmark_group("smooth_into");
-    group
-        .sample_size(10)
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(3))
-        .throughput(Throughput::Elements(SMOOTH_LEN as u64));
     let mut out = vec![0.0; SMOOTH_LEN * (DEGREE + 1)];
-    for window in [11usize, 101, 1_001, 10_001] {
-        group.bench_with_input(
-            BenchmarkId::from_parameter(window),
-            &window,
-            |b, &window| {
-                b.iter(|| smooth_into(&ts, &ys, DEGREE, window, black_box(&mut out)).unwrap());
-            },
-        );
+    for flat in [false, true] {
+        let mut group = c.benchmark_group(if flat { "smooth_into" } else { "smooth" });
+        group
+            .sample_size(10)
+            .warm_up_time(Duration::from_millis(500))
+            .measurement_time(Duration::from_secs(3))
+            .throughput(Throughput::Elements(SMOOTH_LEN as u64));
+        for window in [11usize, 101, 1_001, 10_001] {
+            group.bench_with_input(
+                BenchmarkId::from_parameter(window),
+                &window,
+                |b, &window| {
+                    if flat {
+                        b.iter(|| {
+                            smooth_into(&ts, &ys, DEGREE, window, black_box(&mut out)).unwrap()
+                        });
+                    } else {
+                        b.iter(|| black_box(smooth(&ts, &ys, DEGREE, window).unwrap()));
+                    }
+                },
+            );
+        }
+        group.finish();
     }
-    group.finish();
 }
 
 criterion_group!(
