@@ -134,7 +134,9 @@ bounded (a few chunks plus one filter per series) however long the input. The fi
 rows (the first W for a longer fixed window) are held back: an error in one of them stops the \
 command before any output. An error in a later row (a bad cell, a time not after the previous \
 one of its series, ...) stops the command after every row before it, of every series, has been \
-written; the message names the line, the column and, for a time, the series.
+written to standard output; the message names the line, the column and, for a time, the \
+series. An output file (-o FILE) is written beside FILE and renamed onto it only when the \
+command succeeds: on any error an existing FILE is left as it was.
 
 Progress: on standard error when it is a terminal and the input is longer than one chunk \
 (bytes of the file read, or rows and rows/s from standard input); --no-progress turns it off.

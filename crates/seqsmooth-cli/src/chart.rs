@@ -138,17 +138,26 @@ pub fn write(track: &Track, layout: &Layout, path: &Path) -> Result<(), CliError
     let format = Format::of(path)?;
     let name = path.display();
     let fail = |e: Err| CliError::Data(format!("cannot write the plot to '{name}': {e}"));
+    // Drawn into a temporary file beside `path` (with the extension that picks the encoder),
+    // renamed onto it when complete: a failed plot leaves an existing file as it was.
+    let suffix = match format {
+        Format::Png => ".png",
+        Format::Svg => ".svg",
+    };
+    let temp = crate::io::temp_beside(path, suffix).map_err(|e| fail(e.into()))?;
+    let temp = temp.into_temp_path();
     macro_rules! render {
         ($backend:ident) => {{
-            let root = $backend::new(path, layout.size).into_drawing_area();
+            let root = $backend::new(&temp, layout.size).into_drawing_area();
             draw(&root, track, layout).map_err(fail)?;
-            root.present().map_err(|e| fail(e.into()))
+            root.present().map_err(|e| fail(e.into()))?;
         }};
     }
     match format {
         Format::Png => render!(BitMapBackend),
         Format::Svg => render!(SVGBackend),
     }
+    temp.persist(path).map_err(|e| fail(e.error.into()))
 }
 
 fn font(size: f64) -> TextStyle<'static> {

@@ -5,7 +5,7 @@
 use crate::error::CliError;
 use std::fs::File;
 use std::io::{self, BufWriter, Read, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The shortest text that parses back to exactly `x` (the `ryu` crate's digits): plain decimal
 /// for `0` and `1e-5 <= |x| < 1e16`, otherwise scientific (`1e-300`, `2.5e20`). This is Rust's
@@ -415,20 +415,27 @@ pub struct Output {
     sink: Box<dyn Write>,
     /// `'path'` or `standard output`.
     pub name: String,
+    /// For a file: the temporary file beside it and the file it becomes at [`Output::finish`].
+    file: Option<(tempfile::TempPath, PathBuf)>,
 }
 
 impl Output {
-    /// Creates the output file `path` (standard output for `None` or `-`).
+    /// Creates the output file `path` (standard output for `None` or `-`). The rows go to a
+    /// temporary file in the same directory, renamed onto `path` by [`Output::finish`]: until
+    /// then an existing `path` is untouched, and if the command fails (the `Output` is dropped
+    /// unfinished) the temporary file is removed. Standard output streams: what was written
+    /// stays written (flushed when dropped).
     pub fn create(path: Option<&Path>) -> Result<Self, CliError> {
         match named(path) {
             Some(p) => {
                 let name = format!("'{}'", p.display());
-                let file = File::create(p).map_err(|e| {
-                    CliError::Data(format!("cannot create output file {name}: {e}"))
-                })?;
+                let fail =
+                    |e: io::Error| CliError::Data(format!("cannot create output file {name}: {e}"));
+                let (file, temp) = temp_beside(p, "").map_err(fail)?.into_parts();
                 Ok(Self {
                     sink: Box::new(BufWriter::new(file)),
                     name,
+                    file: Some((temp, p.to_path_buf())),
                 })
             }
             None => Ok(Self::stdout()),
@@ -441,6 +448,7 @@ impl Output {
         Self {
             sink,
             name: "standard output".to_string(),
+            file: None,
         }
     }
 
@@ -489,12 +497,44 @@ impl Output {
         Ok(())
     }
 
-    /// Flushes everything to the sink.
+    /// Flushes everything to the sink; for a file, renames the temporary file onto it.
     pub fn finish(mut self) -> Result<(), CliError> {
         self.sink
             .flush()
-            .map_err(|e| CliError::write(&self.name, e))
+            .map_err(|e| CliError::write(&self.name, e))?;
+        // Close the file before it is renamed.
+        self.sink = Box::new(io::sink());
+        match self.file.take() {
+            Some((temp, path)) => temp
+                .persist(&path)
+                .map_err(|e| CliError::write(&self.name, e.error)),
+            None => Ok(()),
+        }
     }
+}
+
+/// A new temporary file in the directory of `path`, named after it and ending in `suffix`,
+/// with the permissions `path` has (a new file's default, `0o666` less the umask, if it does
+/// not exist yet): what [`Output`] and the plots write before renaming it onto `path`.
+pub fn temp_beside(path: &Path, suffix: &str) -> io::Result<tempfile::NamedTempFile> {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let stem = path
+        .file_name()
+        .map_or("out".into(), |n| n.to_string_lossy());
+    let prefix = format!(".{stem}.");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(suffix);
+    #[cfg(unix)]
+    let permissions = {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::metadata(path).map_or(std::fs::Permissions::from_mode(0o666), |m| m.permissions())
+    };
+    #[cfg(unix)]
+    builder.permissions(permissions);
+    builder.tempfile_in(dir)
 }
 
 /// Refuses an output file that is the input file.

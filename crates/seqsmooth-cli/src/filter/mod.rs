@@ -232,10 +232,11 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             sink.write(piece)?;
         }
         if failed.is_some() || chunk.error.is_some() || chunk.done {
-            out.take().map_or(Ok(()), Output::finish)?;
             return match (failed, chunk.error.take()) {
+                // Dropped unfinished: standard output keeps the rows before the error, a
+                // file is not written.
                 (Some((_, e)), _) | (None, Some(e)) => Err(e),
-                (None, None) => Ok(()),
+                (None, None) => out.take().map_or(Ok(()), Output::finish),
             };
         }
         if first && progress::wanted(a.no_progress) {

@@ -1,0 +1,110 @@
+//! Output files are replaced only on success (`io::Output`, the plots): a failing command leaves
+//! an existing `-o FILE` as it was and no partial or temporary file beside it; standard output
+//! streams the rows before the error as before.
+
+mod common;
+use common::*;
+use std::path::{Path, PathBuf};
+
+/// A fresh, empty directory for one test.
+fn fresh_dir(name: &str) -> PathBuf {
+    let dir = tmp(&format!("output-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The names of the files in `dir`, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// `rows` good rows `t = k, y = k` (header first), then a row whose time goes backwards.
+fn input_failing_after(rows: usize) -> String {
+    let mut text = String::from("t,y\n");
+    for k in 0..rows {
+        text += &format!("{k},{k}\n");
+    }
+    text + "0,1\n"
+}
+
+#[test]
+fn filter_error_after_rows_leaves_the_old_file() {
+    // 300 rows pass the 101-row hold-back, so rows are written before the error is found.
+    let dir = fresh_dir("filter-late");
+    let input = dir.join("in.csv");
+    std::fs::write(&input, input_failing_after(300)).unwrap();
+    let out = dir.join("out.csv");
+    std::fs::write(&out, "old contents\n").unwrap();
+    let args = ["filter", "--kind", "expanding", "--degree", "1"];
+    let (i, o) = (input.to_str().unwrap(), out.to_str().unwrap());
+    let r = run(&[&args[..], &[i, "-o", o]].concat(), "");
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    assert!(r.stderr.contains("line 302"), "{}", r.stderr);
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "old contents\n");
+    assert_eq!(listing(&dir), ["in.csv", "out.csv"]);
+    // No file at all when there was none.
+    std::fs::remove_file(&out).unwrap();
+    assert_eq!(run(&[&args[..], &[i, "-o", o]].concat(), "").code, 1);
+    assert_eq!(listing(&dir), ["in.csv"]);
+    // Standard output still streams every row before the bad one.
+    let r = run(&args, &input_failing_after(300));
+    assert_eq!(r.code, 1);
+    assert_eq!(r.stdout.lines().count(), 301, "header and 300 rows");
+}
+
+#[test]
+fn filter_success_replaces_the_file_keeping_its_permissions() {
+    let dir = fresh_dir("filter-ok");
+    let out = dir.join("out.csv");
+    std::fs::write(&out, "old contents\n").unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o640)).unwrap();
+    }
+    let args = ["filter", "--kind", "expanding", "--degree", "1", "-o"];
+    let r = run(
+        &[&args[..], &[out.to_str().unwrap()]].concat(),
+        "t,y\n0,1\n1,3\n",
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("t,y,d0,d1\n0,1,,\n1,3,3,2\n"), "{text}");
+    assert_eq!(listing(&dir), ["out.csv"]);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o640);
+    }
+}
+
+#[test]
+fn smooth_and_plot_errors_leave_the_old_file() {
+    let dir = fresh_dir("smooth");
+    let out = dir.join("s.csv");
+    std::fs::write(&out, "old\n").unwrap();
+    let o = out.to_str().unwrap();
+    let r = run(
+        &["smooth", "--degree", "1", "--window", "3", "-o", o],
+        "t,y\n0,1\n1,2\n1,3\n",
+    );
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "old\n");
+    assert_eq!(listing(&dir), ["s.csv"]);
+    // A plot that cannot be written (no such directory) leaves nothing behind either.
+    let png = dir.join("no-dir").join("x.png");
+    let r = run(
+        &["demo", "--plot", png.with_extension("").to_str().unwrap()],
+        "",
+    );
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    assert!(r.stderr.contains("cannot write the plot"), "{}", r.stderr);
+    assert_eq!(listing(&dir), ["s.csv"]);
+}
