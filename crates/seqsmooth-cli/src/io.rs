@@ -119,7 +119,7 @@ fn parse_cell_text(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f
             "{at}: the cell is empty, expected a number"
         )));
     }
-    let text = String::from_utf8_lossy(cell);
+    let text = shown(cell);
     let v: f64 = std::str::from_utf8(cell)
         .ok()
         .and_then(|s| s.parse().ok())
@@ -128,6 +128,38 @@ fn parse_cell_text(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f
         return Err(CliError::Data(format!("{at}: {what} {text} is not finite")));
     }
     Ok(v)
+}
+
+/// The longest cell text a message quotes whole, in characters.
+const SHOWN_CHARS: usize = 64;
+
+/// A cell's text as a message quotes it: invalid UTF-8 as `\u{fffd}`, control and other
+/// invisible characters escaped (`\0`, `\t`, `\u{200b}`, …), and a text longer than
+/// 64 characters cut to its first 40, followed by `…` and the cell's length in bytes.
+///
+/// ```
+/// use seqsmooth_cli::io::shown;
+/// assert_eq!(shown(b"1.5"), "1.5");
+/// assert_eq!(shown(b"1\x002"), "1\\02");
+/// assert_eq!(shown(&[b'9'; 100]), format!("{}… (100 bytes)", "9".repeat(40)));
+/// ```
+pub fn shown(cell: &[u8]) -> String {
+    let text = String::from_utf8_lossy(cell);
+    let escaped = |c: char| -> String {
+        let invisible = c.is_control()
+            || matches!(c, '\u{200b}'..='\u{200f}' | '\u{2028}'..='\u{202e}' | '\u{2060}'..='\u{2064}' | '\u{feff}');
+        if invisible {
+            c.escape_debug().collect()
+        } else {
+            c.to_string()
+        }
+    };
+    if text.chars().count() <= SHOWN_CHARS {
+        text.chars().map(escaped).collect()
+    } else {
+        let head: String = text.chars().take(40).map(escaped).collect();
+        format!("{head}… ({} bytes)", cell.len())
+    }
 }
 
 /// `bytes` without leading and trailing whitespace (Unicode whitespace for UTF-8 text, as
@@ -212,8 +244,13 @@ pub fn plural(n: usize) -> &'static str {
 pub fn find_column(headers: &[String], name: &str, why: &str) -> Result<usize, CliError> {
     headers.iter().position(|h| h == name).ok_or_else(|| {
         CliError::Data(format!(
-            "column '{name}' not found in the header{why}; columns are: {}",
-            headers.join(", ")
+            "column '{}' not found in the header{why}; columns are: {}",
+            shown(name.as_bytes()),
+            headers
+                .iter()
+                .map(|h| shown(h.as_bytes()))
+                .collect::<Vec<_>>()
+                .join(", ")
         ))
     })
 }

@@ -540,3 +540,33 @@ fn error_output_is_input() {
 fn error_unknown_argument() {
     fails(&[&EXP1[..], &["--bogus"]].concat(), T9_02, 2, &["--bogus"]);
 }
+
+/// A huge cell is quoted cut to its first characters with its length; a NUL is shown.
+#[test]
+fn error_messages_shorten_and_escape_cells() {
+    let huge = "9".repeat(100_000) + "x";
+    let r = run(&EXP1, &format!("t,y\n0,1\n1,{huge}\n"));
+    assert_eq!(r.code, 1);
+    assert!(r.stderr.len() < 300, "{} bytes", r.stderr.len());
+    assert!(
+        r.stderr.contains(&format!(
+            "'{}… (100001 bytes)' is not a number",
+            "9".repeat(40)
+        )),
+        "{}",
+        r.stderr
+    );
+    let r = run(&EXP1, "t,y\n0,1\n1,2\u{0}3\n");
+    assert_eq!(r.code, 1);
+    assert!(r.stderr.contains("'2\\03' is not a number"), "{}", r.stderr);
+    let r = run(
+        &[&EXP1[..], &["--value-col", "v\u{200b}"]].concat(),
+        "t,y\n0,1\n",
+    );
+    assert_eq!(r.code, 1);
+    assert!(
+        r.stderr.contains("column 'v\\u{200b}' not found"),
+        "{}",
+        r.stderr
+    );
+}

@@ -9,7 +9,7 @@
 //! and its text from chunk to chunk, for the message of a time that goes backwards) are kept.
 
 use crate::error::CliError;
-use crate::io::{csv_field, find_column, parse_cell, write_f64, CsvIn, Need};
+use crate::io::{csv_field, find_column, parse_cell, shown, write_f64, CsvIn, Need};
 use std::collections::HashMap;
 use std::io::Read;
 
@@ -250,14 +250,14 @@ impl<R: Read> RowReader<R> {
                 };
                 let of = match self.id_idx {
                     None => String::new(),
-                    Some(_) => format!(" of series '{}'", self.ids[series]),
+                    Some(_) => format!(" of series '{}'", shown(self.ids[series].as_bytes())),
                 };
                 let prev_text = prev.row.map_or(&prev.text[..], |i| chunk.t_text(i));
                 return Err(CliError::Data(format!(
                     "line {line}: time {} is not after the previous time {} (line {}){of}: \
                      {why}",
-                    String::from_utf8_lossy(t_cell),
-                    String::from_utf8_lossy(prev_text),
+                    shown(t_cell),
+                    shown(prev_text),
                     prev.line
                 )));
             }

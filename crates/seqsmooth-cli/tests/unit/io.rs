@@ -171,3 +171,25 @@ fn csv_fields_are_quoted_where_needed() {
     assert_eq!(csv_field(b"say \"hi\""), b"\"say \"\"hi\"\"\"");
     assert_eq!(csv_field(b"a\nb"), b"\"a\nb\"");
 }
+
+#[test]
+fn messages_quote_cells_short_and_visible() {
+    // Short text as it is; invisible characters escaped; long text cut with its length.
+    assert_eq!(shown(b"abc"), "abc");
+    assert_eq!(shown("é ü".as_bytes()), "é ü");
+    assert_eq!(shown(b"1\x002"), "1\\02");
+    assert_eq!(shown(b"\t1\r"), "\\t1\\r");
+    assert_eq!(
+        shown("a\u{200b}b\u{feff}".as_bytes()),
+        "a\\u{200b}b\\u{feff}"
+    );
+    assert_eq!(shown(&[0xff, b'1']), "\u{fffd}1");
+    let long = vec![b'7'; 10_000_000];
+    let s = shown(&long);
+    assert_eq!(s, format!("{}… (10000000 bytes)", "7".repeat(40)));
+    assert_eq!(shown(&[b'x'; 64]), "x".repeat(64));
+    assert_eq!(
+        shown(&[b'x'; 65]),
+        format!("{}… (65 bytes)", "x".repeat(40))
+    );
+}
