@@ -340,7 +340,7 @@ pub struct PlotArgs {
     pub output: Vec<PathBuf>,
     /// Derivative to plot, one panel each, in the order given (0 the value, 1 the rate, ...);
     /// repeat for several
-    #[arg(long, value_name = "K", default_value = "0", value_parser = parse_degree,
+    #[arg(long, value_name = "K", default_value = "0", value_parser = parse_derivative,
           allow_hyphen_values = true)]
     pub derivative: Vec<usize>,
     /// Leave out the residual panel
@@ -567,8 +567,11 @@ fn parse_whole(name: &str, s: &str, unit: &str, lo: i128, hi: i128) -> Result<i1
     let text = s.trim();
     match text.parse::<i128>() {
         Ok(v) if (lo..=hi).contains(&v) => Ok(v),
-        _ => Err(format!(
+        Ok(_) => Err(format!(
             "{name} {text} is out of range: it must be a whole number{unit} from {lo} to {hi}"
+        )),
+        Err(_) => Err(format!(
+            "{name} '{text}' is not a whole number{unit}; it must be one from {lo} to {hi}"
         )),
     }
 }
@@ -582,6 +585,11 @@ pub fn parse_degree(s: &str) -> Result<usize, String> {
         )),
         _ => parse_whole("degree", s, "", 0, MAX_DEGREE as i128).map(|d| d as usize),
     }
+}
+
+/// Parses `plot --derivative`: a whole number from 0 to [`MAX_DEGREE`].
+pub fn parse_derivative(s: &str) -> Result<usize, String> {
+    parse_whole("derivative", s, "", 0, MAX_DEGREE as i128).map(|d| d as usize)
 }
 
 /// Parses `--n`: the 0-based index of the newest sample, a whole number from 0 to `i64::MAX`.

@@ -571,7 +571,17 @@ pub fn temp_beside(path: &Path, suffix: &str) -> io::Result<tempfile::NamedTempF
     };
     #[cfg(unix)]
     builder.permissions(permissions);
-    builder.tempfile_in(dir)
+    builder.tempfile_in(dir).map_err(|e| {
+        // The message names the file asked for, not the hidden temporary one: drop the
+        // crate's "at path ..." suffix.
+        let text = e.to_string();
+        let own = text
+            .split(" at path \"")
+            .next()
+            .unwrap_or(&text)
+            .to_string();
+        io::Error::new(e.kind(), own)
+    })
 }
 
 /// Refuses an output file that is the input file.

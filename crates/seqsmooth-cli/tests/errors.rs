@@ -570,3 +570,27 @@ fn error_messages_shorten_and_escape_cells() {
         r.stderr
     );
 }
+
+/// A whole-number argument that is not a number says so (not "out of range"), and
+/// `plot --derivative` is named as a derivative, not a degree.
+#[test]
+fn error_whole_number_arguments_name_themselves() {
+    fails(
+        &["filter", "--kind", "fading", "--degree", "abc"],
+        "",
+        2,
+        &["degree 'abc' is not a whole number; it must be one from 0 to 24"],
+    );
+    fails(
+        &["plot", "-o", "x.png", "--derivative", "-1"],
+        "",
+        2,
+        &["derivative -1 is out of range: it must be a whole number from 0 to 24"],
+    );
+    fails(
+        &["gains", "--kind", "expanding", "--degree", "1", "--n", "q"],
+        "",
+        2,
+        &["n 'q' is not a whole number"],
+    );
+}

@@ -106,5 +106,11 @@ fn smooth_and_plot_errors_leave_the_old_file() {
     );
     assert_eq!(r.code, 1, "{}", r.stderr);
     assert!(r.stderr.contains("cannot write the plot"), "{}", r.stderr);
+    // The message names the file asked for, in words (no temporary name, no debug text).
+    assert!(
+        r.stderr.contains("x.png': No such file or directory") && !r.stderr.contains("at path"),
+        "{}",
+        r.stderr
+    );
     assert_eq!(listing(&dir), ["s.csv"]);
 }
