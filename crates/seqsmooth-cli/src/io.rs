@@ -240,8 +240,22 @@ pub fn plural(n: usize) -> &'static str {
 }
 
 /// The index of the column `name` in the header, or an error listing the columns (`why`
-/// after "the header").
+/// after "the header"); a name the header holds more than once is ambiguous, an error too.
 pub fn find_column(headers: &[String], name: &str, why: &str) -> Result<usize, CliError> {
+    let mut at = headers
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| *h == name)
+        .map(|(i, _)| i);
+    if let (Some(first), Some(second)) = (at.next(), at.next()) {
+        return Err(CliError::Data(format!(
+            "column '{}' appears more than once in the header (columns {} and {}): which one \
+             is meant is ambiguous; rename one",
+            shown(name.as_bytes()),
+            first + 1,
+            second + 1
+        )));
+    }
     headers.iter().position(|h| h == name).ok_or_else(|| {
         CliError::Data(format!(
             "column '{}' not found in the header{why}; columns are: {}",

@@ -10,7 +10,7 @@ use crate::args::PlotArgs;
 use crate::chart::{self, Layout, Track};
 use crate::error::CliError;
 use crate::io::{
-    find_column, fmt_f64, input_name, named, not_utf8, open_input, parse_cell, plural, CsvIn,
+    find_column, fmt_f64, input_name, named, not_utf8, open_input, parse_cell, plural, shown, CsvIn,
 };
 use std::path::Path;
 
@@ -83,6 +83,23 @@ impl Table {
     fn filled(&self, idx: usize, what: &str) -> Column<f64> {
         let v = self.numbers(idx, what, false)?;
         Ok(v.into_iter().flatten().collect())
+    }
+
+    /// The times of column `idx`: every cell filled, strictly increasing.
+    fn times(&self, idx: usize) -> Column<f64> {
+        let t = self.filled(idx, "time")?;
+        match (1..t.len()).find(|&i| t[i] <= t[i - 1]) {
+            None => Ok(t),
+            Some(i) => Err(self.error(CliError::Data(format!(
+                "line {}, column '{}': time {} is not after the previous time {} (line {}): \
+                 a plot needs one series in time order",
+                self.rows[i].0,
+                shown(self.header[idx].as_bytes()),
+                shown(self.rows[i].1[idx].as_bytes()),
+                shown(self.rows[i - 1].1[idx].as_bytes()),
+                self.rows[i - 1].0
+            )))),
+        }
     }
 
     /// `read` of the column `col`, empty when there is none.
@@ -163,7 +180,7 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
     let n = out.rows.len();
     let why = " (the output of 'seqsmooth filter' has t,y,d0..dM)";
     let (t_idx, y_idx) = (out.required("t", why)?, out.required("y", why)?);
-    let t = out.filled(t_idx, "time")?;
+    let t = out.times(t_idx)?;
     let y = out.filled(y_idx, "value")?;
     let top = cfg.derivative.iter().copied().max().unwrap_or(0);
     let mut d = vec![vec![None; n]; top + 1];
@@ -193,7 +210,7 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
         let input = Table::read(Some(path))?;
         let ti = input.required(&cfg.time_col, " (give its name with --time-col)")?;
         let yi = input.required(&cfg.value_col, " (give its name with --value-col)")?;
-        let it = input.filled(ti, "time")?;
+        let it = input.times(ti)?;
         let iy = input.filled(yi, "value")?;
         if input.rows.len() != n {
             return Err(CliError::Data(format!(

@@ -457,7 +457,25 @@ fn plot_errors() {
     write("empty.csv", "");
     write("in-short.csv", "t,y\n0,1\n");
     write("in-other.csv", "t,y\n0,1\n1.5,2\n");
-    let cases: [(&[&str], i32, &[&str]); 16] = [
+    write("unsorted.csv", "t,y,d0\n0,1,1\n2,2,2\n1,3,3\n");
+    write("duplicate.csv", "t,y,d0\n0,1,1\n0,2,2\n");
+    write("twice.csv", "t,y,y,d0\n0,1,1,1\n1,2,2,2\n");
+    let cases: [(&[&str], i32, &[&str]); 19] = [
+        (
+            &["plot", "unsorted.csv", "-o", "x.png"],
+            1,
+            &["'unsorted.csv': line 4, column 't': time 1 is not after the previous time 2 (line 3)"],
+        ),
+        (
+            &["plot", "duplicate.csv", "-o", "x.png"],
+            1,
+            &["line 3, column 't': time 0 is not after the previous time 0 (line 2)"],
+        ),
+        (
+            &["plot", "twice.csv", "-o", "x.png"],
+            1,
+            &["column 'y' appears more than once in the header (columns 2 and 3)"],
+        ),
         (
             &["plot", "missing.csv", "-o", "x.png"],
             1,
