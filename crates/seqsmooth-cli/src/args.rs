@@ -619,7 +619,12 @@ pub fn parse_tau(s: &str) -> Result<f64, String> {
 
 /// Parses `--sigma`: a positive finite number.
 pub fn parse_sigma(s: &str) -> Result<f64, String> {
-    parse_f64("sigma", s, POSITIVE)
+    const SIGMA: (fn(f64) -> bool, &str) = (
+        |v| v.is_finite() && v > 0.0 && (v * v).is_finite() && v * v >= f64::MIN_POSITIVE,
+        "a positive number from about 1.5e-154 to 1.3e154 (its square, the noise variance, must \
+         be a normal double; rescale the values otherwise)",
+    );
+    parse_f64("sigma", s, SIGMA)
 }
 
 /// Parses `--lead`: any finite number (negative = retrodiction).

@@ -594,3 +594,16 @@ fn error_whole_number_arguments_name_themselves() {
         &["n 'q' is not a whole number"],
     );
 }
+
+/// A noise σ whose square is not a normal double is an argument error that says to rescale.
+#[test]
+fn error_sigma_out_of_the_variance_range() {
+    for s in ["1e-300", "1e300"] {
+        fails(
+            &[&EXP1[..], &["--sigma", s]].concat(),
+            T9_02,
+            2,
+            &[&format!("sigma {s} is out of range"), "rescale the values"],
+        );
+    }
+}

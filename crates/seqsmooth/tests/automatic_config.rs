@@ -21,6 +21,8 @@ fn bad_configuration_and_input_are_typed_errors() {
         ("τ inf", |_| AutomaticFilter::new(2, 0.9, f64::INFINITY)),
         ("σ = 0", |f| f.with_noise_sigma(0.0)),
         ("σ NaN", |f| f.with_noise_sigma(f64::NAN)),
+        ("σ² underflows", |f| f.with_noise_sigma(1e-300)),
+        ("σ² overflows", |f| f.with_noise_sigma(1e300)),
         ("noise window", |f| {
             f.with_noise_source(NoiseSource::Differences { window: Some(0) })
         }),

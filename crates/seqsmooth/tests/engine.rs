@@ -9,6 +9,7 @@ use common::*;
 use nalgebra::DMatrix;
 use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
 use seqsmooth::polynomial::fading::vrf::fading_vrf;
+use seqsmooth::polynomial::fixed::{FixedEngine, FixedMemory};
 use seqsmooth::polynomial::form::{unscale, EstimateForm};
 use seqsmooth::polynomial::MAX_DEGREE;
 use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, PolynomialFilter};
@@ -203,6 +204,33 @@ fn bad_input_gives_typed_errors_naming_the_value() {
         .unwrap()
         .with_noise_sigma(-1.0)
         .is_err());
+    // σ whose square (the variance every covariance is scaled by) is not a normal double:
+    // refused with the reason, by every filter; the range's ends are accepted.
+    for sigma in [1e-300, 1e-160, 1e160, 1e300] {
+        let e = FadingMemory::new(1, 0.9, 1.0, Engine::Exact)
+            .unwrap()
+            .with_noise_sigma(sigma)
+            .unwrap_err();
+        assert!(e.to_string().contains("rescale the values"), "{e}");
+        assert!(FixedMemory::new(1, 5, FixedEngine::Sliding)
+            .unwrap()
+            .with_noise_sigma(sigma)
+            .is_err());
+    }
+    let mut f = FadingMemory::new(1, 0.9, 1.0, Engine::Gain)
+        .unwrap()
+        .with_noise_sigma(1.5e-154)
+        .unwrap();
+    f.update_many(&[0.0, 1.0, 2.0], &[0.0, 1.0, 2.0]).unwrap();
+    let cov = f.estimate().unwrap().covariance.unwrap();
+    assert!(
+        cov.iter().all(|v| v.is_finite()) && cov[(0, 0)] > 0.0,
+        "{cov}"
+    );
+    assert!(FadingMemory::new(1, 0.9, 1.0, Engine::Gain)
+        .unwrap()
+        .with_noise_sigma(1.3e154)
+        .is_ok());
     let msg = Error::TimeNotIncreasing {
         time: 3.0,
         previous: 4.0,

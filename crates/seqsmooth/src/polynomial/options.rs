@@ -76,6 +76,30 @@ pub(crate) fn check_tau(tau: f64) -> Result<(), Error> {
     Ok(())
 }
 
+/// The measurement noise's 1σ: a positive finite number whose variance `σ²` is a normal,
+/// finite double (`1.5e-154 ≲ σ ≲ 1.3e154`): below, the variance is zero or subnormal and the
+/// innovation statistics that divide by it are meaningless; above, it is infinite. Such values
+/// want rescaling (other units), not a filter. (Inside the range a covariance `σ² · VRF`,
+/// scaled by `k!/τ^k`, can still leave the double range at extreme scales.)
+pub(crate) fn check_noise_sigma(sigma: f64) -> Result<(), Error> {
+    let variance = sigma * sigma;
+    if sigma.is_finite() && sigma > 0.0 && variance.is_finite() && variance >= f64::MIN_POSITIVE {
+        return Ok(());
+    }
+    let reason = if sigma.is_finite() && sigma > 0.0 {
+        "its square (the noise variance) is not a normal double: it must lie between about \
+         1.5e-154 and 1.3e154; rescale the values (e.g. to other units)"
+    } else {
+        "must be a positive finite number"
+    };
+    Err(Error::InvalidParameter {
+        name: "noise sigma",
+        // `{:?}`: 1e-300 as such, not as 300 digits.
+        value: format!("{sigma:?}"),
+        reason: reason.into(),
+    })
+}
+
 pub(crate) fn check_theta(theta: f64) -> Result<(), Error> {
     if !(theta > 0.0 && theta < 1.0) {
         return Err(Error::ThetaOutOfRange { theta });

@@ -114,7 +114,7 @@ impl AutoConfig {
         check_theta(self.theta)?;
         check_tau(self.tau)?;
         if let Some(s) = self.noise_sigma {
-            check_positive("noise sigma", s)?;
+            crate::polynomial::options::check_noise_sigma(s)?;
         }
         if self.noise_source.window() == Some(0) {
             return Err(Error::InvalidParameter {

@@ -109,13 +109,7 @@ impl EngineState {
     }
 
     pub(crate) fn track_covariance(&mut self, sigma: f64) -> Result<(), Error> {
-        if !(sigma.is_finite() && sigma > 0.0) {
-            return Err(Error::InvalidParameter {
-                name: "noise sigma",
-                value: sigma.to_string(),
-                reason: "must be a positive finite number".into(),
-            });
-        }
+        crate::polynomial::options::check_noise_sigma(sigma)?;
         match self {
             EngineState::Exact(e) => e.track_covariance(sigma),
             EngineState::Gain(g) => g.track_covariance(sigma),

@@ -152,13 +152,7 @@ impl FixedMemory {
     /// assert!((v - 4.0 * 42.0 / 132.0).abs() < 1e-14);
     /// ```
     pub fn with_noise_sigma(mut self, sigma: f64) -> Result<Self, Error> {
-        if !(sigma.is_finite() && sigma > 0.0) {
-            return Err(Error::InvalidParameter {
-                name: "noise sigma",
-                value: sigma.to_string(),
-                reason: "must be a positive finite number".into(),
-            });
-        }
+        crate::polynomial::options::check_noise_sigma(sigma)?;
         self.sigma = Some(sigma);
         Ok(self)
     }
