@@ -114,3 +114,35 @@ fn smooth_and_plot_errors_leave_the_old_file() {
     );
     assert_eq!(listing(&dir), ["s.csv"]);
 }
+
+#[test]
+fn a_closed_pipe_ends_quietly() {
+    // As `seqsmooth filter big.csv | head -1`: the reader goes away after one line.
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+    let dir = fresh_dir("pipe");
+    let input = dir.join("big.csv");
+    let mut text = String::from("t,y\n");
+    for k in 0..200_000 {
+        text += &format!("{k},{}\n", k % 7);
+    }
+    std::fs::write(&input, text).unwrap();
+    let args = [
+        "filter", "--kind", "fading", "--degree", "2", "--theta", "0.9",
+    ];
+    let mut child = Command::new(env!("CARGO_BIN_EXE_seqsmooth"))
+        .args(args)
+        .arg(&input)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert_eq!(first, "t,y,d0,d1,d2\n");
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(String::from_utf8_lossy(&out.stderr), "");
+}
