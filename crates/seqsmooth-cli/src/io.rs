@@ -247,7 +247,8 @@ pub fn find_column(headers: &[String], name: &str, why: &str) -> Result<usize, C
         .enumerate()
         .filter(|(_, h)| *h == name)
         .map(|(i, _)| i);
-    if let (Some(first), Some(second)) = (at.next(), at.next()) {
+    let found = at.next();
+    if let (Some(first), Some(second)) = (found, at.next()) {
         return Err(CliError::Data(format!(
             "column '{}' appears more than once in the header (columns {} and {}): which one \
              is meant is ambiguous; rename one",
@@ -256,7 +257,7 @@ pub fn find_column(headers: &[String], name: &str, why: &str) -> Result<usize, C
             second + 1
         )));
     }
-    headers.iter().position(|h| h == name).ok_or_else(|| {
+    found.ok_or_else(|| {
         CliError::Data(format!(
             "column '{}' not found in the header{why}; columns are: {}",
             shown(name.as_bytes()),
