@@ -7,6 +7,7 @@
 
 use crate::scalar::Scalar;
 use nalgebra::DMatrix;
+use num_bigint::BigInt;
 
 /// `k!` in the field `T`.
 ///
@@ -77,6 +78,25 @@ pub fn choose<T: Scalar>(n: usize, k: usize) -> T {
     let mut acc = T::one();
     for i in 0..k {
         acc = acc * T::from_i64((n - i) as i64) / T::from_i64((i + 1) as i64);
+    }
+    acc
+}
+
+/// [`choose`] as a big integer, by exact integer division: the partial product
+/// `Π_{i<j} (n−i)/(i+1)` is `C(n, j)`, an integer, at every step (zero for `k > n`).
+///
+/// ```
+/// use seqsmooth::calculus::choose_integer;
+/// assert_eq!(choose_integer(60, 30).to_string(), "118264581564861424");
+/// ```
+pub fn choose_integer(n: usize, k: usize) -> BigInt {
+    if k > n {
+        return BigInt::from(0);
+    }
+    let k = k.min(n - k);
+    let mut acc = BigInt::from(1);
+    for i in 0..k {
+        acc = acc * BigInt::from(n - i) / BigInt::from(i + 1);
     }
     acc
 }

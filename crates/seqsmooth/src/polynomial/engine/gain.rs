@@ -6,25 +6,26 @@
 //! representation, and the start-up gains `h_k(n)`, `n ≤ m`, are large; run in plain `f64`
 //! from a zero state, the recursion loses accuracy at high degree, almost all of it from
 //! rounding the start-up gains (measured accuracy: see ACCURACY.md). So the engine (1) starts from
-//! the polynomial interpolating the first `m+1` samples, computed in exact rational arithmetic
-//! — the state the recursion reaches from *any* initial state at `n = m` on even spacing
+//! the polynomial interpolating the first `m+1` samples, computed in double-word arithmetic
+//! from Lagrange's form (no cancellation but in the final sum) — the state the recursion reaches from *any* initial state at `n = m` on even spacing
 //! (Morrison §9.6), and the exact least-squares state on any spacing — and (2) carries the
 //! state in compensated (double-word) arithmetic.
 
 use super::recursion::predict_correct;
-use crate::calculus::Polynomial;
 use crate::model::{derivative_scale, factorial_powers, shift_scaled, shift_scaled_compensated};
 use crate::numeric::double_word::{self as dw, two_prod, two_sum, DoubleWord};
+use crate::numeric::memo::Memo;
 use crate::numeric::steps::{same_step, snaps_to, StepCheck};
 use crate::numeric::unrolled::{unrolled_sizes, UNROLLED_MAX_SIZE};
 use crate::polynomial::expanding::gains::ExpandingGainSchedule;
-use crate::polynomial::fading::gains::fading_gains;
+use crate::polynomial::fading::gains::{fading_gains, fading_gains_exact};
 use crate::polynomial::fading::switch::SwitchRule;
 use crate::polynomial::fading::vrf::fading_vrf;
 use crate::polynomial::form::{EstimateForm, GainForm};
 use crate::polynomial::options::{DiscountMode, MAX_DEGREE};
-use crate::scalar::{rational_from_f64, Rational, Scalar};
+use crate::scalar::{rational_from_f64, Scalar};
 use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
 
 /// A kernel's output row (if any): the unscaled derivatives `x_k = z_k·k!/τ^k`.
 #[inline(always)]
@@ -252,17 +253,20 @@ pub(crate) struct FadingGains {
     pub gains: Vec<f64>,
     /// Low words of `gains` (double-word gains), exact to ~2⁻¹⁰⁶.
     pub gains_lo: Vec<f64>,
-    /// The double-word gains of `θ` itself (computed once).
-    pub steady: (Vec<f64>, Vec<f64>),
+    /// The double-word gains of `θ` itself (computed once per `(m, θ)` in the process).
+    pub steady: Arc<(Vec<f64>, Vec<f64>)>,
 }
 
 /// The fading-memory gains at `θ` as double words `hi + lo`, from the exact rational formula.
-pub(crate) fn fading_gains_double_word(m: usize, theta: f64) -> (Vec<f64>, Vec<f64>) {
-    let exact = fading_gains::<Rational>(
-        m,
-        rational_from_f64(theta).expect("finite θ"),
-        GainForm::Current,
-    );
+pub(crate) fn fading_gains_double_word(m: usize, theta: f64) -> Arc<(Vec<f64>, Vec<f64>)> {
+    static GAINS: Memo<(usize, u64), (Vec<f64>, Vec<f64>)> = Memo::new();
+    GAINS.get((m, theta.to_bits()), || {
+        fading_gains_double_word_uncached(m, theta)
+    })
+}
+
+fn fading_gains_double_word_uncached(m: usize, theta: f64) -> (Vec<f64>, Vec<f64>) {
+    let exact = fading_gains_exact(m, theta);
     let hi: Vec<f64> = exact.iter().map(|g| g.to_f64()).collect();
     let lo = exact
         .iter()
@@ -872,56 +876,50 @@ impl GainEngine {
     }
 
     /// The polynomial through the first `m+1` samples, as scaled Taylor coefficients about the
-    /// newest of them, computed exactly (Newton divided differences in rationals), and, when
-    /// tracked, its covariance `σ² L Lᵀ` with `L` the exact interpolation weights.
+    /// newest of them, and, when tracked, its covariance `σ² L Lᵀ` with `L` the interpolation
+    /// weights. Lagrange's form in `u = (t − t_m)/τ` (every `u_j ≤ 0`):
+    /// `ℓ_i(u) = Π_{j≠i} (u − u_j) / Π_{j≠i} (u_i − u_j)`, so `L_ki` is the coefficient of `u^k`
+    /// in the numerator — a product of factors `u + |u_j|`, whose coefficients are sums of
+    /// positive terms — over the product of the differences, each difference `(t_i − t_j)/τ`
+    /// formed from the times without cancellation. In double words every `L_ki` is then good to
+    /// a few units of 2⁻¹⁰⁶ relative, and `z_k = Σ_i L_ki y_i` is a double-word dot product: the
+    /// start is as good as an exact one for an `f64` state, in `O(m³)` double-word operations
+    /// instead of rational arithmetic whose numbers grow with the degree.
     fn exact_start(&mut self) {
         let m = self.m;
-        let t_ref = self.start[m].0;
-        let tau = rational_from_f64(self.tau).expect("finite tau");
-        let tr = rational_from_f64(t_ref).expect("finite time");
-        let u: Vec<Rational> = self
-            .start
-            .iter()
-            .map(|(t, _)| (rational_from_f64(*t).expect("finite time") - tr.clone()) / tau.clone())
-            .collect();
-        let interpolate = |ys: &[Rational]| -> Vec<Rational> {
-            // Divided differences, then nested multiplication into the power basis in u.
-            let mut c = ys.to_vec();
-            for j in 1..=m {
-                for i in (j..=m).rev() {
-                    c[i] = (c[i].clone() - c[i - 1].clone()) / (u[i].clone() - u[i - j].clone());
+        let t = |i: usize| self.start[i].0;
+        let diff = |i: usize, j: usize| dw::div(two_sum(t(i), -t(j)), (self.tau, 0.0));
+        let mut weights = vec![(0.0, 0.0); (m + 1) * (m + 1)]; // L, row-major (k, i)
+        let mut numerator = vec![(0.0, 0.0); m + 1];
+        for i in 0..=m {
+            numerator.fill((0.0, 0.0));
+            numerator[0] = (1.0, 0.0);
+            let mut denominator = (1.0, 0.0);
+            for (len, j) in (1..).zip((0..=m).filter(|&j| j != i)) {
+                // numerator ← numerator · (u + a_j), a_j = (t_m − t_j)/τ ≥ 0.
+                let a = diff(m, j);
+                for k in (0..=len).rev() {
+                    let shifted = if k > 0 { numerator[k - 1] } else { (0.0, 0.0) };
+                    let kept = if k < len {
+                        dw::mul(a, numerator[k])
+                    } else {
+                        (0.0, 0.0)
+                    };
+                    numerator[k] = dw::add(shifted, kept);
                 }
+                denominator = dw::mul(denominator, diff(i, j));
             }
-            let mut p = Polynomial::constant(c[m].clone());
-            for j in (0..m).rev() {
-                p = p.mul(&Polynomial::new(vec![-u[j].clone(), Rational::from_i64(1)]));
-                p = p.add(&Polynomial::constant(c[j].clone()));
+            for (k, c) in numerator.iter().enumerate() {
+                weights[k * (m + 1) + i] = dw::div(*c, denominator);
             }
-            let mut coeffs = p.coeffs;
-            coeffs.resize(m + 1, Rational::from_i64(0));
-            coeffs
-        };
-        let ys: Vec<Rational> = self
-            .start
-            .iter()
-            .map(|(_, y)| rational_from_f64(*y).expect("finite value"))
-            .collect();
-        let z = interpolate(&ys);
-        for (k, zk) in z.iter().enumerate() {
-            let hi = zk.to_f64();
-            self.z[k] = hi;
-            self.z_lo[k] = (zk.clone() - rational_from_f64(hi).unwrap_or_default()).to_f64();
+        }
+        let ys: Vec<DoubleWord> = self.start.iter().map(|&(_, y)| (y, 0.0)).collect();
+        for (k, row) in weights.chunks_exact(m + 1).enumerate() {
+            let zk = dw::dot(row, &ys);
+            (self.z[k], self.z_lo[k]) = two_sum(zk.0, zk.1);
         }
         if let Some((var, p)) = &mut self.cov {
-            let mut l = DMatrix::zeros(m + 1, m + 1);
-            for i in 0..=m {
-                let unit: Vec<Rational> = (0..=m)
-                    .map(|j| Rational::from_i64(i64::from(i == j)))
-                    .collect();
-                for (k, v) in interpolate(&unit).iter().enumerate() {
-                    l[(k, i)] = v.to_f64();
-                }
-            }
+            let l = DMatrix::from_fn(m + 1, m + 1, |k, i| dw::round(&weights[k * (m + 1) + i]));
             *p = &l * l.transpose() * *var;
         }
         self.start.clear();
@@ -1086,6 +1084,73 @@ mod tests {
                 let want = reference(&start, &ts[..done], &ys[..done], gains);
                 let err = scaled_error(&e.z, &want, span);
                 assert!(err <= 1e-12, "m {m} block: {err:e}");
+            }
+        }
+    }
+
+    /// The start from Lagrange's form in double words against the interpolating polynomial in
+    /// exact rationals (Newton's divided differences, expanded about the newest time), state and
+    /// covariance, degrees 0 … 12, on irregular times far from the origin and a τ that is not a
+    /// power of two.
+    #[test]
+    fn start_equals_the_exact_interpolating_polynomial() {
+        use crate::calculus::Polynomial;
+        use crate::scalar::Rational;
+        let exact = |x: f64| rational_from_f64(x).unwrap();
+        for m in 0..=12 {
+            let tau = 0.37;
+            let ts: Vec<f64> = (0..=m)
+                .map(|i| 1.7e9 + 0.01 * i as f64 + 0.003 * ((i * i) % 7) as f64)
+                .collect();
+            let ys: Vec<f64> = (0..=m).map(|i| 1e4 + (i as f64 * 1.3).sin()).collect();
+            let mut e = GainEngine::new(m, tau, None);
+            e.track_covariance(1.0);
+            for (&t, &y) in ts.iter().zip(&ys) {
+                e.update(t, y);
+            }
+            let u: Vec<Rational> = ts
+                .iter()
+                .map(|&t| (exact(t) - exact(ts[m])) / exact(tau))
+                .collect();
+            let interpolate = |v: &[Rational]| -> Vec<Rational> {
+                let mut c = v.to_vec();
+                for j in 1..=m {
+                    for i in (j..=m).rev() {
+                        c[i] =
+                            (c[i].clone() - c[i - 1].clone()) / (u[i].clone() - u[i - j].clone());
+                    }
+                }
+                let mut p = Polynomial::constant(c[m].clone());
+                for j in (0..m).rev() {
+                    p = p.mul(&Polynomial::new(vec![-u[j].clone(), Rational::from_i64(1)]));
+                    p = p.add(&Polynomial::constant(c[j].clone()));
+                }
+                let mut coeffs = p.coeffs;
+                coeffs.resize(m + 1, Rational::from_i64(0));
+                coeffs
+            };
+            let want = interpolate(&ys.iter().map(|&y| exact(y)).collect::<Vec<_>>());
+            // Column i of L: the interpolating polynomial of the i-th unit vector.
+            let l: Vec<Vec<f64>> = (0..=m)
+                .map(|i| {
+                    let unit: Vec<Rational> = (0..=m)
+                        .map(|j| Rational::from_i64(i64::from(i == j)))
+                        .collect();
+                    interpolate(&unit).iter().map(|c| c.to_f64()).collect()
+                })
+                .collect();
+            let scale: f64 = ys.iter().map(|y| y.abs()).sum();
+            let (_, p) = e.cov.as_ref().unwrap();
+            for k in 0..=m {
+                // The weights' relative error is a few 2⁻¹⁰⁶, so the sum's is that times Σ|L y|.
+                let largest = l.iter().map(|col| col[k].abs()).fold(0.0, f64::max);
+                let got = exact(e.z[k]) + exact(e.z_lo[k]);
+                let err = (got - want[k].clone()).to_f64().abs();
+                assert!(err <= 1e-28 * largest * scale, "m={m} k={k}: {err:e}");
+                // The covariance P = L Lᵀ, its diagonal.
+                let var: f64 = l.iter().map(|col| col[k] * col[k]).sum();
+                let rel = (p[(k, k)] - var).abs() / var;
+                assert!(rel <= 1e-13, "m={m} P_{k}{k}: {rel:e}");
             }
         }
     }

@@ -5,10 +5,13 @@
 //! by derivative order `k = 0..m`, used as `Z*_{n,n} = Z*_{n,n-1} + H ε_n`; the 1-step-predictor
 //! form uses `Φ(1) H` ([`GainForm`]).
 
-use crate::calculus::{choose, falling_factorial, link_matrix, Polynomial};
+use crate::calculus::{choose_integer, falling_factorial, link_matrix, Polynomial};
+use crate::numeric::memo::Memo;
 use crate::polynomial::form::{apply_form, GainForm};
 use crate::scalar::{Rational, Scalar};
 use nalgebra::DVector;
+use num_bigint::BigInt;
+use std::sync::Arc;
 
 /// The expanding-memory gains as rational functions of the sample index `n`:
 /// `h_k(n) = N_k(n) / (n+m+1)^(m+1)` with integer polynomial numerators
@@ -29,39 +32,59 @@ use nalgebra::DVector;
 /// assert_eq!(num[1].coeffs, vec![Rational::from_integer(6.into()), Rational::from_integer(0.into())]);
 /// ```
 pub fn expanding_gain_numerators(m: usize) -> Vec<Polynomial<Rational>> {
-    let sa = link_matrix::<Rational>(m);
-    let one = Rational::from_i64(1);
-    // Linear factor (n + a).
-    let lin = |a: i64| Polynomial::new(vec![Rational::from_i64(a), one.clone()]);
-    let falling_shift = |start: i64, count: usize| {
-        // (n + start)(n + start - 1) … (count factors)
-        let mut p = Polynomial::constant(one.clone());
-        for l in 0..count {
-            p = p.mul(&lin(start - l as i64));
+    // Everything is an integer (the link matrix holds unsigned Stirling numbers), so the
+    // polynomials are carried as big-integer coefficient vectors, lowest power first.
+    type Poly = Vec<BigInt>;
+    let int = |r: Rational| r.to_integer();
+    // falling(start)[c] = (n + start)(n + start − 1) … (c factors), c = 0 … m, one linear factor
+    // at a time.
+    let falling = |start: i64| {
+        let mut p: Vec<Poly> = vec![vec![BigInt::from(1)]];
+        for l in 0..m {
+            let a = BigInt::from(start - l as i64);
+            let prev = &p[l];
+            let mut next = vec![BigInt::from(0); prev.len() + 1];
+            for (d, c) in prev.iter().enumerate() {
+                next[d] += &a * c;
+                next[d + 1] += c;
+            }
+            p.push(next);
         }
         p
     };
+    let mul_into = |acc: &mut Poly, a: &Poly, b: &Poly, scale: &BigInt| {
+        for (i, x) in a.iter().enumerate() {
+            let xs = x * scale;
+            for (j, y) in b.iter().enumerate() {
+                acc[i + j] += &xs * y;
+            }
+        }
+    };
+    let upper = falling(m as i64 + 1);
+    // The inner sum does not depend on k: Q_i = Σ_j C(j,i) C(j+i,i) (2j+1) (n−i)^(j−i) (n+m+1)^(m−j),
+    // so N_k = Σ_i 𝒮_ki Q_i.
+    let q: Vec<Poly> = (0..=m)
+        .map(|i| {
+            let lower = falling(-(i as i64));
+            let mut total = vec![BigInt::from(0); m + 1];
+            for j in i..=m {
+                let c = choose_integer(j, i) * choose_integer(j + i, i) * BigInt::from(2 * j + 1);
+                mul_into(&mut total, &lower[j - i], &upper[m - j], &c);
+            }
+            total
+        })
+        .collect();
+    let sa = link_matrix::<Rational>(m);
     (0..=m)
         .map(|k| {
-            let mut total = Polynomial::new(vec![Rational::from_i64(0); m + 1]);
-            for i in k..=m {
-                let s = sa[(k, i)].clone();
-                if s == Rational::from_i64(0) {
-                    continue;
-                }
-                for j in i..=m {
-                    let c = choose::<Rational>(j, i)
-                        * choose::<Rational>(j + i, i)
-                        * Rational::from_i64(2 * j as i64 + 1)
-                        * s.clone();
-                    let term = falling_shift(-(i as i64), j - i)
-                        .mul(&falling_shift(m as i64 + 1, m - j))
-                        .scale(&c);
-                    total = total.add(&term);
+            let mut total = vec![BigInt::from(0); m + 1];
+            for (i, qi) in q.iter().enumerate().skip(k) {
+                let s = int(sa[(k, i)].clone());
+                for (t, c) in total.iter_mut().zip(qi) {
+                    *t += &s * c;
                 }
             }
-            total.coeffs.resize(m + 1, Rational::from_i64(0));
-            total
+            Polynomial::new(total.into_iter().map(Rational::from_integer).collect())
         })
         .collect()
 }
@@ -105,7 +128,8 @@ pub fn expanding_gains<T: Scalar>(m: usize, n: u64, form: GainForm) -> Vec<T> {
 #[derive(Clone, Debug)]
 pub struct ExpandingGainSchedule {
     m: usize,
-    numerators: Vec<Vec<f64>>,
+    /// The numerators' coefficients in `f64`, shared by every schedule of degree `m`.
+    numerators: Arc<Vec<Vec<f64>>>,
 }
 
 impl ExpandingGainSchedule {
@@ -116,10 +140,13 @@ impl ExpandingGainSchedule {
     /// assert_eq!(ExpandingGainSchedule::new(2).degree(), 2);
     /// ```
     pub fn new(m: usize) -> Self {
-        let numerators = expanding_gain_numerators(m)
-            .iter()
-            .map(|p| p.coeffs.iter().map(|c| c.to_f64()).collect())
-            .collect();
+        static NUMERATORS: Memo<usize, Vec<Vec<f64>>> = Memo::new();
+        let numerators = NUMERATORS.get(m, || {
+            expanding_gain_numerators(m)
+                .iter()
+                .map(|p| p.coeffs.iter().map(|c| c.to_f64()).collect())
+                .collect()
+        });
         Self { m, numerators }
     }
 
@@ -147,7 +174,7 @@ impl ExpandingGainSchedule {
         for l in 1..=self.m + 1 {
             den *= nf + l as f64;
         }
-        for (o, num) in out.iter_mut().zip(&self.numerators) {
+        for (o, num) in out.iter_mut().zip(self.numerators.iter()) {
             let mut acc = 0.0;
             for c in num.iter().rev() {
                 acc = acc * nf + c;

@@ -8,11 +8,13 @@
 //! sample chosen by a [`SwitchRule`].
 
 use super::vrf::{fading_vrf, fading_vrf_limit};
+use crate::calculus::{choose_integer, falling_factorial};
 use crate::error::Error;
+use crate::numeric::memo::Memo;
 use crate::polynomial::expanding::gains::ExpandingGainSchedule;
-use crate::polynomial::fixed::fixed_memory_vrf_limit;
 use crate::polynomial::form::EstimateForm;
 use crate::scalar::{Rational, Scalar};
+use num_bigint::BigInt;
 
 /// Morrison's Table 13.4 constant `c_im = (κ_ii(m)/λ_ii(m))^(1/(2i+1))`: a fading-memory filter
 /// of degree `m` and discount `θ` has the variance reduction in derivative `i` of a fixed-memory
@@ -25,9 +27,41 @@ use crate::scalar::{Rational, Scalar};
 /// ```
 pub fn memory_length_constant(i: usize, m: usize) -> f64 {
     assert!(i <= m, "derivative index {i} exceeds degree {m}");
-    let k = fixed_memory_vrf_limit(m)[(i, i)].to_f64();
-    let l = fading_vrf_limit(m)[(i, i)].to_f64();
-    (k / l).powf(1.0 / (2 * i + 1) as f64)
+    static CONSTANTS: Memo<(usize, usize), f64> = Memo::new();
+    *CONSTANTS.get((i, m), || {
+        let (k, l) = vrf_limit_diagonals(i, m);
+        (k.to_f64() / l.to_f64()).powf(1.0 / (2 * i + 1) as f64)
+    })
+}
+
+/// The diagonal entries `κ_ii` of [`crate::polynomial::fixed::fixed_memory_vrf_limit`] and `λ_ii` of
+/// [`fading_vrf_limit`], in integers: `κ = V H⁻¹ Vᵀ` with the inverse Hilbert matrix in its
+/// closed form `(H⁻¹)_jk = (−1)^(j+k) (j+k+1) C(m+1+j, m−k) C(m+1+k, m−j) C(j+k, j)²` and
+/// `V_ij = j^(i)`; `λ = G B Gᵀ` with `G_ij = C(j,i)`, `B_jk = C(j+k, j)/2^(j+k+1)`. One entry
+/// each, `O(m²)` integer products, instead of the whole rational matrices.
+fn vrf_limit_diagonals(i: usize, m: usize) -> (Rational, Rational) {
+    let int = |r: Rational| r.to_integer();
+    let c = choose_integer;
+    let v: Vec<BigInt> = (0..=m)
+        .map(|j| int(falling_factorial(Rational::from_i64(j as i64), i)))
+        .collect();
+    let (mut kappa, mut lambda) = (BigInt::from(0), BigInt::from(0));
+    for j in 0..=m {
+        for k in 0..=m {
+            let mut h = BigInt::from((j + k + 1) as i64)
+                * c(m + 1 + j, m - k)
+                * c(m + 1 + k, m - j)
+                * c(j + k, j).pow(2);
+            if (j + k) % 2 == 1 {
+                h = -h;
+            }
+            kappa += &v[j] * &v[k] * h;
+            // λ_ii on the common denominator 2^(2m+1).
+            lambda += c(j, i) * c(k, i) * c(j + k, j) * (BigInt::from(1) << (2 * m - j - k));
+        }
+    }
+    let two = BigInt::from(1) << (2 * m + 1);
+    (Rational::from_integer(kappa), Rational::new(lambda, two))
 }
 
 /// Reyneke's Table 1 switch constant (= Table 13.4 row 0), exactly: `(m+1)² / λ_00(m)`, the
@@ -207,6 +241,24 @@ mod tests {
                         .unwrap();
                     assert_eq!(first, index, "{rule:?} m {m} θ {theta}");
                 }
+            }
+        }
+    }
+
+    /// The integer closed forms equal the diagonals of the exact rational matrices.
+    #[test]
+    fn limit_diagonals_equal_the_rational_matrices() {
+        for m in 0..=10 {
+            let (kappa, lambda) = (
+                crate::polynomial::fixed::fixed_memory_vrf_limit(m),
+                fading_vrf_limit(m),
+            );
+            for i in 0..=m {
+                assert_eq!(
+                    vrf_limit_diagonals(i, m),
+                    (kappa[(i, i)].clone(), lambda[(i, i)].clone()),
+                    "m={m} i={i}"
+                );
             }
         }
     }
