@@ -50,6 +50,18 @@ pub enum Error {
         /// The largest degree accepted.
         max: usize,
     },
+    /// The degree is beyond what the gain engine supports (the exact engine supports it).
+    #[error(
+        "degree {degree} is too high for the gain engine: it is supported to degree {max} \
+         (above it its fixed-gain recursion is numerically unstable on irregular timestamps); \
+         use the exact engine"
+    )]
+    GainDegreeOutOfRange {
+        /// The rejected degree.
+        degree: usize,
+        /// The largest degree the gain engine accepts.
+        max: usize,
+    },
     /// Not enough samples to determine the estimate.
     #[error("too few samples: {got} given, at least {needed} needed")]
     TooFewSamples {

@@ -139,3 +139,92 @@ fn gain_engine_stays_close_to_least_squares_on_irregular_schedules() {
         }
     }
 }
+
+/// The gain engine's degree bound ([`GAIN_MAX_DEGREE`]): every constructor that runs the
+/// fixed-gain recursion refuses a higher degree with a typed error naming the bound, while the
+/// exact engine accepts it.
+#[test]
+fn gain_engine_refuses_degrees_above_its_bound() {
+    use seqsmooth::polynomial::automatic::AutomaticFilter;
+    use seqsmooth::polynomial::bank::{ExpandingBank, FadingBank};
+    use seqsmooth::polynomial::{GAIN_MAX_DEGREE, MAX_DEGREE};
+    use seqsmooth::Error;
+    let refused = |e: Error, m: usize| {
+        assert_eq!(
+            e,
+            Error::GainDegreeOutOfRange {
+                degree: m,
+                max: GAIN_MAX_DEGREE
+            }
+        );
+        assert!(e.to_string().contains("use the exact engine"), "{e}");
+    };
+    for m in GAIN_MAX_DEGREE + 1..=MAX_DEGREE {
+        refused(ExpandingMemory::new(m, Engine::Gain).unwrap_err(), m);
+        refused(FadingMemory::new(m, 0.9, 1.0, Engine::Gain).unwrap_err(), m);
+        refused(ExpandingBank::new(m, 1.0, 4).unwrap_err(), m);
+        refused(FadingBank::new(m, 0.9, 1.0, 4).unwrap_err(), m);
+        let auto = AutomaticFilter::new(m, 0.9, 1.0).and_then(|f| f.with_engine(Engine::Gain));
+        refused(auto.expect_err("the automatic filter refuses too"), m);
+        assert!(ExpandingMemory::new(m, Engine::Exact).is_ok());
+        assert!(FadingMemory::new(m, 0.9, 1.0, Engine::Exact).is_ok());
+    }
+    for m in 0..=GAIN_MAX_DEGREE {
+        assert!(ExpandingMemory::new(m, Engine::Gain).is_ok());
+        assert!(FadingMemory::new(m, 0.9, 1.0, Engine::Gain).is_ok());
+    }
+}
+
+/// At its highest degree the gain engine is still what ACCURACY.md says: on even steps equal
+/// to exact least squares to rounding, on 20%-jittered steps within a few σ of it (the
+/// approximation of gains scheduled for even spacing), not diverging. Oracle: the exact engine
+/// (itself checked against batch QR), with its own σ for unit noise as the unit.
+#[test]
+fn gain_engine_at_its_highest_degree_stays_close_to_least_squares() {
+    use rand::{Rng, SeedableRng};
+    use rand_distr::{Distribution, StandardNormal};
+    use seqsmooth::polynomial::GAIN_MAX_DEGREE;
+    use seqsmooth::PolynomialFilter;
+    let m = GAIN_MAX_DEGREE;
+    // Bounds: measured at most 2e-9σ on even steps and 1.0σ on jittered ones (10 seeds).
+    for (jitter, bound) in [(0.0, 1e-7), (0.2, 3.0)] {
+        for theta in [None, Some(0.5), Some(0.9)] {
+            let mut r = rand::rngs::StdRng::seed_from_u64(23);
+            let n = if theta.is_none() { 400 } else { 2000 };
+            let mut t = 0.0;
+            let build = |engine: Engine| -> Box<dyn PolynomialFilter> {
+                match theta {
+                    None => Box::new(
+                        ExpandingMemory::new(m, engine)
+                            .unwrap()
+                            .with_noise_sigma(1.0)
+                            .unwrap(),
+                    ),
+                    Some(th) => Box::new(
+                        FadingMemory::new(m, th, 1.0, engine)
+                            .unwrap()
+                            .with_noise_sigma(1.0)
+                            .unwrap(),
+                    ),
+                }
+            };
+            let (mut gain, mut exact) = (build(Engine::Gain), build(Engine::Exact));
+            let mut worst = 0.0f64;
+            for i in 0..n {
+                let noise: f64 = StandardNormal.sample(&mut r);
+                let y = 1e4 + 30.0 * t - 0.01 * t * t + noise;
+                gain.update(t, y).unwrap();
+                exact.update(t, y).unwrap();
+                if i >= n * 3 / 4 {
+                    let g = gain.estimate_at(t).unwrap().derivatives[0];
+                    let e = exact.estimate_at(t).unwrap();
+                    let sigma = e.covariance.unwrap()[(0, 0)].sqrt();
+                    assert!(g.is_finite(), "{theta:?} jitter {jitter}: sample {i}");
+                    worst = worst.max((g - e.derivatives[0]).abs() / sigma);
+                }
+                t += 1.0 + jitter * (r.gen::<f64>() - 0.5) * 2.0;
+            }
+            assert!(worst <= bound, "θ {theta:?} jitter {jitter}: {worst:e}σ");
+        }
+    }
+}

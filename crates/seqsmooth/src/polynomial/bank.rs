@@ -42,7 +42,7 @@ use super::expanding::gains::ExpandingGainSchedule;
 use super::fading::gains::fading_gains;
 use super::fading::switch::SwitchRule;
 use super::form::GainForm;
-use super::options::{check_degree, check_tau, check_theta};
+use super::options::{check_engine_degree, check_tau, check_theta, Engine};
 use crate::error::Error;
 use crate::model::{derivative_scale, for_each_shift_step};
 use rayon::prelude::*;
@@ -70,7 +70,7 @@ struct BankState {
 
 impl BankState {
     fn new(m: usize, tau: f64, channels: usize) -> Result<Self, Error> {
-        check_degree(m)?;
+        check_engine_degree(m, Engine::Gain)?;
         check_tau(tau)?;
         if channels == 0 {
             return Err(Error::InvalidParameter {

@@ -7,7 +7,7 @@
 //! | concept | module | source |
 //! |---|---|---|
 //! | what every filter does: [`PolynomialFilter`]; batch checks | `filter` | — |
-//! | engines, discounting, largest degree: [`Engine`], [`DiscountMode`], [`MAX_DEGREE`] | `options` | — |
+//! | engines, discounting, largest degree: [`Engine`], [`DiscountMode`], [`MAX_DEGREE`], [`GAIN_MAX_DEGREE`] | `options` | — |
 //! | current / predictor form of gains and VRFs: [`form::GainForm`], [`form::EstimateForm`], [`form::unscale`] | [`form`] | Morrison (9.7.4), (13.6.22) |
 //! | expanding memory: [`ExpandingMemory`], gains, VRF | [`expanding`] | Morrison ch. 9, Tables 9.1-9.2; Reyneke §6.3-6.4 |
 //! | fading memory: [`FadingMemory`], gains, VRF, the switch [`SwitchRule`] | [`fading`] | Morrison ch. 13, Tables 13.1-13.4, §13.8; Reyneke §6.5-6.6, Table 1 |
@@ -98,4 +98,4 @@ pub use automatic::{AutoConfig, AutoOutput, AutomaticFilter};
 pub use expanding::ExpandingMemory;
 pub use fading::{FadingMemory, SwitchRule};
 pub use filter::PolynomialFilter;
-pub use options::{DiscountMode, Engine, MAX_DEGREE};
+pub use options::{DiscountMode, Engine, GAIN_MAX_DEGREE, MAX_DEGREE};

@@ -8,7 +8,7 @@ use super::noise::NoiseSource;
 use super::outlier::OutlierRule;
 use crate::error::Error;
 use crate::polynomial::fading::switch::SwitchRule;
-use crate::polynomial::options::{check_degree, check_tau, check_theta};
+use crate::polynomial::options::{check_engine_degree, check_tau, check_theta};
 use crate::polynomial::options::{DiscountMode, Engine};
 
 /// The largest 1-step prediction VRF at which the outlier gate is applied (the default of
@@ -110,7 +110,7 @@ impl AutoConfig {
     /// `σ`, noise window, gate, restart significance, switch rule, ladder). The misfit window
     /// and `α` are checked by [`crate::stats::InnovationChiSquared::new`].
     pub(super) fn validate(&self) -> Result<(), Error> {
-        check_degree(self.degree)?;
+        check_engine_degree(self.degree, self.engine)?;
         check_theta(self.theta)?;
         check_tau(self.tau)?;
         if let Some(s) = self.noise_sigma {

@@ -4,7 +4,7 @@ use crate::error::Error;
 use crate::model::PolynomialState;
 use crate::polynomial::engine::{impl_polynomial_filter, EngineState, ExactEngine, GainEngine};
 use crate::polynomial::filter::PolynomialFilter;
-use crate::polynomial::options::{check_degree, Engine};
+use crate::polynomial::options::{check_engine_degree, Engine};
 
 /// Expanding-memory polynomial filter of degree `m` (Morrison ch. 9; Reyneke §6.3-6.4): the
 /// least-squares polynomial through all samples so far, with its derivatives, predictions and
@@ -38,7 +38,7 @@ impl ExpandingMemory {
     /// assert!(matches!(ExpandingMemory::new(99, Engine::Exact), Err(Error::DegreeOutOfRange { .. })));
     /// ```
     pub fn new(m: usize, engine: Engine) -> Result<Self, Error> {
-        check_degree(m)?;
+        check_engine_degree(m, engine)?;
         let core = match engine {
             Engine::Exact => EngineState::Exact(ExactEngine::new(m, None)),
             // The gain engine's output does not depend on τ for expanding memory; τ = 1.

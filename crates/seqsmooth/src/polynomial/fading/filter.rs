@@ -8,7 +8,7 @@ use crate::polynomial::engine::{
 };
 use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::options::{
-    check_degree, check_not_started, check_tau, check_theta, DiscountMode, Engine,
+    check_engine_degree, check_not_started, check_tau, check_theta, DiscountMode, Engine,
 };
 
 /// Fading-memory polynomial filter of degree `m` and discount `θ` per `τ` (Morrison ch. 13;
@@ -45,7 +45,7 @@ impl FadingMemory {
     /// assert!(matches!(FadingMemory::new(1, 0.9, 0.0, Engine::Gain), Err(Error::TauOutOfRange { .. })));
     /// ```
     pub fn new(m: usize, theta: f64, tau: f64, engine: Engine) -> Result<Self, Error> {
-        check_degree(m)?;
+        check_engine_degree(m, engine)?;
         check_theta(theta)?;
         check_tau(tau)?;
         let mode = DiscountMode::default();
