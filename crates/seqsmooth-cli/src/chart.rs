@@ -172,7 +172,7 @@ pub fn write(track: &Track, layout: &Layout, path: &Path) -> Result<(), CliError
     macro_rules! render {
         ($backend:ident) => {{
             let root = $backend::new(&temp, layout.size).into_drawing_area();
-            draw(&root, track, layout).map_err(fail)?;
+            draw(&root, track, layout, format == Format::Png).map_err(fail)?;
             root.present().map_err(|e| fail(e.into()))?;
         }};
     }
@@ -607,6 +607,7 @@ fn draw<DB: DrawingBackend<ErrorType: 'static>>(
     root: &DrawingArea<DB, Shift>,
     track: &Track,
     layout: &Layout,
+    split: bool,
 ) -> Result<(), Err> {
     root.fill(&WHITE)?;
     let (width, height) = (layout.size.0 as i32, layout.size.1 as i32);
@@ -667,16 +668,16 @@ fn draw<DB: DrawingBackend<ErrorType: 'static>>(
             range: (x0, x1),
             desc: (idx == last).then_some(x_desc),
         };
-        draw_panel(&area, track, panel, &axis)?;
+        draw_panel(&area, track, panel, &axis, split)?;
     }
     Ok(())
 }
 
-/// A polyline as its segments, each drawn on its own: the bitmap backend fills a wider-than-1
-/// polyline as one polygon, which a dense zig-zag turns into holes and spikes; a segment is a
-/// simple quadrilateral.
-fn segments(pts: Vec<(f64, f64)>, style: ShapeStyle) -> Vec<PathElement<(f64, f64)>> {
-    if style.stroke_width <= 1 || pts.len() < 3 {
+/// A polyline, with `split` as its segments, each drawn on its own: the bitmap backend fills a
+/// wider-than-1 polyline as one polygon, which a dense zig-zag turns into holes and spikes; a
+/// segment is a simple quadrilateral. (An SVG viewer strokes the polyline itself.)
+fn segments(pts: Vec<(f64, f64)>, style: ShapeStyle, split: bool) -> Vec<PathElement<(f64, f64)>> {
+    if !split || style.stroke_width <= 1 || pts.len() < 3 {
         return vec![PathElement::new(pts, style)];
     }
     pts.windows(2)
@@ -696,6 +697,7 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     track: &Track,
     p: &PanelData,
     axis: &Axis,
+    split: bool,
 ) -> Result<(), Err> {
     let bottom = axis.desc.is_some();
     let (y0, y1) = p.range;
@@ -823,7 +825,7 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         (&p.line, p.shift, ESTIMATE.stroke_width(2)),
     ] {
         for pts in curves(v, shift, 1.0) {
-            chart.draw_series(segments(pts, style))?;
+            chart.draw_series(segments(pts, style, split))?;
         }
     }
 

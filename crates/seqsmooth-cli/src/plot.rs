@@ -335,13 +335,13 @@ pub fn run(cfg: &PlotArgs) -> Result<(), CliError> {
     let h = fmt_f64(track.lead);
     let with_d0 = track.d[0].iter().filter(|d| d.is_some()).count();
     let lead = match compared {
-        0 if cfg.no_residuals => format!("estimates drawn at their time t + {h}{unit}"),
+        _ if cfg.no_residuals => format!("estimates drawn at t + {h}{unit}, their time"),
         0 => format!(
-            "estimates drawn at their time t + {h}{unit}; no residuals: no estimate has a \
-             sample at its time"
+            "estimates drawn at t + {h}{unit}, their time; no residuals: no sample is at \
+             the time of an estimate"
         ),
         _ => format!(
-            "estimates drawn at their time t + {h}{unit}; residuals against the sample at t + \
+            "estimates drawn at t + {h}{unit}, their time; residuals against the sample at t + \
              {h}{unit} ({compared} of {with_d0} estimates have one)"
         ),
     };

@@ -56,7 +56,7 @@ fn labels_are_short_and_distinct_at_any_magnitude() {
     assert_short_and_distinct("epoch ns", &l);
     assert_eq!(
         s.note("t"),
-        "t = t₀ + tick × 1e9, t₀ = 1700000000123456800 (as Unix ns: 2023-11-14 22:13:20 UTC)"
+        "t = t₀ + tick × 1e9, t₀ = 1.7000000001234568e18 (as Unix ns: 2023-11-14 22:13:20 UTC)"
     );
     for (lo, hi) in [
         (1.7e9, 1.7e9 + 60.0),
