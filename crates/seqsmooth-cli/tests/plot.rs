@@ -96,6 +96,13 @@ fn demo_writes_png_and_svg_in_the_current_directory() {
 
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<svg") && text.contains("width=\"1400\""));
+    // The SVG names the font the PNG embeds, with the viewer's sans-serif as the fallback.
+    let families = count(&text, "font-family=\"");
+    assert!(families > 20, "{families} texts");
+    assert_eq!(
+        count(&text, "font-family=\"DejaVu Sans, sans-serif\""),
+        families
+    );
     for label in [
         "seqsmooth demo: automatic filter on a turning aircraft",
         "time (s)",
