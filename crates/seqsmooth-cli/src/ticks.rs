@@ -78,6 +78,13 @@ impl Scale {
     }
 
     /// How to read a tick back as the value `name`; empty for the identity.
+    ///
+    /// ```
+    /// use seqsmooth_cli::ticks::Scale;
+    /// let s = Scale::for_range(0.0, 3e-9, None);
+    /// assert_eq!(s.note("value"), "value = tick × 1e-9");
+    /// assert!((s.to_axis(2e-9) - 2.0).abs() < 1e-12);
+    /// ```
     pub fn note(&self, name: &str) -> String {
         let power = format!("1e{}", self.exponent);
         let times = if self.exponent == 0 {
@@ -104,6 +111,12 @@ impl Scale {
 }
 
 /// Tick label text with the decimals the axis step needs (`-0` written `0`).
+///
+/// ```
+/// use seqsmooth_cli::ticks::tick;
+/// assert_eq!(tick(0.25, 0.05), "0.25");
+/// assert_eq!(tick(-0.0001, 0.5), "0.0");
+/// ```
 pub fn tick(v: f64, step: f64) -> String {
     let decimals = if step > 0.0 && step.is_finite() {
         (-(step.log10().floor()) as i32).clamp(0, 8) as usize
@@ -132,6 +145,13 @@ fn short(x: f64) -> String {
 
 /// `t` read as a Unix time in seconds, milliseconds, microseconds or nanoseconds — whichever
 /// puts it between 1980 and 2100 — and its UTC date and time (to the second).
+///
+/// ```
+/// use seqsmooth_cli::ticks::unix_date;
+/// let (unit, date) = unix_date(1.7e12).unwrap();
+/// assert_eq!((unit, date.as_str()), ("ms", "2023-11-14 22:13:20 UTC"));
+/// assert_eq!(unix_date(42.0), None);
+/// ```
 pub fn unix_date(t: f64) -> Option<(&'static str, String)> {
     // 1980-01-01 and 2100-01-01 in Unix seconds.
     const SPAN: (f64, f64) = (315_532_800.0, 4_102_444_800.0);
