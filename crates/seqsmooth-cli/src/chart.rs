@@ -335,9 +335,10 @@ fn panel(track: &Track, what: What, label: &str, at: &[Option<usize>]) -> PanelD
     };
     let (point_rows, points) = points.into_iter().unzip();
     // The rows after the start-up (all of them when none is marked settled).
-    let settled = match track.settled.len() == n && track.settled.contains(&true) {
-        true => track.settled.clone(),
-        false => vec![true; n],
+    let settled = if track.settled.len() == n && track.settled.contains(&true) {
+        track.settled.clone()
+    } else {
+        vec![true; n]
     };
     let rows = |f: &dyn Fn(usize, f64) -> Option<f64>| -> Vec<Option<f64>> {
         (0..n).map(|i| base(i).and_then(|b| f(i, b))).collect()
@@ -659,9 +660,10 @@ fn draw<DB: DrawingBackend<ErrorType: 'static>>(
             top
         };
         let note = x.note("t");
-        let x_desc = match note.is_empty() {
-            true => layout.time_label.clone(),
-            false => format!("{}; {note}", layout.time_label),
+        let x_desc = if note.is_empty() {
+            layout.time_label.clone()
+        } else {
+            format!("{}; {note}", layout.time_label)
         };
         let axis = Axis {
             scale: x.clone(),
@@ -716,9 +718,10 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     let x_fmt = move |v: &f64| tick(*v, x_step);
     let y_fmt = move |v: &f64| tick(*v, y_step);
     let note = ys.note("value");
-    let y_desc = match note.is_empty() {
-        true => p.label.clone(),
-        false => format!("{}; {note}", p.label),
+    let y_desc = if note.is_empty() {
+        p.label.clone()
+    } else {
+        format!("{}; {note}", p.label)
     };
     let mut mesh = chart.configure_mesh();
     mesh.x_labels(10)
