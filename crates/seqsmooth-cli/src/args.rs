@@ -83,7 +83,20 @@ columns) and, for K = 0, the samples (rejected ones as red crosses, from the aut
 outlier column); then a residual panel y - d0 with the estimate's +-3 sigma band about zero \
 and the auto filter's +-3 noise sigma (dashed). The spans where the auto filter's misfit flag \
 is up are shaded in every panel. Empty cells leave gaps. Axis ranges leave out the start-up \
-transients of the estimates; residuals beyond the range are drawn as triangles at its edge.
+transients of the estimates (the residual axis, the rows before the highest derivative column \
+has a value); residuals beyond the range are drawn as triangles at its edge.
+
+With a lead column (filter --lead H) each estimate is drawn at its own time t+H and, in the \
+residual panel, compared with the sample at that time (to a thousandth of the median step); \
+rows whose t+H is no sample time have no residual, and the subtitle says how many have one.
+
+A series with more rows than the plot has pixel columns is drawn decimated per pixel column \
+(the first, lowest, highest and last point of each column: every extreme kept), its samples \
+as a thin line instead of dots. An axis whose values share many leading digits, or are very \
+large or small, is drawn in tick units and its label says how to read them back: 'value = \
+tick x 1e9 + 1.7e18'; a time axis counts from its first time, 't = t0 + tick x 1e9, t0 = \
+1.7e18 (as Unix ns: 2023-11-14 22:13:20 UTC)', with the date when t0 reads as Unix seconds, \
+milliseconds, microseconds or nanoseconds.
 
 With --input (the file given to 'seqsmooth filter') the truth column --truth-col is drawn \
 too; the input's times and values must match the output's rows.
@@ -100,9 +113,9 @@ Output: CSV, one row per input row in input order, with the header
   --kind expanding, fading:  t,y,d0..dM            (and s0..sM with --sigma)
   --kind fixed:              t,y,d0..dM,window     (t,y,d0..dM,s0..sM,window with --sigma)
   --kind auto:               t,y,d0..dM,s0..sM,noise,outlier,misfit
-The t and y cells echo the input cells; dk is the k-th time derivative, in the input's time \
-units, of the estimate valid at t+H from the rows up to and including this one, and sk its \
-1-sigma error. Rows before the estimate is determined have empty d and s cells: the first M rows \
+and, with --lead H (H not 0), a last column lead holding H on every row. The t and y cells \
+echo the input cells; dk is the k-th time derivative, in the input's time units, of the \
+estimate valid at t+H from the rows up to and including this one, and sk its 1-sigma error. Rows before the estimate is determined have empty d and s cells: the first M rows \
 (expanding, fading), the first W-1 rows (fixed); auto estimates from the first row on.
 
 fixed: the least-squares polynomial through the last W rows, on any timestamps (Morrison's \
@@ -363,8 +376,8 @@ pub struct PlotArgs {
     /// Unit of the values, for the axis labels (e.g. m)
     #[arg(long, value_name = "UNIT")]
     pub value_unit: Option<String>,
-    /// The --lead H the output was made with: the estimates are drawn at t+H (and the residual
-    /// panel, which needs H = 0, is left out)
+    /// The --lead H the output was made with, for an output without a lead column (one with
+    /// it must agree): the estimates are drawn at t+H and compared with the samples at t+H
     #[arg(long, value_name = "H", default_value = "0", value_parser = parse_lead,
           allow_hyphen_values = true)]
     pub lead: f64,

@@ -9,17 +9,29 @@
 //! - one panel per requested derivative `k`: the estimate `d_k` (line), its ±3σ band (shaded),
 //!   the truth (thin black line) and, for `k = 0`, the samples (grey dots; rejected ones as red
 //!   crosses);
+//! - above them, one error panel per requested `k` where the truth is known: `d_k − truth_k`
+//!   about zero (the truth) with its ±3σ band and, for `k = 0`, the samples' `y − truth` and
+//!   ±3σ of the noise;
 //! - the residual panel `y − d0`, relative to the estimate: the residuals, the estimate's ±3σ
 //!   band about zero, ±3σ of the noise (dashed) where known, and `truth − d0` where known;
-//! - in every panel, the spans where the misfit flag is up (shaded orange), the switches to
-//!   fading memory (green dashed lines) and the restarts (purple lines).
+//!   with a lead, each estimate is compared with the sample at its own time `t + lead`;
+//! - in every panel, the spans without samples (shaded grey), the spans where the misfit flag
+//!   is up (shaded orange), the switches to fading memory (green dashed lines) and the
+//!   restarts (purple lines).
+//!
+//! A series with more points than the plot has pixel columns is drawn decimated per pixel
+//! column ([`crate::decimate`]), and its samples as a thin line rather than dots. Axes whose
+//! values share many leading digits or are very large or small are drawn in tick units with
+//! an offset and a power of ten, said in the axis label ([`crate::ticks`]).
 //!
 //! Axis ranges ignore the start-up transients of the estimates (the 1st-99th percentile of the
 //! estimates widened by the truth); a residual or band beyond the range is clipped to its edge,
-//! where a clipped residual is drawn as a triangle. Text is drawn with the embedded DejaVu Sans
-//! (no system fonts are read).
+//! where a clipped residual is drawn as a triangle. The PNG's text is drawn with the embedded
+//! DejaVu Sans (no system fonts are read); the SVG names the family `DejaVu Sans, sans-serif`.
 
+use crate::decimate::min_max;
 use crate::error::CliError;
+use crate::ticks::Scale;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -29,8 +41,9 @@ use std::sync::OnceLock;
 
 /// DejaVu Sans (Bitstream Vera licence, see `assets/LICENSE-DejaVu.txt`).
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-/// The family name the embedded font is registered under.
-const FAMILY: &str = "sans-serif";
+/// The family name the embedded font is registered under: the PNG is drawn with it; the SVG
+/// names it, with the viewer's `sans-serif` where DejaVu Sans is not installed.
+const FAMILY: &str = "DejaVu Sans, sans-serif";
 
 /// The image formats, chosen by a file's extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,7 +99,13 @@ pub struct Track {
     pub switches: Vec<f64>,
     /// Times at which the memory was restarted on misfit.
     pub restarts: Vec<f64>,
-    /// The estimates are valid at `t + lead` (the residual panel needs `lead = 0`).
+    /// Whether each row is past the start-up (its estimate of the full degree; empty: every
+    /// row): the residual and error panels' ranges leave the others out.
+    pub settled: Vec<bool>,
+    /// Spans `(from, to)` with no samples (e.g. a sensor outage), shaded in every panel.
+    pub outages: Vec<(f64, f64)>,
+    /// The estimates are valid at `t + lead`: drawn there, and compared with the sample at
+    /// that time where there is one ([`samples_at_lead`]).
     pub lead: f64,
 }
 
@@ -99,6 +118,8 @@ pub struct Layout {
     pub subtitle: String,
     /// Label of the time axis, with its unit.
     pub time_label: String,
+    /// The error panels `d_k − truth_k`, on top: the derivative order and the axis label.
+    pub errors: Vec<(usize, String)>,
     /// The derivative panels, top to bottom: the derivative order and the axis label.
     pub panels: Vec<(usize, String)>,
     /// Label of the residual panel; `None` for no residual panel.
@@ -124,6 +145,8 @@ const NOISE: RGBColor = RGBColor(230, 120, 0);
 const SWITCH: RGBColor = RGBColor(0, 140, 70);
 const RESTART: RGBColor = RGBColor(140, 40, 170);
 const MISFIT: RGBColor = RGBColor(255, 170, 60);
+const TRUTH_ERROR: RGBColor = RGBColor(0, 130, 140);
+const OUTAGE: RGBColor = RGBColor(150, 150, 150);
 
 fn register() -> Result<(), CliError> {
     static DONE: OnceLock<bool> = OnceLock::new();
@@ -149,7 +172,7 @@ pub fn write(track: &Track, layout: &Layout, path: &Path) -> Result<(), CliError
     macro_rules! render {
         ($backend:ident) => {{
             let root = $backend::new(&temp, layout.size).into_drawing_area();
-            draw(&root, track, layout).map_err(fail)?;
+            draw(&root, track, layout, format == Format::Png).map_err(fail)?;
             root.present().map_err(|e| fail(e.into()))?;
         }};
     }
@@ -207,79 +230,153 @@ pub fn runs(n: usize, keep: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize
     out
 }
 
-/// Tick label text with the decimals the axis step needs.
-pub fn tick(v: f64, step: f64) -> String {
-    let decimals = if step > 0.0 && step.is_finite() {
-        (-(step.log10().floor()) as i32).clamp(0, 8) as usize
-    } else {
-        2
-    };
-    let s = format!("{v:.decimals$}");
-    // "-0" and "-0.0" read as noise
-    let unsigned = s.trim_start_matches('-');
-    if unsigned.chars().all(|c| c == '0' || c == '.') {
-        unsigned.to_string()
-    } else {
-        s
+pub use crate::ticks::tick;
+
+/// The rows whose estimate has a sample at its own time `t + lead`: for each row, the index
+/// of the sample whose time is within a thousandth of the median step of `t + lead` (every
+/// row itself for `lead = 0`). `t` is strictly increasing.
+///
+/// ```
+/// use seqsmooth_cli::chart::samples_at_lead;
+/// let t = [0.0, 0.1, 0.2, 0.30000000000000004, 0.4];
+/// assert_eq!(samples_at_lead(&t, 0.2), vec![Some(2), Some(3), Some(4), None, None]);
+/// assert_eq!(samples_at_lead(&t, 0.0)[1], Some(1));
+/// ```
+pub fn samples_at_lead(t: &[f64], lead: f64) -> Vec<Option<usize>> {
+    if lead == 0.0 {
+        return (0..t.len()).map(Some).collect();
     }
+    let steps = t.windows(2).map(|w| w[1] - w[0]);
+    let tol = 1e-3 * quantile(steps, 0.5).unwrap_or(0.0);
+    t.iter()
+        .map(|&ti| {
+            let at = ti + lead;
+            let j = t.partition_point(|&s| s < at);
+            [j.checked_sub(1), Some(j)]
+                .into_iter()
+                .flatten()
+                .filter(|&j| j < t.len() && (t[j] - at).abs() <= tol)
+                .min_by(|&a, &b| (t[a] - at).abs().total_cmp(&(t[b] - at).abs()))
+        })
+        .collect()
 }
 
-/// One panel's y data, relative to the estimate for the residual panel.
+/// What a panel shows.
+#[derive(Clone, Copy, PartialEq)]
+enum What {
+    /// The estimate of derivative `k`, with the samples for `k = 0` and the truth.
+    Derivative(usize),
+    /// The error `d_k − truth_k` about zero (the truth), with the samples' `y − truth` for
+    /// `k = 0`.
+    Error(usize),
+    /// `y − d0` about zero (the estimate), with `truth − d0`.
+    Residual,
+}
+
+/// One panel's y data, relative to the estimate (residual panel) or the truth (error panel).
 struct PanelData {
     label: String,
     /// Points: (time, value, rejected).
     points: Vec<(f64, f64, bool)>,
-    /// The centre line (the estimate, or zero) by row.
+    /// The row of each point.
+    point_rows: Vec<usize>,
+    /// Whether each row is past the start-up (the relative panels' range is of those only).
+    settled: Vec<bool>,
+    /// The centre line (the estimate, its error, or zero) by row.
     line: Vec<Option<f64>>,
     /// The ±3σ half-width by row.
     band: Vec<Option<f64>>,
-    /// The truth (or truth − estimate) by row.
+    /// The truth (zero in an error panel, truth − estimate in the residual panel) by row.
     truth: Vec<Option<f64>>,
+    /// What the truth line is, for the legend.
+    truth_key: Key,
     /// ±3σ noise lines by row.
     noise: Vec<Option<f64>>,
-    /// The x offset of the line, band and truth (the lead).
+    /// The x offset of the line, band and truth (the lead), and of the truth alone.
     shift: f64,
+    truth_shift: f64,
     range: (f64, f64),
-    /// Clip points beyond the range to the edge (residual panel).
+    /// Clip points beyond the range to the edge (residual and error panels).
     clip_points: bool,
 }
 
-/// The panel of derivative `k`, or for `k = None` the residual panel, whose values are
-/// relative to the estimate `d0` (the rows without one are left out).
-fn panel(track: &Track, k: Option<usize>, label: &str) -> PanelData {
-    let (n, j) = (track.t.len(), k.unwrap_or(0));
+/// The panel showing `what` of `track`; `at[i]` is the sample at row `i`'s estimate time.
+fn panel(track: &Track, what: What, label: &str, at: &[Option<usize>]) -> PanelData {
+    let n = track.t.len();
+    let j = match what {
+        What::Derivative(k) | What::Error(k) => k,
+        What::Residual => 0,
+    };
     let cell = |v: &[Vec<Option<f64>>], i: usize| v.get(j).and_then(|v| v.get(i)).copied()?;
-    let base = |i: usize| k.map_or_else(|| cell(&track.d, i), |_| Some(0.0));
+    let truth = |i: usize| track.truth.get(j).and_then(|x| x.get(i)).copied();
+    // The sample at row i's estimate time, and the value every row's numbers are relative to.
+    let own = |i: usize| at.get(i).copied().flatten();
+    let base = |i: usize| match what {
+        What::Derivative(_) => Some(0.0),
+        What::Error(_) => own(i).and_then(truth),
+        What::Residual => own(i).and(cell(&track.d, i)),
+    };
     let rejected = |i: usize| track.rejected.get(i) == Some(&true);
-    let points = (0..n)
-        .filter(|_| k.unwrap_or(0) == 0)
-        .filter_map(|i| base(i).map(|b| (track.t[i], track.y[i] - b, rejected(i))))
-        .collect();
+    // Each point with its row: (row, time, value, rejected).
+    let points: Vec<(usize, (f64, f64, bool))> = match what {
+        What::Derivative(0) => (0..n)
+            .map(|i| (i, (track.t[i], track.y[i], rejected(i))))
+            .collect(),
+        What::Error(0) => (0..n)
+            .filter_map(|i| truth(i).map(|x| (i, (track.t[i], track.y[i] - x, rejected(i)))))
+            .collect(),
+        What::Residual => (0..n)
+            .filter_map(|i| {
+                let s = own(i)?;
+                base(i).map(|b| (i, (track.t[s], track.y[s] - b, rejected(s))))
+            })
+            .collect(),
+        _ => Vec::new(),
+    };
+    let (point_rows, points) = points.into_iter().unzip();
+    // The rows after the start-up (all of them when none is marked settled).
+    let settled = if track.settled.len() == n && track.settled.contains(&true) {
+        track.settled.clone()
+    } else {
+        vec![true; n]
+    };
     let rows = |f: &dyn Fn(usize, f64) -> Option<f64>| -> Vec<Option<f64>> {
         (0..n).map(|i| base(i).and_then(|b| f(i, b))).collect()
     };
-    let truth = |i: usize| track.truth.get(j).and_then(|x| x.get(i)).copied();
+    let relative = what != What::Derivative(j);
     let noise = |i: usize| {
         track
             .noise
             .get(i)
             .copied()
             .flatten()
-            .filter(|_| k.is_none())
+            .filter(|_| relative && j == 0)
     };
     let mut p = PanelData {
         label: label.to_string(),
         points,
+        point_rows,
+        settled,
         line: rows(&|i, b| cell(&track.d, i).map(|d| d - b)),
         band: rows(&|i, _| cell(&track.s, i).map(|s| 3.0 * s)),
-        truth: rows(&|i, b| truth(i).map(|x| x - b)),
+        truth: match what {
+            What::Derivative(_) => (0..n).map(truth).collect(),
+            What::Error(_) => rows(&|_, _| Some(0.0)),
+            What::Residual => rows(&|i, b| own(i).and_then(truth).map(|x| x - b)),
+        },
+        truth_key: if what == What::Residual {
+            Key::TruthError
+        } else {
+            Key::Truth
+        },
         noise: (0..n).map(|i| noise(i).map(|s| 3.0 * s)).collect(),
-        shift: if k.is_some() { track.lead } else { 0.0 },
+        shift: track.lead,
+        truth_shift: if relative { track.lead } else { 0.0 },
         range: (0.0, 1.0),
-        clip_points: k.is_none(),
+        clip_points: relative,
     };
     p.range = if p.clip_points {
-        p.residual_range()
+        p.relative_range()
     } else {
         p.derivative_range()
     };
@@ -316,17 +413,33 @@ impl PanelData {
         padded(range.unwrap_or((0.0, 1.0)), 0.05)
     }
 
-    /// Symmetric: the 99th percentile of |residual| of the accepted samples, every rejected one
-    /// up to twice that, the ±3σ noise and the settled band, the truth's error.
-    fn residual_range(&self) -> (f64, f64) {
-        let points = &self.points;
-        let q = |v: &mut dyn Iterator<Item = f64>, p| quantile(v, p).unwrap_or(0.0);
-        let mut r = q(&mut points.iter().filter(|p| !p.2).map(|p| p.1.abs()), 0.99)
-            .max(q(&mut self.noise.iter().flatten().copied(), 0.9))
-            .max(q(&mut self.band.iter().flatten().copied(), 0.9))
-            .max(q(&mut self.truth.iter().flatten().map(|e| e.abs()), 0.99));
+    /// Symmetric: the 99th percentile of |value| of the accepted samples, every rejected one
+    /// up to twice that, the ±3σ noise and the settled band, the truth's and the line's
+    /// distance from zero; of the rows past the start-up.
+    fn relative_range(&self) -> (f64, f64) {
+        let settled = |k: &usize| self.settled[*k];
+        let points = || {
+            let rows = self.point_rows.iter();
+            rows.zip(&self.points)
+                .filter(|(k, _)| settled(k))
+                .map(|(_, p)| p)
+        };
+        let rows = |v: &[Option<f64>]| -> Vec<f64> {
+            v.iter()
+                .zip(&self.settled)
+                .filter(|r| *r.1)
+                .filter_map(|r| *r.0)
+                .map(f64::abs)
+                .collect()
+        };
+        let q = |v: Vec<f64>, p| quantile(v, p).unwrap_or(0.0);
+        let mut r = q(points().filter(|p| !p.2).map(|p| p.1.abs()).collect(), 0.99)
+            .max(q(rows(&self.noise), 0.9))
+            .max(q(rows(&self.band), 0.9))
+            .max(q(rows(&self.truth), 0.99))
+            .max(q(rows(&self.line), 0.99));
         let cap = 2.0 * r;
-        for p in points.iter().filter(|p| p.2) {
+        for p in points().filter(|p| p.2) {
             r = r.max(p.1.abs().min(cap));
         }
         if r <= 0.0 || !r.is_finite() {
@@ -340,14 +453,17 @@ impl PanelData {
 #[derive(Clone, Copy, PartialEq)]
 enum Key {
     Data,
+    DataLine,
     Rejected,
     Estimate,
     Band,
     Truth,
+    TruthError,
     Noise,
     Switch,
     Restart,
     Misfit,
+    Outage,
     Clipped,
 }
 
@@ -355,35 +471,52 @@ impl Key {
     fn label(self) -> &'static str {
         match self {
             Key::Data => "samples",
+            Key::DataLine => "samples (too dense for dots: joined)",
             Key::Rejected => "rejected (outlier)",
             Key::Estimate => "estimate",
             Key::Band => "estimate ±3σ",
             Key::Truth => "truth",
+            Key::TruthError => "truth − estimate",
             Key::Noise => "noise ±3σ",
             Key::Switch => "switch to fading memory",
             Key::Restart => "misfit restart",
             Key::Misfit => "misfit flagged",
+            Key::Outage => "no samples (outage)",
             Key::Clipped => "beyond the axis",
         }
     }
 }
 
-fn legend_keys(panels: &[PanelData], track: &Track) -> Vec<Key> {
+/// Samples drawn as dots up to one per this many pixel columns, else joined by a line.
+const DOTS_PER_PIXEL: f64 = 0.5;
+
+/// Whether the panel's samples are too many for dots across `columns` pixels.
+fn dense(p: &PanelData, columns: u32) -> bool {
+    p.points.iter().filter(|q| !q.2).count() as f64 > DOTS_PER_PIXEL * f64::from(columns)
+}
+
+fn legend_keys(panels: &[PanelData], track: &Track, columns: u32) -> Vec<Key> {
     let any = |f: &dyn Fn(&PanelData) -> bool| panels.iter().any(f);
     let clipped = |p: &PanelData| {
         p.clip_points && p.points.iter().any(|q| q.1 < p.range.0 || q.1 > p.range.1)
     };
+    let samples = |p: &PanelData| p.points.iter().any(|q| !q.2);
+    let truth =
+        |key: Key| move |p: &PanelData| p.truth_key == key && p.truth.iter().any(Option::is_some);
     [
-        (any(&|p| p.points.iter().any(|q| !q.2)), Key::Data),
+        (any(&|p| samples(p) && !dense(p, columns)), Key::Data),
+        (any(&|p| samples(p) && dense(p, columns)), Key::DataLine),
         (any(&|p| p.points.iter().any(|q| q.2)), Key::Rejected),
         (any(&clipped), Key::Clipped),
         (any(&|p| p.line.iter().any(Option::is_some)), Key::Estimate),
         (any(&|p| p.band.iter().any(Option::is_some)), Key::Band),
-        (any(&|p| p.truth.iter().any(Option::is_some)), Key::Truth),
+        (any(&truth(Key::Truth)), Key::Truth),
+        (any(&truth(Key::TruthError)), Key::TruthError),
         (any(&|p| p.noise.iter().any(Option::is_some)), Key::Noise),
         (!track.switches.is_empty(), Key::Switch),
         (!track.restarts.is_empty(), Key::Restart),
         (track.misfit.iter().any(|&m| m), Key::Misfit),
+        (!track.outages.is_empty(), Key::Outage),
     ]
     .into_iter()
     .filter_map(|(on, key)| on.then_some(key))
@@ -406,17 +539,20 @@ fn symbol<DB: DrawingBackend<ErrorType: 'static>>(
     let rect = |c: RGBAColor| area.draw(&Rectangle::new(corners, c.filled()));
     match key {
         Key::Data => area.draw(&Circle::new((x, y), 3, DATA.filled())),
+        Key::DataLine => seg((x - 14, y), (x + 14, y), DATA, 1),
         Key::Rejected => area.draw(&Cross::new((x, y), 5, REJECTED.stroke_width(2))),
         Key::Clipped => area.draw(&TriangleMarker::new((x, y), 5, DATA.filled())),
         Key::Estimate => seg((x - 14, y), (x + 14, y), ESTIMATE, 2),
         Key::Band => rect(ESTIMATE.mix(0.22)),
         Key::Truth => seg((x - 14, y), (x + 14, y), TRUTH, 1),
+        Key::TruthError => seg((x - 14, y), (x + 14, y), TRUTH_ERROR, 2),
         Key::Noise => seg((x - 14, y), (x - 4, y), NOISE, 2)
             .and_then(|_| seg((x + 4, y), (x + 14, y), NOISE, 2)),
         Key::Switch => seg((x, y - 8), (x, y - 2), SWITCH, 2)
             .and_then(|_| seg((x, y + 2), (x, y + 8), SWITCH, 2)),
         Key::Restart => seg((x, y - 8), (x, y + 8), RESTART, 2),
         Key::Misfit => rect(MISFIT.mix(0.3)),
+        Key::Outage => rect(OUTAGE.mix(0.35)),
     }?;
     Ok(())
 }
@@ -450,22 +586,34 @@ fn legend_rows<DB: DrawingBackend<ErrorType: 'static>>(
     Ok(rows.into_iter().map(|(row, _)| row).collect())
 }
 
+/// The panels of `layout` drawn from `track`, top to bottom.
+fn panels(track: &Track, layout: &Layout) -> Vec<PanelData> {
+    let at = samples_at_lead(&track.t, track.lead);
+    let errors = layout.errors.iter().map(|(k, l)| (What::Error(*k), l));
+    let derivatives = layout.panels.iter().map(|(k, l)| (What::Derivative(*k), l));
+    let residuals = layout.residual_label.iter().map(|l| (What::Residual, l));
+    errors
+        .chain(derivatives)
+        .chain(residuals)
+        .map(|(what, label)| panel(track, what, label, &at))
+        .collect()
+}
+
+/// The plot width in pixels (the image less the axis label area and margins).
+fn plot_columns(layout: &Layout) -> u32 {
+    layout.size.0.saturating_sub(130).max(1)
+}
+
 fn draw<DB: DrawingBackend<ErrorType: 'static>>(
     root: &DrawingArea<DB, Shift>,
     track: &Track,
     layout: &Layout,
+    split: bool,
 ) -> Result<(), Err> {
     root.fill(&WHITE)?;
     let (width, height) = (layout.size.0 as i32, layout.size.1 as i32);
-
-    // The derivative panels, then the residual panel.
-    let derivatives = layout.panels.iter().map(|(k, label)| (Some(*k), label));
-    let residuals = layout.residual_label.iter().map(|label| (None, label));
-    let panels: Vec<PanelData> = derivatives
-        .chain(residuals)
-        .map(|(k, label)| panel(track, k, label))
-        .collect();
-    let keys = legend_keys(&panels, track);
+    let panels = panels(track, layout);
+    let keys = legend_keys(&panels, track, plot_columns(layout));
 
     // Title, subtitle, legend.
     let mut y = 12;
@@ -489,16 +637,18 @@ fn draw<DB: DrawingBackend<ErrorType: 'static>>(
     }
     y += 6;
 
-    // Panels: derivative panels weigh 1, the residual panel 0.7; the bottom one carries the
-    // time axis label.
+    // Panels: derivative panels weigh 1, the residual and error panels 0.7 (1 when they are
+    // the only ones); the bottom one carries the time axis label.
     let (_, mut rest) = root.split_vertically(y);
-    let weight = |p: &PanelData| if p.clip_points { 0.7 } else { 1.0 };
+    let residual = |p: &PanelData| p.clip_points && p.truth_key == Key::TruthError;
+    let weight = |p: &PanelData| if residual(p) { 0.7 } else { 1.0 };
     let total: f64 = panels.iter().map(weight).sum();
     // The height less the bottom panel's time axis.
     let usable = (height - y) as f64 - 30.0;
     let mut xr = None;
     widen(&mut xr, track.t.iter().flat_map(|&t| [t, t + track.lead]));
-    let x_range = padded(xr.unwrap_or((0.0, 1.0)), 0.01);
+    let (x0, x1) = padded(xr.unwrap_or((0.0, 1.0)), 0.01);
+    let x = Scale::for_range(x0, x1, track.t.first().copied());
     let last = panels.len().saturating_sub(1);
     for (idx, panel) in panels.iter().enumerate() {
         let area = if idx == last {
@@ -509,21 +659,53 @@ fn draw<DB: DrawingBackend<ErrorType: 'static>>(
             rest = bottom;
             top
         };
-        let x_desc = (idx == last).then_some(layout.time_label.as_str());
-        draw_panel(&area, track, panel, x_range, x_desc)?;
+        let note = x.note("t");
+        let x_desc = if note.is_empty() {
+            layout.time_label.clone()
+        } else {
+            format!("{}; {note}", layout.time_label)
+        };
+        let axis = Axis {
+            scale: x.clone(),
+            range: (x0, x1),
+            desc: (idx == last).then_some(x_desc),
+        };
+        draw_panel(&area, track, panel, &axis, split)?;
     }
     Ok(())
+}
+
+/// A polyline, with `split` as its segments, each drawn on its own: the bitmap backend fills a
+/// wider-than-1 polyline as one polygon, which a dense zig-zag turns into holes and spikes; a
+/// segment is a simple quadrilateral. (An SVG viewer strokes the polyline itself.)
+fn segments(pts: Vec<(f64, f64)>, style: ShapeStyle, split: bool) -> Vec<PathElement<(f64, f64)>> {
+    if !split || style.stroke_width <= 1 || pts.len() < 3 {
+        return vec![PathElement::new(pts, style)];
+    }
+    pts.windows(2)
+        .map(|w| PathElement::new(w.to_vec(), style))
+        .collect()
+}
+
+/// The time axis: its scale, its range (in time units) and, on the bottom panel, its label.
+struct Axis {
+    scale: Scale,
+    range: (f64, f64),
+    desc: Option<String>,
 }
 
 fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     area: &DrawingArea<DB, Shift>,
     track: &Track,
     p: &PanelData,
-    (x0, x1): (f64, f64),
-    x_desc: Option<&str>,
+    axis: &Axis,
+    split: bool,
 ) -> Result<(), Err> {
-    let bottom = x_desc.is_some();
+    let bottom = axis.desc.is_some();
     let (y0, y1) = p.range;
+    let ys = Scale::for_range(y0, y1, None);
+    let (xs, (x0, x1)) = (&axis.scale, axis.range);
+    let (ax, ay) = (|t: f64| xs.to_axis(t), |v: f64| ys.to_axis(v));
     let mut chart = ChartBuilder::on(area)
         .margin_left(10)
         .margin_right(25)
@@ -531,10 +713,16 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         .margin_bottom(if bottom { 8 } else { 4 })
         .x_label_area_size(if bottom { 55 } else { 28 })
         .y_label_area_size(95)
-        .build_cartesian_2d(x0..x1, y0..y1)?;
-    let (x_step, y_step) = ((x1 - x0) / 10.0, (y1 - y0) / 6.0);
+        .build_cartesian_2d(ax(x0)..ax(x1), ay(y0)..ay(y1))?;
+    let (x_step, y_step) = ((ax(x1) - ax(x0)) / 10.0, (ay(y1) - ay(y0)) / 6.0);
     let x_fmt = move |v: &f64| tick(*v, x_step);
     let y_fmt = move |v: &f64| tick(*v, y_step);
+    let note = ys.note("value");
+    let y_desc = if note.is_empty() {
+        p.label.clone()
+    } else {
+        format!("{}; {note}", p.label)
+    };
     let mut mesh = chart.configure_mesh();
     mesh.x_labels(10)
         .y_labels(6)
@@ -545,44 +733,55 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         .max_light_lines(2)
         .light_line_style(RGBColor(242, 242, 242))
         .bold_line_style(RGBColor(215, 215, 215))
-        .y_desc(p.label.clone());
-    if let Some(desc) = x_desc {
-        mesh.x_desc(desc);
+        .y_desc(y_desc);
+    if let Some(desc) = &axis.desc {
+        mesh.x_desc(desc.as_str());
     }
     mesh.draw()?;
 
     let n = track.t.len();
-    let clamp = |v: f64| v.clamp(y0, y1);
+    let columns = chart.plotting_area().dim_in_pixel().0.max(1);
+    let span = (ax(x0), ax(x1));
+    let thin = |pts: Vec<(f64, f64)>| min_max(&pts, span, columns as usize);
+    let clamp = |v: f64| ay(v.clamp(y0, y1));
+    let (top, floor) = (ay(y1), ay(y0));
+    let shade =
+        |a: f64, b: f64, c: RGBAColor| Rectangle::new([(ax(a), top), (ax(b), floor)], c.filled());
 
-    // Misfit spans: from each flagged row to the next row.
+    // Outages, then the misfit spans: from each flagged row to the next row.
+    for &(a, b) in &track.outages {
+        chart.draw_series([shade(a, b, OUTAGE.mix(0.35))])?;
+    }
     if track.misfit.len() == n {
         for r in runs(n, |i| track.misfit[i]) {
             let a = track.t[r.start];
             let b = track.t[r.end.min(n - 1)].max(a);
-            let span = Rectangle::new([(a, y0), (b, y1)], MISFIT.mix(0.3).filled());
-            chart.draw_series([span])?;
+            chart.draw_series([shade(a, b, MISFIT.mix(0.3))])?;
         }
     }
 
-    // ±3σ band.
+    // ±3σ band: each edge decimated on its own.
     for r in runs(n, |i| p.line[i].is_some() && p.band[i].is_some()) {
-        let edge = |i: usize, sign: f64| {
-            let (l, b) = (p.line[i].unwrap_or(0.0), p.band[i].unwrap_or(0.0));
-            (track.t[i] + p.shift, clamp(l + sign * b))
+        let edge = |sign: f64| {
+            let at = |i: usize| {
+                let (l, b) = (p.line[i].unwrap_or(0.0), p.band[i].unwrap_or(0.0));
+                (ax(track.t[i] + p.shift), clamp(l + sign * b))
+            };
+            thin(r.clone().map(at).collect())
         };
-        let poly: Vec<(f64, f64)> = (r.clone().map(|i| edge(i, 1.0)))
-            .chain(r.rev().map(|i| edge(i, -1.0)))
-            .collect();
+        let mut poly = edge(1.0);
+        poly.extend(edge(-1.0).into_iter().rev());
         chart.draw_series([Polygon::new(poly, ESTIMATE.mix(0.22).filled())])?;
     }
 
-    // The runs of a row-wise curve, `sign` times its values, at the times moved by `shift`.
+    // The runs of a row-wise curve, `sign` times its values, at the times moved by `shift`,
+    // decimated to the pixel columns.
     let curves = |v: &[Option<f64>], shift: f64, sign: f64| -> Vec<Vec<(f64, f64)>> {
         runs(n, |i| v[i].is_some())
             .into_iter()
             .map(|r| {
-                r.map(|i| (track.t[i] + shift, clamp(sign * v[i].unwrap_or(0.0))))
-                    .collect()
+                let at = |i: usize| (ax(track.t[i] + shift), clamp(sign * v[i].unwrap_or(0.0)));
+                thin(r.map(at).collect())
             })
             .collect()
     };
@@ -594,11 +793,12 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         }
     }
 
-    // Samples: the points `$keep` picks, as `$shape`s at their values clamped to the range.
+    // Samples: the points `$keep` picks, as `$shape`s at their values clamped to the range;
+    // too many for dots, the accepted ones are joined by a thin line instead.
     let inside = |v: f64| v >= y0 && v <= y1;
     macro_rules! points {
         ($keep:expr, $shape:ident, $size:expr, $style:expr) => {
-            let at = |q: &(f64, f64, bool)| (q.0, clamp(q.1));
+            let at = |q: &(f64, f64, bool)| (ax(q.0), clamp(q.1));
             let shapes = p
                 .points
                 .iter()
@@ -607,18 +807,28 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
             chart.draw_series(shapes)?;
         };
     }
-    points!(|q| !q.2 && inside(q.1), Circle, 2, DATA.filled());
+    if dense(p, columns) {
+        let accepted = p.points.iter().filter(|q| !q.2);
+        let line = thin(accepted.map(|q| (ax(q.0), clamp(q.1))).collect());
+        chart.draw_series(LineSeries::new(line, DATA.stroke_width(1)))?;
+    } else {
+        points!(|q| !q.2 && inside(q.1), Circle, 2, DATA.filled());
+    }
     if p.clip_points {
         points!(|q| !inside(q.1), TriangleMarker, 5, DATA.filled());
     }
 
     // Truth, then the estimate over it.
-    for (v, style) in [
-        (&p.truth, TRUTH.stroke_width(1)),
-        (&p.line, ESTIMATE.stroke_width(2)),
+    let truth_style = match p.truth_key {
+        Key::TruthError => TRUTH_ERROR.stroke_width(2),
+        _ => TRUTH.stroke_width(1),
+    };
+    for (v, shift, style) in [
+        (&p.truth, p.truth_shift, truth_style),
+        (&p.line, p.shift, ESTIMATE.stroke_width(2)),
     ] {
-        for pts in curves(v, p.shift, 1.0) {
-            chart.draw_series(LineSeries::new(pts, style))?;
+        for pts in curves(v, shift, 1.0) {
+            chart.draw_series(segments(pts, style, split))?;
         }
     }
 
@@ -626,7 +836,7 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     points!(|q| q.2, Cross, 5, REJECTED.stroke_width(2));
 
     // Events: switches to fading memory (dashed), restarts.
-    let edge = |t: f64| vec![(t, y0), (t, y1)];
+    let edge = |t: f64| vec![(ax(t), top), (ax(t), floor)];
     for &t in &track.switches {
         chart.draw_series(DashedLineSeries::new(edge(t), 8, 6, SWITCH.stroke_width(2)))?;
     }

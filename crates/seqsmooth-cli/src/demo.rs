@@ -253,6 +253,15 @@ fn track(data: &[Point], outs: &[AutoOutput]) -> Track {
         misfit: outs.iter().map(|o| o.misfit).collect(),
         switches: switches.map(|i| outs[i].time).collect(),
         restarts: outs.iter().filter(|o| o.restart).map(|o| o.time).collect(),
+        settled: outs
+            .iter()
+            .map(|o| {
+                o.estimate
+                    .as_ref()
+                    .is_some_and(|e| e.derivatives.len() > DEGREE)
+            })
+            .collect(),
+        outages: vec![(OUTAGE.0, OUTAGE.0 + OUTAGE.1)],
         lead: 0.0,
     }
 }
@@ -265,10 +274,9 @@ fn layout(tau: f64) -> Layout {
              {SAMPLES} radar samples, σ = {SIGMA} m, jittered steps, dropouts, 6-10σ outliers"
         ),
         time_label: "time (s)".into(),
-        panels: vec![
-            (0, "east position (m)".into()),
-            (1, "east velocity (m/s)".into()),
-        ],
+        // The position itself spans 30 km against σ = 15 m: its error is what can be seen.
+        errors: vec![(0, "east position error: estimate − truth (m)".into())],
+        panels: vec![(1, "east velocity (m/s)".into())],
         residual_label: Some("residual y − estimate (m)".into()),
         size: (1400, Layout::default_height(2, true)),
     }

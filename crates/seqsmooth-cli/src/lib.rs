@@ -6,6 +6,7 @@
 
 pub mod args;
 pub mod chart;
+pub mod decimate;
 pub mod demo;
 pub mod error;
 pub mod filter;
@@ -14,4 +15,5 @@ pub mod io;
 pub mod plot;
 pub mod progress;
 pub mod smooth;
+pub mod ticks;
 pub mod vrf;

@@ -2,7 +2,9 @@
 //!
 //! The output's columns say what there is to draw: `t,y,d0..dM` always, `s0..sM` (the ±3σ
 //! bands) with `--sigma` or `--kind auto`, `noise,outlier,misfit` for `--kind auto` (the ±3σ
-//! noise lines, rejected samples, misfit spans), `window` for `--kind fixed` (not drawn). Empty
+//! noise lines, rejected samples, misfit spans), `window` for `--kind fixed` (not drawn), `lead`
+//! with `--lead H` (the estimates are drawn at `t + H`, and each is compared in the residual
+//! panel with the sample at that time where there is one). Empty
 //! cells (no estimate yet, a degree not reached yet) leave gaps. The filter's input file may be
 //! given too, for a truth column. The drawing is [`crate::chart`]'s, the same as the demo's.
 
@@ -107,6 +109,33 @@ impl Table {
         self.column(col).map_or(Ok(Vec::new()), |i| read(self, i))
     }
 
+    /// The lead of the `lead` column (the same in every row), which `--lead` may repeat.
+    fn lead(&self, idx: usize, given: f64) -> Result<f64, CliError> {
+        let v = self.filled(idx, "lead")?;
+        let first = v[0];
+        let bad = |i: usize, why: &str| {
+            let (line, r) = &self.rows[i];
+            Err(CliError::Data(format!(
+                "{}: line {line}, column 'lead': {} {why}",
+                self.name,
+                shown(r[idx].as_bytes())
+            )))
+        };
+        if let Some(i) = v.iter().position(|&h| h != first) {
+            return bad(
+                i,
+                "differs from the lead of the first row: one filter run has one lead",
+            );
+        }
+        if !first.is_finite() {
+            return bad(0, "is not a finite lead");
+        }
+        if given != 0.0 && given != first {
+            return bad(0, &format!("is not the --lead {} given", fmt_f64(given)));
+        }
+        Ok(first)
+    }
+
     /// Non-negative numbers (standard deviations), empty cells allowed.
     fn sigmas(&self, idx: usize) -> Column<Option<f64>> {
         let v = self.numbers(idx, "standard deviation", true)?;
@@ -205,6 +234,19 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
     let noise = out.optional("noise", Table::sigmas)?;
     let rejected = out.optional("outlier", Table::flags)?;
     let misfit = out.optional("misfit", Table::flags)?;
+    // Past the start-up: the rows with the highest derivative of the output.
+    let highest = (0..)
+        .take_while(|k| out.column(&format!("d{k}")).is_some())
+        .last();
+    let settled = match highest {
+        Some(m) => out.numbers(out.required(&format!("d{m}"), "")?, "derivative", true)?,
+        None => Vec::new(),
+    };
+    let settled = settled.iter().map(Option::is_some).collect();
+    let lead = match out.column("lead") {
+        Some(idx) => out.lead(idx, cfg.lead)?,
+        None => cfg.lead,
+    };
     let mut truth = Vec::new();
     if let Some(path) = &cfg.input {
         let input = Table::read(Some(path))?;
@@ -264,7 +306,8 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
             noise,
             rejected,
             misfit,
-            lead: cfg.lead,
+            lead,
+            settled,
             ..Track::default()
         },
         title,
@@ -277,21 +320,43 @@ pub fn run(cfg: &PlotArgs) -> Result<(), CliError> {
     }
     let (track, default_title) = read_track(cfg)?;
     let (tu, vu) = (cfg.time_unit.as_deref(), cfg.value_unit.as_deref());
-    let residuals = !cfg.no_residuals && cfg.lead == 0.0 && track.d[0].iter().any(Option::is_some);
+    // With a lead, each estimate is compared with the sample at its own time t + H.
+    let at = chart::samples_at_lead(&track.t, track.lead);
+    let compared = (0..track.t.len())
+        .filter(|&i| at[i].is_some() && track.d[0][i].is_some())
+        .count();
+    let residuals = !cfg.no_residuals && compared > 0;
     let panels: Vec<(usize, String)> = cfg
         .derivative
         .iter()
         .map(|&k| (k, derivative_label(k, tu, vu)))
         .collect();
     let unit = tu.map(|u| format!(" {u}")).unwrap_or_default();
-    let lead = format!("estimates drawn at t + {}{unit}", fmt_f64(cfg.lead));
+    let h = fmt_f64(track.lead);
+    let with_d0 = track.d[0].iter().filter(|d| d.is_some()).count();
+    let lead = match compared {
+        _ if cfg.no_residuals => format!("estimates drawn at t + {h}{unit}, their time"),
+        0 => format!(
+            "estimates drawn at t + {h}{unit}, their time; no residuals: no sample is at \
+             the time of an estimate"
+        ),
+        _ => format!(
+            "estimates drawn at t + {h}{unit}, their time; residuals against the sample at t + \
+             {h}{unit} ({compared} of {with_d0} estimates have one)"
+        ),
+    };
     let default_height = Layout::default_height(cfg.derivative.len(), residuals);
     let layout = Layout {
         title: cfg.title.clone().unwrap_or(default_title),
-        subtitle: if cfg.lead != 0.0 { lead } else { String::new() },
+        subtitle: if track.lead != 0.0 {
+            lead
+        } else {
+            String::new()
+        },
         time_label: with_unit("time t", tu),
         residual_label: residuals.then(|| with_unit("residual y − d0", vu)),
         size: (cfg.width, cfg.height.unwrap_or(default_height)),
+        errors: Vec::new(),
         panels,
     };
     for p in &cfg.output {

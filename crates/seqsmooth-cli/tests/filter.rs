@@ -197,11 +197,15 @@ fn filter_output_round_trips_library_values() {
             .unwrap()
             .with_noise_sigma(1e-150)
             .unwrap();
-        let (_, rows) = table(&out);
+        let (header, rows) = table(&out);
+        assert_eq!(header.last().map(String::as_str), Some("lead"));
         for (row, &(t, y)) in rows.iter().zip(&samples) {
             f.update(t, y).unwrap();
             assert_eq!(num(&row[0]).to_bits(), t.to_bits());
             assert_eq!(num(&row[1]).to_bits(), y.to_bits());
+            // The trailing lead column records --lead.
+            let (row, lead) = row.split_at(row.len() - 1);
+            assert_eq!(lead, ["0.002"]);
             match f.estimate_at(t + 2e-3) {
                 None => assert!(row[2..].iter().all(String::is_empty), "{row:?}"),
                 Some(s) => {
@@ -362,6 +366,9 @@ fn filter_fixed_t7_08() {
         let mut want_header = vec!["t".to_string(), "y".to_string()];
         want_header.extend((0..want.len()).map(|k| format!("d{k}")));
         want_header.push("window".into());
+        if lead != "0" {
+            want_header.push("lead".into());
+        }
         assert_eq!(header, want_header);
         assert_eq!(rows.len(), 5);
         for (k, row) in rows[..4].iter().enumerate() {
@@ -468,7 +475,7 @@ fn filter_fixed_irregular_times() {
     let (header, rows) = table(&out);
     assert_eq!(
         header,
-        ["t", "y", "d0", "d1", "d2", "s0", "s1", "s2", "window"]
+        ["t", "y", "d0", "d1", "d2", "s0", "s1", "s2", "window", "lead"]
     );
     let mut f = FixedMemory::new(2, 9, FixedEngine::Irregular)
         .unwrap()

@@ -96,12 +96,21 @@ fn demo_writes_png_and_svg_in_the_current_directory() {
 
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<svg") && text.contains("width=\"1400\""));
+    // The SVG names the font the PNG embeds, with the viewer's sans-serif as the fallback.
+    let families = count(&text, "font-family=\"");
+    assert!(families > 20, "{families} texts");
+    assert_eq!(
+        count(&text, "font-family=\"DejaVu Sans, sans-serif\""),
+        families
+    );
     for label in [
         "seqsmooth demo: automatic filter on a turning aircraft",
         "time (s)",
-        "east position (m)",
+        "east position error: estimate − truth (m)",
         "east velocity (m/s)",
         "residual y − estimate (m)",
+        "truth − estimate",
+        "no samples (outage)",
         "samples",
         "rejected (outlier)",
         "estimate ±3σ",
@@ -324,7 +333,8 @@ fn plot_every_filter_kind() {
 }
 
 /// Two derivative panels with units, a title, a size; standard input as the source; the
-/// input's truth column; a lead drops the residual panel.
+/// input's truth column; with a lead the residual panel compares the estimates with the samples
+/// at their time t + H (`plot_compares_a_lead_with_the_sample_at_its_time`).
 #[test]
 fn plot_options() {
     let dir = fresh_dir("plot-options");
@@ -427,15 +437,26 @@ fn plot_options() {
     );
     let svg = svg_of(&dir.join("lead.svg"));
     assert!(!svg.contains("residual") && svg.contains("estimates drawn at t + 2"));
+    // Without --no-residuals the rows whose t + 2 is a sample time are compared with it.
     ok_in(
         &dir,
-        &["plot", "lead.csv", "-o", "lead2.png", "--lead", "2"],
+        &[
+            "plot",
+            "lead.csv",
+            "-o",
+            "lead2.png",
+            "-o",
+            "lead2.svg",
+            "--lead",
+            "2",
+        ],
         "",
     );
     assert_eq!(
         png_size(&dir.join("lead2.png")),
-        (1200, default_height(1, false))
+        (1200, default_height(1, true))
     );
+    assert!(svg_of(&dir.join("lead2.svg")).contains("residuals against the sample at t + 2 ("));
 }
 
 /// Bad input is a data error (exit 1) naming the file, line and column; bad arguments are
@@ -597,4 +618,134 @@ fn plot_errors() {
         "",
     );
     assert!(svg_of(&dir.join("ok.svg")).contains("dy/dt"));
+}
+
+/// `filter --lead H` records H in a trailing `lead` column; `plot` reads it (no `--lead`
+/// needed), draws each estimate at its own time t + H and compares it with the sample there:
+/// on evenly spaced rows with H = 4 steps every row but the last four has one, and on a
+/// straight line those residuals are zero (the axis then spans the default ±1.08). A lead
+/// that matches no sample says so instead of comparing the estimate with the wrong sample; a
+/// column with two leads, or a `--lead` that contradicts it, is an error.
+#[test]
+fn plot_compares_a_lead_with_the_sample_at_its_time() {
+    let dir = fresh_dir("plot-lead-column");
+    let mut data = String::from("t,y\n");
+    for i in 0..100 {
+        let t = 1.7e9 + 0.5 * i as f64;
+        data += &format!("{t},{}\n", 3.0 + 2.0 * (t - 1.7e9));
+    }
+    std::fs::write(dir.join("data.csv"), &data).unwrap();
+    let out = filter_output(
+        &dir,
+        "lead",
+        &["--kind", "expanding", "--degree", "1", "--lead", "2"],
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("t,y,d0,d1,lead"));
+    assert!(lines.all(|l| l.ends_with(",2")), "{text}");
+    ok_in(
+        &dir,
+        &["plot", "lead.csv", "-o", "lead.svg", "-o", "lead.png"],
+        "",
+    );
+    let svg = svg_of(&dir.join("lead.svg"));
+    assert!(
+        svg.contains("estimates drawn at t + 2, their time; residuals against the sample at t + 2 (95 of 99 estimates have one)"),
+        "{}",
+        svg.lines().filter(|l| l.contains("estimates")).collect::<String>()
+    );
+    assert!(svg.contains("residual y − d0"));
+    assert_eq!(
+        png_size(&dir.join("lead.png")),
+        (1200, default_height(1, true))
+    );
+    // The residuals of a straight line are zero: no residual stretches the axis.
+    assert!(
+        svg.contains("\n1.0\n") && svg.contains("\n-1.0\n"),
+        "residual axis"
+    );
+
+    let odd = filter_output(
+        &dir,
+        "odd",
+        &["--kind", "expanding", "--degree", "1", "--lead", "0.3"],
+    );
+    ok_in(&dir, &["plot", odd.to_str().unwrap(), "-o", "odd.svg"], "");
+    let svg = svg_of(&dir.join("odd.svg"));
+    assert!(svg.contains("no residuals: no sample is at the time of an estimate"));
+    assert!(!svg.contains("residual y − d0"));
+
+    fails_in(
+        &dir,
+        &["plot", "lead.csv", "-o", "x.png", "--lead", "3"],
+        "",
+        1,
+        &[
+            "'lead.csv'",
+            "line 2, column 'lead'",
+            "is not the --lead 3 given",
+        ],
+    );
+    let mixed = text
+        .replacen(",2\n", ",2.5\n", 2)
+        .replacen(",2.5\n", ",2\n", 1);
+    std::fs::write(dir.join("mixed.csv"), mixed).unwrap();
+    fails_in(
+        &dir,
+        &["plot", "mixed.csv", "-o", "x.png"],
+        "",
+        1,
+        &["line 3, column 'lead': 2.5 differs from the lead of the first row"],
+    );
+    assert!(!dir.join("x.png").exists());
+}
+
+/// A dense series (6,070 rows at 100 Hz, more than the 1,070 pixel columns of the plot) is
+/// drawn decimated: its samples as one thin line instead of 6,070 dots, every curve at most
+/// four points per pixel column; epoch-nanosecond times and a 1e-9-scale value get short tick
+/// labels and axis labels that say how to read them.
+#[test]
+fn dense_epoch_series_is_decimated_with_readable_ticks() {
+    let dir = fresh_dir("plot-dense");
+    let mut data = String::from("t,y\n");
+    for i in 0..6070u64 {
+        let t = 1_700_000_000_000_000_000u64 + i * 10_000_000;
+        let noise = ((i * 7919) % 101) as f64 / 100.0 - 0.5;
+        let y = 2e-9 + 1e-9 * (i as f64 / 100.0).sin() + 2e-10 * noise;
+        data += &format!("{t},{y:e}\n");
+    }
+    std::fs::write(dir.join("data.csv"), &data).unwrap();
+    let fading = ["--kind", "fading", "--degree", "2", "--theta", "0.95"];
+    filter_output(
+        &dir,
+        "dense",
+        &[&fading[..], &["--sigma", "2e-10"]].concat(),
+    );
+    let plot = ["plot", "dense.csv", "-o", "dense.svg", "--time-unit", "ns"];
+    ok_in(&dir, &plot, "");
+    let svg = svg_of(&dir.join("dense.svg"));
+    assert!(svg.contains("samples (too dense for dots: joined)"));
+    assert!(
+        count(&svg, "<circle") <= 2,
+        "{} circles",
+        count(&svg, "<circle")
+    );
+    // Every polyline has at most 4 points per pixel column of the plot.
+    for line in svg.lines().filter(|l| l.starts_with("<polyline")) {
+        let points = line.matches(',').count();
+        assert!(points <= 4 * 1070 + 8, "a polyline of {points} points");
+    }
+    assert!(svg.contains(
+        "time t (ns); t = t₀ + tick × 1e9, t₀ = 1.7e18 (as Unix ns: 2023-11-14 22:13:20 UTC)"
+    ));
+    assert!(svg.contains("y; value = tick × 1e-9"));
+    // Tick labels: short numbers, none of them 19 digits or 0.00000000.
+    let labels: Vec<&str> = svg
+        .split("</text>")
+        .filter_map(|t| t.rsplit('>').next().map(str::trim))
+        .filter(|t| !t.is_empty() && t.chars().all(|c| c.is_ascii_digit() || "-.".contains(c)))
+        .collect();
+    assert!(labels.len() >= 20, "{labels:?}");
+    assert!(labels.iter().all(|l| l.len() <= 10), "{labels:?}");
 }

@@ -190,6 +190,11 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         Pipeline::start(reader, sizes.map(move |rows| rows.min(chunk_rows)))
     });
     let lead = a.lead;
+    // A lead is recorded in a trailing column, so that the output says where its estimates are.
+    let lead_cell = [lead];
+    let lead_cells = &lead_cell[..usize::from(lead != 0.0)];
+    let mut columns = extra.to_vec();
+    columns.extend(lead_cells.iter().map(|_| "lead"));
     for first in std::iter::once(true).chain(std::iter::repeat(false)) {
         ids.append(&mut chunk.new_ids);
         values.resize(chunk.len() * stride, 0.0);
@@ -212,7 +217,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             None => {
                 let mut sink = Output::create(a.output.as_deref())?;
                 let mut header = Vec::new();
-                chunk.header(&mut header, a.id_col.as_deref(), a.degree, sigma, extra);
+                chunk.header(&mut header, a.id_col.as_deref(), a.degree, sigma, &columns);
                 sink.write(&header)?;
                 out.insert(sink)
             }
@@ -223,7 +228,8 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             .map(|k| {
                 let mut buf = Vec::with_capacity(PIECE.min(limit) * (stride + 2) * 20);
                 for i in k * PIECE..((k + 1) * PIECE).min(limit) {
-                    chunk.row(&mut buf, i, id(i), &values[i * stride..(i + 1) * stride]);
+                    let values = &values[i * stride..(i + 1) * stride];
+                    chunk.row_with(&mut buf, i, id(i), values, lead_cells);
                 }
                 buf
             })

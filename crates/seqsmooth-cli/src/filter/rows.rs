@@ -75,8 +75,22 @@ impl Chunk {
     /// cell) and the line end.
     #[inline]
     pub fn row(&self, out: &mut Vec<u8>, i: usize, id: Option<&[u8]>, values: &[f64]) {
+        self.row_with(out, i, id, values, &[]);
+    }
+
+    /// [`row`](Self::row) with the cells `tail` after `values` (the `lead` of `seqsmooth
+    /// filter --lead`).
+    #[inline]
+    pub fn row_with(
+        &self,
+        out: &mut Vec<u8>,
+        i: usize,
+        id: Option<&[u8]>,
+        values: &[f64],
+        tail: &[f64],
+    ) {
         self.echo(out, i, id);
-        for &v in values {
+        for &v in values.iter().chain(tail) {
             out.push(b',');
             if !v.is_nan() {
                 write_f64(out, v);

@@ -25,3 +25,21 @@ fn formats_by_extension() {
     assert_eq!(Format::from_path(Path::new("b.pdf")), None);
     assert_eq!(Format::from_path(Path::new("b")), None);
 }
+
+/// With a lead, each row's estimate is compared with the sample at `t + lead`: found within a
+/// thousandth of the median step (the rounding of `t + lead`), never a neighbour.
+#[test]
+fn samples_at_lead_match_the_estimate_time() {
+    let t: Vec<f64> = (0..50).map(|i| 1.7e9 + 0.01 * i as f64).collect();
+    let at = samples_at_lead(&t, 0.03);
+    for (i, a) in at.iter().enumerate() {
+        assert_eq!(*a, (i + 3 < t.len()).then_some(i + 3), "row {i}");
+    }
+    assert!(samples_at_lead(&t, 0.015).iter().all(Option::is_none));
+    assert_eq!(samples_at_lead(&t, -0.01)[0], None);
+    assert_eq!(samples_at_lead(&t, -0.01)[1], Some(0));
+    assert_eq!(
+        samples_at_lead(&t, 0.0),
+        (0..50).map(Some).collect::<Vec<_>>()
+    );
+}

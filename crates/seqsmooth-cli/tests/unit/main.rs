@@ -3,7 +3,9 @@
 
 mod args;
 mod chart;
+mod decimate;
 mod demo;
 mod filter;
 mod io;
 mod plot;
+mod ticks;
