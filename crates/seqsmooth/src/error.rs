@@ -62,6 +62,17 @@ pub enum Error {
         /// The largest degree the gain engine accepts.
         max: usize,
     },
+    /// A value is beyond the gain engine's range (the exact engine accepts it).
+    #[error(
+        "value {value:e} is beyond the gain engine's range: |y| must stay below {max:e} (its \
+         double-word arithmetic needs the headroom); use the exact engine, or rescale the values"
+    )]
+    GainValueOutOfRange {
+        /// The rejected value.
+        value: f64,
+        /// The largest magnitude the gain engine accepts.
+        max: f64,
+    },
     /// Not enough samples to determine the estimate.
     #[error("too few samples: {got} given, at least {needed} needed")]
     TooFewSamples {

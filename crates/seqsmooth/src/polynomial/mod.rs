@@ -98,4 +98,4 @@ pub use automatic::{AutoConfig, AutoOutput, AutomaticFilter};
 pub use expanding::ExpandingMemory;
 pub use fading::{FadingMemory, SwitchRule};
 pub use filter::PolynomialFilter;
-pub use options::{DiscountMode, Engine, GAIN_MAX_DEGREE, MAX_DEGREE};
+pub use options::{DiscountMode, Engine, GAIN_MAX_DEGREE, GAIN_MAX_VALUE, MAX_DEGREE};

@@ -81,6 +81,21 @@ pub enum DiscountMode {
 /// ```
 pub const GAIN_MAX_DEGREE: usize = 10;
 
+/// The largest sample magnitude the gain engine accepts, 2^960 (about 9.7e288): its state is
+/// carried in double words, whose error-free product (Dekker's) splits each operand and needs
+/// it below 2^996; the state's coefficients stay within a few thousand times the values'
+/// magnitude at every supported degree. The exact engine has no such limit.
+///
+/// ```
+/// use seqsmooth::polynomial::GAIN_MAX_VALUE;
+/// use seqsmooth::{Engine, Error, ExpandingMemory, PolynomialFilter};
+/// let mut f = ExpandingMemory::new(1, Engine::Gain).unwrap();
+/// assert!(matches!(f.update(0.0, 1e300), Err(Error::GainValueOutOfRange { .. })));
+/// assert!(f.update(0.0, GAIN_MAX_VALUE).is_ok());
+/// assert_eq!(GAIN_MAX_VALUE, 2f64.powi(960));
+/// ```
+pub const GAIN_MAX_VALUE: f64 = 9.7453140114e288;
+
 /// [`check_degree`], and for the gain engine [`GAIN_MAX_DEGREE`].
 pub(crate) fn check_engine_degree(m: usize, engine: Engine) -> Result<(), Error> {
     check_degree(m)?;

@@ -139,6 +139,17 @@ impl ExactEngine {
                     self.inv_scale = 1.0;
                 }
             }
+            if self.n == 1 {
+                // One row so far, (1, 0, …, 0) at the centre t_first, whatever the unit: the
+                // unit is chosen from the first step at no cost, so that the change of
+                // variables never has to bridge a factor like 2^±1000 (its powers α^j would
+                // overflow) when times are in units far from the step.
+                self.unit = (t - self.t_first).log2().round().exp2();
+                if !(self.unit.is_normal() && self.unit.recip().is_normal()) {
+                    self.unit = 1.0;
+                }
+                self.set_unscale();
+            }
             self.maybe_recentre(t);
         }
         // The row (1, u, u², …, u^m).

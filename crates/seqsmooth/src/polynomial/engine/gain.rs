@@ -299,7 +299,17 @@ impl FadingGains {
 #[derive(Clone, Debug)]
 pub(crate) struct GainEngine {
     m: usize,
+    /// The discount's interval `τ`.
     tau: f64,
+    /// The time unit of the state (scaled derivatives `z_k = x_k unit^k/k!`) and of the steps
+    /// `ζ`: `τ`, unless the samples' step is so far from `τ` (beyond 2^±32) that the powers
+    /// `ζ^k` and `unit^k` would overflow or underflow; then the power of two nearest the step
+    /// (chosen at the start, [`Self::exact_start`]). The estimate does not depend on it beyond
+    /// rounding.
+    unit: f64,
+    /// `unit/τ`: a step in units of the state times this is the step in units of `τ`, the
+    /// exponent of the discount `θ^ζ`.
+    per_tau: f64,
     fading: Option<FadingGains>,
     schedule: ExpandingGainSchedule,
     z: Vec<f64>,
@@ -329,6 +339,8 @@ impl GainEngine {
         Self {
             m,
             tau,
+            unit: tau,
+            per_tau: 1.0,
             fading,
             schedule: ExpandingGainSchedule::new(m),
             z: vec![0.0; m + 1],
@@ -377,7 +389,7 @@ impl GainEngine {
             }
             return;
         }
-        let zeta = (t - self.t_last) / self.tau;
+        let zeta = (t - self.t_last) / self.unit;
         shift_scaled_compensated(&mut self.z, &mut self.z_lo, zeta);
         // e = y - (z0 + z0_lo) as the double-word e + e_lo.
         let (d, de) = two_sum(y, -self.z[0]);
@@ -461,7 +473,7 @@ impl GainEngine {
             row.fill(f64::NAN);
             return;
         }
-        for (k, (x, (f, tk))) in row.iter_mut().zip(factorial_powers(self.tau)).enumerate() {
+        for (k, (x, (f, tk))) in row.iter_mut().zip(factorial_powers(self.unit)).enumerate() {
             *x = (self.z[k] + self.z_lo[k]) * f / tk;
         }
     }
@@ -505,7 +517,7 @@ impl GainEngine {
     /// [`crate::model::scaled_to_derivatives`], rounded once more).
     fn derivative_factors<const N: usize>(&self) -> [f64; N] {
         let mut c = [1.0; N];
-        for (ck, d) in c.iter_mut().zip(derivative_scale(self.tau)) {
+        for (ck, d) in c.iter_mut().zip(derivative_scale(self.unit)) {
             *ck = d;
         }
         c
@@ -542,7 +554,7 @@ impl GainEngine {
     ) -> usize {
         if self.fading.is_none() {
             let mut g = [0.0; N];
-            let (tau, t_first, schedule) = (self.tau, self.t_first, &self.schedule);
+            let (tau, t_first, schedule) = (self.unit, self.t_first, &self.schedule);
             let mut n = self.n;
             let mut last_step = self.step_mean;
             let run = self.plain_run::<N, W>(ts, ys, out, |z, t, zeta, y| {
@@ -562,7 +574,7 @@ impl GainEngine {
             run.done
         } else {
             let g: [f64; N] = std::array::from_fn(|k| self.k[k]);
-            let check = StepCheck::new(self.step_mean, self.tau);
+            let check = StepCheck::new(self.step_mean, self.unit);
             // The correction folded into the prediction (so the chain from one sample to the next
             // is one multiplication and two additions deep): with `d = y − z₀` and the powers
             // `ζʲ`,
@@ -630,7 +642,7 @@ impl GainEngine {
     /// blocks; the first block with an uneven step stops it).
     fn steady_block_run<const N: usize>(&mut self, ts: &[f64], ys: &[f64]) -> usize {
         let step = self.step_mean;
-        let tau = self.tau;
+        let tau = self.unit;
         let check = StepCheck::new(step, tau);
         let even_block = |tb: &[f64], prev: f64| check.all_agree(tb, prev, 1.0 / tau);
         if ts.len() < STEADY_BLOCK || !even_block(&ts[..STEADY_BLOCK], self.t_last) {
@@ -714,11 +726,11 @@ impl GainEngine {
             return ts.len();
         }
         // The mean step so far (the one the recursion's gains are scaled for).
-        let step = (self.t_last - self.t_first) / ((self.n - 1) as f64 * self.tau);
+        let step = (self.t_last - self.t_first) / ((self.n - 1) as f64 * self.unit);
         let mut prev = self.t_last;
         let mut take = 0;
         for tb in ts.chunks_exact(STEADY_BLOCK) {
-            if !StepCheck::new(step, self.tau).all_agree(tb, prev, 1.0 / self.tau) {
+            if !StepCheck::new(step, self.unit).all_agree(tb, prev, 1.0 / self.unit) {
                 break;
             }
             take += STEADY_BLOCK;
@@ -727,7 +739,7 @@ impl GainEngine {
         if take == 0 {
             return 0;
         }
-        let (tau, m, n) = (self.tau, self.m, self.n);
+        let (tau, m, n) = (self.unit, self.m, self.n);
         let t_end = ts[take - 1];
         // The grid from the first sample to the run's last, in units of its step.
         let grid = (t_end - self.t_first) / ((n + take as u64 - 1) as f64 * tau);
@@ -773,7 +785,7 @@ impl GainEngine {
         let c = self.derivative_factors::<N>();
         let mut rows = out.chunks_exact_mut(N);
         let mut z = self.plain_state::<N>();
-        let (tau, mut t_last, mut done) = (self.tau, self.t_last, 0);
+        let (tau, mut t_last, mut done) = (self.unit, self.t_last, 0);
         for (&t, &y) in ts.iter().zip(ys) {
             let zeta = (t - t_last) / tau;
             if !step(&mut z, t, zeta, y) {
@@ -796,18 +808,18 @@ impl GainEngine {
     fn update_step_mean(&mut self, t: f64, zeta: f64) {
         let switched = self.fading.as_ref().and_then(|f| f.switched_at).is_some();
         if !switched {
-            self.step_mean = (t - self.t_first) / (self.n as f64 * self.tau);
+            self.step_mean = (t - self.t_first) / (self.n as f64 * self.unit);
             // Exactly even samples: the mean equals the step up to rounding; use the step.
             if snaps_to(self.step_mean, zeta) {
                 self.step_mean = zeta;
             }
-        } else if !same_step(zeta, self.step_mean, t, self.tau) {
+        } else if !same_step(zeta, self.step_mean, t, self.unit) {
             // Steps equal to the typical one up to the rounding of the timestamps (even
             // sampling) keep the gains; the prediction always uses the true step.
             let f = self.fading.as_ref().expect("switched implies fading");
             let w = match f.mode {
                 DiscountMode::PerUpdate => f.theta,
-                DiscountMode::PerTime => f.theta.powf(self.step_mean),
+                DiscountMode::PerTime => f.theta.powf(self.step_mean * self.per_tau),
             };
             self.step_mean = w * self.step_mean + (1.0 - w) * zeta;
             if snaps_to(self.step_mean, zeta) {
@@ -829,7 +841,9 @@ impl GainEngine {
             // The discount per sample so far: θ itself per update, or θ^(mean step/τ).
             let theta_s = match f.mode {
                 DiscountMode::PerUpdate => f.theta,
-                DiscountMode::PerTime => f.theta.powf((t - self.t_first) / (n as f64 * self.tau)),
+                DiscountMode::PerTime => f
+                    .theta
+                    .powf((t - self.t_first) / (n as f64 * self.unit) * self.per_tau),
             };
             let (schedule, k) = (&self.schedule, &mut self.k);
             let crossover = || {
@@ -855,7 +869,7 @@ impl GainEngine {
             DiscountMode::PerTime if self.step_mean == f.step_cached => f.theta_eff,
             DiscountMode::PerTime => {
                 f.step_cached = self.step_mean;
-                f.theta.powf(self.step_mean)
+                f.theta.powf(self.step_mean * self.per_tau)
             }
         };
         if theta_eff != f.theta_eff {
@@ -887,8 +901,19 @@ impl GainEngine {
     /// instead of rational arithmetic whose numbers grow with the degree.
     fn exact_start(&mut self) {
         let m = self.m;
+        if m > 0 {
+            let step = (self.start[m].0 - self.start[0].0) / m as f64;
+            let ratio = step / self.tau;
+            if !(2f64.powi(-32)..=2f64.powi(32)).contains(&ratio) {
+                // At most 2^980: Dekker's product, under every double-word operation, splits
+                // its operands and needs them below 2^996.
+                let unit = step.log2().round().clamp(-1000.0, 980.0).exp2();
+                self.unit = unit;
+                self.per_tau = unit / self.tau;
+            }
+        }
         let t = |i: usize| self.start[i].0;
-        let diff = |i: usize, j: usize| dw::div(two_sum(t(i), -t(j)), (self.tau, 0.0));
+        let diff = |i: usize, j: usize| dw::div(two_sum(t(i), -t(j)), (self.unit, 0.0));
         let mut weights = vec![(0.0, 0.0); (m + 1) * (m + 1)]; // L, row-major (k, i)
         let mut numerator = vec![(0.0, 0.0); m + 1];
         for i in 0..=m {
@@ -927,7 +952,7 @@ impl GainEngine {
 
     /// Unscaled derivatives (and their covariance) of the estimate valid at `t`.
     pub fn estimate_at(&self, t: f64) -> (Vec<f64>, Option<DMatrix<f64>>) {
-        let v = (t - self.t_last) / self.tau;
+        let v = (t - self.t_last) / self.unit;
         let p = self.m + 1;
         let (mut hi, mut lo) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
         hi[..p].copy_from_slice(&self.z);
@@ -936,9 +961,9 @@ impl GainEngine {
         for (h, l) in hi[..p].iter_mut().zip(&lo[..p]) {
             *h += l;
         }
-        let x = crate::model::scaled_to_derivatives(&hi[..p], self.tau);
+        let x = crate::model::scaled_to_derivatives(&hi[..p], self.unit);
         let cov = self.cov.as_ref().map(|(_, p)| {
-            let j = crate::model::scaling(self.m, self.tau) * crate::model::phi(self.m, v);
+            let j = crate::model::scaling(self.m, self.unit) * crate::model::phi(self.m, v);
             &j * p * j.transpose()
         });
         (x, cov)
@@ -978,7 +1003,7 @@ mod tests {
         let mut z: Vec<f64> = e.z.iter().zip(&e.z_lo).map(|(a, b)| a + b).collect();
         let mut t_last = e.t_last;
         for (i, (&t, &y)) in ts.iter().zip(ys).enumerate() {
-            predict_correct(&mut z, (t - t_last) / e.tau, &h(i), y);
+            predict_correct(&mut z, (t - t_last) / e.unit, &h(i), y);
             t_last = t;
         }
         z

@@ -18,6 +18,7 @@ use crate::error::Error;
 use crate::model::PolynomialState;
 #[cfg(doc)]
 use crate::polynomial::filter::PolynomialFilter;
+use crate::polynomial::options::GAIN_MAX_VALUE;
 pub(crate) use exact::{Discount, ExactEngine};
 pub(crate) use gain::{FadingGains, GainEngine};
 
@@ -42,9 +43,22 @@ impl EngineState {
         }
     }
 
-    pub(crate) fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
+    /// The sample's own check, and for the gain engine its value range
+    /// ([`GAIN_MAX_VALUE`]).
+    fn check(&self, t: f64, y: f64) -> Result<(), Error> {
         let previous = (self.samples() > 0).then(|| self.last_time());
         crate::error::check_sample(t, y, previous)?;
+        if matches!(self, EngineState::Gain(_)) && y.abs() > GAIN_MAX_VALUE {
+            return Err(Error::GainValueOutOfRange {
+                value: y,
+                max: GAIN_MAX_VALUE,
+            });
+        }
+        Ok(())
+    }
+
+    pub(crate) fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
+        self.check(t, y)?;
         match self {
             EngineState::Exact(e) => e.update(t, y),
             EngineState::Gain(g) => g.update(t, y),
@@ -64,7 +78,13 @@ impl EngineState {
             check_estimates_length(times, m, out)?;
         }
         let previous = (self.samples() > 0).then(|| self.last_time());
-        let valid = first_invalid(times, values, previous);
+        let mut valid = first_invalid(times, values, previous);
+        if matches!(self, EngineState::Gain(_)) {
+            valid = values[..valid]
+                .iter()
+                .position(|y| y.abs() > GAIN_MAX_VALUE)
+                .unwrap_or(valid);
+        }
         let (ts, ys) = (&times[..valid], &values[..valid]);
         match (&mut *self, estimates) {
             (EngineState::Exact(e), None) => ts.iter().zip(ys).for_each(|(&t, &y)| e.update(t, y)),
@@ -82,8 +102,7 @@ impl EngineState {
             }
         }
         if valid < times.len() {
-            let previous = (self.samples() > 0).then(|| self.last_time());
-            if let Err(e) = crate::error::check_sample(times[valid], values[valid], previous) {
+            if let Err(e) = self.check(times[valid], values[valid]) {
                 return Err(Error::InBatch {
                     index: valid,
                     source: Box::new(e),

@@ -5,7 +5,7 @@ use super::even::EvenWindow;
 use super::irregular::IrregularWindow;
 use super::ring::Ring;
 use super::sliding::default_refreshes;
-use super::{check_window, steps_agree, EVEN_STEP_TOLERANCE};
+use super::{check_window, steps_agree, steps_equal, EVEN_STEP_TOLERANCE};
 use crate::error::Error;
 use crate::model::PolynomialState;
 use crate::polynomial::filter::PolynomialFilter;
@@ -43,8 +43,9 @@ pub enum FixedEngine {
     /// centred, scaled Legendre basis ([`crate::estimate::PolynomialFit`]), `O(window·m²)` per
     /// sample.
     Irregular,
-    /// Any strictly increasing timestamps: [`FixedEngine::Sliding`] while the steps are even,
-    /// and at the first uneven step the newest `window` samples are replayed into
+    /// Any strictly increasing timestamps: [`FixedEngine::Sliding`] while the steps are even
+    /// to a relative 1e-12 (no allowance for the timestamps' rounding, so that Unix-time
+    /// samples are fitted as they are), and at the first uneven step the newest `window` samples are replayed into
     /// [`FixedEngine::Irregular`], which carries on (the same least-squares fit either way, up
     /// to rounding). [`FixedMemory::engine`] names the engine running now.
     Adaptive,
@@ -253,15 +254,16 @@ impl FixedMemory {
     }
 
     /// Whether `t` follows the previous sample after a step the even-spacing engines cannot
-    /// take ([`steps_agree`]).
+    /// take ([`steps_agree`]; for the adaptive engine the stricter [`steps_equal`]).
     fn uneven_step(&self, t: f64) -> bool {
+        let step = t - self.t_last;
         matches!(self.fit, WindowFit::Even(_))
             && self.n >= 2
-            && !steps_agree(
-                t - self.t_last,
-                self.first_step,
-                self.t_first.abs().max(t.abs()),
-            )
+            && if self.engine == FixedEngine::Adaptive {
+                !steps_equal(step, self.first_step)
+            } else {
+                !steps_agree(step, self.first_step, self.t_first.abs().max(t.abs()))
+            }
     }
 
     fn uneven_step_error(&self, t: f64) -> Error {

@@ -125,6 +125,19 @@ pub(crate) fn steps_agree(step: f64, first: f64, t_scale: f64) -> bool {
     )
 }
 
+/// [`FixedEngine::Adaptive`]'s stricter rule: the even-spacing engine runs only while every
+/// step equals the first to a relative [`ADAPTIVE_STEP_TOLERANCE`], with no allowance for the
+/// timestamps' rounding. Its fit (on the mean step) is then the least-squares fit of the actual
+/// times to about 1e-9 at any time origin: at Unix times the timestamps' own rounding (`2ε|t|`,
+/// a relative 4.8e-5 of a 10 ms step at 1.7e9 s) already exceeds the tolerance, so such samples
+/// go to the QR engine, which fits the times as they are.
+pub(crate) fn steps_equal(step: f64, first: f64) -> bool {
+    (step - first).abs() <= ADAPTIVE_STEP_TOLERANCE * first.abs()
+}
+
+/// The relative step tolerance of [`steps_equal`].
+pub(crate) const ADAPTIVE_STEP_TOLERANCE: f64 = 1e-12;
+
 /// Where in (or beyond) the window an estimate is wanted, for the design helpers.
 ///
 /// ```
