@@ -188,7 +188,7 @@ pub struct FilterArgs {
     /// Filter kind
     #[arg(long, value_enum)]
     pub kind: Kind,
-    /// Polynomial degree M (0 to 24)
+    /// Polynomial degree M (0 to 24; with --engine gain 0 to 10)
     #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
     pub degree: usize,
     /// Fading memory and auto: discount per tau, 0 < T < 1 (e.g. 0.9 or 9/10)

@@ -35,6 +35,14 @@ pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
     let mut fits = vec![0.0; rows.len() * (a.degree + 1)];
     smooth_into(&rows.t, &rows.y, a.degree, a.window, &mut fits)
         .map_err(|e| CliError::Data(format!("cannot smooth the input: {e}")))?;
+    if let Some(i) = fits.iter().position(|v| !v.is_finite()) {
+        let (row, k) = (i / (a.degree + 1), i % (a.degree + 1));
+        return Err(CliError::Data(format!(
+            "line {}: the smoothed d{k} is too large for a double (beyond 1.8e308); express the \
+             times in a larger unit or rescale the values",
+            rows.lines[row]
+        )));
+    }
     let mut out = Output::create(a.output.as_deref())?;
     let mut text = Vec::new();
     rows.header(&mut text, None, a.degree, false, &[]);

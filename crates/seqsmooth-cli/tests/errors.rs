@@ -607,3 +607,108 @@ fn error_sigma_out_of_the_variance_range() {
         );
     }
 }
+
+/// Extreme scales are right or refused, never empty or non-finite cells with exit 0: times
+/// near 1e300 with steps of 1e300 are filtered (every kind and engine gives finite cells from
+/// the row that determines the fit); a derivative beyond the double range (steps of 1e-200 at
+/// degree 2, a lead of 1e308) and a fit that is never determined (τ far shorter than the steps)
+/// are errors naming the line and what to change.
+#[test]
+fn extreme_scales_are_right_or_refused() {
+    let big = "t,y\n1e300,1\n2e300,2\n3e300,3\n4e300,4\n5e300,5\n";
+    for args in [
+        &[
+            "filter", "--kind", "fading", "--degree", "2", "--theta", "0.9",
+        ][..],
+        &[
+            "filter", "--kind", "fading", "--degree", "2", "--theta", "0.9", "--engine", "gain",
+        ],
+        &["filter", "--kind", "expanding", "--degree", "2"],
+        &[
+            "filter",
+            "--kind",
+            "expanding",
+            "--degree",
+            "2",
+            "--engine",
+            "gain",
+        ],
+        &[
+            "filter", "--kind", "fixed", "--degree", "2", "--window", "3",
+        ],
+    ] {
+        let out = ok(args, big);
+        let (head, rows) = table(&out);
+        assert_eq!(rows.len(), 5, "{args:?}");
+        let d0 = head.iter().position(|c| c == "d0").unwrap();
+        for row in &rows[2..] {
+            for cell in &row[d0..d0 + 3] {
+                assert!(num(cell).is_finite(), "{args:?}: {out}");
+            }
+        }
+        assert_eq!(num(&rows[4][d0]), 5.0, "{args:?}: {out}");
+    }
+    // The automatic filter settles its degree as it does at t = 1 … 5: the same cells.
+    let auto = [
+        "filter", "--kind", "auto", "--degree", "2", "--theta", "0.9",
+    ];
+    let cells = |text: &str| -> Vec<Vec<String>> {
+        table(text).1.iter().map(|r| r[2..].to_vec()).collect()
+    };
+    assert_eq!(
+        cells(&ok(&auto, big)),
+        cells(&ok(&auto, "t,y\n1,1\n2,2\n3,3\n4,4\n5,5\n"))
+    );
+    fails(
+        &[
+            "filter", "--kind", "fixed", "--degree", "2", "--window", "3",
+        ],
+        "t,y\n0,1\n1e-200,2\n2e-200,3\n3e-200,5\n4e-200,5\n",
+        1,
+        // Rows 2–4 are linear (d2 = 0); the first curved window ends at line 5.
+        &["line 5", "d2 is too large for a double", "larger unit"],
+    );
+    fails(
+        &[
+            "filter", "--kind", "fading", "--degree", "2", "--theta", "0.9", "--lead", "1e308",
+        ],
+        "t,y\n0,1\n1,2\n2,3\n3,5\n4,5\n",
+        1,
+        &["line 4", "too large for a double", "shorter --lead"],
+    );
+    fails(
+        &[
+            "filter", "--kind", "fading", "--degree", "2", "--theta", "0.9", "--tau", "1e-300",
+        ],
+        "t,y\n0,1\n1,2\n2,3\n3,5\n4,5\n",
+        1,
+        &["line 4", "no estimate for this row", "use a larger --tau"],
+    );
+    let rows: String = (0..13).map(|i| format!("{i},{}\n", i * i)).collect();
+    fails(
+        &[
+            "filter", "--kind", "fading", "--degree", "11", "--theta", "0.9", "--engine", "gain",
+        ],
+        &format!("t,y\n{rows}"),
+        2,
+        &[
+            "degree 11 is too high for the gain engine",
+            "supported to degree 10",
+            "exact engine",
+        ],
+    );
+    fails(
+        &[
+            "filter",
+            "--kind",
+            "expanding",
+            "--degree",
+            "1",
+            "--engine",
+            "gain",
+        ],
+        "t,y\n0,1\n1,1e300\n2,3\n",
+        1,
+        &["line 3", "beyond the gain engine's range", "exact engine"],
+    );
+}

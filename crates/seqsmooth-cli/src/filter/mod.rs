@@ -195,6 +195,13 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     let lead_cells = &lead_cell[..usize::from(lead != 0.0)];
     let mut columns = extra.to_vec();
     columns.extend(lead_cells.iter().map(|_| "lead"));
+    // The names of the estimate columns, for messages, and the rows of each series so far.
+    let mut names: Vec<String> = (0..=a.degree).map(|k| format!("d{k}")).collect();
+    if sigma {
+        names.extend((0..=a.degree).map(|k| format!("s{k}")));
+    }
+    names.extend(extra.iter().map(|c| c.to_string()));
+    let mut counts: Vec<usize> = Vec::new();
     for first in std::iter::once(true).chain(std::iter::repeat(false)) {
         ids.append(&mut chunk.new_ids);
         values.resize(chunk.len() * stride, 0.0);
@@ -208,6 +215,13 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         };
         let failed = bank.update_par(rows, run).err();
         let mut failed = failed.map(|e| row_error(e, &chunk));
+        let limit = failed.as_ref().map_or(chunk.len(), |(i, _)| *i);
+        // Right or refused: a row the library could not represent ends the run here.
+        let unwritable =
+            check_estimates(&values, stride, &names, &chunk, limit, &need, &mut counts);
+        if let Some(bad) = unwritable {
+            failed = Some(bad);
+        }
         let limit = failed.as_ref().map_or(chunk.len(), |(i, _)| *i);
         if let Some((_, e)) = failed.take_if(|_| first && limit < hold) {
             return Err(e);
@@ -255,6 +269,56 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         chunk = next.swap(chunk)?;
     }
     Ok(())
+}
+
+/// The first of the rows `..limit` that cannot be written as it is, and why: a number that is
+/// not finite (an estimate too large for a double: the time unit is too small for the degree,
+/// or the values too large), or no estimate for a row from the `need`-th of its series on (the
+/// fit is not determined). `counts` holds, per series, the rows seen so far.
+fn check_estimates(
+    values: &[f64],
+    stride: usize,
+    names: &[String],
+    chunk: &Chunk,
+    limit: usize,
+    need: &Need,
+    counts: &mut Vec<usize>,
+) -> Option<(usize, CliError)> {
+    let fail = |i: usize, why: String| {
+        let line = chunk.lines[i];
+        Some((i, CliError::Data(format!("line {line}: {why}"))))
+    };
+    for i in 0..limit {
+        let row = &values[i * stride..(i + 1) * stride];
+        if let Some(k) = row.iter().position(|v| v.is_infinite()) {
+            return fail(
+                i,
+                format!(
+                    "the estimate's {} is too large for a double (beyond 1.8e308); express the \
+                     times in a larger unit, rescale the values or use a shorter --lead",
+                    names[k]
+                ),
+            );
+        }
+        let series = chunk.series[i];
+        if counts.len() <= series {
+            counts.resize(series + 1, 0);
+        }
+        counts[series] += 1;
+        if row[0].is_nan() && counts[series] >= need.rows {
+            return fail(
+                i,
+                format!(
+                    "no estimate for this row, sample {} of its series ({} needs {}): the \
+                     filter's fit is not determined (with --kind fading, a tau far shorter \
+                     than the steps, or a gap of many tau, lets the discount θ^(step/τ) \
+                     underflow); use a larger --tau",
+                    counts[series], need.why, need.rows
+                ),
+            );
+        }
+    }
+    None
 }
 
 /// The row and message of the bank's error `e` on `chunk`.
