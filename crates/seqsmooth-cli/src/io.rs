@@ -33,6 +33,10 @@ pub fn write_f64(out: &mut Vec<u8>, x: f64) {
 /// bits first, the digits only then.
 #[inline]
 fn tie_digit(x: f64, text: &[u8]) -> Option<usize> {
+    // Zero is no tie (and its mantissa has no lowest set bit to shift to).
+    if x == 0.0 {
+        return None;
+    }
     let bits = x.abs().to_bits();
     let (m, q) = match bits >> 52 {
         0 => (bits, -1074),
@@ -48,7 +52,7 @@ fn tie_digit(x: f64, text: &[u8]) -> Option<usize> {
             .checked_pow(p.unsigned_abs())
             .and_then(|f| f.checked_mul(odd))
     };
-    if x == 0.0 || (e < -1 && (e < -27 || !scaled(e + 1).is_some_and(|v| v < 2 * 10u128.pow(17)))) {
+    if e < -1 && (e < -27 || !scaled(e + 1).is_some_and(|v| v < 2 * 10u128.pow(17))) {
         return None;
     }
     let (mut d, mut decimals, mut point, mut end) = (0u128, 0i32, false, text.len());

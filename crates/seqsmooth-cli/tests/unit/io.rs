@@ -143,6 +143,9 @@ fn round_trip_special_values() {
         check(x);
     }
     assert_eq!(fmt_f64(1e-300), "1e-300");
+    // Zero and negative zero: no lowest set bit (a shift by 64 panicked with overflow checks).
+    assert_eq!(fmt_f64(0.0), "0");
+    assert_eq!(fmt_f64(-0.0), "-0");
     assert_eq!(fmt_f64(2.5e20), "2.5e20");
     assert_eq!(fmt_f64(0.1), "0.1");
     assert_eq!(fmt_f64(4.6), "4.6");
