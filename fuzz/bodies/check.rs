@@ -28,3 +28,10 @@ pub fn state(s: &PolynomialState, what: &str) {
         finite(&sd, &format!("{what} std devs"));
     }
 }
+
+/// Whether to print the decoded call (environment variable `FUZZ_TRACE` set): how the
+/// reproducers in the findings were decoded.
+pub fn trace() -> bool {
+    static TRACE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *TRACE.get_or_init(|| std::env::var_os("FUZZ_TRACE").is_some())
+}

@@ -23,7 +23,10 @@ use std::path::Path;
 /// The options of `filter` and `smooth`, with values the input picks among.
 const OPTIONS: [(&str, &[&str]); 12] = [
     ("--kind", &["expanding", "fading", "fixed", "auto", "gain"]),
-    ("--degree", &["0", "1", "2", "3", "5", "8", "12", "24", "25", "-1"]),
+    (
+        "--degree",
+        &["0", "1", "2", "3", "5", "8", "12", "24", "25", "-1"],
+    ),
     ("--theta", &["0.9", "0.5", "9/10", "0.999999", "1", "0"]),
     ("--tau", &["1", "0.01", "1e-300", "1e300", "0"]),
     ("--window", &["1", "2", "3", "5", "11", "101"]),
@@ -39,7 +42,11 @@ const OPTIONS: [(&str, &[&str]); 12] = [
 /// The argument vector: subcommand, input and output files, then options as `--name=value`
 /// (so that no value can become a file name).
 fn arguments(input: &mut Input, csv: &Path, out: &Path) -> Vec<String> {
-    let sub = if input.byte() % 4 == 0 { "smooth" } else { "filter" };
+    let sub = if input.byte() % 4 == 0 {
+        "smooth"
+    } else {
+        "filter"
+    };
     let mut args: Vec<String> = vec![
         "seqsmooth".into(),
         sub.into(),
@@ -109,7 +116,11 @@ fn output(cli: &Command, text: &[u8], data_rows: usize) {
         for (c, cell) in record.iter().enumerate().skip(first) {
             computed(cell, line, &header[c]);
         }
-        let series = if id { record[0].to_string() } else { String::new() };
+        let series = if id {
+            record[0].to_string()
+        } else {
+            String::new()
+        };
         let count = seen.entry(series).or_insert(0);
         *count += 1;
         let determined = match kind {
@@ -123,7 +134,11 @@ fn output(cli: &Command, text: &[u8], data_rows: usize) {
         };
         if determined {
             for &k in &d {
-                assert!(!record[k].is_empty(), "line {line}: {} empty: {record:?}", header[k]);
+                assert!(
+                    !record[k].is_empty(),
+                    "line {line}: {} empty: {record:?}",
+                    header[k]
+                );
             }
         }
     }

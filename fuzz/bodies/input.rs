@@ -24,7 +24,8 @@ pub const SPECIAL: [f64; 24] = [
     f64::MAX,
     f64::MIN_POSITIVE,
     5e-324,
-    2.2250738585072009e-308,
+    // The largest subnormal.
+    2.225073858507201e-308,
     f64::EPSILON,
     1.0 - f64::EPSILON / 2.0,
     9007199254740993.0,

@@ -17,9 +17,12 @@ pub mod filters;
 pub mod input;
 pub mod number;
 
+/// A target's body: panics when an invariant fails on the input.
+pub type Body = fn(&[u8]);
+
 /// The targets, by name: `fuzz/corpus/<name>/` and `fuzz/regressions/<name>/` hold their
 /// inputs.
-pub const TARGETS: [(&str, fn(&[u8])); 4] = [
+pub const TARGETS: [(&str, Body); 4] = [
     ("csv", csv_layer::run),
     ("number", number::run),
     ("filters", filters::run),

@@ -14,7 +14,11 @@ pub fn round_trip(x: f64) {
     let text = fmt_f64(x);
     let mut appended = b"1,".to_vec();
     write_f64(&mut appended, x);
-    assert_eq!(&appended[2..], text.as_bytes(), "write_f64 and fmt_f64 differ");
+    assert_eq!(
+        &appended[2..],
+        text.as_bytes(),
+        "write_f64 and fmt_f64 differ"
+    );
     if !x.is_finite() {
         return;
     }
@@ -29,7 +33,11 @@ pub fn round_trip(x: f64) {
         .unwrap_or_else(|e| panic!("{text} (bits {:#x}) does not read back: {e}", x.to_bits()));
     assert_eq!(back.to_bits(), x.to_bits(), "{text} reads back as {back:e}");
     let std: f64 = text.parse().expect("str::parse");
-    assert_eq!(std.to_bits(), x.to_bits(), "{text} is {std:e} to str::parse");
+    assert_eq!(
+        std.to_bits(),
+        x.to_bits(),
+        "{text} is {std:e} to str::parse"
+    );
 }
 
 pub fn run(data: &[u8]) {
@@ -41,7 +49,9 @@ pub fn run(data: &[u8]) {
         Ok(v) => {
             assert!(v.is_finite(), "parse_cell gave {v}");
             // The same double as the standard library's parser.
-            let std = std::str::from_utf8(cell).ok().and_then(|s| s.parse::<f64>().ok());
+            let std = std::str::from_utf8(cell)
+                .ok()
+                .and_then(|s| s.parse::<f64>().ok());
             assert_eq!(
                 std.map(f64::to_bits),
                 Some(v.to_bits()),

@@ -13,7 +13,8 @@ use seqsmooth::polynomial::AutomaticFilter;
 use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory};
 use seqsmooth::{PolynomialFilter, PolynomialState};
 
-/// A filter of any kind the command runs.
+/// A filter of any kind the command runs (a few per case: their sizes do not matter).
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 enum Any {
     Expanding(ExpandingMemory),
@@ -64,7 +65,13 @@ impl PolynomialFilter for Any {
 
 /// The filter `kind` (0-5) of degree `m`, noise σ = 1 for its covariance.
 fn filter(kind: u8, m: usize) -> Any {
-    let engine = |k: u8| if k % 2 == 0 { Engine::Exact } else { Engine::Gain };
+    let engine = |k: u8| {
+        if k % 2 == 0 {
+            Engine::Exact
+        } else {
+            Engine::Gain
+        }
+    };
     let built = match kind {
         0 | 1 => ExpandingMemory::new(m, engine(kind))
             .and_then(|f| f.with_noise_sigma(1.0))
