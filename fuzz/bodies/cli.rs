@@ -1,0 +1,186 @@
+//! The CLI's argument-to-output path, in process: an argument vector decoded from the input
+//! goes through clap (`Cli::try_parse_from`) and the subcommand's `run`, as `main` dispatches
+//! it, on the rest of the input as the CSV file, with `-o` to a file in a fresh temporary
+//! directory (`filter` and `smooth`, the subcommands that read data).
+//!
+//! Checks: a refused command line has a message; a failed run is a typed error (`Usage` or
+//! `Data`) with a message and leaves no output file (nor a temporary one) behind; a
+//! successful run writes a header and one row per data row (the first cells echo the input),
+//! every computed cell (`d*`, `s*`, `window`, `noise`, `outlier`, `misfit`) empty or a
+//! finite number, and no `d` cell empty once the rows of its series determine the estimate
+//! (expanding and fading memory: from the degree's `M+1`-th row; fixed memory: where the window
+//! cell is `W`; `smooth`: every row).
+
+use super::check;
+use super::input::Input;
+use clap::Parser;
+use seqsmooth_cli::args::{Cli, Command, Kind};
+use seqsmooth_cli::error::CliError;
+use seqsmooth_cli::{filter, smooth};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// The options of `filter` and `smooth`, with values the input picks among.
+const OPTIONS: [(&str, &[&str]); 12] = [
+    ("--kind", &["expanding", "fading", "fixed", "auto", "gain"]),
+    (
+        "--degree",
+        &["0", "1", "2", "3", "5", "8", "12", "24", "25", "-1"],
+    ),
+    ("--theta", &["0.9", "0.5", "9/10", "0.999999", "1", "0"]),
+    ("--tau", &["1", "0.01", "1e-300", "1e300", "0"]),
+    ("--window", &["1", "2", "3", "5", "11", "101"]),
+    ("--engine", &["exact", "gain"]),
+    ("--lead", &["0", "1", "-1", "1e308", "-2.5", "1e-300"]),
+    ("--time-col", &["t", "y", "id", "x"]),
+    ("--value-col", &["y", "t", "id", "x"]),
+    ("--sigma", &["1", "0.1", "1e300", "1e-300", "0"]),
+    ("--id-col", &["id", "t", "y", "x"]),
+    ("--chunk-rows", &["1", "2", "3", "100"]),
+];
+
+/// The argument vector: subcommand, input and output files, then options as `--name=value`
+/// (so that no value can become a file name).
+fn arguments(input: &mut Input, csv: &Path, out: &Path) -> Vec<String> {
+    let sub = if input.byte() % 4 == 0 {
+        "smooth"
+    } else {
+        "filter"
+    };
+    let mut args: Vec<String> = vec![
+        "seqsmooth".into(),
+        sub.into(),
+        csv.display().to_string(),
+        format!("--output={}", out.display()),
+    ];
+    let n = input.below(9);
+    let mut used = [false; OPTIONS.len()];
+    for _ in 0..n {
+        let k = input.below(OPTIONS.len() + 1);
+        if k == OPTIONS.len() {
+            args.push("--no-progress".into());
+            continue;
+        }
+        if std::mem::replace(&mut used[k], true) {
+            continue;
+        }
+        let (name, values) = OPTIONS[k];
+        let value = match input.byte() % 8 {
+            0 => input.text(12),
+            1 => seqsmooth_cli::io::fmt_f64(input.any_number()),
+            _ => values[input.below(values.len())].to_string(),
+        };
+        args.push(format!("{name}={value}"));
+    }
+    args
+}
+
+/// A computed cell: empty or a finite number.
+fn computed(cell: &str, line: usize, column: &str) {
+    if !cell.is_empty() {
+        let v: f64 = cell
+            .parse()
+            .unwrap_or_else(|_| panic!("line {line}, column {column}: {cell:?} is not a number"));
+        assert!(v.is_finite(), "line {line}, column {column}: {cell}");
+    }
+}
+
+/// Checks the output of a successful run.
+fn output(cli: &Command, text: &[u8], data_rows: usize) {
+    let mut reader = csv::ReaderBuilder::new().from_reader(text);
+    let header: Vec<String> = reader
+        .headers()
+        .expect("the output has a header")
+        .iter()
+        .map(str::to_string)
+        .collect();
+    let (first, kind, degree, window, id) = match cli {
+        Command::Filter(a) => {
+            let id = a.id_col.is_some();
+            (2 + usize::from(id), Some(a.kind), a.degree, a.window, id)
+        }
+        Command::Smooth(a) => (2, None, a.degree, Some(a.window), false),
+        _ => unreachable!("only filter and smooth are run"),
+    };
+    let d: Vec<usize> = (0..=degree).map(|k| first + k).collect();
+    for &k in &d {
+        assert_eq!(header[k], format!("d{}", k - first), "header {header:?}");
+    }
+    let window_col = header.iter().position(|h| h == "window");
+    let mut seen: HashMap<String, usize> = HashMap::new();
+    let mut rows = 0;
+    for (i, record) in reader.records().enumerate() {
+        let record = record.expect("the output is CSV");
+        let line = i + 2;
+        rows += 1;
+        for (c, cell) in record.iter().enumerate().skip(first) {
+            computed(cell, line, &header[c]);
+        }
+        let series = if id {
+            record[0].to_string()
+        } else {
+            String::new()
+        };
+        let count = seen.entry(series).or_insert(0);
+        *count += 1;
+        let determined = match kind {
+            None => true,
+            Some(Kind::Expanding | Kind::Fading) => *count > degree,
+            Some(Kind::Fixed) => {
+                let w = window.map(|w| w.max(degree + 1)).unwrap_or(usize::MAX);
+                window_col.is_some_and(|c| record[c] == w.to_string())
+            }
+            Some(Kind::Auto) => false,
+        };
+        if determined {
+            for &k in &d {
+                assert!(
+                    !record[k].is_empty(),
+                    "line {line}: {} empty: {record:?}",
+                    header[k]
+                );
+            }
+        }
+    }
+    assert_eq!(rows, data_rows, "one output row per input row");
+}
+
+pub fn run(data: &[u8]) {
+    let mut input = Input::new(data);
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let (csv, out) = (dir.path().join("in.csv"), dir.path().join("out.csv"));
+    let args = arguments(&mut input, &csv, &out);
+    let text = input.rest();
+    std::fs::write(&csv, text).expect("the input file");
+    let cli = match Cli::try_parse_from(&args) {
+        Ok(cli) => cli,
+        Err(e) => return check::error_message(&e),
+    };
+    let result = match &cli.command {
+        Command::Filter(a) => filter::run(a),
+        Command::Smooth(a) => smooth::run(a),
+        _ => unreachable!("only filter and smooth are run"),
+    };
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("the temporary directory")
+        .map(|e| e.expect("an entry").file_name())
+        .filter(|n| n != "in.csv")
+        .collect();
+    match result {
+        Err(e) => {
+            check::error_message(&e);
+            assert!(matches!(e, CliError::Usage(_) | CliError::Data(_)), "{e:?}");
+            assert!(left.is_empty(), "{e} left {left:?} behind");
+        }
+        Ok(()) => {
+            assert_eq!(left, ["out.csv"], "files after a run");
+            let written = std::fs::read(&out).expect("the output file");
+            // The data rows the run read: every record after the header.
+            let rows = csv::ReaderBuilder::new()
+                .from_reader(text)
+                .byte_records()
+                .count();
+            output(&cli.command, &written, rows);
+        }
+    }
+}
