@@ -101,6 +101,18 @@ pub(crate) fn factorial_powers(tau: f64) -> impl Iterator<Item = (f64, f64)> {
     })
 }
 
+/// `z·k!/τ^k` one factor at a time, for a `τ` whose powers leave the double range (`τ^k`
+/// over- or underflows, so that `k!/τ^k` would be infinite or zero): a zero stays zero, and the
+/// result over- or underflows only where the derivative itself does.
+pub(crate) fn unscale_stepwise(z: f64, k: usize, tau: f64) -> f64 {
+    (1..=k).fold(z, |x, i| x * i as f64 / tau)
+}
+
+/// Whether `k!/τ^k`, `k ≤ m`, are all normal doubles (else [`unscale_stepwise`]).
+pub(crate) fn unscale_in_range(m: usize, tau: f64) -> bool {
+    derivative_scale(tau).take(m + 1).all(f64::is_normal)
+}
+
 /// The diagonal of `D(τ)`, `k!/τ^k` for `k = 0, 1, 2, …` (each rounded once from the running
 /// products of [`factorial_powers`]).
 #[inline(always)]
@@ -140,7 +152,14 @@ pub(crate) fn scaling_diagonal<T: Scalar>(m: usize, tau: T) -> Vec<T> {
 pub fn scaled_to_derivatives(z: &[f64], tau: f64) -> Vec<f64> {
     z.iter()
         .zip(factorial_powers(tau))
-        .map(|(&v, (f, tk))| v * f / tk)
+        .enumerate()
+        .map(|(k, (&v, (f, tk)))| {
+            if tk.is_normal() {
+                v * f / tk
+            } else {
+                unscale_stepwise(v, k, tau)
+            }
+        })
         .collect()
 }
 

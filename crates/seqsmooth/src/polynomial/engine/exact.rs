@@ -20,6 +20,7 @@
 //! ([`TriangularFactor`]): no square roots per sample, and once every pivot is positive none
 //! of its `2m+3` divisions per sample waits for another.
 
+use crate::model::taylor::{unscale_in_range, unscale_stepwise};
 use crate::model::{derivative_scale, shift_scaled, shift_scaled_array};
 use crate::numeric::unrolled::unrolled_sizes;
 use crate::polynomial::options::{DiscountMode, MAX_DEGREE};
@@ -70,6 +71,9 @@ pub(crate) struct ExactEngine {
     inv_scale: f64,
     /// `k!/s^k` for the unit `s` (unscaled derivatives from the coefficients).
     unscale: Vec<f64>,
+    /// Whether every `unscale` entry is a normal double; else the derivatives are unscaled one
+    /// factor at a time ([`crate::model::taylor`]'s `unscale_stepwise`).
+    unscale_in_range: bool,
 }
 
 impl ExactEngine {
@@ -92,6 +96,7 @@ impl ExactEngine {
             span_updates: discount.map_or(0.0, |d| 3.0 / -d.theta.ln()),
             span_per_time: discount.map_or(0.0, |d| 3.0 * d.tau / -d.theta.ln()),
             unscale: vec![0.0; m + 1],
+            unscale_in_range: true,
             inv_scale: 1.0,
         }
     }
@@ -210,6 +215,21 @@ impl ExactEngine {
         for (c, d) in self.unscale.iter_mut().zip(derivative_scale(self.unit)) {
             *c = d;
         }
+        self.unscale_in_range = unscale_in_range(self.m, self.unit);
+    }
+
+    /// `x_k = a_k k!/s^k` into `out`.
+    #[inline(always)]
+    fn unscale_into(&self, a: &[f64], out: &mut [f64]) {
+        if self.unscale_in_range {
+            for ((x, z), c) in out.iter_mut().zip(a).zip(&self.unscale) {
+                *x = z * c;
+            }
+        } else {
+            for (k, (x, z)) in out.iter_mut().zip(a).enumerate() {
+                *x = unscale_stepwise(*z, k, self.unit);
+            }
+        }
     }
 
     /// Re-centres: `u_old = α u_new + β`, i.e. new centre `c + β·s`, new unit `α·s`.
@@ -247,11 +267,9 @@ impl ExactEngine {
             return false;
         };
         shift_scaled_array(&mut a, h);
-        // `k!/s^k`: the unit `s` is a power of two (re-centring scales it by powers of two
-        // from 1), so this equals `z·k!/s^k` computed with the division, bit for bit.
-        for ((x, z), c) in out[..N].iter_mut().zip(a).zip(&self.unscale[..N]) {
-            *x = z * c;
-        }
+        // `k!/s^k`: the unit `s` is a power of two, so this equals `z·k!/s^k` computed with
+        // the division, bit for bit.
+        self.unscale_into(&a, &mut out[..N]);
         true
     }
 
@@ -266,9 +284,7 @@ impl ExactEngine {
             return false;
         }
         shift_scaled(a, h);
-        for ((x, z), c) in out.iter_mut().zip(a.iter()).zip(&self.unscale) {
-            *x = z * c;
-        }
+        self.unscale_into(a, out);
         true
     }
 

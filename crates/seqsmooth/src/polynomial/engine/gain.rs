@@ -12,6 +12,7 @@
 //! state in compensated (double-word) arithmetic.
 
 use super::recursion::predict_correct;
+use crate::model::taylor::{unscale_in_range, unscale_stepwise};
 use crate::model::{derivative_scale, factorial_powers, shift_scaled, shift_scaled_compensated};
 use crate::numeric::double_word::{self as dw, two_prod, two_sum, DoubleWord};
 use crate::numeric::memo::Memo;
@@ -474,12 +475,18 @@ impl GainEngine {
             return;
         }
         for (k, (x, (f, tk))) in row.iter_mut().zip(factorial_powers(self.unit)).enumerate() {
-            *x = (self.z[k] + self.z_lo[k]) * f / tk;
+            let z = self.z[k] + self.z_lo[k];
+            *x = if tk.is_normal() {
+                z * f / tk
+            } else {
+                unscale_stepwise(z, k, self.unit)
+            };
         }
     }
 
     fn plain_kernel_applies(&self) -> bool {
         self.cov.is_none()
+            && unscale_in_range(self.m, self.unit)
             && self.m <= PLAIN_KERNEL_MAX_DEGREE
             && match &self.fading {
                 Some(f) => f.switched_at.is_some(),
