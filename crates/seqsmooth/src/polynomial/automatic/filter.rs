@@ -16,7 +16,7 @@ use crate::polynomial::fading::switch::memory_length_constant;
 use crate::polynomial::fading::switch::SwitchRule;
 use crate::polynomial::fading::FadingMemory;
 use crate::polynomial::filter::PolynomialFilter;
-use crate::polynomial::options::check_not_started;
+use crate::polynomial::options::{check_not_started, MAX_DEGREE};
 use crate::polynomial::options::{DiscountMode, Engine};
 use crate::stats::{ChiSquaredOutcome, InnovationChiSquared};
 use std::collections::VecDeque;
@@ -50,6 +50,10 @@ pub struct AutomaticFilter {
     pub(super) expanding: Option<ExpandingMemory>,
     /// The final-degree fading-memory filter of the current memory.
     pub(super) fading: FadingMemory,
+    /// Degree `m + 1` companions of `expanding` and `fading` on the same samples (for the bias
+    /// of the final degree; `None` at `m = MAX_DEGREE`, the expanding one after the switch).
+    pub(super) upper_expanding: Option<ExpandingMemory>,
+    pub(super) upper_fading: Option<FadingMemory>,
     pub(super) active: usize,
     /// Global index (accepted samples) of the latest expanding → fading switch.
     switched_at: Option<u64>,
@@ -77,6 +81,9 @@ pub struct AutomaticFilter {
     pub(super) prev_top: Option<f64>,
     /// The output of the newest update.
     last_output: Option<AutoOutput>,
+    /// The innovations' mean square excess over their noise-only variance in the misfit
+    /// window, `max(0, mean(k²) − 1)·σ²(1 + v)` (value units²), at the newest sample.
+    pub(super) excess: f64,
 }
 
 /// An expanding-memory filter of degree `m` tracking its covariance for unit noise (its VRF).
@@ -84,12 +91,27 @@ pub(super) fn unit_expanding(m: usize, engine: Engine) -> Result<ExpandingMemory
     ExpandingMemory::new(m, engine)?.with_noise_sigma(1.0)
 }
 
-/// The final-degree fading-memory filter of `cfg`, tracking its VRF.
-pub(super) fn unit_fading(cfg: &AutoConfig) -> Result<FadingMemory, Error> {
-    FadingMemory::new(cfg.degree, cfg.theta, cfg.tau, cfg.engine)?
+/// The fading-memory filter of degree `m` with the settings of `cfg`, tracking its VRF.
+pub(super) fn unit_fading(cfg: &AutoConfig, m: usize) -> Result<FadingMemory, Error> {
+    FadingMemory::new(m, cfg.theta, cfg.tau, cfg.engine)?
         .with_discount_mode(cfg.discount)?
         .with_switch_rule(cfg.switch_rule)?
         .with_noise_sigma(1.0)
+}
+
+/// The degree `m + 1` companions (expanding, fading) of the final degree, when `m + 1` is a
+/// supported degree.
+pub(super) fn upper_pair(
+    cfg: &AutoConfig,
+) -> Result<(Option<ExpandingMemory>, Option<FadingMemory>), Error> {
+    let u = cfg.degree + 1;
+    if u > MAX_DEGREE {
+        return Ok((None, None));
+    }
+    Ok((
+        Some(unit_expanding(u, cfg.engine)?),
+        Some(unit_fading(cfg, u)?),
+    ))
 }
 
 /// The `with_*` builders of [`AutomaticFilter`]: each changes the fields of its
@@ -130,7 +152,8 @@ impl AutomaticFilter {
             })
             .collect::<Result<Vec<_>, _>>()?;
         let expanding = Some(unit_expanding(m, config.engine)?);
-        let fading = unit_fading(&config)?;
+        let fading = unit_fading(&config, m)?;
+        let (upper_expanding, upper_fading) = upper_pair(&config)?;
         let noise = NoiseState::new(config.noise_sigma, config.noise_source, m)?;
         Ok(Self {
             active: config.start_degree,
@@ -140,6 +163,8 @@ impl AutomaticFilter {
             ladder,
             expanding,
             fading,
+            upper_expanding,
+            upper_fading,
             switched_at: None,
             switched: false,
             memory_t_first: None,
@@ -156,6 +181,7 @@ impl AutomaticFilter {
             stable_runs: 0,
             prev_top: None,
             last_output: None,
+            excess: 0.0,
         })
     }
 
@@ -541,19 +567,10 @@ impl AutomaticFilter {
             .unwrap_or_else(|| self.final_filter())
     }
 
-    fn scale(&self, state: PolynomialState) -> PolynomialState {
-        let sigma = self.noise_sigma();
-        PolynomialState {
-            covariance: match (state.covariance, sigma) {
-                (Some(c), Some(s)) => Some(c * (s * s)),
-                _ => None,
-            },
-            ..state
-        }
-    }
 
     /// The estimate at any time `t` from the active filter (a prediction after the newest
-    /// accepted sample), with covariance `σ²·VRF` when `σ` is available.
+    /// accepted sample), with the covariance `σ²·VRF + b bᵀ` when `σ` is available: the noise's
+    /// and the estimated bias `b` of the active degree (see the [module docs](super)).
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
@@ -563,7 +580,9 @@ impl AutomaticFilter {
     /// assert!((f.estimate_at(2.0).unwrap().derivatives[0] - 5.0).abs() < 1e-12);
     /// ```
     pub fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
-        self.active_filter().estimate_at(t).map(|s| self.scale(s))
+        self.active_filter()
+            .estimate_at(t)
+            .map(|s| self.honest(s).0)
     }
 
     /// The estimate at the newest accepted sample.
@@ -576,7 +595,7 @@ impl AutomaticFilter {
     /// assert_eq!(f.estimate().unwrap().derivatives, vec![1.0]);
     /// ```
     pub fn estimate(&self) -> Option<PolynomialState> {
-        self.active_filter().estimate().map(|s| self.scale(s))
+        self.active_filter().estimate().map(|s| self.honest(s).0)
     }
 
     /// Processes the sample `y` at time `t` (finite, strictly after the previous sample's time,
@@ -616,6 +635,7 @@ impl AutomaticFilter {
             self.switched = true;
             self.switched_at = Some(self.accepted);
             self.expanding = None;
+            self.upper_expanding = None;
         }
         let sigma = self.noise_sigma();
         let prediction = self.active_filter().estimate_at(t);
@@ -626,15 +646,25 @@ impl AutomaticFilter {
             ),
             None => (None, None),
         };
+        self.excess = match (sigma, vrf) {
+            (Some(s), Some(v)) => self.innovation_excess(s * s * (1.0 + v)),
+            _ => 0.0,
+        };
+        // The prediction's estimated bias: the honest innovation variance σ²(1 + v) + b₀².
+        let bias0 = match (&prediction, sigma) {
+            (Some(p), Some(s)) => self.bias_of(p, s).map_or(0.0, |b| b[0]),
+            _ => 0.0,
+        };
         let innovation_sigma = match (sigma, vrf) {
-            (Some(s), Some(v)) => Some(s * (1.0 + v).sqrt()),
+            (Some(s), Some(v)) => Some((s * s * (1.0 + v) + bias0 * bias0).sqrt()),
             _ => None,
         };
-        let k2 = match (innovation, innovation_sigma) {
-            (Some(nu), Some(se)) if se > 0.0 => Some((nu / se).powi(2)),
+        // The misfit test judges the model: the innovation against its noise-only variance.
+        let k2 = match (innovation, sigma, vrf) {
+            (Some(nu), Some(s), Some(v)) if s > 0.0 => Some(nu * nu / (s * s * (1.0 + v))),
             _ => None,
         };
-        let gate = self.gate(sigma, vrf, t);
+        let gate = self.gate(sigma, vrf, bias0, t);
         let rejected = match (gate, innovation) {
             (Some(g), Some(nu)) => nu.abs() > g,
             _ => false,
@@ -674,10 +704,14 @@ impl AutomaticFilter {
             }
         }
         let outlier = rejected && !manoeuvre;
-        let estimate = if outlier {
-            self.estimate_at(t)
+        let raw = if outlier {
+            self.active_filter().estimate_at(t)
         } else {
-            self.estimate()
+            self.active_filter().estimate()
+        };
+        let (estimate, bias) = match raw.map(|s| self.honest(s)) {
+            Some((s, b)) => (Some(s), b),
+            None => (None, None),
         };
         Ok(AutoOutput {
             time: t,
@@ -688,6 +722,7 @@ impl AutomaticFilter {
             innovation,
             innovation_sigma,
             gate,
+            bias,
             outlier,
             misfit: manoeuvre || restart || self.chi.is_misfit(),
             manoeuvre,
@@ -727,6 +762,12 @@ impl AutomaticFilter {
             f.update(t, y)?;
         }
         self.fading.update(t, y)?;
+        if let Some(f) = &mut self.upper_expanding {
+            f.update(t, y)?;
+        }
+        if let Some(f) = &mut self.upper_fading {
+            f.update(t, y)?;
+        }
         if self.memory_t_first.is_none() {
             self.memory_t_first = Some(t);
         }

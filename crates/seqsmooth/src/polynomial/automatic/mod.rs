@@ -107,6 +107,7 @@ use crate::polynomial::fading::FadingMemory;
 #[cfg(doc)]
 use crate::polynomial::options::{DiscountMode, Engine};
 
+mod bias;
 mod config;
 mod filter;
 mod misfit;
