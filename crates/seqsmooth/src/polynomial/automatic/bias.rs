@@ -25,6 +25,10 @@ use super::AutoOutput;
 use crate::model::PolynomialState;
 use crate::polynomial::filter::PolynomialFilter;
 
+/// `Δ_i` counts as a bias beyond this many of its own noise standard deviations (1: whenever
+/// `Δ_i²` exceeds its noise variance).
+const SIGNIFICANCE: f64 = 1.0;
+
 impl AutomaticFilter {
     /// The filter of the active degree plus one on the active filter's memory: the next rung of
     /// the ladder, or the final degree's own `m + 1` companion.
@@ -54,8 +58,13 @@ impl AutomaticFilter {
             .enumerate()
             .map(|(i, (&xd, &xu))| {
                 let delta = xd - xu;
-                let excess = delta * delta - s2 * (vu[(i, i)] - vd[(i, i)]).max(0.0);
-                let b = excess.max(0.0).sqrt();
+                let var = s2 * (vu[(i, i)] - vd[(i, i)]).max(0.0);
+                // The excess of Δ² over its noise variance, when positive.
+                let b = if delta * delta > SIGNIFICANCE * SIGNIFICANCE * var {
+                    (delta * delta - var).sqrt()
+                } else {
+                    0.0
+                };
                 if b.is_finite() {
                     b.copysign(delta)
                 } else {
@@ -79,8 +88,9 @@ impl AutomaticFilter {
         if n == 0 {
             return 0.0;
         }
+        // Counted while the misfit test says the excess is significant.
         let r = self.chi.statistic() / n as f64 - 1.0;
-        if r.is_finite() && r > 0.0 {
+        if r.is_finite() && r > 0.0 && self.chi.is_misfit() {
             r * var
         } else {
             0.0

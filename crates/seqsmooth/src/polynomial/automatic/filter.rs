@@ -693,11 +693,20 @@ impl AutomaticFilter {
             }
         } else {
             self.pending.clear();
-            let truncation = match (gate, innovation_sigma, vrf) {
-                (Some(g), Some(se), Some(v)) if se > 0.0 => Some((g / se, v)),
+            // The gate cuts the noise at ±g: in units of the noise-only σ√(1 + v).
+            let truncation = match (gate, sigma, vrf) {
+                (Some(g), Some(s), Some(v)) if s > 0.0 => Some((g / (s * (1.0 + v).sqrt()), v)),
                 _ => None,
             };
-            chi_out = self.accept(Kept { t, y, k2 }, truncation, false)?;
+            // Accepted only because the gate includes the estimated bias: like a run of
+            // rejections applied after all, left out of the innovation noise estimate.
+            let beyond_noise = match (truncation, innovation, sigma, vrf) {
+                (Some(_), Some(nu), Some(s), Some(v)) => {
+                    nu.abs() > self.cfg.outliers.multiplier() * s * (1.0 + v).sqrt()
+                }
+                _ => false,
+            };
+            chi_out = self.accept(Kept { t, y, k2 }, truncation, beyond_noise)?;
             if self.active == m && self.restart_test.as_ref().is_some_and(|r| r.is_misfit()) {
                 self.restart()?;
                 restart = true;
