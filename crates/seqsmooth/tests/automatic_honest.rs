@@ -145,7 +145,12 @@ impl Score {
     fn coverage_se(&self) -> f64 {
         let n = self.run_coverage.len() as f64;
         let mean = self.run_coverage.iter().sum::<f64>() / n;
-        let var = self.run_coverage.iter().map(|c| (c - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        let var = self
+            .run_coverage
+            .iter()
+            .map(|c| (c - mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
         (var / n).sqrt()
     }
     fn print(&self, what: &str) {
@@ -218,9 +223,31 @@ fn misses(s: &Score, outliers: bool) -> Vec<String> {
 
 #[test]
 fn honest_sigma_where_the_thresholds_hold() {
+    // The thresholds each scenario misses today (measured, see the file docs); every other
+    // threshold of the issue is asserted to hold.
+    let known: [&[&str]; 8] = [
+        &["good rejected", "σ̂ RMS"],     // landing east, σ = 1 m
+        &["good rejected", "σ̂ RMS"],     // landing north, σ = 1 m
+        &["coverage", "good rejected"],  // landing up, σ = 1 m
+        &["good rejected"],              // landing east, σ = 10 m
+        &["good rejected"],              // landing north, σ = 10 m
+        &["good rejected"],              // landing up, σ = 10 m
+        &["outliers rejected"],          // gentle turn
+        &["outliers rejected", "σ̂ RMS"], // sharp turn
+    ];
     let all = scenarios();
-    for (what, s, outliers) in &all {
-        println!("{what}: misses {:?}", misses(s, *outliers));
+    assert_eq!(all.len(), known.len());
+    for ((what, s, outliers), allowed) in all.iter().zip(known) {
+        let m = misses(s, *outliers);
+        println!("{what}: misses {m:?}");
+        for miss in &m {
+            assert!(
+                allowed.iter().any(|a| miss.starts_with(a)),
+                "{what}: {miss}"
+            );
+        }
+        // Before the bias term the σ covered 81-87% of these rows.
+        assert!(s.coverage() >= 0.95, "{what}: coverage {}", s.coverage());
     }
 }
 

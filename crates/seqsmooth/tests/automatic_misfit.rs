@@ -49,7 +49,10 @@ fn flag_only_response_keeps_the_memory() {
     let onset = index_at(&data, SHARP.onset);
     let up = outs[onset..onset + 100].iter().filter(|o| o.misfit).count();
     assert!(up > 50);
-    println!("flag-only coverage over all samples {:.4}", s.coverage_all());
+    println!(
+        "flag-only coverage over all samples {:.4}",
+        s.coverage_all()
+    );
     assert!(s.coverage_all() >= 0.97);
     // On the gentle manoeuvre nothing restarts anyway.
     let (g, _) = score(&c, GENTLE);

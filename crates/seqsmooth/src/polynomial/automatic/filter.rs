@@ -567,7 +567,6 @@ impl AutomaticFilter {
             .unwrap_or_else(|| self.final_filter())
     }
 
-
     /// The estimate at any time `t` from the active filter (a prediction after the newest
     /// accepted sample), with the covariance `σ²·VRF + b bᵀ` when `σ` is available: the noise's
     /// and the estimated bias `b` of the active degree (see the [module docs](super)).

@@ -143,7 +143,13 @@ impl AutomaticFilter {
     /// (for Morrison's rule `k √(σ²(1 + v) + b₀²)`, `k` times the honest `σ_ε`). Active only at
     /// the final degree, with `σ` known and the prediction at least as good as
     /// [`AutoConfig::gate_max_vrf`] says.
-    pub(super) fn gate(&self, sigma: Option<f64>, vrf: Option<f64>, bias: f64, t: f64) -> Option<f64> {
+    pub(super) fn gate(
+        &self,
+        sigma: Option<f64>,
+        vrf: Option<f64>,
+        bias: f64,
+        t: f64,
+    ) -> Option<f64> {
         match (sigma, vrf) {
             (Some(s), Some(v)) if self.active == self.cfg.degree && v <= self.cfg.gate_max_vrf => {
                 let g = self.cfg.outliers.threshold(s, v, self.memory_length(t))?;
