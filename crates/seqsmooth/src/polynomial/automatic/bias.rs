@@ -16,6 +16,10 @@
 //! it. The same holds for a prediction: the innovation variance is
 //! `σ_ε² = σ²(1 + v) + b̂₀²` at the sample's time.
 //!
+//! While the misfit test is up, the position's `b̂₀²` is at least the innovations' mean
+//! square excess over their noise variance in the misfit window (Morrison §14.8: the
+//! normalised squared innovations have mean 1 while the model fits).
+//!
 //! No bias is estimated (the covariance is the noise's only, [`AutoOutput::bias`] is `None`)
 //! when the next degree is not determined yet or does not exist (`d = MAX_DEGREE`).
 

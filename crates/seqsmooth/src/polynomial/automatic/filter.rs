@@ -681,7 +681,7 @@ impl AutomaticFilter {
                 // The earlier members of the run were counted as rejections; they are not.
                 self.rejected -= (run.len() - 1) as u64;
                 for p in run {
-                    chi_out = self.accept(p, None, true)?.or(chi_out);
+                    chi_out = self.accept(p, None, true, false)?.or(chi_out);
                 }
                 if self.restart_test.is_some() && self.active == m {
                     self.restart()?;
@@ -692,20 +692,19 @@ impl AutomaticFilter {
             }
         } else {
             self.pending.clear();
-            // The gate cuts the noise at ±g: in units of the noise-only σ√(1 + v).
-            let truncation = match (gate, sigma, vrf) {
+            // The noise estimates see the samples the noise-only gate g₀ (the rule without the
+            // bias) passes, with its truncation in units of σ√(1 + v); a sample accepted only
+            // because the gate includes the estimated bias is left out of them.
+            let noise_gate = self.gate(sigma, vrf, 0.0, t);
+            let truncation = match (noise_gate, sigma, vrf) {
                 (Some(g), Some(s), Some(v)) if s > 0.0 => Some((g / (s * (1.0 + v).sqrt()), v)),
                 _ => None,
             };
-            // Accepted only because the gate includes the estimated bias: like a run of
-            // rejections applied after all, left out of the innovation noise estimate.
-            let beyond_noise = match (truncation, innovation, sigma, vrf) {
-                (Some(_), Some(nu), Some(s), Some(v)) => {
-                    nu.abs() > self.cfg.outliers.multiplier() * s * (1.0 + v).sqrt()
-                }
+            let beyond_noise = match (noise_gate, innovation) {
+                (Some(g), Some(nu)) => nu.abs() > g,
                 _ => false,
             };
-            chi_out = self.accept(Kept { t, y, k2 }, truncation, beyond_noise)?;
+            chi_out = self.accept(Kept { t, y, k2 }, truncation, false, beyond_noise)?;
             if self.active == m && self.restart_test.as_ref().is_some_and(|r| r.is_misfit()) {
                 self.restart()?;
                 restart = true;
@@ -743,12 +742,13 @@ impl AutomaticFilter {
     /// then lets the ladder step up. `truncation` is `(a, v)`, the gate half-width in units of
     /// `σ_ε` and the prediction VRF, when the gate was active (the noise estimates correct for
     /// the truncation); `manoeuvre` marks a run of rejections applied after all (left out of the
-    /// innovation noise estimate).
+    /// innovation noise estimate); `unseen` leaves the sample out of every noise estimate.
     fn accept(
         &mut self,
         sample: Kept,
         truncation: Option<(f64, f64)>,
         manoeuvre: bool,
+        unseen: bool,
     ) -> Result<Option<ChiSquaredOutcome>, Error> {
         let Kept { t, y, k2 } = sample;
         // The final-degree filter's own normalised innovation ν²/(1+v), whatever degree is
@@ -762,7 +762,9 @@ impl AutomaticFilter {
         } else {
             None
         };
-        self.noise.push(t, y, innovation, truncation, manoeuvre)?;
+        if !unseen {
+            self.noise.push(t, y, innovation, truncation, manoeuvre)?;
+        }
         for f in self.ladder.iter_mut().flatten() {
             f.update(t, y)?;
         }
