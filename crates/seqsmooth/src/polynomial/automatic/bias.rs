@@ -33,6 +33,10 @@ use crate::polynomial::filter::PolynomialFilter;
 /// `Δ_i²` exceeds its noise variance).
 const SIGNIFICANCE: f64 = 1.0;
 
+/// A rejected sample is a marginal crossing (evidence of bias when the next sample crosses on
+/// the same side) up to this many gate widths.
+const MARGINAL: f64 = 1.25;
+
 impl AutomaticFilter {
     /// The filter of the active degree plus one on the active filter's memory: the next rung of
     /// the ladder, or the final degree's own `m + 1` companion.
@@ -82,6 +86,36 @@ impl AutomaticFilter {
             b[0] = floor.copysign(b[0]);
         }
         Some(b)
+    }
+
+    /// The prediction's position bias `b₀` raised by the current run of rejections: a
+    /// rejected sample on the same side as the innovation `ν` and within [`MARGINAL`] gate widths
+    /// (`|r| ≤ 1.25 k√(σ²(1+v) + b₀²)`, a marginal crossing, not a jump) is taken as evidence of
+    /// bias (Morrison §14.8: repeated crossings mean bias), `b₀² ≥ r² − σ²(1+v)` with `r` its
+    /// residual against the current prediction and `v` that prediction's VRF.
+    pub(super) fn with_pending(&self, b0: f64, nu: Option<f64>, sigma: Option<f64>) -> f64 {
+        let (Some(nu), Some(s)) = (nu, sigma) else {
+            return b0;
+        };
+        let k = self.cfg.outliers.multiplier();
+        let mut b2 = b0 * b0;
+        for p in &self.pending {
+            let Some(pred) = self.active_filter().estimate_at(p.t) else {
+                continue;
+            };
+            let v = pred.covariance.as_ref().map_or(0.0, |c| c[(0, 0)].max(0.0));
+            let r = p.y - pred.derivatives[0];
+            let noise = s * s * (1.0 + v);
+            let marginal = r.abs() <= MARGINAL * k * (noise + b0 * b0).sqrt();
+            if marginal && r.signum() == nu.signum() && r * r - noise > b2 {
+                b2 = r * r - noise;
+            }
+        }
+        if b2.is_finite() {
+            b2.sqrt().copysign(b0)
+        } else {
+            b0
+        }
     }
 
     /// The innovations' mean square excess over their expected variance `var` in the misfit

@@ -75,7 +75,7 @@ pub struct AutomaticFilter {
     /// The newest accepted samples (for a restart).
     pub(super) recent: VecDeque<Kept>,
     /// The current run of rejected samples.
-    pending: Vec<Kept>,
+    pub(super) pending: Vec<Kept>,
     /// Consecutive updates the candidate's top derivative stayed within its 1σ.
     pub(super) stable_runs: usize,
     pub(super) prev_top: Option<f64>,
@@ -654,6 +654,7 @@ impl AutomaticFilter {
             (Some(p), Some(s)) => self.bias_of(p, s).map_or(0.0, |b| b[0]),
             _ => 0.0,
         };
+        let bias0 = self.with_pending(bias0, innovation, sigma);
         let innovation_sigma = match (sigma, vrf) {
             (Some(s), Some(v)) => Some((s * s * (1.0 + v) + bias0 * bias0).sqrt()),
             _ => None,

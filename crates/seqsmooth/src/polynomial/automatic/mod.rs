@@ -76,7 +76,9 @@
 //! uncorrelated with `x_d`), so `b_i = sign(Δ_i) √max(0, Δ_i² − σ²(V_{d+1} − V_d)_ii)`. For the
 //! position, while the misfit test is up, `b₀²` is at least the innovations' mean square excess
 //! over their noise variance in the misfit window, `(mean(ν²/σ²(1+v)) − 1)·σ²(1+v)` (Morrison
-//! §14.8). This covers a start-up at a low degree of the ladder, a degree still settling and a
+//! §14.8), and at least the excess `r² − σ²(1+v)` of a sample just rejected within 1.25 gate
+//! widths on the same side as `ν` (repeated crossings mean bias, Morrison §14.8). This covers
+//! a start-up at a low degree of the ladder, a degree still settling and a
 //! manoeuvre the memory does not follow (Morrison §7.13: the total error is the random error
 //! and the bias together). The gate judges `ν` against the same honest `σ_ε`; the misfit test
 //! keeps judging the model, against the noise-only variance. Measured coverage: see
