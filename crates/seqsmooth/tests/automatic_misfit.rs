@@ -38,7 +38,8 @@ fn sharp_manoeuvre_restarts_keep_the_coverage() {
 #[test]
 fn flag_only_response_keeps_the_memory() {
     // Without the restart the memory carries the sharp manoeuvre: the flag stays up long after
-    // the onset, and the coverage over all samples suffers (which is what the restart is for).
+    // the onset. The reported σ includes the estimated bias, so the coverage over all samples
+    // holds anyway (it fell below 95% while the σ covered the noise only).
     let c = main_filter()
         .with_misfit_response(MisfitResponse::Flag)
         .unwrap();
@@ -48,7 +49,11 @@ fn flag_only_response_keeps_the_memory() {
     let onset = index_at(&data, SHARP.onset);
     let up = outs[onset..onset + 100].iter().filter(|o| o.misfit).count();
     assert!(up > 50);
-    assert!(s.coverage_all() < 0.95);
+    println!(
+        "flag-only coverage over all samples {:.4}",
+        s.coverage_all()
+    );
+    assert!(s.coverage_all() >= 0.97);
     // On the gentle manoeuvre nothing restarts anyway.
     let (g, _) = score(&c, GENTLE);
     let (d, _) = score(&main_filter(), GENTLE);

@@ -16,7 +16,7 @@ use crate::polynomial::fading::switch::memory_length_constant;
 use crate::polynomial::fading::switch::SwitchRule;
 use crate::polynomial::fading::FadingMemory;
 use crate::polynomial::filter::PolynomialFilter;
-use crate::polynomial::options::check_not_started;
+use crate::polynomial::options::{check_not_started, MAX_DEGREE};
 use crate::polynomial::options::{DiscountMode, Engine};
 use crate::stats::{ChiSquaredOutcome, InnovationChiSquared};
 use std::collections::VecDeque;
@@ -50,6 +50,10 @@ pub struct AutomaticFilter {
     pub(super) expanding: Option<ExpandingMemory>,
     /// The final-degree fading-memory filter of the current memory.
     pub(super) fading: FadingMemory,
+    /// Degree `m + 1` companions of `expanding` and `fading` on the same samples (for the bias
+    /// of the final degree; `None` at `m = MAX_DEGREE`, the expanding one after the switch).
+    pub(super) upper_expanding: Option<ExpandingMemory>,
+    pub(super) upper_fading: Option<FadingMemory>,
     pub(super) active: usize,
     /// Global index (accepted samples) of the latest expanding → fading switch.
     switched_at: Option<u64>,
@@ -71,12 +75,15 @@ pub struct AutomaticFilter {
     /// The newest accepted samples (for a restart).
     pub(super) recent: VecDeque<Kept>,
     /// The current run of rejected samples.
-    pending: Vec<Kept>,
+    pub(super) pending: Vec<Kept>,
     /// Consecutive updates the candidate's top derivative stayed within its 1σ.
     pub(super) stable_runs: usize,
     pub(super) prev_top: Option<f64>,
     /// The output of the newest update.
     last_output: Option<AutoOutput>,
+    /// The innovations' mean square excess over their noise-only variance in the misfit
+    /// window, `max(0, mean(k²) − 1)·σ²(1 + v)` (value units²), at the newest sample.
+    pub(super) excess: f64,
 }
 
 /// An expanding-memory filter of degree `m` tracking its covariance for unit noise (its VRF).
@@ -84,12 +91,27 @@ pub(super) fn unit_expanding(m: usize, engine: Engine) -> Result<ExpandingMemory
     ExpandingMemory::new(m, engine)?.with_noise_sigma(1.0)
 }
 
-/// The final-degree fading-memory filter of `cfg`, tracking its VRF.
-pub(super) fn unit_fading(cfg: &AutoConfig) -> Result<FadingMemory, Error> {
-    FadingMemory::new(cfg.degree, cfg.theta, cfg.tau, cfg.engine)?
+/// The fading-memory filter of degree `m` with the settings of `cfg`, tracking its VRF.
+pub(super) fn unit_fading(cfg: &AutoConfig, m: usize) -> Result<FadingMemory, Error> {
+    FadingMemory::new(m, cfg.theta, cfg.tau, cfg.engine)?
         .with_discount_mode(cfg.discount)?
         .with_switch_rule(cfg.switch_rule)?
         .with_noise_sigma(1.0)
+}
+
+/// The degree `m + 1` companions (expanding, fading) of the final degree, when `m + 1` is a
+/// supported degree.
+pub(super) fn upper_pair(
+    cfg: &AutoConfig,
+) -> Result<(Option<ExpandingMemory>, Option<FadingMemory>), Error> {
+    let u = cfg.degree + 1;
+    if u > MAX_DEGREE {
+        return Ok((None, None));
+    }
+    Ok((
+        Some(unit_expanding(u, cfg.engine)?),
+        Some(unit_fading(cfg, u)?),
+    ))
 }
 
 /// The `with_*` builders of [`AutomaticFilter`]: each changes the fields of its
@@ -130,7 +152,8 @@ impl AutomaticFilter {
             })
             .collect::<Result<Vec<_>, _>>()?;
         let expanding = Some(unit_expanding(m, config.engine)?);
-        let fading = unit_fading(&config)?;
+        let fading = unit_fading(&config, m)?;
+        let (upper_expanding, upper_fading) = upper_pair(&config)?;
         let noise = NoiseState::new(config.noise_sigma, config.noise_source, m)?;
         Ok(Self {
             active: config.start_degree,
@@ -140,6 +163,8 @@ impl AutomaticFilter {
             ladder,
             expanding,
             fading,
+            upper_expanding,
+            upper_fading,
             switched_at: None,
             switched: false,
             memory_t_first: None,
@@ -156,6 +181,7 @@ impl AutomaticFilter {
             stable_runs: 0,
             prev_top: None,
             last_output: None,
+            excess: 0.0,
         })
     }
 
@@ -541,19 +567,9 @@ impl AutomaticFilter {
             .unwrap_or_else(|| self.final_filter())
     }
 
-    fn scale(&self, state: PolynomialState) -> PolynomialState {
-        let sigma = self.noise_sigma();
-        PolynomialState {
-            covariance: match (state.covariance, sigma) {
-                (Some(c), Some(s)) => Some(c * (s * s)),
-                _ => None,
-            },
-            ..state
-        }
-    }
-
     /// The estimate at any time `t` from the active filter (a prediction after the newest
-    /// accepted sample), with covariance `σ²·VRF` when `σ` is available.
+    /// accepted sample), with the covariance `σ²·VRF + b bᵀ` when `σ` is available: the noise's
+    /// and the estimated bias `b` of the active degree (see the [module docs](super)).
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
@@ -563,7 +579,9 @@ impl AutomaticFilter {
     /// assert!((f.estimate_at(2.0).unwrap().derivatives[0] - 5.0).abs() < 1e-12);
     /// ```
     pub fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
-        self.active_filter().estimate_at(t).map(|s| self.scale(s))
+        self.active_filter()
+            .estimate_at(t)
+            .map(|s| self.honest(s).0)
     }
 
     /// The estimate at the newest accepted sample.
@@ -576,7 +594,7 @@ impl AutomaticFilter {
     /// assert_eq!(f.estimate().unwrap().derivatives, vec![1.0]);
     /// ```
     pub fn estimate(&self) -> Option<PolynomialState> {
-        self.active_filter().estimate().map(|s| self.scale(s))
+        self.active_filter().estimate().map(|s| self.honest(s).0)
     }
 
     /// Processes the sample `y` at time `t` (finite, strictly after the previous sample's time,
@@ -616,6 +634,7 @@ impl AutomaticFilter {
             self.switched = true;
             self.switched_at = Some(self.accepted);
             self.expanding = None;
+            self.upper_expanding = None;
         }
         let sigma = self.noise_sigma();
         let prediction = self.active_filter().estimate_at(t);
@@ -626,15 +645,26 @@ impl AutomaticFilter {
             ),
             None => (None, None),
         };
+        self.excess = match (sigma, vrf) {
+            (Some(s), Some(v)) => self.innovation_excess(s * s * (1.0 + v)),
+            _ => 0.0,
+        };
+        // The prediction's estimated bias: the honest innovation variance σ²(1 + v) + b₀².
+        let bias0 = match (&prediction, sigma) {
+            (Some(p), Some(s)) => self.bias_of(p, s).map_or(0.0, |b| b[0]),
+            _ => 0.0,
+        };
+        let bias0 = self.with_pending(bias0, innovation, sigma);
         let innovation_sigma = match (sigma, vrf) {
-            (Some(s), Some(v)) => Some(s * (1.0 + v).sqrt()),
+            (Some(s), Some(v)) => Some((s * s * (1.0 + v) + bias0 * bias0).sqrt()),
             _ => None,
         };
-        let k2 = match (innovation, innovation_sigma) {
-            (Some(nu), Some(se)) if se > 0.0 => Some((nu / se).powi(2)),
+        // The misfit test judges the model: the innovation against its noise-only variance.
+        let k2 = match (innovation, sigma, vrf) {
+            (Some(nu), Some(s), Some(v)) if s > 0.0 => Some(nu * nu / (s * s * (1.0 + v))),
             _ => None,
         };
-        let gate = self.gate(sigma, vrf, t);
+        let gate = self.gate(sigma, vrf, bias0, t);
         let rejected = match (gate, innovation) {
             (Some(g), Some(nu)) => nu.abs() > g,
             _ => false,
@@ -652,7 +682,7 @@ impl AutomaticFilter {
                 // The earlier members of the run were counted as rejections; they are not.
                 self.rejected -= (run.len() - 1) as u64;
                 for p in run {
-                    chi_out = self.accept(p, None, true)?.or(chi_out);
+                    chi_out = self.accept(p, None, true, false)?.or(chi_out);
                 }
                 if self.restart_test.is_some() && self.active == m {
                     self.restart()?;
@@ -663,21 +693,33 @@ impl AutomaticFilter {
             }
         } else {
             self.pending.clear();
-            let truncation = match (gate, innovation_sigma, vrf) {
-                (Some(g), Some(se), Some(v)) if se > 0.0 => Some((g / se, v)),
+            // The noise estimates see the samples the noise-only gate g₀ (the rule without the
+            // bias) passes, with its truncation in units of σ√(1 + v); a sample accepted only
+            // because the gate includes the estimated bias is left out of them.
+            let noise_gate = self.gate(sigma, vrf, 0.0, t);
+            let truncation = match (noise_gate, sigma, vrf) {
+                (Some(g), Some(s), Some(v)) if s > 0.0 => Some((g / (s * (1.0 + v).sqrt()), v)),
                 _ => None,
             };
-            chi_out = self.accept(Kept { t, y, k2 }, truncation, false)?;
+            let beyond_noise = match (noise_gate, innovation) {
+                (Some(g), Some(nu)) => nu.abs() > g,
+                _ => false,
+            };
+            chi_out = self.accept(Kept { t, y, k2 }, truncation, false, beyond_noise)?;
             if self.active == m && self.restart_test.as_ref().is_some_and(|r| r.is_misfit()) {
                 self.restart()?;
                 restart = true;
             }
         }
         let outlier = rejected && !manoeuvre;
-        let estimate = if outlier {
-            self.estimate_at(t)
+        let raw = if outlier {
+            self.active_filter().estimate_at(t)
         } else {
-            self.estimate()
+            self.active_filter().estimate()
+        };
+        let (estimate, bias) = match raw.map(|s| self.honest(s)) {
+            Some((s, b)) => (Some(s), b),
+            None => (None, None),
         };
         Ok(AutoOutput {
             time: t,
@@ -688,6 +730,7 @@ impl AutomaticFilter {
             innovation,
             innovation_sigma,
             gate,
+            bias,
             outlier,
             misfit: manoeuvre || restart || self.chi.is_misfit(),
             manoeuvre,
@@ -700,12 +743,13 @@ impl AutomaticFilter {
     /// then lets the ladder step up. `truncation` is `(a, v)`, the gate half-width in units of
     /// `σ_ε` and the prediction VRF, when the gate was active (the noise estimates correct for
     /// the truncation); `manoeuvre` marks a run of rejections applied after all (left out of the
-    /// innovation noise estimate).
+    /// innovation noise estimate); `unseen` leaves the sample out of every noise estimate.
     fn accept(
         &mut self,
         sample: Kept,
         truncation: Option<(f64, f64)>,
         manoeuvre: bool,
+        unseen: bool,
     ) -> Result<Option<ChiSquaredOutcome>, Error> {
         let Kept { t, y, k2 } = sample;
         // The final-degree filter's own normalised innovation ν²/(1+v), whatever degree is
@@ -719,7 +763,9 @@ impl AutomaticFilter {
         } else {
             None
         };
-        self.noise.push(t, y, innovation, truncation, manoeuvre)?;
+        if !unseen {
+            self.noise.push(t, y, innovation, truncation, manoeuvre)?;
+        }
         for f in self.ladder.iter_mut().flatten() {
             f.update(t, y)?;
         }
@@ -727,6 +773,12 @@ impl AutomaticFilter {
             f.update(t, y)?;
         }
         self.fading.update(t, y)?;
+        if let Some(f) = &mut self.upper_expanding {
+            f.update(t, y)?;
+        }
+        if let Some(f) = &mut self.upper_fading {
+            f.update(t, y)?;
+        }
         if self.memory_t_first.is_none() {
             self.memory_t_first = Some(t);
         }

@@ -2,7 +2,7 @@
 //! innovation chi-squared test, and the restart of the final-degree memory from the estimated
 //! onset of the manoeuvre (a CUSUM change point).
 
-use super::filter::{unit_expanding, unit_fading, AutomaticFilter};
+use super::filter::{unit_expanding, unit_fading, upper_pair, AutomaticFilter};
 use crate::error::Error;
 use crate::polynomial::filter::PolynomialFilter;
 
@@ -122,16 +122,26 @@ impl AutomaticFilter {
     pub(super) fn restart(&mut self) -> Result<(), Error> {
         let m = self.cfg.degree;
         let recent: Vec<Kept> = self.recent.iter().copied().collect();
-        let start = misfit_onset(&recent, self.cfg.misfit_window, m);
+        // m + 2 samples at least: the degree m + 1 companion is determined (its bias estimate).
+        let start = misfit_onset(&recent, self.cfg.misfit_window, m + 1);
         let kept = &recent[start..];
         let mut expanding = unit_expanding(m, self.cfg.engine)?;
-        let mut fading = unit_fading(&self.cfg)?;
+        let mut fading = unit_fading(&self.cfg, m)?;
+        let (mut upper_expanding, mut upper_fading) = upper_pair(&self.cfg)?;
         for k in kept {
             expanding.update(k.t, k.y)?;
             fading.update(k.t, k.y)?;
+            if let Some(f) = &mut upper_expanding {
+                f.update(k.t, k.y)?;
+            }
+            if let Some(f) = &mut upper_fading {
+                f.update(k.t, k.y)?;
+            }
         }
         self.expanding = Some(expanding);
         self.fading = fading;
+        self.upper_expanding = upper_expanding;
+        self.upper_fading = upper_fading;
         self.switched = false;
         self.memory_t_first = kept.first().map(|k| k.t);
         self.chi.reset();

@@ -5,8 +5,10 @@
 //! Per sample `(t, y)` ([`AutomaticFilter::update`]):
 //!
 //! 1. **Prediction and innovation.** The active filter predicts `ŷ(t)` with its own covariance;
-//!    the innovation `ν = y − ŷ(t)` has variance `σ_ε² = σ²(1 + v)`, `v` the 1-step prediction's
-//!    position VRF (Morrison (14.8.4)); `σ` is the given noise or its running estimate.
+//!    the innovation `ν = y − ŷ(t)` has noise variance `σ²(1 + v)`, `v` the 1-step prediction's
+//!    position VRF (Morrison (14.8.4)); `σ` is the given noise or its running estimate. Its
+//!    mean square is `σ_ε² = σ²(1 + v) + b₀²` with `b₀` the prediction's estimated bias (see
+//!    *Honest covariance* below).
 //! 2. **Outlier gate** ([`OutlierRule`]): Morrison's `|ν| > k σ_ε` (default `k = 3`, false-alarm
 //!    rate `P(|Z| > 3) = 0.27%`), or Reyneke's `|ν| > k σ (1 + √(2/N))` (§7.4). A rejected sample
 //!    does not touch the state — the estimate is the prediction across it — and is flagged
@@ -60,8 +62,27 @@
 //!    variance `e°/(N−m−1)` (Morrison (6.10.24)) exactly, but every unmodelled manoeuvre inflates
 //!    it (by the squared bias of the predictions).
 //!
-//! Every filter inside tracks its covariance for unit noise (the VRF); the reported covariance
-//! is `σ²` times it, with the given or the estimated `σ`.
+//! Every filter inside tracks its covariance for unit noise (the VRF).
+//!
+//! ## Honest covariance
+//!
+//! The reported covariance is the mean squared error matrix of the estimate, not the noise's
+//! covariance alone: `σ² V_d + b bᵀ` ([`AutoOutput::bias`] holds `b`, or `None` when it is not
+//! estimated). The bias of a degree-`d` estimate on a trend it does not model is dominated by
+//! the `(d+1)`-th term (Morrison (7.13.5), §13.9, (13.9.10), (13.9.28)); a degree-`(d+1)`
+//! filter on the same memory (the next rung of the ladder, or the final degree's `m + 1`
+//! companion, expanding then fading) removes it, and the nested least-squares difference
+//! `Δ = x_d − x_{d+1}` has `E{Δ_i²} = b_i² + σ²(V_{d+1} − V_d)_ii` (the added term is
+//! uncorrelated with `x_d`), so `b_i = sign(Δ_i) √max(0, Δ_i² − σ²(V_{d+1} − V_d)_ii)`. For the
+//! position, while the misfit test is up, `b₀²` is at least the innovations' mean square excess
+//! over their noise variance in the misfit window, `(mean(ν²/σ²(1+v)) − 1)·σ²(1+v)` (Morrison
+//! §14.8), and at least the excess `r² − σ²(1+v)` of a sample just rejected within 1.25 gate
+//! widths on the same side as `ν` (repeated crossings mean bias, Morrison §14.8). This covers
+//! a start-up at a low degree of the ladder, a degree still settling and a
+//! manoeuvre the memory does not follow (Morrison §7.13: the total error is the random error
+//! and the bias together). The gate judges `ν` against the same honest `σ_ε`; the misfit test
+//! keeps judging the model, against the noise-only variance. Measured coverage: see
+//! ACCURACY.md.
 //!
 //! ## Configuration and use
 //!
@@ -81,6 +102,7 @@
 //! | noise `σ`: [`NoiseSource`], [`MIN_NOISE_TERMS`] | `noise` | Reyneke §7.1; Morrison (6.10.24), (14.8.4); [`crate::stats::DifferenceNoise`] |
 //! | misfit and restart: [`MisfitResponse`], CUSUM onset | `misfit` | Morrison §14.8, (14.8.5); [`crate::stats::InnovationChiSquared`] |
 //! | degree settling (the ladder) | `settle` | Reyneke §7.3 |
+//! | bias of the active degree, honest covariance | `bias` | Morrison (7.13.5), §13.9, (13.9.28), §14.8 |
 //! | expanding → fading switch: [`Phase`] | `phase` | Morrison §13.8, (13.8.8), Table 13.4; Reyneke §7.2, Table 1 |
 //!
 //! ```
@@ -107,6 +129,7 @@ use crate::polynomial::fading::FadingMemory;
 #[cfg(doc)]
 use crate::polynomial::options::{DiscountMode, Engine};
 
+mod bias;
 mod config;
 mod filter;
 mod misfit;

@@ -119,6 +119,14 @@ impl OutlierRule {
         two_sided_tail(g / (1.0 + vrf).sqrt()).ok()
     }
 
+    /// The multiplier `k` of the rule (0 for [`OutlierRule::Off`]).
+    pub(super) fn multiplier(&self) -> f64 {
+        match *self {
+            OutlierRule::Off => 0.0,
+            OutlierRule::Innovation { k } | OutlierRule::Reyneke { k } => k,
+        }
+    }
+
     pub(super) fn validate(&self) -> Result<(), Error> {
         match *self {
             OutlierRule::Off => Ok(()),
@@ -130,13 +138,23 @@ impl OutlierRule {
 }
 
 impl AutomaticFilter {
-    /// The gate half-width for the sample at `t`, given the noise `σ` and the prediction's VRF
-    /// `v`: active only at the final degree, with `σ` known and the prediction at least as good
-    /// as [`AutoConfig::gate_max_vrf`] says.
-    pub(super) fn gate(&self, sigma: Option<f64>, vrf: Option<f64>, t: f64) -> Option<f64> {
+    /// The gate half-width for the sample at `t`, given the noise `σ`, the prediction's VRF
+    /// `v` and its estimated bias `b₀`: the rule's `g(σ, v, N)` widened to `√(g² + k²b₀²)`
+    /// (for Morrison's rule `k √(σ²(1 + v) + b₀²)`, `k` times the honest `σ_ε`). Active only at
+    /// the final degree, with `σ` known and the prediction at least as good as
+    /// [`AutoConfig::gate_max_vrf`] says.
+    pub(super) fn gate(
+        &self,
+        sigma: Option<f64>,
+        vrf: Option<f64>,
+        bias: f64,
+        t: f64,
+    ) -> Option<f64> {
         match (sigma, vrf) {
             (Some(s), Some(v)) if self.active == self.cfg.degree && v <= self.cfg.gate_max_vrf => {
-                self.cfg.outliers.threshold(s, v, self.memory_length(t))
+                let g = self.cfg.outliers.threshold(s, v, self.memory_length(t))?;
+                let kb = self.cfg.outliers.multiplier() * bias;
+                Some((g * g + kb * kb).sqrt())
             }
             _ => None,
         }

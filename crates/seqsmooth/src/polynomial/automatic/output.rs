@@ -30,8 +30,9 @@ pub struct AutoOutput {
     /// The sample's time.
     pub time: f64,
     /// The estimate at `time`: derivatives `x … x^(d)` of the active degree `d`, with their
-    /// covariance when `σ` is known or estimated. After a rejected sample, the prediction
-    /// across it. `None` until the active filter is determined.
+    /// mean squared error matrix `σ² V + b bᵀ` when `σ` is known or estimated (the noise's
+    /// covariance plus the estimated bias [`bias`](Self::bias), see the module docs). After a
+    /// rejected sample, the prediction across it. `None` until the active filter is determined.
     pub estimate: Option<PolynomialState>,
     /// The active degree `d` (the final degree once settled).
     pub degree: usize,
@@ -41,10 +42,18 @@ pub struct AutoOutput {
     pub noise_sigma: Option<f64>,
     /// `ν = y − ŷ(t)` against the active filter's prediction (before this sample).
     pub innovation: Option<f64>,
-    /// `σ_ε = σ √(1 + v)`, the innovation's standard deviation.
+    /// `σ_ε = √(σ²(1 + v) + b₀²)`, the innovation's root mean square: noise, the prediction's
+    /// own VRF `v` and its estimated bias `b₀`.
     pub innovation_sigma: Option<f64>,
     /// The gate half-width applied, when the gate was active.
     pub gate: Option<f64>,
+    /// The estimated bias `b` of each derivative (active degree versus the next degree on the
+    /// same memory) whose outer product `b bᵀ` is included in the covariance of
+    /// [`estimate`](Self::estimate). `Some`: the reported σ covers noise and the estimated bias
+    /// (of a start-up at a low degree, a settling degree, a manoeuvre); `None`: it covers the
+    /// noise only (no covariance, the next degree not determined yet, or the degree is
+    /// [`MAX_DEGREE`](crate::polynomial::MAX_DEGREE)).
+    pub bias: Option<Vec<f64>>,
     /// The sample was rejected: the state was not updated.
     pub outlier: bool,
     /// The innovation chi-squared test says the model no longer fits (or a run of rejections

@@ -1,0 +1,165 @@
+//! The systematic error of the active estimate, estimated from the next degree on the same
+//! memory, and the honest covariance that includes it (Morrison §7.13, §13.9; (7.13.5),
+//! (13.9.10), (13.9.28)).
+//!
+//! A degree-`d` least-squares estimate (expanding or fading memory) of a trend of higher degree
+//! carries the bias `b = Σ_{j>d} γ̃_j p_j(r)` (13.9.10), dominated by the `(d+1)`-th term
+//! (7.13.5), (13.9.28). The degree-`(d+1)` estimate `x_{d+1}` on the same samples with the same
+//! weights removes that term, so `Δ = x_d − x_{d+1}` has mean `≈ b` (to the `(d+2)`-th term).
+//! The two estimates are nested weighted least squares: `x_{d+1} = x_d + ` the projection on the
+//! one added (orthogonalised) basis function, which is uncorrelated with `x_d`, so
+//! `Cov(Δ) = σ²(V_{d+1} − V_d)` with `V` the VRFs. Hence `E{Δ_i²} = b_i² + σ²(V_{d+1} − V_d)_ii`,
+//! and `b̂_i² = max(0, Δ_i² − σ²(V_{d+1} − V_d)_ii)` estimates `b_i²` without bias where it is
+//! positive. The reported covariance is the mean squared error matrix
+//! `E{e eᵀ} = σ² V_d + b bᵀ` with `b_i = sign(Δ_i) b̂_i` (positive semi-definite): a start-up at
+//! a low degree, a degree still settling and a manoeuvre the model does not follow are all in
+//! it. The same holds for a prediction: the innovation variance is
+//! `σ_ε² = σ²(1 + v) + b̂₀²` at the sample's time.
+//!
+//! While the misfit test is up, the position's `b̂₀²` is at least the innovations' mean
+//! square excess over their noise variance in the misfit window (Morrison §14.8: the
+//! normalised squared innovations have mean 1 while the model fits).
+//!
+//! No bias is estimated (the covariance is the noise's only, [`AutoOutput::bias`] is `None`)
+//! when the next degree is not determined yet or does not exist (`d = MAX_DEGREE`).
+
+use super::filter::AutomaticFilter;
+#[cfg(doc)]
+use super::AutoOutput;
+use crate::model::PolynomialState;
+use crate::polynomial::filter::PolynomialFilter;
+
+/// `Δ_i` counts as a bias beyond this many of its own noise standard deviations (1: whenever
+/// `Δ_i²` exceeds its noise variance).
+const SIGNIFICANCE: f64 = 1.0;
+
+/// A rejected sample is a marginal crossing (evidence of bias when the next sample crosses on
+/// the same side) up to this many gate widths.
+const MARGINAL: f64 = 1.25;
+
+impl AutomaticFilter {
+    /// The filter of the active degree plus one on the active filter's memory: the next rung of
+    /// the ladder, or the final degree's own `m + 1` companion.
+    fn companion(&self) -> Option<&dyn PolynomialFilter> {
+        if self.active < self.cfg.degree {
+            self.filter(self.active + 1)
+        } else {
+            match (&self.upper_expanding, &self.upper_fading, self.switched) {
+                (Some(e), _, false) => Some(e as &dyn PolynomialFilter),
+                (_, Some(f), _) => Some(f as &dyn PolynomialFilter),
+                _ => None,
+            }
+        }
+    }
+
+    /// The estimated bias `b` (one entry per derivative of `raw`) of the active filter's unit
+    /// noise state `raw` at its time, for noise `σ`: `sign(Δ_i) √max(0, Δ_i² − σ²(V_{d+1} −
+    /// V_d)_ii)`. `None` when the companion is not determined.
+    pub(super) fn bias_of(&self, raw: &PolynomialState, sigma: f64) -> Option<Vec<f64>> {
+        let upper = self.companion()?.estimate_at(raw.time)?;
+        let (vu, vd) = (upper.covariance.as_ref()?, raw.covariance.as_ref()?);
+        let s2 = sigma * sigma;
+        let mut b: Vec<f64> = raw
+            .derivatives
+            .iter()
+            .zip(&upper.derivatives)
+            .enumerate()
+            .map(|(i, (&xd, &xu))| {
+                let delta = xd - xu;
+                let var = s2 * (vu[(i, i)] - vd[(i, i)]).max(0.0);
+                // The excess of Δ² over its noise variance, when positive.
+                let b = if delta * delta > SIGNIFICANCE * SIGNIFICANCE * var {
+                    (delta * delta - var).sqrt()
+                } else {
+                    0.0
+                };
+                if b.is_finite() {
+                    b.copysign(delta)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        // The position's bias is at least what the innovations' excess says.
+        let floor = self.excess.sqrt();
+        if b[0].abs() < floor {
+            b[0] = floor.copysign(b[0]);
+        }
+        Some(b)
+    }
+
+    /// The prediction's position bias `b₀` raised by the current run of rejections: a
+    /// rejected sample on the same side as the innovation `ν` and within [`MARGINAL`] gate widths
+    /// (`|r| ≤ 1.25 k√(σ²(1+v) + b₀²)`, a marginal crossing, not a jump) is taken as evidence of
+    /// bias (Morrison §14.8: repeated crossings mean bias), `b₀² ≥ r² − σ²(1+v)` with `r` its
+    /// residual against the current prediction and `v` that prediction's VRF.
+    pub(super) fn with_pending(&self, b0: f64, nu: Option<f64>, sigma: Option<f64>) -> f64 {
+        let (Some(nu), Some(s)) = (nu, sigma) else {
+            return b0;
+        };
+        let k = self.cfg.outliers.multiplier();
+        let mut b2 = b0 * b0;
+        for p in &self.pending {
+            let Some(pred) = self.active_filter().estimate_at(p.t) else {
+                continue;
+            };
+            let v = pred.covariance.as_ref().map_or(0.0, |c| c[(0, 0)].max(0.0));
+            let r = p.y - pred.derivatives[0];
+            let noise = s * s * (1.0 + v);
+            let marginal = r.abs() <= MARGINAL * k * (noise + b0 * b0).sqrt();
+            if marginal && r.signum() == nu.signum() && r * r - noise > b2 {
+                b2 = r * r - noise;
+            }
+        }
+        if b2.is_finite() {
+            b2.sqrt().copysign(b0)
+        } else {
+            b0
+        }
+    }
+
+    /// The innovations' mean square excess over their expected variance `var` in the misfit
+    /// window: `max(0, mean(k²) − 1)·var` (Morrison §14.8: the normalised squared innovations
+    /// have mean 1 while the model fits; their excess is the squared bias of the predictions).
+    pub(super) fn innovation_excess(&self, var: f64) -> f64 {
+        let n = self.chi.len();
+        if n == 0 {
+            return 0.0;
+        }
+        // Counted while the misfit test says the excess is significant.
+        let r = self.chi.statistic() / n as f64 - 1.0;
+        if r.is_finite() && r > 0.0 && self.chi.is_misfit() {
+            r * var
+        } else {
+            0.0
+        }
+    }
+
+    /// The reported state of a unit noise state `raw` of the active filter: covariance
+    /// `σ² V + b bᵀ` with the bias of [`bias_of`](Self::bias_of), and that bias; without `σ`
+    /// no covariance and no bias.
+    pub(super) fn honest(&self, raw: PolynomialState) -> (PolynomialState, Option<Vec<f64>>) {
+        let Some(sigma) = self.noise_sigma() else {
+            return (
+                PolynomialState {
+                    covariance: None,
+                    ..raw
+                },
+                None,
+            );
+        };
+        let bias = self.bias_of(&raw, sigma);
+        let covariance = raw.covariance.as_ref().map(|c| {
+            let mut c = c * (sigma * sigma);
+            if let Some(b) = &bias {
+                for i in 0..c.nrows() {
+                    for j in 0..c.ncols() {
+                        c[(i, j)] += b[i] * b[j];
+                    }
+                }
+            }
+            c
+        });
+        (PolynomialState { covariance, ..raw }, bias)
+    }
+}
