@@ -112,7 +112,7 @@ const FILTER_AFTER_HELP: &str = concat!(
 Output: CSV, one row per input row in input order, with the header
   --kind expanding, fading:  t,y,d0..dM            (and s0..sM with --sigma)
   --kind fixed:              t,y,d0..dM,window     (t,y,d0..dM,s0..sM,window with --sigma)
-  --kind auto:               t,y,d0..dM,s0..sM,noise,outlier,misfit
+  --kind auto:               t,y,d0..dM,s0..sM,noise,outlier,misfit,bias
 and, with --lead H (H not 0), a last column lead holding H on every row. The t and y cells \
 echo the input cells; dk is the k-th time derivative, in the input's time units, of the \
 estimate valid at t+H from the rows up to and including this one, and sk its 1-sigma error. Rows before the estimate is determined have empty d and s cells: the first M rows \
@@ -133,7 +133,10 @@ is the noise sigma in use: S given with --sigma, otherwise the running estimate 
 (empty while there is none). outlier is 1 when the row's sample was rejected by the 3-sigma \
 innovation gate (it did not update the filter; the row's estimate is the prediction across it), \
 else 0. misfit is 1 while the chi-squared test of the last 10 innovations (false-alarm rate 1%) \
-says the model no longer fits, else 0; a strong misfit restarts the memory.
+says the model no longer fits, else 0; a strong misfit restarts the memory. s0..sM are root \
+mean squared errors: the noise's part plus the estimated bias of a start-up, a degree still \
+settling or a manoeuvre (from the next degree's fit and the innovations' excess, Morrison 7.13, \
+13.9, 14.8); bias is the position bias s0 includes, empty when s0..sM cover the noise only.
 
 Several series (--id-col NAME): the rows with the same id (any text) form a series, filtered \
 on its own with the same settings; the series may be interleaved in any way, on time grids of \

@@ -558,7 +558,7 @@ fn auto_input(outlier_at: Option<usize>) -> (String, Vec<(f64, f64)>) {
     (input, samples)
 }
 
-/// `--kind auto`: the columns t,y,d0,d1,s0,s1,noise,outlier,misfit; the 20σ outlier is flagged
+/// `--kind auto`: the columns t,y,d0,d1,s0,s1,noise,outlier,misfit,bias; the 20σ outlier is flagged
 /// on its row only (the row's estimate is the prediction across it, not pulled towards the
 /// outlier), the noise column is positive once estimated and near σ = 0.2; every cell equals
 /// the library's AutomaticFilter (the binary is a thin layer).
@@ -574,7 +574,7 @@ fn filter_auto_flags_outlier() {
     let (header, rows) = table(&out);
     assert_eq!(
         header,
-        ["t", "y", "d0", "d1", "s0", "s1", "noise", "outlier", "misfit"]
+        ["t", "y", "d0", "d1", "s0", "s1", "noise", "outlier", "misfit", "bias"]
     );
     assert_eq!(rows.len(), 200);
     let flagged: Vec<usize> = (0..200).filter(|&k| rows[k][7] == "1").collect();
@@ -607,6 +607,10 @@ fn filter_auto_flags_outlier() {
         }
         assert_eq!(row[7], if o.outlier { "1" } else { "0" });
         assert_eq!(row[8], if o.misfit { "1" } else { "0" });
+        match &o.bias {
+            Some(b) => assert_eq!(num(&row[9]).to_bits(), b[0].to_bits(), "{row:?}"),
+            None => assert_eq!(row[9], "", "{row:?}"),
+        }
     }
 }
 

@@ -4,7 +4,8 @@
 //! A row's values are `stride` numbers: `d0..dM`, with `--sigma` (always for the automatic
 //! filter) their 1σ `s0..sM` from the covariance, then the kind's trailing cells (fixed memory:
 //! the rows in the window; automatic: the noise σ in use, the outlier and misfit flags as
-//! 0/1). NaN marks an empty cell: a derivative or 1σ not determined yet.
+//! 0/1, and the estimated position bias that `s0` includes, empty when `s0..sM` cover the noise
+//! only). NaN marks an empty cell: a derivative or 1σ not determined yet.
 
 use crate::args::{name, EngineArg, Kind};
 use seqsmooth::polynomial::automatic::AutomaticFilter;
@@ -79,7 +80,7 @@ impl Runner {
         match self {
             Runner::Expanding(_) | Runner::Fading(_) => &[],
             Runner::Fixed(..) => &["window"],
-            Runner::Auto(_) => &["noise", "outlier", "misfit"],
+            Runner::Auto(_) => &["noise", "outlier", "misfit", "bias"],
         }
     }
 
@@ -141,6 +142,7 @@ impl Runner {
                         o.noise_sigma.unwrap_or(f64::NAN),
                         f64::from(u8::from(o.outlier)),
                         f64::from(u8::from(o.misfit)),
+                        o.bias.as_ref().map_or(f64::NAN, |b| b[0]),
                     ]);
                     // The output's estimate is at t: the update's own, or across a rejected
                     // sample the prediction; with a lead the active filter's, the same way.
