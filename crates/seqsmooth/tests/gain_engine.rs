@@ -173,6 +173,17 @@ fn gain_engine_refuses_degrees_above_its_bound() {
         assert!(ExpandingMemory::new(m, Engine::Gain).is_ok());
         assert!(FadingMemory::new(m, 0.9, 1.0, Engine::Gain).is_ok());
     }
+    // The automatic filter at the bound: its degree m+1 companions (bias) run on the exact
+    // engine there, so it builds and runs.
+    use seqsmooth::PolynomialFilter;
+    let mut auto = AutomaticFilter::new(GAIN_MAX_DEGREE, 0.9, 1.0)
+        .and_then(|f| f.with_engine(Engine::Gain))
+        .unwrap();
+    for k in 0..40 {
+        let t = k as f64;
+        PolynomialFilter::update(&mut auto, t, (0.1 * t).sin()).unwrap();
+    }
+    assert!(auto.estimate_at(39.0).is_some());
 }
 
 /// At its highest degree the gain engine is still what ACCURACY.md says: on even steps equal

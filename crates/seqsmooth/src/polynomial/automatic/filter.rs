@@ -16,7 +16,7 @@ use crate::polynomial::fading::switch::memory_length_constant;
 use crate::polynomial::fading::switch::SwitchRule;
 use crate::polynomial::fading::FadingMemory;
 use crate::polynomial::filter::PolynomialFilter;
-use crate::polynomial::options::{check_not_started, MAX_DEGREE};
+use crate::polynomial::options::{check_not_started, GAIN_MAX_DEGREE, MAX_DEGREE};
 use crate::polynomial::options::{DiscountMode, Engine};
 use crate::stats::{ChiSquaredOutcome, InnovationChiSquared};
 use std::collections::VecDeque;
@@ -93,14 +93,20 @@ pub(super) fn unit_expanding(m: usize, engine: Engine) -> Result<ExpandingMemory
 
 /// The fading-memory filter of degree `m` with the settings of `cfg`, tracking its VRF.
 pub(super) fn unit_fading(cfg: &AutoConfig, m: usize) -> Result<FadingMemory, Error> {
-    FadingMemory::new(m, cfg.theta, cfg.tau, cfg.engine)?
+    unit_fading_on(cfg, m, cfg.engine)
+}
+
+/// [`unit_fading`] on the given engine.
+fn unit_fading_on(cfg: &AutoConfig, m: usize, engine: Engine) -> Result<FadingMemory, Error> {
+    FadingMemory::new(m, cfg.theta, cfg.tau, engine)?
         .with_discount_mode(cfg.discount)?
         .with_switch_rule(cfg.switch_rule)?
         .with_noise_sigma(1.0)
 }
 
 /// The degree `m + 1` companions (expanding, fading) of the final degree, when `m + 1` is a
-/// supported degree.
+/// supported degree; on the exact engine where the configured gain engine stops
+/// ([`GAIN_MAX_DEGREE`]): they only measure the bias.
 pub(super) fn upper_pair(
     cfg: &AutoConfig,
 ) -> Result<(Option<ExpandingMemory>, Option<FadingMemory>), Error> {
@@ -108,9 +114,14 @@ pub(super) fn upper_pair(
     if u > MAX_DEGREE {
         return Ok((None, None));
     }
+    let engine = if cfg.engine == Engine::Gain && u > GAIN_MAX_DEGREE {
+        Engine::Exact
+    } else {
+        cfg.engine
+    };
     Ok((
-        Some(unit_expanding(u, cfg.engine)?),
-        Some(unit_fading(cfg, u)?),
+        Some(unit_expanding(u, engine)?),
+        Some(unit_fading_on(cfg, u, engine)?),
     ))
 }
 
