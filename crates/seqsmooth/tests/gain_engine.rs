@@ -197,8 +197,9 @@ fn gain_engine_at_its_highest_degree_stays_close_to_least_squares() {
     use seqsmooth::polynomial::GAIN_MAX_DEGREE;
     use seqsmooth::PolynomialFilter;
     let m = GAIN_MAX_DEGREE;
-    // Bounds: measured at most 2e-9σ on even steps and 1.0σ on jittered ones (10 seeds).
-    for (jitter, bound) in [(0.0, 1e-7), (0.2, 3.0)] {
+    // Bounds: ACCURACY.md measures at most 6e-10σ on even steps and 6.5σ on jittered ones
+    // (10 seeds, expanding memory; 1.1σ fading); at degree 12 the largest is 36σ, at 14 1.6e3σ.
+    for (jitter, bound) in [(0.0, 1e-7), (0.2, 10.0)] {
         for theta in [None, Some(0.5), Some(0.9)] {
             let mut r = rand::rngs::StdRng::seed_from_u64(23);
             let n = if theta.is_none() { 400 } else { 2000 };
