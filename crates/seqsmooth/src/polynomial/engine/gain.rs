@@ -311,6 +311,9 @@ pub(crate) struct GainEngine {
     /// `unit/τ`: a step in units of the state times this is the step in units of `τ`, the
     /// exponent of the discount `θ^ζ`.
     per_tau: f64,
+    /// Whether `k!/unit^k`, `k ≤ m`, are normal doubles (the batch kernels' read-out factors);
+    /// set with the unit, so the per-sample loop does not recompute it.
+    unit_in_range: bool,
     fading: Option<FadingGains>,
     schedule: ExpandingGainSchedule,
     z: Vec<f64>,
@@ -342,6 +345,7 @@ impl GainEngine {
             tau,
             unit: tau,
             per_tau: 1.0,
+            unit_in_range: unscale_in_range(m, tau),
             fading,
             schedule: ExpandingGainSchedule::new(m),
             z: vec![0.0; m + 1],
@@ -486,7 +490,7 @@ impl GainEngine {
 
     fn plain_kernel_applies(&self) -> bool {
         self.cov.is_none()
-            && unscale_in_range(self.m, self.unit)
+            && self.unit_in_range
             && self.m <= PLAIN_KERNEL_MAX_DEGREE
             && match &self.fading {
                 Some(f) => f.switched_at.is_some(),
@@ -917,6 +921,7 @@ impl GainEngine {
                 let unit = step.log2().round().clamp(-1000.0, 980.0).exp2();
                 self.unit = unit;
                 self.per_tau = unit / self.tau;
+                self.unit_in_range = unscale_in_range(m, unit);
             }
         }
         let t = |i: usize| self.start[i].0;
