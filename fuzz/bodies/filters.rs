@@ -106,9 +106,12 @@ fn build(input: &mut Input) -> Result<AnyFilter, Error> {
         Engine::Exact
     };
     let sigma = input.flag().then(|| input.number());
+    if check::trace() {
+        eprintln!("kind {kind}, degree {m}, {engine:?}, sigma {sigma:?}");
+    }
     let built = build_kind(input, kind, m, engine, sigma);
     if check::trace() {
-        eprintln!("kind {kind}, degree {m}, {engine:?}, sigma {sigma:?}: {built:?}");
+        eprintln!("built: {built:?}");
     }
     built
 }
@@ -139,6 +142,9 @@ fn build_kind(
         }
         1 => {
             let (theta, tau) = (theta(input), input.number());
+            if check::trace() {
+                eprintln!("theta {theta:e}, tau {tau:e}");
+            }
             let mut f = FadingMemory::new(m, theta, tau, engine)?;
             if input.flag() {
                 f = f.with_discount_mode(DiscountMode::PerUpdate)?;
@@ -171,6 +177,9 @@ fn build_kind(
         }
         _ => {
             let (theta, tau) = (theta(input), input.number());
+            if check::trace() {
+                eprintln!("theta {theta:e}, tau {tau:e}");
+            }
             let f = AutomaticFilter::new(m, theta, tau)?.with_engine(engine)?;
             AnyFilter::Auto(Box::new(match sigma {
                 Some(s) => f.with_noise_sigma(s)?,

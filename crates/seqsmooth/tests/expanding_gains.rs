@@ -274,3 +274,35 @@ fn f64_expanding_gains_match_exact() {
         }
     }
 }
+
+/// `position_gain` (written in `1/(n+1)` so that it holds for any `n`) equals the exact
+/// rational `h_0(n)` to 1e-14 relative at every degree to `MAX_DEGREE`, from `n = m` to
+/// `n = 10¹⁸`, where `Π (n+j)` is far beyond the double range for high degrees.
+#[test]
+fn position_gain_matches_exact_for_any_n() {
+    let ns: Vec<u64> = (0..40)
+        .chain([
+            1_000,
+            123_457,
+            10_000_000,
+            1 << 40,
+            999_999_999_999,
+            1 << 60,
+        ])
+        .chain([1_000_000_000_000_000_000])
+        .collect();
+    for m in 0..=seqsmooth::polynomial::MAX_DEGREE {
+        let sched = ExpandingGainSchedule::new(m);
+        let num = expanding_gain_numerators(m);
+        for &n in ns.iter().filter(|&&n| n >= m as u64) {
+            let nq = z(n as i64);
+            let den = ff(&(nq.clone() + z(m as i64 + 1)), m + 1);
+            let exact = f(&(num[0].eval(&nq) / den));
+            let got = sched.position_gain(n);
+            assert!(
+                rel_err(got, exact) <= 1e-14,
+                "m={m} n={n}: {got:e} against {exact:e}"
+            );
+        }
+    }
+}

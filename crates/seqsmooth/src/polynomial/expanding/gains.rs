@@ -183,6 +183,33 @@ impl ExpandingGainSchedule {
         }
     }
 
+    /// The position gain `h_0(n)` (the current position VRF) for any `n`, huge ones included:
+    /// the rational function of [`gains`](Self::gains), `P(n)/Π_{j=1}^{m+1} (n+j)`, written in
+    /// `x = 1/(n+1)` and `r = n/(n+1)` as `x^(m+1−D) Σ_k c_k r^k x^(D−k) / Π_{j=0}^{m} (1+jx)`
+    /// (`D` the degree of `P`), a homogeneous Horner sum of non-negative terms in which neither
+    /// `n^D` nor `Π (n+j)` can overflow.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::expanding::gains::ExpandingGainSchedule;
+    /// let s = ExpandingGainSchedule::new(1);
+    /// assert!((s.position_gain(3) - 0.7).abs() < 1e-15); // Morrison T9-01
+    /// // 2(2n+1)/((n+1)(n+2)) → 4/n (Morrison (13.4.8)): 4e-18 at n = 1e18
+    /// assert!((s.position_gain(1_000_000_000_000_000_000) * 1e18 - 4.0).abs() < 1e-12);
+    /// ```
+    pub fn position_gain(&self, n: u64) -> f64 {
+        let x = 1.0 / (n as f64 + 1.0);
+        let r = n as f64 * x;
+        let coeffs = &self.numerators[0];
+        let top = coeffs.len() - 1;
+        let (mut acc, mut xp) = (0.0, 1.0);
+        for c in coeffs.iter().rev() {
+            acc = acc * r + c * xp;
+            xp *= x;
+        }
+        let den: f64 = (0..=self.m).map(|j| 1.0 + j as f64 * x).product();
+        acc * x.powi((self.m + 1 - top) as i32) / den
+    }
+
     /// The gains as a vector.
     ///
     /// ```

@@ -102,6 +102,10 @@ pub enum SwitchRule {
     AtSample(u64),
 }
 
+/// Indices past the degree that [`SwitchRule::ExactCrossover`] checks one by one before it
+/// searches by bisection.
+const LINEAR_SCAN: u64 = 4096;
+
 impl SwitchRule {
     /// The 0-based index of the first sample processed with the fading-memory gains, for degree
     /// `m` and discount `θ`. Never less than `m + 1`, so that the expanding-memory start has
@@ -131,17 +135,7 @@ impl SwitchRule {
             (_, Some(c)) => Self::asymptotic_index(c, theta),
             _ => {
                 let target = fading_vrf(m, theta, EstimateForm::Current)?[(0, 0)];
-                let sched = ExpandingGainSchedule::new(m);
-                // The expanding-memory current position VRF equals its position gain h_0(n).
-                let mut n = m as u64;
-                let mut h = vec![0.0; m + 1];
-                loop {
-                    sched.gains(n, &mut h);
-                    if Self::crossover_reached(h[0], target) {
-                        break n;
-                    }
-                    n += 1;
-                }
+                Self::crossover_index(&ExpandingGainSchedule::new(m), target)
             }
         };
         Ok(n.max(m as u64 + 1))
@@ -167,6 +161,35 @@ impl SwitchRule {
     /// 75/100. Saturates at `u64::MAX`.
     fn asymptotic_index(c: f64, theta: f64) -> u64 {
         (c / (1.0 - theta) + 1e-9).floor() as u64
+    }
+
+    /// The first `n ≥ m` at which the expanding-memory current position VRF, its position gain
+    /// `h_0(n)`, has fallen to `target`: sample by sample for the first [`LINEAR_SCAN`] indices
+    /// (every θ up to about 0.9995 at degree 0), then by doubling and bisection, since `h_0`
+    /// falls monotonically (each sample adds information), so that θ within 1e-12 of 1 (a
+    /// crossover near 2e12) costs about 80 evaluations, not 10¹².
+    fn crossover_index(sched: &ExpandingGainSchedule, target: f64) -> u64 {
+        let reached = |n: u64| Self::crossover_reached(sched.position_gain(n), target);
+        let m = sched.degree() as u64;
+        let scan_end = m + LINEAR_SCAN;
+        if let Some(n) = (m..scan_end).find(|&n| reached(n)) {
+            return n;
+        }
+        // Not reached at `lo`, reached at `hi` (u64::MAX: h_0 ≈ (m+1)²/n ≈ 0 there).
+        let (mut lo, mut hi) = (scan_end - 1, scan_end.saturating_mul(2));
+        while hi < u64::MAX && !reached(hi) {
+            lo = hi;
+            hi = hi.saturating_mul(2);
+        }
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if reached(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        hi
     }
 
     /// The exact crossover: the expanding-memory position VRF `h0` has fallen to the
@@ -243,6 +266,40 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The exact crossover for θ near 1, where it lies beyond the sample-by-sample scan: at
+    /// degree 0 it is the closed form `⌈2θ/(1−θ)⌉` (`1/(n+1) ≤ (1−θ)/(1+θ)`, Morrison
+    /// (13.4.3), (13.8.2)); at every degree the search equals a scan one index at a time
+    /// (here to 1.2e5), and θ = 1 − 1e-13 takes a bounded search (it took 10¹³ steps).
+    #[test]
+    fn exact_crossover_near_theta_one() {
+        for theta in [0.9999, 0.99999, 1.0 - 1e-7, 1.0 - 1e-10] {
+            let n = SwitchRule::ExactCrossover.switch_index(0, theta).unwrap();
+            let closed = 2.0 * theta / (1.0 - theta);
+            assert!(
+                (n as f64 - closed.ceil()).abs() <= 1.0,
+                "θ {theta}: {n} against {closed}"
+            );
+        }
+        for m in [1usize, 3, 8] {
+            let theta = 1.0 - 1e-4 * (m + 1) as f64;
+            let sched = ExpandingGainSchedule::new(m);
+            let target = fading_vrf(m, theta, EstimateForm::Current).unwrap()[(0, 0)];
+            let scanned = (m as u64..)
+                .find(|&n| SwitchRule::crossover_reached(sched.position_gain(n), target))
+                .unwrap();
+            assert!(scanned > m as u64 + LINEAR_SCAN, "m {m}: {scanned}");
+            assert_eq!(
+                SwitchRule::ExactCrossover.switch_index(m, theta).unwrap(),
+                scanned,
+                "m {m}"
+            );
+        }
+        let far = SwitchRule::ExactCrossover
+            .switch_index(4, 1.0 - 1e-13)
+            .unwrap();
+        assert!(far > 1_000_000_000_000, "{far}");
     }
 
     /// The integer closed forms equal the diagonals of the exact rational matrices.
