@@ -85,6 +85,9 @@ impl PolynomialFilter for AnyFilter {
     fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
         self.inner().estimate_at(t)
     }
+    fn try_estimate_at(&self, t: f64) -> Result<PolynomialState, Error> {
+        self.inner().try_estimate_at(t)
+    }
     fn last_time(&self) -> Option<f64> {
         self.inner().last_time()
     }
@@ -228,21 +231,41 @@ fn one_by_one(f: &mut AnyFilter, times: &[f64], values: &[f64], lead: f64) {
                 continue;
             }
         }
-        let estimate = f.estimate();
-        if let Some(s) = &estimate {
-            check::state(s, "estimate");
-        }
-        if f.determined_after().is_some_and(|n| f.samples() >= n) {
-            assert!(
-                estimate.is_some(),
-                "no estimate after {} samples",
-                f.samples()
-            );
-        }
+        let determined = f.determined_after().is_some_and(|n| f.samples() >= n);
+        estimate_or_reason(f, t, determined, "estimate");
         let at = t + lead;
         if at.is_finite() {
-            if let Some(s) = f.estimate_at(at) {
-                check::state(&s, "estimate at t + lead");
+            estimate_or_reason(f, at, determined, "estimate at t + lead");
+        }
+    }
+}
+
+/// The estimate at `t`: finite in every number, or refused with a reason. Once the samples
+/// that determine it are in, the reason is not the sample count: the fit is singular in
+/// doubles, or a number of it is beyond the double range. `estimate_at` agrees.
+fn estimate_or_reason(f: &AnyFilter, t: f64, determined: bool, what: &str) {
+    match f.try_estimate_at(t) {
+        Ok(s) => {
+            check::state(&s, what);
+            assert_eq!(f.estimate_at(t).as_ref(), Some(&s), "{what}");
+        }
+        Err(e) => {
+            check::error_message(&e);
+            if check::trace() {
+                eprintln!("{what}: {e}");
+            }
+            assert!(
+                f.estimate_at(t).is_none(),
+                "{what}: {e}, yet estimate_at has one"
+            );
+            match &e {
+                Error::TooFewSamples { .. } if determined => {
+                    panic!("{what} after {} samples: {e}", f.samples())
+                }
+                Error::TooFewSamples { .. }
+                | Error::NotDetermined { .. }
+                | Error::EstimateOutOfRange { .. } => {}
+                other => panic!("{what}: {other:?} is not a reason for no estimate"),
             }
         }
     }
@@ -259,10 +282,11 @@ fn rows(f: &AnyFilter, before: u64, rows: &[f64], result: &Result<(), Error>) {
     };
     for (i, row) in rows.chunks_exact(w).take(done).enumerate() {
         let n = before + i as u64 + 1;
-        match f.determined_after() {
-            Some(k) if n >= k => check::finite(row, &format!("row {i} (sample {n})")),
-            Some(_) => assert!(row.iter().all(|v| v.is_nan()), "row {i} before determined"),
-            None => assert!(row.iter().all(|v| v.is_finite() || v.is_nan())),
+        // NaN marks "no estimate" (before determined, or a number beyond the double range);
+        // nothing is infinite.
+        assert!(!row.iter().any(|v| v.is_infinite()), "row {i}: {row:?}");
+        if f.determined_after().is_some_and(|k| n < k) {
+            assert!(row.iter().all(|v| v.is_nan()), "row {i} before determined");
         }
     }
 }
@@ -301,8 +325,9 @@ fn batches(f: &mut AnyFilter, input: &mut Input, times: &[f64], values: &[f64]) 
                 continue;
             }
         }
-        if let Some(s) = f.estimate() {
-            check::state(&s, "estimate after a batch");
+        if let Some(t) = f.last_time() {
+            let determined = f.determined_after().is_some_and(|n| f.samples() >= n);
+            estimate_or_reason(f, t, determined, "estimate after a batch");
         }
         start = end;
     }

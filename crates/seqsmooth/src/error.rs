@@ -101,6 +101,25 @@ pub enum Error {
         /// Other channels of the same call that failed too (each stopped at its bad sample).
         also_failed: Vec<usize>,
     },
+    /// No estimate: the samples so far do not determine the fit (too few of them, or weights
+    /// that leave it singular).
+    #[error("no estimate after {samples} samples: {why}")]
+    NotDetermined {
+        /// The samples processed.
+        samples: u64,
+        /// Why the fit is not determined, and what to change.
+        why: String,
+    },
+    /// The estimate exists, but one of its numbers is beyond the double range (about 1.8e308)
+    /// in the caller's units of time and value.
+    #[error(
+        "the estimate's {what} is beyond the double range (about 1.8e308) in these units: \
+         express the times in a larger unit, rescale the values, or estimate nearer the samples"
+    )]
+    EstimateOutOfRange {
+        /// The number: `d2` (the second derivative), `variance of d1`, `covariance of d0, d2`.
+        what: String,
+    },
     /// Some other parameter is out of range.
     #[error("{name} {value} is invalid: {reason}")]
     InvalidParameter {

@@ -55,6 +55,9 @@ impl PolynomialFilter for Any {
     fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
         self.inner().estimate_at(t)
     }
+    fn try_estimate_at(&self, t: f64) -> Result<PolynomialState, Error> {
+        self.inner().try_estimate_at(t)
+    }
     fn last_time(&self) -> Option<f64> {
         self.inner().last_time()
     }

@@ -202,6 +202,13 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     }
     names.extend(extra.iter().map(|c| c.to_string()));
     let mut counts: Vec<usize> = Vec::new();
+    // Every d cell is written once a series is determined; the automatic filter's above the
+    // degree it has reached are empty by design.
+    let cells = if a.kind == Kind::Auto {
+        1
+    } else {
+        a.degree + 1
+    };
     for first in std::iter::once(true).chain(std::iter::repeat(false)) {
         ids.append(&mut chunk.new_ids);
         values.resize(chunk.len() * stride, 0.0);
@@ -217,8 +224,16 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         let mut failed = failed.map(|e| row_error(e, &chunk));
         let limit = failed.as_ref().map_or(chunk.len(), |(i, _)| *i);
         // Right or refused: a row the library could not represent ends the run here.
-        let unwritable =
-            check_estimates(&values, stride, &names, &chunk, limit, &need, &mut counts);
+        let unwritable = check_estimates(
+            &values,
+            stride,
+            &names,
+            cells,
+            &chunk,
+            limit,
+            &need,
+            &mut counts,
+        );
         if let Some(bad) = unwritable {
             failed = Some(bad);
         }
@@ -271,14 +286,17 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// The first of the rows `..limit` that cannot be written as it is, and why: a number that is
-/// not finite (an estimate too large for a double: the time unit is too small for the degree,
-/// or the values too large), or no estimate for a row from the `need`-th of its series on (the
-/// fit is not determined). `counts` holds, per series, the rows seen so far.
+/// The first of the rows `..limit` that cannot be written as it is, and why, from the
+/// `need`-th row of its series on: no estimate (the fit is not determined), or one of its first
+/// `cells` numbers marked NaN by the library because it is beyond the double range (the time
+/// unit too small for the degree, the values too large, or a lead too long). `counts` holds,
+/// per series, the rows seen so far.
+#[allow(clippy::too_many_arguments)]
 fn check_estimates(
     values: &[f64],
     stride: usize,
     names: &[String],
+    cells: usize,
     chunk: &Chunk,
     limit: usize,
     need: &Need,
@@ -290,22 +308,15 @@ fn check_estimates(
     };
     for i in 0..limit {
         let row = &values[i * stride..(i + 1) * stride];
-        if let Some(k) = row.iter().position(|v| v.is_infinite()) {
-            return fail(
-                i,
-                format!(
-                    "the estimate's {} is too large for a double (beyond 1.8e308); express the \
-                     times in a larger unit, rescale the values or use a shorter --lead",
-                    names[k]
-                ),
-            );
-        }
         let series = chunk.series[i];
         if counts.len() <= series {
             counts.resize(series + 1, 0);
         }
         counts[series] += 1;
-        if row[0].is_nan() && counts[series] >= need.rows {
+        if counts[series] < need.rows {
+            continue;
+        }
+        if row[0].is_nan() && row[1..cells].iter().all(|v| v.is_nan()) {
             return fail(
                 i,
                 format!(
@@ -316,6 +327,9 @@ fn check_estimates(
                     counts[series], need.why, need.rows
                 ),
             );
+        }
+        if let Some(k) = row[..cells].iter().position(|v| !v.is_finite()) {
+            return fail(i, too_large(&names[k]));
         }
     }
     None
@@ -331,7 +345,19 @@ fn row_error(e: seqsmooth::Error, chunk: &Chunk) -> (usize, CliError) {
         other => (0, other),
     };
     let line = chunk.lines[index];
-    (index, CliError::Data(format!("line {line}: {source}")))
+    let why = match source {
+        seqsmooth::Error::EstimateOutOfRange { what } => too_large(&what),
+        other => other.to_string(),
+    };
+    (index, CliError::Data(format!("line {line}: {why}")))
+}
+
+/// Why a number of an estimate cannot be written, in the command line's terms.
+fn too_large(what: &str) -> String {
+    format!(
+        "the estimate's {what} is too large for a double (beyond 1.8e308); express the times in \
+         a larger unit, rescale the values or use a shorter --lead"
+    )
 }
 
 /// A thread that reads the input chunk by chunk ahead of the filtering and writing, passing

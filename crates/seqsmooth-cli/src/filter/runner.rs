@@ -134,7 +134,7 @@ impl Runner {
             let estimate = match &mut *self {
                 Runner::Fixed(f, window) => {
                     extra[0] = (f.samples() as usize).min(*window) as f64;
-                    f.estimate_at(t + lead)
+                    reasoned(f.try_estimate_at(t + lead), index)?
                 }
                 Runner::Auto(f) => {
                     let Some(o) = f.last_output() else { continue };
@@ -152,7 +152,7 @@ impl Runner {
                         f.estimate_at(t + lead)
                     }
                 }
-                other => other.estimate_at(t + lead),
+                other => reasoned(other.try_estimate_at(t + lead), index)?,
             };
             store(
                 estimate.as_ref(),
@@ -166,6 +166,22 @@ impl Runner {
 
 /// Copies an estimate into a row's slots: derivatives into `values[..m+1]`, and with `sigma`
 /// their 1σ into `values[m+1..]`. The estimate may be of a lower degree than the slots.
+/// The estimate of row `index`, `None` before the fit is determined, or, once it is, why there
+/// is none (the fit singular in doubles, a number beyond the double range) as the row's error.
+fn reasoned(
+    estimate: Result<PolynomialState, Error>,
+    index: usize,
+) -> Result<Option<PolynomialState>, Error> {
+    match estimate {
+        Ok(s) => Ok(Some(s)),
+        Err(Error::TooFewSamples { .. }) => Ok(None),
+        Err(e) => Err(Error::InBatch {
+            index,
+            source: Box::new(e),
+        }),
+    }
+}
+
 fn store(estimate: Option<&PolynomialState>, sigma: bool, values: &mut [f64]) {
     let Some(s) = estimate else { return };
     let width = values.len() >> usize::from(sigma);
@@ -193,6 +209,9 @@ impl PolynomialFilter for Runner {
     }
     fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
         self.filter().estimate_at(t)
+    }
+    fn try_estimate_at(&self, t: f64) -> Result<PolynomialState, seqsmooth::Error> {
+        self.filter().try_estimate_at(t)
     }
     fn last_time(&self) -> Option<f64> {
         self.filter().last_time()

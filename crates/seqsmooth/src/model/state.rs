@@ -2,6 +2,7 @@
 //! covariance, and its propagation `X(t+ζ) = Φ_X(ζ) X(t)` (Morrison (5.5.21)-(5.5.22)).
 
 use super::transition::psi;
+use crate::error::Error;
 use nalgebra::{DMatrix, DVector};
 
 /// A polynomial state: the value and derivatives `x^(0..=m)` of the estimated process at `time`,
@@ -31,6 +32,37 @@ impl PolynomialState {
             derivatives,
             covariance: None,
         }
+    }
+
+    /// The state itself when every number of it (time, derivatives, covariance) is finite;
+    /// else [`Error::EstimateOutOfRange`] naming the first that is not.
+    ///
+    /// ```
+    /// use seqsmooth::{Error, PolynomialState};
+    /// assert!(PolynomialState::new(0.0, vec![1.0, 2.0]).checked().is_ok());
+    /// let e = PolynomialState::new(0.0, vec![1.0, f64::INFINITY]).checked().unwrap_err();
+    /// assert!(matches!(e, Error::EstimateOutOfRange { what } if what == "d1"));
+    /// ```
+    pub fn checked(self) -> Result<Self, Error> {
+        let out = |what: String| Err(Error::EstimateOutOfRange { what });
+        if !self.time.is_finite() {
+            return out("time".into());
+        }
+        if let Some(k) = self.derivatives.iter().position(|v| !v.is_finite()) {
+            return out(format!("d{k}"));
+        }
+        if let Some(c) = &self.covariance {
+            let p = c.nrows();
+            if let Some(k) = c.iter().position(|v| !v.is_finite()) {
+                let (i, j) = (k % p, k / p);
+                return out(if i == j {
+                    format!("variance of d{i}")
+                } else {
+                    format!("covariance of d{}, d{}", i.min(j), i.max(j))
+                });
+            }
+        }
+        Ok(self)
     }
 
     /// Degree `m` of the polynomial model.

@@ -32,13 +32,51 @@ pub trait PolynomialFilter: std::fmt::Debug + Send {
     /// The estimate valid at any time `t` from the samples so far (a prediction after the
     /// newest sample, a retrodiction before it); `None` until the estimate is determined
     /// (`m+1` samples for the expanding- and fading-memory filters, a full window for the
-    /// fixed-memory filter).
+    /// fixed-memory filter), or when it is not: [`try_estimate_at`](Self::try_estimate_at)
+    /// says why. Every number of a returned estimate is finite.
     fn estimate_at(&self, t: f64) -> Option<PolynomialState>;
+    /// The estimate at `t`, or why there is none: [`Error::TooFewSamples`] (before the fit is
+    /// determined), [`Error::NotDetermined`] (weights that leave the fit singular in doubles,
+    /// with what to change),
+    /// [`Error::EstimateOutOfRange`] (a derivative or variance beyond the double range in the
+    /// caller's units, say the top derivative of a fit over steps of 1e-200), or
+    /// [`Error::NonFinite`] for a `t` that is not finite. The filters of this crate override
+    /// it with their own reasons; the default gives [`Error::TooFewSamples`] for any `None`.
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, Error, ExpandingMemory, PolynomialFilter};
+    /// let mut f = ExpandingMemory::new(2, Engine::Exact).unwrap();
+    /// f.update(0.0, 1.0).unwrap();
+    /// assert!(matches!(f.try_estimate(), Err(Error::TooFewSamples { needed: 3, got: 1 })));
+    /// f.update(1e-200, 2.0).unwrap();
+    /// f.update(2e-200, 5.0).unwrap();
+    /// // d2 = 2e400: not a double in these units
+    /// let e = f.try_estimate().unwrap_err();
+    /// assert!(matches!(e, Error::EstimateOutOfRange { ref what } if what == "d2"), "{e}");
+    /// assert!(f.estimate().is_none());
+    /// ```
+    fn try_estimate_at(&self, t: f64) -> Result<PolynomialState, Error> {
+        self.estimate_at(t).ok_or_else(|| Error::TooFewSamples {
+            needed: self.degree() + 1,
+            got: self.samples() as usize,
+        })
+    }
     /// The time of the newest sample.
     fn last_time(&self) -> Option<f64>;
     /// The current estimate, valid at the newest sample's time.
     fn estimate(&self) -> Option<PolynomialState> {
         self.estimate_at(self.last_time()?)
+    }
+    /// The current estimate, or why there is none ([`try_estimate_at`](Self::try_estimate_at)
+    /// at the newest sample's time).
+    fn try_estimate(&self) -> Result<PolynomialState, Error> {
+        match self.last_time() {
+            Some(t) => self.try_estimate_at(t),
+            None => Err(Error::TooFewSamples {
+                needed: self.degree() + 1,
+                got: 0,
+            }),
+        }
     }
     /// True once the estimate is determined (`m+1` samples).
     fn is_determined(&self) -> bool {
@@ -75,9 +113,12 @@ pub trait PolynomialFilter: std::fmt::Debug + Send {
     }
     /// [`update_many`](Self::update_many) that also writes the estimate after each sample:
     /// `estimates[i·(m+1) + k]` is the `k`-th derivative at `times[i]` from the samples up to
-    /// and including sample `i` (NaN while undetermined, and for the derivatives above the
-    /// degree of an estimate with fewer than `m+1`, as the automatic filter's while its degree
-    /// settles). `estimates.len()` must be
+    /// and including sample `i` (NaN while undetermined, for a derivative beyond the double
+    /// range, which the expanding- and fading-memory filters mark alone and the others mark
+    /// with its whole row, and for the derivatives above the degree of an estimate with fewer
+    /// than `m+1`, as the automatic filter's while its degree settles;
+    /// [`try_estimate_at`](Self::try_estimate_at) says why). No number written is infinite.
+    /// `estimates.len()` must be
     /// `times.len()·(m+1)`. On an invalid sample the rows before it are written, the rest are
     /// left as they were. The gain engine writes from its batch kernels (no allocation per
     /// sample); the rows equal [`estimate`](Self::estimate)'s up to a rounding of the last

@@ -22,6 +22,13 @@ use crate::polynomial::options::GAIN_MAX_VALUE;
 pub(crate) use exact::{Discount, ExactEngine};
 pub(crate) use gain::{FadingGains, GainEngine};
 
+/// Why a least-squares fit with at least `m+1` samples is not determined: its information
+/// matrix is singular in doubles.
+pub(crate) const SINGULAR: &str = "the fit is not determined: the weights of the samples in \
+    memory leave it singular (with fading memory, a discount θ^(step/τ) that underflows, from a \
+    gap of many τ, a τ far shorter than the steps or a θ near 0, forgets the earlier samples; \
+    the estimate returns once m+1 samples share the memory); use a larger τ or θ";
+
 #[derive(Clone, Debug)]
 pub(crate) enum EngineState {
     Exact(ExactEngine),
@@ -86,7 +93,8 @@ impl EngineState {
                 .unwrap_or(valid);
         }
         let (ts, ys) = (&times[..valid], &values[..valid]);
-        match (&mut *self, estimates) {
+        let mut estimates = estimates;
+        match (&mut *self, estimates.as_deref_mut()) {
             (EngineState::Exact(e), None) => ts.iter().zip(ys).for_each(|(&t, &y)| e.update(t, y)),
             (EngineState::Exact(e), Some(out)) => {
                 for ((&t, &y), row) in ts.iter().zip(ys).zip(out.chunks_exact_mut(m + 1)) {
@@ -101,6 +109,9 @@ impl EngineState {
                 g.update_many_into(ts, ys, &mut out[..valid * (m + 1)])
             }
         }
+        if let Some(out) = estimates {
+            mark_out_of_range(&mut out[..valid * (m + 1)]);
+        }
         if valid < times.len() {
             if let Err(e) = self.check(times[valid], values[valid]) {
                 return Err(Error::InBatch {
@@ -112,19 +123,35 @@ impl EngineState {
         Ok(())
     }
 
-    pub(crate) fn estimate_at(&self, m: usize, t: f64) -> Option<PolynomialState> {
-        if self.samples() <= m as u64 || !t.is_finite() {
-            return None;
+    /// The estimate at `t`, finite in every number, or why there is none
+    /// ([`PolynomialFilter::try_estimate_at`]).
+    pub(crate) fn try_estimate_at(&self, m: usize, t: f64) -> Result<PolynomialState, Error> {
+        if !t.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: t,
+            });
+        }
+        let samples = self.samples();
+        if samples <= m as u64 {
+            return Err(Error::TooFewSamples {
+                needed: m + 1,
+                got: samples as usize,
+            });
         }
         let (derivatives, covariance) = match self {
-            EngineState::Exact(e) => e.estimate_at(t)?,
+            EngineState::Exact(e) => e.estimate_at(t).ok_or_else(|| Error::NotDetermined {
+                samples,
+                why: SINGULAR.into(),
+            })?,
             EngineState::Gain(g) => g.estimate_at(t),
         };
-        Some(PolynomialState {
+        PolynomialState {
             time: t,
             derivatives,
             covariance,
-        })
+        }
+        .checked()
     }
 
     pub(crate) fn track_covariance(&mut self, sigma: f64) -> Result<(), Error> {
@@ -134,6 +161,15 @@ impl EngineState {
             EngineState::Gain(g) => g.track_covariance(sigma),
         }
         Ok(())
+    }
+}
+
+/// Marks each number of `rows` beyond the double range (infinite) as NaN, "no estimate", as
+/// [`PolynomialFilter::update_many_into`] documents: only that derivative, the others of its
+/// row stand ([`PolynomialFilter::try_estimate_at`] names it).
+fn mark_out_of_range(rows: &mut [f64]) {
+    for v in rows.iter_mut().filter(|v| v.is_infinite()) {
+        *v = f64::NAN;
     }
 }
 
@@ -160,7 +196,10 @@ macro_rules! impl_polynomial_filter {
                     .update_many(self.m, times, values, Some(estimates))
             }
             fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
-                self.core.estimate_at(self.m, t)
+                self.core.try_estimate_at(self.m, t).ok()
+            }
+            fn try_estimate_at(&self, t: f64) -> Result<PolynomialState, Error> {
+                self.core.try_estimate_at(self.m, t)
             }
             fn last_time(&self) -> Option<f64> {
                 (self.core.samples() > 0).then(|| self.core.last_time())

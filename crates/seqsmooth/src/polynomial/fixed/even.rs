@@ -7,7 +7,9 @@ use super::ring::Ring;
 use super::sliding::SlidingMoments;
 use super::weights::{inverse_norms, legendre_values, taylor_at};
 use crate::basis::DiscreteLegendre;
-use crate::model::taylor::{derivative_scale, scaling_diagonal};
+use crate::model::taylor::{
+    derivative_scale, scaling_diagonal, unscale_in_range, unscale_stepwise,
+};
 use crate::numeric::unrolled::unrolled_sizes;
 use nalgebra::DMatrix;
 use std::borrow::Cow;
@@ -70,8 +72,16 @@ impl MomentFit {
         };
         let mut out = vec![0.0; mu.len()];
         apply_upper(tc, mu, &mut out);
-        for (o, s) in out.iter_mut().zip(derivative_scale(step)) {
-            *o *= s;
+        if unscale_in_range(self.m, step) {
+            for (o, s) in out.iter_mut().zip(derivative_scale(step)) {
+                *o *= s;
+            }
+        } else {
+            // `k!/step^k` overflows or underflows: one factor at a time, so that a zero
+            // coefficient stays 0 and only a derivative truly beyond the range is infinite.
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = unscale_stepwise(*o, k, step);
+            }
         }
         out
     }

@@ -333,26 +333,46 @@ impl PolynomialFilter for FixedMemory {
     }
 
     fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
-        if self.n < self.window as u64 || !t.is_finite() {
-            return None;
+        self.try_estimate_at(t).ok()
+    }
+
+    fn try_estimate_at(&self, t: f64) -> Result<PolynomialState, Error> {
+        if !t.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: t,
+            });
         }
+        if self.n < self.window as u64 {
+            return Err(Error::TooFewSamples {
+                needed: self.window,
+                got: self.n as usize,
+            });
+        }
+        let singular = || Error::NotDetermined {
+            samples: self.n,
+            why: "the window's least-squares fit is singular in doubles (times or values at \
+                  the ends of the double range); rescale the times or values"
+                .into(),
+        };
         let (derivatives, covariance) = match &self.fit {
             WindowFit::Even(w) => {
                 let step = self.step().unwrap_or(1.0);
                 let r = (self.window - 1) as f64 + (t - self.t_last) / step;
-                w.estimate(r, step, self.sigma)?
+                w.estimate(r, step, self.sigma).ok_or_else(singular)?
             }
             WindowFit::Irregular(w) => {
-                let fit = w.fit()?;
+                let fit = w.fit().ok_or_else(singular)?;
                 let cov = self.sigma.map(|s| fit.covariance_at(t) * (s * s));
                 (fit.derivatives_at(t), cov)
             }
         };
-        Some(PolynomialState {
+        PolynomialState {
             time: t,
             derivatives,
             covariance,
-        })
+        }
+        .checked()
     }
 
     fn last_time(&self) -> Option<f64> {

@@ -200,12 +200,16 @@ impl<F: PolynomialFilter, N: Fn(f64) -> Vec<f64> + Send> PolynomialFilter for De
     }
 
     fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
-        let mut s = self.filter.estimate_at(t)?;
+        self.try_estimate_at(t).ok()
+    }
+
+    fn try_estimate_at(&self, t: f64) -> Result<PolynomialState, Error> {
+        let mut s = self.filter.try_estimate_at(t)?;
         let row = (self.nominal)(t);
         for (v, nv) in s.derivatives.iter_mut().zip(row.iter()) {
             *v += nv;
         }
-        Some(s)
+        s.checked()
     }
 
     fn last_time(&self) -> Option<f64> {
