@@ -289,7 +289,8 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
 /// The first of the rows `..limit` that cannot be written as it is, and why, from the
 /// `need`-th row of its series on: no estimate (the fit is not determined), or one of its first
 /// `cells` numbers marked NaN by the library because it is beyond the double range (the time
-/// unit too small for the degree, the values too large, or a lead too long). `counts` holds,
+/// unit too small for the degree, the values too large, or a lead too long), or any number
+/// infinite. `counts` holds,
 /// per series, the rows seen so far.
 #[allow(clippy::too_many_arguments)]
 fn check_estimates(
@@ -308,6 +309,11 @@ fn check_estimates(
     };
     for i in 0..limit {
         let row = &values[i * stride..(i + 1) * stride];
+        // The library marks what it cannot represent as NaN; anything infinite (the automatic
+        // filter's σ, bias or noise columns) is refused the same way.
+        if let Some(k) = row.iter().position(|v| v.is_infinite()) {
+            return fail(i, too_large(&names[k]));
+        }
         let series = chunk.series[i];
         if counts.len() <= series {
             counts.resize(series + 1, 0);
