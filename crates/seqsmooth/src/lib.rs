@@ -26,6 +26,11 @@
 //! - **Fading memory**: `θ ∈ (0,1)` is the discount per nominal interval `τ`; a sample of age
 //!   `Δt` weighs `θ^(Δt/τ)` ([`DiscountMode::PerTime`]) or `θ` per later sample
 //!   ([`DiscountMode::PerUpdate`]).
+//! - **Right or refused**: every number of an estimate is finite. Where there is none,
+//!   [`PolynomialFilter::try_estimate_at`] says why: too few samples, a fit singular in doubles
+//!   (with what to change), or a derivative or variance beyond the double range in the caller's
+//!   units ([`Error::EstimateOutOfRange`]); `estimate_at` is `None` exactly then, and the rows
+//!   of `update_many_into` hold NaN ("no estimate") there, never an infinity.
 //!
 //! ## Modules
 //!
