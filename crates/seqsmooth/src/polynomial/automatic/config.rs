@@ -59,6 +59,11 @@ pub struct AutoConfig {
     pub noise_sigma: Option<f64>,
     /// How `σ` is estimated when not given.
     pub noise_source: NoiseSource,
+    /// The difference noise estimate leaves out a difference beyond `noise_screen · σ̂` and the
+    /// `m + 1` after it, and corrects for the truncation
+    /// ([`crate::stats::DifferenceNoise::with_screen`]): outliers the gate has not seen (before
+    /// it is active) and glitches of the trend stay out of `σ̂`. Default 3; infinity: no screen.
+    pub noise_screen: f64,
     /// Outlier gate.
     pub outliers: OutlierRule,
     /// The gate is applied only while the 1-step prediction VRF is at most this (default
@@ -94,6 +99,7 @@ impl AutoConfig {
             switch_rule: SwitchRule::Position,
             noise_sigma: None,
             noise_source: NoiseSource::default(),
+            noise_screen: 3.0,
             outliers: OutlierRule::default(),
             gate_max_vrf: GATE_MAX_VRF,
             max_consecutive_rejections: 3,
@@ -107,7 +113,7 @@ impl AutoConfig {
     }
 
     /// Checks every setting: a typed error for the first one out of range (degree, `θ`, `τ`,
-    /// `σ`, noise window, gate, restart significance, switch rule, ladder). The misfit window
+    /// `σ`, noise window and screen, gate, restart significance, switch rule, ladder). The misfit window
     /// and `α` are checked by [`crate::stats::InnovationChiSquared::new`].
     pub(super) fn validate(&self) -> Result<(), Error> {
         check_engine_degree(self.degree, self.engine)?;
@@ -121,6 +127,13 @@ impl AutoConfig {
                 name: "noise window",
                 value: "0".into(),
                 reason: "must be at least 1".into(),
+            });
+        }
+        if self.noise_screen.is_nan() || self.noise_screen <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "noise screen",
+                value: self.noise_screen.to_string(),
+                reason: "must be positive (infinity: no screen)".into(),
             });
         }
         self.outliers.validate()?;

@@ -165,7 +165,7 @@ impl AutomaticFilter {
         let expanding = Some(unit_expanding(m, config.engine)?);
         let fading = unit_fading(&config, m)?;
         let (upper_expanding, upper_fading) = upper_pair(&config)?;
-        let noise = NoiseState::new(config.noise_sigma, config.noise_source, m)?;
+        let noise = NoiseState::new(config.noise_sigma, config.noise_source, m, config.noise_screen)?;
         Ok(Self {
             active: config.start_degree,
             memory_constant: memory_length_constant(0, m),
@@ -292,6 +292,19 @@ impl AutomaticFilter {
         /// }
         /// ```
         with_noise_source(source: NoiseSource) => noise_source = source;
+
+        /// The screen `c > 0` of the difference noise estimate (default 3; infinity: none): a
+        /// difference beyond `c σ̂` and the `m + 1` after it are left out of `σ̂`
+        /// ([`crate::stats::DifferenceNoise::with_screen`]).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
+        /// assert_eq!(f.config().noise_screen, 3.0);
+        /// assert!(f.clone().with_noise_screen(0.0).is_err());
+        /// assert!(f.with_noise_screen(f64::INFINITY).is_ok());
+        /// ```
+        with_noise_screen(c: f64) => noise_screen = c;
 
         /// The outlier gate (default [`OutlierRule::morrison`]).
         ///
@@ -704,10 +717,17 @@ impl AutomaticFilter {
             }
         } else {
             self.pending.clear();
-            // The noise estimates see the samples the noise-only gate g₀ (the rule without the
-            // bias) passes, with its truncation in units of σ√(1 + v); a sample accepted only
-            // because the gate includes the estimated bias is left out of them.
-            let noise_gate = self.gate(sigma, vrf, 0.0, t);
+            // The innovation noise estimate sees the samples the noise-only gate g₀ (the rule
+            // without the bias) passes, with its truncation in units of σ√(1 + v); a sample
+            // accepted only because the gate includes the estimated bias is left out of it. The
+            // difference estimate sees every accepted sample, with the truncation of the gate
+            // that passed it (its noise e is cut at [−g − b, g − b], near side at least
+            // √(k² − 1)/k of g₀), and screens outliers itself.
+            let noise_gate = if self.noise.wants_innovations() {
+                self.gate(sigma, vrf, 0.0, t)
+            } else {
+                gate
+            };
             let truncation = match (noise_gate, sigma, vrf) {
                 (Some(g), Some(s), Some(v)) if s > 0.0 => Some((g / (s * (1.0 + v).sqrt()), v)),
                 _ => None,

@@ -51,11 +51,16 @@
 //!    ([`crate::stats::DifferenceNoise`]): unbiased for white noise about any polynomial of
 //!    degree `≤ m` on any timestamps; biased upward by the trend's `(m+1)`-th derivative
 //!    (`E{d²} = σ² + b²`, `b ≈ x^(m+1) Δt^(m+1)/√C(2m+2,m+1)` — negligible unless the samples
-//!    are sparse on the manoeuvre's time scale) and by outliers that pass the gate (each
-//!    contributes `a²/N` to `σ̂²` for an outlier of size `a`; before the gate is active all samples
-//!    pass). The gate truncates the noise of the samples it passes (for `k = 3`, `σ̂` would be
-//!    1.4% low); each gated sample enters with its expected truncated variance
-//!    `σ²(c(a) + v)/(1 + v)`, `c(a)` the variance of a unit Gaussian cut at `±a = ±g/σ_ε`, which
+//!    are sparse on the manoeuvre's time scale). Outliers the gate passes (before it is active
+//!    every sample passes) and isolated glitches of the trend are screened
+//!    ([`AutoConfig::noise_screen`], default `c = 3`): a difference beyond `c σ̂` and the `m + 1`
+//!    after it, which share its samples, are left out, and the kept terms are divided by the
+//!    variance of a unit Gaussian truncated at `±c` ([`crate::stats::DifferenceNoise::with_screen`]).
+//!    The gate truncates the noise of the samples it passes (for `k = 3`, `σ̂` would be 1.4% low);
+//!    each gated sample enters with its expected truncated variance `σ²(c(a) + v)/(1 + v)`,
+//!    `c(a)` the variance of a unit Gaussian cut at `±a = ±g/(σ√(1 + v))`, `g` the gate that
+//!    passed it (with a bias `b` the cut is `[−g − b, g − b]`, `g = k√(σ²(1+v) + b²)`, whose
+//!    near side is never nearer than `√(k² − 1)·σ√(1 + v)`, 0.94 of the symmetric one), which
 //!    removes that bias. Alternatively the innovations of the final-degree filter
 //!    ([`NoiseSource::Innovations`]): `σ̂² = mean(ν²/(1+v))`, corrected for the gate's truncation;
 //!    without gating and before the switch it equals the expanding-memory fit's residual

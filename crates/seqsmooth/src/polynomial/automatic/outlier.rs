@@ -171,19 +171,7 @@ impl AutomaticFilter {
     }
 }
 
-/// The variance of a unit Gaussian truncated to `|Z| ≤ a`: `1 − 2aφ(a)/(1 − 2Q(a))`. The noise
-/// of the samples a gate of half-width `a σ_ε` passes has this variance (in units of `σ_ε²`).
-pub(super) fn truncated_variance(a: f64) -> f64 {
-    if !a.is_finite() {
-        return 1.0;
-    }
-    let phi = (-0.5 * a * a).exp() / (2.0 * std::f64::consts::PI).sqrt();
-    let inside = 1.0 - two_sided_tail(a).unwrap_or(0.0);
-    if inside <= 0.0 {
-        return 1.0;
-    }
-    (1.0 - 2.0 * a * phi / inside).max(1e-3)
-}
+pub(super) use crate::stats::noise::truncated_variance;
 
 #[cfg(test)]
 mod tests {
