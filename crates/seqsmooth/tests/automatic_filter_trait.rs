@@ -201,6 +201,10 @@ fn fully_built() -> AutomaticFilter {
         .unwrap()
         .with_settling(0.4, 2)
         .unwrap()
+        .with_noise_screen(3.5)
+        .unwrap()
+        .with_memory_levels(2)
+        .unwrap()
 }
 
 /// The record [`fully_built`] must hold, field by field.
@@ -214,12 +218,14 @@ fn fully_built_record() -> AutoConfig {
         switch_rule: SwitchRule::ColumnMean,
         noise_sigma: None,
         noise_source: NoiseSource::Differences { window: Some(50) },
+        noise_screen: 3.5,
         outliers: OutlierRule::Innovation { k: 3.5 },
         gate_max_vrf: 0.5,
         max_consecutive_rejections: 4,
         misfit_window: 12,
         misfit_alpha: 0.02,
         misfit_response: MisfitResponse::Restart { alpha: 1e-3 },
+        memory_levels: 2,
         start_degree: 1,
         settle_vrf: 0.4,
         settle_stable: 2,

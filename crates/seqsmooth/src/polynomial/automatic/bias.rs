@@ -37,30 +37,19 @@ const SIGNIFICANCE: f64 = 1.0;
 /// the same side) up to this many gate widths.
 const MARGINAL: f64 = 1.25;
 
-impl AutomaticFilter {
-    /// The filter of the active degree plus one on the active filter's memory: the next rung of
-    /// the ladder, or the final degree's own `m + 1` companion.
-    fn companion(&self) -> Option<&dyn PolynomialFilter> {
-        if self.active < self.cfg.degree {
-            self.filter(self.active + 1)
-        } else {
-            match (&self.upper_expanding, &self.upper_fading, self.switched) {
-                (Some(e), _, false) => Some(e as &dyn PolynomialFilter),
-                (_, Some(f), _) => Some(f as &dyn PolynomialFilter),
-                _ => None,
-            }
-        }
-    }
-
-    /// The estimated bias `b` (one entry per derivative of `raw`) of the active filter's unit
-    /// noise state `raw` at its time, for noise `σ`: `sign(Δ_i) √max(0, Δ_i² − σ²(V_{d+1} −
-    /// V_d)_ii)`. `None` when the companion is not determined.
-    pub(super) fn bias_of(&self, raw: &PolynomialState, sigma: f64) -> Option<Vec<f64>> {
-        let upper = self.companion()?.estimate_at(raw.time)?;
-        let (vu, vd) = (upper.covariance.as_ref()?, raw.covariance.as_ref()?);
-        let s2 = sigma * sigma;
-        let mut b: Vec<f64> = raw
-            .derivatives
+/// The bias `b` (one entry per derivative of `raw`) of the unit noise state `raw` estimated from
+/// its degree-`(d+1)` companion's state `upper` at the same time, for noise `σ`:
+/// `sign(Δ_i) √max(0, Δ_i² − σ²(V_{d+1} − V_d)_ii)`, `Δ = x_d − x_{d+1}`. `None` without
+/// covariances.
+pub(super) fn difference_bias(
+    raw: &PolynomialState,
+    upper: &PolynomialState,
+    sigma: f64,
+) -> Option<Vec<f64>> {
+    let (vu, vd) = (upper.covariance.as_ref()?, raw.covariance.as_ref()?);
+    let s2 = sigma * sigma;
+    Some(
+        raw.derivatives
             .iter()
             .zip(&upper.derivatives)
             .enumerate()
@@ -79,7 +68,27 @@ impl AutomaticFilter {
                     0.0
                 }
             })
-            .collect();
+            .collect(),
+    )
+}
+
+impl AutomaticFilter {
+    /// The filter of the active degree plus one on the active filter's memory: the next rung of
+    /// the ladder, or the companion of the final degree's memory in use.
+    fn companion(&self) -> Option<&dyn PolynomialFilter> {
+        if self.active < self.cfg.degree {
+            self.filter(self.active + 1)
+        } else {
+            self.memory_companion(self.memory)
+        }
+    }
+
+    /// The estimated bias `b` (one entry per derivative of `raw`) of the active filter's unit
+    /// noise state `raw` at its time, for noise `σ` ([`difference_bias`]), the position's
+    /// raised to the innovations' excess. `None` when the companion is not determined.
+    pub(super) fn bias_of(&self, raw: &PolynomialState, sigma: f64) -> Option<Vec<f64>> {
+        let upper = self.companion()?.estimate_at(raw.time)?;
+        let mut b = difference_bias(raw, &upper, sigma)?;
         // The position's bias is at least what the innovations' excess says.
         let floor = self.excess.sqrt();
         if b[0].abs() < floor {

@@ -21,6 +21,17 @@ use crate::polynomial::options::{DiscountMode, Engine};
 /// ```
 pub const GATE_MAX_VRF: f64 = 1.0;
 
+/// The most shorter memories [`AutoConfig::memory_levels`] may ask for (the shortest discounts
+/// by `θ^65536`).
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::{AutomaticFilter, MAX_MEMORY_LEVELS};
+/// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
+/// assert!(f.clone().with_memory_levels(MAX_MEMORY_LEVELS).is_ok());
+/// assert!(f.with_memory_levels(MAX_MEMORY_LEVELS + 1).is_err());
+/// ```
+pub const MAX_MEMORY_LEVELS: usize = 16;
+
 /// Every setting of the [`AutomaticFilter`](super::AutomaticFilter), as its builders set them
 /// (read with [`AutomaticFilter::config`](super::AutomaticFilter::config)).
 ///
@@ -78,6 +89,10 @@ pub struct AutoConfig {
     pub misfit_alpha: f64,
     /// What the filter does when the model no longer fits (default: restart at α = 10⁻⁴).
     pub misfit_response: MisfitResponse,
+    /// Shorter memories `θ², θ⁴, …, θ^(2^J)` the final degree may use (`J`; default 3; 0: only
+    /// `θ`): for each prediction and estimate the memory of least estimated mean squared error
+    /// `σ² V + b̂²` (Morrison §7.13; see [`AutomaticFilter::memory`](super::AutomaticFilter::memory)).
+    pub memory_levels: usize,
     /// First degree of the quick-settling ladder, `≤ degree` (default 0; `degree` disables it).
     pub start_degree: usize,
     /// The candidate degree takes over once its current position VRF is at most this (default ½).
@@ -106,6 +121,7 @@ impl AutoConfig {
             misfit_window: 10,
             misfit_alpha: 0.01,
             misfit_response: MisfitResponse::default(),
+            memory_levels: 3,
             start_degree: 0,
             settle_vrf: 0.5,
             settle_stable: 3,
@@ -134,6 +150,13 @@ impl AutoConfig {
                 name: "noise screen",
                 value: self.noise_screen.to_string(),
                 reason: "must be positive (infinity: no screen)".into(),
+            });
+        }
+        if self.memory_levels > MAX_MEMORY_LEVELS {
+            return Err(Error::InvalidParameter {
+                name: "memory levels",
+                value: self.memory_levels.to_string(),
+                reason: format!("must be at most {MAX_MEMORY_LEVELS}"),
             });
         }
         self.outliers.validate()?;

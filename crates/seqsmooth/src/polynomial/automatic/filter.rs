@@ -4,6 +4,7 @@
 //! the switch ([`super::phase`]) to their modules.
 
 use super::config::AutoConfig;
+use super::memory::{shorter_memories, Shorter};
 use super::misfit::{Kept, MisfitResponse};
 use super::noise::{NoiseSource, NoiseState};
 use super::outlier::OutlierRule;
@@ -54,6 +55,12 @@ pub struct AutomaticFilter {
     /// of the final degree; `None` at `m = MAX_DEGREE`, the expanding one after the switch).
     pub(super) upper_expanding: Option<ExpandingMemory>,
     pub(super) upper_fading: Option<FadingMemory>,
+    /// The shorter memories `θ^(2^j)`, `j = 1 … J`, of the final degree ([`super::memory`]).
+    pub(super) shorter: Vec<Shorter>,
+    /// The memory in use (0: the configured `θ`).
+    pub(super) memory: usize,
+    /// Predictions in a row for which a longer memory had the least estimated error.
+    pub(super) longer_runs: usize,
     pub(super) active: usize,
     /// Global index (accepted samples) of the latest expanding → fading switch.
     switched_at: Option<u64>,
@@ -93,35 +100,49 @@ pub(super) fn unit_expanding(m: usize, engine: Engine) -> Result<ExpandingMemory
 
 /// The fading-memory filter of degree `m` with the settings of `cfg`, tracking its VRF.
 pub(super) fn unit_fading(cfg: &AutoConfig, m: usize) -> Result<FadingMemory, Error> {
-    unit_fading_on(cfg, m, cfg.engine)
+    unit_fading_on(cfg, m, cfg.engine, cfg.theta)
 }
 
-/// [`unit_fading`] on the given engine.
-fn unit_fading_on(cfg: &AutoConfig, m: usize, engine: Engine) -> Result<FadingMemory, Error> {
-    FadingMemory::new(m, cfg.theta, cfg.tau, engine)?
+/// [`unit_fading`] on the given engine and discount `θ` per `τ`.
+pub(super) fn unit_fading_on(
+    cfg: &AutoConfig,
+    m: usize,
+    engine: Engine,
+    theta: f64,
+) -> Result<FadingMemory, Error> {
+    FadingMemory::new(m, theta, cfg.tau, engine)?
         .with_discount_mode(cfg.discount)?
         .with_switch_rule(cfg.switch_rule)?
         .with_noise_sigma(1.0)
 }
 
-/// The degree `m + 1` companions (expanding, fading) of the final degree, when `m + 1` is a
-/// supported degree; on the exact engine where the configured gain engine stops
-/// ([`GAIN_MAX_DEGREE`]): they only measure the bias.
-pub(super) fn upper_pair(
-    cfg: &AutoConfig,
-) -> Result<(Option<ExpandingMemory>, Option<FadingMemory>), Error> {
+/// The degree `m + 1` of the companions and their engine, when `m + 1` is a supported degree;
+/// the exact engine where the configured gain engine stops ([`GAIN_MAX_DEGREE`]): they only
+/// measure the bias.
+pub(super) fn upper_degree(cfg: &AutoConfig) -> Option<(usize, Engine)> {
     let u = cfg.degree + 1;
     if u > MAX_DEGREE {
-        return Ok((None, None));
+        return None;
     }
     let engine = if cfg.engine == Engine::Gain && u > GAIN_MAX_DEGREE {
         Engine::Exact
     } else {
         cfg.engine
     };
+    Some((u, engine))
+}
+
+/// The degree `m + 1` companions (expanding, fading) of the final degree (see
+/// [`upper_degree`]).
+pub(super) fn upper_pair(
+    cfg: &AutoConfig,
+) -> Result<(Option<ExpandingMemory>, Option<FadingMemory>), Error> {
+    let Some((u, engine)) = upper_degree(cfg) else {
+        return Ok((None, None));
+    };
     Ok((
         Some(unit_expanding(u, engine)?),
-        Some(unit_fading_on(cfg, u, engine)?),
+        Some(unit_fading_on(cfg, u, engine, cfg.theta)?),
     ))
 }
 
@@ -165,6 +186,7 @@ impl AutomaticFilter {
         let expanding = Some(unit_expanding(m, config.engine)?);
         let fading = unit_fading(&config, m)?;
         let (upper_expanding, upper_fading) = upper_pair(&config)?;
+        let shorter = shorter_memories(&config)?;
         let noise = NoiseState::new(config.noise_sigma, config.noise_source, m, config.noise_screen)?;
         Ok(Self {
             active: config.start_degree,
@@ -176,6 +198,9 @@ impl AutomaticFilter {
             fading,
             upper_expanding,
             upper_fading,
+            shorter,
+            memory: 0,
+            longer_runs: 0,
             switched_at: None,
             switched: false,
             memory_t_first: None,
@@ -380,6 +405,18 @@ impl AutomaticFilter {
         /// ```
         with_misfit_response(response: MisfitResponse) => misfit_response = response;
 
+        /// The number `J ≤` [`MAX_MEMORY_LEVELS`](super::MAX_MEMORY_LEVELS) of shorter memories
+        /// `θ², θ⁴, …, θ^(2^J)` the final degree may use (default 3; 0: the configured `θ` only);
+        /// see [`memory`](Self::memory).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::new(2, 0.95, 1.0).unwrap();
+        /// assert_eq!(f.config().memory_levels, 3);
+        /// assert_eq!(f.with_memory_levels(0).unwrap().config().memory_levels, 0);
+        /// ```
+        with_memory_levels(levels: usize) => memory_levels = levels;
+
         /// The first degree `d₀ ≤ m` of the quick-settling ladder (default 0; `m` disables it).
         ///
         /// ```
@@ -445,7 +482,7 @@ impl AutomaticFilter {
     pub fn phase(&self) -> Phase {
         if self.active < self.cfg.degree {
             Phase::Settling
-        } else if !self.switched {
+        } else if !self.switched && self.memory == 0 {
             Phase::Expanding
         } else {
             Phase::Fading
@@ -570,10 +607,7 @@ impl AutomaticFilter {
     }
 
     pub(super) fn final_filter(&self) -> &dyn PolynomialFilter {
-        match (&self.expanding, self.switched) {
-            (Some(e), false) => e,
-            _ => &self.fading,
-        }
+        self.memory_filter(self.memory)
     }
 
     pub(super) fn filter(&self, degree: usize) -> Option<&dyn PolynomialFilter> {
@@ -660,6 +694,7 @@ impl AutomaticFilter {
             self.expanding = None;
             self.upper_expanding = None;
         }
+        self.choose_memory(t);
         let sigma = self.noise_sigma();
         let prediction = self.active_filter().estimate_at(t);
         let (innovation, vrf) = match &prediction {
@@ -809,6 +844,10 @@ impl AutomaticFilter {
         }
         if let Some(f) = &mut self.upper_fading {
             f.update(t, y)?;
+        }
+        for s in &mut self.shorter {
+            s.fading.update(t, y)?;
+            s.upper.update(t, y)?;
         }
         if self.memory_t_first.is_none() {
             self.memory_t_first = Some(t);

@@ -137,6 +137,7 @@ use crate::polynomial::options::{DiscountMode, Engine};
 mod bias;
 mod config;
 mod filter;
+mod memory;
 mod misfit;
 mod noise;
 mod outlier;
@@ -144,7 +145,7 @@ mod output;
 mod phase;
 mod settle;
 
-pub use config::{AutoConfig, GATE_MAX_VRF};
+pub use config::{AutoConfig, GATE_MAX_VRF, MAX_MEMORY_LEVELS};
 pub use filter::AutomaticFilter;
 pub use misfit::MisfitResponse;
 pub use noise::{NoiseSource, MIN_NOISE_TERMS};

@@ -163,8 +163,10 @@ impl AutomaticFilter {
     /// Reyneke's memory length `N` at `t`: `c_0m/(1-θ_s)` once faded, else the active filter's
     /// sample count.
     fn memory_length(&self, t: f64) -> f64 {
-        if self.active == self.cfg.degree && self.switched {
-            self.memory_constant / (1.0 - self.theta_per_sample(t))
+        if self.active == self.cfg.degree && (self.switched || self.memory > 0) {
+            // The memory in use discounts by θ^(2^j) per sample.
+            let theta = self.theta_per_sample(t).powi(1 << self.memory);
+            self.memory_constant / (1.0 - theta)
         } else {
             self.active_filter().samples().max(1) as f64
         }
