@@ -323,18 +323,19 @@ pub struct DifferenceNoise {
     screen: Option<f64>,
     /// Differences still to leave out after a screened one (they share its samples).
     holdoff: usize,
-    /// The first [`SCREEN_REFERENCE_TERMS`] squared differences (for the median reference).
+    /// The first [`SCREEN_REFERENCE_TERMS`] squared differences (for the startup reference).
     early: Vec<f64>,
     /// Differences left out by the screen (the screened ones and those that share their samples).
     left_out: u64,
 }
 
-/// Until the screened estimate has this many terms, the screen's reference is the median of the
-/// squared differences seen so far over the median of `χ²₁` (robust to an early outlier).
+/// Until the screened estimate has this many terms, the screen's reference is the mean of the
+/// smallest 80% of the squared differences seen so far, over its value for Gaussian terms
+/// (robust to an early outlier), and the screen twice as wide.
 const SCREEN_REFERENCE_TERMS: usize = 20;
 
-/// The median of `χ²₁` (`(Φ⁻¹(3/4))²`).
-const CHI2_1_MEDIAN: f64 = 0.454_936_423_119_572_7;
+/// The mean of `χ²₁` below its 80% quantile `a² = Φ⁻¹(0.9)²`: `(0.8 − 2aφ(a))/0.8`.
+const CHI2_1_TRIMMED_MEAN: f64 = 0.437_724_6;
 
 impl DifferenceNoise {
     /// An estimator from differences of order `k ≥ 1` (use `k = m + 1` for a degree-`m` trend),
@@ -369,8 +370,9 @@ impl DifferenceNoise {
     }
 
     /// The same estimator, robust to outliers and to isolated glitches of the trend: a difference
-    /// with `|d| > c σ̂` (`σ̂` the estimate before it; the median of the squared differences
-    /// so far over the median of `χ²₁` while fewer than 20 are in) is left out, and so are the
+    /// with `|d| > c σ̂` (`σ̂` the estimate before it; while fewer than 20 are in, `|d| > 2c σ̂₀`
+    /// with `σ̂₀²` the mean of the smallest 80% of the squared differences so far over its
+    /// Gaussian value 0.4377) is left out, and so are the
     /// next `k` differences, which share its samples (an outlier of size `a` at one sample enters
     /// `k + 1` successive differences, with weights `w_j/√(Σw²)`). The kept terms of white
     /// Gaussian noise are truncated at `±cσ`, so the estimate divides their mean by the
@@ -416,8 +418,8 @@ impl DifferenceNoise {
     }
 
     /// The screen's reference variance: the estimate, or while it has fewer than
-    /// [`SCREEN_REFERENCE_TERMS`] terms the median of the squared differences seen so far over
-    /// the median of `χ²₁` (`None` before 3 are seen).
+    /// [`SCREEN_REFERENCE_TERMS`] terms the trimmed mean of the squared differences seen so far
+    /// (`None` before 3 are seen).
     fn screen_reference(&self) -> Option<f64> {
         if self.len() >= SCREEN_REFERENCE_TERMS {
             return self.variance();
@@ -427,13 +429,10 @@ impl DifferenceNoise {
         }
         let mut e = self.early.clone();
         e.sort_by(f64::total_cmp);
-        let n = e.len();
-        let median = if n % 2 == 1 {
-            e[n / 2]
-        } else {
-            0.5 * (e[n / 2 - 1] + e[n / 2])
-        };
-        Some(median / CHI2_1_MEDIAN)
+        // The mean of the smallest 80% (at least 3) over its value for unit Gaussian terms.
+        let kept = ((e.len() * 4) / 5).max(3);
+        let trimmed = e[..kept].iter().sum::<f64>() / kept as f64;
+        Some(trimmed / CHI2_1_TRIMMED_MEAN)
     }
 
     /// Whether the screen leaves out the new squared difference `d2` (and updates its state).
@@ -446,6 +445,13 @@ impl DifferenceNoise {
             self.left_out += 1;
             return true;
         }
+        // While the reference is the trimmed mean (which assumes Gaussian terms), only gross
+        // outliers: twice the screen.
+        let c = if self.len() >= SCREEN_REFERENCE_TERMS {
+            c
+        } else {
+            2.0 * c
+        };
         let reference = self.screen_reference();
         if self.early.len() < SCREEN_REFERENCE_TERMS {
             self.early.push(d2);

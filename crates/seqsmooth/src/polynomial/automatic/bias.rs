@@ -25,7 +25,7 @@
 
 use super::filter::AutomaticFilter;
 #[cfg(doc)]
-use super::AutoOutput;
+use super::{AutoConfig, AutoOutput};
 use crate::model::PolynomialState;
 use crate::polynomial::filter::PolynomialFilter;
 
@@ -46,6 +46,17 @@ pub(super) fn difference_bias(
     upper: &PolynomialState,
     sigma: f64,
 ) -> Option<Vec<f64>> {
+    significant_bias(raw, upper, sigma, SIGNIFICANCE)
+}
+
+/// [`difference_bias`], counted only where `|Δ_i|` exceeds `z` of its noise standard deviations
+/// (0 elsewhere).
+pub(super) fn significant_bias(
+    raw: &PolynomialState,
+    upper: &PolynomialState,
+    sigma: f64,
+    z: f64,
+) -> Option<Vec<f64>> {
     let (vu, vd) = (upper.covariance.as_ref()?, raw.covariance.as_ref()?);
     let s2 = sigma * sigma;
     Some(
@@ -57,7 +68,7 @@ pub(super) fn difference_bias(
                 let delta = xd - xu;
                 let var = s2 * (vu[(i, i)] - vd[(i, i)]).max(0.0);
                 // The excess of Δ² over its noise variance, when positive.
-                let b = if delta * delta > SIGNIFICANCE * SIGNIFICANCE * var {
+                let b = if delta * delta > z * z * var {
                     (delta * delta - var).sqrt()
                 } else {
                     0.0
@@ -127,6 +138,31 @@ impl AutomaticFilter {
         }
     }
 
+    /// True when the current run of rejections ends with
+    /// [`AutoConfig::same_side_rejections`] `≥ 2` samples all on the same side of the active
+    /// filter's prediction (Morrison §14.8: repeated crossings on one side mean bias, not
+    /// outliers; two outliers in a row on one side at an outlier rate `p` happen at `p²/2` per
+    /// sample).
+    pub(super) fn same_side_run(&self) -> bool {
+        let n = self.cfg.same_side_rejections;
+        if n < 2 || self.pending.len() < n {
+            return false;
+        }
+        let f = self.active_filter();
+        let mut side = 0.0;
+        for p in &self.pending[self.pending.len() - n..] {
+            let Some(pred) = f.estimate_at(p.t) else {
+                return false;
+            };
+            let r = (p.y - pred.derivatives[0]).signum();
+            if side != 0.0 && r != side {
+                return false;
+            }
+            side = r;
+        }
+        true
+    }
+
     /// The innovations' mean square excess over their expected variance `var` in the misfit
     /// window: `max(0, mean(k²) − 1)·var` (Morrison §14.8: the normalised squared innovations
     /// have mean 1 while the model fits; their excess is the squared bias of the predictions).
@@ -158,6 +194,7 @@ impl AutomaticFilter {
             );
         };
         let bias = self.bias_of(&raw, sigma);
+        let factor = self.calibration_factor();
         let covariance = raw.covariance.as_ref().map(|c| {
             let mut c = c * (sigma * sigma);
             if let Some(b) = &bias {
@@ -167,7 +204,7 @@ impl AutomaticFilter {
                     }
                 }
             }
-            c
+            c * factor
         });
         (PolynomialState { covariance, ..raw }, bias)
     }

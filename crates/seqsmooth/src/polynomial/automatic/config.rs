@@ -83,6 +83,12 @@ pub struct AutoConfig {
     /// A run of this many consecutive rejections is a manoeuvre, applied after all (`0`: never).
     /// Default 3 (three consecutive outliers at a 2% outlier rate: 8·10⁻⁶ per sample).
     pub max_consecutive_rejections: usize,
+    /// A run of this many consecutive rejections all on the same side of the prediction is a
+    /// manoeuvre too (Morrison §14.8: repeated crossings on one side mean bias), applied after
+    /// all (two outliers in a row on one side at a 2% outlier rate: 2·10⁻⁴ per sample, so 1% of
+    /// the outliers would be taken); default 0: off (0 or 1: only `max_consecutive_rejections`
+    /// counts); off too when that is 0.
+    pub same_side_rejections: usize,
     /// Innovation chi-squared window `K ≥ 1` (default 10).
     pub misfit_window: usize,
     /// Per-sample false-alarm rate `α ∈ (0,1)` of the misfit test (default 0.01).
@@ -118,6 +124,7 @@ impl AutoConfig {
             outliers: OutlierRule::default(),
             gate_max_vrf: GATE_MAX_VRF,
             max_consecutive_rejections: 3,
+            same_side_rejections: 0,
             misfit_window: 10,
             misfit_alpha: 0.01,
             misfit_response: MisfitResponse::default(),

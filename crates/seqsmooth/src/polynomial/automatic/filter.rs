@@ -61,6 +61,10 @@ pub struct AutomaticFilter {
     pub(super) memory: usize,
     /// Predictions in a row for which a longer memory had the least estimated error.
     pub(super) longer_runs: usize,
+    /// Each memory's prediction of the newest sample and its honest mean square.
+    pub(super) predictions: Vec<Option<(f64, f64)>>,
+    /// Each memory's running mean of `ν²/σ_ε²` and its count ([`super::memory`]).
+    pub(super) calibration: Vec<(f64, u64)>,
     pub(super) active: usize,
     /// Global index (accepted samples) of the latest expanding → fading switch.
     switched_at: Option<u64>,
@@ -187,7 +191,12 @@ impl AutomaticFilter {
         let fading = unit_fading(&config, m)?;
         let (upper_expanding, upper_fading) = upper_pair(&config)?;
         let shorter = shorter_memories(&config)?;
-        let noise = NoiseState::new(config.noise_sigma, config.noise_source, m, config.noise_screen)?;
+        let noise = NoiseState::new(
+            config.noise_sigma,
+            config.noise_source,
+            m,
+            config.noise_screen,
+        )?;
         Ok(Self {
             active: config.start_degree,
             memory_constant: memory_length_constant(0, m),
@@ -201,6 +210,8 @@ impl AutomaticFilter {
             shorter,
             memory: 0,
             longer_runs: 0,
+            predictions: Vec::new(),
+            calibration: Vec::new(),
             switched_at: None,
             switched: false,
             memory_t_first: None,
@@ -371,6 +382,24 @@ impl AutomaticFilter {
         /// assert_eq!(f.rejected(), 10);
         /// ```
         with_max_consecutive_rejections(n: usize) => max_consecutive_rejections = n;
+
+        /// A run of `n ≥ 2` consecutive rejections all on the same side of the prediction is a
+        /// manoeuvre, applied after all (default 0: off; 1: off; off too when
+        /// [`with_max_consecutive_rejections`](Self::with_max_consecutive_rejections) is 0).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let run = |n| {
+        ///     let mut f = AutomaticFilter::new(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap()
+        ///         .with_same_side_rejections(n).unwrap();
+        ///     for k in 0..20 { f.update(k as f64, 0.0).unwrap(); }
+        ///     // a step: 2 rejections on one side are a manoeuvre at n = 2, 3 at n = 0 (the run limit)
+        ///     (20..23).map(|k| f.update(k as f64, 10.0).unwrap().outlier).collect::<Vec<_>>()
+        /// };
+        /// assert_eq!(run(2), [true, false, false]);
+        /// assert_eq!(run(0), [true, true, false]);
+        /// ```
+        with_same_side_rejections(n: usize) => same_side_rejections = n;
 
         /// The innovation chi-squared window `K ≥ 1` (default 10).
         ///
@@ -734,7 +763,7 @@ impl AutomaticFilter {
         if rejected {
             self.pending.push(Kept { t, y, k2 });
             let limit = self.cfg.max_consecutive_rejections;
-            if limit > 0 && self.pending.len() >= limit {
+            if limit > 0 && (self.pending.len() >= limit || self.same_side_run()) {
                 // A run of rejections: the model, not the samples, is wrong. Apply the run.
                 manoeuvre = true;
                 let run = std::mem::take(&mut self.pending);
@@ -772,6 +801,7 @@ impl AutomaticFilter {
                 _ => false,
             };
             chi_out = self.accept(Kept { t, y, k2 }, truncation, false, beyond_noise)?;
+            self.calibrate(y);
             if self.active == m && self.restart_test.as_ref().is_some_and(|r| r.is_misfit()) {
                 self.restart()?;
                 restart = true;
@@ -821,7 +851,7 @@ impl AutomaticFilter {
         // The final-degree filter's own normalised innovation ν²/(1+v), whatever degree is
         // active (for the innovation noise estimate).
         let innovation = if self.noise.wants_innovations() {
-            self.final_filter().estimate_at(t).and_then(|p| {
+            self.memory_filter(0).estimate_at(t).and_then(|p| {
                 let v = p.covariance.as_ref()?[(0, 0)].max(0.0);
                 let nu = y - p.derivatives[0];
                 Some(nu * nu / (1.0 + v))

@@ -9,27 +9,45 @@
 //! `(m+1)`-th derivative grows as `(1 − θ)^−(m+1)` (Morrison (13.9.28); (7.13.5) for the fixed
 //! memory). Morrison §7.13 picks the memory where the two balance, and §14.8 answers threshold
 //! crossings with "β can be temporarily reduced until the threshold crossings cease … then the
-//! memory can again be lengthened". Here each memory's mean squared error of the position,
-//! `σ² V_j + b̂_j²` ([`super::bias`]: `b̂_j` from the difference to its companion), is estimated
-//! for each prediction and each reported estimate, and the least one is used: its prediction is
-//! gated and its state reported with its honest covariance. Halving the memory (`θ → θ²`, so
+//! memory can again be lengthened". Here each memory's mean squared error of the predicted
+//! position, `σ² v_j + b̂_j²` ([`super::bias`]: `b̂_j` from the difference to its companion,
+//! counted where it is significant), is estimated before each sample, and the least one is
+//! used (a shorter one at once, a longer one a level at a time once it has been the least for
+//! [`LENGTHEN_AFTER`] predictions in a row): its prediction is gated, and its state after the
+//! sample is reported with its honest covariance. Only with
+//! [`MisfitResponse::Restart`](super::MisfitResponse::Restart) (the flag-only response keeps
+//! the memory). Halving the memory (`θ → θ²`, so
 //! `1 − θ → ≈ 2(1 − θ)`) divides the bias by `≈ 2^(m+1)` and about doubles the VRF. Memory
-//! `j = 0` is the configured one (expanding until the switch, then fading, restarted by
-//! [`MisfitResponse::Restart`](super::MisfitResponse::Restart)); the shorter memories are fading
-//! from the first sample (exact discounted least squares on the default engine) and are not
-//! restarted.
+//! `j = 0` is the configured one (expanding until the switch, then fading); the shorter memories
+//! are fading from the first sample (exact discounted least squares, on the exact engine always); a
+//! restart rebuilds them all from the onset.
 
+use super::bias::significant_bias;
 use super::filter::{unit_fading_on, upper_degree, AutomaticFilter};
+use super::misfit::MisfitResponse;
 #[cfg(doc)]
 use super::AutoConfig;
 use super::AutoConfig as Config;
 use crate::error::Error;
 use crate::polynomial::fading::FadingMemory;
 use crate::polynomial::filter::PolynomialFilter;
+use crate::polynomial::options::Engine;
 
 /// A shorter memory never discounts by less than this per `τ` (a memory of well under one
 /// sample says nothing more).
 const MIN_THETA: f64 = 1e-3;
+
+/// For the choice a memory's bias counts only where `Δ` exceeds this many of its noise standard
+/// deviations (a false shortening on a fitting model at `P(|Z| > 2.5) = 1.2%` of the
+/// predictions; with `SD(Δ) = σ√(V_{m+1} − V_m)` the memory shortens once its bias is a few
+/// times the noise of the estimate, near Morrison §7.13's balance).
+const CHOICE_SIGNIFICANCE: f64 = 2.5;
+
+/// The calibration of [`AutomaticFilter::calibrate`] averages over about this many samples.
+const CALIBRATION_MEMORY: u64 = 20;
+
+/// Samples a memory's calibration needs before it widens the reported error.
+const CALIBRATION_MIN: u64 = 5;
 
 /// A longer memory is taken once it has had the least estimated error for this many
 /// predictions in a row.
@@ -44,9 +62,11 @@ pub(super) struct Shorter {
 }
 
 /// The shorter memories of `cfg` (none when `m + 1` is not a supported degree: without the
-/// companion there is no bias estimate to choose by).
+/// companion there is no bias estimate to choose by), on the exact engine whatever the
+/// configured one: exact discounted least squares from the first sample, whose short memories
+/// the gain engine's step-by-step gains would follow less accurately on irregular steps.
 pub(super) fn shorter_memories(cfg: &Config) -> Result<Vec<Shorter>, Error> {
-    let Some((u, upper_engine)) = upper_degree(cfg) else {
+    let Some((u, _)) = upper_degree(cfg) else {
         return Ok(Vec::new());
     };
     let mut out = Vec::new();
@@ -57,8 +77,8 @@ pub(super) fn shorter_memories(cfg: &Config) -> Result<Vec<Shorter>, Error> {
             break;
         }
         out.push(Shorter {
-            fading: unit_fading_on(cfg, cfg.degree, cfg.engine, theta)?,
-            upper: unit_fading_on(cfg, u, upper_engine, theta)?,
+            fading: unit_fading_on(cfg, cfg.degree, Engine::Exact, theta)?,
+            upper: unit_fading_on(cfg, u, Engine::Exact, theta)?,
         });
     }
     Ok(out)
@@ -97,12 +117,15 @@ impl AutomaticFilter {
             self.memory = 0;
             return;
         };
-        if self.active < self.cfg.degree || self.shorter.is_empty() {
+        let responds = matches!(self.cfg.misfit_response, MisfitResponse::Restart { .. });
+        if self.active < self.cfg.degree || self.shorter.is_empty() || !responds {
             self.memory = 0;
             return;
         }
         let s2 = sigma * sigma;
         let mut best = (f64::INFINITY, self.memory);
+        self.predictions.clear();
+        self.predictions.resize(self.shorter.len() + 1, None);
         for j in 0..=self.shorter.len() {
             let Some(est) = self.memory_filter(j).estimate_at(t) else {
                 continue;
@@ -112,11 +135,18 @@ impl AutomaticFilter {
             };
             let upper = self.memory_companion(j).and_then(|c| c.estimate_at(t));
             let b0 = match &upper {
-                Some(u) => super::bias::difference_bias(&est, u, sigma).map_or(0.0, |b| b[0]),
+                Some(u) => {
+                    significant_bias(&est, u, sigma, CHOICE_SIGNIFICANCE).map_or(0.0, |b| b[0])
+                }
                 // Memory 0 without its companion yet: its noise only; a shorter one: not yet.
                 None if j == 0 => 0.0,
                 None => continue,
             };
+            let honest = upper
+                .as_ref()
+                .and_then(|u| super::bias::difference_bias(&est, u, sigma))
+                .map_or(0.0, |b| b[0]);
+            self.predictions[j] = Some((est.derivatives[0], s2 * (1.0 + v) + honest * honest));
             let mse = s2 * v + b0 * b0;
             if mse.is_finite() && mse < best.0 {
                 best = (mse, j);
@@ -132,6 +162,39 @@ impl AutomaticFilter {
                 self.memory -= 1;
                 self.longer_runs = 0;
             }
+        }
+    }
+
+    /// Adds the accepted sample `y` to each memory's calibration: the running mean (over about
+    /// [`CALIBRATION_MEMORY`] samples) of `ν_j²/σ_ε,j²`, its squared innovation over the
+    /// predicted mean square `σ²(1 + v_j) + b̂_j²` (clipped at 16, so that an outlier the gate
+    /// passed counts as a 4σ innovation). Morrison §14.8: the normalised innovations have mean 1
+    /// while the predictions' honest variance is right.
+    pub(super) fn calibrate(&mut self, y: f64) {
+        self.calibration.resize(self.shorter.len() + 1, (1.0, 0));
+        for (c, p) in self.calibration.iter_mut().zip(&self.predictions) {
+            let Some((pred, var)) = *p else { continue };
+            let k2 = ((y - pred).powi(2) / var).min(16.0);
+            if k2.is_finite() {
+                c.1 += 1;
+                c.0 += (k2 - c.0) / (c.1.min(CALIBRATION_MEMORY) as f64);
+            }
+        }
+    }
+
+    /// The factor of the reported mean squared error of the memory in use:
+    /// `max(1, mean(ν²/σ_ε²))` over its recent accepted samples ([`calibrate`](Self::calibrate)),
+    /// once it has [`CALIBRATION_MIN`] of them, while the final degree is active; 1 otherwise.
+    /// The honest covariance `σ² V + b̂ b̂ᵀ` is an estimate; where the memory's own innovations
+    /// say its predictions err more than it, the reported error is widened by the same ratio
+    /// (the gate is not: it keeps its false-alarm rate by the noise model alone).
+    pub(super) fn calibration_factor(&self) -> f64 {
+        if self.active < self.cfg.degree {
+            return 1.0;
+        }
+        match self.calibration.get(self.memory) {
+            Some(&(mean, n)) if n >= CALIBRATION_MIN && mean.is_finite() => mean.max(1.0),
+            _ => 1.0,
         }
     }
 

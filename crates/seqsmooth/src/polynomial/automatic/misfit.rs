@@ -151,6 +151,7 @@ impl AutomaticFilter {
         self.shorter = shorter;
         self.memory = 0;
         self.longer_runs = 0;
+        self.calibration.clear();
         self.switched = false;
         self.memory_t_first = kept.first().map(|k| k.t);
         self.chi.reset();

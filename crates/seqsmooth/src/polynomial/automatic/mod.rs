@@ -12,7 +12,9 @@
 //! 2. **Outlier gate** ([`OutlierRule`]): Morrison's `|ν| > k σ_ε` (default `k = 3`, false-alarm
 //!    rate `P(|Z| > 3) = 0.27%`), or Reyneke's `|ν| > k σ (1 + √(2/N))` (§7.4). A rejected sample
 //!    does not touch the state — the estimate is the prediction across it — and is flagged
-//!    [`AutoOutput::outlier`]. A run of [`AutoConfig::max_consecutive_rejections`] rejections is
+//!    [`AutoOutput::outlier`]. A run of [`AutoConfig::max_consecutive_rejections`] rejections
+//!    (default 3), or of [`AutoConfig::same_side_rejections`] (default: off) all on the same side of
+//!    the prediction (Morrison §14.8: repeated crossings on one side mean bias), is
 //!    taken for a manoeuvre, not outliers: the run is applied after all (in order), and the
 //!    misfit flag goes up. The gate is active only at the final degree, once `σ` is known and the
 //!    prediction VRF `v ≤` [`AutoConfig::gate_max_vrf`] (default 1: the prediction is at least
@@ -46,6 +48,16 @@
 //!      accepted samples (weights `θ^((t_n−t_k)/τ)`), run in tandem from the first sample, so
 //!      there is no start-up transient; the expanding start is used because its variance is the
 //!      lower one until the crossover.
+//!    - **Adaptive memory** (Morrison §7.13, §14.8; [`AutoConfig::memory_levels`], default 3):
+//!      beside `θ` the final degree runs fading-memory filters of the shorter memories
+//!      `θ², θ⁴, θ⁸` with their degree-`(m+1)` companions. Before each prediction the memory of
+//!      least estimated mean squared error `σ² v_j + b̂_j²` is chosen (bias counted where `|Δ|`
+//!      exceeds 2.5 of its noise standard deviations): the VRF falls as the memory lengthens,
+//!      the bias of the unmodelled `(m+1)`-th derivative grows as `(1−θ)^−(m+1)` (Morrison
+//!      (13.9.28)), and §7.13 balances the two. A shorter memory is taken at once, a longer one
+//!      a level at a time after 10 predictions in a row ("β can be temporarily reduced until
+//!      the threshold crossings cease … then the memory can again be lengthened", §14.8). Only
+//!      with [`MisfitResponse::Restart`]; a restart rebuilds every memory.
 //! 5. **Noise** ([`NoiseSource`]): a given `σ`, or (default) the running estimate from the
 //!    normalised `(m+1)`-th divided differences of the accepted samples
 //!    ([`crate::stats::DifferenceNoise`]): unbiased for white noise about any polynomial of
@@ -108,6 +120,7 @@
 //! | misfit and restart: [`MisfitResponse`], CUSUM onset | `misfit` | Morrison §14.8, (14.8.5); [`crate::stats::InnovationChiSquared`] |
 //! | degree settling (the ladder) | `settle` | Reyneke §7.3 |
 //! | bias of the active degree, honest covariance | `bias` | Morrison (7.13.5), §13.9, (13.9.28), §14.8 |
+//! | adaptive memory: [`AutomaticFilter::memory`], [`MAX_MEMORY_LEVELS`] | `memory` | Morrison §7.13, (13.9.28), §14.8 |
 //! | expanding → fading switch: [`Phase`] | `phase` | Morrison §13.8, (13.8.8), Table 13.4; Reyneke §7.2, Table 1 |
 //!
 //! ```
