@@ -98,7 +98,11 @@
 //! a start-up at a low degree of the ladder, a degree still settling and a
 //! manoeuvre the memory does not follow (Morrison §7.13: the total error is the random error
 //! and the bias together). The gate judges `ν` against the same honest `σ_ε`; the misfit test
-//! keeps judging the model, against the noise-only variance. Measured coverage: see
+//! keeps judging the model, against the noise-only variance. At the final degree the reported
+//! covariance is then multiplied by `max(1, mean(ν²/σ_ε²))`, the memory's own normalised
+//! innovations over about the last 20 accepted samples (each clipped at 16): Morrison §14.8's
+//! check that the innovations' mean square equals its predicted value, applied where the
+//! estimated bias falls short; the gate is not widened by it. Measured coverage: see
 //! ACCURACY.md.
 //!
 //! ## Configuration and use
