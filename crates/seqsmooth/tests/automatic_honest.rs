@@ -232,7 +232,7 @@ fn honest_sigma_where_the_thresholds_hold() {
         &[],                    // landing east, σ = 10 m
         &["good rejected"],     // landing north, σ = 10 m
         &["good rejected"],     // landing up, σ = 10 m
-        &["outliers rejected"], // gentle turn
+        &[],                    // gentle turn
         &["outliers rejected"], // sharp turn
     ];
     let all = scenarios();

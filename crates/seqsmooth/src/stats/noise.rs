@@ -331,7 +331,7 @@ pub struct DifferenceNoise {
 
 /// Until the screened estimate has this many terms, the screen's reference is the mean of the
 /// smallest 80% of the squared differences seen so far, over its value for Gaussian terms
-/// (robust to an early outlier), and the screen twice as wide.
+/// (robust to an early outlier), and the screen 1.5 times as wide.
 const SCREEN_REFERENCE_TERMS: usize = 20;
 
 /// The mean of `χ²₁` below its 80% quantile `a² = Φ⁻¹(0.9)²`: `(0.8 − 2aφ(a))/0.8`.
@@ -370,7 +370,7 @@ impl DifferenceNoise {
     }
 
     /// The same estimator, robust to outliers and to isolated glitches of the trend: a difference
-    /// with `|d| > c σ̂` (`σ̂` the estimate before it; while fewer than 20 are in, `|d| > 2c σ̂₀`
+    /// with `|d| > c σ̂` (`σ̂` the estimate before it; while fewer than 20 are in, `|d| > 1.5c σ̂₀`
     /// with `σ̂₀²` the mean of the smallest 80% of the squared differences so far over its
     /// Gaussian value 0.4377) is left out, and so are the
     /// next `k` differences, which share its samples (an outlier of size `a` at one sample enters
@@ -446,11 +446,11 @@ impl DifferenceNoise {
             return true;
         }
         // While the reference is the trimmed mean (which assumes Gaussian terms), only gross
-        // outliers: twice the screen.
+        // outliers: 1.5 times the screen.
         let c = if self.len() >= SCREEN_REFERENCE_TERMS {
             c
         } else {
-            2.0 * c
+            1.5 * c
         };
         let reference = self.screen_reference();
         if self.early.len() < SCREEN_REFERENCE_TERMS {
