@@ -3,8 +3,9 @@
 //! PolynomialFilter>` holding it; and the builders equal the configuration they record.
 //!
 //! Scenario: degree 2, θ = 0.95 per τ = 1, irregular steps (1 ± 40%), Gaussian noise σ = 0.5,
-//! a 20σ outlier every 97 samples and an unmodelled cubic from t = 300 on (so the gate, the
-//! misfit test, the restart and the ladder all act), 600 samples.
+//! a 20σ outlier every 97 samples, an unmodelled cubic from t = 300 on and a 20σ step at
+//! t = 200 (so the gate, the misfit test, the restart and the ladder all act: the adaptive
+//! memory follows the cubic without a restart, the step restarts it), 600 samples.
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -32,8 +33,9 @@ fn scenario(seed: u64) -> (Vec<f64>, Vec<f64>) {
             0.0
         };
         let outlier = if n % 97 == 50 { 10.0 } else { 0.0 };
+        let step = if t > 200.0 { 10.0 } else { 0.0 };
         times.push(t);
-        values.push(trend + manoeuvre + outlier + noise.sample(&mut rng));
+        values.push(trend + manoeuvre + step + outlier + noise.sample(&mut rng));
     }
     (times, values)
 }
@@ -201,6 +203,12 @@ fn fully_built() -> AutomaticFilter {
         .unwrap()
         .with_settling(0.4, 2)
         .unwrap()
+        .with_noise_screen(3.5)
+        .unwrap()
+        .with_memory_levels(2)
+        .unwrap()
+        .with_same_side_rejections(2)
+        .unwrap()
 }
 
 /// The record [`fully_built`] must hold, field by field.
@@ -214,12 +222,15 @@ fn fully_built_record() -> AutoConfig {
         switch_rule: SwitchRule::ColumnMean,
         noise_sigma: None,
         noise_source: NoiseSource::Differences { window: Some(50) },
+        noise_screen: 3.5,
         outliers: OutlierRule::Innovation { k: 3.5 },
         gate_max_vrf: 0.5,
         max_consecutive_rejections: 4,
+        same_side_rejections: 2,
         misfit_window: 12,
         misfit_alpha: 0.02,
         misfit_response: MisfitResponse::Restart { alpha: 1e-3 },
+        memory_levels: 2,
         start_degree: 1,
         settle_vrf: 0.4,
         settle_stable: 2,

@@ -20,12 +20,19 @@
 //! `2σ⁴/N · C(4k,2k)/C(2k,k)²` (1.5, 1.94, 2.31 × the independent-sample value for `k = 1, 2,
 //! 3`) rather than `2σ⁴/N`.
 //!
+//! An outlier of size `a` at one sample enters `k + 1` successive differences (as `a w_j/√(Σw²)`,
+//! in all `a²`), and an isolated glitch of the trend does the same; the screen of
+//! [`DifferenceNoise::with_screen`] leaves out a difference beyond `c σ̂` and the `k` after it
+//! (which share its samples) and divides the mean of the kept terms by the variance of a unit
+//! Gaussian truncated at `±c`, the expectation of a kept term in units of `σ²`.
+//!
 //! ## Residuals
 //!
 //! After a least-squares fit of `N_X` parameters to `N_O` samples, the residual sum of squares
 //! `e°` has expectation `σ² (N_O − N_X)` (Morrison (6.10.21)), so `σ̂² = e°/(N_O − N_X)`
 //! (6.10.24; [`residual_variance`]). Model mismatch inflates it (6.10.25).
 
+use super::chi_squared::two_sided_tail;
 use super::welford::Welford;
 use super::window::SlidingSum;
 use crate::calculus::choose;
@@ -312,7 +319,23 @@ pub struct DifferenceNoise {
     factors: VecDeque<f64>,
     /// The sum of the normalised squared differences `d²`.
     squares: SlidingSum,
+    /// The screen `c` (`|d| > c σ̂` leaves a difference out), if any.
+    screen: Option<f64>,
+    /// Differences still to leave out after a screened one (they share its samples).
+    holdoff: usize,
+    /// The first [`SCREEN_REFERENCE_TERMS`] squared differences (for the startup reference).
+    early: Vec<f64>,
+    /// Differences left out by the screen (the screened ones and those that share their samples).
+    left_out: u64,
 }
+
+/// Until the screened estimate has this many terms, the screen's reference is the mean of the
+/// smallest 80% of the squared differences seen so far, over its value for Gaussian terms
+/// (robust to an early outlier), and the screen 1.5 times as wide.
+const SCREEN_REFERENCE_TERMS: usize = 20;
+
+/// The mean of `χ²₁` below its 80% quantile `a² = Φ⁻¹(0.9)²`: `(0.8 − 2aφ(a))/0.8`.
+const CHI2_1_TRIMMED_MEAN: f64 = 0.437_724_6;
 
 impl DifferenceNoise {
     /// An estimator from differences of order `k ≥ 1` (use `k = m + 1` for a degree-`m` trend),
@@ -339,7 +362,108 @@ impl DifferenceNoise {
             values: VecDeque::with_capacity(order + 1),
             factors: VecDeque::with_capacity(order + 1),
             squares: SlidingSum::new(window),
+            screen: None,
+            holdoff: 0,
+            early: Vec::new(),
+            left_out: 0,
         })
+    }
+
+    /// The same estimator, robust to outliers and to isolated glitches of the trend: a difference
+    /// with `|d| > c σ̂` (`σ̂` the estimate before it; while fewer than 20 are in, `|d| > 1.5c σ̂₀`
+    /// with `σ̂₀²` the mean of the smallest 80% of the squared differences so far over its
+    /// Gaussian value 0.4377) is left out, and so are the
+    /// next `k` differences, which share its samples (an outlier of size `a` at one sample enters
+    /// `k + 1` successive differences, with weights `w_j/√(Σw²)`). The kept terms of white
+    /// Gaussian noise are truncated at `±cσ`, so the estimate divides their mean by the
+    /// truncated variance `1 − 2cφ(c)/(1 − 2Q(c))` (0.973 at `c = 3`), which keeps it unbiased
+    /// for `σ²`. `c > 0`; infinity: no screen.
+    ///
+    /// ```
+    /// use seqsmooth::stats::DifferenceNoise;
+    /// let mut plain = DifferenceNoise::new(2, None).unwrap();
+    /// let mut robust = DifferenceNoise::new(2, None).unwrap().with_screen(3.0).unwrap();
+    /// for n in 0..400 {
+    ///     let noise = if n % 2 == 0 { 0.1 } else { -0.1 };
+    ///     let y = 2.0 * n as f64 + noise + if n % 100 == 50 { 20.0 } else { 0.0 }; // 4 spikes
+    ///     plain.push(n as f64, y).unwrap();
+    ///     robust.push(n as f64, y).unwrap();
+    /// }
+    /// assert!(plain.sigma().unwrap() > 1.0);   // the spikes dominate
+    /// let s = robust.sigma().unwrap();          // the ±0.1 pattern: ∇²(±0.1)/√6 = ±0.163
+    /// assert!(s > 0.16 && s < 0.17, "{s}");
+    /// assert_eq!(robust.left_out(), 4 * 3);     // each spike and the 2 differences after it
+    /// assert!(DifferenceNoise::new(2, None).unwrap().with_screen(0.0).is_err());
+    /// ```
+    pub fn with_screen(mut self, c: f64) -> Result<Self, Error> {
+        if c.is_nan() || c <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "noise screen",
+                value: c.to_string(),
+                reason: "must be positive (infinity: no screen)".into(),
+            });
+        }
+        self.screen = c.is_finite().then_some(c);
+        Ok(self)
+    }
+
+    /// Differences the screen left out (see [`with_screen`](Self::with_screen)).
+    ///
+    /// ```
+    /// use seqsmooth::stats::DifferenceNoise;
+    /// assert_eq!(DifferenceNoise::new(3, None).unwrap().left_out(), 0);
+    /// ```
+    pub fn left_out(&self) -> u64 {
+        self.left_out
+    }
+
+    /// The screen's reference variance: the estimate, or while it has fewer than
+    /// [`SCREEN_REFERENCE_TERMS`] terms the trimmed mean of the squared differences seen so far
+    /// (`None` before 3 are seen).
+    fn screen_reference(&self) -> Option<f64> {
+        if self.len() >= SCREEN_REFERENCE_TERMS {
+            return self.variance();
+        }
+        if self.early.len() < 3 {
+            return None;
+        }
+        let mut e = self.early.clone();
+        e.sort_by(f64::total_cmp);
+        // The mean of the smallest 80% (at least 3) over its value for unit Gaussian terms.
+        let kept = ((e.len() * 4) / 5).max(3);
+        let trimmed = e[..kept].iter().sum::<f64>() / kept as f64;
+        Some(trimmed / CHI2_1_TRIMMED_MEAN)
+    }
+
+    /// Whether the screen leaves out the new squared difference `d2` (and updates its state).
+    fn screened_out(&mut self, d2: f64) -> bool {
+        let Some(c) = self.screen else {
+            return false;
+        };
+        if self.holdoff > 0 {
+            self.holdoff -= 1;
+            self.left_out += 1;
+            return true;
+        }
+        // While the reference is the trimmed mean (which assumes Gaussian terms), only gross
+        // outliers: 1.5 times the screen.
+        let c = if self.len() >= SCREEN_REFERENCE_TERMS {
+            c
+        } else {
+            1.5 * c
+        };
+        let reference = self.screen_reference();
+        if self.early.len() < SCREEN_REFERENCE_TERMS {
+            self.early.push(d2);
+        }
+        match reference {
+            Some(r) if d2 > c * c * r => {
+                self.holdoff = self.order;
+                self.left_out += 1;
+                true
+            }
+            _ => false,
+        }
     }
 
     /// The difference order `k`.
@@ -410,7 +534,9 @@ impl DifferenceNoise {
         let fs: Vec<f64> = self.factors.iter().copied().collect();
         let (d, expected) = divided_difference_with_factors(&ts, &ys, &fs);
         let d2 = d * d / expected;
-        self.squares.push(d2);
+        if !self.screened_out(d2) {
+            self.squares.push(d2);
+        }
         Ok(Some(d))
     }
 
@@ -440,7 +566,8 @@ impl DifferenceNoise {
         self.len() == 0
     }
 
-    /// The variance estimate `mean(d²)`, once one difference is in.
+    /// The variance estimate `mean(d²)` (with a [screen](Self::with_screen), the mean of the kept
+    /// terms over their truncated variance), once one difference is in.
     ///
     /// ```
     /// use seqsmooth::stats::DifferenceNoise;
@@ -450,7 +577,8 @@ impl DifferenceNoise {
     /// ```
     pub fn variance(&self) -> Option<f64> {
         let n = self.len();
-        (n > 0).then(|| self.squares.sum() / n as f64)
+        let kept = self.screen.map_or(1.0, truncated_variance);
+        (n > 0).then(|| self.squares.sum() / n as f64 / kept)
     }
 
     /// `√variance`.
@@ -464,4 +592,18 @@ impl DifferenceNoise {
     pub fn sigma(&self) -> Option<f64> {
         self.variance().map(f64::sqrt)
     }
+}
+
+/// The variance of a unit Gaussian truncated to `|Z| ≤ a`: `1 − 2aφ(a)/(1 − 2Q(a))`. The noise
+/// of the samples a gate of half-width `a σ_ε` passes has this variance (in units of `σ_ε²`).
+pub(crate) fn truncated_variance(a: f64) -> f64 {
+    if !a.is_finite() {
+        return 1.0;
+    }
+    let phi = (-0.5 * a * a).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    let inside = 1.0 - two_sided_tail(a).unwrap_or(0.0);
+    if inside <= 0.0 {
+        return 1.0;
+    }
+    (1.0 - 2.0 * a * phi / inside).max(1e-3)
 }

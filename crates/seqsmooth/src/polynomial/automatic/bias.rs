@@ -25,7 +25,7 @@
 
 use super::filter::AutomaticFilter;
 #[cfg(doc)]
-use super::AutoOutput;
+use super::{AutoConfig, AutoOutput};
 use crate::model::PolynomialState;
 use crate::polynomial::filter::PolynomialFilter;
 
@@ -37,30 +37,30 @@ const SIGNIFICANCE: f64 = 1.0;
 /// the same side) up to this many gate widths.
 const MARGINAL: f64 = 1.25;
 
-impl AutomaticFilter {
-    /// The filter of the active degree plus one on the active filter's memory: the next rung of
-    /// the ladder, or the final degree's own `m + 1` companion.
-    fn companion(&self) -> Option<&dyn PolynomialFilter> {
-        if self.active < self.cfg.degree {
-            self.filter(self.active + 1)
-        } else {
-            match (&self.upper_expanding, &self.upper_fading, self.switched) {
-                (Some(e), _, false) => Some(e as &dyn PolynomialFilter),
-                (_, Some(f), _) => Some(f as &dyn PolynomialFilter),
-                _ => None,
-            }
-        }
-    }
+/// The bias `b` (one entry per derivative of `raw`) of the unit noise state `raw` estimated from
+/// its degree-`(d+1)` companion's state `upper` at the same time, for noise `σ`:
+/// `sign(Δ_i) √max(0, Δ_i² − σ²(V_{d+1} − V_d)_ii)`, `Δ = x_d − x_{d+1}`. `None` without
+/// covariances.
+pub(super) fn difference_bias(
+    raw: &PolynomialState,
+    upper: &PolynomialState,
+    sigma: f64,
+) -> Option<Vec<f64>> {
+    significant_bias(raw, upper, sigma, SIGNIFICANCE)
+}
 
-    /// The estimated bias `b` (one entry per derivative of `raw`) of the active filter's unit
-    /// noise state `raw` at its time, for noise `σ`: `sign(Δ_i) √max(0, Δ_i² − σ²(V_{d+1} −
-    /// V_d)_ii)`. `None` when the companion is not determined.
-    pub(super) fn bias_of(&self, raw: &PolynomialState, sigma: f64) -> Option<Vec<f64>> {
-        let upper = self.companion()?.estimate_at(raw.time)?;
-        let (vu, vd) = (upper.covariance.as_ref()?, raw.covariance.as_ref()?);
-        let s2 = sigma * sigma;
-        let mut b: Vec<f64> = raw
-            .derivatives
+/// [`difference_bias`], counted only where `|Δ_i|` exceeds `z` of its noise standard deviations
+/// (0 elsewhere).
+pub(super) fn significant_bias(
+    raw: &PolynomialState,
+    upper: &PolynomialState,
+    sigma: f64,
+    z: f64,
+) -> Option<Vec<f64>> {
+    let (vu, vd) = (upper.covariance.as_ref()?, raw.covariance.as_ref()?);
+    let s2 = sigma * sigma;
+    Some(
+        raw.derivatives
             .iter()
             .zip(&upper.derivatives)
             .enumerate()
@@ -68,7 +68,7 @@ impl AutomaticFilter {
                 let delta = xd - xu;
                 let var = s2 * (vu[(i, i)] - vd[(i, i)]).max(0.0);
                 // The excess of Δ² over its noise variance, when positive.
-                let b = if delta * delta > SIGNIFICANCE * SIGNIFICANCE * var {
+                let b = if delta * delta > z * z * var {
                     (delta * delta - var).sqrt()
                 } else {
                     0.0
@@ -79,7 +79,27 @@ impl AutomaticFilter {
                     0.0
                 }
             })
-            .collect();
+            .collect(),
+    )
+}
+
+impl AutomaticFilter {
+    /// The filter of the active degree plus one on the active filter's memory: the next rung of
+    /// the ladder, or the companion of the final degree's memory in use.
+    fn companion(&self) -> Option<&dyn PolynomialFilter> {
+        if self.active < self.cfg.degree {
+            self.filter(self.active + 1)
+        } else {
+            self.memory_companion(self.memory)
+        }
+    }
+
+    /// The estimated bias `b` (one entry per derivative of `raw`) of the active filter's unit
+    /// noise state `raw` at its time, for noise `σ` ([`difference_bias`]), the position's
+    /// raised to the innovations' excess. `None` when the companion is not determined.
+    pub(super) fn bias_of(&self, raw: &PolynomialState, sigma: f64) -> Option<Vec<f64>> {
+        let upper = self.companion()?.estimate_at(raw.time)?;
+        let mut b = difference_bias(raw, &upper, sigma)?;
         // The position's bias is at least what the innovations' excess says.
         let floor = self.excess.sqrt();
         if b[0].abs() < floor {
@@ -118,6 +138,31 @@ impl AutomaticFilter {
         }
     }
 
+    /// True when the current run of rejections ends with
+    /// [`AutoConfig::same_side_rejections`] `≥ 2` samples all on the same side of the active
+    /// filter's prediction (Morrison §14.8: repeated crossings on one side mean bias, not
+    /// outliers; two outliers in a row on one side at an outlier rate `p` happen at `p²/2` per
+    /// sample).
+    pub(super) fn same_side_run(&self) -> bool {
+        let n = self.cfg.same_side_rejections;
+        if n < 2 || self.pending.len() < n {
+            return false;
+        }
+        let f = self.active_filter();
+        let mut side = 0.0;
+        for p in &self.pending[self.pending.len() - n..] {
+            let Some(pred) = f.estimate_at(p.t) else {
+                return false;
+            };
+            let r = (p.y - pred.derivatives[0]).signum();
+            if side != 0.0 && r != side {
+                return false;
+            }
+            side = r;
+        }
+        true
+    }
+
     /// The innovations' mean square excess over their expected variance `var` in the misfit
     /// window: `max(0, mean(k²) − 1)·var` (Morrison §14.8: the normalised squared innovations
     /// have mean 1 while the model fits; their excess is the squared bias of the predictions).
@@ -149,6 +194,7 @@ impl AutomaticFilter {
             );
         };
         let bias = self.bias_of(&raw, sigma);
+        let factor = self.calibration_factor();
         let covariance = raw.covariance.as_ref().map(|c| {
             let mut c = c * (sigma * sigma);
             if let Some(b) = &bias {
@@ -158,7 +204,7 @@ impl AutomaticFilter {
                     }
                 }
             }
-            c
+            c * factor
         });
         (PolynomialState { covariance, ..raw }, bias)
     }

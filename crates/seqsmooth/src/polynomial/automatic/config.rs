@@ -21,6 +21,17 @@ use crate::polynomial::options::{DiscountMode, Engine};
 /// ```
 pub const GATE_MAX_VRF: f64 = 1.0;
 
+/// The most shorter memories [`AutoConfig::memory_levels`] may ask for (the shortest discounts
+/// by `θ^65536`).
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::{AutomaticFilter, MAX_MEMORY_LEVELS};
+/// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
+/// assert!(f.clone().with_memory_levels(MAX_MEMORY_LEVELS).is_ok());
+/// assert!(f.with_memory_levels(MAX_MEMORY_LEVELS + 1).is_err());
+/// ```
+pub const MAX_MEMORY_LEVELS: usize = 16;
+
 /// Every setting of the [`AutomaticFilter`](super::AutomaticFilter), as its builders set them
 /// (read with [`AutomaticFilter::config`](super::AutomaticFilter::config)).
 ///
@@ -59,6 +70,11 @@ pub struct AutoConfig {
     pub noise_sigma: Option<f64>,
     /// How `σ` is estimated when not given.
     pub noise_source: NoiseSource,
+    /// The difference noise estimate leaves out a difference beyond `noise_screen · σ̂` and the
+    /// `m + 1` after it, and corrects for the truncation
+    /// ([`crate::stats::DifferenceNoise::with_screen`]): outliers the gate has not seen (before
+    /// it is active) and glitches of the trend stay out of `σ̂`. Default 3; infinity: no screen.
+    pub noise_screen: f64,
     /// Outlier gate.
     pub outliers: OutlierRule,
     /// The gate is applied only while the 1-step prediction VRF is at most this (default
@@ -67,12 +83,22 @@ pub struct AutoConfig {
     /// A run of this many consecutive rejections is a manoeuvre, applied after all (`0`: never).
     /// Default 3 (three consecutive outliers at a 2% outlier rate: 8·10⁻⁶ per sample).
     pub max_consecutive_rejections: usize,
+    /// A run of this many consecutive rejections all on the same side of the prediction is a
+    /// manoeuvre too (Morrison §14.8: repeated crossings on one side mean bias), applied after
+    /// all (two outliers in a row on one side at a 2% outlier rate: 2·10⁻⁴ per sample, so 1% of
+    /// the outliers would be taken); default 0: off (0 or 1: only `max_consecutive_rejections`
+    /// counts); off too when that is 0.
+    pub same_side_rejections: usize,
     /// Innovation chi-squared window `K ≥ 1` (default 10).
     pub misfit_window: usize,
     /// Per-sample false-alarm rate `α ∈ (0,1)` of the misfit test (default 0.01).
     pub misfit_alpha: f64,
     /// What the filter does when the model no longer fits (default: restart at α = 10⁻⁴).
     pub misfit_response: MisfitResponse,
+    /// Shorter memories `θ², θ⁴, …, θ^(2^J)` the final degree may use (`J`; default 3; 0: only
+    /// `θ`): for each prediction and estimate the memory of least estimated mean squared error
+    /// `σ² V + b̂²` (Morrison §7.13; see [`AutomaticFilter::memory`](super::AutomaticFilter::memory)).
+    pub memory_levels: usize,
     /// First degree of the quick-settling ladder, `≤ degree` (default 0; `degree` disables it).
     pub start_degree: usize,
     /// The candidate degree takes over once its current position VRF is at most this (default ½).
@@ -94,12 +120,15 @@ impl AutoConfig {
             switch_rule: SwitchRule::Position,
             noise_sigma: None,
             noise_source: NoiseSource::default(),
+            noise_screen: 3.0,
             outliers: OutlierRule::default(),
             gate_max_vrf: GATE_MAX_VRF,
             max_consecutive_rejections: 3,
+            same_side_rejections: 0,
             misfit_window: 10,
             misfit_alpha: 0.01,
             misfit_response: MisfitResponse::default(),
+            memory_levels: 3,
             start_degree: 0,
             settle_vrf: 0.5,
             settle_stable: 3,
@@ -107,7 +136,7 @@ impl AutoConfig {
     }
 
     /// Checks every setting: a typed error for the first one out of range (degree, `θ`, `τ`,
-    /// `σ`, noise window, gate, restart significance, switch rule, ladder). The misfit window
+    /// `σ`, noise window and screen, gate, restart significance, switch rule, ladder). The misfit window
     /// and `α` are checked by [`crate::stats::InnovationChiSquared::new`].
     pub(super) fn validate(&self) -> Result<(), Error> {
         check_engine_degree(self.degree, self.engine)?;
@@ -121,6 +150,20 @@ impl AutoConfig {
                 name: "noise window",
                 value: "0".into(),
                 reason: "must be at least 1".into(),
+            });
+        }
+        if self.noise_screen.is_nan() || self.noise_screen <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "noise screen",
+                value: self.noise_screen.to_string(),
+                reason: "must be positive (infinity: no screen)".into(),
+            });
+        }
+        if self.memory_levels > MAX_MEMORY_LEVELS {
+            return Err(Error::InvalidParameter {
+                name: "memory levels",
+                value: self.memory_levels.to_string(),
+                reason: format!("must be at most {MAX_MEMORY_LEVELS}"),
             });
         }
         self.outliers.validate()?;

@@ -4,6 +4,7 @@
 //! the switch ([`super::phase`]) to their modules.
 
 use super::config::AutoConfig;
+use super::memory::{shorter_memories, Shorter};
 use super::misfit::{Kept, MisfitResponse};
 use super::noise::{NoiseSource, NoiseState};
 use super::outlier::OutlierRule;
@@ -54,6 +55,16 @@ pub struct AutomaticFilter {
     /// of the final degree; `None` at `m = MAX_DEGREE`, the expanding one after the switch).
     pub(super) upper_expanding: Option<ExpandingMemory>,
     pub(super) upper_fading: Option<FadingMemory>,
+    /// The shorter memories `θ^(2^j)`, `j = 1 … J`, of the final degree ([`super::memory`]).
+    pub(super) shorter: Vec<Shorter>,
+    /// The memory in use (0: the configured `θ`).
+    pub(super) memory: usize,
+    /// Predictions in a row for which a longer memory had the least estimated error.
+    pub(super) longer_runs: usize,
+    /// Each memory's prediction of the newest sample and its honest mean square.
+    pub(super) predictions: Vec<Option<(f64, f64)>>,
+    /// Each memory's running mean of `ν²/σ_ε²` and its count ([`super::memory`]).
+    pub(super) calibration: Vec<(f64, u64)>,
     pub(super) active: usize,
     /// Global index (accepted samples) of the latest expanding → fading switch.
     switched_at: Option<u64>,
@@ -93,35 +104,49 @@ pub(super) fn unit_expanding(m: usize, engine: Engine) -> Result<ExpandingMemory
 
 /// The fading-memory filter of degree `m` with the settings of `cfg`, tracking its VRF.
 pub(super) fn unit_fading(cfg: &AutoConfig, m: usize) -> Result<FadingMemory, Error> {
-    unit_fading_on(cfg, m, cfg.engine)
+    unit_fading_on(cfg, m, cfg.engine, cfg.theta)
 }
 
-/// [`unit_fading`] on the given engine.
-fn unit_fading_on(cfg: &AutoConfig, m: usize, engine: Engine) -> Result<FadingMemory, Error> {
-    FadingMemory::new(m, cfg.theta, cfg.tau, engine)?
+/// [`unit_fading`] on the given engine and discount `θ` per `τ`.
+pub(super) fn unit_fading_on(
+    cfg: &AutoConfig,
+    m: usize,
+    engine: Engine,
+    theta: f64,
+) -> Result<FadingMemory, Error> {
+    FadingMemory::new(m, theta, cfg.tau, engine)?
         .with_discount_mode(cfg.discount)?
         .with_switch_rule(cfg.switch_rule)?
         .with_noise_sigma(1.0)
 }
 
-/// The degree `m + 1` companions (expanding, fading) of the final degree, when `m + 1` is a
-/// supported degree; on the exact engine where the configured gain engine stops
-/// ([`GAIN_MAX_DEGREE`]): they only measure the bias.
-pub(super) fn upper_pair(
-    cfg: &AutoConfig,
-) -> Result<(Option<ExpandingMemory>, Option<FadingMemory>), Error> {
+/// The degree `m + 1` of the companions and their engine, when `m + 1` is a supported degree;
+/// the exact engine where the configured gain engine stops ([`GAIN_MAX_DEGREE`]): they only
+/// measure the bias.
+pub(super) fn upper_degree(cfg: &AutoConfig) -> Option<(usize, Engine)> {
     let u = cfg.degree + 1;
     if u > MAX_DEGREE {
-        return Ok((None, None));
+        return None;
     }
     let engine = if cfg.engine == Engine::Gain && u > GAIN_MAX_DEGREE {
         Engine::Exact
     } else {
         cfg.engine
     };
+    Some((u, engine))
+}
+
+/// The degree `m + 1` companions (expanding, fading) of the final degree (see
+/// [`upper_degree`]).
+pub(super) fn upper_pair(
+    cfg: &AutoConfig,
+) -> Result<(Option<ExpandingMemory>, Option<FadingMemory>), Error> {
+    let Some((u, engine)) = upper_degree(cfg) else {
+        return Ok((None, None));
+    };
     Ok((
         Some(unit_expanding(u, engine)?),
-        Some(unit_fading_on(cfg, u, engine)?),
+        Some(unit_fading_on(cfg, u, engine, cfg.theta)?),
     ))
 }
 
@@ -165,7 +190,13 @@ impl AutomaticFilter {
         let expanding = Some(unit_expanding(m, config.engine)?);
         let fading = unit_fading(&config, m)?;
         let (upper_expanding, upper_fading) = upper_pair(&config)?;
-        let noise = NoiseState::new(config.noise_sigma, config.noise_source, m)?;
+        let shorter = shorter_memories(&config)?;
+        let noise = NoiseState::new(
+            config.noise_sigma,
+            config.noise_source,
+            m,
+            config.noise_screen,
+        )?;
         Ok(Self {
             active: config.start_degree,
             memory_constant: memory_length_constant(0, m),
@@ -176,6 +207,11 @@ impl AutomaticFilter {
             fading,
             upper_expanding,
             upper_fading,
+            shorter,
+            memory: 0,
+            longer_runs: 0,
+            predictions: Vec::new(),
+            calibration: Vec::new(),
             switched_at: None,
             switched: false,
             memory_t_first: None,
@@ -293,6 +329,19 @@ impl AutomaticFilter {
         /// ```
         with_noise_source(source: NoiseSource) => noise_source = source;
 
+        /// The screen `c > 0` of the difference noise estimate (default 3; infinity: none): a
+        /// difference beyond `c σ̂` and the `m + 1` after it are left out of `σ̂`
+        /// ([`crate::stats::DifferenceNoise::with_screen`]).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
+        /// assert_eq!(f.config().noise_screen, 3.0);
+        /// assert!(f.clone().with_noise_screen(0.0).is_err());
+        /// assert!(f.with_noise_screen(f64::INFINITY).is_ok());
+        /// ```
+        with_noise_screen(c: f64) => noise_screen = c;
+
         /// The outlier gate (default [`OutlierRule::morrison`]).
         ///
         /// ```
@@ -334,6 +383,24 @@ impl AutomaticFilter {
         /// ```
         with_max_consecutive_rejections(n: usize) => max_consecutive_rejections = n;
 
+        /// A run of `n ≥ 2` consecutive rejections all on the same side of the prediction is a
+        /// manoeuvre, applied after all (default 0: off; 1: off; off too when
+        /// [`with_max_consecutive_rejections`](Self::with_max_consecutive_rejections) is 0).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let run = |n| {
+        ///     let mut f = AutomaticFilter::new(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap()
+        ///         .with_same_side_rejections(n).unwrap();
+        ///     for k in 0..20 { f.update(k as f64, 0.0).unwrap(); }
+        ///     // a step: 2 rejections on one side are a manoeuvre at n = 2, 3 at n = 0 (the run limit)
+        ///     (20..23).map(|k| f.update(k as f64, 10.0).unwrap().outlier).collect::<Vec<_>>()
+        /// };
+        /// assert_eq!(run(2), [true, false, false]);
+        /// assert_eq!(run(0), [true, true, false]);
+        /// ```
+        with_same_side_rejections(n: usize) => same_side_rejections = n;
+
         /// The innovation chi-squared window `K ≥ 1` (default 10).
         ///
         /// ```
@@ -366,6 +433,18 @@ impl AutomaticFilter {
         /// assert_eq!(flag.config().misfit_response, MisfitResponse::Flag);
         /// ```
         with_misfit_response(response: MisfitResponse) => misfit_response = response;
+
+        /// The number `J ≤` [`MAX_MEMORY_LEVELS`](super::MAX_MEMORY_LEVELS) of shorter memories
+        /// `θ², θ⁴, …, θ^(2^J)` the final degree may use (default 3; 0: the configured `θ` only);
+        /// see [`memory`](Self::memory).
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::new(2, 0.95, 1.0).unwrap();
+        /// assert_eq!(f.config().memory_levels, 3);
+        /// assert_eq!(f.with_memory_levels(0).unwrap().config().memory_levels, 0);
+        /// ```
+        with_memory_levels(levels: usize) => memory_levels = levels;
 
         /// The first degree `d₀ ≤ m` of the quick-settling ladder (default 0; `m` disables it).
         ///
@@ -432,7 +511,7 @@ impl AutomaticFilter {
     pub fn phase(&self) -> Phase {
         if self.active < self.cfg.degree {
             Phase::Settling
-        } else if !self.switched {
+        } else if !self.switched && self.memory == 0 {
             Phase::Expanding
         } else {
             Phase::Fading
@@ -557,10 +636,7 @@ impl AutomaticFilter {
     }
 
     pub(super) fn final_filter(&self) -> &dyn PolynomialFilter {
-        match (&self.expanding, self.switched) {
-            (Some(e), false) => e,
-            _ => &self.fading,
-        }
+        self.memory_filter(self.memory)
     }
 
     pub(super) fn filter(&self, degree: usize) -> Option<&dyn PolynomialFilter> {
@@ -647,6 +723,7 @@ impl AutomaticFilter {
             self.expanding = None;
             self.upper_expanding = None;
         }
+        self.choose_memory(t);
         let sigma = self.noise_sigma();
         let prediction = self.active_filter().estimate_at(t);
         let (innovation, vrf) = match &prediction {
@@ -686,7 +763,7 @@ impl AutomaticFilter {
         if rejected {
             self.pending.push(Kept { t, y, k2 });
             let limit = self.cfg.max_consecutive_rejections;
-            if limit > 0 && self.pending.len() >= limit {
+            if limit > 0 && (self.pending.len() >= limit || self.same_side_run()) {
                 // A run of rejections: the model, not the samples, is wrong. Apply the run.
                 manoeuvre = true;
                 let run = std::mem::take(&mut self.pending);
@@ -704,10 +781,17 @@ impl AutomaticFilter {
             }
         } else {
             self.pending.clear();
-            // The noise estimates see the samples the noise-only gate g₀ (the rule without the
-            // bias) passes, with its truncation in units of σ√(1 + v); a sample accepted only
-            // because the gate includes the estimated bias is left out of them.
-            let noise_gate = self.gate(sigma, vrf, 0.0, t);
+            // The innovation noise estimate sees the samples the noise-only gate g₀ (the rule
+            // without the bias) passes, with its truncation in units of σ√(1 + v); a sample
+            // accepted only because the gate includes the estimated bias is left out of it. The
+            // difference estimate sees every accepted sample, with the truncation of the gate
+            // that passed it (its noise e is cut at [−g − b, g − b], near side at least
+            // √(k² − 1)/k of g₀), and screens outliers itself.
+            let noise_gate = if self.noise.wants_innovations() {
+                self.gate(sigma, vrf, 0.0, t)
+            } else {
+                gate
+            };
             let truncation = match (noise_gate, sigma, vrf) {
                 (Some(g), Some(s), Some(v)) if s > 0.0 => Some((g / (s * (1.0 + v).sqrt()), v)),
                 _ => None,
@@ -717,6 +801,7 @@ impl AutomaticFilter {
                 _ => false,
             };
             chi_out = self.accept(Kept { t, y, k2 }, truncation, false, beyond_noise)?;
+            self.calibrate(y);
             if self.active == m && self.restart_test.as_ref().is_some_and(|r| r.is_misfit()) {
                 self.restart()?;
                 restart = true;
@@ -766,7 +851,7 @@ impl AutomaticFilter {
         // The final-degree filter's own normalised innovation ν²/(1+v), whatever degree is
         // active (for the innovation noise estimate).
         let innovation = if self.noise.wants_innovations() {
-            self.final_filter().estimate_at(t).and_then(|p| {
+            self.memory_filter(0).estimate_at(t).and_then(|p| {
                 let v = p.covariance.as_ref()?[(0, 0)].max(0.0);
                 let nu = y - p.derivatives[0];
                 Some(nu * nu / (1.0 + v))
@@ -789,6 +874,10 @@ impl AutomaticFilter {
         }
         if let Some(f) = &mut self.upper_fading {
             f.update(t, y)?;
+        }
+        for s in &mut self.shorter {
+            s.fading.update(t, y)?;
+            s.upper.update(t, y)?;
         }
         if self.memory_t_first.is_none() {
             self.memory_t_first = Some(t);

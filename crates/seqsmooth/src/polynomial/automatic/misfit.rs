@@ -3,6 +3,7 @@
 //! onset of the manoeuvre (a CUSUM change point).
 
 use super::filter::{unit_expanding, unit_fading, upper_pair, AutomaticFilter};
+use super::memory::shorter_memories;
 use crate::error::Error;
 use crate::polynomial::filter::PolynomialFilter;
 
@@ -128,7 +129,12 @@ impl AutomaticFilter {
         let mut expanding = unit_expanding(m, self.cfg.engine)?;
         let mut fading = unit_fading(&self.cfg, m)?;
         let (mut upper_expanding, mut upper_fading) = upper_pair(&self.cfg)?;
+        let mut shorter = shorter_memories(&self.cfg)?;
         for k in kept {
+            for s in &mut shorter {
+                s.fading.update(k.t, k.y)?;
+                s.upper.update(k.t, k.y)?;
+            }
             expanding.update(k.t, k.y)?;
             fading.update(k.t, k.y)?;
             if let Some(f) = &mut upper_expanding {
@@ -142,6 +148,10 @@ impl AutomaticFilter {
         self.fading = fading;
         self.upper_expanding = upper_expanding;
         self.upper_fading = upper_fading;
+        self.shorter = shorter;
+        self.memory = 0;
+        self.longer_runs = 0;
+        self.calibration.clear();
         self.switched = false;
         self.memory_t_first = kept.first().map(|k| k.t);
         self.chi.reset();

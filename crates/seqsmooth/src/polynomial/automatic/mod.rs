@@ -12,7 +12,9 @@
 //! 2. **Outlier gate** ([`OutlierRule`]): Morrison's `|ν| > k σ_ε` (default `k = 3`, false-alarm
 //!    rate `P(|Z| > 3) = 0.27%`), or Reyneke's `|ν| > k σ (1 + √(2/N))` (§7.4). A rejected sample
 //!    does not touch the state — the estimate is the prediction across it — and is flagged
-//!    [`AutoOutput::outlier`]. A run of [`AutoConfig::max_consecutive_rejections`] rejections is
+//!    [`AutoOutput::outlier`]. A run of [`AutoConfig::max_consecutive_rejections`] rejections
+//!    (default 3), or of [`AutoConfig::same_side_rejections`] (default: off) all on the same side of
+//!    the prediction (Morrison §14.8: repeated crossings on one side mean bias), is
 //!    taken for a manoeuvre, not outliers: the run is applied after all (in order), and the
 //!    misfit flag goes up. The gate is active only at the final degree, once `σ` is known and the
 //!    prediction VRF `v ≤` [`AutoConfig::gate_max_vrf`] (default 1: the prediction is at least
@@ -46,16 +48,31 @@
 //!      accepted samples (weights `θ^((t_n−t_k)/τ)`), run in tandem from the first sample, so
 //!      there is no start-up transient; the expanding start is used because its variance is the
 //!      lower one until the crossover.
+//!    - **Adaptive memory** (Morrison §7.13, §14.8; [`AutoConfig::memory_levels`], default 3):
+//!      beside `θ` the final degree runs fading-memory filters of the shorter memories
+//!      `θ², θ⁴, θ⁸` with their degree-`(m+1)` companions. Before each prediction the memory of
+//!      least estimated mean squared error `σ² v_j + b̂_j²` is chosen (bias counted where `|Δ|`
+//!      exceeds 2.5 of its noise standard deviations): the VRF falls as the memory lengthens,
+//!      the bias of the unmodelled `(m+1)`-th derivative grows as `(1−θ)^−(m+1)` (Morrison
+//!      (13.9.28)), and §7.13 balances the two. A shorter memory is taken at once, a longer one
+//!      a level at a time after 10 predictions in a row ("β can be temporarily reduced until
+//!      the threshold crossings cease … then the memory can again be lengthened", §14.8). Only
+//!      with [`MisfitResponse::Restart`]; a restart rebuilds every memory.
 //! 5. **Noise** ([`NoiseSource`]): a given `σ`, or (default) the running estimate from the
 //!    normalised `(m+1)`-th divided differences of the accepted samples
 //!    ([`crate::stats::DifferenceNoise`]): unbiased for white noise about any polynomial of
 //!    degree `≤ m` on any timestamps; biased upward by the trend's `(m+1)`-th derivative
 //!    (`E{d²} = σ² + b²`, `b ≈ x^(m+1) Δt^(m+1)/√C(2m+2,m+1)` — negligible unless the samples
-//!    are sparse on the manoeuvre's time scale) and by outliers that pass the gate (each
-//!    contributes `a²/N` to `σ̂²` for an outlier of size `a`; before the gate is active all samples
-//!    pass). The gate truncates the noise of the samples it passes (for `k = 3`, `σ̂` would be
-//!    1.4% low); each gated sample enters with its expected truncated variance
-//!    `σ²(c(a) + v)/(1 + v)`, `c(a)` the variance of a unit Gaussian cut at `±a = ±g/σ_ε`, which
+//!    are sparse on the manoeuvre's time scale). Outliers the gate passes (before it is active
+//!    every sample passes) and isolated glitches of the trend are screened
+//!    ([`AutoConfig::noise_screen`], default `c = 3`): a difference beyond `c σ̂` and the `m + 1`
+//!    after it, which share its samples, are left out, and the kept terms are divided by the
+//!    variance of a unit Gaussian truncated at `±c` ([`crate::stats::DifferenceNoise::with_screen`]).
+//!    The gate truncates the noise of the samples it passes (for `k = 3`, `σ̂` would be 1.4% low);
+//!    each gated sample enters with its expected truncated variance `σ²(c(a) + v)/(1 + v)`,
+//!    `c(a)` the variance of a unit Gaussian cut at `±a = ±g/(σ√(1 + v))`, `g` the gate that
+//!    passed it (with a bias `b` the cut is `[−g − b, g − b]`, `g = k√(σ²(1+v) + b²)`, whose
+//!    near side is never nearer than `√(k² − 1)·σ√(1 + v)`, 0.94 of the symmetric one), which
 //!    removes that bias. Alternatively the innovations of the final-degree filter
 //!    ([`NoiseSource::Innovations`]): `σ̂² = mean(ν²/(1+v))`, corrected for the gate's truncation;
 //!    without gating and before the switch it equals the expanding-memory fit's residual
@@ -81,7 +98,11 @@
 //! a start-up at a low degree of the ladder, a degree still settling and a
 //! manoeuvre the memory does not follow (Morrison §7.13: the total error is the random error
 //! and the bias together). The gate judges `ν` against the same honest `σ_ε`; the misfit test
-//! keeps judging the model, against the noise-only variance. Measured coverage: see
+//! keeps judging the model, against the noise-only variance. At the final degree the reported
+//! covariance is then multiplied by `max(1, mean(ν²/σ_ε²))`, the memory's own normalised
+//! innovations over about the last 20 accepted samples (each clipped at 16): Morrison §14.8's
+//! check that the innovations' mean square equals its predicted value, applied where the
+//! estimated bias falls short; the gate is not widened by it. Measured coverage: see
 //! ACCURACY.md.
 //!
 //! ## Configuration and use
@@ -103,6 +124,7 @@
 //! | misfit and restart: [`MisfitResponse`], CUSUM onset | `misfit` | Morrison §14.8, (14.8.5); [`crate::stats::InnovationChiSquared`] |
 //! | degree settling (the ladder) | `settle` | Reyneke §7.3 |
 //! | bias of the active degree, honest covariance | `bias` | Morrison (7.13.5), §13.9, (13.9.28), §14.8 |
+//! | adaptive memory: [`AutomaticFilter::memory`], [`MAX_MEMORY_LEVELS`] | `memory` | Morrison §7.13, (13.9.28), §14.8 |
 //! | expanding → fading switch: [`Phase`] | `phase` | Morrison §13.8, (13.8.8), Table 13.4; Reyneke §7.2, Table 1 |
 //!
 //! ```
@@ -132,6 +154,7 @@ use crate::polynomial::options::{DiscountMode, Engine};
 mod bias;
 mod config;
 mod filter;
+mod memory;
 mod misfit;
 mod noise;
 mod outlier;
@@ -139,7 +162,7 @@ mod output;
 mod phase;
 mod settle;
 
-pub use config::{AutoConfig, GATE_MAX_VRF};
+pub use config::{AutoConfig, GATE_MAX_VRF, MAX_MEMORY_LEVELS};
 pub use filter::AutomaticFilter;
 pub use misfit::MisfitResponse;
 pub use noise::{NoiseSource, MIN_NOISE_TERMS};

@@ -124,12 +124,18 @@ pub(super) enum NoiseState {
 }
 
 impl NoiseState {
-    /// The state for a given `σ`, or an estimator of the source for degree `m`.
-    pub(super) fn new(sigma: Option<f64>, source: NoiseSource, m: usize) -> Result<Self, Error> {
+    /// The state for a given `σ`, or an estimator of the source for degree `m`; the difference
+    /// estimator with the screen `c` ([`DifferenceNoise::with_screen`]).
+    pub(super) fn new(
+        sigma: Option<f64>,
+        source: NoiseSource,
+        m: usize,
+        screen: f64,
+    ) -> Result<Self, Error> {
         Ok(match (sigma, source) {
             (Some(s), _) => NoiseState::Known(s),
             (None, NoiseSource::Differences { window }) => {
-                NoiseState::Differences(DifferenceNoise::new(m + 1, window)?)
+                NoiseState::Differences(DifferenceNoise::new(m + 1, window)?.with_screen(screen)?)
             }
             (None, NoiseSource::Innovations { window }) => {
                 NoiseState::Innovations(WindowedMean::new(window))

@@ -163,27 +163,17 @@ impl AutomaticFilter {
     /// Reyneke's memory length `N` at `t`: `c_0m/(1-θ_s)` once faded, else the active filter's
     /// sample count.
     fn memory_length(&self, t: f64) -> f64 {
-        if self.active == self.cfg.degree && self.switched {
-            self.memory_constant / (1.0 - self.theta_per_sample(t))
+        if self.active == self.cfg.degree && (self.switched || self.memory > 0) {
+            // The memory in use discounts by θ^(2^j) per sample.
+            let theta = self.theta_per_sample(t).powi(1 << self.memory);
+            self.memory_constant / (1.0 - theta)
         } else {
             self.active_filter().samples().max(1) as f64
         }
     }
 }
 
-/// The variance of a unit Gaussian truncated to `|Z| ≤ a`: `1 − 2aφ(a)/(1 − 2Q(a))`. The noise
-/// of the samples a gate of half-width `a σ_ε` passes has this variance (in units of `σ_ε²`).
-pub(super) fn truncated_variance(a: f64) -> f64 {
-    if !a.is_finite() {
-        return 1.0;
-    }
-    let phi = (-0.5 * a * a).exp() / (2.0 * std::f64::consts::PI).sqrt();
-    let inside = 1.0 - two_sided_tail(a).unwrap_or(0.0);
-    if inside <= 0.0 {
-        return 1.0;
-    }
-    (1.0 - 2.0 * a * phi / inside).max(1e-3)
-}
+pub(super) use crate::stats::noise::truncated_variance;
 
 #[cfg(test)]
 mod tests {

@@ -28,7 +28,8 @@ pub enum Phase {
     Settling,
     /// The final degree, expanding memory (before the switch).
     Expanding,
-    /// The final degree, fading memory.
+    /// The final degree, fading memory (the configured `θ` after the switch, or a shorter
+    /// memory `θ^(2^j)`, see [`AutomaticFilter::memory`](super::AutomaticFilter::memory)).
     Fading,
 }
 
