@@ -666,9 +666,30 @@ impl AutomaticFilter {
     /// assert!((f.estimate_at(2.0).unwrap().derivatives[0] - 5.0).abs() < 1e-12);
     /// ```
     pub fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
-        self.active_filter()
-            .estimate_at(t)
-            .map(|s| self.honest(s).0)
+        self.try_estimate_at(t).ok()
+    }
+
+    /// The estimate at `t`, or why there is none
+    /// ([`PolynomialFilter::try_estimate_at`]): the active filter's reason, or a number of the
+    /// honest covariance beyond the double range ([`Error::EstimateOutOfRange`]).
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+    /// use seqsmooth::Error;
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_start_degree(1).unwrap();
+    /// let mut f = f.with_noise_sigma(1e150).unwrap();
+    /// assert!(matches!(f.try_estimate_at(0.0), Err(Error::TooFewSamples { .. })));
+    /// f.update(0.0, 1.0).unwrap();
+    /// f.update(1.0, 2.0).unwrap();
+    /// assert!(f.try_estimate().is_ok());
+    /// // a line from two samples, 1e6 steps ahead: variance ≈ 1e12·σ² = 1e312
+    /// let e = f.try_estimate_at(1e6).unwrap_err();
+    /// assert!(matches!(e, Error::EstimateOutOfRange { ref what } if what == "variance of d0"), "{e}");
+    /// assert!(f.estimate_at(1e6).is_none());
+    /// ```
+    pub fn try_estimate_at(&self, t: f64) -> Result<PolynomialState, Error> {
+        let s = self.active_filter().try_estimate_at(t)?;
+        self.honest(s).0.checked()
     }
 
     /// The estimate at the newest accepted sample.
@@ -681,7 +702,14 @@ impl AutomaticFilter {
     /// assert_eq!(f.estimate().unwrap().derivatives, vec![1.0]);
     /// ```
     pub fn estimate(&self) -> Option<PolynomialState> {
-        self.active_filter().estimate().map(|s| self.honest(s).0)
+        self.try_estimate().ok()
+    }
+
+    /// The estimate at the newest accepted sample, or why there is none
+    /// ([`try_estimate_at`](Self::try_estimate_at)).
+    pub fn try_estimate(&self) -> Result<PolynomialState, Error> {
+        let s = self.active_filter().try_estimate()?;
+        self.honest(s).0.checked()
     }
 
     /// Processes the sample `y` at time `t` (finite, strictly after the previous sample's time,
@@ -813,8 +841,13 @@ impl AutomaticFilter {
         } else {
             self.active_filter().estimate()
         };
+        // Right or refused: an estimate with a number beyond the double range is none
+        // (`try_estimate_at` names it).
         let (estimate, bias) = match raw.map(|s| self.honest(s)) {
-            Some((s, b)) => (Some(s), b),
+            Some((s, b)) => match s.checked() {
+                Ok(s) => (Some(s), b.filter(|b| b.iter().all(|v| v.is_finite()))),
+                Err(_) => (None, None),
+            },
             None => (None, None),
         };
         Ok(AutoOutput {
@@ -931,6 +964,12 @@ impl PolynomialFilter for AutomaticFilter {
     }
     fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
         AutomaticFilter::estimate_at(self, t)
+    }
+    fn try_estimate_at(&self, t: f64) -> Result<PolynomialState, Error> {
+        AutomaticFilter::try_estimate_at(self, t)
+    }
+    fn try_estimate(&self) -> Result<PolynomialState, Error> {
+        AutomaticFilter::try_estimate(self)
     }
     fn last_time(&self) -> Option<f64> {
         AutomaticFilter::last_time(self)
