@@ -3,8 +3,8 @@
 //! Oracles: the exact values (a line has second derivative 0; 2·Δ²y/Δt² for three samples) and
 //! the double range itself.
 
+use seqsmooth::PolynomialFilter;
 use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory};
-use seqsmooth::{PolynomialFilter, PolynomialState};
 
 fn kinds(m: usize) -> Vec<Box<dyn PolynomialFilter>> {
     let mut v: Vec<Box<dyn PolynomialFilter>> = Vec::new();
@@ -61,8 +61,13 @@ fn derivatives_beyond_the_double_range_are_named() {
         f.update_many_into(&t, &[1.0, 2.0, 3.0, 5.0], &mut rows)
             .unwrap();
         assert!(rows.iter().all(|v| !v.is_infinite()), "{f:?}: {rows:?}");
-        assert!(rows[9..].iter().any(|v| v.is_nan()), "{f:?}: {rows:?}");
-        assert!(rows[9].is_finite() || rows[10].is_nan(), "{f:?}: {rows:?}");
+        // d2 is marked; d0 and d1 stand (expanding, fading) or go with their row (fixed).
+        assert!(rows[11].is_nan(), "{f:?}: {rows:?}");
+        let whole_row = rows[9..].iter().all(|v| v.is_nan());
+        assert!(
+            whole_row || ((rows[9] - 5.0).abs() < 1.0 && rows[10].is_finite()),
+            "{f:?}: {rows:?}"
+        );
     }
 }
 
@@ -110,5 +115,4 @@ fn estimate_at_agrees_with_try_estimate_at() {
             }
         }
     }
-    let _ = PolynomialState::new(0.0, vec![0.0]);
 }

@@ -126,12 +126,7 @@ impl EngineState {
     /// The estimate at `t`, finite in every number, or why there is none
     /// ([`PolynomialFilter::try_estimate_at`]).
     pub(crate) fn try_estimate_at(&self, m: usize, t: f64) -> Result<PolynomialState, Error> {
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
+        crate::error::check_finite("time", &[t])?;
         let samples = self.samples();
         if samples <= m as u64 {
             return Err(Error::TooFewSamples {

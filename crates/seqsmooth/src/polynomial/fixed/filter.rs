@@ -337,12 +337,7 @@ impl PolynomialFilter for FixedMemory {
     }
 
     fn try_estimate_at(&self, t: f64) -> Result<PolynomialState, Error> {
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
+        crate::error::check_finite("time", &[t])?;
         if self.n < self.window as u64 {
             return Err(Error::TooFewSamples {
                 needed: self.window,
