@@ -16,7 +16,7 @@ use crate::error::CliError;
 use crate::filter::runner::Runner;
 use crate::filter::{median_series_step, LOOKAHEAD};
 use crate::io::{fmt_f64, Output};
-use seqsmooth::polynomial::automatic::{AutoOutput, AutomaticFilter, Phase};
+use seqsmooth::polynomial::automatic::{final_outliers, AutoOutput, AutomaticFilter, Phase};
 use seqsmooth::{PolynomialFilter, PolynomialState};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
@@ -249,7 +249,7 @@ fn track(data: &[Point], outs: &[AutoOutput]) -> Track {
             data.iter().map(|p| p.v).collect(),
         ],
         noise: outs.iter().map(|o| o.noise_sigma).collect(),
-        rejected: outs.iter().map(|o| o.outlier).collect(),
+        rejected: final_outliers(outs),
         misfit: outs.iter().map(|o| o.misfit).collect(),
         switches: switches.map(|i| outs[i].time).collect(),
         restarts: outs.iter().filter(|o| o.restart).map(|o| o.time).collect(),
@@ -327,11 +327,12 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
     }
 
     let outliers = data.iter().filter(|p| p.outlier).count();
-    let rejected = outs.iter().filter(|o| o.outlier).count();
-    let caught = outs
+    let flags = final_outliers(&outs);
+    let rejected = flags.iter().filter(|&&r| r).count();
+    let caught = flags
         .iter()
         .zip(&data)
-        .filter(|(o, p)| o.outlier && p.outlier)
+        .filter(|(&r, p)| r && p.outlier)
         .count();
     let plot_track = track(&data, &outs);
     let (switches, restarts) = (&plot_track.switches, &plot_track.restarts);
@@ -347,7 +348,7 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
          noise σ = {SIGMA} m; {outliers} outliers of {}-{}σ\n\
          automatic filter: degree {DEGREE}, θ = {THETA} per τ = {tau:.4} s (the median step), \
          noise estimated\n  \
-         rejected {} samples: {caught} of the {outliers} outliers, {} good samples\n  \
+         rejected {} samples (final decisions): {caught} of the {outliers} outliers, {} good\n  \
          switch from expanding to fading memory: {}\n  \
          misfit restarts: {}; misfit flagged on {} samples\n  \
          noise σ estimated at the end: {} m (true {SIGMA} m)\n\

@@ -1,7 +1,7 @@
 //! End-to-end tests of `seqsmooth filter` of every kind: published test vectors (Morrison 1969; Reyneke et al.
 //! 2012) and the library.
 
-use seqsmooth::polynomial::automatic::AutomaticFilter;
+use seqsmooth::polynomial::automatic::{final_outliers, AutomaticFilter};
 use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
 use seqsmooth::polynomial::fixed::covariance_unscaled;
 use seqsmooth::polynomial::form::EstimateForm;
@@ -646,9 +646,16 @@ fn filter_auto_given_sigma_and_misfit() {
         .unwrap()
         .with_noise_sigma(0.2)
         .unwrap();
-    for (row, &(t, y)) in rows.iter().zip(&samples) {
-        let o = f.update(t, y).unwrap();
-        assert_eq!(row[7], if o.outlier { "1" } else { "0" }, "{row:?}");
+    let outs: Vec<_> = samples
+        .iter()
+        .map(|&(t, y)| f.update(t, y).unwrap())
+        .collect();
+    // The outlier column is the final decision: the manoeuvre's first rejections are applied
+    // after all.
+    let flags = final_outliers(&outs);
+    assert!(outs.iter().zip(&flags).any(|(o, &r)| o.outlier && !r));
+    for ((row, o), rejected) in rows.iter().zip(&outs).zip(flags) {
+        assert_eq!(row[7], if rejected { "1" } else { "0" }, "{row:?}");
         assert_eq!(row[8], if o.misfit { "1" } else { "0" }, "{row:?}");
     }
     assert!(

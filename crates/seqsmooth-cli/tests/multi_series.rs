@@ -537,3 +537,80 @@ fn progress_is_silent_when_stderr_is_not_a_terminal() {
     assert_eq!(o.stderr, "");
     assert_eq!(o.stdout.lines().count(), 5001);
 }
+
+/// The automatic filter's `outlier` column holds the final decision of each sample: a run of
+/// rejections the filter applies after all (a step, not outliers) is written as 0, however the
+/// series are interleaved and the input cut into chunks. The oracle is the library's
+/// `final_outliers` over each series alone.
+#[test]
+fn auto_outlier_column_is_the_final_decision() {
+    use seqsmooth::polynomial::automatic::{final_outliers, AutomaticFilter};
+    // Two series on the same grid: an outlier, then a step (three rejections, the first two
+    // reinstated), at different rows.
+    let value = |s: usize, n: usize| match (s, n) {
+        (0, 20) | (1, 33) => 5.0,
+        (0, 40..) | (1, 57..) => 9.0,
+        _ => 0.0,
+    };
+    let rows = 80;
+    let mut want_flags = Vec::new();
+    for s in 0..2 {
+        let mut f = AutomaticFilter::new(0, 0.9, 1.0)
+            .unwrap()
+            .with_noise_sigma(0.1)
+            .unwrap();
+        let outs: Vec<_> = (0..rows)
+            .map(|n| f.update(n as f64, value(s, n)).unwrap())
+            .collect();
+        let flags = final_outliers(&outs);
+        assert!(
+            outs.iter()
+                .zip(&flags)
+                .filter(|(o, &r)| o.outlier && !r)
+                .count()
+                == 2,
+            "series {s}: the step's first two rejections are reinstated"
+        );
+        want_flags.push(flags);
+    }
+    let mut input = String::from("id,t,y\n");
+    for n in 0..rows {
+        for s in 0..2 {
+            input += &format!("s{s},{n},{}\n", value(s, n));
+        }
+    }
+    let args = |chunk: &'static str| {
+        [
+            "filter",
+            "-",
+            "--kind",
+            "auto",
+            "--degree",
+            "0",
+            "--theta",
+            "0.9",
+            "--tau",
+            "1",
+            "--sigma",
+            "0.1",
+            "--id-col",
+            "id",
+            "--no-progress",
+            "--chunk-rows",
+            chunk,
+        ]
+    };
+    for chunk in ["1", "2", "3", "64"] {
+        let out = ok(&args(chunk), &input);
+        let mut lines = out.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = header.iter().position(|&c| c == "outlier").unwrap();
+        let mut got = vec![Vec::new(), Vec::new()];
+        for line in lines {
+            let cells: Vec<&str> = line.split(',').collect();
+            let s = (cells[0] == "s1") as usize;
+            got[s].push(cells[col] == "1");
+        }
+        assert_eq!(got, want_flags, "--chunk-rows {chunk}");
+    }
+}

@@ -8,8 +8,10 @@
 //! and written in input order. Memory is a few chunks plus one filter per series, whatever the
 //! length of the input. The first [`LOOKAHEAD`] data rows (the first `W` for a fixed-memory
 //! window longer than that) decide the default `τ` (median time step) and the too-few-samples
-//! check before any output is written.
+//! check before any output is written. The automatic filter's rows from a provisional
+//! rejection on wait until it is final (`held`).
 
+mod held;
 pub mod rows;
 pub mod runner;
 
@@ -180,7 +182,12 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     // The automatic filter always writes s0..sM (from the given or the estimated noise).
     let sigma = a.sigma.is_some() || a.kind == Kind::Auto;
     let extra = prototype.extra_columns();
-    let stride = ((a.degree + 1) << usize::from(sigma)) + extra.len();
+    // The automatic filter's rows carry one cell more, not written: how many of its series'
+    // rejections just before were applied after all (see `held`).
+    let auto = a.kind == Kind::Auto;
+    let shown = ((a.degree + 1) << usize::from(sigma)) + extra.len();
+    let stride = shown + usize::from(auto);
+    let mut held = held::Held::default();
     let mut bank = StreamBank::growing(prototype).map_err(|e| CliError::Usage(e.to_string()))?;
     let (mut ids, mut values, mut out) = (Vec::new(), Vec::new(), None);
     let mut progress = Progress::hidden();
@@ -252,21 +259,43 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             }
         };
         let id = |i: usize| a.id_col.as_ref().map(|_| ids[chunk.series[i]].as_slice());
-        let pieces: Vec<Vec<u8>> = (0..limit.div_ceil(PIECE))
-            .into_par_iter()
-            .map(|k| {
-                let mut buf = Vec::with_capacity(PIECE.min(limit) * (stride + 2) * 20);
-                for i in k * PIECE..((k + 1) * PIECE).min(limit) {
-                    let values = &values[i * stride..(i + 1) * stride];
-                    chunk.row_with(&mut buf, i, id(i), values, lead_cells);
-                }
-                buf
-            })
-            .collect();
-        for piece in &pieces {
-            sink.write(piece)?;
+        if auto {
+            // The outlier flag is written once final: `outlier` is the third cell from the
+            // end, before `misfit` and `bias` (and `lead`).
+            for i in 0..limit {
+                let row = &values[i * stride..(i + 1) * stride];
+                let mut buf = Vec::with_capacity(stride * 20);
+                chunk.row_with(&mut buf, i, id(i), &row[..shown], lead_cells);
+                let outlier = row[shown - 3] == 1.0;
+                let reinstated = row[shown] as usize;
+                held.push(
+                    chunk.series[i],
+                    buf,
+                    2 + lead_cells.len(),
+                    outlier,
+                    reinstated,
+                );
+            }
+            held.flush_final(sink)?;
+        } else {
+            let pieces: Vec<Vec<u8>> = (0..limit.div_ceil(PIECE))
+                .into_par_iter()
+                .map(|k| {
+                    let mut buf = Vec::with_capacity(PIECE.min(limit) * (stride + 2) * 20);
+                    for i in k * PIECE..((k + 1) * PIECE).min(limit) {
+                        let values = &values[i * stride..(i + 1) * stride];
+                        chunk.row_with(&mut buf, i, id(i), values, lead_cells);
+                    }
+                    buf
+                })
+                .collect();
+            for piece in &pieces {
+                sink.write(piece)?;
+            }
         }
         if failed.is_some() || chunk.error.is_some() || chunk.done {
+            // No later sample can revise a rejection now.
+            held.flush_all(sink)?;
             return match (failed, chunk.error.take()) {
                 // Dropped unfinished: standard output keeps the rows before the error, a
                 // file is not written.
@@ -281,7 +310,15 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         let next = pipeline.as_mut();
         let next =
             next.ok_or_else(|| CliError::Data("internal error: the input reader is gone".into()))?;
-        chunk = next.swap(chunk)?;
+        chunk = match next.swap(chunk) {
+            Ok(next) => next,
+            Err(e) => {
+                if let Some(sink) = &mut out {
+                    held.flush_all(sink)?;
+                }
+                return Err(e);
+            }
+        };
     }
     Ok(())
 }

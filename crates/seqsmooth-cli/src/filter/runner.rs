@@ -5,7 +5,8 @@
 //! filter) their 1σ `s0..sM` from the covariance, then the kind's trailing cells (fixed memory:
 //! the rows in the window; automatic: the noise σ in use, the outlier and misfit flags as
 //! 0/1, and the estimated position bias that `s0` includes, empty when `s0..sM` cover the noise
-//! only). NaN marks an empty cell: a derivative or 1σ not determined yet.
+//! only; then one cell not written, the count of rejections just before that the filter applied
+//! with this row after all). NaN marks an empty cell: a derivative or 1σ not determined yet.
 
 use crate::args::{name, EngineArg, Kind};
 use seqsmooth::polynomial::automatic::AutomaticFilter;
@@ -138,12 +139,16 @@ impl Runner {
                 }
                 Runner::Auto(f) => {
                     let Some(o) = f.last_output() else { continue };
-                    extra.copy_from_slice(&[
+                    extra[..4].copy_from_slice(&[
                         o.noise_sigma.unwrap_or(f64::NAN),
                         f64::from(u8::from(o.outlier)),
                         f64::from(u8::from(o.misfit)),
                         o.bias.as_ref().map_or(f64::NAN, |b| b[0]),
                     ]);
+                    // The cell after the written ones: rejections just before, applied now.
+                    if let Some(cell) = extra.get_mut(4) {
+                        *cell = o.reinstated as f64;
+                    }
                     // The output's estimate is at t: the update's own, or across a rejected
                     // sample the prediction; with a lead the active filter's, the same way.
                     if lead == 0.0 {

@@ -401,6 +401,7 @@ impl AutomaticFilter {
         /// ```
         with_same_side_rejections(n: usize) => same_side_rejections = n;
 
+
         /// The innovation chi-squared window `K ≥ 1` (default 10).
         ///
         /// ```
@@ -751,43 +752,19 @@ impl AutomaticFilter {
             self.expanding = None;
             self.upper_expanding = None;
         }
-        self.choose_memory(t);
-        let sigma = self.noise_sigma();
-        let prediction = self.active_filter().estimate_at(t);
-        let (innovation, vrf) = match &prediction {
-            Some(p) => (
-                Some(y - p.derivatives[0]),
-                p.covariance.as_ref().map(|c| c[(0, 0)].max(0.0)),
-            ),
-            None => (None, None),
-        };
-        self.excess = match (sigma, vrf) {
-            (Some(s), Some(v)) => self.innovation_excess(s * s * (1.0 + v)),
-            _ => 0.0,
-        };
-        // The prediction's estimated bias: the honest innovation variance σ²(1 + v) + b₀².
-        let bias0 = match (&prediction, sigma) {
-            (Some(p), Some(s)) => self.bias_of(p, s).map_or(0.0, |b| b[0]),
-            _ => 0.0,
-        };
-        let bias0 = self.with_pending(bias0, innovation, sigma);
-        let innovation_sigma = match (sigma, vrf) {
-            (Some(s), Some(v)) => Some((s * s * (1.0 + v) + bias0 * bias0).sqrt()),
-            _ => None,
-        };
-        // The misfit test judges the model: the innovation against its noise-only variance.
-        let k2 = match (innovation, sigma, vrf) {
-            (Some(nu), Some(s), Some(v)) if s > 0.0 => Some(nu * nu / (s * s * (1.0 + v))),
-            _ => None,
-        };
-        let gate = self.gate(sigma, vrf, bias0, t);
-        let rejected = match (gate, innovation) {
-            (Some(g), Some(nu)) => nu.abs() > g,
-            _ => false,
-        };
+        let Judged {
+            sigma,
+            innovation,
+            vrf,
+            innovation_sigma,
+            k2,
+            gate,
+            rejected,
+        } = self.judge(t, y);
         let mut manoeuvre = false;
         let mut restart = false;
         let mut chi_out = None;
+        let mut reinstated = 0;
         if rejected {
             self.pending.push(Kept { t, y, k2 });
             let limit = self.cfg.max_consecutive_rejections;
@@ -796,7 +773,8 @@ impl AutomaticFilter {
                 manoeuvre = true;
                 let run = std::mem::take(&mut self.pending);
                 // The earlier members of the run were counted as rejections; they are not.
-                self.rejected -= (run.len() - 1) as u64;
+                reinstated = run.len() - 1;
+                self.rejected -= reinstated as u64;
                 for p in run {
                     chi_out = self.accept(p, None, true, false)?.or(chi_out);
                 }
@@ -863,9 +841,58 @@ impl AutomaticFilter {
             outlier,
             misfit: manoeuvre || restart || self.chi.is_misfit(),
             manoeuvre,
+            reinstated,
             restart,
             chi_squared: chi_out,
         })
+    }
+
+    /// The prediction of the sample `(t, y)` by the memory of least estimated error, its
+    /// innovation and honest `σ_ε`, and the gate's verdict (Morrison (14.8.1)-(14.8.4)).
+    fn judge(&mut self, t: f64, y: f64) -> Judged {
+        self.choose_memory(t);
+        let sigma = self.noise_sigma();
+        let prediction = self.active_filter().estimate_at(t);
+        let (innovation, vrf) = match &prediction {
+            Some(p) => (
+                Some(y - p.derivatives[0]),
+                p.covariance.as_ref().map(|c| c[(0, 0)].max(0.0)),
+            ),
+            None => (None, None),
+        };
+        self.excess = match (sigma, vrf) {
+            (Some(s), Some(v)) => self.innovation_excess(s * s * (1.0 + v)),
+            _ => 0.0,
+        };
+        // The prediction's estimated bias: the honest innovation variance σ²(1 + v) + b₀².
+        let bias0 = match (&prediction, sigma) {
+            (Some(p), Some(s)) => self.bias_of(p, s).map_or(0.0, |b| b[0]),
+            _ => 0.0,
+        };
+        let bias0 = self.with_pending(bias0, innovation, sigma);
+        let innovation_sigma = match (sigma, vrf) {
+            (Some(s), Some(v)) => Some((s * s * (1.0 + v) + bias0 * bias0).sqrt()),
+            _ => None,
+        };
+        // The misfit test judges the model: the innovation against its noise-only variance.
+        let k2 = match (innovation, sigma, vrf) {
+            (Some(nu), Some(s), Some(v)) if s > 0.0 => Some(nu * nu / (s * s * (1.0 + v))),
+            _ => None,
+        };
+        let gate = self.gate(sigma, vrf, bias0, t);
+        let rejected = match (gate, innovation) {
+            (Some(g), Some(nu)) => nu.abs() > g,
+            _ => false,
+        };
+        Judged {
+            sigma,
+            innovation,
+            vrf,
+            innovation_sigma,
+            k2,
+            gate,
+            rejected,
+        }
     }
 
     /// Applies an accepted sample to every filter, the noise estimate and the misfit window;
@@ -933,6 +960,17 @@ impl AutomaticFilter {
         self.settle();
         Ok(chi_out)
     }
+}
+
+/// What [`AutomaticFilter::judge`] found for one sample.
+struct Judged {
+    sigma: Option<f64>,
+    innovation: Option<f64>,
+    vrf: Option<f64>,
+    innovation_sigma: Option<f64>,
+    k2: Option<f64>,
+    gate: Option<f64>,
+    rejected: bool,
 }
 
 /// The automatic filter through the common trait: the same estimates as its own methods

@@ -15,8 +15,11 @@
 //!    [`AutoOutput::outlier`]. A run of [`AutoConfig::max_consecutive_rejections`] rejections
 //!    (default 3), or of [`AutoConfig::same_side_rejections`] (default: off) all on the same side of
 //!    the prediction (Morrison §14.8: repeated crossings on one side mean bias), is
-//!    taken for a manoeuvre, not outliers: the run is applied after all (in order), and the
-//!    misfit flag goes up. The gate is active only at the final degree, once `σ` is known and the
+//!    taken for a manoeuvre, not outliers: the run is applied after all (in order), the
+//!    misfit flag goes up, and the output says how many earlier samples it reinstated
+//!    ([`AutoOutput::reinstated`]). A rejection is thus provisional until a later sample is
+//!    taken; [`final_outliers`] gives the final decisions of a series' outputs, and
+//!    `seqsmooth filter` writes them. The gate is active only at the final degree, once `σ` is known and the
 //!    prediction VRF `v ≤` [`AutoConfig::gate_max_vrf`] (default 1: the prediction is at least
 //!    as good as a sample; Reyneke's rule, which ignores `v`, needs this to keep its false-alarm
 //!    rate down, see [`REYNEKE_DEFAULT_K`]).
@@ -118,7 +121,7 @@
 //! |---|---|---|
 //! | settings and their checks: [`AutoConfig`], [`GATE_MAX_VRF`] | `config` | — |
 //! | prediction, innovation, acceptance: [`AutomaticFilter`] | `filter` | Morrison (14.8.1)-(14.8.4) |
-//! | what each sample did: [`AutoOutput`] | `output` | — |
+//! | what each sample did: [`AutoOutput`]; the final decisions, [`final_outliers`] | `output` | — |
 //! | outlier gate: [`OutlierRule`], [`MORRISON_K`], [`REYNEKE_DEFAULT_K`]; truncated variance | `outlier` | Morrison §14.8, (14.8.4); Reyneke §7.4 |
 //! | noise `σ`: [`NoiseSource`], [`MIN_NOISE_TERMS`] | `noise` | Reyneke §7.1; Morrison (6.10.24), (14.8.4); [`crate::stats::DifferenceNoise`] |
 //! | misfit and restart: [`MisfitResponse`], CUSUM onset | `misfit` | Morrison §14.8, (14.8.5); [`crate::stats::InnovationChiSquared`] |
@@ -167,5 +170,5 @@ pub use filter::AutomaticFilter;
 pub use misfit::MisfitResponse;
 pub use noise::{NoiseSource, MIN_NOISE_TERMS};
 pub use outlier::{OutlierRule, MORRISON_K, REYNEKE_DEFAULT_K};
-pub use output::AutoOutput;
+pub use output::{final_outliers, AutoOutput};
 pub use phase::Phase;

@@ -61,6 +61,11 @@ pub struct AutoOutput {
     pub misfit: bool,
     /// A run of consecutive rejections was taken for a manoeuvre and applied at this sample.
     pub manoeuvre: bool,
+    /// How many samples just before this one, rejected when they came, were applied with it
+    /// as a manoeuvre's onset ([`manoeuvre`](Self::manoeuvre)): the `outlier` flag of those
+    /// earlier outputs is revised to false. The decision on a rejected sample is final once a
+    /// later sample is accepted.
+    pub reinstated: usize,
     /// The final-degree memory was restarted at this sample ([`MisfitResponse::Restart`]).
     pub restart: bool,
     /// The chi-squared window after this sample (when the sample entered it).
@@ -90,4 +95,33 @@ impl AutoOutput {
     pub fn std_devs(&self) -> Option<Vec<f64>> {
         self.estimate.as_ref().and_then(|s| s.std_devs())
     }
+}
+
+/// The final outlier decision of each of a series' outputs, in order: a sample's `outlier`
+/// flag is revised to false when a later output reinstates it ([`AutoOutput::reinstated`]: the
+/// run of rejections just before that output was applied with it as a manoeuvre's onset).
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::{final_outliers, AutomaticFilter};
+/// let mut f = AutomaticFilter::new(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+/// let mut outs = Vec::new();
+/// for n in 0..20 { outs.push(f.update(n as f64, 0.0).unwrap()); }
+/// outs.push(f.update(20.0, 5.0).unwrap());                     // an outlier
+/// outs.push(f.update(21.0, 0.0).unwrap());
+/// for n in 22..25 { outs.push(f.update(n as f64, 9.0).unwrap()); } // a step: 3 rejections
+/// let flags = final_outliers(&outs);
+/// assert_eq!(outs[22..25].iter().map(|o| o.outlier).collect::<Vec<_>>(), [true, true, false]);
+/// assert_eq!(outs[24].reinstated, 2);
+/// assert_eq!(flags.iter().filter(|&&r| r).count(), 1);      // only the outlier stays rejected
+/// assert!(flags[20] && !flags[22] && !flags[23]);
+/// assert_eq!(f.rejected(), 1);
+/// ```
+pub fn final_outliers(outputs: &[AutoOutput]) -> Vec<bool> {
+    let mut flags: Vec<bool> = outputs.iter().map(|o| o.outlier).collect();
+    for (i, o) in outputs.iter().enumerate() {
+        for flag in flags[i.saturating_sub(o.reinstated)..i].iter_mut() {
+            *flag = false;
+        }
+    }
+    flags
 }
