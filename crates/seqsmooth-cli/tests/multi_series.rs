@@ -614,3 +614,42 @@ fn auto_outlier_column_is_the_final_decision() {
         assert_eq!(got, want_flags, "--chunk-rows {chunk}");
     }
 }
+
+/// An id that is not UTF-8 text is refused with its line and column (it would be written back
+/// in every row of its series); the rows before it are kept on standard output.
+#[test]
+fn id_that_is_not_utf8_is_refused() {
+    let path = common::tmp("not-utf8-id.csv");
+    let mut input = b"id,t,y\n".to_vec();
+    for n in 0..150 {
+        input.extend_from_slice(format!("a,{n},1\n").as_bytes());
+    }
+    input.extend_from_slice(b"\xff\xfe,150,2\n");
+    std::fs::write(&path, &input).unwrap();
+    let file = path.to_str().unwrap();
+    let o = run(
+        &[
+            "filter",
+            file,
+            "--kind",
+            "expanding",
+            "--degree",
+            "0",
+            "--id-col",
+            "id",
+        ],
+        "",
+    );
+    assert_eq!(o.code, 1, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("line 152, column 1: the id") && o.stderr.contains("not valid UTF-8"),
+        "{}",
+        o.stderr
+    );
+    assert_eq!(
+        o.stdout.lines().count(),
+        151,
+        "the header and the 150 rows before"
+    );
+    std::fs::remove_file(&path).unwrap();
+}

@@ -222,19 +222,27 @@ impl<R: Read> RowReader<R> {
         chunk.rows_read = self.rows_read;
     }
 
-    /// The series of the current record: its index, a new one for a new id.
-    fn series(&mut self, chunk: &mut Chunk) -> usize {
-        let Some(i) = self.id_idx else { return 0 };
+    /// The series of the current record: its index, a new one for a new id. An id that is not
+    /// UTF-8 text is refused (it is written back in every row).
+    fn series(&mut self, chunk: &mut Chunk, line: u64) -> Result<usize, CliError> {
+        let Some(i) = self.id_idx else { return Ok(0) };
         let id = self.csv.field(i);
         if let Some(&s) = self.index.get(id) {
-            return s;
+            return Ok(s);
+        }
+        if std::str::from_utf8(id).is_err() {
+            return Err(CliError::Data(format!(
+                "line {line}, column {}: the id {} is not valid UTF-8 text",
+                i + 1,
+                shown(id)
+            )));
         }
         let s = self.ids.len();
         self.index.insert(id.to_vec(), s);
         self.ids.push(String::from_utf8_lossy(id).into_owned());
         self.newest.push(None);
         chunk.new_ids.push(csv_field(id));
-        s
+        Ok(s)
     }
 
     /// Reads one row into `chunk`; `false` at the end of the input.
@@ -249,7 +257,7 @@ impl<R: Read> RowReader<R> {
         );
         let t = parse_cell(t_cell, line, &self.time_col, "time")?;
         let y = parse_cell(y_cell, line, &self.value_col, "value")?;
-        let series = self.series(chunk);
+        let series = self.series(chunk, line)?;
         let (t_cell, y_cell) = (
             self.csv.field(self.time_idx),
             self.csv.field(self.value_idx),
