@@ -211,8 +211,10 @@ fn switch_rule(input: &mut Input) -> SwitchRule {
     }
 }
 
-/// Feeds the samples one by one, checking each step.
+/// Feeds the samples one by one, checking each step; the automatic filter decides every
+/// sample once, in order (its outputs' decisions and `finish`'s).
 fn one_by_one(f: &mut AnyFilter, times: &[f64], values: &[f64], lead: f64) {
+    let mut decided = 0u64;
     for (&t, &y) in times.iter().zip(values) {
         let valid = check_sample(t, y, f.last_time()).is_ok();
         let before = f.taken();
@@ -224,6 +226,10 @@ fn one_by_one(f: &mut AnyFilter, times: &[f64], values: &[f64], lead: f64) {
                     f.last_time()
                 );
                 assert_eq!(f.taken(), before + 1);
+                if let AnyFilter::Auto(a) = f {
+                    decided += a.last_output().expect("an update").decided.len() as u64;
+                    assert!(decided <= f.taken(), "more decisions than samples");
+                }
             }
             Err(e) => {
                 check::error_message(&e);
@@ -236,6 +242,25 @@ fn one_by_one(f: &mut AnyFilter, times: &[f64], values: &[f64], lead: f64) {
         let at = t + lead;
         if at.is_finite() {
             estimate_or_reason(f, at, determined, "estimate at t + lead");
+        }
+    }
+    if let AnyFilter::Auto(a) = f {
+        let taken = a.samples() + a.rejected();
+        let tail = a.finish();
+        decided += tail.len() as u64;
+        assert_eq!(decided, taken, "every sample decided once");
+        let rejected = tail.iter().filter(|&&r| r).count() as u64;
+        assert!(
+            a.rejected() >= rejected,
+            "finish rejected more than the filter counts"
+        );
+        assert_eq!(
+            a.samples() + a.rejected(),
+            taken,
+            "finish changed the count of samples"
+        );
+        if let Some(t) = a.last_time() {
+            estimate_or_reason(f, t, false, "estimate after finish");
         }
     }
 }

@@ -130,9 +130,14 @@ then fading memory with the discount T per TAU; it starts at degree 0 and steps 
 data determine each degree (the d and s cells above the degree reached so far are empty). noise \
 is the noise sigma in use: S given with --sigma, otherwise the running estimate from the \
 (M+1)-th differences of the accepted samples (empty until it has 5 terms); s0..sM come from it \
-(empty while there is none). outlier is 1 when the row's sample was rejected by the 3-sigma \
-innovation gate (it did not update the filter; the row's estimate is the prediction across it), \
-else 0. misfit is 1 while the chi-squared test of the last 10 innovations (false-alarm rate 1%) \
+(empty while there is none). outlier is 1 when the row's sample is rejected, else 0: the final \
+decision, made once N more accepted samples of the series are in (--review-window N, default \
+M+4; the end of the input decides the last rows), by the smaller-variance judge of two: the \
+3-sigma gate on the 1-step prediction, or the sample's residual against a degree M+1 \
+least-squares fit through the N accepted samples on each side of it (Morrison 7, 14.8). A \
+rejected sample does not update the filter (the row's estimate was made before its decision: \
+across a sample the gate rejected it is the prediction). Rows are written once decided, so \
+output lags input by about N rows of each series. misfit is 1 while the chi-squared test of the last 10 innovations (false-alarm rate 1%) \
 says the model no longer fits, else 0; a strong misfit restarts the memory. s0..sM are root \
 mean squared errors: the noise's part plus the estimated bias of a start-up, a degree still \
 settling or a manoeuvre (from the next degree's fit and the innovations' excess, Morrison 7.13, \
@@ -223,6 +228,11 @@ pub struct FilterArgs {
     /// s0..sM) the noise is taken to be S instead of estimated
     #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
     pub sigma: Option<f64>,
+    /// The automatic filter's final outlier decision on each sample waits for N accepted
+    /// samples after it (0 to 31; 0: the gate's decision at the time, final once a later sample
+    /// is taken) [default: degree + 4]
+    #[arg(long, value_name = "N")]
+    pub review_window: Option<usize>,
     /// Output file [default: standard output]
     #[arg(short = 'o', long, value_name = "OUTPUT")]
     pub output: Option<PathBuf>,

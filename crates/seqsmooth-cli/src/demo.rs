@@ -226,7 +226,7 @@ pub fn plot_paths(prefix: &Path) -> [PathBuf; 2] {
 }
 
 /// The automatic filter's run as a plot track.
-fn track(data: &[Point], outs: &[AutoOutput]) -> Track {
+fn track(data: &[Point], outs: &[AutoOutput], rejected: Vec<bool>) -> Track {
     // Row by row, `f` of the estimate where there is one.
     let rows = |f: &dyn Fn(&PolynomialState) -> Option<f64>| -> Vec<Option<f64>> {
         outs.iter()
@@ -249,7 +249,7 @@ fn track(data: &[Point], outs: &[AutoOutput]) -> Track {
             data.iter().map(|p| p.v).collect(),
         ],
         noise: outs.iter().map(|o| o.noise_sigma).collect(),
-        rejected: final_outliers(outs),
+        rejected,
         misfit: outs.iter().map(|o| o.misfit).collect(),
         switches: switches.map(|i| outs[i].time).collect(),
         restarts: outs.iter().filter(|o| o.restart).map(|o| o.time).collect(),
@@ -327,14 +327,16 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
     }
 
     let outliers = data.iter().filter(|p| p.outlier).count();
-    let flags = final_outliers(&outs);
+    // The decisions still waiting at the end of the track, with the samples there are.
+    let tail = auto.finish();
+    let flags = final_outliers(&outs, &tail);
     let rejected = flags.iter().filter(|&&r| r).count();
     let caught = flags
         .iter()
         .zip(&data)
         .filter(|(&r, p)| r && p.outlier)
         .count();
-    let plot_track = track(&data, &outs);
+    let plot_track = track(&data, &outs, flags.clone());
     let (switches, restarts) = (&plot_track.switches, &plot_track.restarts);
     let span = data[SAMPLES - 1].t - data[0].t;
 

@@ -652,7 +652,8 @@ fn filter_auto_given_sigma_and_misfit() {
         .collect();
     // The outlier column is the final decision: the manoeuvre's first rejections are applied
     // after all.
-    let flags = final_outliers(&outs);
+    let tail = f.finish();
+    let flags = final_outliers(&outs, &tail);
     assert!(outs.iter().zip(&flags).any(|(o, &r)| o.outlier && !r));
     for ((row, o), rejected) in rows.iter().zip(&outs).zip(flags) {
         assert_eq!(row[7], if rejected { "1" } else { "0" }, "{row:?}");

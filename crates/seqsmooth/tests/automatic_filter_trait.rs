@@ -209,6 +209,8 @@ fn fully_built() -> AutomaticFilter {
         .unwrap()
         .with_same_side_rejections(2)
         .unwrap()
+        .with_review_window(4)
+        .unwrap()
 }
 
 /// The record [`fully_built`] must hold, field by field.
@@ -227,6 +229,7 @@ fn fully_built_record() -> AutoConfig {
         gate_max_vrf: 0.5,
         max_consecutive_rejections: 4,
         same_side_rejections: 2,
+        review_window: 4,
         misfit_window: 12,
         misfit_alpha: 0.02,
         misfit_response: MisfitResponse::Restart { alpha: 1e-3 },
@@ -286,4 +289,6 @@ fn builders_reject_what_the_configuration_rejects() {
     assert!(f().with_start_degree(3).is_err());
     assert!(f().with_settling(f64::INFINITY, 3).is_err());
     assert!(f().with_switch_rule(SwitchRule::Derivative(3)).is_err());
+    assert!(f().with_review_window(2).is_err());
+    assert!(f().with_review_window(32).is_err());
 }

@@ -23,7 +23,13 @@ fn switch_happens_at_the_rule_index() {
     ] {
         for seed in 0..5 {
             let data = track(seed, GENTLE);
-            let mut f = main_filter().with_switch_rule(rule).unwrap();
+            // The gate's decisions (no review, which may revise them later): the accepted
+            // samples counted here are those the filter took.
+            let mut f = main_filter()
+                .with_switch_rule(rule)
+                .unwrap()
+                .with_review_window(0)
+                .unwrap();
             let c = f.config().clone();
             let (mut n, mut t0, mut expected, mut seen) = (0u64, None, None, None);
             for s in &data {

@@ -1,11 +1,12 @@
 //! The automatic filter's rows, held back until their `outlier` flag is final.
 //!
-//! A rejected sample is provisional: when the next samples of its series show a manoeuvre's
-//! onset, not outliers, the filter applies the run after all
-//! ([`seqsmooth::polynomial::automatic::AutoOutput::reinstated`]) and the rows of the run are
-//! written with `outlier` 0. A rejection is final once a later sample of its series is taken,
-//! or the input ends. Rows are written in input order, so every row from the first
-//! provisional one on waits, across chunks if need be.
+//! The filter decides each sample finally once enough samples after it are in (its review,
+//! [`seqsmooth::polynomial::automatic::AutoOutput::decided`]: by interpolation between the
+//! samples before and after, which may reject a sample the gate passed or take one it rejected),
+//! and at the end of the input from the samples there are
+//! ([`seqsmooth::polynomial::AutomaticFilter::finish`]). Decisions come in each series' sample
+//! order. A row is written with its `outlier` cell set to the decision, in input order, so every
+//! row from the first undecided one on waits, across chunks if need be.
 
 use crate::error::CliError;
 use crate::io::Output;
@@ -14,62 +15,60 @@ use std::collections::VecDeque;
 /// One formatted row and where its `outlier` cell is.
 struct Row {
     bytes: Vec<u8>,
-    /// Byte offset of the `outlier` cell's `1` while the rejection is provisional.
+    /// Byte offset of the `outlier` cell while its decision is to come.
     open: Option<usize>,
+    /// Waiting for the decision.
+    waiting: bool,
 }
 
-/// Formatted rows not written yet, and per series the provisional rejections among them.
+/// Formatted rows not written yet, and per series those among them still undecided.
 #[derive(Default)]
 pub struct Held {
     rows: VecDeque<Row>,
     /// Index of `rows[0]` among all rows pushed.
     first: usize,
-    /// Per series, the indices (among all rows pushed) of its provisional rejections, oldest
-    /// first.
-    open: Vec<Vec<usize>>,
+    /// Per series, the indices (among all rows pushed) of its undecided rows, oldest first.
+    open: Vec<VecDeque<usize>>,
 }
 
 impl Held {
-    /// Takes the formatted `row` of `series`: its `outlier` cell, `trailing` cells before the
-    /// row's end, says `1` when `outlier`; `reinstated` of the series' provisional rejections
-    /// (the newest ones) were applied with this row after all.
-    pub fn push(
-        &mut self,
-        series: usize,
-        bytes: Vec<u8>,
-        trailing: usize,
-        outlier: bool,
-        reinstated: usize,
-    ) {
+    /// Takes the formatted `row` of `series`, undecided (its `outlier` cell `trailing` cells
+    /// before the row's end), then the `decided` verdicts its update made on the series'
+    /// oldest undecided rows (this one included).
+    pub fn push(&mut self, series: usize, bytes: Vec<u8>, trailing: usize, decided: &[bool]) {
         if self.open.len() <= series {
-            self.open.resize_with(series + 1, Vec::new);
+            self.open.resize_with(series + 1, VecDeque::new);
         }
-        let open = &mut self.open[series];
-        // A rejected sample leaves the run open; a taken one closes it.
-        let taken = !outlier || reinstated > 0;
-        let from = open.len() - reinstated.min(open.len());
-        let closed = if taken { open.len() } else { 0 };
-        for (k, index) in open.drain(..closed).enumerate() {
-            let row = &mut self.rows[index - self.first];
-            if let (true, Some(at)) = (k >= from, row.open) {
-                row.bytes[at] = b'0';
-            }
-            // Reinstated or not, a rejection before a taken sample is final.
-            row.open = None;
-        }
-        let open_at = outlier.then(|| outlier_offset(&bytes, trailing)).flatten();
-        if open_at.is_some() {
-            open.push(self.first + self.rows.len());
-        }
+        let open = outlier_offset(&bytes, trailing);
+        self.open[series].push_back(self.first + self.rows.len());
         self.rows.push_back(Row {
             bytes,
-            open: open_at,
+            open,
+            waiting: true,
         });
+        self.decide(series, decided);
     }
 
-    /// Writes the rows up to the first provisional rejection.
+    /// The verdicts (`true`: rejected) on the oldest undecided rows of `series`, in order.
+    pub fn decide(&mut self, series: usize, verdicts: &[bool]) {
+        let Some(open) = self.open.get_mut(series) else {
+            return;
+        };
+        for &rejected in verdicts {
+            let Some(index) = open.pop_front() else {
+                return;
+            };
+            let row = &mut self.rows[index - self.first];
+            if let Some(at) = row.open.take() {
+                row.bytes[at] = if rejected { b'1' } else { b'0' };
+            }
+            row.waiting = false;
+        }
+    }
+
+    /// Writes the rows up to the first undecided one.
     pub fn flush_final(&mut self, sink: &mut Output) -> Result<(), CliError> {
-        while self.rows.front().is_some_and(|r| r.open.is_none()) {
+        while self.rows.front().is_some_and(|r| !r.waiting) {
             let row = self.rows.pop_front().expect("front checked");
             self.first += 1;
             sink.write(&row.bytes)?;
@@ -77,7 +76,7 @@ impl Held {
         Ok(())
     }
 
-    /// Writes every row: the input ended (or stopped), so no rejection can be revised.
+    /// Writes every row, an undecided one with the gate's verdict (the run stopped early).
     pub fn flush_all(&mut self, sink: &mut Output) -> Result<(), CliError> {
         for row in self.rows.drain(..) {
             sink.write(&row.bytes)?;
@@ -89,8 +88,8 @@ impl Held {
 }
 
 /// The byte offset of the cell `trailing` cells before the end of the formatted row `bytes`
-/// (`…,cell,c1,…,c_trailing\n`), when that cell is `1`. The cells after it are numbers or
-/// empty, so the commas are theirs.
+/// (`…,cell,c1,…,c_trailing\n`), when that cell is `0` or `1`. The cells after it are numbers
+/// or empty, so the commas are theirs.
 fn outlier_offset(bytes: &[u8], trailing: usize) -> Option<usize> {
     let commas: Vec<usize> = bytes
         .iter()
@@ -101,7 +100,8 @@ fn outlier_offset(bytes: &[u8], trailing: usize) -> Option<usize> {
         .take(trailing + 1)
         .collect();
     let at = commas.get(trailing)? + 1;
-    (bytes.get(at) == Some(&b'1') && bytes.get(at + 1) == Some(&b',')).then_some(at)
+    let flag = matches!(bytes.get(at), Some(b'0' | b'1'));
+    (flag && bytes.get(at + 1) == Some(&b',')).then_some(at)
 }
 
 #[cfg(test)]
@@ -112,7 +112,8 @@ mod tests {
     fn finds_the_cell_counting_from_the_end() {
         let row = b"\"a,b\",1,2,3,0.5,1,0,\n";
         assert_eq!(outlier_offset(row, 2), Some(16));
-        assert_eq!(outlier_offset(b"1,2,0.5,0,0,\n", 2), None);
+        assert_eq!(outlier_offset(b"1,2,0.5,0,0,\n", 2), Some(8));
+        assert_eq!(outlier_offset(b"1,2,0.5,,0,\n", 2), None);
         assert_eq!(outlier_offset(b"1\n", 2), None);
     }
 }

@@ -8,8 +8,8 @@
 //! and written in input order. Memory is a few chunks plus one filter per series, whatever the
 //! length of the input. The first [`LOOKAHEAD`] data rows (the first `W` for a fixed-memory
 //! window longer than that) decide the default `τ` (median time step) and the too-few-samples
-//! check before any output is written. The automatic filter's rows from a provisional
-//! rejection on wait until it is final (`held`).
+//! check before any output is written. The automatic filter's rows wait until their outlier
+//! decision is final, a few samples of their series later (`held`).
 
 mod held;
 pub mod rows;
@@ -57,6 +57,9 @@ fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
     };
     if matches!(kind, Kind::Expanding | Kind::Fixed) && a.tau.is_some() {
         return Err(only("--tau", "fading and auto"));
+    }
+    if kind != Kind::Auto && a.review_window.is_some() {
+        return Err(only("--review-window", "auto"));
     }
     match (kind, a.window) {
         (Kind::Fixed, w) => _ = check_window(w, a.degree)?,
@@ -178,15 +181,19 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     };
     let engine = a.engine.unwrap_or(EngineArg::Exact);
     let prototype = Runner::build(a.kind, a.degree, theta, tau, a.window, engine, a.sigma)
+        .and_then(|r| match (r, a.review_window) {
+            (Runner::Auto(f), Some(n)) => Ok(Runner::Auto(Box::new(f.with_review_window(n)?))),
+            (r, _) => Ok(r),
+        })
         .map_err(|e| CliError::Usage(e.to_string()))?;
     // The automatic filter always writes s0..sM (from the given or the estimated noise).
     let sigma = a.sigma.is_some() || a.kind == Kind::Auto;
     let extra = prototype.extra_columns();
-    // The automatic filter's rows carry one cell more, not written: how many of its series'
-    // rejections just before were applied after all (see `held`).
+    // The automatic filter's rows carry cells more, not written: the final outlier decisions
+    // each row's update made (see `held`).
     let auto = a.kind == Kind::Auto;
     let shown = ((a.degree + 1) << usize::from(sigma)) + extra.len();
-    let stride = shown + usize::from(auto);
+    let stride = shown + if auto { runner::DECISION_CELLS } else { 0 };
     let mut held = held::Held::default();
     let mut bank = StreamBank::growing(prototype).map_err(|e| CliError::Usage(e.to_string()))?;
     let (mut ids, mut values, mut out) = (Vec::new(), Vec::new(), None);
@@ -266,15 +273,16 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
                 let row = &values[i * stride..(i + 1) * stride];
                 let mut buf = Vec::with_capacity(stride * 20);
                 chunk.row_with(&mut buf, i, id(i), &row[..shown], lead_cells);
-                let outlier = row[shown - 3] == 1.0;
-                let reinstated = row[shown] as usize;
-                held.push(
-                    chunk.series[i],
-                    buf,
-                    2 + lead_cells.len(),
-                    outlier,
-                    reinstated,
-                );
+                let decided = runner::decisions(&row[shown..]);
+                held.push(chunk.series[i], buf, 2 + lead_cells.len(), &decided);
+            }
+            if failed.is_none() && chunk.error.is_none() && chunk.done {
+                // The input is complete: every series decides its samples still waiting.
+                for series in 0..bank.channels() {
+                    if let Some(Runner::Auto(f)) = bank.channel_mut(series) {
+                        held.decide(series, &f.finish());
+                    }
+                }
             }
             held.flush_final(sink)?;
         } else {
@@ -294,7 +302,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             }
         }
         if failed.is_some() || chunk.error.is_some() || chunk.done {
-            // No later sample can revise a rejection now.
+            // Stopped early: the rows still undecided keep the gate's verdict.
             held.flush_all(sink)?;
             return match (failed, chunk.error.take()) {
                 // Dropped unfinished: standard output keeps the rows before the error, a

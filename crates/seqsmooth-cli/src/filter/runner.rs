@@ -5,8 +5,9 @@
 //! filter) their 1σ `s0..sM` from the covariance, then the kind's trailing cells (fixed memory:
 //! the rows in the window; automatic: the noise σ in use, the outlier and misfit flags as
 //! 0/1, and the estimated position bias that `s0` includes, empty when `s0..sM` cover the noise
-//! only; then one cell not written, the count of rejections just before that the filter applied
-//! with this row after all). NaN marks an empty cell: a derivative or 1σ not determined yet.
+//! only; then [`DECISION_CELLS`] cells not written: the final outlier decisions this row's
+//! update made on the series' oldest undecided rows, see [`decisions`]). NaN marks an empty
+//! cell: a derivative or 1σ not determined yet.
 
 use crate::args::{name, EngineArg, Kind};
 use seqsmooth::polynomial::automatic::AutomaticFilter;
@@ -22,6 +23,28 @@ pub enum Runner {
     Fixed(Box<FixedMemory>, usize),
     /// The automatic filter (its last update's flags in [`AutomaticFilter::last_output`]).
     Auto(Box<AutomaticFilter>),
+}
+
+/// The automatic filter's cells after the written ones: how many final outlier decisions the
+/// row's update made (on the series' oldest rows still undecided, in order), and their verdicts
+/// as bits (`1`: rejected), 32 to a cell, oldest in the lowest bit.
+pub const DECISION_CELLS: usize = 3;
+
+/// The decisions `verdicts` (at most 64) in the [`DECISION_CELLS`] cells.
+fn store_decisions(verdicts: &[bool], cells: &mut [f64]) {
+    let bits = verdicts
+        .iter()
+        .enumerate()
+        .fold(0u64, |b, (i, &r)| b | (u64::from(r) << i));
+    cells[0] = verdicts.len() as f64;
+    cells[1] = (bits & 0xffff_ffff) as f64;
+    cells[2] = (bits >> 32) as f64;
+}
+
+/// The decisions stored in `cells` by [`store_decisions`].
+pub fn decisions(cells: &[f64]) -> Vec<bool> {
+    let bits = cells[1] as u64 | ((cells[2] as u64) << 32);
+    (0..cells[0] as usize).map(|i| bits >> i & 1 == 1).collect()
 }
 
 /// A missing parameter of a filter kind.
@@ -145,9 +168,9 @@ impl Runner {
                         f64::from(u8::from(o.misfit)),
                         o.bias.as_ref().map_or(f64::NAN, |b| b[0]),
                     ]);
-                    // The cell after the written ones: rejections just before, applied now.
-                    if let Some(cell) = extra.get_mut(4) {
-                        *cell = o.reinstated as f64;
+                    // The cells after the written ones: the final decisions made now.
+                    if let Some(cells) = extra.get_mut(4..4 + DECISION_CELLS) {
+                        store_decisions(&o.decided, cells);
                     }
                     // The output's estimate is at t: the update's own, or across a rejected
                     // sample the prediction; with a lead the active filter's, the same way.

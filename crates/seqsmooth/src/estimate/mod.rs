@@ -158,6 +158,26 @@ impl PolynomialFit {
         (self.jacobian(t) * &self.coeffs).iter().copied().collect()
     }
 
+    /// `p(t)` and its variance for unit noise, `x(t)ᵀ(AᵀWA)⁻¹x(t)` (the `(0, 0)` entry of
+    /// [`Self::covariance_at`]), from the Legendre values at `t` alone: `O(m²)`, for the many
+    /// points of a window (leverages, deleted residuals).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::PolynomialFit;
+    /// let fit = PolynomialFit::new(&[0.0, 1.0, 3.0, 4.0], &[1.0, 3.1, 6.9, 9.0], None, 1).unwrap();
+    /// let (p, v) = fit.value_and_vrf_at(2.0);
+    /// assert!((p - fit.derivatives_at(2.0)[0]).abs() < 1e-12);
+    /// assert!((v - fit.covariance_at(2.0)[(0, 0)]).abs() < 1e-15);
+    /// assert!((v - 0.25).abs() < 1e-15); // at the centre of a line's symmetric samples: 1/n
+    /// ```
+    pub fn value_and_vrf_at(&self, t: f64) -> (f64, f64) {
+        let mut x =
+            crate::basis::legendre::values(self.degree, (t - self.centre) / self.half_width);
+        let p = x.iter().zip(self.coeffs.iter()).map(|(a, c)| a * c).sum();
+        crate::linalg::solve_upper_transpose_in_place(&self.r, &mut x);
+        (p, x.iter().map(|v| v * v).sum())
+    }
+
     /// Covariance of [`Self::derivatives_at`] when the weights are inverse variances (or
     /// `σ² ×` it for unit weights and noise variance `σ²`).
     ///

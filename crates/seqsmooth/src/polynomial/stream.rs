@@ -283,6 +283,21 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
         self.filters.get(c)
     }
 
+    /// Channel `c`'s filter, to act on between updates (e.g. an automatic filter's
+    /// [`finish`](crate::polynomial::AutomaticFilter::finish) at the end of its stream).
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::stream::StreamBank;
+    /// use seqsmooth::polynomial::AutomaticFilter;
+    /// let mut bank = StreamBank::new(AutomaticFilter::new(1, 0.9, 1.0).unwrap(), 2).unwrap();
+    /// bank.update_channel(1, &[0.0, 1.0, 2.0], &[1.0, 2.0, 3.0]).unwrap();
+    /// let tail = bank.channel_mut(1).unwrap().finish();
+    /// assert!(tail.len() <= 3 && bank.channel_mut(2).is_none());
+    /// ```
+    pub fn channel_mut(&mut self, c: usize) -> Option<&mut F> {
+        self.filters.get_mut(c)
+    }
+
     /// A batch for channel `c` alone.
     pub fn update_channel(&mut self, c: usize, times: &[f64], values: &[f64]) -> Result<(), Error> {
         let n = self.filters.len();

@@ -6,6 +6,7 @@
 use super::misfit::MisfitResponse;
 use super::noise::NoiseSource;
 use super::outlier::OutlierRule;
+use super::review::MAX_REVIEW_WINDOW;
 use crate::error::Error;
 use crate::polynomial::fading::switch::SwitchRule;
 use crate::polynomial::options::{check_engine_degree, check_tau, check_theta};
@@ -89,6 +90,9 @@ pub struct AutoConfig {
     /// the outliers would be taken); default 0: off (0 or 1: only `max_consecutive_rejections`
     /// counts); off too when that is 0.
     pub same_side_rejections: usize,
+    /// The accepted samples `L` on each side of a sample by which its final outlier decision is
+    /// made, by interpolation ([review](crate::polynomial::automatic), step 6); default `m + 4`; 0: the gate's decision.
+    pub review_window: usize,
     /// Innovation chi-squared window `K ≥ 1` (default 10).
     pub misfit_window: usize,
     /// Per-sample false-alarm rate `α ∈ (0,1)` of the misfit test (default 0.01).
@@ -125,6 +129,7 @@ impl AutoConfig {
             gate_max_vrf: GATE_MAX_VRF,
             max_consecutive_rejections: 3,
             same_side_rejections: 0,
+            review_window: (degree + 4).min(MAX_REVIEW_WINDOW),
             misfit_window: 10,
             misfit_alpha: 0.01,
             misfit_response: MisfitResponse::default(),
@@ -172,6 +177,20 @@ impl AutoConfig {
                 name: "gate VRF limit",
                 value: self.gate_max_vrf.to_string(),
                 reason: "must be positive (infinity: always gate)".into(),
+            });
+        }
+        let l = self.review_window;
+        if l > MAX_REVIEW_WINDOW || (l > 0 && 2 * l < self.degree + 4) {
+            return Err(Error::InvalidParameter {
+                name: "review window",
+                value: l.to_string(),
+                reason: format!(
+                    "must be 0 (no review) or from {} to {MAX_REVIEW_WINDOW} at degree {}: the \
+                     degree {} fit through 2L samples needs two to spare",
+                    (self.degree + 5) / 2,
+                    self.degree,
+                    self.degree + 1
+                ),
             });
         }
         self.misfit_response.validate()?;

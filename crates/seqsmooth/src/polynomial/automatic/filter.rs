@@ -10,6 +10,7 @@ use super::noise::{NoiseSource, NoiseState};
 use super::outlier::OutlierRule;
 use super::output::AutoOutput;
 use super::phase::Phase;
+use super::review::Review;
 use crate::error::Error;
 use crate::model::PolynomialState;
 use crate::polynomial::expanding::ExpandingMemory;
@@ -91,10 +92,12 @@ pub struct AutomaticFilter {
     pub(super) stable_runs: usize,
     pub(super) prev_top: Option<f64>,
     /// The output of the newest update.
-    last_output: Option<AutoOutput>,
+    pub(super) last_output: Option<AutoOutput>,
     /// The innovations' mean square excess over their noise-only variance in the misfit
     /// window, `max(0, mean(k²) − 1)·σ²(1 + v)` (value units²), at the newest sample.
     pub(super) excess: f64,
+    /// The samples waiting for their final outlier decision ([`super::review`]).
+    pub(super) review: Review,
 }
 
 /// An expanding-memory filter of degree `m` tracking its covariance for unit noise (its VRF).
@@ -229,6 +232,7 @@ impl AutomaticFilter {
             prev_top: None,
             last_output: None,
             excess: 0.0,
+            review: Review::default(),
         })
     }
 
@@ -421,6 +425,21 @@ impl AutomaticFilter {
         /// assert_eq!(ok, [false, true, false]);
         /// ```
         with_misfit_alpha(alpha: f64) => misfit_alpha = alpha;
+
+        /// The accepted samples on each side of a sample by which its final outlier decision is
+        /// made ([review](crate::polynomial::automatic), step 6; default `m + 4`; 0: the gate's decision at the time, final
+        /// once a later sample is accepted). At most [`MAX_REVIEW_WINDOW`](super::MAX_REVIEW_WINDOW), and 0 or at least
+        /// `(m + 4)/2`.
+        ///
+        /// ```
+        /// use seqsmooth::polynomial::automatic::AutomaticFilter;
+        /// let f = AutomaticFilter::new(2, 0.9, 1.0).unwrap();
+        /// assert_eq!(f.config().review_window, 6);
+        /// assert!(f.clone().with_review_window(0).is_ok());
+        /// assert!(f.clone().with_review_window(2).is_err()); // 4 samples: a cubic has no check
+        /// assert!(f.with_review_window(3).is_ok());
+        /// ```
+        with_review_window(window: usize) => review_window = window;
 
         /// What the filter does when the model no longer fits (default
         /// [`MisfitResponse::Restart`] at `α = 10⁻⁴`).
@@ -713,6 +732,31 @@ impl AutomaticFilter {
         self.honest(s).0.checked()
     }
 
+    /// Decides every sample still waiting for its final outlier decision (the end of a series;
+    /// see [`AutoOutput::decided`]), with the samples there are: the review's window takes more
+    /// samples before. Returns the decisions, oldest first; they follow the ones reported so
+    /// far, in sample order. A decision that differs from the gate's takes the samples since
+    /// again, so the estimate may change. Later samples may still follow.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::{final_outliers, AutomaticFilter};
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+    /// let mut outs = Vec::new();
+    /// for n in 0..40 {
+    ///     let y = 0.5 * n as f64 + if n == 38 { 3.0 } else { 0.0 };
+    ///     outs.push(f.update(n as f64, y).unwrap());
+    /// }
+    /// let reported: usize = outs.iter().map(|o| o.decided.len()).sum();
+    /// let tail = f.finish();
+    /// assert_eq!(reported + tail.len(), 40);         // one decision per sample
+    /// let flags = final_outliers(&outs, &tail);
+    /// assert_eq!(flags.iter().filter(|&&r| r).count(), 1);
+    /// assert!(flags[38]);
+    /// ```
+    pub fn finish(&mut self) -> Vec<bool> {
+        self.decide_all()
+    }
+
     /// Processes the sample `y` at time `t` (finite, strictly after the previous sample's time,
     /// rejected or not) and returns (and keeps, see [`last_output`](Self::last_output)) what it
     /// did. On error nothing changes.
@@ -729,21 +773,30 @@ impl AutomaticFilter {
     pub fn update(&mut self, t: f64, y: f64) -> Result<AutoOutput, Error> {
         crate::error::check_sample(t, y, self.last_time)?;
         // With the input checked, the steps below cannot fail on the data; should an internal
-        // step still fail, restore the state so that an error never leaves a half update.
-        let backup = self.clone();
-        match self.step(t, y) {
+        // step still fail, restore the state so that an error never leaves a half update. The
+        // state before the sample is also what its review may go back to.
+        let before = self.snapshot();
+        match self.step(t, y, None) {
             Ok(out) => {
+                let out = self.review(t, y, out, before);
                 self.last_output = Some(out.clone());
                 Ok(out)
             }
             Err(e) => {
-                *self = backup;
+                self.restore(*before);
                 Err(e)
             }
         }
     }
 
-    fn step(&mut self, t: f64, y: f64) -> Result<AutoOutput, Error> {
+    /// One sample through the gate and the filters; `force` overrides the gate's verdict (a
+    /// review's decision, taken again: a forced rejection is final, not part of a run).
+    pub(super) fn step(
+        &mut self,
+        t: f64,
+        y: f64,
+        force: Option<bool>,
+    ) -> Result<AutoOutput, Error> {
         self.last_time = Some(t);
         let m = self.cfg.degree;
         if self.switch_due(t)? {
@@ -761,11 +814,15 @@ impl AutomaticFilter {
             gate,
             rejected,
         } = self.judge(t, y);
+        let rejected = force.unwrap_or(rejected);
         let mut manoeuvre = false;
         let mut restart = false;
         let mut chi_out = None;
         let mut reinstated = 0;
-        if rejected {
+        if rejected && force.is_some() {
+            self.pending.clear();
+            self.rejected += 1;
+        } else if rejected {
             self.pending.push(Kept { t, y, k2 });
             let limit = self.cfg.max_consecutive_rejections;
             if limit > 0 && (self.pending.len() >= limit || self.same_side_run()) {
@@ -844,6 +901,7 @@ impl AutomaticFilter {
             reinstated,
             restart,
             chi_squared: chi_out,
+            decided: Vec::new(),
         })
     }
 

@@ -17,9 +17,8 @@
 //!    the prediction (Morrison §14.8: repeated crossings on one side mean bias), is
 //!    taken for a manoeuvre, not outliers: the run is applied after all (in order), the
 //!    misfit flag goes up, and the output says how many earlier samples it reinstated
-//!    ([`AutoOutput::reinstated`]). A rejection is thus provisional until a later sample is
-//!    taken; [`final_outliers`] gives the final decisions of a series' outputs, and
-//!    `seqsmooth filter` writes them. The gate is active only at the final degree, once `σ` is known and the
+//!    ([`AutoOutput::reinstated`]). The gate's verdict is provisional: the final decision is
+//!    the review's (step 6), and `seqsmooth filter` writes it. The gate is active only at the final degree, once `σ` is known and the
 //!    prediction VRF `v ≤` [`AutoConfig::gate_max_vrf`] (default 1: the prediction is at least
 //!    as good as a sample; Reyneke's rule, which ignores `v`, needs this to keep its false-alarm
 //!    rate down, see [`REYNEKE_DEFAULT_K`]).
@@ -82,6 +81,21 @@
 //!    variance `e°/(N−m−1)` (Morrison (6.10.24)) exactly, but every unmodelled manoeuvre inflates
 //!    it (by the squared bias of the predictions).
 //!
+//! 6. **Review** (the final outlier decision; [`AutoConfig::review_window`] `L`, default
+//!    `m + 4`): once `L` accepted samples after a sample are in, it is judged again, against a
+//!    least-squares polynomial of degree `m + 1` through the `L` nearest accepted samples on
+//!    each side (its deleted residual: Morrison ch. 7, a fit evaluated inside its window, where
+//!    its VRF is least), with up to two of those neighbours dropped when their studentised
+//!    residual exceeds `k`, the fit's own bias estimated one degree up, and the variance scaled
+//!    by the windows' residual mean square where the residuals are not white (Morrison §14.8).
+//!    The judge of the smaller mean square decides: the gate where its `σ_ε` is the smaller (a
+//!    long memory that fits), the interpolation otherwise (a short memory, where the gate is
+//!    off or wide). Where the verdict differs from the gate's, the filter goes back to its
+//!    state before the sample and takes the samples since again. Each decision is reported
+//!    once, in sample order ([`AutoOutput::decided`]); [`AutomaticFilter::finish`] decides the
+//!    rest at the end of a series; [`final_outliers`] collects them. `L = 0`: the gate's
+//!    decisions, final once a later sample is accepted.
+//!
 //! Every filter inside tracks its covariance for unit noise (the VRF).
 //!
 //! ## Honest covariance
@@ -122,6 +136,7 @@
 //! | settings and their checks: [`AutoConfig`], [`GATE_MAX_VRF`] | `config` | — |
 //! | prediction, innovation, acceptance: [`AutomaticFilter`] | `filter` | Morrison (14.8.1)-(14.8.4) |
 //! | what each sample did: [`AutoOutput`]; the final decisions, [`final_outliers`] | `output` | — |
+//! | the final outlier decision by interpolation, going back: [`MAX_REVIEW_WINDOW`] | `review` | Morrison ch. 7, (6.10.24), (7.13.5), §14.8 |
 //! | outlier gate: [`OutlierRule`], [`MORRISON_K`], [`REYNEKE_DEFAULT_K`]; truncated variance | `outlier` | Morrison §14.8, (14.8.4); Reyneke §7.4 |
 //! | noise `σ`: [`NoiseSource`], [`MIN_NOISE_TERMS`] | `noise` | Reyneke §7.1; Morrison (6.10.24), (14.8.4); [`crate::stats::DifferenceNoise`] |
 //! | misfit and restart: [`MisfitResponse`], CUSUM onset | `misfit` | Morrison §14.8, (14.8.5); [`crate::stats::InnovationChiSquared`] |
@@ -163,6 +178,7 @@ mod noise;
 mod outlier;
 mod output;
 mod phase;
+mod review;
 mod settle;
 
 pub use config::{AutoConfig, GATE_MAX_VRF, MAX_MEMORY_LEVELS};
@@ -172,3 +188,4 @@ pub use noise::{NoiseSource, MIN_NOISE_TERMS};
 pub use outlier::{OutlierRule, MORRISON_K, REYNEKE_DEFAULT_K};
 pub use output::{final_outliers, AutoOutput};
 pub use phase::Phase;
+pub use review::MAX_REVIEW_WINDOW;

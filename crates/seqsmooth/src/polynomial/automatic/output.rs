@@ -70,6 +70,15 @@ pub struct AutoOutput {
     pub restart: bool,
     /// The chi-squared window after this sample (when the sample entered it).
     pub chi_squared: Option<ChiSquaredOutcome>,
+    /// The final outlier decisions made at this update (`true`: rejected), on the oldest
+    /// samples still waiting, in order: decisions come in sample order, so the `i`-th decision
+    /// reported is on the `i`-th sample taken. A sample is decided once
+    /// [`AutoConfig::review_window`](super::AutoConfig::review_window) accepted samples after it
+    /// are in (by interpolation, see the module docs), or by
+    /// [`AutomaticFilter::finish`](super::AutomaticFilter::finish); [`final_outliers`] collects
+    /// them. At most 64 (at most 63 samples wait; beyond that the oldest keeps the gate's
+    /// decision).
+    pub decided: Vec<bool>,
 }
 
 impl AutoOutput {
@@ -97,31 +106,35 @@ impl AutoOutput {
     }
 }
 
-/// The final outlier decision of each of a series' outputs, in order: a sample's `outlier`
-/// flag is revised to false when a later output reinstates it ([`AutoOutput::reinstated`]: the
-/// run of rejections just before that output was applied with it as a manoeuvre's onset).
+/// The final outlier decision of each of a series' outputs, in order: the decisions reported
+/// ([`AutoOutput::decided`], in sample order), then `tail` (what
+/// [`AutomaticFilter::finish`](super::AutomaticFilter::finish) returned, or nothing), and for
+/// any sample still undecided its provisional flag [`AutoOutput::outlier`].
 ///
 /// ```
 /// use seqsmooth::polynomial::automatic::{final_outliers, AutomaticFilter};
-/// let mut f = AutomaticFilter::new(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
+/// let mut f = AutomaticFilter::new(0, 0.9, 1.0).unwrap().with_noise_sigma(0.1).unwrap()
+///     .with_review_window(0).unwrap();                            // the gate's decisions
 /// let mut outs = Vec::new();
 /// for n in 0..20 { outs.push(f.update(n as f64, 0.0).unwrap()); }
 /// outs.push(f.update(20.0, 5.0).unwrap());                     // an outlier
 /// outs.push(f.update(21.0, 0.0).unwrap());
 /// for n in 22..25 { outs.push(f.update(n as f64, 9.0).unwrap()); } // a step: 3 rejections
-/// let flags = final_outliers(&outs);
+/// let flags = final_outliers(&outs, &[]);
 /// assert_eq!(outs[22..25].iter().map(|o| o.outlier).collect::<Vec<_>>(), [true, true, false]);
 /// assert_eq!(outs[24].reinstated, 2);
 /// assert_eq!(flags.iter().filter(|&&r| r).count(), 1);      // only the outlier stays rejected
 /// assert!(flags[20] && !flags[22] && !flags[23]);
 /// assert_eq!(f.rejected(), 1);
 /// ```
-pub fn final_outliers(outputs: &[AutoOutput]) -> Vec<bool> {
-    let mut flags: Vec<bool> = outputs.iter().map(|o| o.outlier).collect();
-    for (i, o) in outputs.iter().enumerate() {
-        for flag in flags[i.saturating_sub(o.reinstated)..i].iter_mut() {
-            *flag = false;
-        }
-    }
+pub fn final_outliers(outputs: &[AutoOutput], tail: &[bool]) -> Vec<bool> {
+    let mut flags: Vec<bool> = outputs
+        .iter()
+        .flat_map(|o| o.decided.iter().copied())
+        .chain(tail.iter().copied())
+        .take(outputs.len())
+        .collect();
+    let decided = flags.len();
+    flags.extend(outputs[decided..].iter().map(|o| o.outlier));
     flags
 }

@@ -1,0 +1,365 @@
+//! Review: each sample's final outlier decision, made once `L` accepted samples after it are in
+//! ([`AutoConfig::review_window`], default `m + 4`), by interpolation as well as prediction.
+//!
+//! The gate judges a sample against the 1-step prediction, whose mean square `σ_ε²` is large
+//! where the filter must use a short memory (a manoeuvre): there the gate is off
+//! ([`AutoConfig::gate_max_vrf`]) and outliers pass. Once samples on both sides are in, the
+//! sample is judged again against a least-squares polynomial of degree `m + 1` through the `L`
+//! nearest accepted samples before it and the `L` after (Morrison ch. 7: a fixed-memory fit
+//! evaluated inside its window, where its VRF is least; one degree up so that a manoeuvre's
+//! `(m+1)`-th derivative is modelled, Morrison (7.13.5)). The sample is left out of the fit
+//! (its deleted residual), so an outlier does not pull the fit towards itself.
+//!
+//! | step | rule | source |
+//! |---|---|---|
+//! | neighbours not caught yet | the fit drops up to two of its samples whose studentised residual `\|r_j\|/(σ√(1 − h_j))` exceeds `k`, the largest first | Morrison (6.10.24) |
+//! | fit's bias at `t` | `b² = max(0, Δ² − σ²(v₊ − v_p))`, `Δ` against the fit one degree up on the same samples | Morrison (7.13.5), §13.9 |
+//! | residuals not white | `c = max(1, Σ RSS/σ² / Σ(n − p))` over the last 20 windows ([`Calibration`]) | Morrison §14.8 |
+//! | verdict | reject when `\|y − p(t)\| > k √(c σ²(1 + v_p) + b²)` (`k` the gate's multiplier) | Morrison §14.8 |
+//! | judge | the gate's verdict stands where its `σ_ε` was at most the interpolation's root mean square (a long memory that fits), the interpolation's otherwise | Morrison §7.13 |
+//!
+//! Near the start the window takes more samples after; at the end of a series
+//! ([`AutomaticFilter::finish`]) more before.
+//!
+//! When the verdict differs from the gate's, the filter goes back to its state before the
+//! sample and takes the samples since again (the gate judging them anew): from then on the
+//! state is what it would have been had the decision been made at the time. Each decision is
+//! reported once, in the output of the update that made it ([`AutoOutput::decided`]); with
+//! `L = 0` a decision is the gate's, final once a later sample is accepted (a run of rejections
+//! applied as a manoeuvre's onset is not rejected). The measured rates are in ACCURACY.md.
+
+use super::filter::AutomaticFilter;
+use super::output::AutoOutput;
+#[cfg(doc)]
+use super::AutoConfig;
+use crate::error::Error;
+use crate::estimate::PolynomialFit;
+use std::collections::VecDeque;
+
+/// The most samples waiting for their decision after an update; beyond it the oldest keeps the
+/// gate's (a long run of rejections with [`AutoConfig::max_consecutive_rejections`] off). An
+/// update thus makes at most 64 decisions.
+pub(super) const MAX_UNDECIDED: usize = 63;
+
+/// The largest [`AutoConfig::review_window`].
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::{AutomaticFilter, MAX_REVIEW_WINDOW};
+/// let f = AutomaticFilter::new(2, 0.9, 1.0).unwrap();
+/// assert!(f.clone().with_review_window(MAX_REVIEW_WINDOW).is_ok());
+/// assert!(f.with_review_window(MAX_REVIEW_WINDOW + 1).is_err());
+/// ```
+pub const MAX_REVIEW_WINDOW: usize = 31;
+
+/// A sample waiting for its decision: the gate's verdict so far and the filter's state before
+/// the sample (without its own review).
+#[derive(Clone, Debug)]
+pub(super) struct Undecided {
+    t: f64,
+    y: f64,
+    rejected: bool,
+    /// The root mean square `σ_ε` of the innovation the gate judged, when the gate was on.
+    gate_rms: Option<f64>,
+    before: Box<AutomaticFilter>,
+}
+
+/// The samples waiting for their decision, oldest first, and the newest accepted ones decided.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Review {
+    undecided: VecDeque<Undecided>,
+    accepted: VecDeque<(f64, f64)>,
+    calibration: Calibration,
+}
+
+/// The windows' residuals about their fits over the last [`CALIBRATION_WINDOWS`] decisions, in
+/// units of `σ²`: `Σ RSS/σ² / Σ (n − p)` estimates the residual variance the fits see, which is
+/// 1 (a little less after the drops) for white noise of the `σ` in use and more where the
+/// residuals are not white about a polynomial of the degree over the window (a trend it does
+/// not follow, coloured noise): the deleted residual is then judged against `σ²` times that
+/// factor, not called an outlier (Morrison §14.8: the innovations' mean square against its
+/// predicted value).
+#[derive(Clone, Debug, Default)]
+pub(super) struct Calibration {
+    windows: VecDeque<(f64, usize)>,
+}
+
+/// How many of the newest windows [`Calibration`] pools.
+const CALIBRATION_WINDOWS: usize = 20;
+
+impl Calibration {
+    fn push(&mut self, rss: f64, spare: usize) {
+        if rss.is_finite() && spare > 0 {
+            self.windows.push_back((rss, spare));
+            if self.windows.len() > CALIBRATION_WINDOWS {
+                self.windows.pop_front();
+            }
+        }
+    }
+
+    /// `max(1, Σ RSS/σ² / Σ (n − p))`.
+    fn factor(&self) -> f64 {
+        let (rss, spare) = self
+            .windows
+            .iter()
+            .fold((0.0, 0usize), |(r, s), &(rss, n)| (r + rss, s + n));
+        if spare == 0 {
+            1.0
+        } else {
+            (rss / spare as f64).max(1.0)
+        }
+    }
+}
+
+impl Review {
+    /// Takes the newest sample with the gate's verdict in `out` and the state before it; the
+    /// `out.reinstated` newest rejections before it were applied after all.
+    fn push(&mut self, t: f64, y: f64, out: &AutoOutput, before: Box<AutomaticFilter>) {
+        self.reinstate(out.reinstated);
+        self.undecided.push_back(Undecided {
+            t,
+            y,
+            rejected: out.outlier,
+            gate_rms: gate_rms(out),
+            before,
+        });
+    }
+
+    /// The newest `n` rejected samples waiting (a run just applied) are not rejected.
+    fn reinstate(&mut self, n: usize) {
+        for u in self
+            .undecided
+            .iter_mut()
+            .rev()
+            .filter(|u| u.rejected)
+            .take(n)
+        {
+            u.rejected = false;
+        }
+    }
+}
+
+/// `σ_ε` of the innovation the gate judged in `out`, when the gate was on.
+fn gate_rms(out: &AutoOutput) -> Option<f64> {
+    out.gate.and(out.innovation_sigma)
+}
+
+/// The verdict on `(t, y)` from the samples around it (`true`: an outlier) and the root mean
+/// square of the deleted residual it judged, `√(σ²(1 + v_p) + b²)`; `None` when the fit cannot
+/// say (too few samples, or numbers beyond the double range).
+pub(super) fn interpolation_verdict(
+    around: &[(f64, f64)],
+    (t, y): (f64, f64),
+    degree: usize,
+    sigma: f64,
+    k: f64,
+    calibration: &mut Calibration,
+) -> Option<(bool, f64)> {
+    let (mut ts, mut ys): (Vec<f64>, Vec<f64>) = around.iter().copied().unzip();
+    let mut fit = PolynomialFit::new(&ts, &ys, None, degree).ok()?;
+    for _ in 0..2 {
+        if ts.len() < degree + 4 {
+            break;
+        }
+        let worst = (0..ts.len())
+            .map(|j| {
+                let (p, h) = fit.value_and_vrf_at(ts[j]);
+                let r = ys[j] - p;
+                (r.abs() / (sigma * (1.0 - h).max(f64::EPSILON).sqrt()), j)
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0))?;
+        if worst.0.is_nan() || worst.0 <= k {
+            break;
+        }
+        ts.remove(worst.1);
+        ys.remove(worst.1);
+        fit = PolynomialFit::new(&ts, &ys, None, degree).ok()?;
+    }
+    let (p, v) = fit.value_and_vrf_at(t);
+    let v = v.max(0.0);
+    // The fit's bias at t, from one degree up on the same samples (nested least squares:
+    // E{Δ²} = b² + σ²(v₊ − v), as for the filter's own bias).
+    let b2 = match PolynomialFit::new(&ts, &ys, None, degree + 1) {
+        Ok(up) if ts.len() >= degree + 3 => {
+            let (pu, vu) = up.value_and_vrf_at(t);
+            let d = p - pu;
+            let vu = vu.max(0.0);
+            (d * d - sigma * sigma * (vu - v).max(0.0)).max(0.0)
+        }
+        _ => 0.0,
+    };
+    let spare = ts.len() - (degree + 1);
+    let scale = calibration.factor();
+    let var = sigma * sigma * scale;
+    let r = y - p;
+    let rms = (var * (1.0 + v) + b2).sqrt();
+    calibration.push(fit.residual_sq() / (sigma * sigma), spare);
+    (r.is_finite() && rms.is_finite()).then_some((r.abs() > k * rms, rms))
+}
+
+impl AutomaticFilter {
+    /// The filter without its review (the state a decision may go back to).
+    pub(super) fn snapshot(&mut self) -> Box<AutomaticFilter> {
+        let review = std::mem::take(&mut self.review);
+        let s = Box::new(self.clone());
+        self.review = review;
+        s
+    }
+
+    /// Goes back to `state`, keeping the review.
+    pub(super) fn restore(&mut self, state: AutomaticFilter) {
+        let review = std::mem::take(&mut self.review);
+        *self = state;
+        self.review = review;
+    }
+
+    /// Takes the newest sample into the review and makes every decision it can; returns the
+    /// newest sample's output (taken again when a decision went back) with the decisions.
+    pub(super) fn review(
+        &mut self,
+        t: f64,
+        y: f64,
+        mut out: AutoOutput,
+        before: Box<AutomaticFilter>,
+    ) -> AutoOutput {
+        self.review.push(t, y, &out, before);
+        let (decided, newest) = self.decide(false);
+        if let Some(newest) = newest {
+            out = newest;
+        }
+        out.decided = decided;
+        out
+    }
+
+    /// Decides every sample still waiting, with the samples there are (at the end of a
+    /// series: the window takes more samples before); the decisions, oldest first.
+    pub(super) fn decide_all(&mut self) -> Vec<bool> {
+        let (decided, newest) = self.decide(true);
+        if let (Some(newest), Some(last)) = (newest, self.last_output.as_mut()) {
+            let keep = std::mem::take(&mut last.decided);
+            *last = newest;
+            last.decided = keep;
+        }
+        decided
+    }
+
+    /// The oldest waiting samples' decisions, in order, and the newest sample's output if a
+    /// decision went back and took the samples again.
+    fn decide(&mut self, finishing: bool) -> (Vec<bool>, Option<AutoOutput>) {
+        let l = self.cfg.review_window;
+        let k = self.cfg.outliers.multiplier();
+        let degree = self.cfg.degree + 1;
+        let mut decided = Vec::new();
+        let mut newest = None;
+        while let Some(front) = self.review.undecided.front() {
+            let after: Vec<(f64, f64)> = self
+                .review
+                .undecided
+                .iter()
+                .skip(1)
+                .filter(|u| !u.rejected)
+                .map(|u| (u.t, u.y))
+                .take(2 * l.max(1))
+                .collect();
+            let overflow = self.review.undecided.len() > MAX_UNDECIDED;
+            let (before_wanted, ready) = if l == 0 {
+                (0, !front.rejected || !after.is_empty() || finishing)
+            } else if finishing {
+                (2 * l - after.len().min(l), true)
+            } else {
+                let before = self.review.accepted.len().min(l);
+                (before, after.len() >= l && after.len() >= 2 * l - before)
+            };
+            if !ready && !overflow {
+                break;
+            }
+            let gate = front.rejected;
+            let verdict = match (l, self.noise_sigma(), overflow) {
+                (1.., Some(sigma), false) if k > 0.0 && sigma > 0.0 => {
+                    let before = self.review.accepted.len().min(before_wanted);
+                    let mut around: Vec<(f64, f64)> = self
+                        .review
+                        .accepted
+                        .iter()
+                        .skip(self.review.accepted.len() - before)
+                        .copied()
+                        .collect();
+                    around.extend(after.iter().take(2 * l - before));
+                    let review = (around.len() >= degree + 2)
+                        .then(|| {
+                            let c = &mut self.review.calibration;
+                            interpolation_verdict(&around, (front.t, front.y), degree, sigma, k, c)
+                        })
+                        .flatten();
+                    // The judge of the smaller mean square: the gate's prediction where the
+                    // memory is long and fits, the interpolation where it is short.
+                    match (review, front.gate_rms) {
+                        (Some((_, rms)), Some(g)) if g <= rms => gate,
+                        (Some((verdict, _)), _) => verdict,
+                        (None, _) => gate,
+                    }
+                }
+                _ => gate,
+            };
+            if verdict != gate {
+                if let Ok(out) = self.take_again(verdict) {
+                    newest = Some(out);
+                }
+            }
+            let front = self.review.undecided.pop_front().expect("front checked");
+            let rejected = if verdict == front.rejected {
+                verdict
+            } else {
+                // Going back failed (it cannot on checked samples): the gate's verdict stands.
+                front.rejected
+            };
+            if !rejected {
+                self.review.accepted.push_back((front.t, front.y));
+                while self.review.accepted.len() > 2 * l.max(1) {
+                    self.review.accepted.pop_front();
+                }
+            }
+            decided.push(rejected);
+        }
+        (decided, newest)
+    }
+
+    /// Goes back to the state before the oldest waiting sample, takes it with the decision
+    /// `rejected`, and the samples after it again (the gate judging them anew). Returns the
+    /// newest sample's output; on an error the state is as before the call.
+    fn take_again(&mut self, rejected: bool) -> Result<AutoOutput, Error> {
+        let current = self.snapshot();
+        let mut waiting = self.review.undecided.clone();
+        let result = (|| {
+            let front = waiting.front_mut().expect("a sample is waiting");
+            self.restore((*front.before).clone());
+            // Every sample before this one is decided: none of them is part of a run.
+            self.pending.clear();
+            let mut out = self.step(front.t, front.y, Some(rejected))?;
+            front.rejected = rejected;
+            front.gate_rms = None;
+            for j in 1..waiting.len() {
+                let before = self.snapshot();
+                let (t, y) = (waiting[j].t, waiting[j].y);
+                out = self.step(t, y, None)?;
+                let n = out.reinstated;
+                for u in waiting.range_mut(1..j).rev().filter(|u| u.rejected).take(n) {
+                    u.rejected = false;
+                }
+                waiting[j].rejected = out.outlier;
+                waiting[j].gate_rms = gate_rms(&out);
+                waiting[j].before = before;
+            }
+            Ok(out)
+        })();
+        match result {
+            Ok(out) => {
+                self.review.undecided = waiting;
+                Ok(out)
+            }
+            Err(e) => {
+                self.restore(*current);
+                Err(e)
+            }
+        }
+    }
+}
