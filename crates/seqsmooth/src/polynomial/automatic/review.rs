@@ -51,22 +51,30 @@ pub(super) const MAX_UNDECIDED: usize = 63;
 /// ```
 pub const MAX_REVIEW_WINDOW: usize = 31;
 
-/// A sample waiting for its decision: the gate's verdict so far and the filter's state before
-/// the sample (without its own review).
+/// One sample in eight keeps the filter's state before it: going back restores the nearest kept
+/// state at or before the sample and takes the samples from there (at most seven more), so a
+/// filter holds one or two copies of its state rather than one per sample waiting.
+const SNAPSHOT_EVERY: usize = 8;
+
+/// A sample of the review: the gate's verdict so far (or the final decision), and for one in
+/// [`SNAPSHOT_EVERY`] the filter's state before the sample (without its own review).
 #[derive(Clone, Debug)]
-pub(super) struct Undecided {
+pub(super) struct Entry {
     t: f64,
     y: f64,
     rejected: bool,
+    /// The final decision is made (`rejected` is it).
+    decided: bool,
     /// The root mean square `σ_ε` of the innovation the gate judged, when the gate was on.
     gate_rms: Option<f64>,
-    before: Box<AutomaticFilter>,
+    before: Option<Box<AutomaticFilter>>,
 }
 
-/// The samples waiting for their decision, oldest first, and the newest accepted ones decided.
+/// The samples waiting for their decision, oldest first, after the decided ones still needed
+/// for the state the first of them keeps; and the newest accepted samples decided.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Review {
-    undecided: VecDeque<Undecided>,
+    entries: VecDeque<Entry>,
     accepted: VecDeque<(f64, f64)>,
     calibration: Calibration,
 }
@@ -111,30 +119,53 @@ impl Calibration {
 }
 
 impl Review {
-    /// Takes the newest sample with the gate's verdict in `out` and the state before it; the
-    /// `out.reinstated` newest rejections before it were applied after all.
+    /// Takes the newest sample with the gate's verdict in `out` and the state before it (kept
+    /// for one sample in [`SNAPSHOT_EVERY`]); the `out.reinstated` newest rejections waiting
+    /// before it were applied after all.
     fn push(&mut self, t: f64, y: f64, out: &AutoOutput, before: Box<AutomaticFilter>) {
         self.reinstate(out.reinstated);
-        self.undecided.push_back(Undecided {
+        let keep = self
+            .entries
+            .iter()
+            .rev()
+            .take(SNAPSHOT_EVERY - 1)
+            .all(|e| e.before.is_none());
+        self.entries.push_back(Entry {
             t,
             y,
             rejected: out.outlier,
+            decided: false,
             gate_rms: gate_rms(out),
-            before,
+            before: keep.then_some(before),
         });
     }
 
     /// The newest `n` rejected samples waiting (a run just applied) are not rejected.
     fn reinstate(&mut self, n: usize) {
-        for u in self
-            .undecided
-            .iter_mut()
-            .rev()
-            .filter(|u| u.rejected)
-            .take(n)
-        {
-            u.rejected = false;
-        }
+        reinstate(self.entries.iter_mut(), n);
+    }
+
+    /// The first sample waiting for its decision.
+    fn first_undecided(&self) -> Option<usize> {
+        self.entries.iter().position(|e| !e.decided)
+    }
+
+    /// Drops the decided samples before the last kept state at or before the first sample
+    /// waiting (all of them when none waits): the first entry always keeps the state before it.
+    fn trim(&mut self) {
+        let Some(f) = self.first_undecided() else {
+            self.entries.clear();
+            return;
+        };
+        let kept = (0..=f).rev().find(|&j| self.entries[j].before.is_some());
+        self.entries.drain(..kept.unwrap_or(0));
+    }
+}
+
+/// The newest `n` of `entries` rejected and waiting are not rejected (a run just applied).
+fn reinstate<'a>(entries: impl DoubleEndedIterator<Item = &'a mut Entry>, n: usize) {
+    for e in entries.rev().filter(|e| !e.decided && e.rejected).take(n) {
+        e.rejected = false;
     }
 }
 
@@ -250,17 +281,18 @@ impl AutomaticFilter {
         let degree = self.cfg.degree + 1;
         let mut decided = Vec::new();
         let mut newest = None;
-        while let Some(front) = self.review.undecided.front() {
+        while let Some(f) = self.review.first_undecided() {
+            let front = &self.review.entries[f];
             let after: Vec<(f64, f64)> = self
                 .review
-                .undecided
+                .entries
                 .iter()
-                .skip(1)
+                .skip(f + 1)
                 .filter(|u| !u.rejected)
                 .map(|u| (u.t, u.y))
                 .take(2 * l.max(1))
                 .collect();
-            let overflow = self.review.undecided.len() > MAX_UNDECIDED;
+            let overflow = self.review.entries.len() - f > MAX_UNDECIDED;
             let (before_wanted, ready) = if l == 0 {
                 (0, !front.rejected || !after.is_empty() || finishing)
             } else if finishing {
@@ -272,7 +304,7 @@ impl AutomaticFilter {
             if !ready && !overflow {
                 break;
             }
-            let gate = front.rejected;
+            let (gate, gate_rms, sample) = (front.rejected, front.gate_rms, (front.t, front.y));
             let verdict = match (l, self.noise_sigma(), overflow) {
                 (1.., Some(sigma), false) if k > 0.0 && sigma > 0.0 => {
                     let before = self.review.accepted.len().min(before_wanted);
@@ -287,12 +319,12 @@ impl AutomaticFilter {
                     let review = (around.len() >= degree + 2)
                         .then(|| {
                             let c = &mut self.review.calibration;
-                            interpolation_verdict(&around, (front.t, front.y), degree, sigma, k, c)
+                            interpolation_verdict(&around, sample, degree, sigma, k, c)
                         })
                         .flatten();
                     // The judge of the smaller mean square: the gate's prediction where the
                     // memory is long and fits, the interpolation where it is short.
-                    match (review, front.gate_rms) {
+                    match (review, gate_rms) {
                         (Some((_, rms)), Some(g)) if g <= rms => gate,
                         (Some((verdict, _)), _) => verdict,
                         (None, _) => gate,
@@ -301,59 +333,69 @@ impl AutomaticFilter {
                 _ => gate,
             };
             if verdict != gate {
-                if let Ok(out) = self.take_again(verdict) {
+                if let Ok(out) = self.take_again(f, verdict) {
                     newest = Some(out);
                 }
             }
-            let front = self.review.undecided.pop_front().expect("front checked");
-            let rejected = if verdict == front.rejected {
-                verdict
-            } else {
-                // Going back failed (it cannot on checked samples): the gate's verdict stands.
-                front.rejected
-            };
+            // Going back failed (it cannot on checked samples): the gate's verdict stands.
+            let entry = &mut self.review.entries[f];
+            entry.decided = true;
+            let rejected = entry.rejected;
             if !rejected {
-                self.review.accepted.push_back((front.t, front.y));
+                self.review.accepted.push_back(sample);
                 while self.review.accepted.len() > 2 * l.max(1) {
                     self.review.accepted.pop_front();
                 }
             }
             decided.push(rejected);
+            self.review.trim();
         }
         (decided, newest)
     }
 
-    /// Goes back to the state before the oldest waiting sample, takes it with the decision
-    /// `rejected`, and the samples after it again (the gate judging them anew). Returns the
-    /// newest sample's output; on an error the state is as before the call.
-    fn take_again(&mut self, rejected: bool) -> Result<AutoOutput, Error> {
+    /// Goes back to the nearest state kept at or before the sample `f` waiting, takes the
+    /// decided samples from there with their decisions, `f` with the decision `rejected`, and
+    /// the samples after it again (the gate judging them anew). Returns the newest sample's
+    /// output; on an error the state is as before the call.
+    fn take_again(&mut self, f: usize, rejected: bool) -> Result<AutoOutput, Error> {
         let current = self.snapshot();
-        let mut waiting = self.review.undecided.clone();
+        let mut entries = self.review.entries.clone();
         let result = (|| {
-            let front = waiting.front_mut().expect("a sample is waiting");
-            self.restore((*front.before).clone());
-            // Every sample before this one is decided: none of them is part of a run.
+            let start = (0..=f)
+                .rev()
+                .find(|&j| entries[j].before.is_some())
+                .expect("the first entry keeps its state");
+            let state = entries[start].before.as_deref().expect("found").clone();
+            self.restore(state);
+            // Every sample before `f` is decided: none of them is part of a run.
             self.pending.clear();
-            let mut out = self.step(front.t, front.y, Some(rejected))?;
-            front.rejected = rejected;
-            front.gate_rms = None;
-            for j in 1..waiting.len() {
-                let before = self.snapshot();
-                let (t, y) = (waiting[j].t, waiting[j].y);
-                out = self.step(t, y, None)?;
-                let n = out.reinstated;
-                for u in waiting.range_mut(1..j).rev().filter(|u| u.rejected).take(n) {
-                    u.rejected = false;
+            let mut out = None;
+            for j in start..entries.len() {
+                if j > start && entries[j].before.is_some() {
+                    entries[j].before = Some(self.snapshot());
                 }
-                waiting[j].rejected = out.outlier;
-                waiting[j].gate_rms = gate_rms(&out);
-                waiting[j].before = before;
+                let (t, y) = (entries[j].t, entries[j].y);
+                let force = match j.cmp(&f) {
+                    std::cmp::Ordering::Less => Some(entries[j].rejected),
+                    std::cmp::Ordering::Equal => Some(rejected),
+                    std::cmp::Ordering::Greater => None,
+                };
+                let o = self.step(t, y, force)?;
+                if j == f {
+                    entries[j].rejected = rejected;
+                    entries[j].gate_rms = None;
+                } else if j > f {
+                    reinstate(entries.range_mut(f + 1..j), o.reinstated);
+                    entries[j].rejected = o.outlier;
+                    entries[j].gate_rms = gate_rms(&o);
+                }
+                out = Some(o);
             }
-            Ok(out)
+            Ok(out.expect("the sample f was taken"))
         })();
         match result {
             Ok(out) => {
-                self.review.undecided = waiting;
+                self.review.entries = entries;
                 Ok(out)
             }
             Err(e) => {
