@@ -668,3 +668,70 @@ fn filter_auto_given_sigma_and_misfit() {
         "misfit after the manoeuvre"
     );
 }
+
+/// `--review-window N`: the automatic filter's outlier column is its review's final decision
+/// (or, with 0, the gate's), as the library's filter gives it for the same N; the option is
+/// checked and refused for the other kinds.
+#[test]
+fn filter_auto_review_window() {
+    let (input, samples) = auto_input(Some(120));
+    for (window, arg) in [(None, None), (Some(0), Some("0")), (Some(9), Some("9"))] {
+        let mut args = vec![
+            "filter", "--kind", "auto", "--degree", "1", "--theta", "0.9",
+        ];
+        if let Some(a) = arg {
+            args.extend(["--review-window", a]);
+        }
+        let (_, rows) = table(&ok(&args, &input));
+        let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
+        if let Some(w) = window {
+            f = f.with_review_window(w).unwrap();
+        }
+        let outs: Vec<_> = samples
+            .iter()
+            .map(|&(t, y)| f.update(t, y).unwrap())
+            .collect();
+        let tail = f.finish();
+        let flags = final_outliers(&outs, &tail);
+        assert!(flags[120], "{window:?}: the 20σ outlier");
+        for (row, rejected) in rows.iter().zip(flags) {
+            assert_eq!(
+                row[7],
+                if rejected { "1" } else { "0" },
+                "{window:?} {row:?}"
+            );
+        }
+    }
+    fails(
+        &[
+            "filter",
+            "--kind",
+            "auto",
+            "--degree",
+            "2",
+            "--theta",
+            "0.9",
+            "--review-window",
+            "2",
+        ],
+        &input,
+        2,
+        &["review window 2", "from 3 to 31"],
+    );
+    fails(
+        &[
+            "filter",
+            "--kind",
+            "fading",
+            "--degree",
+            "1",
+            "--theta",
+            "0.9",
+            "--review-window",
+            "3",
+        ],
+        &input,
+        2,
+        &["--review-window", "--kind auto"],
+    );
+}
