@@ -5,6 +5,8 @@
 # Usage: bash scripts/gain_vs_exact.sh   (builds the release binary first)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=scripts/lib_callgrind.sh
+. scripts/lib_callgrind.sh
 cargo build --release -q -p seqsmooth-cli
 bin=target/release/seqsmooth
 work=$(mktemp -d)
@@ -12,16 +14,7 @@ trap 'rm -rf "$work"' EXIT
 landing=crates/seqsmooth/tests/data/landing.csv
 head -61 "$landing" > "$work/l60.csv"
 # A 6,070-row 100 Hz series at Unix-time seconds (an accelerometer-like log).
-python3 - "$work/acc.csv" <<'PY'
-import math, random, sys
-random.seed(1)
-with open(sys.argv[1], "w") as f:
-    f.write("t,y\n")
-    for i in range(6070):
-        s = i * 0.01
-        f.write(f"{1.7e9 + s:.2f},{9.81 + 2 * math.sin(3 * s) + 0.5 * math.sin(17 * s) + random.gauss(0, 0.05)}\n")
-PY
-ir() { valgrind --tool=callgrind --callgrind-out-file=/dev/null "$@" 2>&1 >/dev/null | sed -n 's/.*Collected : //p'; }
+make_acc "$work/acc.csv"
 printf '| input | filter | gain (Ir) | exact (Ir) | gain/exact |\n|---|---|---:|---:|---:|\n'
 while read -r name file args; do
   g=$(ir $bin filter "$file" $args --engine gain)

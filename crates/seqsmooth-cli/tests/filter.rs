@@ -646,14 +646,9 @@ fn filter_auto_given_sigma_and_misfit() {
         .unwrap()
         .with_noise_sigma(0.2)
         .unwrap();
-    let outs: Vec<_> = samples
-        .iter()
-        .map(|&(t, y)| f.update(t, y).unwrap())
-        .collect();
     // The outlier column is the final decision: the manoeuvre's first rejections are applied
     // after all.
-    let tail = f.finish();
-    let flags = final_outliers(&outs, &tail);
+    let (outs, flags) = library_run(&mut f, &samples);
     assert!(outs.iter().zip(&flags).any(|(o, &r)| o.outlier && !r));
     for ((row, o), rejected) in rows.iter().zip(&outs).zip(flags) {
         assert_eq!(row[7], if rejected { "1" } else { "0" }, "{row:?}");
@@ -667,6 +662,21 @@ fn filter_auto_given_sigma_and_misfit() {
         rows[150..].iter().any(|r| r[8] == "1"),
         "misfit after the manoeuvre"
     );
+}
+
+/// The library's automatic filter over `samples`, finished: its outputs and final outlier
+/// decisions (what `seqsmooth filter --kind auto` writes in its `outlier` column).
+fn library_run(
+    f: &mut AutomaticFilter,
+    samples: &[(f64, f64)],
+) -> (Vec<seqsmooth::polynomial::automatic::AutoOutput>, Vec<bool>) {
+    let outs: Vec<_> = samples
+        .iter()
+        .map(|&(t, y)| f.update(t, y).unwrap())
+        .collect();
+    let tail = f.finish();
+    let flags = final_outliers(&outs, &tail);
+    (outs, flags)
 }
 
 /// `--review-window N`: the automatic filter's outlier column is its review's final decision
@@ -687,12 +697,7 @@ fn filter_auto_review_window() {
         if let Some(w) = window {
             f = f.with_review_window(w).unwrap();
         }
-        let outs: Vec<_> = samples
-            .iter()
-            .map(|&(t, y)| f.update(t, y).unwrap())
-            .collect();
-        let tail = f.finish();
-        let flags = final_outliers(&outs, &tail);
+        let (_, flags) = library_run(&mut f, &samples);
         assert!(flags[120], "{window:?}: the 20σ outlier");
         for (row, rejected) in rows.iter().zip(flags) {
             assert_eq!(
