@@ -151,6 +151,9 @@ pub fn run(data: &[u8]) {
     let (csv, out) = (dir.path().join("in.csv"), dir.path().join("out.csv"));
     let args = arguments(&mut input, &csv, &out);
     let text = input.rest();
+    if check::trace() {
+        eprintln!("args {args:?}\ninput {:?}", String::from_utf8_lossy(text));
+    }
     std::fs::write(&csv, text).expect("the input file");
     let cli = match Cli::try_parse_from(&args) {
         Ok(cli) => cli,

@@ -573,6 +573,16 @@ impl Theta {
 /// Parses `--theta`: `0.9`, `9/10` or `9e-1`, strictly between 0 and 1.
 pub fn parse_theta(s: &str) -> Result<Theta, String> {
     let text = s.trim();
+    // An exponent this large would take unbounded time to expand exactly (a fuzz campaign's
+    // `--theta 5e6999999` took minutes).
+    if let Some((_, e)) = text.split_once(['e', 'E']) {
+        if e.parse::<i64>().is_ok_and(|e| e.unsigned_abs() > 400) {
+            return Err(format!(
+                "theta {text} is out of range: it must lie strictly between 0 and 1 (write it \
+                 with an exponent from -400 to 400)"
+            ));
+        }
+    }
     let exact = parse_rational(text)
         .ok_or_else(|| format!("theta '{text}' is not a number (write it as 0.9 or 9/10)"))?;
     if !(exact > Rational::zero() && exact < Rational::one()) {

@@ -210,6 +210,20 @@ fn error_theta_out_of_range() {
         2,
         &["theta 'abc' is not a number"],
     );
+    // A huge exponent is refused at once, not expanded exactly (a fuzz campaign's time-outs).
+    for theta in ["5e6999999", "104E7161213", "1e-401"] {
+        fails(
+            &[
+                "filter", "--kind", "auto", "--degree", "5", "--theta", theta,
+            ],
+            T9_02,
+            2,
+            &[
+                &format!("theta {theta} is out of range"),
+                "exponent from -400 to 400",
+            ],
+        );
+    }
 }
 
 /// τ must be positive and finite.

@@ -81,13 +81,22 @@ pub fn ratio_to_f64(r: &BigRational) -> f64 {
     ToPrimitive::to_f64(r).unwrap_or(f64::NAN)
 }
 
-/// Parses a rational written as `p/q`, an integer, or a finite decimal such as `0.95`.
+/// The largest decimal exponent [`parse_rational`] takes (`1e-4000` … `1e4000`): beyond it the
+/// exact value has tens of thousands of digits and every operation on it is slow (a
+/// `1e7161213` took minutes), while no parameter it parses is meaningful there.
+pub const MAX_DECIMAL_EXPONENT: i32 = 4000;
+
+/// Parses a rational written as `p/q`, an integer, or a finite decimal such as `0.95`, with a
+/// decimal exponent of at most [`MAX_DECIMAL_EXPONENT`] in magnitude (after the digits).
 ///
 /// ```
 /// use seqsmooth::scalar::parse_rational;
 /// assert_eq!(parse_rational("9/10").unwrap().to_string(), "9/10");
 /// assert_eq!(parse_rational("0.95").unwrap().to_string(), "19/20");
+/// assert_eq!(parse_rational("95e-2").unwrap().to_string(), "19/20");
 /// assert!(parse_rational("x").is_none());
+/// assert!(parse_rational("1e4000").is_some() && parse_rational("1e-4000").is_some());
+/// assert!(parse_rational("1e4001").is_none() && parse_rational("5e6999999").is_none());
 /// ```
 pub fn parse_rational(text: &str) -> Option<BigRational> {
     let s = text.trim();
@@ -122,7 +131,12 @@ pub fn parse_rational(text: &str) -> Option<BigRational> {
     } else {
         digits.parse().ok()?
     };
-    let scale = exp - frac_part.len() as i32;
+    let scale = exp.checked_sub(i32::try_from(frac_part.len()).ok()?)?;
+    if exp.unsigned_abs() > MAX_DECIMAL_EXPONENT as u32
+        || scale.unsigned_abs() > MAX_DECIMAL_EXPONENT as u32 + 400
+    {
+        return None;
+    }
     let mut den = BigInt::one();
     let ten = BigInt::from(10);
     if scale >= 0 {
