@@ -1,8 +1,9 @@
 //! A process-wide memo for constants that depend only on a small key (a degree, a discount)
 //! and cost exact rational arithmetic to derive — the expanding-memory gain numerators
 //! (Morrison Table 9.1), the fading-memory gains at `θ` (Table 13.1), the switch constants
-//! (Table 13.4). Every filter built with the same key shares one copy, so that a bank of
-//! filters, or the automatic filter restarting its memory, pays for them once.
+//! (Table 13.4), the sliding fixed-memory engine's shift matrix. Every filter built with the
+//! same key shares one copy, so that a bank of filters, or the automatic filter restarting its
+//! memory, pays for them once.
 //!
 //! The value is computed outside the lock (two threads asking for a new key at once may both
 //! compute it; the first stored wins). The memo holds at most [`CAPACITY`] keys and is emptied

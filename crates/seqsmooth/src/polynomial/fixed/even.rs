@@ -184,6 +184,14 @@ impl EvenWindow {
         }
     }
 
+    /// Sets the sliding engine's number of refresh accumulators (before the first sample; the
+    /// direct engine has none).
+    pub(super) fn set_refreshes(&mut self, refreshes: usize) {
+        if let Moments::Sliding(s) = &mut self.moments {
+            s.set_refreshes(refreshes);
+        }
+    }
+
     /// The sliding engine's refresh period (`None` for the direct engine).
     pub(super) fn refresh_period(&self) -> Option<usize> {
         match &self.moments {

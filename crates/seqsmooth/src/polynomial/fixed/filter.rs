@@ -177,7 +177,9 @@ impl FixedMemory {
                 reason: "must be at least 1 and set before the first sample".into(),
             });
         }
-        self.fit = Self::make_fit(self.m, self.window, self.engine, q);
+        if let WindowFit::Even(w) = &mut self.fit {
+            w.set_refreshes(q);
+        }
         Ok(self)
     }
 

@@ -12,9 +12,12 @@
 //! window directly (every sample at its final position, no shift) and replace `μ` when their
 //! window is complete, so no error is carried through more than `⌈(L+1)/q⌉` shifts.
 
-use crate::basis::DiscreteLegendre;
+use crate::calculus::choose_integer;
+use crate::numeric::memo::Memo;
 use crate::numeric::unrolled::unrolled_sizes;
 use crate::scalar::{Rational, Scalar};
+use num_bigint::BigInt;
+use std::sync::Arc;
 
 /// The default number of staggered refresh accumulators for degree `m` (an exact refresh every
 /// `⌈(L+1)/q⌉` samples): `q = 2^⌊(m-1)/2⌋`. A carried error is extrapolated over at most `1/q`
@@ -37,23 +40,65 @@ pub(crate) fn smoothing_refreshes(m: usize) -> usize {
 }
 
 /// The exact shift matrix `M` with `p_j(x-1) = Σ_l M_jl p_l(x)` (lower triangular, unit
-/// diagonal), computed in rationals and rounded; row `j` holds `M_j0 … M_jj`.
-fn shift_matrix(m: usize, span: u64) -> Vec<f64> {
-    let basis = DiscreteLegendre::new(Rational::from_integer(span.into()));
-    let polys: Vec<_> = (0..=m).map(|j| basis.polynomial(j)).collect();
-    let minus_one = -Rational::from_i64(1);
-    let mut out = vec![0.0; (m + 1) * (m + 1)];
+/// diagonal), computed in rationals ([`exact_shift_matrix`]) and rounded, once per degree and
+/// span (a process-wide memo); row `j` holds `M_j0 … M_jj`.
+fn shift_matrix(m: usize, span: u64) -> Arc<Vec<f64>> {
+    static SHIFTS: Memo<(usize, u64), Vec<f64>> = Memo::new();
+    SHIFTS.get((m, span), || {
+        exact_shift_matrix(m, span)
+            .iter()
+            .map(Scalar::to_f64)
+            .collect()
+    })
+}
+
+/// `M` exactly, in the falling-factorial basis where the shift has integer coefficients:
+/// `p_j(x) = Σ_ν a_jν x^(ν)` with `a_jν = (-1)^ν C(j,ν) C(j+ν,ν) / L^(ν)` (3.2.20), and
+/// `(x-1)^(ν) = Σ_k (-1)^(ν-k) (ν!/k!) x^(k)` (Vandermonde's theorem for factorial powers), so
+/// `p_j(x-1) = Σ_k b_jk x^(k)`, `b_jk = Σ_{ν≥k} (-1)^(ν-k) (ν!/k!) a_jν`; back-substitution
+/// against the triangular `a` gives row `j`: `O(m³)` rational operations.
+fn exact_shift_matrix(m: usize, span: u64) -> Vec<Rational> {
+    let span = BigInt::from(span);
+    // L^(ν) for ν = 0..=m.
+    let mut falling = vec![BigInt::from(1)];
+    for nu in 0..m {
+        let next = &falling[nu] * (&span - BigInt::from(nu));
+        falling.push(next);
+    }
+    let a: Vec<Vec<Rational>> = (0..=m)
+        .map(|j| {
+            (0..=j)
+                .map(|nu| {
+                    let c = choose_integer(j, nu) * choose_integer(j + nu, nu);
+                    let c = if nu % 2 == 0 { c } else { -c };
+                    Rational::new(c, falling[nu].clone())
+                })
+                .collect()
+        })
+        .collect();
+    let zero = Rational::from_integer(BigInt::from(0));
+    let mut out = vec![zero.clone(); (m + 1) * (m + 1)];
     for j in 0..=m {
-        let mut c: Vec<Rational> = (0..=j)
-            .map(|i| polys[j].taylor_coefficient(i, &minus_one))
+        let mut b: Vec<Rational> = (0..=j)
+            .map(|k| {
+                // (-1)^(ν-k) ν!/k!, from ν = k up.
+                let mut factor = BigInt::from(1);
+                let mut acc = zero.clone();
+                for (nu, a_nu) in a[j].iter().enumerate().skip(k) {
+                    if nu > k {
+                        factor = -factor * BigInt::from(nu);
+                    }
+                    acc += a_nu * Rational::from_integer(factor.clone());
+                }
+                acc
+            })
             .collect();
         for l in (0..=j).rev() {
-            let lead = polys[l].coeffs[l].clone();
-            let f = c[l].clone() / lead;
-            for (i, ci) in c.iter_mut().enumerate().take(l + 1) {
-                *ci = ci.clone() - f.clone() * polys[l].coeffs[i].clone();
+            let f = &b[l] / &a[l][l];
+            for (bk, alk) in b.iter_mut().zip(&a[l]) {
+                *bk -= &f * alk;
             }
-            out[j * (m + 1) + l] = f.to_f64();
+            out[j * (m + 1) + l] = f;
         }
     }
     out
@@ -110,7 +155,7 @@ pub(super) struct SlidingMoments {
     recursion: LegendreRecursion,
     /// `p_j(x)`, row `x = 0..=L`, when tabulated (else evaluated by the recursion as needed).
     table: Vec<f64>,
-    shift: Vec<f64>,
+    shift: Arc<Vec<f64>>,
     mu: Vec<f64>,
     valid: bool,
     /// Refresh accumulator `a` starts at sample `a·period`, holds `counts[a]` samples of its
@@ -151,6 +196,16 @@ impl SlidingMoments {
             period: window.div_ceil(q),
             scratch: vec![0.0; m + 1],
         }
+    }
+
+    /// Sets the number of refresh accumulators (clamped to `1..=window`), before the first
+    /// sample: the shift matrix and the table stay.
+    pub(super) fn set_refreshes(&mut self, refreshes: usize) {
+        debug_assert_eq!(self.started, 0, "refreshes set after a sample");
+        let q = refreshes.clamp(1, self.window);
+        self.counts = vec![0; q];
+        self.sums = vec![0.0; q * self.mu.len()];
+        self.period = self.window.div_ceil(q);
     }
 
     /// The samples between exact refreshes, `⌈(L+1)/q⌉`.
@@ -211,5 +266,43 @@ impl SlidingMoments {
     /// The moments of the newest full window (`None` until `L+1` samples have arrived).
     pub(super) fn moments(&self) -> Option<&[f64]> {
         self.valid.then_some(&self.mu[..])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::exact_shift_matrix;
+    use crate::basis::DiscreteLegendre;
+    use crate::scalar::{Rational, Scalar};
+
+    /// `p_j(x-1) = Σ_l M_jl p_l(x)` exactly, with `p` evaluated by (3.2.20) directly, at
+    /// `x = 0..=L+1` (more points than the degree: the polynomials are equal).
+    #[test]
+    fn shift_matrix_shifts_by_one_exactly() {
+        let cases = (0..=12)
+            .flat_map(|m: usize| {
+                [m as u64, m as u64 + 1, m as u64 + 7, 40].map(move |span| (m, span))
+            })
+            .chain([(24, 24), (25, 62)]);
+        for (m, span) in cases {
+            let shift = exact_shift_matrix(m, span);
+            let basis = DiscreteLegendre::new(Rational::from_i64(span as i64));
+            for x in 0..=span as i64 + 1 {
+                let p: Vec<Rational> = (0..=m)
+                    .map(|l| basis.value(l, Rational::from_i64(x)))
+                    .collect();
+                for j in 0..=m {
+                    let shifted = basis.value(j, Rational::from_i64(x - 1));
+                    let sum = (0..=j).fold(Rational::from_i64(0), |acc, l| {
+                        acc + shift[j * (m + 1) + l].clone() * p[l].clone()
+                    });
+                    assert_eq!(sum, shifted, "degree {m}, span {span}, p_{j}({x} - 1)");
+                    assert!(shift[j * (m + 2)] == Rational::from_i64(1), "unit diagonal");
+                    for l in j + 1..=m {
+                        assert_eq!(shift[j * (m + 1) + l], Rational::from_i64(0));
+                    }
+                }
+            }
+        }
     }
 }
