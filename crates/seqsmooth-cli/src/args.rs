@@ -157,7 +157,8 @@ command before any output. An error in a later row (a bad cell, a time not after
 one of its series, ...) stops the command after every row before it, of every series, has been \
 written to standard output; the message names the line, the column and, for a time, the \
 series. An output file (-o FILE) is written beside FILE and renamed onto it only when the \
-command succeeds: on any error an existing FILE is left as it was.
+command succeeds: on any error an existing FILE is left as it was (a device such as /dev/null \
+or a named pipe is written in place).
 
 Progress: on standard error when it is a terminal and the input is longer than one chunk \
 (bytes of the file read, or rows and rows/s from standard input); --no-progress turns it off.

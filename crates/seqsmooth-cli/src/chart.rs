@@ -162,25 +162,39 @@ pub fn write(track: &Track, layout: &Layout, path: &Path) -> Result<(), CliError
     let name = path.display();
     let fail = |e: Err| CliError::Data(format!("cannot write the plot to '{name}': {e}"));
     // Drawn into a temporary file beside `path` (with the extension that picks the encoder),
-    // renamed onto it when complete: a failed plot leaves an existing file as it was.
+    // renamed onto it when complete: a failed plot leaves an existing file as it was. A device
+    // or a named pipe is drawn into in place.
+    let target = match crate::io::Destination::of(path) {
+        crate::io::Destination::InPlace(device) => {
+            render_into(&device, track, layout, format).map_err(fail)?;
+            return Ok(());
+        }
+        crate::io::Destination::Replace(target) => target,
+    };
     let suffix = match format {
         Format::Png => ".png",
         Format::Svg => ".svg",
     };
-    let temp = crate::io::temp_beside(path, suffix).map_err(|e| fail(e.into()))?;
+    let temp = crate::io::temp_beside(&target, suffix).map_err(|e| fail(e.into()))?;
     let temp = temp.into_temp_path();
+    render_into(&temp, track, layout, format).map_err(fail)?;
+    temp.persist(&target).map_err(|e| fail(e.error.into()))
+}
+
+/// Draws `track` into the file `path` as `format`.
+fn render_into(path: &Path, track: &Track, layout: &Layout, format: Format) -> Result<(), Err> {
     macro_rules! render {
         ($backend:ident) => {{
-            let root = $backend::new(&temp, layout.size).into_drawing_area();
-            draw(&root, track, layout, format == Format::Png).map_err(fail)?;
-            root.present().map_err(|e| fail(e.into()))?;
+            let root = $backend::new(path, layout.size).into_drawing_area();
+            draw(&root, track, layout, format == Format::Png)?;
+            root.present().map_err(|e| -> Err { e.into() })?;
         }};
     }
     match format {
         Format::Png => render!(BitMapBackend),
         Format::Svg => render!(SVGBackend),
     }
-    temp.persist(path).map_err(|e| fail(e.error.into()))
+    Ok(())
 }
 
 fn font(size: f64) -> TextStyle<'static> {

@@ -480,19 +480,35 @@ impl Output {
     /// temporary file in the same directory, renamed onto `path` by [`Output::finish`]: until
     /// then an existing `path` is untouched, and if the command fails (the `Output` is dropped
     /// unfinished) the temporary file is removed. Standard output streams: what was written
-    /// stays written (flushed when dropped).
+    /// stays written (flushed when dropped). So does a `path` that is not a regular file (a
+    /// device such as `/dev/null`, a named pipe): it is written in place ([`Destination`]).
     pub fn create(path: Option<&Path>) -> Result<Self, CliError> {
         match named(path) {
             Some(p) => {
                 let name = format!("'{}'", p.display());
                 let fail =
                     |e: io::Error| CliError::Data(format!("cannot create output file {name}: {e}"));
-                let (file, temp) = temp_beside(p, "").map_err(fail)?.into_parts();
-                Ok(Self {
-                    sink: Box::new(BufWriter::new(file)),
-                    name,
-                    file: Some((temp, p.to_path_buf())),
-                })
+                match Destination::of(p) {
+                    Destination::InPlace(target) => {
+                        let file = std::fs::OpenOptions::new()
+                            .write(true)
+                            .open(target)
+                            .map_err(fail)?;
+                        Ok(Self {
+                            sink: Box::new(BufWriter::new(file)),
+                            name,
+                            file: None,
+                        })
+                    }
+                    Destination::Replace(target) => {
+                        let (file, temp) = temp_beside(&target, "").map_err(fail)?.into_parts();
+                        Ok(Self {
+                            sink: Box::new(BufWriter::new(file)),
+                            name,
+                            file: Some((temp, target)),
+                        })
+                    }
+                }
             }
             None => Ok(Self::stdout()),
         }
@@ -565,6 +581,44 @@ impl Output {
                 .persist(&path)
                 .map_err(|e| CliError::write(&self.name, e.error)),
             None => Ok(()),
+        }
+    }
+}
+
+/// How an output file named by the user is written.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Destination {
+    /// A regular file, or a new one: written whole to a temporary file beside it and renamed
+    /// onto it when complete. The path is the file itself, through any symbolic link, so that
+    /// the link stays a link and the file it names gets the rows.
+    Replace(PathBuf),
+    /// An existing file that is not a regular one (a device such as `/dev/null`, a named
+    /// pipe): written in place, as it goes, since a rename would put a regular file where the
+    /// device was.
+    InPlace(PathBuf),
+}
+
+impl Destination {
+    /// Where the output `path` goes.
+    ///
+    /// ```
+    /// use seqsmooth_cli::io::Destination;
+    /// use std::path::Path;
+    /// let null = Path::new("/dev/null");
+    /// assert_eq!(Destination::of(null), Destination::InPlace(null.to_path_buf()));
+    /// let new = Path::new("no-such-dir/out.csv");
+    /// assert_eq!(Destination::of(new), Destination::Replace(new.to_path_buf()));
+    /// ```
+    pub fn of(path: &Path) -> Self {
+        match std::fs::metadata(path) {
+            // Follows symbolic links: what the path names in the end.
+            Ok(meta) if !meta.is_file() && !meta.is_dir() => Self::InPlace(path.to_path_buf()),
+            Ok(_) => Self::Replace(path.canonicalize().unwrap_or_else(|_| path.to_path_buf())),
+            // New, or a symbolic link to a file not there yet: the file it names.
+            Err(_) => Self::Replace(match std::fs::read_link(path) {
+                Ok(target) => path.parent().unwrap_or(Path::new("")).join(target),
+                Err(_) => path.to_path_buf(),
+            }),
         }
     }
 }

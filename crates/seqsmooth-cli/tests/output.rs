@@ -1,6 +1,8 @@
 //! Output files are replaced only on success (`io::Output`, the plots): a failing command leaves
 //! an existing `-o FILE` as it was and no partial or temporary file beside it; standard output
-//! streams the rows before the error as before.
+//! streams the rows before the error as before. A symbolic link stays a link (its file gets the
+//! rows), and what is not a regular file (a named pipe, a device such as `/dev/null`) is
+//! written in place, not replaced by a regular file.
 
 mod common;
 use common::*;
@@ -113,6 +115,82 @@ fn smooth_and_plot_errors_leave_the_old_file() {
         r.stderr
     );
     assert_eq!(listing(&dir), ["s.csv"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn a_symbolic_link_stays_a_link() {
+    use std::os::unix::fs::symlink;
+    let dir = fresh_dir("symlink");
+    let (link, real) = (dir.join("link.csv"), dir.join("real.csv"));
+    std::fs::write(&real, "old\n").unwrap();
+    symlink("real.csv", &link).unwrap();
+    let args = ["filter", "--kind", "expanding", "--degree", "1", "-o"];
+    let input = "t,y\n0,1\n1,3\n";
+    let expected = ok(&args[..5], input);
+    for out in [&link, &dir.join("dangling.csv")] {
+        if out != &link {
+            symlink("later.csv", out).unwrap();
+        }
+        let r = run(&[&args[..], &[out.to_str().unwrap()]].concat(), input);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        assert!(std::fs::symlink_metadata(out).unwrap().is_symlink());
+        assert_eq!(std::fs::read_to_string(out).unwrap(), expected);
+    }
+    assert_eq!(std::fs::read_to_string(&real).unwrap(), expected);
+    assert_eq!(
+        listing(&dir),
+        ["dangling.csv", "later.csv", "link.csv", "real.csv"]
+    );
+    // A plot through a link too.
+    let (svg, target) = (dir.join("p.svg"), dir.join("target.svg"));
+    symlink("target.svg", &svg).unwrap();
+    let r = run(&["plot", "-o", svg.to_str().unwrap()], &expected);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(std::fs::symlink_metadata(&svg).unwrap().is_symlink());
+    assert!(std::fs::read_to_string(&target).unwrap().contains("<svg"));
+}
+
+/// A named pipe made by `mkfifo`, read by a thread into a string.
+#[cfg(target_os = "linux")]
+fn fifo_reader(path: &Path) -> std::thread::JoinHandle<Vec<u8>> {
+    let made = std::process::Command::new("mkfifo").arg(path).status();
+    assert!(made.unwrap().success(), "mkfifo {}", path.display());
+    let path = path.to_path_buf();
+    std::thread::spawn(move || std::fs::read(path).unwrap())
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_named_pipe_is_written_in_place() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = fresh_dir("fifo");
+    let input = "t,y\n0,1\n1,3\n2,4\n";
+    let is_fifo = |p: &Path| std::fs::metadata(p).unwrap().file_type().is_fifo();
+    let cases: [(&str, &[&str]); 2] = [
+        ("f.csv", &["filter", "--kind", "expanding", "--degree", "1"]),
+        ("s.csv", &["smooth", "--degree", "1", "--window", "3"]),
+    ];
+    for (name, args) in cases {
+        let fifo = dir.join(name);
+        let reader = fifo_reader(&fifo);
+        let r = run(&[args, &["-o", fifo.to_str().unwrap()]].concat(), input);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        // Before joining: a pipe replaced by a file leaves its reader waiting for ever.
+        assert!(is_fifo(&fifo), "{name} is still a named pipe");
+        let got = String::from_utf8(reader.join().unwrap()).unwrap();
+        assert_eq!(got, ok(args, input), "{name}");
+    }
+    let fifo = dir.join("p.svg");
+    let reader = fifo_reader(&fifo);
+    let filtered = ok(cases[0].1, input);
+    let r = run(&["plot", "-o", fifo.to_str().unwrap()], &filtered);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(String::from_utf8(reader.join().unwrap())
+        .unwrap()
+        .contains("<svg"));
+    assert!(is_fifo(&fifo));
+    assert_eq!(listing(&dir), ["f.csv", "p.svg", "s.csv"]);
 }
 
 #[test]
