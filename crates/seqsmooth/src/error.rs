@@ -120,6 +120,24 @@ pub enum Error {
         /// The number: `d2` (the second derivative), `variance of d1`, `covariance of d0, d2`.
         what: String,
     },
+    /// The observations do not determine the state: the (whitened) observation matrix `T` has
+    /// rank below the state dimension (Morrison §8.9, Ex. 6.4).
+    #[error(
+        "the observations determine only {rank} of the {states} state components (smallest \
+         singular value of the whitened T {smallest_singular_value:e}, largest \
+         {largest_singular_value:e}): observe at more distinct times or add observations of \
+         other kinds"
+    )]
+    Unobservable {
+        /// The numerical rank of `T`.
+        rank: usize,
+        /// The state dimension (columns of `T`).
+        states: usize,
+        /// The smallest singular value.
+        smallest_singular_value: f64,
+        /// The largest singular value.
+        largest_singular_value: f64,
+    },
     /// Some other parameter is out of range.
     #[error("{name} {value} is invalid: {reason}")]
     InvalidParameter {

@@ -1,10 +1,16 @@
-//! Batch estimation: weighted least-squares polynomial fits on arbitrary timestamps.
+//! Batch estimation: weighted least-squares polynomial fits on arbitrary timestamps, and the
+//! minimum-variance and least-squares estimates of any state from stacked linear observations
+//! ([`batch`]).
 //!
 //! [`PolynomialFit`] solves the weighted least-squares problem by a Householder QR factorisation
 //! in the Legendre basis on the data interval mapped to `[-1, 1]` (condition number of order
 //! `√(2m+1)` on evenly spread data, against `~10^(0.6 m)` for monomials), never by the normal
 //! equations (Morrison §6.5; Lear's note on conditioning). It is the batch counterpart of the
 //! recursive filters and their test oracle.
+
+pub mod batch;
+
+pub use batch::{least_squares, minimum_variance, BatchEstimate, NoiseCovariance};
 
 use crate::basis::legendre::taylor_table;
 use crate::error::Error;

@@ -1,0 +1,318 @@
+//! Batch estimation of a state from stacked linear observations `Y = T X + N`,
+//! `Cov(N) = R` (Morrison ch. 6 and §8.2):
+//!
+//! | estimator | estimate | covariance | source |
+//! |---|---|---|---|
+//! | minimum variance | `X° = (Tᵀ R⁻¹ T)⁻¹ Tᵀ R⁻¹ Y` | `S° = (Tᵀ R⁻¹ T)⁻¹` | (6.6.x), (8.2.7)-(8.2.9) |
+//! | least squares | `X̂ = (Tᵀ T)⁻¹ Tᵀ Y` | `Ŝ = W R Wᵀ`, `W = (Tᵀ T)⁻¹ Tᵀ` | (6.5.x), (8.2.11)-(8.2.12) |
+//!
+//! Both are computed by a Householder QR of the system (whitened by `R = L Lᵀ` for minimum
+//! variance: `L⁻¹ T`, `L⁻¹ Y`), never by forming the normal equations, whose condition number is
+//! the square of `T`'s. The numerical rank of `T` is checked first (singular values of the QR
+//! factor; a singular value at most `max(N, n) ε σ_max` counts as zero, as numpy's
+//! `matrix_rank` does): a `T` that does not determine the state is [`Error::Unobservable`],
+//! naming the rank. The residual `χ² = (Y − T X)ᵀ R⁻¹ (Y − T X)` has `N − n` degrees of
+//! freedom for the minimum-variance estimate (6.10.x).
+
+use crate::error::Error;
+use nalgebra::{Cholesky, DMatrix, DVector};
+
+/// The covariance `R` of the stacked observation errors.
+#[derive(Clone, Debug, PartialEq)]
+pub enum NoiseCovariance {
+    /// `R = I`.
+    Identity,
+    /// `R = diag(σ_k²)`, one variance per observation, each positive and finite.
+    Variances(Vec<f64>),
+    /// A full symmetric positive definite `R`.
+    Full(DMatrix<f64>),
+}
+
+/// A batch estimate: the state, its covariance, and how well the data fit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BatchEstimate {
+    /// `X`, at the epoch the rows of `T` refer to.
+    pub state: DVector<f64>,
+    /// Its covariance (symmetric).
+    pub covariance: DMatrix<f64>,
+    /// `(Y − T X)ᵀ R⁻¹ (Y − T X)`.
+    pub chi_squared: f64,
+    /// `N − n`: observations less states.
+    pub degrees_of_freedom: usize,
+    /// `σ_max/σ_min` of the whitened `T` (of `T` for least squares).
+    pub condition_number: f64,
+}
+
+/// The minimum-variance (Gauss–Markov) estimate from `Y = T X + N`, `Cov(N) = R`.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::estimate::batch::{minimum_variance, NoiseCovariance};
+/// // Morrison (6.6.36)-(6.6.39): T rows M Φ(−k), R = diag(1, 2, 2).
+/// let t = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 1.0, -1.0, 1.0, -2.0]);
+/// let y = DVector::from_vec(vec![3.1, 2.2, 0.9]);
+/// let e = minimum_variance(&t, &y, &NoiseCovariance::Variances(vec![1.0, 2.0, 2.0])).unwrap();
+/// assert!((e.covariance[(0, 0)] - 10.0 / 11.0).abs() < 1e-15);
+/// assert!((e.state[0] - 69.0 / 22.0).abs() < 1e-14);
+/// ```
+pub fn minimum_variance(
+    t: &DMatrix<f64>,
+    y: &DVector<f64>,
+    noise: &NoiseCovariance,
+) -> Result<BatchEstimate, Error> {
+    check(t, y, noise)?;
+    let (tw, yw) = whiten(t, y, noise)?;
+    let fit = Fit::new(tw, &yw)?;
+    let covariance = fit.inverse_gram();
+    let chi_squared = (&yw - &fit.t * &fit.x).norm_squared();
+    finish(fit, covariance, chi_squared)
+}
+
+/// The least-squares estimate `X̂ = (Tᵀ T)⁻¹ Tᵀ Y`, with its covariance `W R Wᵀ` under the
+/// noise `R` (Morrison (8.2.11)-(8.2.12)); equal to [`minimum_variance`] when `R = σ² I`.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::estimate::batch::{least_squares, NoiseCovariance};
+/// // Morrison (6.5.15)-(6.5.23): X̂ = (19/6, 1.1); with R = diag(1, 2, 2), Ŝ = (1/36)[[35, 21], [21, 27]].
+/// let t = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 1.0, -1.0, 1.0, -2.0]);
+/// let y = DVector::from_vec(vec![3.1, 2.2, 0.9]);
+/// let e = least_squares(&t, &y, &NoiseCovariance::Variances(vec![1.0, 2.0, 2.0])).unwrap();
+/// assert!((e.state[0] - 19.0 / 6.0).abs() < 1e-14 && (e.state[1] - 1.1).abs() < 1e-14);
+/// assert!((e.covariance[(0, 1)] - 21.0 / 36.0).abs() < 1e-15);
+/// ```
+pub fn least_squares(
+    t: &DMatrix<f64>,
+    y: &DVector<f64>,
+    noise: &NoiseCovariance,
+) -> Result<BatchEstimate, Error> {
+    check(t, y, noise)?;
+    let fit = Fit::new(t.clone(), y)?;
+    // W = R⁻¹ Qᵀ (the QR's factors), S = W R Wᵀ.
+    let w = fit.weights();
+    let covariance = match noise {
+        NoiseCovariance::Identity => &w * w.transpose(),
+        NoiseCovariance::Variances(v) => {
+            let mut wr = w.clone();
+            for (mut col, v) in wr.column_iter_mut().zip(v) {
+                col *= *v;
+            }
+            wr * w.transpose()
+        }
+        NoiseCovariance::Full(r) => &w * r * w.transpose(),
+    };
+    let residual = y - t * &fit.x;
+    let chi_squared = whiten(t, &residual, noise)?.1.norm_squared();
+    finish(fit, symmetric(covariance), chi_squared)
+}
+
+/// The QR of a (whitened) system and its solution.
+struct Fit {
+    t: DMatrix<f64>,
+    q: DMatrix<f64>,
+    r: DMatrix<f64>,
+    x: DVector<f64>,
+    condition_number: f64,
+}
+
+impl Fit {
+    /// Factors `t`, checks its rank, solves `t x ≈ y`.
+    fn new(t: DMatrix<f64>, y: &DVector<f64>) -> Result<Self, Error> {
+        let (rows, states) = t.shape();
+        let qr = t.clone().qr();
+        let (q, r) = (qr.q(), qr.r());
+        // The singular values of R are those of T.
+        let sv = r.singular_values();
+        let largest = sv.max();
+        let smallest = if rows < states { 0.0 } else { sv.min() };
+        let tolerance = rows.max(states) as f64 * f64::EPSILON * largest;
+        let rank = sv.iter().filter(|&&s| s > tolerance).count();
+        if rank < states || largest == 0.0 {
+            return Err(Error::Unobservable {
+                rank: if largest == 0.0 { 0 } else { rank },
+                states,
+                smallest_singular_value: smallest,
+                largest_singular_value: largest,
+            });
+        }
+        let qty = q.transpose() * y;
+        let x = r
+            .solve_upper_triangular(&qty)
+            .expect("R is non-singular at full rank");
+        Ok(Self {
+            t,
+            q,
+            r,
+            x,
+            condition_number: largest / smallest,
+        })
+    }
+
+    /// `(Rᵀ R)⁻¹ = R⁻¹ R⁻ᵀ`, the inverse of the Gram matrix `tᵀ t`.
+    fn inverse_gram(&self) -> DMatrix<f64> {
+        let n = self.r.ncols();
+        let r_inv = self
+            .r
+            .solve_upper_triangular(&DMatrix::identity(n, n))
+            .expect("R is non-singular at full rank");
+        symmetric(&r_inv * r_inv.transpose())
+    }
+
+    /// `W = R⁻¹ Qᵀ = (tᵀ t)⁻¹ tᵀ`.
+    fn weights(&self) -> DMatrix<f64> {
+        self.r
+            .solve_upper_triangular(&self.q.transpose())
+            .expect("R is non-singular at full rank")
+    }
+}
+
+fn finish(fit: Fit, covariance: DMatrix<f64>, chi_squared: f64) -> Result<BatchEstimate, Error> {
+    let out_of_range = |what: &str| Error::EstimateOutOfRange { what: what.into() };
+    if !fit.x.iter().all(|v| v.is_finite()) {
+        return Err(out_of_range("state"));
+    }
+    if !covariance.iter().all(|v| v.is_finite()) {
+        return Err(out_of_range("covariance"));
+    }
+    if !chi_squared.is_finite() {
+        return Err(out_of_range("residual chi-squared"));
+    }
+    let (rows, states) = fit.t.shape();
+    Ok(BatchEstimate {
+        state: fit.x,
+        covariance,
+        chi_squared,
+        degrees_of_freedom: rows - states,
+        condition_number: fit.condition_number,
+    })
+}
+
+/// `(a + aᵀ)/2`.
+fn symmetric(a: DMatrix<f64>) -> DMatrix<f64> {
+    (&a + a.transpose()) * 0.5
+}
+
+/// `L⁻¹ T` and `L⁻¹ Y` for `R = L Lᵀ`.
+fn whiten(
+    t: &DMatrix<f64>,
+    y: &DVector<f64>,
+    noise: &NoiseCovariance,
+) -> Result<(DMatrix<f64>, DVector<f64>), Error> {
+    match noise {
+        NoiseCovariance::Identity => Ok((t.clone(), y.clone())),
+        NoiseCovariance::Variances(v) => {
+            let (mut tw, mut yw) = (t.clone(), y.clone());
+            for (k, v) in v.iter().enumerate() {
+                let s = v.sqrt();
+                tw.row_mut(k).unscale_mut(s);
+                yw[k] /= s;
+            }
+            Ok((tw, yw))
+        }
+        NoiseCovariance::Full(r) => {
+            let l = Cholesky::new(r.clone())
+                .ok_or_else(|| Error::InvalidParameter {
+                    name: "noise covariance",
+                    value: format!("{r}").trim().replace('\n', " "),
+                    reason: "must be symmetric positive definite (its Cholesky factorisation \
+                             failed)"
+                        .into(),
+                })?
+                .l();
+            let tw = l
+                .solve_lower_triangular(t)
+                .expect("a Cholesky factor is non-singular");
+            let yw = l
+                .solve_lower_triangular(y)
+                .expect("a Cholesky factor is non-singular");
+            Ok((tw, yw))
+        }
+    }
+}
+
+/// Shapes agree, every number is finite, variances are positive, `R` is symmetric.
+fn check(t: &DMatrix<f64>, y: &DVector<f64>, noise: &NoiseCovariance) -> Result<(), Error> {
+    let bad = |name: &'static str, value: String, reason: &str| Error::InvalidParameter {
+        name,
+        value,
+        reason: reason.into(),
+    };
+    let (rows, states) = t.shape();
+    if states == 0 || rows == 0 {
+        return Err(bad(
+            "observation matrix T",
+            format!("{rows}x{states}"),
+            "must have at least one row and one column",
+        ));
+    }
+    if y.len() != rows {
+        return Err(bad(
+            "observations Y",
+            format!("of length {}", y.len()),
+            &format!("must have one value per row of T ({rows})"),
+        ));
+    }
+    if let Some((k, v)) = t.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        let (i, j) = (k % rows, k / rows);
+        return Err(bad(
+            "observation matrix T",
+            format!("entry [{i}, {j}] = {v}"),
+            "must be finite",
+        ));
+    }
+    if let Some((k, v)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(bad(
+            "observations Y",
+            format!("entry {k} = {v}"),
+            "must be finite",
+        ));
+    }
+    match noise {
+        NoiseCovariance::Identity => {}
+        NoiseCovariance::Variances(v) => {
+            if v.len() != rows {
+                return Err(bad(
+                    "noise variances",
+                    format!("of length {}", v.len()),
+                    &format!("must have one variance per row of T ({rows})"),
+                ));
+            }
+            if let Some((k, v)) = v
+                .iter()
+                .enumerate()
+                .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+            {
+                return Err(bad(
+                    "noise variance",
+                    format!("{v} (observation {k})"),
+                    "must be positive and finite",
+                ));
+            }
+        }
+        NoiseCovariance::Full(r) => {
+            if r.shape() != (rows, rows) {
+                return Err(bad(
+                    "noise covariance",
+                    format!("{}x{}", r.nrows(), r.ncols()),
+                    &format!("must be {rows}x{rows}, one row and column per row of T"),
+                ));
+            }
+            if let Some((k, v)) = r.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                return Err(bad(
+                    "noise covariance",
+                    format!("entry [{}, {}] = {v}", k % rows, k / rows),
+                    "must be finite",
+                ));
+            }
+            let asymmetry = (r - r.transpose()).amax();
+            if asymmetry > 1e-12 * r.amax() {
+                return Err(bad(
+                    "noise covariance",
+                    format!("with |R - Rᵀ| = {asymmetry:e}"),
+                    "must be symmetric",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
