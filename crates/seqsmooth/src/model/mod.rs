@@ -1,5 +1,5 @@
-//! The polynomial process model: state conventions, scaling and transition matrices
-//! (Morrison ch. 4; Reyneke et al. §4).
+//! Process models (Morrison ch. 4): the polynomial model's state conventions, scaling and
+//! transition matrices (Reyneke et al. §4), and constant-coefficient linear dynamics.
 //!
 //! For a degree-`m` process `x(t)` three state vectors appear in the sources:
 //!
@@ -15,7 +15,9 @@
 //! - [`transition`]: the matrices `Φ(h)` and `Ψ(ζ)`.
 //! - [`taylor`]: `Φ(h) z` as an in-place Taylor shift (plain and compensated) and `D(τ)`.
 //! - [`state`]: [`PolynomialState`], the public estimate with its propagation.
+//! - [`linear`]: constant-coefficient linear dynamics `dX/dt = A X`, `Φ(ζ) = e^{ζA}` (§4.6).
 
+pub mod linear;
 pub mod state;
 pub mod taylor;
 pub mod transition;
