@@ -10,10 +10,11 @@
 //! variance: `L⁻¹ T`, `L⁻¹ Y`), never by forming the normal equations, whose condition number is
 //! the square of `T`'s. The numerical rank of `T` is checked first (singular values of the QR
 //! factor; a singular value at most `max(N, n) ε σ_max` counts as zero, as numpy's
-//! `matrix_rank` does): a `T` that does not determine the state is [`Error::Unobservable`],
+//! `matrix_rank` does; [`super::observability`]): a `T` that does not determine the state is [`Error::Unobservable`],
 //! naming the rank. The residual `χ² = (Y − T X)ᵀ R⁻¹ (Y − T X)` has `N − n` degrees of
 //! freedom for the minimum-variance estimate (6.10.x).
 
+use super::observability::numerical_rank;
 use crate::error::Error;
 use nalgebra::{Cholesky, DMatrix, DVector};
 
@@ -125,11 +126,10 @@ impl Fit {
         let sv = r.singular_values();
         let largest = sv.max();
         let smallest = if rows < states { 0.0 } else { sv.min() };
-        let tolerance = rows.max(states) as f64 * f64::EPSILON * largest;
-        let rank = sv.iter().filter(|&&s| s > tolerance).count();
-        if rank < states || largest == 0.0 {
+        let rank = numerical_rank(sv.as_slice(), rows, states);
+        if rank < states {
             return Err(Error::Unobservable {
-                rank: if largest == 0.0 { 0 } else { rank },
+                rank,
                 states,
                 smallest_singular_value: smallest,
                 largest_singular_value: largest,

@@ -1,6 +1,7 @@
 //! Batch estimation: weighted least-squares polynomial fits on arbitrary timestamps, and the
 //! minimum-variance and least-squares estimates of any state from stacked linear observations
-//! ([`batch`]).
+//! ([`batch`]), and whether linear observations of linear dynamics determine the state
+//! ([`observability`]).
 //!
 //! [`PolynomialFit`] solves the weighted least-squares problem by a Householder QR factorisation
 //! in the Legendre basis on the data interval mapped to `[-1, 1]` (condition number of order
@@ -9,8 +10,10 @@
 //! recursive filters and their test oracle.
 
 pub mod batch;
+pub mod observability;
 
 pub use batch::{least_squares, minimum_variance, BatchEstimate, NoiseCovariance};
+pub use observability::{observability, Observability};
 
 use crate::basis::legendre::taylor_table;
 use crate::error::Error;
