@@ -171,12 +171,13 @@ fn minimum_variance_equals_exact_rationals() {
         let (x, s) = exact_minimum_variance(&t, &y, &r);
         let scale = e.condition_number.max(1.0);
         for (k, (g, w)) in e.state.iter().zip(&x).enumerate() {
-            let tol = 1e-14 * scale * scale * w.abs().max(1.0);
+            let tol = 1e-15 * scale * scale * w.abs().max(1.0);
             assert!((g - w).abs() <= tol, "case {case} X[{k}]: {g} against {w}");
         }
         let err = (&e.covariance - &s).amax() / s.amax();
-        // Backward stable QR: error within a few ε κ² (κ below 100 here; measured ≤ 1.4e-14).
-        assert!(err <= 1e-14 * scale * scale, "case {case}: S error {err:e}");
+        // Backward stable QR: error within a few ε κ² (κ below 100 here; measured ≤ 1.4e-14,
+        // where the bound is 3.8e-12).
+        assert!(err <= 1e-15 * scale * scale, "case {case}: S error {err:e}");
     }
 }
 

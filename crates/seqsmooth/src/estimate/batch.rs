@@ -62,8 +62,9 @@ pub fn minimum_variance(
     noise: &NoiseCovariance,
 ) -> Result<BatchEstimate, Error> {
     check(t, y, noise)?;
-    let (tw, yw) = whiten(t, y, noise)?;
-    let fit = Fit::new(tw, &yw)?;
+    let whitener = Whitener::new(noise)?;
+    let yw = whitener.apply(y);
+    let fit = Fit::new(whitener.apply(t), &yw)?;
     let covariance = fit.inverse_gram();
     let chi_squared = (&yw - &fit.t * &fit.x).norm_squared();
     finish(fit, covariance, chi_squared)
@@ -88,6 +89,7 @@ pub fn least_squares(
     noise: &NoiseCovariance,
 ) -> Result<BatchEstimate, Error> {
     check(t, y, noise)?;
+    let whitener = Whitener::new(noise)?;
     let fit = Fit::new(t.clone(), y)?;
     // W = R⁻¹ Qᵀ (the QR's factors), S = W R Wᵀ.
     let w = fit.weights();
@@ -103,7 +105,7 @@ pub fn least_squares(
         NoiseCovariance::Full(r) => &w * r * w.transpose(),
     };
     let residual = y - t * &fit.x;
-    let chi_squared = whiten(t, &residual, noise)?.1.norm_squared();
+    let chi_squared = whitener.apply(&residual).norm_squared();
     finish(fit, symmetric(covariance), chi_squared)
 }
 
@@ -192,40 +194,53 @@ fn symmetric(a: DMatrix<f64>) -> DMatrix<f64> {
     (&a + a.transpose()) * 0.5
 }
 
-/// `L⁻¹ T` and `L⁻¹ Y` for `R = L Lᵀ`.
-fn whiten(
-    t: &DMatrix<f64>,
-    y: &DVector<f64>,
-    noise: &NoiseCovariance,
-) -> Result<(DMatrix<f64>, DVector<f64>), Error> {
-    match noise {
-        NoiseCovariance::Identity => Ok((t.clone(), y.clone())),
-        NoiseCovariance::Variances(v) => {
-            let (mut tw, mut yw) = (t.clone(), y.clone());
-            for (k, v) in v.iter().enumerate() {
-                let s = v.sqrt();
-                tw.row_mut(k).unscale_mut(s);
-                yw[k] /= s;
+/// `x ↦ L⁻¹ x` for `R = L Lᵀ`: the identity, `1/σ_k` per row, or the Cholesky factor's
+/// triangular solve.
+enum Whitener {
+    Identity,
+    Sigmas(Vec<f64>),
+    Cholesky(DMatrix<f64>),
+}
+
+impl Whitener {
+    fn new(noise: &NoiseCovariance) -> Result<Self, Error> {
+        Ok(match noise {
+            NoiseCovariance::Identity => Self::Identity,
+            NoiseCovariance::Variances(v) => Self::Sigmas(v.iter().map(|v| v.sqrt()).collect()),
+            NoiseCovariance::Full(r) => Self::Cholesky(
+                Cholesky::new(r.clone())
+                    .ok_or_else(|| Error::InvalidParameter {
+                        name: "noise covariance",
+                        value: format!("{r}").trim().replace('\n', " "),
+                        reason: "must be symmetric positive definite (its Cholesky \
+                                 factorisation failed)"
+                            .into(),
+                    })?
+                    .l(),
+            ),
+        })
+    }
+
+    /// `L⁻¹ x` for a matrix (or a vector) `x` with one row per observation.
+    fn apply<C: nalgebra::Dim>(
+        &self,
+        x: &nalgebra::OMatrix<f64, nalgebra::Dyn, C>,
+    ) -> nalgebra::OMatrix<f64, nalgebra::Dyn, C>
+    where
+        nalgebra::DefaultAllocator: nalgebra::allocator::Allocator<nalgebra::Dyn, C>,
+    {
+        match self {
+            Self::Identity => x.clone(),
+            Self::Sigmas(s) => {
+                let mut w = x.clone();
+                for (k, s) in s.iter().enumerate() {
+                    w.row_mut(k).unscale_mut(*s);
+                }
+                w
             }
-            Ok((tw, yw))
-        }
-        NoiseCovariance::Full(r) => {
-            let l = Cholesky::new(r.clone())
-                .ok_or_else(|| Error::InvalidParameter {
-                    name: "noise covariance",
-                    value: format!("{r}").trim().replace('\n', " "),
-                    reason: "must be symmetric positive definite (its Cholesky factorisation \
-                             failed)"
-                        .into(),
-                })?
-                .l();
-            let tw = l
-                .solve_lower_triangular(t)
-                .expect("a Cholesky factor is non-singular");
-            let yw = l
-                .solve_lower_triangular(y)
-                .expect("a Cholesky factor is non-singular");
-            Ok((tw, yw))
+            Self::Cholesky(l) => l
+                .solve_lower_triangular(x)
+                .expect("a Cholesky factor is non-singular"),
         }
     }
 }
