@@ -42,7 +42,7 @@ const OPTIONS: [(&str, &[&str]); 12] = [
 /// The argument vector: subcommand, input and output files, then options as `--name=value`
 /// (so that no value can become a file name).
 fn arguments(input: &mut Input, csv: &Path, out: &Path) -> Vec<String> {
-    let sub = if input.byte() % 4 == 0 {
+    let sub = if input.byte().is_multiple_of(4) {
         "smooth"
     } else {
         "filter"

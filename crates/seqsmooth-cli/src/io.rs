@@ -52,7 +52,7 @@ fn tie_digit(x: f64, text: &[u8]) -> Option<usize> {
             .checked_pow(p.unsigned_abs())
             .and_then(|f| f.checked_mul(odd))
     };
-    if e < -1 && (e < -27 || !scaled(e + 1).is_some_and(|v| v < 2 * 10u128.pow(17))) {
+    if e < -1 && (e < -27 || scaled(e + 1).is_none_or(|v| v >= 2 * 10u128.pow(17))) {
         return None;
     }
     let (mut d, mut decimals, mut point, mut end) = (0u128, 0i32, false, text.len());

@@ -172,7 +172,7 @@ fn fading_vrf_full_matrices_13_6_26_13_6_34_and_m2() {
             .collect();
         for m in 0..=6usize {
             let sgn = |i: usize, j: usize, v: &Q| {
-                if (i + j) % 2 == 0 {
+                if (i + j).is_multiple_of(2) {
                     v.clone()
                 } else {
                     -v.clone()

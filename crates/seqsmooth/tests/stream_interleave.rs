@@ -69,7 +69,7 @@ impl PolynomialFilter for Any {
 /// The filter `kind` (0-5) of degree `m`, noise σ = 1 for its covariance.
 fn filter(kind: u8, m: usize) -> Any {
     let engine = |k: u8| {
-        if k % 2 == 0 {
+        if k.is_multiple_of(2) {
             Engine::Exact
         } else {
             Engine::Gain

@@ -36,7 +36,7 @@ pub fn qpow(x: &Q, k: usize) -> Q {
 
 /// (-1)^k.
 pub fn sign(k: usize) -> Q {
-    if k % 2 == 0 {
+    if k.is_multiple_of(2) {
         Q::one()
     } else {
         -Q::one()

@@ -13,7 +13,7 @@ use crate::scalar::Scalar;
 fn g<T: Scalar>(i: usize, j: usize) -> T {
     let v = T::ratio(2 * j as i64 + 1, 2 * i as i64 + 1) * choose::<T>(2 * i + 1, i - j)
         / choose::<T>(2 * i, i);
-    if j % 2 == 0 {
+    if j.is_multiple_of(2) {
         v
     } else {
         -v
@@ -136,7 +136,11 @@ pub fn dominant_bias<T: Scalar>(
     let l = span_scalar::<T>(span);
     let gamma = a_next * tau.powi_u(m + 1) * falling_factorial(l.clone(), m + 1)
         / choose::<T>(2 * m + 2, m + 1);
-    let gamma = if (m + 1) % 2 == 0 { gamma } else { -gamma };
+    let gamma = if (m + 1).is_multiple_of(2) {
+        gamma
+    } else {
+        -gamma
+    };
     let basis = DiscreteLegendre::new(l.clone());
     let dp = basis.derivatives_by_recursion(m + 1, m, &(l + h));
     Ok((0..=m)

@@ -101,7 +101,7 @@ impl Design {
                 });
             }
         }
-        if matches!(self.lead, Lead::Centre) && m % 2 == 0 {
+        if matches!(self.lead, Lead::Centre) && m.is_multiple_of(2) {
             return Err(Error::InvalidParameter {
                 name: "lead",
                 value: "centre".into(),
