@@ -15,9 +15,21 @@
 //! - [`transition`]: the matrices `Φ(h)` and `Ψ(ζ)`.
 //! - [`taylor`]: `Φ(h) z` as an in-place Taylor shift (plain and compensated) and `D(τ)`.
 //! - [`state`]: [`PolynomialState`], the public estimate with its propagation.
+//! - [`dynamics`]: the [`dynamics::Dynamics`] trait (the state at any time from any other, with
+//!   `Φ(t_b, t_a)`) and [`dynamics::PolynomialDynamics`] (degree `m` on `d` axes, through [`psi`]).
 //! - [`linear`]: constant-coefficient linear dynamics `dX/dt = A X`, `Φ(ζ) = e^{ζA}` (§4.6).
+//! - [`nonlinear`]: `dX/dt = F(X, t)` and `dX/dt = A(t) X` with `Φ` from the variational
+//!   equations (§4.7, §8.6), integrated by an embedded Runge–Kutta 8(5,3) pair.
+//! - [`observation`]: the [`observation::Observation`] trait `Y = G(X, t) + N`, `M = ∂G/∂X`,
+//!   linear and nonlinear (§8.2, §8.6).
+//! - [`radar`]: range, azimuth, elevation (and range rate) from a site; polar to Cartesian
+//!   with covariance; the nominal state of §8.5.
 
+pub mod dynamics;
 pub mod linear;
+pub mod nonlinear;
+pub mod observation;
+pub mod radar;
 pub mod state;
 pub mod taylor;
 pub mod transition;

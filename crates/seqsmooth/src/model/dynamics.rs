@@ -1,0 +1,244 @@
+//! The dynamic model of a state (Morrison ch. 4, §8.6): one trait for every model, giving the
+//! state at any time from the state at any other, forwards or backwards, with the transition
+//! matrix `Φ(t_b, t_a; X) = ∂X(t_b)/∂X(t_a)` along that trajectory (4.7.x, (8.6.5)-(8.6.7)).
+//!
+//! | model | `Φ(t_b, t_a)` | source |
+//! |---|---|---|
+//! | [`PolynomialDynamics`] (degree `m`, `d` axes) | `Ψ(t_b − t_a) ⊗ I_d`, exact | (4.2.5), [`super::psi`] |
+//! | [`super::linear::LinearDynamics`] `dX/dt = A X` | `e^{(t_b − t_a) A}` | (4.6.24)-(4.6.28) |
+//! | [`super::nonlinear::NonlinearDynamics`] `dX/dt = F(X, t)` | variational equations `dΦ/dt = (∂F/∂X) Φ` | (4.7.x), (8.6.6) |
+//!
+//! For a linear model `Φ` does not depend on the state; for a nonlinear one it is the
+//! linearisation about the trajectory through the given state (§8.6). A covariance is carried
+//! to first order, `S_b = Φ S_a Φᵀ` ((6.6.x); exact for linear models).
+
+use super::linear::LinearDynamics;
+use super::psi;
+use crate::error::Error;
+use nalgebra::{DMatrix, DVector};
+
+/// The state at `t_b` and the transition matrix `Φ(t_b, t_a)` that carried it there.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Propagation {
+    /// `X(t_b)`.
+    pub state: DVector<f64>,
+    /// `Φ(t_b, t_a) = ∂X(t_b)/∂X(t_a)`.
+    pub transition: DMatrix<f64>,
+}
+
+/// A dynamic model: the state dimension and the propagation of a state from any time to any
+/// other.
+///
+/// ```
+/// use nalgebra::DVector;
+/// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+/// // A constant-velocity state (x, x') carried back 2 time units.
+/// let p = PolynomialDynamics::new(1, 1).propagate(&DVector::from_vec(vec![5.0, 3.0]), 10.0, 8.0).unwrap();
+/// assert_eq!(p.state.as_slice(), &[-1.0, 3.0]);
+/// ```
+pub trait Dynamics {
+    /// The state dimension `n`.
+    fn dimension(&self) -> usize;
+
+    /// `X(t_b)` and `Φ(t_b, t_a)` from `X(t_a)`; `t_b < t_a` goes backwards.
+    fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error>;
+
+    /// `X(t_b)` and, to first order, its covariance `Φ S Φᵀ` from `X(t_a)` with covariance `S`.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+    /// let (x, s) = PolynomialDynamics::new(1, 1)
+    ///     .propagate_covariance(&DVector::from_vec(vec![0.0, 1.0]), &DMatrix::identity(2, 2), 0.0, 1.0)
+    ///     .unwrap();
+    /// assert_eq!(x[0], 1.0);
+    /// assert_eq!(s, DMatrix::from_row_slice(2, 2, &[2.0, 1.0, 1.0, 1.0]));
+    /// ```
+    fn propagate_covariance(
+        &self,
+        state: &DVector<f64>,
+        covariance: &DMatrix<f64>,
+        t_a: f64,
+        t_b: f64,
+    ) -> Result<(DVector<f64>, DMatrix<f64>), Error> {
+        let n = self.dimension();
+        if covariance.shape() != (n, n) {
+            return Err(Error::InvalidParameter {
+                name: "covariance",
+                value: format!("{}x{}", covariance.nrows(), covariance.ncols()),
+                reason: format!("must be {n}x{n}, the state dimension"),
+            });
+        }
+        if let Some(v) = covariance.iter().find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "covariance entry",
+                value: *v,
+            });
+        }
+        let p = self.propagate(state, t_a, t_b)?;
+        let s = &p.transition * covariance * p.transition.transpose();
+        let s = (&s + s.transpose()) * 0.5;
+        finite_matrix(&s, "propagated covariance")?;
+        Ok((p.state, s))
+    }
+}
+
+/// Refuses a state of the wrong length or with a non-finite entry, and non-finite times.
+pub(crate) fn check_propagation(
+    n: usize,
+    state: &DVector<f64>,
+    t_a: f64,
+    t_b: f64,
+) -> Result<(), Error> {
+    if state.len() != n {
+        return Err(Error::InvalidParameter {
+            name: "state",
+            value: format!("of length {}", state.len()),
+            reason: format!("must have the model's dimension {n}"),
+        });
+    }
+    if let Some(v) = state.iter().find(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            what: "state entry",
+            value: *v,
+        });
+    }
+    for t in [t_a, t_b] {
+        if !t.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: t,
+            });
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn finite_matrix(m: &DMatrix<f64>, what: &'static str) -> Result<(), Error> {
+    match m.iter().find(|v| !v.is_finite()) {
+        Some(&value) => Err(Error::NonFinite { what, value }),
+        None => Ok(()),
+    }
+}
+
+/// The polynomial model of degree `m` on `d` axes: each axis a degree-`m` polynomial in time, the
+/// state ordered by derivative, then axis, in unscaled derivatives:
+/// `(x₁, …, x_d, x₁′, …, x_d′, …, x₁^(m), …, x_d^(m))`, so that `d = 3`, `m = 1` is the 3-D
+/// constant-velocity state `(x, y, z, vx, vy, vz)`. `Φ(t_b, t_a) = Ψ(t_b − t_a) ⊗ I_d`
+/// (4.2.5), the one polynomial transition the crate has ([`super::psi`]).
+///
+/// ```
+/// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+/// let cv = PolynomialDynamics::new(1, 3);
+/// assert_eq!(cv.dimension(), 6);
+/// let phi = cv.transition(2.0);
+/// assert_eq!((phi[(0, 3)], phi[(2, 5)], phi[(0, 4)]), (2.0, 2.0, 0.0));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PolynomialDynamics {
+    degree: usize,
+    axes: usize,
+}
+
+impl PolynomialDynamics {
+    /// Degree `m` on `axes` axes (at least one).
+    ///
+    /// ```
+    /// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+    /// assert_eq!(PolynomialDynamics::new(2, 1).dimension(), 3);
+    /// ```
+    pub fn new(degree: usize, axes: usize) -> Self {
+        Self {
+            degree,
+            axes: axes.max(1),
+        }
+    }
+
+    /// The degree `m`.
+    ///
+    /// ```
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// assert_eq!(PolynomialDynamics::new(4, 2).degree(), 4);
+    /// ```
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+
+    /// The number of axes `d`.
+    ///
+    /// ```
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// assert_eq!(PolynomialDynamics::new(4, 2).axes(), 2);
+    /// ```
+    pub fn axes(&self) -> usize {
+        self.axes
+    }
+
+    /// `Φ(ζ) = Ψ(ζ) ⊗ I_d`: `[Φ]_{i d + a, j d + a} = ζ^(j−i)/(j−i)!` for `j ≥ i`.
+    ///
+    /// ```
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// assert_eq!(PolynomialDynamics::new(2, 1).transition(2.0)[(0, 2)], 2.0); // ζ²/2!
+    /// ```
+    pub fn transition(&self, zeta: f64) -> DMatrix<f64> {
+        let d = self.axes;
+        let base = psi(self.degree, zeta);
+        let n = (self.degree + 1) * d;
+        DMatrix::from_fn(n, n, |r, c| {
+            if r % d == c % d {
+                base[(r / d, c / d)]
+            } else {
+                0.0
+            }
+        })
+    }
+}
+
+impl Dynamics for PolynomialDynamics {
+    fn dimension(&self) -> usize {
+        (self.degree + 1) * self.axes
+    }
+
+    fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
+        check_propagation(self.dimension(), state, t_a, t_b)?;
+        let transition = self.transition(t_b - t_a);
+        finite_matrix(&transition, "transition matrix entry")?;
+        let state = &transition * state;
+        if let Some(v) = state.iter().find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "propagated state entry",
+                value: *v,
+            });
+        }
+        Ok(Propagation { state, transition })
+    }
+}
+
+impl Dynamics for LinearDynamics {
+    fn dimension(&self) -> usize {
+        LinearDynamics::dimension(self)
+    }
+
+    fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
+        check_propagation(LinearDynamics::dimension(self), state, t_a, t_b)?;
+        let transition = self.transition(t_b - t_a)?;
+        let state = &transition * state;
+        if let Some(v) = state.iter().find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "propagated state entry",
+                value: *v,
+            });
+        }
+        Ok(Propagation { state, transition })
+    }
+}
+
+impl<D: Dynamics + ?Sized> Dynamics for &D {
+    fn dimension(&self) -> usize {
+        (**self).dimension()
+    }
+
+    fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
+        (**self).propagate(state, t_a, t_b)
+    }
+}

@@ -1,0 +1,268 @@
+//! Observation models (Morrison §8.2, §8.6): what a sensor sees of the state,
+//! `Y = G(X, t) + N`, with the observation matrix `M = ∂G/∂X` ((8.6.8)-(8.6.13)); for a linear
+//! model `G = M X` (8.2.2).
+//!
+//! | model | `G(X, t)` | `M` |
+//! |---|---|---|
+//! | [`LinearObservation`] | `M X` | the given `M` |
+//! | [`NonlinearObservation`] | the caller's `G` | the caller's, or central differences |
+//! | [`super::radar::Radar`] | range, azimuth, elevation (and range rate) from a site | analytic |
+//!
+//! A residual `Y − G` is taken by [`Observation::residual`], where an angle is wrapped.
+
+use super::nonlinear::central_differences;
+use crate::error::Error;
+use nalgebra::{DMatrix, DVector};
+use std::sync::Arc;
+
+/// `G(X, t)` and `M = ∂G/∂X` at one state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Predicted {
+    /// `G(X, t)`, one number per component.
+    pub value: DVector<f64>,
+    /// `M`, components × states.
+    pub jacobian: DMatrix<f64>,
+}
+
+/// An observation model of `components` numbers from a state of `state_dimension`.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::model::observation::{LinearObservation, Observation};
+/// let m = LinearObservation::new(DMatrix::from_row_slice(1, 2, &[1.0, 0.0])).unwrap();
+/// let p = m.predict(&DVector::from_vec(vec![3.0, 4.0]), 0.0).unwrap();
+/// assert_eq!(p.value[0], 3.0);
+/// ```
+pub trait Observation {
+    /// The numbers in one observation.
+    fn components(&self) -> usize;
+
+    /// The state dimension.
+    fn state_dimension(&self) -> usize;
+
+    /// `G(X, t)` and `M(X, t)`.
+    fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error>;
+
+    /// The residual of component `component`, `measured − predicted` (an angle's wrapped to
+    /// `(−π, π]`).
+    fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {
+        let _ = component;
+        measured - predicted
+    }
+}
+
+impl<O: Observation + ?Sized> Observation for &O {
+    fn components(&self) -> usize {
+        (**self).components()
+    }
+    fn state_dimension(&self) -> usize {
+        (**self).state_dimension()
+    }
+    fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error> {
+        (**self).predict(state, t)
+    }
+    fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {
+        (**self).residual(component, measured, predicted)
+    }
+}
+
+/// Refuses a state of the wrong length or with a non-finite entry.
+pub(crate) fn check_state(n: usize, state: &DVector<f64>) -> Result<(), Error> {
+    if state.len() != n {
+        return Err(Error::InvalidParameter {
+            name: "state",
+            value: format!("of length {}", state.len()),
+            reason: format!("the observation model needs {n} states"),
+        });
+    }
+    match state.iter().find(|v| !v.is_finite()) {
+        Some(&value) => Err(Error::NonFinite {
+            what: "state entry",
+            value,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// `Y = M X + N` with a constant `M` (8.2.2).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearObservation {
+    m: DMatrix<f64>,
+}
+
+impl LinearObservation {
+    /// `M`: components × states, finite, not empty.
+    ///
+    /// ```
+    /// use nalgebra::DMatrix;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// assert!(LinearObservation::new(DMatrix::from_row_slice(1, 1, &[f64::NAN])).is_err());
+    /// ```
+    pub fn new(m: DMatrix<f64>) -> Result<Self, Error> {
+        if m.is_empty() {
+            return Err(Error::InvalidParameter {
+                name: "observation matrix M",
+                value: format!("{}x{}", m.nrows(), m.ncols()),
+                reason: "must not be empty".into(),
+            });
+        }
+        if let Some(&value) = m.iter().find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "observation matrix entry",
+                value,
+            });
+        }
+        Ok(Self { m })
+    }
+
+    /// The first component of a polynomial state: `M = (1, 0, …, 0)` (8.3.5).
+    ///
+    /// ```
+    /// use seqsmooth::model::observation::{LinearObservation, Observation};
+    /// assert_eq!(LinearObservation::value_of(3).state_dimension(), 3);
+    /// ```
+    pub fn value_of(states: usize) -> Self {
+        let mut m = DMatrix::zeros(1, states.max(1));
+        m[(0, 0)] = 1.0;
+        Self { m }
+    }
+
+    /// `M`.
+    ///
+    /// ```
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// assert_eq!(LinearObservation::value_of(2).matrix()[(0, 0)], 1.0);
+    /// ```
+    pub fn matrix(&self) -> &DMatrix<f64> {
+        &self.m
+    }
+}
+
+impl Observation for LinearObservation {
+    fn components(&self) -> usize {
+        self.m.nrows()
+    }
+    fn state_dimension(&self) -> usize {
+        self.m.ncols()
+    }
+    fn predict(&self, state: &DVector<f64>, _t: f64) -> Result<Predicted, Error> {
+        check_state(self.m.ncols(), state)?;
+        let value = &self.m * state;
+        match value.iter().find(|v| !v.is_finite()) {
+            Some(&v) => Err(Error::NonFinite {
+                what: "predicted observation",
+                value: v,
+            }),
+            None => Ok(Predicted {
+                value,
+                jacobian: self.m.clone(),
+            }),
+        }
+    }
+}
+
+type Map = Arc<dyn Fn(f64, &DVector<f64>) -> DVector<f64> + Send + Sync>;
+type MapJacobian = Arc<dyn Fn(f64, &DVector<f64>) -> DMatrix<f64> + Send + Sync>;
+
+/// `Y = G(X, t) + N` with the caller's `G` (and `M = ∂G/∂X` if given, else central
+/// differences with the step rule of [`super::nonlinear`]).
+///
+/// ```
+/// use nalgebra::DVector;
+/// use seqsmooth::model::observation::{NonlinearObservation, Observation};
+/// // Morrison Ex. 11.1: the range sqrt(d² + x²) of a body at x from a sensor at distance d = 3.
+/// let range = NonlinearObservation::new(1, 1, |_t, x: &DVector<f64>| DVector::from_vec(vec![(9.0 + x[0] * x[0]).sqrt()]));
+/// let p = range.predict(&DVector::from_vec(vec![4.0]), 0.0).unwrap();
+/// assert_eq!(p.value[0], 5.0);
+/// assert!((p.jacobian[(0, 0)] - 0.8).abs() < 1e-9); // m(x) = x/sqrt(d² + x²)
+/// ```
+#[derive(Clone)]
+pub struct NonlinearObservation {
+    components: usize,
+    states: usize,
+    map: Map,
+    jacobian: Option<MapJacobian>,
+}
+
+impl std::fmt::Debug for NonlinearObservation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NonlinearObservation")
+            .field("components", &self.components)
+            .field("states", &self.states)
+            .field("analytic_jacobian", &self.jacobian.is_some())
+            .finish()
+    }
+}
+
+impl NonlinearObservation {
+    /// `components` numbers `G(t, X)` from `states` states.
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::model::observation::{NonlinearObservation, Observation};
+    /// let g = NonlinearObservation::new(2, 1, |_t, x: &DVector<f64>| DVector::from_vec(vec![x[0], x[0] * x[0]]));
+    /// assert_eq!(g.components(), 2);
+    /// ```
+    pub fn new<G>(components: usize, states: usize, map: G) -> Self
+    where
+        G: Fn(f64, &DVector<f64>) -> DVector<f64> + Send + Sync + 'static,
+    {
+        Self {
+            components,
+            states,
+            map: Arc::new(map),
+            jacobian: None,
+        }
+    }
+
+    /// With the analytic `M = ∂G/∂X` (components × states).
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::model::observation::{NonlinearObservation, Observation};
+    /// let g = NonlinearObservation::new(1, 1, |_t, x: &DVector<f64>| x.map(f64::sin))
+    ///     .with_jacobian(|_t, x: &DVector<f64>| DMatrix::from_element(1, 1, x[0].cos()));
+    /// assert_eq!(g.predict(&DVector::from_vec(vec![0.0]), 0.0).unwrap().jacobian[(0, 0)], 1.0);
+    /// ```
+    pub fn with_jacobian<J>(mut self, jacobian: J) -> Self
+    where
+        J: Fn(f64, &DVector<f64>) -> DMatrix<f64> + Send + Sync + 'static,
+    {
+        self.jacobian = Some(Arc::new(jacobian));
+        self
+    }
+
+    fn value_at(&self, t: f64, x: &DVector<f64>) -> Option<DVector<f64>> {
+        let g = (self.map)(t, x);
+        (g.len() == self.components && g.iter().all(|v| v.is_finite())).then_some(g)
+    }
+}
+
+impl Observation for NonlinearObservation {
+    fn components(&self) -> usize {
+        self.components
+    }
+    fn state_dimension(&self) -> usize {
+        self.states
+    }
+    fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error> {
+        check_state(self.states, state)?;
+        let refuse = || Error::InvalidParameter {
+            name: "observation model",
+            value: format!("at t = {t}"),
+            reason: format!(
+                "G(X, t) or its Jacobian has a non-finite entry or is not {} x {}",
+                self.components, self.states
+            ),
+        };
+        let value = self.value_at(t, state).ok_or_else(refuse)?;
+        let jacobian = match &self.jacobian {
+            Some(j) => Some(j(t, state)).filter(|j| {
+                j.shape() == (self.components, self.states) && j.iter().all(|v| v.is_finite())
+            }),
+            None => central_differences(self.components, state, |x| self.value_at(t, x)),
+        }
+        .ok_or_else(refuse)?;
+        Ok(Predicted { value, jacobian })
+    }
+}

@@ -1,0 +1,283 @@
+//! Radar geometry (Morrison §8.5, (8.5.3)-(8.5.7)): the range, azimuth and elevation (and,
+//! optionally, the range rate) of a Cartesian state seen from a site, their Jacobian, the
+//! conversion of a measurement to Cartesian position with its covariance (the nominal state of
+//! §8.5 from polynomial fits is `estimate::bootstrap`).
+//!
+//! Conventions, once: the state's first three components are the position `(x, y, z)` and the
+//! next three the velocity (the order of [`super::dynamics::PolynomialDynamics`] on 3 axes);
+//! with `p = position − site`,
+//!
+//! | component | definition | range of values |
+//! |---|---|---|
+//! | range `ρ` | `|p|` | `ρ > 0` |
+//! | azimuth `ψ` | from `+x` towards `+y`, `atan2(p_y, p_x)` | `(−π, π]` radians |
+//! | elevation `θ` | from the `x-y` plane, `atan2(p_z, sqrt(p_x² + p_y²))` | `[−π/2, π/2]` radians |
+//! | range rate `ρ̇` | `p · v / ρ` | |
+//!
+//! An azimuth residual is wrapped to `(−π, π]`. Directly above or below the site (`p_x = p_y =
+//! 0`) the azimuth is undefined and a prediction there is refused.
+
+use super::observation::{check_state, Observation, Predicted};
+use crate::error::Error;
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use std::f64::consts::{PI, TAU};
+
+/// A radar at `site` measuring range, azimuth, elevation and, optionally, range rate.
+///
+/// ```
+/// use nalgebra::DVector;
+/// use seqsmooth::model::observation::Observation;
+/// use seqsmooth::model::radar::Radar;
+/// let radar = Radar::new([0.0, 0.0, 0.0], 6).unwrap();
+/// let p = radar.predict(&DVector::from_vec(vec![0.0, 3.0, 4.0, 1.0, 0.0, 0.0]), 0.0).unwrap();
+/// assert_eq!(p.value[0], 5.0);
+/// assert!((p.value[1] - std::f64::consts::FRAC_PI_2).abs() < 1e-15); // +y: azimuth π/2
+/// assert!((p.value[2] - (4.0_f64 / 3.0).atan()).abs() < 1e-15);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Radar {
+    site: [f64; 3],
+    states: usize,
+    range_rate: bool,
+}
+
+impl Radar {
+    /// A radar at `site` (finite) for a state of `states ≥ 3` components.
+    ///
+    /// ```
+    /// use seqsmooth::model::radar::Radar;
+    /// assert!(Radar::new([0.0, 0.0, f64::NAN], 6).is_err());
+    /// assert!(Radar::new([0.0; 3], 2).is_err());
+    /// ```
+    pub fn new(site: [f64; 3], states: usize) -> Result<Self, Error> {
+        if let Some(&value) = site.iter().find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "radar site coordinate",
+                value,
+            });
+        }
+        if states < 3 {
+            return Err(Error::InvalidParameter {
+                name: "state dimension",
+                value: states.to_string(),
+                reason: "a radar needs the position (x, y, z) as the first three states".into(),
+            });
+        }
+        Ok(Self {
+            site,
+            states,
+            range_rate: false,
+        })
+    }
+
+    /// Also measure the range rate `ρ̇ = p · v / ρ` (needs the velocity as states 3-5).
+    ///
+    /// ```
+    /// use seqsmooth::model::observation::Observation;
+    /// use seqsmooth::model::radar::Radar;
+    /// assert_eq!(Radar::new([0.0; 3], 6).unwrap().with_range_rate().unwrap().components(), 4);
+    /// assert!(Radar::new([0.0; 3], 3).unwrap().with_range_rate().is_err());
+    /// ```
+    pub fn with_range_rate(mut self) -> Result<Self, Error> {
+        if self.states < 6 {
+            return Err(Error::InvalidParameter {
+                name: "state dimension",
+                value: self.states.to_string(),
+                reason: "the range rate needs the velocity as states 3-5".into(),
+            });
+        }
+        self.range_rate = true;
+        Ok(self)
+    }
+
+    /// The site.
+    ///
+    /// ```
+    /// use seqsmooth::model::radar::Radar;
+    /// assert_eq!(Radar::new([1.0, 2.0, 3.0], 6).unwrap().site(), [1.0, 2.0, 3.0]);
+    /// ```
+    pub fn site(&self) -> [f64; 3] {
+        self.site
+    }
+
+    /// The Cartesian position (absolute) of a measurement `(ρ, ψ, θ)` and, to first order, its
+    /// covariance `J R Jᵀ`, `J = ∂(x, y, z)/∂(ρ, ψ, θ)` at the measurement (8.5.6).
+    ///
+    /// Valid while the angle errors are small: the converted mean is biased towards the site by
+    /// about `ρ (σ_ψ² cos²θ + σ_θ²)/2` (from `E[cos e] = e^{−σ²/2}` for a Gaussian angle error
+    /// `e`), and the first-order covariance is consistent while that bias is small against the
+    /// smallest standard deviation it reports; [`Converted::bias`] gives the bias to compare.
+    ///
+    /// ```
+    /// use nalgebra::Matrix3;
+    /// use seqsmooth::model::radar::Radar;
+    /// let radar = Radar::new([0.0; 3], 6).unwrap();
+    /// let r = Matrix3::from_diagonal(&[100.0, 1e-6, 1e-6].into()); // σ 10 m, 1 mrad
+    /// let c = radar.to_cartesian([10_000.0, 0.0, 0.0], &r).unwrap();
+    /// assert!((c.position[0] - 10_000.0).abs() < 1e-9);
+    /// assert!((c.covariance[(1, 1)] - 100.0).abs() < 1e-9); // (ρ σ_ψ)²
+    /// assert!(c.bias < 0.011);
+    /// ```
+    pub fn to_cartesian(
+        &self,
+        measured: [f64; 3],
+        covariance: &Matrix3<f64>,
+    ) -> Result<Converted, Error> {
+        if let Some(&value) = measured
+            .iter()
+            .chain(covariance.iter())
+            .find(|v| !v.is_finite())
+        {
+            return Err(Error::NonFinite {
+                what: "radar measurement or covariance entry",
+                value,
+            });
+        }
+        let [rho, psi, theta] = measured;
+        if rho <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "range",
+                value: rho.to_string(),
+                reason: "must be positive".into(),
+            });
+        }
+        if covariance.cholesky().is_none()
+            || (covariance - covariance.transpose()).abs().max() > 1e-12 * covariance.abs().max()
+        {
+            return Err(Error::InvalidParameter {
+                name: "measurement covariance",
+                value: format!("{covariance:?}"),
+                reason: "must be symmetric positive definite".into(),
+            });
+        }
+        let (sp, cp) = psi.sin_cos();
+        let (st, ct) = theta.sin_cos();
+        let direction = Vector3::new(ct * cp, ct * sp, st);
+        let position = Vector3::from(self.site) + direction * rho;
+        let j = Matrix3::new(
+            ct * cp,
+            -rho * ct * sp,
+            -rho * st * cp, //
+            ct * sp,
+            rho * ct * cp,
+            -rho * st * sp, //
+            st,
+            0.0,
+            rho * ct,
+        );
+        let bias = 0.5 * rho * (covariance[(1, 1)] * ct * ct + covariance[(2, 2)]);
+        let covariance = j * covariance * j.transpose();
+        let covariance = (covariance + covariance.transpose()) * 0.5;
+        Ok(Converted {
+            position,
+            covariance,
+            bias,
+        })
+    }
+}
+
+/// A radar measurement in Cartesian position, with its first-order covariance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Converted {
+    /// The position `site + ρ (cos θ cos ψ, cos θ sin ψ, sin θ)`.
+    pub position: Vector3<f64>,
+    /// `J R Jᵀ`.
+    pub covariance: Matrix3<f64>,
+    /// `ρ (σ_ψ² cos²θ + σ_θ²)/2`, the conversion's bias to second order, to compare with the
+    /// reported standard deviations.
+    pub bias: f64,
+}
+
+/// `a` wrapped to `(−π, π]`.
+///
+/// ```
+/// use seqsmooth::model::radar::wrap;
+/// assert!((wrap(3.0 * std::f64::consts::PI / 2.0) + std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+/// assert_eq!(wrap(std::f64::consts::PI), std::f64::consts::PI);
+/// assert_eq!(wrap(-std::f64::consts::PI), std::f64::consts::PI);
+/// ```
+pub fn wrap(a: f64) -> f64 {
+    let w = a - TAU * (a / TAU).round();
+    if w <= -PI {
+        w + TAU
+    } else if w > PI {
+        w - TAU
+    } else {
+        w
+    }
+}
+
+impl Observation for Radar {
+    fn components(&self) -> usize {
+        if self.range_rate {
+            4
+        } else {
+            3
+        }
+    }
+
+    fn state_dimension(&self) -> usize {
+        self.states
+    }
+
+    fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error> {
+        check_state(self.states, state)?;
+        let p = [
+            state[0] - self.site[0],
+            state[1] - self.site[1],
+            state[2] - self.site[2],
+        ];
+        let h2 = p[0] * p[0] + p[1] * p[1];
+        let rho2 = h2 + p[2] * p[2];
+        let (h, rho) = (h2.sqrt(), rho2.sqrt());
+        if !(h > 0.0 && h.is_finite() && rho.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "radar geometry",
+                value: format!(
+                    "position ({}, {}, {}) at t = {t}",
+                    state[0], state[1], state[2]
+                ),
+                reason: "at the site or directly above or below it: the azimuth is undefined"
+                    .into(),
+            });
+        }
+        let rows = self.components();
+        let mut value = DVector::zeros(rows);
+        let mut jacobian = DMatrix::zeros(rows, self.states);
+        value[0] = rho;
+        value[1] = p[1].atan2(p[0]);
+        value[2] = p[2].atan2(h);
+        for k in 0..3 {
+            jacobian[(0, k)] = p[k] / rho;
+        }
+        jacobian[(1, 0)] = -p[1] / h2;
+        jacobian[(1, 1)] = p[0] / h2;
+        jacobian[(2, 0)] = -p[0] * p[2] / (rho2 * h);
+        jacobian[(2, 1)] = -p[1] * p[2] / (rho2 * h);
+        jacobian[(2, 2)] = h / rho2;
+        if self.range_rate {
+            let v = [state[3], state[4], state[5]];
+            let pv = p[0] * v[0] + p[1] * v[1] + p[2] * v[2];
+            value[3] = pv / rho;
+            for k in 0..3 {
+                jacobian[(3, k)] = v[k] / rho - pv * p[k] / (rho2 * rho);
+                jacobian[(3, 3 + k)] = p[k] / rho;
+            }
+        }
+        if let Some(&v) = value.iter().chain(jacobian.iter()).find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "radar prediction",
+                value: v,
+            });
+        }
+        Ok(Predicted { value, jacobian })
+    }
+
+    fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {
+        if component == 1 {
+            wrap(measured - predicted)
+        } else {
+            measured - predicted
+        }
+    }
+}
