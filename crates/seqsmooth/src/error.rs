@@ -138,6 +138,38 @@ pub enum Error {
         /// The largest singular value.
         largest_singular_value: f64,
     },
+    /// Gauss–Newton differential correction (Morrison §8.7) did not settle: the correction was
+    /// still above the tolerance after the allowed iterations.
+    #[error(
+        "differential correction did not converge in {iterations} iterations: the last \
+         correction was {correction:e} of its own sigma (tolerance {tolerance:e}), chi-squared \
+         {chi_squared:e}; start nearer the truth, shorten the window, or allow more iterations"
+    )]
+    NotConverged {
+        /// Iterations done.
+        iterations: usize,
+        /// The last correction, `sqrt(dXᵀ S⁻¹ dX)`.
+        correction: f64,
+        /// The tolerance it had to meet.
+        tolerance: f64,
+        /// The residual chi-squared at the last estimate.
+        chi_squared: f64,
+    },
+    /// Gauss–Newton differential correction diverged: no fraction of the correction (halved
+    /// `halvings` times) lowered the weighted residual sum of squares (Morrison §8.6, step IX).
+    #[error(
+        "differential correction diverged at iteration {iteration}: chi-squared {chi_squared:e} \
+         did not fall along the correction even when halved {halvings} times; the nominal \
+         trajectory is too far from the data"
+    )]
+    Diverged {
+        /// The iteration at which no step was accepted.
+        iteration: usize,
+        /// The chi-squared at the last accepted estimate.
+        chi_squared: f64,
+        /// Halvings tried.
+        halvings: usize,
+    },
     /// Some other parameter is out of range.
     #[error("{name} {value} is invalid: {reason}")]
     InvalidParameter {

@@ -10,6 +10,8 @@
 //! recursive filters and their test oracle.
 
 pub mod batch;
+pub mod bootstrap;
+pub mod gauss_newton;
 pub mod observability;
 
 pub use batch::{least_squares, minimum_variance, BatchEstimate, NoiseCovariance};

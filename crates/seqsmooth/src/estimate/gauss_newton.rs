@@ -1,0 +1,571 @@
+//! Gauss–Newton iterative differential correction over a window of observations (Morrison
+//! §8.6-8.7), with or without an a-priori estimate (ch. 11):
+//!
+//! | step | | source |
+//! |---|---|---|
+//! | nominal `X̄` at the epoch `t_c` | the user's, or [`super::bootstrap`] | §8.5 |
+//! | trajectory and `Φ(t_k, t_c; X̄)` | [`Dynamics::propagate`], outwards from `t_c` | steps II, IV, (8.6.28)-(8.6.29) |
+//! | `T = [M_k Φ(t_k, t_c)]`, `δY_k = Y_k − G(X̄(t_k))` | [`Observation::predict`], present components only | steps III-VII, (8.6.35) |
+//! | `δX = (Tᵀ R⁻¹ T)⁻¹ Tᵀ R⁻¹ δY`, `S = (Tᵀ R⁻¹ T)⁻¹` | [`super::batch::minimum_variance`] of the whitened system | (8.6.36)-(8.6.38) |
+//! | with a prior `X_p`, `S_p`: the rows `S_p^{−1/2} (X_p − X̄)` stacked on | | (11.2.24)-(11.2.27), (11.4.33) |
+//! | `X̄ ← X̄ + λ δX`, `λ = 1, 1/2, …` until `e(X)` falls | | (8.7.1), step halving |
+//!
+//! `e(X) = Σ_k δY_kᵀ R_k⁻¹ δY_k (+ (X_p − X)ᵀ S_p⁻¹ (X_p − X))` is the residual chi-squared
+//! (11.4.9), (11.4.33). Convergence: the correction in units of its own standard deviation,
+//! `c = sqrt(δXᵀ S⁻¹ δX)`, at most the tolerance. `c` is also the norm of the whitened gradient
+//! `Tᵀ R⁻¹ δY (+ S_p⁻¹ (X_p − X̄))`, so `c → 0` is the stationarity condition (11.4.5),
+//! (11.4.26). The covariance reported is `S` of the last linearisation (8.6.38); for a
+//! nonlinear model it is the first-order approximation the book warns of (§11.4).
+
+use super::batch::{minimum_variance, NoiseCovariance};
+use crate::error::Error;
+use crate::model::dynamics::Dynamics;
+use crate::model::observation::Observation;
+use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
+
+/// One observation: its time, its components (`None` for a missing one: its row is dropped),
+/// and the covariance of its errors (of all components; the missing ones' rows and columns are
+/// dropped).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measurement {
+    /// The time `t_k`.
+    pub time: f64,
+    /// `Y_k`, one entry per component of the observation model.
+    pub values: Vec<Option<f64>>,
+    /// `R_k`: [`NoiseCovariance::Variances`] (one per component) or [`NoiseCovariance::Full`].
+    pub noise: NoiseCovariance,
+}
+
+/// The instant the estimate refers to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Epoch {
+    /// The last observation time (the leading edge, §8.3).
+    End,
+    /// The mean of the observation times, where the bias is smallest (§8.6).
+    Centre,
+    /// A given time.
+    At(f64),
+}
+
+impl Epoch {
+    /// The time, for observations at `times` (not empty).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::Epoch;
+    /// assert_eq!(Epoch::Centre.time_for(&[0.0, 1.0, 5.0]), 2.0);
+    /// assert_eq!(Epoch::End.time_for(&[0.0, 1.0, 5.0]), 5.0);
+    /// ```
+    pub fn time_for(&self, times: &[f64]) -> f64 {
+        match *self {
+            Epoch::End => times.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            Epoch::Centre => {
+                // The mean about the first time, so that epoch-sized times keep their digits.
+                let t0 = times.first().copied().unwrap_or(0.0);
+                t0 + times.iter().map(|t| t - t0).sum::<f64>() / times.len().max(1) as f64
+            }
+            Epoch::At(t) => t,
+        }
+    }
+}
+
+/// An a-priori estimate at the fit's epoch: the state and its covariance (symmetric positive
+/// definite).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prior {
+    /// `X*_{n,k}`.
+    pub state: DVector<f64>,
+    /// `S*_{n,k}`.
+    pub covariance: DMatrix<f64>,
+}
+
+/// One iteration of the correction.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Iteration {
+    /// The estimate after the step, `X̄ + step · δX`.
+    pub state: DVector<f64>,
+    /// `sqrt(δXᵀ S⁻¹ δX)`: the correction proposed at this iteration, in units of its own σ.
+    pub correction: f64,
+    /// The fraction of it taken: 1, or 2⁻ʰ after `h` halvings.
+    pub step: f64,
+    /// `e(X)` after the step.
+    pub chi_squared: f64,
+}
+
+/// A converged differential correction.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Correction {
+    /// The epoch `t_c` of the state.
+    pub epoch: f64,
+    /// `X*(t_c)`.
+    pub state: DVector<f64>,
+    /// `S*(t_c) = (Tᵀ R⁻¹ T (+ S_p⁻¹))⁻¹` at the last linearisation.
+    pub covariance: DMatrix<f64>,
+    /// `e(X*)`.
+    pub chi_squared: f64,
+    /// Observation components used (plus `n` with a prior) less `n`.
+    pub degrees_of_freedom: usize,
+    /// The condition number of the whitened `T`.
+    pub condition_number: f64,
+    /// Every iteration, in order; the last one's correction met the tolerance.
+    pub iterations: Vec<Iteration>,
+}
+
+/// The iteration's limits.
+///
+/// ```
+/// use seqsmooth::estimate::gauss_newton::GaussNewton;
+/// let g = GaussNewton::default();
+/// assert_eq!((g.max_iterations, g.tolerance, g.max_halvings), (20, 1e-6, 30));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GaussNewton {
+    /// Linearisations allowed before [`Error::NotConverged`].
+    pub max_iterations: usize,
+    /// The correction, in its own σ, below which the iteration has converged.
+    pub tolerance: f64,
+    /// Halvings of one correction before [`Error::Diverged`].
+    pub max_halvings: usize,
+}
+
+impl Default for GaussNewton {
+    fn default() -> Self {
+        Self {
+            max_iterations: 20,
+            tolerance: 1e-6,
+            max_halvings: 30,
+        }
+    }
+}
+
+/// How one measurement's present components are whitened: `R_k = L Lᵀ` on those rows.
+#[derive(Clone, Debug)]
+struct Rows {
+    time: f64,
+    present: Vec<usize>,
+    values: Vec<f64>,
+    whiten: Whiten,
+}
+
+#[derive(Clone, Debug)]
+enum Whiten {
+    Scale(Vec<f64>),
+    Factor(Cholesky<f64, Dyn>),
+}
+
+impl Whiten {
+    fn apply_vector(&self, v: &mut DVector<f64>) {
+        match self {
+            Whiten::Scale(s) => v.iter_mut().zip(s).for_each(|(x, s)| *x *= s),
+            Whiten::Factor(c) => {
+                let _ = c.l_dirty().solve_lower_triangular_mut(v);
+            }
+        }
+    }
+
+    fn apply_matrix(&self, m: &mut DMatrix<f64>) {
+        match self {
+            Whiten::Scale(s) => {
+                for (r, s) in s.iter().enumerate() {
+                    m.row_mut(r).scale_mut(*s);
+                }
+            }
+            Whiten::Factor(c) => {
+                let _ = c.l_dirty().solve_lower_triangular_mut(m);
+            }
+        }
+    }
+}
+
+/// The whitened linear system at one nominal state.
+struct Linearised {
+    t: DMatrix<f64>,
+    r: DVector<f64>,
+    chi_squared: f64,
+}
+
+impl GaussNewton {
+    /// Corrects `nominal` (the state at `epoch`) by Gauss–Newton iteration until the correction
+    /// is below [`Self::tolerance`] of its own σ, with step halving; `prior`, if given, is an
+    /// a-priori estimate at the same epoch (ch. 11).
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// // A straight line through three points: linear, so one correction, then a check.
+    /// let m: Vec<Measurement> = [(0.0, 1.0), (1.0, 3.0), (2.0, 5.0)]
+    ///     .iter()
+    ///     .map(|&(t, y)| Measurement { time: t, values: vec![Some(y)], noise: NoiseCovariance::Variances(vec![1.0]) })
+    ///     .collect();
+    /// let fit = GaussNewton::default()
+    ///     .fit(&PolynomialDynamics::new(1, 1), &LinearObservation::value_of(2), &m, Epoch::End, &DVector::zeros(2), None)
+    ///     .unwrap();
+    /// assert!((fit.state[0] - 5.0).abs() < 1e-12 && (fit.state[1] - 2.0).abs() < 1e-12);
+    /// assert_eq!(fit.iterations.len(), 2);
+    /// ```
+    pub fn fit<D: Dynamics, O: Observation>(
+        &self,
+        dynamics: &D,
+        observation: &O,
+        measurements: &[Measurement],
+        epoch: Epoch,
+        nominal: &DVector<f64>,
+        prior: Option<&Prior>,
+    ) -> Result<Correction, Error> {
+        self.check()?;
+        let n = dynamics.dimension();
+        if observation.state_dimension() != n {
+            return Err(Error::InvalidParameter {
+                name: "observation model",
+                value: format!("for {} states", observation.state_dimension()),
+                reason: format!("the dynamics have {n} states"),
+            });
+        }
+        if nominal.len() != n {
+            return Err(Error::InvalidParameter {
+                name: "nominal state",
+                value: format!("of length {}", nominal.len()),
+                reason: format!("must have the model's dimension {n}"),
+            });
+        }
+        if let Some(&value) = nominal.iter().find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "nominal state entry",
+                value,
+            });
+        }
+        let rows = prepare(observation, measurements)?;
+        let times: Vec<f64> = measurements.iter().map(|m| m.time).collect();
+        if times.is_empty() {
+            return Err(Error::TooFewSamples { needed: 1, got: 0 });
+        }
+        let t_c = epoch.time_for(&times);
+        if !t_c.is_finite() {
+            return Err(Error::NonFinite {
+                what: "epoch",
+                value: t_c,
+            });
+        }
+        let prior = prior.map(|p| prepare_prior(p, n)).transpose()?;
+        let used: usize =
+            rows.iter().map(|r| r.present.len()).sum::<usize>() + prior.as_ref().map_or(0, |_| n);
+        if used < n {
+            return Err(Error::TooFewSamples {
+                needed: n,
+                got: used,
+            });
+        }
+
+        let mut x = nominal.clone();
+        let mut lin = linearise(dynamics, observation, &rows, t_c, &x, prior.as_ref())?;
+        let mut iterations = Vec::new();
+        for iteration in 1..=self.max_iterations {
+            let solution = minimum_variance(&lin.t, &lin.r, &NoiseCovariance::Identity)?;
+            let dx = &solution.state;
+            let correction = (&lin.t * dx).norm();
+            if correction <= self.tolerance {
+                x += dx;
+                iterations.push(Iteration {
+                    state: x.clone(),
+                    correction,
+                    step: 1.0,
+                    chi_squared: solution.chi_squared,
+                });
+                return Ok(Correction {
+                    epoch: t_c,
+                    state: x,
+                    covariance: solution.covariance,
+                    chi_squared: solution.chi_squared,
+                    degrees_of_freedom: solution.degrees_of_freedom,
+                    condition_number: solution.condition_number,
+                    iterations,
+                });
+            }
+            let slack = 1e-10 * lin.chi_squared.max(1.0);
+            let mut step = 1.0;
+            let mut accepted = None;
+            for _ in 0..=self.max_halvings {
+                let candidate = &x + dx * step;
+                if let Ok(next) = linearise(
+                    dynamics,
+                    observation,
+                    &rows,
+                    t_c,
+                    &candidate,
+                    prior.as_ref(),
+                ) {
+                    if next.chi_squared <= lin.chi_squared + slack {
+                        accepted = Some((candidate, next));
+                        break;
+                    }
+                }
+                step *= 0.5;
+            }
+            let Some((candidate, next)) = accepted else {
+                return Err(Error::Diverged {
+                    iteration,
+                    chi_squared: lin.chi_squared,
+                    halvings: self.max_halvings,
+                });
+            };
+            iterations.push(Iteration {
+                state: candidate.clone(),
+                correction,
+                step,
+                chi_squared: next.chi_squared,
+            });
+            x = candidate;
+            lin = next;
+        }
+        Err(Error::NotConverged {
+            iterations: self.max_iterations,
+            correction: iterations.last().map_or(f64::INFINITY, |i| i.correction),
+            tolerance: self.tolerance,
+            chi_squared: lin.chi_squared,
+        })
+    }
+
+    fn check(&self) -> Result<(), Error> {
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "tolerance",
+                value: self.tolerance.to_string(),
+                reason: "must be positive and finite".into(),
+            });
+        }
+        if self.max_iterations == 0 {
+            return Err(Error::InvalidParameter {
+                name: "max_iterations",
+                value: "0".into(),
+                reason: "must be at least 1".into(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Checks every measurement and builds its whitening of the present components.
+fn prepare<O: Observation>(
+    observation: &O,
+    measurements: &[Measurement],
+) -> Result<Vec<Rows>, Error> {
+    let p = observation.components();
+    measurements
+        .iter()
+        .enumerate()
+        .map(|(index, m)| {
+            prepare_one(p, m).map_err(|source| Error::InBatch {
+                index,
+                source: Box::new(source),
+            })
+        })
+        .collect()
+}
+
+fn prepare_one(p: usize, m: &Measurement) -> Result<Rows, Error> {
+    if !m.time.is_finite() {
+        return Err(Error::NonFinite {
+            what: "time",
+            value: m.time,
+        });
+    }
+    if m.values.len() != p {
+        return Err(Error::InvalidParameter {
+            name: "measurement",
+            value: format!("with {} components", m.values.len()),
+            reason: format!("the observation model has {p}"),
+        });
+    }
+    let mut present = Vec::new();
+    let mut values = Vec::new();
+    for (k, v) in m.values.iter().enumerate() {
+        if let Some(v) = *v {
+            if !v.is_finite() {
+                return Err(Error::NonFinite {
+                    what: "measured value",
+                    value: v,
+                });
+            }
+            present.push(k);
+            values.push(v);
+        }
+    }
+    let bad = |value: String, reason: &str| Error::InvalidParameter {
+        name: "measurement noise",
+        value,
+        reason: reason.into(),
+    };
+    let whiten = match &m.noise {
+        NoiseCovariance::Identity => Whiten::Scale(vec![1.0; present.len()]),
+        NoiseCovariance::Variances(v) => {
+            if v.len() != p {
+                return Err(bad(
+                    format!("{} variances", v.len()),
+                    &format!("need {p}, one per component"),
+                ));
+            }
+            let mut scale = Vec::with_capacity(present.len());
+            for &k in &present {
+                if !(v[k].is_finite() && v[k] > 0.0) {
+                    return Err(bad(
+                        format!("variance {}", v[k]),
+                        "must be positive and finite",
+                    ));
+                }
+                scale.push(1.0 / v[k].sqrt());
+            }
+            Whiten::Scale(scale)
+        }
+        NoiseCovariance::Full(r) => {
+            if r.shape() != (p, p) {
+                return Err(bad(
+                    format!("{}x{}", r.nrows(), r.ncols()),
+                    &format!("must be {p}x{p}"),
+                ));
+            }
+            if r.iter().any(|v| !v.is_finite())
+                || (r - r.transpose()).abs().max() > 1e-12 * r.abs().max()
+            {
+                return Err(bad(format!("{r:?}"), "must be finite and symmetric"));
+            }
+            let sub = DMatrix::from_fn(present.len(), present.len(), |i, j| {
+                r[(present[i], present[j])]
+            });
+            match Cholesky::new(sub) {
+                Some(c) => Whiten::Factor(c),
+                None if present.is_empty() => Whiten::Scale(Vec::new()),
+                None => return Err(bad(format!("{r:?}"), "must be positive definite")),
+            }
+        }
+    };
+    Ok(Rows {
+        time: m.time,
+        present,
+        values,
+        whiten,
+    })
+}
+
+/// The prior's whitening `S_p = L Lᵀ` and state.
+struct PriorRows {
+    state: DVector<f64>,
+    factor: Cholesky<f64, Dyn>,
+}
+
+fn prepare_prior(p: &Prior, n: usize) -> Result<PriorRows, Error> {
+    let bad = |value: String, reason: &str| Error::InvalidParameter {
+        name: "prior",
+        value,
+        reason: reason.into(),
+    };
+    if p.state.len() != n || p.covariance.shape() != (n, n) {
+        return Err(bad(
+            format!(
+                "state of length {}, covariance {}x{}",
+                p.state.len(),
+                p.covariance.nrows(),
+                p.covariance.ncols()
+            ),
+            &format!("the model has {n} states"),
+        ));
+    }
+    if let Some(&value) = p
+        .state
+        .iter()
+        .chain(p.covariance.iter())
+        .find(|v| !v.is_finite())
+    {
+        return Err(Error::NonFinite {
+            what: "prior entry",
+            value,
+        });
+    }
+    let c = &p.covariance;
+    if (c - c.transpose()).abs().max() > 1e-12 * c.abs().max() {
+        return Err(bad(format!("{c:?}"), "the covariance must be symmetric"));
+    }
+    let factor = Cholesky::new(c.clone())
+        .ok_or_else(|| bad(format!("{c:?}"), "the covariance must be positive definite"))?;
+    Ok(PriorRows {
+        state: p.state.clone(),
+        factor,
+    })
+}
+
+/// `T` and `δY` whitened, and `e(X̄)`, at the nominal `x` (state at `t_c`): the trajectory is
+/// carried outwards from `t_c` through the sorted times, `Φ(t_k, t_c) = Φ(t_k, t_{k∓1}) Φ(t_{k∓1}, t_c)`.
+fn linearise<D: Dynamics, O: Observation>(
+    dynamics: &D,
+    observation: &O,
+    rows: &[Rows],
+    t_c: f64,
+    x: &DVector<f64>,
+    prior: Option<&PriorRows>,
+) -> Result<Linearised, Error> {
+    let n = x.len();
+    let total: usize = rows.iter().map(|r| r.present.len()).sum::<usize>() + prior.map_or(0, |_| n);
+    let mut t = DMatrix::zeros(total, n);
+    let mut r = DVector::zeros(total);
+    // Row offsets in input order.
+    let mut offsets = Vec::with_capacity(rows.len());
+    let mut at = 0;
+    for row in rows {
+        offsets.push(at);
+        at += row.present.len();
+    }
+    let mut order: Vec<usize> = (0..rows.len()).collect();
+    order.sort_by(|&a, &b| rows[a].time.total_cmp(&rows[b].time));
+    let split = order.partition_point(|&k| rows[k].time < t_c);
+    let (before, after) = order.split_at(split);
+    for side in [
+        after.iter().collect::<Vec<_>>(),
+        before.iter().rev().collect::<Vec<_>>(),
+    ] {
+        let mut state = x.clone();
+        let mut phi = DMatrix::<f64>::identity(n, n);
+        let mut time = t_c;
+        for &k in side {
+            let row = &rows[k];
+            if row.time != time {
+                let p = dynamics.propagate(&state, time, row.time)?;
+                phi = &p.transition * &phi;
+                state = p.state;
+                time = row.time;
+            }
+            if row.present.is_empty() {
+                continue;
+            }
+            let predicted = observation.predict(&state, row.time)?;
+            let m = &predicted.jacobian * &phi;
+            let count = row.present.len();
+            let mut block = DMatrix::from_fn(count, n, |i, j| m[(row.present[i], j)]);
+            let mut residual = DVector::from_fn(count, |i, _| {
+                let c = row.present[i];
+                observation.residual(c, row.values[i], predicted.value[c])
+            });
+            row.whiten.apply_matrix(&mut block);
+            row.whiten.apply_vector(&mut residual);
+            t.view_mut((offsets[k], 0), (count, n)).copy_from(&block);
+            r.rows_mut(offsets[k], count).copy_from(&residual);
+        }
+    }
+    if let Some(p) = prior {
+        let mut block = DMatrix::identity(n, n);
+        let mut residual = &p.state - x;
+        let l = p.factor.l_dirty();
+        let _ = l.solve_lower_triangular_mut(&mut block);
+        let _ = l.solve_lower_triangular_mut(&mut residual);
+        t.view_mut((at, 0), (n, n)).copy_from(&block);
+        r.rows_mut(at, n).copy_from(&residual);
+    }
+    let chi_squared = r.norm_squared();
+    if !chi_squared.is_finite() || t.iter().any(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            what: "linearised observation system",
+            value: chi_squared,
+        });
+    }
+    Ok(Linearised { t, r, chi_squared })
+}
