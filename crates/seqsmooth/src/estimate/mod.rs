@@ -13,6 +13,7 @@ pub mod batch;
 pub mod bootstrap;
 pub mod gauss_newton;
 pub mod observability;
+pub mod sliding;
 
 pub use batch::{least_squares, minimum_variance, BatchEstimate, NoiseCovariance};
 pub use observability::{observability, Observability};

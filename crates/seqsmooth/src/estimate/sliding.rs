@@ -1,0 +1,318 @@
+//! Differential correction over a sliding window (Morrison §8.7, the fixed-memory form of
+//! [`super::gauss_newton`]): after each measurement, the Gauss–Newton fit of the last `W`
+//! measurements (all of them while fewer have come).
+//!
+//! Each window's iteration starts from the previous window's estimate carried to the new epoch
+//! by the dynamics (one or two iterations where the windows overlap), or, for the first window
+//! and whenever that start fails, from the rule the caller chose: the radar nominal of §8.5
+//! ([`super::bootstrap::radar`]) or a given state (for a linear model any start converges in
+//! one correction). The converged estimate does not depend on the start beyond the tolerance.
+
+use super::bootstrap;
+use super::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
+use crate::error::Error;
+use crate::model::dynamics::Dynamics;
+use crate::model::observation::Observation;
+use crate::model::radar::Radar;
+use nalgebra::DVector;
+use std::collections::VecDeque;
+
+/// Where a window's iteration starts when there is no previous estimate to carry forward.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Start {
+    /// The nominal state of §8.5 from polynomial fits of this degree (at most one less than
+    /// the window's complete measurements) to the radar's range, azimuth and elevation.
+    Radar {
+        /// The radar the measurements are from.
+        radar: Radar,
+        /// The degree of the fits (1 or more).
+        degree: usize,
+    },
+    /// This state at the epoch.
+    State(DVector<f64>),
+}
+
+/// A Gauss–Newton fit of the last `W` measurements, renewed at each one.
+///
+/// ```
+/// use nalgebra::DVector;
+/// use seqsmooth::estimate::batch::NoiseCovariance;
+/// use seqsmooth::estimate::gauss_newton::{Epoch, Measurement};
+/// use seqsmooth::estimate::sliding::{SlidingFit, Start};
+/// use seqsmooth::model::dynamics::PolynomialDynamics;
+/// use seqsmooth::model::observation::LinearObservation;
+/// // A straight line, 3 samples a window.
+/// let mut fit = SlidingFit::new(
+///     PolynomialDynamics::new(1, 1),
+///     LinearObservation::value_of(2),
+///     3,
+///     Epoch::End,
+///     Start::State(DVector::zeros(2)),
+/// )
+/// .unwrap();
+/// let mut last = None;
+/// for (t, y) in [(0.0, 1.0), (1.0, 3.0), (2.0, 5.0), (3.0, 7.5)] {
+///     let m = Measurement { time: t, values: vec![Some(y)], noise: NoiseCovariance::Variances(vec![1.0]) };
+///     last = fit.push(m).unwrap();
+/// }
+/// let c = last.unwrap(); // the line through (1, 3), (2, 5), (3, 7.5)
+/// assert!((c.state[1] - 2.25).abs() < 1e-12);
+/// ```
+#[derive(Clone, Debug)]
+pub struct SlidingFit<D: Dynamics, O: Observation> {
+    dynamics: D,
+    observation: O,
+    solver: GaussNewton,
+    window: usize,
+    epoch: Epoch,
+    start: Start,
+    rows: VecDeque<Measurement>,
+    last: Option<Correction>,
+}
+
+impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
+    /// The fit of the last `window ≥ 1` measurements at `epoch`, started by `start`, with
+    /// [`GaussNewton::default`] limits.
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::estimate::gauss_newton::Epoch;
+    /// use seqsmooth::estimate::sliding::{SlidingFit, Start};
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let bad = SlidingFit::new(
+    ///     PolynomialDynamics::new(1, 1),
+    ///     LinearObservation::value_of(2),
+    ///     0,
+    ///     Epoch::End,
+    ///     Start::State(DVector::zeros(2)),
+    /// );
+    /// assert!(bad.is_err());
+    /// ```
+    pub fn new(
+        dynamics: D,
+        observation: O,
+        window: usize,
+        epoch: Epoch,
+        start: Start,
+    ) -> Result<Self, Error> {
+        let n = dynamics.dimension();
+        if window == 0 {
+            return Err(Error::InvalidParameter {
+                name: "window",
+                value: "0".into(),
+                reason: "must hold at least one measurement".into(),
+            });
+        }
+        if observation.state_dimension() != n {
+            return Err(Error::InvalidParameter {
+                name: "observation model",
+                value: format!("for {} states", observation.state_dimension()),
+                reason: format!("the dynamics have {n} states"),
+            });
+        }
+        match &start {
+            Start::State(x) if x.len() != n || x.iter().any(|v| !v.is_finite()) => {
+                return Err(Error::InvalidParameter {
+                    name: "start state",
+                    value: format!("{:?}", x.as_slice()),
+                    reason: format!("must have {n} finite entries"),
+                })
+            }
+            Start::Radar { radar, degree } if radar.state_dimension() != n || *degree == 0 => {
+                return Err(Error::InvalidParameter {
+                    name: "radar start",
+                    value: format!("degree {degree} for {} states", radar.state_dimension()),
+                    reason: format!("needs degree 1 or more and the model's {n} states"),
+                })
+            }
+            _ => {}
+        }
+        if let Epoch::At(t) = epoch {
+            if !t.is_finite() {
+                return Err(Error::NonFinite {
+                    what: "epoch",
+                    value: t,
+                });
+            }
+        }
+        Ok(Self {
+            dynamics,
+            observation,
+            solver: GaussNewton::default(),
+            window,
+            epoch,
+            start,
+            rows: VecDeque::with_capacity(window),
+            last: None,
+        })
+    }
+
+    /// With these iteration limits.
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton};
+    /// use seqsmooth::estimate::sliding::{SlidingFit, Start};
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let fit = SlidingFit::new(
+    ///     PolynomialDynamics::new(0, 1),
+    ///     LinearObservation::value_of(1),
+    ///     5,
+    ///     Epoch::End,
+    ///     Start::State(DVector::zeros(1)),
+    /// )
+    /// .unwrap()
+    /// .with_solver(GaussNewton { max_iterations: 10, ..GaussNewton::default() });
+    /// assert_eq!(fit.window(), 5);
+    /// ```
+    pub fn with_solver(mut self, solver: GaussNewton) -> Self {
+        self.solver = solver;
+        self
+    }
+
+    /// The window length `W`.
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::estimate::gauss_newton::Epoch;
+    /// use seqsmooth::estimate::sliding::{SlidingFit, Start};
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let fit = SlidingFit::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 7,
+    ///     Epoch::End, Start::State(DVector::zeros(1))).unwrap();
+    /// assert_eq!(fit.window(), 7);
+    /// ```
+    pub fn window(&self) -> usize {
+        self.window
+    }
+
+    /// The measurements in the window, oldest first.
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::{Epoch, Measurement};
+    /// use seqsmooth::estimate::sliding::{SlidingFit, Start};
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut fit = SlidingFit::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 2,
+    ///     Epoch::End, Start::State(DVector::zeros(1))).unwrap();
+    /// for t in 0..3 {
+    ///     let m = Measurement { time: t as f64, values: vec![Some(1.0)], noise: NoiseCovariance::Identity };
+    ///     fit.push(m).unwrap();
+    /// }
+    /// assert_eq!(fit.measurements().map(|m| m.time).collect::<Vec<_>>(), vec![1.0, 2.0]);
+    /// ```
+    pub fn measurements(&self) -> impl Iterator<Item = &Measurement> {
+        self.rows.iter()
+    }
+
+    /// Takes a measurement (after the previous one in time), drops the oldest beyond `W`, and
+    /// fits the window.
+    ///
+    /// `Ok(None)` while the window is not yet full and does not determine the state (too few
+    /// components, or [`Error::Unobservable`]); once it holds `W` measurements, a window that
+    /// does not determine the state is that error. A measurement that is not after the
+    /// previous one, or is malformed, is refused and not kept.
+    pub fn push(&mut self, measurement: Measurement) -> Result<Option<Correction>, Error> {
+        if let Some(previous) = self.rows.back() {
+            if measurement.time.is_finite() && measurement.time <= previous.time {
+                return Err(Error::InvalidParameter {
+                    name: "time",
+                    value: measurement.time.to_string(),
+                    reason: format!(
+                        "must be after the previous measurement's time {}",
+                        previous.time
+                    ),
+                });
+            }
+        }
+        if self.rows.len() == self.window {
+            self.rows.pop_front();
+        }
+        self.rows.push_back(measurement);
+        self.rows.make_contiguous();
+        match self.fit() {
+            Ok(c) => {
+                self.last = Some(c.clone());
+                Ok(Some(c))
+            }
+            Err(Error::Unobservable { .. } | Error::TooFewSamples { .. })
+                if self.rows.len() < self.window =>
+            {
+                self.last = None;
+                Ok(None)
+            }
+            Err(e) => {
+                // A malformed measurement is not kept.
+                if matches!(e, Error::InBatch { index, .. } if index + 1 == self.rows.len()) {
+                    self.rows.pop_back();
+                }
+                self.last = None;
+                Err(e)
+            }
+        }
+    }
+
+    /// The fit of the window: from the previous estimate carried forward, else (or if that
+    /// fails) from the start rule.
+    fn fit(&self) -> Result<Correction, Error> {
+        let rows = self.rows.as_slices().0;
+        let times: Vec<f64> = rows.iter().map(|m| m.time).collect();
+        let epoch = self.epoch.time_for(&times);
+        let n = self.dynamics.dimension();
+        let components: usize = rows.iter().map(|m| m.values.iter().flatten().count()).sum();
+        if components < n {
+            return Err(Error::TooFewSamples {
+                needed: n,
+                got: components,
+            });
+        }
+        let solve = |nominal: &DVector<f64>| {
+            self.solver.fit(
+                &self.dynamics,
+                &self.observation,
+                rows,
+                Epoch::At(epoch),
+                nominal,
+                None,
+            )
+        };
+        if let Some(last) = &self.last {
+            if let Ok(carried) = self.dynamics.propagate(&last.state, last.epoch, epoch) {
+                match solve(&carried.state) {
+                    Ok(c) => return Ok(c),
+                    Err(Error::Diverged { .. } | Error::NotConverged { .. }) => {}
+                    Err(e) => return Err(e),
+                }
+            }
+        }
+        solve(&self.nominal(rows, epoch)?)
+    }
+
+    /// The start rule's nominal state at `epoch`.
+    fn nominal(&self, rows: &[Measurement], epoch: f64) -> Result<DVector<f64>, Error> {
+        match &self.start {
+            Start::State(x) => Ok(x.clone()),
+            Start::Radar { radar, degree } => {
+                let (times, measured): (Vec<f64>, Vec<[f64; 3]>) = rows
+                    .iter()
+                    .filter_map(|m| match m.values.as_slice() {
+                        [Some(r), Some(a), Some(e), ..] => Some((m.time, [*r, *a, *e])),
+                        _ => None,
+                    })
+                    .unzip();
+                if times.len() < 2 {
+                    return Err(Error::TooFewSamples {
+                        needed: 2,
+                        got: times.len(),
+                    });
+                }
+                let degree = (*degree).min(times.len() - 1);
+                bootstrap::radar(radar, &times, &measured, epoch, degree)
+            }
+        }
+    }
+}
