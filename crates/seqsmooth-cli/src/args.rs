@@ -74,7 +74,47 @@ pub enum Command {
     /// Plot the output of 'seqsmooth filter' (any kind) as PNG or SVG
     #[command(after_help = PLOT_AFTER_HELP)]
     Plot(PlotArgs),
+    /// Fit a state to each row's window of measurements by Gauss-Newton differential
+    /// correction: a radar's range, azimuth and elevation, or a scalar polynomial series
+    #[command(after_help = FIT_AFTER_HELP)]
+    Fit(FitArgs),
 }
+
+const FIT_AFTER_HELP: &str = concat!(
+    "\
+Output: CSV, one row per input row in input order, with the header
+  --model radar:       t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,iterations,chi2
+                       (--degree 2: t,x,y,z,vx,vy,vz,ax,ay,az,sx,...,svz,sax,say,saz,...)
+  --model polynomial:  t,y,d0..dM,s0..sM,iterations,chi2
+and, with --epoch other than end, a last column epoch: the time the state refers to. The t \
+(and y) cells echo the input cells. Each row's state is the Gauss-Newton differential \
+correction (Morrison 8.6-8.7) of the last W rows up to and including it (all rows so far \
+while fewer have come): the minimum-variance estimate of the state at the epoch, with its \
+1-sigma errors (s columns), the iterations taken and the residual chi-squared of the window \
+(with the sigmas given; its degrees of freedom are the measured components less the states). \
+Rows before the window determines the state have empty cells.
+
+radar: a Cartesian state, position and velocity (and acceleration with --degree 2) of a \
+constant-velocity (constant-acceleration) target, in the units of the range and of t, from \
+the range, azimuth and elevation seen from --site: azimuth from +x towards +y, elevation from \
+the x-y plane, both in radians. An empty range, azimuth or elevation cell is a missing \
+component: the row's other components are used. The first window's iteration starts from \
+polynomial fits to the range and angles (Morrison 8.5), each later one from the previous \
+state carried forward (from the polynomial fits again if that fails).
+
+polynomial: the value's derivatives d0..dM of a degree-M polynomial in t, each row's state \
+the least-squares fit of its window: the same numbers as 'seqsmooth filter --kind fixed \
+--window W --sigma S' on the rows where both have an estimate (from row W on).
+
+A window that still does not determine the state once it holds W rows (fewer distinct times \
+than a polynomial needs; a radar window with too few angles), an iteration that diverges or \
+does not converge, a bad cell or a time not after the previous one stops the command with the \
+file lines of the window or the line and column of the cell. An output file (-o FILE) is \
+written beside FILE and renamed onto it only when the command succeeds.
+
+",
+    exit_status!("too few samples")
+);
 
 const PLOT_AFTER_HELP: &str = "\
 Reads the CSV written by 'seqsmooth filter' and draws, under a title and a legend: a panel per \
@@ -313,6 +353,115 @@ pub struct VrfArgs {
     /// Output format
     #[arg(long, value_enum, default_value_t = Format::Csv)]
     pub format: Format,
+}
+
+#[derive(Debug, Args)]
+pub struct FitArgs {
+    /// Input CSV with a header row; omitted or '-' reads standard input. Columns other than the
+    /// ones named are ignored
+    #[arg(value_name = "INPUT")]
+    pub input: Option<PathBuf>,
+    /// The dynamic and observation model
+    #[arg(long, value_enum)]
+    pub model: FitModel,
+    /// Degree of the motion: polynomial, the polynomial's degree M (0 to 24, required); radar,
+    /// 1 for constant velocity or 2 for constant acceleration [radar default: 1]
+    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
+    pub degree: Option<usize>,
+    /// The number of rows in each window, W >= 1 (all rows so far while fewer have come)
+    #[arg(long, value_name = "W", default_value = "60", value_parser = parse_window,
+          allow_hyphen_values = true)]
+    pub window: usize,
+    /// The time each row's state refers to: 'end' (the row's own time), 'centre' (the mean
+    /// time of its window) or a time T
+    #[arg(long, value_name = "EPOCH", default_value = "end", value_parser = parse_epoch,
+          allow_hyphen_values = true)]
+    pub epoch: EpochArg,
+    /// Radar: the site's position X,Y,Z in the units of the range
+    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,0", value_parser = parse_site,
+          allow_hyphen_values = true)]
+    pub site: [f64; 3],
+    /// Radar: the range's noise standard deviation (required)
+    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
+    pub sigma_range: Option<f64>,
+    /// Radar: the azimuth's and elevation's noise standard deviation in radians (required)
+    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
+    pub sigma_angle: Option<f64>,
+    /// Polynomial: the values' noise standard deviation (required)
+    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
+    pub sigma: Option<f64>,
+    /// Name of the time column
+    #[arg(long, value_name = "NAME", default_value = "t")]
+    pub time_col: String,
+    /// Polynomial: name of the value column
+    #[arg(long, value_name = "NAME", default_value = "y")]
+    pub value_col: String,
+    /// Radar: name of the range column
+    #[arg(long, value_name = "NAME", default_value = "range")]
+    pub range_col: String,
+    /// Radar: name of the azimuth column
+    #[arg(long, value_name = "NAME", default_value = "azimuth")]
+    pub azimuth_col: String,
+    /// Radar: name of the elevation column
+    #[arg(long, value_name = "NAME", default_value = "elevation")]
+    pub elevation_col: String,
+    /// Gauss-Newton iterations allowed per window
+    #[arg(long, value_name = "N", default_value_t = 20,
+          value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub max_iterations: u32,
+    /// Output file [default: standard output]
+    #[arg(short = 'o', long, value_name = "OUTPUT")]
+    pub output: Option<PathBuf>,
+}
+
+/// The models of `seqsmooth fit`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FitModel {
+    /// A Cartesian target seen by a radar: range, azimuth, elevation.
+    Radar,
+    /// A scalar polynomial in time, observed directly.
+    Polynomial,
+}
+
+/// `--epoch`: the window's end, its centre, or a time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EpochArg {
+    End,
+    Centre,
+    At(f64),
+}
+
+/// Parses `--epoch`: `end`, `centre` (or `center`), or a finite time.
+pub fn parse_epoch(s: &str) -> Result<EpochArg, String> {
+    match s.trim() {
+        "end" => Ok(EpochArg::End),
+        "centre" | "center" => Ok(EpochArg::Centre),
+        text => match text.parse::<f64>() {
+            Ok(t) if t.is_finite() => Ok(EpochArg::At(t)),
+            _ => Err(format!(
+                "epoch '{text}' is neither 'end', 'centre' nor a finite time"
+            )),
+        },
+    }
+}
+
+/// Parses `--site`: three finite numbers `X,Y,Z`.
+pub fn parse_site(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [x, y, z] = parts[..] else {
+        return Err(format!(
+            "site '{}' must be three numbers X,Y,Z separated by commas",
+            s.trim()
+        ));
+    };
+    let mut site = [0.0; 3];
+    for (slot, (axis, text)) in site.iter_mut().zip([("X", x), ("Y", y), ("Z", z)]) {
+        *slot = match text.parse::<f64>() {
+            Ok(v) if v.is_finite() => v,
+            _ => return Err(format!("site {axis} '{text}' is not a finite number")),
+        };
+    }
+    Ok(site)
 }
 
 /// The time and value columns of an input (`seqsmooth filter`, `seqsmooth smooth`).

@@ -198,6 +198,14 @@ impl Need {
         }
     }
 
+    /// `rows` rows for `why` (e.g. `the radar model`).
+    pub fn rows(rows: usize, why: &str) -> Self {
+        Self {
+            rows,
+            why: why.to_string(),
+        }
+    }
+
     /// A window of `w` samples needs `w` rows.
     pub fn window(w: usize) -> Self {
         Self {
