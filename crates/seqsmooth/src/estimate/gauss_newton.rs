@@ -21,7 +21,8 @@ use super::batch::{minimum_variance, NoiseCovariance};
 use crate::error::Error;
 use crate::model::dynamics::Dynamics;
 use crate::model::observation::Observation;
-use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
+use crate::numeric::unrolled::unrolled_sizes;
+use nalgebra::{Cholesky, DMatrix, DMatrixViewMut, DVector, DVectorViewMut, Dyn};
 
 /// One observation: its time, its components (`None` for a missing one: its row is dropped),
 /// and the covariance of its errors (of all components; the missing ones' rows and columns are
@@ -153,7 +154,7 @@ enum Whiten {
 }
 
 impl Whiten {
-    fn apply_vector(&self, v: &mut DVector<f64>) {
+    fn apply_vector(&self, v: &mut DVectorViewMut<f64>) {
         match self {
             Whiten::Scale(s) => v.iter_mut().zip(s).for_each(|(x, s)| *x *= s),
             Whiten::Factor(c) => {
@@ -162,7 +163,7 @@ impl Whiten {
         }
     }
 
-    fn apply_matrix(&self, m: &mut DMatrix<f64>) {
+    fn apply_matrix(&self, m: &mut DMatrixViewMut<f64>) {
         match self {
             Whiten::Scale(s) => {
                 for (r, s) in s.iter().enumerate() {
@@ -258,8 +259,17 @@ impl GaussNewton {
             });
         }
 
+        let layout = Layout::new(&rows, t_c, prior.as_ref().map_or(0, |_| n));
         let mut x = nominal.clone();
-        let mut lin = linearise(dynamics, observation, &rows, t_c, &x, prior.as_ref())?;
+        let mut lin = linearise(
+            dynamics,
+            observation,
+            &rows,
+            &layout,
+            t_c,
+            &x,
+            prior.as_ref(),
+        )?;
         let mut iterations = Vec::new();
         for iteration in 1..=self.max_iterations {
             let solution = minimum_variance(&lin.t, &lin.r, &NoiseCovariance::Identity)?;
@@ -292,6 +302,7 @@ impl GaussNewton {
                     dynamics,
                     observation,
                     &rows,
+                    &layout,
                     t_c,
                     &candidate,
                     prior.as_ref(),
@@ -494,35 +505,96 @@ fn prepare_prior(p: &Prior, n: usize) -> Result<PriorRows, Error> {
     })
 }
 
+/// The order the trajectory is carried in, fixed by the times and the epoch: each
+/// measurement's first row of `T`, the measurements at or after `t_c` by increasing time, those
+/// before it by decreasing time, and the rows in all.
+struct Layout {
+    offsets: Vec<usize>,
+    after: Vec<usize>,
+    before: Vec<usize>,
+    total: usize,
+}
+
+impl Layout {
+    fn new(rows: &[Rows], t_c: f64, prior_states: usize) -> Self {
+        let mut offsets = Vec::with_capacity(rows.len());
+        let mut at = 0;
+        for row in rows {
+            offsets.push(at);
+            at += row.present.len();
+        }
+        let mut order: Vec<usize> = (0..rows.len()).collect();
+        order.sort_by(|&a, &b| rows[a].time.total_cmp(&rows[b].time));
+        let split = order.partition_point(|&k| rows[k].time < t_c);
+        let after = order.split_off(split);
+        order.reverse();
+        Self {
+            offsets,
+            after,
+            before: order,
+            total: at + prior_states,
+        }
+    }
+}
+
+/// `out = a b` for the small `Φ` and `M Φ` products: nalgebra's product of dynamically sized
+/// matrices goes through a general blocked multiplication whose set-up costs more than a 6 × 6
+/// product (it was 30 % of a radar fit's instructions), so the inner size `n` (the state
+/// dimension) goes through the crate's one unrolled-size dispatch.
+fn product_into(a: &DMatrix<f64>, b: &DMatrix<f64>, out: &mut DMatrix<f64>) {
+    let (rows, inner) = a.shape();
+    debug_assert_eq!(
+        (b.nrows(), out.nrows(), out.ncols()),
+        (inner, rows, b.ncols())
+    );
+    let (a, b, out) = (a.as_slice(), b.as_slice(), out.as_mut_slice());
+    unrolled_sizes!(inner, N => product_n::<N>(rows, a, b, out), n => product_any(rows, n, a, b, out));
+}
+
+/// [`product_into`] for an inner size `N` known at compile time (column-major slices).
+fn product_n<const N: usize>(rows: usize, a: &[f64], b: &[f64], out: &mut [f64]) {
+    for (o, b) in out.chunks_exact_mut(rows).zip(b.chunks_exact(N)) {
+        let b: &[f64; N] = b.try_into().expect("a column of N");
+        for (i, o) in o.iter_mut().enumerate() {
+            let mut sum = 0.0;
+            for (l, &w) in b.iter().enumerate() {
+                sum += a[i + l * rows] * w;
+            }
+            *o = sum;
+        }
+    }
+}
+
+/// [`product_into`] for any inner size `n`.
+fn product_any(rows: usize, n: usize, a: &[f64], b: &[f64], out: &mut [f64]) {
+    for (o, b) in out.chunks_exact_mut(rows).zip(b.chunks_exact(n)) {
+        for (i, o) in o.iter_mut().enumerate() {
+            *o = b
+                .iter()
+                .enumerate()
+                .map(|(l, &w)| a[i + l * rows] * w)
+                .sum();
+        }
+    }
+}
+
 /// `T` and `δY` whitened, and `e(X̄)`, at the nominal `x` (state at `t_c`): the trajectory is
 /// carried outwards from `t_c` through the sorted times, `Φ(t_k, t_c) = Φ(t_k, t_{k∓1}) Φ(t_{k∓1}, t_c)`.
 fn linearise<D: Dynamics, O: Observation>(
     dynamics: &D,
     observation: &O,
     rows: &[Rows],
+    layout: &Layout,
     t_c: f64,
     x: &DVector<f64>,
     prior: Option<&PriorRows>,
 ) -> Result<Linearised, Error> {
     let n = x.len();
-    let total: usize = rows.iter().map(|r| r.present.len()).sum::<usize>() + prior.map_or(0, |_| n);
-    let mut t = DMatrix::zeros(total, n);
-    let mut r = DVector::zeros(total);
-    // Row offsets in input order.
-    let mut offsets = Vec::with_capacity(rows.len());
-    let mut at = 0;
-    for row in rows {
-        offsets.push(at);
-        at += row.present.len();
-    }
-    let mut order: Vec<usize> = (0..rows.len()).collect();
-    order.sort_by(|&a, &b| rows[a].time.total_cmp(&rows[b].time));
-    let split = order.partition_point(|&k| rows[k].time < t_c);
-    let (before, after) = order.split_at(split);
-    for side in [
-        after.iter().collect::<Vec<_>>(),
-        before.iter().rev().collect::<Vec<_>>(),
-    ] {
+    let mut t = DMatrix::zeros(layout.total, n);
+    let mut r = DVector::zeros(layout.total);
+    let mut carried = DMatrix::<f64>::zeros(n, n);
+    let mut m = DMatrix::<f64>::zeros(observation.components(), n);
+    for side in [&layout.after, &layout.before] {
         let mut state = x.clone();
         let mut phi = DMatrix::<f64>::identity(n, n);
         let mut time = t_c;
@@ -530,28 +602,29 @@ fn linearise<D: Dynamics, O: Observation>(
             let row = &rows[k];
             if row.time != time {
                 let p = dynamics.propagate(&state, time, row.time)?;
-                phi = &p.transition * &phi;
+                product_into(&p.transition, &phi, &mut carried);
+                std::mem::swap(&mut phi, &mut carried);
                 state = p.state;
                 time = row.time;
             }
-            if row.present.is_empty() {
+            let count = row.present.len();
+            if count == 0 {
                 continue;
             }
             let predicted = observation.predict(&state, row.time)?;
-            let m = &predicted.jacobian * &phi;
-            let count = row.present.len();
-            let mut block = DMatrix::from_fn(count, n, |i, j| m[(row.present[i], j)]);
-            let mut residual = DVector::from_fn(count, |i, _| {
-                let c = row.present[i];
-                observation.residual(c, row.values[i], predicted.value[c])
-            });
-            row.whiten.apply_matrix(&mut block);
-            row.whiten.apply_vector(&mut residual);
-            t.view_mut((offsets[k], 0), (count, n)).copy_from(&block);
-            r.rows_mut(offsets[k], count).copy_from(&residual);
+            product_into(&predicted.jacobian, &phi, &mut m);
+            let at = layout.offsets[k];
+            for (i, &c) in row.present.iter().enumerate() {
+                t.row_mut(at + i).copy_from(&m.row(c));
+                r[at + i] = observation.residual(c, row.values[i], predicted.value[c]);
+            }
+            row.whiten
+                .apply_matrix(&mut t.view_mut((at, 0), (count, n)));
+            row.whiten.apply_vector(&mut r.rows_mut(at, count));
         }
     }
     if let Some(p) = prior {
+        let at = layout.total - n;
         let mut block = DMatrix::identity(n, n);
         let mut residual = &p.state - x;
         let l = p.factor.l_dirty();
