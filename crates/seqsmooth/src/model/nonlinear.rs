@@ -207,7 +207,11 @@ pub(crate) fn central_differences(
     Some(out)
 }
 
-/// The state and `Φ` side by side (`n + n²` numbers, `Φ` by columns) for the integrator.
+/// The state, `Φ` (by columns) and the time offset `ζ` side by side (`n + n² + 1` numbers) for
+/// the integrator. `F` is given the time carried in the last component, not the integrator's
+/// stage time: ode_solvers 0.6.2's DOP853 evaluates its twelfth stage at `c₁₂ = 0` instead of 1
+/// (its `a` coefficients are right), which corrupts every `F` that depends on `t`; the carried
+/// `ζ` (`dζ/dζ = 1`, integrated exactly) has each stage's true time.
 struct Variational<'a> {
     model: &'a NonlinearDynamics,
     t_a: f64,
@@ -215,9 +219,9 @@ struct Variational<'a> {
 }
 
 impl System<f64, DVector<f64>> for Variational<'_> {
-    fn system(&self, zeta: f64, y: &DVector<f64>, dy: &mut DVector<f64>) {
+    fn system(&self, _zeta: f64, y: &DVector<f64>, dy: &mut DVector<f64>) {
         let n = self.model.n;
-        let t = self.t_a + zeta;
+        let t = self.t_a + y[n + n * n];
         let x = y.rows(0, n).into_owned();
         let (Some(f), Some(a)) = (self.model.field_at(t, &x), self.model.jacobian_at(t, &x)) else {
             self.failed.set(Some(t));
@@ -225,9 +229,10 @@ impl System<f64, DVector<f64>> for Variational<'_> {
             return;
         };
         dy.rows_mut(0, n).copy_from(&f);
-        let phi = DMatrix::from_column_slice(n, n, &y.as_slice()[n..]);
+        let phi = DMatrix::from_column_slice(n, n, &y.as_slice()[n..n + n * n]);
         let dphi = a * phi;
         dy.rows_mut(n, n * n).copy_from_slice(dphi.as_slice());
+        dy[n + n * n] = 1.0;
     }
 
     fn solout(&mut self, _x: f64, _y: &DVector<f64>, _dy: &DVector<f64>) -> bool {
@@ -253,7 +258,7 @@ impl Dynamics for NonlinearDynamics {
                 transition: DMatrix::identity(n, n),
             });
         }
-        let mut y0 = DVector::zeros(n + n * n);
+        let mut y0 = DVector::zeros(n + n * n + 1);
         y0.rows_mut(0, n).copy_from(state);
         for k in 0..n {
             y0[n + k * n + k] = 1.0;
@@ -306,7 +311,7 @@ impl Dynamics for NonlinearDynamics {
         };
         Ok(Propagation {
             state: y.rows(0, n).into_owned(),
-            transition: DMatrix::from_column_slice(n, n, &y.as_slice()[n..]),
+            transition: DMatrix::from_column_slice(n, n, &y.as_slice()[n..n + n * n]),
         })
     }
 }
