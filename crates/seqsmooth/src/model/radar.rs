@@ -245,7 +245,7 @@ impl Observation for Radar {
         let mut value = DVector::zeros(rows);
         let mut jacobian = DMatrix::zeros(rows, self.states);
         value[0] = rho;
-        value[1] = p[1].atan2(p[0]);
+        value[1] = (p[1] + 0.0).atan2(p[0]); // + 0.0: atan2(−0, x < 0) is −π, outside (−π, π]
         value[2] = p[2].atan2(h);
         for k in 0..3 {
             jacobian[(0, k)] = p[k] / rho;
