@@ -1,7 +1,7 @@
 //! The CLI's argument-to-output path, in process: an argument vector decoded from the input
 //! goes through clap (`Cli::try_parse_from`) and the subcommand's `run`, as `main` dispatches
 //! it, on the rest of the input as the CSV file, with `-o` to a file in a fresh temporary
-//! directory (`filter` and `smooth`, the subcommands that read data).
+//! directory (`filter`, `smooth` and `fit`, the subcommands that read data).
 //!
 //! Checks: a refused command line has a message; a failed run is a typed error (`Usage` or
 //! `Data`) with a message and leaves no output file (nor a temporary one) behind; a
@@ -9,14 +9,14 @@
 //! every computed cell (`d*`, `s*`, `window`, `noise`, `outlier`, `misfit`) empty or a
 //! finite number, and no `d` cell empty once the rows of its series determine the estimate
 //! (expanding and fading memory: from the degree's `M+1`-th row; fixed memory: where the window
-//! cell is `W`; `smooth`: every row).
+//! cell is `W`; `smooth`: every row; `fit`: the state cells all empty or all numbers).
 
 use super::check;
 use super::input::Input;
 use clap::Parser;
 use seqsmooth_cli::args::{Cli, Command, Kind};
 use seqsmooth_cli::error::CliError;
-use seqsmooth_cli::{filter, smooth};
+use seqsmooth_cli::{filter, fit, smooth};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -39,13 +39,34 @@ const OPTIONS: [(&str, &[&str]); 12] = [
     ("--chunk-rows", &["1", "2", "3", "100"]),
 ];
 
+/// The options of `fit`.
+const FIT_OPTIONS: [(&str, &[&str]); 14] = [
+    ("--model", &["radar", "polynomial", "kalman"]),
+    ("--degree", &["0", "1", "2", "3", "8", "24", "-1"]),
+    ("--window", &["1", "2", "3", "5", "60", "0"]),
+    ("--epoch", &["end", "centre", "0", "1e300", "nan"]),
+    ("--site", &["0,0,0", "1,2,3", "1e300,0,0", "0,0", "nan,0,0"]),
+    ("--sigma-range", &["10", "1e-300", "0"]),
+    ("--sigma-angle", &["1e-3", "1", "1e300"]),
+    ("--sigma", &["1", "0.1", "1e-300"]),
+    ("--time-col", &["t", "y", "range", "x"]),
+    ("--value-col", &["y", "t", "x"]),
+    ("--range-col", &["range", "y", "t"]),
+    ("--azimuth-col", &["azimuth", "y", "x"]),
+    ("--elevation-col", &["elevation", "y", "x"]),
+    ("--max-iterations", &["1", "2", "20", "0"]),
+];
+
 /// The argument vector: subcommand, input and output files, then options as `--name=value`
 /// (so that no value can become a file name).
 fn arguments(input: &mut Input, csv: &Path, out: &Path) -> Vec<String> {
-    let sub = if input.byte().is_multiple_of(4) {
-        "smooth"
+    let pick = input.byte();
+    let (sub, options): (&str, &[(&str, &[&str])]) = if pick.is_multiple_of(4) {
+        ("smooth", &OPTIONS)
+    } else if pick % 8 == 1 {
+        ("fit", &FIT_OPTIONS)
     } else {
-        "filter"
+        ("filter", &OPTIONS)
     };
     let mut args: Vec<String> = vec![
         "seqsmooth".into(),
@@ -54,17 +75,19 @@ fn arguments(input: &mut Input, csv: &Path, out: &Path) -> Vec<String> {
         format!("--output={}", out.display()),
     ];
     let n = input.below(9);
-    let mut used = [false; OPTIONS.len()];
+    let mut used = vec![false; options.len()];
     for _ in 0..n {
-        let k = input.below(OPTIONS.len() + 1);
-        if k == OPTIONS.len() {
-            args.push("--no-progress".into());
+        let k = input.below(options.len() + 1);
+        if k == options.len() {
+            if sub != "fit" {
+                args.push("--no-progress".into());
+            }
             continue;
         }
         if std::mem::replace(&mut used[k], true) {
             continue;
         }
-        let (name, values) = OPTIONS[k];
+        let (name, values) = options[k];
         let value = match input.byte() % 8 {
             0 => input.text(12),
             1 => seqsmooth_cli::io::fmt_f64(input.any_number()),
@@ -100,7 +123,8 @@ fn output(cli: &Command, text: &[u8], data_rows: usize) {
             (2 + usize::from(id), Some(a.kind), a.degree, a.window, id)
         }
         Command::Smooth(a) => (2, None, a.degree, Some(a.window), false),
-        _ => unreachable!("only filter and smooth are run"),
+        Command::Fit(_) => return fitted(&header, &mut reader, data_rows),
+        _ => unreachable!("only filter, smooth and fit are run"),
     };
     let d: Vec<usize> = (0..=degree).map(|k| first + k).collect();
     for &k in &d {
@@ -145,6 +169,38 @@ fn output(cli: &Command, text: &[u8], data_rows: usize) {
     assert_eq!(rows, data_rows, "one output row per input row");
 }
 
+/// Checks the output of a successful `fit`: after the echoed cells (`t`, and `y` for the
+/// polynomial model), every cell empty or a finite number, the state cells all empty or all
+/// numbers, at least one row with a state, one row per data row.
+fn fitted(header: &[String], reader: &mut csv::Reader<&[u8]>, data_rows: usize) {
+    let first = if header.get(1).is_some_and(|h| h == "y") {
+        2
+    } else {
+        1
+    };
+    let states = header
+        .iter()
+        .position(|h| h == "iterations")
+        .expect("an iterations column");
+    let (mut rows, mut estimated) = (0, 0);
+    for (i, record) in reader.records().enumerate() {
+        let record = record.expect("the output is CSV");
+        let line = i + 2;
+        rows += 1;
+        for (c, cell) in record.iter().enumerate().skip(first) {
+            computed(cell, line, &header[c]);
+        }
+        let empty = (first..states).filter(|&c| record[c].is_empty()).count();
+        assert!(
+            empty == 0 || empty == states - first,
+            "line {line}: some state cells empty: {record:?}"
+        );
+        estimated += usize::from(empty == 0);
+    }
+    assert!(estimated > 0, "a successful fit has an estimate");
+    assert_eq!(rows, data_rows, "one output row per input row");
+}
+
 pub fn run(data: &[u8]) {
     let mut input = Input::new(data);
     let dir = tempfile::tempdir().expect("a temporary directory");
@@ -162,7 +218,8 @@ pub fn run(data: &[u8]) {
     let result = match &cli.command {
         Command::Filter(a) => filter::run(a),
         Command::Smooth(a) => smooth::run(a),
-        _ => unreachable!("only filter and smooth are run"),
+        Command::Fit(a) => fit::run(a),
+        _ => unreachable!("only filter, smooth and fit are run"),
     };
     let left: Vec<_> = std::fs::read_dir(dir.path())
         .expect("the temporary directory")
