@@ -316,3 +316,132 @@ fn bad_input_is_refused_by_name() {
         "must be 3x3",
     );
 }
+
+/// T8-01, §8.8: Ex. 8.17's `det R'` (0.0740741, 0.0256312, 0.00312474 at α = 1, 0.1, 0.01;
+/// 2/27 at α = 1), 1 for a diagonal `R` (Ex. 8.16), Ex. 8.18's indefinite matrix
+/// (`det R' = −10000/(10000 · 39999)`), and refusals.
+#[test]
+fn correlation_determinant_ex_8_16_to_8_18() {
+    use seqsmooth::estimate::batch::correlation_determinant;
+    let a = |al: f64| {
+        DMatrix::from_row_slice(
+            3,
+            3,
+            &[
+                5.0 + al,
+                4.0 + al,
+                3.0 + 2.0 * al,
+                4.0 + al,
+                5.0 + al,
+                3.0 + 2.0 * al,
+                3.0 + 2.0 * al,
+                3.0 + 2.0 * al,
+                2.0 + 4.0 * al,
+            ],
+        )
+    };
+    // The printed det R' and half a unit of its last printed digit.
+    for (al, det, det_r, half_digit) in [
+        (1.0, 16.0, 0.0740741, 5e-8),
+        (0.1, 8.0 / 5.0, 0.0256312, 5e-8),
+        (0.01, 4.0 / 25.0, 0.00312474, 5e-9),
+    ] {
+        let m = a(al);
+        assert!(
+            (m.determinant() - det).abs() < 1e-12 * det.max(1.0),
+            "det A({al})"
+        );
+        let got = correlation_determinant(&m).unwrap();
+        // det R' = det A / Π a_ii (the LU's rounding grows as R' nears singular: 3e-14
+        // relative at α = 0.01), printed to 6 significant digits.
+        let exact = det / m.diagonal().product();
+        assert!(
+            (got - exact).abs() < 1e-12 * exact,
+            "{al}: {got} against {exact}"
+        );
+        assert!(
+            (got - det_r).abs() <= half_digit,
+            "{al}: {got} against {det_r}"
+        );
+    }
+    assert!((correlation_determinant(&a(1.0)).unwrap() - 2.0 / 27.0).abs() < 1e-15);
+    let diagonal = DMatrix::from_diagonal(&DVector::from_vec(vec![4.0, 1e-6, 3e8]));
+    assert_eq!(correlation_determinant(&diagonal).unwrap(), 1.0);
+    let ex_8_18 = DMatrix::from_row_slice(2, 2, &[10000.0, 20000.0, 20000.0, 39999.0]);
+    let got = correlation_determinant(&ex_8_18).unwrap();
+    let want = -10000.0 / (10000.0 * 39999.0);
+    assert!((got - want).abs() < 1e-9 * want.abs(), "{got}");
+    assert!((got + 2.5e-5).abs() < 1e-9);
+    for bad in [
+        DMatrix::from_row_slice(2, 2, &[1.0, 0.5, 0.4, 1.0]),
+        DMatrix::from_row_slice(2, 2, &[0.0, 0.0, 0.0, 1.0]),
+        DMatrix::from_row_slice(1, 2, &[1.0, 0.0]),
+        DMatrix::from_row_slice(1, 1, &[f64::NAN]),
+        DMatrix::zeros(0, 0),
+    ] {
+        assert!(correlation_determinant(&bad).is_err(), "{bad:?}");
+    }
+}
+
+/// T8-01, Ex. 8.18: `10000x + 20000y = 30000`, `20000x + 39999y = 59999` gives `x = y = 1`;
+/// changing 39999 to 39998 (one part in 4e4) gives `x = 2`, `y = 1/2`. The square system
+/// through `least_squares` (QR), with the condition number it reports (σ_max/σ_min ≈ 1.25e5 and 2.5e5,
+/// from nalgebra's SVD); errors within κ ε.
+#[test]
+fn ill_conditioned_system_ex_8_18() {
+    for (c, want) in [(39999.0, [1.0, 1.0]), (39998.0, [2.0, 0.5])] {
+        let t = DMatrix::from_row_slice(2, 2, &[10000.0, 20000.0, 20000.0, c]);
+        let y = DVector::from_vec(vec![30000.0, 59999.0]);
+        let e = least_squares(&t, &y, &NoiseCovariance::Identity).unwrap();
+        let sv = t.clone().svd(false, false).singular_values;
+        let kappa = sv.max() / sv.min();
+        assert!(
+            (e.condition_number / kappa - 1.0).abs() < 1e-6,
+            "{}",
+            e.condition_number
+        );
+        assert!(kappa > 1e5 && kappa < 3e5, "{kappa}");
+        for k in 0..2 {
+            assert!(
+                (e.state[k] - want[k]).abs() < 4.0 * kappa * f64::EPSILON * want[k].abs(),
+                "c {c} x{k}: {} against {}",
+                e.state[k],
+                want[k]
+            );
+        }
+        assert_eq!(e.degrees_of_freedom, 0);
+    }
+}
+
+/// T8-01, the §8.8 inverse example ((8.8.2)-(8.8.6)): `A = [[s, 1], [1, 1]]`, `s = 1 + ε`,
+/// `A⁻¹ = (1/ε)[[1, −1], [−1, s]]`. Six-digit arithmetic, which stores ε = 0.000015 as
+/// 0.00001, makes a 5e-6 relative error in `s` a 50% error in `A⁻¹`; the covariance of
+/// `minimum_variance` with `Tᵀ T = A` (`T` the Cholesky factor) holds it to within κ ε.
+#[test]
+fn inverse_example_8_8() {
+    for eps in [0.000015_f64, 0.00001] {
+        let s = 1.0 + eps;
+        // T = Lᵀ with A = L Lᵀ.
+        let (l11, l21) = (s.sqrt(), 1.0 / s.sqrt());
+        let l22 = (1.0 - 1.0 / s).sqrt();
+        let t = DMatrix::from_row_slice(2, 2, &[l11, l21, 0.0, l22]);
+        let y = DVector::from_vec(vec![0.0, 0.0]);
+        let e = minimum_variance(&t, &y, &NoiseCovariance::Identity).unwrap();
+        // The exact inverse of the A that T represents in doubles.
+        let a = t.transpose() * &t;
+        let d = a[(0, 0)] * a[(1, 1)] - a[(0, 1)] * a[(1, 0)];
+        let inverse = [a[(1, 1)] / d, -a[(0, 1)] / d, -a[(1, 0)] / d, a[(0, 0)] / d];
+        let kappa = e.condition_number * e.condition_number;
+        for (k, want) in inverse.iter().enumerate() {
+            let got = e.covariance[(k / 2, k % 2)];
+            assert!(
+                (got - want).abs() <= 4.0 * kappa * f64::EPSILON * want.abs(),
+                "eps {eps} [{k}]: {got} against {want}"
+            );
+        }
+        // The book's figures: 66666.7 and 66667.7 at ε = 0.000015, 1e5 and 100001 at 0.00001.
+        let book = [1.0 / eps, (1.0 + eps) / eps];
+        assert!((e.covariance[(0, 0)] / book[0] - 1.0).abs() < 1e-9);
+        assert!((e.covariance[(1, 1)] / book[1] - 1.0).abs() < 1e-9);
+    }
+}

@@ -12,7 +12,8 @@
 //! factor; a singular value at most `max(N, n) ε σ_max` counts as zero, as numpy's
 //! `matrix_rank` does; [`super::observability`]): a `T` that does not determine the state is [`Error::Unobservable`],
 //! naming the rank. The residual `χ² = (Y − T X)ᵀ R⁻¹ (Y − T X)` has `N − n` degrees of
-//! freedom for the minimum-variance estimate (6.10.x).
+//! freedom for the minimum-variance estimate (6.10.x). [`correlation_determinant`] is §8.8's
+//! conditioning test of a covariance, `det R'`.
 
 use super::observability::numerical_rank;
 use crate::error::Error;
@@ -107,6 +108,45 @@ pub fn least_squares(
     let residual = y - t * &fit.x;
     let chi_squared = whitener.apply(&residual).norm_squared();
     finish(fit, symmetric(covariance), chi_squared)
+}
+
+/// Morrison's conditioning test of a covariance before it is inverted (§8.8, (8.8.7)-(8.8.8)):
+/// `det R'` of the unit-diagonal `R' = P^{−1/2} R P^{−1/2}`, `P = diag(R)`. For a positive
+/// definite `R`, `0 < det R' ≤ 1`, with 1 exactly when `R` is diagonal (Ex. 8.16) and values near
+/// 0 warning of a nearly singular `R`; a value at or below 0 says `R` is not positive definite.
+/// `R` must be square, symmetric and finite with a positive diagonal.
+///
+/// ```
+/// use nalgebra::DMatrix;
+/// use seqsmooth::estimate::batch::correlation_determinant;
+/// // Ex. 8.17 at α = 1: det R' = 0.0740741 (= 2/27).
+/// let a = DMatrix::from_row_slice(3, 3, &[6.0, 5.0, 5.0, 5.0, 6.0, 5.0, 5.0, 5.0, 6.0]);
+/// assert!((correlation_determinant(&a).unwrap() - 16.0 / 216.0).abs() < 1e-15);
+/// ```
+pub fn correlation_determinant(r: &DMatrix<f64>) -> Result<f64, Error> {
+    let bad = |reason: &str| Error::InvalidParameter {
+        name: "covariance",
+        value: format!("{r:?}"),
+        reason: reason.into(),
+    };
+    if !r.is_square() || r.is_empty() {
+        return Err(bad("must be a square matrix with at least one row"));
+    }
+    if let Some(&value) = r.iter().find(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            what: "covariance entry",
+            value,
+        });
+    }
+    if (r - r.transpose()).abs().max() > 1e-12 * r.abs().max() {
+        return Err(bad("must be symmetric"));
+    }
+    if r.diagonal().iter().any(|&d| d <= 0.0) {
+        return Err(bad("its diagonal (the variances) must be positive"));
+    }
+    let scale = r.diagonal().map(|d| 1.0 / d.sqrt());
+    let unit = DMatrix::from_fn(r.nrows(), r.ncols(), |i, j| r[(i, j)] * scale[i] * scale[j]);
+    Ok(unit.determinant())
 }
 
 /// The QR of a (whitened) system and its solution.
