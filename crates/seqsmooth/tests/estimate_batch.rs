@@ -401,12 +401,11 @@ fn ill_conditioned_system_ex_8_18() {
             e.condition_number
         );
         assert!(kappa > 1e5 && kappa < 3e5, "{kappa}");
-        for k in 0..2 {
+        for (k, w) in want.iter().enumerate() {
             assert!(
-                (e.state[k] - want[k]).abs() < 4.0 * kappa * f64::EPSILON * want[k].abs(),
-                "c {c} x{k}: {} against {}",
-                e.state[k],
-                want[k]
+                (e.state[k] - w).abs() < 4.0 * kappa * f64::EPSILON * w.abs(),
+                "c {c} x{k}: {} against {w}",
+                e.state[k]
             );
         }
         assert_eq!(e.degrees_of_freedom, 0);
