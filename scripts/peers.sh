@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# Peer comparison (filterpy, scipy) in one command: builds the Rust side (release), then runs
+# Peer comparison (filterpy, scipy; scipy.optimize.least_squares for the radar Gauss–Newton fit)
+# in one command: builds the Rust side (release), then runs
 # scripts/peers.py, which creates its own virtual environment (target/peers-venv, pinned
 # filterpy/numpy/scipy from PyPI), generates the data, runs and times both sides, checks that
 # their estimates agree and prints the table. Exits non-zero on any disagreement.
 #
-#   bash scripts/peers.sh            # full run: 10^6 even samples, 10^5 for the Kalman pairs
-#   bash scripts/peers.sh --quick    # smoke run
+#   bash scripts/peers.sh            # full run: 10^6 even samples, 10^5 for the Kalman pairs,
+#                                    # 400 radar windows for the Gauss–Newton fit
+#   bash scripts/peers.sh --quick    # smoke run (50 radar windows)
 #
 # Needs python3 (3.11+, with the venv module) and network access to PyPI on the first run.
 set -euo pipefail

@@ -25,6 +25,14 @@
 //! repetitions of the update loop alone and of the loop that also reads each sample's estimate
 //! (I/O and filter construction excluded), and the fading-memory gain engine's switch sample.
 //!
+//! A `gauss-newton` run writes instead `DIR/<name>.data.f64` (`windows × 60 × 4`: `t, ρ, ψ, θ`),
+//! `DIR/<name>.nominal.f64` (`windows × 6`: the bootstrap nominal, where the peer starts too),
+//! `DIR/<name>.est.f64` (`windows × 6`: the converged state) and `DIR/<name>.sigma.f64`
+//! (`windows × 6`: the square roots of its covariance's diagonal), and prints
+//! `name,windows,seconds_fit,seconds_bootstrap_and_fit,,seconds_bootstrap`: the best of `REPS`
+//! runs over all the windows of the fit from the (precomputed) nominal, of the bootstrap and
+//! the fit, and of the bootstrap alone (the measurements built outside the timing).
+//!
 //! Each timed loop is one small function per filter family ([`feed`], [`feed_and_read`],
 //! [`feed_fixed_and_read`]), so a batch update API can replace the per-sample loop in one place.
 
@@ -39,6 +47,9 @@ use std::path::Path;
 use std::time::Instant;
 
 type Res<T> = Result<T, Box<dyn Error>>;
+
+#[path = "../benches/common/radar.rs"]
+mod radar;
 
 /// One line of `runs.txt`.
 struct Run {
@@ -197,6 +208,57 @@ fn time_filter<F: PolynomialFilter>(
     Ok((plain, read, out, last, switched(&f)))
 }
 
+/// The `gauss-newton` run: times the fits of the first `windows` simulated radar passes and
+/// writes the data, the nominal states, the estimates and their σ for the script.
+fn gauss_newton(dir: &Path, name: &str, windows: usize, reps: usize) -> Res<()> {
+    let (dynamics, radar) = radar::models();
+    let passes = radar::windows(radar::SEED, windows);
+    let rows: Vec<_> = passes.iter().map(|w| w.measurements()).collect();
+    let nominals = passes
+        .iter()
+        .map(|w| w.nominal(&radar))
+        .collect::<Result<Vec<_>, _>>()?;
+    let fit_all = |_: &mut ()| -> Res<()> {
+        for (r, x0) in rows.iter().zip(&nominals) {
+            black_box(radar::fit(&dynamics, &radar, black_box(r), x0)?);
+        }
+        Ok(())
+    };
+    let bootstrap_and_fit = |_: &mut ()| -> Res<()> {
+        for (w, r) in passes.iter().zip(&rows) {
+            let x0 = w.nominal(&radar)?;
+            black_box(radar::fit(&dynamics, &radar, black_box(r), &x0)?);
+        }
+        Ok(())
+    };
+    let bootstrap = |_: &mut ()| -> Res<()> {
+        for w in &passes {
+            black_box(black_box(w).nominal(&radar)?);
+        }
+        Ok(())
+    };
+    let secs_fit = best_of(reps, || Ok(()), fit_all)?;
+    let secs_both = best_of(reps, || Ok(()), bootstrap_and_fit)?;
+    let secs_boot = best_of(reps, || Ok(()), bootstrap)?;
+    let mut data = Vec::new();
+    let (mut est, mut sigma, mut nominal) = (Vec::new(), Vec::new(), Vec::new());
+    for ((w, r), x0) in passes.iter().zip(&rows).zip(&nominals) {
+        for (t, m) in w.times.iter().zip(&w.measured) {
+            data.extend([*t, m[0], m[1], m[2]]);
+        }
+        let fit = radar::fit(&dynamics, &radar, r, x0)?;
+        est.extend(fit.state.iter());
+        sigma.extend(fit.covariance.diagonal().iter().map(|v| v.sqrt()));
+        nominal.extend(x0.iter());
+    }
+    write_f64s(&dir.join(format!("{name}.data.f64")), &data)?;
+    write_f64s(&dir.join(format!("{name}.nominal.f64")), &nominal)?;
+    write_f64s(&dir.join(format!("{name}.est.f64")), &est)?;
+    write_f64s(&dir.join(format!("{name}.sigma.f64")), &sigma)?;
+    println!("{name},{windows},{secs_fit:e},{secs_both:e},,{secs_boot:e}");
+    Ok(())
+}
+
 fn main() -> Res<()> {
     let args: Vec<String> = std::env::args().collect();
     if args.len() != 3 {
@@ -216,6 +278,10 @@ fn main() -> Res<()> {
             continue;
         }
         let run = Run::parse(line, i + 1)?;
+        if run.filter == "gauss-newton" {
+            gauss_newton(dir, &run.name, run.key("windows")?, reps)?;
+            continue;
+        }
         if !data.contains_key(&run.data) {
             let t = read_f64s(&dir.join(format!("{}.t.f64", run.data)))?;
             let y = read_f64s(&dir.join(format!("{}.y.f64", run.data)))?;
