@@ -64,11 +64,15 @@ pub fn minimum_variance(
 ) -> Result<BatchEstimate, Error> {
     check(t, y, noise)?;
     let whitener = Whitener::new(noise)?;
-    let yw = whitener.apply(y);
-    let fit = Fit::new(whitener.apply(t), &yw)?;
-    let covariance = fit.inverse_gram();
-    let chi_squared = (&yw - &fit.t * &fit.x).norm_squared();
-    finish(fit, covariance, chi_squared)
+    let solved = solve_whitened(whitener.apply(t), whitener.apply(y))?;
+    let covariance = solved.covariance();
+    finish(
+        solved.x,
+        covariance,
+        solved.chi_squared,
+        solved.degrees_of_freedom,
+        solved.condition_number,
+    )
 }
 
 /// The least-squares estimate `X̂ = (Tᵀ T)⁻¹ Tᵀ Y`, with its covariance `W R Wᵀ` under the
@@ -107,7 +111,14 @@ pub fn least_squares(
     };
     let residual = y - t * &fit.x;
     let chi_squared = whitener.apply(&residual).norm_squared();
-    finish(fit, symmetric(covariance), chi_squared)
+    let (rows, states) = fit.t.shape();
+    finish(
+        fit.x,
+        symmetric(covariance),
+        chi_squared,
+        rows - states,
+        fit.condition_number,
+    )
 }
 
 /// Morrison's conditioning test of a covariance before it is inverted (§8.8, (8.8.7)-(8.8.8)):
@@ -149,7 +160,79 @@ pub fn correlation_determinant(r: &DMatrix<f64>) -> Result<f64, Error> {
     Ok(unit.determinant())
 }
 
-/// The QR of a (whitened) system and its solution.
+/// The least-squares solution of a whitened system `t x ≈ y` by Householder QR, `Q` never
+/// formed (`Qᵀ y` by the reflectors): the state, the triangular factor `R`, `|Qᵀ y|` over the
+/// first `n` rows (`|t x|`, the part of `y` the fit explains) and over the rest (the residual
+/// `χ²`), after the rank check of `R`'s singular values (those of `t`). What
+/// [`minimum_variance`] and each Gauss–Newton correction solve.
+pub(crate) struct Solved {
+    /// `x`.
+    pub(crate) x: DVector<f64>,
+    /// `R`, `n × n` (`t = Q R`).
+    r: DMatrix<f64>,
+    /// `|t x| = |R x|`.
+    pub(crate) explained: f64,
+    /// `|y − t x|²`.
+    pub(crate) chi_squared: f64,
+    /// Rows less states.
+    pub(crate) degrees_of_freedom: usize,
+    /// `σ_max/σ_min` of `t`.
+    pub(crate) condition_number: f64,
+}
+
+/// Solves the whitened `t x ≈ y` (see [`Solved`]); [`Error::Unobservable`] when `t` is
+/// rank-deficient.
+pub(crate) fn solve_whitened(t: DMatrix<f64>, mut y: DVector<f64>) -> Result<Solved, Error> {
+    let (rows, states) = t.shape();
+    let qr = t.qr();
+    let r = qr.r();
+    let condition_number = full_rank(&r, rows, states)?;
+    qr.q_tr_mul(&mut y);
+    let head = y.rows(0, states).into_owned();
+    let x = r
+        .solve_upper_triangular(&head)
+        .expect("R is non-singular at full rank");
+    Ok(Solved {
+        x,
+        r,
+        explained: head.norm(),
+        chi_squared: y.rows(states, rows - states).norm_squared(),
+        degrees_of_freedom: rows - states,
+        condition_number,
+    })
+}
+
+/// The condition number `σ_max/σ_min` of `T = Q R` from `R`'s singular values (those of
+/// `T`), or [`Error::Unobservable`] when its numerical rank is below `states`.
+fn full_rank(r: &DMatrix<f64>, rows: usize, states: usize) -> Result<f64, Error> {
+    let sv = r.singular_values();
+    let largest = sv.max();
+    let smallest = if rows < states { 0.0 } else { sv.min() };
+    let rank = numerical_rank(sv.as_slice(), rows, states);
+    if rank < states {
+        return Err(Error::Unobservable {
+            rank,
+            states,
+            smallest_singular_value: smallest,
+            largest_singular_value: largest,
+        });
+    }
+    Ok(largest / smallest)
+}
+
+impl Solved {
+    /// `(Rᵀ R)⁻¹ = R⁻¹ R⁻ᵀ`, the inverse of the Gram matrix `tᵀ t`: the covariance of `x`.
+    pub(crate) fn covariance(&self) -> DMatrix<f64> {
+        let n = self.r.ncols();
+        let r_inv = self
+            .r
+            .solve_upper_triangular(&DMatrix::identity(n, n))
+            .expect("R is non-singular at full rank");
+        symmetric(&r_inv * r_inv.transpose())
+    }
+}
+
+/// The QR of a system, with `Q` formed (least squares needs `W = R⁻¹ Qᵀ`), and its solution.
 struct Fit {
     t: DMatrix<f64>,
     q: DMatrix<f64>,
@@ -164,19 +247,7 @@ impl Fit {
         let (rows, states) = t.shape();
         let qr = t.clone().qr();
         let (q, r) = (qr.q(), qr.r());
-        // The singular values of R are those of T.
-        let sv = r.singular_values();
-        let largest = sv.max();
-        let smallest = if rows < states { 0.0 } else { sv.min() };
-        let rank = numerical_rank(sv.as_slice(), rows, states);
-        if rank < states {
-            return Err(Error::Unobservable {
-                rank,
-                states,
-                smallest_singular_value: smallest,
-                largest_singular_value: largest,
-            });
-        }
+        let condition_number = full_rank(&r, rows, states)?;
         let qty = q.transpose() * y;
         let x = r
             .solve_upper_triangular(&qty)
@@ -186,18 +257,8 @@ impl Fit {
             q,
             r,
             x,
-            condition_number: largest / smallest,
+            condition_number,
         })
-    }
-
-    /// `(Rᵀ R)⁻¹ = R⁻¹ R⁻ᵀ`, the inverse of the Gram matrix `tᵀ t`.
-    fn inverse_gram(&self) -> DMatrix<f64> {
-        let n = self.r.ncols();
-        let r_inv = self
-            .r
-            .solve_upper_triangular(&DMatrix::identity(n, n))
-            .expect("R is non-singular at full rank");
-        symmetric(&r_inv * r_inv.transpose())
     }
 
     /// `W = R⁻¹ Qᵀ = (tᵀ t)⁻¹ tᵀ`.
@@ -208,9 +269,15 @@ impl Fit {
     }
 }
 
-fn finish(fit: Fit, covariance: DMatrix<f64>, chi_squared: f64) -> Result<BatchEstimate, Error> {
+fn finish(
+    state: DVector<f64>,
+    covariance: DMatrix<f64>,
+    chi_squared: f64,
+    degrees_of_freedom: usize,
+    condition_number: f64,
+) -> Result<BatchEstimate, Error> {
     let out_of_range = |what: &str| Error::EstimateOutOfRange { what: what.into() };
-    if !fit.x.iter().all(|v| v.is_finite()) {
+    if !state.iter().all(|v| v.is_finite()) {
         return Err(out_of_range("state"));
     }
     if !covariance.iter().all(|v| v.is_finite()) {
@@ -219,13 +286,12 @@ fn finish(fit: Fit, covariance: DMatrix<f64>, chi_squared: f64) -> Result<BatchE
     if !chi_squared.is_finite() {
         return Err(out_of_range("residual chi-squared"));
     }
-    let (rows, states) = fit.t.shape();
     Ok(BatchEstimate {
-        state: fit.x,
+        state,
         covariance,
         chi_squared,
-        degrees_of_freedom: rows - states,
-        condition_number: fit.condition_number,
+        degrees_of_freedom,
+        condition_number,
     })
 }
 

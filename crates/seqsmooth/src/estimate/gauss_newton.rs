@@ -6,7 +6,7 @@
 //! | nominal `X̄` at the epoch `t_c` | the user's, or [`super::bootstrap`] | §8.5 |
 //! | trajectory and `Φ(t_k, t_c; X̄)` | [`Dynamics::propagate`], outwards from `t_c` | steps II, IV, (8.6.28)-(8.6.29) |
 //! | `T = [M_k Φ(t_k, t_c)]`, `δY_k = Y_k − G(X̄(t_k))` | [`Observation::predict`], present components only | steps III-VII, (8.6.35) |
-//! | `δX = (Tᵀ R⁻¹ T)⁻¹ Tᵀ R⁻¹ δY`, `S = (Tᵀ R⁻¹ T)⁻¹` | [`super::batch::minimum_variance`] of the whitened system | (8.6.36)-(8.6.38) |
+//! | `δX = (Tᵀ R⁻¹ T)⁻¹ Tᵀ R⁻¹ δY`, `S = (Tᵀ R⁻¹ T)⁻¹` | the whitened system's Householder QR, as [`super::batch::minimum_variance`] solves it | (8.6.36)-(8.6.38) |
 //! | with a prior `X_p`, `S_p`: the rows `S_p^{−1/2} (X_p − X̄)` stacked on | | (11.2.24)-(11.2.27), (11.4.33) |
 //! | `X̄ ← X̄ + λ δX`, `λ = 1, 1/2, …` until `e(X)` falls | | (8.7.1), step halving |
 //!
@@ -17,7 +17,7 @@
 //! (11.4.26). The covariance reported is `S` of the last linearisation (8.6.38); for a
 //! nonlinear model it is the first-order approximation the book warns of (§11.4).
 
-use super::batch::{minimum_variance, NoiseCovariance};
+use super::batch::{solve_whitened, NoiseCovariance};
 use crate::error::Error;
 use crate::model::dynamics::Dynamics;
 use crate::model::observation::Observation;
@@ -259,7 +259,10 @@ impl GaussNewton {
             });
         }
 
-        let layout = Layout::new(&rows, t_c, prior.as_ref().map_or(0, |_| n));
+        let mut layout = Layout::new(&rows, t_c, prior.as_ref().map_or(0, |_| n));
+        if dynamics.is_linear() {
+            layout = layout.with_transitions(dynamics, &rows, t_c, nominal)?;
+        }
         let mut x = nominal.clone();
         let mut lin = linearise(
             dynamics,
@@ -272,11 +275,21 @@ impl GaussNewton {
         )?;
         let mut iterations = Vec::new();
         for iteration in 1..=self.max_iterations {
-            let solution = minimum_variance(&lin.t, &lin.r, &NoiseCovariance::Identity)?;
-            let dx = &solution.state;
-            let correction = (&lin.t * dx).norm();
+            let Linearised { t, r, chi_squared } = lin;
+            let solution = solve_whitened(t, r)?;
+            let dx = &solution.x;
+            // |T δX| = sqrt(δXᵀ S⁻¹ δX), the correction in its own σ.
+            let correction = solution.explained;
             if correction <= self.tolerance {
                 x += dx;
+                let covariance = solution.covariance();
+                if !(x.iter().chain(covariance.iter()).all(|v| v.is_finite())
+                    && solution.chi_squared.is_finite())
+                {
+                    return Err(Error::EstimateOutOfRange {
+                        what: "differential correction's state or covariance".into(),
+                    });
+                }
                 iterations.push(Iteration {
                     state: x.clone(),
                     correction,
@@ -286,14 +299,15 @@ impl GaussNewton {
                 return Ok(Correction {
                     epoch: t_c,
                     state: x,
-                    covariance: solution.covariance,
+                    covariance,
                     chi_squared: solution.chi_squared,
                     degrees_of_freedom: solution.degrees_of_freedom,
                     condition_number: solution.condition_number,
                     iterations,
                 });
             }
-            let slack = 1e-10 * lin.chi_squared.max(1.0);
+            let lin_chi_squared = chi_squared;
+            let slack = 1e-10 * lin_chi_squared.max(1.0);
             let mut step = 1.0;
             let mut accepted = None;
             for _ in 0..=self.max_halvings {
@@ -307,7 +321,7 @@ impl GaussNewton {
                     &candidate,
                     prior.as_ref(),
                 ) {
-                    if next.chi_squared <= lin.chi_squared + slack {
+                    if next.chi_squared <= lin_chi_squared + slack {
                         accepted = Some((candidate, next));
                         break;
                     }
@@ -317,7 +331,7 @@ impl GaussNewton {
             let Some((candidate, next)) = accepted else {
                 return Err(Error::Diverged {
                     iteration,
-                    chi_squared: lin.chi_squared,
+                    chi_squared: lin_chi_squared,
                     halvings: self.max_halvings,
                 });
             };
@@ -513,6 +527,9 @@ struct Layout {
     after: Vec<usize>,
     before: Vec<usize>,
     total: usize,
+    /// `Φ(t_k, t_c)` of each row, once per fit, for dynamics whose `Φ` does not depend on the
+    /// state ([`Dynamics::is_linear`]).
+    transitions: Option<Vec<DMatrix<f64>>>,
 }
 
 impl Layout {
@@ -533,7 +550,28 @@ impl Layout {
             after,
             before: order,
             total: at + prior_states,
+            transitions: None,
         }
+    }
+
+    /// With each row's `Φ(t_k, t_c)`, carried from `t_c` directly (any state will do).
+    fn with_transitions<D: Dynamics>(
+        mut self,
+        dynamics: &D,
+        rows: &[Rows],
+        t_c: f64,
+        x: &DVector<f64>,
+    ) -> Result<Self, Error> {
+        let n = x.len();
+        let mut state = DVector::zeros(n);
+        let mut all = Vec::with_capacity(rows.len());
+        for row in rows {
+            let mut phi = DMatrix::zeros(n, n);
+            dynamics.propagate_into(x, t_c, row.time, &mut state, &mut phi)?;
+            all.push(phi);
+        }
+        self.transitions = Some(all);
+        Ok(self)
     }
 }
 
@@ -547,7 +585,18 @@ fn product_into(a: &DMatrix<f64>, b: &DMatrix<f64>, out: &mut DMatrix<f64>) {
         (b.nrows(), out.nrows(), out.ncols()),
         (inner, rows, b.ncols())
     );
-    let (a, b, out) = (a.as_slice(), b.as_slice(), out.as_mut_slice());
+    product_slices(rows, inner, a.as_slice(), b.as_slice(), out.as_mut_slice());
+}
+
+/// `out = a x` ([`product_into`] for a vector).
+fn product_vector_into(a: &DMatrix<f64>, x: &DVector<f64>, out: &mut DVector<f64>) {
+    let (rows, inner) = a.shape();
+    debug_assert_eq!((x.len(), out.len()), (inner, rows));
+    product_slices(rows, inner, a.as_slice(), x.as_slice(), out.as_mut_slice());
+}
+
+/// The column-major product of `a` (`rows × inner`) and `b` (`inner × out.len()/rows`).
+fn product_slices(rows: usize, inner: usize, a: &[f64], b: &[f64], out: &mut [f64]) {
     unrolled_sizes!(inner, N => product_n::<N>(rows, a, b, out), n => product_any(rows, n, a, b, out));
 }
 
@@ -578,6 +627,26 @@ fn product_any(rows: usize, n: usize, a: &[f64], b: &[f64], out: &mut [f64]) {
     }
 }
 
+/// Writes one observation's present rows, `M Φ` and the residuals, whitened, at `at`.
+fn write_rows<O: Observation>(
+    observation: &O,
+    row: &Rows,
+    at: usize,
+    m: &DMatrix<f64>,
+    value: &DVector<f64>,
+    t: &mut DMatrix<f64>,
+    r: &mut DVector<f64>,
+) {
+    let (count, n) = (row.present.len(), m.ncols());
+    for (i, &c) in row.present.iter().enumerate() {
+        t.row_mut(at + i).copy_from(&m.row(c));
+        r[at + i] = observation.residual(c, row.values[i], value[c]);
+    }
+    row.whiten
+        .apply_matrix(&mut t.view_mut((at, 0), (count, n)));
+    row.whiten.apply_vector(&mut r.rows_mut(at, count));
+}
+
 /// `T` and `δY` whitened, and `e(X̄)`, at the nominal `x` (state at `t_c`): the trajectory is
 /// carried outwards from `t_c` through the sorted times, `Φ(t_k, t_c) = Φ(t_k, t_{k∓1}) Φ(t_{k∓1}, t_c)`.
 fn linearise<D: Dynamics, O: Observation>(
@@ -592,35 +661,63 @@ fn linearise<D: Dynamics, O: Observation>(
     let n = x.len();
     let mut t = DMatrix::zeros(layout.total, n);
     let mut r = DVector::zeros(layout.total);
+    let p = observation.components();
     let mut carried = DMatrix::<f64>::zeros(n, n);
-    let mut m = DMatrix::<f64>::zeros(observation.components(), n);
-    for side in [&layout.after, &layout.before] {
+    let mut m = DMatrix::<f64>::zeros(p, n);
+    let (mut step, mut next) = (DMatrix::<f64>::zeros(n, n), DVector::<f64>::zeros(n));
+    let (mut value, mut jacobian) = (DVector::<f64>::zeros(p), DMatrix::<f64>::zeros(p, n));
+    if let Some(transitions) = &layout.transitions {
+        for (k, (row, phi)) in rows.iter().zip(transitions).enumerate() {
+            let count = row.present.len();
+            if count == 0 {
+                continue;
+            }
+            product_vector_into(phi, x, &mut next);
+            observation.predict_into(&next, row.time, &mut value, &mut jacobian)?;
+            product_into(&jacobian, phi, &mut m);
+            write_rows(
+                observation,
+                row,
+                layout.offsets[k],
+                &m,
+                &value,
+                &mut t,
+                &mut r,
+            );
+        }
+    }
+    let sides = match layout.transitions {
+        Some(_) => [&[][..], &[][..]],
+        None => [&layout.after[..], &layout.before[..]],
+    };
+    for side in sides {
         let mut state = x.clone();
         let mut phi = DMatrix::<f64>::identity(n, n);
         let mut time = t_c;
         for &k in side {
             let row = &rows[k];
             if row.time != time {
-                let p = dynamics.propagate(&state, time, row.time)?;
-                product_into(&p.transition, &phi, &mut carried);
+                dynamics.propagate_into(&state, time, row.time, &mut next, &mut step)?;
+                product_into(&step, &phi, &mut carried);
                 std::mem::swap(&mut phi, &mut carried);
-                state = p.state;
+                std::mem::swap(&mut state, &mut next);
                 time = row.time;
             }
             let count = row.present.len();
             if count == 0 {
                 continue;
             }
-            let predicted = observation.predict(&state, row.time)?;
-            product_into(&predicted.jacobian, &phi, &mut m);
-            let at = layout.offsets[k];
-            for (i, &c) in row.present.iter().enumerate() {
-                t.row_mut(at + i).copy_from(&m.row(c));
-                r[at + i] = observation.residual(c, row.values[i], predicted.value[c]);
-            }
-            row.whiten
-                .apply_matrix(&mut t.view_mut((at, 0), (count, n)));
-            row.whiten.apply_vector(&mut r.rows_mut(at, count));
+            observation.predict_into(&state, row.time, &mut value, &mut jacobian)?;
+            product_into(&jacobian, &phi, &mut m);
+            write_rows(
+                observation,
+                row,
+                layout.offsets[k],
+                &m,
+                &value,
+                &mut t,
+                &mut r,
+            );
         }
     }
     if let Some(p) = prior {

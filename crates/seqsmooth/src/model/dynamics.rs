@@ -13,7 +13,7 @@
 //! to first order, `S_b = Φ S_a Φᵀ` ((6.6.x); exact for linear models).
 
 use super::linear::LinearDynamics;
-use super::psi;
+use super::transition::psi_term;
 use crate::error::Error;
 use nalgebra::{DMatrix, DVector};
 
@@ -42,6 +42,45 @@ pub trait Dynamics {
 
     /// `X(t_b)` and `Φ(t_b, t_a)` from `X(t_a)`; `t_b < t_a` goes backwards.
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error>;
+
+    /// Whether `Φ(t_b, t_a)` is the same for every state (linear dynamics, `dX/dt = A(t) X`):
+    /// the estimators then compute each observation's `Φ(t_k, t_c)` once, not at every
+    /// iteration. `false` unless the model says so.
+    ///
+    /// ```
+    /// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+    /// assert!(PolynomialDynamics::new(1, 3).is_linear());
+    /// ```
+    fn is_linear(&self) -> bool {
+        false
+    }
+
+    /// [`Dynamics::propagate`] into the caller's buffers (`state_out` of length `n`,
+    /// `transition_out` `n × n`, replaced if they are not), allocating nothing where the model
+    /// allows ([`PolynomialDynamics`] does): what the estimators call at every observation time.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+    /// let (mut x, mut phi) = (DVector::zeros(2), DMatrix::zeros(2, 2));
+    /// PolynomialDynamics::new(1, 1)
+    ///     .propagate_into(&DVector::from_vec(vec![5.0, 3.0]), 10.0, 8.0, &mut x, &mut phi)
+    ///     .unwrap();
+    /// assert_eq!((x[0], phi[(0, 1)]), (-1.0, -2.0));
+    /// ```
+    fn propagate_into(
+        &self,
+        state: &DVector<f64>,
+        t_a: f64,
+        t_b: f64,
+        state_out: &mut DVector<f64>,
+        transition_out: &mut DMatrix<f64>,
+    ) -> Result<(), Error> {
+        let p = self.propagate(state, t_a, t_b)?;
+        *state_out = p.state;
+        *transition_out = p.transition;
+        Ok(())
+    }
 
     /// `X(t_b)` and, to first order, its covariance `Φ S Φᵀ` from `X(t_a)` with covariance `S`.
     ///
@@ -181,16 +220,29 @@ impl PolynomialDynamics {
     /// assert_eq!(PolynomialDynamics::new(2, 1).transition(2.0)[(0, 2)], 2.0); // ζ²/2!
     /// ```
     pub fn transition(&self, zeta: f64) -> DMatrix<f64> {
-        let d = self.axes;
-        let base = psi(self.degree, zeta);
-        let n = (self.degree + 1) * d;
-        DMatrix::from_fn(n, n, |r, c| {
-            if r % d == c % d {
-                base[(r / d, c / d)]
-            } else {
-                0.0
+        let n = (self.degree + 1) * self.axes;
+        let mut out = DMatrix::zeros(n, n);
+        self.transition_into(zeta, &mut out);
+        out
+    }
+
+    /// `Φ(ζ) = Ψ(ζ) ⊗ I_d` written into `out` (resized to `n × n` if it is not).
+    fn transition_into(&self, zeta: f64, out: &mut DMatrix<f64>) {
+        let (d, m) = (self.axes, self.degree);
+        let n = (m + 1) * d;
+        if out.shape() != (n, n) {
+            *out = DMatrix::zeros(n, n);
+        } else {
+            out.fill(0.0);
+        }
+        for k in 0..=m {
+            let term = psi_term(k, &zeta);
+            for i in 0..=m - k {
+                for a in 0..d {
+                    out[(i * d + a, (i + k) * d + a)] = term;
+                }
             }
-        })
+        }
     }
 }
 
@@ -199,24 +251,60 @@ impl Dynamics for PolynomialDynamics {
         (self.degree + 1) * self.axes
     }
 
+    fn is_linear(&self) -> bool {
+        true
+    }
+
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
-        check_propagation(self.dimension(), state, t_a, t_b)?;
-        let transition = self.transition(t_b - t_a);
-        finite_matrix(&transition, "transition matrix entry")?;
-        let state = &transition * state;
-        if let Some(v) = state.iter().find(|v| !v.is_finite()) {
+        let n = self.dimension();
+        let mut p = Propagation {
+            state: DVector::zeros(n),
+            transition: DMatrix::zeros(n, n),
+        };
+        self.propagate_into(state, t_a, t_b, &mut p.state, &mut p.transition)?;
+        Ok(p)
+    }
+
+    fn propagate_into(
+        &self,
+        state: &DVector<f64>,
+        t_a: f64,
+        t_b: f64,
+        state_out: &mut DVector<f64>,
+        transition_out: &mut DMatrix<f64>,
+    ) -> Result<(), Error> {
+        let n = self.dimension();
+        check_propagation(n, state, t_a, t_b)?;
+        self.transition_into(t_b - t_a, transition_out);
+        finite_matrix(transition_out, "transition matrix entry")?;
+        if state_out.len() != n {
+            *state_out = DVector::zeros(n);
+        }
+        // Φ is upper triangular: row r sums from column r on.
+        for r in 0..n {
+            let mut acc = 0.0;
+            for c in r..n {
+                acc += transition_out[(r, c)] * state[c];
+            }
+            state_out[r] = acc;
+        }
+        if let Some(v) = state_out.iter().find(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 what: "propagated state entry",
                 value: *v,
             });
         }
-        Ok(Propagation { state, transition })
+        Ok(())
     }
 }
 
 impl Dynamics for LinearDynamics {
     fn dimension(&self) -> usize {
         LinearDynamics::dimension(self)
+    }
+
+    fn is_linear(&self) -> bool {
+        true
     }
 
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
@@ -238,7 +326,22 @@ impl<D: Dynamics + ?Sized> Dynamics for &D {
         (**self).dimension()
     }
 
+    fn is_linear(&self) -> bool {
+        (**self).is_linear()
+    }
+
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
         (**self).propagate(state, t_a, t_b)
+    }
+
+    fn propagate_into(
+        &self,
+        state: &DVector<f64>,
+        t_a: f64,
+        t_b: f64,
+        state_out: &mut DVector<f64>,
+        transition_out: &mut DMatrix<f64>,
+    ) -> Result<(), Error> {
+        (**self).propagate_into(state, t_a, t_b, state_out, transition_out)
     }
 }

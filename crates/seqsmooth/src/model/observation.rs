@@ -43,6 +43,32 @@ pub trait Observation {
     /// `G(X, t)` and `M(X, t)`.
     fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error>;
 
+    /// [`Observation::predict`] into the caller's buffers (`value` of length `components`,
+    /// `jacobian` `components × states`, replaced if they are not), allocating nothing where
+    /// the model allows ([`super::radar::Radar`] does): what the estimators call at every
+    /// observation.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::model::observation::{LinearObservation, Observation};
+    /// let m = LinearObservation::value_of(2);
+    /// let (mut g, mut j) = (DVector::zeros(1), DMatrix::zeros(1, 2));
+    /// m.predict_into(&DVector::from_vec(vec![3.0, 4.0]), 0.0, &mut g, &mut j).unwrap();
+    /// assert_eq!((g[0], j[(0, 0)], j[(0, 1)]), (3.0, 1.0, 0.0));
+    /// ```
+    fn predict_into(
+        &self,
+        state: &DVector<f64>,
+        t: f64,
+        value: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> Result<(), Error> {
+        let p = self.predict(state, t)?;
+        *value = p.value;
+        *jacobian = p.jacobian;
+        Ok(())
+    }
+
     /// The residual of component `component`, `measured − predicted` (an angle's wrapped to
     /// `(−π, π]`).
     fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {
@@ -60,6 +86,15 @@ impl<O: Observation + ?Sized> Observation for &O {
     }
     fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error> {
         (**self).predict(state, t)
+    }
+    fn predict_into(
+        &self,
+        state: &DVector<f64>,
+        t: f64,
+        value: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> Result<(), Error> {
+        (**self).predict_into(state, t, value, jacobian)
     }
     fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {
         (**self).residual(component, measured, predicted)

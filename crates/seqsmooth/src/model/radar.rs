@@ -221,6 +221,22 @@ impl Observation for Radar {
     }
 
     fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error> {
+        let (rows, states) = (self.components(), self.states);
+        let mut p = Predicted {
+            value: DVector::zeros(rows),
+            jacobian: DMatrix::zeros(rows, states),
+        };
+        self.predict_into(state, t, &mut p.value, &mut p.jacobian)?;
+        Ok(p)
+    }
+
+    fn predict_into(
+        &self,
+        state: &DVector<f64>,
+        t: f64,
+        value: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> Result<(), Error> {
         check_state(self.states, state)?;
         let p = [
             state[0] - self.site[0],
@@ -242,8 +258,14 @@ impl Observation for Radar {
             });
         }
         let rows = self.components();
-        let mut value = DVector::zeros(rows);
-        let mut jacobian = DMatrix::zeros(rows, self.states);
+        if value.len() != rows {
+            *value = DVector::zeros(rows);
+        }
+        if jacobian.shape() != (rows, self.states) {
+            *jacobian = DMatrix::zeros(rows, self.states);
+        } else {
+            jacobian.fill(0.0);
+        }
         value[0] = rho;
         value[1] = (p[1] + 0.0).atan2(p[0]); // + 0.0: atan2(−0, x < 0) is −π, outside (−π, π]
         value[2] = p[2].atan2(h);
@@ -270,7 +292,7 @@ impl Observation for Radar {
                 value: v,
             });
         }
-        Ok(Predicted { value, jacobian })
+        Ok(())
     }
 
     fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {

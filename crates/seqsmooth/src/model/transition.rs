@@ -37,7 +37,13 @@ pub fn psi<T: Scalar>(m: usize, zeta: T) -> DMatrix<T> {
         if j < i {
             T::zero()
         } else {
-            zeta.powi_u(j - i) / factorial::<T>(j - i)
+            psi_term(j - i, &zeta)
         }
     })
+}
+
+/// `[Ψ(ζ)]_{i, i+k} = ζ^k/k!`, the one formula of every `Ψ` entry (also
+/// [`super::dynamics::PolynomialDynamics`]'s, filled in place).
+pub(crate) fn psi_term<T: Scalar>(k: usize, zeta: &T) -> T {
+    zeta.powi_u(k) / factorial::<T>(k)
 }
