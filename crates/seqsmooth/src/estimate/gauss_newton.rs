@@ -13,8 +13,10 @@
 //! `e(X) = Σ_k δY_kᵀ R_k⁻¹ δY_k (+ (X_p − X)ᵀ S_p⁻¹ (X_p − X))` is the residual chi-squared
 //! (11.4.9), (11.4.33). Convergence: the correction in units of its own standard deviation,
 //! `c = sqrt(δXᵀ S⁻¹ δX)`, at most the tolerance. `c` is also the norm of the whitened gradient
-//! `Tᵀ R⁻¹ δY (+ S_p⁻¹ (X_p − X̄))`, so `c → 0` is the stationarity condition (11.4.5),
-//! (11.4.26). The covariance reported is `S` of the last linearisation (8.6.38); for a
+//! `Tᵀ R⁻¹ δY (+ S_p⁻¹ (X_p − X̄))` in the metric `S`, so `c → 0` is the stationarity condition
+//! (11.4.5), (11.4.26); and `c²` is the fall of the residual chi-squared the linearised step
+//! predicts, `e(X̄) − |δY − T δX|²`, so the one test bounds both the correction and the change
+//! of `e` still to come. The covariance reported is `S` of the last linearisation (8.6.38); for a
 //! nonlinear model it is the first-order approximation the book warns of (§11.4).
 
 use super::batch::{solve_whitened, NoiseCovariance};
