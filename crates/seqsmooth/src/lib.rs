@@ -76,6 +76,7 @@ pub mod basis;
 pub mod calculus;
 pub mod error;
 pub mod estimate;
+pub mod kalman;
 pub mod linalg;
 pub mod model;
 pub mod numeric;

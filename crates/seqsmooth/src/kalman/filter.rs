@@ -1,0 +1,433 @@
+//! The Kalman filter (Morrison ch. 12, with driving noise ch. 15), in its one-pass extended
+//! form for nonlinear models (§12.5, (12.5.19)-(12.5.23)): any [`Dynamics`] and
+//! [`Observation`], on any times.
+//!
+//! | step | | source |
+//! |---|---|---|
+//! | `X_{n,n−1} = X(t_n)` from `X_{n−1,n−1}`, with `Φ(t_n, t_{n−1})` | [`Dynamics::propagate_into`] | (12.2.15), (15.4.10) |
+//! | `S_{n,n−1} = Φ S_{n−1,n−1} Φᵀ + Q(t_n, t_{n−1})` | [`ProcessNoise`] | (12.2.16), (15.4.11) |
+//! | `ν = Y_n − G(X_{n,n−1})`, `V = M S_{n,n−1} Mᵀ + R_n` (present components) | [`Observation::predict_into`] | (12.2.17) |
+//! | `H = S_{n,n−1} Mᵀ V⁻¹` (Cholesky of `V`) | | (12.2.17), (15.4.12) |
+//! | `X_{n,n} = X_{n,n−1} + H ν` | | (12.2.19), (15.4.14) |
+//! | `S_{n,n} = (I − H M) S_{n,n−1} (I − H M)ᵀ + H R Hᵀ` | Joseph form | (12.3.7) |
+//!
+//! The covariance update is Joseph's form (12.3.7), not (12.2.18): it is the covariance of the
+//! estimate for the gain actually used, a sum of two positive semidefinite terms, so it stays
+//! symmetric positive semidefinite where `(I − H M) S` loses it by cancellation (§12.4 item 5,
+//! Ex. 12.16); it costs two more `n × n` products. A perfect observation (`R = 0`, Ex. 12.12,
+//! 12.13) is allowed while `V` stays positive definite.
+//!
+//! Each update reports its innovation `ν`, its covariance `V`, the normalised innovation
+//! squared `NIS = νᵀ V⁻¹ ν` (χ² with as many degrees of freedom as components when the model
+//! holds, §14.8) and the Gaussian log-likelihood `−(NIS + ln det V + p ln 2π)/2`.
+//!
+//! The filter cannot start from zero information (§12.4 item 2): it needs a prior state and
+//! covariance, e.g. from [`crate::estimate::gauss_newton`] on the first observations.
+
+use super::noise::ProcessNoise;
+use crate::error::Error;
+use crate::estimate::batch::NoiseCovariance;
+use crate::estimate::gauss_newton::Measurement;
+use crate::model::dynamics::Dynamics;
+use crate::model::observation::Observation;
+use nalgebra::{Cholesky, DMatrix, DVector};
+use std::f64::consts::TAU;
+use std::sync::Arc;
+
+/// What one update saw: the innovation and its statistics.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Innovation {
+    /// The components used (the present ones), in the observation's order.
+    pub components: Vec<usize>,
+    /// `ν = Y − G(X_{n,n−1})` on those components (an angle's wrapped).
+    pub innovation: DVector<f64>,
+    /// `V = M S_{n,n−1} Mᵀ + R`.
+    pub covariance: DMatrix<f64>,
+    /// The gain `H = S_{n,n−1} Mᵀ V⁻¹`, states × components.
+    pub gain: DMatrix<f64>,
+    /// `νᵀ V⁻¹ ν`.
+    pub nis: f64,
+    /// `−(NIS + ln det V + p ln 2π)/2`.
+    pub log_likelihood: f64,
+}
+
+/// A Kalman filter on `D` and `O`, with optional driving noise.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::estimate::batch::NoiseCovariance;
+/// use seqsmooth::estimate::gauss_newton::Measurement;
+/// use seqsmooth::kalman::KalmanFilter;
+/// use seqsmooth::model::dynamics::PolynomialDynamics;
+/// use seqsmooth::model::observation::LinearObservation;
+/// // Morrison Ex. 12.1b: S_{n,n−1} = [[1, 1], [1, 2]], M = (1, 0), R = 1 gives (1/2)[[1, 1], [1, 3]].
+/// let mut f = KalmanFilter::new(
+///     PolynomialDynamics::new(1, 1),
+///     LinearObservation::value_of(2),
+///     DVector::zeros(2),
+///     DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 1.0, 2.0]),
+///     0.0,
+/// )
+/// .unwrap();
+/// let m = Measurement { time: 0.0, values: vec![Some(1.0)], noise: NoiseCovariance::Variances(vec![1.0]) };
+/// let i = f.update(&m).unwrap().unwrap();
+/// let want = DMatrix::from_row_slice(2, 2, &[0.5, 0.5, 0.5, 1.5]);
+/// assert!((f.covariance() - want).amax() < 1e-15);
+/// assert!((i.nis - 0.5).abs() < 1e-15); // ν² / V = 1 / 2
+/// ```
+#[derive(Clone, Debug)]
+pub struct KalmanFilter<D: Dynamics, O: Observation> {
+    dynamics: D,
+    observation: O,
+    noise: Option<Arc<dyn ProcessNoise>>,
+    state: DVector<f64>,
+    covariance: DMatrix<f64>,
+    time: f64,
+}
+
+impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
+    /// A filter at `time` with the prior `state` and `covariance` (symmetric, positive
+    /// semidefinite, finite), without driving noise.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let bad = KalmanFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2),
+    ///     DVector::zeros(2), DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 0.0, 1.0]), 0.0);
+    /// assert!(bad.is_err()); // not symmetric
+    /// ```
+    pub fn new(
+        dynamics: D,
+        observation: O,
+        state: DVector<f64>,
+        covariance: DMatrix<f64>,
+        time: f64,
+    ) -> Result<Self, Error> {
+        let n = dynamics.dimension();
+        let bad = |name: &'static str, value: String, reason: String| Error::InvalidParameter {
+            name,
+            value,
+            reason,
+        };
+        if observation.state_dimension() != n {
+            return Err(bad(
+                "observation model",
+                format!("for {} states", observation.state_dimension()),
+                format!("the dynamics have {n} states"),
+            ));
+        }
+        if state.len() != n || covariance.shape() != (n, n) {
+            return Err(bad(
+                "prior",
+                format!(
+                    "state of length {}, covariance {}x{}",
+                    state.len(),
+                    covariance.nrows(),
+                    covariance.ncols()
+                ),
+                format!("the model has {n} states"),
+            ));
+        }
+        if let Some(&value) = state
+            .iter()
+            .chain(covariance.iter())
+            .chain([&time])
+            .find(|v| !v.is_finite())
+        {
+            return Err(Error::NonFinite {
+                what: "prior state, covariance or time",
+                value,
+            });
+        }
+        if (&covariance - covariance.transpose()).abs().max() > 1e-12 * covariance.abs().max()
+            || covariance.diagonal().iter().any(|&v| v < 0.0)
+        {
+            return Err(bad(
+                "prior covariance",
+                format!("{covariance:?}"),
+                "must be symmetric with a non-negative diagonal".into(),
+            ));
+        }
+        Ok(Self {
+            dynamics,
+            observation,
+            noise: None,
+            state,
+            covariance,
+            time,
+        })
+    }
+
+    /// With driving noise `Q` (ch. 15) of the model's dimension.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = KalmanFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2),
+    ///     DVector::zeros(2), DMatrix::zeros(2, 2), 0.0)
+    ///     .unwrap()
+    ///     .with_process_noise(WhiteNoiseDerivative::new(1, 1, 3.0).unwrap())
+    ///     .unwrap();
+    /// f.predict(1.0).unwrap();
+    /// assert_eq!(f.covariance()[(1, 1)], 3.0); // q ζ
+    /// ```
+    pub fn with_process_noise<P: ProcessNoise + 'static>(
+        mut self,
+        noise: P,
+    ) -> Result<Self, Error> {
+        let n = self.dynamics.dimension();
+        if noise.dimension() != n {
+            return Err(Error::InvalidParameter {
+                name: "process noise",
+                value: format!("for {} states", noise.dimension()),
+                reason: format!("the dynamics have {n} states"),
+            });
+        }
+        self.noise = Some(Arc::new(noise));
+        Ok(self)
+    }
+
+    /// The current estimate `X`.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::from_vec(vec![4.0]), DMatrix::identity(1, 1), 0.0).unwrap();
+    /// assert_eq!(f.state()[0], 4.0);
+    /// ```
+    pub fn state(&self) -> &DVector<f64> {
+        &self.state
+    }
+
+    /// The covariance `S` of [`Self::state`].
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::zeros(1), DMatrix::identity(1, 1), 0.0).unwrap();
+    /// assert_eq!(f.covariance()[(0, 0)], 1.0);
+    /// ```
+    pub fn covariance(&self) -> &DMatrix<f64> {
+        &self.covariance
+    }
+
+    /// The time the estimate refers to.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::zeros(1), DMatrix::identity(1, 1), 0.0).unwrap();
+    /// f.predict(2.5).unwrap();
+    /// assert_eq!(f.time(), 2.5);
+    /// ```
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Carries the estimate to `t` (forwards or backwards): (12.2.15)-(12.2.16), (15.4.10)-(15.4.11).
+    /// On an error the filter is unchanged.
+    pub fn predict(&mut self, t: f64) -> Result<(), Error> {
+        if !t.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: t,
+            });
+        }
+        if t == self.time {
+            return Ok(());
+        }
+        let n = self.state.len();
+        let (mut x, mut phi) = (DVector::zeros(n), DMatrix::zeros(n, n));
+        self.dynamics
+            .propagate_into(&self.state, self.time, t, &mut x, &mut phi)?;
+        let mut s = &phi * &self.covariance * phi.transpose();
+        if let Some(q) = &self.noise {
+            s += q.covariance(self.time, t)?;
+        }
+        let s = symmetric(s);
+        finite(&s, "predicted covariance")?;
+        self.state = x;
+        self.covariance = s;
+        self.time = t;
+        Ok(())
+    }
+
+    /// Predicts to the measurement's time and updates with its present components
+    /// ((12.2.17)-(12.2.19), Joseph's covariance (12.3.7)); `Ok(None)` when no component is
+    /// present (the prediction alone). On an error the filter is unchanged.
+    pub fn update(&mut self, measurement: &Measurement) -> Result<Option<Innovation>, Error> {
+        let p = self.observation.components();
+        let (present, values, r) = present_components(p, measurement)?;
+        let saved = (self.state.clone(), self.covariance.clone(), self.time);
+        self.predict(measurement.time)?;
+        if present.is_empty() {
+            return Ok(None);
+        }
+        match self.correct(&present, &values, &r) {
+            Ok(i) => Ok(Some(i)),
+            Err(e) => {
+                (self.state, self.covariance, self.time) = saved;
+                Err(e)
+            }
+        }
+    }
+
+    /// The update at the current (predicted) state.
+    fn correct(
+        &mut self,
+        present: &[usize],
+        values: &[f64],
+        r: &DMatrix<f64>,
+    ) -> Result<Innovation, Error> {
+        let n = self.state.len();
+        let p = self.observation.components();
+        let (mut g, mut m_all) = (DVector::zeros(p), DMatrix::zeros(p, n));
+        self.observation
+            .predict_into(&self.state, self.time, &mut g, &mut m_all)?;
+        let k = present.len();
+        let m = DMatrix::from_fn(k, n, |i, j| m_all[(present[i], j)]);
+        let nu = DVector::from_fn(k, |i, _| {
+            self.observation
+                .residual(present[i], values[i], g[present[i]])
+        });
+        let sm = &self.covariance * m.transpose(); // S Mᵀ, n × k
+        let v = symmetric(&m * &sm + r);
+        let chol = Cholesky::new(v.clone()).ok_or_else(|| Error::InvalidParameter {
+            name: "innovation covariance M S Mᵀ + R",
+            value: format!("{v:?}"),
+            reason: "is not positive definite: the observation adds nothing the filter can \
+                     weigh (a perfect observation of a component already known exactly)"
+                .into(),
+        })?;
+        // H = S Mᵀ V⁻¹: solve V Hᵀ = M S.
+        let gain = chol.solve(&sm.transpose()).transpose();
+        let nis = nu.dot(&chol.solve(&nu));
+        let log_det = 2.0
+            * chol
+                .l_dirty()
+                .diagonal()
+                .iter()
+                .map(|d| d.ln())
+                .sum::<f64>();
+        let log_likelihood = -0.5 * (nis + log_det + k as f64 * TAU.ln());
+        let x = &self.state + &gain * &nu;
+        let a = DMatrix::identity(n, n) - &gain * &m;
+        let s = symmetric(&a * &self.covariance * a.transpose() + &gain * r * gain.transpose());
+        finite(&s, "updated covariance")?;
+        if let Some(&value) = x.iter().find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "updated state entry",
+                value,
+            });
+        }
+        if !(nis.is_finite() && log_likelihood.is_finite()) {
+            return Err(Error::EstimateOutOfRange {
+                what: "normalised innovation squared".into(),
+            });
+        }
+        self.state = x;
+        self.covariance = s;
+        Ok(Innovation {
+            components: present.to_vec(),
+            innovation: nu,
+            covariance: v,
+            gain,
+            nis,
+            log_likelihood,
+        })
+    }
+}
+
+/// A measurement's present components, their values, and their `R`.
+type Present = (Vec<usize>, Vec<f64>, DMatrix<f64>);
+
+/// The present components of a measurement, their values and their `R` (symmetric, finite,
+/// non-negative diagonal: a perfect observation is allowed).
+fn present_components(p: usize, m: &Measurement) -> Result<Present, Error> {
+    if !m.time.is_finite() {
+        return Err(Error::NonFinite {
+            what: "time",
+            value: m.time,
+        });
+    }
+    if m.values.len() != p {
+        return Err(Error::InvalidParameter {
+            name: "measurement",
+            value: format!("with {} components", m.values.len()),
+            reason: format!("the observation model has {p}"),
+        });
+    }
+    let mut present = Vec::with_capacity(p);
+    let mut values = Vec::with_capacity(p);
+    for (k, v) in m.values.iter().enumerate() {
+        if let Some(v) = *v {
+            if !v.is_finite() {
+                return Err(Error::NonFinite {
+                    what: "measured value",
+                    value: v,
+                });
+            }
+            present.push(k);
+            values.push(v);
+        }
+    }
+    let full = match &m.noise {
+        NoiseCovariance::Identity => DMatrix::identity(p, p),
+        NoiseCovariance::Variances(v) if v.len() == p => {
+            DMatrix::from_diagonal(&DVector::from_column_slice(v))
+        }
+        NoiseCovariance::Full(r) if r.shape() == (p, p) => r.clone(),
+        other => {
+            return Err(Error::InvalidParameter {
+                name: "measurement noise",
+                value: format!("{other:?}"),
+                reason: format!("needs {p} components"),
+            })
+        }
+    };
+    if let Some(&value) = full.iter().find(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            what: "measurement noise entry",
+            value,
+        });
+    }
+    if (&full - full.transpose()).abs().max() > 1e-12 * full.abs().max()
+        || full.diagonal().iter().any(|&v| v < 0.0)
+    {
+        return Err(Error::InvalidParameter {
+            name: "measurement noise",
+            value: format!("{full:?}"),
+            reason: "must be symmetric with non-negative variances".into(),
+        });
+    }
+    let r = DMatrix::from_fn(present.len(), present.len(), |i, j| {
+        full[(present[i], present[j])]
+    });
+    Ok((present, values, r))
+}
+
+/// `(a + aᵀ)/2`.
+fn symmetric(a: DMatrix<f64>) -> DMatrix<f64> {
+    (&a + a.transpose()) * 0.5
+}
+
+fn finite(m: &DMatrix<f64>, what: &'static str) -> Result<(), Error> {
+    match m.iter().find(|v| !v.is_finite()) {
+        Some(&value) => Err(Error::NonFinite { what, value }),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,110 @@
+//! Driving noise (Morrison ch. 15): the covariance `Q(t_b, t_a)` of the state perturbation
+//! accumulated over a step,
+//!
+//! `Q(t_b, t_a) = ∫_{t_a}^{t_b} Φ(t_b, l) D K Dᵀ Φ(t_b, l)ᵀ dl` (15.2.23),
+//!
+//! added to the predicted covariance (15.4.11). The book gives no closed form for a particular
+//! model; for the polynomial model with white noise of power spectral density `q` on the
+//! highest derivative of each axis (`D = e_m ⊗ I_d`, `K = q I_d`) the integral is exact in
+//! closed form on any step `ζ = t_b − t_a`:
+//!
+//! `Q_ij = q |ζ|^(2m+1−i−j) / ((m−i)! (m−j)! (2m+1−i−j))` (per axis, derivatives `i, j ≤ m`),
+//!
+//! from `Φ(ζ) = Ψ(ζ)` (4.2.5): `[Ψ(s) e_m]_i = s^(m−i)/(m−i)!`. Degree 1 gives the familiar
+//! constant-velocity `q [[ζ³/3, ζ²/2], [ζ²/2, ζ]]`. A step backwards uses `|ζ|`: the noise
+//! accumulated over the interval either way.
+
+use crate::calculus::factorial;
+use crate::error::Error;
+use nalgebra::DMatrix;
+
+/// A driving-noise model: `Q` over a step.
+pub trait ProcessNoise: std::fmt::Debug + Send + Sync {
+    /// The state dimension.
+    fn dimension(&self) -> usize;
+
+    /// `Q(t_b, t_a)`, symmetric and positive semidefinite, `n × n`.
+    fn covariance(&self, t_a: f64, t_b: f64) -> Result<DMatrix<f64>, Error>;
+}
+
+/// White noise of power spectral density `q` on the highest derivative of a degree-`m`
+/// polynomial model on `d` axes (the state order of
+/// [`crate::model::dynamics::PolynomialDynamics`]): `q` in (value unit)² / (time unit)^(2m+1).
+///
+/// ```
+/// use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};
+/// // Constant velocity on one axis, q = 0.5, over ζ = 2: q [[ζ³/3, ζ²/2], [ζ²/2, ζ]].
+/// let q = WhiteNoiseDerivative::new(1, 1, 0.5).unwrap().covariance(10.0, 12.0).unwrap();
+/// assert_eq!((q[(0, 0)], q[(0, 1)], q[(1, 1)]), (0.5 * 8.0 / 3.0, 0.5 * 2.0, 0.5 * 2.0));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WhiteNoiseDerivative {
+    degree: usize,
+    axes: usize,
+    psd: f64,
+}
+
+impl WhiteNoiseDerivative {
+    /// Degree `m`, `axes ≥ 1`, spectral density `q ≥ 0` (finite; 0 is no driving noise).
+    ///
+    /// ```
+    /// use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+    /// assert!(WhiteNoiseDerivative::new(2, 3, -1.0).is_err());
+    /// assert!(WhiteNoiseDerivative::new(2, 0, 1.0).is_err());
+    /// ```
+    pub fn new(degree: usize, axes: usize, psd: f64) -> Result<Self, Error> {
+        if !(psd.is_finite() && psd >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "driving-noise spectral density q",
+                value: psd.to_string(),
+                reason: "must be finite and at least 0".into(),
+            });
+        }
+        if axes == 0 {
+            return Err(Error::InvalidParameter {
+                name: "axes",
+                value: "0".into(),
+                reason: "must be at least 1".into(),
+            });
+        }
+        Ok(Self { degree, axes, psd })
+    }
+}
+
+impl ProcessNoise for WhiteNoiseDerivative {
+    fn dimension(&self) -> usize {
+        (self.degree + 1) * self.axes
+    }
+
+    fn covariance(&self, t_a: f64, t_b: f64) -> Result<DMatrix<f64>, Error> {
+        for t in [t_a, t_b] {
+            if !t.is_finite() {
+                return Err(Error::NonFinite {
+                    what: "time",
+                    value: t,
+                });
+            }
+        }
+        let (m, d) = (self.degree, self.axes);
+        let zeta = (t_b - t_a).abs();
+        let n = (m + 1) * d;
+        let mut q = DMatrix::zeros(n, n);
+        for i in 0..=m {
+            for j in 0..=m {
+                let p = 2 * m + 1 - i - j;
+                let v = self.psd * zeta.powi(p as i32)
+                    / (factorial::<f64>(m - i) * factorial::<f64>(m - j) * p as f64);
+                for a in 0..d {
+                    q[(i * d + a, j * d + a)] = v;
+                }
+            }
+        }
+        match q.iter().find(|v| !v.is_finite()) {
+            Some(&value) => Err(Error::NonFinite {
+                what: "driving-noise covariance entry",
+                value,
+            }),
+            None => Ok(q),
+        }
+    }
+}
