@@ -538,3 +538,80 @@ fn refusals_and_missing_observations() {
         "predicted only",
     );
 }
+
+/// The iterated update of §12.5 is the Bayes filter with iterative differential correction of
+/// ch. 11 ((12.5.17) against (11.2.27)): on T11-1 (range `sqrt(d² + x²)`, `d = 3`, prior 4 with
+/// `a² = 1`, `s² = 0.01`, `ρ = 5.2`) it converges to 4.243697780575 with covariance
+/// 0.014775907527, as `GaussNewton` with the prior does; for a linear observation it is the
+/// plain update; a limit too small is `NotConverged` and leaves the filter unchanged.
+#[test]
+fn iterated_update_is_chapter_11() {
+    use seqsmooth::model::observation::NonlinearObservation;
+    let range = NonlinearObservation::new(1, 1, |_t, x: &DVector<f64>| {
+        DVector::from_vec(vec![(9.0 + x[0] * x[0]).sqrt()])
+    })
+    .with_jacobian(|_t, x: &DVector<f64>| {
+        DMatrix::from_element(1, 1, x[0] / (9.0 + x[0] * x[0]).sqrt())
+    });
+    let new = || {
+        KalmanFilter::new(
+            PolynomialDynamics::new(0, 1),
+            range.clone(),
+            DVector::from_vec(vec![4.0]),
+            DMatrix::identity(1, 1),
+            0.0,
+        )
+        .unwrap()
+    };
+    let rho = measurement(0.0, &[5.2], NoiseCovariance::Variances(vec![0.01]));
+    let mut f = new();
+    f.update_iterated(&rho, 1e-10, 20).unwrap().unwrap();
+    assert!(
+        (f.state()[0] - 4.243697780575).abs() < 5e-13,
+        "{}",
+        f.state()[0]
+    );
+    assert!((f.covariance()[(0, 0)] - 0.014775907527).abs() < 5e-13);
+    let prior = Prior {
+        state: DVector::from_vec(vec![4.0]),
+        covariance: DMatrix::identity(1, 1),
+    };
+    let gn = GaussNewton {
+        tolerance: 1e-10,
+        ..GaussNewton::default()
+    }
+    .fit(
+        &PolynomialDynamics::new(0, 1),
+        &range,
+        std::slice::from_ref(&rho),
+        Epoch::End,
+        &prior.state,
+        Some(&prior),
+    )
+    .unwrap();
+    assert!((f.state()[0] - gn.state[0]).abs() < 1e-14);
+    assert!((f.covariance()[(0, 0)] - gn.covariance[(0, 0)]).abs() < 1e-14);
+    // The one-pass (extended) update is the first iterate, 4.246153846154.
+    let mut once = new();
+    once.update(&rho).unwrap();
+    assert!((once.state()[0] - 4.246153846154).abs() < 5e-13);
+    // Too few iterations.
+    let mut g = new();
+    let e = g.update_iterated(&rho, 1e-12, 2);
+    assert!(
+        matches!(e, Err(Error::NotConverged { iterations: 2, .. })),
+        "{e:?}"
+    );
+    assert_eq!((g.state()[0], g.time()), (4.0, 0.0));
+    // Linear: the plain update.
+    let s = m(2, 2, &[1.0, 2.0, 2.0, 5.0]);
+    let z = measurement(0.0, &[1.0, 2.0], NoiseCovariance::Variances(vec![1.0, 2.0]));
+    let (mut a, mut b) = (
+        static_filter(s.clone(), DMatrix::identity(2, 2)),
+        static_filter(s, DMatrix::identity(2, 2)),
+    );
+    a.update(&z).unwrap();
+    b.update_iterated(&z, 1e-9, 5).unwrap();
+    assert_close(a.covariance(), b.covariance(), 1e-15, "linear S");
+    assert!((a.state() - b.state()).amax() < 1e-15);
+}

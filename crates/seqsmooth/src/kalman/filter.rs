@@ -241,16 +241,22 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// Carries the estimate to `t` (forwards or backwards): (12.2.15)-(12.2.16), (15.4.10)-(15.4.11).
     /// On an error the filter is unchanged.
     pub fn predict(&mut self, t: f64) -> Result<(), Error> {
+        self.predict_with_transition(t).map(|_| ())
+    }
+
+    /// [`Self::predict`], returning `Φ(t, t_before)` (the identity for no step): what the
+    /// smoother needs.
+    pub(crate) fn predict_with_transition(&mut self, t: f64) -> Result<DMatrix<f64>, Error> {
         if !t.is_finite() {
             return Err(Error::NonFinite {
                 what: "time",
                 value: t,
             });
         }
-        if t == self.time {
-            return Ok(());
-        }
         let n = self.state.len();
+        if t == self.time {
+            return Ok(DMatrix::identity(n, n));
+        }
         let (mut x, mut phi) = (DVector::zeros(n), DMatrix::zeros(n, n));
         self.dynamics
             .propagate_into(&self.state, self.time, t, &mut x, &mut phi)?;
@@ -263,7 +269,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         self.state = x;
         self.covariance = s;
         self.time = t;
-        Ok(())
+        Ok(phi)
     }
 
     /// Predicts to the measurement's time and updates with its present components
@@ -286,6 +292,87 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         }
     }
 
+    /// The iterated update of §12.5 ((12.5.10)-(12.5.17), Morrison's Kalman filter with
+    /// iterative differential correction): predicts to the measurement's time, then relinearises
+    /// the observation about the updated estimate,
+    /// `X_{r+1} = X_{n,n−1} + H(X_r) [Y − G(X_r) − M(X_r)(X_{n,n−1} − X_r)]`, from
+    /// `X_0 = X_{n,n−1}`, until the change `|X_{r+1} − X_r|` is at most `tolerance` of its own σ
+    /// (in the metric of `S_{n,n−1}`), at most `max_iterations` times ([`Error::NotConverged`]
+    /// otherwise). The covariance and the reported innovation are those of the last
+    /// linearisation. For a linear observation it is [`Self::update`] (two passes, the second a
+    /// check). On an error the filter is unchanged.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::NonlinearObservation;
+    /// // Morrison Ex. 11.1 / T11-1: range sqrt(9 + x²), prior x = 4, a² = 1, s² = 0.01, ρ = 5.2.
+    /// let range = NonlinearObservation::new(1, 1, |_t, x: &DVector<f64>| DVector::from_vec(vec![(9.0 + x[0] * x[0]).sqrt()]));
+    /// let mut f = KalmanFilter::new(PolynomialDynamics::new(0, 1), range,
+    ///     DVector::from_vec(vec![4.0]), DMatrix::identity(1, 1), 0.0).unwrap();
+    /// let m = Measurement { time: 0.0, values: vec![Some(5.2)], noise: NoiseCovariance::Variances(vec![0.01]) };
+    /// f.update_iterated(&m, 1e-9, 20).unwrap();
+    /// assert!((f.state()[0] - 4.243697780575).abs() < 1e-9);
+    /// ```
+    pub fn update_iterated(
+        &mut self,
+        measurement: &Measurement,
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<Option<Innovation>, Error> {
+        if !(tolerance.is_finite() && tolerance > 0.0) || max_iterations == 0 {
+            return Err(Error::InvalidParameter {
+                name: "iteration limits",
+                value: format!("tolerance {tolerance}, {max_iterations} iterations"),
+                reason: "the tolerance must be positive and finite, the iterations at least 1"
+                    .into(),
+            });
+        }
+        let p = self.observation.components();
+        let (present, values, r) = present_components(p, measurement)?;
+        let saved = (self.state.clone(), self.covariance.clone(), self.time);
+        self.predict(measurement.time)?;
+        if present.is_empty() {
+            return Ok(None);
+        }
+        let (predicted, prior) = (self.state.clone(), self.covariance.clone());
+        let metric = Cholesky::new(prior.clone());
+        let mut about = predicted.clone();
+        let mut last = None;
+        for _ in 0..max_iterations {
+            (self.state, self.covariance) = (predicted.clone(), prior.clone());
+            let step = self.correct_about(&present, &values, &r, &about);
+            let innovation = match step {
+                Ok(i) => i,
+                Err(e) => {
+                    (self.state, self.covariance, self.time) = saved;
+                    return Err(e);
+                }
+            };
+            let change = &self.state - &about;
+            let size = match &metric {
+                Some(c) => change.dot(&c.solve(&change)).sqrt(),
+                None => change.amax() / prior.diagonal().amax().sqrt().max(f64::MIN_POSITIVE),
+            };
+            about = self.state.clone();
+            last = Some((innovation, size));
+            if size <= tolerance {
+                return Ok(last.map(|(i, _)| i));
+            }
+        }
+        let correction = last.map_or(f64::INFINITY, |(_, size)| size);
+        (self.state, self.covariance, self.time) = saved;
+        Err(Error::NotConverged {
+            iterations: max_iterations,
+            correction,
+            tolerance,
+            chi_squared: f64::NAN,
+        })
+    }
+
     /// The update at the current (predicted) state.
     fn correct(
         &mut self,
@@ -293,16 +380,31 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         values: &[f64],
         r: &DMatrix<f64>,
     ) -> Result<Innovation, Error> {
+        let about = self.state.clone();
+        self.correct_about(present, values, r, &about)
+    }
+
+    /// The update of the predicted state linearised about `about` (12.5.17): the innovation
+    /// `Y − G(about) − M(about)(X_{n,n−1} − about)`, `M` at `about`.
+    fn correct_about(
+        &mut self,
+        present: &[usize],
+        values: &[f64],
+        r: &DMatrix<f64>,
+        about: &DVector<f64>,
+    ) -> Result<Innovation, Error> {
         let n = self.state.len();
         let p = self.observation.components();
         let (mut g, mut m_all) = (DVector::zeros(p), DMatrix::zeros(p, n));
         self.observation
-            .predict_into(&self.state, self.time, &mut g, &mut m_all)?;
+            .predict_into(about, self.time, &mut g, &mut m_all)?;
         let k = present.len();
         let m = DMatrix::from_fn(k, n, |i, j| m_all[(present[i], j)]);
+        let offset = &m * (&self.state - about);
         let nu = DVector::from_fn(k, |i, _| {
             self.observation
                 .residual(present[i], values[i], g[present[i]])
+                - offset[i]
         });
         let sm = &self.covariance * m.transpose(); // S Mᵀ, n × k
         let v = symmetric(&m * &sm + r);

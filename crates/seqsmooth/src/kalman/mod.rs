@@ -2,10 +2,13 @@
 //! Kalman filter, extended for nonlinear models, with or without driving noise.
 //!
 //! - [`filter`]: [`KalmanFilter`], prediction, Joseph-form update, innovation statistics.
+//! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run.
 //! - [`noise`]: the driving-noise covariance `Q` over a step (15.2.23), in closed form for the
 //!   polynomial model ([`noise::WhiteNoiseDerivative`]).
 
 pub mod filter;
 pub mod noise;
+pub mod smoother;
 
 pub use filter::{Innovation, KalmanFilter};
+pub use smoother::{smooth, Smoothed};

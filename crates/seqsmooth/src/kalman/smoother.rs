@@ -1,0 +1,126 @@
+//! Fixed-interval smoothing (Rauch, Tung and Striebel 1965; beyond Morrison's book): after a
+//! forward pass of the [`KalmanFilter`] (plain or extended) over all the measurements, a
+//! backward pass gives at every measurement time the estimate from all of them,
+//!
+//! `C_k = S_{k|k} Φ(t_{k+1}, t_k)ᵀ S_{k+1|k}⁻¹`,
+//! `X_{k|N} = X_{k|k} + C_k (X_{k+1|N} − X_{k+1|k})`,
+//! `S_{k|N} = S_{k|k} + C_k (S_{k+1|N} − S_{k+1|k}) C_kᵀ`,
+//!
+//! on any times (`Φ` and `Q` of the actual step; for the extended filter `Φ` is the
+//! linearisation along the forward trajectory). `S_{k+1|k}⁻¹` is applied by its Cholesky
+//! factor. For linear models without driving noise the result at every time is the batch
+//! minimum-variance estimate from the prior and all the measurements (tested against
+//! [`crate::estimate::gauss_newton`]).
+
+use super::filter::KalmanFilter;
+use crate::error::Error;
+use crate::estimate::gauss_newton::Measurement;
+use crate::model::dynamics::Dynamics;
+use crate::model::observation::Observation;
+use nalgebra::{Cholesky, DMatrix, DVector};
+
+/// The smoothed estimate at one measurement's time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Smoothed {
+    /// The measurement's time.
+    pub time: f64,
+    /// `X_{k|N}`.
+    pub state: DVector<f64>,
+    /// `S_{k|N}`.
+    pub covariance: DMatrix<f64>,
+    /// The forward filter's `X_{k|k}`.
+    pub filtered_state: DVector<f64>,
+    /// The forward filter's `S_{k|k}`.
+    pub filtered_covariance: DMatrix<f64>,
+    /// The forward update's normalised innovation squared (`None` where every component was
+    /// missing).
+    pub nis: Option<f64>,
+}
+
+/// Runs `filter` over `measurements` (in time order) and smooths back: one [`Smoothed`] per
+/// measurement.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::estimate::batch::NoiseCovariance;
+/// use seqsmooth::estimate::gauss_newton::Measurement;
+/// use seqsmooth::kalman::{smoother, KalmanFilter};
+/// use seqsmooth::model::dynamics::PolynomialDynamics;
+/// use seqsmooth::model::observation::LinearObservation;
+/// // A constant with a vague prior: every smoothed value is the mean of all the samples.
+/// let f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+///     DVector::zeros(1), DMatrix::from_element(1, 1, 1e12), 0.0).unwrap();
+/// let rows: Vec<Measurement> = [1.0, 2.0, 6.0].iter().enumerate()
+///     .map(|(k, &y)| Measurement { time: k as f64, values: vec![Some(y)], noise: NoiseCovariance::Identity })
+///     .collect();
+/// let s = smoother::smooth(f, &rows).unwrap();
+/// assert!((s[0].state[0] - 3.0).abs() < 1e-9 && (s[0].filtered_state[0] - 1.0).abs() < 1e-9);
+/// ```
+pub fn smooth<D: Dynamics, O: Observation>(
+    mut filter: KalmanFilter<D, O>,
+    measurements: &[Measurement],
+) -> Result<Vec<Smoothed>, Error> {
+    // Forward: per measurement, Φ from the previous one, the prediction and the update.
+    let mut predicted = Vec::with_capacity(measurements.len());
+    let mut out = Vec::with_capacity(measurements.len());
+    for (index, m) in measurements.iter().enumerate() {
+        let in_batch = |source: Error| Error::InBatch {
+            index,
+            source: Box::new(source),
+        };
+        if let Some(previous) = measurements.get(index.wrapping_sub(1)) {
+            if m.time.is_finite() && m.time < previous.time {
+                return Err(in_batch(Error::InvalidParameter {
+                    name: "time",
+                    value: m.time.to_string(),
+                    reason: format!("is before the previous measurement's {}", previous.time),
+                }));
+            }
+        }
+        let phi = filter.predict_with_transition(m.time).map_err(in_batch)?;
+        predicted.push((phi, filter.state().clone(), filter.covariance().clone()));
+        let nis = filter.update(m).map_err(in_batch)?.map(|i| i.nis);
+        out.push(Smoothed {
+            time: m.time,
+            state: filter.state().clone(),
+            covariance: filter.covariance().clone(),
+            filtered_state: filter.state().clone(),
+            filtered_covariance: filter.covariance().clone(),
+            nis,
+        });
+    }
+    // Backward.
+    for k in (0..out.len().saturating_sub(1)).rev() {
+        let (phi, x_pred, s_pred) = &predicted[k + 1];
+        let chol = Cholesky::new(s_pred.clone()).ok_or_else(|| Error::InBatch {
+            index: k + 1,
+            source: Box::new(Error::InvalidParameter {
+                name: "predicted covariance",
+                value: format!("{s_pred:?}"),
+                reason: "is not positive definite, so the smoother cannot weigh the later \
+                         measurements (add driving noise, or avoid perfect observations)"
+                    .into(),
+            }),
+        })?;
+        // C = S_{k|k} Φᵀ S_pred⁻¹: solve S_pred Cᵀ = Φ S_{k|k}.
+        let c = chol.solve(&(phi * &out[k].filtered_covariance)).transpose();
+        let dx = &out[k + 1].state - x_pred;
+        let ds = &out[k + 1].covariance - s_pred;
+        let state = &out[k].filtered_state + &c * dx;
+        let covariance = &out[k].filtered_covariance + &c * ds * c.transpose();
+        let covariance = (&covariance + covariance.transpose()) * 0.5;
+        if let Some(&value) = state
+            .iter()
+            .chain(covariance.iter())
+            .find(|v| !v.is_finite())
+        {
+            return Err(Error::NonFinite {
+                what: "smoothed state or covariance entry",
+                value,
+            });
+        }
+        out[k].state = state;
+        out[k].covariance = covariance;
+    }
+    Ok(out)
+}
