@@ -80,9 +80,49 @@ pub struct KalmanFilter<D: Dynamics, O: Observation> {
     dynamics: D,
     observation: O,
     noise: Option<Arc<dyn ProcessNoise>>,
+    fading: Option<Fading>,
     state: DVector<f64>,
     covariance: DMatrix<f64>,
     time: f64,
+}
+
+/// How old observations are discounted (Morrison ch. 14): by time, `β^(t_n − t_k)`
+/// (14.2.10), or by count, `θ^(n−k)` (14.2.12). `β = 1` or `θ = 1` is the plain filter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Discount {
+    /// `0 < β ≤ 1` per unit of time.
+    PerTime(f64),
+    /// `0 < θ ≤ 1` per update.
+    PerUpdate(f64),
+}
+
+/// The fading filter's own matrix `P` (14.3.13), not the covariance when the discount is
+/// below 1, and the time of the last update (from which `β` counts).
+#[derive(Clone, Debug)]
+struct Fading {
+    discount: Discount,
+    weight: DMatrix<f64>,
+    last_update: f64,
+}
+
+impl Fading {
+    /// `β^(t − t_last)` or `θ`, in `(0, 1]`.
+    fn factor(&self, t: f64) -> Result<f64, Error> {
+        let f = match self.discount {
+            Discount::PerTime(beta) => beta.powf((t - self.last_update).abs()),
+            Discount::PerUpdate(theta) => theta,
+        };
+        if f > 0.0 && f.is_normal() {
+            Ok(f)
+        } else {
+            Err(Error::InvalidParameter {
+                name: "discount over the step",
+                value: format!("{f:e} over {} since the last update", t - self.last_update),
+                reason: "underflows: the memory holds nothing; raise beta or update more often"
+                    .into(),
+            })
+        }
+    }
 }
 
 impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
@@ -154,6 +194,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             dynamics,
             observation,
             noise: None,
+            fading: None,
             state,
             covariance,
             time,
@@ -189,6 +230,53 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             });
         }
         self.noise = Some(Arc::new(noise));
+        Ok(self)
+    }
+
+    /// The generalized fading-memory filter of ch. 14 ((14.4.34)-(14.4.40)): the gain from
+    /// the recursion's own matrix `P`, `H = P Mᵀ (f R + M P Mᵀ)⁻¹`, `P ← (1/f)(I − H M) P` (in
+    /// Joseph's form), with `f = β^(t_n − t_{n−1})` (time since the previous update) or `θ`;
+    /// the covariance reported, [`Self::covariance`], is the true one of the estimate
+    /// ((14.4.31)-(14.4.32), (14.3.19)), and the innovation statistics use it (§14.8). `P`
+    /// starts as the current covariance, counted from the current time (start at `β = 1` and
+    /// switch, §14.5). The discount must lie in `(0, 1]`.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::{Discount, KalmanFilter};
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// // Degree 0, θ = 0.5, vague prior: the gain settles at 1 − θ = 0.5 (Table 13.1).
+    /// let mut f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::zeros(1), DMatrix::from_element(1, 1, 1e9), 0.0).unwrap()
+    ///     .with_fading(Discount::PerUpdate(0.5)).unwrap();
+    /// let mut gain = 0.0;
+    /// for k in 1..60 {
+    ///     let m = Measurement { time: k as f64, values: vec![Some(1.0)], noise: NoiseCovariance::Identity };
+    ///     gain = f.update(&m).unwrap().unwrap().gain[(0, 0)];
+    /// }
+    /// assert!((gain - 0.5).abs() < 1e-12);
+    /// assert!((f.covariance()[(0, 0)] - 1.0 / 3.0).abs() < 1e-12); // (1 − θ)/(1 + θ)
+    /// ```
+    pub fn with_fading(mut self, discount: Discount) -> Result<Self, Error> {
+        let (name, value) = match discount {
+            Discount::PerTime(b) => ("beta", b),
+            Discount::PerUpdate(t) => ("theta", t),
+        };
+        if !(value > 0.0 && value <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name,
+                value: value.to_string(),
+                reason: "the discount must lie in (0, 1]".into(),
+            });
+        }
+        self.fading = Some(Fading {
+            discount,
+            weight: self.covariance.clone(),
+            last_update: self.time,
+        });
         Ok(self)
     }
 
@@ -260,15 +348,33 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         let (mut x, mut phi) = (DVector::zeros(n), DMatrix::zeros(n, n));
         self.dynamics
             .propagate_into(&self.state, self.time, t, &mut x, &mut phi)?;
-        let mut s = &phi * &self.covariance * phi.transpose();
-        if let Some(q) = &self.noise {
-            s += q.covariance(self.time, t)?;
-        }
-        let s = symmetric(s);
+        let q = match &self.noise {
+            Some(q) => Some(q.covariance(self.time, t)?),
+            None => None,
+        };
+        let carry = |s: &DMatrix<f64>| {
+            let mut s = &phi * s * phi.transpose();
+            if let Some(q) = &q {
+                s += q;
+            }
+            symmetric(s)
+        };
+        let s = carry(&self.covariance);
         finite(&s, "predicted covariance")?;
+        let weight = match &self.fading {
+            Some(f) => {
+                let w = carry(&f.weight);
+                finite(&w, "predicted fading-memory matrix P")?;
+                Some(w)
+            }
+            None => None,
+        };
         self.state = x;
         self.covariance = s;
         self.time = t;
+        if let (Some(f), Some(w)) = (&mut self.fading, weight) {
+            f.weight = w;
+        }
         Ok(phi)
     }
 
@@ -278,7 +384,12 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     pub fn update(&mut self, measurement: &Measurement) -> Result<Option<Innovation>, Error> {
         let p = self.observation.components();
         let (present, values, r) = present_components(p, measurement)?;
-        let saved = (self.state.clone(), self.covariance.clone(), self.time);
+        let saved = (
+            self.state.clone(),
+            self.covariance.clone(),
+            self.time,
+            self.fading.clone(),
+        );
         self.predict(measurement.time)?;
         if present.is_empty() {
             return Ok(None);
@@ -286,7 +397,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         match self.correct(&present, &values, &r) {
             Ok(i) => Ok(Some(i)),
             Err(e) => {
-                (self.state, self.covariance, self.time) = saved;
+                (self.state, self.covariance, self.time, self.fading) = saved;
                 Err(e)
             }
         }
@@ -333,22 +444,32 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         }
         let p = self.observation.components();
         let (present, values, r) = present_components(p, measurement)?;
-        let saved = (self.state.clone(), self.covariance.clone(), self.time);
+        let saved = (
+            self.state.clone(),
+            self.covariance.clone(),
+            self.time,
+            self.fading.clone(),
+        );
         self.predict(measurement.time)?;
         if present.is_empty() {
             return Ok(None);
         }
-        let (predicted, prior) = (self.state.clone(), self.covariance.clone());
+        let (predicted, prior, fading) = (
+            self.state.clone(),
+            self.covariance.clone(),
+            self.fading.clone(),
+        );
         let metric = Cholesky::new(prior.clone());
         let mut about = predicted.clone();
         let mut last = None;
         for _ in 0..max_iterations {
-            (self.state, self.covariance) = (predicted.clone(), prior.clone());
+            (self.state, self.covariance, self.fading) =
+                (predicted.clone(), prior.clone(), fading.clone());
             let step = self.correct_about(&present, &values, &r, &about);
             let innovation = match step {
                 Ok(i) => i,
                 Err(e) => {
-                    (self.state, self.covariance, self.time) = saved;
+                    (self.state, self.covariance, self.time, self.fading) = saved;
                     return Err(e);
                 }
             };
@@ -364,7 +485,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             }
         }
         let correction = last.map_or(f64::INFINITY, |(_, size)| size);
-        (self.state, self.covariance, self.time) = saved;
+        (self.state, self.covariance, self.time, self.fading) = saved;
         Err(Error::NotConverged {
             iterations: max_iterations,
             correction,
@@ -406,17 +527,32 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
                 .residual(present[i], values[i], g[present[i]])
                 - offset[i]
         });
-        let sm = &self.covariance * m.transpose(); // S Mᵀ, n × k
-        let v = symmetric(&m * &sm + r);
-        let chol = Cholesky::new(v.clone()).ok_or_else(|| Error::InvalidParameter {
+        // The gain from P and f R (fading, ch. 14), or from S and R (f = 1, P = S).
+        let f = match &self.fading {
+            Some(fading) => fading.factor(self.time)?,
+            None => 1.0,
+        };
+        let weight = self.fading.as_ref().map_or(&self.covariance, |x| &x.weight);
+        let pm = weight * m.transpose(); // P Mᵀ, n × k
+        let not_pd = |v: &DMatrix<f64>| Error::InvalidParameter {
             name: "innovation covariance M S Mᵀ + R",
             value: format!("{v:?}"),
             reason: "is not positive definite: the observation adds nothing the filter can \
                      weigh (a perfect observation of a component already known exactly)"
                 .into(),
-        })?;
-        // H = S Mᵀ V⁻¹: solve V Hᵀ = M S.
-        let gain = chol.solve(&sm.transpose()).transpose();
+        };
+        let vp = symmetric(&m * &pm + r * f);
+        let chol_p = Cholesky::new(vp.clone()).ok_or_else(|| not_pd(&vp))?;
+        // H = P Mᵀ V_P⁻¹: solve V_P Hᵀ = M P.
+        let gain = chol_p.solve(&pm.transpose()).transpose();
+        // The innovation's true covariance M S Mᵀ + R (§14.8): V_P itself without fading.
+        let (v, chol) = if self.fading.is_some() {
+            let v = symmetric(&m * &self.covariance * m.transpose() + r);
+            let c = Cholesky::new(v.clone()).ok_or_else(|| not_pd(&v))?;
+            (v, c)
+        } else {
+            (vp, chol_p)
+        };
         let nis = nu.dot(&chol.solve(&nu));
         let log_det = 2.0
             * chol
@@ -428,8 +564,19 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         let log_likelihood = -0.5 * (nis + log_det + k as f64 * TAU.ln());
         let x = &self.state + &gain * &nu;
         let a = DMatrix::identity(n, n) - &gain * &m;
-        let s = symmetric(&a * &self.covariance * a.transpose() + &gain * r * gain.transpose());
+        let joseph = |s: &DMatrix<f64>, r: &DMatrix<f64>| {
+            symmetric(&a * s * a.transpose() + &gain * r * gain.transpose())
+        };
+        let s = joseph(&self.covariance, r);
         finite(&s, "updated covariance")?;
+        let weight = match &self.fading {
+            Some(_) => {
+                let w = joseph(weight, &(r * f)) / f;
+                finite(&w, "updated fading-memory matrix P")?;
+                Some(w)
+            }
+            None => None,
+        };
         if let Some(&value) = x.iter().find(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 what: "updated state entry",
@@ -443,6 +590,10 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         }
         self.state = x;
         self.covariance = s;
+        if let (Some(fading), Some(w)) = (&mut self.fading, weight) {
+            fading.weight = w;
+            fading.last_update = self.time;
+        }
         Ok(Innovation {
             components: present.to_vec(),
             innovation: nu,
