@@ -14,6 +14,8 @@
 //!   ([`difference_variance`], and [`DifferenceNoise`] on irregular timestamps, running or
 //!   windowed); residual-based [`residual_variance`] (Morrison (6.10.24)).
 //! - [`Welford`]: running mean and variance.
+//! - [`consistency`]: NEES against a known truth and the chi-squared interval of the mean NEES
+//!   or NIS over many runs (a filter's run-time consistency check).
 //!
 //! ```
 //! use seqsmooth::stats::{difference_variance, reyneke_eq39_variance};
@@ -26,6 +28,7 @@
 //! ```
 
 pub mod chi_squared;
+pub mod consistency;
 pub mod innovation;
 pub mod noise;
 pub mod welford;
