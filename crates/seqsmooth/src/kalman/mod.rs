@@ -1,15 +1,20 @@
-//! Recursive filters over any dynamic and observation model (Morrison chs. 12 and 15): the
-//! Kalman filter, extended for nonlinear models, with or without driving noise.
+//! Recursive filters over any dynamic and observation model (Morrison chs. 10, 12, 14, 15):
+//! the Bayes filter in information form, and the Kalman filter, extended and iterated for
+//! nonlinear models, with driving noise or fading memory, and its smoother.
 //!
+//! - [`bayes`]: [`BayesFilter`], the Bayes filter (ch. 10) in square-root information form, the
+//!   recursion of the exact polynomial engine over any linear model; it starts from nothing.
 //! - [`filter`]: [`KalmanFilter`], prediction, Joseph-form update, the iterated update, the
 //!   generalized fading memory of ch. 14 ([`Discount`]), innovation statistics.
 //! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run.
 //! - [`noise`]: the driving-noise covariance `Q` over a step (15.2.23), in closed form for the
 //!   polynomial model ([`noise::WhiteNoiseDerivative`]).
 
+pub mod bayes;
 pub mod filter;
 pub mod noise;
 pub mod smoother;
 
+pub use bayes::BayesFilter;
 pub use filter::{Discount, Innovation, KalmanFilter};
 pub use smoother::{smooth, Smoothed};

@@ -43,6 +43,17 @@ pub trait Observation {
     /// `G(X, t)` and `M(X, t)`.
     fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error>;
 
+    /// Whether `G(X, t) = M(t) X` exactly (no linearisation error): the Bayes filter then
+    /// folds in the measured values as they are. `false` unless the model says so.
+    ///
+    /// ```
+    /// use seqsmooth::model::observation::{LinearObservation, Observation};
+    /// assert!(LinearObservation::value_of(2).is_linear());
+    /// ```
+    fn is_linear(&self) -> bool {
+        false
+    }
+
     /// [`Observation::predict`] into the caller's buffers (`value` of length `components`,
     /// `jacobian` `components × states`, replaced if they are not), allocating nothing where
     /// the model allows ([`super::radar::Radar`] does): what the estimators call at every
@@ -86,6 +97,9 @@ impl<O: Observation + ?Sized> Observation for &O {
     }
     fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error> {
         (**self).predict(state, t)
+    }
+    fn is_linear(&self) -> bool {
+        (**self).is_linear()
     }
     fn predict_into(
         &self,
@@ -174,6 +188,9 @@ impl LinearObservation {
 }
 
 impl Observation for LinearObservation {
+    fn is_linear(&self) -> bool {
+        true
+    }
     fn components(&self) -> usize {
         self.m.nrows()
     }

@@ -1,0 +1,339 @@
+//! The Bayes filter (Morrison ch. 10) in square-root information form, for linear dynamics:
+//! the same recursion ([`crate::recursive::InformationFilter`], Gentleman's rotations of
+//! [`crate::recursive::TriangularFactor`]) that the exact polynomial engine runs, here over any
+//! [`Dynamics`] with `Φ` independent of the state and any [`Observation`].
+//!
+//! | step | information form | source |
+//! |---|---|---|
+//! | predict to `t_n` | `x(t_{n−1}) = Φ(t_{n−1}, t_n) x(t_n)`: `R ← R Φ(t_{n−1}, t_n)` | (10.2.40)-(10.2.41), §11.3 (11.3.3) |
+//! | update | each whitened row of `M` folded into `R` (`(S_{n,n})⁻¹ = (S_{n,n−1})⁻¹ + Mᵀ R⁻¹ M`) | (10.2.42)-(10.2.44), (11.3.4) |
+//! | estimate, covariance | `X = R⁻¹ d`, `S = R⁻¹ R⁻ᵀ` | (10.2.33)-(10.2.34) |
+//!
+//! Unlike the Kalman filter it can start from zero information (`(S_{1,0})⁻¹ = 0`, (10.3.1)-
+//! (10.3.5)); the estimate exists once the observations determine it. A nonlinear
+//! observation is linearised about the current estimate (it must exist). A perfect observation
+//! (zero variance) cannot be weighed in this form and is refused (§12.4 item 4: the Bayes
+//! filter fails visibly).
+
+use crate::error::Error;
+use crate::estimate::batch::NoiseCovariance;
+use crate::estimate::gauss_newton::Measurement;
+use crate::model::dynamics::Dynamics;
+use crate::model::observation::Observation;
+use crate::recursive::InformationFilter;
+use nalgebra::{Cholesky, DMatrix, DVector};
+
+/// The Bayes filter on `D` (linear) and `O`.
+///
+/// ```
+/// use nalgebra::DVector;
+/// use seqsmooth::estimate::batch::NoiseCovariance;
+/// use seqsmooth::estimate::gauss_newton::Measurement;
+/// use seqsmooth::kalman::BayesFilter;
+/// use seqsmooth::model::dynamics::PolynomialDynamics;
+/// use seqsmooth::model::observation::LinearObservation;
+/// // From no information: a line through two points is determined by them.
+/// let mut f = BayesFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2), 0.0).unwrap();
+/// for (t, y) in [(0.0, 1.0), (2.0, 5.0)] {
+///     f.update(&Measurement { time: t, values: vec![Some(y)], noise: NoiseCovariance::Identity }).unwrap();
+/// }
+/// let x = f.estimate().unwrap();
+/// assert!((x[0] - 5.0).abs() < 1e-14 && (x[1] - 2.0).abs() < 1e-14);
+/// ```
+#[derive(Clone, Debug)]
+pub struct BayesFilter<D: Dynamics, O: Observation> {
+    dynamics: D,
+    observation: O,
+    info: InformationFilter,
+    time: f64,
+}
+
+impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
+    /// A filter at `time` with no information (`(S_{1,0})⁻¹ = 0`, (10.3.5)). The dynamics must
+    /// be linear ([`Dynamics::is_linear`]).
+    ///
+    /// ```
+    /// use seqsmooth::kalman::BayesFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = BayesFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2), 0.0).unwrap();
+    /// assert!(f.estimate().is_none());
+    /// ```
+    pub fn new(dynamics: D, observation: O, time: f64) -> Result<Self, Error> {
+        let n = dynamics.dimension();
+        if !dynamics.is_linear() {
+            return Err(Error::InvalidParameter {
+                name: "dynamics",
+                value: "a nonlinear model".into(),
+                reason: "the Bayes filter here needs Φ independent of the state (linear \
+                         dynamics); use the extended Kalman filter"
+                    .into(),
+            });
+        }
+        if observation.state_dimension() != n {
+            return Err(Error::InvalidParameter {
+                name: "observation model",
+                value: format!("for {} states", observation.state_dimension()),
+                reason: format!("the dynamics have {n} states"),
+            });
+        }
+        if !time.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: time,
+            });
+        }
+        Ok(Self {
+            dynamics,
+            observation,
+            info: InformationFilter::new(n),
+            time,
+        })
+    }
+
+    /// With the prior `state` and its `covariance` (symmetric positive definite).
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::BayesFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = BayesFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 0.0)
+    ///     .unwrap()
+    ///     .with_prior(&DVector::from_vec(vec![3.0]), &DMatrix::from_element(1, 1, 4.0))
+    ///     .unwrap();
+    /// assert!((f.estimate().unwrap()[0] - 3.0).abs() < 1e-15);
+    /// assert!((f.covariance().unwrap()[(0, 0)] - 4.0).abs() < 1e-14);
+    /// ```
+    pub fn with_prior(
+        mut self,
+        state: &DVector<f64>,
+        covariance: &DMatrix<f64>,
+    ) -> Result<Self, Error> {
+        let n = self.dynamics.dimension();
+        if state.len() != n || covariance.shape() != (n, n) {
+            return Err(Error::InvalidParameter {
+                name: "prior",
+                value: format!(
+                    "state of length {}, covariance {}x{}",
+                    state.len(),
+                    covariance.nrows(),
+                    covariance.ncols()
+                ),
+                reason: format!("the model has {n} states"),
+            });
+        }
+        if let Some(&value) = state
+            .iter()
+            .chain(covariance.iter())
+            .find(|v| !v.is_finite())
+        {
+            return Err(Error::NonFinite {
+                what: "prior entry",
+                value,
+            });
+        }
+        let refuse = || Error::InvalidParameter {
+            name: "prior covariance",
+            value: format!("{covariance:?}"),
+            reason: "must be symmetric positive definite".into(),
+        };
+        if (covariance - covariance.transpose()).abs().max() > 1e-12 * covariance.abs().max() {
+            return Err(refuse());
+        }
+        // The information S⁻¹ = L⁻ᵀ L⁻¹ (S = L Lᵀ); its factor R = L_Jᵀ with J = L_J L_Jᵀ.
+        let l = Cholesky::new(covariance.clone()).ok_or_else(refuse)?;
+        let information = l.inverse();
+        let information = (&information + information.transpose()) * 0.5;
+        let r = Cholesky::new(information)
+            .ok_or_else(refuse)?
+            .l()
+            .transpose();
+        self.info = InformationFilter::with_prior(state, &r);
+        Ok(self)
+    }
+
+    /// The estimate at [`Self::time`], once the information determines it.
+    pub fn estimate(&self) -> Option<DVector<f64>> {
+        self.info.solve()
+    }
+
+    /// Its covariance `(RᵀR)⁻¹`, once determined.
+    pub fn covariance(&self) -> Option<DMatrix<f64>> {
+        self.info.covariance()
+    }
+
+    /// The time the information refers to.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Carries the information to `t`: `R ← R Φ(t_old, t)` (10.2.40)-(10.2.41).
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::BayesFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = BayesFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2), 0.0)
+    ///     .unwrap()
+    ///     .with_prior(&DVector::from_vec(vec![1.0, 2.0]), &DMatrix::identity(2, 2))
+    ///     .unwrap();
+    /// f.predict(1.0).unwrap();
+    /// assert!((f.estimate().unwrap()[0] - 3.0).abs() < 1e-14);
+    /// assert!((f.covariance().unwrap()[(0, 0)] - 2.0).abs() < 1e-14); // Φ S Φᵀ
+    /// ```
+    pub fn predict(&mut self, t: f64) -> Result<(), Error> {
+        if !t.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: t,
+            });
+        }
+        if t == self.time {
+            return Ok(());
+        }
+        let n = self.dynamics.dimension();
+        let (mut x, mut back) = (DVector::zeros(n), DMatrix::zeros(n, n));
+        // Φ(t_old, t) does not depend on the state (linear dynamics).
+        self.dynamics
+            .propagate_into(&DVector::zeros(n), t, self.time, &mut x, &mut back)?;
+        self.info.change_variables(&back);
+        self.time = t;
+        Ok(())
+    }
+
+    /// Predicts to the measurement's time and folds in its present components, whitened by
+    /// `R` ((10.2.42)-(10.2.44)). On an error the filter is unchanged.
+    pub fn update(&mut self, measurement: &Measurement) -> Result<(), Error> {
+        let p = self.observation.components();
+        if measurement.values.len() != p {
+            return Err(Error::InvalidParameter {
+                name: "measurement",
+                value: format!("with {} components", measurement.values.len()),
+                reason: format!("the observation model has {p}"),
+            });
+        }
+        let present: Vec<usize> = (0..p)
+            .filter(|&k| measurement.values[k].is_some())
+            .collect();
+        let values: Vec<f64> = present
+            .iter()
+            .map(|&k| measurement.values[k].unwrap_or(f64::NAN))
+            .collect();
+        if let Some(&value) = values
+            .iter()
+            .chain([&measurement.time])
+            .find(|v| !v.is_finite())
+        {
+            return Err(Error::NonFinite {
+                what: "measured value or time",
+                value,
+            });
+        }
+        let whitener = whitener(p, &measurement.noise, &present)?;
+        let saved = (self.info.clone(), self.time);
+        self.predict(measurement.time)?;
+        if present.is_empty() {
+            return Ok(());
+        }
+        let result = self.fold(&present, &values, &whitener);
+        if result.is_err() {
+            (self.info, self.time) = saved;
+        }
+        result
+    }
+
+    /// Folds the present components' whitened rows into the information.
+    fn fold(
+        &mut self,
+        present: &[usize],
+        values: &[f64],
+        whitener: &DMatrix<f64>,
+    ) -> Result<(), Error> {
+        let n = self.dynamics.dimension();
+        let p = self.observation.components();
+        let linear = self.observation.is_linear();
+        let about = if linear {
+            DVector::zeros(n)
+        } else {
+            self.estimate().ok_or_else(|| Error::InvalidParameter {
+                name: "observation model",
+                value: "nonlinear".into(),
+                reason: "the Bayes filter linearises it about its estimate, which the \
+                         information so far does not determine: give a prior"
+                    .into(),
+            })?
+        };
+        let (mut g, mut m_all) = (DVector::zeros(p), DMatrix::zeros(p, n));
+        self.observation
+            .predict_into(&about, self.time, &mut g, &mut m_all)?;
+        let k = present.len();
+        let m = DMatrix::from_fn(k, n, |i, j| m_all[(present[i], j)]);
+        // y' = y (linear), or the residual about x̄ plus M x̄ (linearised).
+        let y = if linear {
+            DVector::from_column_slice(values)
+        } else {
+            let mx = &m * &about;
+            DVector::from_fn(k, |i, _| {
+                self.observation
+                    .residual(present[i], values[i], g[present[i]])
+                    + mx[i]
+            })
+        };
+        let (wm, wy) = (whitener * m, whitener * y);
+        if let Some(&value) = wm.iter().chain(wy.iter()).find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "whitened observation",
+                value,
+            });
+        }
+        let mut row = vec![0.0; n];
+        for i in 0..k {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = wm[(i, j)];
+            }
+            self.info.observe(&row, wy[i], 1.0);
+        }
+        Ok(())
+    }
+}
+
+/// `L⁻¹` for the present components' `R = L Lᵀ` (positive definite: the information form
+/// needs `R⁻¹`).
+fn whitener(p: usize, noise: &NoiseCovariance, present: &[usize]) -> Result<DMatrix<f64>, Error> {
+    let k = present.len();
+    let r = match noise {
+        NoiseCovariance::Identity => DMatrix::identity(k, k),
+        NoiseCovariance::Variances(v) if v.len() == p => {
+            DMatrix::from_fn(k, k, |i, j| if i == j { v[present[i]] } else { 0.0 })
+        }
+        NoiseCovariance::Full(r) if r.shape() == (p, p) => {
+            DMatrix::from_fn(k, k, |i, j| r[(present[i], present[j])])
+        }
+        other => {
+            return Err(Error::InvalidParameter {
+                name: "measurement noise",
+                value: format!("{other:?}"),
+                reason: format!("needs {p} components"),
+            })
+        }
+    };
+    let refuse = || Error::InvalidParameter {
+        name: "measurement noise",
+        value: format!("{r:?}"),
+        reason: "must be finite, symmetric and positive definite (the Bayes filter weighs by \
+                 R⁻¹; a perfect observation needs the Kalman filter)"
+            .into(),
+    };
+    if r.iter().any(|v| !v.is_finite()) || (&r - r.transpose()).abs().max() > 1e-12 * r.abs().max()
+    {
+        return Err(refuse());
+    }
+    if k == 0 {
+        return Ok(DMatrix::zeros(0, 0));
+    }
+    let l = Cholesky::new(r.clone()).ok_or_else(refuse)?.l();
+    l.solve_lower_triangular(&DMatrix::identity(k, k))
+        .ok_or_else(refuse)
+}
