@@ -56,13 +56,16 @@ fn t10_1_and_t10_4() {
     assert!((f.covariance().unwrap() - want).amax() < 1e-12);
 }
 
+/// One figure's observation row, its first five `(S00, S11)` and those at n = 199.
+type Figure<'a> = (&'a [f64], [(f64, f64); 5], (f64, f64));
+
 /// T10-2 (Figs. 10.1/10.2; τ = 1, R = 1): `Φ = [[1, 1], [0, 1]]`, `S_{1,0} = I`, one update
 /// per unit step. `M = (0, 1)`: `(S00, S11)` for n = 1..5 = (1, 1/2), (4/3, 1/3), (2, 1/4),
 /// (14/5, 1/5), (11/3, 1/6), and at n = 199 (197.020, 0.005); `M = (1, 0)`: (1/2, 1), (3/5,
 /// 3/5), (2/3, 4/15), (8/13, 5/39), (47/86, 3/43), and (0.0198536, 1.50048e-6).
 #[test]
 fn t10_2_figures_10_1_and_10_2() {
-    let cases: [(&[f64], [(f64, f64); 5], (f64, f64)); 2] = [
+    let cases: [Figure; 2] = [
         (
             &[0.0, 1.0],
             [

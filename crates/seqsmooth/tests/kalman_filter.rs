@@ -13,8 +13,8 @@ use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
 use seqsmooth::model::linear::LinearDynamics;
 use seqsmooth::model::observation::LinearObservation;
+use seqsmooth::stats::consistency::mean_interval;
 use seqsmooth::Error;
-use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 fn m(rows: usize, cols: usize, v: &[f64]) -> DMatrix<f64> {
     DMatrix::from_row_slice(rows, cols, v)
@@ -463,12 +463,7 @@ fn innovation_statistics() {
             .unwrap();
         sum += i.nis;
     }
-    let dof = 2.0 * count as f64;
-    let chi = ChiSquared::new(dof).unwrap();
-    let (lo, hi) = (
-        chi.inverse_cdf(0.005) / count as f64,
-        chi.inverse_cdf(0.995) / count as f64,
-    );
+    let (lo, hi) = mean_interval(2, count, 0.99).unwrap();
     let mean = sum / count as f64;
     assert!(
         lo <= mean && mean <= hi,

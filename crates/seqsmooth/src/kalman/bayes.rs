@@ -154,16 +154,52 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     }
 
     /// The estimate at [`Self::time`], once the information determines it.
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::BayesFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = BayesFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 0.0).unwrap();
+    /// f.update(&Measurement { time: 1.0, values: vec![Some(2.0)], noise: NoiseCovariance::Variances(vec![4.0]) }).unwrap();
+    /// assert_eq!(f.estimate().unwrap()[0], 2.0);
+    /// ```
     pub fn estimate(&self) -> Option<DVector<f64>> {
         self.info.solve()
     }
 
     /// Its covariance `(RᵀR)⁻¹`, once determined.
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::BayesFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = BayesFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 0.0).unwrap();
+    /// f.update(&Measurement { time: 1.0, values: vec![Some(2.0)], noise: NoiseCovariance::Variances(vec![4.0]) }).unwrap();
+    /// assert!((f.covariance().unwrap()[(0, 0)] - 4.0).abs() < 1e-14);
+    /// ```
     pub fn covariance(&self) -> Option<DMatrix<f64>> {
         self.info.covariance()
     }
 
     /// The time the information refers to.
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::BayesFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = BayesFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 0.0).unwrap();
+    /// f.update(&Measurement { time: 1.0, values: vec![Some(2.0)], noise: NoiseCovariance::Variances(vec![4.0]) }).unwrap();
+    /// assert_eq!(f.time(), 1.0);
+    /// ```
     pub fn time(&self) -> f64 {
         self.time
     }
@@ -205,6 +241,19 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
 
     /// Predicts to the measurement's time and folds in its present components, whitened by
     /// `R` ((10.2.42)-(10.2.44)). On an error the filter is unchanged.
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::BayesFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = BayesFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 0.0).unwrap();
+    /// f.update(&Measurement { time: 1.0, values: vec![Some(2.0)], noise: NoiseCovariance::Variances(vec![4.0]) }).unwrap();
+    /// assert!(f.update(&Measurement { time: 2.0, values: vec![Some(1.0)], noise: NoiseCovariance::Variances(vec![0.0]) }).is_err());
+    /// assert_eq!(f.time(), 1.0);
+    /// ```
     pub fn update(&mut self, measurement: &Measurement) -> Result<(), Error> {
         let p = self.observation.components();
         if measurement.values.len() != p {

@@ -328,6 +328,20 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
 
     /// Carries the estimate to `t` (forwards or backwards): (12.2.15)-(12.2.16), (15.4.10)-(15.4.11).
     /// On an error the filter is unchanged.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = KalmanFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2),
+    ///     DVector::from_vec(vec![0.0, 1.0]), DMatrix::identity(2, 2), 0.0).unwrap();
+    /// f.predict(2.0).unwrap();
+    /// assert_eq!(f.state()[0], 2.0);
+    /// assert_eq!(f.covariance()[(0, 0)], 5.0); // 1 + ζ²
+    /// ```
     pub fn predict(&mut self, t: f64) -> Result<(), Error> {
         self.predict_with_transition(t).map(|_| ())
     }
@@ -381,6 +395,22 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// Predicts to the measurement's time and updates with its present components
     /// ((12.2.17)-(12.2.19), Joseph's covariance (12.3.7)); `Ok(None)` when no component is
     /// present (the prediction alone). On an error the filter is unchanged.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = KalmanFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2),
+    ///     DVector::from_vec(vec![0.0, 1.0]), DMatrix::identity(2, 2), 0.0).unwrap();
+    /// let missing = Measurement { time: 1.0, values: vec![None], noise: NoiseCovariance::Identity };
+    /// assert!(f.update(&missing).unwrap().is_none());
+    /// let z = Measurement { time: 2.0, values: vec![Some(2.5)], noise: NoiseCovariance::Identity };
+    /// let i = f.update(&z).unwrap().unwrap();
+    /// assert_eq!(i.innovation[0], 0.5);
+    /// ```
     pub fn update(&mut self, measurement: &Measurement) -> Result<Option<Innovation>, Error> {
         let p = self.observation.components();
         let (present, values, r) = present_components(p, measurement)?;
