@@ -32,9 +32,9 @@ use crate::error::Error;
 pub struct ChiSquaredOutcome {
     /// The normalised squared innovation `k² = ν²/σ_ε²` just added.
     pub normalised: f64,
-    /// The window sum `Σ k²` over the last `dof` samples.
+    /// The window sum `Σ k²` over the last `K` updates.
     pub statistic: f64,
-    /// Samples in the window (the degrees of freedom).
+    /// The window's degrees of freedom (its samples, for scalar innovations).
     pub dof: usize,
     /// The `(1-α)` quantile of `χ²_dof`.
     pub threshold: f64,
@@ -66,6 +66,10 @@ pub struct InnovationChiSquared {
     thresholds: Vec<f64>,
     /// The window sum of `k²`.
     recent: SlidingSum,
+    /// The degrees of freedom of each update in the window (1 for a scalar innovation, `p` for
+    /// the NIS of `p` components), and their sum.
+    dofs: std::collections::VecDeque<usize>,
+    dof_total: usize,
 }
 
 impl InnovationChiSquared {
@@ -100,6 +104,8 @@ impl InnovationChiSquared {
             alpha,
             thresholds,
             recent: SlidingSum::new(Some(window)),
+            dofs: std::collections::VecDeque::with_capacity(window),
+            dof_total: 0,
         })
     }
 
@@ -166,23 +172,66 @@ impl InnovationChiSquared {
                 reason: "must be a non-negative finite number".into(),
             });
         }
-        self.recent.push(k2);
-        Ok(self.outcome(k2))
+        self.push_dof(k2, 1)
     }
 
-    fn outcome(&self, k2: f64) -> ChiSquaredOutcome {
-        let dof = self.recent.len();
-        let threshold = if dof == 0 {
-            f64::INFINITY
-        } else {
-            self.thresholds[dof - 1]
-        };
-        ChiSquaredOutcome {
+    /// Adds the normalised innovation squared of a `components`-vector innovation,
+    /// `NIS = νᵀ V⁻¹ ν` (χ² with `components` degrees of freedom when the model holds, (14.8.5)
+    /// with `T_n = V`): the window holds the last `K` updates and its sum is tested against
+    /// `χ²` with their summed degrees of freedom. For the Kalman filter with a correct model
+    /// the innovations are independent, so the rate of false alarms per update is `α`.
+    ///
+    /// ```
+    /// use seqsmooth::stats::InnovationChiSquared;
+    /// let mut test = InnovationChiSquared::new(2, 0.01).unwrap();
+    /// test.push_nis(2.0, 3).unwrap();
+    /// let o = test.push_nis(4.0, 3).unwrap();
+    /// assert_eq!((o.statistic, o.dof), (6.0, 6));
+    /// assert!((o.threshold - 16.812).abs() < 1e-3); // 99% point of χ²₆
+    /// assert!(test.push_nis(1.0, 0).is_err());
+    /// ```
+    pub fn push_nis(&mut self, nis: f64, components: usize) -> Result<ChiSquaredOutcome, Error> {
+        if components == 0 {
+            return Err(Error::InvalidParameter {
+                name: "innovation components",
+                value: "0".into(),
+                reason: "an update has at least one component".into(),
+            });
+        }
+        if !(nis.is_finite() && nis >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "normalised innovation squared",
+                value: nis.to_string(),
+                reason: "must be a non-negative finite number".into(),
+            });
+        }
+        self.push_dof(nis, components)
+    }
+
+    fn push_dof(&mut self, k2: f64, dof: usize) -> Result<ChiSquaredOutcome, Error> {
+        if self.dofs.len() == self.window {
+            self.dof_total -= self.dofs.pop_front().unwrap_or(0);
+        }
+        self.dofs.push_back(dof);
+        self.dof_total += dof;
+        self.recent.push(k2);
+        let threshold = self.threshold()?;
+        Ok(ChiSquaredOutcome {
             normalised: k2,
             statistic: self.recent.sum(),
-            dof,
+            dof: self.dof_total,
             threshold,
-            misfit: dof > 0 && self.recent.sum() > threshold,
+            misfit: self.dof_total > 0 && self.recent.sum() > threshold,
+        })
+    }
+
+    /// The `(1-α)` quantile of `χ²` with the window's degrees of freedom (from the table up to
+    /// `K`, the scalar case).
+    fn threshold(&self) -> Result<f64, Error> {
+        match self.dof_total {
+            0 => Ok(f64::INFINITY),
+            d if d <= self.window => Ok(self.thresholds[d - 1]),
+            d => chi_squared_quantile(d as f64, 1.0 - self.alpha),
         }
     }
 
@@ -199,7 +248,7 @@ impl InnovationChiSquared {
         self.recent.sum()
     }
 
-    /// Samples currently in the window.
+    /// Updates currently in the window.
     ///
     /// ```
     /// use seqsmooth::stats::InnovationChiSquared;
@@ -235,8 +284,10 @@ impl InnovationChiSquared {
     /// assert!(test.is_misfit());
     /// ```
     pub fn is_misfit(&self) -> bool {
-        let dof = self.recent.len();
-        dof > 0 && self.recent.sum() > self.thresholds[dof - 1]
+        self.dof_total > 0
+            && self
+                .threshold()
+                .is_ok_and(|threshold| self.recent.sum() > threshold)
     }
 
     /// Empties the window (e.g. after the model has been changed).
@@ -250,5 +301,7 @@ impl InnovationChiSquared {
     /// ```
     pub fn reset(&mut self) {
         self.recent.clear();
+        self.dofs.clear();
+        self.dof_total = 0;
     }
 }
