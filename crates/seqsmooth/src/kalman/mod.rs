@@ -7,6 +7,7 @@
 //! - [`filter`]: [`KalmanFilter`], prediction, Joseph-form update, the iterated update, the
 //!   generalized fading memory of ch. 14 ([`Discount`]), innovation statistics.
 //! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run.
+//! - [`steady`]: the fading filter's steady state (§14.7).
 //! - [`noise`]: the driving-noise covariance `Q` over a step (15.2.23), in closed form for the
 //!   polynomial model ([`noise::WhiteNoiseDerivative`]).
 
@@ -14,6 +15,7 @@ pub mod bayes;
 pub mod filter;
 pub mod noise;
 pub mod smoother;
+pub mod steady;
 
 pub use bayes::BayesFilter;
 pub use filter::{Discount, Innovation, KalmanFilter};
