@@ -78,7 +78,42 @@ pub enum Command {
     /// correction: a radar's range, azimuth and elevation, or a scalar polynomial series
     #[command(after_help = FIT_AFTER_HELP)]
     Fit(FitArgs),
+    /// Track a target from a radar's range, azimuth and elevation: sliding Gauss-Newton window,
+    /// Kalman filter, fading-memory Kalman filter, or Kalman smoother
+    #[command(after_help = TRACK_AFTER_HELP)]
+    Track(TrackArgs),
 }
+
+const TRACK_AFTER_HELP: &str = concat!(
+    "\
+Output: CSV, one row per input row in input order, with the header
+  t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,nis
+t echoes the input cell; x..vz is the constant-velocity state at t (in the units of the range \
+and of t; with --azimuth bearing x is east, y north, z up), s.. their 1-sigma errors, and nis \
+the normalised innovation squared of the row's update (chi-squared with as many degrees of \
+freedom as components present when the model holds; Morrison 14.8). Rows before the state is \
+determinable leave their cells empty.
+
+--method window: the Gauss-Newton fit of each row's last W rows (--window, default 60; all \
+rows so far while fewer), as 'seqsmooth fit --model radar'; nis is the row's innovation \
+against the previous window's estimate.
+--method kalman: the extended Kalman filter (Morrison 12.5) with white-noise acceleration of \
+spectral density --q (m^2/s^3 for metres and seconds; default 0, no driving noise: give a q \
+for a target that manoeuvres), started from the Gauss-Newton fit of the first rows that \
+determine the state (that row's cells are the fit's, its nis empty).
+--method fading: the same start, then the fading-memory Kalman filter (Morrison 14.4) with \
+--beta B per unit of time or --theta T per update; s.. are the true 1-sigma errors.
+--method smooth: the Rauch-Tung-Striebel smoother over the kalman method's run (reads the whole \
+input first); nis is the forward filter's.
+
+Angles in radians; --azimuth from-x (default): from +x towards +y; --azimuth bearing: \
+clockwise from north with x = east, y = north. Elevation from the x-y plane. An empty range, \
+azimuth or elevation cell is a missing component; a row with all three empty is a missing \
+measurement (the filters predict across it).
+
+",
+    exit_status!("too few samples")
+);
 
 const FIT_AFTER_HELP: &str = concat!(
     "\
@@ -412,6 +447,101 @@ pub struct FitArgs {
     /// Output file [default: standard output]
     #[arg(short = 'o', long, value_name = "OUTPUT")]
     pub output: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct TrackArgs {
+    /// Input CSV with a header row; omitted or '-' reads standard input
+    #[arg(value_name = "INPUT")]
+    pub input: Option<PathBuf>,
+    /// The tracking method
+    #[arg(long, value_enum, default_value_t = TrackMethod::Kalman)]
+    pub method: TrackMethod,
+    /// The site's position X,Y,Z in the units of the range
+    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,0", value_parser = parse_site,
+          allow_hyphen_values = true)]
+    pub site: [f64; 3],
+    /// The range's noise standard deviation (required)
+    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
+    pub sigma_range: f64,
+    /// The azimuth's and elevation's noise standard deviation in radians (required)
+    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
+    pub sigma_angle: f64,
+    /// kalman, smooth: spectral density of the white-noise acceleration on each axis
+    #[arg(long = "q", value_name = "ACCEL_PSD", value_parser = parse_psd, allow_hyphen_values = true)]
+    pub q: Option<f64>,
+    /// fading: the discount per unit of time, 0 < B <= 1
+    #[arg(long, value_name = "B", value_parser = parse_discount, allow_hyphen_values = true,
+          conflicts_with = "theta")]
+    pub beta: Option<f64>,
+    /// fading: the discount per update, 0 < T <= 1
+    #[arg(long, value_name = "T", value_parser = parse_discount, allow_hyphen_values = true)]
+    pub theta: Option<f64>,
+    /// window: the number of rows in each window
+    #[arg(long, value_name = "W", default_value = "60", value_parser = parse_window,
+          allow_hyphen_values = true)]
+    pub window: usize,
+    /// The azimuth convention of the input
+    #[arg(long, value_enum, default_value_t = AzimuthConvention::FromX)]
+    pub azimuth: AzimuthConvention,
+    /// Name of the time column
+    #[arg(long, value_name = "NAME", default_value = "t")]
+    pub time_col: String,
+    /// Name of the range column
+    #[arg(long, value_name = "NAME", default_value = "range")]
+    pub range_col: String,
+    /// Name of the azimuth column
+    #[arg(long, value_name = "NAME", default_value = "azimuth")]
+    pub azimuth_col: String,
+    /// Name of the elevation column
+    #[arg(long, value_name = "NAME", default_value = "elevation")]
+    pub elevation_col: String,
+    /// Output file [default: standard output]
+    #[arg(short = 'o', long, value_name = "OUTPUT")]
+    pub output: Option<PathBuf>,
+}
+
+/// The methods of `seqsmooth track`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TrackMethod {
+    /// Gauss-Newton over each row's last W rows.
+    Window,
+    /// The extended Kalman filter with white-noise acceleration (--q).
+    Kalman,
+    /// The fading-memory Kalman filter (--beta or --theta).
+    Fading,
+    /// The Rauch-Tung-Striebel smoother over the Kalman filter.
+    Smooth,
+}
+
+/// How the input's azimuth is measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum AzimuthConvention {
+    /// From +x towards +y.
+    FromX,
+    /// Clockwise from north, with x = east and y = north.
+    Bearing,
+}
+
+/// Parses `--q`: a non-negative finite number.
+pub fn parse_psd(s: &str) -> Result<f64, String> {
+    parse_f64(
+        "q",
+        s,
+        (
+            |v| v.is_finite() && v >= 0.0,
+            "a non-negative finite number",
+        ),
+    )
+}
+
+/// Parses `--beta` and `--theta` of `track`: `0 < v <= 1`.
+pub fn parse_discount(s: &str) -> Result<f64, String> {
+    parse_f64(
+        "discount",
+        s,
+        (|v| v > 0.0 && v <= 1.0, "a number with 0 < value <= 1"),
+    )
 }
 
 /// The models of `seqsmooth fit`.

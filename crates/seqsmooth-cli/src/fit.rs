@@ -36,10 +36,10 @@ impl Fitter {
 }
 
 /// One measured column: its name, index and what it holds (for messages).
-struct Column {
-    name: String,
-    index: usize,
-    what: &'static str,
+pub(crate) struct Column {
+    pub(crate) name: String,
+    pub(crate) index: usize,
+    pub(crate) what: &'static str,
 }
 
 /// The settings the arguments resolve to.
@@ -303,7 +303,7 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
 
 /// The measured components of the current row: an empty cell is a missing component (radar),
 /// anything else a finite number in range.
-fn measured<R: std::io::Read>(
+pub(crate) fn measured<R: std::io::Read>(
     csv: &CsvIn<R>,
     line: u64,
     columns: &[Column],
@@ -340,7 +340,12 @@ fn measured<R: std::io::Read>(
 }
 
 /// A window's error with the file lines of its rows (or of the one row it is about).
-fn window_error(e: Error, lines: &VecDeque<u64>, window: usize, model: FitModel) -> CliError {
+pub(crate) fn window_error(
+    e: Error,
+    lines: &VecDeque<u64>,
+    window: usize,
+    model: FitModel,
+) -> CliError {
     let (first, last) = (
         lines.front().copied().unwrap_or(0),
         lines.back().copied().unwrap_or(0),

@@ -18,4 +18,5 @@ pub mod plot;
 pub mod progress;
 pub mod smooth;
 pub mod ticks;
+pub mod track;
 pub mod vrf;

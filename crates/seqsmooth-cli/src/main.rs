@@ -4,7 +4,7 @@
 use clap::Parser;
 use seqsmooth_cli::args::{Cli, Command};
 use seqsmooth_cli::error::CliError;
-use seqsmooth_cli::{demo, filter, fit, gains, plot, smooth, vrf};
+use seqsmooth_cli::{demo, filter, fit, gains, plot, smooth, track, vrf};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -16,6 +16,7 @@ fn main() -> ExitCode {
         Command::Demo(a) => demo::run(&a),
         Command::Plot(a) => plot::run(&a),
         Command::Fit(a) => fit::run(&a),
+        Command::Track(a) => track::run(&a),
     };
     match result {
         Ok(()) | Err(CliError::BrokenPipe) => ExitCode::SUCCESS,
