@@ -96,13 +96,16 @@ determinable leave their cells empty.
 
 --method window: the Gauss-Newton fit of each row's last W rows (--window, default 60; all \
 rows so far while fewer), as 'seqsmooth fit --model radar'; nis is the row's innovation \
-against the previous window's estimate.
+against the previous window's estimate. The model is straight-line motion across the window: \
+for a manoeuvring target keep the window short (6 rows of 2.7 s on an airliner's approach).
 --method kalman: the extended Kalman filter (Morrison 12.5) with white-noise acceleration of \
-spectral density --q (m^2/s^3 for metres and seconds; default 0, no driving noise: give a q \
-for a target that manoeuvres), started from the Gauss-Newton fit of the first rows that \
-determine the state (that row's cells are the fit's, its nis empty).
+spectral density --q (m^2/s^3 for metres and seconds; default 0, no driving noise), started \
+from the Gauss-Newton fit of the first rows that determine the state (that row's cells are \
+the fit's, its nis empty). For a manoeuvring target give q about the square of its \
+acceleration times its duration: 10 m^2/s^3 for an airliner's turns and descent.
 --method fading: the same start, then the fading-memory Kalman filter (Morrison 14.4) with \
---beta B per unit of time or --theta T per update; s.. are the true 1-sigma errors.
+--beta B per unit of time or --theta T per update; s.. are the true 1-sigma errors. A shorter \
+memory follows manoeuvres: beta 0.7 per second for an airliner.
 --method smooth: the Rauch-Tung-Striebel smoother over the kalman method's run (reads the whole \
 input first); nis is the forward filter's.
 
