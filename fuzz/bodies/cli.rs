@@ -1,7 +1,7 @@
 //! The CLI's argument-to-output path, in process: an argument vector decoded from the input
 //! goes through clap (`Cli::try_parse_from`) and the subcommand's `run`, as `main` dispatches
 //! it, on the rest of the input as the CSV file, with `-o` to a file in a fresh temporary
-//! directory (`filter`, `smooth` and `fit`, the subcommands that read data).
+//! directory (`filter`, `smooth`, `fit` and `track`, the subcommands that read data).
 //!
 //! Checks: a refused command line has a message; a failed run is a typed error (`Usage` or
 //! `Data`) with a message and leaves no output file (nor a temporary one) behind; a
@@ -16,7 +16,7 @@ use super::input::Input;
 use clap::Parser;
 use seqsmooth_cli::args::{Cli, Command, Kind};
 use seqsmooth_cli::error::CliError;
-use seqsmooth_cli::{filter, fit, smooth};
+use seqsmooth_cli::{filter, fit, smooth, track};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -57,6 +57,25 @@ const FIT_OPTIONS: [(&str, &[&str]); 14] = [
     ("--max-iterations", &["1", "2", "20", "0"]),
 ];
 
+/// The options of `track`.
+const TRACK_OPTIONS: [(&str, &[&str]); 12] = [
+    (
+        "--method",
+        &["window", "kalman", "fading", "smooth", "bayes"],
+    ),
+    ("--sigma-range", &["10", "1e-300", "0"]),
+    ("--sigma-angle", &["1e-3", "1", "1e300"]),
+    ("--q", &["0", "1", "10", "1e300", "-1"]),
+    ("--beta", &["0.7", "1", "1e-300", "0"]),
+    ("--theta", &["0.9", "0.5"]),
+    ("--window", &["1", "2", "6", "60", "0"]),
+    ("--azimuth", &["from-x", "bearing"]),
+    ("--site", &["0,0,0", "1,2,3", "1e300,0,0"]),
+    ("--time-col", &["t", "range", "x"]),
+    ("--range-col", &["range", "t", "y"]),
+    ("--elevation-col", &["elevation", "azimuth"]),
+];
+
 /// The argument vector: subcommand, input and output files, then options as `--name=value`
 /// (so that no value can become a file name).
 fn arguments(input: &mut Input, csv: &Path, out: &Path) -> Vec<String> {
@@ -65,6 +84,8 @@ fn arguments(input: &mut Input, csv: &Path, out: &Path) -> Vec<String> {
         ("smooth", &OPTIONS)
     } else if pick % 8 == 1 {
         ("fit", &FIT_OPTIONS)
+    } else if pick % 8 == 3 {
+        ("track", &TRACK_OPTIONS)
     } else {
         ("filter", &OPTIONS)
     };
@@ -79,7 +100,7 @@ fn arguments(input: &mut Input, csv: &Path, out: &Path) -> Vec<String> {
     for _ in 0..n {
         let k = input.below(options.len() + 1);
         if k == options.len() {
-            if sub != "fit" {
+            if sub != "fit" && sub != "track" {
                 args.push("--no-progress".into());
             }
             continue;
@@ -123,8 +144,8 @@ fn output(cli: &Command, text: &[u8], data_rows: usize) {
             (2 + usize::from(id), Some(a.kind), a.degree, a.window, id)
         }
         Command::Smooth(a) => (2, None, a.degree, Some(a.window), false),
-        Command::Fit(_) => return fitted(&header, &mut reader, data_rows),
-        _ => unreachable!("only filter, smooth and fit are run"),
+        Command::Fit(_) | Command::Track(_) => return fitted(&header, &mut reader, data_rows),
+        _ => unreachable!("only filter, smooth, fit and track are run"),
     };
     let d: Vec<usize> = (0..=degree).map(|k| first + k).collect();
     for &k in &d {
@@ -169,9 +190,10 @@ fn output(cli: &Command, text: &[u8], data_rows: usize) {
     assert_eq!(rows, data_rows, "one output row per input row");
 }
 
-/// Checks the output of a successful `fit`: after the echoed cells (`t`, and `y` for the
-/// polynomial model), every cell empty or a finite number, the state cells all empty or all
-/// numbers, at least one row with a state, one row per data row.
+/// Checks the output of a successful `fit` or `track`: after the echoed cells (`t`, and `y`
+/// for the polynomial model), every cell empty or a finite number, the state cells (up to
+/// `iterations` or `nis`) all empty or all numbers, at least one row with a state, one row per
+/// data row.
 fn fitted(header: &[String], reader: &mut csv::Reader<&[u8]>, data_rows: usize) {
     let first = if header.get(1).is_some_and(|h| h == "y") {
         2
@@ -180,8 +202,8 @@ fn fitted(header: &[String], reader: &mut csv::Reader<&[u8]>, data_rows: usize) 
     };
     let states = header
         .iter()
-        .position(|h| h == "iterations")
-        .expect("an iterations column");
+        .position(|h| h == "iterations" || h == "nis")
+        .expect("an iterations or nis column");
     let (mut rows, mut estimated) = (0, 0);
     for (i, record) in reader.records().enumerate() {
         let record = record.expect("the output is CSV");
@@ -219,7 +241,8 @@ pub fn run(data: &[u8]) {
         Command::Filter(a) => filter::run(a),
         Command::Smooth(a) => smooth::run(a),
         Command::Fit(a) => fit::run(a),
-        _ => unreachable!("only filter, smooth and fit are run"),
+        Command::Track(a) => track::run(a),
+        _ => unreachable!("only filter, smooth, fit and track are run"),
     };
     let left: Vec<_> = std::fs::read_dir(dir.path())
         .expect("the temporary directory")
