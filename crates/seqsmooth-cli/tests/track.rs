@@ -216,7 +216,7 @@ fn random_inputs_are_right_or_refused() {
         let v: Vec<f64> = (0..3).map(|_| rng.gen_range(-300.0..300.0)).collect();
         for _ in 0..rng.gen_range(0..60) {
             let p: Vec<f64> = (0..3).map(|i| x0[i] + v[i] * (t % 1e4)).collect();
-            let mut cells = vec![
+            let mut cells = [
                 t.to_string(),
                 ((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() + rng.gen_range(-10.0..10.0))
                     .to_string(),
