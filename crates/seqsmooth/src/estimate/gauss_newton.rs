@@ -39,6 +39,49 @@ pub struct Measurement {
     pub noise: NoiseCovariance,
 }
 
+impl Measurement {
+    /// The present components (indices into the observation's `p`) and their values, after
+    /// the checks every estimator makes: a finite time, `p` values, each present one finite.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// let m = Measurement { time: 1.0, values: vec![Some(2.0), None, Some(4.0)], noise: NoiseCovariance::Identity };
+    /// assert_eq!(m.present(3).unwrap(), (vec![0, 2], vec![2.0, 4.0]));
+    /// assert!(m.present(2).is_err());
+    /// ```
+    pub fn present(&self, p: usize) -> Result<(Vec<usize>, Vec<f64>), Error> {
+        if !self.time.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: self.time,
+            });
+        }
+        if self.values.len() != p {
+            return Err(Error::InvalidParameter {
+                name: "measurement",
+                value: format!("with {} components", self.values.len()),
+                reason: format!("the observation model has {p}"),
+            });
+        }
+        let mut present = Vec::with_capacity(p);
+        let mut values = Vec::with_capacity(p);
+        for (k, v) in self.values.iter().enumerate() {
+            if let Some(v) = *v {
+                if !v.is_finite() {
+                    return Err(Error::NonFinite {
+                        what: "measured value",
+                        value: v,
+                    });
+                }
+                present.push(k);
+                values.push(v);
+            }
+        }
+        Ok((present, values))
+    }
+}
+
 /// The instant the estimate refers to.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Epoch {
@@ -392,33 +435,7 @@ fn prepare<O: Observation>(
 }
 
 fn prepare_one(p: usize, m: &Measurement) -> Result<Rows, Error> {
-    if !m.time.is_finite() {
-        return Err(Error::NonFinite {
-            what: "time",
-            value: m.time,
-        });
-    }
-    if m.values.len() != p {
-        return Err(Error::InvalidParameter {
-            name: "measurement",
-            value: format!("with {} components", m.values.len()),
-            reason: format!("the observation model has {p}"),
-        });
-    }
-    let mut present = Vec::new();
-    let mut values = Vec::new();
-    for (k, v) in m.values.iter().enumerate() {
-        if let Some(v) = *v {
-            if !v.is_finite() {
-                return Err(Error::NonFinite {
-                    what: "measured value",
-                    value: v,
-                });
-            }
-            present.push(k);
-            values.push(v);
-        }
-    }
+    let (present, values) = m.present(p)?;
     let bad = |value: String, reason: &str| Error::InvalidParameter {
         name: "measurement noise",
         value,

@@ -256,30 +256,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     /// ```
     pub fn update(&mut self, measurement: &Measurement) -> Result<(), Error> {
         let p = self.observation.components();
-        if measurement.values.len() != p {
-            return Err(Error::InvalidParameter {
-                name: "measurement",
-                value: format!("with {} components", measurement.values.len()),
-                reason: format!("the observation model has {p}"),
-            });
-        }
-        let present: Vec<usize> = (0..p)
-            .filter(|&k| measurement.values[k].is_some())
-            .collect();
-        let values: Vec<f64> = present
-            .iter()
-            .map(|&k| measurement.values[k].unwrap_or(f64::NAN))
-            .collect();
-        if let Some(&value) = values
-            .iter()
-            .chain([&measurement.time])
-            .find(|v| !v.is_finite())
-        {
-            return Err(Error::NonFinite {
-                what: "measured value or time",
-                value,
-            });
-        }
+        let (present, values) = measurement.present(p)?;
         let whitener = whitener(p, &measurement.noise, &present)?;
         let saved = (self.info.clone(), self.time);
         self.predict(measurement.time)?;

@@ -414,23 +414,31 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     pub fn update(&mut self, measurement: &Measurement) -> Result<Option<Innovation>, Error> {
         let p = self.observation.components();
         let (present, values, r) = present_components(p, measurement)?;
+        self.transaction(|f| {
+            f.predict(measurement.time)?;
+            if present.is_empty() {
+                return Ok(None);
+            }
+            f.correct(&present, &values, &r).map(Some)
+        })
+    }
+
+    /// Runs `step`, restoring the filter as it was if `step` fails.
+    fn transaction<T>(
+        &mut self,
+        step: impl FnOnce(&mut Self) -> Result<T, Error>,
+    ) -> Result<T, Error> {
         let saved = (
             self.state.clone(),
             self.covariance.clone(),
             self.time,
             self.fading.clone(),
         );
-        self.predict(measurement.time)?;
-        if present.is_empty() {
-            return Ok(None);
+        let out = step(self);
+        if out.is_err() {
+            (self.state, self.covariance, self.time, self.fading) = saved;
         }
-        match self.correct(&present, &values, &r) {
-            Ok(i) => Ok(Some(i)),
-            Err(e) => {
-                (self.state, self.covariance, self.time, self.fading) = saved;
-                Err(e)
-            }
-        }
+        out
     }
 
     /// The iterated update of §12.5 ((12.5.10)-(12.5.17), Morrison's Kalman filter with
@@ -474,53 +482,36 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         }
         let p = self.observation.components();
         let (present, values, r) = present_components(p, measurement)?;
-        let saved = (
-            self.state.clone(),
-            self.covariance.clone(),
-            self.time,
-            self.fading.clone(),
-        );
-        self.predict(measurement.time)?;
-        if present.is_empty() {
-            return Ok(None);
-        }
-        let (predicted, prior, fading) = (
-            self.state.clone(),
-            self.covariance.clone(),
-            self.fading.clone(),
-        );
-        let metric = Cholesky::new(prior.clone());
-        let mut about = predicted.clone();
-        let mut last = None;
-        for _ in 0..max_iterations {
-            (self.state, self.covariance, self.fading) =
-                (predicted.clone(), prior.clone(), fading.clone());
-            let step = self.correct_about(&present, &values, &r, &about);
-            let innovation = match step {
-                Ok(i) => i,
-                Err(e) => {
-                    (self.state, self.covariance, self.time, self.fading) = saved;
-                    return Err(e);
-                }
-            };
-            let change = &self.state - &about;
-            let size = match &metric {
-                Some(c) => change.dot(&c.solve(&change)).sqrt(),
-                None => change.amax() / prior.diagonal().amax().sqrt().max(f64::MIN_POSITIVE),
-            };
-            about = self.state.clone();
-            last = Some((innovation, size));
-            if size <= tolerance {
-                return Ok(last.map(|(i, _)| i));
+        self.transaction(|f| {
+            f.predict(measurement.time)?;
+            if present.is_empty() {
+                return Ok(None);
             }
-        }
-        let correction = last.map_or(f64::INFINITY, |(_, size)| size);
-        (self.state, self.covariance, self.time, self.fading) = saved;
-        Err(Error::NotConverged {
-            iterations: max_iterations,
-            correction,
-            tolerance,
-            chi_squared: f64::NAN,
+            let (predicted, prior, fading) =
+                (f.state.clone(), f.covariance.clone(), f.fading.clone());
+            let metric = Cholesky::new(prior.clone());
+            let mut about = predicted.clone();
+            let mut correction = f64::INFINITY;
+            for _ in 0..max_iterations {
+                (f.state, f.covariance, f.fading) =
+                    (predicted.clone(), prior.clone(), fading.clone());
+                let innovation = f.correct_about(&present, &values, &r, &about)?;
+                let change = &f.state - &about;
+                correction = match &metric {
+                    Some(c) => change.dot(&c.solve(&change)).sqrt(),
+                    None => change.amax() / prior.diagonal().amax().sqrt().max(f64::MIN_POSITIVE),
+                };
+                about = f.state.clone();
+                if correction <= tolerance {
+                    return Ok(Some(innovation));
+                }
+            }
+            Err(Error::NotConverged {
+                iterations: max_iterations,
+                correction,
+                tolerance,
+                chi_squared: f64::NAN,
+            })
         })
     }
 
@@ -641,33 +632,7 @@ type Present = (Vec<usize>, Vec<f64>, DMatrix<f64>);
 /// The present components of a measurement, their values and their `R` (symmetric, finite,
 /// non-negative diagonal: a perfect observation is allowed).
 fn present_components(p: usize, m: &Measurement) -> Result<Present, Error> {
-    if !m.time.is_finite() {
-        return Err(Error::NonFinite {
-            what: "time",
-            value: m.time,
-        });
-    }
-    if m.values.len() != p {
-        return Err(Error::InvalidParameter {
-            name: "measurement",
-            value: format!("with {} components", m.values.len()),
-            reason: format!("the observation model has {p}"),
-        });
-    }
-    let mut present = Vec::with_capacity(p);
-    let mut values = Vec::with_capacity(p);
-    for (k, v) in m.values.iter().enumerate() {
-        if let Some(v) = *v {
-            if !v.is_finite() {
-                return Err(Error::NonFinite {
-                    what: "measured value",
-                    value: v,
-                });
-            }
-            present.push(k);
-            values.push(v);
-        }
-    }
+    let (present, values) = m.present(p)?;
     let full = match &m.noise {
         NoiseCovariance::Identity => DMatrix::identity(p, p),
         NoiseCovariance::Variances(v) if v.len() == p => {
