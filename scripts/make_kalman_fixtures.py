@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """Writes the filterpy.kalman.KalmanFilter fixtures that seqsmooth's Kalman filter
 (`seqsmooth::kalman::KalmanFilter`) is checked against: crates/seqsmooth/tests/fixtures/kalman/,
-read by crates/seqsmooth/tests/kalman_filterpy.rs (issue 12, must-show 4).
+read by crates/seqsmooth/tests/kalman_filterpy.rs.
 
 Run:  python3 scripts/make_kalman_fixtures.py
-It uses the pinned virtual environment of scripts/peers.py (target/peers-venv, the same PINS and
+It uses the pinned virtual environment of scripts/peers_venv.py (target/peers-venv, its PINS and
 stamp file; created the same way if missing), re-runs itself there, and writes two problems, each
 on STEPS irregular steps (dt ~ U(0.2, 1.8), seed SEED) with driving noise (Q != 0) and some
 measurements missing:
@@ -26,34 +26,17 @@ side reads back the same doubles.
 """
 import math
 import os
-import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-VENV = os.path.join(ROOT, "target", "peers-venv")
-# The pins of scripts/peers.py (keep the two in step: the venv and its stamp are shared).
-PINS = ["filterpy==2.0.0", "numpy==2.4.6", "scipy==1.17.1"]
-STAMP = os.path.join(VENV, "peers-pins.txt")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import peers_venv  # noqa: E402
+
+VENV, PINS = peers_venv.VENV, peers_venv.PINS
 OUT = os.path.join(ROOT, "crates", "seqsmooth", "tests", "fixtures", "kalman")
 SEED = 20260416
 STEPS = 200
-
-
-def in_venv():
-    return os.path.realpath(sys.prefix) == os.path.realpath(VENV)
-
-
-if not in_venv():
-    py = os.path.join(VENV, "bin", "python")
-    have = open(STAMP).read() if os.path.exists(STAMP) else None
-    if have != "\n".join(PINS):
-        if not os.path.exists(py):
-            subprocess.check_call([sys.executable, "-m", "venv", VENV])
-        subprocess.check_call([py, "-m", "pip", "install", "--quiet", "--upgrade", "pip"])
-        subprocess.check_call([py, "-m", "pip", "install", "--quiet"] + PINS)
-        with open(STAMP, "w") as f:
-            f.write("\n".join(PINS))
-    sys.exit(subprocess.call([py, os.path.abspath(__file__)] + sys.argv[1:]))
+peers_venv.enter(__file__)
 
 import filterpy  # noqa: E402
 import numpy as np  # noqa: E402

@@ -41,26 +41,11 @@ import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-VENV = os.path.join(ROOT, "target", "peers-venv")
-PINS = ["filterpy==2.0.0", "numpy==2.4.6", "scipy==1.17.1"]
-STAMP = os.path.join(VENV, "peers-pins.txt")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import peers_venv  # noqa: E402
 
-
-def in_venv():
-    return os.path.realpath(sys.prefix) == os.path.realpath(VENV)
-
-
-if not in_venv():
-    py = os.path.join(VENV, "bin", "python")
-    have = open(STAMP).read() if os.path.exists(STAMP) else None
-    if have != "\n".join(PINS):
-        if not os.path.exists(py):
-            subprocess.check_call([sys.executable, "-m", "venv", VENV])
-        subprocess.check_call([py, "-m", "pip", "install", "--quiet", "--upgrade", "pip"])
-        subprocess.check_call([py, "-m", "pip", "install", "--quiet"] + PINS)
-        with open(STAMP, "w") as f:
-            f.write("\n".join(PINS))
-    sys.exit(subprocess.call([py, os.path.abspath(__file__)] + sys.argv[1:]))
+VENV, PINS = peers_venv.VENV, peers_venv.PINS
+peers_venv.enter(__file__)
 
 import numpy as np  # noqa: E402
 import scipy  # noqa: E402

@@ -1,7 +1,7 @@
 //! `estimate::gauss_newton`: Morrison's ch. 11 range-only example (T11-1: the iterates of
 //! (11.2.27)/(VI), the covariance, the stationarity condition (11.4.26)), the polynomial model
 //! against the fixed-memory filter on even (T8-02: `W(0)`) and irregular times, epochs and time
-//! origins, missing components, the §8.9 / must-show observability cases, and the typed errors.
+//! origins, missing components, the §8.9 observability cases, and the typed errors.
 
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};

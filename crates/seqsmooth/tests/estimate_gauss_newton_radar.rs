@@ -1,4 +1,4 @@
-//! `estimate::gauss_newton` on simulated radar passes (Issue 11, must-show 4), by Monte Carlo.
+//! `estimate::gauss_newton` on simulated radar passes, by Monte Carlo.
 //!
 //! **What is simulated.** A radar at the origin measures range, azimuth and elevation (Morrison
 //! (8.5.3)) of a target in straight, level-ish flight (the 6-state constant-velocity model,
@@ -30,7 +30,7 @@
 //!
 //! **Tolerances, from the run count `R`.**
 //! - Every run converges with at most 10 iterations (`Correction::iterations.len()`, counting
-//!   the last, the one whose correction met the tolerance): the must-show's bound, no slack.
+//!   the last, the one whose correction met the tolerance): the bound asked, no slack.
 //! - NEES `ε = eᵀ S⁻¹ e`, `e = X* − X(t_c)`, is `χ²(6)` if the estimate is unbiased and `S` its
 //!   covariance; the mean over `R` independent runs is then `χ²(6R)/R`, and it must lie in that
 //!   distribution's two-sided 99% interval (from statrs' inverse cdf; for `R = 5000`,
@@ -44,7 +44,7 @@
 //!   freedom must lie in the two-sided 99% interval of `χ²(174 R)/(174 R)` (`1 ± 0.0039` at
 //!   `R = 5000`), a check that the residuals the correction leaves are the noise.
 //!
-//! Two scenarios of `R = 5000` runs each (the must-show asks for at least 1000; five times as
+//! Two scenarios of `R = 5000` runs each (at least 1000 are asked; five times as
 //! many cost under a second and narrow every interval by `sqrt 5`): the estimate at the
 //! window's end (`Epoch::End`, the leading edge, where a polynomial nominal extrapolates) and
 //! at its centre (`Epoch::Centre`). Measured (release, one thread): at the end at most 4

@@ -274,7 +274,7 @@ fn t12_6_precision() {
 /// of `σ_k σ_j`; degrees 0-4, observations of one or two components. The covariance form's
 /// rounding grows with the spread of `S`'s scales (at degree 4 over 20 time units the fourth
 /// derivative's variance is 1e-8 of the value's): measured 1.7e-9 and 7.6e-10 there, where
-/// the batch QR is the reference (the information form of issue 12 is the remedy, §12.4).
+/// the batch QR is the reference (the information form is the remedy, §12.4).
 #[test]
 fn sequential_equals_batch() {
     let mut rng = rand::rngs::StdRng::seed_from_u64(21);

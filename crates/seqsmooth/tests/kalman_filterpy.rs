@@ -1,5 +1,5 @@
-//! `kalman::filter` against filterpy 2.0.0's `filterpy.kalman.KalmanFilter` on stored fixtures
-//! (issue 12, must-show 4): the same linear problems on irregular steps with driving noise
+//! `kalman::filter` against filterpy 2.0.0's `filterpy.kalman.KalmanFilter` on stored fixtures:
+//! the same linear problems on irregular steps with driving noise
 //! (`Q ≠ 0`) and some measurements missing. The fixtures and the script that made them:
 //! tests/fixtures/kalman/ (`cv1.csv`, `ca2.csv`) and scripts/make_kalman_fixtures.py (filterpy,
 //! numpy versions and the seed in each file's first line).

@@ -1,5 +1,5 @@
 //! Consistency of the window, Kalman, fading and smoothed estimates on simulated radar passes
-//! with irregular steps and missing rows (Issue 12, must-show 6), by Monte Carlo: for each
+//! with irregular steps and missing rows, by Monte Carlo: for each
 //! method the mean NEES and mean NIS lie inside their 99% chi-squared intervals
 //! ([`ConsistencyTest`]) and the 3σ coverage of each state component is at least 97%.
 //!
@@ -62,7 +62,7 @@
 //! seeds are fixed, so the test is deterministic; with 14 interval tests at 99% a different
 //! seed would fail one by chance with probability ~13%.
 //!
-//! **Measured** (release, 3000 runs per method, one thread; the must-show asks for ≥ 1000):
+//! **Measured** (release, 3000 runs per method, one thread; at least 1000 are asked):
 //!
 //! | method | NEES (rows) | NIS | 3σ coverage | time |
 //! |---|---|---|---|---|
