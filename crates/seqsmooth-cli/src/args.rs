@@ -106,13 +106,20 @@ acceleration times its duration: 10 m^2/s^3 for an airliner's turns and descent.
 --method fading: the same start, then the fading-memory Kalman filter (Morrison 14.4) with \
 --beta B per unit of time or --theta T per update; s.. are the true 1-sigma errors. A shorter \
 memory follows manoeuvres: beta 0.7 per second for an airliner.
---method smooth: the Rauch-Tung-Striebel smoother over the kalman method's run (reads the whole \
-input first); nis is the forward filter's.
+--method smooth: the Rauch-Tung-Striebel smoother over the kalman method's run (holds every row \
+after the start, writes at the end); nis is the forward filter's. The other methods stream: \
+each row's output is written as it is read, in memory independent of the input's length.
 
 Angles in radians; --azimuth from-x (default): from +x towards +y; --azimuth bearing: \
 clockwise from north with x = east, y = north. Elevation from the x-y plane. An empty range, \
 azimuth or elevation cell is a missing component; a row with all three empty is a missing \
-measurement (the filters predict across it).
+measurement (the filters predict across it). Azimuths must lie within [-2pi, 2pi], elevations \
+within [-pi/2, pi/2], ranges above 0.
+
+Noise: --sigma-range and --sigma-angle give every row's sigma; --sigma-range-col NAME and \
+--sigma-angle-col NAME name columns of per-row sigmas (the angle column serves azimuth and \
+elevation), each cell a positive number. A row's empty sigma cell takes the flag; without the \
+flag it is refused where the row measures a component that sigma weighs.
 
 ",
     exit_status!("too few samples")
@@ -464,12 +471,20 @@ pub struct TrackArgs {
     #[arg(long, value_name = "X,Y,Z", default_value = "0,0,0", value_parser = parse_site,
           allow_hyphen_values = true)]
     pub site: [f64; 3],
-    /// The range's noise standard deviation (required)
+    /// The range's noise standard deviation (this or --sigma-range-col is required)
     #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
-    pub sigma_range: f64,
-    /// The azimuth's and elevation's noise standard deviation in radians (required)
+    pub sigma_range: Option<f64>,
+    /// The azimuth's and elevation's noise standard deviation in radians (this or
+    /// --sigma-angle-col is required)
     #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
-    pub sigma_angle: f64,
+    pub sigma_angle: Option<f64>,
+    /// Name of a column of per-row range sigmas; an empty cell takes --sigma-range
+    #[arg(long, value_name = "NAME")]
+    pub sigma_range_col: Option<String>,
+    /// Name of a column of per-row angle sigmas (azimuth and elevation, radians); an empty
+    /// cell takes --sigma-angle
+    #[arg(long, value_name = "NAME")]
+    pub sigma_angle_col: Option<String>,
     /// kalman, smooth: spectral density of the white-noise acceleration on each axis
     #[arg(long = "q", value_name = "ACCEL_PSD", value_parser = parse_psd, allow_hyphen_values = true)]
     pub q: Option<f64>,

@@ -2,30 +2,54 @@
 //! track, by the library's sliding Gauss–Newton fit (`estimate::sliding`), Kalman filter
 //! (`kalman::KalmanFilter`, with driving noise or fading memory) or Kalman smoother
 //! (`kalman::smooth`). The Kalman methods start from the first Gauss–Newton fit that
-//! determines the state. Rows are read as `fit` reads them (its column checks and messages).
+//! determines the state.
+//!
+//! Rows are read and checked one at a time ([`rows`]: line and column in every message; each
+//! component's noise σ from the row's σ column or the flag). The window, kalman and fading
+//! methods stream: each row is tracked and its output row written as it is read, in memory
+//! independent of the input's length. The rows before the first estimate are held, so that an
+//! input that never determines the state writes nothing; the output file is a temporary file
+//! renamed onto the named one only when every row is done ([`Output`]), so a failure leaves
+//! no output file. The smoother needs every row before its first output: it keeps the rows
+//! after the start and smooths them at the end.
+
+mod rows;
 
 use crate::args::{AzimuthConvention, FitModel, TrackArgs, TrackMethod};
 use crate::error::CliError;
-use crate::fit::{measured, window_error, Column};
-use crate::io::{check_distinct, find_column, open_input, parse_cell, shown, write_f64, CsvIn};
-use crate::io::{Need, Output};
-use nalgebra::DVector;
-use seqsmooth::estimate::batch::NoiseCovariance;
+use crate::fit::window_error;
+use crate::io::{check_distinct, open_input, write_f64, CsvIn, Need, Output};
+use nalgebra::{DMatrix, DVector};
+use rows::{Names, Rows, SigmaSource};
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, Start};
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::{smooth, Discount, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
-use seqsmooth::model::radar::{wrap, Radar};
+use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
 use std::collections::VecDeque;
-use std::f64::consts::FRAC_PI_2;
 
 /// The window of the Kalman methods' start (the first fit that determines the state).
 const START_WINDOW: usize = 60;
 
-/// One output row's numbers: the state and its σ, and the NIS; `None` for empty cells.
-type Cells = Option<([f64; 6], [f64; 6], Option<f64>)>;
+/// The output's header.
+const HEADER: &[u8] = b"t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,nis\n";
+
+/// Output bytes gathered before they are written.
+const WRITE_BYTES: usize = 1 << 16;
+
+/// One row's estimate: the state, its σ, and the NIS.
+type Estimate = ([f64; 6], [f64; 6], Option<f64>);
+
+/// One output row's numbers; `None` for empty cells.
+type Cells = Option<Estimate>;
+
+/// The filter of the Kalman methods.
+type Filter = KalmanFilter<PolynomialDynamics, Radar>;
+
+/// The sliding fit of the window method and of the Kalman methods' start.
+type Fit = SlidingFit<PolynomialDynamics, Radar>;
 
 /// Runs `seqsmooth track`.
 pub fn run(a: &TrackArgs) -> Result<(), CliError> {
@@ -46,94 +70,166 @@ pub fn run(a: &TrackArgs) -> Result<(), CliError> {
         }
         _ => {}
     }
+    if a.sigma_range.is_none() && a.sigma_range_col.is_none() {
+        return usage(
+            "track needs --sigma-range S (the range's noise sigma) or --sigma-range-col NAME \
+             (a column of per-row sigmas; with both, the flag serves the rows whose cell is empty)",
+        );
+    }
+    if a.sigma_angle.is_none() && a.sigma_angle_col.is_none() {
+        return usage(
+            "track needs --sigma-angle S (the azimuth's and elevation's noise sigma, in radians) \
+             or --sigma-angle-col NAME (a column of per-row sigmas; with both, the flag serves \
+             the rows whose cell is empty)",
+        );
+    }
     check_distinct(a.input.as_deref(), a.output.as_deref())?;
-    let mut csv = CsvIn::new(open_input(a.input.as_deref())?)?;
+    let csv = CsvIn::new(open_input(a.input.as_deref())?)?;
     let need = Need::rows(2, "a radar track");
     need.check_header(&csv.header)?;
-    let time = find_column(&csv.header, &a.time_col, "")?;
-    let column = |name: &str, what: &'static str| -> Result<Column, CliError> {
-        Ok(Column {
-            name: name.to_string(),
-            index: find_column(&csv.header, name, "")?,
-            what,
-        })
+    let names = Names {
+        time: &a.time_col,
+        range: &a.range_col,
+        azimuth: &a.azimuth_col,
+        elevation: &a.elevation_col,
     };
-    let columns = [
-        column(&a.range_col, "range")?,
-        column(&a.azimuth_col, "azimuth")?,
-        column(&a.elevation_col, "elevation")?,
+    let sigmas = [
+        SigmaSource {
+            flag: a.sigma_range,
+            column: a.sigma_range_col.clone(),
+            flag_name: "--sigma-range",
+        },
+        SigmaSource {
+            flag: a.sigma_angle,
+            column: a.sigma_angle_col.clone(),
+            flag_name: "--sigma-angle",
+        },
     ];
-    let noise = NoiseCovariance::Variances(vec![
-        a.sigma_range * a.sigma_range,
-        a.sigma_angle * a.sigma_angle,
-        a.sigma_angle * a.sigma_angle,
-    ]);
+    let bearing = a.azimuth == AzimuthConvention::Bearing;
+    let mut rows = Rows::new(csv, &names, sigmas, bearing)?;
     let radar = Radar::new(a.site, 6).map_err(|e| CliError::Usage(e.to_string()))?;
     let mut tracker = Tracker::new(a, radar)?;
-
-    // Read every row (checked as fit checks them), then track.
-    let (mut rows, mut lines, mut texts) = (Vec::new(), Vec::new(), Vec::new());
-    let mut previous: Option<(f64, u64, Vec<u8>)> = None;
-    while csv.next_record()? {
-        let line = csv.line;
-        let t_cell = csv.field(time).to_vec();
-        let t = parse_cell(&t_cell, line, &a.time_col, "time")?;
-        if let Some((prev, prev_line, prev_text)) = &previous {
-            if t <= *prev {
-                return Err(CliError::Data(format!(
-                    "line {line}: time {} is not after the previous time {} (line \
-                     {prev_line}): times must be strictly increasing",
-                    shown(&t_cell),
-                    shown(prev_text)
-                )));
+    let mut out = Writer::new(a.output.as_deref());
+    let track = || -> Result<(), CliError> {
+        while rows.next()? {
+            match tracker.push(&rows.measurement, rows.line, &rows.time_text)? {
+                Step::Row(cells) => out.row(&rows.time_text, &cells)?,
+                Step::Held => {}
             }
         }
-        let mut values = measured(&csv, line, &columns, FitModel::Radar)?;
-        if a.azimuth == AzimuthConvention::Bearing {
-            values[1] = values[1].map(|b| wrap(FRAC_PI_2 - b));
+        need.check(rows.count)?;
+        tracker.finish(&mut out)
+    };
+    match track() {
+        Ok(()) => out.finish(rows.count),
+        Err(e) => {
+            out.abandon();
+            Err(e)
         }
-        previous = Some((t, line, t_cell.clone()));
-        rows.push(Measurement {
-            time: t,
-            values,
-            noise: noise.clone(),
-        });
-        lines.push(line);
-        texts.push(t_cell);
     }
-    need.check(rows.len())?;
-    let cells = tracker.run(&rows, &lines)?;
-    if cells.iter().all(Option::is_none) {
-        return Err(CliError::Data(format!(
-            "the input's {} rows never determine the state: a radar track needs two rows with \
-             range, azimuth and elevation",
-            rows.len()
-        )));
+}
+
+/// The output: rows gathered in a buffer, written in blocks once the state is determined (the
+/// rows before are held, and never written if it never is).
+struct Writer<'a> {
+    path: Option<&'a std::path::Path>,
+    out: Option<Output>,
+    text: Vec<u8>,
+}
+
+impl<'a> Writer<'a> {
+    fn new(path: Option<&'a std::path::Path>) -> Self {
+        Self {
+            path,
+            out: None,
+            text: HEADER.to_vec(),
+        }
     }
-    let mut text = b"t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,nis\n".to_vec();
-    for (t_cell, c) in texts.iter().zip(&cells) {
-        text.extend_from_slice(t_cell);
-        match c {
+
+    /// Appends the row of time cell `t` and `cells`; creates the output at the first
+    /// determined row.
+    #[inline]
+    fn row(&mut self, t: &[u8], cells: &Cells) -> Result<(), CliError> {
+        let text = &mut self.text;
+        text.extend_from_slice(t);
+        match cells {
             Some((x, s, nis)) => {
                 for v in x.iter().chain(s) {
                     text.push(b',');
-                    write_f64(&mut text, *v);
+                    write_f64(text, *v);
                 }
                 text.push(b',');
                 if let Some(nis) = nis {
-                    write_f64(&mut text, *nis);
+                    write_f64(text, *nis);
                 }
             }
             None => text.extend_from_slice(&[b','; 13]),
         }
         text.push(b'\n');
+        if cells.is_some() && self.out.is_none() {
+            self.out = Some(Output::create(self.path)?);
+        }
+        if let Some(out) = &mut self.out {
+            if self.text.len() >= WRITE_BYTES {
+                out.write(&self.text)?;
+                self.text.clear();
+            }
+        }
+        Ok(())
     }
-    let mut out = Output::create(a.output.as_deref())?;
-    out.write(&text)?;
-    out.finish()
+
+    /// After an error: the rows gathered go to standard output (or a device), which shows
+    /// every row before the error; a file's temporary file is removed unrenamed.
+    fn abandon(mut self) {
+        if let Some(out) = &mut self.out {
+            // The error being reported matters more than one writing it.
+            let _ = out.write(&self.text);
+        }
+    }
+
+    /// Writes what is left and completes the output; refuses an input whose `rows` never
+    /// determined the state.
+    fn finish(self, rows: usize) -> Result<(), CliError> {
+        let Some(mut out) = self.out else {
+            return Err(CliError::Data(format!(
+                "the input's {rows} rows never determine the state: a radar track needs two \
+                 rows with range, azimuth and elevation"
+            )));
+        };
+        out.write(&self.text)?;
+        out.finish()
+    }
 }
 
-/// The chosen method's settings.
+/// What a row gives: its output row now, or later ([`Tracker::finish`], the smoother).
+enum Step {
+    Row(Cells),
+    Held,
+}
+
+/// What the method keeps between rows.
+enum Stage {
+    /// The Kalman methods before the state is determined: the start's fit over the rows so
+    /// far, and their lines.
+    Starting(Box<Fit>, VecDeque<u64>),
+    /// kalman and fading: the filter.
+    Filtering(Box<Filter>),
+    /// smooth: the filter at the start, and the rows after it.
+    Smoothing(Box<Filter>, Held),
+    /// window: the fit over the last rows, their lines, and the previous row's estimate.
+    Window(Box<Fit>, VecDeque<u64>, Option<Correction>),
+}
+
+/// The rows the smoother holds: their measurements, lines and time cells (one buffer).
+#[derive(Default)]
+struct Held {
+    measurements: Vec<Measurement>,
+    lines: Vec<u64>,
+    text: Vec<u8>,
+    ends: Vec<usize>,
+}
+
+/// The chosen method's settings and state.
 struct Tracker {
     method: TrackMethod,
     radar: Radar,
@@ -141,6 +237,7 @@ struct Tracker {
     window: usize,
     q: f64,
     discount: Option<Discount>,
+    stage: Stage,
 }
 
 impl Tracker {
@@ -150,67 +247,121 @@ impl Tracker {
             (_, Some(t)) => Some(Discount::PerUpdate(t)),
             _ => None,
         };
+        let dynamics = PolynomialDynamics::new(1, 3);
+        let stage = match a.method {
+            TrackMethod::Window => Stage::Window(
+                Box::new(sliding(dynamics, radar, a.window)?),
+                VecDeque::with_capacity(a.window.min(1 << 16)),
+                None,
+            ),
+            _ => Stage::Starting(
+                Box::new(sliding(dynamics, radar, START_WINDOW)?),
+                VecDeque::with_capacity(START_WINDOW),
+            ),
+        };
         Ok(Self {
             method: a.method,
             radar,
-            dynamics: PolynomialDynamics::new(1, 3),
+            dynamics,
             window: a.window,
             q: a.q.unwrap_or(0.0),
             discount,
+            stage,
         })
     }
 
-    fn sliding(&self, window: usize) -> Result<SlidingFit<PolynomialDynamics, Radar>, CliError> {
-        SlidingFit::new(
-            self.dynamics,
-            self.radar,
-            window,
-            Epoch::End,
-            Start::Radar {
-                radar: self.radar,
-                degree: 2,
-            },
-        )
-        .map_err(|e| CliError::Usage(e.to_string()))
-    }
-
-    /// The cells of every row.
-    fn run(&mut self, rows: &[Measurement], lines: &[u64]) -> Result<Vec<Cells>, CliError> {
-        match self.method {
-            TrackMethod::Window => self.window_method(rows, lines),
-            _ => self.kalman_methods(rows, lines),
-        }
-    }
-
-    fn window_method(&self, rows: &[Measurement], lines: &[u64]) -> Result<Vec<Cells>, CliError> {
-        let mut fit = self.sliding(self.window)?;
-        let mut window_lines = VecDeque::with_capacity(self.window);
-        let mut previous: Option<Correction> = None;
-        let mut out = Vec::with_capacity(rows.len());
-        for (m, &line) in rows.iter().zip(lines) {
-            if window_lines.len() == self.window {
-                window_lines.pop_front();
+    /// Tracks the row `m` of file line `line` and time cell `t`.
+    fn push(&mut self, m: &Measurement, line: u64, t: &[u8]) -> Result<Step, CliError> {
+        match &mut self.stage {
+            Stage::Filtering(filter) => {
+                let innovation = filter.update(m).map_err(|e| {
+                    CliError::Data(format!("line {line}: the filter's update failed: {e}"))
+                })?;
+                Ok(Step::Row(Some(cells(
+                    filter.state(),
+                    filter.covariance(),
+                    innovation.map(|i| i.nis),
+                ))))
             }
-            window_lines.push_back(line);
-            // The row's innovation against the previous window's estimate.
-            let nis = match &previous {
-                Some(p) => self.filter_from(p)?.update(m).ok().flatten().map(|i| i.nis),
-                None => None,
-            };
-            let c = fit
-                .push(m.clone())
-                .map_err(|e| window_error(e, &window_lines, self.window, FitModel::Radar))?;
-            out.push(c.as_ref().map(|c| cells(&c.state, &c.covariance, nis)));
-            previous = c;
+            Stage::Smoothing(_, held) => {
+                held.measurements.push(m.clone());
+                held.lines.push(line);
+                held.text.extend_from_slice(t);
+                held.ends.push(held.text.len());
+                Ok(Step::Held)
+            }
+            Stage::Starting(fit, lines) => {
+                if lines.len() == START_WINDOW {
+                    lines.pop_front();
+                }
+                lines.push_back(line);
+                let c = fit
+                    .push(m.clone())
+                    .map_err(|e| window_error(e, lines, START_WINDOW, FitModel::Radar))?;
+                let Some(c) = c else {
+                    return Ok(Step::Row(None));
+                };
+                let filter = Box::new(self.filter_from(&c)?);
+                self.stage = if self.method == TrackMethod::Smooth {
+                    Stage::Smoothing(filter, Held::default())
+                } else {
+                    Stage::Filtering(filter)
+                };
+                Ok(Step::Row(Some(cells(&c.state, &c.covariance, None))))
+            }
+            Stage::Window(..) => self.window_step(m, line),
         }
-        Ok(out)
+    }
+
+    /// The window method's row: the fit of the last rows, and the row's innovation against
+    /// the previous row's fit.
+    fn window_step(&mut self, m: &Measurement, line: u64) -> Result<Step, CliError> {
+        let nis = match &self.stage {
+            Stage::Window(_, _, Some(p)) => {
+                self.filter_from(p)?.update(m).ok().flatten().map(|i| i.nis)
+            }
+            _ => None,
+        };
+        let Stage::Window(fit, lines, previous) = &mut self.stage else {
+            return Ok(Step::Held);
+        };
+        if lines.len() == self.window {
+            lines.pop_front();
+        }
+        lines.push_back(line);
+        let c = fit
+            .push(m.clone())
+            .map_err(|e| window_error(e, lines, self.window, FitModel::Radar))?;
+        let row = c.as_ref().map(|c| cells(&c.state, &c.covariance, nis));
+        *previous = c;
+        Ok(Step::Row(row))
+    }
+
+    /// Writes the rows held to the end: the smoother's.
+    fn finish(self, out: &mut Writer) -> Result<(), CliError> {
+        let Stage::Smoothing(filter, held) = self.stage else {
+            return Ok(());
+        };
+        let at = |i: usize| held.lines[i];
+        let smoothed = smooth(*filter, &held.measurements).map_err(|e| match e {
+            Error::InBatch { index, source } => {
+                CliError::Data(format!("line {}: {source}", at(index)))
+            }
+            e => CliError::Data(format!("the smoother failed: {e}")),
+        })?;
+        let mut start = 0;
+        for (s, &end) in smoothed.iter().zip(&held.ends) {
+            out.row(
+                &held.text[start..end],
+                &Some(cells(&s.state, &s.covariance, s.nis)),
+            )?;
+            start = end;
+        }
+        Ok(())
     }
 
     /// A Kalman filter from a fit, with the method's driving noise or fading.
-    fn filter_from(
-        &self,
-        c: &Correction,
-    ) -> Result<KalmanFilter<PolynomialDynamics, Radar>, CliError> {
+    fn filter_from(&self, c: &Correction) -> Result<Filter, CliError> {
         let library = |e: Error| CliError::Data(format!("cannot start the filter: {e}"));
         let f = KalmanFilter::new(
             self.dynamics,
@@ -228,68 +379,22 @@ impl Tracker {
                 .map_err(library),
         }
     }
+}
 
-    fn kalman_methods(&self, rows: &[Measurement], lines: &[u64]) -> Result<Vec<Cells>, CliError> {
-        let mut out: Vec<Cells> = Vec::with_capacity(rows.len());
-        // The start: the first fit of the rows so far that determines the state.
-        let mut start = self.sliding(START_WINDOW)?;
-        let mut window_lines = VecDeque::new();
-        let mut begun = None;
-        for (k, (m, &line)) in rows.iter().zip(lines).enumerate() {
-            window_lines.push_back(line);
-            let c = start
-                .push(m.clone())
-                .map_err(|e| window_error(e, &window_lines, START_WINDOW, FitModel::Radar))?;
-            match c {
-                Some(c) => {
-                    out.push(Some(cells(&c.state, &c.covariance, None)));
-                    begun = Some((k, c));
-                    break;
-                }
-                None => out.push(None),
-            }
-        }
-        let Some((k0, c)) = begun else {
-            return Ok(out);
-        };
-        let filter = self.filter_from(&c)?;
-        let rest = &rows[k0 + 1..];
-        let at = |i: usize| lines[k0 + 1 + i];
-        if self.method == TrackMethod::Smooth {
-            let smoothed = smooth(filter, rest).map_err(|e| match e {
-                Error::InBatch { index, source } => {
-                    CliError::Data(format!("line {}: {source}", at(index)))
-                }
-                e => CliError::Data(format!("the smoother failed: {e}")),
-            })?;
-            out.extend(
-                smoothed
-                    .iter()
-                    .map(|s| Some(cells(&s.state, &s.covariance, s.nis))),
-            );
-            return Ok(out);
-        }
-        let mut filter = filter;
-        for (i, m) in rest.iter().enumerate() {
-            let innovation = filter.update(m).map_err(|e| {
-                CliError::Data(format!("line {}: the filter's update failed: {e}", at(i)))
-            })?;
-            out.push(Some(cells(
-                filter.state(),
-                filter.covariance(),
-                innovation.map(|i| i.nis),
-            )));
-        }
-        Ok(out)
-    }
+/// The sliding fit over `window` rows, started as the radar's nominal (§8.5).
+fn sliding(dynamics: PolynomialDynamics, radar: Radar, window: usize) -> Result<Fit, CliError> {
+    SlidingFit::new(
+        dynamics,
+        radar,
+        window,
+        Epoch::End,
+        Start::Radar { radar, degree: 2 },
+    )
+    .map_err(|e| CliError::Usage(e.to_string()))
 }
 
 /// A row's cells from a state and covariance.
-fn cells(
-    x: &DVector<f64>,
-    s: &nalgebra::DMatrix<f64>,
-    nis: Option<f64>,
-) -> ([f64; 6], [f64; 6], Option<f64>) {
+fn cells(x: &DVector<f64>, s: &DMatrix<f64>, nis: Option<f64>) -> Estimate {
     let mut state = [0.0; 6];
     let mut sigma = [0.0; 6];
     for k in 0..6 {

@@ -281,3 +281,457 @@ fn random_inputs_are_right_or_refused() {
     assert!(succeeded > 200, "{succeeded} successful runs");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The landing trajectory as [`landing`] builds it, with per-row noise: row `k` has range σ
+/// `sigmas(k).0` and angle σ `sigmas(k).1` (the noise drawn with them, seed fixed), written in
+/// the columns `sr` and `sa` after the measurements. Returns the CSV and the σ of each row.
+fn landing_with_sigmas(sigmas: impl Fn(usize) -> (f64, f64)) -> (String, Vec<(f64, f64)>) {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/landing.csv");
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(2027);
+    let unit = Normal::new(0.0, 1.0).unwrap();
+    let mut csv = String::from("t,range,azimuth,elevation,sr,sa\n");
+    let mut used = Vec::new();
+    for (k, line) in text.lines().skip(1).enumerate() {
+        let c: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+        let (sr, sa) = sigmas(k);
+        csv += &format!(
+            "{},{},{},{},{sr},{sa}\n",
+            c[0],
+            c[6] + sr * unit.sample(&mut rng),
+            c[4] + sa * unit.sample(&mut rng),
+            c[5] + sa * unit.sample(&mut rng)
+        );
+        used.push((sr, sa));
+    }
+    (csv, used)
+}
+
+/// `track` with `args` (no σ flags added) on `input`: the output text.
+fn track_text(input: &str, args: &[&str]) -> String {
+    let all: Vec<&str> = ["track", "--azimuth", "bearing"]
+        .iter()
+        .chain(args)
+        .copied()
+        .collect();
+    ok(&all, input)
+}
+
+/// The four methods with the settings the help recommends.
+const METHODS: [&[&str]; 4] = [
+    &["--method", "kalman", "--q", "10"],
+    &["--method", "smooth", "--q", "10"],
+    &["--method", "fading", "--beta", "0.7"],
+    &["--method", "window", "--window", "6"],
+];
+
+/// Per-row σ columns that hold the flags' values give the flags' output byte for byte, every
+/// method: columns alone, columns with flags of other values (a cell wins over the flag), and
+/// columns with empty cells where the flags fill in.
+#[test]
+fn per_row_sigmas_equal_to_the_flags_change_nothing() {
+    let (input, _) = landing_with_sigmas(|_| (10.0, 1e-3));
+    // Every third row's σ cells emptied: those rows take the flags.
+    let holes: String = input
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i > 0 && i % 3 == 0 {
+                let cells: Vec<&str> = l.split(',').collect();
+                format!("{},,\n", cells[..4].join(","))
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    let flags = ["--sigma-range", "10", "--sigma-angle", "1e-3"];
+    let columns = ["--sigma-range-col", "sr", "--sigma-angle-col", "sa"];
+    let other_flags = ["--sigma-range", "99", "--sigma-angle", "0.5"];
+    for method in METHODS {
+        let want = track_text(&input, &[method, &flags[..]].concat());
+        assert_eq!(want.lines().count(), input.lines().count(), "{method:?}");
+        for (what, text, args) in [
+            ("columns", &input, [method, &columns[..]].concat()),
+            (
+                "columns over other flags",
+                &input,
+                [method, &columns[..], &other_flags[..]].concat(),
+            ),
+            (
+                "columns with holes",
+                &holes,
+                [method, &columns[..], &flags[..]].concat(),
+            ),
+        ] {
+            assert!(track_text(text, &args) == want, "{method:?}: {what}");
+        }
+    }
+}
+
+/// One output row's numbers: the state, its σ and the NIS.
+type Row = ([f64; 6], [f64; 6], Option<f64>);
+
+/// The library's start and filter run directly on the rows with their own σ: the fit of the
+/// first rows that determines the state (window 60, the radar nominal of degree 2), then
+/// `KalmanFilter` with white-noise acceleration `q`: per row `None` before the start, then
+/// the state, its σ and the NIS.
+fn library_kalman(input: &str, q: f64) -> Vec<Option<Row>> {
+    use seqsmooth::estimate::batch::NoiseCovariance;
+    use seqsmooth::estimate::gauss_newton::{Epoch, Measurement};
+    use seqsmooth::estimate::sliding::{SlidingFit, Start};
+    use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+    use seqsmooth::kalman::KalmanFilter;
+    use seqsmooth::model::dynamics::PolynomialDynamics;
+    use seqsmooth::model::radar::{wrap, Radar};
+    let radar = Radar::new([0.0; 3], 6).unwrap();
+    let dynamics = PolynomialDynamics::new(1, 3);
+    let mut start = SlidingFit::new(
+        dynamics,
+        radar,
+        60,
+        Epoch::End,
+        Start::Radar { radar, degree: 2 },
+    )
+    .unwrap();
+    let mut filter = None;
+    let mut out = Vec::new();
+    let cells = |x: &nalgebra::DVector<f64>, s: &nalgebra::DMatrix<f64>, nis| {
+        let state: [f64; 6] = std::array::from_fn(|k| x[k]);
+        let sigma: [f64; 6] = std::array::from_fn(|k| s[(k, k)].sqrt());
+        Some((state, sigma, nis))
+    };
+    for line in input.lines().skip(1) {
+        let c: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+        let m = Measurement {
+            time: c[0],
+            values: vec![
+                Some(c[1]),
+                Some(wrap(std::f64::consts::FRAC_PI_2 - c[2])),
+                Some(c[3]),
+            ],
+            noise: NoiseCovariance::Variances(vec![c[4] * c[4], c[5] * c[5], c[5] * c[5]]),
+        };
+        match &mut filter {
+            None => match start.push(m).unwrap() {
+                Some(fit) => {
+                    out.push(cells(&fit.state, &fit.covariance, None));
+                    filter = Some(
+                        KalmanFilter::new(dynamics, radar, fit.state, fit.covariance, fit.epoch)
+                            .unwrap()
+                            .with_process_noise(WhiteNoiseDerivative::new(1, 3, q).unwrap())
+                            .unwrap(),
+                    );
+                }
+                None => out.push(None),
+            },
+            Some(f) => {
+                let nis = f.update(&m).unwrap().map(|i| i.nis);
+                out.push(cells(f.state(), f.covariance(), nis));
+            }
+        }
+    }
+    out
+}
+
+/// Each row's σ reaches the filter: with σ varying row to row (range 3-60 m, angles 0.3-6
+/// mrad, the noise drawn with them), every cell of `track --method kalman` is the library's
+/// own filter run directly on the rows with their σ (the same doubles: the output's digits
+/// round-trip), and not the run with the rows' mean σ.
+#[test]
+fn per_row_sigmas_reach_the_filter() {
+    let sigma = |k: usize| {
+        let f = [1.0, 0.3, 2.0, 6.0, 0.6][k % 5];
+        (10.0 * f, 1e-3 * f)
+    };
+    let (input, _) = landing_with_sigmas(sigma);
+    let text = track_text(
+        &input,
+        &[
+            "--method",
+            "kalman",
+            "--q",
+            "10",
+            "--sigma-range-col",
+            "sr",
+            "--sigma-angle-col",
+            "sa",
+        ],
+    );
+    let (_, rows) = table(&text);
+    let want = library_kalman(&input, 10.0);
+    assert_eq!(rows.len(), want.len());
+    for (k, (row, want)) in rows.iter().zip(&want).enumerate() {
+        match want {
+            None => assert!(row[1..].iter().all(String::is_empty), "row {k}: {row:?}"),
+            Some((x, s, nis)) => {
+                for i in 0..6 {
+                    assert_eq!(num(&row[1 + i]), x[i], "row {k} state {i}");
+                    assert_eq!(num(&row[7 + i]), s[i], "row {k} sigma {i}");
+                }
+                assert_eq!(row[13].parse::<f64>().ok(), *nis, "row {k} nis");
+            }
+        }
+    }
+    // The flags at the mean σ give another track.
+    let mean = track_text(
+        &input,
+        &[
+            "--method",
+            "kalman",
+            "--q",
+            "10",
+            "--sigma-range",
+            "19.8",
+            "--sigma-angle",
+            "1.98e-3",
+        ],
+    );
+    assert_ne!(mean, text);
+}
+
+/// A row with a larger σ weighs less. Row 200's range is given σ 10, 30, 100 and 1000 m in
+/// turn (every other row σ 10 m) and pushed 300 m off: the estimate's shift at that row from
+/// the same run without the 300 m falls as σ grows (the gain `S Mᵀ (M S Mᵀ + R)⁻¹` falls with
+/// `R`); and at σ 1e7 m the row's range carries no weight: the
+/// state equals the run where the row's range cell is empty (a missing component), within
+/// 1e-6 of its σ, at that row and every later one. The same for the angles (σ 1e3 rad against
+/// empty azimuth and elevation cells).
+#[test]
+fn a_row_with_a_larger_sigma_weighs_less() {
+    let (input, _) = landing_with_sigmas(|_| (10.0, 1e-3));
+    let lines: Vec<&str> = input.lines().collect();
+    let row = 200;
+    // The input with row `row`'s cells replaced by `f(cells)`.
+    let edit = |f: &dyn Fn(&mut Vec<String>)| -> String {
+        let mut out = String::new();
+        for (i, l) in lines.iter().enumerate() {
+            let mut cells: Vec<String> = l.split(',').map(String::from).collect();
+            if i == row + 1 {
+                f(&mut cells);
+            }
+            out += &cells.join(",");
+            out.push('\n');
+        }
+        out
+    };
+    let args = [
+        "--method",
+        "kalman",
+        "--q",
+        "10",
+        "--sigma-range-col",
+        "sr",
+        "--sigma-angle-col",
+        "sa",
+    ];
+    let rows = |input: &str| table(&track_text(input, &args)).1;
+    let shift = |a: &[String], b: &[String]| -> f64 {
+        (1..4)
+            .map(|i| (num(&a[i]) - num(&b[i])).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let mut previous = f64::INFINITY;
+    for sr in ["10", "30", "100", "1000"] {
+        let off = rows(&edit(&|c| {
+            c[1] = (num(&c[1]) + 300.0).to_string();
+            c[4] = sr.into();
+        }));
+        let clean = rows(&edit(&|c| c[4] = sr.into()));
+        let s = shift(&off[row], &clean[row]);
+        println!("range sigma {sr}: shift {s:.3} m");
+        assert!(s < previous, "sigma {sr}: shift {s} not below {previous}");
+        previous = s;
+    }
+    assert!(previous < 1.0, "{previous}");
+    // No weight: a huge σ is an empty cell.
+    let same = |a: &[Vec<String>], b: &[Vec<String>], what: &str| {
+        for k in row..a.len() {
+            for i in 0..6 {
+                let (x, y, s) = (num(&a[k][1 + i]), num(&b[k][1 + i]), num(&b[k][7 + i]));
+                assert!(
+                    (x - y).abs() <= 1e-6 * s,
+                    "{what}: row {k}, state {i}: {x} against {y}"
+                );
+            }
+        }
+    };
+    let huge = rows(&edit(&|c| {
+        c[1] = (num(&c[1]) + 300.0).to_string();
+        c[4] = "1e7".into();
+    }));
+    let missing = rows(&edit(&|c| c[1].clear()));
+    same(&huge, &missing, "range");
+    let huge = rows(&edit(&|c| c[5] = "1e3".into()));
+    let missing = rows(&edit(&|c| {
+        c[2].clear();
+        c[3].clear();
+    }));
+    same(&huge, &missing, "angles");
+}
+
+/// Issue 12 must-show 8: bad input stops with the usual typed message (exit 1, `error: `)
+/// naming the line and the column: NaN and non-numbers in every column, times that repeat or
+/// go back, missing columns (the header's line), angles out of range, ranges not positive,
+/// σ cells not positive, not finite, not numbers or out of range, and an empty σ cell where
+/// no flag fills in. Flags that are out of range are command-line errors (exit 2).
+#[test]
+fn bad_input_names_line_and_column() {
+    let flags = ["track", "--sigma-range", "10", "--sigma-angle", "1e-3"];
+    let head = "t,range,azimuth,elevation\n0,10000,0.1,0.2\n1,10010,0.11,0.2\n";
+    let bad = |row: &str, parts: &[&str]| {
+        fails(&flags, &format!("{head}{row}\n"), 1, parts);
+    };
+    for (row, column, why) in [
+        ("NaN,10020,0.12,0.2", "t", "not finite"),
+        ("2,NaN,0.12,0.2", "range", "not finite"),
+        ("2,10020,nan,0.2", "azimuth", "not finite"),
+        ("2,10020,0.12,inf", "elevation", "not finite"),
+        ("2,ten,0.12,0.2", "range", "not a number"),
+        ("2,10020,0.12,0.2x", "elevation", "not a number"),
+        ("1,10020,0.12,0.2", "t", "duplicate time"),
+        (
+            "0.5,10020,0.12,0.2",
+            "t",
+            "not after the previous time 1 (line 3)",
+        ),
+        ("2,10020,0.12,1.6", "elevation", "outside [-pi/2, pi/2]"),
+        ("2,10020,0.12,-1.6", "elevation", "outside [-pi/2, pi/2]"),
+        ("2,10020,45,0.2", "azimuth", "outside [-2pi, 2pi]"),
+        ("2,10020,-7,0.2", "azimuth", "outside [-2pi, 2pi]"),
+        ("2,0,0.12,0.2", "range", "not positive"),
+        ("2,-5,0.12,0.2", "range", "not positive"),
+    ] {
+        bad(row, &["line 4", &format!("column '{column}'"), why]);
+    }
+    // Missing columns: the header's line.
+    for (header, column) in [
+        ("time,range,azimuth,elevation", "t"),
+        ("t,rng,azimuth,elevation", "range"),
+        ("t,range,elevation", "azimuth"),
+        ("t,range,azimuth", "elevation"),
+    ] {
+        let cells = header.split(',').count();
+        let row = ["0", "10000", "0.1", "0.2"][..cells].join(",");
+        fails(
+            &flags,
+            &format!("{header}\n{row}\n"),
+            1,
+            &["line 1", &format!("column '{column}' not found")],
+        );
+    }
+    // σ columns.
+    let sigma_head = "t,range,azimuth,elevation,sr,sa\n0,10000,0.1,0.2,10,1e-3\n\
+                      1,10010,0.11,0.2,10,1e-3\n";
+    let columns = [
+        "track",
+        "--sigma-range-col",
+        "sr",
+        "--sigma-angle-col",
+        "sa",
+    ];
+    for (row, column, why) in [
+        ("2,10020,0.12,0.2,0,1e-3", "sr", "sigma 0 is not positive"),
+        ("2,10020,0.12,0.2,-3,1e-3", "sr", "sigma -3 is not positive"),
+        (
+            "2,10020,0.12,0.2,10,-1e-3",
+            "sa",
+            "sigma -1e-3 is not positive",
+        ),
+        ("2,10020,0.12,0.2,NaN,1e-3", "sr", "not finite"),
+        ("2,10020,0.12,0.2,10,inf", "sa", "not finite"),
+        ("2,10020,0.12,0.2,ten,1e-3", "sr", "not a number"),
+        ("2,10020,0.12,0.2,1e200,1e-3", "sr", "out of range"),
+        ("2,10020,0.12,0.2,10,1e-160", "sa", "out of range"),
+        ("2,10020,0.12,0.2,,1e-3", "sr", "no --sigma-range is given"),
+        ("2,10020,0.12,,10,", "sa", "no --sigma-angle is given"),
+    ] {
+        fails(
+            &columns,
+            &format!("{sigma_head}{row}\n"),
+            1,
+            &["line 4", &format!("column '{column}'"), why],
+        );
+    }
+    fails(
+        &["track", "--sigma-range-col", "s_r", "--sigma-angle", "1e-3"],
+        sigma_head,
+        1,
+        &["line 1", "column 's_r' not found"],
+    );
+    // An empty σ cell is fine where the components it weighs are missing.
+    let out = ok(
+        &columns,
+        &format!("{sigma_head}2,,0.12,0.2,,1e-3\n3,10030,,,10,\n"),
+    );
+    assert_eq!(out.lines().count(), 5);
+    // Flags: command-line errors.
+    for (args, part) in [
+        (&["track", "--sigma-angle", "1e-3"][..], "--sigma-range"),
+        (&["track", "--sigma-range", "10"], "--sigma-angle"),
+        (
+            &["track", "--sigma-range", "0", "--sigma-angle", "1e-3"],
+            "sigma",
+        ),
+        (
+            &["track", "--sigma-range", "10", "--sigma-angle", "-1"],
+            "sigma",
+        ),
+        (
+            &["track", "--sigma-range", "nan", "--sigma-angle", "1e-3"],
+            "sigma",
+        ),
+    ] {
+        fails(args, head, 2, &[part]);
+    }
+}
+
+/// A failure after many rows have been written leaves no output file, and an existing one as
+/// it was (kalman, fading and window stream their rows into a temporary file renamed only at
+/// the end); on standard output the rows before the error are written.
+#[test]
+fn a_late_error_leaves_no_output() {
+    let (input, _) = landing();
+    let bad = format!("{input}1e9,NaN,0.1,0.2\n");
+    let dir = tmp("track-late-error");
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("out.csv");
+    for method in METHODS {
+        let _ = std::fs::remove_file(&out);
+        let o = format!("--output={}", out.display());
+        let args: Vec<&str> = [
+            &["track", "--azimuth", "bearing", "--sigma-range", "10"][..],
+            &["--sigma-angle", "1e-3", &o],
+            method,
+        ]
+        .concat();
+        fails(&args, &bad, 1, &["line 476", "column 'range'"]);
+        assert!(!out.exists(), "{method:?}");
+        std::fs::write(&out, "before\n").unwrap();
+        fails(&args, &bad, 1, &["line 476"]);
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "before\n");
+        let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+        assert_eq!(left.len(), 1, "{method:?}: temporary files left: {left:?}");
+    }
+    let o = run(
+        &[
+            "track",
+            "--azimuth",
+            "bearing",
+            "--sigma-range",
+            "10",
+            "--sigma-angle",
+            "1e-3",
+            "--q",
+            "10",
+        ],
+        &bad,
+    );
+    assert_eq!(o.code, 1);
+    assert_eq!(
+        o.stdout.lines().count(),
+        475,
+        "the header and the 474 good rows"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

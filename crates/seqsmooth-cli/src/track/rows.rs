@@ -1,0 +1,253 @@
+//! The rows of `seqsmooth track`'s input, read and checked one at a time.
+//!
+//! Each row's time must be a finite number after the previous row's; its range, azimuth and
+//! elevation cells are numbers in range or empty (a missing component): the range positive,
+//! the azimuth within `[−2π, 2π]` and the elevation within `[−π/2, π/2]` (radians; a bearing
+//! is turned into the angle from +x). Each present component's noise σ comes from the row's
+//! σ column when the command names one and the cell is not empty, else from the flag; a σ
+//! cell must hold a positive number whose square (the variance) is a normal double. Every
+//! refusal names the file line and the column.
+//!
+//! One [`Measurement`] is kept and overwritten row after row: reading allocates nothing per
+//! row once the time cell's buffer has grown.
+
+use crate::error::CliError;
+use crate::io::{find_column, parse_cell, shown, CsvIn};
+use seqsmooth::estimate::batch::NoiseCovariance;
+use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::model::radar::wrap;
+use std::f64::consts::{FRAC_PI_2, TAU};
+use std::io::Read;
+
+/// A measured column: its name (for messages), index and what it holds.
+struct Cell {
+    name: String,
+    index: usize,
+    what: &'static str,
+}
+
+/// Where one σ comes from: a column of the input, the flag, or both (the column first).
+pub(crate) struct SigmaSource {
+    /// The flag's value (`--sigma-range`, `--sigma-angle`).
+    pub(crate) flag: Option<f64>,
+    /// The column's name, if the command names one (`--sigma-range-col`, `--sigma-angle-col`).
+    pub(crate) column: Option<String>,
+    /// The flag, for messages: `--sigma-range`.
+    pub(crate) flag_name: &'static str,
+}
+
+/// A [`SigmaSource`] with its column found in the header.
+struct Sigma {
+    flag: Option<f64>,
+    column: Option<(String, usize)>,
+    flag_name: &'static str,
+}
+
+/// The input, read row by row: [`Rows::next`] checks the next row and sets [`Rows::line`],
+/// [`Rows::time_text`] and [`Rows::measurement`].
+pub(crate) struct Rows<R: Read> {
+    csv: CsvIn<R>,
+    time: Cell,
+    /// Range, azimuth, elevation: the observation's component order.
+    cells: [Cell; 3],
+    /// The range's σ and the angles' σ.
+    sigmas: [Sigma; 2],
+    bearing: bool,
+    /// The previous row's time and line.
+    previous: Option<(f64, u64)>,
+    /// The current row's 1-based file line (the header's before the first row).
+    pub(crate) line: u64,
+    /// The current row's time cell, as written (trimmed); the previous row's while a row is
+    /// being checked.
+    pub(crate) time_text: Vec<u8>,
+    /// The current row's measurement: time, components (`None` for an empty cell, azimuths
+    /// from +x) and their variances (1 where a component is missing: unused).
+    pub(crate) measurement: Measurement,
+    /// Data rows read so far.
+    pub(crate) count: usize,
+}
+
+/// The names of the columns `track` reads.
+pub(crate) struct Names<'a> {
+    pub(crate) time: &'a str,
+    pub(crate) range: &'a str,
+    pub(crate) azimuth: &'a str,
+    pub(crate) elevation: &'a str,
+}
+
+impl<R: Read> Rows<R> {
+    /// The reader of `csv`'s rows: finds the columns (a missing or ambiguous one is refused
+    /// with the header's line).
+    pub(crate) fn new(
+        csv: CsvIn<R>,
+        names: &Names,
+        sigmas: [SigmaSource; 2],
+        bearing: bool,
+    ) -> Result<Self, CliError> {
+        let line = csv.line;
+        let at_header = |e: CliError| match e {
+            CliError::Data(m) => CliError::Data(format!("line {line} (the header): {m}")),
+            e => e,
+        };
+        let find = |name: &str| find_column(&csv.header, name, "").map_err(at_header);
+        let cell = |name: &str, what: &'static str| -> Result<Cell, CliError> {
+            Ok(Cell {
+                name: name.to_string(),
+                index: find(name)?,
+                what,
+            })
+        };
+        let [range_sigma, angle_sigma] = sigmas;
+        let sigma = |s: SigmaSource| -> Result<Sigma, CliError> {
+            let column = match s.column {
+                Some(name) => Some((name.clone(), find(&name)?)),
+                None => None,
+            };
+            Ok(Sigma {
+                flag: s.flag,
+                column,
+                flag_name: s.flag_name,
+            })
+        };
+        Ok(Self {
+            time: cell(names.time, "time")?,
+            cells: [
+                cell(names.range, "range")?,
+                cell(names.azimuth, "azimuth")?,
+                cell(names.elevation, "elevation")?,
+            ],
+            sigmas: [sigma(range_sigma)?, sigma(angle_sigma)?],
+            bearing,
+            previous: None,
+            line,
+            time_text: Vec::new(),
+            measurement: Measurement {
+                time: 0.0,
+                values: vec![None; 3],
+                noise: NoiseCovariance::Variances(vec![1.0; 3]),
+            },
+            count: 0,
+            csv,
+        })
+    }
+
+    /// Reads and checks the next row; `false` at the end of the input.
+    pub(crate) fn next(&mut self) -> Result<bool, CliError> {
+        if !self.csv.next_record()? {
+            return Ok(false);
+        }
+        let line = self.csv.line;
+        self.line = line;
+        let t_cell = self.csv.field(self.time.index);
+        let t = parse_cell(t_cell, line, &self.time.name, "time")?;
+        if let Some((previous, previous_line)) = self.previous {
+            if t <= previous {
+                let why = if t == previous {
+                    "duplicate time; times must be strictly increasing"
+                } else {
+                    "times must be strictly increasing"
+                };
+                return Err(CliError::Data(format!(
+                    "line {line}, column '{}': time {} is not after the previous time {} (line \
+                     {previous_line}): {why}",
+                    self.time.name,
+                    shown(t_cell),
+                    shown(&self.time_text)
+                )));
+            }
+        }
+        let mut values = [None; 3];
+        for (value, c) in values.iter_mut().zip(&self.cells) {
+            *value = component(self.csv.field(c.index), line, c)?;
+        }
+        let mut variances = [1.0; 3];
+        let needed = [
+            values[0].is_some(),
+            values[1].is_some() || values[2].is_some(),
+        ];
+        for (k, s) in self.sigmas.iter().enumerate() {
+            if let Some(sigma) = self.sigma(s, needed[k], line)? {
+                let v = sigma * sigma;
+                if k == 0 {
+                    variances[0] = v;
+                } else {
+                    variances[1] = v;
+                    variances[2] = v;
+                }
+            }
+        }
+        if self.bearing {
+            values[1] = values[1].map(|b| wrap(FRAC_PI_2 - b));
+        }
+        let t_cell = self.csv.field(self.time.index);
+        self.time_text.clear();
+        self.time_text.extend_from_slice(t_cell);
+        self.previous = Some((t, line));
+        self.count += 1;
+        let m = &mut self.measurement;
+        m.time = t;
+        m.values.copy_from_slice(&values);
+        if let NoiseCovariance::Variances(v) = &mut m.noise {
+            v.copy_from_slice(&variances);
+        }
+        Ok(true)
+    }
+
+    /// The row's σ from `s`: its cell, else the flag; `None` when neither gives one and none
+    /// is `needed` (the components it weighs are missing), an error when one is.
+    fn sigma(&self, s: &Sigma, needed: bool, line: u64) -> Result<Option<f64>, CliError> {
+        if let Some((name, index)) = &s.column {
+            let cell = self.csv.field(*index);
+            if !cell.is_empty() {
+                let v = parse_cell(cell, line, name, "sigma")?;
+                let usable = v > 0.0 && v * v >= f64::MIN_POSITIVE && (v * v).is_finite();
+                if !usable {
+                    return Err(CliError::Data(format!(
+                        "line {line}, column '{name}': sigma {} is {}",
+                        shown(cell),
+                        if v <= 0.0 {
+                            "not positive: a noise standard deviation must be above 0"
+                        } else {
+                            "out of range: its square, the noise variance, must be a normal \
+                             double (sigma from about 1.5e-154 to 1.3e154; rescale the values)"
+                        }
+                    )));
+                }
+                return Ok(Some(v));
+            }
+            if s.flag.is_none() && needed {
+                return Err(CliError::Data(format!(
+                    "line {line}, column '{name}': the cell is empty and no {} is given: the \
+                     row's measurement needs its noise sigma (give the cell, or {} S for the \
+                     rows without one)",
+                    s.flag_name, s.flag_name
+                )));
+            }
+        }
+        Ok(s.flag)
+    }
+}
+
+/// A component's cell: `None` when empty, else a finite number in range.
+fn component(cell: &[u8], line: u64, c: &Cell) -> Result<Option<f64>, CliError> {
+    if cell.is_empty() {
+        return Ok(None);
+    }
+    let v = parse_cell(cell, line, &c.name, c.what)?;
+    let bad = |why: &str| {
+        Err(CliError::Data(format!(
+            "line {line}, column '{}': {} {} {why}",
+            c.name,
+            c.what,
+            shown(cell)
+        )))
+    };
+    match c.what {
+        "range" if v <= 0.0 => bad("is not positive"),
+        "azimuth" if v.abs() > TAU => bad("is outside [-2pi, 2pi]: azimuths are in radians"),
+        "elevation" if v.abs() > FRAC_PI_2 => {
+            bad("is outside [-pi/2, pi/2]: elevations are in radians from the x-y plane")
+        }
+        _ => Ok(Some(v)),
+    }
+}
