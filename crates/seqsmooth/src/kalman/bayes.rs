@@ -10,11 +10,18 @@
 //! | estimate, covariance | `X = R⁻¹ d`, `S = R⁻¹ R⁻ᵀ` | (10.2.33)-(10.2.34) |
 //!
 //! Unlike the Kalman filter it can start from zero information (`(S_{1,0})⁻¹ = 0`, (10.3.1)-
-//! (10.3.5)); the estimate exists once the observations determine it. A nonlinear
+//! (10.3.5)); the estimate exists once the observations determine it.
+//!
+//! With fading memory ([`BayesFilter::with_fading`], the fading-memory Bayes filter of
+//! (14.4.26)-(14.4.32)) the information so far is multiplied by `β^(t_n − t_(n−1))` or `θ`
+//! before each update, so the estimate minimises the discounted criterion (14.2.10) or
+//! (14.2.12); [`BayesFilter::covariance`] is then the estimate's true covariance `S*`
+//! (14.3.11)-(14.3.13), and [`BayesFilter::information_covariance`] the recursion's own `P`. A nonlinear
 //! observation is linearised about the current estimate (it must exist). A perfect observation
 //! (zero variance) cannot be weighed in this form and is refused (§12.4 item 4: the Bayes
 //! filter fails visibly).
 
+use super::filter::Discount;
 use crate::error::Error;
 use crate::estimate::batch::NoiseCovariance;
 use crate::estimate::gauss_newton::Measurement;
@@ -46,6 +53,8 @@ pub struct BayesFilter<D: Dynamics, O: Observation> {
     observation: O,
     info: InformationFilter,
     time: f64,
+    /// The discount and the time of the last update (from which `β` counts).
+    fading: Option<(Discount, f64)>,
 }
 
 impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
@@ -88,6 +97,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
             observation,
             info: InformationFilter::new(n),
             time,
+            fading: None,
         })
     }
 
@@ -150,6 +160,38 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
             .l()
             .transpose();
         self.info = InformationFilter::with_prior(state, &r);
+        if self.fading.is_some() {
+            self.info = self.info.with_true_covariance();
+        }
+        Ok(self)
+    }
+
+    /// The fading-memory Bayes filter (14.4.26)-(14.4.32): before each update the information
+    /// so far is multiplied by the discount over the step ([`Discount`]: `β` per unit of time
+    /// since the last update, or `θ` per update); [`Self::covariance`] becomes the true
+    /// covariance. `β = 1` or `θ = 1` is the plain filter.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::{BayesFilter, Discount};
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// // A constant with θ = 1/2: the fading-memory polynomial filter of degree 0, whose
+    /// // variance tends to (1 − θ)/(1 + θ) = 1/3 (Table 13.2).
+    /// let mut f = BayesFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 0.0)
+    ///     .unwrap()
+    ///     .with_fading(Discount::PerUpdate(0.5))
+    ///     .unwrap();
+    /// for k in 0..60 {
+    ///     f.update(&Measurement { time: k as f64, values: vec![Some(1.0)], noise: NoiseCovariance::Identity }).unwrap();
+    /// }
+    /// assert!((f.covariance().unwrap()[(0, 0)] - 1.0 / 3.0).abs() < 1e-12);
+    /// assert!((f.information_covariance().unwrap()[(0, 0)] - 0.5).abs() < 1e-12); // 1 − θ
+    /// ```
+    pub fn with_fading(mut self, discount: Discount) -> Result<Self, Error> {
+        self.fading = Some((discount.checked()?, self.time));
+        self.info = self.info.with_true_covariance();
         Ok(self)
     }
 
@@ -170,7 +212,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
         self.info.solve()
     }
 
-    /// Its covariance `(RᵀR)⁻¹`, once determined.
+    /// Its covariance, once determined: `(RᵀR)⁻¹`, or with fading memory the true covariance
+    /// `S* = P (Σ w_k² M_kᵀ R_k⁻¹ M_k) P` (14.3.11)-(14.3.13).
     ///
     /// ```
     /// use nalgebra::DVector;
@@ -185,6 +228,30 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     /// ```
     pub fn covariance(&self) -> Option<DMatrix<f64>> {
         self.info.covariance()
+    }
+
+    /// The recursion's own matrix `P = (RᵀR)⁻¹` (14.3.13), the inverse of the discounted
+    /// information: the covariance itself without fading memory.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::{BayesFilter, Discount};
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = BayesFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 0.0)
+    ///     .unwrap()
+    ///     .with_fading(Discount::PerTime(0.25))
+    ///     .unwrap();
+    /// for t in [0.0, 1.0] {
+    ///     f.update(&Measurement { time: t, values: vec![Some(t)], noise: NoiseCovariance::Identity }).unwrap();
+    /// }
+    /// // information 1/4 + 1: P = 4/5; S* = (1/16 + 1)·P² = 17/25.
+    /// assert!((f.information_covariance().unwrap()[(0, 0)] - 0.8).abs() < 1e-15);
+    /// assert!((f.covariance().unwrap()[(0, 0)] - 0.68).abs() < 1e-15);
+    /// ```
+    pub fn information_covariance(&self) -> Option<DMatrix<f64>> {
+        self.info.information_covariance()
     }
 
     /// The time the information refers to.
@@ -258,16 +325,29 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
         let p = self.observation.components();
         let (present, values) = measurement.present(p)?;
         let whitener = whitener(p, &measurement.noise, &present)?;
-        let saved = (self.info.clone(), self.time);
+        let saved = (self.info.clone(), self.time, self.fading);
         self.predict(measurement.time)?;
         if present.is_empty() {
             return Ok(());
         }
-        let result = self.fold(&present, &values, &whitener);
+        let result = self
+            .fade()
+            .and_then(|()| self.fold(&present, &values, &whitener));
         if result.is_err() {
-            (self.info, self.time) = saved;
+            (self.info, self.time, self.fading) = saved;
         }
         result
+    }
+
+    /// Multiplies the information so far by the discount over the step since the last update
+    /// ((14.4.26)-(14.4.27)).
+    fn fade(&mut self) -> Result<(), Error> {
+        if let Some((discount, last)) = &mut self.fading {
+            let f = discount.factor_over(self.time - *last)?;
+            self.info.fade(1.0 / f.sqrt());
+            *last = self.time;
+        }
+        Ok(())
     }
 
     /// Folds the present components' whitened rows into the information.

@@ -3,7 +3,8 @@
 //! nonlinear models, with driving noise or fading memory, and its smoother.
 //!
 //! - [`bayes`]: [`BayesFilter`], the Bayes filter (ch. 10) in square-root information form, the
-//!   recursion of the exact polynomial engine over any linear model; it starts from nothing.
+//!   recursion of the exact polynomial engine over any linear model; it starts from nothing;
+//!   with fading memory (ch. 14, [`Discount`]) it reports its true covariance.
 //! - [`filter`]: [`KalmanFilter`], prediction, Joseph-form update, the iterated update, the
 //!   generalized fading memory of ch. 14 ([`Discount`]), innovation statistics.
 //! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run.
@@ -12,6 +13,7 @@
 //!   polynomial model ([`noise::WhiteNoiseDerivative`]).
 
 pub mod bayes;
+mod discount;
 pub mod filter;
 pub mod noise;
 pub mod smoother;

@@ -13,24 +13,22 @@
 //! the old one times a power of two and the centre moves by a multiple of unit/8, so `α`, `β`
 //! and the powers of `α` are exact, and `(t - c)/s` is a multiplication by the exact `1/s`.
 //!
-//! The fading-memory discount is applied lazily: instead of multiplying `[R | d]` by `√θ^ζ` at
-//! every sample, new rows get the weight `1/Π θ^ζ`, folded back into the factor when its square
-//! root passes 1e30. The estimate `R⁻¹d` and the sandwich covariance do not depend on that
-//! common scale. The factor itself is kept in Gentleman's square-root-free form
-//! ([`TriangularFactor`]): no square roots per sample, and once every pivot is positive none
-//! of its `2m+3` divisions per sample waits for another.
+//! The fading-memory discount `θ^ζ` per sample is [`InformationFilter::fade`] (applied
+//! lazily), and the covariance with fading memory is the filter's true (sandwich) covariance,
+//! [`InformationFilter::with_true_covariance`]: this engine is the Bayes filter
+//! ([`crate::kalman::BayesFilter`]'s recursion) with the polynomial model, its state kept at a
+//! centre that moves only now and then instead of at every sample. The factor itself is kept
+//! in Gentleman's square-root-free form ([`TriangularFactor`]): no square roots per sample,
+//! and once every pivot is positive none of its `2m+3` divisions per sample waits for another.
 
 use crate::model::taylor::{unscale_in_range, unscale_stepwise};
 use crate::model::{derivative_scale, shift_scaled, shift_scaled_array};
 use crate::numeric::unrolled::unrolled_sizes;
 use crate::polynomial::options::{DiscountMode, MAX_DEGREE};
-use crate::recursive::{InformationFilter, TriangularFactor};
+use crate::recursive::InformationFilter;
+#[cfg(doc)]
+use crate::recursive::TriangularFactor;
 use nalgebra::DMatrix;
-
-/// When the lazy discount's row scale `1/√(Π θ^ζ)` exceeds this, it is folded into the factors
-/// (the rows' weights are its square, the noise factor's its fourth power: ≤ 1e120, far from
-/// overflow in the squares the square-root-free rotations form).
-const RENORMALISE: f64 = 1e30;
 
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Discount {
@@ -44,9 +42,6 @@ pub(crate) struct ExactEngine {
     m: usize,
     discount: Option<Discount>,
     info: InformationFilter,
-    /// Square root of `Σ w_k² h_k h_kᵀ`: the fading-memory estimate's covariance is the sandwich
-    /// `(RᵀR)⁻¹ (QᵀQ) (RᵀR)⁻¹ σ²` (weights are discounts, not inverse variances).
-    noise: Option<TriangularFactor>,
     centre: f64,
     unit: f64,
     /// `1/unit`, exact (the unit is a power of two).
@@ -55,8 +50,8 @@ pub(crate) struct ExactEngine {
     t_last: f64,
     n: u64,
     sigma: Option<f64>,
-    /// The last step `Δt` (per time) and the growth `1/√(θ^ζ)` of the lazy row scale per
-    /// sample: constant per update, per time evaluated only when the step changes.
+    /// The last step `Δt` (per time) and `1/√(θ^ζ)`, the fade per sample: constant per
+    /// update, per time evaluated only when the step changes.
     step_cached: f64,
     inv_root: f64,
     /// `-ln θ / (2τ)`: `1/√(θ^(Δt/τ)) = exp(Δt · that)` (per time).
@@ -64,11 +59,6 @@ pub(crate) struct ExactEngine {
     /// The effective memory span `3/(-ln θ)`, in updates (per update) or times `τ` (per time).
     span_updates: f64,
     span_per_time: f64,
-    /// The discount applied lazily: the true factors are the stored ones divided by
-    /// `inv_scale` (the noise factor by `inv_scale²`), and each new row gets the weight
-    /// `inv_scale²` (`inv_scale⁴`). Solutions and the sandwich covariance do not depend on the
-    /// common scale.
-    inv_scale: f64,
     /// `k!/s^k` for the unit `s` (unscaled derivatives from the coefficients).
     unscale: Vec<f64>,
     /// Whether every `unscale` entry is a normal double; else the derivatives are unscaled one
@@ -82,7 +72,6 @@ impl ExactEngine {
             m,
             discount,
             info: InformationFilter::new(m + 1),
-            noise: None,
             centre: 0.0,
             unit: 1.0,
             inv_unit: 1.0,
@@ -97,14 +86,14 @@ impl ExactEngine {
             span_per_time: discount.map_or(0.0, |d| 3.0 * d.tau / -d.theta.ln()),
             unscale: vec![0.0; m + 1],
             unscale_in_range: true,
-            inv_scale: 1.0,
         }
     }
 
     pub fn track_covariance(&mut self, sigma: f64) {
         self.sigma = Some(sigma);
         if self.discount.is_some() {
-            self.noise = Some(TriangularFactor::new(self.m + 1));
+            self.info =
+                std::mem::replace(&mut self.info, InformationFilter::new(0)).with_true_covariance();
         }
     }
 
@@ -132,17 +121,7 @@ impl ExactEngine {
                         self.inv_root = (dt * self.half_rate).exp();
                     }
                 }
-                // Lazily: the factors stay as they are and new rows get the weight
-                // 1/Π θ^ζ instead.
-                self.inv_scale *= self.inv_root;
-                if self.inv_scale > RENORMALISE {
-                    let f = 1.0 / (self.inv_scale * self.inv_scale);
-                    self.info.discount(f);
-                    if let Some(q) = &mut self.noise {
-                        q.discount(f * f);
-                    }
-                    self.inv_scale = 1.0;
-                }
+                self.info.fade(self.inv_root);
             }
             if self.n == 1 {
                 // One row so far, (1, 0, …, 0) at the centre t_first, whatever the unit: the
@@ -159,11 +138,7 @@ impl ExactEngine {
         }
         // The row (1, u, u², …, u^m).
         let u = (t - self.centre) * self.inv_unit;
-        let w = self.inv_scale * self.inv_scale;
-        self.info.observe_powers(u, y, w);
-        if let Some(q) = &mut self.noise {
-            q.add_row_powers(u, 0.0, w * w);
-        }
+        self.info.observe_powers(u, y, 1.0);
         self.t_last = t;
         self.n += 1;
     }
@@ -235,9 +210,6 @@ impl ExactEngine {
     /// Re-centres: `u_old = α u_new + β`, i.e. new centre `c + β·s`, new unit `α·s`.
     fn recentre(&mut self, alpha: f64, beta: f64) {
         self.info.change_variables_polynomial(alpha, beta);
-        if let Some(q) = &mut self.noise {
-            q.change_variables_polynomial(alpha, beta);
-        }
         self.centre += beta * self.unit;
         if alpha != 1.0 {
             self.unit *= alpha;
@@ -302,25 +274,7 @@ impl ExactEngine {
             None => None,
             Some(sigma) => {
                 let j = crate::model::scaling(self.m, self.unit) * crate::model::phi(self.m, v);
-                let jr = self.info.right_divide(&j)?;
-                let c = match &self.noise {
-                    None => &jr * jr.transpose(),
-                    Some(q) => {
-                        // K = J (RᵀR)⁻¹, Kᵀ = R⁻¹ (J R⁻¹)ᵀ; covariance K QᵀQ Kᵀ.
-                        let mut kt = jr.transpose();
-                        let r = self.info.factor().r();
-                        for mut col in kt.column_iter_mut() {
-                            let mut c: Vec<f64> = col.iter().copied().collect();
-                            if !crate::linalg::solve_upper_in_place(&r, &mut c) {
-                                return None;
-                            }
-                            col.copy_from_slice(&c);
-                        }
-                        let qk = q.r() * kt;
-                        qk.transpose() * qk
-                    }
-                };
-                Some(c * (sigma * sigma))
+                Some(self.info.covariance_of(&j)? * (sigma * sigma))
             }
         };
         Some((x, cov))

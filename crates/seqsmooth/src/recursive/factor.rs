@@ -1,0 +1,757 @@
+use crate::numeric::unrolled::unrolled_sizes;
+use nalgebra::{DMatrix, DVector};
+
+/// An upper-triangular factor `R` of an accumulated Gram matrix `RᵀR = Σ_k c_k a_k a_kᵀ`, kept
+/// up to date row by row, with a right-hand column `d` (`Rᵀd = Σ_k c_k a_k b_k`).
+///
+/// Stored in Gentleman's square-root-free form (W. M. Gentleman, *Least squares computations by
+/// Givens transformations without square roots*, J. Inst. Maths Applics 12, 329–336, 1973):
+/// `R = D^½ U` and `d = D^½ ū` with `U` unit upper triangular and `D ≥ 0` diagonal. A row `a`
+/// with weight `δ_0 = c` is folded in by the square-root-free Givens rotations: per pivot
+/// `i = 0, 1, …`, with `x_i` the row's entry `i` after the previous pivots,
+///
+/// `d_i' = d_i + δ_i x_i²`, `c̄_i = d_i/d_i'`, `s̄_i = δ_i x_i/d_i'`, `δ_(i+1) = δ_i c̄_i`,
+/// `x_j ← x_j − x_i u_ij`, `u_ij ← c̄_i u_ij + s̄_i x_j` (`j > i`, old `x_j` and `u_ij`),
+///
+/// and likewise for `b` against `ū`; finally the residual sum of squares grows by
+/// `δ_p b_p²` (`b_p`: `b` after all pivots). A zero pivot `d_i' = 0` leaves everything as it
+/// is. These are the same orthogonal transformations as with square roots, without them. A
+/// discount scales `D` alone.
+///
+/// Written that way each pivot waits for the previous one's two divisions. But the row entries
+/// `x_i` do not depend on the weights (`x = U⁻ᵀ a`, a forward substitution with the old `U`),
+/// and when every `d_i > 0` the reciprocal weights `η_i = 1/δ_i` obey
+/// `η_(i+1) = η_i + x_i²/d_i` (from `δ_(i+1) = δ_i d_i/(d_i + δ_i x_i²)`): a prefix sum of
+/// non-negative terms, `η_0 = 1/c`. With `δ_(i+1) = 1/η_(i+1)`,
+///
+/// `d_i' = d_i + δ_i x_i²`, `s̄_i = δ_(i+1) x_i/d_i` (`= δ_i x_i/d_i'`),
+/// `u_ij ← u_ij + s̄_i x_j'`, `ū_i ← ū_i + s̄_i b'`,
+///
+/// where `x_j' = x_j − x_i u_ij` and `b'` are the entries after pivot `i` (the same update, as
+/// `c̄_i = 1 − s̄_i x_i`). The row then costs `2p+1` divisions (`1/d_i`, `1/c`, `1/η_(i+1)`)
+/// of which none waits for another, instead of a chain of `2p`, and one multiplication fewer
+/// per entry. The old `u_ij` is kept and only the increment rounded: when the row adds little
+/// to much information (`c̄ ≈ 1`, a long memory) that is about `ε|u'|` per row against several
+/// `ε|u|` in the first form (`c̄` itself, its product, the sum), and for any `c̄` within a few
+/// `ε(|u| + |u'| + s̄|x_j|)`. This form is used whenever every `d_i` and the weight are normal
+/// positive numbers (from the first `p` independent rows on); Gentleman's sequential form
+/// otherwise.
+///
+/// ```
+/// use seqsmooth::recursive::TriangularFactor;
+/// let mut f = TriangularFactor::new(2);
+/// f.add_row(&[1.0, 0.0], 0.0, 4.0);
+/// f.add_row(&[1.0, 1.0], 0.0, 1.0);
+/// let g = f.gram();
+/// assert!((g[(0, 0)] - 5.0).abs() < 1e-12 && (g[(1, 1)] - 1.0).abs() < 1e-12);
+/// let r = f.r(); // upper triangular with RᵀR = the Gram matrix
+/// assert!((r[(0, 0)] - 5f64.sqrt()).abs() < 1e-12 && r[(1, 0)] == 0.0);
+/// ```
+#[derive(Clone, Debug)]
+pub struct TriangularFactor {
+    /// `D`, the squares of `R`'s diagonal, each in its own 16-byte slot ([`Pivot`]).
+    d: Vec<Pivot>,
+    /// `U`, unit upper triangular, row-major (`u[i·p + j]`, `j > i`; the rest unused).
+    u: Vec<f64>,
+    /// `ū = D^-½ d`.
+    ubar: Vec<f64>,
+    residual_sq: f64,
+    /// Every `d_i` is a normal positive number (the rows' reciprocal form applies).
+    positive: bool,
+    scratch: Vec<f64>,
+}
+
+/// A pivot `d_i` alone in a 16-byte slot, so that no two pivots share a (vectorised) load or
+/// store. In the reciprocal form of [`TriangularFactor::add_row`] the next row's `1/d_i` is
+/// the first thing it computes, while `d_(i+1)` is updated only after `δ_(i+1) = 1/η_(i+1)`,
+/// which depends on `1/d_i`: stored as one pair, `d_i` would wait for `d_(i+1)` and every row
+/// for two divisions of the previous one (measured: see BENCHMARKS.md). And a
+/// 16-byte load spanning two 8-byte stores cannot be forwarded from the store buffer.
+#[derive(Clone, Copy, Debug)]
+#[repr(align(16))]
+struct Pivot(f64);
+
+impl TriangularFactor {
+    /// The zero factor of dimension `p`.
+    pub fn new(p: usize) -> Self {
+        Self {
+            d: vec![Pivot(0.0); p],
+            u: vec![0.0; p * p],
+            ubar: vec![0.0; p],
+            residual_sq: 0.0,
+            positive: p == 0,
+            scratch: vec![0.0; 4 * p],
+        }
+    }
+
+    /// Recomputes [`positive`](Self::positive) after `d` changed other than by a row in the
+    /// reciprocal form (which only increases `d`).
+    fn refresh_positive(&mut self) {
+        self.positive = self.d.iter().all(|v| v.0 >= f64::MIN_POSITIVE);
+    }
+
+    /// The factor of a given upper-triangular `R` and right-hand side `rhs` (rows of `R` with a
+    /// zero diagonal carry no information and must be zero).
+    pub fn from_r(r: &DMatrix<f64>, rhs: &DVector<f64>) -> Self {
+        let p = rhs.len();
+        let mut f = Self::new(p);
+        for i in 0..p {
+            let rii = r[(i, i)];
+            if rii == 0.0 {
+                continue;
+            }
+            f.d[i].0 = rii * rii;
+            f.ubar[i] = rhs[i] / rii;
+            for j in i + 1..p {
+                f.u[i * p + j] = r[(i, j)] / rii;
+            }
+        }
+        f.refresh_positive();
+        f
+    }
+
+    /// Dimension `p`.
+    pub fn dim(&self) -> usize {
+        self.d.len()
+    }
+
+    /// The factor `R = D^½ U` (computed).
+    pub fn r(&self) -> DMatrix<f64> {
+        let p = self.dim();
+        DMatrix::from_fn(p, p, |i, j| {
+            let s = self.d[i].0.sqrt();
+            match j.cmp(&i) {
+                std::cmp::Ordering::Less => 0.0,
+                std::cmp::Ordering::Equal => s,
+                std::cmp::Ordering::Greater => s * self.u[i * p + j],
+            }
+        })
+    }
+
+    /// The right-hand vector `d = D^½ ū` (`Rᵀd = Σ c_k a_k b_k`; computed).
+    pub fn rhs(&self) -> DVector<f64> {
+        DVector::from_iterator(
+            self.dim(),
+            self.d.iter().zip(&self.ubar).map(|(d, u)| d.0.sqrt() * u),
+        )
+    }
+
+    /// The part of `Σ c_k b_k²` that no linear combination of the rows explains: the (weighted)
+    /// residual sum of squares of the least-squares fit.
+    pub fn residual_sq(&self) -> f64 {
+        self.residual_sq
+    }
+
+    /// `RᵀR = UᵀDU`.
+    pub fn gram(&self) -> DMatrix<f64> {
+        let r = self.r();
+        r.transpose() * &r
+    }
+
+    /// True when every diagonal entry of `R` is non-zero.
+    pub fn is_determined(&self) -> bool {
+        self.positive || self.d.iter().all(|d| d.0 > 0.0)
+    }
+
+    /// Solves `R x = d` into `x` (`U x = ū`, no divisions); false while not determined.
+    pub fn solve_into(&self, x: &mut [f64]) -> bool {
+        unrolled_sizes!(self.dim(), N => self.solve_n::<N>(x), p => self.solve_any(p, x))
+    }
+
+    #[inline(always)]
+    fn solve_n<const N: usize>(&self, x: &mut [f64]) -> bool {
+        self.solve_any(N, x)
+    }
+
+    /// [`solve_into`](Self::solve_into) for the dimension `N` known at compile time.
+    #[inline(always)]
+    pub(crate) fn solve_array<const N: usize>(&self) -> Option<[f64; N]> {
+        debug_assert_eq!(self.dim(), N);
+        let mut x = [0.0; N];
+        self.solve_n::<N>(&mut x).then_some(x)
+    }
+
+    #[inline(always)]
+    fn solve_any(&self, p: usize, x: &mut [f64]) -> bool {
+        if !self.is_determined() {
+            return false;
+        }
+        let u: &[f64] = &self.u[..p * p];
+        let ubar: &[f64] = &self.ubar[..p];
+        let x: &mut [f64] = &mut x[..p];
+        for i in (0..p).rev() {
+            // The newest unknown last: the next row waits for one multiply-subtract only.
+            let mut s = load_unmerged(&ubar[i]);
+            for (uij, xj) in u[i * p + i + 1..(i + 1) * p].iter().zip(&x[i + 1..]).rev() {
+                s -= load_unmerged(uij) * xj;
+            }
+            x[i] = s;
+        }
+        true
+    }
+
+    /// Folds the row `√c·[a | b]` into `[R | d]`: `O(p²)`, no square roots.
+    pub fn add_row(&mut self, a: &[f64], b: f64, weight: f64) {
+        let p = self.dim();
+        assert_eq!(a.len(), p, "row of the wrong length");
+        // Fixed sizes unroll completely (the polynomial filters' common degrees).
+        unrolled_sizes!(p, N => self.add_row_n::<N>(row_of(a), b, weight), _ => {
+            self.scratch.clear();
+            self.scratch.extend_from_slice(a);
+            self.add_row_any(b, weight);
+        })
+    }
+
+    /// [`add_row`](Self::add_row) with the row of powers `a = (1, v, v², …, v^(p-1))` (a
+    /// polynomial's coefficients observed at `v`), without forming it in memory.
+    ///
+    /// ```
+    /// use seqsmooth::recursive::TriangularFactor;
+    /// let (mut f, mut g) = (TriangularFactor::new(3), TriangularFactor::new(3));
+    /// for (v, b) in [(-1.0, 2.0), (0.5, 1.0), (2.0, -3.0), (3.0, 0.5)] {
+    ///     f.add_row_powers(v, b, 2.0);
+    ///     g.add_row(&[1.0, v, v * v], b, 2.0);
+    /// }
+    /// assert_eq!(f.r(), g.r());
+    /// ```
+    pub fn add_row_powers(&mut self, v: f64, b: f64, weight: f64) {
+        unrolled_sizes!(self.dim(), N => self.add_row_n::<N>(powers(v), b, weight), p => {
+            self.scratch.clear();
+            let mut pw = 1.0;
+            for _ in 0..p {
+                self.scratch.push(pw);
+                pw *= v;
+            }
+            self.add_row_any(b, weight);
+        })
+    }
+
+    #[inline(always)]
+    fn add_row_n<const N: usize>(&mut self, a: [f64; N], b: f64, weight: f64) {
+        if self.positive && weight >= f64::MIN_POSITIVE {
+            self.add_row_reciprocal_n::<N>(a, b, weight);
+        } else {
+            self.add_row_gentleman_n::<N>(a, b, weight);
+            self.refresh_positive();
+        }
+    }
+
+    /// Gentleman's rotations one pivot after the other (any `D ≥ 0`, any weight `≥ 0`).
+    #[inline(always)]
+    fn add_row_gentleman_n<const N: usize>(&mut self, a: [f64; N], b: f64, weight: f64) {
+        let mut x = a;
+        let mut y = b;
+        let mut delta = weight;
+        let d: &mut [Pivot] = &mut self.d[..N];
+        let u: &mut [f64] = &mut self.u[..N * N];
+        let ubar: &mut [f64] = &mut self.ubar[..N];
+        for i in 0..N {
+            let xi = x[i];
+            let (cbar, sbar) = gentleman_pivot(&mut delta, xi, &mut d[i].0);
+            for j in i + 1..N {
+                let xj = x[j];
+                let uij = u[i * N + j];
+                x[j] = xj - xi * uij;
+                u[i * N + j] = cbar * uij + sbar * xj;
+            }
+            let ui = ubar[i];
+            ubar[i] = cbar * ui + sbar * y;
+            y -= xi * ui;
+        }
+        self.residual_sq += delta * y * y;
+    }
+
+    /// The same rotations in the reciprocal form (every `d_i` and the weight normal and
+    /// positive; see the [type docs](Self)): the transformed row, the prefix sums `η`, the
+    /// reciprocals (independent of each other), then the updates.
+    #[inline(always)]
+    fn add_row_reciprocal_n<const N: usize>(&mut self, a: [f64; N], b: f64, weight: f64) {
+        let d: &mut [Pivot] = &mut self.d[..N];
+        let u: &mut [f64] = &mut self.u[..N * N];
+        let ubar: &mut [f64] = &mut self.ubar[..N];
+        let mut e = [0.0; N];
+        for (ei, di) in e.iter_mut().zip(d.iter()) {
+            *ei = 1.0 / di.0;
+        }
+        // The row after each pivot: `after[i][j]` (`j > i`) is entry `j` once pivots `0..=i`
+        // are done, `y_after[i]` likewise for `b`; `x[i]` ends as pivot `i`'s own entry.
+        let mut x = a;
+        let mut after = [[0.0; N]; N];
+        let mut y_after = [0.0; N];
+        let mut y = b;
+        for i in 0..N {
+            let xi = x[i];
+            for j in i + 1..N {
+                x[j] -= xi * u[i * N + j];
+            }
+            after[i][i + 1..].copy_from_slice(&x[i + 1..]);
+            y -= xi * ubar[i];
+            y_after[i] = y;
+        }
+        // `η_(i+1) = η_i + x_i²/d_i` from `η_0 = 1/c`, then `δ_(i+1) = 1/η_(i+1)`.
+        let mut xe = [0.0; N];
+        let mut delta = [0.0; N];
+        let mut eta = 1.0 / weight;
+        for i in 0..N {
+            xe[i] = x[i] * e[i];
+            eta += x[i] * xe[i];
+            delta[i] = eta;
+        }
+        for di in delta.iter_mut() {
+            *di = 1.0 / *di;
+        }
+        for i in 0..N {
+            let delta_i = if i == 0 { weight } else { delta[i - 1] };
+            let sbar = xe[i] * delta[i];
+            d[i].0 += delta_i * (x[i] * x[i]);
+            for j in i + 1..N {
+                u[i * N + j] += sbar * after[i][j];
+            }
+            ubar[i] += sbar * y_after[i];
+        }
+        self.residual_sq += delta[N - 1] * y * y;
+    }
+
+    /// Any size, the row in `scratch[..p]` (overwritten).
+    fn add_row_any(&mut self, b: f64, weight: f64) {
+        if self.positive && weight >= f64::MIN_POSITIVE {
+            self.add_row_reciprocal_any(b, weight);
+        } else {
+            self.add_row_gentleman_any(b, weight);
+            self.refresh_positive();
+        }
+    }
+
+    fn add_row_gentleman_any(&mut self, b: f64, weight: f64) {
+        let p = self.dim();
+        let x = &mut self.scratch[..p];
+        let mut y = b;
+        let mut delta = weight;
+        for i in 0..p {
+            let xi = x[i];
+            let (cbar, sbar) = gentleman_pivot(&mut delta, xi, &mut self.d[i].0);
+            let row = &mut self.u[i * p + i + 1..(i + 1) * p];
+            for (xj, uij) in x[i + 1..p].iter_mut().zip(row.iter_mut()) {
+                let (a, u) = (*xj, *uij);
+                *xj = a - xi * u;
+                *uij = cbar * u + sbar * a;
+            }
+            let ui = self.ubar[i];
+            self.ubar[i] = cbar * ui + sbar * y;
+            y -= xi * ui;
+        }
+        self.residual_sq += delta * y * y;
+    }
+
+    /// [`Self::add_row_reciprocal_n`] for any size: the first pass keeps only the pivot
+    /// entries, the second recomputes the row as it goes.
+    fn add_row_reciprocal_any(&mut self, b: f64, weight: f64) {
+        let p = self.dim();
+        self.scratch.resize(4 * p, 0.0);
+        let (a, rest) = self.scratch.split_at_mut(p);
+        let (x, rest) = rest.split_at_mut(p);
+        let (xe, delta) = rest.split_at_mut(p);
+        x.copy_from_slice(a);
+        let mut eta = 1.0 / weight;
+        for i in 0..p {
+            let xi = x[i];
+            let row = &self.u[i * p + i + 1..(i + 1) * p];
+            for (xj, uij) in x[i + 1..].iter_mut().zip(row) {
+                *xj -= xi * uij;
+            }
+            xe[i] = xi / self.d[i].0;
+            eta += xi * xe[i];
+            delta[i] = eta;
+        }
+        for di in delta.iter_mut() {
+            *di = 1.0 / *di;
+        }
+        x.copy_from_slice(a);
+        let mut y = b;
+        for i in 0..p {
+            let xi = x[i];
+            let delta_i = if i == 0 { weight } else { delta[i - 1] };
+            let sbar = xe[i] * delta[i];
+            self.d[i].0 += delta_i * (xi * xi);
+            let row = &mut self.u[i * p + i + 1..(i + 1) * p];
+            for (xj, uij) in x[i + 1..].iter_mut().zip(row.iter_mut()) {
+                *xj -= xi * *uij;
+                *uij += sbar * *xj;
+            }
+            y -= xi * self.ubar[i];
+            self.ubar[i] += sbar * y;
+        }
+        self.residual_sq += delta.last().unwrap_or(&weight) * y * y;
+    }
+
+    /// Multiplies the accumulated Gram matrix by `f ≥ 0` (a fading-memory discount): `D ← fD`.
+    pub fn discount(&mut self, f: f64) {
+        self.d.iter_mut().for_each(|v| v.0 *= f);
+        self.residual_sq *= f;
+        self.refresh_positive();
+    }
+
+    /// [`discount`](Self::discount) by `f = s²`, given `s ≥ 0`.
+    pub fn discount_root(&mut self, s: f64) {
+        self.discount(s * s);
+    }
+
+    /// [`change_variables`](Self::change_variables) for an upper-triangular `A` with a positive
+    /// or negative (non-zero) diagonal (only its upper triangle is read): `U ← diag(A)⁻¹ U A`,
+    /// `D ← D diag(A)²`, `ū ← diag(A)⁻¹ ū`, in place, `O(p³/6)`, no allocation.
+    pub fn change_variables_upper(&mut self, a: &DMatrix<f64>) {
+        let p = self.dim();
+        assert_eq!(a.shape(), (p, p), "change of variables of the wrong size");
+        let a = a.as_slice();
+        for i in 0..p {
+            // Row i of U A from the right (entry (i, j) needs U_ik for i ≤ k ≤ j, still old;
+            // U_ii = 1).
+            let aii = a[i + i * p];
+            for j in (i + 1..p).rev() {
+                let mut acc = a[i + j * p];
+                for k in i + 1..=j {
+                    acc += self.u[i * p + k] * a[k + j * p];
+                }
+                self.u[i * p + j] = acc / aii;
+            }
+            self.d[i].0 *= aii * aii;
+            self.ubar[i] /= aii;
+        }
+        self.refresh_positive();
+    }
+
+    /// [`change_variables_upper`](Self::change_variables_upper) for the re-expansion of a
+    /// polynomial's coefficients about a new centre and unit: the state is `x` with
+    /// `f = Σ_k x_k v^k`, and with `v = α v' + β` the new state `x'` has `f = Σ_j x'_j v'^j`, so
+    /// `x = A x'` with `A_kj = C(j,k) (-β)^(j-k) / α^j` (`α ≠ 0`) — without forming `A`, in
+    /// `O(p³/6)` multiply-adds and no divisions.
+    ///
+    /// `A = P(-β) diag(α^-j)` with the Pascal matrix `P(h)_kj = C(j,k) h^(j-k)`, which is the
+    /// product of the elementary steps `E_k = I + h e_k e_(k+1)ᵀ` of the Taylor shift by
+    /// repeated synthetic division ([`shift_scaled`](crate::model::shift_scaled)). `U P` applies
+    /// them as column operations `col_(k+1) += h col_k` in the reverse order; then
+    /// `U ← diag(A)⁻¹ (U P) diag(α^-j)` is `U_ij ← α^(i-j) (U P)_ij` (`(U P)_ii = 1`),
+    /// `D_i ← α^(-2i) D_i` and `ū_i ← α^i ū_i`. With `α` a power of two the scalings are exact.
+    pub fn change_variables_polynomial(&mut self, alpha: f64, beta: f64) {
+        unrolled_sizes!(self.dim(), N => self.change_variables_polynomial_n::<N>(alpha, beta), p => {
+            self.change_variables_polynomial_any(p, alpha, beta)
+        })
+    }
+
+    #[inline(always)]
+    fn change_variables_polynomial_n<const N: usize>(&mut self, alpha: f64, beta: f64) {
+        self.change_variables_polynomial_any(N, alpha, beta);
+    }
+
+    #[inline(always)]
+    fn change_variables_polynomial_any(&mut self, p: usize, alpha: f64, beta: f64) {
+        let u: &mut [f64] = &mut self.u[..p * p];
+        let h = -beta;
+        if h != 0.0 {
+            // The shift's steps `for i { for k in (i..p-1).rev() { z_k += h z_(k+1) } }` in
+            // reverse order, each transposed: `col_(k+1) += h col_k`, where column `k` of `U`
+            // is zero below row `k` and 1 at it.
+            for i in (0..p.saturating_sub(1)).rev() {
+                for k in i..p - 1 {
+                    for r in 0..k {
+                        u[r * p + k + 1] += h * u[r * p + k];
+                    }
+                    u[k * p + k + 1] += h;
+                }
+            }
+        }
+        if alpha != 1.0 {
+            // `U_ij ← α^(i-j) U_ij`, `D_i ← α^(-2i) D_i`, `ū_i ← α^i ū_i`.
+            let inv = 1.0 / alpha;
+            let d: &mut [Pivot] = &mut self.d[..p];
+            let ubar: &mut [f64] = &mut self.ubar[..p];
+            let mut down = 1.0;
+            let mut up = 1.0;
+            for i in 0..p {
+                let mut s = inv;
+                for j in i + 1..p {
+                    u[i * p + j] *= s;
+                    s *= inv;
+                }
+                d[i].0 *= down * down;
+                ubar[i] *= up;
+                down *= inv;
+                up *= alpha;
+            }
+            self.refresh_positive();
+        }
+    }
+
+    /// Change of variables `x_old = A x_new`: `R ← R A`. When `A` is upper triangular the result
+    /// stays triangular (the polynomial re-centring case); otherwise it is re-triangularised by
+    /// a Householder QR of `[R A | d]`.
+    pub fn change_variables(&mut self, a: &DMatrix<f64>) {
+        let p = self.dim();
+        if (0..p).all(|i| (0..i).all(|j| a[(i, j)] == 0.0) && a[(i, i)] != 0.0) {
+            self.change_variables_upper(a);
+            return;
+        }
+        let ra = self.r() * a;
+        let mut aug = DMatrix::zeros(p, p + 1);
+        aug.view_mut((0, 0), (p, p)).copy_from(&ra);
+        aug.set_column(p, &self.rhs());
+        let qr = aug.qr();
+        let r = qr.r();
+        let mut rr: DMatrix<f64> = r.view((0, 0), (p, p)).into_owned();
+        for i in 0..p {
+            for j in 0..i {
+                rr[(i, j)] = 0.0;
+            }
+        }
+        let residual = self.residual_sq;
+        *self = Self::from_r(&rr, &r.column(p).into_owned());
+        self.residual_sq = residual;
+    }
+}
+
+/// One pivot of Gentleman's rotation for the row entry `x` against the pivot `d`:
+/// `d' = d + δx²`, `c̄ = d/d'`, `s̄ = δx/d'`, `δ ← δc̄`; returns `(c̄, s̄)`. A zero pivot (no
+/// information yet and a zero entry) leaves everything as it is.
+#[inline(always)]
+fn gentleman_pivot(delta: &mut f64, x: f64, d: &mut f64) -> (f64, f64) {
+    let dx = *delta * x;
+    let di = *d;
+    let dp = di + dx * x;
+    let (cbar, sbar) = if dp > 0.0 {
+        (di / dp, dx / dp)
+    } else {
+        (1.0, 0.0)
+    };
+    *delta *= cbar;
+    *d = dp;
+    (cbar, sbar)
+}
+
+/// `a` as an array (its length is checked by the caller).
+#[inline(always)]
+fn row_of<const N: usize>(a: &[f64]) -> [f64; N] {
+    let mut x = [0.0; N];
+    x.copy_from_slice(&a[..N]);
+    x
+}
+
+/// `(1, v, v², …, v^(N-1))`, each power the previous one times `v`.
+#[inline(always)]
+fn powers<const N: usize>(v: f64) -> [f64; N] {
+    let mut x = [1.0; N];
+    for k in 1..N {
+        x[k] = x[k - 1] * v;
+    }
+    x
+}
+
+/// A load of one `f64` that the compiler keeps on its own (never merged with its neighbour into
+/// one 16-byte load).
+///
+/// [`TriangularFactor::solve_into`] typically runs right after a row was folded in, reading
+/// what [`TriangularFactor::add_row`] has just stored with stores of the compiler's choosing
+/// (some 8, some 16 bytes wide). A load spanning two stores cannot be forwarded from the store
+/// buffer and waits until both have been written to the cache: measured as a stall of the
+/// whole per-sample pipeline (see BENCHMARKS.md). An
+/// 8-byte load is always forwarded from the store containing it; hiding the address from the
+/// optimiser (`black_box`) keeps each load on its own.
+#[inline(always)]
+fn load_unmerged(x: &f64) -> f64 {
+    *std::hint::black_box(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    /// Largest relative difference between two matrices (relative to the larger's max entry).
+    fn rel_diff(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+        let scale = a.amax().max(b.amax()).max(f64::MIN_POSITIVE);
+        (a - b).amax() / scale
+    }
+
+    /// Gentleman's sequential rotations for any state (the reference for the reciprocal form).
+    fn add_row_sequential(f: &mut TriangularFactor, a: &[f64], b: f64, weight: f64) {
+        f.scratch.clear();
+        f.scratch.extend_from_slice(a);
+        f.add_row_gentleman_any(b, weight);
+        f.refresh_positive();
+    }
+
+    fn random_row(rng: &mut StdRng, p: usize) -> (Vec<f64>, f64, f64) {
+        let a = (0..p).map(|_| rng.gen_range(-2.0..2.0)).collect();
+        (a, rng.gen_range(-5.0..5.0), rng.gen_range(0.1..10.0))
+    }
+
+    #[test]
+    fn reciprocal_form_equals_sequential_rotations() {
+        // Sizes with and without a fixed-size kernel; weights over many decades, as the lazy
+        // fading-memory discount produces.
+        let mut rng = StdRng::seed_from_u64(7);
+        for p in 1..=12 {
+            let mut fast = TriangularFactor::new(p);
+            let mut reference = TriangularFactor::new(p);
+            for k in 0..200usize {
+                let (a, b, w) = random_row(&mut rng, p);
+                // Weights growing by 1.2 per row (cosines near 1), then by 4 (cosines near 1/4).
+                let w = w * if k < 100 {
+                    1.2f64.powi(k as i32)
+                } else {
+                    4f64.powi(k as i32 - 100)
+                };
+                fast.add_row(&a, b, w);
+                add_row_sequential(&mut reference, &a, b, w);
+                if k >= p {
+                    assert!(fast.positive, "p={p} k={k}");
+                }
+            }
+            let (r, r0) = (fast.r(), reference.r());
+            let d = rel_diff(&r, &r0);
+            let rhs = rel_diff(
+                &DMatrix::from_column_slice(p, 1, fast.rhs().as_slice()),
+                &DMatrix::from_column_slice(p, 1, reference.rhs().as_slice()),
+            );
+            let res =
+                (fast.residual_sq() - reference.residual_sq()).abs() / reference.residual_sq();
+            eprintln!("p={p}: R {d:.1e}, rhs {rhs:.1e}, residual {res:.1e}");
+            assert!(
+                d < 1e-14 && rhs < 1e-14 && res < 1e-12,
+                "p={p}: {d:e} {rhs:e} {res:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn rows_equal_the_normal_equations() {
+        // Independent check of both forms: RᵀR = Σ w a aᵀ, Rᵀd = Σ w a b.
+        let mut rng = StdRng::seed_from_u64(8);
+        for p in [1, 3, 6, 9, 11] {
+            let mut f = TriangularFactor::new(p);
+            let mut gram = DMatrix::zeros(p, p);
+            let mut atb = DVector::zeros(p);
+            for _ in 0..3 * p + 5 {
+                let (a, b, w) = random_row(&mut rng, p);
+                f.add_row(&a, b, w);
+                let a = DVector::from_vec(a);
+                gram += &a * a.transpose() * w;
+                atb += &a * (w * b);
+            }
+            assert!(rel_diff(&f.gram(), &gram) < 1e-13, "p={p}");
+            let rtd = f.r().transpose() * f.rhs();
+            assert!(
+                rel_diff(
+                    &DMatrix::from_column_slice(p, 1, rtd.as_slice()),
+                    &DMatrix::from_column_slice(p, 1, atb.as_slice())
+                ) < 1e-12,
+                "p={p}"
+            );
+        }
+    }
+
+    #[test]
+    fn zero_pivots_and_zero_weights_leave_the_factor_alone() {
+        for p in [3, 4, 10] {
+            let mut f = TriangularFactor::new(p);
+            // Rows reaching only the first pivots: the rest stay empty (zero pivots).
+            let mut a = vec![0.0; p];
+            a[0] = 1.0;
+            f.add_row(&a, 2.0, 1.0);
+            a[1] = 3.0;
+            f.add_row(&a, 1.0, 0.5);
+            assert!(!f.is_determined() && !f.positive);
+            assert!(f.d[2..].iter().all(|d| d.0 == 0.0) && f.u.iter().all(|v| v.is_finite()));
+            for k in 0..p {
+                let mut a = vec![0.0; p];
+                a[k] = 1.0 + k as f64;
+                a[p - 1] += 0.5;
+                f.add_row(&a, k as f64, 2.0);
+            }
+            assert!(f.is_determined() && f.positive);
+            let before = (f.r(), f.rhs(), f.residual_sq());
+            f.add_row(&vec![1.0; p], 3.0, 0.0);
+            f.add_row_powers(0.5, 3.0, 0.0);
+            assert_eq!((f.r(), f.rhs(), f.residual_sq()), before);
+        }
+    }
+
+    #[test]
+    fn underflowing_discount_falls_back_to_sequential_rotations() {
+        let mut f = TriangularFactor::new(3);
+        for v in [-1.0, 0.0, 1.0, 2.0] {
+            f.add_row_powers(v, v * v, 1.0);
+        }
+        assert!(f.positive);
+        f.discount(1e-310);
+        assert!(!f.positive && f.is_determined());
+        f.add_row_powers(0.5, 0.25, 1.0);
+        let mut x = [0.0; 3];
+        assert!(f.solve_into(&mut x));
+        assert!((x[0]).abs() < 1e-12 && x[1].abs() < 1e-12 && (x[2] - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn polynomial_change_of_variables_equals_the_explicit_matrix() {
+        let mut rng = StdRng::seed_from_u64(9);
+        for p in 1..=12 {
+            let mut worst = 0.0f64;
+            for (alpha, beta) in [
+                (1.0, 0.375),
+                (2.0, -1.25),
+                (0.5, 0.0),
+                (0.25, 3.5),
+                (1.5, -0.3),
+            ] {
+                let mut f = TriangularFactor::new(p);
+                for _ in 0..p + 3 {
+                    let (a, b, w) = random_row(&mut rng, p);
+                    f.add_row(&a, b, w);
+                }
+                let mut g = f.clone();
+                f.change_variables_polynomial(alpha, beta);
+                let a = DMatrix::from_fn(p, p, |k, j| {
+                    if j < k {
+                        0.0
+                    } else {
+                        crate::calculus::choose::<f64>(j, k) * (-beta).powi((j - k) as i32)
+                            / alpha.powi(j as i32)
+                    }
+                });
+                g.change_variables_upper(&a);
+                let d = rel_diff(&f.r(), &g.r());
+                let rhs = rel_diff(
+                    &DMatrix::from_column_slice(p, 1, f.rhs().as_slice()),
+                    &DMatrix::from_column_slice(p, 1, g.rhs().as_slice()),
+                );
+                assert!(
+                    d < 1e-14 && rhs < 1e-14,
+                    "p={p} α={alpha} β={beta}: {d:e} {rhs:e}"
+                );
+                worst = worst.max(d).max(rhs);
+            }
+            eprintln!("p={p}: worst {worst:.1e}");
+        }
+    }
+
+    #[test]
+    fn power_rows_equal_explicit_rows() {
+        let mut rng = StdRng::seed_from_u64(10);
+        for p in [1, 5, 9, 10, 14] {
+            let (mut f, mut g) = (TriangularFactor::new(p), TriangularFactor::new(p));
+            for _ in 0..2 * p + 3 {
+                let v: f64 = rng.gen_range(-1.5..1.5);
+                let mut a = vec![1.0; p];
+                for k in 1..p {
+                    a[k] = a[k - 1] * v;
+                }
+                f.add_row_powers(v, v.sin(), 3.0);
+                g.add_row(&a, v.sin(), 3.0);
+            }
+            assert_eq!(
+                (f.r(), f.rhs(), f.residual_sq()),
+                (g.r(), g.rhs(), g.residual_sq())
+            );
+        }
+    }
+}
