@@ -609,11 +609,8 @@ fn t10_8_ex_10_9_time_varying_transition() {
 }
 
 /// Ex. 10.11 asks for the Bayes filter (p. 386) on the model of Ex. 10.9, which is linear
-/// (`dX/dt = A(t) X`, (10.2.1)): the filter must take it. Ignored while it fails:
-/// `NonlinearDynamics::time_varying_linear` does not report `Dynamics::is_linear`, and
-/// `BayesFilter::new` refuses every model that does not.
+/// (`dX/dt = A(t) X`, (10.2.1)): the filter must take it.
 #[test]
-#[ignore = "gap: BayesFilter::new refuses NonlinearDynamics::time_varying_linear (is_linear() is false)"]
 fn ex_10_11_bayes_filter_on_a_time_varying_linear_model() {
     let dynamics = NonlinearDynamics::time_varying_linear(2, ex_10_9_a)
         .with_tolerances(1e-13, 1e-15)

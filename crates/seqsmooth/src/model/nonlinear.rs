@@ -52,6 +52,9 @@ pub struct NonlinearDynamics {
     jacobian: Option<Jacobian>,
     relative_tolerance: f64,
     absolute_tolerance: f64,
+    /// `F = A(t) X` ([`NonlinearDynamics::time_varying_linear`]): `Φ` is the same for every
+    /// state.
+    linear: bool,
 }
 
 impl std::fmt::Debug for NonlinearDynamics {
@@ -87,10 +90,12 @@ impl NonlinearDynamics {
             jacobian: None,
             relative_tolerance: 1e-10,
             absolute_tolerance: 1e-12,
+            linear: false,
         }
     }
 
-    /// `dX/dt = A(t) X`: `F = A(t) X`, `∂F/∂X = A(t)` exactly.
+    /// `dX/dt = A(t) X`: `F = A(t) X`, `∂F/∂X = A(t)` exactly; linear
+    /// ([`Dynamics::is_linear`]), so the Bayes filter and the estimators' cached `Φ` apply.
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
@@ -100,6 +105,7 @@ impl NonlinearDynamics {
     /// let d = NonlinearDynamics::time_varying_linear(1, |t| DMatrix::from_element(1, 1, t));
     /// let p = d.propagate(&DVector::from_vec(vec![1.0]), 0.0, 2.0).unwrap();
     /// assert!((p.transition[(0, 0)] / 2.0_f64.exp() - 1.0).abs() < 1e-9);
+    /// assert!(d.is_linear());
     /// ```
     pub fn time_varying_linear<A>(n: usize, a: A) -> Self
     where
@@ -116,6 +122,7 @@ impl NonlinearDynamics {
             }
         });
         d.jacobian = Some(Arc::new(move |t, _x: &DVector<f64>| a(t)));
+        d.linear = true;
         d
     }
 
@@ -250,6 +257,10 @@ impl System<f64, DVector<f64>> for Variational<'_> {
 impl Dynamics for NonlinearDynamics {
     fn dimension(&self) -> usize {
         self.n
+    }
+
+    fn is_linear(&self) -> bool {
+        self.linear
     }
 
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
