@@ -7,7 +7,7 @@
 //! | `X_{n,n−1} = X(t_n)` from `X_{n−1,n−1}`, with `Φ(t_n, t_{n−1})` | [`Dynamics::propagate_into`] | (12.2.15), (15.4.10) |
 //! | `S_{n,n−1} = Φ S_{n−1,n−1} Φᵀ + Q(t_n, t_{n−1})` | [`ProcessNoise`] | (12.2.16), (15.4.11) |
 //! | `ν = Y_n − G(X_{n,n−1})`, `V = M S_{n,n−1} Mᵀ + R_n` (present components) | [`Observation::predict_into`] | (12.2.17) |
-//! | `H = S_{n,n−1} Mᵀ V⁻¹` (Cholesky of `V`) | | (12.2.17), (15.4.12) |
+//! | `H = S_{n,n−1} Mᵀ V⁻¹` (`V = L D Lᵀ`, square-root-free Cholesky) | | (12.2.17), (15.4.12) |
 //! | `X_{n,n} = X_{n,n−1} + H ν` | | (12.2.19), (15.4.14) |
 //! | `S_{n,n} = (I − H M) S_{n,n−1} (I − H M)ᵀ + H R Hᵀ` | Joseph form | (12.3.7) |
 //!
@@ -23,6 +23,28 @@
 //!
 //! The filter cannot start from zero information (§12.4 item 2): it needs a prior state and
 //! covariance, e.g. from [`crate::estimate::gauss_newton`] on the first observations.
+//!
+//! ## The arithmetic
+//!
+//! One recursion serves every model and size; what makes it fast is where it works and in
+//! which order it multiplies, not a second copy:
+//!
+//! - The filter keeps its work buffers ([`Dynamics::propagate_into`],
+//!   [`ProcessNoise::covariance_into`] and [`Observation::predict_into`] fill them), writes each
+//!   prediction and update there, and swaps them in only when every check has passed: nothing
+//!   is allocated per update for the polynomial and radar models, and an update that fails
+//!   leaves the filter as it was. [`KalmanFilter::update_stats`] reports the NIS and
+//!   log-likelihood without building an [`Innovation`]'s vectors.
+//! - `Φ S Φᵀ` is two products `X Φᵀ`, each an `axpy` of columns with `Φ`'s entries as the
+//!   scalars, skipping its zeros (`Ψ ⊗ I`, (4.2.5), is mostly zeros: 9 of 36 entries are not for
+//!   constant velocity on three axes); `S Mᵀ` and `X Mᵀ` skip the zeros of `M` likewise.
+//!   Adding `0 · a` changes nothing for a finite `a`, so skipping them changes no result.
+//! - Joseph's form applies `I − H M` from each side instead of forming it:
+//!   `X = S − H (M S)`, then `X − (X Mᵀ) Hᵀ + H R Hᵀ`, `O(n² k)` for `k` components instead of
+//!   `O(n³)`.
+//! - The state dimension `n` goes through the crate's one size dispatch (`unrolled_sizes!`,
+//!   [`crate::numeric`]): for `n ≤ 9` each kernel is compiled with `n` a constant (its loops
+//!   unrolled), larger `n` take the same source with `n` a variable.
 
 use super::noise::ProcessNoise;
 use crate::error::Error;
@@ -30,6 +52,7 @@ use crate::estimate::batch::NoiseCovariance;
 use crate::estimate::gauss_newton::Measurement;
 use crate::model::dynamics::Dynamics;
 use crate::model::observation::Observation;
+use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
 use nalgebra::{Cholesky, DMatrix, DVector};
 use std::f64::consts::TAU;
 use std::sync::Arc;
@@ -45,6 +68,24 @@ pub struct Innovation {
     pub covariance: DMatrix<f64>,
     /// The gain `H = S_{n,n−1} Mᵀ V⁻¹`, states × components.
     pub gain: DMatrix<f64>,
+    /// `νᵀ V⁻¹ ν`.
+    pub nis: f64,
+    /// `−(NIS + ln det V + p ln 2π)/2`.
+    pub log_likelihood: f64,
+}
+
+/// What one update saw, in numbers only: an [`Innovation`] without its vectors and matrices,
+/// what [`KalmanFilter::update_stats`] returns.
+///
+/// ```
+/// use seqsmooth::kalman::filter::InnovationStats;
+/// let s = InnovationStats { components: 1, nis: 0.5, log_likelihood: -1.0 };
+/// assert_eq!(s, s.clone());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InnovationStats {
+    /// The number of components used (the present ones).
+    pub components: usize,
     /// `νᵀ V⁻¹ ν`.
     pub nis: f64,
     /// `−(NIS + ln det V + p ln 2π)/2`.
@@ -84,6 +125,7 @@ pub struct KalmanFilter<D: Dynamics, O: Observation> {
     state: DVector<f64>,
     covariance: DMatrix<f64>,
     time: f64,
+    work: Work,
 }
 
 /// How old observations are discounted (Morrison ch. 14): by time, `β^(t_n − t_k)`
@@ -190,6 +232,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
                 "must be symmetric with a non-negative diagonal".into(),
             ));
         }
+        let work = Work::new(n, observation.components());
         Ok(Self {
             dynamics,
             observation,
@@ -198,6 +241,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             state,
             covariance,
             time,
+            work,
         })
     }
 
@@ -343,53 +387,20 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// assert_eq!(f.covariance()[(0, 0)], 5.0); // 1 + ζ²
     /// ```
     pub fn predict(&mut self, t: f64) -> Result<(), Error> {
-        self.predict_with_transition(t).map(|_| ())
+        self.predict_work(t)?;
+        self.commit_prediction(t);
+        Ok(())
     }
 
     /// [`Self::predict`], returning `Φ(t, t_before)` (the identity for no step): what the
     /// smoother needs.
     pub(crate) fn predict_with_transition(&mut self, t: f64) -> Result<DMatrix<f64>, Error> {
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
         let n = self.state.len();
         if t == self.time {
             return Ok(DMatrix::identity(n, n));
         }
-        let (mut x, mut phi) = (DVector::zeros(n), DMatrix::zeros(n, n));
-        self.dynamics
-            .propagate_into(&self.state, self.time, t, &mut x, &mut phi)?;
-        let q = match &self.noise {
-            Some(q) => Some(q.covariance(self.time, t)?),
-            None => None,
-        };
-        let carry = |s: &DMatrix<f64>| {
-            let mut s = &phi * s * phi.transpose();
-            if let Some(q) = &q {
-                s += q;
-            }
-            symmetric(s)
-        };
-        let s = carry(&self.covariance);
-        finite(&s, "predicted covariance")?;
-        let weight = match &self.fading {
-            Some(f) => {
-                let w = carry(&f.weight);
-                finite(&w, "predicted fading-memory matrix P")?;
-                Some(w)
-            }
-            None => None,
-        };
-        self.state = x;
-        self.covariance = s;
-        self.time = t;
-        if let (Some(f), Some(w)) = (&mut self.fading, weight) {
-            f.weight = w;
-        }
-        Ok(phi)
+        self.predict(t)?;
+        Ok(self.work.phi.clone())
     }
 
     /// Predicts to the measurement's time and updates with its present components
@@ -412,33 +423,58 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// assert_eq!(i.innovation[0], 0.5);
     /// ```
     pub fn update(&mut self, measurement: &Measurement) -> Result<Option<Innovation>, Error> {
-        let p = self.observation.components();
-        let (present, values, r) = present_components(p, measurement)?;
-        self.transaction(|f| {
-            f.predict(measurement.time)?;
-            if present.is_empty() {
-                return Ok(None);
-            }
-            f.correct(&present, &values, &r).map(Some)
-        })
+        self.update_with(measurement, Work::innovation)
     }
 
-    /// Runs `step`, restoring the filter as it was if `step` fails.
-    fn transaction<T>(
+    /// [`Self::update`] reporting only the innovation's statistics ([`InnovationStats`]): the
+    /// same update, the same state and covariance afterwards, without the vectors and
+    /// matrices of an [`Innovation`], so that it allocates nothing (for
+    /// [`PolynomialDynamics`](crate::model::dynamics::PolynomialDynamics),
+    /// [`LinearObservation`](crate::model::observation::LinearObservation),
+    /// [`Radar`](crate::model::radar::Radar) and
+    /// [`WhiteNoiseDerivative`](super::noise::WhiteNoiseDerivative)): the filter's fast path.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = KalmanFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2),
+    ///     DVector::from_vec(vec![0.0, 1.0]), DMatrix::identity(2, 2), 0.0).unwrap();
+    /// let z = Measurement { time: 2.0, values: vec![Some(2.5)], noise: NoiseCovariance::Identity };
+    /// let (mut a, mut b) = (f.clone(), f);
+    /// let stats = a.update_stats(&z).unwrap().unwrap();
+    /// let full = b.update(&z).unwrap().unwrap();
+    /// assert_eq!((stats.components, stats.nis, stats.log_likelihood), (1, full.nis, full.log_likelihood));
+    /// assert_eq!((a.state(), a.covariance()), (b.state(), b.covariance()));
+    /// ```
+    pub fn update_stats(
         &mut self,
-        step: impl FnOnce(&mut Self) -> Result<T, Error>,
-    ) -> Result<T, Error> {
-        let saved = (
-            self.state.clone(),
-            self.covariance.clone(),
-            self.time,
-            self.fading.clone(),
-        );
-        let out = step(self);
-        if out.is_err() {
-            (self.state, self.covariance, self.time, self.fading) = saved;
+        measurement: &Measurement,
+    ) -> Result<Option<InnovationStats>, Error> {
+        self.update_with(measurement, |_, stats| stats)
+    }
+
+    /// The one update behind [`Self::update`] and [`Self::update_stats`]: `report` reads what
+    /// the caller wants from the work buffers once the update has succeeded.
+    fn update_with<T>(
+        &mut self,
+        measurement: &Measurement,
+        report: impl FnOnce(&Work, InnovationStats) -> T,
+    ) -> Result<Option<T>, Error> {
+        let k = self.measure(measurement)?;
+        let t = measurement.time;
+        self.predict_work(t)?;
+        if k == 0 {
+            self.commit_prediction(t);
+            return Ok(None);
         }
-        out
+        let stats = self.correct(t, false)?;
+        let out = report(&self.work, stats);
+        self.commit_correction(t);
+        Ok(Some(out))
     }
 
     /// The iterated update of §12.5 ((12.5.10)-(12.5.17), Morrison's Kalman filter with
@@ -480,165 +516,232 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
                     .into(),
             });
         }
-        let p = self.observation.components();
-        let (present, values, r) = present_components(p, measurement)?;
-        self.transaction(|f| {
-            f.predict(measurement.time)?;
-            if present.is_empty() {
-                return Ok(None);
+        let k = self.measure(measurement)?;
+        let t = measurement.time;
+        self.predict_work(t)?;
+        if k == 0 {
+            self.commit_prediction(t);
+            return Ok(None);
+        }
+        let prior = self.work.s.clone();
+        let metric = Cholesky::new(prior.clone());
+        self.work.about.copy_from(&self.work.x);
+        let mut correction = f64::INFINITY;
+        for _ in 0..max_iterations {
+            let stats = self.correct(t, true)?;
+            let change = &self.work.x_out - &self.work.about;
+            correction = match &metric {
+                Some(c) => change.dot(&c.solve(&change)).sqrt(),
+                None => change.amax() / prior.diagonal().amax().sqrt().max(f64::MIN_POSITIVE),
+            };
+            self.work.about.copy_from(&self.work.x_out);
+            if correction <= tolerance {
+                let innovation = self.work.innovation(stats);
+                self.commit_correction(t);
+                return Ok(Some(innovation));
             }
-            let (predicted, prior, fading) =
-                (f.state.clone(), f.covariance.clone(), f.fading.clone());
-            let metric = Cholesky::new(prior.clone());
-            let mut about = predicted.clone();
-            let mut correction = f64::INFINITY;
-            for _ in 0..max_iterations {
-                (f.state, f.covariance, f.fading) =
-                    (predicted.clone(), prior.clone(), fading.clone());
-                let innovation = f.correct_about(&present, &values, &r, &about)?;
-                let change = &f.state - &about;
-                correction = match &metric {
-                    Some(c) => change.dot(&c.solve(&change)).sqrt(),
-                    None => change.amax() / prior.diagonal().amax().sqrt().max(f64::MIN_POSITIVE),
-                };
-                about = f.state.clone();
-                if correction <= tolerance {
-                    return Ok(Some(innovation));
-                }
-            }
-            Err(Error::NotConverged {
-                iterations: max_iterations,
-                correction,
-                tolerance,
-                chi_squared: f64::NAN,
-            })
+        }
+        Err(Error::NotConverged {
+            iterations: max_iterations,
+            correction,
+            tolerance,
+            chi_squared: f64::NAN,
         })
     }
 
-    /// The update at the current (predicted) state.
-    fn correct(
-        &mut self,
-        present: &[usize],
-        values: &[f64],
-        r: &DMatrix<f64>,
-    ) -> Result<Innovation, Error> {
-        let about = self.state.clone();
-        self.correct_about(present, values, r, &about)
-    }
-
-    /// The update of the predicted state linearised about `about` (12.5.17): the innovation
-    /// `Y − G(about) − M(about)(X_{n,n−1} − about)`, `M` at `about`.
-    fn correct_about(
-        &mut self,
-        present: &[usize],
-        values: &[f64],
-        r: &DMatrix<f64>,
-        about: &DVector<f64>,
-    ) -> Result<Innovation, Error> {
-        let n = self.state.len();
-        let p = self.observation.components();
-        let (mut g, mut m_all) = (DVector::zeros(p), DMatrix::zeros(p, n));
-        self.observation
-            .predict_into(about, self.time, &mut g, &mut m_all)?;
-        let k = present.len();
-        let m = DMatrix::from_fn(k, n, |i, j| m_all[(present[i], j)]);
-        let offset = &m * (&self.state - about);
-        let nu = DVector::from_fn(k, |i, _| {
-            self.observation
-                .residual(present[i], values[i], g[present[i]])
-                - offset[i]
-        });
-        // The gain from P and f R (fading, ch. 14), or from S and R (f = 1, P = S).
-        let f = match &self.fading {
-            Some(fading) => fading.factor(self.time)?,
-            None => 1.0,
-        };
-        let weight = self.fading.as_ref().map_or(&self.covariance, |x| &x.weight);
-        let pm = weight * m.transpose(); // P Mᵀ, n × k
-        let not_pd = |v: &DMatrix<f64>| Error::InvalidParameter {
-            name: "innovation covariance M S Mᵀ + R",
-            value: format!("{v:?}"),
-            reason: "is not positive definite: the observation adds nothing the filter can \
-                     weigh (a perfect observation of a component already known exactly)"
-                .into(),
-        };
-        let vp = symmetric(&m * &pm + r * f);
-        let chol_p = Cholesky::new(vp.clone()).ok_or_else(|| not_pd(&vp))?;
-        // H = P Mᵀ V_P⁻¹: solve V_P Hᵀ = M P.
-        let gain = chol_p.solve(&pm.transpose()).transpose();
-        // The innovation's true covariance M S Mᵀ + R (§14.8): V_P itself without fading.
-        let (v, chol) = if self.fading.is_some() {
-            let v = symmetric(&m * &self.covariance * m.transpose() + r);
-            let c = Cholesky::new(v.clone()).ok_or_else(|| not_pd(&v))?;
-            (v, c)
-        } else {
-            (vp, chol_p)
-        };
-        let nis = nu.dot(&chol.solve(&nu));
-        let log_det = 2.0
-            * chol
-                .l_dirty()
-                .diagonal()
-                .iter()
-                .map(|d| d.ln())
-                .sum::<f64>();
-        let log_likelihood = -0.5 * (nis + log_det + k as f64 * TAU.ln());
-        let x = &self.state + &gain * &nu;
-        let a = DMatrix::identity(n, n) - &gain * &m;
-        let joseph = |s: &DMatrix<f64>, r: &DMatrix<f64>| {
-            symmetric(&a * s * a.transpose() + &gain * r * gain.transpose())
-        };
-        let s = joseph(&self.covariance, r);
-        finite(&s, "updated covariance")?;
-        let weight = match &self.fading {
-            Some(_) => {
-                let w = joseph(weight, &(r * f)) / f;
-                finite(&w, "updated fading-memory matrix P")?;
-                Some(w)
+    /// The prediction to `t` into the work buffers (`X_{n,n−1}`, `S_{n,n−1}` and the fading
+    /// `P`), the filter unchanged: `Φ` and the propagated state from the dynamics, `Q` from the
+    /// driving noise, `Φ S Φᵀ + Q` by [`carry`]. No step (`t` the current time) copies.
+    fn predict_work(&mut self, t: f64) -> Result<(), Error> {
+        if !t.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: t,
+            });
+        }
+        let w = &mut self.work;
+        if t == self.time {
+            w.x.copy_from(&self.state);
+            w.s.copy_from(&self.covariance);
+            if let Some(f) = &self.fading {
+                w.p.copy_from(&f.weight);
+            }
+            return Ok(());
+        }
+        self.dynamics
+            .propagate_into(&self.state, self.time, t, &mut w.x, &mut w.phi)?;
+        let q = match &self.noise {
+            Some(noise) => {
+                noise.covariance_into(self.time, t, &mut w.q)?;
+                Some(w.q.as_slice())
             }
             None => None,
         };
-        if let Some(&value) = x.iter().find(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                what: "updated state entry",
-                value,
+        let n = self.state.len();
+        let phi = w.phi.as_slice();
+        let mut carry_into = |from: &DMatrix<f64>, to: &mut DMatrix<f64>, what| {
+            let (from, to) = (from.as_slice(), to.as_mut_slice());
+            let finite_out = unrolled_sizes!(n, N => carry(Fixed::<N>, phi, from, q, &mut w.square, to),
+                n => carry(Any(n), phi, from, q, &mut w.square, to));
+            if finite_out {
+                Ok(())
+            } else {
+                finite(to, what)
+            }
+        };
+        carry_into(&self.covariance, &mut w.s, "predicted covariance")?;
+        if let Some(f) = &self.fading {
+            carry_into(&f.weight, &mut w.p, "predicted fading-memory matrix P")?;
+        }
+        Ok(())
+    }
+
+    /// Makes the predicted state, covariance and `P` in the work buffers the filter's, at `t`.
+    fn commit_prediction(&mut self, t: f64) {
+        std::mem::swap(&mut self.state, &mut self.work.x);
+        std::mem::swap(&mut self.covariance, &mut self.work.s);
+        if let Some(f) = &mut self.fading {
+            std::mem::swap(&mut f.weight, &mut self.work.p);
+        }
+        self.time = t;
+    }
+
+    /// Makes the corrected state, covariance and `P` in the work buffers the filter's, at `t`.
+    fn commit_correction(&mut self, t: f64) {
+        std::mem::swap(&mut self.state, &mut self.work.x_out);
+        std::mem::swap(&mut self.covariance, &mut self.work.s_out);
+        if let Some(f) = &mut self.fading {
+            std::mem::swap(&mut f.weight, &mut self.work.p_out);
+            f.last_update = t;
+        }
+        self.time = t;
+    }
+
+    /// The measurement's present components and values, and `R` on them, into the work
+    /// buffers; their number. The checks are [`Measurement::present`]'s (called for its
+    /// refusal when this measurement fails them) and, on the whole `R`: finite, symmetric,
+    /// non-negative variances (a perfect observation is allowed).
+    fn measure(&mut self, m: &Measurement) -> Result<usize, Error> {
+        let p = self.observation.components();
+        let w = &mut self.work;
+        w.present.clear();
+        w.values.clear();
+        let accepted = m.time.is_finite()
+            && m.values.len() == p
+            && m.values.iter().all(|v| v.is_none_or(f64::is_finite));
+        if accepted {
+            for (c, v) in m.values.iter().enumerate() {
+                if let Some(v) = *v {
+                    w.present.push(c);
+                    w.values.push(v);
+                }
+            }
+        } else {
+            (w.present, w.values) = m.present(p)?;
+        }
+        let entry = noise_entries(p, &m.noise)?;
+        let (mut largest, mut asymmetry, mut negative) = (0.0_f64, 0.0_f64, false);
+        for i in 0..p {
+            for j in 0..p {
+                let v = entry(i, j);
+                if !v.is_finite() {
+                    return Err(Error::NonFinite {
+                        what: "measurement noise entry",
+                        value: v,
+                    });
+                }
+                largest = largest.max(v.abs());
+                asymmetry = asymmetry.max((v - entry(j, i)).abs());
+                negative |= i == j && v < 0.0;
+            }
+        }
+        if asymmetry > 1e-12 * largest || negative {
+            return Err(Error::InvalidParameter {
+                name: "measurement noise",
+                value: format!("{:?}", DMatrix::from_fn(p, p, entry)),
+                reason: "must be symmetric with non-negative variances".into(),
             });
+        }
+        let k = w.present.len();
+        for (j, &b) in w.present.iter().enumerate() {
+            for (i, &a) in w.present.iter().enumerate() {
+                w.r[i + j * k] = entry(a, b);
+            }
+        }
+        Ok(k)
+    }
+
+    /// The update of the predicted state in the work buffers with the measured components
+    /// (after [`Self::measure`] and [`Self::predict_work`]), into the work buffers' outputs,
+    /// the filter unchanged: the observation linearised about the prediction, or with
+    /// `iterated` about `work.about` ((12.5.17): the innovation
+    /// `Y − G(about) − M(about)(X_{n,n−1} − about)`, `M` at `about`); then [`correct_kernel`].
+    fn correct(&mut self, t: f64, iterated: bool) -> Result<InnovationStats, Error> {
+        let (n, p) = (self.state.len(), self.observation.components());
+        let w = &mut self.work;
+        let about = if iterated { &w.about } else { &w.x };
+        self.observation
+            .predict_into(about, t, &mut w.g, &mut w.m_all)?;
+        let k = w.present.len();
+        for (c, (&a, &y)) in w.present.iter().zip(&w.values).enumerate() {
+            let m_all = w.m_all.as_slice();
+            for (l, mt) in w.mt[c * n..(c + 1) * n].iter_mut().enumerate() {
+                *mt = m_all[a + l * p];
+            }
+            let mut nu = self.observation.residual(a, y, w.g[a]);
+            if iterated {
+                let mut offset = 0.0;
+                for (l, mt) in w.mt[c * n..(c + 1) * n].iter().enumerate() {
+                    offset += mt * (w.x[l] - w.about[l]);
+                }
+                nu -= offset;
+            }
+            w.nu[c] = nu;
+        }
+        // The gain from P and f R (fading, ch. 14), or from S and R (f = 1, P = S).
+        let f = match &self.fading {
+            Some(fading) => fading.factor(t)?,
+            None => 1.0,
+        };
+        let fading = self.fading.is_some();
+        let (nis, log_det, finite_out) = unrolled_sizes!(n, N => match k {
+                1 => correct_kernel(Fixed::<N>, Fixed::<1>, f, fading, w),
+                2 => correct_kernel(Fixed::<N>, Fixed::<2>, f, fading, w),
+                3 => correct_kernel(Fixed::<N>, Fixed::<3>, f, fading, w),
+                4 => correct_kernel(Fixed::<N>, Fixed::<4>, f, fading, w),
+                k => correct_kernel(Fixed::<N>, Any(k), f, fading, w),
+            },
+            n => correct_kernel(Any(n), Any(k), f, fading, w))?;
+        let log_likelihood = -0.5 * (nis + log_det + k as f64 * TAU.ln());
+        if !finite_out {
+            finite(w.s_out.as_slice(), "updated covariance")?;
+            if fading {
+                finite(w.p_out.as_slice(), "updated fading-memory matrix P")?;
+            }
+            finite(w.x_out.as_slice(), "updated state entry")?;
         }
         if !(nis.is_finite() && log_likelihood.is_finite()) {
             return Err(Error::EstimateOutOfRange {
                 what: "normalised innovation squared".into(),
             });
         }
-        self.state = x;
-        self.covariance = s;
-        if let (Some(fading), Some(w)) = (&mut self.fading, weight) {
-            fading.weight = w;
-            fading.last_update = self.time;
-        }
-        Ok(Innovation {
-            components: present.to_vec(),
-            innovation: nu,
-            covariance: v,
-            gain,
+        Ok(InnovationStats {
+            components: k,
             nis,
             log_likelihood,
         })
     }
 }
 
-/// A measurement's present components, their values, and their `R`.
-type Present = (Vec<usize>, Vec<f64>, DMatrix<f64>);
-
-/// The present components of a measurement, their values and their `R` (symmetric, finite,
-/// non-negative diagonal: a perfect observation is allowed).
-fn present_components(p: usize, m: &Measurement) -> Result<Present, Error> {
-    let (present, values) = m.present(p)?;
-    let full = match &m.noise {
-        NoiseCovariance::Identity => DMatrix::identity(p, p),
-        NoiseCovariance::Variances(v) if v.len() == p => {
-            DMatrix::from_diagonal(&DVector::from_column_slice(v))
-        }
-        NoiseCovariance::Full(r) if r.shape() == (p, p) => r.clone(),
+/// `R`'s entry `(i, j)` as a function, once its shape is checked against `p` components.
+fn noise_entries(
+    p: usize,
+    noise: &NoiseCovariance,
+) -> Result<impl Fn(usize, usize) -> f64 + '_, Error> {
+    match noise {
+        NoiseCovariance::Identity => {}
+        NoiseCovariance::Variances(v) if v.len() == p => {}
+        NoiseCovariance::Full(r) if r.shape() == (p, p) => {}
         other => {
             return Err(Error::InvalidParameter {
                 name: "measurement noise",
@@ -646,34 +749,458 @@ fn present_components(p: usize, m: &Measurement) -> Result<Present, Error> {
                 reason: format!("needs {p} components"),
             })
         }
+    }
+    Ok(move |i: usize, j: usize| match noise {
+        NoiseCovariance::Identity => f64::from(u8::from(i == j)),
+        NoiseCovariance::Variances(v) => {
+            if i == j {
+                v[i]
+            } else {
+                0.0
+            }
+        }
+        NoiseCovariance::Full(r) => r[(i, j)],
+    })
+}
+
+/// The filter's preallocated buffers: every update and prediction works in these, so that
+/// the hot path allocates nothing, and writes its results here before they become the
+/// filter's (an update that fails leaves the filter as it was). Matrices are column-major;
+/// `n` states, `p` observation components, `k ≤ p` present in the update.
+#[derive(Clone, Debug)]
+struct Work {
+    /// The prediction: `X_{n,n−1}`, `Φ(t_n, t_{n−1})`, `Q`, `S_{n,n−1}` and the fading `P`.
+    x: DVector<f64>,
+    phi: DMatrix<f64>,
+    q: DMatrix<f64>,
+    s: DMatrix<f64>,
+    p: DMatrix<f64>,
+    /// `n × n` scratch (`S Φᵀ`, then `(I − H M) S`).
+    square: Vec<f64>,
+    /// The measurement: the present components, their values, `R` on them (`k × k`).
+    present: Vec<usize>,
+    values: Vec<f64>,
+    r: Vec<f64>,
+    /// `f R` for the fading `P` (`k × k`).
+    rf: Vec<f64>,
+    /// The linearisation point of an iterated update, and `G` and `M` (all components) there.
+    about: DVector<f64>,
+    g: DVector<f64>,
+    m_all: DMatrix<f64>,
+    /// `Mᵀ` of the present rows, `P Mᵀ`, `S Mᵀ`, the gain `H`, `(I − H M) S Mᵀ` (`n × k`).
+    mt: Vec<f64>,
+    u: Vec<f64>,
+    sm: Vec<f64>,
+    h: Vec<f64>,
+    y: Vec<f64>,
+    /// `H R` (`n × k`), and a column (`n`).
+    hr: Vec<f64>,
+    column: Vec<f64>,
+    /// `ν`, and `L⁻¹ ν` (`k`).
+    nu: Vec<f64>,
+    z: Vec<f64>,
+    /// `V_P = M P Mᵀ + f R` and its `L D Lᵀ` factors; `V = M S Mᵀ + R` and its (`k × k`).
+    vp: Vec<f64>,
+    lp: Vec<f64>,
+    v: Vec<f64>,
+    lv: Vec<f64>,
+    /// The update's results: `X_{n,n}`, `S_{n,n}`, the fading `P`.
+    x_out: DVector<f64>,
+    s_out: DMatrix<f64>,
+    p_out: DMatrix<f64>,
+}
+
+impl Work {
+    fn new(n: usize, p: usize) -> Self {
+        let vector = |len: usize| vec![0.0; len];
+        Self {
+            x: DVector::zeros(n),
+            phi: DMatrix::zeros(n, n),
+            q: DMatrix::zeros(n, n),
+            s: DMatrix::zeros(n, n),
+            p: DMatrix::zeros(n, n),
+            square: vector(n * n),
+            present: Vec::with_capacity(p),
+            values: Vec::with_capacity(p),
+            r: vector(p * p),
+            rf: vector(p * p),
+            about: DVector::zeros(n),
+            g: DVector::zeros(p),
+            m_all: DMatrix::zeros(p, n),
+            mt: vector(n * p),
+            u: vector(n * p),
+            sm: vector(n * p),
+            h: vector(n * p),
+            y: vector(n * p),
+            hr: vector(n * p),
+            column: vector(n),
+            nu: vector(p),
+            z: vector(p),
+            vp: vector(p * p),
+            lp: vector(p * p),
+            v: vector(p * p),
+            lv: vector(p * p),
+            x_out: DVector::zeros(n),
+            s_out: DMatrix::zeros(n, n),
+            p_out: DMatrix::zeros(n, n),
+        }
+    }
+
+    /// The last correction's [`Innovation`], from the buffers.
+    fn innovation(&self, stats: InnovationStats) -> Innovation {
+        let (n, k) = (self.x.len(), stats.components);
+        Innovation {
+            components: self.present.clone(),
+            innovation: DVector::from_column_slice(&self.nu[..k]),
+            covariance: DMatrix::from_column_slice(k, k, &self.v[..k * k]),
+            gain: DMatrix::from_column_slice(n, k, &self.h[..n * k]),
+            nis: stats.nis,
+            log_likelihood: stats.log_likelihood,
+        }
+    }
+}
+
+// The kernels below index column-major slices in loops over `0..n`, with `n` a constant in
+// every size `unrolled_sizes!` dispatches (their callers are generic over `Size`, and these
+// are inlined into them), so that the loops have constant trip counts and unroll.
+
+/// `out = A Bᵀ` for `A` `n × n` (column-major `a`) and `B` `cols × n` (its entries `b(i, l)`),
+/// column-major `out` (`n × cols`): each column of `out` an `axpy` of the columns of `A` with
+/// `B`'s entries as the scalars, skipping the entries that are zero (adding `0 · a` changes
+/// nothing for a finite `a`): `Φ` of the polynomial model is `Ψ ⊗ I`, mostly zeros, and so is
+/// a radar's `M`.
+#[inline(always)]
+fn times_transpose(
+    n: usize,
+    a: &[f64],
+    cols: usize,
+    b: impl Fn(usize, usize) -> f64,
+    out: &mut [f64],
+) {
+    let a = &a[..n * n];
+    for i in 0..cols {
+        let column = &mut out[i * n..(i + 1) * n];
+        column.fill(0.0);
+        for l in 0..n {
+            let scale = b(i, l);
+            if scale != 0.0 {
+                let a = &a[l * n..(l + 1) * n];
+                for r in 0..n {
+                    column[r] += a[r] * scale;
+                }
+            }
+        }
+    }
+}
+
+/// `out = Σ_c b(c) a[:, c]` for one column `out` (`n`) and `a` `n × k`.
+#[inline(always)]
+fn combine(n: usize, k: usize, a: &[f64], b: impl Fn(usize) -> f64, out: &mut [f64]) {
+    let out = &mut out[..n];
+    out.fill(0.0);
+    for c in 0..k {
+        let (a, scale) = (&a[c * n..(c + 1) * n], b(c));
+        for r in 0..n {
+            out[r] += a[r] * scale;
+        }
+    }
+}
+
+/// `a ← (a + aᵀ)/2` for an `n × n` column-major `a`.
+#[inline(always)]
+fn symmetrize(n: usize, a: &mut [f64]) {
+    let a = &mut a[..n * n];
+    for j in 0..n {
+        for i in j + 1..n {
+            let v = (a[i + j * n] + a[j + i * n]) * 0.5;
+            a[i + j * n] = v;
+            a[j + i * n] = v;
+        }
+    }
+}
+
+/// `a ← aᵀ` for an `n × n` column-major `a`.
+#[inline(always)]
+fn transpose(n: usize, a: &mut [f64]) {
+    let a = &mut a[..n * n];
+    for j in 0..n {
+        for i in j + 1..n {
+            a.swap(i + j * n, j + i * n);
+        }
+    }
+}
+
+/// `out = Φ S Φᵀ + Q`, symmetrized ((12.2.16), (15.4.11)): `A = S Φᵀ = (Φ S)ᵀ` (`S`
+/// symmetric), transposed in place, then `(Φ S) Φᵀ`, both products by [`times_transpose`]
+/// (the zeros of `Φ` skipped); `a` is `n × n` scratch. Whether every entry is finite.
+fn carry<S: Size>(
+    n: S,
+    phi: &[f64],
+    s: &[f64],
+    q: Option<&[f64]>,
+    a: &mut [f64],
+    out: &mut [f64],
+) -> bool {
+    let n = n.get();
+    let (phi, out) = (&phi[..n * n], &mut out[..n * n]);
+    times_transpose(n, s, n, |i, l| phi[i + l * n], a);
+    transpose(n, a);
+    times_transpose(n, a, n, |j, l| phi[j + l * n], out);
+    match q {
+        // (out + Q) symmetrized, in one pass.
+        Some(q) => {
+            let q = &q[..n * n];
+            for j in 0..n {
+                out[j + j * n] += q[j + j * n];
+                for i in j + 1..n {
+                    let (lower, upper) = (i + j * n, j + i * n);
+                    let v = ((out[lower] + q[lower]) + (out[upper] + q[upper])) * 0.5;
+                    out[lower] = v;
+                    out[upper] = v;
+                }
+            }
+        }
+        None => symmetrize(n, out),
+    }
+    all_finite(out)
+}
+
+/// Whether every entry of `a` is finite (no early exit: a reduction the compiler unrolls).
+#[inline(always)]
+fn all_finite(a: &[f64]) -> bool {
+    a.iter().fold(true, |ok, v| ok & v.is_finite())
+}
+
+/// `V = L D Lᵀ` (`k × k`, column-major) into `l`: the unit lower triangle `L` below the
+/// diagonal, `D` on it (left-looking: column `j` of `V` less `L_{·c} D_c L_{jc}` for `c < j`,
+/// then divided by its pivot `D_j`); `false` if a pivot is not positive (`V` is not positive
+/// definite). The square-root-free Cholesky factorisation: `V⁻¹` and `ln det V` follow from it
+/// with no square root and fewer roundings.
+#[inline(always)]
+fn ldl(k: usize, v: &[f64], l: &mut [f64]) -> bool {
+    let l = &mut l[..k * k];
+    l.copy_from_slice(&v[..k * k]);
+    for j in 0..k {
+        for c in 0..j {
+            let scale = l[j + c * k] * l[c + c * k];
+            for i in j..k {
+                l[i + j * k] -= l[i + c * k] * scale;
+            }
+        }
+        let d = l[j + j * k];
+        if d.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return false;
+        }
+        for i in j + 1..k {
+            l[i + j * k] /= d;
+        }
+    }
+    true
+}
+
+/// `ln det V = Σ ln D_c` from `V`'s [`ldl`] factors: one logarithm of the product while it
+/// stays a normal number, else the sum of the logarithms.
+#[inline(always)]
+fn log_det(k: usize, l: &[f64]) -> f64 {
+    let product: f64 = (0..k).map(|c| l[c + c * k]).product();
+    if product.is_normal() {
+        product.ln()
+    } else {
+        (0..k).map(|c| l[c + c * k].ln()).sum::<f64>()
+    }
+}
+
+/// `v = M sm + f R` (`k × k`), symmetrized: `sm = S Mᵀ` (`n × k`) and `mt = Mᵀ`.
+#[inline(always)]
+fn innovation_covariance(
+    (n, k): (usize, usize),
+    mt: &[f64],
+    sm: &[f64],
+    r: &[f64],
+    f: f64,
+    v: &mut [f64],
+) {
+    for b in 0..k {
+        let sm = &sm[b * n..(b + 1) * n];
+        for a in 0..k {
+            let mt = &mt[a * n..(a + 1) * n];
+            let mut msm = 0.0;
+            for l in 0..n {
+                msm += mt[l] * sm[l];
+            }
+            v[a + b * k] = msm + r[a + b * k] * f;
+        }
+    }
+    symmetrize(k, v);
+}
+
+/// Joseph's form (12.3.7) `out = (I − H M) S (I − H M)ᵀ + H R Hᵀ`, symmetrized, with
+/// `I − H M` applied from each side rather than formed: `X = S − H (M S)` (`M S = (S Mᵀ)ᵀ`
+/// for the symmetric `S`, `sm = S Mᵀ`), then `X (I − H M)ᵀ = X − (X Mᵀ) Hᵀ`: the same
+/// products associated differently, `O(n² k)` for `k` components instead of `O(n³)`; and
+/// `(H R) Hᵀ`. `x` (`n × n`), `y` and `hr` (`n × k`) and `column` (`n`) are scratch.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn joseph(
+    (n, k): (usize, usize),
+    s: &[f64],
+    h: &[f64],
+    sm: &[f64],
+    mt: &[f64],
+    r: &[f64],
+    (x, y, hr, column): (&mut [f64], &mut [f64], &mut [f64], &mut [f64]),
+    out: &mut [f64],
+) {
+    let (s, x, out) = (&s[..n * n], &mut x[..n * n], &mut out[..n * n]);
+    let (h, sm, column) = (&h[..n * k], &sm[..n * k], &mut column[..n]);
+    for j in 0..n {
+        combine(n, k, h, |c| sm[j + c * n], column);
+        for i in 0..n {
+            x[i + j * n] = s[i + j * n] - column[i];
+        }
+    }
+    times_transpose(n, x, k, |c, l| mt[l + c * n], y);
+    for d in 0..k {
+        combine(n, k, h, |c| r[c + d * k], &mut hr[d * n..(d + 1) * n]);
+    }
+    for j in 0..n {
+        let out = &mut out[j * n..(j + 1) * n];
+        combine(n, k, y, |c| h[j + c * n], out);
+        combine(n, k, hr, |d| h[j + d * n], column);
+        for i in 0..n {
+            out[i] = (x[i + j * n] - out[i]) + column[i];
+        }
+    }
+    symmetrize(n, out);
+}
+
+/// The numbers of one correction ((12.2.17)-(12.2.19), (12.3.7); fading (14.4.34)-(14.4.40)),
+/// from the work buffers' prediction, `Mᵀ`, `ν` and `R` into its outputs; `NIS`, `ln det V`
+/// and whether the outputs are all finite.
+/// With `f` the discount over the step (1 without fading, when `P = S`):
+///
+/// `U = P Mᵀ`, `V_P = M U + f R = L_P D_P L_Pᵀ` ([`ldl`]), `H = U V_P⁻¹` (two unit
+/// triangular solves and the pivots), `V = M S Mᵀ + R = L D Lᵀ` (`V_P` without fading),
+/// `NIS = Σ z_c² / D_c` with `z = L⁻¹ ν`, `ln det V = Σ ln D_c`, `X = X_{n,n−1} + H ν`,
+/// `S` by [`joseph`] with `R`, and the fading `P` by [`joseph`] with `f R`, divided by `f`.
+fn correct_kernel<S: Size, C: Size>(
+    n: S,
+    k: C,
+    f: f64,
+    fading: bool,
+    w: &mut Work,
+) -> Result<(f64, f64, bool), Error> {
+    let (n, k) = (n.get(), k.get());
+    let (nn, nk, kk) = (n * n, n * k, k * k);
+    let s = &w.s.as_slice()[..nn];
+    let p = if fading { &w.p.as_slice()[..nn] } else { s };
+    let (mt, u, h) = (&w.mt[..nk], &mut w.u[..nk], &mut w.h[..nk]);
+    let (r, vp, lp) = (&w.r[..kk], &mut w.vp[..kk], &mut w.lp[..kk]);
+    times_transpose(n, p, k, |c, l| mt[l + c * n], u);
+    let not_pd = |v: &[f64]| Error::InvalidParameter {
+        name: "innovation covariance M S Mᵀ + R",
+        value: format!("{:?}", DMatrix::from_column_slice(k, k, v)),
+        reason: "is not positive definite: the observation adds nothing the filter can weigh \
+                 (a perfect observation of a component already known exactly)"
+            .into(),
     };
-    if let Some(&value) = full.iter().find(|v| !v.is_finite()) {
-        return Err(Error::NonFinite {
-            what: "measurement noise entry",
-            value,
-        });
+    innovation_covariance((n, k), mt, u, r, f, vp);
+    if !ldl(k, vp, lp) {
+        return Err(not_pd(vp));
     }
-    if (&full - full.transpose()).abs().max() > 1e-12 * full.abs().max()
-        || full.diagonal().iter().any(|&v| v < 0.0)
-    {
-        return Err(Error::InvalidParameter {
-            name: "measurement noise",
-            value: format!("{full:?}"),
-            reason: "must be symmetric with non-negative variances".into(),
-        });
+    // H = U V_P⁻¹ = U L⁻ᵀ D⁻¹ L⁻¹, a column at a time: G Lᵀ = U (columns forwards), each
+    // column divided by its pivot, then H L = G (backwards).
+    h.copy_from_slice(u);
+    for c in 0..k {
+        let (done, rest) = h.split_at_mut(c * n);
+        let column = &mut rest[..n];
+        for d in 0..c {
+            let (l, hd) = (lp[c + d * k], &done[d * n..(d + 1) * n]);
+            for i in 0..n {
+                column[i] -= l * hd[i];
+            }
+        }
     }
-    let r = DMatrix::from_fn(present.len(), present.len(), |i, j| {
-        full[(present[i], present[j])]
-    });
-    Ok((present, values, r))
+    for c in 0..k {
+        let pivot = lp[c + c * k];
+        for o in &mut h[c * n..(c + 1) * n] {
+            *o /= pivot;
+        }
+    }
+    for c in (0..k).rev() {
+        let (head, later) = h.split_at_mut((c + 1) * n);
+        let column = &mut head[c * n..];
+        for d in c + 1..k {
+            let (l, hd) = (lp[d + c * k], &later[(d - c - 1) * n..(d - c) * n]);
+            for i in 0..n {
+                column[i] -= l * hd[i];
+            }
+        }
+    }
+    // The innovation's true covariance M S Mᵀ + R (§14.8): V_P itself without fading.
+    let (v, lv, sm) = (&mut w.v[..kk], &mut w.lv[..kk], &mut w.sm[..nk]);
+    if fading {
+        times_transpose(n, s, k, |c, l| mt[l + c * n], sm);
+        innovation_covariance((n, k), mt, sm, r, 1.0, v);
+        if !ldl(k, v, lv) {
+            return Err(not_pd(v));
+        }
+    } else {
+        v.copy_from_slice(vp);
+        lv.copy_from_slice(lp);
+        sm.copy_from_slice(u);
+    }
+    let (nu, z) = (&w.nu[..k], &mut w.z[..k]);
+    // NIS = νᵀ V⁻¹ ν = Σ z_c² / D_c, z = L⁻¹ ν.
+    let mut nis = 0.0;
+    for c in 0..k {
+        let mut acc = nu[c];
+        for d in 0..c {
+            acc -= lv[c + d * k] * z[d];
+        }
+        z[c] = acc;
+        nis += acc * acc / lv[c + c * k];
+    }
+    let (x, x_out) = (&w.x.as_slice()[..n], &mut w.x_out.as_mut_slice()[..n]);
+    combine(n, k, h, |c| nu[c], x_out);
+    for i in 0..n {
+        x_out[i] += x[i];
+    }
+    let scratch = (
+        &mut w.square[..],
+        &mut w.y[..],
+        &mut w.hr[..],
+        &mut w.column[..],
+    );
+    let s_out = &mut w.s_out.as_mut_slice()[..nn];
+    joseph((n, k), s, h, sm, mt, r, scratch, s_out);
+    let mut finite_out = all_finite(x_out) & all_finite(s_out);
+    if fading {
+        let rf = &mut w.rf[..kk];
+        for (rf, r) in rf.iter_mut().zip(r) {
+            *rf = r * f;
+        }
+        let scratch = (
+            &mut w.square[..],
+            &mut w.y[..],
+            &mut w.hr[..],
+            &mut w.column[..],
+        );
+        let out = &mut w.p_out.as_mut_slice()[..nn];
+        joseph((n, k), p, h, u, mt, rf, scratch, out);
+        for v in out.iter_mut() {
+            *v /= f;
+        }
+        finite_out &= all_finite(out);
+    }
+    Ok((nis, log_det(k, lv), finite_out))
 }
 
-/// `(a + aᵀ)/2`.
-fn symmetric(a: DMatrix<f64>) -> DMatrix<f64> {
-    (&a + a.transpose()) * 0.5
-}
-
-fn finite(m: &DMatrix<f64>, what: &'static str) -> Result<(), Error> {
+/// A non-finite entry of `m`, named `what`, as an error.
+fn finite(m: &[f64], what: &'static str) -> Result<(), Error> {
+    if !m.iter().fold(false, |bad, v| bad | !v.is_finite()) {
+        return Ok(());
+    }
     match m.iter().find(|v| !v.is_finite()) {
         Some(&value) => Err(Error::NonFinite { what, value }),
         None => Ok(()),

@@ -16,6 +16,7 @@
 
 use crate::calculus::factorial;
 use crate::error::Error;
+use crate::numeric::power::powi;
 use nalgebra::DMatrix;
 
 /// A driving-noise model: `Q` over a step.
@@ -25,6 +26,23 @@ pub trait ProcessNoise: std::fmt::Debug + Send + Sync {
 
     /// `Q(t_b, t_a)`, symmetric and positive semidefinite, `n × n`.
     fn covariance(&self, t_a: f64, t_b: f64) -> Result<DMatrix<f64>, Error>;
+
+    /// [`ProcessNoise::covariance`] into the caller's `n × n` buffer (replaced if it is not
+    /// `n × n`), allocating nothing where the model allows ([`WhiteNoiseDerivative`] does):
+    /// what the Kalman filter calls at every prediction.
+    ///
+    /// ```
+    /// use nalgebra::DMatrix;
+    /// use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};
+    /// let noise = WhiteNoiseDerivative::new(1, 1, 0.5).unwrap();
+    /// let mut q = DMatrix::zeros(2, 2);
+    /// noise.covariance_into(10.0, 12.0, &mut q).unwrap();
+    /// assert_eq!(q, noise.covariance(10.0, 12.0).unwrap());
+    /// ```
+    fn covariance_into(&self, t_a: f64, t_b: f64, out: &mut DMatrix<f64>) -> Result<(), Error> {
+        *out = self.covariance(t_a, t_b)?;
+        Ok(())
+    }
 }
 
 /// White noise of power spectral density `q` on the highest derivative of a degree-`m`
@@ -77,6 +95,15 @@ impl ProcessNoise for WhiteNoiseDerivative {
     }
 
     fn covariance(&self, t_a: f64, t_b: f64) -> Result<DMatrix<f64>, Error> {
+        let n = self.dimension();
+        let mut q = DMatrix::zeros(n, n);
+        self.covariance_into(t_a, t_b, &mut q)?;
+        Ok(q)
+    }
+
+    /// The closed form on the upper triangle (`i ≤ j`), mirrored (the formula is symmetric in
+    /// `i, j`), `ζ^p` by [`powi`] (the roundings of `f64::powi`); the rest of `out` zero.
+    fn covariance_into(&self, t_a: f64, t_b: f64, out: &mut DMatrix<f64>) -> Result<(), Error> {
         for t in [t_a, t_b] {
             if !t.is_finite() {
                 return Err(Error::NonFinite {
@@ -88,23 +115,42 @@ impl ProcessNoise for WhiteNoiseDerivative {
         let (m, d) = (self.degree, self.axes);
         let zeta = (t_b - t_a).abs();
         let n = (m + 1) * d;
-        let mut q = DMatrix::zeros(n, n);
-        for i in 0..=m {
-            for j in 0..=m {
-                let p = 2 * m + 1 - i - j;
-                let v = self.psd * zeta.powi(p as i32)
-                    / (factorial::<f64>(m - i) * factorial::<f64>(m - j) * p as f64);
+        if out.shape() != (n, n) {
+            *out = DMatrix::zeros(n, n);
+        }
+        let out = out.as_mut_slice();
+        if d > 1 {
+            out.fill(0.0);
+        }
+        let mut finite = true;
+        // Derivatives i ≤ j counted from the highest, u = m − i ≥ v = m − j: p = u + v + 1.
+        for u in 0..m + 1 {
+            let fact_u = factorial::<f64>(u);
+            // v! as a running product: the operations of `factorial`, in the same order.
+            let mut fact_v = 1.0;
+            for v in 0..u + 1 {
+                if v > 1 {
+                    fact_v *= v as f64;
+                }
+                let p = u + v + 1;
+                let q = self.psd * powi(zeta, p as u32) / (fact_u * fact_v * p as f64);
+                finite &= q.is_finite();
+                let (i, j) = ((m - u) * d, (m - v) * d);
                 for a in 0..d {
-                    q[(i * d + a, j * d + a)] = v;
+                    out[(i + a) + (j + a) * n] = q;
+                    out[(j + a) + (i + a) * n] = q;
                 }
             }
         }
-        match q.iter().find(|v| !v.is_finite()) {
+        if finite {
+            return Ok(());
+        }
+        match out.iter().find(|v| !v.is_finite()) {
             Some(&value) => Err(Error::NonFinite {
                 what: "driving-noise covariance entry",
                 value,
             }),
-            None => Ok(q),
+            None => Ok(()),
         }
     }
 }

@@ -136,7 +136,7 @@ pub(crate) fn check_propagation(
             reason: format!("must have the model's dimension {n}"),
         });
     }
-    if let Some(v) = state.iter().find(|v| !v.is_finite()) {
+    if let Some(v) = state.as_slice().iter().find(|v| !v.is_finite()) {
         return Err(Error::NonFinite {
             what: "state entry",
             value: *v,
@@ -154,7 +154,7 @@ pub(crate) fn check_propagation(
 }
 
 pub(crate) fn finite_matrix(m: &DMatrix<f64>, what: &'static str) -> Result<(), Error> {
-    match m.iter().find(|v| !v.is_finite()) {
+    match m.as_slice().iter().find(|v| !v.is_finite()) {
         Some(&value) => Err(Error::NonFinite { what, value }),
         None => Ok(()),
     }
@@ -228,18 +228,25 @@ impl PolynomialDynamics {
 
     /// `Φ(ζ) = Ψ(ζ) ⊗ I_d` written into `out` (resized to `n × n` if it is not).
     fn transition_into(&self, zeta: f64, out: &mut DMatrix<f64>) {
-        let (d, m) = (self.axes, self.degree);
-        let n = (m + 1) * d;
+        let n = self.dimension();
         if out.shape() != (n, n) {
             *out = DMatrix::zeros(n, n);
-        } else {
-            out.fill(0.0);
         }
+        let out = out.as_mut_slice();
+        out.fill(0.0);
+        self.for_each_entry(zeta, |r, c, term| out[r + c * n] = term);
+    }
+
+    /// Calls `entry(r, c, ζ^k/k!)` for every entry of `Φ(ζ)` that is not structurally zero,
+    /// `[Φ]_{i d + a, (i + k) d + a}`, by `k` ascending (so each row's columns ascending), each
+    /// `ζ^k/k!` from [`psi_term`] once.
+    fn for_each_entry(&self, zeta: f64, mut entry: impl FnMut(usize, usize, f64)) {
+        let (d, m) = (self.axes, self.degree);
         for k in 0..=m {
             let term = psi_term(k, &zeta);
             for i in 0..=m - k {
                 for a in 0..d {
-                    out[(i * d + a, (i + k) * d + a)] = term;
+                    entry(i * d + a, (i + k) * d + a, term);
                 }
             }
         }
@@ -275,20 +282,31 @@ impl Dynamics for PolynomialDynamics {
     ) -> Result<(), Error> {
         let n = self.dimension();
         check_propagation(n, state, t_a, t_b)?;
-        self.transition_into(t_b - t_a, transition_out);
-        finite_matrix(transition_out, "transition matrix entry")?;
+        if transition_out.shape() != (n, n) {
+            *transition_out = DMatrix::zeros(n, n);
+        }
         if state_out.len() != n {
             *state_out = DVector::zeros(n);
         }
-        // Φ is upper triangular: row r sums from column r on.
-        for r in 0..n {
-            let mut acc = 0.0;
-            for c in r..n {
-                acc += transition_out[(r, c)] * state[c];
-            }
-            state_out[r] = acc;
+        // Φ's entries, and X(t_b) = Φ X(t_a) over them (each row's columns ascending; the
+        // structural zeros would add nothing), in one pass.
+        let (phi, x, out) = (
+            transition_out.as_mut_slice(),
+            state.as_slice(),
+            state_out.as_mut_slice(),
+        );
+        phi.fill(0.0);
+        out.fill(0.0);
+        let mut finite = true;
+        self.for_each_entry(t_b - t_a, |r, c, term| {
+            phi[r + c * n] = term;
+            out[r] += term * x[c];
+            finite &= term.is_finite();
+        });
+        if !finite {
+            finite_matrix(transition_out, "transition matrix entry")?;
         }
-        if let Some(v) = state_out.iter().find(|v| !v.is_finite()) {
+        if let Some(v) = state_out.as_slice().iter().find(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 what: "propagated state entry",
                 value: *v,

@@ -124,7 +124,7 @@ pub(crate) fn check_state(n: usize, state: &DVector<f64>) -> Result<(), Error> {
             reason: format!("the observation model needs {n} states"),
         });
     }
-    match state.iter().find(|v| !v.is_finite()) {
+    match state.as_slice().iter().find(|v| !v.is_finite()) {
         Some(&value) => Err(Error::NonFinite {
             what: "state entry",
             value,
@@ -210,6 +210,39 @@ impl Observation for LinearObservation {
                 jacobian: self.m.clone(),
             }),
         }
+    }
+
+    /// `M X` and `M` into the caller's buffers, allocating nothing when they have the right
+    /// shapes.
+    fn predict_into(
+        &self,
+        state: &DVector<f64>,
+        _t: f64,
+        value: &mut DVector<f64>,
+        jacobian: &mut DMatrix<f64>,
+    ) -> Result<(), Error> {
+        let (p, n) = self.m.shape();
+        check_state(n, state)?;
+        if value.len() != p {
+            *value = DVector::zeros(p);
+        }
+        // M X, each row's sum over the columns in order.
+        let (m, x, value) = (self.m.as_slice(), state.as_slice(), value.as_mut_slice());
+        for (r, v) in value.iter_mut().enumerate() {
+            *v = (0..n).map(|c| m[r + c * p] * x[c]).sum();
+        }
+        if let Some(&v) = value.iter().find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "predicted observation",
+                value: v,
+            });
+        }
+        if jacobian.shape() == self.m.shape() {
+            jacobian.as_mut_slice().copy_from_slice(self.m.as_slice());
+        } else {
+            *jacobian = self.m.clone();
+        }
+        Ok(())
     }
 }
 

@@ -264,7 +264,7 @@ impl Observation for Radar {
         if jacobian.shape() != (rows, self.states) {
             *jacobian = DMatrix::zeros(rows, self.states);
         } else {
-            jacobian.fill(0.0);
+            jacobian.as_mut_slice().fill(0.0);
         }
         value[0] = rho;
         value[1] = (p[1] + 0.0).atan2(p[0]); // + 0.0: atan2(−0, x < 0) is −π, outside (−π, π]
@@ -286,7 +286,12 @@ impl Observation for Radar {
                 jacobian[(3, 3 + k)] = p[k] / rho;
             }
         }
-        if let Some(&v) = value.iter().chain(jacobian.iter()).find(|v| !v.is_finite()) {
+        let (values, entries) = (value.as_slice(), jacobian.as_slice());
+        let finite = |a: &[f64]| a.iter().fold(true, |ok, v| ok & v.is_finite());
+        if finite(values) && finite(entries) {
+            return Ok(());
+        }
+        if let Some(&v) = values.iter().chain(entries).find(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 what: "radar prediction",
                 value: v,

@@ -1,10 +1,12 @@
 //! Numerical building blocks shared by the engines, banks and fixed-memory filters: one home
 //! each for the double-word (error-free) arithmetic ([`double_word`]), the tolerance that
 //! decides whether two sampling steps are the same step ([`steps`]), the memo of constants
-//! that cost exact arithmetic (`memo`), and the dispatch from a
-//! run-time state size to code compiled for that size (the crate-internal `unrolled_sizes!`).
+//! that cost exact arithmetic (`memo`), the dispatch from a
+//! run-time state size to code compiled for that size (the crate-internal `unrolled_sizes!`),
+//! and integer powers inline ([`power`]).
 
 pub mod double_word;
 pub(crate) mod memo;
+pub mod power;
 pub mod steps;
 pub(crate) mod unrolled;

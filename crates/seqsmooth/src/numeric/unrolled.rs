@@ -33,9 +33,47 @@ macro_rules! unrolled_sizes {
 }
 pub(crate) use unrolled_sizes;
 
+/// A size known at compile time ([`Fixed`]) or only at run time ([`Any`]). A kernel generic
+/// over it is one source, compiled once for each fixed size (its loops then have constant
+/// trip counts and unroll, closures and all) and once for any size; the caller picks through
+/// [`unrolled_sizes!`]: `unrolled_sizes!(n, N => kernel(Fixed::<N>, …), n => kernel(Any(n), …))`.
+pub(crate) trait Size: Copy {
+    /// The size.
+    fn get(self) -> usize;
+}
+
+/// The size `N`, a constant.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Fixed<const N: usize>;
+
+impl<const N: usize> Size for Fixed<N> {
+    #[inline(always)]
+    fn get(self) -> usize {
+        N
+    }
+}
+
+/// A size known only at run time.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Any(pub(crate) usize);
+
+impl Size for Any {
+    #[inline(always)]
+    fn get(self) -> usize {
+        self.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A fixed size is its constant; any size its value.
+    #[test]
+    fn sizes_report_themselves() {
+        let got = unrolled_sizes!(4usize, N => Fixed::<N>.get(), n => Any(n).get());
+        assert_eq!((got, Any(11).get()), (4, 11));
+    }
 
     /// Every size in range gets its own constant; the rest the general arm.
     #[test]
