@@ -10,6 +10,7 @@ use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
 use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::kalman::bayes::MAX_VARIANCE_INFLATION;
 use seqsmooth::kalman::{BayesFilter, Discount, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::LinearObservation;
@@ -248,4 +249,86 @@ fn true_covariance_covers_the_error() {
     println!("mean NEES with S*: {mean_true:.4}, with P: {mean_p:.4}, interval 2 ± {half:.4}");
     assert!((mean_true - 2.0).abs() <= half, "{mean_true}");
     assert!((mean_p - 2.0).abs() > 10.0 * half, "{mean_p}");
+}
+
+/// Ex. 14.9a (`Φ = I₂`, `M = (1, 1)`, `R = 1`, θ = 0.8 per update, prior `I`): the direction
+/// `v = (1, −1)/√2` is never observed, so its information fades as `θ^n` and the estimate's
+/// rounding error grows with the variance inflation (`θ^{−n}`). Oracle: the scalar recursion of
+/// `u = (1, 1)/√2` — information `z_n = θ z_{n−1} + 2` from `z_0 = 1`, estimate
+/// `û_n = (θ z_{n−1} û_{n−1} + √2 y_n)/z_n`, true variance `s_n = (θ z_{n−1}/z_n)² s_{n−1} +
+/// 2/z_n²` — with `v` at its prior (mean 0, variance 1). While the filter reports an estimate
+/// it is within 1e-4 σ of the oracle (its error ≤ 2 ε × the variance inflation; measured 1.1);
+/// from the update where the inflation passes `MAX_VARIANCE_INFLATION` on (near n = 110) it
+/// reports none (right or refused), up to n = 1,000.
+#[test]
+fn ex_14_9a_unobserved_direction_is_refused_once_it_has_faded() {
+    let theta: f64 = 0.8;
+    let mut f = BayesFilter::new(
+        PolynomialDynamics::new(0, 2),
+        LinearObservation::new(DMatrix::from_row_slice(1, 2, &[1.0, 1.0])).unwrap(),
+        0.0,
+    )
+    .unwrap()
+    .with_prior(&DVector::zeros(2), &DMatrix::identity(2, 2))
+    .unwrap()
+    .with_fading(Discount::PerUpdate(theta))
+    .unwrap();
+    let (mut z, mut u, mut s_u) = (1.0, 0.0, 1.0);
+    let (mut worst, mut worst_ratio): (f64, f64) = (0.0, 0.0);
+    let mut refused_from = None;
+    for n in 1..=1000 {
+        let y = (n as f64).cos() + 3.0;
+        let z_old = theta * z;
+        z = z_old + 2.0;
+        u = (z_old * u + std::f64::consts::SQRT_2 * y) / z;
+        s_u = (z_old / z).powi(2) * s_u + 2.0 / (z * z);
+        f.update(&Measurement {
+            time: n as f64,
+            values: vec![Some(y)],
+            noise: NoiseCovariance::Identity,
+        })
+        .unwrap();
+        // The oracle's variance inflation: P = diag in (u, v) of 1/z_n and θ^{−n}; P_00 J_00.
+        let inflation = (1.0 / z + theta.powi(-n)) / 2.0 * (z + theta.powi(n)) / 2.0;
+        let (Some(x), Some(s)) = (f.estimate(), f.covariance()) else {
+            refused_from.get_or_insert(n);
+            assert!(
+                inflation > 0.5 * MAX_VARIANCE_INFLATION,
+                "n {n}: refused at inflation {inflation:e}"
+            );
+            continue;
+        };
+        assert!(
+            refused_from.is_none(),
+            "n {n}: reported again after a refusal"
+        );
+        let r = std::f64::consts::FRAC_1_SQRT_2;
+        let want_x = DVector::from_vec(vec![u * r, u * r]);
+        let want_s = DMatrix::from_row_slice(
+            2,
+            2,
+            &[
+                (s_u + 1.0) / 2.0,
+                (s_u - 1.0) / 2.0,
+                (s_u - 1.0) / 2.0,
+                (s_u + 1.0) / 2.0,
+            ],
+        );
+        let e = worst_difference(&x, &s, &want_x, &want_s);
+        worst = worst.max(e);
+        worst_ratio = worst_ratio.max(e / (f64::EPSILON * inflation));
+        assert!(
+            e <= 1e-4,
+            "n {n}: {x} {s} against {want_x} {want_s} ({e:e})"
+        );
+        assert!(
+            e <= 2.0 * f64::EPSILON * inflation.max(10.0),
+            "n {n}: {e:e} at inflation {inflation:e}"
+        );
+    }
+    let from = refused_from.expect("the faded direction is refused");
+    assert!((100..=125).contains(&from), "refused from n = {from}");
+    println!(
+        "Ex. 14.9a: worst {worst:.2e} σ, {worst_ratio:.2} ε × inflation; refused from n = {from}"
+    );
 }

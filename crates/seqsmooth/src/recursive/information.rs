@@ -303,6 +303,32 @@ impl InformationFilter {
         Some(out)
     }
 
+    /// The largest variance inflation `max_i P_ii (RᵀR)_ii` (`P = (RᵀR)⁻¹`): 1 for a component
+    /// whose information is independent of the others', `1/(1 − ρ_i²)` for one whose estimate
+    /// correlates with the rest by the multiple correlation `ρ_i`, and without bound as a
+    /// direction loses its information (an unobserved direction under fading memory). It does
+    /// not depend on the state's units; the rounding error of the estimate, in its σ, grows
+    /// with it (measured 0.1-1.1 `ε` times it: the polynomial model to degree 8, Morrison's
+    /// Ex. 14.9a). `None` while not determined.
+    ///
+    /// ```
+    /// use seqsmooth::recursive::InformationFilter;
+    /// let mut f = InformationFilter::new(2);
+    /// f.observe(&[1.0, 0.0], 0.0, 1.0);
+    /// f.observe(&[0.0, 1e6], 0.0, 1.0);
+    /// assert!((f.variance_inflation().unwrap() - 1.0).abs() < 1e-12); // units don't matter
+    /// f.observe(&[1.0, 1e6], 0.0, 1e6);
+    /// assert!(f.variance_inflation().unwrap() > 1e5); // the two now move together
+    /// ```
+    pub fn variance_inflation(&self) -> Option<f64> {
+        let p = self.dim();
+        let ri = self.right_divide(&DMatrix::identity(p, p))?;
+        let r = self.info.r();
+        Some((0..p).fold(0.0, |worst: f64, i| {
+            worst.max(ri.row(i).norm_squared() * r.column(i).norm_squared())
+        }))
+    }
+
     /// The recursion's own matrix `P = (RᵀR)⁻¹` (14.3.13): the covariance when the weights
     /// are inverse variances and nothing faded.
     ///
