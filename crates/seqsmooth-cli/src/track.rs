@@ -4,16 +4,20 @@
 //! (`kalman::smooth`). The Kalman methods start from the first Gauss–Newton fit that
 //! determines the state.
 //!
-//! Rows are read and checked one at a time ([`rows`]: line and column in every message; each
-//! component's noise σ from the row's σ column or the flag). The window, kalman and fading
-//! methods stream: each row is tracked and its output row written as it is read, in memory
-//! independent of the input's length. The rows before the first estimate are held, so that an
-//! input that never determines the state writes nothing; the output file is a temporary file
-//! renamed onto the named one only when every row is done ([`Output`]), so a failure leaves
-//! no output file. The smoother needs every row before its first output: it keeps the rows
-//! after the start and smooths them at the end.
+//! Rows are read and checked one at a time (`track/rows.rs`: line and column in every
+//! message; each component's noise σ from the row's σ column or the flag). The window, kalman
+//! and fading methods stream: each row is tracked and its output row written as it is read, in
+//! memory independent of the input's length. Reading, tracking and writing run on three threads
+//! with a few batches of rows between them (`track/stream.rs`), so that parsing and formatting
+//! overlap the tracking; the output is the one of taking the rows one at a time, byte for byte.
+//! The rows before the first estimate are held, so that an input that never determines the
+//! state writes nothing; the output file is a temporary file renamed onto the named one only
+//! when every row is done ([`Output`]), so a failure leaves no output file. The smoother needs
+//! every row before its first output: it keeps the rows after the start and smooths them at
+//! the end.
 
 mod rows;
+mod stream;
 
 use crate::args::{AzimuthConvention, FitModel, TrackArgs, TrackMethod};
 use crate::error::CliError;
@@ -29,6 +33,7 @@ use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
 use std::collections::VecDeque;
+use stream::Block;
 
 /// The window of the Kalman methods' start (the first fit that determines the state).
 const START_WINDOW: usize = 60;
@@ -106,27 +111,10 @@ pub fn run(a: &TrackArgs) -> Result<(), CliError> {
         },
     ];
     let bearing = a.azimuth == AzimuthConvention::Bearing;
-    let mut rows = Rows::new(csv, &names, sigmas, bearing)?;
+    let rows = Rows::new(csv, &names, sigmas, bearing)?;
     let radar = Radar::new(a.site, 6).map_err(|e| CliError::Usage(e.to_string()))?;
     let mut tracker = Tracker::new(a, radar)?;
-    let mut out = Writer::new(a.output.as_deref());
-    let track = || -> Result<(), CliError> {
-        while rows.next()? {
-            match tracker.push(&rows.measurement, rows.line, &rows.time_text)? {
-                Step::Row(cells) => out.row(&rows.time_text, &cells)?,
-                Step::Held => {}
-            }
-        }
-        need.check(rows.count)?;
-        tracker.finish(&mut out)
-    };
-    match track() {
-        Ok(()) => out.finish(rows.count),
-        Err(e) => {
-            out.abandon();
-            Err(e)
-        }
-    }
+    stream::run(rows, &mut tracker, a.output.as_deref(), &need)
 }
 
 /// The output: rows gathered in a buffer, written in blocks once the state is determined (the
@@ -337,27 +325,28 @@ impl Tracker {
         Ok(Step::Row(row))
     }
 
-    /// Writes the rows held to the end: the smoother's.
-    fn finish(self, out: &mut Writer) -> Result<(), CliError> {
-        let Stage::Smoothing(filter, held) = self.stage else {
-            return Ok(());
+    /// The rows held to the end (the smoother's), smoothed.
+    fn finish(&mut self) -> Result<Option<Block>, CliError> {
+        let Stage::Smoothing(filter, held) = &mut self.stage else {
+            return Ok(None);
         };
+        let held = std::mem::take(held);
         let at = |i: usize| held.lines[i];
-        let smoothed = smooth(*filter, &held.measurements).map_err(|e| match e {
+        let smoothed = smooth((**filter).clone(), &held.measurements).map_err(|e| match e {
             Error::InBatch { index, source } => {
                 CliError::Data(format!("line {}: {source}", at(index)))
             }
             e => CliError::Data(format!("the smoother failed: {e}")),
         })?;
-        let mut start = 0;
-        for (s, &end) in smoothed.iter().zip(&held.ends) {
-            out.row(
-                &held.text[start..end],
-                &Some(cells(&s.state, &s.covariance, s.nis)),
-            )?;
-            start = end;
-        }
-        Ok(())
+        let cells = smoothed
+            .iter()
+            .map(|s| Some(Some(cells(&s.state, &s.covariance, s.nis))))
+            .collect();
+        Ok(Some(Block::Rows {
+            text: held.text,
+            ends: held.ends,
+            cells,
+        }))
     }
 
     /// A Kalman filter from a fit, with the method's driving noise or fading.

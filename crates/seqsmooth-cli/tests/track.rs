@@ -735,3 +735,111 @@ fn a_late_error_leaves_no_output() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A straight pass of `rows` rows (from (20, −15, 3) km at (−40, 25, −1) m/s, steps of
+/// 0.1 s, noise σ 10 m and 1 mrad, seed fixed), azimuth from +x.
+fn long_pass(rows: usize) -> String {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    let (nr, na) = (
+        Normal::new(0.0, SIGMA_RANGE).unwrap(),
+        Normal::new(0.0, SIGMA_ANGLE).unwrap(),
+    );
+    let mut csv = String::from("t,range,azimuth,elevation\n");
+    for k in 0..rows {
+        let t = k as f64 * 0.1;
+        let (x, y, z) = (2e4 - 40.0 * t, -1.5e4 + 25.0 * t, 3e3 - t);
+        csv += &format!(
+            "{t},{},{},{}\n",
+            (x * x + y * y + z * z).sqrt() + nr.sample(&mut rng),
+            y.atan2(x) + na.sample(&mut rng),
+            z.atan2(x.hypot(y)) + na.sample(&mut rng)
+        );
+    }
+    csv
+}
+
+/// The rows are read, tracked and written in batches of thousands on three threads; on an
+/// input of 10,000 rows the filters' output rows for the first 2,500, 4,096, 4,097 and 6,000
+/// rows are the first rows of the whole input's output, byte for byte (a filter's estimate
+/// depends only on the rows so far, so no batch boundary may show), and the same from a file
+/// as from standard input. An error on row 9,000 stops every streaming method with its line,
+/// leaves no output file, and gives standard output the header and the 8,999 rows before it.
+#[test]
+fn long_inputs_stream_across_batches() {
+    let input = long_pass(10_000);
+    let lines: Vec<&str> = input.lines().collect();
+    let prefix = |n: usize| lines[..=n].join("\n") + "\n";
+    let dir = tmp("track-long");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (file, out) = (dir.join("in.csv"), dir.join("out.csv"));
+    std::fs::write(&file, &input).unwrap();
+    let base = ["track", "--sigma-range", "10", "--sigma-angle", "1e-3"];
+    for method in [
+        &["--method", "kalman", "--q", "1"][..],
+        &["--method", "fading", "--beta", "0.9"],
+    ] {
+        let args: Vec<&str> = [&base[..], method].concat();
+        let whole = ok(&args, &input);
+        assert_eq!(whole.lines().count(), 10_001);
+        for n in [2500, 4096, 4097, 6000] {
+            let part = ok(&args, &prefix(n));
+            assert!(whole.starts_with(&part), "{method:?}: the first {n} rows");
+        }
+        let o = format!("--output={}", out.display());
+        let from_file: Vec<&str> = [&args[..], &[file.to_str().unwrap(), &o]].concat();
+        ok(&from_file, "");
+        assert!(
+            std::fs::read_to_string(&out).unwrap() == whole,
+            "{method:?}"
+        );
+    }
+    let mut bad = lines.clone();
+    bad[9000] = "899.9,NaN,0.1,0.1";
+    let bad = bad.join("\n") + "\n";
+    for method in [
+        &["--method", "kalman", "--q", "1"][..],
+        &["--method", "fading", "--beta", "0.9"],
+        &["--method", "smooth", "--q", "1"],
+    ] {
+        let args: Vec<&str> = [&base[..], method].concat();
+        let o = run(&args, &bad);
+        assert_eq!(o.code, 1, "{method:?}: {}", o.stderr);
+        assert!(
+            o.stderr.contains("line 9001, column 'range'"),
+            "{}",
+            o.stderr
+        );
+        if method[1] != "smooth" {
+            assert_eq!(o.stdout.lines().count(), 9000, "{method:?}");
+        }
+        let _ = std::fs::remove_file(&out);
+        let to_file = format!("--output={}", out.display());
+        fails(&[&args[..], &[&to_file]].concat(), &bad, 1, &["line 9001"]);
+        assert!(!out.exists(), "{method:?}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The writer's errors: an output file that cannot be created, and one that cannot be written
+/// (`/dev/full`), stop the command with a message naming the file (exit 1).
+#[test]
+fn output_errors_are_reported() {
+    let input = long_pass(3000);
+    let base = ["track", "--sigma-range", "10", "--sigma-angle", "1e-3"];
+    let missing = tmp("track-no-such-dir").join("sub").join("out.csv");
+    let o = format!("--output={}", missing.display());
+    fails(
+        &[&base[..], &[&o]].concat(),
+        &input,
+        1,
+        &["cannot create output file"],
+    );
+    if std::path::Path::new("/dev/full").exists() {
+        fails(
+            &[&base[..], &["--output=/dev/full"]].concat(),
+            &input,
+            1,
+            &["cannot write to '/dev/full'"],
+        );
+    }
+}

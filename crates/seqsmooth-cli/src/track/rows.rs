@@ -8,13 +8,11 @@
 //! cell must hold a positive number whose square (the variance) is a normal double. Every
 //! refusal names the file line and the column.
 //!
-//! One [`Measurement`] is kept and overwritten row after row: reading allocates nothing per
-//! row once the time cell's buffer has grown.
+//! The rows go into [`Batch`]es (numbers by row, time cells in one buffer): reading allocates
+//! nothing per row once a batch's buffers have grown.
 
 use crate::error::CliError;
 use crate::io::{find_column, parse_cell, shown, CsvIn};
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::model::radar::wrap;
 use std::f64::consts::{FRAC_PI_2, TAU};
 use std::io::Read;
@@ -43,8 +41,41 @@ struct Sigma {
     flag_name: &'static str,
 }
 
-/// The input, read row by row: [`Rows::next`] checks the next row and sets [`Rows::line`],
-/// [`Rows::time_text`] and [`Rows::measurement`].
+/// One checked row: its time, components (`None` for an empty cell, azimuths from +x), their
+/// noise variances (1 where a component is missing: unused) and its 1-based file line.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Row {
+    pub(crate) time: f64,
+    pub(crate) values: [Option<f64>; 3],
+    pub(crate) variances: [f64; 3],
+    pub(crate) line: u64,
+}
+
+/// Consecutive rows of the input, with their time cells as written (trimmed) in one buffer.
+#[derive(Debug, Default)]
+pub(crate) struct Batch {
+    pub(crate) rows: Vec<Row>,
+    /// The time cells, end to end; row `i`'s ends at `ends[i]`.
+    pub(crate) text: Vec<u8>,
+    pub(crate) ends: Vec<usize>,
+    /// Why the input ends after these rows, when it is an error: the next row's.
+    pub(crate) error: Option<CliError>,
+    /// Whether the input ends after these rows (at its end or at `error`).
+    pub(crate) last: bool,
+    /// Data rows read up to the end of this batch.
+    pub(crate) count: usize,
+}
+
+impl Batch {
+    /// The time cell of row `i`, as written.
+    pub(crate) fn time_text(&self, i: usize) -> &[u8] {
+        let start = if i == 0 { 0 } else { self.ends[i - 1] };
+        &self.text[start..self.ends[i]]
+    }
+}
+
+/// The input, read row by row: [`Rows::next`] checks the next row and appends it to a
+/// [`Batch`].
 pub(crate) struct Rows<R: Read> {
     csv: CsvIn<R>,
     time: Cell,
@@ -53,16 +84,10 @@ pub(crate) struct Rows<R: Read> {
     /// The range's σ and the angles' σ.
     sigmas: [Sigma; 2],
     bearing: bool,
-    /// The previous row's time and line.
+    /// The previous row's time, line and time cell (for the message of a time that does not
+    /// increase).
     previous: Option<(f64, u64)>,
-    /// The current row's 1-based file line (the header's before the first row).
-    pub(crate) line: u64,
-    /// The current row's time cell, as written (trimmed); the previous row's while a row is
-    /// being checked.
-    pub(crate) time_text: Vec<u8>,
-    /// The current row's measurement: time, components (`None` for an empty cell, azimuths
-    /// from +x) and their variances (1 where a component is missing: unused).
-    pub(crate) measurement: Measurement,
+    previous_text: Vec<u8>,
     /// Data rows read so far.
     pub(crate) count: usize,
 }
@@ -119,25 +144,19 @@ impl<R: Read> Rows<R> {
             sigmas: [sigma(range_sigma)?, sigma(angle_sigma)?],
             bearing,
             previous: None,
-            line,
-            time_text: Vec::new(),
-            measurement: Measurement {
-                time: 0.0,
-                values: vec![None; 3],
-                noise: NoiseCovariance::Variances(vec![1.0; 3]),
-            },
+            previous_text: Vec::new(),
             count: 0,
             csv,
         })
     }
 
-    /// Reads and checks the next row; `false` at the end of the input.
-    pub(crate) fn next(&mut self) -> Result<bool, CliError> {
+    /// Reads and checks the next row and appends it to `batch`; `false` at the end of the
+    /// input.
+    pub(crate) fn next(&mut self, batch: &mut Batch) -> Result<bool, CliError> {
         if !self.csv.next_record()? {
             return Ok(false);
         }
         let line = self.csv.line;
-        self.line = line;
         let t_cell = self.csv.field(self.time.index);
         let t = parse_cell(t_cell, line, &self.time.name, "time")?;
         if let Some((previous, previous_line)) = self.previous {
@@ -152,7 +171,7 @@ impl<R: Read> Rows<R> {
                      {previous_line}): {why}",
                     self.time.name,
                     shown(t_cell),
-                    shown(&self.time_text)
+                    shown(&self.previous_text)
                 )));
             }
         }
@@ -180,16 +199,18 @@ impl<R: Read> Rows<R> {
             values[1] = values[1].map(|b| wrap(FRAC_PI_2 - b));
         }
         let t_cell = self.csv.field(self.time.index);
-        self.time_text.clear();
-        self.time_text.extend_from_slice(t_cell);
+        self.previous_text.clear();
+        self.previous_text.extend_from_slice(t_cell);
+        batch.text.extend_from_slice(t_cell);
+        batch.ends.push(batch.text.len());
+        batch.rows.push(Row {
+            time: t,
+            values,
+            variances,
+            line,
+        });
         self.previous = Some((t, line));
         self.count += 1;
-        let m = &mut self.measurement;
-        m.time = t;
-        m.values.copy_from_slice(&values);
-        if let NoiseCovariance::Variances(v) = &mut m.noise {
-            v.copy_from_slice(&variances);
-        }
         Ok(true)
     }
 
