@@ -262,7 +262,7 @@ impl Tracker {
     fn push(&mut self, m: &Measurement, line: u64, t: &[u8]) -> Result<Step, CliError> {
         match &mut self.stage {
             Stage::Filtering(filter) => {
-                let innovation = filter.update(m).map_err(|e| {
+                let innovation = filter.update_stats(m).map_err(|e| {
                     CliError::Data(format!("line {line}: the filter's update failed: {e}"))
                 })?;
                 Ok(Step::Row(Some(cells(
@@ -305,9 +305,12 @@ impl Tracker {
     /// the previous row's fit.
     fn window_step(&mut self, m: &Measurement, line: u64) -> Result<Step, CliError> {
         let nis = match &self.stage {
-            Stage::Window(_, _, Some(p)) => {
-                self.filter_from(p)?.update(m).ok().flatten().map(|i| i.nis)
-            }
+            Stage::Window(_, _, Some(p)) => self
+                .filter_from(p)?
+                .update_stats(m)
+                .ok()
+                .flatten()
+                .map(|i| i.nis),
             _ => None,
         };
         let Stage::Window(fit, lines, previous) = &mut self.stage else {
