@@ -148,22 +148,9 @@ struct Fading {
 }
 
 impl Fading {
-    /// `β^(t − t_last)` or `θ`, in `(0, 1]`.
+    /// `β^(t − t_last)` or `θ`, in `(0, 1]` ([`Discount`]'s factor over the step).
     fn factor(&self, t: f64) -> Result<f64, Error> {
-        let f = match self.discount {
-            Discount::PerTime(beta) => beta.powf((t - self.last_update).abs()),
-            Discount::PerUpdate(theta) => theta,
-        };
-        if f > 0.0 && f.is_normal() {
-            Ok(f)
-        } else {
-            Err(Error::InvalidParameter {
-                name: "discount over the step",
-                value: format!("{f:e} over {} since the last update", t - self.last_update),
-                reason: "underflows: the memory holds nothing; raise beta or update more often"
-                    .into(),
-            })
-        }
+        self.discount.factor_over(t - self.last_update)
     }
 }
 
@@ -305,17 +292,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// assert!((f.covariance()[(0, 0)] - 1.0 / 3.0).abs() < 1e-12); // (1 − θ)/(1 + θ)
     /// ```
     pub fn with_fading(mut self, discount: Discount) -> Result<Self, Error> {
-        let (name, value) = match discount {
-            Discount::PerTime(b) => ("beta", b),
-            Discount::PerUpdate(t) => ("theta", t),
-        };
-        if !(value > 0.0 && value <= 1.0) {
-            return Err(Error::InvalidParameter {
-                name,
-                value: value.to_string(),
-                reason: "the discount must lie in (0, 1]".into(),
-            });
-        }
+        let discount = discount.checked()?;
         self.fading = Some(Fading {
             discount,
             weight: self.covariance.clone(),
@@ -640,9 +617,11 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             (w.present, w.values) = m.present(p)?;
         }
         let entry = noise_entries(p, &m.noise)?;
+        // Column by column; off the diagonal only a full R has entries other than 0.
+        let full = matches!(m.noise, NoiseCovariance::Full(_));
         let (mut largest, mut asymmetry, mut negative) = (0.0_f64, 0.0_f64, false);
-        for i in 0..p {
-            for j in 0..p {
+        for j in 0..p {
+            for i in if full { 0..p } else { j..j + 1 } {
                 let v = entry(i, j);
                 if !v.is_finite() {
                     return Err(Error::NonFinite {
@@ -893,16 +872,17 @@ fn times_transpose(
     }
 }
 
-/// `out = Σ_c b(c) a[:, c]` for one column `out` (`n`) and `a` `n × k`.
+/// `out = Σ_c b(c) a[:, c]` for one column `out` (`n`) and `a` `n × k`: each entry summed
+/// over `c` in order (in a register, with both sizes constants).
 #[inline(always)]
 fn combine(n: usize, k: usize, a: &[f64], b: impl Fn(usize) -> f64, out: &mut [f64]) {
-    let out = &mut out[..n];
-    out.fill(0.0);
-    for c in 0..k {
-        let (a, scale) = (&a[c * n..(c + 1) * n], b(c));
-        for r in 0..n {
-            out[r] += a[r] * scale;
+    let (a, out) = (&a[..n * k], &mut out[..n]);
+    for r in 0..n {
+        let mut acc = 0.0;
+        for c in 0..k {
+            acc += a[r + c * n] * b(c);
         }
+        out[r] = acc;
     }
 }
 

@@ -17,6 +17,7 @@
 use crate::calculus::factorial;
 use crate::error::Error;
 use crate::numeric::power::powi;
+use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
 use nalgebra::DMatrix;
 
 /// A driving-noise model: `Q` over a step.
@@ -122,26 +123,9 @@ impl ProcessNoise for WhiteNoiseDerivative {
         if d > 1 {
             out.fill(0.0);
         }
-        let mut finite = true;
-        // Derivatives i ≤ j counted from the highest, u = m − i ≥ v = m − j: p = u + v + 1.
-        for u in 0..m + 1 {
-            let fact_u = factorial::<f64>(u);
-            // v! as a running product: the operations of `factorial`, in the same order.
-            let mut fact_v = 1.0;
-            for v in 0..u + 1 {
-                if v > 1 {
-                    fact_v *= v as f64;
-                }
-                let p = u + v + 1;
-                let q = self.psd * powi(zeta, p as u32) / (fact_u * fact_v * p as f64);
-                finite &= q.is_finite();
-                let (i, j) = ((m - u) * d, (m - v) * d);
-                for a in 0..d {
-                    out[(i + a) + (j + a) * n] = q;
-                    out[(j + a) + (i + a) * n] = q;
-                }
-            }
-        }
+        let psd = self.psd;
+        let finite = unrolled_sizes!(m + 1, M => fill(Fixed::<M>, d, psd, zeta, out),
+            size => fill(Any(size), d, psd, zeta, out));
         if finite {
             return Ok(());
         }
@@ -153,4 +137,34 @@ impl ProcessNoise for WhiteNoiseDerivative {
             None => Ok(()),
         }
     }
+}
+
+/// The entries of [`WhiteNoiseDerivative`]'s `Q` for `size = m + 1` (a constant through the
+/// size dispatch for the common degrees, so that each `ζ^p` is multiplied out and each
+/// denominator folded: the same operations) on `d` axes into the zeroed `out`; whether all are
+/// finite. Derivatives `i ≤ j` are counted from the highest, `u = m − i ≥ v = m − j`, so
+/// `p = 2m + 1 − i − j = u + v + 1`; each entry is written at `(i, j)` and `(j, i)` of each axis.
+#[inline(always)]
+fn fill<S: Size>(size: S, d: usize, psd: f64, zeta: f64, out: &mut [f64]) -> bool {
+    let (size, mut finite) = (size.get(), true);
+    let n = size * d;
+    for u in 0..size {
+        let fact_u = factorial::<f64>(u);
+        // v! as a running product: the operations of `factorial`, in the same order.
+        let mut fact_v = 1.0;
+        for v in 0..u + 1 {
+            if v > 1 {
+                fact_v *= v as f64;
+            }
+            let p = u + v + 1;
+            let q = psd * powi(zeta, p as u32) / (fact_u * fact_v * p as f64);
+            finite &= q.is_finite();
+            let (i, j) = ((size - 1 - u) * d, (size - 1 - v) * d);
+            for a in 0..d {
+                out[(i + a) + (j + a) * n] = q;
+                out[(j + a) + (i + a) * n] = q;
+            }
+        }
+    }
+    finite
 }

@@ -15,6 +15,7 @@
 use super::linear::LinearDynamics;
 use super::transition::psi_term;
 use crate::error::Error;
+use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
 use nalgebra::{DMatrix, DVector};
 
 /// The state at `t_b` and the transition matrix `Φ(t_b, t_a)` that carried it there.
@@ -239,15 +240,25 @@ impl PolynomialDynamics {
 
     /// Calls `entry(r, c, ζ^k/k!)` for every entry of `Φ(ζ)` that is not structurally zero,
     /// `[Φ]_{i d + a, (i + k) d + a}`, by `k` ascending (so each row's columns ascending), each
-    /// `ζ^k/k!` from [`psi_term`] once.
-    fn for_each_entry(&self, zeta: f64, mut entry: impl FnMut(usize, usize, f64)) {
-        let (d, m) = (self.axes, self.degree);
-        for k in 0..=m {
-            let term = psi_term(k, &zeta);
-            for i in 0..=m - k {
-                for a in 0..d {
-                    entry(i * d + a, (i + k) * d + a, term);
-                }
+    /// `ζ^k/k!` from [`psi_term`] once. The size `m + 1` goes through the crate's size dispatch:
+    /// for the common degrees `k` is then a constant in each `ζ^k/k!` (its power multiplied
+    /// out, the factorial folded; the same operations).
+    fn for_each_entry(&self, zeta: f64, entry: impl FnMut(usize, usize, f64)) {
+        let d = self.axes;
+        unrolled_sizes!(self.degree + 1, M => entries(Fixed::<M>, d, zeta, entry),
+            m => entries(Any(m), d, zeta, entry));
+    }
+}
+
+/// [`PolynomialDynamics::for_each_entry`] for `size = m + 1` on `d` axes.
+#[inline(always)]
+fn entries<S: Size>(size: S, d: usize, zeta: f64, mut entry: impl FnMut(usize, usize, f64)) {
+    let size = size.get();
+    for k in 0..size {
+        let term = psi_term(k, &zeta);
+        for i in 0..size - k {
+            for a in 0..d {
+                entry(i * d + a, (i + k) * d + a, term);
             }
         }
     }
@@ -296,11 +307,15 @@ impl Dynamics for PolynomialDynamics {
             state_out.as_mut_slice(),
         );
         phi.fill(0.0);
-        out.fill(0.0);
         let mut finite = true;
+        // Each row's diagonal entry (k = 0) comes first: it starts the row's sum.
         self.for_each_entry(t_b - t_a, |r, c, term| {
             phi[r + c * n] = term;
-            out[r] += term * x[c];
+            if r == c {
+                out[r] = term * x[c];
+            } else {
+                out[r] += term * x[c];
+            }
             finite &= term.is_finite();
         });
         if !finite {
