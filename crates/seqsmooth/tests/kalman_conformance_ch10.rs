@@ -20,6 +20,7 @@
 
 mod common;
 
+use common::kalman::cov_err;
 use common::rational::{eye, fr, inv, mm, to_f64, z, Q};
 use nalgebra::{DMatrix, DVector};
 use num_traits::Zero;
@@ -46,19 +47,6 @@ fn meas(t: f64, values: &[f64], noise: NoiseCovariance) -> Measurement {
         values: values.iter().map(|&v| Some(v)).collect(),
         noise,
     }
-}
-
-/// The largest `|A_ij − B_ij| / sqrt(B_ii B_jj)` (a covariance difference in units of its
-/// standard deviations; `B` positive definite).
-fn cov_err(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
-    let mut worst: f64 = 0.0;
-    for i in 0..b.nrows() {
-        for j in 0..b.ncols() {
-            let scale = (b[(i, i)] * b[(j, j)]).sqrt();
-            worst = worst.max((a[(i, j)] - b[(i, j)]).abs() / scale);
-        }
-    }
-    worst
 }
 
 /// The exact Bayes filter in information form over the rationals ((10.2.51)-(10.2.55) as

@@ -10,6 +10,7 @@
 
 mod common;
 
+use common::kalman::cov_err;
 use common::rational::{eye, inv, mm, to_f64, z, Q};
 use nalgebra::{DMatrix, DVector};
 use num_traits::Zero;
@@ -28,18 +29,6 @@ fn m(rows: usize, cols: usize, v: &[f64]) -> DMatrix<f64> {
 
 fn to_q(a: &DMatrix<f64>) -> DMatrix<Q> {
     a.map(|v| Q::from_float(v).unwrap())
-}
-
-/// The largest `|A_ij − B_ij| / sqrt(B_ii B_jj)` over the entries where `B_ii B_jj > 0`.
-fn cov_err(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
-    let mut worst: f64 = 0.0;
-    for i in 0..b.nrows() {
-        for j in 0..b.ncols() {
-            let scale = (b[(i, i)] * b[(j, j)]).sqrt();
-            worst = worst.max((a[(i, j)] - b[(i, j)]).abs() / scale);
-        }
-    }
-    worst
 }
 
 /// The driving noise of the transformed state `Λ = C X`: `C Q Cᵀ` ((15.2.23) with `C D`).

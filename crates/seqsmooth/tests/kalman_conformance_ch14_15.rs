@@ -20,6 +20,7 @@
 
 mod common;
 
+use common::kalman::cov_err;
 use common::rational::{mm, to_f64};
 use nalgebra::{DMatrix, DVector};
 use num_traits::Zero;
@@ -44,18 +45,6 @@ fn meas(t: f64, values: &[f64], variances: &[f64]) -> Measurement {
         values: values.iter().map(|&v| Some(v)).collect(),
         noise: NoiseCovariance::Variances(variances.to_vec()),
     }
-}
-
-/// The largest `|A_ij − B_ij| / sqrt(B_ii B_jj)` (`B` positive definite).
-fn cov_err(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
-    let mut worst: f64 = 0.0;
-    for i in 0..b.nrows() {
-        for j in 0..b.ncols() {
-            let scale = (b[(i, i)] * b[(j, j)]).sqrt();
-            worst = worst.max((a[(i, j)] - b[(i, j)]).abs() / scale);
-        }
-    }
-    worst
 }
 
 /// `Φ(ζ) = diag(1, (−1)^ζ)` on whole steps ζ (Ex. 14.9b's transition): a model no real
@@ -135,6 +124,29 @@ fn run_fading<D: Dynamics>(
     (gain, f.covariance().clone())
 }
 
+/// Runs [`run_fading`] for 400 updates and checks its gain and true covariance against
+/// [`limit`] of `z` (`Z_∞` at θ) and `z2` (at θ²) within `tol` relative; returns the larger
+/// error.
+#[allow(clippy::too_many_arguments)]
+fn reaches_limit<D: Dynamics>(
+    dynamics: D,
+    obs: &DMatrix<f64>,
+    theta: f64,
+    step: f64,
+    z: &DMatrix<f64>,
+    z2: &DMatrix<f64>,
+    tol: f64,
+    label: &str,
+) -> f64 {
+    let (want_h, want_s) = limit(z, z2, obs);
+    let (h, s) = run_fading(dynamics, obs, theta, step, 400);
+    let eh = (&h - &want_h).amax() / want_h.amax();
+    let es = cov_err(&s, &want_s);
+    assert!(eh < tol, "{label}: H {h} against {want_h} ({eh:e})");
+    assert!(es < tol, "{label}: S {s} against {want_s} ({es:e})");
+    eh.max(es)
+}
+
 /// Ex. 14.9b: `Φ = diag(1, −1)`, `M = (1, 1)`, `R = 1`: `Z_∞ = I/(1−β) + [[0, 1], [1, 0]]/(1+β)`
 /// (positive definite: the filter settles). The count-based fading Kalman filter, θ = 0.5, 0.8,
 /// 0.9, 400 updates: its gain and true covariance reach the closed form's within 1e-12 relative
@@ -153,13 +165,18 @@ fn ex_14_9b_the_filter_reaches_z_infinity() {
             acc + (&d * obs.transpose() * &obs * &d) * theta.powi(k)
         });
         assert!((&series - z(theta)).amax() < 1e-12 * z(theta).amax());
-        let (want_h, want_s) = limit(&z(theta), &z(theta * theta), &obs);
-        let (h, s) = run_fading(Flip, &obs, theta, 1.0, 400);
-        let eh = (&h - &want_h).amax() / want_h.amax();
-        let es = cov_err(&s, &want_s);
-        worst = worst.max(eh).max(es);
-        assert!(eh < 1e-12, "θ {theta}: H {h} against {want_h}");
-        assert!(es < 1e-12, "θ {theta}: S {s} against {want_s}");
+        let label = format!("θ {theta}");
+        let e = reaches_limit(
+            Flip,
+            &obs,
+            theta,
+            1.0,
+            &z(theta),
+            &z(theta * theta),
+            1e-12,
+            &label,
+        );
+        worst = worst.max(e);
     }
     println!("worst: {worst:e}");
 }
@@ -208,13 +225,17 @@ fn ex_14_6_and_14_7_the_filter_reaches_z_infinity() {
     });
     assert!((&series - z(theta)).amax() < 1e-12 * z(theta).amax());
     let mut worst: f64 = 0.0;
-    let (want_h, want_s) = limit(&z(theta), &z(theta * theta), &obs);
-    let (h, s) = run_fading(dynamics.clone(), &obs, theta, PI, 400);
-    let eh = (&h - &want_h).amax() / want_h.amax();
-    let es = cov_err(&s, &want_s);
-    worst = worst.max(eh).max(es);
-    assert!(eh < 1e-11, "τ = π: H {h} against {want_h} ({eh:e})");
-    assert!(es < 1e-11, "τ = π: S {s} against {want_s} ({es:e})");
+    let (z1, z2) = (z(theta), z(theta * theta));
+    worst = worst.max(reaches_limit(
+        dynamics.clone(),
+        &obs,
+        theta,
+        PI,
+        &z1,
+        &z2,
+        1e-11,
+        "τ = π",
+    ));
 
     // τ = 2π: Φ = I₄, Z = MᵀM/(1−θ) with a rank-4 M.
     let obs4 = m(
@@ -226,13 +247,17 @@ fn ex_14_6_and_14_7_the_filter_reaches_z_infinity() {
     );
     assert_eq!(obs4.rank(1e-12), 4);
     let g = obs4.transpose() * &obs4;
-    let (want_h, want_s) = limit(&(&g / (1.0 - theta)), &(&g / (1.0 - theta * theta)), &obs4);
-    let (h, s) = run_fading(dynamics, &obs4, theta, 2.0 * PI, 400);
-    let eh = (&h - &want_h).amax() / want_h.amax();
-    let es = cov_err(&s, &want_s);
-    worst = worst.max(eh).max(es);
-    assert!(eh < 1e-11, "τ = 2π: H {h} against {want_h} ({eh:e})");
-    assert!(es < 1e-11, "τ = 2π: S {s} against {want_s} ({es:e})");
+    let (z1, z2) = (&g / (1.0 - theta), &g / (1.0 - theta * theta));
+    worst = worst.max(reaches_limit(
+        dynamics,
+        &obs4,
+        theta,
+        2.0 * PI,
+        &z1,
+        &z2,
+        1e-11,
+        "τ = 2π",
+    ));
     println!("worst: {worst:e}");
 }
 

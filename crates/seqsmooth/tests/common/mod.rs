@@ -9,6 +9,7 @@ pub mod batch;
 pub mod book;
 pub mod engine;
 pub mod fixed;
+pub mod kalman;
 pub mod monte_carlo;
 pub mod rational;
 pub mod smooth;
