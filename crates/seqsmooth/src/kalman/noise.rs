@@ -17,7 +17,7 @@
 use crate::calculus::factorial;
 use crate::error::Error;
 use crate::numeric::power::powi;
-use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
+use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size, UNROLLED_MAX_SIZE};
 use nalgebra::DMatrix;
 
 /// A driving-noise model: `Q` over a step.
@@ -148,16 +148,24 @@ impl ProcessNoise for WhiteNoiseDerivative {
 fn fill<S: Size>(size: S, d: usize, psd: f64, zeta: f64, out: &mut [f64]) -> bool {
     let (size, mut finite) = (size.get(), true);
     let n = size * d;
+    // k! for k < size as a running product (the operations of `factorial`, in its order), in a
+    // table when `size` is one the dispatch unrolls.
+    let mut table = [1.0; UNROLLED_MAX_SIZE];
+    let tabled = size <= UNROLLED_MAX_SIZE;
+    for k in 2..if tabled { size } else { 0 } {
+        table[k] = table[k - 1] * k as f64;
+    }
+    let fact = |k: usize| {
+        if tabled {
+            table[k]
+        } else {
+            factorial::<f64>(k)
+        }
+    };
     for u in 0..size {
-        let fact_u = factorial::<f64>(u);
-        // v! as a running product: the operations of `factorial`, in the same order.
-        let mut fact_v = 1.0;
         for v in 0..u + 1 {
-            if v > 1 {
-                fact_v *= v as f64;
-            }
             let p = u + v + 1;
-            let q = psd * powi(zeta, p as u32) / (fact_u * fact_v * p as f64);
+            let q = psd * powi(zeta, p as u32) / (fact(u) * fact(v) * p as f64);
             finite &= q.is_finite();
             let (i, j) = ((size - 1 - u) * d, (size - 1 - v) * d);
             for a in 0..d {

@@ -12,7 +12,7 @@
 /// assert_eq!(powi(1.5, 0), 1.0);
 /// assert_eq!(powi(0.1, 7), 0.1f64.powi(7));
 /// ```
-#[inline]
+#[inline(always)]
 pub fn powi(x: f64, p: u32) -> f64 {
     let (mut base, mut p, mut acc) = (x, p, 1.0);
     loop {
