@@ -33,9 +33,36 @@
 //! runs over all the windows of the fit from the (precomputed) nominal, of the bootstrap and
 //! the fit, and of the bootstrap alone (the measurements built outside the timing).
 //!
+//! A `kalman-q` run (`name data kalman-q degree q=Q r=R`) is the Kalman filter
+//! ([`KalmanFilter`]) on the polynomial model of that degree on one axis with white-noise
+//! driving noise of spectral density `Q` on the highest derivative
+//! ([`WhiteNoiseDerivative`]), the first value observed with variance `R`, started at sample
+//! `degree` from the prior in `DIR/<name>.prior.f64` (the state, then the covariance row by
+//! row, as the script computed it for filterpy) and predicted and updated with every later
+//! sample. It writes `.est.f64` and `.last.f64` as above and prints
+//! `name,updates,seconds_update,seconds_update_estimate,,seconds_full_innovation`: the best of
+//! `REPS` runs of the loop of [`KalmanFilter::update_stats`] (NIS and log-likelihood, no
+//! allocation), of that loop also copying each state out, and of the loop of
+//! [`KalmanFilter::update`] (each update's full [`seqsmooth::kalman::Innovation`]).
+//!
+//! An `ekf` run (`name radar ekf 1 tracks=W`) is the extended Kalman filter on the first `W`
+//! radar tracks of `benches/common/kalman.rs` (the criterion bench's): it writes
+//! `DIR/<name>.data.f64` (`W × 59 × 4`: `t, ρ, ψ, θ` of each update), `DIR/<name>.prior.f64`
+//! (`W × 43`: the prior's time, state and covariance row by row), `DIR/<name>.est.f64` and
+//! `DIR/<name>.sigma.f64` (`W × 59 × 6`: the state and the square roots of its covariance's
+//! diagonal after each update), and prints the timings as a `kalman-q` run does, over all the
+//! tracks (each track's filter copied before the timing).
+//!
 //! Each timed loop is one small function per filter family ([`feed`], [`feed_and_read`],
 //! [`feed_fixed_and_read`]), so a batch update API can replace the per-sample loop in one place.
 
+use nalgebra::{DMatrix, DVector};
+use seqsmooth::estimate::batch::NoiseCovariance;
+use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+use seqsmooth::kalman::KalmanFilter;
+use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+use seqsmooth::model::observation::{LinearObservation, Observation};
 use seqsmooth::polynomial::fixed::smooth_into;
 use seqsmooth::{
     DiscountMode, Engine, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory, PolynomialFilter,
@@ -50,6 +77,9 @@ type Res<T> = Result<T, Box<dyn Error>>;
 
 #[path = "../benches/common/radar.rs"]
 mod radar;
+
+#[path = "../benches/common/kalman.rs"]
+mod kalman_tracks;
 
 /// One line of `runs.txt`.
 struct Run {
@@ -259,6 +289,120 @@ fn gauss_newton(dir: &Path, name: &str, windows: usize, reps: usize) -> Res<()> 
     Ok(())
 }
 
+/// The three timed loops of a Kalman filter over `tracks` (each a filter and its measurements,
+/// the filters copied before each timing): [`KalmanFilter::update_stats`], the same copying
+/// each state into `out` (`updates × n`, in order), and [`KalmanFilter::update`]; seconds.
+fn time_kalman<D, O>(
+    reps: usize,
+    tracks: &[(KalmanFilter<D, O>, &[Measurement])],
+    out: &mut [f64],
+) -> Res<(f64, f64, f64)>
+where
+    D: Dynamics + Clone,
+    O: Observation + Clone,
+{
+    let filters = || Ok(tracks.iter().map(|(f, _)| f.clone()).collect::<Vec<_>>());
+    let quiet = best_of(reps, filters, |fs| {
+        for (f, (_, rows)) in fs.iter_mut().zip(tracks) {
+            for m in rows.iter() {
+                black_box(f.update_stats(black_box(m))?);
+            }
+        }
+        Ok(())
+    })?;
+    let read = best_of(reps, filters, |fs| {
+        let mut at = out.chunks_exact_mut(tracks[0].0.state().len());
+        for (f, (_, rows)) in fs.iter_mut().zip(tracks) {
+            for m in rows.iter() {
+                black_box(f.update_stats(black_box(m))?);
+                let row = at.next().ok_or("output too short")?;
+                row.copy_from_slice(f.state().as_slice());
+            }
+        }
+        Ok(())
+    })?;
+    let full = best_of(reps, filters, |fs| {
+        for (f, (_, rows)) in fs.iter_mut().zip(tracks) {
+            for m in rows.iter() {
+                black_box(f.update(black_box(m))?);
+            }
+        }
+        Ok(())
+    })?;
+    Ok((quiet, read, full))
+}
+
+/// The `kalman-q` run (see the module docs).
+fn kalman_q(dir: &Path, run: &Run, t: &[f64], y: &[f64], reps: usize) -> Res<()> {
+    let (m, w) = (run.degree, run.degree + 1);
+    let (q, r): (f64, f64) = (run.key("q")?, run.key("r")?);
+    let prior = read_f64s(&dir.join(format!("{}.prior.f64", run.name)))?;
+    if prior.len() != w + w * w || t.len() <= w {
+        return Err(format!("run {}: prior or data of the wrong size", run.name).into());
+    }
+    let filter = KalmanFilter::new(
+        PolynomialDynamics::new(m, 1),
+        LinearObservation::value_of(w),
+        DVector::from_column_slice(&prior[..w]),
+        DMatrix::from_row_slice(w, w, &prior[w..]),
+        t[m],
+    )?
+    .with_process_noise(WhiteNoiseDerivative::new(m, 1, q)?)?;
+    let rows: Vec<Measurement> = (w..t.len())
+        .map(|i| Measurement {
+            time: t[i],
+            values: vec![Some(y[i])],
+            noise: NoiseCovariance::Variances(vec![r]),
+        })
+        .collect();
+    let mut out = vec![f64::NAN; t.len() * w];
+    out[m * w..w * w].copy_from_slice(&prior[..w]);
+    let tracks = [(filter, &rows[..])];
+    let (quiet, read, full) = time_kalman(reps, &tracks, &mut out[w * w..])?;
+    let mut f = tracks[0].0.clone();
+    for m in &rows {
+        f.update_stats(m)?;
+    }
+    write_f64s(&dir.join(format!("{}.est.f64", run.name)), &out)?;
+    write_f64s(
+        &dir.join(format!("{}.last.f64", run.name)),
+        f.state().as_slice(),
+    )?;
+    println!("{},{},{quiet:e},{read:e},,{full:e}", run.name, rows.len());
+    Ok(())
+}
+
+/// The `ekf` run (see the module docs).
+fn ekf(dir: &Path, name: &str, count: usize, reps: usize) -> Res<()> {
+    let tracks = kalman_tracks::tracks(radar::SEED, count);
+    let filters: Vec<_> = tracks
+        .iter()
+        .map(|t| (t.filter(), &t.measurements[..]))
+        .collect();
+    let updates: usize = tracks.iter().map(|t| t.measurements.len()).sum();
+    let mut est = vec![0.0; updates * 6];
+    let (quiet, read, full) = time_kalman(reps, &filters, &mut est)?;
+    let (mut data, mut prior, mut sigma) = (Vec::new(), Vec::new(), Vec::new());
+    for (track, (filter, rows)) in tracks.iter().zip(&filters) {
+        prior.push(track.time);
+        prior.extend(track.state.iter());
+        prior.extend(track.covariance.transpose().iter());
+        let mut f = filter.clone();
+        for m in rows.iter() {
+            data.push(m.time);
+            data.extend(m.values.iter().map(|v| v.unwrap_or(f64::NAN)));
+            f.update_stats(m)?;
+            sigma.extend(f.covariance().diagonal().iter().map(|v| v.sqrt()));
+        }
+    }
+    write_f64s(&dir.join(format!("{name}.data.f64")), &data)?;
+    write_f64s(&dir.join(format!("{name}.prior.f64")), &prior)?;
+    write_f64s(&dir.join(format!("{name}.est.f64")), &est)?;
+    write_f64s(&dir.join(format!("{name}.sigma.f64")), &sigma)?;
+    println!("{name},{updates},{quiet:e},{read:e},,{full:e}");
+    Ok(())
+}
+
 fn main() -> Res<()> {
     let args: Vec<String> = std::env::args().collect();
     if args.len() != 3 {
@@ -282,6 +426,10 @@ fn main() -> Res<()> {
             gauss_newton(dir, &run.name, run.key("windows")?, reps)?;
             continue;
         }
+        if run.filter == "ekf" {
+            ekf(dir, &run.name, run.key("tracks")?, reps)?;
+            continue;
+        }
         if !data.contains_key(&run.data) {
             let t = read_f64s(&dir.join(format!("{}.t.f64", run.data)))?;
             let y = read_f64s(&dir.join(format!("{}.y.f64", run.data)))?;
@@ -293,6 +441,10 @@ fn main() -> Res<()> {
             data.insert(run.data.clone(), (t, y));
         }
         let (t, y) = &data[&run.data];
+        if run.filter == "kalman-q" {
+            kalman_q(dir, &run, t, y, reps)?;
+            continue;
+        }
         let m = run.degree;
         let (plain, read, out, last, switched) = match run.filter.as_str() {
             "fading-gain" => {
