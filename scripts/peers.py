@@ -244,12 +244,25 @@ def psi_q(m, h, q):
     return F, Q
 
 
+def kf_pass(kf, ys, fq, out):
+    """filterpy KalmanFilter: predict(F=F, Q=Q) and update(y) for each y and (F, Q) of fq (a
+    list, or a generator building them), the state after each into out (unless None); the
+    seconds."""
+    start = time.perf_counter()
+    for i, (z, (F, Q)) in enumerate(zip(ys, fq)):
+        kf.predict(F=F, Q=Q)
+        kf.update(z)
+        if out is not None:
+            out[i] = kf.x[:, 0]
+    return time.perf_counter() - start
+
+
 def run_kf_q(t, y, m, q, x0, P0):
     """filterpy.kalman.KalmanFilter with driving noise from sample m (prior x0, P0): predict
     with F(dt), Q(dt), update with y. Timed twice: with F and Q prepared for every step before
     the loop (predict + update alone), and building them in the loop."""
     n = len(t)
-    FQ = [psi_q(m, t[i] - t[i - 1], q) for i in range(m + 1, n)]
+    steps = np.diff(t)[m:]
 
     def make():
         kf = KalmanFilter(dim_x=m + 1, dim_z=1)
@@ -262,21 +275,10 @@ def run_kf_q(t, y, m, q, x0, P0):
 
     out = np.full((n, m + 1), np.nan)
     out[m] = x0
-    kf = make()
-    start = time.perf_counter()
-    for i, (F, Q) in zip(range(m + 1, n), FQ):
-        kf.predict(F=F, Q=Q)
-        kf.update(y[i])
-        out[i] = kf.x[:, 0]
-    secs = time.perf_counter() - start
-    kf2 = make()
-    start = time.perf_counter()
-    for i in range(m + 1, n):
-        F, Q = psi_q(m, t[i] - t[i - 1], q)
-        kf2.predict(F=F, Q=Q)
-        kf2.update(y[i])
-    secs_build = time.perf_counter() - start
-    if not np.array_equal(kf.x, kf2.x):
+    kf, kf_built = make(), make()
+    secs = kf_pass(kf, y[m + 1:], [psi_q(m, h, q) for h in steps], out[m + 1:])
+    secs_build = kf_pass(kf_built, y[m + 1:], (psi_q(m, h, q) for h in steps), None)
+    if not np.array_equal(kf.x, kf_built.x):
         sys.exit("filterpy KalmanFilter: the two timed loops differ")
     return out, secs, secs_build, n - m - 1
 
@@ -471,15 +473,16 @@ def main():
     def last(name):
         return np.fromfile(os.path.join(a.dir, f"{name}.last.f64"), dtype="<f8")
 
-    def check_last(pair, peer_name, peer_last, our_name, our_label, scale_rows, tol):
+    def check_last(pair, peer_name, peer_last, our_name, our_label, scale_rows, tol,
+                   call="update_many"):
         """The state after our update-only call (the timed one) against the peer's last."""
         mine = last(our_name)
         scale = np.max(np.abs(scale_rows), axis=0)
         err = float(np.max(np.abs(peer_last - mine) / np.where(scale > 0, scale, 1.0)))
-        agree.append({"pair": f"{pair}: {peer_name}, last state vs {our_label} after update_many",
+        agree.append({"pair": f"{pair}: {peer_name}, last state vs {our_label} after {call}",
                       "err": err, "tol": tol, "rows": "last", "metric": "max abs(ours_k)"})
         if not err <= tol:
-            failures.append(f"{pair}, {our_label} update_many: difference {err:.2e} > {tol:.1e}")
+            failures.append(f"{pair}, {our_label} {call}: difference {err:.2e} > {tol:.1e}")
 
     def record(pair, peer_name, peer_updates, peer_secs, our_name, our_label, err, tol, rows_cmp,
                metric="max abs(ours_k)"):
@@ -675,8 +678,8 @@ def main():
     pair = f"Kalman, {KQ_DEGREE + 1} states, q = {KQ_Q}, irregular"
     record(pair, "filterpy KalmanFilter (F, Q given)", count, secs, name,
            "KalmanFilter::update_stats", err, TOL["kalman_q"], f"{KQ_DEGREE}..{len(tk) - 1}")
-    check_last(pair, "filterpy KalmanFilter", out[-1], name, "KalmanFilter::update_stats",
-               mine[KQ_DEGREE:], TOL["kalman_q"])
+    check_last(pair, "filterpy KalmanFilter", out[-1], name, "KalmanFilter", mine[KQ_DEGREE:],
+               TOL["kalman_q"], call="the update_stats loop")
     o = ours[name]
     kq_rows.append((pair, "KalmanFilter.predict(F, Q) + update", secs / count,
                     secs_build / count, o["upd"] / o["n"], o["extra"][0] / o["n"],

@@ -289,44 +289,53 @@ fn gauss_newton(dir: &Path, name: &str, windows: usize, reps: usize) -> Res<()> 
     Ok(())
 }
 
-/// The three timed loops of a Kalman filter over `tracks` (each a filter and its measurements,
-/// the filters copied before each timing): [`KalmanFilter::update_stats`], the same copying
-/// each state into `out` (`updates × n`, in order), and [`KalmanFilter::update`]; seconds.
-fn time_kalman<D, O>(
+/// Filters, each with the measurements it updates with.
+type Tracks<'a, D, O> = [(KalmanFilter<D, O>, &'a [Measurement])];
+
+/// Best seconds of `reps` runs of `step(filter, measurement, index)` over every measurement of
+/// every track (`index` counting the updates in order), the filters copied before each run.
+fn time_tracks<D, O>(
     reps: usize,
-    tracks: &[(KalmanFilter<D, O>, &[Measurement])],
-    out: &mut [f64],
-) -> Res<(f64, f64, f64)>
+    tracks: &Tracks<D, O>,
+    mut step: impl FnMut(&mut KalmanFilter<D, O>, &Measurement, usize) -> Res<()>,
+) -> Res<f64>
 where
     D: Dynamics + Clone,
     O: Observation + Clone,
 {
-    let filters = || Ok(tracks.iter().map(|(f, _)| f.clone()).collect::<Vec<_>>());
-    let quiet = best_of(reps, filters, |fs| {
+    let setup = || Ok(tracks.iter().map(|(f, _)| f.clone()).collect::<Vec<_>>());
+    best_of(reps, setup, |fs| {
+        let mut index = 0;
         for (f, (_, rows)) in fs.iter_mut().zip(tracks) {
             for m in rows.iter() {
-                black_box(f.update_stats(black_box(m))?);
+                step(f, black_box(m), index)?;
+                index += 1;
             }
         }
         Ok(())
-    })?;
-    let read = best_of(reps, filters, |fs| {
-        let mut at = out.chunks_exact_mut(tracks[0].0.state().len());
-        for (f, (_, rows)) in fs.iter_mut().zip(tracks) {
-            for m in rows.iter() {
-                black_box(f.update_stats(black_box(m))?);
-                let row = at.next().ok_or("output too short")?;
-                row.copy_from_slice(f.state().as_slice());
-            }
-        }
+    })
+}
+
+/// The three timed loops of a Kalman filter over `tracks`: [`KalmanFilter::update_stats`], the
+/// same copying each state into `out` (`updates × n`, in order), and [`KalmanFilter::update`];
+/// seconds.
+fn time_kalman<D, O>(reps: usize, tracks: &Tracks<D, O>, out: &mut [f64]) -> Res<(f64, f64, f64)>
+where
+    D: Dynamics + Clone,
+    O: Observation + Clone,
+{
+    let n = tracks[0].0.state().len();
+    let quiet = time_tracks(reps, tracks, |f, m, _| {
+        black_box(f.update_stats(m)?);
         Ok(())
     })?;
-    let full = best_of(reps, filters, |fs| {
-        for (f, (_, rows)) in fs.iter_mut().zip(tracks) {
-            for m in rows.iter() {
-                black_box(f.update(black_box(m))?);
-            }
-        }
+    let read = time_tracks(reps, tracks, |f, m, i| {
+        black_box(f.update_stats(m)?);
+        out[i * n..(i + 1) * n].copy_from_slice(f.state().as_slice());
+        Ok(())
+    })?;
+    let full = time_tracks(reps, tracks, |f, m, _| {
+        black_box(f.update(m)?);
         Ok(())
     })?;
     Ok((quiet, read, full))

@@ -441,13 +441,9 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         measurement: &Measurement,
         report: impl FnOnce(&Work, InnovationStats) -> T,
     ) -> Result<Option<T>, Error> {
-        let k = self.measure(measurement)?;
-        let t = measurement.time;
-        self.predict_work(t)?;
-        if k == 0 {
-            self.commit_prediction(t);
+        let Some(t) = self.measure_and_predict(measurement)? else {
             return Ok(None);
-        }
+        };
         let stats = self.correct(t, false)?;
         let out = report(&self.work, stats);
         self.commit_correction(t);
@@ -493,13 +489,9 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
                     .into(),
             });
         }
-        let k = self.measure(measurement)?;
-        let t = measurement.time;
-        self.predict_work(t)?;
-        if k == 0 {
-            self.commit_prediction(t);
+        let Some(t) = self.measure_and_predict(measurement)? else {
             return Ok(None);
-        }
+        };
         let prior = self.work.s.clone();
         let metric = Cholesky::new(prior.clone());
         self.work.about.copy_from(&self.work.x);
@@ -524,6 +516,20 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             tolerance,
             chi_squared: f64::NAN,
         })
+    }
+
+    /// The start of every update: the measurement read ([`Self::measure`]) and the prediction
+    /// to its time ([`Self::predict_work`]); with no component present the prediction is made
+    /// the filter's and `None` returned, else the time to correct at.
+    fn measure_and_predict(&mut self, measurement: &Measurement) -> Result<Option<f64>, Error> {
+        let k = self.measure(measurement)?;
+        let t = measurement.time;
+        self.predict_work(t)?;
+        if k == 0 {
+            self.commit_prediction(t);
+            return Ok(None);
+        }
+        Ok(Some(t))
     }
 
     /// The prediction to `t` into the work buffers (`X_{n,n−1}`, `S_{n,n−1}` and the fading
