@@ -14,8 +14,9 @@
 //! The covariance update is Joseph's form (12.3.7), not (12.2.18): it is the covariance of the
 //! estimate for the gain actually used, a sum of two positive semidefinite terms, so it stays
 //! symmetric positive semidefinite where `(I − H M) S` loses it by cancellation (§12.4 item 5,
-//! Ex. 12.16); it costs two more `n × n` products. A perfect observation (`R = 0`, Ex. 12.12,
-//! 12.13) is allowed while `V` stays positive definite.
+//! Ex. 12.16); as applied here (below) it costs `O(n² k)` more than (12.2.18) for `k`
+//! components. A perfect observation (`R = 0`, Ex. 12.12, 12.13) is allowed while `V` stays
+//! positive definite.
 //!
 //! Each update reports its innovation `ν`, its covariance `V`, the normalised innovation
 //! squared `NIS = νᵀ V⁻¹ ν` (χ² with as many degrees of freedom as components when the model
@@ -41,10 +42,16 @@
 //!   Adding `0 · a` changes nothing for a finite `a`, so skipping them changes no result.
 //! - Joseph's form applies `I − H M` from each side instead of forming it:
 //!   `X = S − H (M S)`, then `X − (X Mᵀ) Hᵀ + H R Hᵀ`, `O(n² k)` for `k` components instead of
-//!   `O(n³)`.
-//! - The state dimension `n` goes through the crate's one size dispatch (`unrolled_sizes!`,
-//!   [`crate::numeric`]): for `n ≤ 9` each kernel is compiled with `n` a constant (its loops
-//!   unrolled), larger `n` take the same source with `n` a variable.
+//!   `O(n³)`: the same products associated differently (for any gain, not only the optimal
+//!   one).
+//! - `V = L D Lᵀ` (the square-root-free Cholesky factorisation) gives the gain
+//!   `H = (S Mᵀ) L⁻ᵀ D⁻¹ L⁻¹`, `NIS = Σ (L⁻¹ ν)_c² / D_c` and `ln det V = Σ ln D_c`, with no square
+//!   root and fewer roundings than `L Lᵀ`.
+//! - The state dimension `n` and the present components `k` go through the crate's one size
+//!   dispatch (`unrolled_sizes!`, [`crate::numeric`]): for `n ≤ 9` and `k ≤ 4` each kernel is
+//!   compiled with them constants (its loops unrolled), other sizes take the same source with
+//!   them variables. Measured in BENCHMARKS.md ("Kalman and extended Kalman filters against
+//!   filterpy").
 
 use super::noise::ProcessNoise;
 use crate::error::Error;
