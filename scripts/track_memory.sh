@@ -6,8 +6,8 @@
 # the origin at steps U(0.05, 0.15) s, range noise sigma 10 m, angle noise 1 mrad by
 # Box-Muller; awk's srand(1), so the same digits for the same awk), columns
 # t,range,azimuth,elevation. The output goes to /dev/null. Prints, per method, the rows, the
-# wall time (generation included: awk writes ~1e6 rows/s, on the other core), rows/s and the
-# maximum resident set size of the seqsmooth process.
+# wall time (generation included: awk writes about 5e5 rows/s, slower than the filters, so the
+# wall is awk's for kalman and fading), rows/s and the peak resident set size of seqsmooth.
 #
 # Usage: scripts/track_memory.sh [ROWS] [METHOD...]
 #   ROWS defaults to 200000; METHODs (kalman, fading, smooth, window) default to
