@@ -372,6 +372,25 @@ fn scalar_run(
     out
 }
 
+/// Checks each step of a [`scalar_run`] with constant `σ²`: `p = h σ²` and `s*` within 1e-12
+/// relative of the recursions; returns the larger error.
+fn follows_the_recursion(run: &[(f64, f64, f64, f64)], sigma2: f64, beta: f64) -> f64 {
+    let mut worst: f64 = 0.0;
+    for (n, &(h, s, p, s_want)) in run.iter().enumerate() {
+        let eh = (h * sigma2 / p - 1.0).abs();
+        let es = (s / s_want - 1.0).abs();
+        worst = worst.max(eh).max(es);
+        assert!(
+            eh < 1e-12,
+            "β {beta} n {}: p {} against {p}",
+            n + 1,
+            h * sigma2
+        );
+        assert!(es < 1e-12, "β {beta} n {}: s* {s} against {s_want}", n + 1);
+    }
+    worst
+}
+
 /// Ex. 14.14: `ẋ = −x`, eigenvalue `e^{−1}` inside the unit circle: `p_n⁻¹ = β^τ e^{2τ}
 /// p_{n−1}⁻¹ + m²/σ²`, so for `e^{−2} < β ≤ 1` `p_{n,n} → 0` and `s*_{n,n} → 0`, with or without
 /// observations. σ² = 1/4; β = 1, 0.5 (> e^{−2}): the gain is `p_n/σ²` of the recursion within
@@ -385,18 +404,7 @@ fn ex_14_14_stable_scalar() {
     let mut worst: f64 = 0.0;
     for beta in [1.0, 0.5, 0.1] {
         let run = scalar_run(-1.0, beta, 120, |_| sigma2);
-        for (n, &(h, s, p, s_want)) in run.iter().enumerate() {
-            let eh = (h * sigma2 / p - 1.0).abs();
-            let es = (s / s_want - 1.0).abs();
-            worst = worst.max(eh).max(es);
-            assert!(
-                eh < 1e-12,
-                "β {beta} n {}: p {} against {p}",
-                n + 1,
-                h * sigma2
-            );
-            assert!(es < 1e-12, "β {beta} n {}: s* {s} against {s_want}", n + 1);
-        }
+        worst = worst.max(follows_the_recursion(&run, sigma2, beta));
         let &(h, s, _, _) = run.last().unwrap();
         if beta > (-2.0f64).exp() {
             assert!(
@@ -456,18 +464,7 @@ fn ex_14_15_unstable_scalar() {
     let mut worst: f64 = 0.0;
     for beta in [1.0, 0.7] {
         let run = scalar_run(1.0, beta, 60, |_| sigma2);
-        for (n, &(h, s, p, s_want)) in run.iter().enumerate() {
-            let eh = (h * sigma2 / p - 1.0).abs();
-            let es = (s / s_want - 1.0).abs();
-            worst = worst.max(eh).max(es);
-            assert!(
-                eh < 1e-12,
-                "β {beta} n {}: p {} against {p}",
-                n + 1,
-                h * sigma2
-            );
-            assert!(es < 1e-12, "β {beta} n {}: s* {s} against {s_want}", n + 1);
-        }
+        worst = worst.max(follows_the_recursion(&run, sigma2, beta));
         let &(h, s, _, _) = run.last().unwrap();
         let want = sigma2 * (1.0 - beta * (-2.0f64).exp());
         assert!(
