@@ -10,6 +10,7 @@ use crate::error::CliError;
 use crate::filter::rows::{Chunk, RowReader};
 use crate::io::{check_distinct, open_input, Need, Output};
 use seqsmooth::polynomial::fixed::smooth_into;
+use seqsmooth::Error;
 
 /// Runs `seqsmooth smooth`: header `t,y,d0..dM`, one row per input row in input order.
 pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
@@ -31,18 +32,23 @@ pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
     }
     need.check(rows.len())?;
     // The arguments and the rows are checked already (degree, window, finite and increasing
-    // values, enough of them): an error left here is about the data as a whole.
+    // values, enough of them): an error left here is a derivative beyond the double range at
+    // a row, or about the data as a whole.
     let mut fits = vec![0.0; rows.len() * (a.degree + 1)];
-    smooth_into(&rows.t, &rows.y, a.degree, a.window, &mut fits)
-        .map_err(|e| CliError::Data(format!("cannot smooth the input: {e}")))?;
-    if let Some(i) = fits.iter().position(|v| !v.is_finite()) {
-        let (row, k) = (i / (a.degree + 1), i % (a.degree + 1));
-        return Err(CliError::Data(format!(
-            "line {}: the smoothed d{k} is too large for a double (beyond 1.8e308); express the \
-             times in a larger unit or rescale the values",
-            rows.lines[row]
-        )));
-    }
+    smooth_into(&rows.t, &rows.y, a.degree, a.window, &mut fits).map_err(|e| match e {
+        Error::InBatch { index, source } => match *source {
+            Error::EstimateOutOfRange { what } => CliError::Data(format!(
+                "line {}: the smoothed {what} is too large for a double (beyond 1.8e308); \
+                 express the times in a larger unit or rescale the values",
+                rows.lines[index]
+            )),
+            other => CliError::Data(format!(
+                "line {}: cannot smooth: {other}",
+                rows.lines[index]
+            )),
+        },
+        e => CliError::Data(format!("cannot smooth the input: {e}")),
+    })?;
     let mut out = Output::create(a.output.as_deref())?;
     let mut text = Vec::new();
     rows.header(&mut text, None, a.degree, false, &[]);

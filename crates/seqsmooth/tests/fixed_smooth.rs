@@ -223,3 +223,29 @@ fn smooth_rejects_bad_input_anywhere_in_long_series() {
         })
     ));
 }
+
+/// A derivative beyond the double range is refused with its sample, even and irregular
+/// times alike: values near 1e308 at steps of 1e-3 have first derivatives near 1e311. The
+/// same values at unit steps are in range and returned.
+#[test]
+fn smooth_refuses_derivatives_beyond_the_double_range() {
+    let mut y = vec![1.0; 10];
+    (y[3], y[4]) = (1e308, -1e308);
+    let even: Vec<f64> = (0..10).map(|k| 1e-3 * k as f64).collect();
+    let irregular: Vec<f64> = even.iter().map(|t| t * (1.0 + 0.01 * t)).collect();
+    for t in [&even, &irregular] {
+        match smooth(t, &y, 2, 5) {
+            Err(Error::InBatch { index, source }) => {
+                assert!(index < 10);
+                assert!(
+                    matches!(*source, Error::EstimateOutOfRange { ref what } if what.starts_with('d')),
+                    "{source}"
+                );
+            }
+            other => panic!("expected an error, got {other:?}"),
+        }
+    }
+    let unit: Vec<f64> = (0..10).map(f64::from).collect();
+    let rows = smooth(&unit, &y, 2, 5).unwrap();
+    assert!(rows.iter().flatten().all(|v| v.is_finite()));
+}

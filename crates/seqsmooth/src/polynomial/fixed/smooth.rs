@@ -145,7 +145,9 @@ impl SeriesWindows for IrregularSeries<'_> {
 ///   in a centred Legendre basis ([`crate::estimate::PolynomialFit`]).
 ///
 /// Errors: `window < m+1`, `window` longer than the series, `m > MAX_DEGREE`, NaN or
-/// infinite input, non-increasing times, mismatched lengths.
+/// infinite input, non-increasing times, mismatched lengths; a derivative beyond the double
+/// range ([`Error::EstimateOutOfRange`] in [`Error::InBatch`] naming the sample): no number
+/// returned is NaN or infinite.
 ///
 /// ```
 /// use seqsmooth::polynomial::fixed::smooth;
@@ -173,7 +175,9 @@ pub fn smooth(
 /// layout of [`crate::PolynomialFilter::update_many_into`] and of numpy's `(len, m+1)`
 /// arrays), without allocating per sample.
 ///
-/// Errors: those of [`smooth`], and `estimates.len() ≠ times.len()·(m+1)`.
+/// Errors: those of [`smooth`], and `estimates.len() ≠ times.len()·(m+1)`. A derivative
+/// beyond the double range is [`Error::EstimateOutOfRange`] inside [`Error::InBatch`] with the
+/// first such sample's index (the estimates are written, that one and later ones unusable).
 ///
 /// ```
 /// use seqsmooth::polynomial::fixed::{smooth, smooth_into};
@@ -201,7 +205,7 @@ pub fn smooth_into(
         });
     }
     check_estimates_length(times, m, estimates)?;
-    if is_evenly_spaced(times) {
+    let fitted = if is_evenly_spaced(times) {
         let span = window - 1;
         let step = if len >= 2 {
             (times[len - 1] - times[0]) / (len - 1) as f64
@@ -225,5 +229,15 @@ pub fn smooth_into(
             fits: IrregularWindow::new(m, window),
         };
         centred_rows(len, window, irregular, estimates)
+    };
+    fitted?;
+    match estimates.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(Error::InBatch {
+            index: i / (m + 1),
+            source: Box::new(Error::EstimateOutOfRange {
+                what: format!("d{}", i % (m + 1)),
+            }),
+        }),
     }
 }
