@@ -332,6 +332,11 @@ fn command_modules_import_only_from_their_level_or_below() {
 }
 
 #[test]
+fn binding_modules_import_only_from_their_level_or_below() {
+    check_crate("seqsmooth-py", &root().join("crates/seqsmooth-py/src"));
+}
+
+#[test]
 fn the_checker_sees_braced_relative_and_inline_paths() {
     let module: Vec<String> = ["polynomial", "fading", "filter"]
         .iter()

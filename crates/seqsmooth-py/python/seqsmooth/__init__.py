@@ -1,0 +1,56 @@
+"""seqsmooth: sequential smoothing and prediction (Morrison, *Introduction to Sequential
+Smoothing and Prediction*, 1969), a binding of the Rust library of the same name.
+
+Filters
+-------
+ExpandingMemory, FadingMemory, FixedMemory
+    The polynomial filters of any degree on any (irregular, Unix-epoch) timestamps:
+    ``update(t, y)``, ``update_many(t, y) -> ndarray``, ``estimate()``, ``estimate_at(t)``.
+
+Functions
+---------
+smooth
+    ``scipy.signal.savgol_filter``'s names and meaning, on irregular times too.
+
+Conventions: derivatives are unscaled, in the caller's time units (``[x, x', x'', ...]``);
+every error is a :class:`SeqsmoothError` (a ``ValueError``) naming the bad value and, in a
+batch, its ``index``.
+"""
+
+from . import errors
+from ._seqsmooth import (
+    MAX_DEGREE,
+    ExpandingMemory,
+    FadingMemory,
+    FixedMemory,
+    PolynomialFilter,
+    State,
+    smooth,
+)
+from .errors import (
+    InvalidInputError,
+    InvalidTypeError,
+    NotDeterminedError,
+    NumericalError,
+    ParameterError,
+    SeqsmoothError,
+    TooFewSamplesError,
+)
+
+__all__ = [
+    "MAX_DEGREE",
+    "ExpandingMemory",
+    "FadingMemory",
+    "FixedMemory",
+    "PolynomialFilter",
+    "State",
+    "smooth",
+    "errors",
+    "SeqsmoothError",
+    "InvalidInputError",
+    "InvalidTypeError",
+    "ParameterError",
+    "TooFewSamplesError",
+    "NotDeterminedError",
+    "NumericalError",
+]

@@ -1,0 +1,81 @@
+"""Type stubs of the native module (the classes and functions re-exported by seqsmooth)."""
+
+from typing import Literal, overload
+
+import numpy as np
+import numpy.typing as npt
+
+ArrayLike = npt.ArrayLike
+Matrix = npt.NDArray[np.float64]
+Vector = npt.NDArray[np.float64]
+
+MAX_DEGREE: int
+
+class State:
+    """The estimate of a polynomial filter at one time."""
+
+    @property
+    def time(self) -> float: ...
+    @property
+    def derivatives(self) -> Vector: ...
+    @property
+    def covariance(self) -> Matrix | None: ...
+    @property
+    def sigma(self) -> Vector | None: ...
+
+class PolynomialFilter:
+    @property
+    def degree(self) -> int: ...
+    @property
+    def samples(self) -> int: ...
+    @property
+    def last_time(self) -> float | None: ...
+    @property
+    def is_determined(self) -> bool: ...
+    def update(self, t: float, y: float) -> None: ...
+    @overload
+    def update_many(
+        self, t: ArrayLike, y: ArrayLike, return_sigma: Literal[False] = ...
+    ) -> Matrix: ...
+    @overload
+    def update_many(
+        self, t: ArrayLike, y: ArrayLike, return_sigma: Literal[True]
+    ) -> tuple[Matrix, Matrix]: ...
+    def estimate(self) -> State: ...
+    def estimate_at(self, t: float) -> State: ...
+
+class ExpandingMemory(PolynomialFilter):
+    def __init__(
+        self,
+        degree: int,
+        engine: Literal["exact", "gain"] = "exact",
+        sigma: float | None = None,
+    ) -> None: ...
+
+class FadingMemory(PolynomialFilter):
+    def __init__(
+        self,
+        degree: int,
+        theta: float,
+        tau: float = 1.0,
+        engine: Literal["exact", "gain"] = "exact",
+        sigma: float | None = None,
+    ) -> None: ...
+
+class FixedMemory(PolynomialFilter):
+    def __init__(
+        self,
+        degree: int,
+        window: int,
+        engine: Literal["adaptive", "sliding", "direct", "irregular"] = "adaptive",
+        sigma: float | None = None,
+    ) -> None: ...
+
+def smooth(
+    y: ArrayLike,
+    window_length: int,
+    polyorder: int,
+    deriv: int = 0,
+    delta: float = 1.0,
+    t: ArrayLike | None = None,
+) -> Vector: ...

@@ -1,0 +1,97 @@
+//! The library's [`seqsmooth::Error`] as the Python exceptions of `seqsmooth.errors` (defined
+//! in Python, so that `InvalidTypeError` can be both an `InvalidInputError` and a
+//! `TypeError`): the class by the kind of error, the message the library's, and the sample's
+//! index for an error inside a batch.
+
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use pyo3::types::PyType;
+use seqsmooth::Error;
+
+/// The Python class of each kind of error (its name in `seqsmooth.errors`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    InvalidInput,
+    InvalidType,
+    Parameter,
+    TooFewSamples,
+    NotDetermined,
+    Numerical,
+}
+
+impl Kind {
+    fn class_name(self) -> &'static str {
+        match self {
+            Kind::InvalidInput => "InvalidInputError",
+            Kind::InvalidType => "InvalidTypeError",
+            Kind::Parameter => "ParameterError",
+            Kind::TooFewSamples => "TooFewSamplesError",
+            Kind::NotDetermined => "NotDeterminedError",
+            Kind::Numerical => "NumericalError",
+        }
+    }
+
+    /// The kind of a library error (inside a batch, the kind of its cause).
+    fn of(error: &Error) -> Kind {
+        match error {
+            Error::NonFinite { .. } | Error::TimeNotIncreasing { .. } => Kind::InvalidInput,
+            Error::ThetaOutOfRange { .. }
+            | Error::TauOutOfRange { .. }
+            | Error::DegreeOutOfRange { .. }
+            | Error::GainDegreeOutOfRange { .. }
+            | Error::GainValueOutOfRange { .. }
+            | Error::InvalidParameter { .. } => Kind::Parameter,
+            Error::TooFewSamples { .. } => Kind::TooFewSamples,
+            Error::NotDetermined { .. } => Kind::NotDetermined,
+            Error::InBatch { source, .. } | Error::InChannel { source, .. } => Kind::of(source),
+            _ => Kind::Numerical,
+        }
+    }
+}
+
+/// An exception of `kind` with `message` and `index` (the offending sample's position).
+pub fn raise(kind: Kind, message: impl Into<String>, index: Option<usize>) -> PyErr {
+    let message = message.into();
+    Python::attach(|py| {
+        let class = py
+            .import("seqsmooth.errors")
+            .and_then(|m| m.getattr(kind.class_name()))
+            .and_then(|c| c.cast_into::<PyType>().map_err(PyErr::from));
+        match class.and_then(|c| c.call1((message.clone(), index))) {
+            Ok(instance) => PyErr::from_value(instance),
+            // The package's own module is missing: still an exception, never a panic.
+            Err(e) => PyRuntimeError::new_err(format!("{message} (and seqsmooth.errors: {e})")),
+        }
+    })
+}
+
+/// A library error as its Python exception; `offset` is added to a batch index (the batch
+/// was a slice of the caller's arrays starting there).
+pub fn to_py(error: Error, offset: usize) -> PyErr {
+    let index = match &error {
+        Error::InBatch { index, .. } => Some(index + offset),
+        _ => None,
+    };
+    let message = match (&error, index) {
+        (Error::InBatch { source, .. }, Some(i)) => format!("sample {i} of the batch: {source}"),
+        _ => error.to_string(),
+    };
+    raise(Kind::of(&error), message, index)
+}
+
+/// `Result<T, Error>` into `PyResult<T>`.
+pub trait IntoPy<T> {
+    /// The error as its Python exception, a batch index shifted by `offset`.
+    fn py_at(self, offset: usize) -> PyResult<T>;
+    /// The error as its Python exception.
+    fn py(self) -> PyResult<T>;
+}
+
+impl<T> IntoPy<T> for Result<T, Error> {
+    fn py_at(self, offset: usize) -> PyResult<T> {
+        self.map_err(|e| to_py(e, offset))
+    }
+    fn py(self) -> PyResult<T> {
+        self.py_at(0)
+    }
+}

@@ -1,0 +1,23 @@
+//! The native part of the `seqsmooth` Python package (`seqsmooth._seqsmooth`): a thin binding
+//! of the `seqsmooth` library with pyo3 and rust-numpy. Each module binds one part of the
+//! library; `python/seqsmooth/` re-exports it with the exceptions (`errors.py`) and the type
+//! stubs.
+
+mod arrays;
+mod errors;
+mod polynomial;
+mod smooth;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<polynomial::State>()?;
+    m.add_class::<polynomial::PyPolynomialFilter>()?;
+    m.add_class::<polynomial::PyExpandingMemory>()?;
+    m.add_class::<polynomial::PyFadingMemory>()?;
+    m.add_class::<polynomial::PyFixedMemory>()?;
+    m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
+    m.add("MAX_DEGREE", seqsmooth::polynomial::MAX_DEGREE)?;
+    Ok(())
+}

@@ -1,0 +1,445 @@
+//! The polynomial filters as Python classes: `ExpandingMemory`, `FadingMemory` and
+//! `FixedMemory`, each a subclass of `PolynomialFilter`, which holds the library's filter and
+//! owns every method (`update`, `update_many`, `estimate`, `estimate_at`). The numbers are the
+//! library's: `update_many` runs the same path as `seqsmooth filter` (the batch kernels of the
+//! expanding- and fading-memory filters without σ; otherwise a sample at a time, each
+//! estimate from `try_estimate_at`), so the same input gives the same bits.
+
+use crate::arrays::{matrix, pair};
+use crate::errors::{raise, IntoPy, Kind};
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use seqsmooth::polynomial::fixed::FixedEngine;
+use seqsmooth::{
+    Engine, Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter, PolynomialState,
+};
+
+/// Samples run between two checks for Ctrl-C (each run without the GIL).
+const CHUNK: usize = 1 << 16;
+
+/// A filter the binding can run on another thread while Python goes on.
+type Filter = Box<dyn PolynomialFilter + Sync>;
+
+/// The estimate of a polynomial filter at one time.
+#[pyclass(name = "State", module = "seqsmooth", frozen)]
+pub struct State {
+    state: PolynomialState,
+}
+
+#[pymethods]
+impl State {
+    /// The time the estimate is valid at.
+    #[getter]
+    fn time(&self) -> f64 {
+        self.state.time
+    }
+
+    /// ``[x, x', x'', …]`` at ``time``: unscaled derivatives in the caller's time units.
+    #[getter]
+    fn derivatives<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.state.derivatives)
+    }
+
+    /// The covariance of the derivatives' errors, ``(m+1, m+1)``, or ``None`` when the
+    /// filter was given no noise ``sigma``.
+    #[getter]
+    fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.state
+            .covariance
+            .as_ref()
+            .map(|c| {
+                let n = c.nrows();
+                // nalgebra is column-major; the covariance is symmetric, so this is row-major.
+                matrix(py, c.as_slice().to_vec(), n, n)
+            })
+            .transpose()
+    }
+
+    /// The 1σ error of each derivative (the square roots of the covariance's diagonal), or
+    /// ``None`` without a covariance.
+    #[getter]
+    fn sigma<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        self.state.std_devs().map(|s| PyArray1::from_vec(py, s))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "State(time={:?}, derivatives={:?}, sigma={:?})",
+            self.state.time,
+            self.state.derivatives,
+            self.state.std_devs()
+        )
+    }
+}
+
+/// The base of the polynomial filters: ``update``, ``update_many``, ``estimate`` and
+/// ``estimate_at`` (Morrison chs. 9, 13; Reyneke et al. 2012 on irregular times).
+#[pyclass(name = "PolynomialFilter", module = "seqsmooth", subclass)]
+pub struct PyPolynomialFilter {
+    filter: Filter,
+    /// Whether `update_many` without σ may take the library's batch kernels (expanding and
+    /// fading memory, as `seqsmooth filter` does).
+    batch: bool,
+}
+
+impl PyPolynomialFilter {
+    fn new(filter: Filter, batch: bool) -> PyClassInitializer<Self> {
+        PyClassInitializer::from(Self { filter, batch })
+    }
+}
+
+/// One row per sample, a sample at a time: the derivatives of `try_estimate_at(t)` into
+/// `out` (and their 1σ into `sigma`), NaN while the filter has too few samples; any other
+/// reason for no estimate is the sample's error. Errors carry the index within the slice.
+fn rows_one_by_one(
+    filter: &mut dyn PolynomialFilter,
+    t: &[f64],
+    y: &[f64],
+    out: &mut [f64],
+    mut sigma: Option<&mut [f64]>,
+) -> Result<(), Error> {
+    let w = filter.degree() + 1;
+    let at = |index: usize| {
+        move |e: Error| Error::InBatch {
+            index,
+            source: Box::new(e),
+        }
+    };
+    for (i, (&t, &y)) in t.iter().zip(y).enumerate() {
+        filter.update(t, y).map_err(at(i))?;
+        let row = &mut out[i * w..(i + 1) * w];
+        let state = match filter.try_estimate_at(t) {
+            Ok(s) => s,
+            Err(Error::TooFewSamples { .. }) => {
+                row.fill(f64::NAN);
+                if let Some(s) = sigma.as_deref_mut() {
+                    s[i * w..(i + 1) * w].fill(f64::NAN);
+                }
+                continue;
+            }
+            Err(e) => return Err(at(i)(e)),
+        };
+        let d = &state.derivatives;
+        row[..d.len()].copy_from_slice(d);
+        row[d.len()..].fill(f64::NAN);
+        if let Some(s) = sigma.as_deref_mut() {
+            let Some(sd) = state.std_devs() else {
+                return Err(at(i)(Error::InvalidParameter {
+                    name: "return_sigma",
+                    value: "True".into(),
+                    reason: "the filter has no noise sigma: construct it with sigma=...".into(),
+                }));
+            };
+            let s = &mut s[i * w..(i + 1) * w];
+            s[..sd.len()].copy_from_slice(&sd);
+            s[sd.len()..].fill(f64::NAN);
+        }
+    }
+    Ok(())
+}
+
+/// The rows the batch kernels wrote (`update_many_into`), checked as `seqsmooth filter`
+/// checks them: NaN marks a row whose estimate the library could not give, which is an error
+/// once the filter has `m+1` samples (before, the fit is not determined): a row all NaN is a
+/// fit not determined (a fading discount that underflowed), one NaN a derivative beyond the
+/// double range. `before` is the filter's sample count before the rows.
+fn check_batch_rows(rows: &[f64], w: usize, before: u64) -> Result<(), Error> {
+    for (i, row) in rows.chunks_exact(w).enumerate() {
+        let samples = before + i as u64 + 1;
+        if samples < w as u64 {
+            continue;
+        }
+        let error = if row.iter().all(|v| v.is_nan()) {
+            Error::NotDetermined {
+                samples,
+                why: "the fit is not determined in doubles (with fading memory, a tau far \
+                      shorter than the steps, or a gap of many tau, lets the discount \
+                      theta**(step/tau) underflow): use a larger tau"
+                    .into(),
+            }
+        } else if let Some(k) = row.iter().position(|v| !v.is_finite()) {
+            Error::EstimateOutOfRange {
+                what: format!("d{k}"),
+            }
+        } else {
+            continue;
+        };
+        return Err(Error::InBatch {
+            index: i,
+            source: Box::new(error),
+        });
+    }
+    Ok(())
+}
+
+#[pymethods]
+impl PyPolynomialFilter {
+    /// The polynomial degree ``m``.
+    #[getter]
+    fn degree(&self) -> usize {
+        self.filter.degree()
+    }
+
+    /// The number of samples taken.
+    #[getter]
+    fn samples(&self) -> u64 {
+        self.filter.samples()
+    }
+
+    /// The newest sample's time, or ``None`` before the first.
+    #[getter]
+    fn last_time(&self) -> Option<f64> {
+        self.filter.last_time()
+    }
+
+    /// Whether the filter has an estimate (enough samples at distinct times).
+    #[getter]
+    fn is_determined(&self) -> bool {
+        self.filter.is_determined()
+    }
+
+    /// Takes one sample ``y`` at time ``t`` (after the previous sample's time).
+    ///
+    /// Raises
+    /// ------
+    /// InvalidInputError
+    ///     ``t`` or ``y`` NaN or infinite, or ``t`` not after the previous time.
+    fn update(&mut self, t: f64, y: f64) -> PyResult<()> {
+        self.filter.update(t, y).py()
+    }
+
+    /// Takes the samples ``(t[i], y[i])`` in order and returns the estimate after each:
+    /// an array ``(len(t), m+1)`` whose row ``i`` is ``[x, x', …, x^(m)]`` at ``t[i]`` from the
+    /// samples up to ``i`` (NaN while the filter is not yet determined). With
+    /// ``return_sigma=True`` also the 1σ errors, a second array of the same shape (the filter
+    /// needs its noise ``sigma``).
+    ///
+    /// The work runs without the GIL; Ctrl-C stops it between blocks of 65,536 samples, the
+    /// samples before the block taken.
+    ///
+    /// Raises
+    /// ------
+    /// InvalidInputError
+    ///     NaN or infinite values, times that do not increase (``.index`` is the sample's
+    ///     position; the samples before it are taken), mismatched or empty arrays.
+    /// InvalidTypeError
+    ///     arrays that do not hold real numbers.
+    #[pyo3(signature = (t, y, return_sigma = false))]
+    fn update_many<'py>(
+        &mut self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        y: &Bound<'py, PyAny>,
+        return_sigma: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (ts, ys) = pair(t, y)?;
+        let (t, y) = (ts.as_slice(), ys.as_slice());
+        let (n, w) = (t.len(), self.filter.degree() + 1);
+        let mut out = vec![0.0; n * w];
+        let mut sigma = if return_sigma {
+            vec![0.0; n * w]
+        } else {
+            Vec::new()
+        };
+        let batch = self.batch && !return_sigma;
+        for start in (0..n).step_by(CHUNK) {
+            let end = (start + CHUNK).min(n);
+            let (tc, yc) = (&t[start..end], &y[start..end]);
+            let oc = &mut out[start * w..end * w];
+            let sc = if return_sigma {
+                Some(&mut sigma[start * w..end * w])
+            } else {
+                None
+            };
+            let filter = &mut *self.filter;
+            py.detach(|| {
+                if batch {
+                    let before = filter.samples();
+                    filter.update_many_into(tc, yc, oc)?;
+                    check_batch_rows(oc, w, before)
+                } else {
+                    rows_one_by_one(filter, tc, yc, oc, sc)
+                }
+            })
+            .py_at(start)?;
+            py.check_signals()?;
+        }
+        let estimates = matrix(py, out, n, w)?;
+        if return_sigma {
+            let sigma = matrix(py, sigma, n, w)?;
+            Ok((estimates, sigma).into_pyobject(py)?.into_any())
+        } else {
+            Ok(estimates)
+        }
+    }
+
+    /// The estimate at the newest sample's time.
+    ///
+    /// Raises
+    /// ------
+    /// TooFewSamplesError, NumericalError
+    ///     no estimate yet, or none to working accuracy (the reason in the message).
+    fn estimate(&self) -> PyResult<State> {
+        self.filter.try_estimate().py().map(|state| State { state })
+    }
+
+    /// The estimate carried to time ``t`` (a prediction ahead of the newest sample, a
+    /// retrodiction before it), its covariance carried with it.
+    fn estimate_at(&self, t: f64) -> PyResult<State> {
+        if !t.is_finite() {
+            return Err(raise(
+                Kind::InvalidInput,
+                format!("time {t} is not finite"),
+                None,
+            ));
+        }
+        self.filter
+            .try_estimate_at(t)
+            .py()
+            .map(|state| State { state })
+    }
+
+    fn __repr__(slf: &Bound<'_, Self>) -> PyResult<String> {
+        let this = slf.borrow();
+        Ok(format!(
+            "{}(degree={}, samples={}, last_time={:?})",
+            slf.get_type().name()?,
+            this.filter.degree(),
+            this.filter.samples(),
+            this.filter.last_time()
+        ))
+    }
+}
+
+/// `"exact"` or `"gain"`.
+fn engine(name: &str) -> PyResult<Engine> {
+    match name {
+        "exact" => Ok(Engine::Exact),
+        "gain" => Ok(Engine::Gain),
+        other => Err(raise(
+            Kind::Parameter,
+            format!("engine {other:?} is not one of 'exact', 'gain'"),
+            None,
+        )),
+    }
+}
+
+/// The expanding-memory polynomial filter of degree ``degree`` (Morrison ch. 9; Reyneke et
+/// al. 2012 eqs. 20-27 on irregular times): the least-squares polynomial through every
+/// sample so far, updated recursively.
+///
+/// Parameters
+/// ----------
+/// degree : int
+///     ``m``, 0 to 24 (0 to 10 with ``engine="gain"``).
+/// engine : {"exact", "gain"}
+///     ``"exact"``: recursive least squares, exact on any timestamps. ``"gain"``: Morrison's
+///     fixed-gain recursion (9.3.x), exact on evenly spaced times only.
+/// sigma : float, optional
+///     The white noise's standard deviation: the estimates then carry their covariance.
+#[pyclass(name = "ExpandingMemory", module = "seqsmooth", extends = PyPolynomialFilter)]
+pub struct PyExpandingMemory;
+
+#[pymethods]
+impl PyExpandingMemory {
+    #[new]
+    #[pyo3(signature = (degree, engine = "exact", sigma = None))]
+    fn new(degree: usize, engine: &str, sigma: Option<f64>) -> PyResult<PyClassInitializer<Self>> {
+        let mut f = ExpandingMemory::new(degree, self::engine(engine)?).py()?;
+        if let Some(s) = sigma {
+            f = f.with_noise_sigma(s).py()?;
+        }
+        Ok(PyPolynomialFilter::new(Box::new(f), true).add_subclass(Self))
+    }
+}
+
+/// The fading-memory polynomial filter of degree ``degree`` (Morrison ch. 13; Reyneke et al.
+/// 2012 on irregular times): the polynomial fitted with weight ``theta**((t_n − t_k)/tau)``
+/// on sample ``k``.
+///
+/// Parameters
+/// ----------
+/// degree : int
+///     ``m``, 0 to 24 (0 to 10 with ``engine="gain"``).
+/// theta : float
+///     The discount per ``tau`` of time, ``0 < theta < 1``.
+/// tau : float
+///     The time interval ``theta`` applies to (default 1).
+/// engine : {"exact", "gain"}
+///     As for :class:`ExpandingMemory`.
+/// sigma : float, optional
+///     The white noise's standard deviation: the estimates then carry their covariance.
+#[pyclass(name = "FadingMemory", module = "seqsmooth", extends = PyPolynomialFilter)]
+pub struct PyFadingMemory;
+
+#[pymethods]
+impl PyFadingMemory {
+    #[new]
+    #[pyo3(signature = (degree, theta, tau = 1.0, engine = "exact", sigma = None))]
+    fn new(
+        degree: usize,
+        theta: f64,
+        tau: f64,
+        engine: &str,
+        sigma: Option<f64>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let mut f = FadingMemory::new(degree, theta, tau, self::engine(engine)?).py()?;
+        if let Some(s) = sigma {
+            f = f.with_noise_sigma(s).py()?;
+        }
+        Ok(PyPolynomialFilter::new(Box::new(f), true).add_subclass(Self))
+    }
+}
+
+/// The fixed-memory polynomial filter (Morrison ch. 7): the least-squares polynomial of
+/// degree ``degree`` through the newest ``window`` samples.
+///
+/// Parameters
+/// ----------
+/// degree : int
+///     ``m``, 0 to 24.
+/// window : int
+///     The number of samples in the window, at least ``degree + 1`` (Morrison's ``L + 1``,
+///     savgol's ``window_length``).
+/// engine : {"adaptive", "sliding", "direct", "irregular"}
+///     ``"adaptive"`` (default): the sliding moments while the steps are even, the QR refit
+///     of the window from the first uneven step on; ``"sliding"`` and ``"direct"`` need evenly
+///     spaced times; ``"irregular"`` refits every window by QR.
+/// sigma : float, optional
+///     The white noise's standard deviation: the estimates then carry their covariance.
+#[pyclass(name = "FixedMemory", module = "seqsmooth", extends = PyPolynomialFilter)]
+pub struct PyFixedMemory;
+
+#[pymethods]
+impl PyFixedMemory {
+    #[new]
+    #[pyo3(signature = (degree, window, engine = "adaptive", sigma = None))]
+    fn new(
+        degree: usize,
+        window: usize,
+        engine: &str,
+        sigma: Option<f64>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let engine = match engine {
+            "adaptive" => FixedEngine::Adaptive,
+            "sliding" => FixedEngine::Sliding,
+            "direct" => FixedEngine::Direct,
+            "irregular" => FixedEngine::Irregular,
+            other => {
+                return Err(raise(
+                    Kind::Parameter,
+                    format!(
+                        "engine {other:?} is not one of 'adaptive', 'sliding', 'direct', \
+                         'irregular'"
+                    ),
+                    None,
+                ))
+            }
+        };
+        let mut f = FixedMemory::new(degree, window, engine).py()?;
+        if let Some(s) = sigma {
+            f = f.with_noise_sigma(s).py()?;
+        }
+        Ok(PyPolynomialFilter::new(Box::new(f), false).add_subclass(Self))
+    }
+}

@@ -1,0 +1,58 @@
+"""Shared fixtures: the `seqsmooth` command (the Rust results the binding must equal to the
+last bit) and seeded series."""
+
+from __future__ import annotations
+
+import csv
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def cli_path() -> Path:
+    """The `seqsmooth` binary: $SEQSMOOTH_CLI, else the workspace's release build (the test
+    command builds it before pytest runs)."""
+    path = Path(os.environ.get("SEQSMOOTH_CLI", ROOT / "target" / "release" / "seqsmooth"))
+    if not path.exists():
+        pytest.fail(f"{path} is missing: run `cargo build --release -p seqsmooth-cli` first")
+    return path
+
+
+def run_filter(tmp_path: Path, t: np.ndarray, y: np.ndarray, *args: str) -> dict:
+    """`seqsmooth filter` on the series (times and values written with repr, which round-trips
+    exactly); its columns as float arrays (an empty cell is NaN), keyed by header name."""
+    source = tmp_path / "in.csv"
+    with open(source, "w") as f:
+        f.write("t,y\n")
+        for a, b in zip(t.tolist(), y.tolist()):
+            f.write(f"{a!r},{b!r}\n")
+    out = subprocess.run(
+        [str(cli_path()), "filter", str(source), "--no-progress", *args],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    rows = list(csv.reader(out.splitlines()))
+    header, body = rows[0], rows[1:]
+    return {
+        name: np.array([float(r[i]) if r[i] else np.nan for r in body])
+        for i, name in enumerate(header)
+    }
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(20261204)
+
+
+def irregular_series(rng: np.random.Generator, n: int, start: float = 0.0):
+    """`n` samples at steps U(0.5, 1.5) of a cubic trend plus N(0, 0.3²) noise."""
+    t = start + np.cumsum(rng.uniform(0.5, 1.5, n))
+    x = t - t[0]
+    y = 2.0 + 0.3 * x - 0.01 * x**2 + 1e-4 * x**3 + 0.3 * rng.standard_normal(n)
+    return t, y

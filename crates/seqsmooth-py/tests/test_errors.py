@@ -1,0 +1,169 @@
+"""Bad input from Python raises the right SeqsmoothError with the sample's index, never a
+PanicException, and a filter keeps the samples before the bad one."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import seqsmooth as ss
+from seqsmooth import errors
+
+
+def test_the_hierarchy_is_value_error():
+    for name in errors.__all__:
+        assert issubclass(getattr(errors, name), ValueError)
+    assert issubclass(ss.InvalidTypeError, TypeError)
+    assert issubclass(ss.InvalidTypeError, ss.InvalidInputError)
+
+
+@pytest.mark.parametrize("where", [0, 3, 9])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_a_non_finite_value_is_named_with_its_index(where, bad):
+    t = np.arange(10.0)
+    y = np.ones(10)
+    y[where] = bad
+    f = ss.FadingMemory(degree=1, theta=0.9)
+    with pytest.raises(ss.InvalidInputError) as e:
+        f.update_many(t, y)
+    assert e.value.index == where
+    assert f"sample {where}" in str(e.value) and "not finite" in str(e.value)
+    assert f.samples == where  # the samples before it are taken
+
+
+def test_unsorted_times_name_the_sample():
+    t = np.array([0.0, 1.0, 2.0, 2.0, 3.0])
+    f = ss.ExpandingMemory(degree=1)
+    with pytest.raises(ss.InvalidInputError) as e:
+        f.update_many(t, np.zeros(5))
+    assert e.value.index == 3 and "strictly increasing" in str(e.value)
+    with pytest.raises(ss.InvalidInputError):
+        f.update(1.5, 0.0)
+
+
+def test_the_index_counts_from_the_callers_array_across_blocks():
+    n = (1 << 16) + 10  # past the first block of the GIL-free loop
+    t = np.arange(float(n))
+    y = np.zeros(n)
+    y[n - 3] = np.nan
+    with pytest.raises(ss.InvalidInputError) as e:
+        ss.ExpandingMemory(degree=0).update_many(t, y)
+    assert e.value.index == n - 3
+
+
+@pytest.mark.parametrize(
+    "t,y,kind",
+    [
+        ([1.0, 2.0], [1.0], ss.InvalidInputError),  # mismatched lengths
+        ([], [], ss.InvalidInputError),  # empty
+        ([[1.0, 2.0]], [[1.0, 2.0]], ss.InvalidInputError),  # two-dimensional
+        (["a", "b"], [1.0, 2.0], ss.InvalidTypeError),  # strings
+        ([1.0, 2.0], np.array([1 + 2j, 2 + 0j]), ss.InvalidTypeError),  # complex
+        ([1.0, 2.0], [object(), object()], ss.InvalidTypeError),
+        (
+            np.array(["2026-01-01", "2026-01-02"], dtype="datetime64[ns]"),
+            [1.0, 2.0],
+            ss.InvalidTypeError,
+        ),
+    ],
+)
+def test_bad_arrays(t, y, kind):
+    with pytest.raises(kind):
+        ss.ExpandingMemory(degree=0).update_many(t, y)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: ss.FadingMemory(degree=1, theta=1.0),
+        lambda: ss.FadingMemory(degree=1, theta=0.0),
+        lambda: ss.FadingMemory(degree=1, theta=float("nan")),
+        lambda: ss.FadingMemory(degree=1, theta=0.9, tau=0.0),
+        lambda: ss.FadingMemory(degree=1, theta=0.9, engine="fast"),
+        lambda: ss.ExpandingMemory(degree=25),
+        lambda: ss.ExpandingMemory(degree=11, engine="gain"),
+        lambda: ss.ExpandingMemory(degree=1, sigma=-1.0),
+        lambda: ss.ExpandingMemory(degree=1, sigma=0.0),
+        lambda: ss.FixedMemory(degree=3, window=3),
+        lambda: ss.FixedMemory(degree=1, window=5, engine="slow"),
+    ],
+)
+def test_bad_settings_raise_parameter_errors(make):
+    with pytest.raises(ss.ParameterError):
+        make()
+
+
+def test_negative_degree_is_refused_by_python():
+    with pytest.raises(OverflowError):
+        ss.ExpandingMemory(degree=-1)
+
+
+def test_sigma_needs_the_noise():
+    with pytest.raises(ss.ParameterError) as e:
+        ss.ExpandingMemory(degree=0).update_many([0.0, 1.0], [1.0, 2.0], return_sigma=True)
+    assert "sigma" in str(e.value)
+
+
+def test_ten_thousand_random_bad_calls_never_panic():
+    """A seeded loop of 10⁴ calls with random bad (and some good) arguments: each returns or
+    raises a SeqsmoothError (or Python's own OverflowError/TypeError for a negative or
+    non-integer count); none raises pyo3's PanicException or crashes the interpreter."""
+    rng = np.random.default_rng(13)
+    specials = [np.nan, np.inf, -np.inf, 0.0, -0.0, 1e308, -1e308, 5e-324, 1.0, 2.0]
+
+    def values(n):
+        v = rng.standard_normal(n) * 10.0 ** rng.integers(-300, 300)
+        k = rng.integers(0, max(n, 1))
+        if n and rng.random() < 0.5:
+            v[k] = specials[rng.integers(len(specials))]
+        return v
+
+    def times(n):
+        t = np.cumsum(rng.uniform(0.0, 2.0, n)) * 10.0 ** rng.integers(-200, 200)
+        if n and rng.random() < 0.3:
+            t[rng.integers(n)] = specials[rng.integers(len(specials))]
+        if n > 1 and rng.random() < 0.3:
+            rng.shuffle(t)
+        return t + (1.7e9 if rng.random() < 0.3 else 0.0)
+
+    outcomes = {"ok": 0, "error": 0}
+    for _ in range(10_000):
+        n = int(rng.integers(0, 40))
+        degree = int(rng.integers(-1, 27))
+        theta = float(rng.choice([rng.random(), -0.5, 1.0, 1.5, np.nan]))
+        tau = float(rng.choice([1.0, rng.random() * 1e3, 0.0, -1.0, np.inf]))
+        engine = str(rng.choice(["exact", "gain", "adaptive", "x"]))
+        window = int(rng.integers(-1, 50))
+        try:
+            kind = rng.integers(5)
+            if kind == 0:
+                f = ss.ExpandingMemory(degree=degree, engine=engine)
+            elif kind == 1:
+                f = ss.FadingMemory(degree=degree, theta=theta, tau=tau, engine=engine)
+            elif kind == 2:
+                f = ss.FixedMemory(degree=degree, window=window)
+            elif kind == 3:
+                out = ss.smooth(
+                    values(n),
+                    window,
+                    degree,
+                    deriv=int(rng.integers(0, 4)),
+                    t=times(n) if rng.random() < 0.5 else None,
+                )
+                assert np.isfinite(out).all()
+                outcomes["ok"] += 1
+                continue
+            else:
+                f = ss.FadingMemory(degree=max(degree, 0) % 4, theta=0.9)
+            out = f.update_many(times(n), values(n), return_sigma=bool(rng.random() < 0.2))
+            est = out[0] if isinstance(out, tuple) else out
+            assert not np.isinf(est).any()
+            if kind != 2:  # expanding and fading: every row from sample m+1 on is finite
+                assert np.isfinite(est[f.degree :]).all()
+            if f.is_determined:
+                assert np.isfinite(f.estimate().derivatives).all()
+            outcomes["ok"] += 1
+        except (ss.SeqsmoothError, OverflowError) as e:
+            assert str(e)
+            outcomes["error"] += 1
+    assert outcomes["ok"] > 100 and outcomes["error"] > 1000, outcomes

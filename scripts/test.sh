@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# The whole test suite (the README's test command; .ci/run runs it): the Rust workspace, then
+# the Python package, built and installed into its own virtual environment (target/py-venv,
+# made from crates/seqsmooth-py/requirements-test.txt on first use), linted and tested with
+# pytest against the `seqsmooth` binary built here.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cargo test --workspace --release
+cargo build --release -p seqsmooth-cli
+
+venv=target/py-venv
+requirements=crates/seqsmooth-py/requirements-test.txt
+if [ ! -x "$venv/bin/python" ]; then
+    python3 -m venv "$venv"
+fi
+if ! cmp -s "$requirements" "$venv/requirements-test.txt"; then
+    "$venv/bin/python" -m pip install --quiet --upgrade pip
+    "$venv/bin/python" -m pip install --quiet -r "$requirements"
+    cp "$requirements" "$venv/requirements-test.txt"
+fi
+# The install line of the README, with the pinned maturin already in the environment (and on
+# PATH, where the build backend looks for it).
+export PATH="$PWD/$venv/bin:$PATH"
+"$venv/bin/python" -m pip install --quiet --no-build-isolation --force-reinstall --no-deps \
+    ./crates/seqsmooth-py
+(
+    cd crates/seqsmooth-py
+    "../../$venv/bin/ruff" check .
+    "../../$venv/bin/ruff" format --check .
+    SEQSMOOTH_CLI="$PWD/../../target/release/seqsmooth" "../../$venv/bin/python" -m pytest -q
+)
