@@ -93,3 +93,32 @@ pub fn matrix<'py>(
         .reshape([rows, cols])
         .map(Bound::into_any)
 }
+
+/// `obj` as a row-major table of reals, named `name` in errors: a 2-D array as it is, a 1-D
+/// array as one column; its values (contiguous, row-major), rows and columns.
+pub fn table<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<(Series<'py>, usize, usize)> {
+    let py = obj.py();
+    let np = py.import("numpy")?;
+    let array = np.call_method1("asarray", (obj,)).map_err(|e| {
+        raise(
+            Kind::InvalidType,
+            format!("{name} is not an array of numbers: {e}"),
+            None,
+        )
+    })?;
+    let ndim: usize = array.getattr("ndim")?.extract()?;
+    let (rows, cols) = match ndim {
+        1 => (array.getattr("shape")?.get_item(0)?.extract()?, 1),
+        2 => array.getattr("shape")?.extract()?,
+        _ => {
+            let shape = array.getattr("shape")?.str()?.to_string();
+            return Err(raise(
+                Kind::InvalidInput,
+                format!("{name} has shape {shape}: it must be one- or two-dimensional"),
+                None,
+            ));
+        }
+    };
+    let flat = array.call_method1("reshape", (-1,))?;
+    Ok((series(&flat, name)?, rows, cols))
+}

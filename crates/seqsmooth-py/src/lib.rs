@@ -5,6 +5,7 @@
 
 mod arrays;
 mod errors;
+mod kalman;
 mod polynomial;
 mod smooth;
 
@@ -17,6 +18,8 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<polynomial::PyExpandingMemory>()?;
     m.add_class::<polynomial::PyFadingMemory>()?;
     m.add_class::<polynomial::PyFixedMemory>()?;
+    m.add_class::<kalman::PyKalmanFilter>()?;
+    m.add_class::<kalman::PyInnovation>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
     m.add("MAX_DEGREE", seqsmooth::polynomial::MAX_DEGREE)?;
     Ok(())

@@ -135,7 +135,7 @@ def test_ten_thousand_random_bad_calls_never_panic():
         engine = str(rng.choice(["exact", "gain", "adaptive", "x"]))
         window = int(rng.integers(-1, 50))
         try:
-            kind = rng.integers(5)
+            kind = rng.integers(6)
             if kind == 0:
                 f = ss.ExpandingMemory(degree=degree, engine=engine)
             elif kind == 1:
@@ -151,6 +151,19 @@ def test_ten_thousand_random_bad_calls_never_panic():
                     t=times(n) if rng.random() < 0.5 else None,
                 )
                 assert np.isfinite(out).all()
+                outcomes["ok"] += 1
+                continue
+            elif kind == 4:
+                m = max(degree, 0) % 4
+                f = ss.KalmanFilter(
+                    degree=m,
+                    x0=values(m + 1),
+                    P0=float(rng.choice([1.0, 1e300, 0.0, -1.0, np.nan])),
+                    q=float(rng.choice([0.0, 1.0, -1.0, 1e300])),
+                    theta=float(rng.choice([0.5, 1.0, 2.0])) if rng.random() < 0.3 else None,
+                )
+                x, p, nis = f.update_many(times(n), values(n), float(rng.choice([1.0, 0.0, -1.0])))
+                assert np.isfinite(x).all() and np.isfinite(p).all()
                 outcomes["ok"] += 1
                 continue
             else:

@@ -7,6 +7,10 @@ ExpandingMemory, FadingMemory, FixedMemory
     The polynomial filters of any degree on any (irregular, Unix-epoch) timestamps:
     ``update(t, y)``, ``update_many(t, y) -> ndarray``, ``estimate()``, ``estimate_at(t)``.
 
+KalmanFilter
+    The Kalman filter over the polynomial model (Morrison chs. 12, 14, 15): driving noise,
+    fading memory, missing components, ``update_many`` and the RTS ``smooth``.
+
 Functions
 ---------
 smooth
@@ -23,6 +27,8 @@ from ._seqsmooth import (
     ExpandingMemory,
     FadingMemory,
     FixedMemory,
+    Innovation,
+    KalmanFilter,
     PolynomialFilter,
     State,
     smooth,
@@ -42,6 +48,8 @@ __all__ = [
     "ExpandingMemory",
     "FadingMemory",
     "FixedMemory",
+    "KalmanFilter",
+    "Innovation",
     "PolynomialFilter",
     "State",
     "smooth",

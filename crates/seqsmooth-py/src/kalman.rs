@@ -1,0 +1,462 @@
+//! The Kalman filter over the polynomial model as a Python class, `KalmanFilter`: the
+//! library's `kalman::KalmanFilter` with `PolynomialDynamics` (degree `m` on `axes` axes, the
+//! state ordered derivative then axis), a linear observation (the positions by default),
+//! optional white-noise driving of the highest derivative (`q`, Morrison (15.2.23) over each
+//! actual step) and optional fading memory (`beta` per unit time or `theta` per update, ch.
+//! 14); and its Rauch–Tung–Striebel smoother.
+
+use crate::arrays::{matrix, series, table};
+use crate::errors::{raise, IntoPy, Kind};
+use nalgebra::{DMatrix, DVector};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use seqsmooth::estimate::batch::NoiseCovariance;
+use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::kalman::filter::{Discount, Innovation};
+use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+use seqsmooth::kalman::{smoother, KalmanFilter};
+use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::observation::{LinearObservation, Observation};
+
+type Linear = KalmanFilter<PolynomialDynamics, LinearObservation>;
+
+/// What one update saw: the innovation `ν = z − M X_{n,n−1}` on the present components, its
+/// covariance `V = M S Mᵀ + R`, the gain, the NIS `νᵀ V⁻¹ ν` and the log-likelihood.
+#[pyclass(name = "Innovation", module = "seqsmooth", frozen)]
+pub struct PyInnovation {
+    inner: Innovation,
+}
+
+#[pymethods]
+impl PyInnovation {
+    /// The components used (the present ones), in the observation's order.
+    #[getter]
+    fn components(&self) -> Vec<usize> {
+        self.inner.components.clone()
+    }
+    /// ``ν`` on those components.
+    #[getter]
+    fn innovation<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.inner.innovation.as_slice())
+    }
+    /// ``V = M S Mᵀ + R``.
+    #[getter]
+    fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        square(py, &self.inner.covariance)
+    }
+    /// The gain ``S Mᵀ V⁻¹``, states × components.
+    #[getter]
+    fn gain<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let g = &self.inner.gain;
+        matrix(py, g.transpose().as_slice().to_vec(), g.nrows(), g.ncols())
+    }
+    /// ``νᵀ V⁻¹ ν``, χ² with ``len(components)`` degrees of freedom for a consistent filter.
+    #[getter]
+    fn nis(&self) -> f64 {
+        self.inner.nis
+    }
+    /// ``−(NIS + ln det V + p ln 2π)/2``.
+    #[getter]
+    fn log_likelihood(&self) -> f64 {
+        self.inner.log_likelihood
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Innovation(components={:?}, nis={:?}, log_likelihood={:?})",
+            self.inner.components, self.inner.nis, self.inner.log_likelihood
+        )
+    }
+}
+
+/// A symmetric (or any square) matrix as a numpy array.
+fn square<'py>(py: Python<'py>, m: &DMatrix<f64>) -> PyResult<Bound<'py, PyAny>> {
+    matrix(py, m.transpose().as_slice().to_vec(), m.nrows(), m.ncols())
+}
+
+/// A vector of `n` from a scalar (every entry), or a matrix `n × n` from a scalar (times the
+/// identity), a vector (the diagonal) or a matrix.
+fn square_from(obj: &Bound<'_, PyAny>, n: usize, name: &str) -> PyResult<DMatrix<f64>> {
+    if let Ok(v) = obj.extract::<f64>() {
+        return Ok(DMatrix::from_diagonal_element(n, n, v));
+    }
+    let (values, rows, cols) = table(obj, name)?;
+    let v = values.as_slice();
+    match (rows, cols) {
+        (r, 1) if r == n => Ok(DMatrix::from_diagonal(&DVector::from_column_slice(v))),
+        (r, c) if r == n && c == n => Ok(DMatrix::from_row_slice(n, n, v)),
+        (r, c) => Err(raise(
+            Kind::InvalidInput,
+            format!("{name} is {r}x{c}: it must be a number, {n} variances or {n}x{n}"),
+            None,
+        )),
+    }
+}
+
+/// The measurement noise of `p` components from `R`: a variance for every component, `p`
+/// variances, or `p × p`.
+fn noise(obj: &Bound<'_, PyAny>, p: usize) -> PyResult<NoiseCovariance> {
+    if let Ok(v) = obj.extract::<f64>() {
+        return Ok(NoiseCovariance::Variances(vec![v; p]));
+    }
+    let (values, rows, cols) = table(obj, "R")?;
+    match (rows, cols) {
+        (r, 1) if r == p => Ok(NoiseCovariance::Variances(values.as_slice().to_vec())),
+        (r, c) if r == p && c == p => Ok(NoiseCovariance::Full(DMatrix::from_row_slice(
+            p,
+            p,
+            values.as_slice(),
+        ))),
+        (r, c) => Err(raise(
+            Kind::InvalidInput,
+            format!("R is {r}x{c}: it must be a number, {p} variances or {p}x{p}"),
+            None,
+        )),
+    }
+}
+
+/// The measurements `(t[i], z[i])` with noise `R`: `z` is `n` values (one component) or
+/// `n × p`; NaN marks a missing component.
+fn measurements(
+    t: &Bound<'_, PyAny>,
+    z: &Bound<'_, PyAny>,
+    r: &Bound<'_, PyAny>,
+    p: usize,
+) -> PyResult<Vec<Measurement>> {
+    let ts = series(t, "t")?;
+    let (zs, rows, cols) = table(z, "z")?;
+    let t = ts.as_slice();
+    if rows != t.len() || cols != p {
+        return Err(raise(
+            Kind::InvalidInput,
+            format!(
+                "z is {rows}x{cols} for {} times: it must hold {p} component(s) per time",
+                t.len()
+            ),
+            None,
+        ));
+    }
+    if t.is_empty() {
+        return Err(raise(Kind::InvalidInput, "t and z are empty", None));
+    }
+    let noise = noise(r, p)?;
+    Ok(t.iter()
+        .zip(zs.as_slice().chunks_exact(p))
+        .map(|(&time, row)| Measurement {
+            time,
+            values: row.iter().map(|&v| (!v.is_nan()).then_some(v)).collect(),
+            noise: noise.clone(),
+        })
+        .collect())
+}
+
+/// A measurement at `t` before the time `previous` the filter has reached, as an error.
+fn before(t: f64, previous: f64, index: Option<usize>) -> PyErr {
+    let at = index.map_or(String::new(), |i| format!("sample {i} of the batch: "));
+    raise(
+        Kind::InvalidInput,
+        format!(
+            "{at}time {t} is before the previous time {previous}: measurements must come in \
+             time order (predict() goes anywhere)"
+        ),
+        index,
+    )
+}
+
+/// The first measurement of `rows` before its predecessor (the first, before `start`): its
+/// index, time and the predecessor's time. (A NaN time is the library's to refuse.)
+fn out_of_order(start: f64, rows: &[Measurement]) -> Option<(usize, f64, f64)> {
+    let mut previous = start;
+    for (k, m) in rows.iter().enumerate() {
+        if m.time < previous {
+            return Some((k, m.time, previous));
+        }
+        if !m.time.is_nan() {
+            previous = m.time;
+        }
+    }
+    None
+}
+
+/// The Kalman filter (Morrison chs. 12, 15; fading memory ch. 14) over the polynomial model:
+/// degree ``degree`` on ``axes`` axes, the state ``(x, y, …, x', y', …)`` (derivative, then
+/// axis), unscaled derivatives in the caller's time units.
+///
+/// Parameters
+/// ----------
+/// degree : int
+///     The polynomial degree of the motion on each axis (1: constant velocity).
+/// x0, P0 : array_like
+///     The prior state and covariance (a number: that variance on every state; a vector: the
+///     diagonal) at time ``t0``.
+/// t0 : float
+///     The prior's time.
+/// axes : int
+///     The number of axes (default 1).
+/// q : float
+///     The spectral density of the white noise driving the highest derivative of each axis
+///     (value²/time^(2m+1)); 0 for none. ``Q`` is integrated over each actual step.
+/// observation : array_like, optional
+///     The observation matrix ``M``, components × states; default the positions
+///     (``[I_axes, 0, …]``).
+/// beta, theta : float, optional
+///     Fading memory (ch. 14): the discount per unit time, or per update, in (0, 1]; the
+///     covariance reported is then the true one, not the recursion's internal matrix.
+///
+/// The update is Joseph's form (12.3.7); a missing component (NaN) is left out, a time with
+/// none is a prediction only.
+#[pyclass(name = "KalmanFilter", module = "seqsmooth")]
+pub struct PyKalmanFilter {
+    filter: Linear,
+    /// The observation's components `p`.
+    components: usize,
+}
+
+#[pymethods]
+impl PyKalmanFilter {
+    #[new]
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    #[pyo3(signature = (degree, x0, P0, t0 = 0.0, axes = 1, q = 0.0, observation = None, beta = None, theta = None))]
+    fn new(
+        degree: usize,
+        x0: &Bound<'_, PyAny>,
+        P0: &Bound<'_, PyAny>,
+        t0: f64,
+        axes: usize,
+        q: f64,
+        observation: Option<&Bound<'_, PyAny>>,
+        beta: Option<f64>,
+        theta: Option<f64>,
+    ) -> PyResult<Self> {
+        if axes == 0 {
+            return Err(raise(
+                Kind::Parameter,
+                "axes 0 is invalid: at least 1",
+                None,
+            ));
+        }
+        let n = (degree + 1) * axes;
+        let x = series(x0, "x0")?;
+        if x.as_slice().len() != n {
+            return Err(raise(
+                Kind::InvalidInput,
+                format!(
+                    "x0 has {} values: degree {degree} on {axes} axes has {n} states",
+                    x.as_slice().len()
+                ),
+                None,
+            ));
+        }
+        let p0 = square_from(P0, n, "P0")?;
+        let observe = match observation {
+            None => {
+                LinearObservation::new(DMatrix::from_fn(axes, n, |i, j| f64::from(i == j))).py()?
+            }
+            Some(m) => {
+                let (values, rows, cols) = table(m, "observation")?;
+                if cols != n {
+                    return Err(raise(
+                        Kind::InvalidInput,
+                        format!("observation is {rows}x{cols}: it needs {n} columns (states)"),
+                        None,
+                    ));
+                }
+                LinearObservation::new(DMatrix::from_row_slice(rows, cols, values.as_slice()))
+                    .py()?
+            }
+        };
+        let components = observe.components();
+        let mut filter = KalmanFilter::new(
+            PolynomialDynamics::new(degree, axes),
+            observe,
+            DVector::from_column_slice(x.as_slice()),
+            p0,
+            t0,
+        )
+        .py()?;
+        if q != 0.0 {
+            filter = filter
+                .with_process_noise(WhiteNoiseDerivative::new(degree, axes, q).py()?)
+                .py()?;
+        }
+        filter = match (beta, theta) {
+            (Some(_), Some(_)) => {
+                return Err(raise(
+                    Kind::Parameter,
+                    "beta and theta are both given: fading memory takes one of them",
+                    None,
+                ))
+            }
+            (Some(b), None) => filter.with_fading(Discount::PerTime(b)).py()?,
+            (None, Some(t)) => filter.with_fading(Discount::PerUpdate(t)).py()?,
+            (None, None) => filter,
+        };
+        Ok(Self { filter, components })
+    }
+
+    /// The current estimate ``X``.
+    #[getter]
+    fn state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.filter.state().as_slice())
+    }
+
+    /// The covariance of ``X``'s errors (with fading memory, the true covariance).
+    #[getter]
+    fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        square(py, self.filter.covariance())
+    }
+
+    /// The time the estimate is valid at.
+    #[getter]
+    fn time(&self) -> f64 {
+        self.filter.time()
+    }
+
+    /// Carries the estimate and its covariance to time ``t`` (no measurement).
+    fn predict(&mut self, t: f64) -> PyResult<()> {
+        self.filter.predict(t).py()
+    }
+
+    /// Predicts to ``t`` and updates with ``z`` (a number, or one value per component; NaN
+    /// for a missing one) of noise ``R`` (a variance for every component, the variances, or
+    /// the covariance). Returns the :class:`Innovation`, or ``None`` when every component is
+    /// missing (a prediction only). On an error the filter is unchanged.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R))]
+    fn update(
+        &mut self,
+        t: f64,
+        z: &Bound<'_, PyAny>,
+        R: &Bound<'_, PyAny>,
+    ) -> PyResult<Option<PyInnovation>> {
+        let p = self.filter_components();
+        let values: Vec<f64> = match z.extract::<f64>() {
+            Ok(v) => vec![v],
+            Err(_) => series(z, "z")?.as_slice().to_vec(),
+        };
+        if values.len() != p {
+            return Err(raise(
+                Kind::InvalidInput,
+                format!(
+                    "z has {} values: the observation has {p} components",
+                    values.len()
+                ),
+                None,
+            ));
+        }
+        if t < self.filter.time() {
+            return Err(before(t, self.filter.time(), None));
+        }
+        let m = Measurement {
+            time: t,
+            values: values.iter().map(|&v| (!v.is_nan()).then_some(v)).collect(),
+            noise: noise(R, p)?,
+        };
+        Ok(self
+            .filter
+            .update(&m)
+            .py()?
+            .map(|inner| PyInnovation { inner }))
+    }
+
+    /// Runs the measurements ``(t[i], z[i])`` (``z`` of shape ``(n,)`` or ``(n, p)``, NaN for
+    /// a missing component) with noise ``R`` on every one. Returns ``(states, covariances,
+    /// nis)``: ``(n, dim)``, ``(n, dim, dim)`` and ``(n,)`` (NaN where nothing was measured).
+    /// The work runs without the GIL. On an error (``.index`` names the measurement) the
+    /// measurements before it are taken.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R))]
+    fn update_many<'py>(
+        &mut self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        R: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let mut rows = measurements(t, z, R, self.filter_components())?;
+        let disorder = out_of_order(self.filter.time(), &rows);
+        if let Some((k, _, _)) = disorder {
+            rows.truncate(k);
+        }
+        let n = self.filter.state().len();
+        let mut states = vec![0.0; rows.len() * n];
+        let mut covariances = vec![0.0; rows.len() * n * n];
+        let mut nis = vec![f64::NAN; rows.len()];
+        let filter = &mut self.filter;
+        py.detach(|| {
+            for (i, m) in rows.iter().enumerate() {
+                let stats = filter
+                    .update_stats(m)
+                    .map_err(|e| seqsmooth::Error::InBatch {
+                        index: i,
+                        source: Box::new(e),
+                    })?;
+                if let Some(s) = stats {
+                    nis[i] = s.nis;
+                }
+                states[i * n..(i + 1) * n].copy_from_slice(filter.state().as_slice());
+                // Symmetric: column-major is row-major.
+                covariances[i * n * n..(i + 1) * n * n]
+                    .copy_from_slice(filter.covariance().as_slice());
+            }
+            Ok::<(), seqsmooth::Error>(())
+        })
+        .py()?;
+        if let Some((k, t, previous)) = disorder {
+            return Err(before(t, previous, Some(k)));
+        }
+        let count = rows.len();
+        let states = matrix(py, states, count, n)?;
+        let covariances = PyArray1::from_vec(py, covariances)
+            .reshape([count, n, n])?
+            .into_any();
+        let nis = PyArray1::from_vec(py, nis).into_any();
+        PyTuple::new(py, [states, covariances, nis])
+    }
+
+    /// The Rauch–Tung–Striebel smoother over the measurements, from this filter's current
+    /// state (the filter itself is not changed): at each measurement's time the estimate from
+    /// all of them. Returns ``(states, covariances)``, ``(n, dim)`` and ``(n, dim, dim)``.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R))]
+    fn smooth<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        R: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let rows = measurements(t, z, R, self.filter_components())?;
+        let filter = self.filter.clone();
+        let smoothed = py.detach(|| smoother::smooth(filter, &rows)).py()?;
+        let n = self.filter.state().len();
+        let states: Vec<f64> = smoothed
+            .iter()
+            .flat_map(|s| s.state.iter().copied())
+            .collect();
+        let covariances: Vec<f64> = smoothed
+            .iter()
+            .flat_map(|s| s.covariance.iter().copied())
+            .collect();
+        let count = smoothed.len();
+        let states = matrix(py, states, count, n)?;
+        let covariances = PyArray1::from_vec(py, covariances)
+            .reshape([count, n, n])?
+            .into_any();
+        PyTuple::new(py, [states, covariances])
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "KalmanFilter(states={}, time={:?})",
+            self.filter.state().len(),
+            self.filter.time()
+        )
+    }
+}
+
+impl PyKalmanFilter {
+    fn filter_components(&self) -> usize {
+        self.components
+    }
+}

@@ -1,0 +1,184 @@
+"""KalmanFilter: against filterpy's KalmanFilter on the stored fixtures (≤ 1e-10), against
+filterpy's fading memory (alpha) live, the RTS smoother against the batch least-squares
+solve, update against update_many, and its errors."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import seqsmooth as ss
+from conftest import ROOT
+
+FIXTURES = ROOT / "crates" / "seqsmooth" / "tests" / "fixtures" / "kalman"
+
+
+def read_fixture(name: str):
+    """The setup ('# key,values' lines) and the rows of a fixture of
+    scripts/make_kalman_fixtures.py."""
+    setup, rows = {}, []
+    with open(FIXTURES / f"{name}.csv") as f:
+        for line in f:
+            if line.startswith("# ") and "," in line and not line.startswith("# made"):
+                key, *values = line[2:].strip().split(",")
+                setup[key] = [float(v) for v in values]
+            elif line[0].isdigit() or line[0] == "-":
+                rows.append([float(v) for v in line.strip().split(",")])
+    return setup, np.array(rows)
+
+
+@pytest.mark.parametrize("name", ["cv1", "ca2"])
+def test_equals_filterpy_on_the_stored_fixtures(name):
+    """Each state component within 1e-10 of max(|x_i|, σ_i) and each covariance entry within
+    1e-10 of σ_i σ_j (filterpy's x and σ), at every step, missing rows included."""
+    setup, rows = read_fixture(name)
+    m, d = int(setup["degree"][0]), int(setup["axes"][0])
+    n = (m + 1) * d
+    f = ss.KalmanFilter(
+        degree=m,
+        axes=d,
+        q=setup["q"][0],
+        t0=setup["t0"][0],
+        x0=setup["x0"],
+        P0=np.reshape(setup["P0"], (n, n)),
+    )
+    R = np.reshape(setup["R"], (d, d))
+    t, z = rows[:, 0], rows[:, 1 : 1 + d]
+    x, P, nis = f.update_many(t, z, R)
+    want_x = rows[:, 1 + d : 1 + d + n]
+    want_p = rows[:, 1 + d + n :].reshape(-1, n, n)
+    sigma = np.sqrt(np.einsum("kii->ki", want_p))
+    assert np.max(np.abs(x - want_x) / np.maximum(np.abs(want_x), sigma)) <= 1e-10
+    assert np.max(np.abs(P - want_p) / (sigma[:, :, None] * sigma[:, None, :])) <= 1e-10
+    missing = np.isnan(z).all(axis=1)
+    assert missing.any() and np.isnan(nis[missing]).all() and np.isfinite(nis[~missing]).all()
+
+
+def test_update_equals_update_many_bit_for_bit():
+    setup, rows = read_fixture("ca2")
+    kwargs = dict(
+        degree=2,
+        axes=2,
+        q=setup["q"][0],
+        t0=setup["t0"][0],
+        x0=setup["x0"],
+        P0=np.reshape(setup["P0"], (6, 6)),
+    )
+    R = np.reshape(setup["R"], (2, 2))
+    x, P, nis = ss.KalmanFilter(**kwargs).update_many(rows[:, 0], rows[:, 1:3], R)
+    one = ss.KalmanFilter(**kwargs)
+    for i, row in enumerate(rows):
+        innovation = one.update(row[0], row[1:3], R)
+        assert np.array_equal(one.state, x[i]) and np.array_equal(one.covariance, P[i])
+        if innovation is None:
+            assert np.isnan(nis[i])
+        else:
+            assert innovation.nis == nis[i] and innovation.components == [0, 1]
+            assert innovation.gain.shape == (6, 2) and innovation.covariance.shape == (2, 2)
+    assert one.time == rows[-1, 0]
+
+
+def test_fading_memory_per_update_equals_filterpy_alpha():
+    """Fading memory per update θ (Morrison ch. 14) is filterpy's alpha = 1/√θ without driving
+    noise: the same gains, so the same estimates (≤ 1e-10 of the scale)."""
+    from filterpy.kalman import KalmanFilter as Peer
+
+    rng = np.random.default_rng(7)
+    dt, theta, steps = 0.5, 0.8, 300
+    t = dt * np.arange(1, steps + 1)
+    z = 3.0 + 2.0 * t - 0.05 * t**2 + rng.standard_normal(steps)
+    ours = ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=100.0, theta=theta)
+    x, _, _ = ours.update_many(t, z, 1.0)
+    peer = Peer(dim_x=2, dim_z=1)
+    peer.x = np.zeros((2, 1))
+    peer.P = 100.0 * np.eye(2)
+    peer.F = np.array([[1.0, dt], [0.0, 1.0]])
+    peer.H = np.array([[1.0, 0.0]])
+    peer.R = np.array([[1.0]])
+    peer.Q = np.zeros((2, 2))
+    peer.alpha = 1.0 / math.sqrt(theta)
+    theirs = np.empty((steps, 2))
+    for i in range(steps):
+        peer.predict()
+        peer.update(z[i])
+        theirs[i] = peer.x[:, 0]
+    assert np.max(np.abs(x - theirs) / np.max(np.abs(theirs), axis=0)) <= 1e-10
+
+
+def test_the_smoother_is_the_batch_least_squares_estimate():
+    """Without driving noise, the smoothed state at every time is the batch minimum-variance
+    estimate from the prior and all the measurements (a whitened least-squares solve in
+    numpy, carried to each time by Φ), on irregular times with missing values: ≤ 1e-9."""
+    rng = np.random.default_rng(11)
+    t = 10.0 + np.cumsum(rng.uniform(0.2, 1.8, 80))
+    z = 1.0 + 0.5 * (t - 10) + 0.02 * (t - 10) ** 2 + 0.3 * rng.standard_normal(t.size)
+    z[rng.choice(t.size, 8, replace=False)] = np.nan
+    x0, p0, r = np.array([0.0, 0.0, 0.0]), np.diag([100.0, 10.0, 1.0]), 0.09
+    f = ss.KalmanFilter(degree=2, x0=x0, P0=p0, t0=10.0)
+    states, covariances = f.smooth(t, z, r)
+    assert f.time == 10.0  # the filter itself is unchanged
+
+    def phi(dt):
+        return np.array([[1.0, dt, dt * dt / 2], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
+
+    ok = ~np.isnan(z)
+    rows = [phi(dt)[0] / math.sqrt(r) for dt in t[ok] - 10.0]
+    prior = np.linalg.cholesky(np.linalg.inv(p0)).T
+    a = np.vstack([prior, np.array(rows)])
+    b = np.concatenate([prior @ x0, z[ok] / math.sqrt(r)])
+    x_hat = np.linalg.lstsq(a, b, rcond=None)[0]
+    cov0 = np.linalg.inv(a.T @ a)
+    for k, tk in enumerate(t):
+        want = phi(tk - 10.0) @ x_hat
+        scale = np.sqrt(np.diag(covariances[k]))
+        assert np.max(np.abs(states[k] - want) / scale) <= 1e-9
+        want_cov = phi(tk - 10.0) @ cov0 @ phi(tk - 10.0).T
+        np.testing.assert_allclose(covariances[k], want_cov, rtol=1e-8, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "call,kind",
+    [
+        (lambda: ss.KalmanFilter(degree=1, x0=[0.0], P0=1.0), ss.InvalidInputError),
+        (
+            lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=np.ones((3, 3))),
+            ss.InvalidInputError,
+        ),
+        (
+            lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=[[1.0, 2.0], [0.0, 1.0]]),
+            ss.ParameterError,
+        ),
+        (lambda: ss.KalmanFilter(degree=1, x0=[0.0, np.nan], P0=1.0), ss.InvalidInputError),
+        (lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, q=-1.0), ss.ParameterError),
+        (
+            lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, beta=0.9, theta=0.9),
+            ss.ParameterError,
+        ),
+        (lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, theta=1.5), ss.ParameterError),
+        (lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, axes=0), ss.ParameterError),
+    ],
+)
+def test_bad_settings(call, kind):
+    with pytest.raises(kind):
+        call()
+
+
+def test_bad_measurements_name_their_index():
+    f = ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=10.0)
+    with pytest.raises(ss.SeqsmoothError) as e:
+        f.update_many([1.0, 2.0, np.nan, 4.0], [1.0, 2.0, 3.0, 4.0], 1.0)
+    assert e.value.index == 2
+    assert f.time == 2.0  # the measurements before it are taken
+    with pytest.raises(ss.SeqsmoothError) as e:
+        f.update_many([3.0, 2.5], [1.0, 2.0], 1.0)
+    assert e.value.index == 1
+    with pytest.raises(ss.InvalidInputError):
+        f.update_many([5.0, 6.0], [[1.0, 2.0], [3.0, 4.0]], 1.0)  # two components for one
+    with pytest.raises(ss.InvalidInputError):
+        f.update(7.0, [1.0, 2.0], 1.0)
+    with pytest.raises(ss.SeqsmoothError):
+        f.update(8.0, 1.0, -1.0)  # a negative variance
+    with pytest.raises(ss.InvalidTypeError):
+        f.update_many(["a"], [1.0], 1.0)
