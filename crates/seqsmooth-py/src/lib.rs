@@ -8,6 +8,7 @@ mod errors;
 mod kalman;
 mod polynomial;
 mod smooth;
+mod tables;
 
 use pyo3::prelude::*;
 
@@ -21,6 +22,8 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<kalman::PyKalmanFilter>()?;
     m.add_class::<kalman::PyInnovation>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
+    m.add_function(wrap_pyfunction!(tables::gains, m)?)?;
+    m.add_function(wrap_pyfunction!(tables::vrf, m)?)?;
     m.add("MAX_DEGREE", seqsmooth::polynomial::MAX_DEGREE)?;
     Ok(())
 }

@@ -135,7 +135,7 @@ def test_ten_thousand_random_bad_calls_never_panic():
         engine = str(rng.choice(["exact", "gain", "adaptive", "x"]))
         window = int(rng.integers(-1, 50))
         try:
-            kind = rng.integers(6)
+            kind = rng.integers(7)
             if kind == 0:
                 f = ss.ExpandingMemory(degree=degree, engine=engine)
             elif kind == 1:
@@ -151,6 +151,20 @@ def test_ten_thousand_random_bad_calls_never_panic():
                     t=times(n) if rng.random() < 0.5 else None,
                 )
                 assert np.isfinite(out).all()
+                outcomes["ok"] += 1
+                continue
+            elif kind == 5:
+                table = ss.gains if rng.random() < 0.5 else ss.vrf
+                args = {
+                    "n": int(rng.integers(0, 30)) if rng.random() < 0.6 else None,
+                    "theta": rng.choice([theta, "9/10", "x", 0]) if rng.random() < 0.6 else None,
+                    "exact": bool(rng.random() < 0.3),
+                }
+                if table is ss.vrf and rng.random() < 0.4:
+                    args.update(window=window, lead=float(rng.normal() * 3))
+                out = table(str(rng.choice(["expanding", "fading", "fixed"])), degree % 12, **args)
+                if not args["exact"]:
+                    assert np.isfinite(out).all()
                 outcomes["ok"] += 1
                 continue
             elif kind == 4:

@@ -15,6 +15,9 @@ Functions
 ---------
 smooth
     ``scipy.signal.savgol_filter``'s names and meaning, on irregular times too.
+gains, vrf
+    The gains and variance-reduction matrices of Morrison's tables, in floats or exactly as
+    ``fractions.Fraction``.
 
 Conventions: derivatives are unscaled, in the caller's time units (``[x, x', x'', ...]``);
 every error is a :class:`SeqsmoothError` (a ``ValueError``) naming the bad value and, in a
@@ -31,7 +34,9 @@ from ._seqsmooth import (
     KalmanFilter,
     PolynomialFilter,
     State,
+    gains,
     smooth,
+    vrf,
 )
 from .errors import (
     InvalidInputError,
@@ -53,6 +58,8 @@ __all__ = [
     "PolynomialFilter",
     "State",
     "smooth",
+    "gains",
+    "vrf",
     "errors",
     "SeqsmoothError",
     "InvalidInputError",

@@ -1,5 +1,6 @@
 """Type stubs of the native module (the classes and functions re-exported by seqsmooth)."""
 
+from fractions import Fraction
 from typing import Literal, overload
 
 import numpy as np
@@ -123,3 +124,48 @@ class KalmanFilter:
     def smooth(
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
+
+Exact = Fraction | int | float | str
+
+@overload
+def gains(
+    kind: Literal["expanding", "fading"],
+    degree: int,
+    n: int | None = None,
+    theta: Exact | None = None,
+    form: Literal["current", "predictor"] = "current",
+    exact: Literal[False] = False,
+) -> Vector: ...
+@overload
+def gains(
+    kind: Literal["expanding", "fading"],
+    degree: int,
+    n: int | None = None,
+    theta: Exact | None = None,
+    form: Literal["current", "predictor"] = "current",
+    *,
+    exact: Literal[True],
+) -> list[Fraction]: ...
+@overload
+def vrf(
+    kind: Literal["expanding", "fading", "fixed"],
+    degree: int,
+    n: int | None = None,
+    theta: Exact | None = None,
+    window: int | None = None,
+    lead: Exact | None = None,
+    form: Literal["current", "predictor"] | None = None,
+    exact: Literal[False] = False,
+) -> Matrix: ...
+@overload
+def vrf(
+    kind: Literal["expanding", "fading", "fixed"],
+    degree: int,
+    n: int | None = None,
+    theta: Exact | None = None,
+    window: int | None = None,
+    lead: Exact | None = None,
+    form: Literal["current", "predictor"] | None = None,
+    *,
+    exact: Literal[True],
+) -> list[list[Fraction]]: ...
