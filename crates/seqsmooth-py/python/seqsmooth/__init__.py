@@ -15,6 +15,9 @@ Functions
 ---------
 smooth
     ``scipy.signal.savgol_filter``'s names and meaning, on irregular times too.
+filter_frame
+    Many series of a pandas or Polars DataFrame or a pyarrow Table, one filter each: the rows
+    of ``seqsmooth filter --id-col``, as a frame of the same kind.
 gains, vrf
     The gains and variance-reduction matrices of Morrison's tables, in floats or exactly as
     ``fractions.Fraction``.
@@ -47,6 +50,7 @@ from .errors import (
     SeqsmoothError,
     TooFewSamplesError,
 )
+from .frame import filter_frame
 
 __all__ = [
     "MAX_DEGREE",
@@ -58,6 +62,7 @@ __all__ = [
     "PolynomialFilter",
     "State",
     "smooth",
+    "filter_frame",
     "gains",
     "vrf",
     "errors",
