@@ -4,6 +4,7 @@
 //! stubs.
 
 mod arrays;
+mod automatic;
 mod errors;
 mod kalman;
 mod polynomial;
@@ -19,6 +20,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<polynomial::PyExpandingMemory>()?;
     m.add_class::<polynomial::PyFadingMemory>()?;
     m.add_class::<polynomial::PyFixedMemory>()?;
+    m.add_class::<automatic::PyAutomaticFilter>()?;
     m.add_class::<kalman::PyKalmanFilter>()?;
     m.add_class::<kalman::PyInnovation>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;

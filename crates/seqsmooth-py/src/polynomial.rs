@@ -26,6 +26,12 @@ pub struct State {
     state: PolynomialState,
 }
 
+impl From<PolynomialState> for State {
+    fn from(state: PolynomialState) -> Self {
+        Self { state }
+    }
+}
+
 #[pymethods]
 impl State {
     /// The time the estimate is valid at.

@@ -7,6 +7,9 @@ ExpandingMemory, FadingMemory, FixedMemory
     The polynomial filters of any degree on any (irregular, Unix-epoch) timestamps:
     ``update(t, y)``, ``update_many(t, y) -> ndarray``, ``estimate()``, ``estimate_at(t)``.
 
+AutomaticFilter
+    Expanding start, fading memory, outlier rejection, noise estimation, misfit restarts and
+    degree settling, with each sample's flags.
 KalmanFilter
     The Kalman filter over the polynomial model (Morrison chs. 12, 14, 15): driving noise,
     fading memory, missing components, ``update_many`` and the RTS ``smooth``.
@@ -30,6 +33,7 @@ batch, its ``index``.
 from . import errors
 from ._seqsmooth import (
     MAX_DEGREE,
+    AutomaticFilter,
     ExpandingMemory,
     FadingMemory,
     FixedMemory,
@@ -54,6 +58,7 @@ from .frame import filter_frame
 
 __all__ = [
     "MAX_DEGREE",
+    "AutomaticFilter",
     "ExpandingMemory",
     "FadingMemory",
     "FixedMemory",

@@ -1,0 +1,182 @@
+//! The automatic filter (`polynomial::automatic::AutomaticFilter`) as a Python class: start-up
+//! on expanding memory, the switch to fading memory, outlier rejection, noise estimation,
+//! misfit restarts and the degree settling, with each sample's flags; `update_many` gives the
+//! numbers `seqsmooth filter --kind auto` writes (the estimate of each update, its 1σ, the
+//! noise in use, the flags), and `finish` the final outlier decisions.
+
+use crate::arrays::{matrix, pair};
+use crate::errors::{raise, IntoPy, Kind};
+use crate::polynomial::State;
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use seqsmooth::polynomial::automatic::AutomaticFilter;
+use seqsmooth::{Engine, Error};
+
+/// The automatic polynomial filter of degree up to ``degree`` (Reyneke et al. 2012; Morrison
+/// chs. 9, 13): it starts on expanding memory, switches to fading memory with ``theta`` per
+/// ``tau`` at Morrison's (13.8.8) point, rejects outliers at a gate from the innovation's σ,
+/// estimates the noise unless ``sigma`` is given, restarts on a misfit, and settles the
+/// degree; every estimate's covariance covers the noise and the estimated bias.
+///
+/// Parameters
+/// ----------
+/// degree : int
+///     The highest degree, 0 to 24.
+/// theta : float
+///     The fading-memory discount per ``tau``, ``0 < theta < 1``.
+/// tau : float
+///     The time interval ``theta`` applies to (default 1).
+/// engine : {"exact", "gain"}
+///     The engine of every internal filter.
+/// sigma : float, optional
+///     The noise's standard deviation, if known (otherwise estimated).
+/// review_window : int, optional
+///     Accepted samples after a sample before its outlier decision is final (default degree
+///     + 4).
+#[pyclass(name = "AutomaticFilter", module = "seqsmooth")]
+pub struct PyAutomaticFilter {
+    filter: AutomaticFilter,
+    /// The final outlier decisions reported so far, in sample order.
+    decided: Vec<bool>,
+}
+
+#[pymethods]
+impl PyAutomaticFilter {
+    #[new]
+    #[pyo3(signature = (degree, theta, tau = 1.0, engine = "exact", sigma = None, review_window = None))]
+    fn new(
+        degree: usize,
+        theta: f64,
+        tau: f64,
+        engine: &str,
+        sigma: Option<f64>,
+        review_window: Option<usize>,
+    ) -> PyResult<Self> {
+        let engine = match engine {
+            "exact" => Engine::Exact,
+            "gain" => Engine::Gain,
+            other => {
+                return Err(raise(
+                    Kind::Parameter,
+                    format!("engine {other:?} is not one of 'exact', 'gain'"),
+                    None,
+                ))
+            }
+        };
+        let mut filter = AutomaticFilter::new(degree, theta, tau)
+            .py()?
+            .with_engine(engine)
+            .py()?;
+        if let Some(s) = sigma {
+            filter = filter.with_noise_sigma(s).py()?;
+        }
+        if let Some(n) = review_window {
+            filter = filter.with_review_window(n).py()?;
+        }
+        Ok(Self {
+            filter,
+            decided: Vec::new(),
+        })
+    }
+
+    /// The highest degree ``m``.
+    #[getter]
+    fn degree(&self) -> usize {
+        self.filter.degree()
+    }
+
+    /// The number of samples accepted (a rejected outlier is not counted).
+    #[getter]
+    fn samples(&self) -> u64 {
+        self.filter.samples()
+    }
+
+    /// Takes the samples ``(t[i], y[i])`` and returns, per sample, what ``seqsmooth filter
+    /// --kind auto`` writes: a dict of numpy arrays ``d`` and ``s`` (``(n, m+1)``: the
+    /// estimate at ``t[i]`` of the active degree and its 1σ, NaN above that degree or before
+    /// the filter is determined), ``noise`` (the σ in use), ``bias`` (the estimated bias of
+    /// ``d0``), ``degree`` (the active degree), and the flags ``outlier`` (the decision at the
+    /// update: see :meth:`finish` for the final ones) and ``misfit``.
+    fn update_many<'py>(
+        &mut self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        y: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (ts, ys) = pair(t, y)?;
+        let (t, y) = (ts.as_slice(), ys.as_slice());
+        let (n, w) = (t.len(), self.filter.degree() + 1);
+        let mut d = vec![f64::NAN; n * w];
+        let mut s = vec![f64::NAN; n * w];
+        let mut noise = vec![f64::NAN; n];
+        let mut bias = vec![f64::NAN; n];
+        let mut degree = vec![0usize; n];
+        let mut outlier = vec![false; n];
+        let mut misfit = vec![false; n];
+        let (filter, decided) = (&mut self.filter, &mut self.decided);
+        py.detach(|| {
+            for (i, (&t, &y)) in t.iter().zip(y).enumerate() {
+                let o = filter.update(t, y).map_err(|e| Error::InBatch {
+                    index: i,
+                    source: Box::new(e),
+                })?;
+                decided.extend_from_slice(&o.decided);
+                if let Some(x) = o.derivatives() {
+                    d[i * w..i * w + x.len()].copy_from_slice(x);
+                }
+                if let Some(sd) = o.std_devs() {
+                    s[i * w..i * w + sd.len()].copy_from_slice(&sd);
+                }
+                noise[i] = o.noise_sigma.unwrap_or(f64::NAN);
+                bias[i] = o.bias.as_ref().map_or(f64::NAN, |b| b[0]);
+                (degree[i], outlier[i], misfit[i]) = (o.degree, o.outlier, o.misfit);
+            }
+            Ok::<(), Error>(())
+        })
+        .py()?;
+        let out = PyDict::new(py);
+        out.set_item("d", matrix(py, d, n, w)?)?;
+        out.set_item("s", matrix(py, s, n, w)?)?;
+        out.set_item("noise", PyArray1::from_vec(py, noise))?;
+        out.set_item("bias", PyArray1::from_vec(py, bias))?;
+        out.set_item("degree", PyArray1::from_vec(py, degree))?;
+        out.set_item("outlier", PyArray1::from_vec(py, outlier))?;
+        out.set_item("misfit", PyArray1::from_vec(py, misfit))?;
+        Ok(out)
+    }
+
+    /// Decides every sample still waiting for its review and returns the final outlier
+    /// decision of every sample taken so far (``True``: rejected), in order.
+    fn finish<'py>(&mut self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        let tail = self.filter.finish();
+        self.decided.extend_from_slice(&tail);
+        PyArray1::from_slice(py, &self.decided)
+    }
+
+    /// The estimate at the newest sample (the active filter's; after a rejected sample, the
+    /// prediction across it).
+    fn estimate(&self) -> PyResult<State> {
+        self.filter.try_estimate().py().map(State::from)
+    }
+
+    /// The estimate carried to time ``t``.
+    fn estimate_at(&self, t: f64) -> PyResult<State> {
+        if !t.is_finite() {
+            return Err(raise(
+                Kind::InvalidInput,
+                format!("time {t} is not finite"),
+                None,
+            ));
+        }
+        self.filter.try_estimate_at(t).py().map(State::from)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "AutomaticFilter(degree={}, samples={})",
+            self.filter.degree(),
+            self.filter.samples()
+        )
+    }
+}

@@ -1,0 +1,56 @@
+"""AutomaticFilter: the numbers of `seqsmooth filter --kind auto` to the last bit (estimate,
+1σ, noise, bias, misfit) and its final outlier decisions, on irregular times with outliers
+and a manoeuvre; its errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import seqsmooth as ss
+from conftest import irregular_series, run_filter
+
+
+def same_bits(a, b, name):
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    np.testing.assert_array_equal(np.isnan(a), np.isnan(b), err_msg=name)
+    ok = ~np.isnan(a)
+    assert np.array_equal(a[ok].view(np.int64), b[ok].view(np.int64)), name
+
+
+@pytest.mark.parametrize("sigma", [None, 0.3])
+def test_equals_the_command(tmp_path, rng, sigma):
+    t, y = irregular_series(rng, 600, start=1.7e9)
+    y = y.copy()
+    y[[100, 250, 251, 400]] += [8.0, -6.0, 7.0, 9.0]  # outliers
+    y[500:] += 0.2 * (t[500:] - t[500])  # a change of slope
+    m = 2
+    f = ss.AutomaticFilter(degree=m, theta=0.95, tau=1.0, sigma=sigma)
+    got = f.update_many(t, y)
+    final = f.finish()
+    flags = ["--kind", "auto", "--degree", "2", "--theta", "0.95", "--tau", "1"]
+    want = run_filter(tmp_path, t, y, *flags, *(["--sigma", "0.3"] if sigma else []))
+    for k in range(m + 1):
+        same_bits(got["d"][:, k], want[f"d{k}"], f"d{k}")
+        same_bits(got["s"][:, k], want[f"s{k}"], f"s{k}")
+    same_bits(got["noise"], want["noise"], "noise")
+    same_bits(got["bias"], want["bias"], "bias")
+    assert np.array_equal(got["misfit"], want["misfit"] == 1.0)
+    assert np.array_equal(final, want["outlier"] == 1.0)
+    assert final[[100, 400]].all() and final.sum() < 20
+    assert len(final) == len(t) and f.samples <= len(t)  # samples counts the accepted ones
+    assert set(got["degree"]) <= set(range(m + 1))
+    assert np.isfinite(f.estimate().derivatives).all()
+
+
+def test_errors():
+    with pytest.raises(ss.ParameterError):
+        ss.AutomaticFilter(degree=2, theta=1.2)
+    with pytest.raises(ss.ParameterError):
+        ss.AutomaticFilter(degree=2, theta=0.9, engine="x")
+    with pytest.raises(ss.ParameterError):
+        ss.AutomaticFilter(degree=3, theta=0.9, review_window=2)
+    f = ss.AutomaticFilter(degree=1, theta=0.9)
+    with pytest.raises(ss.InvalidInputError) as e:
+        f.update_many([0.0, 1.0, 1.0], [1.0, 2.0, 3.0])
+    assert e.value.index == 2 and f.samples == 2
