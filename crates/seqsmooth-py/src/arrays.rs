@@ -19,6 +19,18 @@ impl Series<'_> {
     }
 }
 
+/// `numpy.asarray(obj)`, its failure an [`Kind::InvalidType`] error naming `name`.
+fn asarray<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+    let np = obj.py().import("numpy")?;
+    np.call_method1("asarray", (obj,)).map_err(|e| {
+        raise(
+            Kind::InvalidType,
+            format!("{name} is not an array of numbers: {e}"),
+            None,
+        )
+    })
+}
+
 /// `obj` as a one-dimensional series of reals, named `name` in errors.
 pub fn series<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Series<'py>> {
     if let Ok(a) = obj.cast::<PyArray1<f64>>() {
@@ -27,15 +39,7 @@ pub fn series<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Series<'py>>
             return Ok(Series(a));
         }
     }
-    let py = obj.py();
-    let np = py.import("numpy")?;
-    let array = np.call_method1("asarray", (obj,)).map_err(|e| {
-        raise(
-            Kind::InvalidType,
-            format!("{name} is not an array of numbers: {e}"),
-            None,
-        )
-    })?;
+    let array = asarray(obj, name)?;
     let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
     if !matches!(kind.as_str(), "f" | "i" | "u") {
         let dtype = array.getattr("dtype")?.str()?.to_string();
@@ -54,6 +58,7 @@ pub fn series<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Series<'py>>
             None,
         ));
     }
+    let np = obj.py().import("numpy")?;
     let converted = np.call_method1("ascontiguousarray", (array, "float64"))?;
     Ok(Series(converted.cast::<PyArray1<f64>>()?.readonly()))
 }
@@ -97,15 +102,7 @@ pub fn matrix<'py>(
 /// `obj` as a row-major table of reals, named `name` in errors: a 2-D array as it is, a 1-D
 /// array as one column; its values (contiguous, row-major), rows and columns.
 pub fn table<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<(Series<'py>, usize, usize)> {
-    let py = obj.py();
-    let np = py.import("numpy")?;
-    let array = np.call_method1("asarray", (obj,)).map_err(|e| {
-        raise(
-            Kind::InvalidType,
-            format!("{name} is not an array of numbers: {e}"),
-            None,
-        )
-    })?;
+    let array = asarray(obj, name)?;
     let ndim: usize = array.getattr("ndim")?.extract()?;
     let (rows, cols) = match ndim {
         1 => (array.getattr("shape")?.get_item(0)?.extract()?, 1),

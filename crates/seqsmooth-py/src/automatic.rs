@@ -6,7 +6,7 @@
 
 use crate::arrays::{matrix, pair};
 use crate::errors::{raise, IntoPy, Kind};
-use crate::polynomial::State;
+use crate::polynomial::{state_of, State};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -157,19 +157,12 @@ impl PyAutomaticFilter {
     /// The estimate at the newest sample (the active filter's; after a rejected sample, the
     /// prediction across it).
     fn estimate(&self) -> PyResult<State> {
-        self.filter.try_estimate().py().map(State::from)
+        state_of(&self.filter, None)
     }
 
     /// The estimate carried to time ``t``.
     fn estimate_at(&self, t: f64) -> PyResult<State> {
-        if !t.is_finite() {
-            return Err(raise(
-                Kind::InvalidInput,
-                format!("time {t} is not finite"),
-                None,
-            ));
-        }
-        self.filter.try_estimate_at(t).py().map(State::from)
+        state_of(&self.filter, Some(t))
     }
 
     fn __repr__(&self) -> String {

@@ -78,6 +78,20 @@ impl State {
     }
 }
 
+/// The estimate of `filter` at `t` (without `t`, at its newest sample) as a [`State`]; why
+/// there is none as the error.
+pub(crate) fn state_of(filter: &dyn PolynomialFilter, t: Option<f64>) -> PyResult<State> {
+    match t {
+        None => filter.try_estimate().py().map(State::from),
+        Some(t) if !t.is_finite() => Err(raise(
+            Kind::InvalidInput,
+            format!("time {t} is not finite"),
+            None,
+        )),
+        Some(t) => filter.try_estimate_at(t).py().map(State::from),
+    }
+}
+
 /// The base of the polynomial filters: ``update``, ``update_many``, ``estimate`` and
 /// ``estimate_at`` (Morrison chs. 9, 13; Reyneke et al. 2012 on irregular times).
 #[pyclass(name = "PolynomialFilter", module = "seqsmooth", subclass)]
@@ -286,23 +300,13 @@ impl PyPolynomialFilter {
     /// TooFewSamplesError, NumericalError
     ///     no estimate yet, or none to working accuracy (the reason in the message).
     fn estimate(&self) -> PyResult<State> {
-        self.filter.try_estimate().py().map(|state| State { state })
+        state_of(&*self.filter, None)
     }
 
     /// The estimate carried to time ``t`` (a prediction ahead of the newest sample, a
     /// retrodiction before it), its covariance carried with it.
     fn estimate_at(&self, t: f64) -> PyResult<State> {
-        if !t.is_finite() {
-            return Err(raise(
-                Kind::InvalidInput,
-                format!("time {t} is not finite"),
-                None,
-            ));
-        }
-        self.filter
-            .try_estimate_at(t)
-            .py()
-            .map(|state| State { state })
+        state_of(&*self.filter, Some(t))
     }
 
     fn __repr__(slf: &Bound<'_, Self>) -> PyResult<String> {
