@@ -6,6 +6,8 @@ unit-step samples in one `update_many_into` call) and then this script in target
 
 - `update_many` of the same filters on 10⁶ samples from numpy (float64, contiguous): best of
   REPEATS calls, each on a fresh filter, in samples/s;
+- `filter_frame` on 10⁴ series × 10³ samples (a pandas DataFrame, integer ids, the rows
+  interleaved as in the Rust bench `one_call/stream_fading_exact_10000x1000/2`): best of 3;
 - filterpy 2.0.0's `FadingMemoryFilter` (order 2, beta 0.9) fed the same samples one
   `update` at a time (the way its users run it), on the first PEER_SAMPLES samples: best of 3;
   and the ratio of the two fading-memory rates.
@@ -18,6 +20,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+import pandas as pd
 from filterpy.memory import FadingMemoryFilter
 
 import seqsmooth as ss
@@ -52,6 +55,20 @@ def main() -> None:
             lambda: ss.ExpandingMemory(degree=2, engine="gain"), t, y
         ),
     }
+    # filter_frame on 10⁴ series × 10³ samples, interleaved as in the Rust bench, from a
+    # pandas DataFrame with integer ids (best of 3).
+    series, each = 10_000, 1_000
+    rows = series * each
+    ids = np.tile(np.arange(series), each)
+    times = np.repeat(np.arange(each, dtype=np.float64), series) + ids * 1e-3
+    frame = pd.DataFrame({"id": ids, "t": times, "y": rng.standard_normal(rows)})
+    best = float("inf")
+    for _ in range(3):
+        start = time.perf_counter()
+        ss.filter_frame(frame, by="id", kind="fading", degree=2, theta=0.9, tau=1.0)
+        best = min(best, time.perf_counter() - start)
+    rates["python/filter_frame_fading_exact_10000x1000/2"] = rows / best
+    del frame
     best = float("inf")
     for _ in range(3):
         f = FadingMemoryFilter(x0=np.zeros(3), dt=1.0, order=2, beta=0.9)

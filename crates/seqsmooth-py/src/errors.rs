@@ -68,6 +68,11 @@ pub fn raise(kind: Kind, message: impl Into<String>, index: Option<usize>) -> Py
 /// A library error as its Python exception; `offset` is added to a batch index (the batch
 /// was a slice of the caller's arrays starting there).
 pub fn to_py(error: Error, offset: usize) -> PyErr {
+    // A bank's error is its channel's: the row's index and the cause.
+    let error = match error {
+        Error::InChannel { source, .. } if matches!(*source, Error::InBatch { .. }) => *source,
+        other => other,
+    };
     let index = match &error {
         Error::InBatch { index, .. } => Some(index + offset),
         _ => None,

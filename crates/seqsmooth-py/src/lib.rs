@@ -6,6 +6,7 @@
 mod arrays;
 mod automatic;
 mod errors;
+mod frame;
 mod kalman;
 mod polynomial;
 mod smooth;
@@ -24,6 +25,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<kalman::PyKalmanFilter>()?;
     m.add_class::<kalman::PyInnovation>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
+    m.add_function(wrap_pyfunction!(frame::filter_series, m)?)?;
     m.add_function(wrap_pyfunction!(tables::gains, m)?)?;
     m.add_function(wrap_pyfunction!(tables::vrf, m)?)?;
     m.add("MAX_DEGREE", seqsmooth::polynomial::MAX_DEGREE)?;

@@ -108,49 +108,63 @@ impl PyPolynomialFilter {
     }
 }
 
-/// One row per sample, a sample at a time: the derivatives of `try_estimate_at(t)` into
-/// `out` (and their 1σ into `sigma`), NaN while the filter has too few samples; any other
-/// reason for no estimate is the sample's error. Errors carry the index within the slice.
-fn rows_one_by_one(
+/// Runs the samples `(t[i], y[i])` and writes row `i` of `out`: the derivatives at `t[i]`
+/// (`m+1` cells), then with `sigma` their 1σ (`m+1` more), as `seqsmooth filter` computes
+/// them: with `batch` (expanding and fading memory without σ) by the library's batch kernels
+/// (`update_many_into`, its rows checked by [`check_batch_rows`]), otherwise a sample at a
+/// time, each estimate from `try_estimate_at(t)`: NaN while the filter has too few samples,
+/// any other reason for no estimate the sample's error. Errors are [`Error::InBatch`] with the
+/// index within the slice. The one row runner of `update_many` and `filter_series`.
+pub(crate) fn run_rows(
     filter: &mut dyn PolynomialFilter,
+    batch: bool,
     t: &[f64],
     y: &[f64],
     out: &mut [f64],
-    mut sigma: Option<&mut [f64]>,
+    sigma: bool,
 ) -> Result<(), Error> {
     let w = filter.degree() + 1;
+    if batch && !sigma {
+        let before = filter.samples();
+        filter.update_many_into(t, y, out)?;
+        return check_batch_rows(out, w, before);
+    }
+    let stride = w << usize::from(sigma);
     let at = |index: usize| {
         move |e: Error| Error::InBatch {
             index,
             source: Box::new(e),
         }
     };
-    for (i, (&t, &y)) in t.iter().zip(y).enumerate() {
+    for (i, ((&t, &y), row)) in t
+        .iter()
+        .zip(y)
+        .zip(out.chunks_exact_mut(stride))
+        .enumerate()
+    {
         filter.update(t, y).map_err(at(i))?;
-        let row = &mut out[i * w..(i + 1) * w];
         let state = match filter.try_estimate_at(t) {
             Ok(s) => s,
             Err(Error::TooFewSamples { .. }) => {
                 row.fill(f64::NAN);
-                if let Some(s) = sigma.as_deref_mut() {
-                    s[i * w..(i + 1) * w].fill(f64::NAN);
-                }
                 continue;
             }
             Err(e) => return Err(at(i)(e)),
         };
-        let d = &state.derivatives;
-        row[..d.len()].copy_from_slice(d);
-        row[d.len()..].fill(f64::NAN);
-        if let Some(s) = sigma.as_deref_mut() {
+        let (d, s) = row.split_at_mut(w);
+        let x = &state.derivatives;
+        d[..x.len()].copy_from_slice(x);
+        d[x.len()..].fill(f64::NAN);
+        if sigma {
             let Some(sd) = state.std_devs() else {
                 return Err(at(i)(Error::InvalidParameter {
-                    name: "return_sigma",
-                    value: "True".into(),
-                    reason: "the filter has no noise sigma: construct it with sigma=...".into(),
+                    name: "sigma",
+                    value: "None".into(),
+                    reason: "the filter has no noise sigma for the 1σ: construct it with \
+                             sigma=..."
+                        .into(),
                 }));
             };
-            let s = &mut s[i * w..(i + 1) * w];
             s[..sd.len()].copy_from_slice(&sd);
             s[sd.len()..].fill(f64::NAN);
         }
@@ -255,42 +269,28 @@ impl PyPolynomialFilter {
         let (ts, ys) = pair(t, y)?;
         let (t, y) = (ts.as_slice(), ys.as_slice());
         let (n, w) = (t.len(), self.filter.degree() + 1);
-        let mut out = vec![0.0; n * w];
-        let mut sigma = if return_sigma {
-            vec![0.0; n * w]
-        } else {
-            Vec::new()
-        };
-        let batch = self.batch && !return_sigma;
+        let stride = w << usize::from(return_sigma);
+        let mut out = vec![0.0; n * stride];
         for start in (0..n).step_by(CHUNK) {
             let end = (start + CHUNK).min(n);
             let (tc, yc) = (&t[start..end], &y[start..end]);
-            let oc = &mut out[start * w..end * w];
-            let sc = if return_sigma {
-                Some(&mut sigma[start * w..end * w])
-            } else {
-                None
-            };
-            let filter = &mut *self.filter;
-            py.detach(|| {
-                if batch {
-                    let before = filter.samples();
-                    filter.update_many_into(tc, yc, oc)?;
-                    check_batch_rows(oc, w, before)
-                } else {
-                    rows_one_by_one(filter, tc, yc, oc, sc)
-                }
-            })
-            .py_at(start)?;
+            let oc = &mut out[start * stride..end * stride];
+            let (filter, batch) = (&mut *self.filter, self.batch);
+            py.detach(|| run_rows(filter, batch, tc, yc, oc, return_sigma))
+                .py_at(start)?;
             py.check_signals()?;
         }
-        let estimates = matrix(py, out, n, w)?;
-        if return_sigma {
-            let sigma = matrix(py, sigma, n, w)?;
-            Ok((estimates, sigma).into_pyobject(py)?.into_any())
-        } else {
-            Ok(estimates)
+        if !return_sigma {
+            return matrix(py, out, n, w);
         }
+        // Rows [d, s] into the two arrays.
+        let (mut d, mut s) = (Vec::with_capacity(n * w), Vec::with_capacity(n * w));
+        for row in out.chunks_exact(stride) {
+            d.extend_from_slice(&row[..w]);
+            s.extend_from_slice(&row[w..]);
+        }
+        let (d, s) = (matrix(py, d, n, w)?, matrix(py, s, n, w)?);
+        Ok((d, s).into_pyobject(py)?.into_any())
     }
 
     /// The estimate at the newest sample's time.

@@ -7,6 +7,12 @@
 //!   τ = 1) already past its start-up; each iteration processes a batch of samples, by `update`
 //!   per sample, by one `update_many` call, or by one `update_many_into` call (which also
 //!   writes every sample's estimate); throughput in samples.
+//! - `one_call/<memory>_<engine>_many_into/2`: a fresh degree-2 filter (fading: θ = 0.9,
+//!   τ = 1) given 10⁶ unit-step samples in one `update_many_into` call (every estimate
+//!   written, start-up included): the figure the Python package's `update_many` is compared
+//!   with (`scripts/py_bench.sh`); and `one_call/stream_fading_exact_10000x1000/2`: 10⁴ series
+//!   of 10³ samples interleaved, through a `StreamBank` on the rayon pool (the Python
+//!   `filter_frame`'s counterpart, `seqsmooth filter --id-col` without the CSV).
 //! - `bank/<serial|parallel>/<K>`: a degree-2 [`FadingBank`] (θ = 0.9) of `K` channels past
 //!   its switch; each iteration is one time step of all channels; throughput in
 //!   channel-updates.
@@ -16,6 +22,7 @@
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use seqsmooth::polynomial::bank::FadingBank;
+use seqsmooth::polynomial::stream::{Chunk, StreamBank};
 use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
 mod common;
 
@@ -90,6 +97,75 @@ fn single_stream(c: &mut Criterion) {
     group.finish();
 }
 
+fn one_call(c: &mut Criterion) {
+    const LEN: usize = 1_000_000;
+    const M: usize = 2;
+    let ys = data(LEN);
+    let times: Vec<f64> = (0..LEN).map(|n| n as f64).collect();
+    let mut est = vec![0.0; LEN * (M + 1)];
+    let mut group = c.benchmark_group("one_call");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(3))
+        .throughput(Throughput::Elements(LEN as u64));
+    for (memory, engine, eng) in [
+        ("fading", Engine::Gain, "gain"),
+        ("fading", Engine::Exact, "exact"),
+        ("expanding", Engine::Gain, "gain"),
+    ] {
+        let id = BenchmarkId::new(format!("{memory}_{eng}_many_into"), M);
+        group.bench_function(id, |b| {
+            b.iter(|| {
+                let mut f: Box<dyn PolynomialFilter> = if memory == "fading" {
+                    Box::new(FadingMemory::new(M, 0.9, 1.0, engine).unwrap())
+                } else {
+                    Box::new(ExpandingMemory::new(M, engine).unwrap())
+                };
+                f.update_many_into(&times, &ys, &mut est).unwrap();
+                black_box(est[est.len() - 1])
+            });
+        });
+    }
+    // Many series: 10⁴ series of 10³ samples, interleaved round-robin (row i·10⁴ + k is
+    // sample i of series k at time i + k·10⁻³), through a growing `StreamBank` of degree-2
+    // exact fading-memory filters on the rayon pool, every estimate written: what `seqsmooth
+    // filter --id-col` runs without the CSV, and what the Python `filter_frame` is compared
+    // with.
+    const SERIES: usize = 10_000;
+    const EACH: usize = 1_000;
+    let rows = SERIES * EACH;
+    let channels: Vec<usize> = (0..rows).map(|r| r % SERIES).collect();
+    let times: Vec<f64> = (0..rows)
+        .map(|r| (r / SERIES) as f64 + (r % SERIES) as f64 * 1e-3)
+        .collect();
+    let values = data(rows);
+    let mut est = vec![0.0; rows * (M + 1)];
+    group.throughput(Throughput::Elements(rows as u64));
+    group.bench_function(BenchmarkId::new("stream_fading_exact_10000x1000", M), |b| {
+        b.iter(|| {
+            let prototype = FadingMemory::new(M, 0.9, 1.0, Engine::Exact).unwrap();
+            let mut bank = StreamBank::growing(prototype).unwrap();
+            let chunk = Chunk {
+                channels: &channels,
+                times: &times,
+                values: &values,
+                estimates: &mut est,
+                stride: M + 1,
+            };
+            bank.update_par(
+                chunk,
+                |f: &mut FadingMemory, t: &[f64], y: &[f64], o: &mut [f64]| {
+                    f.update_many_into(t, y, o)
+                },
+            )
+            .unwrap();
+            black_box(est[est.len() - 1])
+        });
+    });
+    group.finish();
+}
+
 fn bank(c: &mut Criterion) {
     let mut group = c.benchmark_group("bank");
     group
@@ -143,5 +219,5 @@ fn copy(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, single_stream, bank, copy);
+criterion_group!(benches, single_stream, one_call, bank, copy);
 criterion_main!(benches);

@@ -3,22 +3,21 @@ dict of arrays), each filtered on its own with the same settings, the result the
 ``seqsmooth filter --id-col`` as a frame of the same kind, in input order.
 
 The columns are read as numpy arrays (no copy for numeric columns in pandas, Polars and
-Arrow); the rows are grouped by the ``by`` column (stable, so each series keeps its input
-order) and each series runs through one filter's ``update_many`` (the GIL released, the
-series on a thread pool); the estimates are scattered back to the input rows.
+Arrow); the ``by`` column is factorised into series numbers; the library's ``StreamBank``
+(``filter_series``, without the GIL) groups the rows by series, runs each series through one
+filter as ``seqsmooth filter --id-col`` does (the series on the rayon pool) and puts the
+estimates back in the input's row order.
 """
 
 from __future__ import annotations
 
-import os
 from collections.abc import Mapping
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
 
-from ._seqsmooth import ExpandingMemory, FadingMemory, FixedMemory
-from .errors import InvalidInputError, ParameterError, SeqsmoothError
+from ._seqsmooth import filter_series
+from .errors import InvalidInputError, SeqsmoothError
 
 
 def _column(frame: Any, name: str) -> np.ndarray:
@@ -39,13 +38,29 @@ def _column(frame: Any, name: str) -> np.ndarray:
         raise InvalidInputError(f"no column {name!r} in the frame (columns: {columns})") from None
 
 
+def _codes(keys: np.ndarray, by: str) -> tuple[np.ndarray, Any]:
+    """Each row's series as a number from 0 (pandas' hash factorisation when pandas is
+    there, else numpy's sort), and the series' names by number."""
+    try:
+        import pandas
+    except ImportError:
+        names, codes = np.unique(keys, return_inverse=True)
+        return codes.astype(np.int64), names
+    codes, names = pandas.factorize(keys)
+    missing = np.flatnonzero(codes < 0)
+    if missing.size:
+        i = int(missing[0])
+        raise InvalidInputError(f"row {i}: the {by!r} cell is empty (no series)", i)
+    return codes.astype(np.int64, copy=False), np.asarray(names)
+
+
 def _like(frame: Any, columns: dict[str, np.ndarray]) -> Any:
     """``columns`` as a frame of the kind of ``frame``."""
     module = type(frame).__module__.split(".")[0]
     if module == "pandas":
         import pandas
 
-        return pandas.DataFrame(columns)
+        return pandas.DataFrame(columns, copy=False)
     if module == "polars":
         import polars
 
@@ -69,7 +84,6 @@ def filter_frame(
     window: int | None = None,
     engine: str | None = None,
     sigma: float | None = None,
-    threads: int | None = None,
 ) -> Any:
     """Filters every series of a frame, as ``seqsmooth filter [--id-col BY]`` does.
 
@@ -85,8 +99,6 @@ def filter_frame(
     degree, theta, tau, window, engine, sigma
         As for :class:`ExpandingMemory`, :class:`FadingMemory` and :class:`FixedMemory`
         (``engine`` defaults to ``"exact"``, for ``fixed`` to ``"adaptive"``).
-    threads : int, optional
-        Series filtered at once (default: the CPU count).
 
     Returns
     -------
@@ -101,87 +113,46 @@ def filter_frame(
         As ``update_many``; ``.index`` is the row of the frame, and the message names its
         series.
     """
-    if kind == "expanding":
-        make = lambda: ExpandingMemory(degree, engine=engine or "exact", sigma=sigma)  # noqa: E731
-    elif kind == "fading":
-        if theta is None:
-            raise ParameterError("kind 'fading' needs theta, the discount per tau (0 < theta < 1)")
-        make = lambda: FadingMemory(  # noqa: E731
-            degree, theta, tau=tau, engine=engine or "exact", sigma=sigma
-        )
-    elif kind == "fixed":
-        if window is None:
-            raise ParameterError("kind 'fixed' needs window, the number of samples in the window")
-        make = lambda: FixedMemory(  # noqa: E731
-            degree, window, engine=engine or "adaptive", sigma=sigma
-        )
-    else:
-        raise ParameterError(f"kind {kind!r} is not one of 'expanding', 'fading', 'fixed'")
-    make()  # the settings checked once, before any row
     t = np.ascontiguousarray(_column(df, time), dtype=np.float64)
     y = np.ascontiguousarray(_column(df, value), dtype=np.float64)
     n = len(t)
     if n == 0:
         raise InvalidInputError("the frame has no rows")
-    if by is None:
-        keys, codes = None, np.zeros(n, dtype=np.intp)
-        groups = [np.arange(n)]
-        names = [None]
-    else:
-        keys = _column(df, by)
-        names, codes = np.unique(keys, return_inverse=True)
-        order = np.argsort(codes, kind="stable")
-        cuts = np.flatnonzero(np.diff(codes[order])) + 1
-        groups = np.split(order, cuts)
-    width = degree + 1
-    d = np.full((n, width), np.nan)
-    s = np.full((n, width), np.nan) if sigma is not None else None
-
-    def run(rows: np.ndarray) -> None:
-        f = make()
-        out = f.update_many(t[rows], y[rows], return_sigma=sigma is not None)
-        if s is None:
-            d[rows] = out
-        else:
-            d[rows], s[rows] = out
-
-    errors: list[tuple[int, BaseException]] = []
-
-    def guarded(k: int) -> None:
-        try:
-            run(groups[k])
-        except SeqsmoothError as e:
-            errors.append((k, e))
-
-    with ThreadPoolExecutor(max_workers=threads or os.cpu_count() or 1) as pool:
-        list(pool.map(guarded, range(len(groups))))
-    if errors:
-        # The error of the earliest bad row in the frame.
-        def row(item):
-            k, e = item
-            return groups[k][e.index] if e.index is not None else groups[k][0]
-
-        k, e = min(errors, key=row)
-        index = int(groups[k][e.index]) if e.index is not None else None
-        series = "" if by is None else f" (series {names[k]!r} of column {by!r})"
+    keys = None if by is None else _column(df, by)
+    codes, names = (np.zeros(n, dtype=np.int64), [None]) if keys is None else _codes(keys, by)
+    try:
+        result = filter_series(
+            codes,
+            t,
+            y,
+            kind,
+            degree,
+            theta=theta,
+            tau=tau,
+            window=window,
+            engine=engine,
+            sigma=sigma,
+        )
+    except SeqsmoothError as e:
+        if e.index is None:
+            raise
         message = str(e)
-        if index is not None and message.startswith("sample ") and ": " in message:
-            message = message.split(": ", 1)[1]  # the index within the series, replaced
-        where = f"row {index}{series}: " if index is not None else f"{series.strip()}: "
-        raise type(e)(f"{where}{message}", index) from e
+        if message.startswith("sample ") and ": " in message:
+            message = message.split(": ", 1)[1]  # the row is named below
+        series = "" if by is None else f" (series {names[codes[e.index]]!r} of column {by!r})"
+        raise type(e)(f"row {e.index}{series}: {message}", e.index) from e
+    values, cells = result if kind == "fixed" else (result, None)
+    width = degree + 1
     columns: dict[str, np.ndarray] = {}
     if keys is not None:
         columns[by] = keys
     columns[time] = t
     columns[value] = y
     for k in range(width):
-        columns[f"d{k}"] = d[:, k]
-    if s is not None:
+        columns[f"d{k}"] = values[k]
+    if sigma is not None:
         for k in range(width):
-            columns[f"s{k}"] = s[:, k]
-    if kind == "fixed":
-        cells = np.empty(n)
-        for rows in groups:
-            cells[rows] = np.minimum(np.arange(1, len(rows) + 1), window)
+            columns[f"s{k}"] = values[width + k]
+    if cells is not None:
         columns["window"] = cells
     return _like(df, columns)

@@ -1,0 +1,179 @@
+//! `filter_series`, the engine of `seqsmooth.filter_frame`: many series in one set of columns,
+//! each row tagged with its series (`codes`, 0-based), run through the library's
+//! `StreamBank` (one filter per series, grouped by a counting sort, the series on the rayon
+//! pool) with the rows of [`run_rows`], the same as `seqsmooth filter --id-col`.
+
+use crate::arrays::{matrix, series};
+use crate::errors::{raise, IntoPy, Kind};
+use crate::polynomial::run_rows;
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use seqsmooth::polynomial::fixed::FixedEngine;
+use seqsmooth::polynomial::stream::{Chunk, StreamBank};
+use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter};
+
+/// Every series of `chunk` through a copy of `prototype`.
+fn run_bank<F: PolynomialFilter + Clone + Send>(
+    prototype: F,
+    batch: bool,
+    chunk: Chunk<'_>,
+    sigma: bool,
+) -> Result<(), Error> {
+    let mut bank = StreamBank::growing(prototype)?;
+    bank.update_par(chunk, |f: &mut F, t: &[f64], y: &[f64], out: &mut [f64]| {
+        run_rows(f, batch, t, y, out, sigma)
+    })
+}
+
+/// Filters the rows ``(t[i], y[i])`` of series ``codes[i]`` (0-based integers), each series
+/// on its own filter of the given settings, and returns the columns ``d0..dM`` and with
+/// ``sigma`` their 1σ ``s0..sM``, one value per input row, as the rows of one array
+/// ``(columns, rows)`` (NaN while the series is not determined); for ``fixed`` also the ``window`` cell of each row (the rows in its window),
+/// as a pair. Errors are those of the earliest bad row, with its index.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (codes, t, y, kind, degree, theta = None, tau = 1.0, window = None, engine = None, sigma = None))]
+pub fn filter_series<'py>(
+    py: Python<'py>,
+    codes: &Bound<'py, PyAny>,
+    t: &Bound<'py, PyAny>,
+    y: &Bound<'py, PyAny>,
+    kind: &str,
+    degree: usize,
+    theta: Option<f64>,
+    tau: f64,
+    window: Option<usize>,
+    engine: Option<&str>,
+    sigma: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (ts, ys) = (series(t, "t")?, series(y, "y")?);
+    let (t, y) = (ts.as_slice(), ys.as_slice());
+    let n = t.len();
+    let codes = codes.cast::<PyArray1<i64>>().map_err(|_| {
+        raise(
+            Kind::InvalidType,
+            "codes must be a one-dimensional int64 numpy array",
+            None,
+        )
+    })?;
+    let codes = codes.readonly();
+    let codes = codes.as_slice()?;
+    if y.len() != n || codes.len() != n {
+        return Err(raise(
+            Kind::InvalidInput,
+            format!(
+                "{} codes, {n} times and {} values: one of each per row",
+                codes.len(),
+                y.len()
+            ),
+            None,
+        ));
+    }
+    let mut channels = Vec::with_capacity(n);
+    for (i, &c) in codes.iter().enumerate() {
+        match usize::try_from(c) {
+            Ok(c) if c < n => channels.push(c),
+            _ => {
+                return Err(raise(
+                    Kind::InvalidInput,
+                    format!(
+                        "code {c} of row {i} is not a series number from 0 to {}",
+                        n - 1
+                    ),
+                    Some(i),
+                ))
+            }
+        }
+    }
+    let unknown = |e: &str, allowed: &str| {
+        raise(
+            Kind::Parameter,
+            format!("engine {e:?} is not one of {allowed}"),
+            None,
+        )
+    };
+    let engine_of = |e: Option<&str>| match e.unwrap_or("exact") {
+        "exact" => Ok(Engine::Exact),
+        "gain" => Ok(Engine::Gain),
+        other => Err(unknown(other, "'exact', 'gain'")),
+    };
+    let with_sigma = sigma.is_some();
+    let stride = (degree + 1) << usize::from(with_sigma);
+    let mut out = vec![0.0; n * stride];
+    let chunk = Chunk {
+        channels: &channels,
+        times: t,
+        values: y,
+        estimates: &mut out,
+        stride,
+    };
+    let needs = |what: &str| raise(Kind::Parameter, format!("kind {kind:?} needs {what}"), None);
+    match kind {
+        "expanding" => {
+            let mut f = ExpandingMemory::new(degree, engine_of(engine)?).py()?;
+            if let Some(s) = sigma {
+                f = f.with_noise_sigma(s).py()?;
+            }
+            py.detach(|| run_bank(f, true, chunk, with_sigma))
+        }
+        "fading" => {
+            let theta = theta.ok_or_else(|| needs("theta"))?;
+            let mut f = FadingMemory::new(degree, theta, tau, engine_of(engine)?).py()?;
+            if let Some(s) = sigma {
+                f = f.with_noise_sigma(s).py()?;
+            }
+            py.detach(|| run_bank(f, true, chunk, with_sigma))
+        }
+        "fixed" => {
+            let window = window.ok_or_else(|| needs("window"))?;
+            let engine = match engine.unwrap_or("adaptive") {
+                "adaptive" => FixedEngine::Adaptive,
+                "sliding" => FixedEngine::Sliding,
+                "direct" => FixedEngine::Direct,
+                "irregular" => FixedEngine::Irregular,
+                other => {
+                    return Err(unknown(
+                        other,
+                        "'adaptive', 'sliding', 'direct', 'irregular'",
+                    ))
+                }
+            };
+            let mut f = FixedMemory::new(degree, window, engine).py()?;
+            if let Some(s) = sigma {
+                f = f.with_noise_sigma(s).py()?;
+            }
+            py.detach(|| run_bank(f, false, chunk, with_sigma))
+        }
+        other => {
+            return Err(raise(
+                Kind::Parameter,
+                format!("kind {other:?} is not one of 'expanding', 'fading', 'fixed'"),
+                None,
+            ))
+        }
+    }
+    .py()?;
+    // Column by column (each derivative's column contiguous, for the frame's columns).
+    let mut columns = vec![0.0; n * stride];
+    for (k, column) in columns.chunks_exact_mut(n).enumerate() {
+        for (v, row) in column.iter_mut().zip(out.chunks_exact(stride)) {
+            *v = row[k];
+        }
+    }
+    let values = matrix(py, columns, stride, n)?;
+    if kind != "fixed" {
+        return Ok(values);
+    }
+    // The fixed-memory filter's `window` cell: the rows in each row's window.
+    let window = window.unwrap_or(0) as f64;
+    let mut seen = vec![0.0f64; channels.iter().max().map_or(0, |&c| c + 1)];
+    let cells: Vec<f64> = channels
+        .iter()
+        .map(|&c| {
+            seen[c] += 1.0;
+            seen[c].min(window)
+        })
+        .collect();
+    let cells = PyArray1::from_vec(py, cells).into_any();
+    Ok((values, cells).into_pyobject(py)?.into_any())
+}
