@@ -10,7 +10,8 @@
 //! - `one_call/<memory>_<engine>_many_into/2`: a fresh degree-2 filter (fading: θ = 0.9,
 //!   τ = 1) given 10⁶ unit-step samples in one `update_many_into` call (every estimate
 //!   written, start-up included): the figure the Python package's `update_many` is compared
-//!   with (`scripts/py_bench.sh`); and `one_call/stream_fading_exact_10000x1000/2`: 10⁴ series
+//!   with (`scripts/py_bench.sh`); `one_call/fading_gain_many_into_fresh_output/2`, the same
+//!   into a new buffer per call; and `one_call/stream_fading_exact_10000x1000/2`: 10⁴ series
 //!   of 10³ samples interleaved, through a `StreamBank` on the rayon pool (the Python
 //!   `filter_frame`'s counterpart, `seqsmooth filter --id-col` without the CSV).
 //! - `bank/<serial|parallel>/<K>`: a degree-2 [`FadingBank`] (θ = 0.9) of `K` channels past
@@ -127,6 +128,20 @@ fn one_call(c: &mut Criterion) {
             });
         });
     }
+    // The same with a fresh estimates buffer per call, as a caller that keeps every call's
+    // estimates (and the Python `update_many`, which returns them) pays: the first touch of
+    // 24 MB of new memory.
+    group.bench_function(
+        BenchmarkId::new("fading_gain_many_into_fresh_output", M),
+        |b| {
+            b.iter(|| {
+                let mut f = FadingMemory::new(M, 0.9, 1.0, Engine::Gain).unwrap();
+                let mut out = vec![0.0; LEN * (M + 1)];
+                f.update_many_into(&times, &ys, &mut out).unwrap();
+                black_box(out[out.len() - 1])
+            });
+        },
+    );
     // Many series: 10⁴ series of 10³ samples, interleaved round-robin (row i·10⁴ + k is
     // sample i of series k at time i + k·10⁻³), through a growing `StreamBank` of degree-2
     // exact fading-memory filters on the rayon pool, every estimate written: what `seqsmooth
