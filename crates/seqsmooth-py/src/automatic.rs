@@ -5,13 +5,13 @@
 //! noise in use, the flags), and `finish` the final outlier decisions.
 
 use crate::arrays::{matrix, pair};
-use crate::errors::{raise, IntoPy, Kind};
-use crate::polynomial::{state_of, State};
+use crate::errors::IntoPy;
+use crate::polynomial::{engine as engine_named, state_of, State};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use seqsmooth::polynomial::automatic::AutomaticFilter;
-use seqsmooth::{Engine, Error};
+use seqsmooth::Error;
 
 /// The automatic polynomial filter of degree up to ``degree`` (Reyneke et al. 2012; Morrison
 /// chs. 9, 13): it starts on expanding memory, switches to fading memory with ``theta`` per
@@ -53,17 +53,7 @@ impl PyAutomaticFilter {
         sigma: Option<f64>,
         review_window: Option<usize>,
     ) -> PyResult<Self> {
-        let engine = match engine {
-            "exact" => Engine::Exact,
-            "gain" => Engine::Gain,
-            other => {
-                return Err(raise(
-                    Kind::Parameter,
-                    format!("engine {other:?} is not one of 'exact', 'gain'"),
-                    None,
-                ))
-            }
-        };
+        let engine = engine_named(engine)?;
         let mut filter = AutomaticFilter::new(degree, theta, tau)
             .py()?
             .with_engine(engine)

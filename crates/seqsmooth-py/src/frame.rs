@@ -5,12 +5,11 @@
 
 use crate::arrays::{matrix, series};
 use crate::errors::{raise, IntoPy, Kind};
-use crate::polynomial::run_rows;
+use crate::polynomial::{engine as engine_named, fixed_engine, run_rows};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
-use seqsmooth::polynomial::fixed::FixedEngine;
 use seqsmooth::polynomial::stream::{Chunk, StreamBank};
-use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter};
+use seqsmooth::{Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter};
 
 /// Every series of `chunk` through a copy of `prototype`.
 fn run_bank<F: PolynomialFilter + Clone + Send>(
@@ -85,18 +84,7 @@ pub fn filter_series<'py>(
             }
         }
     }
-    let unknown = |e: &str, allowed: &str| {
-        raise(
-            Kind::Parameter,
-            format!("engine {e:?} is not one of {allowed}"),
-            None,
-        )
-    };
-    let engine_of = |e: Option<&str>| match e.unwrap_or("exact") {
-        "exact" => Ok(Engine::Exact),
-        "gain" => Ok(Engine::Gain),
-        other => Err(unknown(other, "'exact', 'gain'")),
-    };
+    let engine_of = |e: Option<&str>| engine_named(e.unwrap_or("exact"));
     let with_sigma = sigma.is_some();
     let stride = (degree + 1) << usize::from(with_sigma);
     let mut out = vec![0.0; n * stride];
@@ -126,18 +114,7 @@ pub fn filter_series<'py>(
         }
         "fixed" => {
             let window = window.ok_or_else(|| needs("window"))?;
-            let engine = match engine.unwrap_or("adaptive") {
-                "adaptive" => FixedEngine::Adaptive,
-                "sliding" => FixedEngine::Sliding,
-                "direct" => FixedEngine::Direct,
-                "irregular" => FixedEngine::Irregular,
-                other => {
-                    return Err(unknown(
-                        other,
-                        "'adaptive', 'sliding', 'direct', 'irregular'",
-                    ))
-                }
-            };
+            let engine = fixed_engine(engine.unwrap_or("adaptive"))?;
             let mut f = FixedMemory::new(degree, window, engine).py()?;
             if let Some(s) = sigma {
                 f = f.with_noise_sigma(s).py()?;

@@ -321,14 +321,30 @@ impl PyPolynomialFilter {
     }
 }
 
-/// `"exact"` or `"gain"`.
-fn engine(name: &str) -> PyResult<Engine> {
+/// The engine named `name`: `"exact"` or `"gain"`.
+pub(crate) fn engine(name: &str) -> PyResult<Engine> {
     match name {
         "exact" => Ok(Engine::Exact),
         "gain" => Ok(Engine::Gain),
         other => Err(raise(
             Kind::Parameter,
             format!("engine {other:?} is not one of 'exact', 'gain'"),
+            None,
+        )),
+    }
+}
+
+/// The fixed-memory engine named `name`: `"adaptive"`, `"sliding"`, `"direct"` or
+/// `"irregular"`.
+pub(crate) fn fixed_engine(name: &str) -> PyResult<FixedEngine> {
+    match name {
+        "adaptive" => Ok(FixedEngine::Adaptive),
+        "sliding" => Ok(FixedEngine::Sliding),
+        "direct" => Ok(FixedEngine::Direct),
+        "irregular" => Ok(FixedEngine::Irregular),
+        other => Err(raise(
+            Kind::Parameter,
+            format!("engine {other:?} is not one of 'adaptive', 'sliding', 'direct', 'irregular'"),
             None,
         )),
     }
@@ -430,22 +446,7 @@ impl PyFixedMemory {
         engine: &str,
         sigma: Option<f64>,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let engine = match engine {
-            "adaptive" => FixedEngine::Adaptive,
-            "sliding" => FixedEngine::Sliding,
-            "direct" => FixedEngine::Direct,
-            "irregular" => FixedEngine::Irregular,
-            other => {
-                return Err(raise(
-                    Kind::Parameter,
-                    format!(
-                        "engine {other:?} is not one of 'adaptive', 'sliding', 'direct', \
-                         'irregular'"
-                    ),
-                    None,
-                ))
-            }
-        };
+        let engine = fixed_engine(engine)?;
         let mut f = FixedMemory::new(degree, window, engine).py()?;
         if let Some(s) = sigma {
             f = f.with_noise_sigma(s).py()?;
