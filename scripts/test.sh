@@ -19,11 +19,10 @@ if ! cmp -s "$requirements" "$venv/requirements-test.txt"; then
     "$venv/bin/python" -m pip install --quiet -r "$requirements"
     cp "$requirements" "$venv/requirements-test.txt"
 fi
-# The install line of the README, with the pinned maturin already in the environment (and on
-# PATH, where the build backend looks for it).
-export PATH="$PWD/$venv/bin:$PATH"
-"$venv/bin/python" -m pip install --quiet --no-build-isolation --force-reinstall --no-deps \
-    ./crates/seqsmooth-py
+# The README's install line (pip builds the wheel with maturin from PyPI in an isolated
+# environment), then the import it promises.
+"$venv/bin/python" -m pip install --quiet --force-reinstall --no-deps ./crates/seqsmooth-py
+"$venv/bin/python" -c "import seqsmooth"
 (
     cd crates/seqsmooth-py
     "../../$venv/bin/ruff" check .

@@ -62,3 +62,30 @@ def test_derivatives_above_the_order_are_zero():
 def test_errors(call, kind):
     with pytest.raises(kind):
         call()
+
+
+@pytest.mark.parametrize("spacing", ["even", "irregular"])
+def test_equals_the_command_to_the_last_bit(tmp_path, spacing):
+    """Every derivative of `seqsmooth smooth` for the same rows, bit for bit."""
+    import csv
+    import subprocess
+
+    from conftest import cli_path
+
+    rng = np.random.default_rng(8)
+    n = 500
+    t = 0.25 * np.arange(n) if spacing == "even" else np.cumsum(rng.uniform(0.5, 1.5, n))
+    y = np.sin(t / 7.0) + 0.1 * rng.standard_normal(n)
+    source = tmp_path / "in.csv"
+    source.write_text("t,y\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), y.tolist())))
+    out = subprocess.run(
+        [str(cli_path()), "smooth", str(source), "--degree", "3", "--window", "15"],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    rows = list(csv.reader(out.splitlines()))[1:]
+    for k in range(4):
+        got = ss.smooth(y, 15, 3, deriv=k, t=t)
+        want = np.array([float(r[2 + k]) for r in rows])
+        assert np.array_equal(got.view(np.int64), want.view(np.int64)), k
