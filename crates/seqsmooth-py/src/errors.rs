@@ -35,6 +35,8 @@ impl Kind {
     fn of(error: &Error) -> Kind {
         match error {
             Error::NonFinite { .. } | Error::TimeNotIncreasing { .. } => Kind::InvalidInput,
+            // The library's parameter errors about the data handed in rather than a setting.
+            Error::InvalidParameter { name, .. } if DATA.contains(name) => Kind::InvalidInput,
             Error::ThetaOutOfRange { .. }
             | Error::TauOutOfRange { .. }
             | Error::DegreeOutOfRange { .. }
@@ -48,6 +50,18 @@ impl Kind {
         }
     }
 }
+
+/// The names of [`Error::InvalidParameter`] that describe the data passed (a sample, the
+/// shape of the arrays), not a setting: [`Kind::InvalidInput`].
+const DATA: &[&str] = &[
+    "input value",
+    "input length",
+    "matrix length",
+    "batch lengths",
+    "chunk lengths",
+    "estimates length",
+    "time",
+];
 
 /// An exception of `kind` with `message` and `index` (the offending sample's position).
 pub fn raise(kind: Kind, message: impl Into<String>, index: Option<usize>) -> PyErr {

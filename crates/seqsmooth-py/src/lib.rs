@@ -5,6 +5,7 @@
 
 mod arrays;
 mod automatic;
+mod bank;
 mod errors;
 mod frame;
 mod kalman;
@@ -22,6 +23,8 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<polynomial::PyFadingMemory>()?;
     m.add_class::<polynomial::PyFixedMemory>()?;
     m.add_class::<automatic::PyAutomaticFilter>()?;
+    m.add_class::<bank::PyFadingBank>()?;
+    m.add_class::<bank::PyExpandingBank>()?;
     m.add_class::<kalman::PyKalmanFilter>()?;
     m.add_class::<kalman::PyInnovation>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;

@@ -10,6 +10,8 @@ ExpandingMemory, FadingMemory, FixedMemory
 AutomaticFilter
     Expanding start, fading memory, outlier rejection, noise estimation, misfit restarts and
     degree settling, with each sample's flags.
+FadingBank, ExpandingBank
+    Many channels on one even time grid, a time step of all channels at a time.
 KalmanFilter
     The Kalman filter over the polynomial model (Morrison chs. 12, 14, 15): driving noise,
     fading memory, missing components, ``update_many`` and the RTS ``smooth``.
@@ -34,7 +36,9 @@ from . import errors
 from ._seqsmooth import (
     MAX_DEGREE,
     AutomaticFilter,
+    ExpandingBank,
     ExpandingMemory,
+    FadingBank,
     FadingMemory,
     FixedMemory,
     Innovation,
@@ -59,7 +63,9 @@ from .frame import filter_frame
 __all__ = [
     "MAX_DEGREE",
     "AutomaticFilter",
+    "ExpandingBank",
     "ExpandingMemory",
+    "FadingBank",
     "FadingMemory",
     "FixedMemory",
     "KalmanFilter",
