@@ -135,7 +135,7 @@ def test_ten_thousand_random_bad_calls_never_panic():
         engine = str(rng.choice(["exact", "gain", "adaptive", "x"]))
         window = int(rng.integers(-1, 50))
         try:
-            kind = rng.integers(7)
+            kind = rng.integers(8)
             if kind == 0:
                 f = ss.ExpandingMemory(degree=degree, engine=engine)
             elif kind == 1:
@@ -151,6 +151,13 @@ def test_ten_thousand_random_bad_calls_never_panic():
                     t=times(n) if rng.random() < 0.5 else None,
                 )
                 assert np.isfinite(out).all()
+                outcomes["ok"] += 1
+                continue
+            elif kind == 6:
+                k = int(rng.integers(-1, 5))
+                bank = ss.FadingBank(degree=degree, theta=theta, channels=k, tau=tau)
+                bank.update(values(n * max(k, 1)).reshape(n, max(k, 1)) if n else [])
+                assert not np.isinf(bank.estimate()).any()
                 outcomes["ok"] += 1
                 continue
             elif kind == 5:
