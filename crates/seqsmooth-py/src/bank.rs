@@ -84,68 +84,65 @@ fn estimates<'py>(py: Python<'py>, bank: &dyn Bank) -> PyResult<Bound<'py, PyAny
     matrix(py, rows, k, w)
 }
 
+/// The base of the banks: ``update``, ``estimate`` and ``samples`` (the banks differ only in
+/// how they are made).
+#[pyclass(name = "Bank", module = "seqsmooth", subclass)]
+pub struct PyBank {
+    bank: Box<dyn Bank + Sync>,
+}
+
+#[pymethods]
+impl PyBank {
+    /// The time steps taken.
+    #[getter]
+    fn samples(&self) -> u64 {
+        self.bank.samples()
+    }
+    /// Takes one time step (``K`` values) or many (``n × K``).
+    fn update(&mut self, py: Python<'_>, y: &Bound<'_, PyAny>) -> PyResult<()> {
+        update(py, &mut *self.bank, y)
+    }
+    /// Every channel's estimate, ``K × (m+1)`` (NaN before ``m+1`` steps).
+    fn estimate<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        estimates(py, &*self.bank)
+    }
+}
+
 /// ``channels`` fading-memory filters of degree ``degree`` on evenly spaced samples (step
 /// ``tau``), discount ``theta`` per sample (Morrison Table 13.1, started by the
 /// expanding-memory gains of Table 9.1 until the switch of §13.8).
 ///
 /// ``update(y)`` takes one time step (``K`` values) or many (an ``n × K`` array);
 /// ``estimate()`` returns every channel's ``[x, x', …]`` as a ``K × (m+1)`` array.
-#[pyclass(name = "FadingBank", module = "seqsmooth")]
-pub struct PyFadingBank {
-    bank: FadingBank,
-}
+#[pyclass(name = "FadingBank", module = "seqsmooth", extends = PyBank)]
+pub struct PyFadingBank;
 
 #[pymethods]
 impl PyFadingBank {
     #[new]
     #[pyo3(signature = (degree, theta, channels, tau = 1.0))]
-    fn new(degree: usize, theta: f64, channels: usize, tau: f64) -> PyResult<Self> {
-        Ok(Self {
-            bank: FadingBank::new(degree, theta, tau, channels).py()?,
-        })
-    }
-    /// The time steps taken.
-    #[getter]
-    fn samples(&self) -> u64 {
-        self.bank.samples()
-    }
-    /// Takes one time step (``K`` values) or many (``n × K``).
-    fn update(&mut self, py: Python<'_>, y: &Bound<'_, PyAny>) -> PyResult<()> {
-        update(py, &mut self.bank, y)
-    }
-    /// Every channel's estimate, ``K × (m+1)`` (NaN before ``m+1`` steps).
-    fn estimate<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        estimates(py, &self.bank)
+    fn new(
+        degree: usize,
+        theta: f64,
+        channels: usize,
+        tau: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let bank = Box::new(FadingBank::new(degree, theta, tau, channels).py()?);
+        Ok(PyClassInitializer::from(PyBank { bank }).add_subclass(Self))
     }
 }
 
 /// ``channels`` expanding-memory filters of degree ``degree`` on evenly spaced samples (step
 /// ``tau``; Morrison Table 9.1). Methods as :class:`FadingBank`.
-#[pyclass(name = "ExpandingBank", module = "seqsmooth")]
-pub struct PyExpandingBank {
-    bank: ExpandingBank,
-}
+#[pyclass(name = "ExpandingBank", module = "seqsmooth", extends = PyBank)]
+pub struct PyExpandingBank;
 
 #[pymethods]
 impl PyExpandingBank {
     #[new]
     #[pyo3(signature = (degree, channels, tau = 1.0))]
-    fn new(degree: usize, channels: usize, tau: f64) -> PyResult<Self> {
-        Ok(Self {
-            bank: ExpandingBank::new(degree, tau, channels).py()?,
-        })
-    }
-    /// The time steps taken.
-    #[getter]
-    fn samples(&self) -> u64 {
-        self.bank.samples()
-    }
-    /// Takes one time step (``K`` values) or many (``n × K``).
-    fn update(&mut self, py: Python<'_>, y: &Bound<'_, PyAny>) -> PyResult<()> {
-        update(py, &mut self.bank, y)
-    }
-    /// Every channel's estimate, ``K × (m+1)`` (NaN before ``m+1`` steps).
-    fn estimate<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        estimates(py, &self.bank)
+    fn new(degree: usize, channels: usize, tau: f64) -> PyResult<PyClassInitializer<Self>> {
+        let bank = Box::new(ExpandingBank::new(degree, tau, channels).py()?);
+        Ok(PyClassInitializer::from(PyBank { bank }).add_subclass(Self))
     }
 }

@@ -23,6 +23,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<polynomial::PyFadingMemory>()?;
     m.add_class::<polynomial::PyFixedMemory>()?;
     m.add_class::<automatic::PyAutomaticFilter>()?;
+    m.add_class::<bank::PyBank>()?;
     m.add_class::<bank::PyFadingBank>()?;
     m.add_class::<bank::PyExpandingBank>()?;
     m.add_class::<kalman::PyKalmanFilter>()?;

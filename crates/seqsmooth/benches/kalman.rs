@@ -14,7 +14,10 @@
 //! one predict + update. The measurements are built once, outside the timing. Run:
 //! `cargo bench -p seqsmooth --bench kalman` (results in BENCHMARKS.md).
 
-use criterion::{black_box, criterion_group, criterion_main, BatchSize, Criterion, Throughput};
+use criterion::measurement::WallTime;
+use criterion::{
+    black_box, criterion_group, criterion_main, BatchSize, BenchmarkGroup, Criterion, Throughput,
+};
 use nalgebra::{DMatrix, DVector};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -23,8 +26,8 @@ use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::KalmanFilter;
-use seqsmooth::model::dynamics::PolynomialDynamics;
-use seqsmooth::model::observation::LinearObservation;
+use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+use seqsmooth::model::observation::{LinearObservation, Observation};
 use std::time::Duration;
 
 #[path = "common/radar.rs"]
@@ -75,6 +78,47 @@ fn polynomial_case() -> (
     (filter, rows)
 }
 
+/// Benchmark `name`: every filter of `filters` (a fresh copy each iteration, made outside the
+/// timing) through its run of measurements in `runs`, one `update(filter, measurement)` each
+/// (its NIS summed so that nothing is optimised away).
+fn bench_updates<D: Dynamics + Clone, O: Observation + Clone>(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    filters: &[KalmanFilter<D, O>],
+    runs: &[&[Measurement]],
+    update: impl Fn(&mut KalmanFilter<D, O>, &Measurement) -> f64,
+) {
+    group.bench_function(name, |b| {
+        b.iter_batched(
+            || filters.to_vec(),
+            |mut fs| {
+                let mut acc = 0.0;
+                for (f, run) in fs.iter_mut().zip(runs) {
+                    for m in *run {
+                        acc += update(f, black_box(m));
+                    }
+                }
+                (fs, acc)
+            },
+            BatchSize::LargeInput,
+        )
+    });
+}
+
+/// `update_stats` and `update` of every filter over its run, as two benchmarks of `group`.
+fn bench_both<D: Dynamics + Clone, O: Observation + Clone>(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    filters: &[KalmanFilter<D, O>],
+    runs: &[&[Measurement]],
+) {
+    bench_updates(group, "update_stats", filters, runs, |f, m| {
+        f.update_stats(m).unwrap().map_or(0.0, |i| i.nis)
+    });
+    bench_updates(group, "update", filters, runs, |f, m| {
+        f.update(m).unwrap().map_or(0.0, |i| i.nis)
+    });
+}
+
 fn kalman3(c: &mut Criterion) {
     let (filter, rows) = polynomial_case();
     let mut group = c.benchmark_group("kalman3");
@@ -83,75 +127,22 @@ fn kalman3(c: &mut Criterion) {
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(4))
         .throughput(Throughput::Elements(rows.len() as u64));
-    group.bench_function("update_stats", |b| {
-        b.iter_batched(
-            || filter.clone(),
-            |mut f| {
-                let mut acc = 0.0;
-                for m in &rows {
-                    acc += f.update_stats(black_box(m)).unwrap().map_or(0.0, |i| i.nis);
-                }
-                (f, acc)
-            },
-            BatchSize::LargeInput,
-        )
-    });
-    group.bench_function("update", |b| {
-        b.iter_batched(
-            || filter.clone(),
-            |mut f| {
-                let mut acc = 0.0;
-                for m in &rows {
-                    acc += f.update(black_box(m)).unwrap().map_or(0.0, |i| i.nis);
-                }
-                (f, acc)
-            },
-            BatchSize::LargeInput,
-        )
-    });
+    bench_both(&mut group, &[filter], &[&rows]);
     group.finish();
 }
 
 fn ekf6(c: &mut Criterion) {
     let tracks = kalman_tracks::tracks(radar::SEED, TRACKS);
     let filters: Vec<_> = tracks.iter().map(|t| t.filter()).collect();
-    let updates: usize = tracks.iter().map(|t| t.measurements.len()).sum();
+    let runs: Vec<&[Measurement]> = tracks.iter().map(|t| t.measurements.as_slice()).collect();
+    let updates: usize = runs.iter().map(|r| r.len()).sum();
     let mut group = c.benchmark_group("ekf6");
     group
         .sample_size(30)
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(4))
         .throughput(Throughput::Elements(updates as u64));
-    group.bench_function("update_stats", |b| {
-        b.iter_batched(
-            || filters.clone(),
-            |mut fs| {
-                let mut acc = 0.0;
-                for (f, t) in fs.iter_mut().zip(&tracks) {
-                    for m in &t.measurements {
-                        acc += f.update_stats(black_box(m)).unwrap().map_or(0.0, |i| i.nis);
-                    }
-                }
-                (fs, acc)
-            },
-            BatchSize::LargeInput,
-        )
-    });
-    group.bench_function("update", |b| {
-        b.iter_batched(
-            || filters.clone(),
-            |mut fs| {
-                let mut acc = 0.0;
-                for (f, t) in fs.iter_mut().zip(&tracks) {
-                    for m in &t.measurements {
-                        acc += f.update(black_box(m)).unwrap().map_or(0.0, |i| i.nis);
-                    }
-                }
-                (fs, acc)
-            },
-            BatchSize::LargeInput,
-        )
-    });
+    bench_both(&mut group, &filters, &runs);
     group.finish();
 }
 
