@@ -25,18 +25,15 @@ use crate::fit::window_error;
 use crate::io::{check_distinct, open_input, write_f64, CsvIn, Need, Output};
 use nalgebra::{DMatrix, DVector};
 use rows::{Names, Rows, SigmaSource};
-use seqsmooth::estimate::gauss_newton::{Correction, Epoch, Measurement};
-use seqsmooth::estimate::sliding::{SlidingFit, Start};
-use seqsmooth::kalman::noise::WhiteNoiseDerivative;
-use seqsmooth::kalman::{smooth, Discount, KalmanFilter};
-use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::kalman::track::{
+    RadarTracker, TrackError, TrackMethod as Method, Tracked, START_WINDOW,
+};
+use seqsmooth::kalman::Discount;
 use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
 use std::collections::VecDeque;
 use stream::Block;
-
-/// The window of the Kalman methods' start (the first fit that determines the state).
-const START_WINDOW: usize = 60;
 
 /// The output's header.
 const HEADER: &[u8] = b"t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,nis\n";
@@ -49,12 +46,6 @@ type Estimate = ([f64; 6], [f64; 6], Option<f64>);
 
 /// One output row's numbers; `None` for empty cells.
 type Cells = Option<Estimate>;
-
-/// The filter of the Kalman methods.
-type Filter = KalmanFilter<PolynomialDynamics, Radar>;
-
-/// The sliding fit of the window method and of the Kalman methods' start.
-type Fit = SlidingFit<PolynomialDynamics, Radar>;
 
 /// Runs `seqsmooth track`.
 pub fn run(a: &TrackArgs) -> Result<(), CliError> {
@@ -195,155 +186,106 @@ enum Step {
     Held,
 }
 
-/// What the method keeps between rows.
-enum Stage {
-    /// The Kalman methods before the state is determined: the start's fit over the rows so
-    /// far, and their lines.
-    Starting(Box<Fit>, VecDeque<u64>),
-    /// kalman and fading: the filter.
-    Filtering(Box<Filter>),
-    /// smooth: the filter at the start, and the rows after it.
-    Smoothing(Box<Filter>, Held),
-    /// window: the fit over the last rows, their lines, and the previous row's estimate.
-    Window(Box<Fit>, VecDeque<u64>, Option<Correction>),
-}
-
-/// The rows the smoother holds: their measurements, lines and time cells (one buffer).
+/// The rows the smoother holds: their lines and time cells (one buffer), and the tracker's
+/// number of the first.
 #[derive(Default)]
 struct Held {
-    measurements: Vec<Measurement>,
+    first: usize,
     lines: Vec<u64>,
     text: Vec<u8>,
     ends: Vec<usize>,
 }
 
-/// The chosen method's settings and state.
+/// The library's tracker, with the file lines of the last rows (for its messages) and the
+/// rows the smoother holds.
 struct Tracker {
-    method: TrackMethod,
-    radar: Radar,
-    dynamics: PolynomialDynamics,
-    window: usize,
-    q: f64,
-    discount: Option<Discount>,
-    stage: Stage,
+    inner: RadarTracker,
+    /// The lines of the last `keep` rows, the latest last (enough for any window).
+    lines: VecDeque<u64>,
+    keep: usize,
+    held: Held,
 }
 
 impl Tracker {
     fn new(a: &TrackArgs, radar: Radar) -> Result<Self, CliError> {
-        let discount = match (a.beta, a.theta) {
-            (Some(b), _) => Some(Discount::PerTime(b)),
-            (_, Some(t)) => Some(Discount::PerUpdate(t)),
-            _ => None,
+        let method = match a.method {
+            TrackMethod::Window => Method::Window { window: a.window },
+            TrackMethod::Kalman => Method::Kalman {
+                q: a.q.unwrap_or(0.0),
+            },
+            TrackMethod::Smooth => Method::Smooth {
+                q: a.q.unwrap_or(0.0),
+            },
+            TrackMethod::Fading => Method::Fading(match (a.beta, a.theta) {
+                (Some(b), _) => Discount::PerTime(b),
+                (_, Some(t)) => Discount::PerUpdate(t),
+                _ => unreachable!("run() refuses fading without --beta or --theta"),
+            }),
         };
-        let dynamics = PolynomialDynamics::new(1, 3);
-        let stage = match a.method {
-            TrackMethod::Window => Stage::Window(
-                Box::new(sliding(dynamics, radar, a.window)?),
-                VecDeque::with_capacity(a.window.min(1 << 16)),
-                None,
-            ),
-            _ => Stage::Starting(
-                Box::new(sliding(dynamics, radar, START_WINDOW)?),
-                VecDeque::with_capacity(START_WINDOW),
-            ),
+        let inner = RadarTracker::new(radar, method).map_err(|e| CliError::Usage(e.to_string()))?;
+        let keep = match a.method {
+            TrackMethod::Window => a.window,
+            _ => START_WINDOW,
         };
         Ok(Self {
-            method: a.method,
-            radar,
-            dynamics,
-            window: a.window,
-            q: a.q.unwrap_or(0.0),
-            discount,
-            stage,
+            inner,
+            lines: VecDeque::with_capacity(keep.min(1 << 16)),
+            keep,
+            held: Held::default(),
         })
     }
 
     /// Tracks the row `m` of file line `line` and time cell `t`.
     fn push(&mut self, m: &Measurement, line: u64, t: &[u8]) -> Result<Step, CliError> {
-        match &mut self.stage {
-            Stage::Filtering(filter) => {
-                let innovation = filter.update_stats(m).map_err(|e| {
-                    CliError::Data(format!("line {line}: the filter's update failed: {e}"))
-                })?;
-                Ok(Step::Row(Some(cells(
-                    filter.state(),
-                    filter.covariance(),
-                    innovation.map(|i| i.nis),
-                ))))
-            }
-            Stage::Smoothing(_, held) => {
-                held.measurements.push(m.clone());
+        if self.lines.len() == self.keep {
+            self.lines.pop_front();
+        }
+        self.lines.push_back(line);
+        match self.inner.push(m) {
+            Ok(Tracked::Undetermined) => Ok(Step::Row(None)),
+            Ok(Tracked::Estimate(e)) => Ok(Step::Row(Some(cells(e.state, e.covariance, e.nis)))),
+            Ok(Tracked::Held) => {
+                let held = &mut self.held;
+                if held.lines.is_empty() {
+                    held.first = self.inner.rows() - 1;
+                }
                 held.lines.push(line);
                 held.text.extend_from_slice(t);
                 held.ends.push(held.text.len());
                 Ok(Step::Held)
             }
-            Stage::Starting(fit, lines) => {
-                if lines.len() == START_WINDOW {
-                    lines.pop_front();
-                }
-                lines.push_back(line);
-                let c = fit
-                    .push(m.clone())
-                    .map_err(|e| window_error(e, lines, START_WINDOW, FitModel::Radar))?;
-                let Some(c) = c else {
-                    return Ok(Step::Row(None));
-                };
-                let filter = Box::new(self.filter_from(&c)?);
-                self.stage = if self.method == TrackMethod::Smooth {
-                    Stage::Smoothing(filter, Held::default())
-                } else {
-                    Stage::Filtering(filter)
-                };
-                Ok(Step::Row(Some(cells(&c.state, &c.covariance, None))))
+            Err(TrackError::Window { rows, source }) => {
+                let lines: VecDeque<u64> = self
+                    .lines
+                    .iter()
+                    .skip(self.lines.len().saturating_sub(rows.len()))
+                    .copied()
+                    .collect();
+                Err(window_error(source, &lines, rows.len(), FitModel::Radar))
             }
-            Stage::Window(..) => self.window_step(m, line),
+            Err(TrackError::Update { source, .. }) => Err(CliError::Data(format!(
+                "line {line}: the filter's update failed: {source}"
+            ))),
+            Err(e) => Err(CliError::Data(e.to_string())),
         }
-    }
-
-    /// The window method's row: the fit of the last rows, and the row's innovation against
-    /// the previous row's fit.
-    fn window_step(&mut self, m: &Measurement, line: u64) -> Result<Step, CliError> {
-        let nis = match &self.stage {
-            Stage::Window(_, _, Some(p)) => self
-                .filter_from(p)?
-                .update_stats(m)
-                .ok()
-                .flatten()
-                .map(|i| i.nis),
-            _ => None,
-        };
-        let Stage::Window(fit, lines, previous) = &mut self.stage else {
-            return Ok(Step::Held);
-        };
-        if lines.len() == self.window {
-            lines.pop_front();
-        }
-        lines.push_back(line);
-        let c = fit
-            .push(m.clone())
-            .map_err(|e| window_error(e, lines, self.window, FitModel::Radar))?;
-        let row = c.as_ref().map(|c| cells(&c.state, &c.covariance, nis));
-        *previous = c;
-        Ok(Step::Row(row))
     }
 
     /// The rows held to the end (the smoother's), smoothed.
     fn finish(&mut self) -> Result<Option<Block>, CliError> {
-        let Stage::Smoothing(filter, held) = &mut self.stage else {
-            return Ok(None);
-        };
-        let held = std::mem::take(held);
-        let at = |i: usize| held.lines[i];
-        let smoothed = smooth((**filter).clone(), &held.measurements).map_err(|e| match e {
-            Error::InBatch { index, source } => {
-                CliError::Data(format!("line {}: {source}", at(index)))
+        let held = std::mem::take(&mut self.held);
+        let smoothed = self.inner.finish().map_err(|e| match e {
+            TrackError::Smooth(Error::InBatch { index, source }) => {
+                let line = held.lines[index - held.first];
+                CliError::Data(format!("line {line}: {source}"))
             }
-            e => CliError::Data(format!("the smoother failed: {e}")),
+            e => CliError::Data(e.to_string()),
         })?;
+        if held.lines.is_empty() {
+            return Ok(None);
+        }
         let cells = smoothed
             .iter()
-            .map(|s| Some(Some(cells(&s.state, &s.covariance, s.nis))))
+            .map(|(_, s)| Some(Some(cells(&s.state, &s.covariance, s.nis))))
             .collect();
         Ok(Some(Block::Rows {
             text: held.text,
@@ -351,38 +293,6 @@ impl Tracker {
             cells,
         }))
     }
-
-    /// A Kalman filter from a fit, with the method's driving noise or fading.
-    fn filter_from(&self, c: &Correction) -> Result<Filter, CliError> {
-        let library = |e: Error| CliError::Data(format!("cannot start the filter: {e}"));
-        let f = KalmanFilter::new(
-            self.dynamics,
-            self.radar,
-            c.state.clone(),
-            c.covariance.clone(),
-            c.epoch,
-        )
-        .map_err(library)?;
-        match (self.method, self.discount) {
-            (TrackMethod::Fading, Some(d)) => f.with_fading(d).map_err(library),
-            (TrackMethod::Window, _) => Ok(f),
-            _ => f
-                .with_process_noise(WhiteNoiseDerivative::new(1, 3, self.q).map_err(library)?)
-                .map_err(library),
-        }
-    }
-}
-
-/// The sliding fit over `window` rows, started as the radar's nominal (§8.5).
-fn sliding(dynamics: PolynomialDynamics, radar: Radar, window: usize) -> Result<Fit, CliError> {
-    SlidingFit::new(
-        dynamics,
-        radar,
-        window,
-        Epoch::End,
-        Start::Radar { radar, degree: 2 },
-    )
-    .map_err(|e| CliError::Usage(e.to_string()))
 }
 
 /// A row's cells from a state and covariance.

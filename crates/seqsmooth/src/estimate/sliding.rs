@@ -214,11 +214,18 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
     ///
     /// `Ok(None)` while the window is not yet full and does not determine the state (too few
     /// components, or [`Error::Unobservable`]); once it holds `W` measurements, a window that
-    /// does not determine the state is that error. A measurement that is not after the
-    /// previous one, or is malformed, is refused and not kept.
+    /// does not determine the state is that error. Any error refuses the measurement: the fit
+    /// is then as before it (a measurement that is not after the previous one, malformed, or
+    /// that leaves the full window undetermined).
     pub fn push(&mut self, measurement: Measurement) -> Result<Option<Correction>, Error> {
+        if !measurement.time.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: measurement.time,
+            });
+        }
         if let Some(previous) = self.rows.back() {
-            if measurement.time.is_finite() && measurement.time <= previous.time {
+            if measurement.time <= previous.time {
                 return Err(Error::InvalidParameter {
                     name: "time",
                     value: measurement.time.to_string(),
@@ -229,9 +236,11 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
                 });
             }
         }
-        if self.rows.len() == self.window {
-            self.rows.pop_front();
-        }
+        let dropped = if self.rows.len() == self.window {
+            self.rows.pop_front()
+        } else {
+            None
+        };
         self.rows.push_back(measurement);
         self.rows.make_contiguous();
         match self.fit() {
@@ -246,11 +255,10 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
                 Ok(None)
             }
             Err(e) => {
-                // A malformed measurement is not kept.
-                if matches!(e, Error::InBatch { index, .. } if index + 1 == self.rows.len()) {
-                    self.rows.pop_back();
+                self.rows.pop_back();
+                if let Some(d) = dropped {
+                    self.rows.push_front(d);
                 }
-                self.last = None;
                 Err(e)
             }
         }

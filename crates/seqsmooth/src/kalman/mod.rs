@@ -8,6 +8,8 @@
 //! - [`filter`]: [`KalmanFilter`], prediction, Joseph-form update, the iterated update, the
 //!   generalized fading memory of ch. 14 ([`Discount`]), innovation statistics.
 //! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run.
+//! - [`track`]: [`track::RadarTracker`], a radar's rows to a Cartesian track by the sliding
+//!   Gauss–Newton fit, the extended Kalman filter (driving noise or fading) or its smoother.
 //! - [`steady`]: the fading filter's steady state (§14.7).
 //! - [`noise`]: the driving-noise covariance `Q` over a step (15.2.23), in closed form for the
 //!   polynomial model ([`noise::WhiteNoiseDerivative`]).
@@ -18,7 +20,8 @@ pub mod filter;
 pub mod noise;
 pub mod smoother;
 pub mod steady;
+pub mod track;
 
 pub use bayes::BayesFilter;
 pub use filter::{Discount, Innovation, KalmanFilter};
-pub use smoother::{smooth, Smoothed};
+pub use smoother::{smooth, Smoothed, Smoother};

@@ -56,71 +56,133 @@ pub struct Smoothed {
 /// let s = smoother::smooth(f, &rows).unwrap();
 /// assert!((s[0].state[0] - 3.0).abs() < 1e-9 && (s[0].filtered_state[0] - 1.0).abs() < 1e-9);
 /// ```
-pub fn smooth<D: Dynamics, O: Observation>(
-    mut filter: KalmanFilter<D, O>,
+pub fn smooth<D: Dynamics + Clone, O: Observation + Clone>(
+    filter: KalmanFilter<D, O>,
     measurements: &[Measurement],
 ) -> Result<Vec<Smoothed>, Error> {
-    // Forward: per measurement, Φ from the previous one, the prediction and the update.
-    let mut predicted = Vec::with_capacity(measurements.len());
-    let mut out = Vec::with_capacity(measurements.len());
+    let mut smoother = Smoother::new(filter);
     for (index, m) in measurements.iter().enumerate() {
-        let in_batch = |source: Error| Error::InBatch {
+        smoother.push(m).map_err(|source| Error::InBatch {
             index,
             source: Box::new(source),
-        };
-        if let Some(previous) = measurements.get(index.wrapping_sub(1)) {
+        })?;
+    }
+    smoother.finish()
+}
+
+/// The smoother a measurement at a time: the forward pass as the measurements come
+/// ([`Smoother::push`]), the backward pass at the end ([`Smoother::finish`]). [`smooth`] is
+/// this over a slice.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::estimate::batch::NoiseCovariance;
+/// use seqsmooth::estimate::gauss_newton::Measurement;
+/// use seqsmooth::kalman::smoother::Smoother;
+/// use seqsmooth::kalman::KalmanFilter;
+/// use seqsmooth::model::dynamics::PolynomialDynamics;
+/// use seqsmooth::model::observation::LinearObservation;
+/// let f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+///     DVector::from_vec(vec![0.0]), DMatrix::from_element(1, 1, 1e6), 0.0).unwrap();
+/// let mut s = Smoother::new(f);
+/// for (k, y) in [1.0, 3.0].into_iter().enumerate() {
+///     s.push(&Measurement { time: k as f64, values: vec![Some(y)], noise: NoiseCovariance::Identity }).unwrap();
+/// }
+/// let out = s.finish().unwrap();
+/// assert!((out[0].state[0] - 2.0).abs() < 1e-5); // the mean of both
+/// ```
+#[derive(Clone, Debug)]
+pub struct Smoother<D: Dynamics, O: Observation> {
+    filter: KalmanFilter<D, O>,
+    /// Per measurement: `Φ` from the previous one, `X_{k|k−1}` and `S_{k|k−1}`.
+    predicted: Vec<(DMatrix<f64>, DVector<f64>, DMatrix<f64>)>,
+    out: Vec<Smoothed>,
+}
+
+impl<D: Dynamics + Clone, O: Observation + Clone> Smoother<D, O> {
+    /// A smoother whose forward pass starts as `filter`.
+    pub fn new(filter: KalmanFilter<D, O>) -> Self {
+        Self {
+            filter,
+            predicted: Vec::new(),
+            out: Vec::new(),
+        }
+    }
+
+    /// The forward filter so far.
+    pub fn filter(&self) -> &KalmanFilter<D, O> {
+        &self.filter
+    }
+
+    /// The forward pass over `m` (not before the previous measurement): the prediction and
+    /// the update; the update's NIS (`None` where every component is missing). On an error
+    /// the smoother is unchanged.
+    pub fn push(&mut self, m: &Measurement) -> Result<Option<f64>, Error> {
+        if let Some(previous) = self.out.last() {
             if m.time.is_finite() && m.time < previous.time {
-                return Err(in_batch(Error::InvalidParameter {
+                return Err(Error::InvalidParameter {
                     name: "time",
                     value: m.time.to_string(),
                     reason: format!("is before the previous measurement's {}", previous.time),
-                }));
+                });
             }
         }
-        let phi = filter.predict_with_transition(m.time).map_err(in_batch)?;
-        predicted.push((phi, filter.state().clone(), filter.covariance().clone()));
-        let nis = filter.update(m).map_err(in_batch)?.map(|i| i.nis);
-        out.push(Smoothed {
+        let before = self.filter.clone();
+        let step = |filter: &mut KalmanFilter<D, O>| {
+            let phi = filter.predict_with_transition(m.time)?;
+            let predicted = (phi, filter.state().clone(), filter.covariance().clone());
+            Ok::<_, Error>((predicted, filter.update(m)?.map(|i| i.nis)))
+        };
+        let (predicted, nis) = step(&mut self.filter).inspect_err(|_| self.filter = before)?;
+        self.predicted.push(predicted);
+        self.out.push(Smoothed {
             time: m.time,
-            state: filter.state().clone(),
-            covariance: filter.covariance().clone(),
-            filtered_state: filter.state().clone(),
-            filtered_covariance: filter.covariance().clone(),
+            state: self.filter.state().clone(),
+            covariance: self.filter.covariance().clone(),
+            filtered_state: self.filter.state().clone(),
+            filtered_covariance: self.filter.covariance().clone(),
             nis,
         });
+        Ok(nis)
     }
-    // Backward.
-    for k in (0..out.len().saturating_sub(1)).rev() {
-        let (phi, x_pred, s_pred) = &predicted[k + 1];
-        let chol = Cholesky::new(s_pred.clone()).ok_or_else(|| Error::InBatch {
-            index: k + 1,
-            source: Box::new(Error::InvalidParameter {
-                name: "predicted covariance",
-                value: format!("{s_pred:?}"),
-                reason: "is not positive definite, so the smoother cannot weigh the later \
+
+    /// The backward pass: every measurement's smoothed estimate, in order. An error names its
+    /// measurement ([`Error::InBatch`], counted from the first pushed).
+    pub fn finish(self) -> Result<Vec<Smoothed>, Error> {
+        let (predicted, mut out) = (self.predicted, self.out);
+        // Backward.
+        for k in (0..out.len().saturating_sub(1)).rev() {
+            let (phi, x_pred, s_pred) = &predicted[k + 1];
+            let chol = Cholesky::new(s_pred.clone()).ok_or_else(|| Error::InBatch {
+                index: k + 1,
+                source: Box::new(Error::InvalidParameter {
+                    name: "predicted covariance",
+                    value: format!("{s_pred:?}"),
+                    reason: "is not positive definite, so the smoother cannot weigh the later \
                          measurements (add driving noise, or avoid perfect observations)"
-                    .into(),
-            }),
-        })?;
-        // C = S_{k|k} Φᵀ S_pred⁻¹: solve S_pred Cᵀ = Φ S_{k|k}.
-        let c = chol.solve(&(phi * &out[k].filtered_covariance)).transpose();
-        let dx = &out[k + 1].state - x_pred;
-        let ds = &out[k + 1].covariance - s_pred;
-        let state = &out[k].filtered_state + &c * dx;
-        let covariance = &out[k].filtered_covariance + &c * ds * c.transpose();
-        let covariance = (&covariance + covariance.transpose()) * 0.5;
-        if let Some(&value) = state
-            .iter()
-            .chain(covariance.iter())
-            .find(|v| !v.is_finite())
-        {
-            return Err(Error::NonFinite {
-                what: "smoothed state or covariance entry",
-                value,
-            });
+                        .into(),
+                }),
+            })?;
+            // C = S_{k|k} Φᵀ S_pred⁻¹: solve S_pred Cᵀ = Φ S_{k|k}.
+            let c = chol.solve(&(phi * &out[k].filtered_covariance)).transpose();
+            let dx = &out[k + 1].state - x_pred;
+            let ds = &out[k + 1].covariance - s_pred;
+            let state = &out[k].filtered_state + &c * dx;
+            let covariance = &out[k].filtered_covariance + &c * ds * c.transpose();
+            let covariance = (&covariance + covariance.transpose()) * 0.5;
+            if let Some(&value) = state
+                .iter()
+                .chain(covariance.iter())
+                .find(|v| !v.is_finite())
+            {
+                return Err(Error::NonFinite {
+                    what: "smoothed state or covariance entry",
+                    value,
+                });
+            }
+            out[k].state = state;
+            out[k].covariance = covariance;
         }
-        out[k].state = state;
-        out[k].covariance = covariance;
+        Ok(out)
     }
-    Ok(out)
 }

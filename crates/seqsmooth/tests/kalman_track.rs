@@ -1,0 +1,285 @@
+//! `kalman::track::RadarTracker` against the same methods composed by hand from their parts
+//! (`SlidingFit`, `KalmanFilter`, `kalman::smooth`), bit for bit, on a noisy pass with
+//! irregular steps and missing components; the smoother's last row against the filter's (the
+//! RTS property); refused rows leaving the tracker as it was; refused settings.
+
+use nalgebra::{DMatrix, DVector};
+use rand::{Rng, SeedableRng};
+use rand_distr::{Distribution, Normal};
+use seqsmooth::estimate::batch::NoiseCovariance;
+use seqsmooth::estimate::gauss_newton::{Correction, Epoch, Measurement};
+use seqsmooth::estimate::sliding::{SlidingFit, Start};
+use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+use seqsmooth::kalman::track::{RadarTracker, TrackError, TrackMethod, Tracked, START_WINDOW};
+use seqsmooth::kalman::{smooth, Discount, KalmanFilter};
+use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::radar::Radar;
+
+/// `n` rows of a constant-velocity target seen from `site`, steps `U(0.5, 1.5)` s from a
+/// Unix-epoch start, σ 10 m and 1 mrad, 5% of components missing.
+fn pass(n: usize, site: [f64; 3], seed: u64) -> Vec<Measurement> {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let (sr, sa) = (10.0, 1e-3);
+    let (nr, na) = (Normal::new(0.0, sr).unwrap(), Normal::new(0.0, sa).unwrap());
+    let mut t = 1.7e9;
+    (0..n)
+        .map(|_| {
+            t += rng.gen_range(0.5..1.5);
+            let s = t - 1.7e9;
+            let (x, y, z) = (
+                20_000.0 + 150.0 * s - site[0],
+                -8_000.0 + 60.0 * s - site[1],
+                3_000.0 - 4.0 * s - site[2],
+            );
+            let r = (x * x + y * y + z * z).sqrt();
+            let clean = [r, y.atan2(x), (z / r).asin()];
+            let noisy = [
+                clean[0] + nr.sample(&mut rng),
+                clean[1] + na.sample(&mut rng),
+                clean[2] + na.sample(&mut rng),
+            ];
+            Measurement {
+                time: t,
+                values: noisy
+                    .iter()
+                    .map(|&v| (!rng.gen_bool(0.05)).then_some(v))
+                    .collect(),
+                noise: NoiseCovariance::Variances(vec![sr * sr, sa * sa, sa * sa]),
+            }
+        })
+        .collect()
+}
+
+/// One row's output: `None` undetermined or held, else the state, covariance and NIS.
+type Row = Option<(DVector<f64>, DMatrix<f64>, Option<f64>)>;
+
+/// Every row of `rows` through a tracker, then its `finish()`.
+fn tracked(radar: Radar, method: TrackMethod, rows: &[Measurement]) -> (Vec<Row>, Vec<Row>) {
+    let mut t = RadarTracker::new(radar, method).unwrap();
+    let out = rows
+        .iter()
+        .map(|m| match t.push(m).unwrap() {
+            Tracked::Estimate(e) => Some((e.state.clone(), e.covariance.clone(), e.nis)),
+            Tracked::Undetermined | Tracked::Held => None,
+        })
+        .collect();
+    let mut held = vec![None; rows.len()];
+    for (row, s) in t.finish().unwrap() {
+        held[row] = Some((s.state, s.covariance, s.nis));
+    }
+    (out, held)
+}
+
+/// The sliding fit over `w` rows at the radar's nominal.
+fn fit(radar: Radar, w: usize) -> SlidingFit<PolynomialDynamics, Radar> {
+    SlidingFit::new(
+        PolynomialDynamics::new(1, 3),
+        radar,
+        w,
+        Epoch::End,
+        Start::Radar { radar, degree: 2 },
+    )
+    .unwrap()
+}
+
+/// A Kalman filter from a fit.
+fn filter(radar: Radar, c: &Correction) -> KalmanFilter<PolynomialDynamics, Radar> {
+    KalmanFilter::new(
+        PolynomialDynamics::new(1, 3),
+        radar,
+        c.state.clone(),
+        c.covariance.clone(),
+        c.epoch,
+    )
+    .unwrap()
+}
+
+/// The first row whose start fit determines the state, and that fit.
+fn start(radar: Radar, rows: &[Measurement]) -> (usize, Correction) {
+    let mut f = fit(radar, START_WINDOW);
+    for (k, m) in rows.iter().enumerate() {
+        if let Some(c) = f.push(m.clone()).unwrap() {
+            return (k, c);
+        }
+    }
+    panic!("the pass never determines the state");
+}
+
+#[test]
+fn kalman_and_fading_equal_the_filter_from_the_first_fit() {
+    let radar = Radar::new([100.0, -50.0, 10.0], 6).unwrap();
+    let rows = pass(400, [100.0, -50.0, 10.0], 1);
+    let (k0, c) = start(radar, &rows);
+    for method in [
+        TrackMethod::Kalman { q: 0.5 },
+        TrackMethod::Fading(Discount::PerTime(0.9)),
+        TrackMethod::Fading(Discount::PerUpdate(0.8)),
+    ] {
+        let (out, held) = tracked(radar, method, &rows);
+        assert!(held.iter().all(Option::is_none));
+        assert!(out[..k0].iter().all(Option::is_none), "{method:?}");
+        let first = out[k0].as_ref().unwrap();
+        assert_eq!(
+            (&first.0, &first.1, first.2),
+            (&c.state, &c.covariance, None)
+        );
+        let mut f = filter(radar, &c);
+        f = match method {
+            TrackMethod::Kalman { q } => f
+                .with_process_noise(WhiteNoiseDerivative::new(1, 3, q).unwrap())
+                .unwrap(),
+            TrackMethod::Fading(d) => f.with_fading(d).unwrap(),
+            _ => unreachable!(),
+        };
+        for (k, m) in rows.iter().enumerate().skip(k0 + 1) {
+            let nis = f.update_stats(m).unwrap().map(|i| i.nis);
+            let (x, s, n) = out[k].as_ref().unwrap();
+            assert_eq!(
+                (x, s, *n),
+                (f.state(), f.covariance(), nis),
+                "{method:?} row {k}"
+            );
+        }
+    }
+}
+
+#[test]
+fn smooth_is_the_smoother_over_the_rows_after_the_start() {
+    let radar = Radar::new([0.0; 3], 6).unwrap();
+    let rows = pass(300, [0.0; 3], 2);
+    let (k0, c) = start(radar, &rows);
+    let q = 0.2;
+    let (out, held) = tracked(radar, TrackMethod::Smooth { q }, &rows);
+    assert!(out
+        .iter()
+        .enumerate()
+        .all(|(k, r)| r.is_some() == (k == k0)));
+    assert!(held
+        .iter()
+        .enumerate()
+        .all(|(k, r)| r.is_some() == (k > k0)));
+    let f = filter(radar, &c)
+        .with_process_noise(WhiteNoiseDerivative::new(1, 3, q).unwrap())
+        .unwrap();
+    let s = smooth(f.clone(), &rows[k0 + 1..]).unwrap();
+    for (k, s) in s.iter().enumerate() {
+        let (x, p, n) = held[k0 + 1 + k].as_ref().unwrap();
+        assert_eq!((x, p, *n), (&s.state, &s.covariance, s.nis));
+    }
+    // At the last row the smoothed estimate is the filtered one (RTS).
+    let (kalman, _) = tracked(radar, TrackMethod::Kalman { q }, &rows);
+    let (x, p, _) = held.last().unwrap().as_ref().unwrap();
+    let (xf, pf, _) = kalman.last().unwrap().as_ref().unwrap();
+    assert!((x - xf).amax() <= 1e-9 * xf.amax() && (p - pf).amax() <= 1e-9 * pf.amax());
+}
+
+#[test]
+fn window_is_the_sliding_fit_with_the_previous_fits_innovation() {
+    let radar = Radar::new([0.0; 3], 6).unwrap();
+    let rows = pass(200, [0.0; 3], 3);
+    let w = 12;
+    let (out, _) = tracked(radar, TrackMethod::Window { window: w }, &rows);
+    let mut f = fit(radar, w);
+    let mut previous: Option<Correction> = None;
+    for (k, m) in rows.iter().enumerate() {
+        let nis = previous.as_ref().and_then(|p| {
+            let mut kf = filter(radar, p);
+            kf.update_stats(m).unwrap().map(|i| i.nis)
+        });
+        previous = f.push(m.clone()).unwrap();
+        match (&previous, &out[k]) {
+            (None, None) => {}
+            (Some(c), Some((x, s, n))) => {
+                assert_eq!((x, s, *n), (&c.state, &c.covariance, nis), "row {k}")
+            }
+            (c, o) => panic!("row {k}: fit {:?}, tracker {:?}", c.is_some(), o.is_some()),
+        }
+    }
+    assert!(
+        out.iter()
+            .filter(|r| r.as_ref().is_some_and(|r| r.2.is_some()))
+            .count()
+            > 150
+    );
+}
+
+#[test]
+fn a_refused_row_names_its_rows_and_changes_nothing() {
+    let radar = Radar::new([0.0; 3], 6).unwrap();
+    let rows = pass(80, [0.0; 3], 4);
+    let (k0, _) = start(radar, &rows);
+    for (method, at) in [
+        (TrackMethod::Kalman { q: 1.0 }, 1),
+        (TrackMethod::Kalman { q: 1.0 }, 40),
+        (TrackMethod::Window { window: 10 }, 30),
+        (TrackMethod::Smooth { q: 1.0 }, 50),
+    ] {
+        let mut t = RadarTracker::new(radar, method).unwrap();
+        let mut reference = RadarTracker::new(radar, method).unwrap();
+        for m in &rows[..at] {
+            t.push(m).unwrap();
+            reference.push(m).unwrap();
+        }
+        let mut bad = rows[at].clone();
+        bad.time = f64::NAN;
+        let e = t.push(&bad).map(|_| ()).unwrap_err();
+        match (&e, method) {
+            (TrackError::Window { rows, .. }, TrackMethod::Window { window }) => {
+                assert_eq!(*rows, at + 1 - window..at + 1)
+            }
+            (TrackError::Window { rows, .. }, _) if at <= k0 => assert_eq!(*rows, 0..at + 1),
+            (
+                TrackError::Update { row, .. },
+                TrackMethod::Kalman { .. } | TrackMethod::Smooth { .. },
+            ) if at > k0 => {
+                assert_eq!(*row, at)
+            }
+            (e, m) => panic!("{m:?} at {at}: {e:?}"),
+        }
+        assert_eq!(t.rows(), at);
+        let later = |t: &mut RadarTracker| -> Vec<Option<DVector<f64>>> {
+            let mut v: Vec<_> = rows[at..]
+                .iter()
+                .map(|m| match t.push(m).unwrap() {
+                    Tracked::Estimate(e) => Some(e.state.clone()),
+                    _ => None,
+                })
+                .collect();
+            v.extend(t.finish().unwrap().into_iter().map(|(_, s)| Some(s.state)));
+            v
+        };
+        assert_eq!(later(&mut t), later(&mut reference), "{method:?} at {at}");
+    }
+    // The smoother refuses a row out of order when it comes, and none after its finish.
+    let mut t = RadarTracker::new(radar, TrackMethod::Smooth { q: 1.0 }).unwrap();
+    for m in &rows[..60] {
+        t.push(m).unwrap();
+    }
+    let mut bad = rows[60].clone();
+    bad.time = rows[59].time - 1.0;
+    assert!(matches!(
+        t.push(&bad),
+        Err(TrackError::Update { row: 60, .. })
+    ));
+    assert_eq!(t.finish().unwrap().len(), 59 - k0);
+    assert!(matches!(
+        t.push(&rows[60]),
+        Err(TrackError::Update { row: 60, .. })
+    ));
+}
+
+#[test]
+fn bad_settings_are_refused() {
+    let radar = Radar::new([0.0; 3], 6).unwrap();
+    for method in [
+        TrackMethod::Kalman { q: -1.0 },
+        TrackMethod::Smooth { q: f64::NAN },
+        TrackMethod::Kalman { q: f64::INFINITY },
+        TrackMethod::Fading(Discount::PerTime(0.0)),
+        TrackMethod::Fading(Discount::PerUpdate(1.5)),
+        TrackMethod::Fading(Discount::PerUpdate(f64::NAN)),
+        TrackMethod::Window { window: 1 },
+    ] {
+        assert!(RadarTracker::new(radar, method).is_err(), "{method:?}");
+    }
+}
