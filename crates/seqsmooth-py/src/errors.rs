@@ -32,7 +32,7 @@ impl Kind {
     }
 
     /// The kind of a library error (inside a batch, the kind of its cause).
-    fn of(error: &Error) -> Kind {
+    pub fn of(error: &Error) -> Kind {
         match error {
             Error::NonFinite { .. } | Error::TimeNotIncreasing { .. } => Kind::InvalidInput,
             // The library's parameter errors about the data handed in rather than a setting.
@@ -61,6 +61,12 @@ const DATA: &[&str] = &[
     "chunk lengths",
     "estimates length",
     "time",
+    "range",
+    "azimuth",
+    "elevation",
+    "sigma_range",
+    "sigma_angle",
+    "row",
 ];
 
 /// An exception of `kind` with `message` and `index` (the offending sample's position).

@@ -12,6 +12,7 @@ mod kalman;
 mod polynomial;
 mod smooth;
 mod tables;
+mod track;
 
 use pyo3::prelude::*;
 
@@ -28,6 +29,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<bank::PyExpandingBank>()?;
     m.add_class::<kalman::PyKalmanFilter>()?;
     m.add_class::<kalman::PyInnovation>()?;
+    m.add_class::<track::PyRadarTracker>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
     m.add_function(wrap_pyfunction!(frame::filter_series, m)?)?;
     m.add_function(wrap_pyfunction!(tables::gains, m)?)?;

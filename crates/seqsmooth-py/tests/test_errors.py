@@ -135,7 +135,7 @@ def test_ten_thousand_random_bad_calls_never_panic():
         engine = str(rng.choice(["exact", "gain", "adaptive", "x"]))
         window = int(rng.integers(-1, 50))
         try:
-            kind = rng.integers(8)
+            kind = rng.integers(9)
             if kind == 0:
                 f = ss.ExpandingMemory(degree=degree, engine=engine)
             elif kind == 1:
@@ -185,6 +185,23 @@ def test_ten_thousand_random_bad_calls_never_panic():
                 )
                 x, p, nis = f.update_many(times(n), values(n), float(rng.choice([1.0, 0.0, -1.0])))
                 assert np.isfinite(x).all() and np.isfinite(p).all()
+                outcomes["ok"] += 1
+                continue
+            elif kind == 8:
+                tracker = ss.RadarTracker(
+                    str(rng.choice(["kalman", "fading", "smooth", "window"])),
+                    sigma_range=float(rng.choice([10.0, 0.0, -1.0, np.nan])),
+                    sigma_angle=float(rng.choice([1e-3, 0.0, 1e300])),
+                    theta=float(rng.choice([0.9, 1.5])) if rng.random() < 0.5 else None,
+                    window=window if rng.random() < 0.3 else None,
+                )
+                r = np.abs(values(n)) if rng.random() < 0.7 else values(n)
+                with np.errstate(invalid="ignore"):
+                    az, el = values(n) % 7.0, values(n) % 1.6
+                x, p, nis = tracker.update_many(times(n), r, az, el)
+                held, xs, ps, ns = tracker.finish()
+                assert not np.isinf(x).any() and not np.isinf(p).any()
+                assert np.isfinite(xs).all() and np.isfinite(ps).all()
                 outcomes["ok"] += 1
                 continue
             else:

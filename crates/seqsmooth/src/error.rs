@@ -170,6 +170,21 @@ pub enum Error {
         /// Halvings tried.
         halvings: usize,
     },
+    /// A singular value decomposition did not converge within its iteration limit (entries
+    /// of very different scales: rescale the data).
+    #[error(
+        "the singular value decomposition of a {rows}x{cols} matrix did not converge in \
+         {iterations} iterations (its entries span too many orders of magnitude: rescale the \
+         data)"
+    )]
+    SvdNotConverged {
+        /// Rows of the matrix.
+        rows: usize,
+        /// Its columns.
+        cols: usize,
+        /// The iterations allowed.
+        iterations: usize,
+    },
     /// Some other parameter is out of range.
     #[error("{name} {value} is invalid: {reason}")]
     InvalidParameter {

@@ -1,8 +1,9 @@
 //! Small dense linear algebra the library needs beyond nalgebra: exact (field-generic) inversion
 //! for the rational oracles, and triangular solves.
 
+use crate::error::Error;
 use crate::scalar::Scalar;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 /// Inverse of a square matrix over any field by Gauss–Jordan elimination with pivot search on
 /// non-zero entries. Meant for exact rationals (conditioning is irrelevant there); `None` when
@@ -102,4 +103,28 @@ pub fn mul<T: Scalar>(a: &DMatrix<T>, b: &DMatrix<T>) -> DMatrix<T> {
 /// `A B Aᵀ` over any field.
 pub fn congruence<T: Scalar>(a: &DMatrix<T>, b: &DMatrix<T>) -> DMatrix<T> {
     mul(&mul(a, b), &a.transpose())
+}
+
+/// The iterations [`singular_values`] allows: far above the few dozen sweeps a well-scaled
+/// matrix of a filter's size takes (nalgebra's own limit, none, can loop forever on entries
+/// that span hundreds of orders of magnitude).
+pub const SVD_ITERATIONS: usize = 10_000;
+
+/// The singular values of `m`, or [`Error::SvdNotConverged`] when the iteration does not
+/// converge within [`SVD_ITERATIONS`].
+///
+/// ```
+/// use nalgebra::DMatrix;
+/// use seqsmooth::linalg::singular_values;
+/// let sv = singular_values(&DMatrix::from_row_slice(2, 2, &[3.0, 0.0, 0.0, 4.0])).unwrap();
+/// assert_eq!((sv.max(), sv.min()), (4.0, 3.0));
+/// ```
+pub fn singular_values(m: &DMatrix<f64>) -> Result<DVector<f64>, Error> {
+    nalgebra::linalg::SVD::try_new(m.clone(), false, false, f64::EPSILON, SVD_ITERATIONS)
+        .map(|svd| svd.singular_values)
+        .ok_or(Error::SvdNotConverged {
+            rows: m.nrows(),
+            cols: m.ncols(),
+            iterations: SVD_ITERATIONS,
+        })
 }

@@ -250,6 +250,22 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
         };
         assert_eq!(later(&mut t), later(&mut reference), "{method:?} at {at}");
     }
+    // Every method refuses a row at or before the previous one.
+    for method in [
+        TrackMethod::Kalman { q: 1.0 },
+        TrackMethod::Fading(Discount::PerUpdate(0.9)),
+    ] {
+        let mut t = RadarTracker::new(radar, method).unwrap();
+        for m in &rows[..30] {
+            t.push(m).unwrap();
+        }
+        let mut bad = rows[30].clone();
+        bad.time = rows[29].time;
+        assert!(matches!(
+            t.push(&bad),
+            Err(TrackError::Update { row: 30, .. })
+        ));
+    }
     // The smoother refuses a row out of order when it comes, and none after its finish.
     let mut t = RadarTracker::new(radar, TrackMethod::Smooth { q: 1.0 }).unwrap();
     for m in &rows[..60] {
@@ -257,6 +273,11 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
     }
     let mut bad = rows[60].clone();
     bad.time = rows[59].time - 1.0;
+    assert!(matches!(
+        t.push(&bad),
+        Err(TrackError::Update { row: 60, .. })
+    ));
+    bad.time = rows[59].time;
     assert!(matches!(
         t.push(&bad),
         Err(TrackError::Update { row: 60, .. })
@@ -282,4 +303,160 @@ fn bad_settings_are_refused() {
     ] {
         assert!(RadarTracker::new(radar, method).is_err(), "{method:?}");
     }
+}
+
+/// Rows of times ~1e154 and ranges ~1e143 (from the Python package's random bad calls): the
+/// fit's SVD once looped forever; now every row is taken or refused, each quickly.
+#[test]
+fn extreme_scales_end_instead_of_looping() {
+    use seqsmooth::estimate::batch::NoiseCovariance;
+    use seqsmooth::estimate::gauss_newton::Measurement;
+    use seqsmooth::kalman::track::{RadarTracker, TrackMethod};
+    use seqsmooth::kalman::Discount;
+    use seqsmooth::model::radar::Radar;
+    const ROWS: [[f64; 4]; 21] = [
+        [
+            5.189989720259441e+153,
+            4.343369678197512e+143,
+            1.0,
+            0.35815060192307024,
+        ],
+        [
+            1.3004337721720608e+154,
+            4.482171586874016e+143,
+            3.0,
+            0.3185789684307956,
+        ],
+        [
+            2.0328771235231785e+154,
+            9.19681854217737e+142,
+            2.0,
+            1.3782278975051496,
+        ],
+        [
+            2.1111487976650718e+154,
+            2.223210355810719e+143,
+            6.0,
+            0.3178608960246514,
+        ],
+        [
+            3.198505549909155e+154,
+            9.60050259794795e+143,
+            2.0,
+            0.9275605718175588,
+        ],
+        [
+            3.2003960690930776e+154,
+            4.566473787203499e+143,
+            4.0,
+            1.0790561955952045,
+        ],
+        [
+            4.3916954058887045e+154,
+            1.4930380120096661e+144,
+            5.0,
+            0.40787054068400685,
+        ],
+        [
+            5.774891746193836e+154,
+            7.092263945740531e+143,
+            1.0,
+            1.0840238966711118,
+        ],
+        [
+            6.151250121628603e+154,
+            8.905790274046526e+143,
+            1.0,
+            0.9644424469659629,
+        ],
+        [
+            7.886553680523178e+154,
+            2.1364666538294956e+143,
+            3.0,
+            1.3820522152992165,
+        ],
+        [
+            8.986925675622439e+154,
+            9.886560927833852e+143,
+            3.0,
+            0.048383814776340905,
+        ],
+        [
+            9.862186290331828e+154,
+            1.1935784705930634e+144,
+            3.0,
+            0.992949186206753,
+        ],
+        [
+            1.0367359745801437e+155,
+            5.429961324449483e+143,
+            5.0,
+            0.9379756105606916,
+        ],
+        [
+            1.0870267131028484e+155,
+            7.205164776380282e+142,
+            6.0,
+            0.3390616064214047,
+        ],
+        [
+            1.2294234416777332e+155,
+            3.9922639809911e+143,
+            4.0,
+            0.5379817228973374,
+        ],
+        [
+            1.322736969043096e+155,
+            4.397890882350564e+143,
+            4.0,
+            1.271790401932301,
+        ],
+        [
+            1.368723367289903e+155,
+            9.096713738000042e+143,
+            0.0,
+            1.3606348027158912,
+        ],
+        [
+            1.3980266202499044e+155,
+            5.699196766197036e+143,
+            0.0,
+            1.5141887220432602,
+        ],
+        [
+            1.5433674482063594e+155,
+            2.8067329229701373e+143,
+            6.0,
+            1.1654243849509878,
+        ],
+        [
+            1.7231310073417664e+155,
+            3.8102528520735687e+143,
+            5.0,
+            1.116065198832751,
+        ],
+        [
+            1.758103307726431e+155,
+            2.740796096314142e+143,
+            1.0,
+            0.16621265262958795,
+        ],
+    ];
+    let radar = Radar::new([0.0; 3], 6).unwrap();
+    let mut t = RadarTracker::new(radar, TrackMethod::Fading(Discount::PerUpdate(0.9))).unwrap();
+    let mut refused = Vec::new();
+    for (k, [time, r, az, el]) in ROWS.into_iter().enumerate() {
+        let m = Measurement {
+            time,
+            values: vec![Some(r), Some(az), Some(el)],
+            noise: NoiseCovariance::Variances(vec![100.0, 1e-6, 1e-6]),
+        };
+        if let Err(e) = t.push(&m) {
+            refused.push((k, e.to_string()));
+        }
+    }
+    assert!(
+        refused.iter().any(|(_, e)| e.contains("did not converge")),
+        "{refused:?}"
+    );
 }

@@ -15,6 +15,10 @@ FadingBank, ExpandingBank
 KalmanFilter
     The Kalman filter over the polynomial model (Morrison chs. 12, 14, 15): driving noise,
     fading memory, missing components, ``update_many`` and the RTS ``smooth``.
+RadarTracker
+    A radar's range, azimuth and elevation to a constant-velocity track: the sliding
+    Gauss–Newton fit, the extended Kalman filter (driving noise or fading memory) or its
+    smoother; the numbers of ``seqsmooth track``.
 
 Functions
 ---------
@@ -44,6 +48,7 @@ from ._seqsmooth import (
     Innovation,
     KalmanFilter,
     PolynomialFilter,
+    RadarTracker,
     State,
     gains,
     smooth,
@@ -69,6 +74,7 @@ __all__ = [
     "FadingMemory",
     "FixedMemory",
     "KalmanFilter",
+    "RadarTracker",
     "Innovation",
     "PolynomialFilter",
     "State",

@@ -125,6 +125,35 @@ class KalmanFilter:
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
 
+class RadarTracker:
+    def __init__(
+        self,
+        method: Literal["kalman", "fading", "smooth", "window"] = "kalman",
+        *,
+        sigma_range: float | None = None,
+        sigma_angle: float | None = None,
+        site: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        q: float | None = None,
+        beta: float | None = None,
+        theta: float | None = None,
+        window: int | None = None,
+        azimuth: Literal["from-x", "bearing"] = "from-x",
+    ) -> None: ...
+    @property
+    def rows_taken(self) -> int: ...
+    def update_many(
+        self,
+        t: ArrayLike,
+        range: ArrayLike,
+        azimuth: ArrayLike,
+        elevation: ArrayLike,
+        sigma_range: ArrayLike | None = None,
+        sigma_angle: ArrayLike | None = None,
+    ) -> tuple[Matrix, npt.NDArray[np.float64], Vector]: ...
+    def finish(
+        self,
+    ) -> tuple[npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64], Vector]: ...
+
 Exact = Fraction | int | float | str
 
 @overload

@@ -205,7 +205,7 @@ pub(crate) fn solve_whitened(t: DMatrix<f64>, mut y: DVector<f64>) -> Result<Sol
 /// The condition number `σ_max/σ_min` of `T = Q R` from `R`'s singular values (those of
 /// `T`), or [`Error::Unobservable`] when its numerical rank is below `states`.
 fn full_rank(r: &DMatrix<f64>, rows: usize, states: usize) -> Result<f64, Error> {
-    let sv = r.singular_values();
+    let sv = crate::linalg::singular_values(r)?;
     let largest = sv.max();
     let smallest = if rows < states { 0.0 } else { sv.min() };
     let rank = numerical_rank(sv.as_slice(), rows, states);

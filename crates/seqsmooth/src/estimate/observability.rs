@@ -120,7 +120,7 @@ pub fn observability(dynamics: &LinearDynamics, m: &DMatrix<f64>) -> Result<Obse
             reason: "its powers up to n - 1 leave the double range".into(),
         });
     }
-    let sv = g.singular_values();
+    let sv = crate::linalg::singular_values(&g)?;
     let sv = sv.as_slice();
     Ok(Observability {
         rank: numerical_rank(sv, rows, n),

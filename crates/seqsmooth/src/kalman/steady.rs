@@ -96,14 +96,21 @@ pub fn steady_state(
     let g = m.transpose() * r_chol.solve(m);
     let z = information(&phi_inv, &g, beta)?;
     let z2 = information(&phi_inv, &g, beta * beta)?;
-    let weight = Cholesky::new(z.clone())
-        .ok_or_else(|| Error::Unobservable {
-            rank: z.rank(1e-12 * z.amax().max(f64::MIN_POSITIVE)),
-            states: n,
-            smallest_singular_value: z.singular_values().min(),
-            largest_singular_value: z.singular_values().max(),
-        })?
-        .inverse();
+    let weight = match Cholesky::new(z.clone()) {
+        Some(c) => c.inverse(),
+        None => {
+            let sv = crate::linalg::singular_values(&z)?;
+            return Err(Error::Unobservable {
+                rank: sv
+                    .iter()
+                    .filter(|&&v| v > 1e-12 * z.amax().max(f64::MIN_POSITIVE))
+                    .count(),
+                states: n,
+                smallest_singular_value: sv.min(),
+                largest_singular_value: sv.max(),
+            });
+        }
+    };
     let weight = (&weight + weight.transpose()) * 0.5;
     let gain = &weight * m.transpose() * r_chol.inverse();
     let covariance = &weight * z2 * &weight;

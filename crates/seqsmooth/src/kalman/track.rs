@@ -163,6 +163,8 @@ pub struct RadarTracker {
     stage: Stage,
     /// The rows taken so far.
     rows: usize,
+    /// The last row's time.
+    last_time: f64,
 }
 
 impl RadarTracker {
@@ -208,6 +210,7 @@ impl RadarTracker {
             dynamics,
             stage,
             rows: 0,
+            last_time: f64::NEG_INFINITY,
         })
     }
 
@@ -221,10 +224,20 @@ impl RadarTracker {
         self.rows
     }
 
-    /// Tracks the next row (after the previous one in time). A refused row is not taken, and
-    /// the tracker is as before it.
+    /// Tracks the next row (after the previous one in time: a row at or before it is refused
+    /// as [`TrackError::Update`]). A refused row is not taken, and the tracker is as before it.
     pub fn push(&mut self, m: &Measurement) -> Result<Tracked<'_>, TrackError> {
         let row = self.rows;
+        if m.time <= self.last_time {
+            return Err(TrackError::Update {
+                row,
+                source: Error::InvalidParameter {
+                    name: "time",
+                    value: m.time.to_string(),
+                    reason: format!("must be after the previous row's time {}", self.last_time),
+                },
+            });
+        }
         let window = |w: usize, source: Error| TrackError::Window {
             rows: (row + 1).saturating_sub(w)..row + 1,
             source,
@@ -234,6 +247,7 @@ impl RadarTracker {
             Stage::Starting(fit) => {
                 let Some(c) = fit.push(m.clone()).map_err(|e| window(START_WINDOW, e))? else {
                     self.rows += 1;
+                    self.last_time = m.time;
                     return Ok(Tracked::Undetermined);
                 };
                 let filter = filter_from(self.dynamics, self.radar, self.method, &c);
@@ -285,6 +299,7 @@ impl RadarTracker {
             }
         };
         self.rows += 1;
+        self.last_time = m.time;
         let Some(nis) = nis else {
             return Ok(Tracked::Held);
         };
@@ -365,4 +380,103 @@ fn sliding(
         Epoch::End,
         Start::Radar { radar, degree: 2 },
     )
+}
+
+/// A radar row as a [`Measurement`], checked as `seqsmooth track` checks its rows: the time
+/// finite; each of range, azimuth and elevation missing (`None`) or in range (the range above
+/// 0, the azimuth within `[−2π, 2π]`, the elevation within `[−π/2, π/2]`, radians); the σ of
+/// each present component (`sigma_range`, `sigma_angle` for both angles) above 0 with a normal
+/// double square. With `bearing` the azimuth is a bearing (from +y, clockwise, x east and y
+/// north) and is turned into the angle from +x.
+///
+/// ```
+/// use seqsmooth::kalman::track::radar_row;
+/// let m = radar_row(0.0, [Some(1000.0), Some(0.0), None], Some(5.0), Some(1e-3), true).unwrap();
+/// assert!((m.values[1].unwrap() - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+/// assert!(radar_row(0.0, [Some(-1.0), None, None], Some(5.0), None, false).is_err());
+/// ```
+pub fn radar_row(
+    time: f64,
+    values: [Option<f64>; 3],
+    sigma_range: Option<f64>,
+    sigma_angle: Option<f64>,
+    bearing: bool,
+) -> Result<Measurement, Error> {
+    use std::f64::consts::{FRAC_PI_2, TAU};
+    if !time.is_finite() {
+        return Err(Error::NonFinite {
+            what: "time",
+            value: time,
+        });
+    }
+    let limits: [(&'static str, f64, &str); 3] = [
+        ("range", f64::INFINITY, "must be a finite number above 0"),
+        (
+            "azimuth",
+            TAU,
+            "must lie in [-2pi, 2pi]: azimuths are in radians",
+        ),
+        (
+            "elevation",
+            FRAC_PI_2,
+            "must lie in [-pi/2, pi/2]: elevations are in radians from the x-y plane",
+        ),
+    ];
+    for (v, (name, limit, reason)) in values.iter().zip(limits) {
+        if let Some(v) = *v {
+            let bad = !v.is_finite() || v.abs() > limit || (name == "range" && v <= 0.0);
+            if bad {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: v.to_string(),
+                    reason: reason.into(),
+                });
+            }
+        }
+    }
+    let needed = [
+        ("sigma_range", sigma_range, values[0].is_some()),
+        (
+            "sigma_angle",
+            sigma_angle,
+            values[1].is_some() || values[2].is_some(),
+        ),
+    ];
+    let mut variances = [1.0; 2];
+    for (k, (name, sigma, needed)) in needed.into_iter().enumerate() {
+        match sigma {
+            Some(s) if s > 0.0 && s * s >= f64::MIN_POSITIVE && (s * s).is_finite() => {
+                variances[k] = s * s
+            }
+            Some(s) => {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: s.to_string(),
+                    reason: "must be above 0 with a normal double square (the noise variance)"
+                        .into(),
+                })
+            }
+            None if needed => {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value: "none".into(),
+                    reason: "is needed: the row has a component it weighs".into(),
+                })
+            }
+            None => {}
+        }
+    }
+    let mut values = values;
+    if bearing {
+        values[1] = values[1].map(|b| crate::model::radar::wrap(FRAC_PI_2 - b));
+    }
+    Ok(Measurement {
+        time,
+        values: values.to_vec(),
+        noise: crate::estimate::batch::NoiseCovariance::Variances(vec![
+            variances[0],
+            variances[1],
+            variances[1],
+        ]),
+    })
 }

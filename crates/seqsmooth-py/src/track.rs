@@ -1,0 +1,358 @@
+//! The radar tracker (`kalman::track::RadarTracker`) as a Python class, `RadarTracker`: a
+//! radar's range, azimuth and elevation to a constant-velocity Cartesian track by the sliding
+//! Gauss–Newton fit, the extended Kalman filter (driving noise or fading memory) or its
+//! smoother; the rows checked by the library's `radar_row`, as `seqsmooth track` checks them.
+
+use crate::arrays::{matrix, series, Series};
+use crate::errors::{raise, to_py, IntoPy, Kind};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::kalman::track::{radar_row, RadarTracker, TrackError, TrackMethod, Tracked};
+use seqsmooth::kalman::Discount;
+use seqsmooth::model::radar::Radar;
+use seqsmooth::Error;
+
+/// A tracker's error as its exception; `offset` is the batch's first row in the tracker's
+/// count, so that an index names the caller's position in the batch.
+fn track_error(e: TrackError, offset: usize) -> PyErr {
+    let in_batch = |row: usize, source: Error| {
+        to_py(
+            Error::InBatch {
+                index: row - offset,
+                source: Box::new(source),
+            },
+            0,
+        )
+    };
+    match e {
+        TrackError::Window { rows, source } => match source {
+            Error::InBatch { index, source } if rows.start + index >= offset => {
+                in_batch(rows.start + index, *source)
+            }
+            source => {
+                let message = format!(
+                    "rows {}-{} (the window): {source}",
+                    rows.start,
+                    rows.end.saturating_sub(1)
+                );
+                let kind = Kind::of(&source);
+                let last = rows.end.saturating_sub(1);
+                raise(kind, message, last.checked_sub(offset))
+            }
+        },
+        TrackError::Update { row, source } if row >= offset => in_batch(row, source),
+        TrackError::Smooth(Error::InBatch { index, source }) => to_py(
+            Error::InBatch {
+                index: index.saturating_sub(offset),
+                source,
+            },
+            0,
+        ),
+        e => raise(Kind::Numerical, e.to_string(), None),
+    }
+}
+
+/// One output row: state, covariance (row-major) and NIS; NaN where none.
+fn write_row(estimate: &Tracked<'_>, states: &mut [f64], covariances: &mut [f64], nis: &mut f64) {
+    if let Tracked::Estimate(e) = estimate {
+        states.copy_from_slice(e.state.as_slice());
+        // Symmetric: column-major is row-major.
+        covariances.copy_from_slice(e.covariance.as_slice());
+        *nis = e.nis.unwrap_or(f64::NAN);
+    }
+}
+
+/// A radar track (Morrison §8.5-8.7, chs. 12, 14, 15): range, azimuth and elevation seen from
+/// ``site`` to the state ``(x, y, z, vx, vy, vz)`` of a constant-velocity target, in the
+/// range's units and the times' units.
+///
+/// Parameters
+/// ----------
+/// method : {"kalman", "fading", "smooth", "window"}
+///     ``"window"``: the Gauss–Newton fit of each row's last ``window`` rows;
+///     ``"kalman"``: the extended Kalman filter with white-noise acceleration ``q``;
+///     ``"fading"``: the fading-memory extended Kalman filter (``beta`` or ``theta``);
+///     ``"smooth"``: the Rauch–Tung–Striebel smoother over the Kalman filter (estimates at
+///     ``finish()``). The Kalman methods start from the first fit of the rows so far (at most
+///     60) that determines the state.
+/// sigma_range, sigma_angle : float, optional
+///     The range's and the angles' noise σ (radians), for the rows that give none.
+/// site : (float, float, float)
+///     The radar's position.
+/// q : float
+///     kalman, smooth: the acceleration's spectral density on each axis (default 0).
+/// beta, theta : float
+///     fading: the discount per unit of time, or per update (one of them).
+/// window : int
+///     window: the rows of each fit (default 60).
+/// azimuth : {"from-x", "bearing"}
+///     ``"from-x"``: from +x towards +y; ``"bearing"``: clockwise from +y (x east, y north).
+#[pyclass(name = "RadarTracker", module = "seqsmooth")]
+pub struct PyRadarTracker {
+    inner: RadarTracker,
+    sigmas: [Option<f64>; 2],
+    bearing: bool,
+}
+
+impl PyRadarTracker {
+    /// The rows of a batch as measurements; the first refused one's error (its index the
+    /// position in the batch) after the rows before it.
+    #[allow(clippy::too_many_arguments)]
+    fn rows(
+        &self,
+        t: &Series<'_>,
+        values: [&Series<'_>; 3],
+        sigmas: [Option<&Series<'_>>; 2],
+    ) -> (Vec<Measurement>, Option<PyErr>) {
+        let n = t.as_slice().len();
+        let mut rows = Vec::with_capacity(n);
+        for i in 0..n {
+            let v = values.map(|s| {
+                let x = s.as_slice()[i];
+                (!x.is_nan()).then_some(x)
+            });
+            let sigma = |k: usize| {
+                sigmas[k]
+                    .map(|s| s.as_slice()[i])
+                    .filter(|s| !s.is_nan())
+                    .or(self.sigmas[k])
+            };
+            match radar_row(t.as_slice()[i], v, sigma(0), sigma(1), self.bearing) {
+                Ok(m) => rows.push(m),
+                Err(e) => {
+                    let e = Error::InBatch {
+                        index: i,
+                        source: Box::new(e),
+                    };
+                    return (rows, Some(to_py(e, 0)));
+                }
+            }
+        }
+        (rows, None)
+    }
+}
+
+/// An optional per-row σ array of `n` values.
+fn sigma_series<'py>(
+    obj: Option<&Bound<'py, PyAny>>,
+    name: &str,
+    n: usize,
+) -> PyResult<Option<Series<'py>>> {
+    let Some(obj) = obj else { return Ok(None) };
+    let s = series(obj, name)?;
+    if s.as_slice().len() != n {
+        return Err(raise(
+            Kind::InvalidInput,
+            format!(
+                "{name} has {} values for {n} times: one per row (NaN takes the tracker's)",
+                s.as_slice().len()
+            ),
+            None,
+        ));
+    }
+    Ok(Some(s))
+}
+
+#[pymethods]
+impl PyRadarTracker {
+    #[new]
+    #[pyo3(signature = (method = "kalman", *, sigma_range = None, sigma_angle = None,
+        site = (0.0, 0.0, 0.0), q = None, beta = None, theta = None, window = None,
+        azimuth = "from-x"))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        method: &str,
+        sigma_range: Option<f64>,
+        sigma_angle: Option<f64>,
+        site: (f64, f64, f64),
+        q: Option<f64>,
+        beta: Option<f64>,
+        theta: Option<f64>,
+        window: Option<usize>,
+        azimuth: &str,
+    ) -> PyResult<Self> {
+        let usage = |m: &str| Err(raise(Kind::Parameter, m, None));
+        let fading = beta.is_some() || theta.is_some();
+        let method = match method {
+            "window" if q.is_some() || fading => {
+                return usage("q, beta and theta do not apply to method='window'")
+            }
+            "window" => TrackMethod::Window {
+                window: window.unwrap_or(60),
+            },
+            "kalman" | "smooth" if fading => {
+                return usage("beta and theta apply only to method='fading'")
+            }
+            "kalman" => TrackMethod::Kalman {
+                q: q.unwrap_or(0.0),
+            },
+            "smooth" => TrackMethod::Smooth {
+                q: q.unwrap_or(0.0),
+            },
+            "fading" if q.is_some() => return usage("q applies only to 'kalman' and 'smooth'"),
+            "fading" => match (beta, theta) {
+                (Some(b), None) => TrackMethod::Fading(Discount::PerTime(b)),
+                (None, Some(t)) => TrackMethod::Fading(Discount::PerUpdate(t)),
+                _ => return usage(
+                    "method='fading' needs beta (per unit of time) or theta (per update), not both",
+                ),
+            },
+            other => {
+                return usage(&format!(
+                    "method {other:?} is not one of 'kalman', 'fading', 'smooth', 'window'"
+                ))
+            }
+        };
+        if window.is_some() && !matches!(method, TrackMethod::Window { .. }) {
+            return usage("window applies only to method='window'");
+        }
+        let bearing = match azimuth {
+            "from-x" => false,
+            "bearing" => true,
+            other => {
+                return usage(&format!(
+                    "azimuth {other:?} is not one of 'from-x', 'bearing'"
+                ))
+            }
+        };
+        for (name, sigma) in [("sigma_range", sigma_range), ("sigma_angle", sigma_angle)] {
+            if let Some(s) = sigma {
+                if !(s > 0.0 && s * s >= f64::MIN_POSITIVE && (s * s).is_finite()) {
+                    return usage(&format!(
+                        "{name} {s} must be above 0 with a normal double square (the variance)"
+                    ));
+                }
+            }
+        }
+        let radar = Radar::new([site.0, site.1, site.2], 6)
+            .map_err(|e| raise(Kind::Parameter, e.to_string(), None))?;
+        Ok(Self {
+            inner: RadarTracker::new(radar, method).py()?,
+            sigmas: [sigma_range, sigma_angle],
+            bearing,
+        })
+    }
+
+    /// The rows taken so far.
+    #[getter]
+    fn rows_taken(&self) -> usize {
+        self.inner.rows()
+    }
+
+    /// Tracks the rows ``(t[i], range[i], azimuth[i], elevation[i])`` (NaN: a missing
+    /// component), with per-row σ where given (NaN: the tracker's). Returns ``(states,
+    /// covariances, nis)``, ``(n, 6)``, ``(n, 6, 6)`` and ``(n,)``: NaN rows where the rows so
+    /// far do not determine the state, or the smoother holds the row (see ``finish``); a NIS
+    /// is NaN where there is no innovation. On a refused row the rows before it are taken and
+    /// the exception's ``index`` is its position.
+    #[pyo3(signature = (t, range, azimuth, elevation, sigma_range = None, sigma_angle = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn update_many<'py>(
+        &mut self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        range: &Bound<'py, PyAny>,
+        azimuth: &Bound<'py, PyAny>,
+        elevation: &Bound<'py, PyAny>,
+        sigma_range: Option<&Bound<'py, PyAny>>,
+        sigma_angle: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let ts = series(t, "t")?;
+        let n = ts.as_slice().len();
+        let values = [
+            series(range, "range")?,
+            series(azimuth, "azimuth")?,
+            series(elevation, "elevation")?,
+        ];
+        for (s, name) in values.iter().zip(["range", "azimuth", "elevation"]) {
+            if s.as_slice().len() != n {
+                return Err(raise(
+                    Kind::InvalidInput,
+                    format!("{name} has {} values for {n} times", s.as_slice().len()),
+                    None,
+                ));
+            }
+        }
+        if n == 0 {
+            return Err(raise(Kind::InvalidInput, "t is empty", None));
+        }
+        let sr = sigma_series(sigma_range, "sigma_range", n)?;
+        let sa = sigma_series(sigma_angle, "sigma_angle", n)?;
+        let (rows, refused) = self.rows(
+            &ts,
+            [&values[0], &values[1], &values[2]],
+            [sr.as_ref(), sa.as_ref()],
+        );
+        let count = rows.len();
+        let mut states = vec![f64::NAN; count * 6];
+        let mut covariances = vec![f64::NAN; count * 36];
+        let mut nis = vec![f64::NAN; count];
+        let offset = self.inner.rows();
+        let tracker = &mut self.inner;
+        let mut taken = 0;
+        let failed = py.detach(|| {
+            for (i, m) in rows.iter().enumerate() {
+                let tracked = tracker.push(m)?;
+                write_row(
+                    &tracked,
+                    &mut states[i * 6..(i + 1) * 6],
+                    &mut covariances[i * 36..(i + 1) * 36],
+                    &mut nis[i],
+                );
+                taken = i + 1;
+            }
+            Ok::<(), TrackError>(())
+        });
+        if let Err(e) = failed {
+            return Err(track_error(e, offset));
+        }
+        if let Some(e) = refused {
+            return Err(e);
+        }
+        debug_assert_eq!(taken, count);
+        let states = matrix(py, states, count, 6)?;
+        let covariances = PyArray1::from_vec(py, covariances)
+            .reshape([count, 6, 6])?
+            .into_any();
+        let nis = PyArray1::from_vec(py, nis).into_any();
+        PyTuple::new(py, [states, covariances, nis])
+    }
+
+    /// The smoother's estimates of the rows it held: ``(rows, states, covariances, nis)``,
+    /// ``rows`` their numbers counted from the tracker's first row (0); empty for the other
+    /// methods. The smoother takes no more rows after it.
+    fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let tracker = &mut self.inner;
+        let smoothed = py
+            .detach(|| tracker.finish())
+            .map_err(|e| track_error(e, 0))?;
+        let count = smoothed.len();
+        let mut rows = Vec::with_capacity(count);
+        let mut states = Vec::with_capacity(count * 6);
+        let mut covariances = Vec::with_capacity(count * 36);
+        let mut nis = Vec::with_capacity(count);
+        for (row, s) in smoothed {
+            rows.push(row as i64);
+            states.extend_from_slice(s.state.as_slice());
+            covariances.extend_from_slice(s.covariance.as_slice());
+            nis.push(s.nis.unwrap_or(f64::NAN));
+        }
+        let rows = PyArray1::from_vec(py, rows).into_any();
+        let states = matrix(py, states, count, 6)?;
+        let covariances = PyArray1::from_vec(py, covariances)
+            .reshape([count, 6, 6])?
+            .into_any();
+        let nis = PyArray1::from_vec(py, nis).into_any();
+        PyTuple::new(py, [rows, states, covariances, nis])
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "RadarTracker(method={:?}, rows_taken={})",
+            self.inner.method(),
+            self.inner.rows()
+        )
+    }
+}

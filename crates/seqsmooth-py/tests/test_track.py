@@ -1,0 +1,233 @@
+"""`RadarTracker` against `seqsmooth track` bit for bit (every method, per-row sigmas, missing
+components, bearings), against filterpy's `ExtendedKalmanFilter`, and its refusals."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+
+import numpy as np
+import pytest
+
+import seqsmooth as ss
+from conftest import cli_path
+from seqsmooth.errors import InvalidInputError, ParameterError
+
+SR, SA = 10.0, 1e-3
+
+
+def radar_pass(rng: np.random.Generator, n: int = 300, site=(0.0, 0.0, 0.0), missing=0.03):
+    """`n` rows of a constant-velocity target from `site`: Unix-epoch times at steps
+    U(0.5, 1.5) s, σ 10 m and 1 mrad, a fraction `missing` of components missing (NaN)."""
+    t = 1.7e9 + np.cumsum(rng.uniform(0.5, 1.5, n))
+    s = t - 1.7e9
+    x = 20_000.0 + 150.0 * s - site[0]
+    y = -8_000.0 + 60.0 * s - site[1]
+    z = 3_000.0 - 4.0 * s - site[2]
+    r = np.sqrt(x * x + y * y + z * z)
+    rows = np.column_stack([r, np.arctan2(y, x), np.arcsin(z / r)])
+    rows += rng.standard_normal((n, 3)) * [SR, SA, SA]
+    rows[rng.random((n, 3)) < missing] = np.nan
+    return t, rows
+
+
+def run_track(tmp_path, t, rows, *args, sigmas=None):
+    """`seqsmooth track` on the rows (NaN written as an empty cell); its numbers, NaN where a
+    cell is empty: `(states, sigmas, nis)`."""
+    source = tmp_path / "radar.csv"
+    cell = lambda v: "" if np.isnan(v) else repr(float(v))  # noqa: E731
+    header = "t,range,azimuth,elevation" + (",sr,sa" if sigmas is not None else "")
+    with open(source, "w") as f:
+        f.write(header + "\n")
+        for i in range(len(t)):
+            cells = [repr(float(t[i]))] + [cell(v) for v in rows[i]]
+            if sigmas is not None:
+                cells += [cell(sigmas[0][i]), cell(sigmas[1][i])]
+            f.write(",".join(cells) + "\n")
+    extra = ["--sigma-range-col", "sr", "--sigma-angle-col", "sa"] if sigmas is not None else []
+    out = subprocess.run(
+        [str(cli_path()), "track", str(source), "--sigma-range", str(SR)]
+        + ["--sigma-angle", str(SA), *extra, *args],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    body = list(csv.reader(out.splitlines()))[1:]
+    table = np.array([[float(c) if c else np.nan for c in r[1:]] for r in body])
+    return table[:, :6], table[:, 6:12], table[:, 12]
+
+
+def tracked(tracker, t, rows, **kw):
+    """Every row through `update_many`, the smoother's rows from `finish()`; σ from the
+    covariance's diagonal as the command writes it."""
+    x, p, nis = tracker.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2], **kw)
+    held, xs, ps, ns = tracker.finish()
+    x[held], p[held], nis[held] = xs, ps, ns
+    sigma = np.sqrt(np.maximum(np.diagonal(p, axis1=1, axis2=2), 0.0))
+    return x, sigma, nis
+
+
+def same(a, b):
+    return np.array_equal(np.isnan(a), np.isnan(b)) and np.array_equal(
+        np.nan_to_num(a).view(np.int64), np.nan_to_num(b).view(np.int64)
+    )
+
+
+METHODS = [
+    ({"method": "kalman", "q": 0.5}, ["--method", "kalman", "--q", "0.5"]),
+    ({"method": "kalman"}, ["--method", "kalman"]),
+    ({"method": "fading", "beta": 0.9}, ["--method", "fading", "--beta", "0.9"]),
+    ({"method": "fading", "theta": 0.8}, ["--method", "fading", "--theta", "0.8"]),
+    ({"method": "smooth", "q": 0.2}, ["--method", "smooth", "--q", "0.2"]),
+    ({"method": "window", "window": 12}, ["--method", "window", "--window", "12"]),
+]
+
+
+@pytest.mark.parametrize("kw,args", METHODS, ids=lambda v: str(v))
+def test_equals_the_command_to_the_last_bit(tmp_path, kw, args):
+    rng = np.random.default_rng(11)
+    site = (100.0, -50.0, 10.0)
+    t, rows = radar_pass(rng, site=site)
+    want = run_track(tmp_path, t, rows, *args, "--site", "100,-50,10")
+    tracker = ss.RadarTracker(**kw, sigma_range=SR, sigma_angle=SA, site=site)
+    got = tracked(tracker, t, rows)
+    for g, w in zip(got, want):
+        assert same(g, w)
+    assert np.isfinite(got[0][-1]).all() and tracker.rows_taken == len(t)
+
+
+def test_per_row_sigmas_bearings_and_batches_equal_the_command(tmp_path):
+    rng = np.random.default_rng(12)
+    t, rows = radar_pass(rng, n=200)
+    bearing = rows.copy()
+    bearing[:, 1] = np.pi / 2 - rows[:, 1]
+    sr = np.where(rng.random(len(t)) < 0.5, np.nan, rng.uniform(5, 20, len(t)))
+    sa = np.where(rng.random(len(t)) < 0.5, np.nan, rng.uniform(5e-4, 2e-3, len(t)))
+    want = run_track(
+        tmp_path,
+        t,
+        bearing,
+        "--method",
+        "kalman",
+        "--q",
+        "1",
+        "--azimuth",
+        "bearing",
+        sigmas=(sr, sa),
+    )
+    tracker = ss.RadarTracker("kalman", q=1.0, sigma_range=SR, sigma_angle=SA, azimuth="bearing")
+    # In three batches: the same as one.
+    parts = [
+        tracker.update_many(
+            t[a:b],
+            bearing[a:b, 0],
+            bearing[a:b, 1],
+            bearing[a:b, 2],
+            sigma_range=sr[a:b],
+            sigma_angle=sa[a:b],
+        )
+        for a, b in [(0, 1), (1, 77), (77, 200)]
+    ]
+    x = np.concatenate([p[0] for p in parts])
+    sigma = np.sqrt(np.maximum(np.diagonal(np.concatenate([p[1] for p in parts]), 0, 1, 2), 0))
+    nis = np.concatenate([p[2] for p in parts])
+    for g, w in zip((x, sigma, nis), want):
+        assert same(g, w)
+
+
+def test_extended_kalman_equals_filterpy():
+    """From the tracker's start, filterpy's `ExtendedKalmanFilter` (Joseph form, the radar's
+    Jacobian, the azimuth residual wrapped) gives the same states and covariances ≤ 1e-9
+    relative."""
+    from filterpy.kalman import ExtendedKalmanFilter
+
+    rng = np.random.default_rng(13)
+    t, rows = radar_pass(rng, n=150, missing=0.0)
+    tracker = ss.RadarTracker("kalman", sigma_range=SR, sigma_angle=SA)
+    x, p, _ = tracker.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2])
+    k0 = int(np.argmax(np.isfinite(x[:, 0])))
+    ekf = ExtendedKalmanFilter(dim_x=6, dim_z=3)
+    ekf.x, ekf.P = x[k0].copy(), p[k0].copy()
+    ekf.R = np.diag([SR**2, SA**2, SA**2])
+    ekf.Q = np.zeros((6, 6))
+
+    def hx(s):
+        r = np.sqrt(s[0] ** 2 + s[1] ** 2 + s[2] ** 2)
+        return np.array([r, np.arctan2(s[1], s[0]), np.arcsin(s[2] / r)])
+
+    def jacobian(s):
+        px, py, pz = s[:3]
+        rho2 = px * px + py * py
+        r2 = rho2 + pz * pz
+        r, rho = np.sqrt(r2), np.sqrt(rho2)
+        h = np.zeros((3, 6))
+        h[0, :3] = [px / r, py / r, pz / r]
+        h[1, :2] = [-py / rho2, px / rho2]
+        h[2, :3] = [-px * pz / (r2 * rho), -py * pz / (r2 * rho), rho / r2]
+        return h
+
+    def residual(a, b):
+        d = a - b
+        d[1] = (d[1] + np.pi) % (2 * np.pi) - np.pi
+        return d
+
+    for k in range(k0 + 1, len(t)):
+        dt = t[k] - t[k - 1]
+        ekf.F = np.eye(6)
+        ekf.F[:3, 3:] = dt * np.eye(3)
+        ekf.predict()
+        ekf.update(rows[k], jacobian, hx, residual=residual)
+        scale = np.abs(ekf.x).max()
+        assert np.abs(ekf.x - x[k]).max() <= 1e-9 * scale, k
+        assert np.abs(ekf.P - p[k]).max() <= 1e-9 * np.abs(ekf.P).max(), k
+
+
+def test_refused_rows_name_their_index_and_keep_the_rows_before():
+    rng = np.random.default_rng(14)
+    t, rows = radar_pass(rng, n=50)
+    for column, value in [(0, -5.0), (1, 7.0), (2, 2.0)]:
+        bad = rows.copy()
+        bad[30, column] = value
+        tracker = ss.RadarTracker("kalman", sigma_range=SR, sigma_angle=SA)
+        with pytest.raises(InvalidInputError) as e:
+            tracker.update_many(t, bad[:, 0], bad[:, 1], bad[:, 2])
+        assert e.value.index == 30 and tracker.rows_taken == 30
+        # The rest goes on as if the bad row had never come.
+        reference = ss.RadarTracker("kalman", sigma_range=SR, sigma_angle=SA)
+        reference.update_many(t[:30], rows[:30, 0], rows[:30, 1], rows[:30, 2])
+        a = tracker.update_many(t[31:], rows[31:, 0], rows[31:, 1], rows[31:, 2])
+        b = reference.update_many(t[31:], rows[31:, 0], rows[31:, 1], rows[31:, 2])
+        assert all(same(u, v) for u, v in zip(a, b))
+    for method in ["kalman", "window", "smooth"]:
+        tracker = ss.RadarTracker(method, sigma_range=SR, sigma_angle=SA)
+        tt = t.copy()
+        tt[20] = tt[19]
+        with pytest.raises(InvalidInputError) as e:
+            tracker.update_many(tt, rows[:, 0], rows[:, 1], rows[:, 2])
+        assert e.value.index == 20, method
+    tracker = ss.RadarTracker("kalman", sigma_angle=SA)
+    with pytest.raises(InvalidInputError) as e:
+        tracker.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2])
+    assert "sigma_range" in str(e.value) and e.value.index == 0
+
+
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"method": "fading"},
+        {"method": "fading", "beta": 0.9, "theta": 0.9},
+        {"method": "fading", "theta": 1.5},
+        {"method": "kalman", "q": -1.0},
+        {"method": "kalman", "theta": 0.9},
+        {"method": "window", "q": 1.0},
+        {"method": "window", "window": 1},
+        {"method": "kalman", "window": 10},
+        {"method": "ekf"},
+        {"method": "kalman", "azimuth": "north"},
+        {"method": "kalman", "sigma_range": -1.0},
+        {"method": "kalman", "site": (np.nan, 0.0, 0.0)},
+    ],
+)
+def test_bad_settings_raise_parameter_errors(kw):
+    with pytest.raises(ParameterError):
+        ss.RadarTracker(**kw)
