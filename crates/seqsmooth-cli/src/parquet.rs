@@ -25,10 +25,11 @@ use parquet::arrow::arrow_reader::{ParquetRecordBatchReader, ParquetRecordBatchR
 use parquet::arrow::{ArrowWriter, ProjectionMask};
 use parquet::basic::Compression;
 use parquet::file::properties::WriterProperties;
+use std::cell::Cell;
 use std::fs::File;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, Once};
 
 /// Rows read from the file per record batch.
 const READ_BATCH_ROWS: usize = 16_384;
@@ -55,10 +56,33 @@ pub fn is_parquet(path: Option<&Path>) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("parquet"))
 }
 
+thread_local! {
+    /// Whether this thread is in [`guarded`]: its panics are reported as errors, not printed.
+    static GUARDED: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Installs, once, the panic hook that stays quiet on a thread in [`guarded`] and runs the
+/// previous hook on any other.
+fn quiet_hook() {
+    static HOOK: Once = Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !GUARDED.with(Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+}
+
 /// Runs `f`, a call into the `parquet` crate on data from the file, turning a panic (a corrupt
 /// file the crate does not check) into an error of `name`.
 fn guarded<T>(name: &str, what: &str, f: impl FnOnce() -> T) -> Result<T, CliError> {
-    catch_unwind(AssertUnwindSafe(f)).map_err(|_| {
+    quiet_hook();
+    GUARDED.with(|g| g.set(true));
+    let result = catch_unwind(AssertUnwindSafe(f));
+    GUARDED.with(|g| g.set(false));
+    result.map_err(|_| {
         CliError::Data(format!(
             "cannot read the Parquet file {name}: it is corrupt ({what} failed)"
         ))

@@ -11,10 +11,10 @@ mod common;
 use common::{run, run_at};
 
 use arrow::array::{
-    Array, ArrayRef, AsArray, BooleanArray, Float32Array, Float64Array, Int64Array, ListArray,
-    StringArray, TimestampMicrosecondArray,
+    Array, ArrayRef, AsArray, BooleanArray, DictionaryArray, Float32Array, Float64Array,
+    Int64Array, LargeStringArray, ListArray, StringArray, TimestampMicrosecondArray,
 };
-use arrow::datatypes::{DataType, Field, Float64Type, Int64Type, Schema};
+use arrow::datatypes::{DataType, Field, Float64Type, Int32Type, Int64Type, Schema};
 use arrow::record_batch::RecordBatch;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use parquet::arrow::ArrowWriter;
@@ -340,6 +340,31 @@ fn expanding_with_ids_is_the_csv_output_bit_for_bit() {
     assert!(table.columns[0].contains(&Some("a,\"b\"".to_string())));
     let ids: std::collections::HashSet<_> = table.columns[0].iter().collect();
     assert_eq!(ids.len(), 25);
+    // The ids as a dictionary of strings, and as large strings: the same output, ids as text.
+    let d = Data::new(4000, 25, 2);
+    let dictionary: DictionaryArray<Int32Type> = d.ids.iter().map(String::as_str).collect();
+    let large = LargeStringArray::from(d.ids.clone());
+    for (name, ids) in [
+        ("dict.parquet", Arc::new(dictionary) as ArrayRef),
+        ("large.parquet", Arc::new(large)),
+    ] {
+        let path = at(dir.path(), name);
+        write_parquet(
+            Path::new(&path),
+            vec![
+                ("id", ids),
+                ("t", Arc::new(Float64Array::from(d.t()))),
+                ("y", Arc::new(Float64Array::from(d.y.clone()))),
+            ],
+        );
+        let out = at(dir.path(), "out_dict.parquet");
+        filter_ok(&path, &args, Some(&out));
+        assert_eq!(
+            read_parquet(Path::new(&out), Some(&DataType::Utf8)),
+            table,
+            "{name}"
+        );
+    }
 }
 
 #[test]

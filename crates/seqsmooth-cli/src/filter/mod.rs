@@ -1,5 +1,7 @@
 //! `seqsmooth filter`: streams a CSV time series — or many, told apart by an id column —
-//! through polynomial filters.
+//! through polynomial filters. A `.parquet` input or output is a Parquet file
+//! ([`crate::parquet`]): its rows are read as records into the same chunks, and the output rows
+//! written as a table, so everything in between is the CSV path's.
 //!
 //! The command reads, filters and writes chunks of rows ([`CHUNK_ROWS`]): a reader thread
 //! reads and validates ([`rows`]) the next chunk while the current one is run through the
