@@ -174,26 +174,33 @@ struct Selected {
 pub struct ParquetRows {
     /// `'path'`, for messages.
     name: Arc<str>,
+    /// The names of the file's columns.
     header: Vec<String>,
+    /// The Arrow types of the file's columns.
     types: Vec<DataType>,
     /// Until [`Records::select`]: the reader to build.
     builder: Option<ParquetRecordBatchReaderBuilder<File>>,
+    /// After [`Records::select`]: the record batches of the selected columns.
     batches: Option<ParquetRecordBatchReader>,
     /// The slot of each file column in `selected`, if selected.
     slots: Vec<Option<usize>>,
+    /// The selected columns, by slot.
     selected: Vec<Selected>,
     /// The selected columns of the current batch, by slot.
     columns: Vec<Column>,
     /// The text of the current row's numbers, by slot.
     texts: Vec<Vec<u8>>,
-    /// The current row in the batch, and the rows of the batch.
+    /// The current row in the batch.
     at: usize,
+    /// The rows of the batch.
     batch_rows: usize,
     /// 1-based data row of the current record (0 before the first).
     row: u64,
-    /// The file's rows and bytes, for the progress estimate.
+    /// The file's rows, for the progress estimate.
     total_rows: u64,
+    /// The file's bytes, for the progress estimate.
     size: u64,
+    /// The type of the id column (text when there is none).
     id_type: IdType,
 }
 
@@ -466,9 +473,13 @@ impl Records for ParquetRows {
 
 /// A column of the output being built.
 enum Builder {
+    /// A number column: `Float64`, null for an empty cell.
     Numbers(Float64Builder),
+    /// Text ids.
     Text(StringBuilder),
+    /// Signed integer ids.
     Signed(Int64Builder),
+    /// Unsigned integer ids.
     Unsigned(UInt64Builder),
 }
 
@@ -522,8 +533,11 @@ pub struct ParquetTable {
     id: Option<IdType>,
     /// Until the header is read: the file.
     file: Option<File>,
+    /// Once the header is read: the writer of the file.
     writer: Option<ArrowWriter<File>>,
+    /// Once the header is read: the columns.
     schema: Option<SchemaRef>,
+    /// The columns of the rows not written yet.
     builders: Vec<Builder>,
     /// Rows in the builders.
     rows: usize,
