@@ -25,6 +25,7 @@ use parquet::arrow::arrow_reader::{ParquetRecordBatchReader, ParquetRecordBatchR
 use parquet::arrow::{ArrowWriter, ProjectionMask};
 use parquet::basic::Compression;
 use parquet::file::properties::WriterProperties;
+use parquet::schema::types::ColumnPath;
 use std::cell::Cell;
 use std::fs::File;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -582,11 +583,18 @@ impl ParquetTable {
             fields.push(Field::new(name, data_type, k != 0 || self.id.is_none()));
             self.builders.push(builder);
         }
-        let schema = Arc::new(Schema::new(fields));
-        let props = WriterProperties::builder()
+        // Dictionary encoding only for the ids: the estimates are almost all distinct, so a
+        // dictionary would be built and dropped for every page.
+        let mut props = WriterProperties::builder()
             .set_compression(Compression::SNAPPY)
             .set_max_row_group_row_count(Some(ROW_GROUP_ROWS))
-            .build();
+            .set_dictionary_enabled(false);
+        if let (Some(_), Some(id)) = (self.id, fields.first()) {
+            let column = ColumnPath::new(vec![id.name().clone()]);
+            props = props.set_column_dictionary_enabled(column, true);
+        }
+        let props = props.build();
+        let schema = Arc::new(Schema::new(fields));
         let file = self
             .file
             .take()
