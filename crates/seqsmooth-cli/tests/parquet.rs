@@ -11,8 +11,9 @@ mod common;
 use common::{run, run_at};
 
 use arrow::array::{
-    Array, ArrayRef, AsArray, BooleanArray, DictionaryArray, Float32Array, Float64Array,
-    Int64Array, LargeStringArray, ListArray, StringArray, TimestampMicrosecondArray,
+    Array, ArrayRef, AsArray, BooleanArray, Date32Array, DictionaryArray, Float32Array,
+    Float64Array, Int64Array, LargeStringArray, ListArray, StringArray, TimestampMicrosecondArray,
+    TimestampNanosecondArray,
 };
 use arrow::datatypes::{DataType, Field, Float64Type, Int32Type, Int64Type, Schema};
 use arrow::record_batch::RecordBatch;
@@ -169,6 +170,23 @@ fn read_parquet(path: &Path, id: Option<&DataType>) -> Table {
     Table { names, columns }
 }
 
+/// Asserts the tables are the same; the message names the first cell that differs.
+fn same(got: &Table, want: &Table, what: &str) {
+    assert_eq!(got.names, want.names, "{what}: column names");
+    for (k, (g, w)) in got.columns.iter().zip(&want.columns).enumerate() {
+        assert_eq!(g.len(), w.len(), "{what}: rows of column {}", want.names[k]);
+        if let Some(i) = (0..g.len()).find(|&i| g[i] != w[i]) {
+            panic!(
+                "{what}: column {} row {}: {:?} instead of {:?}",
+                want.names[k],
+                i + 1,
+                g[i],
+                w[i]
+            );
+        }
+    }
+}
+
 /// Reads a CSV output: the first column is the id when `id`, the others numbers.
 fn read_csv(text: &str, id: bool) -> Table {
     let mut reader = csv::ReaderBuilder::new().from_reader(text.as_bytes());
@@ -236,32 +254,29 @@ fn same_four_ways(
     // Parquet → Parquet.
     let out = at(dir, "out.parquet");
     assert_eq!(filter_ok(parquet, args, Some(&out)), "");
-    assert_eq!(
-        read_parquet(Path::new(&out), id.as_ref()),
-        reference,
-        "parquet -> parquet"
+    same(
+        &read_parquet(Path::new(&out), id.as_ref()),
+        &reference,
+        "parquet -> parquet",
     );
     // Parquet → CSV (standard output and a file).
     let text = filter_ok(parquet, args, None);
-    assert_eq!(read_csv(&text, id.is_some()), reference, "parquet -> csv");
+    same(&read_csv(&text, id.is_some()), &reference, "parquet -> csv");
     let out_csv = at(dir, "out.csv");
     filter_ok(parquet, args, Some(&out_csv));
     let file_text = std::fs::read_to_string(&out_csv).expect("csv output");
-    assert_eq!(
-        read_csv(&file_text, id.is_some()),
-        reference,
-        "parquet -> csv file"
+    same(
+        &read_csv(&file_text, id.is_some()),
+        &reference,
+        "parquet -> csv file",
     );
     // CSV → Parquet (the extension in capitals).
     let out2 = at(dir, "out2.PARQUET");
     filter_ok(&csv_in, args, Some(&out2));
     let text_ids = id.as_ref().map(|_| DataType::Utf8);
+    // The ids of a CSV input are text (integer ids of the Parquet input too: their decimal text).
     let back = read_parquet(Path::new(&out2), text_ids.as_ref());
-    if id == Some(DataType::Utf8) || id.is_none() {
-        assert_eq!(back, reference, "csv -> parquet");
-    } else {
-        assert_eq!(back.columns[1..], reference.columns[1..], "csv -> parquet");
-    }
+    same(&back, &reference, "csv -> parquet");
     reference
 }
 
@@ -359,10 +374,10 @@ fn expanding_with_ids_is_the_csv_output_bit_for_bit() {
         );
         let out = at(dir.path(), "out_dict.parquet");
         filter_ok(&path, &args, Some(&out));
-        assert_eq!(
-            read_parquet(Path::new(&out), Some(&DataType::Utf8)),
-            table,
-            "{name}"
+        same(
+            &read_parquet(Path::new(&out), Some(&DataType::Utf8)),
+            &table,
+            name,
         );
     }
 }
@@ -490,6 +505,53 @@ fn a_timestamp_time_column_is_seconds_since_the_epoch() {
     let first =
         f64::from_bits(u64::from_str_radix(table.columns[0][0].as_deref().unwrap(), 16).unwrap());
     assert!((1.7e9..1.8e9).contains(&first), "{first}");
+}
+
+#[test]
+fn nanosecond_timestamps_and_dates_are_the_seconds_written_out() {
+    let dir = scratch();
+    let d = Data::new(2000, 1, 12);
+    let y: Vec<Option<String>> = d.y.iter().map(|v| Some(format!("{v}"))).collect();
+    // Nanoseconds beyond 2^53: the seconds are the decimal text's nearest double.
+    let nanos: Vec<i64> = d
+        .micros
+        .iter()
+        .enumerate()
+        .map(|(i, &u)| u * 1000 + (i as i64 * 7919) % 1000)
+        .collect();
+    let text: Vec<String> = nanos
+        .iter()
+        .map(|&n| format!("{}.{:09}", n / 1_000_000_000, n % 1_000_000_000))
+        .collect();
+    let t: Vec<f64> = text.iter().map(|s| s.parse().unwrap()).collect();
+    let pq = at(dir.path(), "ns.parquet");
+    write_parquet(
+        Path::new(&pq),
+        vec![
+            (
+                "t",
+                Arc::new(TimestampNanosecondArray::from(nanos)) as ArrayRef,
+            ),
+            ("y", Arc::new(Float64Array::from(d.y.clone()))),
+        ],
+    );
+    let args = [
+        "--kind", "fading", "--degree", "1", "--theta", "0.9", "--tau", "1",
+    ];
+    same_four_ways(dir.path(), &csv_text(None, &t, &y), &pq, &args, None);
+    // Days since the epoch: 86 400 s each.
+    let days: Vec<i32> = (0..2000).map(|i| 19_000 + i * 3 + i % 2).collect();
+    let t: Vec<f64> = days.iter().map(|&d| f64::from(d) * 86_400.0).collect();
+    let pq = at(dir.path(), "dates.parquet");
+    write_parquet(
+        Path::new(&pq),
+        vec![
+            ("t", Arc::new(Date32Array::from(days)) as ArrayRef),
+            ("y", Arc::new(Float64Array::from(d.y.clone()))),
+        ],
+    );
+    let args = ["--kind", "expanding", "--degree", "2"];
+    same_four_ways(dir.path(), &csv_text(None, &t, &y), &pq, &args, None);
 }
 
 /// The single-series data with the value of data row `row` (1-based) missing: CSV (an empty
