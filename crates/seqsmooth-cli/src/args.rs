@@ -322,8 +322,8 @@ pub struct FilterArgs {
     #[arg(long, value_name = "N")]
     pub review_window: Option<usize>,
     /// Output file: CSV, or Parquet if the name ends in .parquet (any case; the CSV output's
-    /// columns, numbers as Float64 with null for an empty cell, the id column of the input's
-    /// type) [default: CSV on standard output]
+    /// columns, numbers as Float64 with null for an empty cell, the time in seconds, the id
+    /// column text or integers as in the input) [default: CSV on standard output]
     #[arg(short = 'o', long, value_name = "OUTPUT")]
     pub output: Option<PathBuf>,
     /// Name of a column naming the series: the rows of each id (any text) are a series of
