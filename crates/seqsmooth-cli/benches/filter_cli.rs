@@ -8,6 +8,8 @@
 //!   degree 2; fading memory with θ = 0.9 (τ the median step).
 //! - `filter_cli/id_col_100/<kind>_<engine>`: the same number of rows as 100 series `id,t,y`,
 //!   interleaved in a shuffled round-robin order, with `--id-col id`.
+//! - `filter_cli/parquet_to_{csv,parquet}/fading_exact`: the single series as a Parquet file
+//!   (`Float64` columns), to CSV on standard output and to a Parquet file.
 //!
 //! Throughput is in rows (criterion's elements/s).
 
@@ -61,6 +63,30 @@ fn generate(path: &Path, series: Option<usize>) -> std::io::Result<()> {
     std::fs::rename(tmp, path)
 }
 
+/// Writes the CSV `csv` as the Parquet file `path` (once; kept between runs), through the
+/// command itself (its output holds `t` and `y` as `Float64`).
+fn to_parquet(csv: &Path, path: &Path) {
+    if path.exists() {
+        return;
+    }
+    let args = [
+        "--kind",
+        "expanding",
+        "--degree",
+        "0",
+        "--no-progress",
+        "-o",
+    ];
+    let status = Command::new(env!("CARGO_BIN_EXE_seqsmooth"))
+        .arg("filter")
+        .args(args)
+        .arg(path)
+        .arg(csv)
+        .status()
+        .expect("run seqsmooth");
+    assert!(status.success(), "seqsmooth filter {args:?} failed");
+}
+
 /// Runs `seqsmooth filter args… input` with the output discarded.
 fn run(args: &[&str], input: &Path) {
     let status = Command::new(env!("CARGO_BIN_EXE_seqsmooth"))
@@ -79,6 +105,9 @@ fn filter_cli(c: &mut Criterion) {
     let multi = dir.join("filter_cli_1e6_100_series.csv");
     generate(&single, None).expect("write the bench input");
     generate(&multi, Some(100)).expect("write the bench input");
+    let parquet = dir.join("filter_cli_1e6.parquet");
+    to_parquet(&single, &parquet);
+    let parquet_out = dir.join("filter_cli_out.parquet");
 
     let configs: [(&str, &[&str]); 4] = [
         (
@@ -114,6 +143,15 @@ fn filter_cli(c: &mut Criterion) {
             b.iter(|| run(&args, &multi))
         });
     }
+    let fading = [configs[1].1, &["--degree", "2"][..]].concat();
+    group.bench_function("parquet_to_csv/fading_exact", |b| {
+        b.iter(|| run(&fading, &parquet))
+    });
+    let out = parquet_out.to_str().expect("a UTF-8 path");
+    let to_file = [&fading[..], &["-o", out][..]].concat();
+    group.bench_function("parquet_to_parquet/fading_exact", |b| {
+        b.iter(|| run(&to_file, &parquet))
+    });
     group.finish();
 }
 

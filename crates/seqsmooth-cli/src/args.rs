@@ -275,8 +275,10 @@ window reaches rows after it); use 'seqsmooth filter --kind fixed' for a causal,
 
 #[derive(Debug, Args)]
 pub struct FilterArgs {
-    /// Input CSV with a header row; omitted or '-' reads standard input. Columns other than the
-    /// time and value columns are ignored
+    /// Input CSV with a header row, or a Parquet file if the name ends in .parquet (any case):
+    /// numbers of any integer, float or decimal type, the time also a timestamp or date (as
+    /// seconds since the Unix epoch), the id text or integers; omitted or '-' reads CSV from
+    /// standard input. Columns other than the time, value and id columns are ignored
     #[arg(value_name = "INPUT")]
     pub input: Option<PathBuf>,
     /// Filter kind
@@ -319,7 +321,9 @@ pub struct FilterArgs {
     /// is taken) [default: degree + 4]
     #[arg(long, value_name = "N")]
     pub review_window: Option<usize>,
-    /// Output file [default: standard output]
+    /// Output file: CSV, or Parquet if the name ends in .parquet (any case; the CSV output's
+    /// columns, numbers as Float64 with null for an empty cell, the time in seconds, the id
+    /// column text or integers as in the input) [default: CSV on standard output]
     #[arg(short = 'o', long, value_name = "OUTPUT")]
     pub output: Option<PathBuf>,
     /// Name of a column naming the series: the rows of each id (any text) are a series of

@@ -1,6 +1,8 @@
 //! The command's files: opening inputs and outputs, the one CSV reader (records with their
 //! 1-based file lines, header checks, column lookup, number cells) and the one CSV writer
-//! (cells, numbers with round-trip precision) of every subcommand. Imports no subcommand.
+//! (cells, numbers with round-trip precision) of every subcommand. Other formats come in as
+//! [`Records`] and go out as a [`Table`] of [`Output`] (Parquet: `crate::parquet`). Imports no
+//! subcommand.
 
 use crate::error::CliError;
 use std::fs::File;
@@ -435,6 +437,163 @@ impl<R: Read> CsvIn<R> {
     }
 }
 
+/// Where the rows of an input are, for messages: the lines of a CSV text, or the data rows of a
+/// Parquet file (which has no lines).
+#[derive(Clone, Debug, Default)]
+pub enum Places {
+    /// 1-based lines of a CSV text (the header is line 1 unless blank lines precede it).
+    #[default]
+    Lines,
+    /// 1-based data rows of the Parquet file named here (`'path'`).
+    ParquetRows(std::sync::Arc<str>),
+}
+
+impl Places {
+    /// Place `n` as a message starts with it: `line 5`, or `row 4 of the Parquet file 'x'`.
+    ///
+    /// ```
+    /// use seqsmooth_cli::io::Places;
+    /// assert_eq!(Places::Lines.at(5), "line 5");
+    /// let rows = Places::ParquetRows("'a.parquet'".into());
+    /// assert_eq!(rows.at(4), "row 4 of the Parquet file 'a.parquet'");
+    /// assert_eq!(rows.short(3), "row 3");
+    /// ```
+    pub fn at(&self, n: u64) -> String {
+        match self {
+            Places::Lines => format!("line {n}"),
+            Places::ParquetRows(file) => format!("row {n} of the Parquet file {file}"),
+        }
+    }
+
+    /// Place `n` named a second time in a message: `line 5` or `row 4`.
+    pub fn short(&self, n: u64) -> String {
+        match self {
+            Places::Lines => format!("line {n}"),
+            Places::ParquetRows(_) => format!("row {n}"),
+        }
+    }
+}
+
+/// A source of data records with named columns: the CSV reader ([`CsvIn`]) or a Parquet
+/// file's rows. Records are read one at a time; the cells of the current one are read by
+/// column index (in [`Records::header`]).
+pub trait Records {
+    /// The column names, in order.
+    fn header(&self) -> &[String];
+
+    /// What follows "the header" in a message about a column not found or ambiguous (`""`
+    /// for CSV).
+    fn header_why(&self) -> String {
+        String::new()
+    }
+
+    /// Declares the columns the reader will ask for: `numbers` through [`Records::number`]
+    /// and [`Records::field`], `text` (an id) through [`Records::field`]. A source that
+    /// decodes only what is asked (Parquet) checks their types here. The default accepts any.
+    fn select(&mut self, numbers: &[usize], text: Option<usize>) -> Result<(), CliError> {
+        let _ = (numbers, text);
+        Ok(())
+    }
+
+    /// Reads the next record; `false` at the end of the input.
+    fn next_record(&mut self) -> Result<bool, CliError>;
+
+    /// The 1-based place of the current record (see [`Records::places`]).
+    fn place(&self) -> u64;
+
+    /// What [`Records::place`] counts.
+    fn places(&self) -> Places;
+
+    /// The text of cell `i` of the current record (trimmed): as written for CSV, the
+    /// shortest round-trip digits of a number ([`write_f64`]) for Parquet.
+    fn field(&self, i: usize) -> &[u8];
+
+    /// The number in cell `i` of the current record, in `column`, holding the `what` (`time`,
+    /// `value`): a typed error for a missing (empty or null) cell, a non-number or a non-finite
+    /// number.
+    fn number(&self, i: usize, column: &str, what: &str) -> Result<f64, CliError>;
+
+    /// How much of the input has been read, in bytes (estimated for Parquet), for the progress
+    /// display.
+    fn bytes_read(&self) -> u64;
+
+    /// How the id column's values are typed, for an output that keeps types (Parquet).
+    fn id_type(&self) -> IdType {
+        IdType::Text
+    }
+}
+
+impl<T: Records + ?Sized> Records for Box<T> {
+    fn header(&self) -> &[String] {
+        (**self).header()
+    }
+    fn header_why(&self) -> String {
+        (**self).header_why()
+    }
+    fn select(&mut self, numbers: &[usize], text: Option<usize>) -> Result<(), CliError> {
+        (**self).select(numbers, text)
+    }
+    fn next_record(&mut self) -> Result<bool, CliError> {
+        (**self).next_record()
+    }
+    fn place(&self) -> u64 {
+        (**self).place()
+    }
+    fn places(&self) -> Places {
+        (**self).places()
+    }
+    fn field(&self, i: usize) -> &[u8] {
+        (**self).field(i)
+    }
+    fn number(&self, i: usize, column: &str, what: &str) -> Result<f64, CliError> {
+        (**self).number(i, column, what)
+    }
+    fn bytes_read(&self) -> u64 {
+        (**self).bytes_read()
+    }
+    fn id_type(&self) -> IdType {
+        (**self).id_type()
+    }
+}
+
+/// The type of an id column's values.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum IdType {
+    /// Text (CSV, and Parquet strings and dictionaries of strings).
+    #[default]
+    Text,
+    /// Signed integers (Parquet), written as their decimal text in CSV.
+    Signed,
+    /// Unsigned integers (Parquet), written as their decimal text in CSV.
+    Unsigned,
+}
+
+impl<R: Read> Records for CsvIn<R> {
+    fn header(&self) -> &[String] {
+        &self.header
+    }
+    fn next_record(&mut self) -> Result<bool, CliError> {
+        CsvIn::next_record(self)
+    }
+    fn place(&self) -> u64 {
+        self.line
+    }
+    fn places(&self) -> Places {
+        Places::Lines
+    }
+    #[inline]
+    fn field(&self, i: usize) -> &[u8] {
+        CsvIn::field(self, i)
+    }
+    #[inline]
+    fn number(&self, i: usize, column: &str, what: &str) -> Result<f64, CliError> {
+        parse_cell(CsvIn::field(self, i), self.line, column, what)
+    }
+    fn bytes_read(&self) -> u64 {
+        CsvIn::bytes_read(self)
+    }
+}
+
 /// The error of a row on `line` that is not UTF-8 text.
 pub fn not_utf8(line: u64) -> CliError {
     CliError::Data(format!(
@@ -474,9 +633,27 @@ pub fn input_size(path: Option<&Path>) -> Option<u64> {
     meta.is_file().then_some(meta.len())
 }
 
+/// Rows written in another format than CSV text (a Parquet file): given the rows as the CSV
+/// output would hold them, whole rows (and the header first) at a time.
+pub trait Table {
+    /// Takes whole CSV rows (`\n`-terminated; the first call's first row is the header).
+    fn write_rows(&mut self, csv: &[u8]) -> Result<(), CliError>;
+
+    /// Writes what is still buffered and the file's end; the file is complete after it.
+    fn close(self: Box<Self>) -> Result<(), CliError>;
+}
+
+/// Where an [`Output`]'s bytes go.
+enum Sink {
+    /// CSV text, buffered.
+    Text(Box<dyn Write>),
+    /// A table that takes whole CSV rows ([`Output::table`]); `None` once closed.
+    Table(Option<Box<dyn Table>>),
+}
+
 /// An output: a buffered file or buffered standard output, with its name for messages.
 pub struct Output {
-    sink: Box<dyn Write>,
+    sink: Sink,
     /// `'path'` or `standard output`.
     pub name: String,
     /// For a file: the temporary file beside it and the file it becomes at [`Output::finish`].
@@ -493,38 +670,60 @@ impl Output {
     pub fn create(path: Option<&Path>) -> Result<Self, CliError> {
         match named(path) {
             Some(p) => {
-                let name = format!("'{}'", p.display());
-                let fail =
-                    |e: io::Error| CliError::Data(format!("cannot create output file {name}: {e}"));
-                match Destination::of(p) {
-                    Destination::InPlace(target) => {
-                        let file = std::fs::OpenOptions::new()
-                            .write(true)
-                            .open(target)
-                            .map_err(fail)?;
-                        Ok(Self {
-                            sink: Box::new(BufWriter::new(file)),
-                            name,
-                            file: None,
-                        })
-                    }
-                    Destination::Replace(target) => {
-                        let (file, temp) = temp_beside(&target, "").map_err(fail)?.into_parts();
-                        Ok(Self {
-                            sink: Box::new(BufWriter::new(file)),
-                            name,
-                            file: Some((temp, target)),
-                        })
-                    }
-                }
+                let (file, name, rename) = Self::open(p)?;
+                Ok(Self {
+                    sink: Sink::Text(Box::new(BufWriter::new(file))),
+                    name,
+                    file: rename,
+                })
             }
             None => Ok(Self::stdout()),
         }
     }
 
+    /// Creates the output file `path` as [`Output::create`] does (a temporary file beside it,
+    /// renamed onto it by [`Output::finish`]), written by the [`Table`] that `make` returns for
+    /// the open file and its name for messages (`'path'`).
+    pub fn table(
+        path: &Path,
+        make: impl FnOnce(File, &str) -> Result<Box<dyn Table>, CliError>,
+    ) -> Result<Self, CliError> {
+        let (file, name, rename) = Self::open(path)?;
+        let table = make(file, &name)?;
+        Ok(Self {
+            sink: Sink::Table(Some(table)),
+            name,
+            file: rename,
+        })
+    }
+
+    /// Opens the file an output named `path` is written to: the file itself when written in
+    /// place, else a temporary file beside it (with the temporary path and the target to
+    /// rename it onto); and its name for messages.
+    #[allow(clippy::type_complexity)]
+    fn open(
+        path: &Path,
+    ) -> Result<(File, String, Option<(tempfile::TempPath, PathBuf)>), CliError> {
+        let name = format!("'{}'", path.display());
+        let fail = |e: io::Error| CliError::Data(format!("cannot create output file {name}: {e}"));
+        match Destination::of(path) {
+            Destination::InPlace(target) => {
+                let file = std::fs::OpenOptions::new()
+                    .write(true)
+                    .open(target)
+                    .map_err(fail)?;
+                Ok((file, name, None))
+            }
+            Destination::Replace(target) => {
+                let (file, temp) = temp_beside(&target, "").map_err(fail)?.into_parts();
+                Ok((file, name, Some((temp, target))))
+            }
+        }
+    }
+
     /// Buffered standard output.
     pub fn stdout() -> Self {
-        let sink = Box::new(BufWriter::new(io::stdout().lock()));
+        let sink = Sink::Text(Box::new(BufWriter::new(io::stdout().lock())));
         Self {
             sink,
             name: "standard output".to_string(),
@@ -532,10 +731,18 @@ impl Output {
         }
     }
 
+    /// Writes `bytes` of CSV text (for a [`Table`] output: whole rows).
     pub fn write(&mut self, bytes: &[u8]) -> Result<(), CliError> {
-        self.sink
-            .write_all(bytes)
-            .map_err(|e| CliError::write(&self.name, e))
+        match &mut self.sink {
+            Sink::Text(sink) => sink
+                .write_all(bytes)
+                .map_err(|e| CliError::write(&self.name, e)),
+            Sink::Table(Some(table)) => table.write_rows(bytes),
+            Sink::Table(None) => Err(CliError::Data(format!(
+                "internal error: {} is closed",
+                self.name
+            ))),
+        }
     }
 
     /// Writes a CSV row of `cells` (each quoted where needed).
@@ -579,11 +786,16 @@ impl Output {
 
     /// Flushes everything to the sink; for a file, renames the temporary file onto it.
     pub fn finish(mut self) -> Result<(), CliError> {
-        self.sink
-            .flush()
-            .map_err(|e| CliError::write(&self.name, e))?;
+        match &mut self.sink {
+            Sink::Text(sink) => sink.flush().map_err(|e| CliError::write(&self.name, e))?,
+            Sink::Table(table) => {
+                if let Some(table) = table.take() {
+                    table.close()?;
+                }
+            }
+        }
         // Close the file before it is renamed.
-        self.sink = Box::new(io::sink());
+        self.sink = Sink::Text(Box::new(io::sink()));
         match self.file.take() {
             Some((temp, path)) => temp
                 .persist(&path)

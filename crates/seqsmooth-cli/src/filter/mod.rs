@@ -1,5 +1,7 @@
 //! `seqsmooth filter`: streams a CSV time series — or many, told apart by an id column —
-//! through polynomial filters.
+//! through polynomial filters. A `.parquet` input or output is a Parquet file
+//! ([`crate::parquet`]): its rows are read as records into the same chunks, and the output rows
+//! written as a table, so everything in between is the CSV path's.
 //!
 //! The command reads, filters and writes chunks of rows ([`CHUNK_ROWS`]): a reader thread
 //! reads and validates ([`rows`]) the next chunk while the current one is run through the
@@ -17,14 +19,15 @@ pub mod runner;
 
 use crate::args::{check_window, name, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
 use crate::error::CliError;
-use crate::io::{check_distinct, fmt_f64, input_size, open_input, Need, Output};
+use crate::io::{check_distinct, fmt_f64, input_size, named, open_input, CsvIn, Need, Output};
+use crate::io::{IdType, Records};
+use crate::parquet::{is_parquet, ParquetRows, ParquetTable};
 use crate::progress::{self, Progress};
 use rayon::prelude::*;
 use rows::{Chunk, RowReader};
 use runner::Runner;
 use seqsmooth::polynomial::stream::{self, StreamBank};
 use std::collections::HashMap;
-use std::io::Read;
 use std::sync::mpsc;
 
 /// Data rows buffered before output starts: up to 100 time steps for the `τ` median.
@@ -146,14 +149,19 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     };
     let started = std::time::Instant::now();
     let size = input_size(a.input.as_deref());
-    let input = open_input(a.input.as_deref())?;
-    let mut reader = RowReader::new(
-        input,
+    // A `.parquet` input is read as Parquet, anything else as CSV, through the same checks.
+    let records: Box<dyn Records + Send> = match named(a.input.as_deref()) {
+        Some(path) if is_parquet(Some(path)) => Box::new(ParquetRows::open(path)?),
+        _ => Box::new(CsvIn::new(open_input(a.input.as_deref())?)?),
+    };
+    let mut reader = RowReader::from_records(
+        records,
         &a.columns.time_col,
         &a.columns.value_col,
         a.id_col.as_deref(),
         &need,
     )?;
+    let id_type = a.id_col.as_ref().map(|_| reader.id_type());
     // A fixed-memory window longer than LOOKAHEAD is read in full before the first output row:
     // its rows have no estimate, and an input shorter than the window is an error.
     let hold = LOOKAHEAD.max(need.rows);
@@ -258,7 +266,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         let sink = match &mut out {
             Some(sink) => sink,
             None => {
-                let mut sink = Output::create(a.output.as_deref())?;
+                let mut sink = create_output(a.output.as_deref(), id_type)?;
                 let mut header = Vec::new();
                 chunk.header(&mut header, a.id_col.as_deref(), a.degree, sigma, &columns);
                 sink.write(&header)?;
@@ -331,6 +339,20 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The output `path`: a Parquet file for a `.parquet` path (ids of `id_type` in the first
+/// column, if any), else CSV text (a file, or standard output).
+fn create_output(
+    path: Option<&std::path::Path>,
+    id_type: Option<IdType>,
+) -> Result<Output, CliError> {
+    match named(path) {
+        Some(p) if is_parquet(Some(p)) => Output::table(p, |file, name| {
+            Ok(Box::new(ParquetTable::new(file, name, id_type)))
+        }),
+        _ => Output::create(path),
+    }
+}
+
 /// The first of the rows `..limit` that cannot be written as it is, and why, from the
 /// `need`-th row of its series on: no estimate (the fit is not determined), or one of its first
 /// `cells` numbers marked NaN by the library because it is beyond the double range (the time
@@ -348,10 +370,7 @@ fn check_estimates(
     need: &Need,
     counts: &mut Vec<usize>,
 ) -> Option<(usize, CliError)> {
-    let fail = |i: usize, why: String| {
-        let line = chunk.lines[i];
-        Some((i, CliError::Data(format!("line {line}: {why}"))))
-    };
+    let fail = |i: usize, why: String| Some((i, CliError::Data(format!("{}: {why}", chunk.at(i)))));
     for i in 0..limit {
         let row = &values[i * stride..(i + 1) * stride];
         // The library marks what it cannot represent as NaN; anything infinite (the automatic
@@ -395,12 +414,11 @@ fn row_error(e: seqsmooth::Error, chunk: &Chunk) -> (usize, CliError) {
         },
         other => (0, other),
     };
-    let line = chunk.lines[index];
     let why = match source {
         seqsmooth::Error::EstimateOutOfRange { what } => too_large(&what),
         other => other.to_string(),
     };
-    (index, CliError::Data(format!("line {line}: {why}")))
+    (index, CliError::Data(format!("{}: {why}", chunk.at(index))))
 }
 
 /// Why a number of an estimate cannot be written, in the command line's terms.
@@ -421,8 +439,8 @@ struct Pipeline {
 impl Pipeline {
     /// Starts reading chunks from `reader` on a new thread, of as many rows as `sizes` gives
     /// in turn. The thread ends after the last chunk, or when the pipeline is dropped.
-    fn start<R: Read + Send + 'static>(
-        mut reader: RowReader<R>,
+    fn start<S: Records + Send + 'static>(
+        mut reader: RowReader<S>,
         mut sizes: impl Iterator<Item = usize> + Send + 'static,
     ) -> Self {
         let (full_tx, full) = mpsc::sync_channel::<Chunk>(1);

@@ -1,15 +1,16 @@
-//! The rows of a CSV time series, one series or many (`--id-col`), read and validated in
-//! chunks, and echoed to the output.
+//! The rows of a time series, one series or many (`--id-col`), read and validated in
+//! chunks, and echoed to the output. The rows come from any [`Records`]: a CSV text, or a
+//! Parquet file's rows (`crate::parquet`), through the same checks.
 //!
 //! Every row is validated as it is read — the time and value cells are numbers, finite, and
 //! the time is strictly after the previous time of the same series — with its 1-based file
-//! line and column. A chunk holds its rows' numbers column by column and the text of their
+//! line (data row of a Parquet file) and column. A chunk holds its rows' numbers column by column and the text of their
 //! time and value cells (echoed to the output) in one buffer, so reading allocates nothing per
 //! row once the buffers have grown. Per series only the id, the newest time (with its line,
 //! and its text from chunk to chunk, for the message of a time that goes backwards) are kept.
 
 use crate::error::CliError;
-use crate::io::{csv_field, find_column, parse_cell, shown, write_f64, CsvIn, Need};
+use crate::io::{csv_field, find_column, shown, write_f64, CsvIn, IdType, Need, Places, Records};
 use std::collections::HashMap;
 use std::io::Read;
 
@@ -23,8 +24,10 @@ pub struct Chunk {
     /// The series of each row: 0 for a single series, else its id's index in order of
     /// appearance.
     pub series: Vec<usize>,
-    /// 1-based file lines (header = line 1).
+    /// 1-based file lines (header = line 1), or data rows of a Parquet file: see `places`.
     pub lines: Vec<u64>,
+    /// What `lines` count, for messages.
+    pub places: Places,
     /// Per row: offset in `text` of the time cell's text, its length, the value cell's length.
     cells: Vec<(usize, usize, usize)>,
     /// The time and value cells of the rows, as written (trimmed).
@@ -44,12 +47,20 @@ pub struct Chunk {
 }
 
 impl Chunk {
+    /// The number of rows.
     pub fn len(&self) -> usize {
         self.t.len()
     }
 
+    /// Whether the chunk has no rows.
     pub fn is_empty(&self) -> bool {
         self.t.is_empty()
+    }
+
+    /// Where row `i` is, as a message starts with it (`line 5`, `row 4 of the Parquet file
+    /// 'x'`).
+    pub fn at(&self, i: usize) -> String {
+        self.places.at(self.lines[i])
     }
 
     /// The time cell of row `i`, as written.
@@ -143,9 +154,10 @@ struct Newest {
     text: Vec<u8>,
 }
 
-/// Reads and validates the data rows of a CSV time series in chunks.
-pub struct RowReader<R: Read> {
-    csv: CsvIn<R>,
+/// Reads and validates the data rows of a time series in chunks, from a CSV text
+/// (`RowReader::new`) or any [`Records`] (`RowReader::from_records`).
+pub struct RowReader<S: Records> {
+    csv: S,
     time_idx: usize,
     value_idx: usize,
     id_idx: Option<usize>,
@@ -161,8 +173,9 @@ pub struct RowReader<R: Read> {
     rows_read: u64,
 }
 
-impl<R: Read> RowReader<R> {
-    /// Reads the header and locates the time and value columns, and the id column if given.
+impl<R: Read> RowReader<CsvIn<R>> {
+    /// Reads the header of the CSV text `input` and locates the time and value columns, and the
+    /// id column if given.
     pub fn new(
         input: R,
         time_col: &str,
@@ -170,11 +183,26 @@ impl<R: Read> RowReader<R> {
         id_col: Option<&str>,
         need: &Need,
     ) -> Result<Self, CliError> {
-        let csv = CsvIn::new(input)?;
-        need.check_header(&csv.header)?;
-        let find = |name: &str| find_column(&csv.header, name, "");
+        Self::from_records(CsvIn::new(input)?, time_col, value_col, id_col, need)
+    }
+}
+
+impl<S: Records> RowReader<S> {
+    /// Locates the time and value columns of `csv`, and the id column if given, and selects
+    /// them.
+    pub fn from_records(
+        mut csv: S,
+        time_col: &str,
+        value_col: &str,
+        id_col: Option<&str>,
+        need: &Need,
+    ) -> Result<Self, CliError> {
+        need.check_header(csv.header())?;
+        let why = csv.header_why();
+        let find = |name: &str| find_column(csv.header(), name, &why);
         let (time_idx, value_idx) = (find(time_col)?, find(value_col)?);
         let id_idx = id_col.map(find).transpose()?;
+        csv.select(&[time_idx, value_idx], id_idx)?;
         Ok(Self {
             csv,
             time_idx,
@@ -219,7 +247,13 @@ impl<R: Read> RowReader<R> {
             }
         }
         chunk.bytes_read = self.csv.bytes_read();
+        chunk.places = self.csv.places();
         chunk.rows_read = self.rows_read;
+    }
+
+    /// How the id column's values are typed (text for CSV).
+    pub fn id_type(&self) -> IdType {
+        self.csv.id_type()
     }
 
     /// The series of the current record: its index, a new one for a new id. An id that is not
@@ -232,7 +266,8 @@ impl<R: Read> RowReader<R> {
         }
         if std::str::from_utf8(id).is_err() {
             return Err(CliError::Data(format!(
-                "line {line}, column {}: the id {} is not valid UTF-8 text",
+                "{}, column {}: the id {} is not valid UTF-8 text",
+                self.csv.places().at(line),
                 i + 1,
                 shown(id)
             )));
@@ -250,13 +285,9 @@ impl<R: Read> RowReader<R> {
         if !self.csv.next_record()? {
             return Ok(false);
         }
-        let line = self.csv.line;
-        let (t_cell, y_cell) = (
-            self.csv.field(self.time_idx),
-            self.csv.field(self.value_idx),
-        );
-        let t = parse_cell(t_cell, line, &self.time_col, "time")?;
-        let y = parse_cell(y_cell, line, &self.value_col, "value")?;
+        let line = self.csv.place();
+        let t = self.csv.number(self.time_idx, &self.time_col, "time")?;
+        let y = self.csv.number(self.value_idx, &self.value_col, "value")?;
         let series = self.series(chunk, line)?;
         let (t_cell, y_cell) = (
             self.csv.field(self.time_idx),
@@ -275,12 +306,13 @@ impl<R: Read> RowReader<R> {
                     Some(_) => format!(" of series '{}'", shown(self.ids[series].as_bytes())),
                 };
                 let prev_text = prev.row.map_or(&prev.text[..], |i| chunk.t_text(i));
+                let places = self.csv.places();
                 return Err(CliError::Data(format!(
-                    "line {line}: time {} is not after the previous time {} (line {}){of}: \
-                     {why}",
+                    "{}: time {} is not after the previous time {} ({}){of}: {why}",
+                    places.at(line),
                     shown(t_cell),
                     shown(prev_text),
-                    prev.line
+                    places.short(prev.line)
                 )));
             }
             Some(prev) => {
