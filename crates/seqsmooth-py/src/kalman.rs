@@ -70,13 +70,13 @@ impl PyInnovation {
 }
 
 /// A symmetric (or any square) matrix as a numpy array.
-fn square<'py>(py: Python<'py>, m: &DMatrix<f64>) -> PyResult<Bound<'py, PyAny>> {
+pub(crate) fn square<'py>(py: Python<'py>, m: &DMatrix<f64>) -> PyResult<Bound<'py, PyAny>> {
     matrix(py, m.transpose().as_slice().to_vec(), m.nrows(), m.ncols())
 }
 
 /// A vector of `n` from a scalar (every entry), or a matrix `n × n` from a scalar (times the
 /// identity), a vector (the diagonal) or a matrix.
-fn square_from(obj: &Bound<'_, PyAny>, n: usize, name: &str) -> PyResult<DMatrix<f64>> {
+pub(crate) fn square_from(obj: &Bound<'_, PyAny>, n: usize, name: &str) -> PyResult<DMatrix<f64>> {
     if let Ok(v) = obj.extract::<f64>() {
         return Ok(DMatrix::from_diagonal_element(n, n, v));
     }
@@ -95,7 +95,7 @@ fn square_from(obj: &Bound<'_, PyAny>, n: usize, name: &str) -> PyResult<DMatrix
 
 /// The measurement noise of `p` components from `R`: a variance for every component, `p`
 /// variances, or `p × p`.
-fn noise(obj: &Bound<'_, PyAny>, p: usize) -> PyResult<NoiseCovariance> {
+pub(crate) fn noise(obj: &Bound<'_, PyAny>, p: usize) -> PyResult<NoiseCovariance> {
     if let Ok(v) = obj.extract::<f64>() {
         return Ok(NoiseCovariance::Variances(vec![v; p]));
     }
@@ -117,7 +117,7 @@ fn noise(obj: &Bound<'_, PyAny>, p: usize) -> PyResult<NoiseCovariance> {
 
 /// The measurements `(t[i], z[i])` with noise `R`: `z` is `n` values (one component) or
 /// `n × p`; NaN marks a missing component.
-fn measurements(
+pub(crate) fn measurements(
     t: &Bound<'_, PyAny>,
     z: &Bound<'_, PyAny>,
     r: &Bound<'_, PyAny>,
@@ -150,8 +150,45 @@ fn measurements(
         .collect())
 }
 
+/// The observation matrix `M` (components × `n` states) from the caller's, or the positions
+/// of `axes` axes (`[I_axes, 0, …]`).
+pub(crate) fn observation_from(
+    observation: Option<&Bound<'_, PyAny>>,
+    axes: usize,
+    n: usize,
+) -> PyResult<LinearObservation> {
+    match observation {
+        None => LinearObservation::new(DMatrix::from_fn(axes, n, |i, j| f64::from(i == j))).py(),
+        Some(m) => {
+            let (values, rows, cols) = table(m, "observation")?;
+            if cols != n {
+                return Err(raise(
+                    Kind::InvalidInput,
+                    format!("observation is {rows}x{cols}: it needs {n} columns (states)"),
+                    None,
+                ));
+            }
+            LinearObservation::new(DMatrix::from_row_slice(rows, cols, values.as_slice())).py()
+        }
+    }
+}
+
+/// The fading discount from `beta` (per unit of time) or `theta` (per update), at most one.
+pub(crate) fn discount_from(beta: Option<f64>, theta: Option<f64>) -> PyResult<Option<Discount>> {
+    match (beta, theta) {
+        (Some(_), Some(_)) => Err(raise(
+            Kind::Parameter,
+            "beta and theta are both given: fading memory takes one of them",
+            None,
+        )),
+        (Some(b), None) => Ok(Some(Discount::PerTime(b))),
+        (None, Some(t)) => Ok(Some(Discount::PerUpdate(t))),
+        (None, None) => Ok(None),
+    }
+}
+
 /// A measurement at `t` before the time `previous` the filter has reached, as an error.
-fn before(t: f64, previous: f64, index: Option<usize>) -> PyErr {
+pub(crate) fn before(t: f64, previous: f64, index: Option<usize>) -> PyErr {
     let at = index.map_or(String::new(), |i| format!("sample {i} of the batch: "));
     raise(
         Kind::InvalidInput,
@@ -165,7 +202,7 @@ fn before(t: f64, previous: f64, index: Option<usize>) -> PyErr {
 
 /// The first measurement of `rows` before its predecessor (the first, before `start`): its
 /// index, time and the predecessor's time. (A NaN time is the library's to refuse.)
-fn out_of_order(start: f64, rows: &[Measurement]) -> Option<(usize, f64, f64)> {
+pub(crate) fn out_of_order(start: f64, rows: &[Measurement]) -> Option<(usize, f64, f64)> {
     let mut previous = start;
     for (k, m) in rows.iter().enumerate() {
         if m.time < previous {
@@ -248,23 +285,7 @@ impl PyKalmanFilter {
             ));
         }
         let p0 = square_from(P0, n, "P0")?;
-        let observe = match observation {
-            None => {
-                LinearObservation::new(DMatrix::from_fn(axes, n, |i, j| f64::from(i == j))).py()?
-            }
-            Some(m) => {
-                let (values, rows, cols) = table(m, "observation")?;
-                if cols != n {
-                    return Err(raise(
-                        Kind::InvalidInput,
-                        format!("observation is {rows}x{cols}: it needs {n} columns (states)"),
-                        None,
-                    ));
-                }
-                LinearObservation::new(DMatrix::from_row_slice(rows, cols, values.as_slice()))
-                    .py()?
-            }
-        };
+        let observe = observation_from(observation, axes, n)?;
         let components = observe.components();
         let mut filter = KalmanFilter::new(
             PolynomialDynamics::new(degree, axes),
@@ -279,18 +300,9 @@ impl PyKalmanFilter {
                 .with_process_noise(WhiteNoiseDerivative::new(degree, axes, q).py()?)
                 .py()?;
         }
-        filter = match (beta, theta) {
-            (Some(_), Some(_)) => {
-                return Err(raise(
-                    Kind::Parameter,
-                    "beta and theta are both given: fading memory takes one of them",
-                    None,
-                ))
-            }
-            (Some(b), None) => filter.with_fading(Discount::PerTime(b)).py()?,
-            (None, Some(t)) => filter.with_fading(Discount::PerUpdate(t)).py()?,
-            (None, None) => filter,
-        };
+        if let Some(d) = discount_from(beta, theta)? {
+            filter = filter.with_fading(d).py()?;
+        }
         Ok(Self { filter, components })
     }
 

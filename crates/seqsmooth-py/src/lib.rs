@@ -6,6 +6,7 @@
 mod arrays;
 mod automatic;
 mod bank;
+mod bayes;
 mod errors;
 mod frame;
 mod kalman;
@@ -29,6 +30,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<bank::PyExpandingBank>()?;
     m.add_class::<kalman::PyKalmanFilter>()?;
     m.add_class::<kalman::PyInnovation>()?;
+    m.add_class::<bayes::PyBayesFilter>()?;
     m.add_class::<track::PyRadarTracker>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
     m.add_function(wrap_pyfunction!(frame::filter_series, m)?)?;

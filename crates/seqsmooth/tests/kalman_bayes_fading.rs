@@ -332,3 +332,36 @@ fn ex_14_9a_unobserved_direction_is_refused_once_it_has_faded() {
         "Ex. 14.9a: worst {worst:.2e} σ, {worst_ratio:.2} ε × inflation; refused from n = {from}"
     );
 }
+
+/// With no information yet there is nothing to discount: a fading filter started at time 0
+/// whose first measurement is at a Unix-epoch time (β^(1.7e9) underflows) gives, bit for bit,
+/// the estimates of one started at that measurement's time.
+#[test]
+fn the_first_update_does_not_discount_nothing() {
+    let rows: Vec<Measurement> = (0..20)
+        .map(|k| Measurement {
+            time: 1.7e9 + f64::from(k) * 0.75,
+            values: vec![Some(f64::from(k * k % 7))],
+            noise: NoiseCovariance::Variances(vec![0.25]),
+        })
+        .collect();
+    let run = |t0: f64| {
+        let mut f = BayesFilter::new(
+            PolynomialDynamics::new(2, 1),
+            LinearObservation::value_of(3),
+            t0,
+        )
+        .unwrap()
+        .with_fading(Discount::PerTime(0.9))
+        .unwrap();
+        rows.iter()
+            .map(|m| {
+                f.update(m).unwrap();
+                (f.estimate(), f.covariance())
+            })
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (run(0.0), run(1.7e9));
+    assert!(a[19].0.is_some());
+    assert_eq!(a, b);
+}

@@ -15,6 +15,9 @@ FadingBank, ExpandingBank
 KalmanFilter
     The Kalman filter over the polynomial model (Morrison chs. 12, 14, 15): driving noise,
     fading memory, missing components, ``update_many`` and the RTS ``smooth``.
+BayesFilter
+    The Bayes filter (Morrison ch. 10) in square-root information form over the same model:
+    starts from no information, fading memory with the true covariance.
 RadarTracker
     A radar's range, azimuth and elevation to a constant-velocity track: the sliding
     Gauss–Newton fit, the extended Kalman filter (driving noise or fading memory) or its
@@ -40,6 +43,7 @@ from . import errors
 from ._seqsmooth import (
     MAX_DEGREE,
     AutomaticFilter,
+    BayesFilter,
     ExpandingBank,
     ExpandingMemory,
     FadingBank,
@@ -68,6 +72,7 @@ from .frame import filter_frame
 __all__ = [
     "MAX_DEGREE",
     "AutomaticFilter",
+    "BayesFilter",
     "ExpandingBank",
     "ExpandingMemory",
     "FadingBank",

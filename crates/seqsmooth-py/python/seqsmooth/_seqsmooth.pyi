@@ -125,6 +125,34 @@ class KalmanFilter:
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
 
+class BayesFilter:
+    def __init__(
+        self,
+        degree: int,
+        t0: float = 0.0,
+        axes: int = 1,
+        observation: ArrayLike | None = None,
+        x0: ArrayLike | None = None,
+        P0: ArrayLike | float | None = None,
+        beta: float | None = None,
+        theta: float | None = None,
+    ) -> None: ...
+    @property
+    def is_determined(self) -> bool: ...
+    @property
+    def state(self) -> Vector | None: ...
+    @property
+    def covariance(self) -> Matrix | None: ...
+    @property
+    def information_covariance(self) -> Matrix | None: ...
+    @property
+    def time(self) -> float: ...
+    def predict(self, t: float) -> None: ...
+    def update(self, t: float, z: ArrayLike | float, R: ArrayLike | float) -> None: ...
+    def update_many(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
+    ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
+
 class RadarTracker:
     def __init__(
         self,

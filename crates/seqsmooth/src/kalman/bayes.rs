@@ -61,6 +61,8 @@ pub struct BayesFilter<D: Dynamics, O: Observation> {
     time: f64,
     /// The discount and the time of the last update (from which `β` counts).
     fading: Option<(Discount, f64)>,
+    /// Whether there is information to discount (a prior or an update).
+    informed: bool,
 }
 
 impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
@@ -104,6 +106,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
             info: InformationFilter::new(n),
             time,
             fading: None,
+            informed: false,
         })
     }
 
@@ -166,6 +169,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
             .l()
             .transpose();
         self.info = InformationFilter::with_prior(state, &r);
+        self.informed = true;
         if self.fading.is_some() {
             self.info = self.info.with_true_covariance();
         }
@@ -354,8 +358,9 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
         let result = self
             .fade()
             .and_then(|()| self.fold(&present, &values, &whitener));
-        if result.is_err() {
-            (self.info, self.time, self.fading) = saved;
+        match result {
+            Ok(()) => self.informed = true,
+            Err(_) => (self.info, self.time, self.fading) = saved,
         }
         result
     }
@@ -364,6 +369,11 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     /// ((14.4.26)-(14.4.27)).
     fn fade(&mut self) -> Result<(), Error> {
         if let Some((discount, last)) = &mut self.fading {
+            if !self.informed {
+                // Nothing to discount: the memory starts here, whatever the time origin.
+                *last = self.time;
+                return Ok(());
+            }
             let f = discount.factor_over(self.time - *last)?;
             self.info.fade(1.0 / f.sqrt());
             *last = self.time;

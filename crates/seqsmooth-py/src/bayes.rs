@@ -1,0 +1,257 @@
+//! The Bayes filter (`kalman::BayesFilter`) over the polynomial model as a Python class,
+//! `BayesFilter`: Morrison ch. 10 in square-root information form, starting from no
+//! information (or a prior), with optional fading memory (ch. 14) and its true covariance.
+//! The model and observation are `KalmanFilter`'s (`kalman.rs`'s parsers).
+
+use crate::arrays::{matrix, series};
+use crate::errors::{raise, IntoPy, Kind};
+use crate::kalman::{
+    before, discount_from, measurements, noise, observation_from, out_of_order, square, square_from,
+};
+use nalgebra::DVector;
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::kalman::BayesFilter;
+use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::observation::{LinearObservation, Observation};
+
+type Filter = BayesFilter<PolynomialDynamics, LinearObservation>;
+
+/// The Bayes filter (Morrison ch. 10, (10.2.40)-(10.2.44)) over the polynomial model, in
+/// square-root information form: the recursion of the exact polynomial engine. It starts
+/// from no information (``(S_{1,0})⁻¹ = 0``, (10.3.5)), so the estimate exists once the
+/// measurements determine it; with fading memory (ch. 14, (14.4.26)-(14.4.32)) the reported
+/// covariance is the estimate's true one.
+///
+/// Parameters
+/// ----------
+/// degree : int
+///     The polynomial degree of the motion on each axis.
+/// t0 : float
+///     The filter's starting time.
+/// axes : int
+///     The number of axes (default 1); the state is ``(x, y, …, x', y', …)``.
+/// observation : array_like, optional
+///     The observation matrix ``M``, components × states; default the positions.
+/// x0, P0 : array_like, optional
+///     A prior state and covariance at ``t0`` (both or neither).
+/// beta, theta : float, optional
+///     Fading memory: the discount per unit of time, or per update, in (0, 1].
+#[pyclass(name = "BayesFilter", module = "seqsmooth")]
+pub struct PyBayesFilter {
+    filter: Filter,
+    /// The observation's components `p`.
+    components: usize,
+    /// The states `(m + 1) · axes`.
+    states: usize,
+}
+
+#[pymethods]
+impl PyBayesFilter {
+    #[new]
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    #[pyo3(signature = (degree, t0 = 0.0, axes = 1, observation = None, x0 = None, P0 = None, beta = None, theta = None))]
+    fn new(
+        degree: usize,
+        t0: f64,
+        axes: usize,
+        observation: Option<&Bound<'_, PyAny>>,
+        x0: Option<&Bound<'_, PyAny>>,
+        P0: Option<&Bound<'_, PyAny>>,
+        beta: Option<f64>,
+        theta: Option<f64>,
+    ) -> PyResult<Self> {
+        if axes == 0 {
+            return Err(raise(
+                Kind::Parameter,
+                "axes 0 is invalid: at least 1",
+                None,
+            ));
+        }
+        if degree > seqsmooth::polynomial::MAX_DEGREE {
+            return Err(raise(
+                Kind::Parameter,
+                format!(
+                    "degree {degree} is above {}, the largest the polynomial model takes",
+                    seqsmooth::polynomial::MAX_DEGREE
+                ),
+                None,
+            ));
+        }
+        let n = (degree + 1) * axes;
+        let observe = observation_from(observation, axes, n)?;
+        let components = observe.components();
+        let mut filter =
+            BayesFilter::new(PolynomialDynamics::new(degree, axes), observe, t0).py()?;
+        if let Some(d) = discount_from(beta, theta)? {
+            filter = filter.with_fading(d).py()?;
+        }
+        match (x0, P0) {
+            (Some(x0), Some(p0)) => {
+                let x = series(x0, "x0")?;
+                if x.as_slice().len() != n {
+                    return Err(raise(
+                        Kind::InvalidInput,
+                        format!(
+                            "x0 has {} values: degree {degree} on {axes} axes has {n} states",
+                            x.as_slice().len()
+                        ),
+                        None,
+                    ));
+                }
+                let p = square_from(p0, n, "P0")?;
+                filter = filter
+                    .with_prior(&DVector::from_column_slice(x.as_slice()), &p)
+                    .py()?;
+            }
+            (None, None) => {}
+            _ => {
+                return Err(raise(
+                    Kind::Parameter,
+                    "x0 and P0 go together: give both for a prior, or neither",
+                    None,
+                ))
+            }
+        }
+        Ok(Self {
+            filter,
+            components,
+            states: n,
+        })
+    }
+
+    /// Whether the measurements so far determine the state.
+    #[getter]
+    fn is_determined(&self) -> bool {
+        self.filter.estimate().is_some()
+    }
+
+    /// The estimate ``X = R⁻¹ d`` (10.2.33), or ``None`` while not determined.
+    #[getter]
+    fn state<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        self.filter
+            .estimate()
+            .map(|x| PyArray1::from_slice(py, x.as_slice()))
+    }
+
+    /// The covariance of ``X``'s errors (10.2.34); with fading memory the true one
+    /// (14.3.11)-(14.3.13). ``None`` while not determined.
+    #[getter]
+    fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.filter.covariance().map(|c| square(py, &c)).transpose()
+    }
+
+    /// With fading memory, the recursion's own matrix ``P`` (not the covariance); without,
+    /// the covariance. ``None`` while not determined.
+    #[getter]
+    fn information_covariance<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.filter
+            .information_covariance()
+            .map(|c| square(py, &c))
+            .transpose()
+    }
+
+    /// The time the estimate is valid at.
+    #[getter]
+    fn time(&self) -> f64 {
+        self.filter.time()
+    }
+
+    /// Carries the information to time ``t`` (no measurement; (10.2.40)-(10.2.41)).
+    fn predict(&mut self, t: f64) -> PyResult<()> {
+        self.filter.predict(t).py()
+    }
+
+    /// Predicts to ``t`` (not before the filter's time) and folds in ``z`` (a number, or one
+    /// value per component; NaN for a missing one) of noise ``R`` (a variance for every
+    /// component, the variances, or the covariance; positive definite). On an error the
+    /// filter is unchanged.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R))]
+    fn update(&mut self, t: f64, z: &Bound<'_, PyAny>, R: &Bound<'_, PyAny>) -> PyResult<()> {
+        let p = self.components;
+        let values: Vec<f64> = match z.extract::<f64>() {
+            Ok(v) => vec![v],
+            Err(_) => series(z, "z")?.as_slice().to_vec(),
+        };
+        if values.len() != p {
+            return Err(raise(
+                Kind::InvalidInput,
+                format!(
+                    "z has {} values: the observation has {p} components",
+                    values.len()
+                ),
+                None,
+            ));
+        }
+        if t < self.filter.time() {
+            return Err(before(t, self.filter.time(), None));
+        }
+        let m = Measurement {
+            time: t,
+            values: values.iter().map(|&v| (!v.is_nan()).then_some(v)).collect(),
+            noise: noise(R, p)?,
+        };
+        self.filter.update(&m).py()
+    }
+
+    /// Runs the measurements ``(t[i], z[i])`` (``z`` of shape ``(n,)`` or ``(n, p)``, NaN for
+    /// a missing component) with noise ``R`` on every one. Returns ``(states, covariances)``,
+    /// ``(n, dim)`` and ``(n, dim, dim)``, NaN rows while the state is not determined. The
+    /// work runs without the GIL. On an error (``.index`` names the measurement) the
+    /// measurements before it are taken.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R))]
+    fn update_many<'py>(
+        &mut self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        R: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let mut rows = measurements(t, z, R, self.components)?;
+        let disorder = out_of_order(self.filter.time(), &rows);
+        if let Some((k, _, _)) = disorder {
+            rows.truncate(k);
+        }
+        let n = self.states;
+        let mut states = vec![f64::NAN; rows.len() * n];
+        let mut covariances = vec![f64::NAN; rows.len() * n * n];
+        let filter = &mut self.filter;
+        py.detach(|| {
+            for (i, m) in rows.iter().enumerate() {
+                filter.update(m).map_err(|e| seqsmooth::Error::InBatch {
+                    index: i,
+                    source: Box::new(e),
+                })?;
+                if let (Some(x), Some(c)) = (filter.estimate(), filter.covariance()) {
+                    states[i * n..(i + 1) * n].copy_from_slice(x.as_slice());
+                    // Symmetric: column-major is row-major.
+                    covariances[i * n * n..(i + 1) * n * n].copy_from_slice(c.as_slice());
+                }
+            }
+            Ok::<(), seqsmooth::Error>(())
+        })
+        .py()?;
+        if let Some((k, t, previous)) = disorder {
+            return Err(before(t, previous, Some(k)));
+        }
+        let count = rows.len();
+        let states = matrix(py, states, count, n)?;
+        let covariances = PyArray1::from_vec(py, covariances)
+            .reshape([count, n, n])?
+            .into_any();
+        PyTuple::new(py, [states, covariances])
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "BayesFilter(states={}, time={:?}, determined={})",
+            self.states,
+            self.filter.time(),
+            self.is_determined()
+        )
+    }
+}
