@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use seqsmooth::polynomial::stream::{Chunk, StreamBank};
 use seqsmooth::{Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter};
 
-/// Every series of `chunk` through a copy of `prototype`.
+/// Every series of `chunk` through a copy of `prototype`, the results by column.
 fn run_bank<F: PolynomialFilter + Clone + Send>(
     prototype: F,
     batch: bool,
@@ -19,7 +19,7 @@ fn run_bank<F: PolynomialFilter + Clone + Send>(
     sigma: bool,
 ) -> Result<(), Error> {
     let mut bank = StreamBank::growing(prototype)?;
-    bank.update_par(chunk, |f: &mut F, t: &[f64], y: &[f64], out: &mut [f64]| {
+    bank.update_par_columns(chunk, |f: &mut F, t: &[f64], y: &[f64], out: &mut [f64]| {
         run_rows(f, batch, t, y, out, sigma)
     })
 }
@@ -130,14 +130,8 @@ pub fn filter_series<'py>(
         }
     }
     .py()?;
-    // Column by column (each derivative's column contiguous, for the frame's columns).
-    let mut columns = vec![0.0; n * stride];
-    for (k, column) in columns.chunks_exact_mut(n).enumerate() {
-        for (v, row) in column.iter_mut().zip(out.chunks_exact(stride)) {
-            *v = row[k];
-        }
-    }
-    let values = matrix(py, columns, stride, n)?;
+    // Column by column already (each derivative's column contiguous, for the frame's columns).
+    let values = matrix(py, out, stride, n)?;
     if kind != "fixed" {
         return Ok(values);
     }

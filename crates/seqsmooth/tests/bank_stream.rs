@@ -91,3 +91,50 @@ fn stream_bank_channels_equal_lone_filters() {
     assert!(StreamBank::new(ExpandingMemory::new(1, Engine::Exact).unwrap(), 0).is_err());
     assert!(bank.update_channel(k, &[1e9], &[0.0]).is_err());
 }
+
+/// `update_par_columns` writes `update_par`'s results transposed, bit for bit: 37 interleaved
+/// fading series (one row of the chunk from a lone series too), and a chunk of one series.
+#[test]
+fn columns_are_the_rows_transposed() {
+    use seqsmooth::polynomial::stream::{Chunk, StreamBank};
+    use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
+    for series in [37usize, 1] {
+        let n = 2_000;
+        let channels: Vec<usize> = (0..n).map(|i| (i * 7 + i / 13) % series).collect();
+        let times: Vec<f64> = (0..n).map(|i| 1.7e9 + i as f64 * 0.5).collect();
+        let values: Vec<f64> = (0..n).map(|i| ((i * i) % 17) as f64 - 8.0).collect();
+        let stride = 3;
+        let run = |columns: bool| {
+            let f = FadingMemory::new(2, 0.9, 1.0, Engine::Exact).unwrap();
+            let mut bank = StreamBank::growing(f).unwrap();
+            let mut est = vec![0.0; n * stride];
+            let chunk = Chunk {
+                channels: &channels,
+                times: &times,
+                values: &values,
+                estimates: &mut est,
+                stride,
+            };
+            let each = |f: &mut FadingMemory, t: &[f64], y: &[f64], out: &mut [f64]| {
+                f.update_many_into(t, y, out)
+            };
+            if columns {
+                bank.update_par_columns(chunk, each).unwrap();
+            } else {
+                bank.update_par(chunk, each).unwrap();
+            }
+            est
+        };
+        let (rows, columns) = (run(false), run(true));
+        for i in 0..n {
+            for k in 0..stride {
+                let (a, b) = (rows[i * stride + k], columns[k * n + i]);
+                assert!(
+                    a.to_bits() == b.to_bits(),
+                    "series {series}, row {i}, result {k}"
+                );
+            }
+        }
+        assert!(rows[(n - 1) * stride].is_finite());
+    }
+}

@@ -173,7 +173,7 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
     /// [`Error::InBatch`] with that row's index in the chunk (the rows before it, of every
     /// channel, are done).
     pub fn update(&mut self, chunk: Chunk<'_>, run: impl ChannelRun<F>) -> Result<(), Error> {
-        self.run_chunk(chunk, &run, false)
+        self.run_chunk(chunk, &run, false, false)
     }
 
     /// [`update`](Self::update) with the channels on the rayon pool.
@@ -181,7 +181,34 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
     where
         F: Send,
     {
-        self.run_chunk(chunk, &run, true)
+        self.run_chunk(chunk, &run, true, false)
+    }
+
+    /// [`update_par`](Self::update_par) with the results by column: result `k` of row `i` in
+    /// `estimates[k·n + i]` (`n` rows), each result's column contiguous (for a data frame's
+    /// columns, without a transposition afterwards).
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::stream::{Chunk, StreamBank};
+    /// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
+    /// let mut bank = StreamBank::growing(ExpandingMemory::new(1, Engine::Exact)?)?;
+    /// let (ch, t) = ([0, 1, 0, 1, 1], [0.0, 0.0, 1.0, 1.0, 2.0]);
+    /// let y = [0.0, 0.0, 1.0, 2.0, 4.0];
+    /// let mut est = [0.0f64; 10]; // d0 of rows 0-4, then d1 of rows 0-4
+    /// let chunk = Chunk { channels: &ch, times: &t, values: &y, estimates: &mut est, stride: 2 };
+    /// bank.update_par_columns(chunk, |f, t, y, out| f.update_many_into(t, y, out))?;
+    /// assert!(est[5].is_nan() && (est[9] - 2.0).abs() < 1e-12); // row 4's slope: 2
+    /// # Ok::<(), seqsmooth::Error>(())
+    /// ```
+    pub fn update_par_columns(
+        &mut self,
+        chunk: Chunk<'_>,
+        run: impl ChannelRun<F>,
+    ) -> Result<(), Error>
+    where
+        F: Send,
+    {
+        self.run_chunk(chunk, &run, true, true)
     }
 
     fn run_chunk(
@@ -189,6 +216,7 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
         chunk: Chunk<'_>,
         run: &dyn ChannelRun<F>,
         parallel: bool,
+        columns: bool,
     ) -> Result<(), Error>
     where
         F: Send,
@@ -224,7 +252,7 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
             (rows(k), c, source)
         };
         // One channel in the chunk: its rows are the chunk, nothing to group.
-        if channels.iter().all(|&c| c == channels[0]) {
+        if !columns && channels.iter().all(|&c| c == channels[0]) {
             let Some(&c) = channels.first() else {
                 return Ok(());
             };
@@ -263,8 +291,16 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
         } else {
             work.iter_mut().filter_map(one).collect()
         };
-        for (&i, e) in s.order.iter().zip(s.out.chunks_exact(stride.max(1))) {
-            estimates[i * stride..(i + 1) * stride].copy_from_slice(&e[..stride]);
+        if columns {
+            for (&i, e) in s.order.iter().zip(s.out.chunks_exact(stride.max(1))) {
+                for (k, &v) in e[..stride].iter().enumerate() {
+                    estimates[k * n + i] = v;
+                }
+            }
+        } else {
+            for (&i, e) in s.order.iter().zip(s.out.chunks_exact(stride.max(1))) {
+                estimates[i * stride..(i + 1) * stride].copy_from_slice(&e[..stride]);
+            }
         }
         if failed.is_empty() {
             return Ok(());
