@@ -182,3 +182,46 @@ def test_bad_measurements_name_their_index():
         f.update(8.0, 1.0, -1.0)  # a negative variance
     with pytest.raises(ss.InvalidTypeError):
         f.update_many(["a"], [1.0], 1.0)
+
+
+def test_kalman_and_bayes_equal_the_librarys_run_to_the_last_bit():
+    """The library's own run (tests/fixtures/kalman_rust.txt, written and checked by
+    crates/seqsmooth/tests/kalman_python_fixture.rs): two axes, a 3 × 4 observation, driving
+    noise, missing components, Unix-epoch times; the Bayes filter from nothing with fading."""
+    from pathlib import Path
+
+    path = Path(__file__).parent / "fixtures" / "kalman_rust.txt"
+    rows: dict[str, list] = {"input": [], "kalman": [], "bayes": []}
+    for text in path.read_text().splitlines():
+        tag, *cells = text.split(",")
+        rows[tag].append([np.nan] * 20 if cells == ["-"] else [float(c) for c in cells])
+    inputs = np.array(rows["input"])
+    t, z = inputs[:, 0], inputs[:, 1:]
+    m = np.array([[1.0, 0, 0, 0], [0, 1.0, 0, 0], [1.0, 1.0, 0, 0]])
+    r = [1.0, 2.0, 0.5]
+    kf = ss.KalmanFilter(
+        degree=1,
+        axes=2,
+        observation=m,
+        x0=[1.0, 0.0, 0.3, 0.1],
+        P0=[4.0, 4.0, 1.0, 1.0],
+        t0=1.7e9 - 1.0,
+        q=0.05,
+    )
+    x, p, nis = kf.update_many(t, z, r)
+    got = np.column_stack([x, p.reshape(len(t), 16), nis])
+
+    def same_bits(a, b):
+        finite = np.isfinite(b)
+        return np.array_equal(np.isnan(a), np.isnan(b)) and np.array_equal(
+            a[finite].view(np.int64), b[finite].view(np.int64)
+        )
+
+    assert same_bits(got, np.array(rows["kalman"]))
+    x, p = ss.BayesFilter(1, axes=2, observation=m, theta=0.9).update_many(t, z, r)
+    got = np.column_stack([x, p.reshape(len(t), 16)])
+    want = np.array(rows["bayes"])
+    assert np.array_equal(
+        got.view(np.int64)[np.isfinite(got)], want.view(np.int64)[np.isfinite(want)]
+    )
+    assert np.array_equal(np.isnan(got), np.isnan(want))
