@@ -606,9 +606,36 @@ pub fn named(path: Option<&Path>) -> Option<&Path> {
     path.filter(|p| p.as_os_str() != "-")
 }
 
-/// Opens the input: a file, or standard input for `None` or `-`.
+/// Whether `path` names a Parquet file: its extension is `.parquet`, in any case. Standard
+/// input and output (`None`, `-`) are CSV.
+///
+/// ```
+/// use seqsmooth_cli::parquet::is_parquet;
+/// use std::path::Path;
+/// assert!(is_parquet(Some(Path::new("a/b.PARQUET"))));
+/// assert!(!is_parquet(Some(Path::new("b.csv"))));
+/// assert!(!is_parquet(None));
+/// ```
+pub fn is_parquet(path: Option<&Path>) -> bool {
+    named(path)
+        .and_then(Path::extension)
+        .is_some_and(|e| e.eq_ignore_ascii_case("parquet"))
+}
+
+/// The refusal of a Parquet file by a command that reads and writes CSV only.
+fn csv_only(p: &Path) -> CliError {
+    CliError::Usage(format!(
+        "'{}' is a Parquet file: only `seqsmooth filter` reads and writes Parquet; this \
+         command takes CSV",
+        p.display()
+    ))
+}
+
+/// Opens the input: a file, or standard input for `None` or `-`. A `.parquet` file is
+/// refused: the commands that call this read CSV (`filter` reads Parquet itself).
 pub fn open_input(path: Option<&Path>) -> Result<Box<dyn Read + Send>, CliError> {
     match named(path) {
+        Some(p) if is_parquet(Some(p)) => Err(csv_only(p)),
         Some(p) => {
             let file = File::open(p).map_err(|e| {
                 CliError::Data(format!("cannot open input file '{}': {e}", p.display()))
@@ -667,8 +694,11 @@ impl Output {
     /// unfinished) the temporary file is removed. Standard output streams: what was written
     /// stays written (flushed when dropped). So does a `path` that is not a regular file (a
     /// device such as `/dev/null`, a named pipe): it is written in place ([`Destination`]).
+    /// A `.parquet` path is refused: this output is CSV text (`filter` writes Parquet through
+    /// [`Output::table`]).
     pub fn create(path: Option<&Path>) -> Result<Self, CliError> {
         match named(path) {
+            Some(p) if is_parquet(Some(p)) => Err(csv_only(p)),
             Some(p) => {
                 let (file, name, rename) = Self::open(p)?;
                 Ok(Self {

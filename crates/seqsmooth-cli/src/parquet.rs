@@ -41,21 +41,7 @@ pub const BATCH_ROWS: usize = 65_536;
 /// The most rows in a row group of an output file.
 pub const ROW_GROUP_ROWS: usize = 262_144;
 
-/// Whether `path` names a Parquet file: its extension is `.parquet`, in any case. Standard
-/// input and output (`None`, `-`) are CSV.
-///
-/// ```
-/// use seqsmooth_cli::parquet::is_parquet;
-/// use std::path::Path;
-/// assert!(is_parquet(Some(Path::new("a/b.PARQUET"))));
-/// assert!(!is_parquet(Some(Path::new("b.csv"))));
-/// assert!(!is_parquet(None));
-/// ```
-pub fn is_parquet(path: Option<&Path>) -> bool {
-    crate::io::named(path)
-        .and_then(Path::extension)
-        .is_some_and(|e| e.eq_ignore_ascii_case("parquet"))
-}
+pub use crate::io::is_parquet;
 
 thread_local! {
     /// Whether this thread is in [`guarded`]: its panics are reported as errors, not printed.

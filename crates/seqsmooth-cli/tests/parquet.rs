@@ -842,3 +842,21 @@ fn a_failed_run_leaves_the_output_file_as_it_was() {
     assert_eq!(table.columns[1], [bits(1.0), bits(2.0), bits(4.0)]);
     assert_eq!(table.columns[3][0], None);
 }
+
+/// The commands that read and write CSV only refuse a `.parquet` input or output by name,
+/// with the usage exit code, and write no file.
+#[test]
+fn other_commands_refuse_parquet_by_name() {
+    let out = common::tmp("refused.parquet");
+    let _ = std::fs::remove_file(&out);
+    let out = out.to_str().unwrap();
+    let csv = "t,y\n0,1\n1,2\n2,4\n3,9\n4,16\n5,25\n";
+    for args in [
+        vec!["smooth", "--degree", "2", "--window", "5", "in.parquet"],
+        vec!["fit", "--model", "polynomial", "--degree", "1", "--sigma", "1", "x.PARQUET"],
+        vec!["smooth", "--degree", "2", "--window", "5", "-o", out],
+    ] {
+        common::fails(&args, csv, 2, &["is a Parquet file", "only `seqsmooth filter`"]);
+    }
+    assert!(!std::path::Path::new(out).exists());
+}
