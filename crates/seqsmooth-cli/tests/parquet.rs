@@ -853,10 +853,24 @@ fn other_commands_refuse_parquet_by_name() {
     let csv = "t,y\n0,1\n1,2\n2,4\n3,9\n4,16\n5,25\n";
     for args in [
         vec!["smooth", "--degree", "2", "--window", "5", "in.parquet"],
-        vec!["fit", "--model", "polynomial", "--degree", "1", "--sigma", "1", "x.PARQUET"],
+        vec![
+            "fit",
+            "--model",
+            "polynomial",
+            "--degree",
+            "1",
+            "--sigma",
+            "1",
+            "x.PARQUET",
+        ],
         vec!["smooth", "--degree", "2", "--window", "5", "-o", out],
     ] {
-        common::fails(&args, csv, 2, &["is a Parquet file", "only `seqsmooth filter`"]);
+        common::fails(
+            &args,
+            csv,
+            2,
+            &["is a Parquet file", "only `seqsmooth filter`"],
+        );
     }
     assert!(!std::path::Path::new(out).exists());
 }
