@@ -12,7 +12,7 @@ use crate::io::{check_distinct, find_column, open_input, parse_cell, shown, writ
 use crate::io::{Need, Output};
 use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
-use seqsmooth::estimate::sliding::{SlidingFit, Start};
+use seqsmooth::estimate::sliding::SlidingFit;
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::model::radar::Radar;
@@ -29,8 +29,8 @@ enum Fitter {
 impl Fitter {
     fn push(&mut self, m: Measurement) -> Result<Option<Correction>, Error> {
         match self {
-            Fitter::Radar(f) => f.push(m),
-            Fitter::Polynomial(f) => f.push(m),
+            Fitter::Radar(f) => f.push_finite(m),
+            Fitter::Polynomial(f) => f.push_finite(m),
         }
     }
 }
@@ -82,7 +82,7 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
     text.push(b'\n');
 
     let mut out: Option<Output> = None;
-    let mut lines: VecDeque<u64> = VecDeque::with_capacity(a.window);
+    let mut lines: VecDeque<u64> = VecDeque::with_capacity(a.window.min(1 << 12));
     let mut previous: Option<(f64, u64, Vec<u8>)> = None;
     let mut rows = 0usize;
     let n = setup.states.len();
@@ -117,10 +117,16 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
             values,
             noise: NoiseCovariance::Variances(setup.variances.clone()),
         };
-        let fit = setup
-            .fitter
-            .push(m)
-            .map_err(|e| window_error(e, &lines, a.window, a.model))?;
+        let fit = setup.fitter.push(m).map_err(|e| match e {
+            Error::NonFinite {
+                what: "fitted state",
+                value,
+            } => CliError::Data(format!(
+                "line {line}: the fitted state holds {value}, beyond the double range; \
+                 express the times in a larger unit or rescale the values"
+            )),
+            e => window_error(e, &lines, a.window, a.model),
+        })?;
 
         text.extend_from_slice(&t_cell);
         if setup.echo_value {
@@ -129,13 +135,8 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
         }
         match &fit {
             Some(c) => {
+                // Finite: `push_finite` refuses any other estimate.
                 let sigmas: Vec<f64> = (0..n).map(|k| c.covariance[(k, k)].sqrt()).collect();
-                if let Some(v) = c.state.iter().chain(&sigmas).find(|v| !v.is_finite()) {
-                    return Err(CliError::Data(format!(
-                        "line {line}: the fitted state holds {v}, beyond the double range; \
-                         express the times in a larger unit or rescale the values"
-                    )));
-                }
                 for &v in c.state.iter().chain(&sigmas) {
                     text.push(b',');
                     write_f64(&mut text, v);
@@ -222,21 +223,9 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
             }
             let need = Need::rows(2, "the radar model");
             need.check_header(header)?;
-            let dynamics = PolynomialDynamics::new(degree, 3);
             let states = 3 * (degree + 1);
-            let radar = Radar::new(a.site, states).map_err(library)?;
-            let fit = SlidingFit::new(
-                dynamics,
-                radar,
-                a.window,
-                epoch,
-                Start::Radar {
-                    radar,
-                    degree: 2.max(degree),
-                },
-            )
-            .map_err(library)?
-            .with_solver(solver);
+            let fit =
+                SlidingFit::radar(a.site, degree, a.window, epoch, solver).map_err(library)?;
             let names = ["x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"];
             Ok(Setup {
                 fitter: Fitter::Radar(fit),
@@ -279,15 +268,7 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
             }
             let need = Need::degree(degree);
             need.check_header(header)?;
-            let fit = SlidingFit::new(
-                PolynomialDynamics::new(degree, 1),
-                LinearObservation::value_of(degree + 1),
-                a.window,
-                epoch,
-                Start::State(nalgebra::DVector::zeros(degree + 1)),
-            )
-            .map_err(library)?
-            .with_solver(solver);
+            let fit = SlidingFit::polynomial(degree, a.window, epoch, solver).map_err(library)?;
             Ok(Setup {
                 fitter: Fitter::Polynomial(fit),
                 columns: vec![column(&a.value_col, "value")?],

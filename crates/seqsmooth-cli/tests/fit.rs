@@ -530,3 +530,36 @@ fn random_inputs_are_right_or_refused() {
     assert!(succeeded > 300, "{succeeded} successful runs");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// An epoch ~1e200 from the times made nalgebra's SVD panic on NaN singular values, and a
+/// window of 2^63 - 1 rows the row buffer's allocation: now a refusal naming the window, and
+/// the fit of all rows so far.
+#[test]
+fn far_epochs_and_huge_windows_do_not_panic() {
+    let poly = [
+        "fit",
+        "--model",
+        "polynomial",
+        "--degree",
+        "1",
+        "--sigma",
+        "1",
+    ];
+    let input = "t,y\n0,0\n1,1\n2,2.5\n3,3\n";
+    for epoch in ["1e200", "-1e250", "1e300"] {
+        let args: Vec<&str> = poly.iter().copied().chain(["--epoch", epoch]).collect();
+        fails(&args, input, 1, &["(the window)", "not finite"]);
+    }
+    let huge = i64::MAX.to_string();
+    let args: Vec<&str> = poly.iter().copied().chain(["--window", &huge]).collect();
+    let all = ok(&args, input);
+    let window = ok(
+        &poly
+            .iter()
+            .copied()
+            .chain(["--window", "4"])
+            .collect::<Vec<_>>(),
+        input,
+    );
+    assert_eq!(all, window);
+}

@@ -8,6 +8,7 @@ mod automatic;
 mod bank;
 mod bayes;
 mod errors;
+mod fit;
 mod frame;
 mod kalman;
 mod polynomial;
@@ -32,6 +33,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<kalman::PyInnovation>()?;
     m.add_class::<bayes::PyBayesFilter>()?;
     m.add_class::<track::PyRadarTracker>()?;
+    m.add_class::<fit::PySlidingFit>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
     m.add_function(wrap_pyfunction!(frame::filter_series, m)?)?;
     m.add_function(wrap_pyfunction!(tables::gains, m)?)?;

@@ -135,7 +135,7 @@ def test_ten_thousand_random_bad_calls_never_panic():
         engine = str(rng.choice(["exact", "gain", "adaptive", "x"]))
         window = int(rng.integers(-1, 50))
         try:
-            kind = rng.integers(9)
+            kind = rng.integers(10)
             if kind == 0:
                 f = ss.ExpandingMemory(degree=degree, engine=engine)
             elif kind == 1:
@@ -202,6 +202,38 @@ def test_ten_thousand_random_bad_calls_never_panic():
                 held, xs, ps, ns = tracker.finish()
                 assert not np.isinf(x).any() and not np.isinf(p).any()
                 assert np.isfinite(xs).all() and np.isfinite(ps).all()
+                outcomes["ok"] += 1
+                continue
+            elif kind == 9:
+                # Each setting good most of the time, so that most calls reach the rows.
+                def pick(good, bad):
+                    return good if rng.random() < 0.85 else bad[rng.integers(len(bad))]
+
+                radar = rng.random() < 0.5
+                kw = {
+                    "window": pick(max(window, 4), [window, 0, -1]),
+                    "epoch": pick(
+                        ["end", "centre", 1.7e9, float(rng.normal() * 1e3)][rng.integers(4)],
+                        ["x", np.nan, np.inf],
+                    ),
+                    "degree": pick(degree % 2 + 1 if radar else degree % 4, [degree, None, -1]),
+                    "max_iterations": pick(20, [3, 0, 1001]),
+                }
+                if radar:
+                    kw["sigma_range"] = pick(10.0, [0.0, -1.0, np.nan, 1e200])
+                    kw["sigma_angle"] = pick(1e-3, [0.0, 1e300, 1e-170])
+                else:
+                    kw["sigma"] = pick(0.3, [0.0, 1e-200, np.inf])
+                fit = ss.SlidingFit("radar" if radar else "polynomial", **kw)
+                if radar:
+                    r = np.abs(values(n)) if rng.random() < 0.7 else values(n)
+                    with np.errstate(invalid="ignore"):
+                        az, el = values(n) % 7.0, values(n) % 1.6
+                    x, p, info = fit.update_many(times(n), r, az, el)
+                else:
+                    x, p, info = fit.update_many(times(n), values(n))
+                assert np.isfinite(x).all(axis=1).sum() == np.isfinite(info["chi2"]).sum()
+                assert not np.isinf(x).any() and not np.isinf(p).any()
                 outcomes["ok"] += 1
                 continue
             else:

@@ -111,15 +111,25 @@ pub fn congruence<T: Scalar>(a: &DMatrix<T>, b: &DMatrix<T>) -> DMatrix<T> {
 pub const SVD_ITERATIONS: usize = 10_000;
 
 /// The singular values of `m`, or [`Error::SvdNotConverged`] when the iteration does not
-/// converge within [`SVD_ITERATIONS`].
+/// converge within [`SVD_ITERATIONS`], or [`Error::NonFinite`] (`what` `"matrix entry"`, the
+/// first such entry) when `m` holds an infinity or a NaN (nalgebra's SVD would panic on the
+/// NaN singular values: a QR factor of a system whose column norms overflow, as a window fit
+/// of times ~1e200 at an epoch far away gives).
 ///
 /// ```
 /// use nalgebra::DMatrix;
 /// use seqsmooth::linalg::singular_values;
 /// let sv = singular_values(&DMatrix::from_row_slice(2, 2, &[3.0, 0.0, 0.0, 4.0])).unwrap();
 /// assert_eq!((sv.max(), sv.min()), (4.0, 3.0));
+/// assert!(singular_values(&DMatrix::from_row_slice(1, 2, &[f64::NAN, 1.0])).is_err());
 /// ```
 pub fn singular_values(m: &DMatrix<f64>) -> Result<DVector<f64>, Error> {
+    if let Some(&value) = m.iter().find(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            what: "matrix entry",
+            value,
+        });
+    }
     nalgebra::linalg::SVD::try_new(m.clone(), false, false, f64::EPSILON, SVD_ITERATIONS)
         .map(|svd| svd.singular_values)
         .ok_or(Error::SvdNotConverged {

@@ -243,3 +243,62 @@ fn refusals() {
     )
     .is_err());
 }
+
+/// One value with unit variance at `t`.
+fn value(t: f64, y: f64) -> Measurement {
+    Measurement {
+        time: t,
+        values: vec![Some(y)],
+        noise: NoiseCovariance::Variances(vec![1.0]),
+    }
+}
+
+/// An epoch ~1e200 from the times: the QR factor of the linearised system overflows; the
+/// window is an error, never nalgebra's panic on NaN singular values (`seqsmooth fit --epoch
+/// 1e200` panicked so).
+#[test]
+fn an_epoch_far_from_the_times_is_an_error_not_a_panic() {
+    for epoch in [1e200, -1e250, 1e300] {
+        let mut fit =
+            SlidingFit::polynomial(1, 3, Epoch::At(epoch), GaussNewton::default()).unwrap();
+        let mut refused = 0;
+        for (t, y) in [(0.0, 0.0), (1.0, 1.0), (2.0, 2.5), (3.0, 3.0)] {
+            if fit.push_finite(value(t, y)).is_err() {
+                refused += 1;
+            }
+        }
+        assert!(refused > 0, "epoch {epoch}");
+    }
+}
+
+/// The constructors of `seqsmooth fit`'s two models: the settings refused, and the polynomial
+/// model the same fit as `SlidingFit::new` with its parts.
+#[test]
+fn the_command_models() {
+    let solver = GaussNewton::default();
+    assert!(SlidingFit::radar([0.0; 3], 0, 5, Epoch::End, solver).is_err());
+    assert!(SlidingFit::radar([0.0, f64::NAN, 0.0], 1, 5, Epoch::End, solver).is_err());
+    assert!(SlidingFit::radar([0.0; 3], 2, 0, Epoch::End, solver).is_err());
+    assert!(SlidingFit::polynomial(1, 1, Epoch::End, solver).is_err());
+    assert!(SlidingFit::polynomial(1, 2, Epoch::At(f64::INFINITY), solver).is_err());
+    // A window of 2^62 rows holds no memory ahead of the rows.
+    assert!(SlidingFit::polynomial(1, 1 << 62, Epoch::End, solver).is_ok());
+    let mut a = SlidingFit::polynomial(2, 6, Epoch::Centre, solver).unwrap();
+    let mut b = SlidingFit::new(
+        PolynomialDynamics::new(2, 1),
+        LinearObservation::value_of(3),
+        6,
+        Epoch::Centre,
+        Start::State(DVector::zeros(3)),
+    )
+    .unwrap();
+    for k in 0..20 {
+        let t = 1.7e9 + k as f64 * 1.25;
+        let y = (k as f64 * 0.7).sin();
+        let (x, z) = (
+            a.push_finite(value(t, y)).unwrap(),
+            b.push(value(t, y)).unwrap(),
+        );
+        assert_eq!(x, z);
+    }
+}

@@ -455,8 +455,12 @@ fn extreme_scales_end_instead_of_looping() {
             refused.push((k, e.to_string()));
         }
     }
+    // The window's QR factor holds a NaN here: `linalg::singular_values` refuses it before
+    // the SVD (which looped on it, and stops after its iteration limit on finite matrices).
     assert!(
-        refused.iter().any(|(_, e)| e.contains("did not converge")),
+        refused
+            .iter()
+            .any(|(_, e)| e.contains("did not converge") || e.contains("NaN is not finite")),
         "{refused:?}"
     );
 }

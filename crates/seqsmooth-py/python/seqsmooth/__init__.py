@@ -22,6 +22,10 @@ RadarTracker
     A radar's range, azimuth and elevation to a constant-velocity track: the sliding
     Gauss–Newton fit, the extended Kalman filter (driving noise or fading memory) or its
     smoother; the numbers of ``seqsmooth track``.
+SlidingFit
+    Gauss–Newton differential correction of each row's window of the last W rows (Morrison
+    §8.5-8.7), radar or scalar polynomial model: ``update_many`` gives the states,
+    covariances, iterations, chi-squared and epochs of ``seqsmooth fit``.
 
 Functions
 ---------
@@ -53,6 +57,7 @@ from ._seqsmooth import (
     KalmanFilter,
     PolynomialFilter,
     RadarTracker,
+    SlidingFit,
     State,
     gains,
     smooth,
@@ -80,6 +85,7 @@ __all__ = [
     "FixedMemory",
     "KalmanFilter",
     "RadarTracker",
+    "SlidingFit",
     "Innovation",
     "PolynomialFilter",
     "State",

@@ -182,6 +182,32 @@ class RadarTracker:
         self,
     ) -> tuple[npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64], Vector]: ...
 
+class SlidingFit:
+    def __init__(
+        self,
+        model: Literal["radar", "polynomial"] = "radar",
+        *,
+        window: int = 60,
+        epoch: Literal["end", "centre", "center"] | float | None = "end",
+        degree: int | None = None,
+        site: tuple[float, float, float] | None = None,
+        sigma_range: float | None = None,
+        sigma_angle: float | None = None,
+        sigma: float | None = None,
+        azimuth: Literal["from-x", "bearing"] = "from-x",
+        max_iterations: int = 20,
+    ) -> None: ...
+    @property
+    def rows_taken(self) -> int: ...
+    @overload
+    def update_many(
+        self, t: ArrayLike, y: ArrayLike, /
+    ) -> tuple[Matrix, npt.NDArray[np.float64], dict[str, Vector]]: ...
+    @overload
+    def update_many(
+        self, t: ArrayLike, range: ArrayLike, azimuth: ArrayLike, elevation: ArrayLike, /
+    ) -> tuple[Matrix, npt.NDArray[np.float64], dict[str, Vector]]: ...
+
 Exact = Fraction | int | float | str
 
 @overload

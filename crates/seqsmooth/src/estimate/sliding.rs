@@ -11,8 +11,8 @@
 use super::bootstrap;
 use super::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use crate::error::Error;
-use crate::model::dynamics::Dynamics;
-use crate::model::observation::Observation;
+use crate::model::dynamics::{Dynamics, PolynomialDynamics};
+use crate::model::observation::{LinearObservation, Observation};
 use crate::model::radar::Radar;
 use nalgebra::DVector;
 use std::collections::VecDeque;
@@ -143,7 +143,7 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
             window,
             epoch,
             start,
-            rows: VecDeque::with_capacity(window),
+            rows: VecDeque::with_capacity(window.min(1 << 12)),
             last: None,
         })
     }
@@ -209,6 +209,48 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
         self.rows.iter()
     }
 
+    /// As [`SlidingFit::push`], and an estimate whose state or 1-σ errors
+    /// `sqrt(S*_{k,k})` are not all finite (beyond the double range: epoch-sized times in a
+    /// small unit, or huge values) is refused too, as [`Error::NonFinite`] with `what`
+    /// `"fitted state"` and the first such number (state first, then the σ); the fit is then
+    /// as before the measurement.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
+    /// use seqsmooth::estimate::sliding::SlidingFit;
+    /// use seqsmooth::Error;
+    /// let mut fit = SlidingFit::polynomial(1, 3, Epoch::End, GaussNewton::default()).unwrap();
+    /// let m = |t: f64, y: f64| Measurement { time: t, values: vec![Some(y)], noise: NoiseCovariance::Variances(vec![1.0]) };
+    /// assert!(fit.push_finite(m(0.0, 1.0)).unwrap().is_none()); // one value: no line yet
+    /// let c = fit.push_finite(m(1.0, 3.0)).unwrap().unwrap();
+    /// assert!((c.state[1] - 2.0).abs() < 1e-12);
+    /// assert!(matches!(fit.push_finite(m(1.0, 5.0)), Err(Error::InvalidParameter { name: "time", .. })));
+    /// assert_eq!(fit.measurements().count(), 2);
+    /// ```
+    ///
+    /// (The refusal of a non-finite estimate is a guard: the windows that would give one,
+    /// found so far, already fail as a linearised system or a rank that is not finite.)
+    pub fn push_finite(&mut self, measurement: Measurement) -> Result<Option<Correction>, Error> {
+        self.push_checked(measurement, |c| {
+            let n = c.state.len();
+            let sigmas = (0..n).map(|k| c.covariance[(k, k)].sqrt());
+            match c
+                .state
+                .iter()
+                .copied()
+                .chain(sigmas)
+                .find(|v| !v.is_finite())
+            {
+                Some(value) => Err(Error::NonFinite {
+                    what: "fitted state",
+                    value,
+                }),
+                None => Ok(()),
+            }
+        })
+    }
+
     /// Takes a measurement (after the previous one in time), drops the oldest beyond `W`, and
     /// fits the window.
     ///
@@ -218,6 +260,15 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
     /// is then as before it (a measurement that is not after the previous one, malformed, or
     /// that leaves the full window undetermined).
     pub fn push(&mut self, measurement: Measurement) -> Result<Option<Correction>, Error> {
+        self.push_checked(measurement, |_| Ok(()))
+    }
+
+    /// [`SlidingFit::push`], the estimate also refused where `accept` refuses it.
+    fn push_checked(
+        &mut self,
+        measurement: Measurement,
+        accept: impl Fn(&Correction) -> Result<(), Error>,
+    ) -> Result<Option<Correction>, Error> {
         if !measurement.time.is_finite() {
             return Err(Error::NonFinite {
                 what: "time",
@@ -243,7 +294,7 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
         };
         self.rows.push_back(measurement);
         self.rows.make_contiguous();
-        match self.fit() {
+        match self.fit().and_then(|c| accept(&c).map(|()| c)) {
             Ok(c) => {
                 self.last = Some(c.clone());
                 Ok(Some(c))
@@ -322,5 +373,142 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
                 bootstrap::radar(radar, &times, &measured, epoch, degree)
             }
         }
+    }
+}
+
+impl SlidingFit<PolynomialDynamics, Radar> {
+    /// The radar fit of `seqsmooth fit --model radar`: a Cartesian target of constant velocity
+    /// (`degree` 1, state `(x, y, z, vx, vy, vz)`) or constant acceleration (`degree` 2, and
+    /// `(ax, ay, az)`), `PolynomialDynamics::new(degree, 3)` (Morrison ch. 4), seen by a
+    /// [`Radar`] at `site` (range, azimuth from +x
+    /// towards +y, elevation from the x-y plane). The first window's iteration (and any whose
+    /// carried-forward start fails) starts from the nominal of §8.5: polynomial fits of degree
+    /// `max(2, degree)` (at most one less than the complete rows) to the range and angles,
+    /// then Gauss–Newton differential correction (§8.6-8.7) with `solver`'s limits.
+    ///
+    /// Errors: a degree other than 1 or 2, a `window` of 0, a site or an [`Epoch::At`] time
+    /// not finite ([`Error::InvalidParameter`], [`Error::NonFinite`]).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton};
+    /// use seqsmooth::estimate::sliding::SlidingFit;
+    /// let fit = SlidingFit::radar([0.0; 3], 1, 10, Epoch::End, GaussNewton::default()).unwrap();
+    /// assert_eq!(fit.window(), 10);
+    /// assert!(SlidingFit::radar([0.0; 3], 3, 10, Epoch::End, GaussNewton::default()).is_err());
+    /// ```
+    pub fn radar(
+        site: [f64; 3],
+        degree: usize,
+        window: usize,
+        epoch: Epoch,
+        solver: GaussNewton,
+    ) -> Result<Self, Error> {
+        if !(1..=2).contains(&degree) {
+            return Err(Error::InvalidParameter {
+                name: "degree",
+                value: degree.to_string(),
+                reason: "must be 1 (constant velocity) or 2 (constant acceleration) for the \
+                         radar model"
+                    .into(),
+            });
+        }
+        let radar = Radar::new(site, 3 * (degree + 1))?;
+        Ok(SlidingFit::new(
+            PolynomialDynamics::new(degree, 3),
+            radar,
+            window,
+            epoch,
+            Start::Radar {
+                radar,
+                degree: 2.max(degree),
+            },
+        )?
+        .with_solver(solver))
+    }
+}
+
+impl SlidingFit<PolynomialDynamics, LinearObservation> {
+    /// The scalar polynomial fit of `seqsmooth fit --model polynomial`: the state
+    /// `(y, y', …, y⁽ᵐ⁾)` of a degree-`m` polynomial in `t` (`PolynomialDynamics::new(m, 1)`,
+    /// ch. 4), observed through `M = (1, 0, …, 0)` (8.3.5). The model is linear, so each
+    /// window's converged correction is its weighted least-squares fit, `X* = (Tᵀ R⁻¹ T)⁻¹
+    /// Tᵀ R⁻¹ Y` with `S* = (Tᵀ R⁻¹ T)⁻¹` at the epoch (§8.6-8.7), whatever the start.
+    ///
+    /// Errors: a `window` shorter than `degree + 1`, an [`Epoch::At`] time not finite. The
+    /// degree is not bounded here (the command and the Python binding bound it by the
+    /// polynomial filters' largest degree; beyond ~20 the window's design is ill-conditioned).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton};
+    /// use seqsmooth::estimate::sliding::SlidingFit;
+    /// assert!(SlidingFit::polynomial(2, 3, Epoch::Centre, GaussNewton::default()).is_ok());
+    /// assert!(SlidingFit::polynomial(2, 2, Epoch::Centre, GaussNewton::default()).is_err());
+    /// ```
+    pub fn polynomial(
+        degree: usize,
+        window: usize,
+        epoch: Epoch,
+        solver: GaussNewton,
+    ) -> Result<Self, Error> {
+        if window < degree + 1 {
+            return Err(Error::InvalidParameter {
+                name: "window",
+                value: window.to_string(),
+                reason: format!(
+                    "is too small for degree {degree}: a degree-{degree} fit needs a window of \
+                     at least {} rows",
+                    degree + 1
+                ),
+            });
+        }
+        Ok(SlidingFit::new(
+            PolynomialDynamics::new(degree, 1),
+            LinearObservation::value_of(degree + 1),
+            window,
+            epoch,
+            Start::State(DVector::zeros(degree + 1)),
+        )?
+        .with_solver(solver))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::estimate::batch::NoiseCovariance;
+
+    fn value(t: f64, y: f64) -> Measurement {
+        Measurement {
+            time: t,
+            values: vec![Some(y)],
+            noise: NoiseCovariance::Variances(vec![1.0]),
+        }
+    }
+
+    /// An estimate the check refuses leaves the window, the last estimate and so the next
+    /// fit as before the refused measurement, also when the window was full.
+    #[test]
+    fn a_refused_estimate_leaves_the_fit_as_before() {
+        let solver = GaussNewton::default();
+        let mut a = SlidingFit::polynomial(1, 3, Epoch::End, solver).unwrap();
+        let mut b = a.clone();
+        for k in 0..5 {
+            let m = value(k as f64, (k * k) as f64);
+            assert_eq!(a.push(m.clone()).unwrap(), b.push_finite(m).unwrap());
+        }
+        let refused = b.push_checked(value(5.0, 1e9), |_| {
+            Err(Error::NonFinite {
+                what: "fitted state",
+                value: f64::INFINITY,
+            })
+        });
+        assert!(refused.is_err());
+        let times = |f: &SlidingFit<_, _>| f.measurements().map(|m| m.time).collect::<Vec<_>>();
+        assert_eq!(times(&a), times(&b));
+        assert_eq!(a.last, b.last);
+        assert_eq!(
+            a.push(value(6.0, 30.0)).unwrap(),
+            b.push(value(6.0, 30.0)).unwrap()
+        );
     }
 }
