@@ -135,7 +135,7 @@ def test_ten_thousand_random_bad_calls_never_panic():
         engine = str(rng.choice(["exact", "gain", "adaptive", "x"]))
         window = int(rng.integers(-1, 50))
         try:
-            kind = rng.integers(10)
+            kind = rng.integers(11)
             if kind == 0:
                 f = ss.ExpandingMemory(degree=degree, engine=engine)
             elif kind == 1:
@@ -234,6 +234,21 @@ def test_ten_thousand_random_bad_calls_never_panic():
                     x, p, info = fit.update_many(times(n), values(n))
                 assert np.isfinite(x).all(axis=1).sum() == np.isfinite(info["chi2"]).sum()
                 assert not np.isinf(x).any() and not np.isinf(p).any()
+                outcomes["ok"] += 1
+                continue
+            elif kind == 10:
+                m = max(degree, 0) % 5
+                prior = rng.random() < 0.3
+                f = ss.BayesFilter(
+                    m,
+                    t0=float(rng.choice([0.0, 1.7e9, np.nan])),
+                    x0=values(m + 1) if prior else None,
+                    P0=float(rng.choice([1.0, 1e300, 0.0, -1.0])) if prior else None,
+                    beta=float(rng.choice([0.9, 0.0, 1.5, np.nan])) if rng.random() < 0.3 else None,
+                )
+                x, p = f.update_many(times(n), values(n), float(rng.choice([1.0, 0.0, -1.0])))
+                assert not np.isinf(x).any() and not np.isinf(p).any()
+                assert np.array_equal(np.isnan(x).all(axis=1), np.isnan(x).any(axis=1))
                 outcomes["ok"] += 1
                 continue
             else:

@@ -304,3 +304,36 @@ fn refusals() {
         .is_err());
     assert_eq!(g.time(), 0.0);
 }
+
+/// An update after which the estimate leaves the double range (a slope of −2e308 per unit
+/// time) is refused with the value, and the filter is as before it.
+#[test]
+fn an_estimate_beyond_the_double_range_is_refused() {
+    use seqsmooth::estimate::batch::NoiseCovariance;
+    use seqsmooth::estimate::gauss_newton::Measurement;
+    use seqsmooth::kalman::BayesFilter;
+    use seqsmooth::model::dynamics::PolynomialDynamics;
+    use seqsmooth::model::observation::LinearObservation;
+    use seqsmooth::Error;
+    let row = |time: f64, y: f64| Measurement {
+        time,
+        values: vec![Some(y)],
+        noise: NoiseCovariance::Variances(vec![1.0]),
+    };
+    let mut f = BayesFilter::new(
+        PolynomialDynamics::new(1, 1),
+        LinearObservation::value_of(2),
+        0.0,
+    )
+    .unwrap();
+    f.update(&row(0.0, 1e308)).unwrap();
+    let before = (f.time(), f.estimate());
+    let e = f.update(&row(1.0, -1e308)).unwrap_err();
+    assert!(
+        matches!(e, Error::NonFinite { value, .. } if value.is_infinite()),
+        "{e}"
+    );
+    assert_eq!((f.time(), f.estimate()), before);
+    f.update(&row(1.0, 1.5e308)).unwrap();
+    assert!((f.estimate().unwrap()[1] - 0.5e308).abs() <= 1e294);
+}

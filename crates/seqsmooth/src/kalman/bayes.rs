@@ -357,12 +357,27 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
         }
         let result = self
             .fade()
-            .and_then(|()| self.fold(&present, &values, &whitener));
+            .and_then(|()| self.fold(&present, &values, &whitener))
+            .and_then(|()| self.check_finite());
         match result {
             Ok(()) => self.informed = true,
             Err(_) => (self.info, self.time, self.fading) = saved,
         }
         result
+    }
+
+    /// Refuses an update after which the estimate or its covariance leaves the double range.
+    fn check_finite(&self) -> Result<(), Error> {
+        let (Some(x), Some(c)) = (self.estimate(), self.covariance()) else {
+            return Ok(());
+        };
+        match x.iter().chain(c.iter()).find(|v| !v.is_finite()) {
+            Some(&value) => Err(Error::NonFinite {
+                what: "estimate or covariance entry after the update",
+                value,
+            }),
+            None => Ok(()),
+        }
     }
 
     /// Multiplies the information so far by the discount over the step since the last update
