@@ -6,13 +6,13 @@
 use crate::arrays::{matrix, series};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{
-    before, discount_from, measurements, noise, observation_from, out_of_order, square, square_from,
+    before, discount_from, measurement, measurements, observation_from, out_of_order, square,
+    square_from,
 };
 use nalgebra::DVector;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
-use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::BayesFilter;
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::{LinearObservation, Observation};
@@ -171,29 +171,7 @@ impl PyBayesFilter {
     #[allow(non_snake_case)]
     #[pyo3(signature = (t, z, R))]
     fn update(&mut self, t: f64, z: &Bound<'_, PyAny>, R: &Bound<'_, PyAny>) -> PyResult<()> {
-        let p = self.components;
-        let values: Vec<f64> = match z.extract::<f64>() {
-            Ok(v) => vec![v],
-            Err(_) => series(z, "z")?.as_slice().to_vec(),
-        };
-        if values.len() != p {
-            return Err(raise(
-                Kind::InvalidInput,
-                format!(
-                    "z has {} values: the observation has {p} components",
-                    values.len()
-                ),
-                None,
-            ));
-        }
-        if t < self.filter.time() {
-            return Err(before(t, self.filter.time(), None));
-        }
-        let m = Measurement {
-            time: t,
-            values: values.iter().map(|&v| (!v.is_nan()).then_some(v)).collect(),
-            noise: noise(R, p)?,
-        };
+        let m = measurement(t, z, R, self.components, self.filter.time())?;
         self.filter.update(&m).py()
     }
 

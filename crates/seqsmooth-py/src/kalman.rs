@@ -187,6 +187,39 @@ pub(crate) fn discount_from(beta: Option<f64>, theta: Option<f64>) -> PyResult<O
     }
 }
 
+/// One measurement `(t, z)` of `p` components (a number, or one value per component; NaN
+/// a missing one) with noise `R`, not before the filter's time `now`.
+pub(crate) fn measurement(
+    t: f64,
+    z: &Bound<'_, PyAny>,
+    r: &Bound<'_, PyAny>,
+    p: usize,
+    now: f64,
+) -> PyResult<Measurement> {
+    let values: Vec<f64> = match z.extract::<f64>() {
+        Ok(v) => vec![v],
+        Err(_) => series(z, "z")?.as_slice().to_vec(),
+    };
+    if values.len() != p {
+        return Err(raise(
+            Kind::InvalidInput,
+            format!(
+                "z has {} values: the observation has {p} components",
+                values.len()
+            ),
+            None,
+        ));
+    }
+    if t < now {
+        return Err(before(t, now, None));
+    }
+    Ok(Measurement {
+        time: t,
+        values: values.iter().map(|&v| (!v.is_nan()).then_some(v)).collect(),
+        noise: noise(r, p)?,
+    })
+}
+
 /// A measurement at `t` before the time `previous` the filter has reached, as an error.
 pub(crate) fn before(t: f64, previous: f64, index: Option<usize>) -> PyErr {
     let at = index.map_or(String::new(), |i| format!("sample {i} of the batch: "));
@@ -341,29 +374,7 @@ impl PyKalmanFilter {
         z: &Bound<'_, PyAny>,
         R: &Bound<'_, PyAny>,
     ) -> PyResult<Option<PyInnovation>> {
-        let p = self.filter_components();
-        let values: Vec<f64> = match z.extract::<f64>() {
-            Ok(v) => vec![v],
-            Err(_) => series(z, "z")?.as_slice().to_vec(),
-        };
-        if values.len() != p {
-            return Err(raise(
-                Kind::InvalidInput,
-                format!(
-                    "z has {} values: the observation has {p} components",
-                    values.len()
-                ),
-                None,
-            ));
-        }
-        if t < self.filter.time() {
-            return Err(before(t, self.filter.time(), None));
-        }
-        let m = Measurement {
-            time: t,
-            values: values.iter().map(|&v| (!v.is_nan()).then_some(v)).collect(),
-            noise: noise(R, p)?,
-        };
+        let m = measurement(t, z, R, self.filter_components(), self.filter.time())?;
         Ok(self
             .filter
             .update(&m)
