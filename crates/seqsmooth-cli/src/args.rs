@@ -958,7 +958,7 @@ pub fn parse_tau(s: &str) -> Result<f64, String> {
 /// Parses `--sigma`: a positive finite number.
 pub fn parse_sigma(s: &str) -> Result<f64, String> {
     const SIGMA: (fn(f64) -> bool, &str) = (
-        |v| v.is_finite() && v > 0.0 && (v * v).is_finite() && v * v >= f64::MIN_POSITIVE,
+        seqsmooth::estimate::batch::is_usable_sigma,
         "a positive number from about 1.5e-154 to 1.3e154 (its square, the noise variance, must \
          be a normal double; rescale the values otherwise)",
     );

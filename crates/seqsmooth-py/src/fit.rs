@@ -38,8 +38,8 @@ impl Fitter {
 }
 
 /// A σ as `seqsmooth fit` accepts it: above 0, its square (the variance) a normal double.
-fn check_sigma(name: &str, s: f64) -> PyResult<f64> {
-    if s > 0.0 && s * s >= f64::MIN_POSITIVE && (s * s).is_finite() {
+pub(crate) fn check_sigma(name: &str, s: f64) -> PyResult<f64> {
+    if seqsmooth::estimate::batch::is_usable_sigma(s) {
         Ok(s)
     } else {
         Err(raise(

@@ -219,11 +219,7 @@ impl PyRadarTracker {
         };
         for (name, sigma) in [("sigma_range", sigma_range), ("sigma_angle", sigma_angle)] {
             if let Some(s) = sigma {
-                if !(s > 0.0 && s * s >= f64::MIN_POSITIVE && (s * s).is_finite()) {
-                    return usage(&format!(
-                        "{name} {s} must be above 0 with a normal double square (the variance)"
-                    ));
-                }
+                crate::fit::check_sigma(name, s)?;
             }
         }
         let radar = Radar::new([site.0, site.1, site.2], 6)

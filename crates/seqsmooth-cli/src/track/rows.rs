@@ -221,8 +221,7 @@ impl<R: Read> Rows<R> {
             let cell = self.csv.field(*index);
             if !cell.is_empty() {
                 let v = parse_cell(cell, line, name, "sigma")?;
-                let usable = v > 0.0 && v * v >= f64::MIN_POSITIVE && (v * v).is_finite();
-                if !usable {
+                if !seqsmooth::estimate::batch::is_usable_sigma(v) {
                     return Err(CliError::Data(format!(
                         "line {line}, column '{name}': sigma {} is {}",
                         shown(cell),

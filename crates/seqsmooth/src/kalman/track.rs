@@ -445,9 +445,7 @@ pub fn radar_row(
     let mut variances = [1.0; 2];
     for (k, (name, sigma, needed)) in needed.into_iter().enumerate() {
         match sigma {
-            Some(s) if s > 0.0 && s * s >= f64::MIN_POSITIVE && (s * s).is_finite() => {
-                variances[k] = s * s
-            }
+            Some(s) if crate::estimate::batch::is_usable_sigma(s) => variances[k] = s * s,
             Some(s) => {
                 return Err(Error::InvalidParameter {
                     name,
