@@ -1,6 +1,6 @@
-"""FadingBank and ExpandingBank: each channel as its single-stream filter (≤ 1e-11), the
-expanding bank as numpy's least-squares fit, one step at a time as many at once (bit for
-bit), and their errors."""
+"""FadingBank and ExpandingBank: the library's run to the last bit, each channel as its
+single-stream filter (≤ 1e-11), the expanding bank as numpy's least-squares fit, one step at a
+time as many at once (bit for bit), and their errors."""
 
 from __future__ import annotations
 
@@ -76,3 +76,36 @@ def test_undetermined_then_errors():
         ss.FadingBank(degree=2, theta=1.0, channels=3)
     with pytest.raises(ss.ParameterError):
         ss.FadingBank(degree=2, theta=0.9, channels=0)
+
+
+def test_banks_equal_the_librarys_run_to_the_last_bit():
+    """The library's own run (tests/fixtures/bank_rust.txt, written and checked by
+    crates/seqsmooth/tests/bank_python_fixture.rs): five channels, 60 steps taken in chunks of
+    1, 2, 7 and 50 rows, fading (θ = 0.875) of degrees 0-3 and 5, expanding of degrees 0-2, 4
+    and 8, every channel's estimate after each chunk."""
+    from pathlib import Path
+
+    path = Path(__file__).parent / "fixtures" / "bank_rust.txt"
+    lines = [text.split(",") for text in path.read_text().splitlines()]
+    assert lines[0][0] == "input"
+    y = np.array([float(c) for c in lines[0][1:]]).reshape(60, 5)
+    runs: dict[tuple[str, int], list[list[str]]] = {}
+    for tag, degree, *cells in lines[1:]:
+        runs.setdefault((tag, int(degree)), []).append(cells)
+    assert len(runs) == 10
+    for (tag, m), rows in runs.items():
+        if tag == "fading":
+            bank = ss.FadingBank(degree=m, theta=0.875, channels=5, tau=0.25)
+        else:
+            bank = ss.ExpandingBank(degree=m, channels=5, tau=0.25)
+        done = 0
+        for chunk, (steps, *cells) in zip([1, 2, 7, 50], rows):
+            bank.update(y[done : done + chunk])
+            done += chunk
+            assert int(steps) == done == bank.samples
+            got = bank.estimate()
+            if cells == ["-"]:
+                assert np.isnan(got).all()
+                continue
+            want = np.array([float(c) for c in cells]).reshape(5, m + 1)
+            assert np.array_equal(got.view(np.int64), want.view(np.int64)), (tag, m, done)
