@@ -272,3 +272,116 @@ fn update_many_across_gaps_and_step_changes() {
         }
     }
 }
+
+/// Times from 1.7e9 in steps of 0.1 with a stretch of uneven steps (the steady kernels stop
+/// and start again), and values on a curve with a bounded wiggle.
+fn long_batch(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let t: Vec<f64> = (0..n)
+        .map(|k| {
+            let jitter = if (2_000..2_100).contains(&k) {
+                0.03 * (k % 3) as f64
+            } else {
+                0.0
+            };
+            1.7e9 + k as f64 * 0.1 + jitter
+        })
+        .collect();
+    let y = (0..n)
+        .map(|k| (k as f64 * 1e-3).sin() * 5.0 + ((k * 37) % 11) as f64 / 20.0)
+        .collect();
+    (t, y)
+}
+
+/// `update_many_into` checks, runs and marks its batch in chunks (so that each chunk's
+/// numbers stay in cache): the rows are the same to the bit however the batch is split, for
+/// every kind and engine at degrees 2 and 8, across the chunks and the uneven stretch.
+#[test]
+fn update_many_into_is_the_same_in_any_split() {
+    let n = 5_000;
+    let (t, y) = long_batch(n);
+    for m in [2, 8] {
+        let w = m + 1;
+        let whole: Vec<(String, Vec<f64>)> = filters(m, true)
+            .into_iter()
+            .map(|(name, mut f)| {
+                let mut rows = vec![0.0; n * w];
+                f.update_many_into(&t, &y, &mut rows).unwrap();
+                (name, rows)
+            })
+            .collect();
+        for split in [&[1usize, 1023, 1, 1024, 1025, 7][..], &[4999], &[2048, 1]] {
+            for ((name, mut f), (_, want)) in filters(m, true).into_iter().zip(&whole) {
+                let mut rows = vec![0.0; n * w];
+                let mut start = 0;
+                for &len in split.iter().chain([&n]) {
+                    let end = (start + len).min(n);
+                    f.update_many_into(
+                        &t[start..end],
+                        &y[start..end],
+                        &mut rows[start * w..end * w],
+                    )
+                    .unwrap();
+                    start = end;
+                }
+                let same = rows
+                    .iter()
+                    .zip(want)
+                    .all(|(a, b)| a.to_bits() == b.to_bits());
+                assert!(same, "m = {m} {name}, split {split:?}");
+                assert!(rows[n * w - w..].iter().all(|v| v.is_finite()), "{name}");
+            }
+        }
+    }
+}
+
+/// A bad sample in a later chunk of `update_many_into` is reported at its index; the samples
+/// before it are taken and their rows written as in a clean run.
+#[test]
+fn update_many_into_reports_a_bad_sample_in_a_later_chunk() {
+    let n = 5_000;
+    let (t, mut y) = long_batch(n);
+    let (clean_t, clean_y) = (t[..3_333].to_vec(), y[..3_333].to_vec());
+    y[3_333] = f64::NAN;
+    for ((name, mut f), (_, mut g)) in filters(2, true).into_iter().zip(filters(2, true)) {
+        let mut rows = vec![0.0; n * 3];
+        match f.update_many_into(&t, &y, &mut rows).unwrap_err() {
+            Error::InBatch { index, .. } => assert_eq!(index, 3_333, "{name}"),
+            other => panic!("{name}: {other}"),
+        }
+        assert_eq!(f.samples(), 3_333, "{name}");
+        let mut want = vec![0.0; 3_333 * 3];
+        g.update_many_into(&clean_t, &clean_y, &mut want).unwrap();
+        let same = rows[..want.len()]
+            .iter()
+            .zip(&want)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(same, "{name}");
+    }
+}
+
+/// Derivatives beyond the double range in the gain engine's steady kernel (τ = 1e-100 with
+/// samples τ apart, y = 1e110·k²: x'' = 2e310 per unit time²) are NaN in the rows, the other
+/// derivatives stand, and no row holds an infinity; the estimate names `d2`.
+#[test]
+fn the_steady_kernel_marks_derivatives_beyond_the_double_range() {
+    let n = 3_000;
+    let tau = 1e-100;
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * tau).collect();
+    let y: Vec<f64> = (0..n).map(|k| 1e110 * (k as f64).powi(2)).collect();
+    for (m, theta) in [(2, 0.9), (3, 0.95)] {
+        let mut f = FadingMemory::new(m, theta, tau, Engine::Gain).unwrap();
+        let mut rows = vec![0.0; n * (m + 1)];
+        f.update_many_into(&t, &y, &mut rows).unwrap();
+        assert!(rows.iter().all(|v| !v.is_infinite()));
+        let last = &rows[(n - 1) * (m + 1)..];
+        assert!(last[2].is_nan(), "{last:?}");
+        // d0 ≈ y, d1 ≈ 2e110·k/τ = 6e213 at k = 3000 (the fading fit of a parabola is exact)
+        let k = (n - 1) as f64;
+        assert!((last[0] / (1e110 * k * k) - 1.0).abs() < 1e-6, "{last:?}");
+        assert!((last[1] / (2e110 * k / tau) - 1.0).abs() < 1e-6, "{last:?}");
+        match f.try_estimate() {
+            Err(Error::EstimateOutOfRange { what }) => assert_eq!(what, "d2"),
+            other => panic!("{other:?}"),
+        }
+    }
+}

@@ -28,14 +28,29 @@ use crate::scalar::{rational_from_f64, Scalar};
 use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 
-/// A kernel's output row (if any): the unscaled derivatives `x_k = z_k·k!/τ^k`.
+/// A kernel's output row (if any): the unscaled derivatives `x_k = z_k·k!/τ^k`; returns
+/// `0·Σ x_k`, which is 0 when they are all finite and NaN when one is not (a probe the kernels
+/// add up, three operations a row where marking each number would take nine).
 #[inline(always)]
-fn write_row(row: Option<&mut [f64]>, z: &[f64], c: &[f64]) {
+fn write_row(row: Option<&mut [f64]>, z: &[f64], c: &[f64]) -> f64 {
+    let mut sum = 0.0;
     if let Some(row) = row {
         for ((x, z), c) in row.iter_mut().zip(z).zip(c) {
             *x = z * c;
+            sum += *x;
         }
     }
+    sum * 0.0
+}
+
+/// `x`, or NaN ("no estimate") for an infinite `x`, branch-free: `x·((x − x) + 1)`, where
+/// `x − x` is `0` for a finite `x` (so `x·1 = x`, the sign of a zero kept) and NaN for an
+/// infinite one. Three floating-point operations, where the comparison `|x| = ∞` compiles to
+/// integer masks; marking as the kernels write spares a pass over the rows.
+#[inline(always)]
+#[allow(clippy::eq_op)] // `x − x` is the test itself
+pub(crate) fn out_of_range_as_nan(x: f64) -> f64 {
+    x * ((x - x) + 1.0)
 }
 
 /// The gains for the typical step `ζ̄` from those for the unit step: `g_k ← g_k/ζ̄^k`
@@ -444,7 +459,8 @@ impl GainEngine {
     }
 
     /// [`update_many`](Self::update_many), writing the unscaled derivatives after each sample
-    /// into `out` (`ts.len()·(m+1)` values, row-major; NaN until determined).
+    /// into `out` (`ts.len()·(m+1)` values, row-major; NaN until determined, and for a
+    /// derivative beyond the double range).
     pub fn update_many_into(&mut self, ts: &[f64], ys: &[f64], out: &mut [f64]) {
         self.update_many_with(ts, ys, out, true);
     }
@@ -480,11 +496,11 @@ impl GainEngine {
         }
         for (k, (x, (f, tk))) in row.iter_mut().zip(factorial_powers(self.unit)).enumerate() {
             let z = self.z[k] + self.z_lo[k];
-            *x = if tk.is_normal() {
+            *x = out_of_range_as_nan(if tk.is_normal() {
                 z * f / tk
             } else {
                 unscale_stepwise(z, k, self.unit)
-            };
+            });
         }
     }
 
@@ -797,16 +813,23 @@ impl GainEngine {
         let mut rows = out.chunks_exact_mut(N);
         let mut z = self.plain_state::<N>();
         let (tau, mut t_last, mut done) = (self.unit, self.t_last, 0);
+        let mut probe = 0.0;
         for (&t, &y) in ts.iter().zip(ys) {
             let zeta = (t - t_last) / tau;
             if !step(&mut z, t, zeta, y) {
                 break;
             }
             if W {
-                write_row(rows.next(), &z, &c);
+                probe += write_row(rows.next(), &z, &c);
             }
             t_last = t;
             done += 1;
+        }
+        if W && probe != 0.0 {
+            // A number beyond the double range (rare): marked NaN, "no estimate".
+            for x in &mut out[..done * N] {
+                *x = out_of_range_as_nan(*x);
+            }
         }
         PlainRun { z, t_last, done }
     }
