@@ -13,7 +13,9 @@
 //!   with (`scripts/py_bench.sh`); `one_call/fading_gain_many_into_fresh_output/2`, the same
 //!   into a new buffer per call; and `one_call/stream_fading_exact_10000x1000/2`: 10⁴ series
 //!   of 10³ samples interleaved, through a `StreamBank` on the rayon pool (the Python
-//!   `filter_frame`'s counterpart, `seqsmooth filter --id-col` without the CSV).
+//!   `filter_frame`'s counterpart, `seqsmooth filter --id-col` without the CSV), and
+//!   `…_fresh_columns`, the same into a new buffer per call written column by column, as
+//!   `filter_frame` runs it.
 //! - `bank/<serial|parallel>/<K>`: a degree-2 [`FadingBank`] (θ = 0.9) of `K` channels past
 //!   its switch; each iteration is one time step of all channels; throughput in
 //!   channel-updates.
@@ -178,6 +180,33 @@ fn one_call(c: &mut Criterion) {
             black_box(est[est.len() - 1])
         });
     });
+    // The same as the Python `filter_frame` runs it: a fresh 240 MB estimates buffer per call
+    // (its first touch is about 59,000 page faults), written column by column.
+    group.bench_function(
+        BenchmarkId::new("stream_fading_exact_10000x1000_fresh_columns", M),
+        |b| {
+            b.iter(|| {
+                let prototype = FadingMemory::new(M, 0.9, 1.0, Engine::Exact).unwrap();
+                let mut bank = StreamBank::growing(prototype).unwrap();
+                let mut out = vec![0.0; rows * (M + 1)];
+                let chunk = Chunk {
+                    channels: &channels,
+                    times: &times,
+                    values: &values,
+                    estimates: &mut out,
+                    stride: M + 1,
+                };
+                bank.update_par_columns(
+                    chunk,
+                    |f: &mut FadingMemory, t: &[f64], y: &[f64], o: &mut [f64]| {
+                        f.update_many_into(t, y, o)
+                    },
+                )
+                .unwrap();
+                black_box(out[out.len() - 1])
+            });
+        },
+    );
     group.finish();
 }
 
