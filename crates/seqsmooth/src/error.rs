@@ -185,6 +185,17 @@ pub enum Error {
         /// The iterations allowed.
         iterations: usize,
     },
+    /// A symmetric eigendecomposition did not converge within its iteration limit.
+    #[error(
+        "the eigendecomposition of a symmetric {size}x{size} matrix did not converge in \
+         {iterations} iterations"
+    )]
+    EigenNotConverged {
+        /// Rows (and columns) of the matrix.
+        size: usize,
+        /// The iterations allowed.
+        iterations: usize,
+    },
     /// Some other parameter is out of range.
     #[error("{name} {value} is invalid: {reason}")]
     InvalidParameter {
