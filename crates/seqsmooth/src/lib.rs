@@ -80,6 +80,7 @@ pub mod kalman;
 pub mod linalg;
 pub mod model;
 pub mod numeric;
+pub mod paml;
 pub mod polynomial;
 pub mod recursive;
 pub mod scalar;
