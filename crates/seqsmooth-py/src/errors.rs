@@ -67,6 +67,10 @@ const DATA: &[&str] = &[
     "sigma_range",
     "sigma_angle",
     "row",
+    "weight",
+    "weights",
+    "segment",
+    "sigmas",
 ];
 
 /// An exception of `kind` with `message` and `index` (the offending sample's position).

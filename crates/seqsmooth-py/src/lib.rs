@@ -11,6 +11,7 @@ mod errors;
 mod fit;
 mod frame;
 mod kalman;
+mod paml;
 mod polynomial;
 mod smooth;
 mod tables;
@@ -38,6 +39,9 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(frame::filter_series, m)?)?;
     m.add_function(wrap_pyfunction!(tables::gains, m)?)?;
     m.add_function(wrap_pyfunction!(tables::vrf, m)?)?;
+    m.add_function(wrap_pyfunction!(paml::gauss_rule, m)?)?;
+    m.add_function(wrap_pyfunction!(paml::polynomial_samples, m)?)?;
+    m.add_function(wrap_pyfunction!(paml::luenberger_gains, m)?)?;
     m.add("MAX_DEGREE", seqsmooth::polynomial::MAX_DEGREE)?;
     Ok(())
 }

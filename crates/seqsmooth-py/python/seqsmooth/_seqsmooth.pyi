@@ -252,6 +252,21 @@ def vrf(
     *,
     exact: Literal[True],
 ) -> list[list[Fraction]]: ...
+def gauss_rule(
+    n: int,
+    t: ArrayLike | None = None,
+    weights: ArrayLike | None = None,
+    kind: Literal["legendre", "chebyshev"] = "legendre",
+    a: float = -1.0,
+    b: float = 1.0,
+) -> tuple[Vector, Vector]: ...
+def polynomial_samples(
+    t: ArrayLike, y: ArrayLike, sigma: float | ArrayLike, n: int
+) -> tuple[Vector, Vector, Vector]: ...
+@overload
+def luenberger_gains(n: int, exact: Literal[False] = False) -> Vector: ...
+@overload
+def luenberger_gains(n: int, *, exact: Literal[True]) -> list[int]: ...
 
 class AutomaticFilter:
     def __init__(

@@ -65,7 +65,7 @@ impl PolynomialSamples {
             .find(|(_, &s)| !crate::estimate::batch::is_usable_sigma(s))
         {
             return Err(Error::InvalidParameter {
-                name: "sigma",
+                name: "sigmas",
                 value: s.to_string(),
                 reason: format!("sample {j}: a noise sigma must be above 0 with a normal square"),
             });
