@@ -10,7 +10,10 @@
 //! | the samples' measure, its Gauss nodes and Christoffel numbers | [`crate::basis::Jacobi`], [`crate::basis::GaussRule`] | Lemma 1, Corollary 1, eqs. 21, 26 |
 //! | polynomial samples of a segment | [`PolynomialSamples`] | eqs. 8-9, 19-21, 37 |
 //! | the Chebyshev-weight variance approximation | [`approximate_variance`] | eqs. 22-25 (eq. 22 lacks a factor 2) |
+//! | online smoothing with precomputed gains, virtual sampling | [`SmootherGains`], [`OnlineSmoother`] | §V, eqs. 34-37, Table I |
 
+mod online;
 mod samples;
 
+pub use online::{OnlineSmoother, SmootherGains};
 pub use samples::{approximate_variance, approximate_variance_as_printed, PolynomialSamples};
