@@ -82,6 +82,57 @@ pub enum Command {
     /// Kalman filter, fading-memory Kalman filter, or Kalman smoother
     #[command(after_help = TRACK_AFTER_HELP)]
     Track(TrackArgs),
+    /// Compress a series into polynomial samples (Villien & Ostertag 2009): per segment of
+    /// SECONDS, its weighted least-squares polynomial of degree N at the N+1 Gauss nodes of
+    /// its own samples, uncorrelated, with their variances
+    #[command(after_help = PAML_AFTER_HELP)]
+    Paml(PamlArgs),
+}
+
+const PAML_AFTER_HELP: &str = "\
+Output: CSV with the header
+  segment,t,value,variance
+N+1 rows per segment: segment k covers [t0 + k*SECONDS, t0 + (k+1)*SECONDS), t0 the first \
+sample's time; t a Gauss node of the segment's samples weighted by 1/sigma^2, value the \
+segment's weighted least-squares polynomial there and variance its variance (in the units of \
+sigma^2; the N+1 values are uncorrelated). A segment with fewer than N+1 samples is named on \
+standard error by its time span and left out. Without --sigma or --sigma-col every sample's \
+sigma is 1 (the variances are then per unit noise variance).";
+
+#[derive(Debug, Args)]
+pub struct PamlArgs {
+    /// Input CSV with a header row; omitted or '-' reads standard input. Times strictly
+    /// increasing; read segment by segment
+    #[arg(value_name = "INPUT")]
+    pub input: Option<PathBuf>,
+    /// Polynomial degree N of each segment (0 to 30): N+1 polynomial samples per segment
+    #[arg(long, value_name = "N", value_parser = parse_order, allow_hyphen_values = true)]
+    pub order: usize,
+    /// Segment length in the time column's units
+    #[arg(long, value_name = "SECONDS", value_parser = parse_segment, allow_hyphen_values = true)]
+    pub segment: f64,
+    /// The values' noise standard deviation, the same for every sample
+    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true,
+          conflicts_with = "sigma_col")]
+    pub sigma: Option<f64>,
+    /// The column holding each sample's noise standard deviation
+    #[arg(long, value_name = "NAME")]
+    pub sigma_col: Option<String>,
+    #[command(flatten)]
+    pub columns: Columns,
+    /// Output file [default: standard output]
+    #[arg(short = 'o', long, value_name = "OUTPUT")]
+    pub output: Option<PathBuf>,
+}
+
+/// Parses `--order`: a whole number from 0 to 30.
+pub fn parse_order(s: &str) -> Result<usize, String> {
+    parse_whole("order", s, "", 0, 30).map(|v| v as usize)
+}
+
+/// Parses `--segment`: a positive finite number.
+pub fn parse_segment(s: &str) -> Result<f64, String> {
+    parse_f64("segment", s, POSITIVE)
 }
 
 const TRACK_AFTER_HELP: &str = concat!(

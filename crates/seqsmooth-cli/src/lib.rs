@@ -14,6 +14,7 @@ pub mod filter;
 pub mod fit;
 pub mod gains;
 pub mod io;
+pub mod paml;
 pub mod parquet;
 pub mod plot;
 pub mod progress;

@@ -4,7 +4,7 @@
 use clap::Parser;
 use seqsmooth_cli::args::{Cli, Command};
 use seqsmooth_cli::error::CliError;
-use seqsmooth_cli::{demo, filter, fit, gains, plot, smooth, track, vrf};
+use seqsmooth_cli::{demo, filter, fit, gains, paml, plot, smooth, track, vrf};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -17,6 +17,7 @@ fn main() -> ExitCode {
         Command::Plot(a) => plot::run(&a),
         Command::Fit(a) => fit::run(&a),
         Command::Track(a) => track::run(&a),
+        Command::Paml(a) => paml::run(&a),
     };
     match result {
         Ok(()) | Err(CliError::BrokenPipe) => ExitCode::SUCCESS,

@@ -21,6 +21,8 @@ pub struct Chunk {
     pub t: Vec<f64>,
     /// Values.
     pub y: Vec<f64>,
+    /// A third number per row, when the reader has one ([`RowReader::with_extra`]).
+    pub extra: Vec<f64>,
     /// The series of each row: 0 for a single series, else its id's index in order of
     /// appearance.
     pub series: Vec<usize>,
@@ -133,6 +135,7 @@ impl Chunk {
     fn clear(&mut self) {
         self.t.clear();
         self.y.clear();
+        self.extra.clear();
         self.series.clear();
         self.lines.clear();
         self.cells.clear();
@@ -163,6 +166,8 @@ pub struct RowReader<S: Records> {
     id_idx: Option<usize>,
     time_col: String,
     value_col: String,
+    /// A third numeric column, its index, name and what it holds (for messages).
+    extra: Option<(usize, String, &'static str)>,
     /// Series index by id (with `--id-col`), and the ids as written, for messages.
     index: HashMap<Vec<u8>, usize>,
     ids: Vec<String>,
@@ -210,12 +215,24 @@ impl<S: Records> RowReader<S> {
             id_idx,
             time_col: time_col.to_string(),
             value_col: value_col.to_string(),
+            extra: None,
             index: HashMap::new(),
             ids: Vec::new(),
             newest: id_idx.map_or_else(|| vec![None], |_| Vec::new()),
             touched: Vec::new(),
             rows_read: 0,
         })
+    }
+
+    /// Also reads the numeric column `name` (holding the `what`, for messages) into
+    /// [`Chunk::extra`], checked as the time and value are.
+    pub fn with_extra(mut self, name: &str, what: &'static str) -> Result<Self, CliError> {
+        let why = self.csv.header_why();
+        let i = find_column(self.csv.header(), name, &why)?;
+        self.csv
+            .select(&[self.time_idx, self.value_idx, i], self.id_idx)?;
+        self.extra = Some((i, name.to_string(), what));
+        Ok(self)
     }
 
     /// Reads up to `max_rows` rows into `chunk` (replacing its contents). Reading stops early
@@ -288,6 +305,10 @@ impl<S: Records> RowReader<S> {
         let line = self.csv.place();
         let t = self.csv.number(self.time_idx, &self.time_col, "time")?;
         let y = self.csv.number(self.value_idx, &self.value_col, "value")?;
+        let extra = match &self.extra {
+            Some((i, name, what)) => Some(self.csv.number(*i, name, what)?),
+            None => None,
+        };
         let series = self.series(chunk, line)?;
         let (t_cell, y_cell) = (
             self.csv.field(self.time_idx),
@@ -338,6 +359,7 @@ impl<S: Records> RowReader<S> {
         chunk.text.extend_from_slice(y_cell);
         chunk.t.push(t);
         chunk.y.push(y);
+        chunk.extra.extend(extra);
         chunk.series.push(series);
         chunk.lines.push(line);
         self.rows_read += 1;
