@@ -7,8 +7,10 @@
 //! `crates/seqsmooth-py/tests/test_bank.py` reads it.
 
 use seqsmooth::polynomial::bank::{ExpandingBank, FadingBank};
+mod common;
+
+use common::python_fixture::{check, line};
 use std::fmt::Write;
-use std::path::PathBuf;
 
 const CHANNELS: usize = 5;
 const STEPS: usize = 60;
@@ -26,14 +28,6 @@ fn inputs() -> Vec<f64> {
         }
     }
     y
-}
-
-fn line(out: &mut String, tag: &str, values: impl IntoIterator<Item = f64>) {
-    out.push_str(tag);
-    for v in values {
-        write!(out, ",{v:?}").unwrap();
-    }
-    out.push('\n');
 }
 
 /// One bank's run: after each chunk, `tag,<steps so far>` and each channel's `m+1` unscaled
@@ -99,18 +93,8 @@ fn fixture() -> String {
 
 #[test]
 fn the_python_fixture_is_this_librarys_run() {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../seqsmooth-py/tests/fixtures/bank_rust.txt");
     let text = fixture();
-    if std::env::var_os("SEQSMOOTH_WRITE_FIXTURES").is_some() {
-        std::fs::write(&path, &text).unwrap();
-    }
-    let stored = std::fs::read_to_string(&path).unwrap();
-    assert!(
-        stored == text,
-        "{} is not this library's run",
-        path.display()
-    );
+    check("bank_rust.txt", &text);
     // a bank of degree m has no estimate before m+1 steps (chunks end at 1, 3, 10, 60 steps)
     let undetermined = |m: usize| {
         CHUNKS

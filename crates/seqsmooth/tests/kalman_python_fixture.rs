@@ -13,8 +13,9 @@ use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::{BayesFilter, Discount, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::LinearObservation;
-use std::fmt::Write;
-use std::path::PathBuf;
+mod common;
+
+use common::python_fixture::{check, line};
 
 /// The inputs: times and three components (NaN missing), made from integers (exact).
 fn inputs() -> Vec<(f64, [f64; 3])> {
@@ -37,14 +38,6 @@ fn inputs() -> Vec<(f64, [f64; 3])> {
             (t, z)
         })
         .collect()
-}
-
-fn line(out: &mut String, tag: &str, values: impl IntoIterator<Item = f64>) {
-    out.push_str(tag);
-    for v in values {
-        write!(out, ",{v:?}").unwrap();
-    }
-    out.push('\n');
 }
 
 /// The file's text: the inputs, then each row's Kalman state, covariance (row-major) and NIS,
@@ -97,17 +90,7 @@ fn fixture() -> String {
 
 #[test]
 fn the_python_fixture_is_this_librarys_run() {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../seqsmooth-py/tests/fixtures/kalman_rust.txt");
     let text = fixture();
-    if std::env::var_os("SEQSMOOTH_WRITE_FIXTURES").is_some() {
-        std::fs::write(&path, &text).unwrap();
-    }
-    let stored = std::fs::read_to_string(&path).unwrap();
-    assert!(
-        stored == text,
-        "{} is not this library's run",
-        path.display()
-    );
+    check("kalman_rust.txt", &text);
     assert!(text.lines().filter(|l| l.starts_with("bayes,-")).count() < 5);
 }

@@ -1,8 +1,9 @@
 //! `paml::SmootherGains` / `OnlineSmoother`: the segment's least-squares fit accumulated one
-//! sample at a time equals the batch polynomial samples (`PolynomialSamples::from_segment`,
-//! itself checked against a direct QR fit in tests/paml_samples.rs) for `N` to 10⁵ and degrees
-//! to 8 on irregular Unix-epoch times with varying noise — where the paper's recursion (eq. 35)
-//! drifts (examples/accuracy_paml_online.rs); one layout serves many segments; the refusals.
+//! sample at a time. `PolynomialSamples::from_segment` runs on it (and is checked against a
+//! direct QR fit in tests/paml_samples.rs); here, that the samples pushed one at a time, in
+//! parts or all at once give those numbers, for `N` to 10⁵ and degrees to 8 on irregular
+//! Unix-epoch times with varying noise — where the paper's recursion (eq. 35) drifts
+//! (examples/accuracy_paml_online.rs); one layout serves many segments; the refusals.
 
 use seqsmooth::paml::{PolynomialSamples, SmootherGains};
 use seqsmooth::Error;

@@ -55,6 +55,11 @@ impl SmootherGains {
                 }),
             });
         }
+        Self::layout(times, sigmas, n)
+    }
+
+    /// [`new`](Self::new) for times in any order (the order `push` follows).
+    pub(super) fn layout(times: &[f64], sigmas: &[f64], n: usize) -> Result<Self, Error> {
         if let Some((j, &s)) = sigmas
             .iter()
             .enumerate()

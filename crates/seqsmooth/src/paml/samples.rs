@@ -6,7 +6,7 @@
 //! `δ_kl/λ_k` at the Gauss nodes (Corollary 1, eq. 21): exactly, on the actual samples (the
 //! discrete form of their eq. 6).
 
-use crate::basis::{GaussRule, Jacobi};
+use super::online::SmootherGains;
 use crate::error::{check_finite, Error};
 
 /// A segment's `n+1` polynomial samples: at `centre + offsets[k]`, the values of the segment's
@@ -59,43 +59,11 @@ impl PolynomialSamples {
             });
         }
         check_finite("value", values)?;
-        if let Some((j, &s)) = sigmas
-            .iter()
-            .enumerate()
-            .find(|(_, &s)| !crate::estimate::batch::is_usable_sigma(s))
-        {
-            return Err(Error::InvalidParameter {
-                name: "sigmas",
-                value: s.to_string(),
-                reason: format!("sample {j}: a noise sigma must be above 0 with a normal square"),
-            });
-        }
-        let weights: Vec<f64> = sigmas.iter().map(|s| 1.0 / (s * s)).collect();
-        let jacobi = Jacobi::discrete(times, &weights, n)?;
-        let rule = GaussRule::new(&jacobi)?;
-        // ⟨y, b_i⟩ = Σ_j w_j y_j b_i(t_j)
-        let mut coefficients = vec![0.0; n + 1];
-        for ((&t, &y), &w) in times.iter().zip(values).zip(&weights) {
-            let b = jacobi.orthonormal_at_offset(t - jacobi.centre);
-            for (c, b) in coefficients.iter_mut().zip(&b) {
-                *c += w * y * b;
-            }
-        }
-        let values: Vec<f64> = rule
-            .offsets
-            .iter()
-            .map(|&o| {
-                let b = jacobi.orthonormal_at_offset(o);
-                coefficients.iter().zip(&b).map(|(c, b)| c * b).sum()
-            })
-            .collect();
-        check_finite("polynomial sample", &values)?;
-        Ok(Self {
-            centre: rule.centre,
-            offsets: rule.offsets,
-            values,
-            variances: rule.weights.iter().map(|l| 1.0 / l).collect(),
-        })
+        // The one engine: the layout of these times and sigmas, the values accumulated.
+        let gains = SmootherGains::layout(times, sigmas, n)?;
+        let mut smoother = gains.smoother();
+        smoother.push_all(values)?;
+        smoother.polynomial_samples()
     }
 
     /// The samples' times `t_k*` (rounded to the times' precision; [`offsets`](Self::offsets)
