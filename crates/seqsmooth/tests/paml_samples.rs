@@ -4,8 +4,9 @@
 //! Unix-epoch times with noise varying tenfold; Example 1's noise model (eq. 39) as a test
 //! vector; the corrected eq. 22 against the exact variances; the refusals.
 
-use nalgebra::{DMatrix, DVector};
-use seqsmooth::basis::legendre::values as legendre;
+mod common;
+
+use common::paml::direct_fit;
 use seqsmooth::paml::{approximate_variance, approximate_variance_as_printed, PolynomialSamples};
 use seqsmooth::Error;
 
@@ -44,21 +45,9 @@ fn the_samples_are_the_weighted_fit_at_the_nodes_and_uncorrelated() {
     for n in [1, 3, 5, 10] {
         let ps = PolynomialSamples::from_segment(&s.t, &s.y, &s.sigma, n).unwrap();
         assert_eq!(ps.offsets.len(), n + 1);
-        // the direct fit: rows P_i(u_j)/σ_j, u = (t − c)/h on the span
         let (a, b) = (s.t[0], s.t[s.t.len() - 1]);
-        let (c, h) = ((a + b) / 2.0, (b - a) / 2.0);
-        assert_eq!(ps.centre, c);
-        let rows = s.t.len();
-        let design = DMatrix::from_fn(rows, n + 1, |j, i| {
-            legendre(n, (s.t[j] - c) / h)[i] / s.sigma[j]
-        });
-        let rhs = DVector::from_fn(rows, |j, _| s.y[j] / s.sigma[j]);
-        let (q, r) = design.qr().unpack();
-        let coef = r.solve_upper_triangular(&(q.transpose() * rhs)).unwrap();
-        let r_inv = r.try_inverse().unwrap();
-        let at_nodes = DMatrix::from_fn(n + 1, n + 1, |k, i| legendre(n, ps.offsets[k] / h)[i]);
-        let want = &at_nodes * &coef;
-        let cov = &at_nodes * &r_inv * r_inv.transpose() * at_nodes.transpose();
+        assert_eq!(ps.centre, (a + b) / 2.0);
+        let (want, cov) = direct_fit(&s.t, &s.y, &s.sigma, n, &ps.offsets);
         let scale = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for k in 0..=n {
             assert!(

@@ -11,6 +11,7 @@ pub mod engine;
 pub mod fixed;
 pub mod kalman;
 pub mod monte_carlo;
+pub mod paml;
 pub mod python_fixture;
 pub mod rational;
 pub mod smooth;
