@@ -7,8 +7,20 @@
 //! - `paml/segment_batch/5`: `PolynomialSamples::from_segment` on the same 1 000 samples
 //!   (the Jacobi matrix, the Gauss rule and the fit from nothing).
 //! - `paml/layout/5`: `SmootherGains::new`, the offline part.
+//! - `paml_fit/{raw,polynomial_samples}_{analytic,differenced}`: Example 1 (1 200 samples,
+//!   eqs. 38-39, 1 m miss): the Levenberg–Marquardt maximum-likelihood fit on the raw samples
+//!   and on their n = 5 and n = 11 polynomial samples, from the same start, with eq. 38's
+//!   analytic gradient and with central differences (the target: ≥ 50× faster on the
+//!   polynomial samples).
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+#[path = "../tests/common/doppler.rs"]
+mod doppler;
+
+use doppler::{prior, Doppler, DopplerDifferenced, Scenario, SAMPLES};
+use rand::rngs::StdRng;
+use rand::SeedableRng;
+use seqsmooth::estimate::curve::{fit_curve, CurveModel};
 use seqsmooth::paml::{PolynomialSamples, SmootherGains};
 use std::time::Duration;
 
@@ -57,5 +69,32 @@ fn paml(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, paml);
+fn paml_fit(c: &mut Criterion) {
+    let sc = Scenario::new(1.0, SAMPLES);
+    let mut rng = StdRng::seed_from_u64(1);
+    let y = sc.measure(&mut rng);
+    let start = prior(&sc.truth, &mut rng);
+    let mut group = c.benchmark_group("paml_fit");
+    group
+        .sample_size(30)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2));
+    let models: [(&str, &dyn CurveModel); 2] =
+        [("analytic", &Doppler), ("differenced", &DopplerDifferenced)];
+    for (name, model) in models {
+        group.bench_function(format!("raw_{name}"), |b| {
+            b.iter(|| fit_curve(model, black_box(&sc.times), &y, &sc.sigmas, &start).unwrap())
+        });
+        for n in [5, 11] {
+            let ps = PolynomialSamples::from_segment(&sc.times, &y, &sc.sigmas, n).unwrap();
+            group.bench_function(
+                BenchmarkId::new(format!("polynomial_samples_{name}"), n),
+                |b| b.iter(|| black_box(&ps).fit(model, &start).unwrap()),
+            );
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, paml, paml_fit);
 criterion_main!(benches);

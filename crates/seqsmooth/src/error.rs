@@ -170,6 +170,21 @@ pub enum Error {
         /// Halvings tried.
         halvings: usize,
     },
+    /// A Levenberg–Marquardt fit stopped short of a minimum: the evaluations allowed ran out,
+    /// or no step lowered the residual sum of squares.
+    #[error(
+        "the Levenberg-Marquardt fit stopped after {evaluations} evaluations without converging \
+         ({reason}); chi-squared {chi_squared:e} at its last estimate: start nearer the \
+         solution, or check that the data determine the model's parameters"
+    )]
+    FitNotConverged {
+        /// Model evaluations made.
+        evaluations: usize,
+        /// Why it stopped.
+        reason: String,
+        /// The residual chi-squared at the last estimate.
+        chi_squared: f64,
+    },
     /// A singular value decomposition did not converge within its iteration limit (entries
     /// of very different scales: rescale the data).
     #[error(

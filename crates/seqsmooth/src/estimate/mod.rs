@@ -11,6 +11,7 @@
 
 pub mod batch;
 pub mod bootstrap;
+pub mod curve;
 pub mod gauss_newton;
 pub mod observability;
 pub mod sliding;

@@ -11,6 +11,7 @@
 //! | polynomial samples of a segment | [`PolynomialSamples`] | eqs. 8-9, 19-21, 37 |
 //! | the Chebyshev-weight variance approximation | [`approximate_variance`] | eqs. 22-25 (eq. 22 lacks a factor 2) |
 //! | online smoothing with precomputed gains, virtual sampling | [`SmootherGains`], [`OnlineSmoother`] | §V, eqs. 34-37, Table I |
+//! | the PAML estimate and the raw ML estimate, one Levenberg–Marquardt fit; the Cramér–Rao bound | [`PolynomialSamples::fit`], [`crate::estimate::curve`] | eqs. 2-4, Lemma 4 |
 
 mod online;
 mod samples;

@@ -8,6 +8,7 @@
 
 use super::online::SmootherGains;
 use crate::error::{check_finite, Error};
+use crate::estimate::curve::{fit_curve, CurveFit, CurveModel};
 
 /// A segment's `n+1` polynomial samples: at `centre + offsets[k]`, the values of the segment's
 /// weighted least-squares polynomial and their variances (uncorrelated).
@@ -64,6 +65,31 @@ impl PolynomialSamples {
         let mut smoother = gains.smoother();
         smoother.push_all(values)?;
         smoother.polynomial_samples()
+    }
+
+    /// The PAML estimate (V&O eqs. 3-4): the maximum-likelihood fit of `model` to these
+    /// samples as measurements with their variances, by the same Levenberg–Marquardt fit as
+    /// the raw samples' ([`fit_curve`]), from `start`. When `∇h` is a polynomial of degree
+    /// `≤ n` in `t` and `h ∇h` one of degree `≤ 2n+1`, its normal equations are the raw ones
+    /// exactly (Lemma 3); otherwise it differs by the quadrature remainder (Lemma 4, eq. 49).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::curve::{fit_curve, Curve};
+    /// use seqsmooth::paml::PolynomialSamples;
+    /// // a quadratic model from degree-2 samples: the raw fit, from 3 numbers instead of 200
+    /// let h = Curve::new(3, |th: &[f64], t| th[0] + th[1] * t + th[2] * t * t);
+    /// let t: Vec<f64> = (0..200).map(|k| k as f64 * 0.01).collect();
+    /// let y: Vec<f64> = t.iter().map(|t| 1.0 - t + (40.0 * t).sin() * 0.1).collect();
+    /// let s: Vec<f64> = t.iter().map(|t| 0.1 + t).collect();
+    /// let raw = fit_curve(&h, &t, &y, &s, &[0.0; 3])?;
+    /// let paml = PolynomialSamples::from_segment(&t, &y, &s, 2)?.fit(&h, &[0.0; 3])?;
+    /// assert!((paml.parameters - &raw.parameters).amax() < 1e-9);
+    /// assert!((paml.covariance - &raw.covariance).amax() < 1e-9 * raw.covariance.amax());
+    /// # Ok::<(), seqsmooth::Error>(())
+    /// ```
+    pub fn fit<M: CurveModel + ?Sized>(&self, model: &M, start: &[f64]) -> Result<CurveFit, Error> {
+        let sigmas: Vec<f64> = self.variances.iter().map(|v| v.sqrt()).collect();
+        fit_curve(model, &self.times(), &self.values, &sigmas, start)
     }
 
     /// The samples' times `t_k*` (rounded to the times' precision; [`offsets`](Self::offsets)
