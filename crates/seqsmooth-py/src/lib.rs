@@ -42,6 +42,10 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(paml::gauss_rule, m)?)?;
     m.add_function(wrap_pyfunction!(paml::polynomial_samples, m)?)?;
     m.add_function(wrap_pyfunction!(paml::luenberger_gains, m)?)?;
+    m.add_function(wrap_pyfunction!(paml::fit_curve, m)?)?;
+    m.add_function(wrap_pyfunction!(paml::cramer_rao_bound, m)?)?;
+    m.add_class::<paml::PyOnlineSmoother>()?;
+    m.add_class::<paml::PyCurveFit>()?;
     m.add("MAX_DEGREE", seqsmooth::polynomial::MAX_DEGREE)?;
     Ok(())
 }

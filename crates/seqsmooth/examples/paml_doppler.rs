@@ -195,7 +195,13 @@ fn main() {
     }
 }
 
+/// DejaVu Sans, the command's embedded font (Bitstream Vera licence, beside it in
+/// `crates/seqsmooth-cli/assets/`): plotters reads no system fonts here.
+static FONT: &[u8] = include_bytes!("../../seqsmooth-cli/assets/DejaVuSans.ttf");
+
 fn plot(path: &str, spans: &[Span], order: usize) -> Result<(), Box<dyn std::error::Error>> {
+    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+        .map_err(|_| "the embedded font could not be loaded")?;
     let root = SVGBackend::new(path, (960, 420)).into_drawing_area();
     root.fill(&WHITE)?;
     let panels = root.split_evenly((1, 2));

@@ -236,6 +236,22 @@ fn bad_input_is_refused_by_name() {
         ),
         "{r:?}"
     );
+    // away from zero the differenced columns differ by their rounding (~1e-11), which the
+    // QR's rank rule alone would take for a second direction
+    let t20: Vec<f64> = (0..20).map(|k| k as f64 * 2.0 / 19.0).collect();
+    let y20: Vec<f64> = t20.iter().map(|t| (0.8 * t).exp()).collect();
+    let r = fit_curve(&twins, &t20, &y20, &[0.05; 20], &[0.0, 0.0]);
+    assert!(
+        matches!(
+            r,
+            Err(Error::Unobservable {
+                rank: 1,
+                states: 2,
+                ..
+            })
+        ),
+        "{r:?}"
+    );
     let r = cramer_rao_bound(&twins, &[0.0, 0.0], &t, &s);
     assert!(matches!(r, Err(Error::Unobservable { .. })), "{r:?}");
     // a model's own error comes back as it is

@@ -1,5 +1,6 @@
 """Type stubs of the native module (the classes and functions re-exported by seqsmooth)."""
 
+from collections.abc import Callable
 from fractions import Fraction
 from typing import Literal, overload
 
@@ -267,6 +268,52 @@ def polynomial_samples(
 def luenberger_gains(n: int, exact: Literal[False] = False) -> Vector: ...
 @overload
 def luenberger_gains(n: int, *, exact: Literal[True]) -> list[int]: ...
+def fit_curve(
+    h: Callable[[Vector, Vector], ArrayLike],
+    t: ArrayLike,
+    y: ArrayLike,
+    sigma: float | ArrayLike,
+    start: ArrayLike,
+    jac: Callable[[Vector, Vector], ArrayLike] | None = None,
+) -> CurveFit: ...
+def cramer_rao_bound(
+    h: Callable[[Vector, Vector], ArrayLike],
+    theta: ArrayLike,
+    t: ArrayLike,
+    sigma: float | ArrayLike,
+    jac: Callable[[Vector, Vector], ArrayLike] | None = None,
+) -> Matrix: ...
+
+class CurveFit:
+    """A converged maximum-likelihood fit (``fit_curve``)."""
+
+    @property
+    def parameters(self) -> Vector: ...
+    @property
+    def covariance(self) -> Matrix: ...
+    @property
+    def standard_deviations(self) -> Vector: ...
+    @property
+    def chi_squared(self) -> float: ...
+    @property
+    def degrees_of_freedom(self) -> int: ...
+    @property
+    def condition_number(self) -> float: ...
+    @property
+    def evaluations(self) -> int: ...
+
+class OnlineSmoother:
+    """A segment's polynomial samples accumulated a sample at a time."""
+
+    def __init__(self, t: ArrayLike, sigma: float | ArrayLike, n: int) -> None: ...
+    def push(self, y: float) -> None: ...
+    def push_all(self, y: ArrayLike) -> None: ...
+    @property
+    def taken(self) -> int: ...
+    @property
+    def size(self) -> int: ...
+    def polynomial_samples(self) -> tuple[Vector, Vector, Vector]: ...
+    def reset(self) -> None: ...
 
 class AutomaticFilter:
     def __init__(

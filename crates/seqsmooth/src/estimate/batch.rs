@@ -237,6 +237,11 @@ fn full_rank(r: &DMatrix<f64>, rows: usize, states: usize) -> Result<f64, Error>
 }
 
 impl Solved {
+    /// The singular values of `t` (those of `R`).
+    pub(crate) fn singular_values(&self) -> Result<DVector<f64>, Error> {
+        crate::linalg::singular_values(&self.r)
+    }
+
     /// `(Rᵀ R)⁻¹ = R⁻¹ R⁻ᵀ`, the inverse of the Gram matrix `tᵀ t`: the covariance of `x`.
     pub(crate) fn covariance(&self) -> DMatrix<f64> {
         let n = self.r.ncols();

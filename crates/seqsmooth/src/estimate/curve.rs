@@ -19,9 +19,11 @@
 //!
 //! The Jacobian `∂h/∂θ` is the model's when given ([`CurveModel::jacobian`]); otherwise central
 //! differences with the step `ε^{1/3} max(|θ_j|, 1)` (error `O(ε^{2/3})` relative for
-//! parameters of order one or more; give the analytic Jacobian for smaller ones).
+//! parameters of order one or more; give the analytic Jacobian for smaller ones). A
+//! differenced Jacobian whose singular values span more than `10⁸` leaves the parameters
+//! undetermined ([`Error::Unobservable`]): differences resolve no finer.
 
-use super::batch::{is_usable_sigma, solve_whitened};
+use super::batch::{is_usable_sigma, solve_whitened, Solved};
 use crate::error::{check_finite, Error};
 use crate::model::nonlinear::central_differences;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
@@ -270,8 +272,19 @@ impl<'a> Samples<'a> {
         model: &M,
         theta: &[f64],
     ) -> Result<DMatrix<f64>, Error> {
+        self.jacobian_and_kind(model, theta).map(|(j, _)| j)
+    }
+
+    /// `∂h/∂θ` and whether it was differenced.
+    fn jacobian_and_kind<M: CurveModel + ?Sized>(
+        &self,
+        model: &M,
+        theta: &[f64],
+    ) -> Result<(DMatrix<f64>, bool), Error> {
         let m = model.parameters();
-        let j = match model.jacobian(theta, self.times) {
+        let analytic = model.jacobian(theta, self.times);
+        let differenced = analytic.is_none();
+        let j = match analytic {
             Some(j) => j?,
             None => {
                 let failed = RefCell::new(None);
@@ -299,7 +312,7 @@ impl<'a> Samples<'a> {
             });
         }
         check_finite("model Jacobian entry", j.as_slice())?;
-        Ok(j)
+        Ok((j, differenced))
     }
 
     /// `diag(1/σ) J`.
@@ -432,8 +445,8 @@ pub fn fit_curve<M: CurveModel + ?Sized>(
             .zip(&samples.inverse_sigmas)
             .map(|((h, y), w)| (y - h) * w),
     );
-    let j = samples.whiten(samples.model_jacobian(model, theta.as_slice())?);
-    let solved = solve_whitened(j, residuals.clone())?;
+    let (j, differenced) = samples.jacobian_and_kind(model, theta.as_slice())?;
+    let solved = solve_checked((samples.whiten(j), differenced), residuals.clone())?;
     Ok(CurveFit {
         covariance: solved.covariance(),
         chi_squared: residuals.norm_squared(),
@@ -464,10 +477,42 @@ pub fn cramer_rao_bound<M: CurveModel + ?Sized>(
     let m = model.parameters();
     let samples = Samples::new(times, None, sigmas, m)?;
     check_start(theta, m)?;
-    let j = samples.whiten(samples.model_jacobian(model, theta)?);
+    let (j, differenced) = samples.jacobian_and_kind(model, theta)?;
     let rows = j.nrows();
-    Ok(solve_whitened(j, DVector::zeros(rows))?.covariance())
+    Ok(solve_checked((samples.whiten(j), differenced), DVector::zeros(rows))?.covariance())
 }
+
+/// The whitened Jacobian's solve, refused as [`Error::Unobservable`] when a differenced
+/// Jacobian leaves a singular value below `1e-8` of the largest: central differences are
+/// accurate to about `ε^{2/3} ≈ 4e-11` of the largest, so a direction they resolve no better
+/// is undetermined, not merely ill-conditioned (the QR's own rank rule works at `ε`).
+fn solve_checked(
+    (j, differenced): (DMatrix<f64>, bool),
+    residuals: DVector<f64>,
+) -> Result<Solved, Error> {
+    let states = j.ncols();
+    let solved = solve_whitened(j, residuals)?;
+    if differenced {
+        let sv = solved.singular_values()?;
+        let largest = sv.max();
+        let rank = sv
+            .iter()
+            .filter(|&&s| s > DIFFERENCED_RANK * largest)
+            .count();
+        if rank < states {
+            return Err(Error::Unobservable {
+                rank,
+                states,
+                smallest_singular_value: sv.min(),
+                largest_singular_value: largest,
+            });
+        }
+    }
+    Ok(solved)
+}
+
+/// The smallest singular value, relative to the largest, that a differenced Jacobian resolves.
+const DIFFERENCED_RANK: f64 = 1e-8;
 
 fn check_start(theta: &[f64], m: usize) -> Result<(), Error> {
     if theta.len() != m {

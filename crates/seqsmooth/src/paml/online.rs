@@ -20,6 +20,7 @@
 use super::samples::PolynomialSamples;
 use crate::basis::{GaussRule, Jacobi};
 use crate::error::{check_finite, Error};
+use std::ops::Deref;
 
 /// The offline part of [`OnlineSmoother`] for one layout of sample times and noise: each
 /// sample's `b_i(t_k)/σ_k²`, the segment's Gauss rule and `b_i` at its nodes. Shared by every
@@ -103,13 +104,9 @@ impl SmootherGains {
         false
     }
 
-    /// A smoother for one segment of this layout.
-    pub fn smoother(&self) -> OnlineSmoother<'_> {
-        OnlineSmoother {
-            gains: self,
-            taken: 0,
-            coefficients: vec![0.0; self.n + 1],
-        }
+    /// A smoother for one segment of this layout, borrowing it.
+    pub fn smoother(&self) -> OnlineSmoother<&Self> {
+        OnlineSmoother::new(self)
     }
 }
 
@@ -132,19 +129,43 @@ impl SmootherGains {
 /// }
 /// # Ok::<(), seqsmooth::Error>(())
 /// ```
+///
+/// It holds its layout by any pointer: borrowed (`&SmootherGains`, as
+/// [`SmootherGains::smoother`] gives), or shared (`Arc<SmootherGains>`, for a smoother that
+/// outlives the scope of its layout):
+///
+/// ```
+/// use std::sync::Arc;
+/// use seqsmooth::paml::{OnlineSmoother, SmootherGains};
+/// let gains = Arc::new(SmootherGains::new(&[0.0, 1.0, 2.0], &[1.0; 3], 1)?);
+/// let mut s = OnlineSmoother::new(Arc::clone(&gains));
+/// s.push_all(&[1.0, 2.0, 3.0])?;
+/// assert_eq!(s.taken(), 3);
+/// # Ok::<(), seqsmooth::Error>(())
+/// ```
 #[derive(Clone, Debug)]
-pub struct OnlineSmoother<'g> {
-    gains: &'g SmootherGains,
+pub struct OnlineSmoother<G: Deref<Target = SmootherGains>> {
+    gains: G,
     taken: usize,
     /// `Σ_{k<taken} (b_i(t_k)/σ_k²) y_k`.
     coefficients: Vec<f64>,
 }
 
-impl OnlineSmoother<'_> {
+impl<G: Deref<Target = SmootherGains>> OnlineSmoother<G> {
+    /// A smoother for one segment of the layout `gains`, no sample taken.
+    pub fn new(gains: G) -> Self {
+        let size = gains.n + 1;
+        Self {
+            gains,
+            taken: 0,
+            coefficients: vec![0.0; size],
+        }
+    }
+
     /// The next sample's value (the layout gives its time and noise):
     /// `c_i ← c_i + (b_i(t_k)/σ_k²) y`, `n+1` multiplications and additions.
     pub fn push(&mut self, y: f64) -> Result<(), Error> {
-        let g = self.gains;
+        let g = &*self.gains;
         let size = g.n + 1;
         if !y.is_finite() {
             return Err(Error::NonFinite {
@@ -170,7 +191,7 @@ impl OnlineSmoother<'_> {
     /// Every value of a segment at once, as [`push`](Self::push) on each (`values.len()` must
     /// be the layout's; nothing is taken on an error).
     pub fn push_all(&mut self, values: &[f64]) -> Result<(), Error> {
-        let g = self.gains;
+        let g = &*self.gains;
         if self.taken + values.len() > g.len() {
             return Err(Error::InvalidParameter {
                 name: "segment",
@@ -186,6 +207,11 @@ impl OnlineSmoother<'_> {
         Ok(())
     }
 
+    /// The layout it runs on.
+    pub fn gains(&self) -> &G {
+        &self.gains
+    }
+
     /// The samples taken.
     pub fn taken(&self) -> usize {
         self.taken
@@ -195,7 +221,7 @@ impl OnlineSmoother<'_> {
     /// polynomial `Σ_i c_i b_i` at the Gauss nodes of the layout's measure, with their
     /// variances.
     pub fn polynomial_samples(&self) -> Result<PolynomialSamples, Error> {
-        let g = self.gains;
+        let g = &*self.gains;
         if self.taken < g.len() {
             return Err(Error::TooFewSamples {
                 needed: g.len(),
