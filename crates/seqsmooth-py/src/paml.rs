@@ -463,6 +463,13 @@ impl PyCurveFit {
         self.inner.condition_number
     }
 
+    /// The Gauss–Newton correction still proposed at the estimate, in units of its own σ
+    /// (``sqrt(δᵀ F δ)``; at most ``1e-9`` unless rounding stopped it first).
+    #[getter]
+    fn correction(&self) -> f64 {
+        self.inner.correction
+    }
+
     /// Model evaluations made.
     #[getter]
     fn evaluations(&self) -> usize {

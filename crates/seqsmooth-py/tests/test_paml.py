@@ -148,6 +148,7 @@ def test_fit_curve_is_scipys_least_squares(analytic):
     assert np.max(np.abs(fit.covariance - cov)) <= tol * np.max(np.abs(cov))
     assert np.allclose(fit.standard_deviations, sd, rtol=tol)
     assert fit.degrees_of_freedom == len(t) - 3
+    assert fit.correction <= 1e-9
     assert fit.chi_squared == pytest.approx(2 * ref.cost, rel=1e-10)
     bound = ss.cramer_rao_bound(_demo, ref.x, t, sigma, jac=_demo_jac)
     assert np.max(np.abs(bound - cov)) <= 1e-9 * np.max(np.abs(cov))

@@ -1,4 +1,4 @@
-"""The README's and docs/python.md's Python examples run as printed."""
+"""The README's, docs/python.md's and docs/paml.md's Python examples run as printed."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from conftest import ROOT
 
 
-@pytest.mark.parametrize("page", ["README.md", "docs/python.md"])
+@pytest.mark.parametrize("page", ["README.md", "docs/python.md", "docs/paml.md"])
 def test_python_blocks_run(page):
     text = (ROOT / page).read_text()
     blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)

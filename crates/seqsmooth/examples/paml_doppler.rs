@@ -4,7 +4,7 @@
 //! Cramér–Rao bound, for observation spans of 150 to 1200 samples.
 //!
 //! cargo run --release -p seqsmooth --example paml_doppler -- [--runs 300] [--order 5]
-//!     [--miss 1.0] [--seed 1] [--svg docs/paml_doppler.svg]
+//!     [--miss 1.0] [--seed 1] [--plot docs/images/paml_doppler_n5.png]
 //!
 //! It prints, for each span, each parameter's σ by method (the RMS error about the truth) and
 //! the share of runs in which PAML is within 1 % of the ML σ of the ML estimate; then the time
@@ -14,6 +14,7 @@
 mod doppler;
 
 use doppler::{extended_kalman, prior, Doppler, Scenario, SAMPLES};
+use nalgebra::{DMatrix, DVector};
 use plotters::prelude::*;
 use rand::rngs::StdRng;
 use rand::SeedableRng;
@@ -26,7 +27,7 @@ struct Args {
     order: usize,
     miss: f64,
     seed: u64,
-    svg: Option<String>,
+    plot: Option<String>,
 }
 
 fn args() -> Args {
@@ -35,7 +36,7 @@ fn args() -> Args {
         order: 5,
         miss: 1.0,
         seed: 1,
-        svg: None,
+        plot: None,
     };
     let v: Vec<String> = std::env::args().skip(1).collect();
     for pair in v.chunks(2) {
@@ -45,19 +46,20 @@ fn args() -> Args {
             "--order" => a.order = value.parse().expect("--order N"),
             "--miss" => a.miss = value.parse().expect("--miss METRES"),
             "--seed" => a.seed = value.parse().expect("--seed N"),
-            "--svg" => a.svg = Some(value.clone()),
+            "--plot" => a.plot = Some(value.clone()),
             other => panic!("unknown option {other}"),
         }
     }
     a
 }
 
-/// σ by method for one span: `[crlb, ml, paml, ekf][parameter]`, and PAML's agreement.
+/// σ by method for one span: `[crlb, crlb with the prior, ml, paml, ekf][parameter]`, and
+/// PAML's agreement.
 struct Span {
     samples: usize,
     /// Runs in which a fit did not converge or left a parameter undetermined.
     failed: usize,
-    sigma: [[f64; 3]; 4],
+    sigma: [[f64; 3]; 5],
     within: [f64; 3],
     within_all: f64,
     largest: [f64; 3],
@@ -77,6 +79,14 @@ fn span(full: &Scenario, samples: usize, a: &Args) -> Span {
     let sc = full.first(samples);
     let mut rng = StdRng::seed_from_u64(a.seed);
     let crlb = cramer_rao_bound(&Doppler, &sc.truth, &sc.times, &sc.sigmas).expect("CRLB");
+    // The bound for an estimator that also has the prior (the EKF's): (F + P₀⁻¹)⁻¹.
+    let prior_information = DMatrix::from_diagonal(&DVector::from_iterator(
+        3,
+        doppler::PRIOR_SIGMA.iter().map(|s| 1.0 / (s * s)),
+    ));
+    let with_prior = (crlb.clone().try_inverse().expect("F") + prior_information)
+        .try_inverse()
+        .expect("F + P0^-1");
     let (mut ml, mut pa, mut ekf) = (vec![], vec![], vec![]);
     let mut failed = 0;
     for _ in 0..a.runs {
@@ -120,6 +130,7 @@ fn span(full: &Scenario, samples: usize, a: &Args) -> Span {
         failed,
         sigma: [
             [0, 1, 2].map(|i| crlb[(i, i)].sqrt()),
+            [0, 1, 2].map(|i| with_prior[(i, i)].sqrt()),
             ml_sigma,
             rms(&pa),
             rms(&ekf),
@@ -139,15 +150,15 @@ fn main() {
         a.miss, a.runs, a.order
     );
     println!(
-        "| samples | span (ms) | parameter | CRLB σ | ML σ | PAML σ | EKF σ | PAML within 1 % of ML σ | largest abs(PAML − ML)/σ |"
+        "| samples | span (ms) | parameter | CRLB σ | CRLB σ with the prior | ML σ | PAML σ | EKF σ | PAML within 1 % of ML σ | largest abs(PAML − ML)/σ |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     let names = ["x0 (m)", "y0 (m)", "v0 (m/s)"];
-    let spans: Vec<Span> = (1..=8).map(|k| span(&full, 150 * k, &a)).collect();
+    let spans: Vec<Span> = (0..=8).map(|k| span(&full, 600 + 75 * k, &a)).collect();
     for s in &spans {
         for (i, name) in names.iter().enumerate() {
             println!(
-                "| {} | {:.1} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.1} % | {:.3} |",
+                "| {} | {:.1} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.1} % | {:.3} |",
                 s.samples,
                 s.samples as f64 * doppler::STEP * 1e3,
                 name,
@@ -155,12 +166,13 @@ fn main() {
                 s.sigma[1][i],
                 s.sigma[2][i],
                 s.sigma[3][i],
+                s.sigma[4][i],
                 100.0 * s.within[i],
                 s.largest[i],
             );
         }
         println!(
-            "|  |  | all three within 1 % ({} runs failed) |  |  |  |  | {:.1} % |  |",
+            "|  |  | all three within 1 % ({} runs failed) |  |  |  |  |  | {:.1} % |  |",
             s.failed,
             100.0 * s.within_all
         );
@@ -189,7 +201,7 @@ fn main() {
         raw / paml
     );
 
-    if let Some(path) = &a.svg {
+    if let Some(path) = &a.plot {
         plot(path, &spans, a.order).expect("plot");
         println!("plot: {path}");
     }
@@ -199,14 +211,38 @@ fn main() {
 /// `crates/seqsmooth-cli/assets/`): plotters reads no system fonts here.
 static FONT: &[u8] = include_bytes!("../../seqsmooth-cli/assets/DejaVuSans.ttf");
 
+/// The plot as SVG, or PNG when `path` ends in `.png`.
 fn plot(path: &str, spans: &[Span], order: usize) -> Result<(), Box<dyn std::error::Error>> {
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
         .map_err(|_| "the embedded font could not be loaded")?;
-    let root = SVGBackend::new(path, (960, 420)).into_drawing_area();
+    if path.ends_with(".png") {
+        draw(
+            BitMapBackend::new(path, (960, 420)).into_drawing_area(),
+            spans,
+            order,
+        )
+    } else {
+        draw(
+            SVGBackend::new(path, (960, 420)).into_drawing_area(),
+            spans,
+            order,
+        )
+    }
+}
+
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    spans: &[Span],
+    order: usize,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
     root.fill(&WHITE)?;
     let panels = root.split_evenly((1, 2));
     let methods = [
         ("CRLB", BLACK),
+        ("CRLB with the prior", MAGENTA),
         ("ML (raw)", BLUE),
         ("PAML", RED),
         ("EKF", GREEN),
@@ -246,6 +282,7 @@ fn plot(path: &str, spans: &[Span], order: usize) -> Result<(), Box<dyn std::err
         }
         chart
             .configure_series_labels()
+            .position(SeriesLabelPosition::LowerLeft)
             .background_style(WHITE)
             .border_style(BLACK)
             .draw()?;

@@ -63,6 +63,7 @@ fn equals_scipy_least_squares_on_the_demonstration_model() {
         let chi = (fit.chi_squared / expected["chi_squared"] - 1.0).abs();
         assert!(chi <= 1e-12, "chi-squared off by {chi:e}");
         assert_eq!(fit.degrees_of_freedom, 1997);
+        assert!(fit.correction <= 1e-9, "correction {:e}", fit.correction);
         assert!(fit.evaluations > 1);
     }
 }
