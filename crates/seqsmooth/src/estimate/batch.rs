@@ -198,33 +198,79 @@ pub(crate) struct Solved {
 
 /// Solves the whitened `t x ≈ y` (see [`Solved`]); [`Error::Unobservable`] when `t` is
 /// rank-deficient.
-pub(crate) fn solve_whitened(t: DMatrix<f64>, mut y: DVector<f64>) -> Result<Solved, Error> {
-    let (rows, states) = t.shape();
-    let qr = t.qr();
-    let r = qr.r();
-    let condition_number = full_rank(&r, rows, states)?;
-    qr.q_tr_mul(&mut y);
-    let head = y.rows(0, states).into_owned();
-    let x = r
-        .solve_upper_triangular(&head)
-        .expect("R is non-singular at full rank");
-    Ok(Solved {
-        x,
-        r,
-        explained: head.norm(),
-        chi_squared: y.rows(states, rows - states).norm_squared(),
-        degrees_of_freedom: rows - states,
-        condition_number,
-    })
+pub(crate) fn solve_whitened(t: DMatrix<f64>, y: DVector<f64>) -> Result<Solved, Error> {
+    Factored::new(t, y).solve(0.0)
+}
+
+/// The whitened system after its Householder QR: `R` and `Qᵀ y`, for a step without the rank
+/// check ([`Factored::step`]) or the solve with it ([`Factored::solve`]).
+pub(crate) struct Factored {
+    r: DMatrix<f64>,
+    /// `Qᵀ y`.
+    rotated: DVector<f64>,
+    rows: usize,
+    states: usize,
+}
+
+impl Factored {
+    pub(crate) fn new(t: DMatrix<f64>, mut y: DVector<f64>) -> Self {
+        let (rows, states) = t.shape();
+        let qr = t.qr();
+        qr.q_tr_mul(&mut y);
+        Self {
+            r: qr.r(),
+            rotated: y,
+            rows,
+            states,
+        }
+    }
+
+    /// `x` and `|R x| = |(Qᵀ y)_head|` without the rank check (the caller makes it where its
+    /// steps end), or `None` when `R` has a zero or non-finite pivot.
+    pub(crate) fn step(&self) -> Option<(DVector<f64>, f64)> {
+        if self
+            .r
+            .diagonal()
+            .iter()
+            .any(|d| *d == 0.0 || !d.is_finite())
+        {
+            return None;
+        }
+        let head = self.rotated.rows(0, self.states).into_owned();
+        let x = self.r.solve_upper_triangular(&head)?;
+        Some((x, head.norm()))
+    }
+
+    /// The solve after the rank check: [`Error::Unobservable`] when a singular value is at or
+    /// below `floor` of the largest (or the rounding level, whichever is larger).
+    pub(crate) fn solve(self, floor: f64) -> Result<Solved, Error> {
+        let (rows, states) = (self.rows, self.states);
+        let condition_number = full_rank(&self.r, rows, states, floor)?;
+        let head = self.rotated.rows(0, states).into_owned();
+        let x = self
+            .r
+            .solve_upper_triangular(&head)
+            .expect("R is non-singular at full rank");
+        Ok(Solved {
+            x,
+            explained: head.norm(),
+            chi_squared: self.rotated.rows(states, rows - states).norm_squared(),
+            degrees_of_freedom: rows - states,
+            condition_number,
+            r: self.r,
+        })
+    }
 }
 
 /// The condition number `σ_max/σ_min` of `T = Q R` from `R`'s singular values (those of
-/// `T`), or [`Error::Unobservable`] when its numerical rank is below `states`.
-fn full_rank(r: &DMatrix<f64>, rows: usize, states: usize) -> Result<f64, Error> {
+/// `T`), or [`Error::Unobservable`] when its numerical rank is below `states`, singular
+/// values at or below `floor` of the largest counting as zero too.
+fn full_rank(r: &DMatrix<f64>, rows: usize, states: usize, floor: f64) -> Result<f64, Error> {
     let sv = crate::linalg::singular_values(r)?;
     let largest = sv.max();
     let smallest = if rows < states { 0.0 } else { sv.min() };
-    let rank = numerical_rank(sv.as_slice(), rows, states);
+    let rank = numerical_rank(sv.as_slice(), rows, states)
+        .min(sv.iter().filter(|&&s| s > floor * largest).count());
     if rank < states {
         return Err(Error::Unobservable {
             rank,
@@ -237,11 +283,6 @@ fn full_rank(r: &DMatrix<f64>, rows: usize, states: usize) -> Result<f64, Error>
 }
 
 impl Solved {
-    /// The singular values of `t` (those of `R`).
-    pub(crate) fn singular_values(&self) -> Result<DVector<f64>, Error> {
-        crate::linalg::singular_values(&self.r)
-    }
-
     /// `(Rᵀ R)⁻¹ = R⁻¹ R⁻ᵀ`, the inverse of the Gram matrix `tᵀ t`: the covariance of `x`.
     pub(crate) fn covariance(&self) -> DMatrix<f64> {
         let n = self.r.ncols();
@@ -268,7 +309,7 @@ impl Fit {
         let (rows, states) = t.shape();
         let qr = t.clone().qr();
         let (q, r) = (qr.q(), qr.r());
-        let condition_number = full_rank(&r, rows, states)?;
+        let condition_number = full_rank(&r, rows, states, 0.0)?;
         let qty = q.transpose() * y;
         let x = r
             .solve_upper_triangular(&qty)

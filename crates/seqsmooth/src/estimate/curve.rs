@@ -26,7 +26,7 @@
 //! differenced Jacobian whose singular values span more than `10⁸` leaves the parameters
 //! undetermined ([`Error::Unobservable`]): differences resolve no finer.
 
-use super::batch::{is_usable_sigma, solve_whitened, Solved};
+use super::batch::{is_usable_sigma, Factored, Solved};
 use crate::error::{check_finite, Error};
 use crate::model::nonlinear::central_differences;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
@@ -437,7 +437,7 @@ pub fn fit_curve<M: CurveModel + ?Sized>(
     }
     let Finish {
         theta,
-        residuals,
+        chi_squared,
         solved,
     } = finish;
     if solved.explained > NOT_CONVERGED {
@@ -447,12 +447,12 @@ pub fn fit_curve<M: CurveModel + ?Sized>(
                 "the Gauss-Newton correction is still {:e} of its own sigma",
                 solved.explained
             ),
-            chi_squared: residuals.norm_squared(),
+            chi_squared,
         });
     }
     Ok(CurveFit {
         covariance: solved.covariance(),
-        chi_squared: residuals.norm_squared(),
+        chi_squared,
         degrees_of_freedom: solved.degrees_of_freedom,
         condition_number: solved.condition_number,
         correction: solved.explained,
@@ -512,12 +512,14 @@ fn minimize<M: CurveModel + ?Sized>(
 /// The estimate after the Gauss–Newton finish, its residuals and last linearisation.
 struct Finish {
     theta: DVector<f64>,
-    residuals: DVector<f64>,
+    chi_squared: f64,
     solved: Solved,
 }
 
 /// Gauss–Newton steps from `theta` until the correction is at most [`CONVERGED`] of its own σ
 /// (at most [`POLISH`] of them; near the minimum each squares it), and the evaluations made.
+/// Each linearisation is factored once; the steps skip the rank check, the last one, whose
+/// covariance is reported, has it.
 fn polish<M: CurveModel + ?Sized>(
     model: &M,
     samples: &Samples<'_>,
@@ -527,40 +529,45 @@ fn polish<M: CurveModel + ?Sized>(
     let mut step = 0;
     loop {
         let residuals = samples.whitened_residuals(model, theta.as_slice())?;
+        let chi_squared = residuals.norm_squared();
         let (j, differenced) = samples.jacobian_and_kind(model, theta.as_slice())?;
-        let solved = solve_checked((samples.whiten(j), differenced), residuals.clone())?;
+        let factored = Factored::new(samples.whiten(j), residuals);
         evaluations += 1;
-        if solved.explained <= CONVERGED || step == POLISH {
-            return Ok((
-                Finish {
-                    theta,
-                    residuals,
-                    solved,
-                },
-                evaluations,
-            ));
+        let proposed = if step < POLISH {
+            factored
+                .step()
+                .filter(|(_, c)| *c > CONVERGED)
+                .map(|(x, c)| (&theta + x, c))
+                .filter(|(candidate, c)| {
+                    // A correction within LINEAR of its σ is taken as it is (the
+                    // linearisation holds there, and e(θ) changes by c² only, below the
+                    // rounding of a sum of many squares); a larger one only if it lowers e(θ).
+                    candidate.iter().all(|v| v.is_finite())
+                        && (*c <= LINEAR
+                            || samples
+                                .whitened_residuals(model, candidate.as_slice())
+                                .is_ok_and(|r| r.norm_squared() < chi_squared))
+                })
+        } else {
+            None
+        };
+        match proposed {
+            Some((candidate, _)) => {
+                theta = candidate;
+                step += 1;
+            }
+            None => {
+                let floor = if differenced { DIFFERENCED_RANK } else { 0.0 };
+                return Ok((
+                    Finish {
+                        theta,
+                        chi_squared,
+                        solved: factored.solve(floor)?,
+                    },
+                    evaluations,
+                ));
+            }
         }
-        let candidate = &theta + &solved.x;
-        // A correction within LINEAR of its σ is taken as it is (the linearisation holds
-        // there, and e(θ) changes by c² only, below the rounding of a sum of many squares);
-        // a larger one only if it lowers e(θ).
-        let take = candidate.iter().all(|v| v.is_finite())
-            && (solved.explained <= LINEAR
-                || samples
-                    .whitened_residuals(model, candidate.as_slice())
-                    .is_ok_and(|r| r.norm_squared() < residuals.norm_squared()));
-        if !take {
-            return Ok((
-                Finish {
-                    theta,
-                    residuals,
-                    solved,
-                },
-                evaluations,
-            ));
-        }
-        theta = candidate;
-        step += 1;
     }
 }
 
@@ -602,39 +609,16 @@ pub fn cramer_rao_bound<M: CurveModel + ?Sized>(
     check_start(theta, m)?;
     let (j, differenced) = samples.jacobian_and_kind(model, theta)?;
     let rows = j.nrows();
-    Ok(solve_checked((samples.whiten(j), differenced), DVector::zeros(rows))?.covariance())
+    let floor = if differenced { DIFFERENCED_RANK } else { 0.0 };
+    Ok(Factored::new(samples.whiten(j), DVector::zeros(rows))
+        .solve(floor)?
+        .covariance())
 }
 
-/// The whitened Jacobian's solve, refused as [`Error::Unobservable`] when a differenced
-/// Jacobian leaves a singular value below `1e-8` of the largest: central differences are
-/// accurate to about `ε^{2/3} ≈ 4e-11` of the largest, so a direction they resolve no better
-/// is undetermined, not merely ill-conditioned (the QR's own rank rule works at `ε`).
-fn solve_checked(
-    (j, differenced): (DMatrix<f64>, bool),
-    residuals: DVector<f64>,
-) -> Result<Solved, Error> {
-    let states = j.ncols();
-    let solved = solve_whitened(j, residuals)?;
-    if differenced {
-        let sv = solved.singular_values()?;
-        let largest = sv.max();
-        let rank = sv
-            .iter()
-            .filter(|&&s| s > DIFFERENCED_RANK * largest)
-            .count();
-        if rank < states {
-            return Err(Error::Unobservable {
-                rank,
-                states,
-                smallest_singular_value: sv.min(),
-                largest_singular_value: largest,
-            });
-        }
-    }
-    Ok(solved)
-}
-
-/// The smallest singular value, relative to the largest, that a differenced Jacobian resolves.
+/// The smallest singular value, relative to the largest, that a differenced Jacobian
+/// resolves: central differences are accurate to about `ε^{2/3} ≈ 4e-11` of the largest, so a
+/// direction they resolve no better is undetermined, not merely ill-conditioned (the QR's own
+/// rank rule works at `ε`).
 const DIFFERENCED_RANK: f64 = 1e-8;
 
 fn check_start(theta: &[f64], m: usize) -> Result<(), Error> {
