@@ -4,7 +4,7 @@ fit (estimate::curve) is checked against (crates/seqsmooth/tests/fixtures/curve/
 
 Run:  python3 scripts/make_curve_fixtures.py
 It creates (once) a private virtual environment in target/savgol-venv with numpy and scipy
-(the one make_savgol_fixtures.py uses), re-runs itself there, and writes:
+(scripts/fixture_venv.py, shared with make_savgol_fixtures.py), re-runs itself there, and writes:
   demo.csv    - t,y,sigma: Villien & Ostertag's demonstration model h = a exp(b t) + c t,
                 truth (1, 0.8, -0.5), 2000 samples on [0, 2], noise sigma 0.05 (1 + t)
   fit.csv     - name,value: scipy's Levenberg-Marquardt (MINPACK lmder) estimate from
@@ -13,24 +13,13 @@ It creates (once) a private virtual environment in target/savgol-venv with numpy
   versions.txt - the numpy and scipy versions used
 """
 import os
-import subprocess
 import sys
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-VENV = os.path.join(ROOT, "target", "savgol-venv")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fixture_venv import ROOT, reexec  # noqa: E402
+
+reexec(__file__)
 OUT = os.path.join(ROOT, "crates", "seqsmooth", "tests", "fixtures", "curve")
-
-
-def in_venv():
-    return os.path.realpath(sys.prefix) == os.path.realpath(VENV)
-
-
-if not in_venv():
-    py = os.path.join(VENV, "bin", "python")
-    if not os.path.exists(py):
-        subprocess.check_call([sys.executable, "-m", "venv", VENV])
-        subprocess.check_call([py, "-m", "pip", "install", "--quiet", "numpy", "scipy"])
-    sys.exit(subprocess.call([py, os.path.abspath(__file__)]))
 
 import numpy as np  # noqa: E402
 import scipy  # noqa: E402

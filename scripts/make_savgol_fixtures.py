@@ -11,24 +11,13 @@ re-runs itself there, and writes:
   versions.txt - the numpy and scipy versions used
 """
 import os
-import subprocess
 import sys
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-VENV = os.path.join(ROOT, "target", "savgol-venv")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fixture_venv import ROOT, reexec  # noqa: E402
+
+reexec(__file__)
 OUT = os.path.join(ROOT, "crates", "seqsmooth", "tests", "fixtures", "savgol")
-
-
-def in_venv():
-    return os.path.realpath(sys.prefix) == os.path.realpath(VENV)
-
-
-if not in_venv():
-    py = os.path.join(VENV, "bin", "python")
-    if not os.path.exists(py):
-        subprocess.check_call([sys.executable, "-m", "venv", VENV])
-        subprocess.check_call([py, "-m", "pip", "install", "--quiet", "numpy", "scipy"])
-    sys.exit(subprocess.call([py, os.path.abspath(__file__)]))
 
 import numpy as np  # noqa: E402
 import scipy  # noqa: E402

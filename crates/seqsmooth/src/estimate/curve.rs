@@ -172,7 +172,8 @@ pub struct CurveFit {
     /// from the minimum it is, in units of its own σ (at most `1e-9` unless rounding or a
     /// long curved valley stopped it first; a fit above `1e-3` is refused).
     pub correction: f64,
-    /// Model evaluations made (each Jacobian counts as one more).
+    /// Evaluations of the model: the Levenberg–Marquardt stage's residual evaluations and one a
+    /// Gauss–Newton finishing step (its values and Jacobian together).
     pub evaluations: usize,
 }
 
