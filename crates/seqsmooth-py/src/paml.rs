@@ -3,8 +3,9 @@
 //! gains (1967): `gauss_rule`, `polynomial_samples`, `OnlineSmoother`, `fit_curve`,
 //! `cramer_rao_bound`, `CurveFit`, `luenberger_gains`.
 
-use crate::arrays::{matrix, series, table};
+use crate::arrays::{series, table};
 use crate::errors::{raise, IntoPy, Kind};
+use crate::kalman::square;
 use nalgebra::DMatrix;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -410,12 +411,7 @@ pub fn cramer_rao_bound<'py>(
     let model = model(h, jac, theta.as_slice().len())?;
     let bound = curve::cramer_rao_bound(&model, theta.as_slice(), ts.as_slice(), &sigmas);
     let bound = model.result(bound)?;
-    matrix(
-        py,
-        bound.transpose().as_slice().to_vec(),
-        bound.nrows(),
-        bound.ncols(),
-    )
+    square(py, &bound)
 }
 
 /// A converged maximum-likelihood fit (``fit_curve``).
@@ -436,7 +432,7 @@ impl PyCurveFit {
     #[getter]
     fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let c = &self.inner.covariance;
-        matrix(py, c.transpose().as_slice().to_vec(), c.nrows(), c.ncols())
+        square(py, c)
     }
 
     /// The square roots of the covariance's diagonal.

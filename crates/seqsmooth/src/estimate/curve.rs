@@ -382,16 +382,13 @@ impl<M: CurveModel + ?Sized> LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, 
         self.theta.clone()
     }
 
+    /// `(h − y)/σ`: the optimiser's sign, the negated whitened residuals.
     fn residuals(&self) -> Option<DVector<f64>> {
-        let h = self.keep(self.samples.model_values(self.model, self.theta.as_slice()))?;
-        let s = self.samples;
-        Some(DVector::from_iterator(
-            h.len(),
-            h.iter()
-                .zip(s.values)
-                .zip(&s.inverse_sigmas)
-                .map(|((h, y), w)| (h - y) * w),
-        ))
+        self.keep(
+            self.samples
+                .whitened_residuals(self.model, self.theta.as_slice()),
+        )
+        .map(|r| -r)
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
