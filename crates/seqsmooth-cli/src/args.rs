@@ -252,7 +252,7 @@ Output: CSV, one row per input row in input order, with the header
 and, with --lead H (H not 0), a last column lead holding H on every row. The t and y cells \
 echo the input cells; dk is the k-th time derivative, in the input's time units, of the \
 estimate valid at t+H from the rows up to and including this one, and sk its 1-sigma error. Rows before the estimate is determined have empty d and s cells: the first M rows \
-(expanding, fading), the first W-1 rows (fixed); auto estimates from the first row on.
+(expanding, fading), the first W-1 rows (fixed); auto gives no estimate without its sigma: from the first row with --sigma, else from row M+6 (the noise cell empty before: not estimated yet).
 
 fixed: the least-squares polynomial through the last W rows, on any timestamps (Morrison's \
 sliding O(M^2) recursion while the times are evenly spaced, a refit of the window from the \
@@ -265,8 +265,8 @@ auto: the automatic filter (Morrison 13.8, 14.8; Reyneke et al. 7): expanding me
 then fading memory with the discount T per TAU; it starts at degree 0 and steps up to M as the \
 data determine each degree (the d and s cells above the degree reached so far are empty). noise \
 is the noise sigma in use: S given with --sigma, otherwise the running estimate from the \
-(M+1)-th differences of the accepted samples (empty until it has 5 terms); s0..sM come from it \
-(empty while there is none). outlier is 1 when the row's sample is rejected, else 0: the final \
+(M+1)-th differences of the accepted samples (empty until it has 5 terms); s0..sM come from it, \
+and while it is empty so are d0..dM (no estimate is written without its sigma). outlier is 1 when the row's sample is rejected, else 0: the final \
 decision, made once N more accepted samples of the series are in (--review-window N, default \
 M+4; the end of the input decides the last rows), by the smaller-variance judge of two: the \
 3-sigma gate on the 1-step prediction, or the sample's residual against a degree M+1 \

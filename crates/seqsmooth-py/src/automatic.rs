@@ -84,8 +84,9 @@ impl PyAutomaticFilter {
 
     /// Takes the samples ``(t[i], y[i])`` and returns, per sample, what ``seqsmooth filter
     /// --kind auto`` writes: a dict of numpy arrays ``d`` and ``s`` (``(n, m+1)``: the
-    /// estimate at ``t[i]`` of the active degree and its 1σ, NaN above that degree or before
-    /// the filter is determined), ``noise`` (the σ in use), ``bias`` (the estimated bias of
+    /// estimate at ``t[i]`` of the active degree and its 1σ, NaN above that degree, before
+    /// the filter is determined, and while ``noise`` is NaN: no estimate is given without its
+    /// σ), ``noise`` (the σ in use, NaN until estimated), ``bias`` (the estimated bias of
     /// ``d0``), ``degree`` (the active degree), and the flags ``outlier`` (the decision at the
     /// update: see :meth:`finish` for the final ones) and ``misfit``.
     fn update_many<'py>(

@@ -190,6 +190,51 @@ impl TriangularFactor {
         true
     }
 
+    /// `z = (RᵀR)⁻¹ h` into `z` (`UᵀDU z = h`: a forward and a back substitution, no
+    /// allocation), returning `hᵀ z = Σ g_i²/d_i` (`Uᵀ g = h`); `None` while not determined.
+    pub(crate) fn solve_gram(&self, h: &[f64], z: &mut [f64]) -> Option<f64> {
+        if !self.is_determined() {
+            return None;
+        }
+        let p = self.dim();
+        let u = &self.u[..p * p];
+        let mut quad = 0.0;
+        // Uᵀ g = h (unit lower triangular), then w = g/d into z.
+        for i in 0..p {
+            let mut g = h[i];
+            for k in 0..i {
+                g -= u[k * p + i] * z[k];
+            }
+            z[i] = g;
+        }
+        for i in 0..p {
+            let d = self.d[i].0;
+            quad += z[i] * z[i] / d;
+            z[i] /= d;
+        }
+        // U z = w (unit upper triangular).
+        for i in (0..p).rev() {
+            let mut s = z[i];
+            for j in i + 1..p {
+                s -= u[i * p + j] * z[j];
+            }
+            z[i] = s;
+        }
+        Some(quad)
+    }
+
+    /// `‖R z‖² = Σ d_i (U z)_i²` (no allocation, no square roots).
+    pub(crate) fn norm_sq_of(&self, z: &[f64]) -> f64 {
+        let p = self.dim();
+        let u = &self.u[..p * p];
+        (0..p)
+            .map(|i| {
+                let s = z[i] + (i + 1..p).map(|j| u[i * p + j] * z[j]).sum::<f64>();
+                self.d[i].0 * s * s
+            })
+            .sum()
+    }
+
     /// Folds the row `√c·[a | b]` into `[R | d]`: `O(p²)`, no square roots.
     pub fn add_row(&mut self, a: &[f64], b: f64, weight: f64) {
         let p = self.dim();

@@ -359,6 +359,19 @@ impl InformationFilter {
         self.covariance_of(&DMatrix::identity(p, p))
     }
 
+    /// The variance `hᵀ C h` of one linear combination `hᵀx` of the estimate
+    /// ([`covariance_of`](Self::covariance_of) for one row, without allocating: `z` is
+    /// scratch of the state's dimension); `None` while not determined.
+    pub(crate) fn variance_of_row(&self, h: &[f64], z: &mut [f64]) -> Option<f64> {
+        let quad = self.info.solve_gram(h, z)?;
+        Some(match &self.spread {
+            // Stored R is s·R: hᵀ(RᵀR)⁻¹h = s²·quad.
+            None => quad * (self.scale * self.scale),
+            // ‖Q (RᵀR)⁻¹ h‖², Q stored times s², (RᵀR)⁻¹ divided by s²: the scale cancels.
+            Some(q) => q.norm_sq_of(z),
+        })
+    }
+
     /// The covariance of `J x`: `J C Jᵀ` for the estimate's covariance `C`
     /// ([`covariance`](Self::covariance)), without forming `C`.
     ///

@@ -83,6 +83,25 @@ pub(super) fn significant_bias(
     )
 }
 
+/// The position's bias from the positions `(x, v)` of a filter and `(x₊, v₊)` of its
+/// degree-`(d+1)` companion at the same time (their unit variances `v`): [`significant_bias`]
+/// of the position alone, `sign(Δ) √(Δ² − σ²(v₊ − v))` where `|Δ|` exceeds `z` of its noise
+/// standard deviations, else 0.
+pub(super) fn position_bias((x, v): (f64, f64), (xu, vu): (f64, f64), sigma: f64, z: f64) -> f64 {
+    let delta = x - xu;
+    let var = sigma * sigma * (vu - v).max(0.0);
+    let b = if delta * delta > z * z * var {
+        (delta * delta - var).sqrt()
+    } else {
+        0.0
+    };
+    if b.is_finite() {
+        b.copysign(delta)
+    } else {
+        0.0
+    }
+}
+
 impl AutomaticFilter {
     /// The filter of the active degree plus one on the active filter's memory: the next rung of
     /// the ladder, or the companion of the final degree's memory in use.
@@ -106,6 +125,43 @@ impl AutomaticFilter {
             b[0] = floor.copysign(b[0]);
         }
         Some(b)
+    }
+
+    /// The active filter's position at `t` and its unit variance, without allocating.
+    pub(super) fn active_position(&self, t: f64) -> Option<(f64, f64)> {
+        if self.active < self.cfg.degree {
+            self.ladder[self.active].as_ref()?.position_at(t)
+        } else {
+            self.memory_position(self.memory, t)
+        }
+    }
+
+    /// The position at `t` of the active filter's companion ([`companion`](Self::companion)).
+    fn companion_position(&self, t: f64) -> Option<(f64, f64)> {
+        let c = self.active + 1;
+        if self.active == self.cfg.degree {
+            self.memory_companion_position(self.memory, t)
+        } else if c < self.cfg.degree {
+            self.ladder[c].as_ref()?.position_at(t)
+        } else {
+            self.memory_position(self.memory, t)
+        }
+    }
+
+    /// The position bias `b₀` of the active filter's position `(x, v)` at `t` (the first entry
+    /// of [`bias_of`](Self::bias_of), without allocating): 0 while the companion is not
+    /// determined.
+    pub(super) fn position_bias_of(&self, position: (f64, f64), t: f64, sigma: f64) -> f64 {
+        let Some(upper) = self.companion_position(t) else {
+            return 0.0;
+        };
+        let b = position_bias(position, upper, sigma, SIGNIFICANCE);
+        let floor = self.excess.sqrt();
+        if b.abs() < floor {
+            floor.copysign(b)
+        } else {
+            b
+        }
     }
 
     /// The prediction's position bias `b₀` raised by the current run of rejections: a

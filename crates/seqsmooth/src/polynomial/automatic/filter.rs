@@ -8,7 +8,7 @@ use super::memory::{shorter_memories, Shorter};
 use super::misfit::{Kept, MisfitResponse};
 use super::noise::{NoiseSource, NoiseState};
 use super::outlier::OutlierRule;
-use super::output::AutoOutput;
+use super::output::{AutoOutput, Withheld};
 use super::phase::Phase;
 use super::review::Review;
 use crate::error::Error;
@@ -81,7 +81,7 @@ pub struct AutomaticFilter {
     pub(super) restarts: u64,
     pub(super) last_restart: Option<u64>,
     last_time: Option<f64>,
-    noise: NoiseState,
+    pub(super) noise: NoiseState,
     pub(super) chi: InnovationChiSquared,
     pub(super) restart_test: Option<InnovationChiSquared>,
     /// The newest accepted samples (for a restart).
@@ -246,9 +246,12 @@ impl AutomaticFilter {
     /// let mut f = AutomaticFilter::new(2, 0.95, 0.5).unwrap();
     /// let out = f.update(0.0, 1.0).unwrap();
     /// assert_eq!(out.degree, 0);                       // the ladder starts at degree 0
-    /// assert_eq!(out.derivatives(), Some(&[1.0][..]));
-    /// assert!(out.noise_sigma.is_none());               // not estimated yet
+    /// assert!(out.noise_sigma.is_none());               // not estimated yet: no estimate
+    /// assert!(out.estimate.is_none() && out.withheld.is_some());
+    /// let mut f = AutomaticFilter::new(2, 0.95, 0.5)?.with_noise_sigma(0.1)?;
+    /// assert_eq!(f.update(0.0, 1.0)?.derivatives(), Some(&[1.0][..])); // σ given
     /// assert!(matches!(AutomaticFilter::new(2, 1.5, 1.0), Err(Error::ThetaOutOfRange { .. })));
+    /// # Ok::<(), Error>(())
     /// ```
     pub fn new(m: usize, theta: f64, tau: f64) -> Result<Self, Error> {
         Self::build(AutoConfig::new(m, theta, tau))
@@ -683,6 +686,13 @@ impl AutomaticFilter {
     /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_start_degree(1).unwrap();
     /// f.update(0.0, 1.0).unwrap();
     /// f.update(1.0, 3.0).unwrap();
+    /// assert!(f.estimate_at(2.0).is_none()); // σ not known yet: no estimate without it
+    /// let mut f = f.clone().with_noise_sigma(0.1);
+    /// assert!(f.is_err()); // the settings are fixed once started
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_start_degree(1).unwrap();
+    /// let mut f = f.with_noise_sigma(0.1).unwrap();
+    /// f.update(0.0, 1.0).unwrap();
+    /// f.update(1.0, 3.0).unwrap();
     /// assert!((f.estimate_at(2.0).unwrap().derivatives[0] - 5.0).abs() < 1e-12);
     /// ```
     pub fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
@@ -709,14 +719,31 @@ impl AutomaticFilter {
     /// ```
     pub fn try_estimate_at(&self, t: f64) -> Result<PolynomialState, Error> {
         let s = self.active_filter().try_estimate_at(t)?;
+        self.check_sigma()?;
         self.honest(s).0.checked()
+    }
+
+    /// No estimate without its σ: [`Error::NotDetermined`] naming [`Withheld::NoiseUnknown`]'s
+    /// reason while `σ` is neither given nor estimated yet.
+    fn check_sigma(&self) -> Result<(), Error> {
+        match self.noise_sigma() {
+            Some(_) => Ok(()),
+            None => Err(Error::NotDetermined {
+                samples: self.accepted,
+                why: format!(
+                    "{}: the estimate is given with its σ, after {} samples",
+                    Withheld::NoiseUnknown.reason(),
+                    Withheld::noise_samples(self.cfg.degree)
+                ),
+            }),
+        }
     }
 
     /// The estimate at the newest accepted sample.
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_noise_sigma(0.5).unwrap();
     /// assert!(f.estimate().is_none());
     /// f.update(0.0, 1.0).unwrap();
     /// assert_eq!(f.estimate().unwrap().derivatives, vec![1.0]);
@@ -729,6 +756,7 @@ impl AutomaticFilter {
     /// ([`try_estimate_at`](Self::try_estimate_at)).
     pub fn try_estimate(&self) -> Result<PolynomialState, Error> {
         let s = self.active_filter().try_estimate()?;
+        self.check_sigma()?;
         self.honest(s).0.checked()
     }
 
@@ -773,9 +801,10 @@ impl AutomaticFilter {
     pub fn update(&mut self, t: f64, y: f64) -> Result<AutoOutput, Error> {
         crate::error::check_sample(t, y, self.last_time)?;
         // With the input checked, the steps below cannot fail on the data; should an internal
-        // step still fail, restore the state so that an error never leaves a half update. The
-        // state before the sample is also what its review may go back to.
-        let before = self.snapshot();
+        // step still fail, go back to the state before the sample so that an error never
+        // leaves a half update ([`Self::recover`]). The state before one sample in eight is
+        // kept: what its review may go back to.
+        let before = self.review.keeps_next().then(|| self.snapshot());
         match self.step(t, y, None) {
             Ok(out) => {
                 let out = self.review(t, y, out, before);
@@ -783,7 +812,7 @@ impl AutomaticFilter {
                 Ok(out)
             }
             Err(e) => {
-                self.restore(*before);
+                self.recover(before);
                 Err(e)
             }
         }
@@ -876,18 +905,23 @@ impl AutomaticFilter {
         } else {
             self.active_filter().estimate()
         };
-        // Right or refused: an estimate with a number beyond the double range is none
-        // (`try_estimate_at` names it).
-        let (estimate, bias) = match raw.map(|s| self.honest(s)) {
-            Some((s, b)) => match s.checked() {
-                Ok(s) => (Some(s), b.filter(|b| b.iter().all(|v| v.is_finite()))),
-                Err(_) => (None, None),
-            },
-            None => (None, None),
+        // Right or refused: no estimate without its σ, and an estimate with a number beyond
+        // the double range is none (`try_estimate_at` names it); `withheld` says which.
+        let (estimate, bias, withheld) = match (raw, self.noise_sigma()) {
+            (_, None) => (None, None, Some(Withheld::NoiseUnknown)),
+            (None, _) => (None, None, Some(Withheld::NotDetermined)),
+            (Some(raw), Some(_)) => {
+                let (s, b) = self.honest(raw);
+                match s.checked() {
+                    Ok(s) => (Some(s), b.filter(|b| b.iter().all(|v| v.is_finite())), None),
+                    Err(_) => (None, None, Some(Withheld::OutOfRange)),
+                }
+            }
         };
         Ok(AutoOutput {
             time: t,
             estimate,
+            withheld,
             degree: self.active,
             phase: self.phase(),
             noise_sigma: self.noise_sigma(),
@@ -910,12 +944,9 @@ impl AutomaticFilter {
     fn judge(&mut self, t: f64, y: f64) -> Judged {
         self.choose_memory(t);
         let sigma = self.noise_sigma();
-        let prediction = self.active_filter().estimate_at(t);
-        let (innovation, vrf) = match &prediction {
-            Some(p) => (
-                Some(y - p.derivatives[0]),
-                p.covariance.as_ref().map(|c| c[(0, 0)].max(0.0)),
-            ),
+        let prediction = self.active_position(t);
+        let (innovation, vrf) = match prediction {
+            Some((x, v)) => (Some(y - x), Some(v.max(0.0))),
             None => (None, None),
         };
         self.excess = match (sigma, vrf) {
@@ -923,8 +954,8 @@ impl AutomaticFilter {
             _ => 0.0,
         };
         // The prediction's estimated bias: the honest innovation variance σ²(1 + v) + b₀².
-        let bias0 = match (&prediction, sigma) {
-            (Some(p), Some(s)) => self.bias_of(p, s).map_or(0.0, |b| b[0]),
+        let bias0 = match (prediction, sigma) {
+            (Some(p), Some(s)) => self.position_bias_of(p, t, s),
             _ => 0.0,
         };
         let bias0 = self.with_pending(bias0, innovation, sigma);
@@ -1073,7 +1104,8 @@ impl PolynomialFilter for AutomaticFilter {
     fn estimate(&self) -> Option<PolynomialState> {
         AutomaticFilter::estimate(self)
     }
+    /// The active filter is determined and `σ` is known (no estimate without its σ).
     fn is_determined(&self) -> bool {
-        self.active_filter().is_determined()
+        self.active_filter().is_determined() && self.noise_sigma().is_some()
     }
 }

@@ -22,7 +22,7 @@
 //! are fading from the first sample (exact discounted least squares, on the exact engine always); a
 //! restart rebuilds them all from the onset.
 
-use super::bias::significant_bias;
+use super::bias::position_bias;
 use super::filter::{unit_fading_on, upper_degree, AutomaticFilter};
 use super::misfit::MisfitResponse;
 #[cfg(doc)]
@@ -94,6 +94,27 @@ impl AutomaticFilter {
         }
     }
 
+    /// The position at `t` and its unit variance from memory `j`'s filter, without allocating.
+    pub(super) fn memory_position(&self, j: usize, t: f64) -> Option<(f64, f64)> {
+        match (j, &self.expanding, self.switched) {
+            (0, Some(e), false) => e.position_at(t),
+            (0, _, _) => self.fading.position_at(t),
+            _ => self.shorter[j - 1].fading.position_at(t),
+        }
+    }
+
+    /// The position at `t` and its unit variance from memory `j`'s companion.
+    pub(super) fn memory_companion_position(&self, j: usize, t: f64) -> Option<(f64, f64)> {
+        if j > 0 {
+            return self.shorter[j - 1].upper.position_at(t);
+        }
+        match (&self.upper_expanding, &self.upper_fading, self.switched) {
+            (Some(e), _, false) => e.position_at(t),
+            (_, Some(f), _) => f.position_at(t),
+            _ => None,
+        }
+    }
+
     /// The degree `m + 1` companion of memory `j`.
     pub(super) fn memory_companion(&self, j: usize) -> Option<&dyn PolynomialFilter> {
         if j > 0 {
@@ -127,26 +148,21 @@ impl AutomaticFilter {
         self.predictions.clear();
         self.predictions.resize(self.shorter.len() + 1, None);
         for j in 0..=self.shorter.len() {
-            let Some(est) = self.memory_filter(j).estimate_at(t) else {
+            let Some(est) = self.memory_position(j, t) else {
                 continue;
             };
-            let Some(v) = est.covariance.as_ref().map(|c| c[(0, 0)].max(0.0)) else {
-                continue;
-            };
-            let upper = self.memory_companion(j).and_then(|c| c.estimate_at(t));
-            let b0 = match &upper {
-                Some(u) => {
-                    significant_bias(&est, u, sigma, CHOICE_SIGNIFICANCE).map_or(0.0, |b| b[0])
-                }
+            let upper = self.memory_companion_position(j, t);
+            let (b0, honest) = match upper {
+                Some(u) => (
+                    position_bias(est, u, sigma, CHOICE_SIGNIFICANCE),
+                    position_bias(est, u, sigma, 1.0),
+                ),
                 // Memory 0 without its companion yet: its noise only; a shorter one: not yet.
-                None if j == 0 => 0.0,
+                None if j == 0 => (0.0, 0.0),
                 None => continue,
             };
-            let honest = upper
-                .as_ref()
-                .and_then(|u| super::bias::difference_bias(&est, u, sigma))
-                .map_or(0.0, |b| b[0]);
-            self.predictions[j] = Some((est.derivatives[0], s2 * (1.0 + v) + honest * honest));
+            let (x, v) = (est.0, est.1.max(0.0));
+            self.predictions[j] = Some((x, s2 * (1.0 + v) + honest * honest));
             let mse = s2 * v + b0 * b0;
             if mse.is_finite() && mse < best.0 {
                 best = (mse, j);

@@ -186,6 +186,6 @@ pub use filter::AutomaticFilter;
 pub use misfit::MisfitResponse;
 pub use noise::{NoiseSource, MIN_NOISE_TERMS};
 pub use outlier::{OutlierRule, MORRISON_K, REYNEKE_DEFAULT_K};
-pub use output::{final_outliers, AutoOutput};
+pub use output::{final_outliers, AutoOutput, Withheld};
 pub use phase::Phase;
 pub use review::MAX_REVIEW_WINDOW;

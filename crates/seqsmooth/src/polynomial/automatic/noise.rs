@@ -119,8 +119,96 @@ impl WindowedMean {
 #[derive(Clone, Debug)]
 pub(super) enum NoiseState {
     Known(f64),
-    Differences(DifferenceNoise),
+    Differences(DifferenceNoise, Early),
     Innovations(WindowedMean),
+}
+
+/// The accepted samples whose differences the start-up estimate screens at once ([`Early`]).
+pub(super) const EARLY_SAMPLES: usize = 40;
+
+/// The mean of `χ²₁` below its 80% quantile (the trimmed reference of [`Early`]).
+const CHI2_1_TRIMMED_MEAN: f64 = 0.437_724_6;
+
+/// The difference estimate over the first [`EARLY_SAMPLES`] accepted samples, screened against
+/// a reference from all of them at once. The running estimate screens each difference against
+/// the differences before it, so an outlier among the first few samples — before there is a
+/// reference — enters up to `m + 2` of its first terms and inflates `σ̂` (an 8σ outlier in
+/// the first 5 terms of third differences: `σ̂ ≈ 3.7σ`), and with it every gate and every review
+/// of the start-up, which then pass it. Here every early difference is screened at `|d| > c σ̂₀`
+/// (and the `m + 1` after it, which share its samples), `σ̂₀²` the mean of the smallest 80% of
+/// the early squared differences over its Gaussian value (robust while under a fifth of the
+/// terms are an outlier's), the kept ones divided by the truncated variance. Once the review
+/// rejects the outlier, the filter takes the samples again without it, and the running estimate
+/// is clean too.
+#[derive(Clone, Debug)]
+pub(super) struct Early {
+    /// The screen `c` ([`AutoConfig::noise_screen`](super::AutoConfig::noise_screen)).
+    screen: f64,
+    /// `(t, y, variance factor)` of the first accepted samples, until [`EARLY_SAMPLES`].
+    samples: Vec<(f64, f64, f64)>,
+    /// The estimate from them, once it has [`MIN_NOISE_TERMS`] terms.
+    sigma: Option<f64>,
+    done: bool,
+}
+
+impl Early {
+    fn new(screen: f64) -> Self {
+        Self {
+            screen,
+            samples: Vec::new(),
+            sigma: None,
+            done: false,
+        }
+    }
+
+    /// Adds an accepted sample; recomputes the early estimate of differences of order `k`.
+    fn push(&mut self, t: f64, y: f64, factor: f64, k: usize) -> Result<(), Error> {
+        let c = self.screen;
+        if self.done {
+            return Ok(());
+        }
+        self.samples.push((t, y, factor));
+        if self.samples.len() > EARLY_SAMPLES {
+            self.done = true;
+            self.samples = Vec::new();
+            self.sigma = None;
+            return Ok(());
+        }
+        // Each squared difference over its expected value: an estimator of one term.
+        let mut probe = DifferenceNoise::new(k, Some(1))?;
+        let mut terms = Vec::with_capacity(self.samples.len());
+        for &(t, y, f) in &self.samples {
+            probe.push_with_variance_factor(t, y, f)?;
+            if let Some(v) = probe.variance() {
+                terms.push(v);
+            }
+        }
+        if terms.len() < MIN_NOISE_TERMS {
+            return Ok(());
+        }
+        let mut sorted = terms.clone();
+        sorted.sort_by(f64::total_cmp);
+        let kept = ((sorted.len() * 4) / 5).max(3);
+        let reference = sorted[..kept].iter().sum::<f64>() / kept as f64 / CHI2_1_TRIMMED_MEAN;
+        let (mut sum, mut n, mut holdoff) = (0.0, 0usize, 0usize);
+        for d2 in terms {
+            if holdoff > 0 {
+                holdoff -= 1;
+            } else if c.is_finite() && d2 > c * c * reference {
+                holdoff = k;
+            } else {
+                sum += d2;
+                n += 1;
+            }
+        }
+        let truncation = if c.is_finite() {
+            truncated_variance(c)
+        } else {
+            1.0
+        };
+        self.sigma = (n > 0 && sum > 0.0).then(|| (sum / n as f64 / truncation).sqrt());
+        Ok(())
+    }
 }
 
 impl NoiseState {
@@ -135,12 +223,20 @@ impl NoiseState {
         Ok(match (sigma, source) {
             (Some(s), _) => NoiseState::Known(s),
             (None, NoiseSource::Differences { window }) => {
-                NoiseState::Differences(DifferenceNoise::new(m + 1, window)?.with_screen(screen)?)
+                let d = DifferenceNoise::new(m + 1, window)?.with_screen(screen)?;
+                NoiseState::Differences(d, Early::new(screen))
             }
             (None, NoiseSource::Innovations { window }) => {
                 NoiseState::Innovations(WindowedMean::new(window))
             }
         })
+    }
+
+    /// True while the difference estimate is the start-up one ([`Early`]): the review waits
+    /// for the first [`EARLY_SAMPLES`] accepted samples before it decides, so that one or two
+    /// outliers among the first samples are judged against a `σ̂` screened of them.
+    pub(super) fn is_early(&self) -> bool {
+        matches!(self, NoiseState::Differences(_, e) if !e.done)
     }
 
     /// True when the estimate is built from the final-degree filter's innovations (the caller
@@ -153,13 +249,8 @@ impl NoiseState {
     pub(super) fn sigma(&self) -> Option<f64> {
         match self {
             NoiseState::Known(s) => Some(*s),
-            NoiseState::Differences(d) => {
-                if d.len() >= MIN_NOISE_TERMS {
-                    d.sigma()
-                } else {
-                    None
-                }
-            }
+            NoiseState::Differences(_, e) if !e.done => e.sigma,
+            NoiseState::Differences(d, _) => d.sigma(),
             NoiseState::Innovations(w) => {
                 if w.count >= MIN_NOISE_TERMS {
                     w.mean().map(f64::sqrt)
@@ -191,12 +282,13 @@ impl NoiseState {
                     w.push(term / truncation.map_or(1.0, |(a, _)| truncated_variance(a)));
                 }
             }
-            NoiseState::Differences(d) => {
+            NoiseState::Differences(d, early) => {
                 // A gated sample's own noise e has E{e² | |ν| ≤ aσ_ε} = σ²(c(a) + v)/(1 + v),
                 // with c(a) the truncated unit variance (e = ν/(1+v) + an independent part).
                 let factor =
                     truncation.map_or(1.0, |(a, v)| (truncated_variance(a) + v) / (1.0 + v));
                 d.push_with_variance_factor(t, y, factor)?;
+                early.push(t, y, factor, d.order())?;
             }
         }
         Ok(())

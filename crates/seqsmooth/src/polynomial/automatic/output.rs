@@ -32,8 +32,12 @@ pub struct AutoOutput {
     /// The estimate at `time`: derivatives `x … x^(d)` of the active degree `d`, with their
     /// mean squared error matrix `σ² V + b bᵀ` when `σ` is known or estimated (the noise's
     /// covariance plus the estimated bias [`bias`](Self::bias), see the module docs). After a
-    /// rejected sample, the prediction across it. `None` until the active filter is determined.
+    /// rejected sample, the prediction across it. `None`, with the reason in
+    /// [`withheld`](Self::withheld), until the active filter is determined and `σ` is known: no
+    /// estimate is given without its σ.
     pub estimate: Option<PolynomialState>,
+    /// Why [`estimate`](Self::estimate) is `None` (`None` when there is an estimate).
+    pub withheld: Option<Withheld>,
     /// The active degree `d` (the final degree once settled).
     pub degree: usize,
     /// Which filter is active.
@@ -86,7 +90,7 @@ impl AutoOutput {
     ///
     /// ```
     /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap();
+    /// let mut f = AutomaticFilter::new(1, 0.9, 1.0).unwrap().with_noise_sigma(0.5).unwrap();
     /// assert_eq!(f.update(0.0, 4.0).unwrap().derivatives(), Some(&[4.0][..])); // degree 0 first
     /// ```
     pub fn derivatives(&self) -> Option<&[f64]> {
@@ -103,6 +107,56 @@ impl AutoOutput {
     /// ```
     pub fn std_devs(&self) -> Option<Vec<f64>> {
         self.estimate.as_ref().and_then(|s| s.std_devs())
+    }
+}
+
+/// Why an [`AutoOutput`] has no estimate: the automatic filter gives an estimate only with its
+/// σ (the mean squared error `σ² V + b bᵀ`, see the module docs), or none with the reason.
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::{AutomaticFilter, Withheld, MIN_NOISE_TERMS};
+/// let mut f = AutomaticFilter::new(2, 0.9, 1.0).unwrap(); // σ estimated
+/// let outs: Vec<_> = (0..12).map(|n| f.update(n as f64, (n * n % 7) as f64).unwrap()).collect();
+/// // σ from the third differences needs MIN_NOISE_TERMS of them: 3 + 5 = 8 samples
+/// assert_eq!(Withheld::noise_samples(2), 3 + MIN_NOISE_TERMS);
+/// assert!(outs[..7].iter().all(|o| o.estimate.is_none() && o.withheld == Some(Withheld::NoiseUnknown)));
+/// assert!(outs[7..].iter().all(|o| o.withheld.is_none() && o.std_devs().is_some()));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Withheld {
+    /// The noise `σ` is not given and not estimated yet: the `(m+1)`-th differences need
+    /// [`MIN_NOISE_TERMS`](super::MIN_NOISE_TERMS) terms, `m + 1 +` that many samples
+    /// ([`noise_samples`](Self::noise_samples)); give `σ` to have estimates from the first
+    /// sample.
+    NoiseUnknown,
+    /// The active filter's fit is not determined (too few samples, or singular in doubles).
+    NotDetermined,
+    /// A number of the estimate or its covariance is beyond the double range
+    /// ([`AutomaticFilter::try_estimate`](super::AutomaticFilter::try_estimate) names it).
+    OutOfRange,
+}
+
+impl Withheld {
+    /// The accepted samples after which [`Withheld::NoiseUnknown`] ends for final degree `m`
+    /// with the default noise source (the innovations' source needs as many).
+    pub fn noise_samples(m: usize) -> usize {
+        m + 1 + super::MIN_NOISE_TERMS
+    }
+
+    /// The reason in words.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::automatic::Withheld;
+    /// assert!(Withheld::NoiseUnknown.reason().contains("σ"));
+    /// ```
+    pub fn reason(&self) -> &'static str {
+        match self {
+            Withheld::NoiseUnknown => {
+                "the noise σ is not known yet (give it, or wait for its estimate)"
+            }
+            Withheld::NotDetermined => "the fit is not determined yet",
+            Withheld::OutOfRange => "a number of the estimate is beyond the double range",
+        }
     }
 }
 

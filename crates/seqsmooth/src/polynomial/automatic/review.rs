@@ -33,7 +33,8 @@ use super::output::AutoOutput;
 #[cfg(doc)]
 use super::AutoConfig;
 use crate::error::Error;
-use crate::estimate::PolynomialFit;
+use crate::polynomial::options::MAX_DEGREE;
+use crate::recursive::TriangularFactor;
 use std::collections::VecDeque;
 
 /// The most samples waiting for their decision after an update; beyond it the oldest keeps the
@@ -122,22 +123,26 @@ impl Review {
     /// Takes the newest sample with the gate's verdict in `out` and the state before it (kept
     /// for one sample in [`SNAPSHOT_EVERY`]); the `out.reinstated` newest rejections waiting
     /// before it were applied after all.
-    fn push(&mut self, t: f64, y: f64, out: &AutoOutput, before: Box<AutomaticFilter>) {
+    fn push(&mut self, t: f64, y: f64, out: &AutoOutput, before: Option<Box<AutomaticFilter>>) {
         self.reinstate(out.reinstated);
-        let keep = self
-            .entries
-            .iter()
-            .rev()
-            .take(SNAPSHOT_EVERY - 1)
-            .all(|e| e.before.is_none());
         self.entries.push_back(Entry {
             t,
             y,
             rejected: out.outlier,
             decided: false,
             gate_rms: gate_rms(out),
-            before: keep.then_some(before),
+            before,
         });
+    }
+
+    /// Whether the next sample keeps the state before it: one in [`SNAPSHOT_EVERY`], and the
+    /// first one waiting (the state is taken only then, not at every sample).
+    pub(super) fn keeps_next(&self) -> bool {
+        self.entries
+            .iter()
+            .rev()
+            .take(SNAPSHOT_EVERY - 1)
+            .all(|e| e.before.is_none())
     }
 
     /// The newest `n` rejected samples waiting (a run just applied) are not rejected.
@@ -163,16 +168,84 @@ impl Review {
 }
 
 /// The newest `n` of `entries` rejected and waiting are not rejected (a run just applied).
+/// The gate did not pass them: it judged them against a model the run says no longer fits
+/// (Morrison §14.8), so its verdict does not stand for them; the interpolation decides.
 fn reinstate<'a>(entries: impl DoubleEndedIterator<Item = &'a mut Entry>, n: usize) {
     for e in entries.rev().filter(|e| !e.decided && e.rejected).take(n) {
         e.rejected = false;
+        e.gate_rms = None;
     }
 }
 
-/// `σ_ε` of the innovation the gate judged in `out`, when the gate was on.
+/// `σ_ε` of the innovation the gate judged in `out`, when the gate was on and passed it (a
+/// sample that ends a run of rejections, applied as a manoeuvre, was not passed: see
+/// [`reinstate`]).
 fn gate_rms(out: &AutoOutput) -> Option<f64> {
-    out.gate.and(out.innovation_sigma)
+    out.gate
+        .and(out.innovation_sigma)
+        .filter(|_| !out.manoeuvre)
 }
+
+/// A least-squares polynomial through the samples of a review window: the square-root-free
+/// QR factor of the rows `(1, u, …, u^d)`, `u = (t − c)/h` centred and scaled on the window
+/// (so `|u| ≤ 1`), without allocating beyond the factor.
+struct WindowFit {
+    factor: TriangularFactor,
+    centre: f64,
+    inv_half: f64,
+    degree: usize,
+}
+
+impl WindowFit {
+    /// The fit of degree `d` through `(ts, ys)` (at least `d + 1` distinct times); `None` when
+    /// it is not determined.
+    fn new(ts: &[f64], ys: &[f64], degree: usize) -> Option<Self> {
+        let (lo, hi) = ts
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
+                (a.min(t), b.max(t))
+            });
+        let half = 0.5 * (hi - lo);
+        let mut fit = Self {
+            factor: TriangularFactor::new(degree + 1),
+            centre: 0.5 * (lo + hi),
+            inv_half: if half > 0.0 { 1.0 / half } else { 1.0 },
+            degree,
+        };
+        for (&t, &y) in ts.iter().zip(ys) {
+            fit.factor
+                .add_row_powers((t - fit.centre) * fit.inv_half, y, 1.0);
+        }
+        fit.factor.is_determined().then_some(fit)
+    }
+
+    /// `p(t)` and its variance for unit noise `h(t)ᵀ(AᵀA)⁻¹h(t)`.
+    fn value_and_vrf_at(&self, t: f64) -> Option<(f64, f64)> {
+        let p = self.degree + 1;
+        let u = (t - self.centre) * self.inv_half;
+        let mut a = [0.0; MAX_FIT];
+        let mut h = [0.0; MAX_FIT];
+        let mut z = [0.0; MAX_FIT];
+        if !self.factor.solve_into(&mut a[..p]) {
+            return None;
+        }
+        let mut power = 1.0;
+        for hk in &mut h[..p] {
+            *hk = power;
+            power *= u;
+        }
+        let value = a[..p].iter().zip(&h[..p]).map(|(a, h)| a * h).sum();
+        let vrf = self.factor.solve_gram(&h[..p], &mut z[..p])?;
+        Some((value, vrf))
+    }
+
+    fn residual_sq(&self) -> f64 {
+        self.factor.residual_sq()
+    }
+}
+
+/// The most coefficients of a [`WindowFit`]: degree `MAX_DEGREE + 2`.
+const MAX_FIT: usize = MAX_DEGREE + 3;
 
 /// The verdict on `(t, y)` from the samples around it (`true`: an outlier) and the root mean
 /// square of the deleted residual it judged, `√(σ²(1 + v_p) + b²)`; `None` when the fit cannot
@@ -186,37 +259,43 @@ pub(super) fn interpolation_verdict(
     calibration: &mut Calibration,
 ) -> Option<(bool, f64)> {
     let (mut ts, mut ys): (Vec<f64>, Vec<f64>) = around.iter().copied().unzip();
-    let mut fit = PolynomialFit::new(&ts, &ys, None, degree).ok()?;
+    let mut fit = WindowFit::new(&ts, &ys, degree)?;
     for _ in 0..2 {
         if ts.len() < degree + 4 {
             break;
         }
-        let worst = (0..ts.len())
-            .map(|j| {
-                let (p, h) = fit.value_and_vrf_at(ts[j]);
-                let r = ys[j] - p;
-                (r.abs() / (sigma * (1.0 - h).max(f64::EPSILON).sqrt()), j)
-            })
-            .max_by(|a, b| a.0.total_cmp(&b.0))?;
-        if worst.0.is_nan() || worst.0 <= k {
+        let mut worst = (f64::NEG_INFINITY, 0);
+        for j in 0..ts.len() {
+            let (p, h) = fit.value_and_vrf_at(ts[j])?;
+            let r = (ys[j] - p).abs() / (sigma * (1.0 - h).max(f64::EPSILON).sqrt());
+            if r.is_nan() {
+                return None;
+            }
+            if r > worst.0 {
+                worst = (r, j);
+            }
+        }
+        if worst.0 <= k {
             break;
         }
         ts.remove(worst.1);
         ys.remove(worst.1);
-        fit = PolynomialFit::new(&ts, &ys, None, degree).ok()?;
+        fit = WindowFit::new(&ts, &ys, degree)?;
     }
-    let (p, v) = fit.value_and_vrf_at(t);
+    let (p, v) = fit.value_and_vrf_at(t)?;
     let v = v.max(0.0);
     // The fit's bias at t, from one degree up on the same samples (nested least squares:
     // E{Δ²} = b² + σ²(v₊ − v), as for the filter's own bias).
-    let b2 = match PolynomialFit::new(&ts, &ys, None, degree + 1) {
-        Ok(up) if ts.len() >= degree + 3 => {
-            let (pu, vu) = up.value_and_vrf_at(t);
+    let up = (ts.len() >= degree + 3)
+        .then(|| WindowFit::new(&ts, &ys, degree + 1))
+        .flatten()
+        .and_then(|up| up.value_and_vrf_at(t));
+    let b2 = match up {
+        Some((pu, vu)) => {
             let d = p - pu;
-            let vu = vu.max(0.0);
-            (d * d - sigma * sigma * (vu - v).max(0.0)).max(0.0)
+            (d * d - sigma * sigma * (vu.max(0.0) - v).max(0.0)).max(0.0)
         }
-        _ => 0.0,
+        None => 0.0,
     };
     let spare = ts.len() - (degree + 1);
     let scale = calibration.factor();
@@ -236,6 +315,28 @@ impl AutomaticFilter {
         s
     }
 
+    /// After an internal step failed on the newest sample (not yet in the review): back to
+    /// `before`, the state before it, or when that was not kept, to the newest state the review
+    /// keeps, taking the samples since again with their decisions so far (the gate judging the
+    /// undecided ones anew, as it did).
+    pub(super) fn recover(&mut self, before: Option<Box<AutomaticFilter>>) {
+        if let Some(state) = before {
+            self.restore(*state);
+            return;
+        }
+        let entries = self.review.entries.clone();
+        let Some(start) = entries.iter().rposition(|e| e.before.is_some()) else {
+            return;
+        };
+        let state = entries[start].before.as_deref().expect("found").clone();
+        self.restore(state);
+        for e in entries.range(start..) {
+            let force = e.decided.then_some(e.rejected);
+            // The same samples from the same state: it cannot fail where it did not.
+            let _ = self.step(e.t, e.y, force);
+        }
+    }
+
     /// Goes back to `state`, keeping the review.
     pub(super) fn restore(&mut self, state: AutomaticFilter) {
         let review = std::mem::take(&mut self.review);
@@ -250,7 +351,7 @@ impl AutomaticFilter {
         t: f64,
         y: f64,
         mut out: AutoOutput,
-        before: Box<AutomaticFilter>,
+        before: Option<Box<AutomaticFilter>>,
     ) -> AutoOutput {
         self.review.push(t, y, &out, before);
         let (decided, newest) = self.decide(false);
@@ -298,8 +399,11 @@ impl AutomaticFilter {
             } else if finishing {
                 (2 * l - after.len().min(l), true)
             } else {
+                // At start-up the noise estimate waits for its first samples (see
+                // `NoiseState::is_early`).
                 let before = self.review.accepted.len().min(l);
-                (before, after.len() >= l && after.len() >= 2 * l - before)
+                let enough = after.len() >= l && after.len() >= 2 * l - before;
+                (before, enough && !self.noise.is_early())
             };
             if !ready && !overflow {
                 break;

@@ -260,6 +260,31 @@ impl ExactEngine {
         true
     }
 
+    /// The fit's value at `t` and its variance (times the tracked `σ²`), without allocating;
+    /// `None` while not determined or without a tracked `σ`. The position is `Σ a_k u^k`, so
+    /// its variance is `σ² hᵀ C h` with `h = (1, u, …, u^m)`.
+    pub fn position_at(&self, t: f64) -> Option<(f64, f64)> {
+        let sigma = self.sigma?;
+        if !self.is_determined() {
+            return None;
+        }
+        let mut x = [0.0; MAX_DEGREE + 1];
+        if !self.derivatives_into(t, &mut x) {
+            return None;
+        }
+        let u = (t - self.centre) * self.inv_unit;
+        let p = self.m + 1;
+        let mut h = [0.0; MAX_DEGREE + 1];
+        let mut power = 1.0;
+        for hk in &mut h[..p] {
+            *hk = power;
+            power *= u;
+        }
+        let mut z = [0.0; MAX_DEGREE + 1];
+        let v = self.info.variance_of_row(&h[..p], &mut z[..p])? * (sigma * sigma);
+        Some((x[0], v))
+    }
+
     /// Unscaled derivatives (and covariance, when tracked) of the fit evaluated at `t`.
     pub fn estimate_at(&self, t: f64) -> Option<(Vec<f64>, Option<DMatrix<f64>>)> {
         if !self.is_determined() {

@@ -166,6 +166,23 @@ impl EngineState {
         valid
     }
 
+    /// The position at `t` and its variance (with the tracked `σ`), both finite, or `None`
+    /// (not determined, no tracked `σ`, or beyond the double range): the exact engine without
+    /// allocating, the gain engine from its estimate.
+    pub(crate) fn position_at(&self, m: usize, t: f64) -> Option<(f64, f64)> {
+        if self.samples() <= m as u64 || !t.is_finite() {
+            return None;
+        }
+        let (x, v) = match self {
+            EngineState::Exact(e) => e.position_at(t)?,
+            EngineState::Gain(g) => {
+                let (x, c) = g.estimate_at(t);
+                (x[0], c?[(0, 0)])
+            }
+        };
+        (x.is_finite() && v.is_finite()).then_some((x, v))
+    }
+
     /// The estimate at `t`, finite in every number, or why there is none
     /// ([`PolynomialFilter::try_estimate_at`]).
     pub(crate) fn try_estimate_at(&self, m: usize, t: f64) -> Result<PolynomialState, Error> {

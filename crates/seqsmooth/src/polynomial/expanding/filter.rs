@@ -29,6 +29,13 @@ pub struct ExpandingMemory {
 }
 
 impl ExpandingMemory {
+    /// The position at `t` and its variance, without allocating (the automatic filter's
+    /// per-sample choices); `None` when [`PolynomialFilter::estimate_at`] has no covariance
+    /// or is `None`.
+    pub(crate) fn position_at(&self, t: f64) -> Option<(f64, f64)> {
+        self.core.position_at(self.m, t)
+    }
+
     /// A filter of degree `m` on the given engine.
     ///
     /// ```

@@ -35,6 +35,13 @@ pub struct FadingMemory {
 }
 
 impl FadingMemory {
+    /// The position at `t` and its variance, without allocating (the automatic filter's
+    /// per-sample choices); `None` when [`PolynomialFilter::estimate_at`] has no covariance
+    /// or is `None`.
+    pub(crate) fn position_at(&self, t: f64) -> Option<(f64, f64)> {
+        self.core.position_at(self.m, t)
+    }
+
     /// A filter of degree `m`, discount `θ ∈ (0,1)` per nominal interval `τ > 0`.
     ///
     /// ```
