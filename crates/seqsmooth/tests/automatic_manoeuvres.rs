@@ -321,36 +321,3 @@ fn defaults_flag_outliers_and_cover_on_manoeuvres_and_landing() {
         .collect();
     assert!(failed.is_empty(), "{failed:#?}");
 }
-
-#[test]
-#[ignore]
-fn debug_case() {
-    let seed: u64 = std::env::var("SEED").unwrap().parse().unwrap();
-    let kind = std::env::var("KIND").unwrap();
-    let rows = landing();
-    let data = match kind.as_str() {
-        "steps" => steps_run(seed),
-        "turns" => turns_run(seed),
-        _ => landing_run(&rows, kind.parse().unwrap(), seed).0,
-    };
-    let lo: f64 = std::env::var("LO").unwrap().parse().unwrap();
-    let hi: f64 = std::env::var("HI").unwrap().parse().unwrap();
-    let mut f = AutomaticFilter::new(2, 0.95, median_step(&data)).unwrap();
-    let mut outs = Vec::new();
-    for d in &data {
-        outs.push(f.update(d.t, d.y).unwrap());
-    }
-    let tail = f.finish();
-    let fin = final_outliers(&outs, &tail);
-    for (i, (d, o)) in data.iter().zip(&outs).enumerate() {
-        if d.t >= lo && d.t <= hi {
-            println!(
-                "{i} t {:.1} out {:.1} y-truth {:.1} est-truth {:?} sd {:?} σ̂ {:?} deg {} {:?} nu {:?} σε {:?} gate {:?} gate-rej {} final {} misfit {} man {} restart {} dec {:?}",
-                d.t, d.outlier, d.y - d.truth,
-                o.estimate.as_ref().map(|e| e.derivatives[0] - d.truth),
-                o.std_devs().map(|s| s[0]), o.noise_sigma, o.degree, o.phase,
-                o.innovation, o.innovation_sigma, o.gate, o.outlier, fin[i], o.misfit, o.manoeuvre, o.restart, o.decided
-            );
-        }
-    }
-}

@@ -231,6 +231,8 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     } else {
         a.degree + 1
     };
+    // The automatic filter's noise cell, after d0..dM and s0..sM: empty, no estimate.
+    let withheld_cell = (a.kind == Kind::Auto).then_some(2 * (a.degree + 1));
     for first in std::iter::once(true).chain(std::iter::repeat(false)) {
         ids.append(&mut chunk.new_ids);
         values.resize(chunk.len() * stride, 0.0);
@@ -255,6 +257,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             limit,
             &need,
             &mut counts,
+            withheld_cell,
         );
         if let Some(bad) = unwritable {
             failed = Some(bad);
@@ -358,7 +361,8 @@ fn create_output(
 /// `cells` numbers marked NaN by the library because it is beyond the double range (the time
 /// unit too small for the degree, the values too large, or a lead too long), or any number
 /// infinite. `counts` holds,
-/// per series, the rows seen so far.
+/// per series, the rows seen so far; a row whose cell `withheld` is empty has no estimate for
+/// that stated reason (the automatic filter's noise cell).
 #[allow(clippy::too_many_arguments)]
 fn check_estimates(
     values: &[f64],
@@ -369,6 +373,7 @@ fn check_estimates(
     limit: usize,
     need: &Need,
     counts: &mut Vec<usize>,
+    withheld: Option<usize>,
 ) -> Option<(usize, CliError)> {
     let fail = |i: usize, why: String| Some((i, CliError::Data(format!("{}: {why}", chunk.at(i)))));
     for i in 0..limit {
@@ -384,6 +389,11 @@ fn check_estimates(
         }
         counts[series] += 1;
         if counts[series] < need.rows {
+            continue;
+        }
+        // The automatic filter's estimate is withheld, empty cells, while its noise cell is
+        // empty (no estimate without its σ: the σ is not estimated yet).
+        if withheld.is_some_and(|k| row[k].is_nan()) {
             continue;
         }
         if row[0].is_nan() && row[1..cells].iter().all(|v| v.is_nan()) {

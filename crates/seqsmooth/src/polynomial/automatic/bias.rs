@@ -28,6 +28,7 @@ use super::filter::AutomaticFilter;
 use super::{AutoConfig, AutoOutput};
 use crate::model::PolynomialState;
 use crate::polynomial::filter::PolynomialFilter;
+use crate::polynomial::options::MAX_DEGREE;
 
 /// `Δ_i` counts as a bias beyond this many of its own noise standard deviations (1: whenever
 /// `Δ_i²` exceeds its noise variance).
@@ -117,8 +118,21 @@ impl AutomaticFilter {
     /// noise state `raw` at its time, for noise `σ` ([`difference_bias`]), the position's
     /// raised to the innovations' excess. `None` when the companion is not determined.
     pub(super) fn bias_of(&self, raw: &PolynomialState, sigma: f64) -> Option<Vec<f64>> {
-        let upper = self.companion()?.estimate_at(raw.time)?;
-        let mut b = difference_bias(raw, &upper, sigma)?;
+        let mut xu = [0.0; MAX_DEGREE + 2];
+        let mut vu = [0.0; MAX_DEGREE + 2];
+        let mut b = if self.companion_variances(raw.time, &mut xu, &mut vu) {
+            let vd = raw.covariance.as_ref()?;
+            let upper = (0..raw.derivatives.len()).map(|i| (xu[i], vu[i]));
+            raw.derivatives
+                .iter()
+                .enumerate()
+                .zip(upper)
+                .map(|((i, &x), u)| position_bias((x, vd[(i, i)]), u, sigma, SIGNIFICANCE))
+                .collect()
+        } else {
+            let upper = self.companion()?.estimate_at(raw.time)?;
+            difference_bias(raw, &upper, sigma)?
+        };
         // The position's bias is at least what the innovations' excess says.
         let floor = self.excess.sqrt();
         if b[0].abs() < floor {
@@ -133,6 +147,35 @@ impl AutomaticFilter {
             self.ladder[self.active].as_ref()?.position_at(t)
         } else {
             self.memory_position(self.memory, t)
+        }
+    }
+
+    /// The derivatives at `t` of the active filter's companion ([`companion`](Self::companion))
+    /// and their variances into `x` and `var`, without allocating on the exact engine; false
+    /// when it is not determined (or has no such path: the caller takes its estimate).
+    fn companion_variances(&self, t: f64, x: &mut [f64], var: &mut [f64]) -> bool {
+        let c = self.active + 1;
+        let m = self.cfg.degree;
+        if self.active == m {
+            let j = self.memory;
+            if j > 0 {
+                return self.shorter[j - 1].upper.variances_at(t, x, var);
+            }
+            return match (&self.upper_expanding, &self.upper_fading, self.switched) {
+                (Some(e), _, false) => e.variances_at(t, x, var),
+                (_, Some(f), _) => f.variances_at(t, x, var),
+                _ => false,
+            };
+        }
+        if c < m {
+            return self.ladder[c]
+                .as_ref()
+                .is_some_and(|f| f.variances_at(t, x, var));
+        }
+        match (self.memory, &self.expanding, self.switched) {
+            (0, Some(e), false) => e.variances_at(t, x, var),
+            (0, _, _) => self.fading.variances_at(t, x, var),
+            (j, _, _) => self.shorter[j - 1].fading.variances_at(t, x, var),
         }
     }
 

@@ -191,6 +191,8 @@ fn gate_rms(out: &AutoOutput) -> Option<f64> {
 /// (so `|u| ≤ 1`), without allocating beyond the factor.
 struct WindowFit {
     factor: TriangularFactor,
+    /// The coefficients of `u^k`.
+    coefficients: [f64; MAX_FIT],
     centre: f64,
     inv_half: f64,
     degree: usize,
@@ -208,6 +210,7 @@ impl WindowFit {
         let half = 0.5 * (hi - lo);
         let mut fit = Self {
             factor: TriangularFactor::new(degree + 1),
+            coefficients: [0.0; MAX_FIT],
             centre: 0.5 * (lo + hi),
             inv_half: if half > 0.0 { 1.0 / half } else { 1.0 },
             degree,
@@ -216,19 +219,19 @@ impl WindowFit {
             fit.factor
                 .add_row_powers((t - fit.centre) * fit.inv_half, y, 1.0);
         }
-        fit.factor.is_determined().then_some(fit)
+        let p = degree + 1;
+        fit.factor
+            .solve_into(&mut fit.coefficients[..p])
+            .then_some(fit)
     }
 
     /// `p(t)` and its variance for unit noise `h(t)ᵀ(AᵀA)⁻¹h(t)`.
     fn value_and_vrf_at(&self, t: f64) -> Option<(f64, f64)> {
         let p = self.degree + 1;
         let u = (t - self.centre) * self.inv_half;
-        let mut a = [0.0; MAX_FIT];
+        let a = &self.coefficients;
         let mut h = [0.0; MAX_FIT];
         let mut z = [0.0; MAX_FIT];
-        if !self.factor.solve_into(&mut a[..p]) {
-            return None;
-        }
         let mut power = 1.0;
         for hk in &mut h[..p] {
             *hk = power;

@@ -285,6 +285,37 @@ impl ExactEngine {
         Some((x[0], v))
     }
 
+    /// The derivatives at `t` into `x` and their variances (the covariance's diagonal, times
+    /// the tracked `σ²`) into `var`, `m + 1` each, without allocating; false (and the slices
+    /// unspecified) while not determined, without a tracked `σ`, or where the unit's scaling
+    /// is not a normal double. Row `k` of the read-out is `(k!/s^k) C(j,k) u^(j−k)`, `j ≥ k`.
+    pub fn variances_at(&self, t: f64, x: &mut [f64], var: &mut [f64]) -> bool {
+        let Some(sigma) = self.sigma else {
+            return false;
+        };
+        if !self.unscale_in_range || !self.is_determined() || !self.derivatives_into(t, x) {
+            return false;
+        }
+        let u = (t - self.centre) * self.inv_unit;
+        let p = self.m + 1;
+        let mut h = [0.0; MAX_DEGREE + 1];
+        let mut z = [0.0; MAX_DEGREE + 1];
+        for (k, v) in var[..p].iter_mut().enumerate() {
+            // C(j, k) u^(j−k) for j = k … m, by C(j+1,k) = C(j,k)(j+1)/(j+1−k).
+            h[..k].fill(0.0);
+            let mut c = 1.0;
+            for j in k..p {
+                h[j] = c;
+                c *= u * (j + 1) as f64 / (j + 1 - k) as f64;
+            }
+            let Some(q) = self.info.variance_of_row(&h[..p], &mut z[..p]) else {
+                return false;
+            };
+            *v = q * (sigma * self.unscale[k]).powi(2);
+        }
+        true
+    }
+
     /// Unscaled derivatives (and covariance, when tracked) of the fit evaluated at `t`.
     pub fn estimate_at(&self, t: f64) -> Option<(Vec<f64>, Option<DMatrix<f64>>)> {
         if !self.is_determined() {

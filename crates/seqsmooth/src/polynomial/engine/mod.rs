@@ -183,6 +183,31 @@ impl EngineState {
         (x.is_finite() && v.is_finite()).then_some((x, v))
     }
 
+    /// The derivatives at `t` and their variances (the covariance's diagonal with the tracked
+    /// `σ`) into `x` and `var` (`m + 1` each), all finite, or false: the exact engine without
+    /// allocating, the gain engine (or an exact one whose unit is out of range) from its
+    /// estimate.
+    pub(crate) fn variances_at(&self, m: usize, t: f64, x: &mut [f64], var: &mut [f64]) -> bool {
+        let p = m + 1;
+        let done = match self {
+            EngineState::Exact(e) => e.variances_at(t, x, var),
+            EngineState::Gain(_) => false,
+        };
+        if !done {
+            let Ok(s) = self.try_estimate_at(m, t) else {
+                return false;
+            };
+            let Some(c) = s.covariance else {
+                return false;
+            };
+            x[..p].copy_from_slice(&s.derivatives);
+            for (k, v) in var[..p].iter_mut().enumerate() {
+                *v = c[(k, k)];
+            }
+        }
+        x[..p].iter().chain(&var[..p]).all(|v| v.is_finite())
+    }
+
     /// The estimate at `t`, finite in every number, or why there is none
     /// ([`PolynomialFilter::try_estimate_at`]).
     pub(crate) fn try_estimate_at(&self, m: usize, t: f64) -> Result<PolynomialState, Error> {

@@ -36,6 +36,13 @@ impl ExpandingMemory {
         self.core.position_at(self.m, t)
     }
 
+    /// The derivatives at `t` and their variances into `x` and `var` (`m + 1` each), without
+    /// allocating on the exact engine; false when [`PolynomialFilter::estimate_at`] has no
+    /// covariance or is `None`.
+    pub(crate) fn variances_at(&self, t: f64, x: &mut [f64], var: &mut [f64]) -> bool {
+        self.core.variances_at(self.m, t, x, var)
+    }
+
     /// A filter of degree `m` on the given engine.
     ///
     /// ```

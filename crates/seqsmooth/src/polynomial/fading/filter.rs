@@ -42,6 +42,13 @@ impl FadingMemory {
         self.core.position_at(self.m, t)
     }
 
+    /// The derivatives at `t` and their variances into `x` and `var` (`m + 1` each), without
+    /// allocating on the exact engine; false when [`PolynomialFilter::estimate_at`] has no
+    /// covariance or is `None`.
+    pub(crate) fn variances_at(&self, t: f64, x: &mut [f64], var: &mut [f64]) -> bool {
+        self.core.variances_at(self.m, t, x, var)
+    }
+
     /// A filter of degree `m`, discount `θ ∈ (0,1)` per nominal interval `τ > 0`.
     ///
     /// ```
