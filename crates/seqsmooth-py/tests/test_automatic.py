@@ -54,3 +54,17 @@ def test_errors():
     with pytest.raises(ss.InvalidInputError) as e:
         f.update_many([0.0, 1.0, 1.0], [1.0, 2.0, 3.0])
     assert e.value.index == 2 and f.samples == 2
+
+
+def test_no_estimate_without_its_sigma(rng):
+    """Without ``sigma``, the first m + 5 rows have no estimate (NaN ``d`` and ``s``) while
+    ``noise`` is NaN (not estimated yet); every row with an estimate has its σ."""
+    t, y = irregular_series(rng, 100, start=0.0)
+    got = ss.AutomaticFilter(degree=2, theta=0.95, tau=1.0).update_many(t, y)
+    unknown = np.isnan(got["noise"])
+    assert unknown[:7].all() and not unknown[7:].any()
+    assert np.isnan(got["d"][unknown]).all() and np.isnan(got["s"][unknown]).all()
+    has = ~np.isnan(got["d"][:, 0])
+    assert has[7:].all() and np.isfinite(got["s"][has, 0]).all()
+    known = ss.AutomaticFilter(degree=2, theta=0.95, tau=1.0, sigma=0.3).update_many(t, y)
+    assert np.isfinite(known["d"][:, 0]).all() and np.isfinite(known["s"][:, 0]).all()
