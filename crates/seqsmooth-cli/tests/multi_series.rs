@@ -584,7 +584,10 @@ fn auto_outlier_column_is_the_final_decision() {
             outs.iter().any(|o| o.reinstated == 2),
             "series {s}: the step's first two rejections are reinstated"
         );
-        assert!(flags.iter().any(|&r| r), "series {s}: the outlier is rejected");
+        assert!(
+            flags.iter().any(|&r| r),
+            "series {s}: the outlier is rejected"
+        );
         want_flags.push(flags);
     }
     let mut input = String::from("id,t,y\n");

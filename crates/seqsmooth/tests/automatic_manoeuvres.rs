@@ -102,7 +102,7 @@ fn steps_run(seed: u64) -> Vec<Sample> {
 
 fn turns_run(seed: u64) -> Vec<Sample> {
     let mut r = StdRng::seed_from_u64(seed);
-    let (amp, period) = if seed % 2 == 0 {
+    let (amp, period) = if seed.is_multiple_of(2) {
         (1000.0, 120.0)
     } else {
         (5000.0, 1000.0)

@@ -207,10 +207,9 @@ impl TriangularFactor {
             }
             z[i] = g;
         }
-        for i in 0..p {
-            let d = self.d[i].0;
-            quad += z[i] * z[i] / d;
-            z[i] /= d;
+        for (zi, d) in z[..p].iter_mut().zip(&self.d) {
+            quad += *zi * *zi / d.0;
+            *zi /= d.0;
         }
         // U z = w (unit upper triangular).
         for i in (0..p).rev() {

@@ -119,7 +119,7 @@ impl WindowedMean {
 #[derive(Clone, Debug)]
 pub(super) enum NoiseState {
     Known(f64),
-    Differences(DifferenceNoise, Early),
+    Differences(DifferenceNoise, Box<Early>),
     Innovations(WindowedMean),
 }
 
@@ -224,7 +224,7 @@ impl NoiseState {
             (Some(s), _) => NoiseState::Known(s),
             (None, NoiseSource::Differences { window }) => {
                 let d = DifferenceNoise::new(m + 1, window)?.with_screen(screen)?;
-                NoiseState::Differences(d, Early::new(screen))
+                NoiseState::Differences(d, Box::new(Early::new(screen)))
             }
             (None, NoiseSource::Innovations { window }) => {
                 NoiseState::Innovations(WindowedMean::new(window))

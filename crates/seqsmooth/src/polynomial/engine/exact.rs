@@ -304,8 +304,8 @@ impl ExactEngine {
             // C(j, k) u^(j−k) for j = k … m, by C(j+1,k) = C(j,k)(j+1)/(j+1−k).
             h[..k].fill(0.0);
             let mut c = 1.0;
-            for j in k..p {
-                h[j] = c;
+            for (j, hj) in h[..p].iter_mut().enumerate().skip(k) {
+                *hj = c;
                 c *= u * (j + 1) as f64 / (j + 1 - k) as f64;
             }
             let Some(q) = self.info.variance_of_row(&h[..p], &mut z[..p]) else {
