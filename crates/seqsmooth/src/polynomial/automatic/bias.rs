@@ -59,35 +59,20 @@ pub(super) fn significant_bias(
     z: f64,
 ) -> Option<Vec<f64>> {
     let (vu, vd) = (upper.covariance.as_ref()?, raw.covariance.as_ref()?);
-    let s2 = sigma * sigma;
     Some(
         raw.derivatives
             .iter()
             .zip(&upper.derivatives)
             .enumerate()
-            .map(|(i, (&xd, &xu))| {
-                let delta = xd - xu;
-                let var = s2 * (vu[(i, i)] - vd[(i, i)]).max(0.0);
-                // The excess of Δ² over its noise variance, when positive.
-                let b = if delta * delta > z * z * var {
-                    (delta * delta - var).sqrt()
-                } else {
-                    0.0
-                };
-                if b.is_finite() {
-                    b.copysign(delta)
-                } else {
-                    0.0
-                }
-            })
+            .map(|(i, (&xd, &xu))| position_bias((xd, vd[(i, i)]), (xu, vu[(i, i)]), sigma, z))
             .collect(),
     )
 }
 
-/// The position's bias from the positions `(x, v)` of a filter and `(x₊, v₊)` of its
-/// degree-`(d+1)` companion at the same time (their unit variances `v`): [`significant_bias`]
-/// of the position alone, `sign(Δ) √(Δ² − σ²(v₊ − v))` where `|Δ|` exceeds `z` of its noise
-/// standard deviations, else 0.
+/// The bias of one derivative from its value and unit variance `(x, v)` in a filter and
+/// `(x₊, v₊)` in its degree-`(d+1)` companion at the same time: `sign(Δ) √(Δ² − σ²(v₊ − v))`
+/// (the excess of `Δ²` over its noise variance) where `|Δ|` exceeds `z` of its noise standard
+/// deviations, else 0.
 pub(super) fn position_bias((x, v): (f64, f64), (xu, vu): (f64, f64), sigma: f64, z: f64) -> f64 {
     let delta = x - xu;
     let var = sigma * sigma * (vu - v).max(0.0);
