@@ -129,44 +129,28 @@ pub(crate) fn run_rows(
         filter.update_many_into(t, y, out)?;
         return check_batch_rows(out, w, before);
     }
-    let stride = w << usize::from(sigma);
-    let at = |index: usize| {
-        move |e: Error| Error::InBatch {
-            index,
+    if sigma {
+        // The library's batch σ path: rows of d0..dM, s0..sM.
+        return filter.update_many_sigma_into(t, y, out);
+    }
+    for (i, ((&t, &y), row)) in t.iter().zip(y).zip(out.chunks_exact_mut(w)).enumerate() {
+        filter.update(t, y).map_err(|e| Error::InBatch {
+            index: i,
             source: Box::new(e),
-        }
-    };
-    for (i, ((&t, &y), row)) in t
-        .iter()
-        .zip(y)
-        .zip(out.chunks_exact_mut(stride))
-        .enumerate()
-    {
-        filter.update(t, y).map_err(at(i))?;
-        let state = match filter.try_estimate_at(t) {
-            Ok(s) => s,
-            Err(Error::TooFewSamples { .. }) => {
-                row.fill(f64::NAN);
-                continue;
+        })?;
+        match filter.try_estimate_at(t) {
+            Ok(state) => {
+                let x = &state.derivatives;
+                row[..x.len()].copy_from_slice(x);
+                row[x.len()..].fill(f64::NAN);
             }
-            Err(e) => return Err(at(i)(e)),
-        };
-        let (d, s) = row.split_at_mut(w);
-        let x = &state.derivatives;
-        d[..x.len()].copy_from_slice(x);
-        d[x.len()..].fill(f64::NAN);
-        if sigma {
-            let Some(sd) = state.std_devs() else {
-                return Err(at(i)(Error::InvalidParameter {
-                    name: "sigma",
-                    value: "None".into(),
-                    reason: "the filter has no noise sigma for the 1σ: construct it with \
-                             sigma=..."
-                        .into(),
-                }));
-            };
-            s[..sd.len()].copy_from_slice(&sd);
-            s[sd.len()..].fill(f64::NAN);
+            Err(Error::TooFewSamples { .. }) => row.fill(f64::NAN),
+            Err(e) => {
+                return Err(Error::InBatch {
+                    index: i,
+                    source: Box::new(e),
+                })
+            }
         }
     }
     Ok(())

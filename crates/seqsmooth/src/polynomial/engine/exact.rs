@@ -97,6 +97,11 @@ impl ExactEngine {
         }
     }
 
+    /// Whether the covariance is tracked (a noise σ was given).
+    pub fn tracks_covariance(&self) -> bool {
+        self.sigma.is_some()
+    }
+
     pub fn samples(&self) -> u64 {
         self.n
     }
