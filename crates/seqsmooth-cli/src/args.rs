@@ -323,8 +323,8 @@ step; for even W each row sits half a step after the centre of its window. Irreg
 the same windows, each fitted by least squares at the actual times.
 
 Reading: streams: a row is written once the row floor(W/2) after it has been read (memory \
-bounded by the window, not the input). A bad row stops the command with its line; the rows \
-before it are written to standard output (a file output is left untouched).
+bounded by the window, not the input). A bad row stops the command with its line; a file \
+output is left untouched (standard output keeps the rows already written, a megabyte at a time).
 
 ",
     exit_status!("fewer rows than the window")

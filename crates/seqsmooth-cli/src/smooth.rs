@@ -144,9 +144,6 @@ pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
             text.clear();
         }
         if let Some(e) = error {
-            if written > 0 {
-                out.write(&text)?;
-            }
             return Err(e);
         }
         if done {

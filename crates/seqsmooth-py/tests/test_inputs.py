@@ -95,10 +95,18 @@ def test_every_entry_point_takes_dates():
         lambda: ss.FadingMemory(degree=1, theta=0.9, tau=0.25, sigma=0.1),
         lambda: ss.ExpandingMemory(degree=2),
         lambda: ss.FixedMemory(degree=1, window=9),
-        lambda: ss.AutomaticFilter(degree=1),
     ]:
         a, b = make().update_many(secs, y), make().update_many(dates, y)
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+    a = ss.AutomaticFilter(degree=1, theta=0.9).update_many(secs, y)
+    b = ss.AutomaticFilter(degree=1, theta=0.9).update_many(pl.Series(dates), y)
+    np.testing.assert_array_equal(a["d"], b["d"])
+    np.testing.assert_array_equal(a["s"], b["s"])
+    kf = ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1e6, t0=float(EPOCH) - 1.0)
+    a = kf.update_many(secs, y, 0.01)[0]
+    kf = ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1e6, t0=float(EPOCH) - 1.0)
+    b = kf.update_many(pa.array(dates), y, 0.01)[0]
+    np.testing.assert_array_equal(a, b)
     a = ss.smooth(y, 9, 2, t=secs, return_sigma=True)
     b = ss.smooth(y, 9, 2, t=pd.Series(dates).dt.tz_localize("UTC"), return_sigma=True)
     np.testing.assert_array_equal(a, b)
