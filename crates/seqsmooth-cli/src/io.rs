@@ -132,12 +132,14 @@ fn parse_cell_text(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f
     let text = shown(cell);
     if what == "time" && seqsmooth::numeric::epoch::looks_like_date(cell) {
         let iso = std::str::from_utf8(cell).map_err(|_| {
-            CliError::Data(format!("{at}: '{text}' is not a number or an ISO-8601 time"))
+            CliError::Data(format!(
+                "{at}: '{text}' is not a number or an ISO-8601 time"
+            ))
         })?;
         return seqsmooth::numeric::epoch::parse_iso8601(iso).map_err(|e| match e {
-            seqsmooth::Error::InvalidParameter { reason, .. } => CliError::Data(format!(
-                "{at}: '{text}' is not an ISO-8601 time: {reason}"
-            )),
+            seqsmooth::Error::InvalidParameter { reason, .. } => {
+                CliError::Data(format!("{at}: '{text}' is not an ISO-8601 time: {reason}"))
+            }
             e => CliError::Data(format!("{at}: '{text}': {e}")),
         });
     }

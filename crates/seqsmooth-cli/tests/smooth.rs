@@ -137,7 +137,14 @@ fn smooth_streams_across_chunks() {
         let w = window.to_string();
         let out = ok(&["smooth", "--degree", "2", "--window", &w], &input);
         let from_file = ok(
-            &["smooth", path.to_str().unwrap(), "--degree", "2", "--window", &w],
+            &[
+                "smooth",
+                path.to_str().unwrap(),
+                "--degree",
+                "2",
+                "--window",
+                &w,
+            ],
             "",
         );
         assert_eq!(out, from_file);
@@ -147,8 +154,16 @@ fn smooth_streams_across_chunks() {
         assert_eq!(rows.len(), n);
         for (k, row) in rows.iter().enumerate() {
             for j in 0..3 {
-                assert_eq!(num(&row[2 + j]).to_bits(), d[k * 3 + j].to_bits(), "row {k}");
-                assert_eq!(num(&row[5 + j]).to_bits(), s[k * 3 + j].to_bits(), "row {k}");
+                assert_eq!(
+                    num(&row[2 + j]).to_bits(),
+                    d[k * 3 + j].to_bits(),
+                    "row {k}"
+                );
+                assert_eq!(
+                    num(&row[5 + j]).to_bits(),
+                    s[k * 3 + j].to_bits(),
+                    "row {k}"
+                );
             }
         }
     }
@@ -178,7 +193,11 @@ fn smooth_reads_iso_8601_times() {
         &args,
         "t,y\n2024-03-01T12:00:00Z,1\n2024-02-30T00:00:00Z,2\n2024-03-03,3\n",
         1,
-        &["line 3, column 't'", "'2024-02-30T00:00:00Z' is not an ISO-8601 time", "day 30"],
+        &[
+            "line 3, column 't'",
+            "'2024-02-30T00:00:00Z' is not an ISO-8601 time",
+            "day 30",
+        ],
     );
     fails(
         &args,
@@ -187,7 +206,12 @@ fn smooth_reads_iso_8601_times() {
         &["line 2", "leap second"],
     );
     // A value column never takes dates.
-    fails(&args, "t,y\n1,2024-03-01\n", 1, &["column 'y'", "not a number"]);
+    fails(
+        &args,
+        "t,y\n1,2024-03-01\n",
+        1,
+        &["column 'y'", "not a number"],
+    );
 }
 
 /// A CSV without a header line: the first row is named as data, and the header the command
@@ -199,16 +223,29 @@ fn missing_header_is_named() {
         &["smooth", "--degree", "1", "--window", "3"],
         data,
         1,
-        &["first row ('0,-173184.4958') looks like data, not a header", "'t,y'"],
+        &[
+            "first row ('0,-173184.4958') looks like data, not a header",
+            "'t,y'",
+        ],
     );
     fails(
-        &["filter", "--kind", "fading", "--degree", "1", "--theta", "0.9"],
+        &[
+            "filter", "--kind", "fading", "--degree", "1", "--theta", "0.9",
+        ],
         data,
         1,
         &["looks like data, not a header", "'t,y'"],
     );
     fails(
-        &["smooth", "--degree", "1", "--window", "3", "--time-col", "time"],
+        &[
+            "smooth",
+            "--degree",
+            "1",
+            "--window",
+            "3",
+            "--time-col",
+            "time",
+        ],
         "2024-03-01T12:00:00Z,1\n",
         1,
         &["looks like data", "'time,y'"],

@@ -170,7 +170,11 @@ fn tick_seconds(
             None => None,
             Some(k) if num == 0 => {
                 // Years or months since 1970: their first day.
-                let months = if unit == "Y" { k.checked_mul(12) } else { Some(k) };
+                let months = if unit == "Y" {
+                    k.checked_mul(12)
+                } else {
+                    Some(k)
+                };
                 months.and_then(|mo| {
                     let (y, m) = (1970 + mo.div_euclid(12), mo.rem_euclid(12) as u32 + 1);
                     seconds_from_ticks(days_from_civil(y, m, 1), 86_400, 1).ok()

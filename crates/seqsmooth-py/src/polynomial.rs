@@ -9,6 +9,7 @@ use crate::arrays::{matrix, pair};
 use crate::errors::{raise, IntoPy, Kind};
 use numpy::PyArray1;
 use pyo3::prelude::*;
+use pyo3::types::PySlice;
 use seqsmooth::polynomial::fixed::FixedEngine;
 use seqsmooth::{
     Engine, Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter, PolynomialState,
@@ -237,7 +238,10 @@ impl PyPolynomialFilter {
     /// an array ``(len(t), m+1)`` whose row ``i`` is ``[x, x', …, x^(m)]`` at ``t[i]`` from the
     /// samples up to ``i`` (NaN while the filter is not yet determined). With
     /// ``return_sigma=True`` also the 1σ errors, a second array of the same shape (the filter
-    /// needs its noise ``sigma``).
+    /// needs its noise ``sigma``): the two are views of one ``(len(t), 2(m+1))`` buffer, the
+    /// rows ``d0..dM, s0..sM`` of ``seqsmooth filter --sigma``, written by the library's batch
+    /// σ path (no covariance matrix per sample; within about 2× of the plain call's time, the
+    /// output being twice as large: BENCHMARKS.md).
     ///
     /// The work runs without the GIL; Ctrl-C stops it between blocks of 65,536 samples, the
     /// samples before the block taken.
@@ -274,13 +278,11 @@ impl PyPolynomialFilter {
         if !return_sigma {
             return matrix(py, out, n, w);
         }
-        // Rows [d, s] into the two arrays.
-        let (mut d, mut s) = (Vec::with_capacity(n * w), Vec::with_capacity(n * w));
-        for row in out.chunks_exact(stride) {
-            d.extend_from_slice(&row[..w]);
-            s.extend_from_slice(&row[w..]);
-        }
-        let (d, s) = (matrix(py, d, n, w)?, matrix(py, s, n, w)?);
+        // Rows [d, s]: the two arrays are views of the one buffer (no copy).
+        let rows = matrix(py, out, n, stride)?;
+        let all = PySlice::full(py);
+        let d = rows.get_item((&all, PySlice::new(py, 0, w as isize, 1)))?;
+        let s = rows.get_item((&all, PySlice::new(py, w as isize, stride as isize, 1)))?;
         Ok((d, s).into_pyobject(py)?.into_any())
     }
 

@@ -3,8 +3,8 @@
 //! Joseph recursion, Morrison (12.2.x), kept without a matrix per sample; its steady state held
 //! by the plain kernels), for every engine, even and irregular steps and gaps; and its refusals.
 
-use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter};
 use seqsmooth::FixedEngine;
+use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter};
 
 /// Times with even stretches, jitter and a gap (the steady covariance is left and re-found).
 fn samples(n: usize) -> (Vec<f64>, Vec<f64>) {
@@ -69,8 +69,12 @@ fn batch_sigma_equals_per_sample_estimates() {
         let mut rows = vec![0.0; t.len() * 2 * w];
         // Two calls: the state carries over.
         let half = 1200 * 2 * w;
-        batch.update_many_sigma_into(&t[..1200], &y[..1200], &mut rows[..half]).unwrap();
-        batch.update_many_sigma_into(&t[1200..], &y[1200..], &mut rows[half..]).unwrap();
+        batch
+            .update_many_sigma_into(&t[..1200], &y[..1200], &mut rows[..half])
+            .unwrap();
+        batch
+            .update_many_sigma_into(&t[1200..], &y[1200..], &mut rows[half..])
+            .unwrap();
         for (i, row) in rows.chunks_exact(2 * w).enumerate() {
             single.update(t[i], y[i]).unwrap();
             match single.try_estimate_at(t[i]) {
@@ -119,7 +123,11 @@ fn batch_sigma_refusals() {
         .unwrap();
     let y = [1.0, 2.0, f64::NAN, 4.0];
     let mut rows = vec![0.0; 4 * 4];
-    let e = f.update_many_sigma_into(&t[..4], &y, &mut rows).unwrap_err();
+    let e = f
+        .update_many_sigma_into(&t[..4], &y, &mut rows)
+        .unwrap_err();
     assert!(matches!(e, Error::InBatch { index: 2, .. }), "{e}");
-    assert!(f.update_many_sigma_into(&t[..4], &y, &mut rows[..15]).is_err());
+    assert!(f
+        .update_many_sigma_into(&t[..4], &y, &mut rows[..15])
+        .is_err());
 }

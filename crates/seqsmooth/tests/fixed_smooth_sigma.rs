@@ -32,13 +32,7 @@ fn series(kind: usize, n: usize, seed: u64) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// Rows of a stream fed `(t, y)` one at a time: derivatives and 1σ, in order of index.
-fn streamed(
-    t: &[f64],
-    y: &[f64],
-    m: usize,
-    w: usize,
-    sigma: SmoothSigma,
-) -> (Vec<f64>, Vec<f64>) {
+fn streamed(t: &[f64], y: &[f64], m: usize, w: usize, sigma: SmoothSigma) -> (Vec<f64>, Vec<f64>) {
     let mut s = CentredSmoother::new(m, w, sigma).unwrap();
     let (mut d, mut sd, mut next) = (Vec::new(), Vec::new(), 0);
     let mut take = |r: seqsmooth::polynomial::fixed::SmoothedRow<'_>| -> Result<(), Error> {
@@ -246,6 +240,8 @@ fn refusals() {
     ));
     let (mut d, mut sd) = (vec![0.0; 6], vec![0.0; 6]);
     let t = [0.0, 1.0, 2.0];
-    assert!(smooth_with_sigma_into(&t, &[1.0, 2.0, 4.0], 1, 3, None, &mut d, &mut sd[..5]).is_err());
+    assert!(
+        smooth_with_sigma_into(&t, &[1.0, 2.0, 4.0], 1, 3, None, &mut d, &mut sd[..5]).is_err()
+    );
     assert!(smooth_with_sigma_into(&t, &[1.0, 2.0, 4.0], 1, 2, None, &mut d, &mut sd).is_err());
 }

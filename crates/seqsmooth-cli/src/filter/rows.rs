@@ -206,7 +206,9 @@ impl<S: Records> RowReader<S> {
         if crate::io::looks_like_data(csv.header()) {
             let mut names = format!("the header line '{time_col},{value_col}'");
             if let Some(id) = id_col {
-                names = format!("a header line naming the columns '{id}', '{time_col}' and '{value_col}'");
+                names = format!(
+                    "a header line naming the columns '{id}', '{time_col}' and '{value_col}'"
+                );
             }
             return Err(crate::io::headerless(csv.header(), &names));
         }

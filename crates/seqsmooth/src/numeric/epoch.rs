@@ -99,7 +99,10 @@ fn is_nearest(x: f64, scaled: i128, d: i128) -> bool {
             Some(s) if e < 100 => s,
             _ => return false,
         };
-        match (m.checked_mul(d).and_then(|v| v.checked_mul(scale)), d.checked_mul(scale)) {
+        match (
+            m.checked_mul(d).and_then(|v| v.checked_mul(scale)),
+            d.checked_mul(scale),
+        ) {
             (Some(x), Some(g)) => (a, x, g),
             _ => return false,
         }
@@ -200,9 +203,7 @@ pub fn parse_iso8601(text: &str) -> Result<f64, Error> {
         return Err(bad(&format!("month {month:02} is not 01 to 12")));
     }
     if day < 1 || day > days_in_month(year, month) {
-        return Err(bad(&format!(
-            "day {day:02} is not in {year:04}-{month:02}"
-        )));
+        return Err(bad(&format!("day {day:02} is not in {year:04}-{month:02}")));
     }
     let mut seconds = days_from_civil(year, month, day) * DAY;
     let (mut frac, mut frac_digits) = (0i128, 0u32);
@@ -273,7 +274,10 @@ pub fn parse_iso8601(text: &str) -> Result<f64, Error> {
         }
     }
     let den = 10i64.pow(frac_digits);
-    Ok(decimal_seconds(i128::from(seconds) * den as i128 + frac, den))
+    Ok(decimal_seconds(
+        i128::from(seconds) * den as i128 + frac,
+        den,
+    ))
 }
 
 /// The unread rest of a text.

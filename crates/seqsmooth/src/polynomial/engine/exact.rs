@@ -265,6 +265,58 @@ impl ExactEngine {
         true
     }
 
+    /// The 1σ of the unscaled derivatives at `t` into `out` without allocating: row `i` of
+    /// `J = D(s) Φ(v)` (`v` the time in the basis' units) through the information factor
+    /// ([`InformationFilter::variance_of_row`]), times σ. `false` (and `out` unspecified)
+    /// without a tracked covariance or while not determined.
+    pub fn std_devs_into(&self, t: f64, out: &mut [f64]) -> bool {
+        let p = self.m + 1;
+        // A stack table of p² values for the sizes compiled in, else one on the heap.
+        unrolled_sizes!(p, N => self.std_devs_with(t, [[0.0; N]; N].as_flattened_mut(), out), _ => self.std_devs_with(t, &mut vec![0.0; p * p], out))
+    }
+
+    /// [`Self::std_devs_into`] with `rows` (`p²` zeros) for the rows of `Φ(v)`.
+    #[inline(always)]
+    fn std_devs_with(&self, t: f64, rows: &mut [f64], out: &mut [f64]) -> bool {
+        let Some(sigma) = self.sigma.filter(|_| self.n > self.m as u64) else {
+            return false;
+        };
+        let p = self.m + 1;
+        let v = (t - self.centre) * self.inv_unit;
+        // The rows of Φ(v): Φ_ik = C(k, i) v^(k-i), k ≥ i (zero below the diagonal).
+        let mut powers = [1.0; MAX_DEGREE + 1];
+        for k in 1..p {
+            powers[k] = powers[k - 1] * v;
+        }
+        let mut binomial = [0.0; MAX_DEGREE + 1];
+        for k in 0..p {
+            // Row k of Pascal's triangle from row k-1, in place.
+            binomial[k] = 1.0;
+            for i in (1..k).rev() {
+                binomial[i] += binomial[i - 1];
+            }
+            for i in 0..=k {
+                rows[i * p + k] = binomial[i] * powers[k - i];
+            }
+        }
+        let (mut inv, mut var) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+        if !self
+            .info
+            .variances_of_rows(rows, &mut inv[..p], &mut var[..p])
+        {
+            return false;
+        }
+        for (i, (o, var)) in out[..p].iter_mut().zip(&var[..p]).enumerate() {
+            let sd = sigma * var.max(0.0).sqrt();
+            *o = if self.unscale_in_range {
+                sd * self.unscale[i]
+            } else {
+                unscale_stepwise(sd, i, self.unit)
+            };
+        }
+        true
+    }
+
     /// Unscaled derivatives (and covariance, when tracked) of the fit evaluated at `t`.
     pub fn estimate_at(&self, t: f64) -> Option<(Vec<f64>, Option<DMatrix<f64>>)> {
         if !self.is_determined() {

@@ -346,7 +346,7 @@ pub(crate) struct GainEngine {
     /// Noise variance and the scaled covariance of the estimate's random error.
     cov: Option<(f64, DMatrix<f64>)>,
     /// The covariance after the previous update (row-major), and whether the update left it
-    /// unchanged (to 4ε relative in every entry) after the fading switch: the steady state of
+    /// unchanged (to [`COV_STEADY`] relative in every entry) after the fading switch: the steady state of
     /// the covariance's recursion for the current step and gains, which the plain kernels then
     /// keep while the steps stay equal to the typical one.
     cov_last: Vec<f64>,
@@ -358,6 +358,12 @@ pub(crate) struct GainEngine {
     block_credit: usize,
     block_credit_step: f64,
 }
+
+/// The relative change of every covariance entry below which an update has left the fading
+/// filter's covariance at its steady state (the Joseph recursion contracts by `θ²` a step, and
+/// its rounding keeps the last few bits moving): the plain kernels then keep it, the reported
+/// 1σ within this of the recursion's.
+const COV_STEADY: f64 = 1e-13;
 
 impl GainEngine {
     pub fn new(m: usize, tau: f64, fading: Option<FadingGains>) -> Self {
@@ -529,12 +535,15 @@ impl GainEngine {
                 *c = p[(i, 0)];
             }
             let p00 = row0[0] + *var;
-            let mut converged = self.fading.as_ref().is_some_and(|f| f.switched_at.is_some());
+            let mut converged = self
+                .fading
+                .as_ref()
+                .is_some_and(|f| f.switched_at.is_some());
             for j in 0..dim {
                 for i in 0..dim {
                     let (ki, kj) = (self.k[i], self.k[j]);
                     let v = p[(i, j)] - ki * row0[j] - col0[i] * kj + ki * kj * p00;
-                    converged &= (v - self.cov_last[i * dim + j]).abs() <= 4.0 * f64::EPSILON * v.abs();
+                    converged &= (v - self.cov_last[i * dim + j]).abs() <= COV_STEADY * v.abs();
                     self.cov_last[i * dim + j] = v;
                     p[(i, j)] = v;
                 }

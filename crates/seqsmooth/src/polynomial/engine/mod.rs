@@ -188,7 +188,8 @@ impl EngineState {
         let before = self.samples();
         if !self.tracks_covariance() {
             // Rows NaN until determined; the first determined sample is the error.
-            let first = usize::try_from((w as u64).saturating_sub(before + 1)).unwrap_or(usize::MAX);
+            let first =
+                usize::try_from((w as u64).saturating_sub(before + 1)).unwrap_or(usize::MAX);
             let end = first.saturating_add(1).min(times.len());
             self.update_many(m, &times[..end], &values[..end], None)?;
             rows[..end * 2 * w].fill(f64::NAN);
@@ -206,7 +207,12 @@ impl EngineState {
             let (ts, ys) = (&times[start..end], &values[start..end]);
             let out = &mut rows[start * 2 * w..end * 2 * w];
             let valid = start + self.run_valid_sigma(m, ts, ys, out, &mut scratch);
-            check_sigma_rows(&rows[start * 2 * w..valid * 2 * w], w, before + start as u64, start)?;
+            check_sigma_rows(
+                &rows[start * 2 * w..valid * 2 * w],
+                w,
+                before + start as u64,
+                start,
+            )?;
             if valid < end {
                 return match self.check(times[valid], values[valid]) {
                     Err(e) => Err(Error::InBatch {
@@ -240,18 +246,15 @@ impl EngineState {
         let (ts, ys) = (&times[..valid], &values[..valid]);
         let w = m + 1;
         match self {
-            EngineState::Gain(g) => g.update_many_sigma_into(ts, ys, &mut rows[..valid * 2 * w], scratch),
+            EngineState::Gain(g) => {
+                g.update_many_sigma_into(ts, ys, &mut rows[..valid * 2 * w], scratch)
+            }
             EngineState::Exact(e) => {
                 for ((&t, &y), row) in ts.iter().zip(ys).zip(rows.chunks_exact_mut(2 * w)) {
                     e.update(t, y);
-                    match e.estimate_at(t) {
-                        Some((x, Some(c))) => {
-                            row[..w].copy_from_slice(&x);
-                            for (k, s) in row[w..].iter_mut().enumerate() {
-                                *s = c[(k, k)].max(0.0).sqrt();
-                            }
-                        }
-                        _ => row.fill(f64::NAN),
+                    let (d, s) = row.split_at_mut(w);
+                    if !(e.derivatives_into(t, d) && e.std_devs_into(t, s)) {
+                        row.fill(f64::NAN);
                     }
                 }
             }
@@ -320,7 +323,11 @@ fn check_sigma_rows(rows: &[f64], w: usize, before: u64, first: usize) -> Result
             }
         } else if let Some(k) = row.iter().position(|v| !v.is_finite()) {
             Error::EstimateOutOfRange {
-                what: if k < w { format!("d{k}") } else { format!("s{}", k - w) },
+                what: if k < w {
+                    format!("d{k}")
+                } else {
+                    format!("s{}", k - w)
+                },
             }
         } else {
             continue;

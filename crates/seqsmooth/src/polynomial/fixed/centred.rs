@@ -305,7 +305,8 @@ impl CentredSmoother {
                 let mu = self.moments.moments().expect("the window is full");
                 self.fit.derivatives_into(mu, r as f64, *step, d);
                 if sigma {
-                    self.fit.std_devs_into(r as f64, *step, self.window_sigma, s);
+                    self.fit
+                        .std_devs_into(r as f64, *step, self.window_sigma, s);
                 }
             }
             WindowFit::Irregular(fit) => {

@@ -46,6 +46,10 @@ impl<T: Copy> Ring<T> {
     pub(super) fn get(&self, i: usize) -> T {
         // While filling, `head` is 0; once full, the oldest is at `head`.
         let k = self.head + i;
-        self.buf[if k >= self.capacity { k - self.capacity } else { k }]
+        self.buf[if k >= self.capacity {
+            k - self.capacity
+        } else {
+            k
+        }]
     }
 }

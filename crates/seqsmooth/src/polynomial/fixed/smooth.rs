@@ -153,7 +153,15 @@ pub fn smooth_with_sigma_into(
     check_estimates_length(times, m, estimates)?;
     check_estimates_length(times, m, std_devs)?;
     let sigma = sigma.map_or(SmoothSigma::Estimated, SmoothSigma::Given);
-    run_series(times, values, m, window, sigma, estimates, Some(&mut *std_devs))?;
+    run_series(
+        times,
+        values,
+        m,
+        window,
+        sigma,
+        estimates,
+        Some(&mut *std_devs),
+    )?;
     first_out_of_range(estimates, "d", m)?;
     first_out_of_range(std_devs, "s", m)
 }
