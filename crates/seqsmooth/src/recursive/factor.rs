@@ -120,7 +120,8 @@ impl TriangularFactor {
     /// [`Self::right_divide_row`] and [`Self::left_solve`] share across rows.
     pub(crate) fn inverse_sqrt_pivots(&self, out: &mut [f64]) -> bool {
         for (o, d) in out.iter_mut().zip(&self.d) {
-            if !(d.0 > 0.0) {
+            // NaN fails too.
+            if d.0.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 return false;
             }
             *o = 1.0 / d.0.sqrt();
@@ -134,11 +135,12 @@ impl TriangularFactor {
     pub(crate) fn right_divide_row(&self, x: &mut [f64], inv: &[f64]) {
         let p = self.dim();
         for i in 0..p {
-            let mut v = x[i];
-            for k in 0..i {
-                v -= self.u[k * p + i] * x[k];
-            }
-            x[i] = v;
+            let (done, rest) = x.split_at_mut(i);
+            let v = done
+                .iter()
+                .enumerate()
+                .fold(rest[0], |v, (k, xk)| v - self.u[k * p + i] * xk);
+            rest[0] = v;
         }
         for (v, r) in x.iter_mut().zip(inv) {
             *v *= r;
@@ -153,11 +155,9 @@ impl TriangularFactor {
             *v *= r;
         }
         for i in (0..p).rev() {
-            let mut v = x[i];
-            for k in i + 1..p {
-                v -= self.u[i * p + k] * x[k];
-            }
-            x[i] = v;
+            let (head, later) = x.split_at_mut(i + 1);
+            let u = &self.u[i * p + i + 1..(i + 1) * p];
+            head[i] = later.iter().zip(u).fold(head[i], |v, (xk, uk)| v - uk * xk);
         }
     }
 
