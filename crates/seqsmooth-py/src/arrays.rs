@@ -37,6 +37,20 @@ fn asarray<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Bound<'py, PyAn
     })
 }
 
+/// The error of an array `name` that is not one-dimensional.
+fn one_dimensional(array: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
+    let ndim: usize = array.getattr("ndim")?.extract()?;
+    if ndim != 1 {
+        let shape = array.getattr("shape")?.str()?.to_string();
+        return Err(raise(
+            Kind::InvalidInput,
+            format!("{name} has shape {shape}: it must be one-dimensional"),
+            None,
+        ));
+    }
+    Ok(())
+}
+
 /// `obj` as a one-dimensional series of reals, named `name` in errors.
 pub fn series<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Series<'py>> {
     if let Ok(a) = obj.cast::<PyArray1<f64>>() {
@@ -55,15 +69,7 @@ pub fn series<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Series<'py>>
             None,
         ));
     }
-    let ndim: usize = array.getattr("ndim")?.extract()?;
-    if ndim != 1 {
-        let shape = array.getattr("shape")?.str()?.to_string();
-        return Err(raise(
-            Kind::InvalidInput,
-            format!("{name} has shape {shape}: it must be one-dimensional"),
-            None,
-        ));
-    }
+    one_dimensional(&array, name)?;
     let np = obj.py().import("numpy")?;
     let converted = np.call_method1("ascontiguousarray", (array, "float64"))?;
     Ok(Series(converted.cast::<PyArray1<f64>>()?.readonly()))
@@ -102,15 +108,7 @@ pub fn times<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Series<'py>> 
     if !matches!(kind.as_str(), "M" | "m") {
         return series(&array, name);
     }
-    let ndim: usize = array.getattr("ndim")?.extract()?;
-    if ndim != 1 {
-        let shape = array.getattr("shape")?.str()?.to_string();
-        return Err(raise(
-            Kind::InvalidInput,
-            format!("{name} has shape {shape}: it must be one-dimensional"),
-            None,
-        ));
-    }
+    one_dimensional(&array, name)?;
     let (unit, count): (String, i64) = np
         .call_method1("datetime_data", (array.getattr("dtype")?,))?
         .extract()?;

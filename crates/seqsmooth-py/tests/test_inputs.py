@@ -7,16 +7,16 @@ from __future__ import annotations
 
 import datetime as dt
 import subprocess
-import tomllib
 
 import numpy as np
 import pandas as pd
 import polars as pl
 import pyarrow as pa
 import pytest
-from conftest import ROOT, cli_path
+import tomllib
 
 import seqsmooth as ss
+from conftest import ROOT, cli_path
 
 # 2024-03-01T12:00:00Z, and 40 samples 250 ms apart from it.
 EPOCH = 1_709_294_400
@@ -112,7 +112,9 @@ def test_every_entry_point_takes_dates():
     np.testing.assert_array_equal(a, b)
     frame = pd.DataFrame({"t": dates, "y": y})
     got = ss.filter_frame(frame, kind="fading", degree=1, theta=0.9, tau=0.25)
-    want = ss.filter_frame(pd.DataFrame({"t": secs, "y": y}), kind="fading", degree=1, theta=0.9, tau=0.25)
+    want = ss.filter_frame(
+        pd.DataFrame({"t": secs, "y": y}), kind="fading", degree=1, theta=0.9, tau=0.25
+    )
     pd.testing.assert_frame_equal(got, want)
     got = ss.filter_frame(pl.DataFrame({"t": dates, "y": y}), kind="expanding", degree=1)
     assert got["t"].to_list() == secs.tolist()

@@ -51,7 +51,6 @@ batch, its ``index``.
 from . import errors
 from ._seqsmooth import (
     MAX_DEGREE,
-    __version__,
     AutomaticFilter,
     BayesFilter,
     CurveFit,
@@ -67,6 +66,7 @@ from ._seqsmooth import (
     RadarTracker,
     SlidingFit,
     State,
+    __version__,
     cramer_rao_bound,
     fit_curve,
     gains,

@@ -116,7 +116,8 @@ def filter_frame(
     Returns
     -------
     The kind of ``df`` with the columns of ``seqsmooth filter``'s CSV: ``[by,] time, value,
-    d0..dM`` (``time`` in seconds, as the filter read it) (the estimate at each row's time, from its series up to that row), then
+    d0..dM`` (``time`` in seconds, as the filter read it; ``dk`` the estimate at each row's
+    time, from its series up to that row), then
     ``s0..sM`` (their 1σ) with ``sigma``, then ``window`` (rows in the window) for ``fixed``;
     NaN where the series is not yet determined. Rows in input order.
 

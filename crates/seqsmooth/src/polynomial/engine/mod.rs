@@ -111,16 +111,22 @@ impl EngineState {
             let out = estimates.as_deref_mut().map(|o| &mut o[start * w..end * w]);
             let valid = start + self.run_valid(m, &times[start..end], &values[start..end], out);
             if valid < end {
-                return match self.check(times[valid], values[valid]) {
-                    Err(e) => Err(Error::InBatch {
-                        index: valid,
-                        source: Box::new(e),
-                    }),
-                    Ok(()) => unreachable!("first_invalid and check disagree at {valid}"),
-                };
+                return Err(self.rejection(times, values, valid));
             }
         }
         Ok(())
+    }
+
+    /// The error of sample `valid`, the first that [`first_invalid`] (or the gain engine's value
+    /// range) rejected: its own check's, with its index.
+    fn rejection(&self, times: &[f64], values: &[f64], valid: usize) -> Error {
+        match self.check(times[valid], values[valid]) {
+            Err(e) => Error::InBatch {
+                index: valid,
+                source: Box::new(e),
+            },
+            Ok(()) => unreachable!("first_invalid and check disagree at {valid}"),
+        }
     }
 
     /// Runs the samples of `times`, `values` up to the first one [`first_invalid`] (or the
@@ -214,13 +220,7 @@ impl EngineState {
                 start,
             )?;
             if valid < end {
-                return match self.check(times[valid], values[valid]) {
-                    Err(e) => Err(Error::InBatch {
-                        index: valid,
-                        source: Box::new(e),
-                    }),
-                    Ok(()) => unreachable!("first_invalid and check disagree at {valid}"),
-                };
+                return Err(self.rejection(times, values, valid));
             }
         }
         Ok(())
