@@ -107,7 +107,11 @@ pub fn csv_field(cell: &[u8]) -> Vec<u8> {
 /// Parses the number in the (trimmed) cell of `line` in `column`, holding the `what`: a typed
 /// error for an empty cell, a non-number or a non-finite value. The `fast-float2` crate
 /// parses (correctly rounded, so the same double as `str::parse`); anything it does not take
-/// as a finite number goes through `str::parse` for the same result and messages.
+/// as a finite number goes through `str::parse` for the same result and messages. A time
+/// (`what` is `"time"`) may also be an ISO-8601 text (`2024-03-01T12:00:00Z`, fractional
+/// seconds, an offset, a date alone; UTC without an offset), read as seconds since the Unix
+/// epoch by the library's rule ([`seqsmooth::numeric::epoch::parse_iso8601`]), as Parquet
+/// timestamps are: only after the number parser has failed, so numbers cost what they did.
 #[inline]
 pub fn parse_cell(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f64, CliError> {
     match fast_float2::parse::<f64, _>(cell) {
@@ -126,6 +130,19 @@ fn parse_cell_text(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f
         )));
     }
     let text = shown(cell);
+    if what == "time" && seqsmooth::numeric::epoch::looks_like_date(cell) {
+        let iso = std::str::from_utf8(cell).map_err(|_| {
+            CliError::Data(format!(
+                "{at}: '{text}' is not a number or an ISO-8601 time"
+            ))
+        })?;
+        return seqsmooth::numeric::epoch::parse_iso8601(iso).map_err(|e| match e {
+            seqsmooth::Error::InvalidParameter { reason, .. } => {
+                CliError::Data(format!("{at}: '{text}' is not an ISO-8601 time: {reason}"))
+            }
+            e => CliError::Data(format!("{at}: '{text}': {e}")),
+        });
+    }
     let v: f64 = std::str::from_utf8(cell)
         .ok()
         .and_then(|s| s.parse().ok())
@@ -272,6 +289,9 @@ pub fn find_column(headers: &[String], name: &str, why: &str) -> Result<usize, C
         )));
     }
     found.ok_or_else(|| {
+        if looks_like_data(headers) {
+            return headerless(headers, &format!("a column '{}'", shown(name.as_bytes())));
+        }
         CliError::Data(format!(
             "column '{}' not found in the header{why}; columns are: {}",
             shown(name.as_bytes()),
@@ -282,6 +302,39 @@ pub fn find_column(headers: &[String], name: &str, why: &str) -> Result<usize, C
                 .join(", ")
         ))
     })
+}
+
+/// Whether a header's cells all read as numbers or ISO-8601 dates: the first row of a CSV
+/// without a header line.
+///
+/// ```
+/// use seqsmooth_cli::io::looks_like_data;
+/// let cells = |c: &[&str]| c.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+/// assert!(looks_like_data(&cells(&["0", "-173184.4958"])));
+/// assert!(looks_like_data(&cells(&["2024-03-01T12:00:00Z", "1.5"])));
+/// assert!(!looks_like_data(&cells(&["t", "y"])) && !looks_like_data(&cells(&["0", "y"])));
+/// ```
+pub fn looks_like_data(headers: &[String]) -> bool {
+    !headers.is_empty()
+        && headers.iter().all(|h| {
+            let b = h.as_bytes();
+            fast_float2::parse::<f64, _>(b).is_ok() || seqsmooth::numeric::epoch::looks_like_date(b)
+        })
+}
+
+/// The error for an input whose first row (`headers`) looks like data, not a header: what the
+/// command needs (`needs`, e.g. `the header line 't,y'`) and how to give it.
+pub fn headerless(headers: &[String], needs: &str) -> CliError {
+    let first = headers
+        .iter()
+        .map(|h| shown(h.as_bytes()))
+        .collect::<Vec<_>>()
+        .join(",");
+    CliError::Data(format!(
+        "the first row ('{first}') looks like data, not a header: the input needs a header line \
+         naming its columns first, and this command needs {needs}: add it as the first line of \
+         the file"
+    ))
 }
 
 /// The numbers of `\r` and `\n` bytes in `bytes`, counted in `u8` lanes over chunks of at most

@@ -121,22 +121,10 @@ fn id_type_of(t: &DataType) -> Option<IdType> {
     }
 }
 
-/// `ticks` at `per_second` to the second as the nearest double to the exact decimal (what
-/// parsing the number written out in seconds gives): one correctly rounded division where
-/// both operands are exact doubles, else through the decimal text.
+/// `ticks` at `per_second` to the second as the nearest double to the exact decimal: the
+/// library's one rule ([`seqsmooth::numeric::epoch::seconds_from_ticks`]).
 fn seconds(ticks: i64, per_second: i64) -> f64 {
-    const EXACT: u64 = 1 << 53;
-    if per_second == 1 || ticks.unsigned_abs() <= EXACT {
-        return ticks as f64 / per_second as f64;
-    }
-    let digits = per_second.ilog10() as usize;
-    let sign = if ticks < 0 { "-" } else { "" };
-    let (whole, frac) = (
-        ticks.unsigned_abs() / per_second.unsigned_abs(),
-        ticks.unsigned_abs() % per_second.unsigned_abs(),
-    );
-    format!("{sign}{whole}.{frac:0digits$}")
-        .parse()
+    seqsmooth::numeric::epoch::seconds_from_ticks(ticks, 1, per_second)
         .unwrap_or(ticks as f64 / per_second as f64)
 }
 
@@ -304,7 +292,7 @@ fn to_f64(array: &ArrayRef, how: Numbers) -> Result<Float64Array, arrow::error::
         Numbers::Days => {
             let days = cast(array, &DataType::Int64)?;
             let days = days.as_primitive_opt::<Int64Type>().ok_or_else(wrong)?;
-            Ok(days.unary::<_, Float64Type>(|d| d as f64 * 86_400.0))
+            Ok(days.unary::<_, Float64Type>(|d| seconds(d * 86_400, 1)))
         }
     }
 }

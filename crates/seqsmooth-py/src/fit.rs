@@ -6,7 +6,7 @@
 //! `radar_row`, and an estimate beyond the double range refused by `push_finite`, so that each
 //! row is the command's to the last bit.
 
-use crate::arrays::{matrix, series, Series};
+use crate::arrays::{matrix, series, times, Series};
 use crate::errors::{raise, to_py, Kind};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -408,7 +408,7 @@ impl PySlidingFit {
                 None,
             ));
         }
-        let ts = series(t, "t")?;
+        let ts = times(t, "t")?;
         let n = ts.as_slice().len();
         let mut columns = Vec::with_capacity(names.len());
         for (v, name) in values.iter().zip(names) {

@@ -3,7 +3,7 @@
 //! `StreamBank` (one filter per series, grouped by a counting sort, the series on the rayon
 //! pool) with the rows of [`run_rows`], the same as `seqsmooth filter --id-col`.
 
-use crate::arrays::{matrix, series};
+use crate::arrays::{matrix, series, times};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::polynomial::{engine as engine_named, fixed_engine, run_rows};
 use numpy::{PyArray1, PyArrayMethods};
@@ -45,7 +45,7 @@ pub fn filter_series<'py>(
     engine: Option<&str>,
     sigma: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let (ts, ys) = (series(t, "t")?, series(y, "y")?);
+    let (ts, ys) = (times(t, "t")?, series(y, "y")?);
     let (t, y) = (ts.as_slice(), ys.as_slice());
     let n = t.len();
     let codes = codes.cast::<PyArray1<i64>>().map_err(|_| {

@@ -5,7 +5,7 @@
 //! actual step) and optional fading memory (`beta` per unit time or `theta` per update, ch.
 //! 14); and its Rauch–Tung–Striebel smoother.
 
-use crate::arrays::{matrix, series, table};
+use crate::arrays::{matrix, series, table, times};
 use crate::errors::{raise, IntoPy, Kind};
 use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayMethods};
@@ -123,7 +123,7 @@ pub(crate) fn measurements(
     r: &Bound<'_, PyAny>,
     p: usize,
 ) -> PyResult<Vec<Measurement>> {
-    let ts = series(t, "t")?;
+    let ts = times(t, "t")?;
     let (zs, rows, cols) = table(z, "z")?;
     let t = ts.as_slice();
     if rows != t.len() || cols != p {

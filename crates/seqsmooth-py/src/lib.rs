@@ -46,6 +46,9 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(paml::cramer_rao_bound, m)?)?;
     m.add_class::<paml::PyOnlineSmoother>()?;
     m.add_class::<paml::PyCurveFit>()?;
+    m.add_function(wrap_pyfunction!(arrays::seconds, m)?)?;
     m.add("MAX_DEGREE", seqsmooth::polynomial::MAX_DEGREE)?;
+    // The one version: the workspace's Cargo version, which maturin also gives the package.
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

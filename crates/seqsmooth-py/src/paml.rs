@@ -3,7 +3,7 @@
 //! gains (1967): `gauss_rule`, `polynomial_samples`, `OnlineSmoother`, `fit_curve`,
 //! `cramer_rao_bound`, `CurveFit`, `luenberger_gains`.
 
-use crate::arrays::{series, table};
+use crate::arrays::{series, table, times};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::square;
 use nalgebra::DMatrix;
@@ -67,7 +67,7 @@ pub fn gauss_rule<'py>(
     }
     let rule: GaussRule = match t {
         Some(t) => {
-            let ts = series(t, "t")?;
+            let ts = times(t, "t")?;
             let ws = match weights {
                 Some(w) => series(w, "weights")?.as_slice().to_vec(),
                 None => vec![1.0; ts.as_slice().len()],
@@ -198,7 +198,7 @@ impl PyOnlineSmoother {
         sigma: &Bound<'_, PyAny>,
         n: usize,
     ) -> PyResult<Self> {
-        let ts = series(t, "t")?.as_slice().to_vec();
+        let ts = times(t, "t")?.as_slice().to_vec();
         let sigmas = sigmas(sigma, ts.len())?;
         check_degree(n)?;
         let gains = py.detach(|| SmootherGains::new(&ts, &sigmas, n)).py()?;
@@ -405,7 +405,7 @@ pub fn cramer_rao_bound<'py>(
     sigma: &Bound<'py, PyAny>,
     jac: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let ts = series(t, "t")?;
+    let ts = times(t, "t")?;
     let sigmas = sigmas(sigma, ts.as_slice().len())?;
     let theta = series(theta, "theta")?;
     let model = model(h, jac, theta.as_slice().len())?;

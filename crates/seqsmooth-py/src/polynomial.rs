@@ -9,6 +9,7 @@ use crate::arrays::{matrix, pair};
 use crate::errors::{raise, IntoPy, Kind};
 use numpy::PyArray1;
 use pyo3::prelude::*;
+use pyo3::types::PySlice;
 use seqsmooth::polynomial::fixed::FixedEngine;
 use seqsmooth::{
     Engine, Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter, PolynomialState,
@@ -129,44 +130,28 @@ pub(crate) fn run_rows(
         filter.update_many_into(t, y, out)?;
         return check_batch_rows(out, w, before);
     }
-    let stride = w << usize::from(sigma);
-    let at = |index: usize| {
-        move |e: Error| Error::InBatch {
-            index,
+    if sigma {
+        // The library's batch σ path: rows of d0..dM, s0..sM.
+        return filter.update_many_sigma_into(t, y, out);
+    }
+    for (i, ((&t, &y), row)) in t.iter().zip(y).zip(out.chunks_exact_mut(w)).enumerate() {
+        filter.update(t, y).map_err(|e| Error::InBatch {
+            index: i,
             source: Box::new(e),
-        }
-    };
-    for (i, ((&t, &y), row)) in t
-        .iter()
-        .zip(y)
-        .zip(out.chunks_exact_mut(stride))
-        .enumerate()
-    {
-        filter.update(t, y).map_err(at(i))?;
-        let state = match filter.try_estimate_at(t) {
-            Ok(s) => s,
-            Err(Error::TooFewSamples { .. }) => {
-                row.fill(f64::NAN);
-                continue;
+        })?;
+        match filter.try_estimate_at(t) {
+            Ok(state) => {
+                let x = &state.derivatives;
+                row[..x.len()].copy_from_slice(x);
+                row[x.len()..].fill(f64::NAN);
             }
-            Err(e) => return Err(at(i)(e)),
-        };
-        let (d, s) = row.split_at_mut(w);
-        let x = &state.derivatives;
-        d[..x.len()].copy_from_slice(x);
-        d[x.len()..].fill(f64::NAN);
-        if sigma {
-            let Some(sd) = state.std_devs() else {
-                return Err(at(i)(Error::InvalidParameter {
-                    name: "sigma",
-                    value: "None".into(),
-                    reason: "the filter has no noise sigma for the 1σ: construct it with \
-                             sigma=..."
-                        .into(),
-                }));
-            };
-            s[..sd.len()].copy_from_slice(&sd);
-            s[sd.len()..].fill(f64::NAN);
+            Err(Error::TooFewSamples { .. }) => row.fill(f64::NAN),
+            Err(e) => {
+                return Err(Error::InBatch {
+                    index: i,
+                    source: Box::new(e),
+                })
+            }
         }
     }
     Ok(())
@@ -253,7 +238,10 @@ impl PyPolynomialFilter {
     /// an array ``(len(t), m+1)`` whose row ``i`` is ``[x, x', …, x^(m)]`` at ``t[i]`` from the
     /// samples up to ``i`` (NaN while the filter is not yet determined). With
     /// ``return_sigma=True`` also the 1σ errors, a second array of the same shape (the filter
-    /// needs its noise ``sigma``).
+    /// needs its noise ``sigma``): the two are views of one ``(len(t), 2(m+1))`` buffer, the
+    /// rows ``d0..dM, s0..sM`` of ``seqsmooth filter --sigma``, written by the library's batch
+    /// σ path (no covariance matrix per sample; within about 2× of the plain call's time, the
+    /// output being twice as large: BENCHMARKS.md).
     ///
     /// The work runs without the GIL; Ctrl-C stops it between blocks of 65,536 samples, the
     /// samples before the block taken.
@@ -290,13 +278,11 @@ impl PyPolynomialFilter {
         if !return_sigma {
             return matrix(py, out, n, w);
         }
-        // Rows [d, s] into the two arrays.
-        let (mut d, mut s) = (Vec::with_capacity(n * w), Vec::with_capacity(n * w));
-        for row in out.chunks_exact(stride) {
-            d.extend_from_slice(&row[..w]);
-            s.extend_from_slice(&row[w..]);
-        }
-        let (d, s) = (matrix(py, d, n, w)?, matrix(py, s, n, w)?);
+        // Rows [d, s]: the two arrays are views of the one buffer (no copy).
+        let rows = matrix(py, out, n, stride)?;
+        let all = PySlice::full(py);
+        let d = rows.get_item((&all, PySlice::new(py, 0, w as isize, 1)))?;
+        let s = rows.get_item((&all, PySlice::new(py, w as isize, stride as isize, 1)))?;
         Ok((d, s).into_pyobject(py)?.into_any())
     }
 

@@ -3,7 +3,7 @@
 //! Gauss–Newton fit, the extended Kalman filter (driving noise or fading memory) or its
 //! smoother; the rows checked by the library's `radar_row`, as `seqsmooth track` checks them.
 
-use crate::arrays::{matrix, series, Series};
+use crate::arrays::{matrix, series, times, Series};
 use crate::errors::{raise, to_py, IntoPy, Kind};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -255,7 +255,7 @@ impl PyRadarTracker {
         sigma_range: Option<&Bound<'py, PyAny>>,
         sigma_angle: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let ts = series(t, "t")?;
+        let ts = times(t, "t")?;
         let n = ts.as_slice().len();
         let values = [
             series(range, "range")?,

@@ -60,9 +60,9 @@ def test_the_index_counts_from_the_callers_array_across_blocks():
         (["a", "b"], [1.0, 2.0], ss.InvalidTypeError),  # strings
         ([1.0, 2.0], np.array([1 + 2j, 2 + 0j]), ss.InvalidTypeError),  # complex
         ([1.0, 2.0], [object(), object()], ss.InvalidTypeError),
-        (
-            np.array(["2026-01-01", "2026-01-02"], dtype="datetime64[ns]"),
+        (  # dates are times (test_inputs.py), never values
             [1.0, 2.0],
+            np.array(["2026-01-01", "2026-01-02"], dtype="datetime64[ns]"),
             ss.InvalidTypeError,
         ),
     ],

@@ -203,6 +203,15 @@ impl<S: Records> RowReader<S> {
         need: &Need,
     ) -> Result<Self, CliError> {
         need.check_header(csv.header())?;
+        if crate::io::looks_like_data(csv.header()) {
+            let mut names = format!("the header line '{time_col},{value_col}'");
+            if let Some(id) = id_col {
+                names = format!(
+                    "a header line naming the columns '{id}', '{time_col}' and '{value_col}'"
+                );
+            }
+            return Err(crate::io::headerless(csv.header(), &names));
+        }
         let why = csv.header_why();
         let find = |name: &str| find_column(csv.header(), name, &why);
         let (time_idx, value_idx) = (find(time_col)?, find(value_col)?);
@@ -352,10 +361,14 @@ impl<S: Records> RowReader<S> {
                 self.touched.push(series);
             }
         }
-        chunk
-            .cells
-            .push((chunk.text.len(), t_cell.len(), y_cell.len()));
-        chunk.text.extend_from_slice(t_cell);
+        // An ISO-8601 time is echoed as the seconds it was read as (as a Parquet timestamp is).
+        let at = chunk.text.len();
+        if seqsmooth::numeric::epoch::looks_like_date(t_cell) {
+            write_f64(&mut chunk.text, t);
+        } else {
+            chunk.text.extend_from_slice(t_cell);
+        }
+        chunk.cells.push((at, chunk.text.len() - at, y_cell.len()));
         chunk.text.extend_from_slice(y_cell);
         chunk.t.push(t);
         chunk.y.push(y);

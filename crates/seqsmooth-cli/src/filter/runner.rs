@@ -128,8 +128,9 @@ impl Runner {
 
     /// Runs the samples `(t[i], y[i])` of one series and writes each row's values (the
     /// estimate at `t[i] + lead`, with 1σ when `sigma`) to `out`, `stride` per row. The
-    /// expanding- and fading-memory filters without 1σ or lead take the batch kernels
-    /// ([`PolynomialFilter::update_many_into`]). An error is [`Error::InBatch`] of its row.
+    /// expanding- and fading-memory filters without lead take the batch kernels
+    /// ([`PolynomialFilter::update_many_into`], with 1σ
+    /// [`PolynomialFilter::update_many_sigma_into`]). An error is [`Error::InBatch`] of its row.
     pub fn run(
         &mut self,
         t: &[f64],
@@ -140,8 +141,13 @@ impl Runner {
     ) -> Result<(), Error> {
         out.fill(f64::NAN);
         let w = self.degree() + 1;
-        if let (Runner::Expanding(_) | Runner::Fading(_), false, 0.0) = (&*self, sigma, lead) {
-            return self.filter_mut().update_many_into(t, y, out);
+        if let (Runner::Expanding(_) | Runner::Fading(_), 0.0) = (&*self, lead) {
+            // The library's batch paths: the kernels, and with 1σ its batch σ path (rows of
+            // d0..dM, s0..sM), the numbers of Python's `update_many`.
+            return match sigma {
+                false => self.filter_mut().update_many_into(t, y, out),
+                true => self.filter_mut().update_many_sigma_into(t, y, out),
+            };
         }
         let stride = out.len().checked_div(t.len()).unwrap_or(0);
         for (index, ((&t, &y), row)) in t

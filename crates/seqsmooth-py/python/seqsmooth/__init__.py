@@ -38,7 +38,12 @@ gains, vrf
     The gains and variance-reduction matrices of Morrison's tables, in floats or exactly as
     ``fractions.Fraction``.
 
-Conventions: derivatives are unscaled, in the caller's time units (``[x, x', x'', ...]``);
+seconds
+    Times as the entry points read them: numbers as they are, dates (numpy ``datetime64``,
+    pandas, Polars, Arrow) as seconds since the Unix epoch (naive dates are UTC).
+
+Conventions: every argument ``t`` takes numbers or dates (read as by ``seconds``);
+derivatives are unscaled, in the caller's time units (``[x, x', x'', ...]``);
 every error is a :class:`SeqsmoothError` (a ``ValueError``) naming the bad value and, in a
 batch, its ``index``.
 """
@@ -61,12 +66,14 @@ from ._seqsmooth import (
     RadarTracker,
     SlidingFit,
     State,
+    __version__,
     cramer_rao_bound,
     fit_curve,
     gains,
     gauss_rule,
     luenberger_gains,
     polynomial_samples,
+    seconds,
     smooth,
     vrf,
 )
@@ -82,6 +89,7 @@ from .errors import (
 from .frame import filter_frame
 
 __all__ = [
+    "__version__",
     "MAX_DEGREE",
     "AutomaticFilter",
     "BayesFilter",
@@ -97,6 +105,7 @@ __all__ = [
     "PolynomialFilter",
     "State",
     "smooth",
+    "seconds",
     "filter_frame",
     "gains",
     "vrf",

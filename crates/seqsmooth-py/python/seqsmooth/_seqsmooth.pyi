@@ -12,6 +12,7 @@ Matrix = npt.NDArray[np.float64]
 Vector = npt.NDArray[np.float64]
 
 MAX_DEGREE: int
+__version__: str
 
 class State:
     """The estimate of a polynomial filter at one time."""
@@ -73,6 +74,7 @@ class FixedMemory(PolynomialFilter):
         sigma: float | None = None,
     ) -> None: ...
 
+@overload
 def smooth(
     y: ArrayLike,
     window_length: int,
@@ -80,7 +82,25 @@ def smooth(
     deriv: int = 0,
     delta: float = 1.0,
     t: ArrayLike | None = None,
+    sigma: float | None = None,
+    return_sigma: Literal[False] = ...,
 ) -> Vector: ...
+@overload
+def smooth(
+    y: ArrayLike,
+    window_length: int,
+    polyorder: int,
+    deriv: int = 0,
+    delta: float = 1.0,
+    t: ArrayLike | None = None,
+    sigma: float | None = None,
+    *,
+    return_sigma: Literal[True],
+) -> tuple[Vector, Vector]: ...
+def seconds(t: ArrayLike, name: str = "t") -> Vector:
+    """Times as every entry point reads them: numbers as they are; dates (numpy datetime64 of
+    any unit, pandas datetime columns, tz-aware too, Polars Datetime/Date, Arrow timestamps and
+    dates) as seconds since the Unix epoch (naive dates are UTC); timedelta64 as seconds."""
 
 class Innovation:
     """What one Kalman update saw."""

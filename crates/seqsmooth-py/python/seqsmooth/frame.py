@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ._seqsmooth import filter_series
+from ._seqsmooth import filter_series, seconds
 from .errors import InvalidInputError, SeqsmoothError
 
 
@@ -36,6 +36,17 @@ def _column(frame: Any, name: str) -> np.ndarray:
         else:
             columns = list(getattr(frame, "columns", getattr(frame, "column_names", [])))
         raise InvalidInputError(f"no column {name!r} in the frame (columns: {columns})") from None
+
+
+def _raw_column(frame: Any, name: str) -> Any:
+    """Column ``name`` as the frame holds it (a pandas or Polars Series keeps its dtype, a
+    tz-aware one too), for :func:`seconds`."""
+    if hasattr(frame, "column_names") and hasattr(frame, "column"):  # pyarrow
+        return _column(frame, name)
+    try:
+        return frame[name]
+    except (KeyError, IndexError, ValueError, TypeError):
+        return _column(frame, name)  # raises the error naming the columns
 
 
 def _codes(keys: np.ndarray, by: str) -> tuple[np.ndarray, Any]:
@@ -92,7 +103,9 @@ def filter_frame(
     df : pandas.DataFrame, polars.DataFrame, pyarrow.Table or dict of arrays
         The rows; each series' times strictly increasing (series may interleave).
     time, value : str
-        The time and value columns.
+        The time and value columns. The times may be numbers or dates (numpy
+        ``datetime64``, pandas datetime, tz-aware too, Polars ``Datetime``/``Date``, Arrow
+        timestamps), read as seconds since the Unix epoch (naive dates are UTC).
     by : str, optional
         The column naming each row's series (any type); without it the frame is one series.
     kind : {"expanding", "fading", "fixed"}
@@ -103,7 +116,8 @@ def filter_frame(
     Returns
     -------
     The kind of ``df`` with the columns of ``seqsmooth filter``'s CSV: ``[by,] time, value,
-    d0..dM`` (the estimate at each row's time, from its series up to that row), then
+    d0..dM`` (``time`` in seconds, as the filter read it; ``dk`` the estimate at each row's
+    time, from its series up to that row), then
     ``s0..sM`` (their 1σ) with ``sigma``, then ``window`` (rows in the window) for ``fixed``;
     NaN where the series is not yet determined. Rows in input order.
 
@@ -113,7 +127,7 @@ def filter_frame(
         As ``update_many``; ``.index`` is the row of the frame, and the message names its
         series.
     """
-    t = np.ascontiguousarray(_column(df, time), dtype=np.float64)
+    t = seconds(_raw_column(df, time), time)
     y = np.ascontiguousarray(_column(df, value), dtype=np.float64)
     n = len(t)
     if n == 0:

@@ -3,9 +3,11 @@
 //! decides whether two sampling steps are the same step ([`steps`]), the memo of constants
 //! that cost exact arithmetic (`memo`), the dispatch from a
 //! run-time state size to code compiled for that size (the crate-internal `unrolled_sizes!`),
-//! and integer powers inline ([`power`]).
+//! integer powers inline ([`power`]), and timestamps as seconds since the Unix epoch
+//! ([`epoch`]: ticks of any unit, ISO-8601 text; the one rule of every front end).
 
 pub mod double_word;
+pub mod epoch;
 pub(crate) mod memo;
 pub mod power;
 pub mod steps;

@@ -157,6 +157,99 @@ pub trait PolynomialFilter: std::fmt::Debug + Send {
         }
         Ok(())
     }
+    /// The batch σ path: [`update_many_into`](Self::update_many_into) that also writes each
+    /// estimate's 1σ (the square roots of its covariance's diagonal). Row `i` of `rows` holds
+    /// `2(m+1)` values, the derivatives `x, x', …, x^(m)` at `times[i]` and then their 1σ (the
+    /// columns `d0..dM,s0..sM` of `seqsmooth filter --sigma`); both NaN while the filter is not
+    /// determined. The filters of this crate write without a covariance matrix per sample
+    /// where they can (speed: BENCHMARKS.md); the numbers are [`try_estimate_at`](Self::try_estimate_at)'s
+    /// up to the rounding of the covariance's recursion.
+    ///
+    /// Errors: those of [`update_many_into`](Self::update_many_into) and of
+    /// [`try_estimate_at`](Self::try_estimate_at) once determined, in [`Error::InBatch`]
+    /// with the sample's index; `rows` of another length; a filter without a noise σ
+    /// ([`Error::InvalidParameter`] naming `sigma`, at the first determined sample).
+    ///
+    /// ```
+    /// use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
+    /// let mut f = FadingMemory::new(1, 0.9, 1.0, Engine::Gain).unwrap().with_noise_sigma(0.5).unwrap();
+    /// let t: Vec<f64> = (0..50).map(f64::from).collect();
+    /// let y: Vec<f64> = t.iter().map(|t| 1.0 + 2.0 * t).collect();
+    /// let mut rows = vec![0.0; 50 * 4];
+    /// f.update_many_sigma_into(&t, &y, &mut rows).unwrap();
+    /// assert!(rows[0].is_nan());                             // one sample: no line yet
+    /// let last = &rows[49 * 4..];
+    /// assert!((last[1] - 2.0).abs() < 1e-9);                // x'
+    /// let s = f.estimate().unwrap().std_devs().unwrap();
+    /// assert!((last[2] - s[0]).abs() <= 1e-12 * s[0]);       // the estimate's own 1σ
+    /// ```
+    fn update_many_sigma_into(
+        &mut self,
+        times: &[f64],
+        values: &[f64],
+        rows: &mut [f64],
+    ) -> Result<(), Error> {
+        check_batch_lengths(times, values)?;
+        let w = self.degree() + 1;
+        check_sigma_rows_length(times, self.degree(), rows)?;
+        for (index, ((&t, &y), row)) in times
+            .iter()
+            .zip(values)
+            .zip(rows.chunks_exact_mut(2 * w))
+            .enumerate()
+        {
+            let at = |e: Error| Error::InBatch {
+                index,
+                source: Box::new(e),
+            };
+            self.update(t, y).map_err(at)?;
+            let state = match self.try_estimate_at(t) {
+                Ok(s) => s,
+                Err(Error::TooFewSamples { .. }) => {
+                    row.fill(f64::NAN);
+                    continue;
+                }
+                Err(e) => return Err(at(e)),
+            };
+            let (d, s) = row.split_at_mut(w);
+            let x = &state.derivatives;
+            d[..x.len()].copy_from_slice(x);
+            d[x.len()..].fill(f64::NAN);
+            let sd = state.std_devs().ok_or_else(|| at(no_noise_sigma()))?;
+            s[..sd.len()].copy_from_slice(&sd);
+            s[sd.len()..].fill(f64::NAN);
+        }
+        Ok(())
+    }
+}
+
+/// Checks a batch's rows of derivatives and 1σ for
+/// [`PolynomialFilter::update_many_sigma_into`]: `rows.len() = times.len()·2(m+1)`.
+pub(crate) fn check_sigma_rows_length(times: &[f64], m: usize, rows: &[f64]) -> Result<(), Error> {
+    if rows.len() != times.len() * 2 * (m + 1) {
+        return Err(Error::InvalidParameter {
+            name: "rows length",
+            value: rows.len().to_string(),
+            reason: format!(
+                "{} samples of degree {m} need {} values (one row of m+1 derivatives and their \
+                 m+1 sigmas per sample)",
+                times.len(),
+                times.len() * 2 * (m + 1)
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The error of a filter asked for 1σ without a noise σ.
+pub(crate) fn no_noise_sigma() -> Error {
+    Error::InvalidParameter {
+        name: "sigma",
+        value: "None".into(),
+        reason: "the filter has no noise sigma for the 1σ: construct it with one \
+                 (with_noise_sigma, sigma=...)"
+            .into(),
+    }
 }
 
 /// Writes one row of [`PolynomialFilter::update_many_into`]: the estimate's derivatives, NaN

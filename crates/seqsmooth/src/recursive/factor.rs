@@ -115,6 +115,63 @@ impl TriangularFactor {
         self.d.len()
     }
 
+    /// `1/√d_i` for every pivot into `out`, or `false` when a pivot is not positive (the factor
+    /// does not determine the state): the one set of square roots and divisions that
+    /// [`Self::right_divide_row`] and [`Self::left_solve`] share across rows.
+    pub(crate) fn inverse_sqrt_pivots(&self, out: &mut [f64]) -> bool {
+        for (o, d) in out.iter_mut().zip(&self.d) {
+            // NaN fails too.
+            if d.0.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                return false;
+            }
+            *o = 1.0 / d.0.sqrt();
+        }
+        true
+    }
+
+    /// `x ← D^-½ U⁻ᵀ x`, i.e. `(x R⁻¹)ᵀ` for a row `x` (forward substitution with the unit
+    /// triangular `Uᵀ`, then the pivots' `inv` from [`Self::inverse_sqrt_pivots`]), without
+    /// allocating.
+    pub(crate) fn right_divide_row(&self, x: &mut [f64], inv: &[f64]) {
+        let p = self.dim();
+        for i in 0..p {
+            let (done, rest) = x.split_at_mut(i);
+            let v = done
+                .iter()
+                .enumerate()
+                .fold(rest[0], |v, (k, xk)| v - self.u[k * p + i] * xk);
+            rest[0] = v;
+        }
+        for (v, r) in x.iter_mut().zip(inv) {
+            *v *= r;
+        }
+    }
+
+    /// `x ← U⁻¹ D^-½ x`, i.e. `R⁻¹ x` (the pivots' `inv`, then back substitution with the unit
+    /// triangular `U`), without allocating.
+    pub(crate) fn left_solve(&self, x: &mut [f64], inv: &[f64]) {
+        let p = self.dim();
+        for (v, r) in x.iter_mut().zip(inv) {
+            *v *= r;
+        }
+        for i in (0..p).rev() {
+            let (head, later) = x.split_at_mut(i + 1);
+            let u = &self.u[i * p + i + 1..(i + 1) * p];
+            head[i] = later.iter().zip(u).fold(head[i], |v, (xk, uk)| v - uk * xk);
+        }
+    }
+
+    /// `‖R x‖² = Σ_i d_i (U x)_i²`, without allocating.
+    pub(crate) fn norm_sq_of(&self, x: &[f64]) -> f64 {
+        let p = self.dim();
+        (0..p)
+            .map(|i| {
+                let ux = x[i] + (i + 1..p).map(|k| self.u[i * p + k] * x[k]).sum::<f64>();
+                self.d[i].0 * ux * ux
+            })
+            .sum()
+    }
+
     /// The factor `R = D^½ U` (computed).
     pub fn r(&self) -> DMatrix<f64> {
         let p = self.dim();
@@ -220,18 +277,6 @@ impl TriangularFactor {
             z[i] = s;
         }
         Some(quad)
-    }
-
-    /// `‖R z‖² = Σ d_i (U z)_i²` (no allocation, no square roots).
-    pub(crate) fn norm_sq_of(&self, z: &[f64]) -> f64 {
-        let p = self.dim();
-        let u = &self.u[..p * p];
-        (0..p)
-            .map(|i| {
-                let s = z[i] + (i + 1..p).map(|j| u[i * p + j] * z[j]).sum::<f64>();
-                self.d[i].0 * s * s
-            })
-            .sum()
     }
 
     /// Folds the row `√c·[a | b]` into `[R | d]`: `O(p²)`, no square roots.

@@ -303,6 +303,35 @@ impl InformationFilter {
         Some(out)
     }
 
+    /// The variances of `j·X` for the rows `j` of `rows` (`p` values each, row-major;
+    /// overwritten), into `out`: the diagonal of [`Self::covariance_of`], the true covariance's
+    /// when it is kept, without allocating (the batch σ path of the polynomial filters). `false`
+    /// while not determined. `inv` is scratch of `p` values.
+    pub(crate) fn variances_of_rows(
+        &self,
+        rows: &mut [f64],
+        inv: &mut [f64],
+        out: &mut [f64],
+    ) -> bool {
+        let p = self.dim();
+        if !self.info.inverse_sqrt_pivots(&mut inv[..p]) {
+            return false;
+        }
+        for (j, o) in rows.chunks_exact_mut(p).zip(out.iter_mut()) {
+            // J R⁻¹ as a column, from the stored factor (R times the lazy scale).
+            self.info.right_divide_row(j, inv);
+            *o = match &self.spread {
+                None => j.iter().map(|v| v * v).sum::<f64>() * (self.scale * self.scale),
+                Some(q) => {
+                    // kᵀ = R⁻¹ (J R⁻¹)ᵀ, the variance ‖Q k‖² (the lazy scale cancels).
+                    self.info.left_solve(j, inv);
+                    q.norm_sq_of(j)
+                }
+            };
+        }
+        true
+    }
+
     /// The largest variance inflation `max_i P_ii (RᵀR)_ii` (`P = (RᵀR)⁻¹`): 1 for a component
     /// whose information is independent of the others', `1/(1 − ρ_i²)` for one whose estimate
     /// correlates with the rest by the multiple correlation `ρ_i`, and without bound as a
@@ -357,19 +386,6 @@ impl InformationFilter {
     pub fn covariance(&self) -> Option<DMatrix<f64>> {
         let p = self.dim();
         self.covariance_of(&DMatrix::identity(p, p))
-    }
-
-    /// The variance `hᵀ C h` of one linear combination `hᵀx` of the estimate
-    /// ([`covariance_of`](Self::covariance_of) for one row, without allocating: `z` is
-    /// scratch of the state's dimension); `None` while not determined.
-    pub(crate) fn variance_of_row(&self, h: &[f64], z: &mut [f64]) -> Option<f64> {
-        let quad = self.info.solve_gram(h, z)?;
-        Some(match &self.spread {
-            // Stored R is s·R: hᵀ(RᵀR)⁻¹h = s²·quad.
-            None => quad * (self.scale * self.scale),
-            // ‖Q (RᵀR)⁻¹ h‖², Q stored times s², (RᵀR)⁻¹ divided by s²: the scale cancels.
-            Some(q) => q.norm_sq_of(z),
-        })
     }
 
     /// The covariance of `J x`: `J C Jᵀ` for the estimate's covariance `C`

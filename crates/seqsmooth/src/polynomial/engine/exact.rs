@@ -97,6 +97,11 @@ impl ExactEngine {
         }
     }
 
+    /// Whether the covariance is tracked (a noise σ was given).
+    pub fn tracks_covariance(&self) -> bool {
+        self.sigma.is_some()
+    }
+
     pub fn samples(&self) -> u64 {
         self.n
     }
@@ -262,12 +267,10 @@ impl ExactEngine {
 
     /// The fit's value at `t` and its variance (times the tracked `σ²`), without allocating;
     /// `None` while not determined or without a tracked `σ`. The position is `Σ a_k u^k`, so
-    /// its variance is `σ² hᵀ C h` with `h = (1, u, …, u^m)`.
+    /// its variance is `σ² hᵀ C h` with `h = (1, u, …, u^m)`
+    /// ([`InformationFilter::variances_of_rows`] with the one row `h`).
     pub fn position_at(&self, t: f64) -> Option<(f64, f64)> {
-        let sigma = self.sigma?;
-        if !self.is_determined() {
-            return None;
-        }
+        let sigma = self.sigma.filter(|_| self.is_determined())?;
         let mut x = [0.0; MAX_DEGREE + 1];
         if !self.derivatives_into(t, &mut x) {
             return None;
@@ -280,38 +283,74 @@ impl ExactEngine {
             *hk = power;
             power *= u;
         }
-        let mut z = [0.0; MAX_DEGREE + 1];
-        let v = self.info.variance_of_row(&h[..p], &mut z[..p])? * (sigma * sigma);
-        Some((x[0], v))
+        let (mut inv, mut var) = ([0.0; MAX_DEGREE + 1], [0.0]);
+        if !self.info.variances_of_rows(&mut h[..p], &mut inv[..p], &mut var) {
+            return None;
+        }
+        Some((x[0], var[0] * (sigma * sigma)))
     }
 
-    /// The derivatives at `t` into `x` and their variances (the covariance's diagonal, times
-    /// the tracked `σ²`) into `var`, `m + 1` each, without allocating; false (and the slices
-    /// unspecified) while not determined, without a tracked `σ`, or where the unit's scaling
-    /// is not a normal double. Row `k` of the read-out is `(k!/s^k) C(j,k) u^(j−k)`, `j ≥ k`.
+    /// The derivatives at `t` into `x` and their variances (the squares of
+    /// [`Self::std_devs_into`]) into `var`, `m + 1` each, without allocating; false (and the
+    /// slices unspecified) while not determined or without a tracked `σ`.
     pub fn variances_at(&self, t: f64, x: &mut [f64], var: &mut [f64]) -> bool {
-        let Some(sigma) = self.sigma else {
-            return false;
-        };
-        if !self.unscale_in_range || !self.is_determined() || !self.derivatives_into(t, x) {
+        if !(self.is_determined() && self.derivatives_into(t, x) && self.std_devs_into(t, var)) {
             return false;
         }
-        let u = (t - self.centre) * self.inv_unit;
+        for v in &mut var[..=self.m] {
+            *v *= *v;
+        }
+        true
+    }
+
+    /// The 1σ of the unscaled derivatives at `t` into `out` without allocating: row `i` of
+    /// `J = D(s) Φ(v)` (`v` the time in the basis' units) through the information factor
+    /// ([`InformationFilter::variances_of_rows`]), times σ. `false` (and `out` unspecified)
+    /// without a tracked covariance or while not determined.
+    pub fn std_devs_into(&self, t: f64, out: &mut [f64]) -> bool {
         let p = self.m + 1;
-        let mut h = [0.0; MAX_DEGREE + 1];
-        let mut z = [0.0; MAX_DEGREE + 1];
-        for (k, v) in var[..p].iter_mut().enumerate() {
-            // C(j, k) u^(j−k) for j = k … m, by C(j+1,k) = C(j,k)(j+1)/(j+1−k).
-            h[..k].fill(0.0);
-            let mut c = 1.0;
-            for (j, hj) in h[..p].iter_mut().enumerate().skip(k) {
-                *hj = c;
-                c *= u * (j + 1) as f64 / (j + 1 - k) as f64;
+        // A stack table of p² values for the sizes compiled in, else one on the heap.
+        unrolled_sizes!(p, N => self.std_devs_with(t, [[0.0; N]; N].as_flattened_mut(), out), _ => self.std_devs_with(t, &mut vec![0.0; p * p], out))
+    }
+
+    /// [`Self::std_devs_into`] with `rows` (`p²` zeros) for the rows of `Φ(v)`.
+    #[inline(always)]
+    fn std_devs_with(&self, t: f64, rows: &mut [f64], out: &mut [f64]) -> bool {
+        let Some(sigma) = self.sigma.filter(|_| self.n > self.m as u64) else {
+            return false;
+        };
+        let p = self.m + 1;
+        let v = (t - self.centre) * self.inv_unit;
+        // The rows of Φ(v): Φ_ik = C(k, i) v^(k-i), k ≥ i (zero below the diagonal).
+        let mut powers = [1.0; MAX_DEGREE + 1];
+        for k in 1..p {
+            powers[k] = powers[k - 1] * v;
+        }
+        let mut binomial = [0.0; MAX_DEGREE + 1];
+        for k in 0..p {
+            // Row k of Pascal's triangle from row k-1, in place.
+            binomial[k] = 1.0;
+            for i in (1..k).rev() {
+                binomial[i] += binomial[i - 1];
             }
-            let Some(q) = self.info.variance_of_row(&h[..p], &mut z[..p]) else {
-                return false;
+            for i in 0..=k {
+                rows[i * p + k] = binomial[i] * powers[k - i];
+            }
+        }
+        let (mut inv, mut var) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
+        if !self
+            .info
+            .variances_of_rows(rows, &mut inv[..p], &mut var[..p])
+        {
+            return false;
+        }
+        for (i, (o, var)) in out[..p].iter_mut().zip(&var[..p]).enumerate() {
+            let sd = sigma * var.max(0.0).sqrt();
+            *o = if self.unscale_in_range {
+                sd * self.unscale[i]
+            } else {
+                unscale_stepwise(sd, i, self.unit)
             };
-            *v = q * (sigma * self.unscale[k]).powi(2);
         }
         true
     }

@@ -25,7 +25,7 @@ use crate::polynomial::fading::vrf::fading_vrf;
 use crate::polynomial::form::{EstimateForm, GainForm};
 use crate::polynomial::options::{DiscountMode, MAX_DEGREE};
 use crate::scalar::{rational_from_f64, Scalar};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use std::sync::Arc;
 
 /// A kernel's output row (if any): the unscaled derivatives `x_k = z_k·k!/τ^k`; returns
@@ -345,6 +345,12 @@ pub(crate) struct GainEngine {
     k_lo: Vec<f64>,
     /// Noise variance and the scaled covariance of the estimate's random error.
     cov: Option<(f64, DMatrix<f64>)>,
+    /// The covariance after the previous update (row-major), and whether the update left it
+    /// unchanged (to [`COV_STEADY`] relative in every entry) after the fading switch: the steady state of
+    /// the covariance's recursion for the current step and gains, which the plain kernels then
+    /// keep while the steps stay equal to the typical one.
+    cov_last: Vec<f64>,
+    cov_steady: bool,
     /// The steady fading recursion's block map (built on first use).
     block: Option<Box<SteadyBlock>>,
     /// Samples the steady recursion has run in batches since the typical step was last
@@ -352,6 +358,12 @@ pub(crate) struct GainEngine {
     block_credit: usize,
     block_credit_step: f64,
 }
+
+/// The relative change of every covariance entry below which an update has left the fading
+/// filter's covariance at its steady state (the Joseph recursion contracts by `θ²` a step, and
+/// its rounding keeps the last few bits moving): the plain kernels then keep it, the reported
+/// 1σ within this of the recursion's.
+const COV_STEADY: f64 = 1e-13;
 
 impl GainEngine {
     pub fn new(m: usize, tau: f64, fading: Option<FadingGains>) -> Self {
@@ -373,6 +385,8 @@ impl GainEngine {
             k: vec![0.0; m + 1],
             k_lo: vec![0.0; m + 1],
             cov: None,
+            cov_last: Vec::new(),
+            cov_steady: false,
             block: None,
             block_credit: 0,
             block_credit_step: f64::NAN,
@@ -381,6 +395,74 @@ impl GainEngine {
 
     pub fn track_covariance(&mut self, sigma: f64) {
         self.cov = Some((sigma * sigma, DMatrix::zeros(self.m + 1, self.m + 1)));
+        self.cov_last = vec![f64::NAN; (self.m + 1) * (self.m + 1)];
+        self.cov_steady = false;
+    }
+
+    /// Whether the covariance is tracked (a noise σ was given).
+    pub fn tracks_covariance(&self) -> bool {
+        self.cov.is_some()
+    }
+
+    /// The 1σ of the unscaled derivatives at the newest sample, `√P_kk · k!/τ^k`, into `row`
+    /// (NaN until determined or without a tracked covariance; a value beyond the double range
+    /// is infinite, for the caller to refuse).
+    pub fn std_devs_into(&self, row: &mut [f64]) {
+        let Some((_, p)) = self.cov.as_ref().filter(|_| self.n > self.m as u64) else {
+            row.fill(f64::NAN);
+            return;
+        };
+        for (k, (s, (f, tk))) in row.iter_mut().zip(factorial_powers(self.unit)).enumerate() {
+            let sd = p[(k, k)].max(0.0).sqrt();
+            *s = if tk.is_normal() {
+                sd * f / tk
+            } else {
+                unscale_stepwise(sd, k, self.unit)
+            };
+        }
+    }
+
+    /// [`update_many_into`](Self::update_many_into) with each row's 1σ: rows of `2(m+1)`
+    /// (derivatives, then 1σ). The plain kernels run where they apply — with a tracked
+    /// covariance, once it is steady ([`Self::update`]), its 1σ then the same for the run —
+    /// the per-sample recursion elsewhere. `scratch` holds `ts.len()·(m+1)` derivatives.
+    pub fn update_many_sigma_into(
+        &mut self,
+        ts: &[f64],
+        ys: &[f64],
+        rows: &mut [f64],
+        scratch: &mut Vec<f64>,
+    ) {
+        let w = self.m + 1;
+        let mut i = 0;
+        while i < ts.len() {
+            if self.plain_kernel_applies() {
+                scratch.clear();
+                scratch.resize((ts.len() - i) * w, 0.0);
+                let done = self.steady_run(&ts[i..], &ys[i..], scratch, true);
+                if done > 0 {
+                    let mut sd = [0.0; MAX_DEGREE + 1];
+                    self.std_devs_into(&mut sd[..w]);
+                    for (row, d) in rows[i * 2 * w..(i + done) * 2 * w]
+                        .chunks_exact_mut(2 * w)
+                        .zip(scratch.chunks_exact(w))
+                    {
+                        row[..w].copy_from_slice(d);
+                        row[w..].copy_from_slice(&sd[..w]);
+                    }
+                    i += done;
+                    if i == ts.len() {
+                        break;
+                    }
+                }
+            }
+            self.update(ts[i], ys[i]);
+            let row = &mut rows[i * 2 * w..(i + 1) * 2 * w];
+            let (d, s) = row.split_at_mut(w);
+            self.derivatives_into(d);
+            self.std_devs_into(s);
+            i += 1;
+        }
     }
 
     pub fn samples(&self) -> u64 {
@@ -433,20 +515,40 @@ impl GainEngine {
         }
         if let Some((var, p)) = &mut self.cov {
             // P ← Φ(ζ) P Φ(ζ)ᵀ, then the Joseph form P ← (I - K e0ᵀ) P (I - K e0ᵀ)ᵀ + σ² K Kᵀ:
-            // the exact covariance of this linear estimator's random error.
-            let transition = crate::model::phi(self.m, zeta);
-            *p = &transition * &*p * transition.transpose();
+            // the exact covariance of this linear estimator's random error. In place, without
+            // allocating: the shift on P's columns, P transposed (Pᵀ Φᵀ = (Φ P)ᵀ), the shift
+            // on its columns again; then (A P Aᵀ)_ij = P_ij − K_i P_0j − P_i0 K_j + K_i K_j P_00.
             let dim = self.m + 1;
-            let a = DMatrix::from_fn(dim, dim, |i, j| {
-                let id = if i == j { 1.0 } else { 0.0 };
-                if j == 0 {
-                    id - self.k[i]
-                } else {
-                    id
+            for col in p.as_mut_slice().chunks_exact_mut(dim) {
+                shift_scaled(col, zeta);
+            }
+            p.transpose_mut();
+            for col in p.as_mut_slice().chunks_exact_mut(dim) {
+                shift_scaled(col, zeta);
+            }
+            let mut row0 = [0.0; MAX_DEGREE + 1];
+            for (j, r) in row0[..dim].iter_mut().enumerate() {
+                *r = p[(0, j)];
+            }
+            let mut col0 = [0.0; MAX_DEGREE + 1];
+            for (i, c) in col0[..dim].iter_mut().enumerate() {
+                *c = p[(i, 0)];
+            }
+            let p00 = row0[0] + *var;
+            let mut converged = self
+                .fading
+                .as_ref()
+                .is_some_and(|f| f.switched_at.is_some());
+            for j in 0..dim {
+                for i in 0..dim {
+                    let (ki, kj) = (self.k[i], self.k[j]);
+                    let v = p[(i, j)] - ki * row0[j] - col0[i] * kj + ki * kj * p00;
+                    converged &= (v - self.cov_last[i * dim + j]).abs() <= COV_STEADY * v.abs();
+                    self.cov_last[i * dim + j] = v;
+                    p[(i, j)] = v;
                 }
-            });
-            let kv = DVector::from_column_slice(&self.k);
-            *p = &a * &*p * a.transpose() + (&kv * kv.transpose()) * *var;
+            }
+            self.cov_steady = converged;
         }
         self.t_last = t;
         self.n += 1;
@@ -505,7 +607,7 @@ impl GainEngine {
     }
 
     fn plain_kernel_applies(&self) -> bool {
-        self.cov.is_none()
+        (self.cov.is_none() || self.cov_steady)
             && self.unit_in_range
             && self.m <= PLAIN_KERNEL_MAX_DEGREE
             && match &self.fading {
@@ -981,6 +1083,7 @@ impl GainEngine {
         if let Some((var, p)) = &mut self.cov {
             let l = DMatrix::from_fn(m + 1, m + 1, |k, i| dw::round(&weights[k * (m + 1) + i]));
             *p = &l * l.transpose() * *var;
+            self.cov_steady = false;
         }
         self.start.clear();
     }

@@ -13,7 +13,10 @@ pub(crate) mod expanding_block;
 pub(crate) mod gain;
 pub(crate) mod recursion;
 
-use super::filter::{check_batch_lengths, check_estimates_length, first_invalid};
+use super::filter::{
+    check_batch_lengths, check_estimates_length, check_sigma_rows_length, first_invalid,
+    no_noise_sigma,
+};
 use crate::error::Error;
 use crate::model::PolynomialState;
 #[cfg(doc)]
@@ -108,16 +111,22 @@ impl EngineState {
             let out = estimates.as_deref_mut().map(|o| &mut o[start * w..end * w]);
             let valid = start + self.run_valid(m, &times[start..end], &values[start..end], out);
             if valid < end {
-                return match self.check(times[valid], values[valid]) {
-                    Err(e) => Err(Error::InBatch {
-                        index: valid,
-                        source: Box::new(e),
-                    }),
-                    Ok(()) => unreachable!("first_invalid and check disagree at {valid}"),
-                };
+                return Err(self.rejection(times, values, valid));
             }
         }
         Ok(())
+    }
+
+    /// The error of sample `valid`, the first that [`first_invalid`] (or the gain engine's value
+    /// range) rejected: its own check's, with its index.
+    fn rejection(&self, times: &[f64], values: &[f64], valid: usize) -> Error {
+        match self.check(times[valid], values[valid]) {
+            Err(e) => Error::InBatch {
+                index: valid,
+                source: Box::new(e),
+            },
+            Ok(()) => unreachable!("first_invalid and check disagree at {valid}"),
+        }
     }
 
     /// Runs the samples of `times`, `values` up to the first one [`first_invalid`] (or the
@@ -208,6 +217,100 @@ impl EngineState {
         x[..p].iter().chain(&var[..p]).all(|v| v.is_finite())
     }
 
+    /// The batch σ path ([`PolynomialFilter::update_many_sigma_into`]): rows of `2(m+1)`,
+    /// the derivatives and their 1σ after each sample, in chunks of [`FUSED_CHUNK`] as
+    /// [`Self::update_many`]; without a covariance matrix per sample (the gain engine's
+    /// `std_devs_into`, its plain kernels once the covariance is steady), then checked as
+    /// [`Self::try_estimate_at`] checks an estimate (a number beyond the double range, a fit
+    /// not determined: the row's error).
+    pub(crate) fn update_many_sigma(
+        &mut self,
+        m: usize,
+        times: &[f64],
+        values: &[f64],
+        rows: &mut [f64],
+    ) -> Result<(), Error> {
+        check_batch_lengths(times, values)?;
+        check_sigma_rows_length(times, m, rows)?;
+        let w = m + 1;
+        let before = self.samples();
+        if !self.tracks_covariance() {
+            // Rows NaN until determined; the first determined sample is the error.
+            let first =
+                usize::try_from((w as u64).saturating_sub(before + 1)).unwrap_or(usize::MAX);
+            let end = first.saturating_add(1).min(times.len());
+            self.update_many(m, &times[..end], &values[..end], None)?;
+            rows[..end * 2 * w].fill(f64::NAN);
+            if end > first {
+                return Err(Error::InBatch {
+                    index: first,
+                    source: Box::new(no_noise_sigma()),
+                });
+            }
+            return Ok(());
+        }
+        let mut scratch = Vec::new();
+        for start in (0..times.len()).step_by(FUSED_CHUNK) {
+            let end = (start + FUSED_CHUNK).min(times.len());
+            let (ts, ys) = (&times[start..end], &values[start..end]);
+            let out = &mut rows[start * 2 * w..end * 2 * w];
+            let valid = start + self.run_valid_sigma(m, ts, ys, out, &mut scratch);
+            check_sigma_rows(
+                &rows[start * 2 * w..valid * 2 * w],
+                w,
+                before + start as u64,
+                start,
+            )?;
+            if valid < end {
+                return Err(self.rejection(times, values, valid));
+            }
+        }
+        Ok(())
+    }
+
+    /// [`Self::run_valid`] for [`Self::update_many_sigma`].
+    fn run_valid_sigma(
+        &mut self,
+        m: usize,
+        times: &[f64],
+        values: &[f64],
+        rows: &mut [f64],
+        scratch: &mut Vec<f64>,
+    ) -> usize {
+        let previous = (self.samples() > 0).then(|| self.last_time());
+        let mut valid = first_invalid(times, values, previous);
+        if matches!(self, EngineState::Gain(_)) {
+            valid = values[..valid]
+                .iter()
+                .position(|y| y.abs() > GAIN_MAX_VALUE)
+                .unwrap_or(valid);
+        }
+        let (ts, ys) = (&times[..valid], &values[..valid]);
+        let w = m + 1;
+        match self {
+            EngineState::Gain(g) => {
+                g.update_many_sigma_into(ts, ys, &mut rows[..valid * 2 * w], scratch)
+            }
+            EngineState::Exact(e) => {
+                for ((&t, &y), row) in ts.iter().zip(ys).zip(rows.chunks_exact_mut(2 * w)) {
+                    e.update(t, y);
+                    let (d, s) = row.split_at_mut(w);
+                    if !(e.derivatives_into(t, d) && e.std_devs_into(t, s)) {
+                        row.fill(f64::NAN);
+                    }
+                }
+            }
+        }
+        valid
+    }
+
+    fn tracks_covariance(&self) -> bool {
+        match self {
+            EngineState::Exact(e) => e.tracks_covariance(),
+            EngineState::Gain(g) => g.tracks_covariance(),
+        }
+    }
+
     /// The estimate at `t`, finite in every number, or why there is none
     /// ([`PolynomialFilter::try_estimate_at`]).
     pub(crate) fn try_estimate_at(&self, m: usize, t: f64) -> Result<PolynomialState, Error> {
@@ -244,6 +347,41 @@ impl EngineState {
     }
 }
 
+/// The rows of [`EngineState::update_many_sigma`] checked as an estimate is: from the
+/// determined ones on (`before` samples before the first row, which is sample `first` of the
+/// batch), a row all NaN is a fit not determined, any other number that is not finite one
+/// beyond the double range — the row's error.
+fn check_sigma_rows(rows: &[f64], w: usize, before: u64, first: usize) -> Result<(), Error> {
+    let undetermined = usize::try_from((w as u64).saturating_sub(before + 1)).unwrap_or(usize::MAX);
+    let from = undetermined.saturating_mul(2 * w).min(rows.len());
+    if rows[from..].iter().fold(true, |ok, v| ok & v.is_finite()) {
+        return Ok(());
+    }
+    for (i, row) in rows.chunks_exact(2 * w).enumerate().skip(undetermined) {
+        let error = if row[..w].iter().all(|v| v.is_nan()) {
+            Error::NotDetermined {
+                samples: before + i as u64 + 1,
+                why: SINGULAR.into(),
+            }
+        } else if let Some(k) = row.iter().position(|v| !v.is_finite()) {
+            Error::EstimateOutOfRange {
+                what: if k < w {
+                    format!("d{k}")
+                } else {
+                    format!("s{}", k - w)
+                },
+            }
+        } else {
+            continue;
+        };
+        return Err(Error::InBatch {
+            index: first + i,
+            source: Box::new(error),
+        });
+    }
+    Ok(())
+}
+
 /// Marks each number of `rows` beyond the double range (infinite) as NaN, "no estimate", as
 /// [`PolynomialFilter::update_many_into`] documents: only that derivative, the others of its
 /// row stand ([`PolynomialFilter::try_estimate_at`] names it).
@@ -274,6 +412,9 @@ macro_rules! impl_polynomial_filter {
             fn update_many_into(&mut self, times: &[f64], values: &[f64], estimates: &mut [f64]) -> Result<(), Error> {
                 self.core
                     .update_many(self.m, times, values, Some(estimates))
+            }
+            fn update_many_sigma_into(&mut self, times: &[f64], values: &[f64], rows: &mut [f64]) -> Result<(), Error> {
+                self.core.update_many_sigma(self.m, times, values, rows)
             }
             fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
                 self.core.try_estimate_at(self.m, t).ok()

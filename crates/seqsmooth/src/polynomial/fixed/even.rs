@@ -63,6 +63,13 @@ impl MomentFit {
 
     /// Unscaled derivatives at `r` of the fit with moments `mu`.
     pub(super) fn derivatives(&self, mu: &[f64], r: f64, step: f64) -> Vec<f64> {
+        let mut out = vec![0.0; mu.len()];
+        self.derivatives_into(mu, r, step, &mut out);
+        out
+    }
+
+    /// [`Self::derivatives`] into `out` (`m+1` values), allocating nothing at the kept `r`.
+    pub(super) fn derivatives_into(&self, mu: &[f64], r: f64, step: f64, out: &mut [f64]) {
         let computed;
         let tc = if r == self.kept_r {
             &self.kept_tc
@@ -70,32 +77,22 @@ impl MomentFit {
             computed = Self::times_c(&self.taylor(r), &self.inv_norm);
             &computed
         };
-        let mut out = vec![0.0; mu.len()];
-        apply_upper(tc, mu, &mut out);
-        if unscale_in_range(self.m, step) {
-            for (o, s) in out.iter_mut().zip(derivative_scale(step)) {
-                *o *= s;
-            }
-        } else {
-            // `k!/step^k` overflows or underflows: one factor at a time, so that a zero
-            // coefficient stays 0 and only a derivative truly beyond the range is infinite.
-            for (k, o) in out.iter_mut().enumerate() {
-                *o = unscale_stepwise(*o, k, step);
-            }
-        }
-        out
+        apply_upper(tc, mu, out);
+        unscale(out, step);
     }
 
-    /// `D(τ) T(r) C` row-major, `τ = step`: the map from the moments to the unscaled
-    /// derivatives at `r` ([`apply_upper`] applies it).
-    pub(super) fn evaluator(&self, r: f64, step: f64) -> Vec<f64> {
-        let tc = Self::times_c(&self.taylor(r), &self.inv_norm);
-        let scale: Vec<f64> = derivative_scale(step).take(self.m + 1).collect();
-        let p = self.m + 1;
-        tc.iter()
-            .enumerate()
-            .map(|(k, v)| v * scale[k / p])
-            .collect()
+    /// The 1σ of the unscaled derivatives at `r` for noise σ `sigma`: the square roots of the
+    /// diagonal of `σ² D(τ) T(r) C T(r)ᵀ D(τ)` (7.5.26)-(7.5.28), into `out` (`T` upper
+    /// triangular: `O(m²)`, allocating nothing at the kept `r`).
+    pub(super) fn std_devs_into(&self, r: f64, step: f64, sigma: f64, out: &mut [f64]) {
+        let t = self.taylor(r);
+        for (i, o) in out.iter_mut().enumerate() {
+            let v: f64 = (i..=self.m)
+                .map(|j| t[(i, j)] * t[(i, j)] * self.inv_norm[j])
+                .sum();
+            *o = sigma * v.sqrt();
+        }
+        unscale(out, step);
     }
 
     /// Unscaled derivatives at `r` of the fit with moments `mu` and, given the noise σ, their
@@ -119,6 +116,21 @@ impl MomentFit {
             })
         });
         (x, cov)
+    }
+}
+
+/// Scaled `z_k = τ^k x^(k)/k!` to derivatives in place: `x^(k) = z_k k!/τ^k`.
+fn unscale(out: &mut [f64], step: f64) {
+    if unscale_in_range(out.len() - 1, step) {
+        for (o, s) in out.iter_mut().zip(derivative_scale(step)) {
+            *o *= s;
+        }
+    } else {
+        // `k!/step^k` overflows or underflows: one factor at a time, so that a zero
+        // coefficient stays 0 and only a derivative truly beyond the range is infinite.
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = unscale_stepwise(*o, k, step);
+        }
     }
 }
 

@@ -27,7 +27,8 @@
 //! | [`Design::balance_span`] | bias against random error | §7.13 |
 //! | [`smooth_detrended`], [`Detrended`] | trend removal | §7.14 |
 //! | [`FixedMemory`], [`FixedEngine`] | streaming filter: direct, sliding, irregular, adaptive | §7.1, §9.5 |
-//! | [`smooth`], [`smooth_into`] | whole-series centred smoothing (savgol `mode="interp"`), the sliding engine | (7.4.16), `h = -L/2` |
+//! | [`smooth`], [`smooth_into`], [`smooth_with_sigma_into`] | whole-series centred smoothing (savgol `mode="interp"`), the sliding engine, with 1σ | (7.4.16), `h = -L/2`, (7.5.26)-(7.5.28) |
+//! | [`CentredSmoother`], [`SmoothSigma`] | the same smoothing as a stream (memory bounded by the window): the one engine of [`smooth`] | (7.4.16), §7.5 |
 //! | window moments `μ_j = Σ y(x) p_j(x)`, `β = C μ`, `T(r)` | the even-spacing fit (private `even`) | (7.4.5), (7.4.10), (7.4.15), (7.5.21) |
 //! | sliding moments, shift matrix, refreshes | `O(m²)` per sample (private `sliding`) | (A1.1), §9.5 |
 //! | QR fit of the window | irregular timestamps (private `irregular`) | §6.5 |
@@ -82,6 +83,7 @@
 //! ```
 
 mod bias;
+mod centred;
 mod covariance;
 mod design;
 mod even;
@@ -95,10 +97,11 @@ mod weights;
 mod window_vrf;
 
 pub use bias::{bias, dominant_bias, end_point_bias_bound};
+pub use centred::{CentredSmoother, SmoothSigma, SmoothedRow};
 pub use covariance::{correlated_covariance, covariance, covariance_unscaled, vrf_limit};
 pub use design::{tau_for_derivative_sigma, Balance, Design};
 pub use filter::{FixedEngine, FixedMemory};
-pub use smooth::{smooth, smooth_into};
+pub use smooth::{smooth, smooth_into, smooth_with_sigma_into};
 pub use trend::{smooth_detrended, Detrended, Nominal};
 pub use weights::{weights, weights_unscaled};
 pub use window_vrf::{fixed_memory_vrf_limit, window_covariance};

@@ -41,4 +41,15 @@ impl<T: Copy> Ring<T> {
         let (newer, older) = self.buf.split_at(self.head);
         older.iter().chain(newer)
     }
+
+    /// The `i`-th value, oldest first (`i` below the number held).
+    pub(super) fn get(&self, i: usize) -> T {
+        // While filling, `head` is 0; once full, the oldest is at `head`.
+        let k = self.head + i;
+        self.buf[if k >= self.capacity {
+            k - self.capacity
+        } else {
+            k
+        }]
+    }
 }

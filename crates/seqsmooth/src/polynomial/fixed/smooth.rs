@@ -1,13 +1,10 @@
 //! Whole-series (non-causal) smoothing with centred fixed-memory windows: the counterpart of
 //! `scipy.signal.savgol_filter(…, mode="interp")`, with derivatives.
 
-use super::even::{apply_upper, MomentFit};
-use super::irregular::IrregularWindow;
-use super::sliding::{smoothing_refreshes, SlidingMoments};
-use super::{check_window, steps_agree};
+use super::centred::{CentredSmoother, SmoothSigma};
+use super::check_window;
 use crate::error::Error;
 use crate::polynomial::filter::{check_estimates_length, first_invalid};
-use std::ops::Range;
 
 /// Checks lengths, finiteness and strictly increasing times: the first sample that
 /// [`crate::error::check_sample`] rejects is the error.
@@ -25,124 +22,26 @@ pub(crate) fn check_series(times: &[f64], values: &[f64]) -> Result<(), Error> {
     }
 }
 
-/// True when every step equals the first (the rule of [`steps_agree`]).
-pub(crate) fn is_evenly_spaced(times: &[f64]) -> bool {
-    if times.len() < 3 {
-        return true;
-    }
-    let first = times[1] - times[0];
-    let t_scale = times[0].abs().max(times[times.len() - 1].abs());
-    times
-        .windows(2)
-        .all(|w| steps_agree(w[1] - w[0], first, t_scale))
-}
-
-/// The samples the full window starting at `start` serves (savgol's "interp" mode): the one
-/// `⌊L/2⌋` after its start and, for the first (last) window, every sample before (after) it.
-fn rows_served(start: usize, window: usize, len: usize) -> Range<usize> {
-    let centre = start + (window - 1) / 2;
-    let first = if start == 0 { 0 } else { centre };
-    let end = if start + window == len {
-        len
-    } else {
-        centre + 1
-    };
-    first..end
-}
-
-/// The window fits of a series, taken window by window.
-trait SeriesWindows {
-    /// Takes sample `n` of the series (the samples arrive in order).
-    fn push(&mut self, n: usize) -> Result<(), Error>;
-    /// Writes the derivatives at sample `row` of the fit of the full window starting at `start`
-    /// (the newest window pushed).
-    fn row(&self, row: usize, start: usize, out: &mut [f64]);
-}
-
-/// Every sample's row, in order, from the fits of the series' `len - window + 1` windows, into
-/// `out` (`len` rows of `p` values).
-fn centred_rows(
-    len: usize,
-    window: usize,
-    mut fits: impl SeriesWindows,
-    out: &mut [f64],
-) -> Result<(), Error> {
-    let p = out.len() / len;
-    for n in 0..len {
-        fits.push(n)?;
-        if let Some(start) = (n + 1).checked_sub(window) {
-            for row in rows_served(start, window, len) {
-                fits.row(row, start, &mut out[row * p..(row + 1) * p]);
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Evenly spaced samples: the sliding moments of each window, evaluated through `D(τ) T(r) C`
-/// (kept for the centre row, computed for the edge rows).
-struct EvenSeries<'a> {
-    values: &'a [f64],
-    window: usize,
-    moments: SlidingMoments,
-    fit: MomentFit,
-    step: f64,
-    centre: Vec<f64>,
-}
-
-impl SeriesWindows for EvenSeries<'_> {
-    fn push(&mut self, n: usize) -> Result<(), Error> {
-        let old = n.checked_sub(self.window).map(|k| self.values[k]);
-        self.moments.push(n as u64, self.values[n], old);
-        Ok(())
-    }
-
-    fn row(&self, row: usize, start: usize, out: &mut [f64]) {
-        let mu = self.moments.moments().expect("the window is full");
-        let r = row - start;
-        if r == (self.window - 1) / 2 {
-            apply_upper(&self.centre, mu, out);
-        } else {
-            apply_upper(&self.fit.evaluator(r as f64, self.step), mu, out);
-        }
-    }
-}
-
-/// Irregular samples: each window's QR fit, evaluated at the sample's time.
-struct IrregularSeries<'a> {
-    times: &'a [f64],
-    values: &'a [f64],
-    fits: IrregularWindow,
-}
-
-impl SeriesWindows for IrregularSeries<'_> {
-    fn push(&mut self, n: usize) -> Result<(), Error> {
-        self.fits.update(self.times[n], self.values[n])
-    }
-
-    fn row(&self, row: usize, _start: usize, out: &mut [f64]) {
-        let fit = self.fits.fit().expect("the window is full");
-        out.copy_from_slice(&fit.derivatives_at(self.times[row]));
-    }
-}
-
 /// Smooths a whole series: at each sample, the least-squares polynomial of degree `m` through
 /// the `window` samples most nearly centred on it, evaluated at that sample's time. Returns,
 /// for every sample, the unscaled derivatives `[x, x', …, x^(m)]` in the caller's time units.
 ///
-/// - **Evenly spaced** times (every step within a relative `1e-9` of the first, plus the
-///   timestamps' own rounding, `2ε|t|`): the fit of each window `W(h) Y` with the centred
-///   weights `D(Δt) W(-L/2)` (Morrison (7.4.16) with `h = -L/2`; `Δt` the mean step) at the
-///   sample `⌊L/2⌋` after the window's start, by the sliding engine of [`super::FixedMemory`]
-///   (the window's discrete Legendre moments slid one sample at a time, `O(m²)` per sample at
-///   any window; see the [module docs](super#the-sliding-engine)); the first and last `⌊L/2⌋`
-///   (or `⌈L/2⌉`) samples take the fit of the first (last) full window evaluated at their own
-///   times. For odd `window` this is `scipy.signal.savgol_filter(y, window, m, deriv=k,
-///   delta=Δt, mode="interp")` for each `k`. (For even `window` each sample sits half a step
-///   after the window centre, `h = -(L+1)/2`; savgol evaluates at the half-sample centre
-///   instead.)
-/// - **Irregular** times: the same windows (by sample count), each fitted by Householder QR
+/// - **Evenly spaced** windows (their `W − 1` steps one run of equal steps: each within a
+///   relative `1e-9` of the run's first, plus the timestamps' own rounding `2ε|t|`): the fit
+///   `W(h) Y` with the centred weights `D(Δt) W(-L/2)` (Morrison (7.4.16) with `h = -L/2`; `Δt`
+///   the window's mean step) at the sample `⌊L/2⌋` after the window's start, by the sliding
+///   engine of [`super::FixedMemory`] (the window's discrete Legendre moments slid one sample
+///   at a time, `O(m²)` per sample at any window; see the
+///   [module docs](super#the-sliding-engine)); the first and last `⌊L/2⌋` (or `⌈L/2⌉`) samples
+///   take the fit of the first (last) full window evaluated at their own times. For odd
+///   `window` this is `scipy.signal.savgol_filter(y, window, m, deriv=k, delta=Δt,
+///   mode="interp")` for each `k`. (For even `window` each sample sits half a step after the
+///   window centre, `h = -(L+1)/2`; savgol evaluates at the half-sample centre instead.)
+/// - **Irregular** windows: the same windows (by sample count), each fitted by Householder QR
 ///   in a centred Legendre basis ([`crate::estimate::PolynomialFit`]).
+///
+/// This is [`CentredSmoother`] run over the series (one engine: the rows are its rows, bit for
+/// bit); [`smooth_with_sigma_into`] gives their 1σ too.
 ///
 /// Errors: `window < m+1`, `window` longer than the series, `m > MAX_DEGREE`, NaN or
 /// infinite input, non-increasing times, mismatched lengths; a derivative beyond the double
@@ -205,39 +104,104 @@ pub fn smooth_into(
         });
     }
     check_estimates_length(times, m, estimates)?;
-    let fitted = if is_evenly_spaced(times) {
-        let span = window - 1;
-        let step = if len >= 2 {
-            (times[len - 1] - times[0]) / (len - 1) as f64
-        } else {
-            1.0
-        };
-        let fit = MomentFit::new(m, span, span / 2);
-        let even = EvenSeries {
-            values,
-            window,
-            moments: SlidingMoments::new(m, window, smoothing_refreshes(m), true),
-            centre: fit.evaluator((span / 2) as f64, step),
-            fit,
-            step,
-        };
-        centred_rows(len, window, even, estimates)
-    } else {
-        let irregular = IrregularSeries {
-            times,
-            values,
-            fits: IrregularWindow::new(m, window),
-        };
-        centred_rows(len, window, irregular, estimates)
-    };
-    fitted?;
-    match estimates.iter().position(|v| !v.is_finite()) {
+    run_series(times, values, m, window, SmoothSigma::Off, estimates, None)?;
+    first_out_of_range(estimates, "d", m)
+}
+
+/// [`smooth_into`] with the 1σ of every derivative into `std_devs` (the same layout): from
+/// each window fit's covariance (Morrison §7.5: `σ²` times the variance-reduction factors of the
+/// row's point in its window, (7.5.26)-(7.5.28), or of the QR fit for irregular windows), with
+/// the noise σ `sigma` when given, else estimated from each window's residuals
+/// ([`SmoothSigma::Estimated`]: `s² = Σ r²/(W − m − 1)`, Student-t coverage with
+/// `W − m − 1` degrees of freedom).
+///
+/// Errors: those of [`smooth_into`]; `std_devs` of another length; a given σ not positive and
+/// finite; an estimated σ with `window = m + 1`. A derivative or 1σ beyond the double range is
+/// [`Error::EstimateOutOfRange`] in [`Error::InBatch`] with the first such sample's index.
+///
+/// ```
+/// use seqsmooth::polynomial::fixed::{smooth_into, smooth_with_sigma_into};
+/// let t: Vec<f64> = (0..9).map(|k| k as f64).collect();
+/// let y = [2.0, 1.0, 3.0, 2.0, 4.0, 6.0, 5.0, 7.0, 6.0];
+/// let (mut d, mut s) = (vec![0.0; 9 * 2], vec![0.0; 9 * 2]);
+/// smooth_with_sigma_into(&t, &y, 1, 5, Some(0.5), &mut d, &mut s).unwrap();
+/// // the centre of a 5-sample line fit: Var(x) = σ²/5
+/// assert!((s[4 * 2] - 0.5 / 5f64.sqrt()).abs() < 1e-15);
+/// let mut plain = vec![0.0; 9 * 2];
+/// smooth_into(&t, &y, 1, 5, &mut plain).unwrap();
+/// assert_eq!(plain, d);
+/// smooth_with_sigma_into(&t, &y, 1, 5, None, &mut d, &mut s).unwrap(); // σ from the residuals
+/// assert!(s.iter().all(|v| v.is_finite() && *v > 0.0));
+/// ```
+pub fn smooth_with_sigma_into(
+    times: &[f64],
+    values: &[f64],
+    m: usize,
+    window: usize,
+    sigma: Option<f64>,
+    estimates: &mut [f64],
+    std_devs: &mut [f64],
+) -> Result<(), Error> {
+    check_window(m, window)?;
+    check_series(times, values)?;
+    if window > times.len() {
+        return Err(Error::TooFewSamples {
+            needed: window,
+            got: times.len(),
+        });
+    }
+    check_estimates_length(times, m, estimates)?;
+    check_estimates_length(times, m, std_devs)?;
+    let sigma = sigma.map_or(SmoothSigma::Estimated, SmoothSigma::Given);
+    run_series(
+        times,
+        values,
+        m,
+        window,
+        sigma,
+        estimates,
+        Some(&mut *std_devs),
+    )?;
+    first_out_of_range(estimates, "d", m)?;
+    first_out_of_range(std_devs, "s", m)
+}
+
+/// The first value of `rows` (rows of `m+1`) that is not finite, as the error naming its
+/// sample and column (`{prefix}{k}`).
+fn first_out_of_range(rows: &[f64], prefix: &str, m: usize) -> Result<(), Error> {
+    match rows.iter().position(|v| !v.is_finite()) {
         None => Ok(()),
         Some(i) => Err(Error::InBatch {
             index: i / (m + 1),
             source: Box::new(Error::EstimateOutOfRange {
-                what: format!("d{}", i % (m + 1)),
+                what: format!("{prefix}{}", i % (m + 1)),
             }),
         }),
     }
+}
+
+/// Runs the checked series through [`CentredSmoother`], each row into its place.
+fn run_series(
+    times: &[f64],
+    values: &[f64],
+    m: usize,
+    window: usize,
+    sigma: SmoothSigma,
+    estimates: &mut [f64],
+    mut std_devs: Option<&mut [f64]>,
+) -> Result<(), Error> {
+    let p = m + 1;
+    let mut smoother = CentredSmoother::new(m, window, sigma)?;
+    let mut put = |row: super::centred::SmoothedRow<'_>| -> Result<(), Error> {
+        let at = row.index * p..(row.index + 1) * p;
+        estimates[at.clone()].copy_from_slice(row.derivatives);
+        if let (Some(out), Some(s)) = (std_devs.as_deref_mut(), row.std_devs) {
+            out[at].copy_from_slice(s);
+        }
+        Ok(())
+    };
+    for (&t, &y) in times.iter().zip(values) {
+        smoother.push(t, y, &mut put)?;
+    }
+    smoother.finish(&mut put)
 }
