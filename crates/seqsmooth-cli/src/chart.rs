@@ -15,27 +15,42 @@
 //! - the residual panel `y − d0`, relative to the estimate: the residuals, the estimate's ±3σ
 //!   band about zero, ±3σ of the noise (dashed) where known, and `truth − d0` where known;
 //!   with a lead, each estimate is compared with the sample at its own time `t + lead`;
-//! - in every panel, the spans without samples (shaded grey), the spans where the misfit flag
-//!   is up (shaded orange), the switches to fading memory (green dashed lines) and the
-//!   restarts (purple lines).
+//! - in every panel, the outages (hatched grey), the spans where the misfit flag is up
+//!   (shaded pink under a solid strip along the top), the switches to fading memory (green dashed lines) and the restarts
+//!   (purple lines).
 //!
-//! A series with more points than the plot has pixel columns is drawn decimated per pixel
-//! column ([`crate::decimate`]), and its samples as a thin line rather than dots. Axes whose
-//! values share many leading digits or are very large or small are drawn in tick units with
-//! an offset and a power of ten, said in the axis label ([`crate::ticks`]).
+//! **Outages.** A step between consecutive samples longer than [`OUTAGE_STEPS`] times the
+//! typical step (the median step) is an outage ([`is_outage`], [`outages`]): it is hatched, and
+//! no line, band or envelope is drawn across it — every curve breaks there, as it does where
+//! its value is missing.
 //!
-//! Axis ranges ignore the start-up transients of the estimates (the 1st-99th percentile of the
-//! estimates widened by the truth); a residual or band beyond the range is clipped to its edge,
-//! where a clipped residual is drawn as a triangle. The PNG's text is drawn with the embedded
-//! DejaVu Sans (no system fonts are read); the SVG names the family `DejaVu Sans, sans-serif`.
+//! **Dense series.** A series with more points than the plot has pixel columns is drawn
+//! decimated per pixel column ([`crate::decimate`]); its samples, too many for dots, as the
+//! band between each column's lowest and highest sample (an envelope, not a zig-zag line that
+//! would fill it solid), and its rejected samples as small crosses, at most the lowest and
+//! highest of each column, their number in the legend. `seqsmooth plot` reads its rows into a
+//! [`Track`] through [`crate::decimate::Reducer`], keeping per half pixel the rows that hold
+//! the extremes of every quantity drawn ([`drawn`]) plus a systematic sample of rows for the
+//! axis ranges' quantiles ([`Track::sampled`]). Axes whose values share many leading digits
+//! or are very large or small are drawn in tick units with an offset and a power of ten, said
+//! in the axis label ([`crate::ticks`]).
+//!
+//! **Beyond the axis.** Axis ranges ignore the start-up transients of the estimates (the
+//! 1st-99th percentile of the estimates widened by the truth). A value beyond the range is
+//! drawn at the axis edge and marked: a clipped sample as a triangle pointing off the axis,
+//! each run of a clipped line (estimate, truth, error) by such a triangle at its farthest
+//! point, and the panel notes how far the line goes ("beyond the axis: …"). The PNG's text is
+//! drawn with the embedded DejaVu Sans (no system fonts are read); the SVG names the family
+//! `DejaVu Sans, sans-serif`.
 
-use crate::decimate::min_max;
+use crate::decimate::{envelope, min_max};
 use crate::error::CliError;
 use crate::ticks::Scale;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{register_font, FontStyle};
+use std::collections::VecDeque;
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -93,8 +108,8 @@ pub struct Track {
     pub noise: Vec<Option<f64>>,
     /// Whether each row's sample was rejected as an outlier (empty: no such column).
     pub rejected: Vec<bool>,
-    /// Whether the misfit flag is up at each row (empty: no such column).
-    pub misfit: Vec<bool>,
+    /// The spans `(from, to)` where the misfit flag is up ([`flag_spans`]).
+    pub misfit: Vec<(f64, f64)>,
     /// Times at which the output switched from expanding to fading memory.
     pub switches: Vec<f64>,
     /// Times at which the memory was restarted on misfit.
@@ -102,11 +117,149 @@ pub struct Track {
     /// Whether each row is past the start-up (its estimate of the full degree; empty: every
     /// row): the residual and error panels' ranges leave the others out.
     pub settled: Vec<bool>,
-    /// Spans `(from, to)` with no samples (e.g. a sensor outage), shaded in every panel.
+    /// Spans `(from, to)` with no samples (a sensor outage: [`outages`]), hatched in every
+    /// panel; no curve is drawn across one.
     pub outages: Vec<(f64, f64)>,
     /// The estimates are valid at `t + lead`: drawn there, and compared with the sample at
     /// that time where there is one ([`samples_at_lead`]).
     pub lead: f64,
+    /// The sample at each row's estimate time `t + lead` (empty: found in the track itself by
+    /// [`samples_at_lead`]); a track of decimated rows carries them.
+    pub at: Vec<Option<Sample>>,
+    /// Whether each row belongs to the systematic sample the axis ranges' quantiles are taken
+    /// over (empty: every row does); the other rows of a decimated track are kept for their
+    /// extremes, which would bias the quantiles.
+    pub sampled: Vec<bool>,
+    /// The rows and rejected samples the track was decimated from (`None`: the track's own).
+    pub counts: Option<Counts>,
+}
+
+/// How many rows (and rejected samples among them) a decimated track was read from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counts {
+    pub rows: usize,
+    pub rejected: usize,
+}
+
+/// A sample as a row's estimate is compared with it: its time, value, rejection and truth.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Sample {
+    pub t: f64,
+    pub y: f64,
+    pub rejected: bool,
+    /// The true derivatives at its time, where known.
+    pub truth: Vec<Option<f64>>,
+}
+
+/// One row of a [`Track`], as [`Track::push`] takes it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Row {
+    pub t: f64,
+    pub y: f64,
+    pub d: Vec<Option<f64>>,
+    pub s: Vec<Option<f64>>,
+    pub truth: Vec<f64>,
+    pub noise: Option<f64>,
+    pub rejected: bool,
+    pub settled: bool,
+    /// The sample at the estimate's time `t + lead`.
+    pub at: Option<Sample>,
+}
+
+impl Row {
+    /// The row's own sample (what [`Row::at`] is with no lead).
+    pub fn sample(&self) -> Sample {
+        Sample {
+            t: self.t,
+            y: self.y,
+            rejected: self.rejected,
+            truth: self.truth.iter().copied().map(Some).collect(),
+        }
+    }
+}
+
+impl Track {
+    /// Appends `row` (a row of the decimated track when `sampled` is `Some`: whether it is in
+    /// the systematic sample).
+    pub fn push(&mut self, row: Row, sampled: Option<bool>) {
+        let n = self.t.len();
+        let grow = |v: &mut Vec<Vec<Option<f64>>>, m: usize| {
+            while v.len() < m {
+                v.push(vec![None; n]);
+            }
+        };
+        grow(&mut self.d, row.d.len());
+        grow(&mut self.s, row.s.len());
+        for (k, col) in self.d.iter_mut().enumerate() {
+            col.push(row.d.get(k).copied().flatten());
+        }
+        for (k, col) in self.s.iter_mut().enumerate() {
+            col.push(row.s.get(k).copied().flatten());
+        }
+        while self.truth.len() < row.truth.len() {
+            self.truth.push(Vec::new());
+        }
+        for (k, x) in row.truth.iter().enumerate() {
+            self.truth[k].push(*x);
+        }
+        self.t.push(row.t);
+        self.y.push(row.y);
+        self.noise.push(row.noise);
+        self.rejected.push(row.rejected);
+        self.settled.push(row.settled);
+        self.at.push(row.at);
+        if let Some(s) = sampled {
+            self.sampled.push(s);
+        }
+    }
+}
+
+/// The values `row` contributes to the panels — every curve, band edge and point any panel
+/// draws of it (NaN where it has none), in a fixed order for rows of the same shape: the
+/// sample (accepted, rejected); per derivative `k`, the estimate, its ±3σ band's edges, its 3σ,
+/// the truth and the estimate's error against the truth at its time; the residual against the
+/// sample at its time (accepted, rejected), the truth there less the estimate, 3σ of the noise;
+/// the sample less the truth (accepted, rejected). A decimated track keeps, per half pixel,
+/// the rows holding each one's lowest and highest value.
+///
+/// ```
+/// use seqsmooth_cli::chart::{drawn, Row};
+/// let row = Row { t: 1.0, y: 5.0, d: vec![Some(4.5)], s: vec![Some(0.5)], ..Row::default() };
+/// let mut v = Vec::new();
+/// drawn(&row, &mut v);
+/// assert_eq!(v[0], 5.0); // an accepted sample
+/// assert!(v[1].is_nan()); // no rejected one
+/// assert_eq!(&v[2..6], &[4.5, 6.0, 3.0, 1.5]); // d0, d0 ± 3σ, 3σ
+/// ```
+pub fn drawn(row: &Row, out: &mut Vec<f64>) {
+    out.clear();
+    let nan = f64::NAN;
+    let o = |v: Option<f64>| v.unwrap_or(nan);
+    let split = |v: Option<f64>, rejected: bool| {
+        let v = o(v);
+        if rejected {
+            [nan, v]
+        } else {
+            [v, nan]
+        }
+    };
+    out.extend(split(Some(row.y), row.rejected));
+    let at = row.at.as_ref();
+    let truth_at = |k: usize| at.and_then(|a| a.truth.get(k).copied().flatten());
+    for (k, d) in row.d.iter().enumerate() {
+        let s = row.s.get(k).copied().flatten();
+        let band = |sign: f64| d.zip(s).map(|(d, s)| d + sign * 3.0 * s);
+        out.extend([o(*d), o(band(1.0)), o(band(-1.0)), o(s.map(|s| 3.0 * s))]);
+        out.push(o(row.truth.get(k).copied()));
+        out.push(o(d.zip(truth_at(k)).map(|(d, x)| d - x)));
+    }
+    let d0 = row.d.first().copied().flatten();
+    let residual = at.zip(d0).map(|(a, d)| a.y - d);
+    out.extend(split(residual, at.is_some_and(|a| a.rejected)));
+    out.push(o(truth_at(0).zip(d0).map(|(x, d)| x - d)));
+    out.push(o(row.noise.map(|s| 3.0 * s)));
+    let error = row.truth.first().map(|x| row.y - x);
+    out.extend(split(error, row.rejected));
 }
 
 /// What to draw and how to label it.
@@ -144,9 +297,15 @@ const TRUTH: RGBColor = RGBColor(0, 0, 0);
 const NOISE: RGBColor = RGBColor(230, 120, 0);
 const SWITCH: RGBColor = RGBColor(0, 140, 70);
 const RESTART: RGBColor = RGBColor(140, 40, 170);
-const MISFIT: RGBColor = RGBColor(255, 170, 60);
+const MISFIT: RGBColor = RGBColor(225, 60, 150);
 const TRUTH_ERROR: RGBColor = RGBColor(0, 130, 140);
-const OUTAGE: RGBColor = RGBColor(150, 150, 150);
+const OUTAGE: RGBColor = RGBColor(110, 110, 110);
+/// Opacities of the misfit and outage shading and of a dense series' envelope.
+const MISFIT_ALPHA: f64 = 0.16;
+const OUTAGE_ALPHA: f64 = 0.12;
+const ENVELOPE_ALPHA: f64 = 0.35;
+/// Height in pixels of the solid strip along the top of a misfit span.
+const MISFIT_STRIP: i32 = 4;
 
 fn register() -> Result<(), CliError> {
     static DONE: OnceLock<bool> = OnceLock::new();
@@ -246,9 +405,209 @@ pub fn runs(n: usize, keep: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize
 
 pub use crate::ticks::tick;
 
-/// The rows whose estimate has a sample at its own time `t + lead`: for each row, the index
-/// of the sample whose time is within a thousandth of the median step of `t + lead` (every
-/// row itself for `lead = 0`). `t` is strictly increasing.
+/// An outage is a step between consecutive samples longer than this many typical steps.
+pub const OUTAGE_STEPS: f64 = 10.0;
+
+/// The typical step of a series: the median of its `steps` (nearest rank), if any.
+pub fn typical_step(steps: impl IntoIterator<Item = f64>) -> Option<f64> {
+    quantile(steps, 0.5)
+}
+
+/// Whether a step of `step` between consecutive samples is an outage, the typical step being
+/// `typical`: longer than [`OUTAGE_STEPS`] of them. No curve is drawn across an outage.
+///
+/// ```
+/// use seqsmooth_cli::chart::is_outage;
+/// assert!(is_outage(12.5, 1.0) && !is_outage(9.0, 1.0));
+/// ```
+pub fn is_outage(step: f64, typical: f64) -> bool {
+    step > OUTAGE_STEPS * typical
+}
+
+/// The outages of the increasing times `t`: the steps `(t[i-1], t[i])` that [`is_outage`]
+/// against the median step.
+///
+/// ```
+/// use seqsmooth_cli::chart::outages;
+/// let mut t: Vec<f64> = (0..50).map(f64::from).collect();
+/// t.extend((0..50).map(|i| 70.0 + f64::from(i)));
+/// assert_eq!(outages(&t), vec![(49.0, 70.0)]);
+/// ```
+pub fn outages(t: &[f64]) -> Vec<(f64, f64)> {
+    let steps = || t.windows(2).map(|w| (w[0], w[1]));
+    let Some(typical) = typical_step(steps().map(|(a, b)| b - a)) else {
+        return Vec::new();
+    };
+    steps().filter(|(a, b)| is_outage(b - a, typical)).collect()
+}
+
+/// The spans of a flag over rows in time order: each run of flagged rows spans from its
+/// first row's time to the time of the row after it (the last row's, at the end). Spans
+/// closer than `merge` (e.g. a pixel's width in time) are joined, which bounds their number.
+#[derive(Clone, Debug, Default)]
+pub struct Spans {
+    spans: Vec<(f64, f64)>,
+    open: Option<f64>,
+    last: Option<f64>,
+}
+
+impl Spans {
+    /// Takes the next row: its time and flag; spans closer than `merge` are joined.
+    pub fn push(&mut self, t: f64, flag: bool, merge: f64) {
+        match (self.open, flag) {
+            (None, true) => self.open = Some(t),
+            (Some(a), false) => {
+                self.close(a, t, merge);
+                self.open = None;
+            }
+            _ => {}
+        }
+        self.last = Some(t);
+    }
+
+    fn close(&mut self, a: f64, b: f64, merge: f64) {
+        match self.spans.last_mut() {
+            Some(last) if a - last.1 <= merge => last.1 = b,
+            _ => self.spans.push((a, b)),
+        }
+    }
+
+    /// The spans, a run still open closed at the last row.
+    pub fn finish(mut self, merge: f64) -> Vec<(f64, f64)> {
+        if let (Some(a), Some(b)) = (self.open, self.last) {
+            self.close(a, b, merge);
+        }
+        let mut out: Vec<(f64, f64)> = Vec::with_capacity(self.spans.len());
+        for s in self.spans {
+            match out.last_mut() {
+                Some(last) if s.0 - last.1 <= merge => last.1 = s.1,
+                _ => out.push(s),
+            }
+        }
+        out
+    }
+}
+
+/// The spans of `flags` over the rows at times `t` ([`Spans`], none joined).
+///
+/// ```
+/// use seqsmooth_cli::chart::flag_spans;
+/// let t = [0.0, 1.0, 2.0, 3.0, 4.0];
+/// assert_eq!(flag_spans(&t, &[false, true, true, false, true]), vec![(1.0, 3.0), (4.0, 4.0)]);
+/// ```
+pub fn flag_spans(t: &[f64], flags: &[bool]) -> Vec<(f64, f64)> {
+    let mut spans = Spans::default();
+    for (&t, &f) in t.iter().zip(flags) {
+        spans.push(t, f, 0.0);
+    }
+    spans.finish(0.0)
+}
+
+/// Steps at the start of a series that set the tolerance of [`LeadMatcher`].
+pub const LEAD_HEAD: usize = 1024;
+
+/// Matches each row of a stream in time order with the sample at its estimate's time
+/// `t + lead`: the sample whose time is within a thousandth of the typical step of `t + lead`
+/// (the median of the first [`LEAD_HEAD`] steps; nearest if two are), or none. It holds only
+/// the rows and samples within the lead (and the first steps until they are known).
+#[derive(Clone, Debug)]
+pub struct LeadMatcher<R, S> {
+    lead: f64,
+    tol: Option<f64>,
+    head: Vec<f64>,
+    newest: Option<f64>,
+    samples: VecDeque<(f64, S)>,
+    pending: VecDeque<(f64, R)>,
+    ready: VecDeque<(R, Option<S>)>,
+}
+
+impl<R, S: Clone> LeadMatcher<R, S> {
+    pub fn new(lead: f64) -> Self {
+        LeadMatcher {
+            lead,
+            tol: None,
+            head: Vec::new(),
+            newest: None,
+            samples: VecDeque::new(),
+            pending: VecDeque::new(),
+            ready: VecDeque::new(),
+        }
+    }
+
+    /// Takes the next row at time `t` with its sample.
+    pub fn push(&mut self, t: f64, row: R, sample: S) {
+        if let Some(p) = self.newest.replace(t) {
+            if self.tol.is_none() {
+                self.head.push(t - p);
+                if self.head.len() >= LEAD_HEAD {
+                    self.settle_tolerance();
+                }
+            }
+        }
+        if self.lead == 0.0 {
+            self.ready.push_back((row, Some(sample)));
+            return;
+        }
+        self.samples.push_back((t, sample));
+        self.pending.push_back((t, row));
+        self.resolve(false);
+    }
+
+    fn settle_tolerance(&mut self) {
+        self.tol = Some(1e-3 * typical_step(self.head.drain(..)).unwrap_or(0.0));
+    }
+
+    /// Resolves the pending rows whose match is decided (all of them at the end).
+    fn resolve(&mut self, end: bool) {
+        let Some(tol) = self.tol else { return };
+        let newest = self.newest.unwrap_or(f64::NEG_INFINITY);
+        while let Some(&(t, _)) = self.pending.front() {
+            let at = t + self.lead;
+            if !end && newest <= at + tol {
+                break;
+            }
+            let j = self.samples.partition_point(|s| s.0 < at);
+            let near = [j.checked_sub(1), Some(j)]
+                .into_iter()
+                .flatten()
+                .filter(|&j| j < self.samples.len() && (self.samples[j].0 - at).abs() <= tol)
+                .min_by(|&a, &b| {
+                    let d = |j: usize| (self.samples[j].0 - at).abs();
+                    d(a).total_cmp(&d(b))
+                });
+            let sample = near.map(|j| self.samples[j].1.clone());
+            if let Some((_, row)) = self.pending.pop_front() {
+                self.ready.push_back((row, sample));
+            }
+        }
+        // Samples no pending or later row can match.
+        let oldest = self.pending.front().map_or(newest, |p| p.0);
+        while self
+            .samples
+            .front()
+            .is_some_and(|s| s.0 < oldest + self.lead - tol)
+        {
+            self.samples.pop_front();
+        }
+    }
+
+    /// The next row whose match is decided, with its sample.
+    pub fn pop(&mut self) -> Option<(R, Option<S>)> {
+        self.ready.pop_front()
+    }
+
+    /// At the end of the stream: decides every row still pending.
+    pub fn finish(&mut self) {
+        if self.tol.is_none() {
+            self.settle_tolerance();
+        }
+        self.resolve(true);
+    }
+}
+
+/// The rows whose estimate has a sample at its own time `t + lead` ([`LeadMatcher`]): for
+/// each row, the index of that sample (every row itself for `lead = 0`). `t` is strictly
+/// increasing.
 ///
 /// ```
 /// use seqsmooth_cli::chart::samples_at_lead;
@@ -257,22 +616,15 @@ pub use crate::ticks::tick;
 /// assert_eq!(samples_at_lead(&t, 0.0)[1], Some(1));
 /// ```
 pub fn samples_at_lead(t: &[f64], lead: f64) -> Vec<Option<usize>> {
-    if lead == 0.0 {
-        return (0..t.len()).map(Some).collect();
+    let mut m = LeadMatcher::new(lead);
+    let mut out = Vec::with_capacity(t.len());
+    for (i, &ti) in t.iter().enumerate() {
+        m.push(ti, (), i);
+        out.extend(std::iter::from_fn(|| m.pop()).map(|r| r.1));
     }
-    let steps = t.windows(2).map(|w| w[1] - w[0]);
-    let tol = 1e-3 * quantile(steps, 0.5).unwrap_or(0.0);
-    t.iter()
-        .map(|&ti| {
-            let at = ti + lead;
-            let j = t.partition_point(|&s| s < at);
-            [j.checked_sub(1), Some(j)]
-                .into_iter()
-                .flatten()
-                .filter(|&j| j < t.len() && (t[j] - at).abs() <= tol)
-                .min_by(|&a, &b| (t[a] - at).abs().total_cmp(&(t[b] - at).abs()))
-        })
-        .collect()
+    m.finish();
+    out.extend(std::iter::from_fn(|| m.pop()).map(|r| r.1));
+    out
 }
 
 /// What a panel shows.
@@ -296,6 +648,8 @@ struct PanelData {
     point_rows: Vec<usize>,
     /// Whether each row is past the start-up (the relative panels' range is of those only).
     settled: Vec<bool>,
+    /// Whether each row is in the sample the ranges' quantiles are taken over.
+    sampled: Vec<bool>,
     /// The centre line (the estimate, its error, or zero) by row.
     line: Vec<Option<f64>>,
     /// The ±3σ half-width by row.
@@ -304,6 +658,8 @@ struct PanelData {
     truth: Vec<Option<f64>>,
     /// What the truth line is, for the legend.
     truth_key: Key,
+    /// What the centre line is, for the note on values beyond the axis.
+    line_name: &'static str,
     /// ±3σ noise lines by row.
     noise: Vec<Option<f64>>,
     /// The x offset of the line, band and truth (the lead), and of the truth alone.
@@ -315,7 +671,7 @@ struct PanelData {
 }
 
 /// The panel showing `what` of `track`; `at[i]` is the sample at row `i`'s estimate time.
-fn panel(track: &Track, what: What, label: &str, at: &[Option<usize>]) -> PanelData {
+fn panel(track: &Track, what: What, label: &str, at: &[Option<Sample>]) -> PanelData {
     let n = track.t.len();
     let j = match what {
         What::Derivative(k) | What::Error(k) => k,
@@ -324,10 +680,11 @@ fn panel(track: &Track, what: What, label: &str, at: &[Option<usize>]) -> PanelD
     let cell = |v: &[Vec<Option<f64>>], i: usize| v.get(j).and_then(|v| v.get(i)).copied()?;
     let truth = |i: usize| track.truth.get(j).and_then(|x| x.get(i)).copied();
     // The sample at row i's estimate time, and the value every row's numbers are relative to.
-    let own = |i: usize| at.get(i).copied().flatten();
+    let own = |i: usize| at.get(i).and_then(Option::as_ref);
+    let truth_at = |i: usize| own(i).and_then(|s| s.truth.get(j).copied().flatten());
     let base = |i: usize| match what {
         What::Derivative(_) => Some(0.0),
-        What::Error(_) => own(i).and_then(truth),
+        What::Error(_) => truth_at(i),
         What::Residual => own(i).and(cell(&track.d, i)),
     };
     let rejected = |i: usize| track.rejected.get(i) == Some(&true);
@@ -342,15 +699,21 @@ fn panel(track: &Track, what: What, label: &str, at: &[Option<usize>]) -> PanelD
         What::Residual => (0..n)
             .filter_map(|i| {
                 let s = own(i)?;
-                base(i).map(|b| (i, (track.t[s], track.y[s] - b, rejected(s))))
+                base(i).map(|b| (i, (s.t, s.y - b, s.rejected)))
             })
             .collect(),
         _ => Vec::new(),
     };
     let (point_rows, points) = points.into_iter().unzip();
-    // The rows after the start-up (all of them when none is marked settled).
+    // The rows after the start-up (all of them when none is marked settled), and of those
+    // the rows the quantiles are taken over.
     let settled = if track.settled.len() == n && track.settled.contains(&true) {
         track.settled.clone()
+    } else {
+        vec![true; n]
+    };
+    let sampled = if track.sampled.len() == n {
+        track.sampled.clone()
     } else {
         vec![true; n]
     };
@@ -371,17 +734,22 @@ fn panel(track: &Track, what: What, label: &str, at: &[Option<usize>]) -> PanelD
         points,
         point_rows,
         settled,
+        sampled,
         line: rows(&|i, b| cell(&track.d, i).map(|d| d - b)),
         band: rows(&|i, _| cell(&track.s, i).map(|s| 3.0 * s)),
         truth: match what {
             What::Derivative(_) => (0..n).map(truth).collect(),
             What::Error(_) => rows(&|_, _| Some(0.0)),
-            What::Residual => rows(&|i, b| own(i).and_then(truth).map(|x| x - b)),
+            What::Residual => rows(&|i, b| truth_at(i).map(|x| x - b)),
         },
         truth_key: if what == What::Residual {
             Key::TruthError
         } else {
             Key::Truth
+        },
+        line_name: match what {
+            What::Error(_) => "estimate − truth",
+            _ => "estimate",
         },
         noise: (0..n).map(|i| noise(i).map(|s| 3.0 * s)).collect(),
         shift: track.lead,
@@ -405,14 +773,22 @@ impl PanelData {
         let mut range = None;
         widen(&mut range, self.points.iter().map(|p| p.1));
         widen(&mut range, self.truth.iter().flatten().copied());
-        let est = || line.iter().flatten().copied().filter(|v| v.is_finite());
-        if let (Some(lo), Some(hi)) = (quantile(est(), 0.01), quantile(est(), 0.99)) {
+        let sampled = |v: &[Option<f64>]| -> Vec<f64> {
+            v.iter()
+                .zip(&self.sampled)
+                .filter(|r| *r.1)
+                .filter_map(|r| *r.0)
+                .filter(|v| v.is_finite())
+                .collect()
+        };
+        let est = sampled(line);
+        if let (Some(lo), Some(hi)) = (quantile(est.clone(), 0.01), quantile(est, 0.99)) {
             widen(&mut range, [lo, hi]);
         }
         // The band where it is no wider than the spread of the panel (not at start-up).
         if let Some((lo, hi)) = range {
             let span = (hi - lo).max(f64::MIN_POSITIVE);
-            if let Some(h) = quantile(band.iter().flatten().copied(), 0.9) {
+            if let Some(h) = quantile(sampled(band), 0.9) {
                 if h < 0.25 * span {
                     for (l, b) in line.iter().zip(band) {
                         if let (Some(l), Some(b)) = (l, b) {
@@ -431,7 +807,7 @@ impl PanelData {
     /// up to twice that, the ±3σ noise and the settled band, the truth's and the line's
     /// distance from zero; of the rows past the start-up.
     fn relative_range(&self) -> (f64, f64) {
-        let settled = |k: &usize| self.settled[*k];
+        let settled = |k: &usize| self.settled[*k] && self.sampled[*k];
         let points = || {
             let rows = self.point_rows.iter();
             rows.zip(&self.points)
@@ -440,8 +816,8 @@ impl PanelData {
         };
         let rows = |v: &[Option<f64>]| -> Vec<f64> {
             v.iter()
-                .zip(&self.settled)
-                .filter(|r| *r.1)
+                .zip(self.settled.iter().zip(&self.sampled))
+                .filter(|r| *r.1 .0 && *r.1 .1)
                 .filter_map(|r| *r.0)
                 .map(f64::abs)
                 .collect()
@@ -453,7 +829,8 @@ impl PanelData {
             .max(q(rows(&self.truth), 0.99))
             .max(q(rows(&self.line), 0.99));
         let cap = 2.0 * r;
-        for p in points().filter(|p| p.2) {
+        let rows = self.point_rows.iter().zip(&self.points);
+        for (_, p) in rows.filter(|(k, p)| self.settled[**k] && p.2) {
             r = r.max(p.1.abs().min(cap));
         }
         if r <= 0.0 || !r.is_finite() {
@@ -482,11 +859,17 @@ enum Key {
 }
 
 impl Key {
-    fn label(self) -> &'static str {
-        match self {
+    fn label(self, track: &Track) -> String {
+        let text = match self {
             Key::Data => "samples",
-            Key::DataLine => "samples (too dense for dots: joined)",
-            Key::Rejected => "rejected (outlier)",
+            Key::DataLine => "samples, lowest to highest per pixel (too dense for dots)",
+            Key::Rejected => {
+                let n = match track.counts {
+                    Some(c) => c.rejected,
+                    None => track.rejected.iter().filter(|&&r| r).count(),
+                };
+                return format!("rejected (outlier): {n}");
+            }
             Key::Estimate => "estimate",
             Key::Band => "estimate ±3σ",
             Key::Truth => "truth",
@@ -496,13 +879,16 @@ impl Key {
             Key::Restart => "misfit restart",
             Key::Misfit => "misfit flagged",
             Key::Outage => "no samples (outage)",
-            Key::Clipped => "beyond the axis",
-        }
+            Key::Clipped => "beyond the axis (at its edge)",
+        };
+        text.to_string()
     }
 }
 
-/// Samples drawn as dots up to one per this many pixel columns, else joined by a line.
+/// Samples drawn as dots up to one per this many pixel columns, else as their envelope.
 const DOTS_PER_PIXEL: f64 = 0.5;
+/// Rejected samples drawn as large crosses up to one per this many pixel columns, else small.
+const CROSSES_PER_PIXEL: f64 = 0.05;
 
 /// Whether the panel's samples are too many for dots across `columns` pixels.
 fn dense(p: &PanelData, columns: u32) -> bool {
@@ -512,7 +898,9 @@ fn dense(p: &PanelData, columns: u32) -> bool {
 fn legend_keys(panels: &[PanelData], track: &Track, columns: u32) -> Vec<Key> {
     let any = |f: &dyn Fn(&PanelData) -> bool| panels.iter().any(f);
     let clipped = |p: &PanelData| {
-        p.clip_points && p.points.iter().any(|q| q.1 < p.range.0 || q.1 > p.range.1)
+        let out = |v: f64| v < p.range.0 || v > p.range.1;
+        (p.clip_points && p.points.iter().any(|q| out(q.1)))
+            || p.line.iter().chain(&p.truth).flatten().any(|&v| out(v))
     };
     let samples = |p: &PanelData| p.points.iter().any(|q| !q.2);
     let truth =
@@ -529,7 +917,7 @@ fn legend_keys(panels: &[PanelData], track: &Track, columns: u32) -> Vec<Key> {
         (any(&|p| p.noise.iter().any(Option::is_some)), Key::Noise),
         (!track.switches.is_empty(), Key::Switch),
         (!track.restarts.is_empty(), Key::Restart),
-        (track.misfit.iter().any(|&m| m), Key::Misfit),
+        (!track.misfit.is_empty(), Key::Misfit),
         (!track.outages.is_empty(), Key::Outage),
     ]
     .into_iter()
@@ -539,6 +927,30 @@ fn legend_keys(panels: &[PanelData], track: &Track, columns: u32) -> Vec<Key> {
 
 /// A drawing error of either backend.
 type Err = Box<dyn std::error::Error>;
+
+/// A triangle at `$at` (a coordinate of the area drawn on) pointing up (`$up`) or down, 9
+/// pixels tall: the mark of a value beyond the top or bottom of the axis.
+macro_rules! edge_mark {
+    ($at:expr, $up:expr, $style:expr) => {{
+        let h = if $up { -9 } else { 9 };
+        EmptyElement::at($at) + Polygon::new(vec![(-6, 0), (6, 0), (0, h)], $style)
+    }};
+}
+
+/// Hatching of the pixel rectangle `(x0, y0)-(x1, y1)`: 45° lines `gap` pixels apart.
+fn hatch((x0, y0): (i32, i32), (x1, y1): (i32, i32), gap: i32) -> Vec<[(i32, i32); 2]> {
+    let (w, h) = (x1 - x0, y1 - y0);
+    let mut out = Vec::new();
+    // Lines x - x0 + (y - y0) = c, from the bottom-left to the top-right.
+    let mut c = gap / 2;
+    while c < w + h {
+        let a = (x0 + (c - h).max(0), y0 + c.min(h));
+        let b = (x0 + c.min(w), y0 + (c - w).max(0));
+        out.push([a, b]);
+        c += gap;
+    }
+    out
+}
 
 /// Draws the legend symbol of `key` centred at `(x, y)`.
 fn symbol<DB: DrawingBackend<ErrorType: 'static>>(
@@ -553,9 +965,11 @@ fn symbol<DB: DrawingBackend<ErrorType: 'static>>(
     let rect = |c: RGBAColor| area.draw(&Rectangle::new(corners, c.filled()));
     match key {
         Key::Data => area.draw(&Circle::new((x, y), 3, DATA.filled())),
-        Key::DataLine => seg((x - 14, y), (x + 14, y), DATA, 1),
+        Key::DataLine => rect(DATA.mix(ENVELOPE_ALPHA)),
         Key::Rejected => area.draw(&Cross::new((x, y), 5, REJECTED.stroke_width(2))),
-        Key::Clipped => area.draw(&TriangleMarker::new((x, y), 5, DATA.filled())),
+        Key::Clipped => area
+            .draw(&edge_mark!((x - 7, y + 4), true, DATA.filled()))
+            .and_then(|_| area.draw(&edge_mark!((x + 7, y - 4), false, DATA.filled()))),
         Key::Estimate => seg((x - 14, y), (x + 14, y), ESTIMATE, 2),
         Key::Band => rect(ESTIMATE.mix(0.22)),
         Key::Truth => seg((x - 14, y), (x + 14, y), TRUTH, 1),
@@ -565,8 +979,15 @@ fn symbol<DB: DrawingBackend<ErrorType: 'static>>(
         Key::Switch => seg((x, y - 8), (x, y - 2), SWITCH, 2)
             .and_then(|_| seg((x, y + 2), (x, y + 8), SWITCH, 2)),
         Key::Restart => seg((x, y - 8), (x, y + 8), RESTART, 2),
-        Key::Misfit => rect(MISFIT.mix(0.3)),
-        Key::Outage => rect(OUTAGE.mix(0.35)),
+        Key::Misfit => rect(MISFIT.mix(MISFIT_ALPHA)).and_then(|_| {
+            let strip = [(x - 14, y - 7), (x + 14, y - 7 + MISFIT_STRIP)];
+            area.draw(&Rectangle::new(strip, MISFIT.filled()))
+        }),
+        Key::Outage => rect(OUTAGE.mix(OUTAGE_ALPHA)).and_then(|_| {
+            hatch(corners[0], corners[1], 6)
+                .into_iter()
+                .try_for_each(|[a, b]| seg(a, b, OUTAGE, 1))
+        }),
     }?;
     Ok(())
 }
@@ -575,13 +996,14 @@ fn symbol<DB: DrawingBackend<ErrorType: 'static>>(
 fn legend_rows<DB: DrawingBackend<ErrorType: 'static>>(
     area: &DrawingArea<DB, Shift>,
     keys: &[Key],
+    track: &Track,
     width: i32,
 ) -> Result<Vec<Vec<(Key, i32)>>, Err> {
     let style = font(15.0);
     // Each row's items (key, x from the row's start) and width.
     let mut rows: Vec<(Vec<(Key, i32)>, i32)> = vec![(Vec::new(), 0)];
     for &k in keys {
-        let item = 32 + area.estimate_text_size(k.label(), &style)?.0 as i32 + 18;
+        let item = 32 + area.estimate_text_size(&k.label(track), &style)?.0 as i32 + 18;
         if rows
             .last()
             .is_some_and(|(row, w)| w + item > width - 40 && !row.is_empty())
@@ -602,7 +1024,22 @@ fn legend_rows<DB: DrawingBackend<ErrorType: 'static>>(
 
 /// The panels of `layout` drawn from `track`, top to bottom.
 fn panels(track: &Track, layout: &Layout) -> Vec<PanelData> {
-    let at = samples_at_lead(&track.t, track.lead);
+    let at = if track.at.len() == track.t.len() {
+        track.at.clone()
+    } else {
+        let truth = |j: usize| {
+            let col = |x: &Vec<f64>| x.get(j).copied();
+            track.truth.iter().map(col).collect()
+        };
+        let sample = |j: usize| Sample {
+            t: track.t[j],
+            y: track.y[j],
+            rejected: track.rejected.get(j) == Some(&true),
+            truth: truth(j),
+        };
+        let at = samples_at_lead(&track.t, track.lead).into_iter();
+        at.map(|j| j.map(sample)).collect()
+    };
     let errors = layout.errors.iter().map(|(k, l)| (What::Error(*k), l));
     let derivatives = layout.panels.iter().map(|(k, l)| (What::Derivative(*k), l));
     let residuals = layout.residual_label.iter().map(|l| (What::Residual, l));
@@ -615,7 +1052,13 @@ fn panels(track: &Track, layout: &Layout) -> Vec<PanelData> {
 
 /// The plot width in pixels (the image less the axis label area and margins).
 fn plot_columns(layout: &Layout) -> u32 {
-    layout.size.0.saturating_sub(130).max(1)
+    columns_for_width(layout.size.0)
+}
+
+/// The plot's width in pixel columns in an image `width` pixels wide (less the axis label
+/// area and margins).
+pub fn columns_for_width(width: u32) -> u32 {
+    width.saturating_sub(130).max(1)
 }
 
 fn draw<DB: DrawingBackend<ErrorType: 'static>>(
@@ -641,11 +1084,11 @@ fn draw<DB: DrawingBackend<ErrorType: 'static>>(
     }
     y += 6;
     let label_style = font(15.0).pos(Pos::new(HPos::Left, VPos::Center));
-    for row in legend_rows(root, &keys, width)? {
+    for row in legend_rows(root, &keys, track, width)? {
         let cy = y + 11;
         for (key, x) in row {
             symbol(root, key, (x + 14, cy))?;
-            root.draw_text(key.label(), &label_style, (x + 32, cy))?;
+            root.draw_text(&key.label(track), &label_style, (x + 32, cy))?;
         }
         y += 26;
     }
@@ -761,21 +1204,38 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     let (top, floor) = (ay(y1), ay(y0));
     let shade =
         |a: f64, b: f64, c: RGBAColor| Rectangle::new([(ax(a), top), (ax(b), floor)], c.filled());
+    let spec = chart.as_coord_spec().clone();
+    let pixel = |x: f64, y: f64| spec.translate(&(x, y));
 
-    // Outages, then the misfit spans: from each flagged row to the next row.
+    // Outages (hatched), then the misfit spans.
+    let area = chart.plotting_area().strip_coord_spec();
+    let base = chart.plotting_area().get_base_pixel();
     for &(a, b) in &track.outages {
-        chart.draw_series([shade(a, b, OUTAGE.mix(0.35))])?;
-    }
-    if track.misfit.len() == n {
-        for r in runs(n, |i| track.misfit[i]) {
-            let a = track.t[r.start];
-            let b = track.t[r.end.min(n - 1)].max(a);
-            chart.draw_series([shade(a, b, MISFIT.mix(0.3))])?;
+        chart.draw_series([shade(a, b, OUTAGE.mix(OUTAGE_ALPHA))])?;
+        let (p0, p1) = (pixel(ax(a), top), pixel(ax(b), floor));
+        let local = |p: (i32, i32)| (p.0 - base.0, p.1 - base.1);
+        for [u, v] in hatch(local(p0), local(p1), 8) {
+            area.draw(&PathElement::new(
+                vec![u, v],
+                OUTAGE.mix(0.5).stroke_width(1),
+            ))?;
         }
     }
+    for &(a, b) in &track.misfit {
+        chart.draw_series([shade(a, b, MISFIT.mix(MISFIT_ALPHA))])?;
+        let (p0, p1) = (pixel(ax(a), top), pixel(ax(b), top));
+        let local = |p: (i32, i32)| (p.0 - base.0, p.1 - base.1);
+        let (u, v) = (local(p0), local(p1));
+        let strip = [u, (v.0.max(u.0 + 1), v.1 + MISFIT_STRIP)];
+        area.draw(&Rectangle::new(strip, MISFIT.filled()))?;
+    }
+
+    // The runs of rows where `keep` holds, broken at the outages.
+    let after = breaks(track);
+    let runs_of = |keep: &dyn Fn(usize) -> bool| split_runs(runs(n, keep), &after);
 
     // ±3σ band: each edge decimated on its own.
-    for r in runs(n, |i| p.line[i].is_some() && p.band[i].is_some()) {
+    for r in runs_of(&|i| p.line[i].is_some() && p.band[i].is_some()) {
         let edge = |sign: f64| {
             let at = |i: usize| {
                 let (l, b) = (p.line[i].unwrap_or(0.0), p.band[i].unwrap_or(0.0));
@@ -791,7 +1251,7 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     // The runs of a row-wise curve, `sign` times its values, at the times moved by `shift`,
     // decimated to the pixel columns.
     let curves = |v: &[Option<f64>], shift: f64, sign: f64| -> Vec<Vec<(f64, f64)>> {
-        runs(n, |i| v[i].is_some())
+        runs_of(&|i| v[i].is_some())
             .into_iter()
             .map(|r| {
                 let at = |i: usize| (ax(track.t[i] + shift), clamp(sign * v[i].unwrap_or(0.0)));
@@ -807,47 +1267,123 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         }
     }
 
-    // Samples: the points `$keep` picks, as `$shape`s at their values clamped to the range;
-    // too many for dots, the accepted ones are joined by a thin line instead.
+    // Samples: dots, or too many for dots, the envelope of the accepted ones between the
+    // outages; those beyond the axis as triangles at its edge, one per pixel column and edge.
     let inside = |v: f64| v >= y0 && v <= y1;
-    macro_rules! points {
-        ($keep:expr, $shape:ident, $size:expr, $style:expr) => {
-            let at = |q: &(f64, f64, bool)| (ax(q.0), clamp(q.1));
-            let shapes = p
-                .points
-                .iter()
-                .filter($keep)
-                .map(|q| $shape::new(at(q), $size, $style));
-            chart.draw_series(shapes)?;
-        };
-    }
+    let column = |x: f64| {
+        let c = (ax(x) - span.0) / (span.1 - span.0) * f64::from(columns);
+        c.floor() as i64
+    };
     if dense(p, columns) {
-        let accepted = p.points.iter().filter(|q| !q.2);
-        let line = thin(accepted.map(|q| (ax(q.0), clamp(q.1))).collect());
-        chart.draw_series(LineSeries::new(line, DATA.stroke_width(1)))?;
+        let accepted: Vec<(f64, f64)> = p
+            .points
+            .iter()
+            .filter(|q| !q.2)
+            .map(|q| (ax(q.0), clamp(q.1)))
+            .collect();
+        let gaps: Vec<(f64, f64)> = track.outages.iter().map(|o| (ax(o.0), ax(o.1))).collect();
+        for poly in envelope(&accepted, span, columns as usize, &gaps) {
+            chart.draw_series([Polygon::new(
+                poly.clone(),
+                DATA.mix(ENVELOPE_ALPHA).filled(),
+            )])?;
+            let mut outline = poly;
+            outline.push(outline[0]);
+            chart.draw_series([PathElement::new(outline, DATA.mix(0.6).stroke_width(1))])?;
+        }
     } else {
-        points!(|q| !q.2 && inside(q.1), Circle, 2, DATA.filled());
+        let dots = p.points.iter().filter(|q| !q.2 && inside(q.1));
+        chart.draw_series(dots.map(|q| Circle::new((ax(q.0), ay(q.1)), 2, DATA.filled())))?;
     }
     if p.clip_points {
-        points!(|q| !inside(q.1), TriangleMarker, 5, DATA.filled());
+        let mut marked = std::collections::HashSet::new();
+        let beyond = p.points.iter().filter(|q| !inside(q.1));
+        let marks = beyond.filter(|q| marked.insert((column(q.0), q.1 > y1)));
+        let marks: Vec<_> = marks
+            .map(|q| edge_mark!((ax(q.0), clamp(q.1)), q.1 > y1, DATA.filled()))
+            .collect();
+        chart.draw_series(marks)?;
     }
 
-    // Truth, then the estimate over it.
+    // Truth, then the estimate over it; each run beyond the axis marked at its farthest point.
     let truth_style = match p.truth_key {
         Key::TruthError => TRUTH_ERROR.stroke_width(2),
         _ => TRUTH.stroke_width(1),
     };
-    for (v, shift, style) in [
-        (&p.truth, p.truth_shift, truth_style),
-        (&p.line, p.shift, ESTIMATE.stroke_width(2)),
+    let mut notes = Vec::new();
+    for (v, shift, style, name, colour) in [
+        (
+            &p.truth,
+            p.truth_shift,
+            truth_style,
+            p.truth_key.label(track),
+            if p.truth_key == Key::TruthError {
+                TRUTH_ERROR
+            } else {
+                TRUTH
+            },
+        ),
+        (
+            &p.line,
+            p.shift,
+            ESTIMATE.stroke_width(2),
+            p.line_name.to_string(),
+            ESTIMATE,
+        ),
     ] {
         for pts in curves(v, shift, 1.0) {
             chart.draw_series(segments(pts, style, split))?;
         }
+        let mut last_mark: Option<(i32, bool)> = None;
+        let mut far: [Option<(f64, f64)>; 2] = [None, None];
+        for r in runs_of(&|i| v[i].is_some_and(|v| !inside(v))) {
+            let (i, value) = r
+                .map(|i| (i, v[i].unwrap_or(0.0)))
+                .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+                .unwrap_or((0, 0.0));
+            let up = value > y1;
+            let at = (ax(track.t[i] + shift), clamp(value));
+            let x = pixel(at.0, at.1).0;
+            if last_mark.is_none_or(|(px, pu)| pu != up || (x - px).abs() >= 12) {
+                chart.draw_series([edge_mark!(at, up, colour.filled())])?;
+                last_mark = Some((x, up));
+            }
+            let slot = &mut far[usize::from(up)];
+            if slot.is_none_or(|(_, f)| value.abs() > f.abs()) {
+                *slot = Some((track.t[i] + shift, value));
+            }
+        }
+        let reach: Vec<String> = far
+            .iter()
+            .flatten()
+            .map(|&(t, v)| format!("{} at t = {}", significant(v), significant(t)))
+            .collect();
+        if !reach.is_empty() {
+            notes.push(format!("{name} reaches {}", reach.join(" and ")));
+        }
     }
 
-    // Rejected samples on top.
-    points!(|q| q.2, Cross, 5, REJECTED.stroke_width(2));
+    // Rejected samples on top: large crosses, or when many, small ones, at most the lowest
+    // and highest of each pixel column.
+    let rejected: Vec<(f64, f64)> = p
+        .points
+        .iter()
+        .filter(|q| q.2)
+        .map(|q| (ax(q.0), clamp(q.1)))
+        .collect();
+    if rejected.len() as f64 > CROSSES_PER_PIXEL * f64::from(columns) {
+        let kept = thin(rejected);
+        chart.draw_series(
+            kept.into_iter()
+                .map(|q| Cross::new(q, 3, REJECTED.stroke_width(1))),
+        )?;
+    } else {
+        chart.draw_series(
+            rejected
+                .into_iter()
+                .map(|q| Cross::new(q, 5, REJECTED.stroke_width(2))),
+        )?;
+    }
 
     // Events: switches to fading memory (dashed), restarts.
     let edge = |t: f64| vec![(ax(t), top), (ax(t), floor)];
@@ -857,5 +1393,65 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     for &t in &track.restarts {
         chart.draw_series(LineSeries::new(edge(t), RESTART.stroke_width(2)))?;
     }
+
+    // What lies beyond the axis, in the panel's top left corner.
+    if !notes.is_empty() {
+        let text = format!("beyond the axis: {}", notes.join("; "));
+        let style = font(13.0).color(&RGBColor(60, 60, 60));
+        let (w, h) = area.estimate_text_size(&text, &style)?;
+        let (w, h) = (w as i32, h as i32);
+        area.draw(&Rectangle::new(
+            [(4, 4), (12 + w, 10 + h)],
+            WHITE.mix(0.85).filled(),
+        ))?;
+        area.draw_text(&text, &style, (8, 7))?;
+    }
     Ok(())
+}
+
+/// For each row, whether an outage lies between it and the row before.
+fn breaks(track: &Track) -> Vec<bool> {
+    let t = &track.t;
+    let mut out = vec![false; t.len()];
+    let mut k = 0;
+    for i in 1..t.len() {
+        while k < track.outages.len() && track.outages[k].1 <= t[i - 1] {
+            k += 1;
+        }
+        out[i] = track.outages[k..]
+            .iter()
+            .take_while(|o| o.1 <= t[i])
+            .any(|o| t[i - 1] <= o.0);
+    }
+    out
+}
+
+/// `runs` cut where `after[i]` (row `i` follows an outage).
+fn split_runs(runs: Vec<std::ops::Range<usize>>, after: &[bool]) -> Vec<std::ops::Range<usize>> {
+    let mut out = Vec::with_capacity(runs.len());
+    for r in runs {
+        let mut start = r.start;
+        for i in r.start + 1..r.end {
+            if after[i] {
+                out.push(start..i);
+                start = i;
+            }
+        }
+        out.push(start..r.end);
+    }
+    out
+}
+
+/// `x` to four significant digits.
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let a = x.abs();
+    if (1e-3..1e6).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.3e}")
+    }
 }
