@@ -304,6 +304,8 @@ const OUTAGE: RGBColor = RGBColor(110, 110, 110);
 const MISFIT_ALPHA: f64 = 0.16;
 const OUTAGE_ALPHA: f64 = 0.12;
 const ENVELOPE_ALPHA: f64 = 0.35;
+/// Marks of values beyond the axis at most one per this many pixels along each edge.
+const MARK_SPACING: i64 = 12;
 /// Height in pixels of the solid strip along the top of a misfit span.
 const MISFIT_STRIP: i32 = 4;
 
@@ -1296,13 +1298,30 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         chart.draw_series(dots.map(|q| Circle::new((ax(q.0), ay(q.1)), 2, DATA.filled())))?;
     }
     if p.clip_points {
+        // One mark per MARK_SPACING pixels and edge.
         let mut marked = std::collections::HashSet::new();
         let beyond = p.points.iter().filter(|q| !inside(q.1));
-        let marks = beyond.filter(|q| marked.insert((column(q.0), q.1 > y1)));
+        let marks = beyond.filter(|q| marked.insert((column(q.0) / MARK_SPACING, q.1 > y1)));
         let marks: Vec<_> = marks
             .map(|q| edge_mark!((ax(q.0), clamp(q.1)), q.1 > y1, DATA.filled()))
             .collect();
         chart.draw_series(marks)?;
+    }
+
+    // Rejected samples: large crosses on top, or when many, small translucent ones, at most
+    // the lowest and highest of each pixel column, under the estimate (which they would hide
+    // where the value's range dwarfs the noise).
+    let rejected: Vec<(f64, f64)> = p
+        .points
+        .iter()
+        .filter(|q| q.2)
+        .map(|q| (ax(q.0), clamp(q.1)))
+        .collect();
+    let many = rejected.len() as f64 > CROSSES_PER_PIXEL * f64::from(columns);
+    if many {
+        let kept = thin(rejected.clone());
+        let style = REJECTED.mix(0.7).stroke_width(1);
+        chart.draw_series(kept.into_iter().map(|q| Cross::new(q, 3, style)))?;
     }
 
     // Truth, then the estimate over it; each run beyond the axis marked at its farthest point.
@@ -1344,7 +1363,7 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
             let up = value > y1;
             let at = (ax(track.t[i] + shift), clamp(value));
             let x = pixel(at.0, at.1).0;
-            if last_mark.is_none_or(|(px, pu)| pu != up || (x - px).abs() >= 12) {
+            if last_mark.is_none_or(|(px, pu)| pu != up || (x - px).abs() >= MARK_SPACING as i32) {
                 chart.draw_series([edge_mark!(at, up, colour.filled())])?;
                 last_mark = Some((x, up));
             }
@@ -1363,26 +1382,9 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         }
     }
 
-    // Rejected samples on top: large crosses, or when many, small ones, at most the lowest
-    // and highest of each pixel column.
-    let rejected: Vec<(f64, f64)> = p
-        .points
-        .iter()
-        .filter(|q| q.2)
-        .map(|q| (ax(q.0), clamp(q.1)))
-        .collect();
-    if rejected.len() as f64 > CROSSES_PER_PIXEL * f64::from(columns) {
-        let kept = thin(rejected);
-        chart.draw_series(
-            kept.into_iter()
-                .map(|q| Cross::new(q, 3, REJECTED.stroke_width(1))),
-        )?;
-    } else {
-        chart.draw_series(
-            rejected
-                .into_iter()
-                .map(|q| Cross::new(q, 5, REJECTED.stroke_width(2))),
-        )?;
+    if !many {
+        let style = REJECTED.stroke_width(2);
+        chart.draw_series(rejected.into_iter().map(|q| Cross::new(q, 5, style)))?;
     }
 
     // Events: switches to fading memory (dashed), restarts.

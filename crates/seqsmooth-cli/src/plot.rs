@@ -144,12 +144,13 @@ impl Source {
 
 /// The previous row's time, its cell and line: each time must come after it.
 #[derive(Default)]
-struct Order(Option<(f64, Vec<u8>, u64)>);
+struct Order(Option<(f64, u64)>, Vec<u8>);
 
 impl Order {
     fn check(&mut self, src: &Source, idx: usize, t: f64) -> Result<(), CliError> {
-        if let Some((p, cell, line)) = &self.0 {
-            if t <= *p {
+        if let Some((p, line)) = self.0 {
+            let cell = &self.1;
+            if t <= p {
                 return Err(src.error(CliError::Data(format!(
                     "line {}, column '{}': time {} is not after the previous time {} (line \
                      {line}): a plot needs one series in time order",
@@ -160,7 +161,9 @@ impl Order {
                 ))));
             }
         }
-        self.0 = Some((t, src.cell(idx).to_vec(), src.line()));
+        self.0 = Some((t, src.line()));
+        self.1.clear();
+        self.1.extend_from_slice(src.cell(idx));
         Ok(())
     }
 }
