@@ -12,8 +12,9 @@
 #     smooth      `smooth --degree 2 --window 101`, standard input to /dev/null
 #     track-kalman, track-fading, track-smooth, track-window
 #                 `track` of a radar's range, azimuth and elevation, standard input to /dev/null
-#   The plot cases first write the filter's output to a temporary directory (not measured);
-#   KEEP_IMAGES=DIR keeps their PNGs there.
+#   The plot cases first write the filter's output to a temporary directory (not measured),
+#   or to WORK_DIR=DIR if set, where it is kept and used again by later runs; KEEP_IMAGES=DIR
+#   keeps their PNGs there.
 #
 # Each command runs under /usr/bin/time (its "maximum resident set size", the kernel's VmHWM);
 # a watchdog stops it if its resident set passes MEMORY_CAP_MB (default 6000) and says so,
@@ -33,6 +34,8 @@ cargo build --release -q -p seqsmooth-cli
 bin="${CARGO_TARGET_DIR:-target}/release/seqsmooth"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+outputs=${WORK_DIR:-$tmp}
+mkdir -p "$outputs"
 
 # Rows "t,y" (K = 0: one series) or "id,t,y" (K series in turn), a noisy sine at 100 Hz.
 generate_series() {
@@ -132,14 +135,14 @@ measure() {
 filter_output() {
     local name=$1 gen=$2
     shift 2
-    if [ ! -e "$tmp/$name.csv" ]; then
-        $gen | "$bin" filter "$@" -o "$tmp/$name.csv" --no-progress
+    if [ ! -e "$outputs/$name.csv" ]; then
+        $gen | "$bin" filter "$@" -o "$outputs/$name.csv" --no-progress
     fi
 }
 
 plot_case() {
     local label=$1 name=$2
-    measure "$label" "$bin" plot "$tmp/$name.csv" -o "$tmp/$name.png"
+    measure "$label" "$bin" plot "$outputs/$name.csv" -o "$tmp/$name.png"
     if [ -n "${KEEP_IMAGES:-}" ]; then
         mkdir -p "$KEEP_IMAGES"
         cp "$tmp/$name.png" "$KEEP_IMAGES/"

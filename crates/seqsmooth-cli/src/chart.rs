@@ -252,6 +252,9 @@ impl Key {
             Key::Noise => "noise ±3σ",
             Key::Switch => "switch to fading memory",
             Key::Restart => "misfit restart",
+            Key::Misfit if !track.misfit_share.is_empty() => {
+                "misfit flagged (the darker, the more of the time)"
+            }
             Key::Misfit => "misfit flagged",
             Key::Outage => "no samples (outage)",
             Key::Clipped => "beyond the axis (at its edge)",
@@ -292,7 +295,10 @@ fn legend_keys(panels: &[PanelData], track: &Track, columns: u32) -> Vec<Key> {
         (any(&|p| p.noise.iter().any(Option::is_some)), Key::Noise),
         (!track.switches.is_empty(), Key::Switch),
         (!track.restarts.is_empty(), Key::Restart),
-        (!track.misfit.is_empty(), Key::Misfit),
+        (
+            !track.misfit.is_empty() || !track.misfit_share.is_empty(),
+            Key::Misfit,
+        ),
         (!track.outages.is_empty(), Key::Outage),
     ]
     .into_iter()
@@ -568,6 +574,20 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
             ))?;
         }
     }
+    // A decimated track's misfit: per pixel column, the share of its time flagged (in
+    // tenths), shaded the darker the more, with the strip where it is at least half.
+    let shares = misfit_columns(&track.misfit_share, span, columns as usize, &ax);
+    for (a, b, share) in shares {
+        let tint = MISFIT.mix(MISFIT_ALPHA * (0.25 + 0.75 * share));
+        chart.draw_series([Rectangle::new([(a, top), (b, floor)], tint.filled())])?;
+        if share >= 0.5 {
+            let (p0, p1) = (pixel(a, top), pixel(b, top));
+            let local = |p: (i32, i32)| (p.0 - base.0, p.1 - base.1);
+            let (u, v) = (local(p0), local(p1));
+            let strip = [u, (v.0.max(u.0 + 1), v.1 + MISFIT_STRIP)];
+            area.draw(&Rectangle::new(strip, MISFIT.filled()))?;
+        }
+    }
     for &(a, b) in &track.misfit {
         chart.draw_series([shade(a, b, MISFIT.mix(MISFIT_ALPHA))])?;
         let (p0, p1) = (pixel(ax(a), top), pixel(ax(b), top));
@@ -754,6 +774,54 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         area.draw_text(&text, &style, (8, 7))?;
     }
     Ok(())
+}
+
+/// The pixel columns (of `columns` across the axis span `span`) that `shares` (spans of
+/// time, each with the share of it flagged) cover: runs of columns of the same share in
+/// tenths, as `(from, to, share)` in axis units, the share of each column the mean over it.
+fn misfit_columns(
+    shares: &[(f64, f64, f64)],
+    span: (f64, f64),
+    columns: usize,
+    ax: &dyn Fn(f64) -> f64,
+) -> Vec<(f64, f64, f64)> {
+    let w = (span.1 - span.0) / columns.max(1) as f64;
+    if shares.is_empty() || !(w > 0.0) {
+        return Vec::new();
+    }
+    let mut col = vec![0.0; columns];
+    for &(a, b, s) in shares {
+        let (xa, xb) = (ax(a), ax(b));
+        let c0 = ((xa - span.0) / w).floor().max(0.0) as usize;
+        let c1 = (((xb - span.0) / w).ceil().max(0.0) as usize).min(columns);
+        for (c, v) in col.iter_mut().enumerate().take(c1).skip(c0) {
+            let lo = span.0 + c as f64 * w;
+            *v += s * (xb.min(lo + w) - xa.max(lo)).max(0.0) / w;
+        }
+    }
+    // in tenths, any flagged time at least one: however little, it shows
+    let tenths = |v: f64| {
+        let t = (v.min(1.0) * 10.0).round() as u8;
+        if v > 0.0 {
+            t.max(1)
+        } else {
+            0
+        }
+    };
+    let mut out = Vec::new();
+    let mut c = 0;
+    while c < columns {
+        let level = tenths(col[c]);
+        let end = (c..columns)
+            .find(|&e| tenths(col[e]) != level)
+            .unwrap_or(columns);
+        if level > 0 {
+            let x = |c: usize| span.0 + c as f64 * w;
+            out.push((x(c), x(end), f64::from(level) / 10.0));
+        }
+        c = end;
+    }
+    out
 }
 
 /// `x` to four significant digits.

@@ -218,6 +218,8 @@ struct Bin<R> {
     /// Rows other than the first and last that hold an extreme (and a few that did).
     kept: Vec<(u64, R)>,
     step: Option<(f64, f64)>,
+    /// What [`Reducer::weigh`] added to the bin.
+    weight: f64,
 }
 
 impl<R> Bin<R> {
@@ -236,6 +238,7 @@ impl<R> Bin<R> {
             hi: ext,
             kept: Vec::new(),
             step: None,
+            weight: 0.0,
         }
     }
 
@@ -286,6 +289,7 @@ impl<R> Bin<R> {
             (None, b) => b,
             (a, _) => a,
         };
+        self.weight += next.weight;
         self.kept.extend(self.last.take());
         match next.last {
             Some(last) => {
@@ -324,6 +328,8 @@ pub struct Reducer<R> {
     width: f64,
     bins: Vec<Option<Bin<R>>>,
     previous: Option<f64>,
+    /// The bin of the last row pushed.
+    current: usize,
 }
 
 /// What a [`Reducer`] kept.
@@ -335,6 +341,8 @@ pub struct Reduced<R> {
     pub steps: Vec<(f64, f64)>,
     /// The bins' final width.
     pub width: f64,
+    /// Per bin with a weight ([`Reducer::weigh`]): its span `(from, to)` and weight.
+    pub weights: Vec<(f64, f64, f64)>,
 }
 
 impl<R> Reducer<R> {
@@ -347,6 +355,7 @@ impl<R> Reducer<R> {
             width: 0.0,
             bins: (0..capacity).map(|_| None).collect(),
             previous: None,
+            current: 0,
         }
     }
 
@@ -371,6 +380,7 @@ impl<R> Reducer<R> {
             0
         };
         let step = self.previous.replace(t).map(|p| (p, t));
+        self.current = b;
         match &mut self.bins[b] {
             Some(bin) => bin.add(idx, row, values),
             slot => *slot = Some(Bin::new(idx, row, values)),
@@ -394,15 +404,31 @@ impl<R> Reducer<R> {
         }
         self.bins.resize_with(self.capacity, || None);
         self.width *= 2.0;
+        self.current /= 2;
+    }
+
+    /// Adds `amount` to the weight of the last row's bin (e.g. the time it spends under a
+    /// flag, to shade each bin by its share).
+    pub fn weigh(&mut self, amount: f64) {
+        if let Some(bin) = &mut self.bins[self.current] {
+            bin.weight += amount;
+        }
     }
 
     /// The rows kept, the largest steps, the bins' width.
     pub fn finish(self) -> Reduced<R> {
         let mut rows = Vec::new();
         let mut steps = Vec::new();
-        for mut bin in self.bins.into_iter().flatten() {
+        let mut weights = Vec::new();
+        let origin = self.origin.unwrap_or(0.0);
+        for (b, bin) in self.bins.into_iter().enumerate() {
+            let Some(mut bin) = bin else { continue };
             bin.prune();
             steps.extend(bin.step);
+            if bin.weight > 0.0 {
+                let from = origin + b as f64 * self.width;
+                weights.push((from, from + self.width, bin.weight));
+            }
             let start = rows.len();
             rows.push(bin.first);
             rows.extend(bin.kept);
@@ -414,6 +440,7 @@ impl<R> Reducer<R> {
             rows,
             steps,
             width: self.width,
+            weights,
         }
     }
 }

@@ -12,12 +12,12 @@
 //! per half pixel column, the rows holding the extremes of every quantity drawn; time bins
 //! that merge pairwise as the time range grows, since standard input cannot be read twice),
 //! with a systematic sample of rows for the axis ranges, the outages' candidate steps, the
-//! misfit spans and the counts: memory is bounded by the image's width, not the input's
+//! share of each bin's time under the misfit flag and the counts: memory is bounded by the image's width, not the input's
 //! length. With a lead, the rows within the lead wait for the sample at their time
 //! ([`crate::chart::LeadMatcher`]).
 
 use crate::args::PlotArgs;
-use crate::chart::{self, Counts, Layout, LeadMatcher, Row, Sample, Spans, Track};
+use crate::chart::{self, Counts, Layout, LeadMatcher, Row, Sample, Track};
 use crate::decimate::{Reducer, Stride};
 use crate::error::CliError;
 use crate::io::{
@@ -412,10 +412,11 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, Tally, String), CliError> {
         tally: Tally::default(),
     };
     let mut steps = Stride::new(SAMPLE_STEPS);
-    let mut misfit = Spans::default();
+    // The time under the misfit flag, per bin of the reducer's kind.
+    let mut misfit = Reducer::<()>::new(bins);
     let mut order = Order::default();
     let (mut lead, mut matcher) = (None, None);
-    let (mut rejected, mut previous) = (0, None);
+    let (mut rejected, mut previous, mut was_flagged) = (0, None, false);
     while out.next()? {
         let t = out.filled(cols.t, "time")?;
         order.check(&out, cols.t, t)?;
@@ -452,11 +453,16 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, Tally, String), CliError> {
         if let Some(input) = &mut input {
             row.truth.extend(input.row(&mut out, &cols, cfg, (t, y))?);
         }
-        // Per row: the step before it, the misfit flag, the rejection.
+        // Per row: the step before it, the misfit flag's time (to the next row, as
+        // `chart::flag_spans` has it), the rejection.
         if let Some(p) = previous.replace(t) {
             steps.push(out.rows as u64 - 2, t - p);
+            if was_flagged {
+                misfit.weigh(t - p);
+            }
         }
-        misfit.push(t, flagged, gather.reducer.width());
+        misfit.push(out.rows as u64, t, (), &[]);
+        was_flagged = flagged;
         rejected += usize::from(row.rejected);
         let m = matcher.get_or_insert_with(|| LeadMatcher::new(lead.unwrap_or(cfg.lead)));
         let sample = row.sample();
@@ -498,7 +504,12 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, Tally, String), CliError> {
         .filter(|&(a, b)| typical.is_some_and(|m| chart::is_outage(b - a, m)))
         .collect();
     let mut track = Track {
-        misfit: misfit.finish(reduced.width),
+        misfit_share: misfit
+            .finish()
+            .weights
+            .into_iter()
+            .map(|(a, b, w)| (a, b, w / (b - a)))
+            .collect(),
         outages,
         lead: lead.unwrap_or(cfg.lead),
         counts: Some(Counts { rows, rejected }),

@@ -24,6 +24,10 @@ pub struct Track {
     pub rejected: Vec<bool>,
     /// The spans `(from, to)` where the misfit flag is up ([`flag_spans`]).
     pub misfit: Vec<(f64, f64)>,
+    /// Of a decimated track, instead: spans `(from, to, share)` each shaded by the share of
+    /// its time under the misfit flag (a flag up now and then in every pixel would otherwise
+    /// shade the whole plot).
+    pub misfit_share: Vec<(f64, f64, f64)>,
     /// Times at which the output switched from expanding to fading memory.
     pub switches: Vec<f64>,
     /// Times at which the memory was restarted on misfit.
