@@ -223,12 +223,20 @@ transients of the estimates (the residual axis, the rows before the highest deri
 has a value); residuals beyond the range are drawn as triangles at its edge.
 
 With a lead column (filter --lead H) each estimate is drawn at its own time t+H and, in the \
-residual panel, compared with the sample at that time (to a thousandth of the median step); \
+residual panel, compared with the sample at that time (to a thousandth of the median of the \
+first 1,024 steps); \
 rows whose t+H is no sample time have no residual, and the subtitle says how many have one.
 
-A series with more rows than the plot has pixel columns is drawn decimated per pixel column \
-(the first, lowest, highest and last point of each column: every extreme kept), its samples \
-as a thin line instead of dots. An axis whose values share many leading digits, or are very \
+The rows are read one at a time and decimated as they come, in memory set by the image's \
+width, not the input's length (standard input too: one pass). A series with more rows than \
+the plot has pixel columns is drawn decimated per pixel column (the first, lowest, highest and \
+last point of each column: every extreme kept); its samples, too many for dots, as the band \
+from each column's lowest to its highest; many rejected samples as small crosses (at most \
+the lowest and highest per column), their number in the legend; the misfit flag by the share \
+of each column's time it is up. A step between samples longer than 10 times the median step \
+is an outage: hatched, and no line or band is drawn across it. A value beyond an axis (a \
+start-up transient, an outlier) is drawn at its edge and marked by a triangle, and the panel \
+notes how far the lines go. An axis whose values share many leading digits, or are very \
 large or small, is drawn in tick units and its label says how to read them back: 'value = \
 tick x 1e9 + 1.7e18'; a time axis counts from its first time, 't = t0 + tick x 1e9, t0 = \
 1.7e18 (as Unix ns: 2023-11-14 22:13:20 UTC)', with the date when t0 reads as Unix seconds, \

@@ -786,7 +786,7 @@ fn misfit_columns(
     ax: &dyn Fn(f64) -> f64,
 ) -> Vec<(f64, f64, f64)> {
     let w = (span.1 - span.0) / columns.max(1) as f64;
-    if shares.is_empty() || !(w > 0.0) {
+    if shares.is_empty() || w.is_nan() || w <= 0.0 {
         return Vec::new();
     }
     let mut col = vec![0.0; columns];

@@ -172,7 +172,7 @@ impl<T> Stride<T> {
 
     /// Whether the item of index `idx` would be kept (to build it only then).
     pub fn wants(&self, idx: u64) -> bool {
-        idx % self.stride == 0
+        idx.is_multiple_of(self.stride)
     }
 
     /// Offers the item of index `idx` (indices increase from call to call).
@@ -184,7 +184,7 @@ impl<T> Stride<T> {
         while self.items.len() > self.capacity {
             self.stride *= 2;
             let stride = self.stride;
-            self.items.retain(|(i, _)| i % stride == 0);
+            self.items.retain(|(i, _)| i.is_multiple_of(stride));
         }
     }
 

@@ -452,8 +452,8 @@ pub(super) fn split_runs(
     let mut out = Vec::with_capacity(runs.len());
     for r in runs {
         let mut start = r.start;
-        for i in r.start + 1..r.end {
-            if after[i] {
+        for (i, &cut) in after.iter().enumerate().take(r.end).skip(r.start + 1) {
+            if cut {
                 out.push(start..i);
                 start = i;
             }

@@ -115,7 +115,8 @@ fn one_column_keeps_first_lowest_highest_last() {
 /// several channels with gaps and spikes, capacities from 2 to 600 bins), every bin of the
 /// final width keeps each channel's lowest and highest value of the data in it (exactly, the
 /// value and its row), the first and last row of the series, the rows in order, at most
-/// 2 + 2·channels rows per bin; the largest step ending in each bin is the data's.
+/// 2 + 2·channels rows per bin; the largest step ending in each bin is the data's, and its
+/// weight the sum of its rows'.
 #[test]
 fn reducer_keeps_every_bins_extremes_of_every_channel() {
     let mut rng = rand::rngs::StdRng::seed_from_u64(1969);
@@ -143,8 +144,11 @@ fn reducer_keeps_every_bins_extremes_of_every_channel() {
             rows.push((t, v));
         }
         let mut r = Reducer::new(capacity);
+        // A weight of i mod 3 on row i's bin.
+        let weight = |i: usize| (i % 3) as f64;
         for (i, (t, v)) in rows.iter().enumerate() {
             r.push(i as u64, *t, i, v);
+            r.weigh(weight(i));
         }
         let out = r.finish();
         let what = format!("case {case}: {n} rows, {capacity} bins, {channels} channels");
@@ -204,6 +208,16 @@ fn reducer_keeps_every_bins_extremes_of_every_channel() {
             }
         }
         assert_eq!(out.steps, steps, "{what}: largest steps");
+        let weights: Vec<(f64, f64, f64)> = per_bin
+            .iter()
+            .enumerate()
+            .map(|(b, all)| {
+                let from = origin + b as f64 * out.width;
+                (from, from + out.width, all.iter().map(|&i| weight(i)).sum())
+            })
+            .filter(|w| w.2 > 0.0)
+            .collect();
+        assert_eq!(out.weights, weights, "{what}: weights");
         if n > 4 * capacity {
             assert!(kept.len() < n, "{what}: decimated");
         }
