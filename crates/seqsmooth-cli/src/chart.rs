@@ -662,7 +662,22 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         let dots = p.points.iter().filter(|q| !q.2 && inside(q.1));
         chart.draw_series(dots.map(|q| Circle::new((ax(q.0), ay(q.1)), 2, DATA.filled())))?;
     }
-    if p.clip_points {
+    // Samples beyond the axis: sparse, a mark each (one per MARK_SPACING pixels and edge);
+    // dense, where the envelope runs into the edges of a range made of quantiles, the share
+    // of them in a note (of the sampled rows: a decimated track keeps every extreme).
+    let mut notes = Vec::new();
+    if p.clip_points && dense(p, columns) {
+        let sampled = || {
+            let rows = p.point_rows.iter().zip(&p.points);
+            rows.filter(|(k, q)| p.sampled[**k] && !q.2).map(|(_, q)| q)
+        };
+        let all = sampled().count();
+        let out = sampled().filter(|q| !inside(q.1)).count();
+        if out > 0 {
+            let share = 100.0 * out as f64 / all.max(1) as f64;
+            notes.push(format!("about {share:.2} % of the samples"));
+        }
+    } else if p.clip_points {
         // One mark per MARK_SPACING pixels and edge.
         let mut marked = std::collections::HashSet::new();
         let beyond = p.points.iter().filter(|q| !inside(q.1));
@@ -694,7 +709,6 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         Key::TruthError => TRUTH_ERROR.stroke_width(2),
         _ => TRUTH.stroke_width(1),
     };
-    let mut notes = Vec::new();
     for (v, shift, style, name, colour) in [
         (
             &p.truth,

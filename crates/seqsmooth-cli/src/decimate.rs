@@ -269,8 +269,9 @@ impl<R> Bin<R> {
     }
 
     fn prune(&mut self) {
-        let kept = std::mem::take(&mut self.kept);
-        self.kept = kept.into_iter().filter(|r| self.holds(r.0)).collect();
+        let (lo, hi) = (&self.lo, &self.hi);
+        let holds = |idx: u64| lo.iter().chain(hi).any(|e| e.is_some_and(|e| e.row == idx));
+        self.kept.retain(|r| holds(r.0));
     }
 
     /// The bin covering `self` then `next`.

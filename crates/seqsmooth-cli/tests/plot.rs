@@ -1009,6 +1009,13 @@ fn dense_automatic_output_is_legible() {
         envelopes >= 4,
         "{envelopes} envelopes (two panels, split at the outage)"
     );
+    // Dense samples beyond the axis are noted by their share, not marked per column (the
+    // rejected ones here, 8-10σ, are drawn as crosses at the edge).
+    let marks = elements(&svg, "polygon")
+        .into_iter()
+        .filter(|e| e["fill"] == "#787878" && e["opacity"] == "1" && vertices(e).len() == 3)
+        .count();
+    assert_eq!(marks, 2, "only the legend's marks are grey triangles");
     // Small crosses, at most 4 per pixel column and panel (each cross is two lines).
     let crosses = elements(&svg, "line")
         .into_iter()
