@@ -667,15 +667,18 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     // of them in a note (of the sampled rows: a decimated track keeps every extreme).
     let mut notes = Vec::new();
     if p.clip_points && dense(p, columns) {
-        let sampled = || {
-            let rows = p.point_rows.iter().zip(&p.points);
-            rows.filter(|(k, q)| p.sampled[**k] && !q.2).map(|(_, q)| q)
-        };
-        let all = sampled().count();
-        let out = sampled().filter(|q| !inside(q.1)).count();
-        if out > 0 {
-            let share = 100.0 * out as f64 / all.max(1) as f64;
-            notes.push(format!("about {share:.2} % of the samples"));
+        for (rejected, what) in [(false, "samples"), (true, "rejected samples")] {
+            let sampled = || {
+                let rows = p.point_rows.iter().zip(&p.points);
+                rows.filter(|(k, q)| p.sampled[**k] && q.2 == rejected)
+                    .map(|(_, q)| q)
+            };
+            let all = sampled().count();
+            let out = sampled().filter(|q| !inside(q.1)).count();
+            if out > 0 {
+                let share = 100.0 * out as f64 / all.max(1) as f64;
+                notes.push(format!("about {share:.1} % of the {what}"));
+            }
         }
     } else if p.clip_points {
         // One mark per MARK_SPACING pixels and edge.
