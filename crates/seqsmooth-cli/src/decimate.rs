@@ -82,7 +82,7 @@ pub fn min_max(points: &[(f64, f64)], (x0, x1): (f64, f64), columns: usize) -> V
 /// ```
 /// use seqsmooth_cli::decimate::envelope;
 /// let pts: Vec<(f64, f64)> = (0..100).map(|i| (i as f64, (i % 2) as f64)).collect();
-/// let polys = envelope(&pts, (0.0, 100.0), 10, &[(49.5, 50.5)]);
+/// let polys = envelope(&pts, (0.0, 100.0), 10, &[(49.0, 50.0)]);
 /// assert_eq!(polys.len(), 2);
 /// // Columns 0-4 then 5-9: the highest value 1, the lowest 0, at the column centres.
 /// assert_eq!(polys[0].first(), Some(&(5.0, 1.0)));
