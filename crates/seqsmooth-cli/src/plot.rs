@@ -30,8 +30,11 @@ use std::path::Path;
 /// the one the typical step (for the outages) is the median of.
 const SAMPLE_ROWS: usize = 20_000;
 const SAMPLE_STEPS: usize = 20_000;
-/// Time bins per pixel column of the plot.
+/// Time bins per pixel column of the plot, and at most this many in all (about 17 KB each
+/// at 10⁷ rows of an automatic filter's output: 90 MB at the default width, 166 MB at most;
+/// wider than 2,048 columns a bin spans more than half a pixel).
 const BINS_PER_COLUMN: usize = 4;
+const MAX_BINS: usize = 8192;
 
 /// A CSV file read a row at a time.
 struct Source {
@@ -403,7 +406,8 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, Tally, String), CliError> {
     let mut out = Source::open(cfg.source.as_deref())?;
     let cols = Columns::of(&out, cfg)?;
     let mut input = Input::open(cfg)?;
-    let bins = BINS_PER_COLUMN * chart::columns_for_width(cfg.width) as usize;
+    let columns = chart::columns_for_width(cfg.width) as usize;
+    let bins = (BINS_PER_COLUMN * columns).min(MAX_BINS);
     let mut gather = Gather {
         reducer: Reducer::new(bins),
         sample: Stride::new(SAMPLE_ROWS),
