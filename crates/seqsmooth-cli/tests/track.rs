@@ -40,18 +40,19 @@ fn landing() -> (String, Vec<[f64; 3]>) {
     (csv, truth)
 }
 
+/// `track` on the landing trajectory's noisy rows: the convention and noise of [`landing`].
+const LANDING_ARGS: [&str; 7] = [
+    "track",
+    "--azimuth",
+    "bearing",
+    "--sigma-range",
+    "10",
+    "--sigma-angle",
+    "1e-3",
+];
+
 fn track(input: &str, method: &[&str]) -> Vec<Vec<String>> {
-    let mut args = vec![
-        "track",
-        "--azimuth",
-        "bearing",
-        "--sigma-range",
-        "10",
-        "--sigma-angle",
-        "1e-3",
-        "--method",
-    ];
-    args.extend_from_slice(method);
+    let args: Vec<&str> = [&LANDING_ARGS[..], &["--method"], method].concat();
     let (header, rows) = table(&ok(&args, input));
     assert_eq!(
         header.join(","),
@@ -725,20 +726,7 @@ fn a_late_error_leaves_no_output() {
         let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
         assert_eq!(left.len(), 1, "{method:?}: temporary files left: {left:?}");
     }
-    let o = run(
-        &[
-            "track",
-            "--azimuth",
-            "bearing",
-            "--sigma-range",
-            "10",
-            "--sigma-angle",
-            "1e-3",
-            "--q",
-            "10",
-        ],
-        &bad,
-    );
+    let o = run(&[&LANDING_ARGS[..], &["--q", "10"]].concat(), &bad);
     assert_eq!(o.code, 1);
     assert_eq!(
         o.stdout.lines().count(),
@@ -922,22 +910,16 @@ fn a_flagged_row_is_named() {
 #[test]
 fn a_window_that_does_not_converge_says_what_to_change() {
     let (input, _) = landing();
+    let window = [
+        "--method",
+        "window",
+        "--window",
+        "60",
+        "--max-iterations",
+        "1",
+    ];
     fails(
-        &[
-            "track",
-            "--azimuth",
-            "bearing",
-            "--sigma-range",
-            "10",
-            "--sigma-angle",
-            "1e-3",
-            "--method",
-            "window",
-            "--window",
-            "60",
-            "--max-iterations",
-            "1",
-        ],
+        &[&LANDING_ARGS[..], &window].concat(),
         &input,
         1,
         &["did not converge", "--max-iterations N", "--window W"],
@@ -949,18 +931,8 @@ fn a_window_that_does_not_converge_says_what_to_change() {
 #[test]
 fn fit_radar_defaults_run_on_landing_with_a_flag_column() {
     let (input, _) = landing();
-    let out = ok(
-        &[
-            "fit",
-            "--model",
-            "radar",
-            "--sigma-range",
-            "10",
-            "--sigma-angle",
-            "1e-3",
-        ],
-        &input,
-    );
+    let args = "fit --model radar --sigma-range 10 --sigma-angle 1e-3";
+    let out = ok(&args.split(' ').collect::<Vec<_>>(), &input);
     let (header, rows) = table(&out);
     assert_eq!(header.last().unwrap(), "flag");
     let flagged = rows
