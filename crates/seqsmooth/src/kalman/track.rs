@@ -21,7 +21,9 @@
 //! shortens it (a larger `q`, a smaller `θ`), quiet updates lengthen it again; the driving
 //! noise starts at `q₀ = σ_r² / T³` (the range's noise variance over the cube of the start's
 //! mean step: a tracking index of 1), the discount at `θ₀ = 0.9` per update. The window
-//! method tests each window's residual χ² against its degrees of freedom (§8.6) and carries
+//! method gates each row likewise, on its NIS against the previous window's estimate (a lone
+//! row beyond the gate takes its place in the window unmeasured), tests each window's
+//! residual χ² against its degrees of freedom (§8.6) and carries
 //! the misfit in its covariance, scaled by `max(1, χ²/ν)` ([`misfit_scale`](crate::estimate::sliding::misfit_scale)); a window beyond
 //! `χ²_ν` at `1 − MISFIT_ALPHA` is flagged.
 
@@ -311,10 +313,12 @@ enum Stage {
     ),
     /// smooth after [`RadarTracker::finish`]: no more rows.
     Finished,
-    /// window: the fit over the last rows, and the previous row's estimate.
+    /// window: the fit over the last rows, the previous row's estimate, and the outlier gate
+    /// on the row's innovation against it.
     Window(
         Box<SlidingFit<PolynomialDynamics, Radar>>,
         Option<Correction>,
+        Box<Monitor>,
     ),
 }
 
@@ -412,7 +416,11 @@ impl RadarTracker {
                             .into(),
                     });
                 }
-                Stage::Window(Box::new(sliding(dynamics, radar, window, solver)?), None)
+                Stage::Window(
+                    Box::new(sliding(dynamics, radar, window, solver)?),
+                    None,
+                    Box::new(Monitor::new(3, false, 0, 0)?),
+                )
             }
             TrackMethod::Kalman { q } | TrackMethod::Smooth { q } => {
                 if let Some(q) = q {
@@ -492,20 +500,33 @@ impl RadarTracker {
                 };
                 Some((None, TrackFlag::None))
             }
-            Stage::Window(fit, previous) => {
-                let nis = match previous {
+            Stage::Window(fit, previous, gate) => {
+                let stats = match previous {
                     Some(p) => filter_from(self.dynamics, self.radar, p)
                         .map_err(TrackError::Start)?
                         .update_stats(m)
                         .ok()
-                        .flatten()
-                        .map(|i| i.nis),
+                        .flatten(),
                     None => None,
                 };
+                // The gate: a lone row beyond it takes its place in the window unmeasured.
+                let used = stats.is_none_or(|s| gate.accepts(s.nis, s.components));
+                let mut taken = m.clone();
+                if !used {
+                    taken.values.iter_mut().for_each(|v| *v = None);
+                }
                 let w = fit.window();
-                *previous = fit.push(m.clone()).map_err(|e| window(w, e))?;
-                let flag = previous.as_ref().map_or(TrackFlag::None, window_flag);
-                Some((nis, flag))
+                let fitted = fit.push(taken).map_err(|e| window(w, e))?;
+                if let Some(s) = stats {
+                    gate.record(s.nis, s.components, used);
+                }
+                *previous = fitted;
+                let flag = match previous {
+                    _ if !used => TrackFlag::Outlier,
+                    Some(c) => window_flag(c),
+                    None => TrackFlag::None,
+                };
+                Some((stats.map(|s| s.nis), flag))
             }
             Stage::Filtering(kalman, start) => {
                 let (filter, memory) = &mut **kalman;
@@ -545,7 +566,7 @@ impl RadarTracker {
             return Ok(Tracked::Held);
         };
         let (state, covariance) = match &self.stage {
-            Stage::Window(_, Some(c))
+            Stage::Window(_, Some(c), _)
             | Stage::Filtering(_, Some(c))
             | Stage::Smoothing(_, Some(c), ..) => (&c.state, &c.covariance),
             Stage::Filtering(kalman, None) => (kalman.0.state(), kalman.0.covariance()),
