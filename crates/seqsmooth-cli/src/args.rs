@@ -147,7 +147,8 @@ determinable leave their cells empty.
 
 flag says where the sigmas may not cover the error: empty when the tests pass; 'outlier' when \
 the row's NIS is beyond the gate (the 99.9% point of chi-squared) after a row within it: the \
-measurement is left out and the row's estimate is the prediction; 'misfit' when the model does \
+measurement is left out (the row's estimate is the prediction; window: the fit of the window \
+without it); 'misfit' when the model does \
 not follow the target (a manoeuvre): the NIS summed over the last 5 updates is beyond its 99% \
 point (kalman, fading, smooth), or the window's residual chi-squared is beyond the 99% point \
 for its degrees of freedom (window). Keep the unflagged rows for estimates whose 3-sigma \

@@ -886,8 +886,8 @@ fn defaults_run_on_landing_and_name_their_flags() {
     }
 }
 
-/// A range 30σ off is named: the Kalman methods flag its row `outlier` (and leave it out, so
-/// the next row is unflagged), the window method flags its windows `misfit`.
+/// A range 30σ off is named: every method flags its row `outlier` and leaves it out (the next
+/// row is not flagged `outlier`).
 #[test]
 fn a_flagged_row_is_named() {
     let (input, _) = landing();
@@ -897,13 +897,11 @@ fn a_flagged_row_is_named() {
     cells[1] = (num(&cells[1]) + 300.0).to_string();
     lines[k + 1] = cells.join(",");
     let bad = lines.join("\n") + "\n";
-    for method in ["kalman", "fading", "smooth"] {
+    for method in ["kalman", "fading", "smooth", "window"] {
         let rows = track(&bad, &[method]);
         assert_eq!(rows[k][14], "outlier", "{method}");
         assert_ne!(rows[k + 1][14], "outlier", "{method}");
     }
-    let rows = track(&bad, &["window"]);
-    assert_eq!(rows[k][14], "misfit");
 }
 
 /// A window that does not converge names what to change with this command's options.

@@ -241,7 +241,7 @@ def test_bad_settings_raise_parameter_errors(kw):
 
 def test_flags_name_an_outlier_and_a_manoeuvre():
     """A range 30σ off is flagged ``"outlier"`` and left out (the next row is not), by every
-    Kalman method at its defaults; a 5g turn the constant-velocity model does not follow is
+    method at its defaults; a 5g turn the constant-velocity model does not follow is
     flagged ``"misfit"`` by every method; the flags are the command's ``flag`` column."""
     rng = np.random.default_rng(21)
     n = 240
@@ -262,9 +262,6 @@ def test_flags_name_an_outlier_and_a_manoeuvre():
         tracker = ss.RadarTracker(method, sigma_range=SR, sigma_angle=SA)
         x, sigma, nis, flags = tracked(tracker, t, rows)
         assert flags.dtype.kind == "U" and set(flags) <= {"", "outlier", "misfit"}
-        if method != "window":
-            assert flags[k] == "outlier" and flags[k + 1] != "outlier", method
-        else:
-            assert flags[k] == "misfit"
+        assert flags[k] == "outlier" and flags[k + 1] != "outlier", method
         assert (flags[turn] == "misfit").any(), method
         assert (flags != "").mean() < 0.5, method

@@ -1,4 +1,5 @@
-//! The innovation monitor of the radar tracker's Kalman methods (Morrison §14.8): each
+//! The innovation monitor of the radar tracker's Kalman methods (and the window method's
+//! gate) (Morrison §14.8): each
 //! update's normalised innovation squared `NIS = νᵀ V⁻¹ ν` is `χ²(p)` for `p` components while
 //! the model holds, and the sum over the last [`WINDOW`] updates is `χ²` with their summed
 //! components (14.8.4)-(14.8.5).
@@ -43,7 +44,8 @@ pub enum TrackFlag {
     #[default]
     None,
     /// The row's measurement failed the outlier gate and was left out; the estimate is the
-    /// prediction from the rows before (its σ covers that).
+    /// prediction from the rows before (the window method: the fit of the window without it),
+    /// whose σ covers that.
     Outlier,
     /// The model does not follow the data here (a manoeuvre): the innovation test (Kalman
     /// methods) or the window's χ² (the sliding fit) failed, so the σ may not cover the error.
