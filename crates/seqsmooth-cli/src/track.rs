@@ -25,9 +25,11 @@ use crate::fit::window_error;
 use crate::io::{check_distinct, open_input, write_f64, CsvIn, Need, Output};
 use nalgebra::{DMatrix, DVector};
 use rows::{Names, Rows, SigmaSource};
+use seqsmooth::estimate::gauss_newton::GaussNewton;
 use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::track::{
-    RadarTracker, TrackError, TrackMethod as Method, Tracked, START_WINDOW,
+    RadarTracker, TrackError, TrackFlag, TrackMethod as Method, Tracked, DEFAULT_WINDOW,
+    START_WINDOW,
 };
 use seqsmooth::kalman::Discount;
 use seqsmooth::model::radar::Radar;
@@ -36,13 +38,13 @@ use std::collections::VecDeque;
 use stream::Block;
 
 /// The output's header.
-const HEADER: &[u8] = b"t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,nis\n";
+const HEADER: &[u8] = b"t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,nis,flag\n";
 
 /// Output bytes gathered before they are written.
 const WRITE_BYTES: usize = 1 << 16;
 
-/// One row's estimate: the state, its σ, and the NIS.
-type Estimate = ([f64; 6], [f64; 6], Option<f64>);
+/// One row's estimate: the state, its σ, the NIS and the flag.
+type Estimate = ([f64; 6], [f64; 6], Option<f64>, TrackFlag);
 
 /// One output row's numbers; `None` for empty cells.
 type Cells = Option<Estimate>;
@@ -51,11 +53,6 @@ type Cells = Option<Estimate>;
 pub fn run(a: &TrackArgs) -> Result<(), CliError> {
     let usage = |s: &str| Err(CliError::Usage(s.into()));
     match a.method {
-        TrackMethod::Fading if a.beta.is_none() && a.theta.is_none() => {
-            return usage(
-                "--method fading needs --beta B (per unit of time) or --theta T (per update)",
-            )
-        }
         TrackMethod::Fading | TrackMethod::Window if a.q.is_some() => {
             return usage("--q applies only to --method kalman and smooth")
         }
@@ -63,6 +60,9 @@ pub fn run(a: &TrackArgs) -> Result<(), CliError> {
             if a.beta.is_some() || a.theta.is_some() =>
         {
             return usage("--beta and --theta apply only to --method fading")
+        }
+        TrackMethod::Kalman | TrackMethod::Fading | TrackMethod::Smooth if a.window.is_some() => {
+            return usage("--window applies only to --method window")
         }
         _ => {}
     }
@@ -132,7 +132,7 @@ impl<'a> Writer<'a> {
         let text = &mut self.text;
         text.extend_from_slice(t);
         match cells {
-            Some((x, s, nis)) => {
+            Some((x, s, nis, flag)) => {
                 for v in x.iter().chain(s) {
                     text.push(b',');
                     write_f64(text, *v);
@@ -141,8 +141,10 @@ impl<'a> Writer<'a> {
                 if let Some(nis) = nis {
                     write_f64(text, *nis);
                 }
+                text.push(b',');
+                text.extend_from_slice(flag.name().as_bytes());
             }
-            None => text.extend_from_slice(&[b','; 13]),
+            None => text.extend_from_slice(&[b','; 14]),
         }
         text.push(b'\n');
         if cells.is_some() && self.out.is_none() {
@@ -209,22 +211,25 @@ struct Tracker {
 impl Tracker {
     fn new(a: &TrackArgs, radar: Radar) -> Result<Self, CliError> {
         let method = match a.method {
-            TrackMethod::Window => Method::Window { window: a.window },
-            TrackMethod::Kalman => Method::Kalman {
-                q: a.q.unwrap_or(0.0),
+            TrackMethod::Window => Method::Window {
+                window: a.window.unwrap_or(DEFAULT_WINDOW),
             },
-            TrackMethod::Smooth => Method::Smooth {
-                q: a.q.unwrap_or(0.0),
-            },
+            TrackMethod::Kalman => Method::Kalman { q: a.q },
+            TrackMethod::Smooth => Method::Smooth { q: a.q },
             TrackMethod::Fading => Method::Fading(match (a.beta, a.theta) {
-                (Some(b), _) => Discount::PerTime(b),
-                (_, Some(t)) => Discount::PerUpdate(t),
-                _ => unreachable!("run() refuses fading without --beta or --theta"),
+                (Some(b), _) => Some(Discount::PerTime(b)),
+                (_, Some(t)) => Some(Discount::PerUpdate(t)),
+                _ => None,
             }),
         };
-        let inner = RadarTracker::new(radar, method).map_err(|e| CliError::Usage(e.to_string()))?;
-        let keep = match a.method {
-            TrackMethod::Window => a.window,
+        let solver = GaussNewton {
+            max_iterations: a.max_iterations as usize,
+            ..GaussNewton::default()
+        };
+        let inner = RadarTracker::with_solver(radar, method, solver)
+            .map_err(|e| CliError::Usage(e.to_string()))?;
+        let keep = match method {
+            Method::Window { window } => window,
             _ => START_WINDOW,
         };
         Ok(Self {
@@ -243,7 +248,9 @@ impl Tracker {
         self.lines.push_back(line);
         match self.inner.push(m) {
             Ok(Tracked::Undetermined) => Ok(Step::Row(None)),
-            Ok(Tracked::Estimate(e)) => Ok(Step::Row(Some(cells(e.state, e.covariance, e.nis)))),
+            Ok(Tracked::Estimate(e)) => {
+                Ok(Step::Row(Some(cells(e.state, e.covariance, e.nis, e.flag))))
+            }
             Ok(Tracked::Held) => {
                 let held = &mut self.held;
                 if held.lines.is_empty() {
@@ -285,7 +292,7 @@ impl Tracker {
         }
         let cells = smoothed
             .iter()
-            .map(|(_, s)| Some(Some(cells(&s.state, &s.covariance, s.nis))))
+            .map(|(_, s, flag)| Some(Some(cells(&s.state, &s.covariance, s.nis, *flag))))
             .collect();
         Ok(Some(Block::Rows {
             text: held.text,
@@ -296,12 +303,12 @@ impl Tracker {
 }
 
 /// A row's cells from a state and covariance.
-fn cells(x: &DVector<f64>, s: &DMatrix<f64>, nis: Option<f64>) -> Estimate {
+fn cells(x: &DVector<f64>, s: &DMatrix<f64>, nis: Option<f64>, flag: TrackFlag) -> Estimate {
     let mut state = [0.0; 6];
     let mut sigma = [0.0; 6];
     for k in 0..6 {
         state[k] = x[k];
         sigma[k] = s[(k, k)].max(0.0).sqrt();
     }
-    (state, sigma, nis)
+    (state, sigma, nis, flag)
 }

@@ -8,8 +8,10 @@ use crate::errors::{raise, to_py, IntoPy, Kind};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
-use seqsmooth::estimate::gauss_newton::Measurement;
-use seqsmooth::kalman::track::{radar_row, RadarTracker, TrackError, TrackMethod, Tracked};
+use seqsmooth::estimate::gauss_newton::{GaussNewton, Measurement};
+use seqsmooth::kalman::track::{
+    radar_row, RadarTracker, TrackError, TrackMethod, Tracked, DEFAULT_WINDOW,
+};
 use seqsmooth::kalman::Discount;
 use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
@@ -54,14 +56,30 @@ fn track_error(e: TrackError, offset: usize) -> PyErr {
     }
 }
 
-/// One output row: state, covariance (row-major) and NIS; NaN where none.
-fn write_row(estimate: &Tracked<'_>, states: &mut [f64], covariances: &mut [f64], nis: &mut f64) {
+/// One output row: state, covariance (row-major), NIS and flag; NaN (`""`) where none.
+fn write_row(
+    estimate: &Tracked<'_>,
+    states: &mut [f64],
+    covariances: &mut [f64],
+    nis: &mut f64,
+    flag: &mut &'static str,
+) {
     if let Tracked::Estimate(e) = estimate {
         states.copy_from_slice(e.state.as_slice());
         // Symmetric: column-major is row-major.
         covariances.copy_from_slice(e.covariance.as_slice());
         *nis = e.nis.unwrap_or(f64::NAN);
+        *flag = e.flag.name();
     }
+}
+
+/// The rows' flags (`TrackFlag::name`: `""`, `"outlier"`, `"misfit"`) as a numpy array of str.
+pub(crate) fn flag_array<'py>(py: Python<'py>, flags: &[&str]) -> PyResult<Bound<'py, PyAny>> {
+    let kwargs = pyo3::types::PyDict::new(py);
+    kwargs.set_item("dtype", "<U7")?;
+    py.import("numpy")?
+        .getattr("array")?
+        .call((pyo3::types::PyList::new(py, flags)?,), Some(&kwargs))
 }
 
 /// A radar track (Morrison §8.5-8.7, chs. 12, 14, 15): range, azimuth and elevation seen from
@@ -81,12 +99,23 @@ fn write_row(estimate: &Tracked<'_>, states: &mut [f64], covariances: &mut [f64]
 ///     The range's and the angles' noise σ (radians), for the rows that give none.
 /// site : (float, float, float)
 ///     The radar's position.
-/// q : float
-///     kalman, smooth: the acceleration's spectral density on each axis (default 0).
-/// beta, theta : float
-///     fading: the discount per unit of time, or per update (one of them).
+/// q : float, optional
+///     kalman, smooth: the acceleration's spectral density on each axis; by default
+///     adaptive: from ``σ_range² / T³`` (``T`` the start's mean step), raised by the
+///     innovation test's misfits and lowered when the innovations are quiet (Morrison §14.8).
+/// beta, theta : float, optional
+///     fading: the discount per unit of time, or per update (one of them); by default an
+///     adaptive discount per update from 0.9, shortened by misfits likewise.
 /// window : int
-///     window: the rows of each fit (default 60).
+///     window: the rows of each fit (default 8).
+/// max_iterations : int
+///     The Gauss–Newton iterations allowed per fit (the window method's, the Kalman methods'
+///     start), 1 to 1000 (default 20).
+///
+/// Every row's estimate has a flag (``update_many``'s fourth array): ``""``; ``"outlier"``,
+/// the row's measurement failed the innovation gate and was left out (the estimate is the
+/// prediction); ``"misfit"``, the model does not follow the target here (the innovation test,
+/// or the window's χ²), so the σ may not cover the error.
 /// azimuth : {"from-x", "bearing"}
 ///     ``"from-x"``: from +x towards +y; ``"bearing"``: clockwise from +y (x east, y north).
 #[pyclass(name = "RadarTracker", module = "seqsmooth")]
@@ -160,7 +189,7 @@ impl PyRadarTracker {
     #[new]
     #[pyo3(signature = (method = "kalman", *, sigma_range = None, sigma_angle = None,
         site = (0.0, 0.0, 0.0), q = None, beta = None, theta = None, window = None,
-        azimuth = "from-x"))]
+        azimuth = "from-x", max_iterations = 20))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         method: &str,
@@ -172,6 +201,7 @@ impl PyRadarTracker {
         theta: Option<f64>,
         window: Option<usize>,
         azimuth: &str,
+        max_iterations: i64,
     ) -> PyResult<Self> {
         let usage = |m: &str| Err(raise(Kind::Parameter, m, None));
         let fading = beta.is_some() || theta.is_some();
@@ -180,23 +210,20 @@ impl PyRadarTracker {
                 return usage("q, beta and theta do not apply to method='window'")
             }
             "window" => TrackMethod::Window {
-                window: window.unwrap_or(60),
+                window: window.unwrap_or(DEFAULT_WINDOW),
             },
             "kalman" | "smooth" if fading => {
                 return usage("beta and theta apply only to method='fading'")
             }
-            "kalman" => TrackMethod::Kalman {
-                q: q.unwrap_or(0.0),
-            },
-            "smooth" => TrackMethod::Smooth {
-                q: q.unwrap_or(0.0),
-            },
+            "kalman" => TrackMethod::Kalman { q },
+            "smooth" => TrackMethod::Smooth { q },
             "fading" if q.is_some() => return usage("q applies only to 'kalman' and 'smooth'"),
             "fading" => match (beta, theta) {
-                (Some(b), None) => TrackMethod::Fading(Discount::PerTime(b)),
-                (None, Some(t)) => TrackMethod::Fading(Discount::PerUpdate(t)),
+                (Some(b), None) => TrackMethod::Fading(Some(Discount::PerTime(b))),
+                (None, Some(t)) => TrackMethod::Fading(Some(Discount::PerUpdate(t))),
+                (None, None) => TrackMethod::Fading(None),
                 _ => return usage(
-                    "method='fading' needs beta (per unit of time) or theta (per update), not both",
+                    "method='fading' takes beta (per unit of time) or theta (per update), not both",
                 ),
             },
             other => {
@@ -222,10 +249,19 @@ impl PyRadarTracker {
                 crate::fit::check_sigma(name, s)?;
             }
         }
+        if !(1..=1000).contains(&max_iterations) {
+            return usage(&format!(
+                "max_iterations {max_iterations} must be from 1 to 1000"
+            ));
+        }
+        let solver = GaussNewton {
+            max_iterations: max_iterations as usize,
+            ..GaussNewton::default()
+        };
         let radar = Radar::new([site.0, site.1, site.2], 6)
             .map_err(|e| raise(Kind::Parameter, e.to_string(), None))?;
         Ok(Self {
-            inner: RadarTracker::new(radar, method).py()?,
+            inner: RadarTracker::with_solver(radar, method, solver).py()?,
             sigmas: [sigma_range, sigma_angle],
             bearing,
         })
@@ -239,9 +275,10 @@ impl PyRadarTracker {
 
     /// Tracks the rows ``(t[i], range[i], azimuth[i], elevation[i])`` (NaN: a missing
     /// component), with per-row σ where given (NaN: the tracker's). Returns ``(states,
-    /// covariances, nis)``, ``(n, 6)``, ``(n, 6, 6)`` and ``(n,)``: NaN rows where the rows so
-    /// far do not determine the state, or the smoother holds the row (see ``finish``); a NIS
-    /// is NaN where there is no innovation. On a refused row the rows before it are taken and
+    /// covariances, nis, flags)``, ``(n, 6)``, ``(n, 6, 6)``, ``(n,)`` and ``(n,)`` of str:
+    /// NaN rows (flag ``""``) where the rows so far do not determine the state, or the
+    /// smoother holds the row (see ``finish``); a NIS is NaN where there is no innovation;
+    /// a flag is ``""``, ``"outlier"`` or ``"misfit"`` (``seqsmooth track``'s ``flag``). On a refused row the rows before it are taken and
     /// the exception's ``index`` is its position.
     #[pyo3(signature = (t, range, azimuth, elevation, sigma_range = None, sigma_angle = None))]
     #[allow(clippy::too_many_arguments)]
@@ -285,6 +322,7 @@ impl PyRadarTracker {
         let mut states = vec![f64::NAN; count * 6];
         let mut covariances = vec![f64::NAN; count * 36];
         let mut nis = vec![f64::NAN; count];
+        let mut flags = vec![""; count];
         let offset = self.inner.rows();
         let tracker = &mut self.inner;
         let mut taken = 0;
@@ -296,6 +334,7 @@ impl PyRadarTracker {
                     &mut states[i * 6..(i + 1) * 6],
                     &mut covariances[i * 36..(i + 1) * 36],
                     &mut nis[i],
+                    &mut flags[i],
                 );
                 taken = i + 1;
             }
@@ -313,10 +352,12 @@ impl PyRadarTracker {
             .reshape([count, 6, 6])?
             .into_any();
         let nis = PyArray1::from_vec(py, nis).into_any();
-        PyTuple::new(py, [states, covariances, nis])
+        let flags = flag_array(py, &flags)?;
+        PyTuple::new(py, [states, covariances, nis, flags])
     }
 
-    /// The smoother's estimates of the rows it held: ``(rows, states, covariances, nis)``,
+    /// The smoother's estimates of the rows it held: ``(rows, states, covariances, nis,
+    /// flags)``,
     /// ``rows`` their numbers counted from the tracker's first row (0); empty for the other
     /// methods. The smoother takes no more rows after it.
     fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
@@ -329,7 +370,9 @@ impl PyRadarTracker {
         let mut states = Vec::with_capacity(count * 6);
         let mut covariances = Vec::with_capacity(count * 36);
         let mut nis = Vec::with_capacity(count);
-        for (row, s) in smoothed {
+        let mut flags = Vec::with_capacity(count);
+        for (row, s, flag) in smoothed {
+            flags.push(flag.name());
             rows.push(row as i64);
             states.extend_from_slice(s.state.as_slice());
             covariances.extend_from_slice(s.covariance.as_slice());
@@ -341,7 +384,8 @@ impl PyRadarTracker {
             .reshape([count, 6, 6])?
             .into_any();
         let nis = PyArray1::from_vec(py, nis).into_any();
-        PyTuple::new(py, [rows, states, covariances, nis])
+        let flags = flag_array(py, &flags)?;
+        PyTuple::new(py, [rows, states, covariances, nis, flags])
     }
 
     fn __repr__(&self) -> String {

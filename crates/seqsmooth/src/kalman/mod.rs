@@ -10,10 +10,13 @@
 //! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run.
 //! - [`track`]: [`track::RadarTracker`], a radar's rows to a Cartesian track by the sliding
 //!   Gauss–Newton fit, the extended Kalman filter (driving noise or fading) or its smoother.
+//! - [`adaptive`]: the tracker's innovation monitor (§14.8): the outlier gate, the window
+//!   test of the NIS, the adaptive memory, and the rows' [`track::TrackFlag`].
 //! - [`steady`]: the fading filter's steady state (§14.7).
 //! - [`noise`]: the driving-noise covariance `Q` over a step (15.2.23), in closed form for the
 //!   polynomial model ([`noise::WhiteNoiseDerivative`]).
 
+pub mod adaptive;
 pub mod bayes;
 mod discount;
 pub mod filter;

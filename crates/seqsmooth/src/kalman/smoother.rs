@@ -114,6 +114,12 @@ impl<D: Dynamics + Clone, O: Observation + Clone> Smoother<D, O> {
         &self.filter
     }
 
+    /// The forward filter, to change its driving noise or fading between pushes (an adaptive
+    /// filter): the backward pass uses each step's own prediction, so it stays consistent.
+    pub fn filter_mut(&mut self) -> &mut KalmanFilter<D, O> {
+        &mut self.filter
+    }
+
     /// The forward pass over `m` (not before the previous measurement): the prediction and
     /// the update; the update's NIS (`None` where every component is missing). On an error
     /// the smoother is unchanged.
