@@ -157,9 +157,13 @@ acceleration times its duration: 10 m^2/s^3 for an airliner's turns and descent.
 --method fading: the same start, then the fading-memory Kalman filter (Morrison 14.4) with \
 --beta B per unit of time or --theta T per update; s.. are the true 1-sigma errors. A shorter \
 memory follows manoeuvres: beta 0.7 per second for an airliner.
---method smooth: the Rauch-Tung-Striebel smoother over the kalman method's run (holds every row \
-after the start, writes at the end); nis is the forward filter's. The other methods stream: \
-each row's output is written as it is read, in memory independent of the input's length.
+--method smooth: the fixed-lag Rauch-Tung-Striebel smoother over the kalman method's run: each \
+row's estimate from the rows up to --lag N rows after it (default 200), written N rows later, \
+the last N rows from every row at the end; nis is the forward filter's. It holds N+1 rows \
+(about 2.3 kB each: 0.5 MB at the default); a lag beyond the input's rows is the \
+whole-interval smoother, and a lag whose rows would take over 100 MB is said on stderr before \
+the first row. The other methods stream: each row's output is written as it is read, in \
+memory independent of the input's length.
 
 Angles in radians; --azimuth from-x (default): from +x towards +y; --azimuth bearing: \
 clockwise from north with x = east, y = north. Elevation from the x-y plane. An empty range, \
@@ -554,6 +558,10 @@ pub struct TrackArgs {
     #[arg(long, value_name = "W", default_value = "60", value_parser = parse_window,
           allow_hyphen_values = true)]
     pub window: usize,
+    /// smooth: the lag in rows: each row's estimate from the N rows after it, written N rows
+    /// later; the smoother holds N+1 rows (0 is the kalman filter) [default: 200]
+    #[arg(long, value_name = "N")]
+    pub lag: Option<usize>,
     /// The azimuth convention of the input
     #[arg(long, value_enum, default_value_t = AzimuthConvention::FromX)]
     pub azimuth: AzimuthConvention,

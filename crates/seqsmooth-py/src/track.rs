@@ -9,7 +9,10 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::estimate::gauss_newton::Measurement;
-use seqsmooth::kalman::track::{radar_row, RadarTracker, TrackError, TrackMethod, Tracked};
+use seqsmooth::kalman::smoother::Smoothed;
+use seqsmooth::kalman::track::{
+    radar_row, RadarTracker, TrackError, TrackMethod, Tracked, DEFAULT_LAG,
+};
 use seqsmooth::kalman::Discount;
 use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
@@ -74,9 +77,10 @@ fn write_row(estimate: &Tracked<'_>, states: &mut [f64], covariances: &mut [f64]
 ///     ``"window"``: the Gauss–Newton fit of each row's last ``window`` rows;
 ///     ``"kalman"``: the extended Kalman filter with white-noise acceleration ``q``;
 ///     ``"fading"``: the fading-memory extended Kalman filter (``beta`` or ``theta``);
-///     ``"smooth"``: the Rauch–Tung–Striebel smoother over the Kalman filter (estimates at
-///     ``finish()``). The Kalman methods start from the first fit of the rows so far (at most
-///     60) that determines the state.
+///     ``"smooth"``: the fixed-lag Rauch–Tung–Striebel smoother over the Kalman filter: each
+///     row's estimate from the ``lag`` rows after it, given ``lag`` rows later (``smoothed()``),
+///     the last ones at ``finish()``. The Kalman methods start from the first fit of the rows
+///     so far (at most 60) that determines the state.
 /// sigma_range, sigma_angle : float, optional
 ///     The range's and the angles' noise σ (radians), for the rows that give none.
 /// site : (float, float, float)
@@ -87,6 +91,9 @@ fn write_row(estimate: &Tracked<'_>, states: &mut [f64], covariances: &mut [f64]
 ///     fading: the discount per unit of time, or per update (one of them).
 /// window : int
 ///     window: the rows of each fit (default 60).
+/// lag : int
+///     smooth: the lag in rows (default 200); the smoother holds ``lag + 1`` rows; 0 is the
+///     filter, a lag beyond the rows the whole-interval smoother.
 /// azimuth : {"from-x", "bearing"}
 ///     ``"from-x"``: from +x towards +y; ``"bearing"``: clockwise from +y (x east, y north).
 #[pyclass(name = "RadarTracker", module = "seqsmooth")]
@@ -94,6 +101,39 @@ pub struct PyRadarTracker {
     inner: RadarTracker,
     sigmas: [Option<f64>; 2],
     bearing: bool,
+    /// The smoother's rows given and not yet returned.
+    given: Given,
+}
+
+/// Smoothed rows as the arrays `smoothed()` returns: row numbers, states, covariances
+/// (row-major: symmetric) and NIS.
+#[derive(Default)]
+struct Given {
+    rows: Vec<i64>,
+    states: Vec<f64>,
+    covariances: Vec<f64>,
+    nis: Vec<f64>,
+}
+
+impl Given {
+    fn push(&mut self, row: usize, s: &Smoothed) {
+        self.rows.push(row as i64);
+        self.states.extend_from_slice(s.state.as_slice());
+        self.covariances.extend_from_slice(s.covariance.as_slice());
+        self.nis.push(s.nis.unwrap_or(f64::NAN));
+    }
+
+    /// `(rows, states, covariances, nis)`, `(n,)`, `(n, 6)`, `(n, 6, 6)`, `(n,)`.
+    fn arrays<'py>(self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let count = self.rows.len();
+        let rows = PyArray1::from_vec(py, self.rows).into_any();
+        let states = matrix(py, self.states, count, 6)?;
+        let covariances = PyArray1::from_vec(py, self.covariances)
+            .reshape([count, 6, 6])?
+            .into_any();
+        let nis = PyArray1::from_vec(py, self.nis).into_any();
+        PyTuple::new(py, [rows, states, covariances, nis])
+    }
 }
 
 impl PyRadarTracker {
@@ -160,7 +200,7 @@ impl PyRadarTracker {
     #[new]
     #[pyo3(signature = (method = "kalman", *, sigma_range = None, sigma_angle = None,
         site = (0.0, 0.0, 0.0), q = None, beta = None, theta = None, window = None,
-        azimuth = "from-x"))]
+        lag = None, azimuth = "from-x"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         method: &str,
@@ -171,6 +211,7 @@ impl PyRadarTracker {
         beta: Option<f64>,
         theta: Option<f64>,
         window: Option<usize>,
+        lag: Option<usize>,
         azimuth: &str,
     ) -> PyResult<Self> {
         let usage = |m: &str| Err(raise(Kind::Parameter, m, None));
@@ -190,6 +231,7 @@ impl PyRadarTracker {
             },
             "smooth" => TrackMethod::Smooth {
                 q: q.unwrap_or(0.0),
+                lag: lag.unwrap_or(DEFAULT_LAG),
             },
             "fading" if q.is_some() => return usage("q applies only to 'kalman' and 'smooth'"),
             "fading" => match (beta, theta) {
@@ -207,6 +249,9 @@ impl PyRadarTracker {
         };
         if window.is_some() && !matches!(method, TrackMethod::Window { .. }) {
             return usage("window applies only to method='window'");
+        }
+        if lag.is_some() && !matches!(method, TrackMethod::Smooth { .. }) {
+            return usage("lag applies only to method='smooth'");
         }
         let bearing = match azimuth {
             "from-x" => false,
@@ -228,6 +273,7 @@ impl PyRadarTracker {
             inner: RadarTracker::new(radar, method).py()?,
             sigmas: [sigma_range, sigma_angle],
             bearing,
+            given: Given::default(),
         })
     }
 
@@ -240,9 +286,10 @@ impl PyRadarTracker {
     /// Tracks the rows ``(t[i], range[i], azimuth[i], elevation[i])`` (NaN: a missing
     /// component), with per-row σ where given (NaN: the tracker's). Returns ``(states,
     /// covariances, nis)``, ``(n, 6)``, ``(n, 6, 6)`` and ``(n,)``: NaN rows where the rows so
-    /// far do not determine the state, or the smoother holds the row (see ``finish``); a NIS
-    /// is NaN where there is no innovation. On a refused row the rows before it are taken and
-    /// the exception's ``index`` is its position.
+    /// far do not determine the state, or the smoother holds the row (its estimate comes
+    /// ``lag`` rows later from ``smoothed()``, or from ``finish``); a NIS is NaN where there is
+    /// no innovation. On a refused row the rows before it are taken and the exception's
+    /// ``index`` is its position.
     #[pyo3(signature = (t, range, azimuth, elevation, sigma_range = None, sigma_angle = None))]
     #[allow(clippy::too_many_arguments)]
     fn update_many<'py>(
@@ -287,10 +334,14 @@ impl PyRadarTracker {
         let mut nis = vec![f64::NAN; count];
         let offset = self.inner.rows();
         let tracker = &mut self.inner;
+        let given = &mut self.given;
         let mut taken = 0;
         let failed = py.detach(|| {
             for (i, m) in rows.iter().enumerate() {
                 let tracked = tracker.push(m)?;
+                if let Tracked::Smoothed { row, estimate } = tracked {
+                    given.push(row, estimate);
+                }
                 write_row(
                     &tracked,
                     &mut states[i * 6..(i + 1) * 6],
@@ -316,32 +367,29 @@ impl PyRadarTracker {
         PyTuple::new(py, [states, covariances, nis])
     }
 
-    /// The smoother's estimates of the rows it held: ``(rows, states, covariances, nis)``,
-    /// ``rows`` their numbers counted from the tracker's first row (0); empty for the other
-    /// methods. The smoother takes no more rows after it.
+    /// The smoother's estimates given since the last call (each row's from the ``lag`` rows
+    /// after it): ``(rows, states, covariances, nis)``, ``(n,)``, ``(n, 6)``, ``(n, 6, 6)``,
+    /// ``(n,)``, ``rows`` their numbers counted from the tracker's first row (0), ``nis`` the
+    /// forward filter's; empty for the other methods. Call it after ``update_many`` to keep
+    /// memory bounded by the lag; rows not taken wait for ``finish``.
+    fn smoothed<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        std::mem::take(&mut self.given).arrays(py)
+    }
+
+    /// The smoother's estimates of the rows given and not yet taken by ``smoothed()``, then
+    /// those of the rows it still holds (smoothed by every row): ``(rows, states, covariances,
+    /// nis)`` as ``smoothed()``; empty for the other methods. The smoother takes no more rows
+    /// after it.
     fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
         let tracker = &mut self.inner;
         let smoothed = py
             .detach(|| tracker.finish())
             .map_err(|e| track_error(e, 0))?;
-        let count = smoothed.len();
-        let mut rows = Vec::with_capacity(count);
-        let mut states = Vec::with_capacity(count * 6);
-        let mut covariances = Vec::with_capacity(count * 36);
-        let mut nis = Vec::with_capacity(count);
-        for (row, s) in smoothed {
-            rows.push(row as i64);
-            states.extend_from_slice(s.state.as_slice());
-            covariances.extend_from_slice(s.covariance.as_slice());
-            nis.push(s.nis.unwrap_or(f64::NAN));
+        let mut given = std::mem::take(&mut self.given);
+        for (row, s) in &smoothed {
+            given.push(*row, s);
         }
-        let rows = PyArray1::from_vec(py, rows).into_any();
-        let states = matrix(py, states, count, 6)?;
-        let covariances = PyArray1::from_vec(py, covariances)
-            .reshape([count, 6, 6])?
-            .into_any();
-        let nis = PyArray1::from_vec(py, nis).into_any();
-        PyTuple::new(py, [rows, states, covariances, nis])
+        given.arrays(py)
     }
 
     fn __repr__(&self) -> String {

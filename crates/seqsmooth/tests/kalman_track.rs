@@ -11,7 +11,7 @@ use seqsmooth::estimate::gauss_newton::{Correction, Epoch, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, Start};
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::track::{RadarTracker, TrackError, TrackMethod, Tracked, START_WINDOW};
-use seqsmooth::kalman::{smooth, Discount, KalmanFilter};
+use seqsmooth::kalman::{smooth, Discount, FixedLagSmoother, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::radar::Radar;
 
@@ -53,18 +53,30 @@ fn pass(n: usize, site: [f64; 3], seed: u64) -> Vec<Measurement> {
 /// One row's output: `None` undetermined or held, else the state, covariance and NIS.
 type Row = Option<(DVector<f64>, DMatrix<f64>, Option<f64>)>;
 
-/// Every row of `rows` through a tracker, then its `finish()`.
+/// Every row of `rows` through a tracker, then its `finish()`: the rows' own estimates, and
+/// the smoother's (given with its lag or at the end), each at its row.
 fn tracked(radar: Radar, method: TrackMethod, rows: &[Measurement]) -> (Vec<Row>, Vec<Row>) {
     let mut t = RadarTracker::new(radar, method).unwrap();
+    let mut held = vec![None; rows.len()];
     let out = rows
         .iter()
-        .map(|m| match t.push(m).unwrap() {
+        .enumerate()
+        .map(|(k, m)| match t.push(m).unwrap() {
             Tracked::Estimate(e) => Some((e.state.clone(), e.covariance.clone(), e.nis)),
+            Tracked::Smoothed { row, estimate: s } => {
+                let TrackMethod::Smooth { lag, .. } = method else {
+                    panic!("{method:?} smoothed")
+                };
+                assert_eq!(row, k - lag);
+                assert!(held[row].is_none());
+                held[row] = Some((s.state.clone(), s.covariance.clone(), s.nis));
+                None
+            }
             Tracked::Undetermined | Tracked::Held => None,
         })
         .collect();
-    let mut held = vec![None; rows.len()];
     for (row, s) in t.finish().unwrap() {
+        assert!(held[row].is_none());
         held[row] = Some((s.state, s.covariance, s.nis));
     }
     (out, held)
@@ -149,23 +161,38 @@ fn smooth_is_the_smoother_over_the_rows_after_the_start() {
     let rows = pass(300, [0.0; 3], 2);
     let (k0, c) = start(radar, &rows);
     let q = 0.2;
-    let (out, held) = tracked(radar, TrackMethod::Smooth { q }, &rows);
-    assert!(out
-        .iter()
-        .enumerate()
-        .all(|(k, r)| r.is_some() == (k == k0)));
-    assert!(held
-        .iter()
-        .enumerate()
-        .all(|(k, r)| r.is_some() == (k > k0)));
     let f = filter(radar, &c)
         .with_process_noise(WhiteNoiseDerivative::new(1, 3, q).unwrap())
         .unwrap();
-    let s = smooth(f.clone(), &rows[k0 + 1..]).unwrap();
-    for (k, s) in s.iter().enumerate() {
-        let (x, p, n) = held[k0 + 1 + k].as_ref().unwrap();
-        assert_eq!((x, p, *n), (&s.state, &s.covariance, s.nis));
+    // An unbounded lag: the whole-interval smoother's; a lag of 25 rows: the fixed-lag
+    // smoother's, each row given 25 rows later.
+    for lag in [usize::MAX, 300, 25, 0] {
+        let (out, held) = tracked(radar, TrackMethod::Smooth { q, lag }, &rows);
+        assert!(out
+            .iter()
+            .enumerate()
+            .all(|(k, r)| r.is_some() == (k == k0)));
+        assert!(held
+            .iter()
+            .enumerate()
+            .all(|(k, r)| r.is_some() == (k > k0)));
+        let s = if lag >= rows.len() {
+            smooth(f.clone(), &rows[k0 + 1..]).unwrap()
+        } else {
+            let mut s = FixedLagSmoother::new(f.clone(), lag);
+            let mut v: Vec<_> = rows[k0 + 1..]
+                .iter()
+                .filter_map(|m| s.push(m).unwrap())
+                .collect();
+            v.extend(s.finish().unwrap());
+            v
+        };
+        for (k, s) in s.iter().enumerate() {
+            let (x, p, n) = held[k0 + 1 + k].as_ref().unwrap();
+            assert_eq!((x, p, *n), (&s.state, &s.covariance, s.nis), "lag {lag}");
+        }
     }
+    let (_, held) = tracked(radar, TrackMethod::Smooth { q, lag: 300 }, &rows);
     // At the last row the smoothed estimate is the filtered one (RTS).
     let (kalman, _) = tracked(radar, TrackMethod::Kalman { q }, &rows);
     let (x, p, _) = held.last().unwrap().as_ref().unwrap();
@@ -212,7 +239,8 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
         (TrackMethod::Kalman { q: 1.0 }, 1),
         (TrackMethod::Kalman { q: 1.0 }, 40),
         (TrackMethod::Window { window: 10 }, 30),
-        (TrackMethod::Smooth { q: 1.0 }, 50),
+        (TrackMethod::Smooth { q: 1.0, lag: 500 }, 50),
+        (TrackMethod::Smooth { q: 1.0, lag: 3 }, 50),
     ] {
         let mut t = RadarTracker::new(radar, method).unwrap();
         let mut reference = RadarTracker::new(radar, method).unwrap();
@@ -242,6 +270,7 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
                 .iter()
                 .map(|m| match t.push(m).unwrap() {
                     Tracked::Estimate(e) => Some(e.state.clone()),
+                    Tracked::Smoothed { estimate, .. } => Some(estimate.state.clone()),
                     _ => None,
                 })
                 .collect();
@@ -267,7 +296,7 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
         ));
     }
     // The smoother refuses a row out of order when it comes, and none after its finish.
-    let mut t = RadarTracker::new(radar, TrackMethod::Smooth { q: 1.0 }).unwrap();
+    let mut t = RadarTracker::new(radar, TrackMethod::Smooth { q: 1.0, lag: 500 }).unwrap();
     for m in &rows[..60] {
         t.push(m).unwrap();
     }
@@ -294,7 +323,10 @@ fn bad_settings_are_refused() {
     let radar = Radar::new([0.0; 3], 6).unwrap();
     for method in [
         TrackMethod::Kalman { q: -1.0 },
-        TrackMethod::Smooth { q: f64::NAN },
+        TrackMethod::Smooth {
+            q: f64::NAN,
+            lag: 10,
+        },
         TrackMethod::Kalman { q: f64::INFINITY },
         TrackMethod::Fading(Discount::PerTime(0.0)),
         TrackMethod::Fading(Discount::PerUpdate(1.5)),

@@ -166,6 +166,7 @@ class RadarTracker:
         beta: float | None = None,
         theta: float | None = None,
         window: int | None = None,
+        lag: int | None = None,
         azimuth: Literal["from-x", "bearing"] = "from-x",
     ) -> None: ...
     @property
@@ -179,6 +180,9 @@ class RadarTracker:
         sigma_range: ArrayLike | None = None,
         sigma_angle: ArrayLike | None = None,
     ) -> tuple[Matrix, npt.NDArray[np.float64], Vector]: ...
+    def smoothed(
+        self,
+    ) -> tuple[npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64], Vector]: ...
     def finish(
         self,
     ) -> tuple[npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64], Vector]: ...

@@ -8,6 +8,8 @@
 //! - [`filter`]: [`KalmanFilter`], prediction, Joseph-form update, the iterated update, the
 //!   generalized fading memory of ch. 14 ([`Discount`]), innovation statistics.
 //! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run.
+//! - [`fixed_lag`]: the same smoother with a fixed lag: each measurement's estimate from the
+//!   `L` after it, in memory bounded by `L`.
 //! - [`track`]: [`track::RadarTracker`], a radar's rows to a Cartesian track by the sliding
 //!   Gauss–Newton fit, the extended Kalman filter (driving noise or fading) or its smoother.
 //! - [`steady`]: the fading filter's steady state (§14.7).
@@ -17,6 +19,7 @@
 pub mod bayes;
 mod discount;
 pub mod filter;
+pub mod fixed_lag;
 pub mod noise;
 pub mod smoother;
 pub mod steady;
@@ -24,4 +27,5 @@ pub mod track;
 
 pub use bayes::BayesFilter;
 pub use filter::{Discount, Innovation, KalmanFilter};
+pub use fixed_lag::FixedLagSmoother;
 pub use smoother::{smooth, Smoothed, Smoother};

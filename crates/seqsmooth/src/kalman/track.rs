@@ -6,7 +6,7 @@
 //! | [`TrackMethod::Window`] | the Gauss–Newton fit of the last `W` rows (warm started), its innovation against the previous row's fit | §8.5-8.7 ([`SlidingFit`]) |
 //! | [`TrackMethod::Kalman`] | the extended Kalman filter, white noise of density `q` driving the acceleration | ch. 12, (15.2.23) |
 //! | [`TrackMethod::Fading`] | the extended Kalman filter with fading memory (`β` per time or `θ` per update), its true covariance | ch. 14 |
-//! | [`TrackMethod::Smooth`] | the Rauch–Tung–Striebel smoother over the Kalman filter's run, at the end | [`super::smooth`] |
+//! | [`TrackMethod::Smooth`] | the Rauch–Tung–Striebel smoother over the Kalman filter's run with a lag of `L` rows: each row's estimate from the `L` rows after it, given `L` rows later | [`super::fixed_lag`] |
 //!
 //! The Kalman methods start from the first Gauss–Newton fit of the rows so far (at most
 //! [`START_WINDOW`]) that determines the state, started at the radar nominal of §8.5; that
@@ -15,7 +15,8 @@
 
 use super::filter::{Discount, KalmanFilter};
 use super::noise::WhiteNoiseDerivative;
-use super::smoother::{Smoothed, Smoother};
+use super::fixed_lag::FixedLagSmoother;
+use super::smoother::Smoothed;
 use crate::error::Error;
 use crate::estimate::gauss_newton::{Correction, Epoch, Measurement};
 use crate::estimate::sliding::{SlidingFit, Start};
@@ -27,6 +28,9 @@ use std::ops::Range;
 /// The window of the Kalman methods' start: the first fit of at most this many last rows that
 /// determines the state.
 pub const START_WINDOW: usize = 60;
+
+/// The smoother's default lag, in rows ([`TrackMethod::Smooth`]).
+pub const DEFAULT_LAG: usize = 200;
 
 /// How rows become estimates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,11 +48,15 @@ pub enum TrackMethod {
     },
     /// The extended Kalman filter with fading memory.
     Fading(Discount),
-    /// The smoother over the Kalman filter's run (driving noise `q`); the estimates come at
-    /// [`RadarTracker::finish`].
+    /// The fixed-lag smoother over the Kalman filter's run (driving noise `q`): each row's
+    /// estimate from the `lag` rows after it, given when the `lag`-th comes
+    /// ([`Tracked::Smoothed`]); the last `lag` rows' at [`RadarTracker::finish`], from every
+    /// row. `lag` 0 is the filter; a lag at least the rows' number the whole-interval smoother.
     Smooth {
         /// `q ≥ 0`.
         q: f64,
+        /// `L`, in rows ([`DEFAULT_LAG`] by default): the smoother holds `L + 1` rows.
+        lag: usize,
     },
 }
 
@@ -99,8 +107,17 @@ pub enum Tracked<'a> {
     Undetermined,
     /// The row's estimate.
     Estimate(TrackEstimate<'a>),
-    /// Held for [`RadarTracker::finish`] (the smoother).
+    /// Held by the smoother, which gives no row yet (its first `lag` rows; the rest come at
+    /// [`RadarTracker::finish`]).
     Held,
+    /// Held by the smoother, which gives the estimate of the earlier row `row` (`lag` rows
+    /// back), from the rows up to this one.
+    Smoothed {
+        /// The row given, counted from the tracker's first (0).
+        row: usize,
+        /// Its smoothed estimate (`nis` the forward filter's at that row).
+        estimate: &'a Smoothed,
+    },
 }
 
 /// The filter of the Kalman methods.
@@ -113,12 +130,13 @@ enum Stage {
     Starting(Box<SlidingFit<PolynomialDynamics, Radar>>),
     /// kalman and fading: the filter, and the start's fit for the row that made it.
     Filtering(Box<Filter>, Option<Correction>),
-    /// smooth: the smoother's forward pass over the rows after the start, the start's fit,
-    /// and its row.
+    /// smooth: the fixed-lag smoother over the rows after the start, the start's fit, its
+    /// row, and the row the last push gave.
     Smoothing(
-        Box<Smoother<PolynomialDynamics, Radar>>,
+        Box<FixedLagSmoother<PolynomialDynamics, Radar>>,
         Option<Correction>,
         usize,
+        Option<(usize, Smoothed)>,
     ),
     /// smooth after [`RadarTracker::finish`]: no more rows.
     Finished,
@@ -195,7 +213,7 @@ impl RadarTracker {
                 }
                 Stage::Window(Box::new(sliding(dynamics, radar, window)?), None)
             }
-            TrackMethod::Kalman { q } | TrackMethod::Smooth { q } => {
+            TrackMethod::Kalman { q } | TrackMethod::Smooth { q, .. } => {
                 check("q", q)?;
                 Stage::Starting(Box::new(sliding(dynamics, radar, START_WINDOW)?))
             }
@@ -252,8 +270,9 @@ impl RadarTracker {
                 };
                 let filter = filter_from(self.dynamics, self.radar, self.method, &c);
                 let filter = Box::new(filter.map_err(TrackError::Start)?);
-                self.stage = if matches!(self.method, TrackMethod::Smooth { .. }) {
-                    Stage::Smoothing(Box::new(Smoother::new(*filter)), Some(c), row)
+                self.stage = if let TrackMethod::Smooth { lag, .. } = self.method {
+                    let smoother = FixedLagSmoother::new(*filter, lag);
+                    Stage::Smoothing(Box::new(smoother), Some(c), row, None)
                 } else {
                     Stage::Filtering(filter, Some(c))
                 };
@@ -290,10 +309,14 @@ impl RadarTracker {
                     },
                 })
             }
-            Stage::Smoothing(smoother, start, _) => {
-                smoother
-                    .push(m)
-                    .map_err(|source| TrackError::Update { row, source })?;
+            Stage::Smoothing(smoother, start, first, given) => {
+                let first = *first + 1;
+                let out = smoother.push(m).map_err(|e| match e {
+                    // The backward pass's (push's update errors are not in a batch).
+                    Error::InBatch { .. } => smoothing_error(e, first),
+                    source => TrackError::Update { row, source },
+                })?;
+                *given = out.map(|s| (row - smoother.held(), s));
                 *start = None;
                 None
             }
@@ -301,7 +324,13 @@ impl RadarTracker {
         self.rows += 1;
         self.last_time = m.time;
         let Some(nis) = nis else {
-            return Ok(Tracked::Held);
+            return Ok(match &self.stage {
+                Stage::Smoothing(.., Some((row, estimate))) => Tracked::Smoothed {
+                    row: *row,
+                    estimate,
+                },
+                _ => Tracked::Held,
+            });
         };
         let (state, covariance) = match &self.stage {
             Stage::Window(_, Some(c))
@@ -317,31 +346,51 @@ impl RadarTracker {
         }))
     }
 
-    /// The smoother's estimates of the rows it held (from the row after the start on, each
-    /// with its row), smoothed; nothing for the other methods. The smoother takes no more
-    /// rows after it.
+    /// The smoother's estimates of the rows it still holds (its last `lag` rows, each with
+    /// its row), smoothed by every row; nothing for the other methods. The smoother takes no
+    /// more rows after it.
     pub fn finish(&mut self) -> Result<Vec<(usize, Smoothed)>, TrackError> {
         let stage = std::mem::replace(&mut self.stage, Stage::Finished);
-        let Stage::Smoothing(smoother, _, start) = stage else {
+        let Stage::Smoothing(smoother, _, start, _) = stage else {
             self.stage = stage;
             return Ok(Vec::new());
         };
-        let first = start + 1;
-        let smoothed = smoother.finish().map_err(|e| {
-            TrackError::Smooth(match e {
-                Error::InBatch { index, source } => Error::InBatch {
-                    index: first + index,
-                    source,
-                },
-                e => e,
-            })
-        })?;
+        let first = start + 1 + smoother.pushed() - smoother.held();
+        let smoothed = smoother
+            .finish()
+            .map_err(|e| smoothing_error(e, start + 1))?;
         Ok(smoothed
             .into_iter()
             .enumerate()
             .map(|(k, s)| (first + k, s))
             .collect())
     }
+
+    /// The rows the smoother holds at most (`lag + 1`; 0 for the other methods), and the
+    /// bytes they take: a bound of the tracker's memory beyond a few kilobytes, known before
+    /// the first row.
+    pub fn held_bound(&self) -> (usize, usize) {
+        match self.method {
+            TrackMethod::Smooth { lag, .. } => {
+                let rows = lag.saturating_add(1);
+                let each = FixedLagSmoother::<PolynomialDynamics, Radar>::bytes_per_measurement(6);
+                (rows, rows.saturating_mul(each))
+            }
+            _ => (0, 0),
+        }
+    }
+}
+
+/// The smoother's error, an [`Error::InBatch`] index (counted from its first row, the tracker's
+/// `first`) counted from the tracker's first row.
+fn smoothing_error(e: Error, first: usize) -> TrackError {
+    TrackError::Smooth(match e {
+        Error::InBatch { index, source } => Error::InBatch {
+            index: first + index,
+            source,
+        },
+        e => e,
+    })
 }
 
 /// A Kalman filter from a fit, with `method`'s driving noise or fading.
@@ -361,7 +410,7 @@ fn filter_from(
     match method {
         TrackMethod::Fading(d) => f.with_fading(d),
         TrackMethod::Window { .. } => Ok(f),
-        TrackMethod::Kalman { q } | TrackMethod::Smooth { q } => {
+        TrackMethod::Kalman { q } | TrackMethod::Smooth { q, .. } => {
             f.with_process_noise(WhiteNoiseDerivative::new(1, 3, q)?)
         }
     }
