@@ -223,12 +223,12 @@ impl Held {
     }
 
     /// Moves the first held row, row `row`, into `out` with `cells`.
-    fn give(&mut self, row: usize, cells: Cells, out: &mut Given) {
+    fn give(&mut self, row: usize, cells: Estimate, out: &mut Given) {
         assert_eq!(row, self.first, "the smoother gives its rows in order");
         let (_, len) = self.rows.pop_front().expect("the row given is held");
         out.text.extend(self.text.drain(..len));
         out.ends.push(out.text.len());
-        out.cells.push(Some(cells));
+        out.cells.push(Some(Some(cells)));
         self.first += 1;
     }
 
