@@ -1,22 +1,29 @@
 //! Fixed-lag smoothing (Rauch, Tung and Striebel 1965; beyond Morrison's book): the forward
 //! [`KalmanFilter`] a measurement at a time, and each measurement's estimate from the `L`
 //! measurements after it, `X_{k|k+L}` and `S_{k|k+L}`, given as soon as measurement `k + L` is
-//! in — the Rauch–Tung–Striebel backward recursion of [`super::smoother`] run over the last
-//! `L + 1` measurements only,
+//! in — the Rauch–Tung–Striebel backward recursion of [`super::smoother`] over the last `L + 1`
+//! measurements,
 //!
 //! `C_j = S_{j|j} Φ(t_{j+1}, t_j)ᵀ S_{j+1|j}⁻¹`,
-//! `X_{j|k+L} = X_{j|j} + C_j (X_{j+1|k+L} − X_{j+1|j})`,
-//! `S_{j|k+L} = S_{j|j} + C_j (S_{j+1|k+L} − S_{j+1|j}) C_jᵀ`, `j = k+L−1, …, k`,
+//! `X_{j|N} = X_{j|j} + C_j (X_{j+1|N} − X_{j+1|j})`,
+//! `S_{j|N} = S_{j|j} + C_j (S_{j+1|N} − S_{j+1|j}) C_jᵀ`, `j = N−1, …, k`, `N = k + L`,
 //!
-//! from `X_{k+L|k+L}`, the filter's. The lag counts measurements (not time): memory is `L + 1`
-//! measurements' filtered and predicted states, covariances and transitions, whatever the
-//! input's length. Each gain `C_j` is formed once (when measurement `j + 1` is in) and kept, so
-//! a measurement costs the filter's update and `L` backward steps of two matrix products. The
-//! estimate is exactly the whole-interval smoother's run over measurements `0..=k+L`, read at
-//! `k`: `L = 0` gives the filter, `L` at least the number of measurements gives the
-//! whole-interval smoother ([`super::Smoother`] is this with an unbounded lag). At
-//! [`FixedLagSmoother::finish`] the last `L` measurements get the whole-interval smoother's
-//! estimates (the backward pass from the last).
+//! from `X_{N|N}`, the filter's. Each step is an affine map of the later estimate,
+//! `T_j: (X, S) ↦ (a_j + C_j X, D_j + C_j S C_jᵀ)` with `a_j = X_{j|j} − C_j X_{j+1|j}` and
+//! `D_j = S_{j|j} − C_j S_{j+1|j} C_jᵀ` (positive semidefinite: the covariance of `x_j` given
+//! `x_{j+1}` and the measurements to `j`), and maps compose into maps:
+//! `T ∘ T' = (a + C a', D + C D' Cᵀ, C C')`. So `X_{k|k+L}` is the composition
+//! `T_k ∘ … ∘ T_{k+L−1}` applied to the filter's estimate at `k + L`, and the window of the last
+//! `L` maps slides by one each measurement: its composition is kept by the two-stack method of
+//! sliding-window aggregation (no inverse is needed, each map is composed about three times),
+//! so a measurement costs the filter's update and a few 6×6 products whatever `L`. The
+//! whole-interval smoother ([`super::Smoother`], this with an unbounded lag) and
+//! [`FixedLagSmoother::finish`] apply the same maps one at a time from the last estimate: the
+//! backward recursion above, one code. The estimate is the whole-interval smoother's over
+//! measurements `0..=k+L` read at `k`, to rounding: `L = 0` gives the filter, `L` at least the
+//! number of measurements the whole-interval smoother. The lag counts measurements (not
+//! time): memory is `L + 1` measurements' filtered estimates and maps, whatever the input's
+//! length.
 
 use super::filter::KalmanFilter;
 use super::smoother::Smoothed;
@@ -27,21 +34,152 @@ use crate::model::observation::Observation;
 use nalgebra::{Cholesky, DMatrix, DVector};
 use std::collections::VecDeque;
 
-/// One measurement's forward pass.
+/// One measurement's filtered estimate, until it is given.
 #[derive(Clone, Debug)]
 struct Row {
     time: f64,
-    /// `Φ` from the previous measurement to this one, `X_{k|k−1}` and `S_{k|k−1}`.
-    transition: DMatrix<f64>,
-    predicted_state: DVector<f64>,
-    predicted_covariance: DMatrix<f64>,
     /// `X_{k|k}`, `S_{k|k}`.
     state: DVector<f64>,
     covariance: DMatrix<f64>,
     /// The update's NIS (`None` where every component was missing).
     nis: Option<f64>,
-    /// `C_kᵀ`, once the next measurement is in and it has been formed.
-    gain: Option<DMatrix<f64>>,
+}
+
+/// `(X, S) ↦ (a + C X, D + C S Cᵀ)`: a backward step, a composition of them, or (`c` `None`)
+/// the constant `(a, D)`, an estimate.
+#[derive(Clone, Debug)]
+struct Map {
+    a: DVector<f64>,
+    d: DMatrix<f64>,
+    c: Option<DMatrix<f64>>,
+}
+
+impl Map {
+    /// The estimate `(x, s)` as a constant map.
+    fn point(x: &DVector<f64>, s: &DMatrix<f64>) -> Self {
+        Self {
+            a: x.clone(),
+            d: s.clone(),
+            c: None,
+        }
+    }
+
+    /// `self ∘ inner`: `(a + C a', D + C D' Cᵀ, C C')` (`D` kept exactly symmetric); a constant
+    /// `self` is itself, and a constant `inner` gives a constant (the backward step applied).
+    fn then(&self, inner: &Map) -> Map {
+        let Some(c) = &self.c else {
+            return self.clone();
+        };
+        let mut d = &self.d + c * &inner.d * c.transpose();
+        symmetrise(&mut d);
+        Map {
+            a: &self.a + c * &inner.a,
+            d,
+            c: inner.c.as_ref().map(|ci| c * ci),
+        }
+    }
+
+    /// An error naming measurement `index` if the map holds a number that is not finite.
+    fn finite(self, index: usize) -> Result<Self, Error> {
+        match self.a.iter().chain(self.d.iter()).find(|v| !v.is_finite()) {
+            Some(&value) => Err(Error::InBatch {
+                index,
+                source: Box::new(Error::NonFinite {
+                    what: "smoothed state or covariance entry",
+                    value,
+                }),
+            }),
+            None => Ok(self),
+        }
+    }
+}
+
+/// `(M + Mᵀ)/2` in place.
+fn symmetrise(m: &mut DMatrix<f64>) {
+    for j in 0..m.ncols() {
+        for i in 0..j {
+            let v = 0.5 * (m[(i, j)] + m[(j, i)]);
+            m[(i, j)] = v;
+            m[(j, i)] = v;
+        }
+    }
+}
+
+/// The backward step `T_k` from measurement `k + 1` to `k`: `C = S_{k|k} Φᵀ S_{k+1|k}⁻¹` by the
+/// Cholesky factor of `S_{k+1|k}`, `a = X_{k|k} − C X_{k+1|k}`, `D = S_{k|k} − C Φ S_{k|k}` (that
+/// is, `S_{k|k} − C S_{k+1|k} Cᵀ`); an error names measurement `index` (`k + 1`).
+fn step(
+    row: &Row,
+    (phi, x_pred, s_pred): (&DMatrix<f64>, &DVector<f64>, &DMatrix<f64>),
+    index: usize,
+) -> Result<Map, Error> {
+    let chol = Cholesky::new(s_pred.clone()).ok_or_else(|| Error::InBatch {
+        index,
+        source: Box::new(Error::InvalidParameter {
+            name: "predicted covariance",
+            value: format!("{s_pred:?}"),
+            reason: "is not positive definite, so the smoother cannot weigh the later \
+                     measurements (add driving noise, or avoid perfect observations)"
+                .into(),
+        }),
+    })?;
+    let p = phi * &row.covariance;
+    // S_pred Cᵀ = Φ S_{k|k}.
+    let c = chol.solve(&p).transpose();
+    let mut d = &row.covariance - &c * p;
+    symmetrise(&mut d);
+    Map {
+        a: &row.state - &c * x_pred,
+        d,
+        c: Some(c),
+    }
+    .finite(index)
+}
+
+/// The maps of the window, oldest first, in two stacks (sliding-window aggregation): `front`
+/// with the oldest last, each with the composition of it and every newer map of `front`;
+/// `back` in order, with the composition of all of them (kept only for a bounded lag).
+#[derive(Clone, Debug, Default)]
+struct Window {
+    front: Vec<(Map, Map)>,
+    back: Vec<Map>,
+    back_all: Option<Map>,
+}
+
+impl Window {
+    /// The composition of every map of the window applied to `point`.
+    fn apply(&self, point: &Map) -> Map {
+        let inner = match &self.back_all {
+            Some(b) => b.then(point),
+            None => point.clone(),
+        };
+        match self.front.last() {
+            Some((_, all)) => all.then(&inner),
+            None => inner,
+        }
+    }
+
+    /// Removes the oldest map (after moving `back` onto `front` if `front` is empty).
+    fn pop(&mut self) {
+        if self.front.is_empty() {
+            let mut all: Option<Map> = None;
+            for m in std::mem::take(&mut self.back).into_iter().rev() {
+                let composed = match &all {
+                    Some(a) => m.then(a),
+                    None => m.clone(),
+                };
+                all = Some(composed.clone());
+                self.front.push((m, composed));
+            }
+            self.back_all = None;
+        }
+        self.front.pop();
+    }
+
+    /// The maps, oldest first.
+    fn maps(&self) -> impl Iterator<Item = &Map> {
+        self.front.iter().rev().map(|(m, _)| m).chain(&self.back)
+    }
 }
 
 /// The fixed-lag smoother: [`FixedLagSmoother::push`] gives the estimate of the measurement
@@ -77,10 +215,12 @@ pub struct FixedLagSmoother<D: Dynamics, O: Observation> {
     lag: usize,
     /// The measurements not yet given, at most `lag + 1` (after a push that gives one, `lag`).
     rows: VecDeque<Row>,
+    /// The backward steps between them (one fewer).
+    window: Window,
     /// The measurements pushed.
     pushed: usize,
-    /// The last measurement's time.
-    last_time: Option<f64>,
+    /// The last measurement's time and NIS.
+    last: Option<(f64, Option<f64>)>,
 }
 
 impl<D: Dynamics + Clone, O: Observation + Clone> FixedLagSmoother<D, O> {
@@ -90,8 +230,9 @@ impl<D: Dynamics + Clone, O: Observation + Clone> FixedLagSmoother<D, O> {
             filter,
             lag,
             rows: VecDeque::with_capacity(lag.saturating_add(1).min(1 << 12)),
+            window: Window::default(),
             pushed: 0,
-            last_time: None,
+            last: None,
         }
     }
 
@@ -117,14 +258,18 @@ impl<D: Dynamics + Clone, O: Observation + Clone> FixedLagSmoother<D, O> {
 
     /// The last update's NIS (`None` before the first, or where every component was missing).
     pub fn nis(&self) -> Option<f64> {
-        self.rows.back().and_then(|r| r.nis)
+        self.last.and_then(|l| l.1)
     }
 
     /// Bytes held per measurement for a state of `n` components: a bound of the smoother's
-    /// memory is `(lag + 1)` times this (plus the filter's).
+    /// memory is `lag + 1` times this (plus the filter's).
     pub fn bytes_per_measurement(n: usize) -> usize {
-        // Four n×n matrices and two n-vectors of f64, with their allocations' headers.
-        std::mem::size_of::<Row>() + 8 * (4 * n * n + 2 * n) + 6 * 16
+        // A row (an n-vector and an n×n matrix) and two or three maps (an n-vector and two
+        // n×n matrices each), with their allocations' headers.
+        std::mem::size_of::<Row>()
+            + 3 * std::mem::size_of::<Map>()
+            + 8 * (n * n + n + 3 * (2 * n * n + n))
+            + 10 * 16
     }
 
     /// The forward pass over `m` (not before the previous measurement), and the smoothed
@@ -132,7 +277,7 @@ impl<D: Dynamics + Clone, O: Observation + Clone> FixedLagSmoother<D, O> {
     /// pass is the update's; one of the backward pass is [`Error::InBatch`] naming the
     /// measurement (counted from the first pushed). On an error the smoother is unchanged.
     pub fn push(&mut self, m: &Measurement) -> Result<Option<Smoothed>, Error> {
-        if let Some(previous) = self.last_time {
+        if let Some((previous, _)) = self.last {
             if m.time.is_finite() && m.time < previous {
                 return Err(Error::InvalidParameter {
                     name: "time",
@@ -142,197 +287,108 @@ impl<D: Dynamics + Clone, O: Observation + Clone> FixedLagSmoother<D, O> {
             }
         }
         let before = self.filter.clone();
-        let step = |filter: &mut KalmanFilter<D, O>| {
+        let step_forward = |filter: &mut KalmanFilter<D, O>| {
             let phi = filter.predict_with_transition(m.time)?;
             let predicted = (phi, filter.state().clone(), filter.covariance().clone());
             Ok::<_, Error>((predicted, filter.update(m)?.map(|i| i.nis)))
         };
-        let ((transition, predicted_state, predicted_covariance), nis) =
-            match step(&mut self.filter) {
-                Ok(v) => v,
-                Err(e) => {
-                    self.filter = before;
-                    return Err(e);
-                }
-            };
-        self.rows.push_back(Row {
+        let undo = |this: &mut Self, e: Error| {
+            this.filter = before.clone();
+            Err(e)
+        };
+        let ((phi, x_pred, s_pred), nis) = match step_forward(&mut self.filter) {
+            Ok(v) => v,
+            Err(e) => return undo(self, e),
+        };
+        let row = Row {
             time: m.time,
-            transition,
-            predicted_state,
-            predicted_covariance,
             state: self.filter.state().clone(),
             covariance: self.filter.covariance().clone(),
             nis,
-            gain: None,
-        });
-        if self.rows.len() <= self.lag {
-            self.pushed += 1;
-            self.last_time = Some(m.time);
-            return Ok(None);
-        }
-        let first = self.pushed + 1 - self.rows.len();
-        let mut out = None;
-        let backward = backward(&mut self.rows, first, |k, x, s| {
-            if k == 0 {
-                out = Some((x.clone(), s.clone()));
+        };
+        // The step from this measurement back to the previous one, if that is still held.
+        let map = match self.rows.back() {
+            Some(previous) => match step(previous, (&phi, &x_pred, &s_pred), self.pushed) {
+                Ok(map) => Some(map),
+                Err(e) => return undo(self, e),
+            },
+            None => None,
+        };
+        let bounded = self.lag < usize::MAX;
+        let back_all = match (&map, bounded) {
+            (Some(map), true) => Some(match &self.window.back_all {
+                Some(all) => all.then(map),
+                None => map.clone(),
+            }),
+            _ => self.window.back_all.clone(),
+        };
+        let given = if self.rows.len() + 1 > self.lag {
+            // Measurement `pushed − lag` from the window's maps and this estimate.
+            let mut window = std::mem::take(&mut self.window);
+            let saved = std::mem::replace(&mut window.back_all, back_all.clone());
+            let smoothed = window
+                .apply(&Map::point(&row.state, &row.covariance))
+                .finite(self.pushed - self.lag);
+            window.back_all = saved;
+            self.window = window;
+            match smoothed {
+                Ok(s) => Some(s),
+                Err(e) => return undo(self, e),
             }
-        });
-        if let Err(e) = backward {
-            // Undo: the filter, the row, and the gain formed against it.
-            self.filter = before;
-            self.rows.pop_back();
-            if let Some(last) = self.rows.back_mut() {
-                last.gain = None;
-            }
-            return Err(e);
-        }
+        } else {
+            None
+        };
+        // Committed from here.
         self.pushed += 1;
-        self.last_time = Some(m.time);
-        let row = self.rows.pop_front().expect("a row was pushed");
-        let (state, covariance) = out.expect("the backward pass reaches the first row");
-        Ok(Some(smoothed(row, state, covariance)))
+        self.last = Some((m.time, nis));
+        self.rows.push_back(row);
+        if let Some(map) = map {
+            self.window.back.push(map);
+            self.window.back_all = back_all;
+        }
+        let Some(s) = given else {
+            return Ok(None);
+        };
+        let oldest = self.rows.pop_front().expect("a row was pushed");
+        if self.lag > 0 {
+            self.window.pop();
+        }
+        Ok(Some(smoothed(oldest, s)))
     }
 
-    /// The measurements held, each smoothed by every measurement pushed (the backward pass from
-    /// the last), in order. An error names its measurement ([`Error::InBatch`], counted from
-    /// the first pushed).
+    /// The measurements held, each smoothed by every measurement pushed (the backward
+    /// recursion from the last), in order. An error names its measurement ([`Error::InBatch`],
+    /// counted from the first pushed).
     pub fn finish(self) -> Result<Vec<Smoothed>, Error> {
-        let mut rows = self.rows;
-        let first = self.pushed - rows.len();
-        let mut out = vec![None; rows.len()];
-        backward(&mut rows, first, |k, x, s| {
-            out[k] = Some((x.clone(), s.clone()));
-        })?;
-        Ok(rows
+        let first = self.pushed - self.rows.len();
+        let Some(last) = self.rows.back() else {
+            return Ok(Vec::new());
+        };
+        let mut point = Map::point(&last.state, &last.covariance);
+        let mut out = Vec::with_capacity(self.rows.len());
+        out.push(point.clone());
+        let maps: Vec<&Map> = self.window.maps().collect();
+        for (k, map) in maps.into_iter().enumerate().rev() {
+            point = map.then(&point).finite(first + k)?;
+            out.push(point.clone());
+        }
+        Ok(self
+            .rows
             .into_iter()
-            .zip(out)
-            .map(|(row, o)| {
-                let (state, covariance) = o.expect("the backward pass reaches every row");
-                smoothed(row, state, covariance)
-            })
+            .zip(out.into_iter().rev())
+            .map(|(row, s)| smoothed(row, s))
             .collect())
     }
 }
 
-/// A row's [`Smoothed`], with its smoothed `state` and `covariance`.
-fn smoothed(row: Row, state: DVector<f64>, covariance: DMatrix<f64>) -> Smoothed {
+/// A row's [`Smoothed`], with its smoothed estimate (a constant map).
+fn smoothed(row: Row, s: Map) -> Smoothed {
     Smoothed {
         time: row.time,
-        state,
-        covariance,
+        state: s.a,
+        covariance: s.d,
         filtered_state: row.state,
         filtered_covariance: row.covariance,
         nis: row.nis,
     }
-}
-
-/// The Rauch–Tung–Striebel backward pass over `rows` (the module's recursion; the first row is
-/// measurement `first`): from the last row's filtered estimate back to the first, calling
-/// `each(k, X_{k|last}, S_{k|last})` for every row, the last first. Forms and keeps the gains it
-/// lacks.
-fn backward(
-    rows: &mut VecDeque<Row>,
-    first: usize,
-    mut each: impl FnMut(usize, &DVector<f64>, &DMatrix<f64>),
-) -> Result<(), Error> {
-    let Some(last) = rows.back() else {
-        return Ok(());
-    };
-    let (mut x, mut s) = (last.state.clone(), last.covariance.clone());
-    let n = x.len();
-    let (mut x_next, mut s_next) = (DVector::zeros(n), DMatrix::zeros(n, n));
-    let mut w = DMatrix::zeros(n, n);
-    each(rows.len() - 1, &x, &s);
-    for k in (0..rows.len() - 1).rev() {
-        if rows[k].gain.is_none() {
-            let gain = gain(&rows[k], &rows[k + 1], first + k + 1)?;
-            rows[k].gain = Some(gain);
-        }
-        let (row, next) = (&rows[k], &rows[k + 1]);
-        let g = row.gain.as_ref().expect("formed above");
-        // x, s hold X_{k+1|N}, S_{k+1|N}: their differences from the prediction, then
-        // X_{k|N} = X_{k|k} + Gᵀ dx and S_{k|N} = S_{k|k} + Gᵀ (dS G), G = Cᵀ.
-        x -= &next.predicted_state;
-        s -= &next.predicted_covariance;
-        step(
-            n,
-            g.as_slice(),
-            (x.as_slice(), s.as_slice()),
-            (row.state.as_slice(), row.covariance.as_slice()),
-            w.as_mut_slice(),
-            (x_next.as_mut_slice(), s_next.as_mut_slice()),
-        );
-        if let Some(&value) = x_next
-            .iter()
-            .chain(s_next.iter())
-            .find(|v| !v.is_finite())
-        {
-            return Err(Error::InBatch {
-                index: first + k,
-                source: Box::new(Error::NonFinite {
-                    what: "smoothed state or covariance entry",
-                    value,
-                }),
-            });
-        }
-        std::mem::swap(&mut x, &mut x_next);
-        std::mem::swap(&mut s, &mut s_next);
-        each(k, &x, &s);
-    }
-    Ok(())
-}
-
-/// One backward step on column-major `n × n` slices: from `dx = X_{k+1|N} − X_{k+1|k}` and
-/// `dS = S_{k+1|N} − S_{k+1|k}`, `X_{k|N} = X_{k|k} + Gᵀ dx` and `S_{k|N} = S_{k|k} + Gᵀ (dS G)`
-/// (its upper triangle, mirrored: exactly symmetric), `G = C_kᵀ`; `w` is scratch. Loops over
-/// contiguous columns: a 6-state step is a few hundred multiply-adds, no allocation.
-fn step(
-    n: usize,
-    g: &[f64],
-    (dx, ds): (&[f64], &[f64]),
-    (xf, sf): (&[f64], &[f64]),
-    w: &mut [f64],
-    (x, s): (&mut [f64], &mut [f64]),
-) {
-    fn column(m: &[f64], n: usize, j: usize) -> &[f64] {
-        &m[j * n..(j + 1) * n]
-    }
-    let dot = |a: &[f64], b: &[f64]| -> f64 { a.iter().zip(b).map(|(a, b)| a * b).sum() };
-    for i in 0..n {
-        x[i] = xf[i] + dot(column(g, n, i), dx);
-    }
-    // w = dS G, column by column: w_j = Σ_r dS_r G[r, j].
-    for j in 0..n {
-        let wj = &mut w[j * n..(j + 1) * n];
-        wj.fill(0.0);
-        for (r, &grj) in column(g, n, j).iter().enumerate() {
-            for (wi, di) in wj.iter_mut().zip(column(ds, n, r)) {
-                *wi += di * grj;
-            }
-        }
-    }
-    for j in 0..n {
-        for i in 0..=j {
-            let v = sf[j * n + i] + dot(column(g, n, i), column(w, n, j));
-            s[j * n + i] = v;
-            s[i * n + j] = v;
-        }
-    }
-}
-
-/// `Gᵀ = C_k = S_{k|k} Φᵀ S_{k+1|k}⁻¹` as `G = S_{k+1|k}⁻¹ Φ S_{k|k}` (a Cholesky solve); an
-/// error names measurement `index` (the later one).
-fn gain(row: &Row, next: &Row, index: usize) -> Result<DMatrix<f64>, Error> {
-    let s_pred = &next.predicted_covariance;
-    let chol = Cholesky::new(s_pred.clone()).ok_or_else(|| Error::InBatch {
-        index,
-        source: Box::new(Error::InvalidParameter {
-            name: "predicted covariance",
-            value: format!("{s_pred:?}"),
-            reason: "is not positive definite, so the smoother cannot weigh the later \
-                     measurements (add driving noise, or avoid perfect observations)"
-                .into(),
-        }),
-    })?;
-    Ok(chol.solve(&(&next.transition * &row.covariance)))
 }
