@@ -319,7 +319,10 @@ impl Tracker {
                 self.held.hold(row, line, t);
                 Ok(Step::Held)
             }
-            Ok(Tracked::Smoothed { row: given, estimate: s }) => {
+            Ok(Tracked::Smoothed {
+                row: given,
+                estimate: s,
+            }) => {
                 let c = cells(&s.state, &s.covariance, s.nis);
                 self.held.hold(row, line, t);
                 self.held.give(given, c, &mut self.given);

@@ -125,31 +125,64 @@ fn smoother_and_filter_agree_where_they_must() {
             );
         }
     }
-    assert_eq!(track(&input, &["smooth", "--q", "10", "--lag", "0"]), kalman);
+    assert_eq!(
+        track(&input, &["smooth", "--q", "10", "--lag", "0"]),
+        kalman
+    );
     let mut previous = kalman;
     for lag in ["1", "10", "100"] {
         let lagged = track(&input, &["smooth", "--q", "10", "--lag", lag]);
         for (p, s) in previous.iter().zip(&lagged).skip(1) {
             assert_eq!(p[13], s[13], "nis");
             for c in 7..13 {
-                assert!(num(&s[c]) <= num(&p[c]) * (1.0 + 1e-12), "lag {lag}: {s:?} against {p:?}");
+                assert!(
+                    num(&s[c]) <= num(&p[c]) * (1.0 + 1e-12),
+                    "lag {lag}: {s:?} against {p:?}"
+                );
             }
         }
         previous = lagged;
     }
     let whole = track(&input, &["smooth", "--q", "10", "--lag", "473"]);
-    assert_eq!(track(&input, &["smooth", "--q", "10", "--lag", "5000"]), whole);
+    assert_eq!(
+        track(&input, &["smooth", "--q", "10", "--lag", "5000"]),
+        whole
+    );
     let args = [
-        "track", "--azimuth", "bearing", "--sigma-range", "10", "--sigma-angle", "1e-3",
-        "--method", "smooth", "--q", "10", "--lag", "100000000",
+        "track",
+        "--azimuth",
+        "bearing",
+        "--sigma-range",
+        "10",
+        "--sigma-angle",
+        "1e-3",
+        "--method",
+        "smooth",
+        "--q",
+        "10",
+        "--lag",
+        "100000000",
     ];
     let o = run(&args, &input);
     assert_eq!(o.code, 0, "{}", o.stderr);
-    assert!(o.stderr.contains("--lag 100000000 holds up to 100000001 rows: up to"), "{}", o.stderr);
+    assert!(
+        o.stderr
+            .contains("--lag 100000000 holds up to 100000001 rows: up to"),
+        "{}",
+        o.stderr
+    );
     assert_eq!(table(&o.stdout).1, whole);
     assert!(run(&args[..args.len() - 2], &input).stderr.is_empty());
     fails(
-        &["track", "--sigma-range", "10", "--sigma-angle", "1e-3", "--lag", "5"],
+        &[
+            "track",
+            "--sigma-range",
+            "10",
+            "--sigma-angle",
+            "1e-3",
+            "--lag",
+            "5",
+        ],
         &input,
         2,
         &["--lag applies only to --method smooth"],
@@ -192,7 +225,10 @@ fn the_smoother_writes_before_its_input_ends() {
             Err(_) => break,
         }
     }
-    assert!(count >= want, "{count} lines written before the input's end");
+    assert!(
+        count >= want,
+        "{count} lines written before the input's end"
+    );
     drop(stdin);
     assert!(child.wait().unwrap().success());
 }
@@ -872,16 +908,24 @@ fn long_inputs_stream_across_batches() {
     }
     // The smoother: row k's output is the same once row k + lag is in, whatever comes after.
     for lag in ["0", "37", "200"] {
-        let args: Vec<&str> = [&base[..], &["--method", "smooth", "--q", "1", "--lag", lag]].concat();
+        let args: Vec<&str> =
+            [&base[..], &["--method", "smooth", "--q", "1", "--lag", lag]].concat();
         let whole = ok(&args, &input);
         assert_eq!(whole.lines().count(), 10_001);
         let lag: usize = lag.parse().unwrap();
         for n in [2500, 4096, 4097, 6000] {
             let part = ok(&args, &prefix(n));
             let final_rows = |text: &str| -> String {
-                text.lines().take(1 + n - lag).collect::<Vec<_>>().join("\n")
+                text.lines()
+                    .take(1 + n - lag)
+                    .collect::<Vec<_>>()
+                    .join("\n")
             };
-            assert_eq!(final_rows(&part), final_rows(&whole), "lag {lag}: the first {n} rows");
+            assert_eq!(
+                final_rows(&part),
+                final_rows(&whole),
+                "lag {lag}: the first {n} rows"
+            );
         }
     }
     let mut bad = lines.clone();
@@ -901,7 +945,11 @@ fn long_inputs_stream_across_batches() {
             o.stderr
         );
         // The smoother writes the rows it gave: all but its last `lag`.
-        let lag = if method[1] == "smooth" { DEFAULT_LAG } else { 0 };
+        let lag = if method[1] == "smooth" {
+            DEFAULT_LAG
+        } else {
+            0
+        };
         assert_eq!(o.stdout.lines().count(), 9000 - lag, "{method:?}");
         let _ = std::fs::remove_file(&out);
         let to_file = format!("--output={}", out.display());

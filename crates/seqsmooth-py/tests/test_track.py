@@ -250,13 +250,13 @@ def test_smoothed_streams_with_the_lag():
     want = whole.finish()
     assert np.array_equal(want[0], np.arange(start + 1, len(t)))
     tracker = ss.RadarTracker("smooth", q=0.5, lag=lag, sigma_range=SR, sigma_angle=SA)
-    got = []
+    got, last = [], start  # the last row given so far
     for a, b in [(0, 1), (1, 70), (70, 71), (71, 200), (200, 240)]:
         tracker.update_many(t[a:b], rows[a:b, 0], rows[a:b, 1], rows[a:b, 2])
         part = tracker.smoothed()
-        # Every row given has its L rows after it in; every row older than that is given.
-        expected = np.arange(len(np.concatenate([g[0] for g in got] or [[]])) + start + 1, b - lag)
-        assert np.array_equal(part[0], expected[expected > start]), (a, b, part[0])
+        # Row k is given once row k + lag is in (rows 0..b-1 are in).
+        assert np.array_equal(part[0], np.arange(last + 1, max(last + 1, b - lag))), (a, b)
+        last = max(last, b - lag - 1)
         got.append(part)
     assert tracker.smoothed()[0].size == 0
     got.append(tracker.finish())

@@ -163,10 +163,18 @@ fn fixed_lag_equals_the_posterior_of_the_rows_up_to_k_plus_lag() {
                 let si = cov[(i, i)].sqrt();
                 let e = (s.state[i] - mean[i]).abs() / si;
                 worst = worst.max(e);
-                assert!(e <= 1e-9, "lag {lag} row {k} x{i}: {} against {}", s.state[i], mean[i]);
+                assert!(
+                    e <= 1e-9,
+                    "lag {lag} row {k} x{i}: {} against {}",
+                    s.state[i],
+                    mean[i]
+                );
                 let e = (s.state[i] - rts.state[i]).abs() / si;
                 worst_rts = worst_rts.max(e);
-                assert!(e <= 1e-12, "lag {lag} row {k} x{i} against the RTS over 0..={end}");
+                assert!(
+                    e <= 1e-12,
+                    "lag {lag} row {k} x{i} against the RTS over 0..={end}"
+                );
                 for jj in 0..2 {
                     let scale = si * cov[(jj, jj)].sqrt();
                     let e = (s.covariance[(i, jj)] - cov[(i, jj)]).abs() / scale;
@@ -191,8 +199,14 @@ fn lag_zero_is_the_filter() {
     let mut f = filter(0.3);
     for (m, s) in rows.iter().zip(fixed_lag(0.3, 0, &rows)) {
         let nis = f.update(m).unwrap().map(|i| i.nis);
-        assert_eq!((&s.state, &s.covariance, s.nis), (f.state(), f.covariance(), nis));
-        assert_eq!((&s.filtered_state, &s.filtered_covariance), (&s.state, &s.covariance));
+        assert_eq!(
+            (&s.state, &s.covariance, s.nis),
+            (f.state(), f.covariance(), nis)
+        );
+        assert_eq!(
+            (&s.filtered_state, &s.filtered_covariance),
+            (&s.state, &s.covariance)
+        );
     }
 }
 
@@ -247,8 +261,14 @@ fn nees_of_the_fixed_lag_estimate_is_chi_squared() {
         for (i, &k) in at.iter().enumerate() {
             let mean = sums[i] / runs as f64;
             let se = (4.0 / runs as f64).sqrt();
-            println!("lag {lag}, row {k}: mean NEES {mean:.4} (2 ± {:.4})", 4.0 * se);
-            assert!((mean - 2.0).abs() <= 4.0 * se, "lag {lag} row {k}: mean NEES {mean}");
+            println!(
+                "lag {lag}, row {k}: mean NEES {mean:.4} (2 ± {:.4})",
+                4.0 * se
+            );
+            assert!(
+                (mean - 2.0).abs() <= 4.0 * se,
+                "lag {lag} row {k}: mean NEES {mean}"
+            );
         }
     }
 }
@@ -267,7 +287,10 @@ fn refusals_leave_the_smoother_unchanged() {
     let reference = format!("{s:?}");
     let mut bad = rows[3].clone();
     bad.time = rows[1].time;
-    assert!(matches!(s.push(&bad), Err(Error::InvalidParameter { name: "time", .. })));
+    assert!(matches!(
+        s.push(&bad),
+        Err(Error::InvalidParameter { name: "time", .. })
+    ));
     bad.time = f64::NAN;
     assert!(s.push(&bad).is_err());
     assert_eq!(format!("{s:?}"), reference);
@@ -293,11 +316,7 @@ fn refusals_leave_the_smoother_unchanged() {
 
 /// The radar tracker's smoother at lag `lag` on `rows`: every row's σ (the six components), `None`
 /// for the rows before the smoother's.
-fn tracker_sigmas(
-    rows: &[Measurement],
-    q: f64,
-    lag: usize,
-) -> Vec<Option<[f64; 6]>> {
+fn tracker_sigmas(rows: &[Measurement], q: f64, lag: usize) -> Vec<Option<[f64; 6]>> {
     use seqsmooth::kalman::track::{RadarTracker, TrackMethod, Tracked};
     use seqsmooth::model::radar::Radar;
     let radar = Radar::new([0.0; 3], 6).unwrap();
@@ -387,8 +406,14 @@ fn the_default_lag_is_within_one_percent_of_the_whole_smoother() {
             .iter()
             .map(|&lag| format!("{lag}: {:.2e}", excess(lag)))
             .collect();
-        println!("{name}: worst σ excess over the whole-interval smoother by lag: {}", table.join(", "));
+        println!(
+            "{name}: worst σ excess over the whole-interval smoother by lag: {}",
+            table.join(", ")
+        );
         let e = excess(DEFAULT_LAG);
-        assert!(e <= 0.01, "{name}: the default lag's σ exceed the whole smoother's by {e}");
+        assert!(
+            e <= 0.01,
+            "{name}: the default lag's σ exceed the whole smoother's by {e}"
+        );
     }
 }

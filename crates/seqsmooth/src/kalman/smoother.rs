@@ -112,7 +112,10 @@ impl<D: Dynamics + Clone, O: Observation + Clone> Smoother<D, O> {
     /// the smoother is unchanged.
     pub fn push(&mut self, m: &Measurement) -> Result<Option<f64>, Error> {
         let given = self.0.push(m)?;
-        debug_assert!(given.is_none(), "an unbounded lag gives nothing before finish");
+        debug_assert!(
+            given.is_none(),
+            "an unbounded lag gives nothing before finish"
+        );
         Ok(self.0.nis())
     }
 

@@ -14,8 +14,8 @@
 //! the `seqsmooth track` command and of the Python binding.
 
 use super::filter::{Discount, KalmanFilter};
-use super::noise::WhiteNoiseDerivative;
 use super::fixed_lag::FixedLagSmoother;
+use super::noise::WhiteNoiseDerivative;
 use super::smoother::Smoothed;
 use crate::error::Error;
 use crate::estimate::gauss_newton::{Correction, Epoch, Measurement};
