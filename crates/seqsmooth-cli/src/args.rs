@@ -160,7 +160,7 @@ memory follows manoeuvres: beta 0.7 per second for an airliner.
 --method smooth: the fixed-lag Rauch-Tung-Striebel smoother over the kalman method's run: each \
 row's estimate from the rows up to --lag N rows after it (default 200), written N rows later, \
 the last N rows from every row at the end; nis is the forward filter's. It holds N+1 rows \
-(about 2.3 kB each: 0.5 MB at the default); a lag beyond the input's rows is the \
+(at most 2.8 kB each: 0.6 MB at the default); a lag beyond the input's rows is the \
 whole-interval smoother, and a lag whose rows would take over 100 MB is said on stderr before \
 the first row. The other methods stream: each row's output is written as it is read, in \
 memory independent of the input's length.

@@ -41,17 +41,20 @@ fn landing() -> (String, Vec<[f64; 3]>) {
     (csv, truth)
 }
 
+/// `track` on the landing rows with their σ, the method's name and settings to follow.
+const LANDING_ARGS: [&str; 8] = [
+    "track",
+    "--azimuth",
+    "bearing",
+    "--sigma-range",
+    "10",
+    "--sigma-angle",
+    "1e-3",
+    "--method",
+];
+
 fn track(input: &str, method: &[&str]) -> Vec<Vec<String>> {
-    let mut args = vec![
-        "track",
-        "--azimuth",
-        "bearing",
-        "--sigma-range",
-        "10",
-        "--sigma-angle",
-        "1e-3",
-        "--method",
-    ];
+    let mut args = LANDING_ARGS.to_vec();
     args.extend_from_slice(method);
     let (header, rows) = table(&ok(&args, input));
     assert_eq!(
@@ -149,20 +152,10 @@ fn smoother_and_filter_agree_where_they_must() {
         whole
     );
     let args = [
-        "track",
-        "--azimuth",
-        "bearing",
-        "--sigma-range",
-        "10",
-        "--sigma-angle",
-        "1e-3",
-        "--method",
-        "smooth",
-        "--q",
-        "10",
-        "--lag",
-        "100000000",
-    ];
+        &LANDING_ARGS[..],
+        &["smooth", "--q", "10", "--lag", "100000000"],
+    ]
+    .concat();
     let o = run(&args, &input);
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(
