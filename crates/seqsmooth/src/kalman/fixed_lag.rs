@@ -70,13 +70,28 @@ impl Map {
         let Some(c) = &self.c else {
             return self.clone();
         };
-        let mut d = &self.d + c * &inner.d * c.transpose();
-        symmetrise(&mut d);
-        Map {
-            a: &self.a + c * &inner.a,
-            d,
-            c: inner.c.as_ref().map(|ci| c * ci),
+        let n = self.a.len();
+        let (cs, mut w) = (c.as_slice(), vec![0.0; n * n]);
+        let mut a = self.a.clone();
+        for (r, &ar) in inner.a.iter().enumerate() {
+            axpy(ar, &cs[r * n..(r + 1) * n], a.as_mut_slice());
         }
+        // D + (C D') Cᵀ.
+        mul_into(n, cs, inner.d.as_slice(), &mut w);
+        let mut d = self.d.clone();
+        for r in 0..n {
+            let wr = &w[r * n..(r + 1) * n];
+            for (j, dj) in d.as_mut_slice().chunks_exact_mut(n).enumerate() {
+                axpy(cs[j + r * n], wr, dj);
+            }
+        }
+        symmetrise(&mut d);
+        let c = inner.c.as_ref().map(|ci| {
+            let mut out = DMatrix::zeros(n, n);
+            mul_into(n, cs, ci.as_slice(), out.as_mut_slice());
+            out
+        });
+        Map { a, d, c }
     }
 
     /// An error naming measurement `index` if the map holds a number that is not finite.
@@ -90,6 +105,24 @@ impl Map {
                 }),
             }),
             None => Ok(self),
+        }
+    }
+}
+
+/// `y += alpha x`.
+fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
+    for (y, x) in y.iter_mut().zip(x) {
+        *y += alpha * x;
+    }
+}
+
+/// `out = A B`, column-major `n × n` slices (loops over contiguous columns: for 6×6 far
+/// cheaper than a general product's packing and allocation).
+fn mul_into(n: usize, a: &[f64], b: &[f64], out: &mut [f64]) {
+    out.fill(0.0);
+    for (j, oj) in out.chunks_exact_mut(n).enumerate() {
+        for r in 0..n {
+            axpy(b[r + j * n], &a[r * n..(r + 1) * n], oj);
         }
     }
 }
