@@ -819,20 +819,7 @@ fn a_late_error_leaves_no_output() {
         let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
         assert_eq!(left.len(), 1, "{method:?}: temporary files left: {left:?}");
     }
-    let o = run(
-        &[
-            "track",
-            "--azimuth",
-            "bearing",
-            "--sigma-range",
-            "10",
-            "--sigma-angle",
-            "1e-3",
-            "--q",
-            "10",
-        ],
-        &bad,
-    );
+    let o = run(&[&LANDING_ARGS[..7], &["--q", "10"]].concat(), &bad);
     assert_eq!(o.code, 1);
     assert_eq!(
         o.stdout.lines().count(),
