@@ -170,10 +170,14 @@ divided by 4 after 15 quiet updates whose mean NIS is below its expectation.
 --beta B per unit of time or --theta T per update; s.. are the true 1-sigma errors. Without \
 either the discount is adaptive, per update from 0.9: each misfit doubles 1 - theta, quiet \
 updates halve it again.
---method smooth: the Rauch-Tung-Striebel smoother over the kalman method's run (its --q or \
-adaptive driving noise, its flags; holds every row after the start, writes at the end); nis \
-is the forward filter's. The other methods stream: each row's output is written as it is read, \
-in memory independent of the input's length.
+--method smooth: the fixed-lag Rauch-Tung-Striebel smoother over the kalman method's run (its \
+--q or adaptive driving noise, its gate and flags): each row's estimate from the rows up to \
+--lag N rows after it (default 200), written N rows later with the flag the forward filter \
+gave it, the last N rows from every row at the end; nis is the forward filter's. It holds N+1 \
+rows (at most 2.8 kB each: 0.6 MB at the default); a lag beyond the input's rows is the \
+whole-interval smoother, and a lag whose rows would take over 100 MB is said on stderr before \
+the first row. The other methods stream: each row's output is written as it is read, in \
+memory independent of the input's length.
 
 Angles in radians; --azimuth from-x (default): from +x towards +y; --azimuth bearing: \
 clockwise from north with x = east, y = north. Elevation from the x-y plane. An empty range, \
@@ -586,6 +590,10 @@ pub struct TrackArgs {
     #[arg(long, value_name = "N", default_value_t = 20,
           value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub max_iterations: u32,
+    /// smooth: the lag in rows: each row's estimate from the N rows after it, written N rows
+    /// later; the smoother holds N+1 rows (0 is the kalman filter) [default: 200]
+    #[arg(long, value_name = "N")]
+    pub lag: Option<usize>,
     /// The azimuth convention of the input
     #[arg(long, value_enum, default_value_t = AzimuthConvention::FromX)]
     pub azimuth: AzimuthConvention,

@@ -5,6 +5,7 @@
 
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
+use seqsmooth::kalman::track::DEFAULT_LAG;
 use std::path::PathBuf;
 
 mod common;
@@ -106,7 +107,10 @@ fn landing_within_three_sigma() {
 }
 
 /// The smoother's last row is the filter's (the backward pass starts there), and its σ are at
-/// most the filter's on every row; the NIS column is the forward filter's.
+/// most the filter's on every row; the NIS column is the forward filter's. Lag 0 is the
+/// filter, byte for byte; a longer lag never raises a σ; any lag at least the rows' number is
+/// the whole-interval smoother (the same output), said on stderr before the first row when its
+/// rows would take over 100 MB.
 #[test]
 fn smoother_and_filter_agree_where_they_must() {
     let (input, _) = landing();
@@ -122,6 +126,118 @@ fn smoother_and_filter_agree_where_they_must() {
             );
         }
     }
+    assert_eq!(
+        track(&input, &["smooth", "--q", "10", "--lag", "0"]),
+        kalman
+    );
+    // With the adaptive driving noise too: the forward filter gated and adapted as kalman's,
+    // each row's flag carried to its smoothed row.
+    let adaptive = track(&input, &["kalman"]);
+    assert_eq!(track(&input, &["smooth", "--lag", "0"]), adaptive);
+    for lag in ["7", "200"] {
+        let lagged = track(&input, &["smooth", "--lag", lag]);
+        assert_eq!(lagged.len(), adaptive.len());
+        for (k, s) in adaptive.iter().zip(&lagged) {
+            assert_eq!((&k[13], &k[14]), (&s[13], &s[14]), "lag {lag}: nis, flag");
+        }
+    }
+    assert!(
+        adaptive.iter().any(|r| !r[14].is_empty()),
+        "the landing rows have flagged rows"
+    );
+    let mut previous = kalman;
+    for lag in ["1", "10", "100"] {
+        let lagged = track(&input, &["smooth", "--q", "10", "--lag", lag]);
+        for (p, s) in previous.iter().zip(&lagged).skip(1) {
+            assert_eq!(p[13], s[13], "nis");
+            assert_eq!(p[14], s[14], "lag {lag}: the flag is the forward filter's");
+            for c in 7..13 {
+                assert!(
+                    num(&s[c]) <= num(&p[c]) * (1.0 + 1e-12),
+                    "lag {lag}: {s:?} against {p:?}"
+                );
+            }
+        }
+        previous = lagged;
+    }
+    let whole = track(&input, &["smooth", "--q", "10", "--lag", "473"]);
+    assert_eq!(
+        track(&input, &["smooth", "--q", "10", "--lag", "5000"]),
+        whole
+    );
+    let args = [
+        &LANDING_ARGS[..],
+        &["--method", "smooth", "--q", "10", "--lag", "100000000"],
+    ]
+    .concat();
+    let o = run(&args, &input);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stderr
+            .contains("--lag 100000000 holds up to 100000001 rows: up to"),
+        "{}",
+        o.stderr
+    );
+    assert_eq!(table(&o.stdout).1, whole);
+    assert!(run(&args[..args.len() - 2], &input).stderr.is_empty());
+    fails(
+        &[
+            "track",
+            "--sigma-range",
+            "10",
+            "--sigma-angle",
+            "1e-3",
+            "--lag",
+            "5",
+        ],
+        &input,
+        2,
+        &["--lag applies only to --method smooth"],
+    );
+}
+
+/// `track --method smooth` streams: fed 30,000 rows on a pipe left open, it has written the
+/// output rows of all but the last few thousand (a batch, the lag, the writer's buffer) before
+/// its input ends.
+#[test]
+fn the_smoother_writes_before_its_input_ends() {
+    use std::io::{BufRead, Write};
+    let input = long_pass(30_000);
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_seqsmooth"))
+        .args(["track", "--sigma-range", "10", "--sigma-angle", "1e-3"])
+        .args(["--method", "smooth", "--q", "1"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    stdin.write_all(input.as_bytes()).unwrap();
+    stdin.flush().unwrap();
+    let stdout = child.stdout.take().unwrap();
+    let (lines, seen) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for (k, _) in std::io::BufReader::new(stdout).lines().enumerate() {
+            if lines.send(k + 1).is_err() {
+                return;
+            }
+        }
+    });
+    let want = 20_000;
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let mut count = 0;
+    while count < want {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        match seen.recv_timeout(left) {
+            Ok(n) => count = n,
+            Err(_) => break,
+        }
+    }
+    assert!(
+        count >= want,
+        "{count} lines written before the input's end"
+    );
+    drop(stdin);
+    assert!(child.wait().unwrap().success());
 }
 
 /// Refusals: usage (exit 2) and data (exit 1) errors with their line and column.
@@ -262,6 +378,9 @@ fn random_inputs_are_right_or_refused() {
             "--sigma-angle=1e-3".into(),
             ["--azimuth=from-x", "--azimuth=bearing"][rng.gen_range(0..2)].into(),
         ];
+        if method == "smooth" {
+            args.push(format!("--lag={}", [0, 1, 5, 200][rng.gen_range(0..4)]));
+        }
         match method {
             "window" => args.push(format!("--window={}", rng.gen_range(1..30))),
             "fading" => args.push(format!("--beta={}", rng.gen_range(0.01..1.0))),
@@ -793,6 +912,28 @@ fn long_inputs_stream_across_batches() {
             "{method:?}"
         );
     }
+    // The smoother: row k's output is the same once row k + lag is in, whatever comes after.
+    for lag in ["0", "37", "200"] {
+        let args: Vec<&str> =
+            [&base[..], &["--method", "smooth", "--q", "1", "--lag", lag]].concat();
+        let whole = ok(&args, &input);
+        assert_eq!(whole.lines().count(), 10_001);
+        let lag: usize = lag.parse().unwrap();
+        for n in [2500, 4096, 4097, 6000] {
+            let part = ok(&args, &prefix(n));
+            let final_rows = |text: &str| -> String {
+                text.lines()
+                    .take(1 + n - lag)
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            };
+            assert_eq!(
+                final_rows(&part),
+                final_rows(&whole),
+                "lag {lag}: the first {n} rows"
+            );
+        }
+    }
     let mut bad = lines.clone();
     bad[9000] = "899.9,NaN,0.1,0.1";
     let bad = bad.join("\n") + "\n";
@@ -809,9 +950,13 @@ fn long_inputs_stream_across_batches() {
             "{}",
             o.stderr
         );
-        if method[1] != "smooth" {
-            assert_eq!(o.stdout.lines().count(), 9000, "{method:?}");
-        }
+        // The smoother writes the rows it gave: all but its last `lag`.
+        let lag = if method[1] == "smooth" {
+            DEFAULT_LAG
+        } else {
+            0
+        };
+        assert_eq!(o.stdout.lines().count(), 9000 - lag, "{method:?}");
         let _ = std::fs::remove_file(&out);
         let to_file = format!("--output={}", out.display());
         fails(&[&args[..], &[&to_file]].concat(), &bad, 1, &["line 9001"]);

@@ -9,8 +9,10 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::estimate::gauss_newton::{GaussNewton, Measurement};
+use seqsmooth::kalman::smoother::Smoothed;
 use seqsmooth::kalman::track::{
-    radar_row, RadarTracker, TrackError, TrackMethod, Tracked, DEFAULT_WINDOW,
+    radar_row, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, DEFAULT_LAG,
+    DEFAULT_WINDOW,
 };
 use seqsmooth::kalman::Discount;
 use seqsmooth::model::radar::Radar;
@@ -92,9 +94,10 @@ pub(crate) fn flag_array<'py>(py: Python<'py>, flags: &[&str]) -> PyResult<Bound
 ///     ``"window"``: the Gauss–Newton fit of each row's last ``window`` rows;
 ///     ``"kalman"``: the extended Kalman filter with white-noise acceleration ``q``;
 ///     ``"fading"``: the fading-memory extended Kalman filter (``beta`` or ``theta``);
-///     ``"smooth"``: the Rauch–Tung–Striebel smoother over the Kalman filter (estimates at
-///     ``finish()``). The Kalman methods start from the first fit of the rows so far (at most
-///     60) that determines the state.
+///     ``"smooth"``: the fixed-lag Rauch–Tung–Striebel smoother over the Kalman filter: each
+///     row's estimate from the ``lag`` rows after it, given ``lag`` rows later (``smoothed()``),
+///     the last ones at ``finish()``. The Kalman methods start from the first fit of the rows
+///     so far (at most 60) that determines the state.
 /// sigma_range, sigma_angle : float, optional
 ///     The range's and the angles' noise σ (radians), for the rows that give none.
 /// site : (float, float, float)
@@ -108,14 +111,18 @@ pub(crate) fn flag_array<'py>(py: Python<'py>, flags: &[&str]) -> PyResult<Bound
 ///     adaptive discount per update from 0.9, shortened by misfits likewise.
 /// window : int
 ///     window: the rows of each fit (default 8).
+/// lag : int
+///     smooth: the lag in rows (default 200); the smoother holds ``lag + 1`` rows; 0 is the
+///     filter, a lag beyond the rows the whole-interval smoother.
 /// max_iterations : int
 ///     The Gauss–Newton iterations allowed per fit (the window method's, the Kalman methods'
 ///     start), 1 to 1000 (default 20).
 ///
-/// Every row's estimate has a flag (``update_many``'s fourth array): ``""``; ``"outlier"``,
-/// the row's measurement failed the innovation gate and was left out (the estimate is the
-/// prediction); ``"misfit"``, the model does not follow the target here (the innovation test,
-/// or the window's χ²), so the σ may not cover the error.
+/// Every row's estimate has a flag (``update_many``'s fourth array, ``smoothed()``'s and
+/// ``finish()``'s fifth): ``""``; ``"outlier"``, the row's measurement failed the innovation
+/// gate and was left out (the estimate is the prediction); ``"misfit"``, the model does not
+/// follow the target here (the innovation test, or the window's χ²), so the σ may not cover
+/// the error. The smoother's rows carry the flag its forward filter gave them.
 /// azimuth : {"from-x", "bearing"}
 ///     ``"from-x"``: from +x towards +y; ``"bearing"``: clockwise from +y (x east, y north).
 #[pyclass(name = "RadarTracker", module = "seqsmooth")]
@@ -123,6 +130,43 @@ pub struct PyRadarTracker {
     inner: RadarTracker,
     sigmas: [Option<f64>; 2],
     bearing: bool,
+    /// The smoother's rows given and not yet returned.
+    given: Given,
+}
+
+/// Smoothed rows as the arrays `smoothed()` returns: row numbers, states, covariances
+/// (row-major: symmetric), NIS and flags.
+#[derive(Default)]
+struct Given {
+    rows: Vec<i64>,
+    states: Vec<f64>,
+    covariances: Vec<f64>,
+    nis: Vec<f64>,
+    flags: Vec<&'static str>,
+}
+
+impl Given {
+    fn push(&mut self, row: usize, s: &Smoothed, flag: TrackFlag) {
+        self.rows.push(row as i64);
+        self.states.extend_from_slice(s.state.as_slice());
+        self.covariances.extend_from_slice(s.covariance.as_slice());
+        self.nis.push(s.nis.unwrap_or(f64::NAN));
+        self.flags.push(flag.name());
+    }
+
+    /// `(rows, states, covariances, nis, flags)`, `(n,)`, `(n, 6)`, `(n, 6, 6)`, `(n,)`,
+    /// `(n,)`.
+    fn arrays<'py>(self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let count = self.rows.len();
+        let rows = PyArray1::from_vec(py, self.rows).into_any();
+        let states = matrix(py, self.states, count, 6)?;
+        let covariances = PyArray1::from_vec(py, self.covariances)
+            .reshape([count, 6, 6])?
+            .into_any();
+        let nis = PyArray1::from_vec(py, self.nis).into_any();
+        let flags = flag_array(py, &self.flags)?;
+        PyTuple::new(py, [rows, states, covariances, nis, flags])
+    }
 }
 
 impl PyRadarTracker {
@@ -189,7 +233,7 @@ impl PyRadarTracker {
     #[new]
     #[pyo3(signature = (method = "kalman", *, sigma_range = None, sigma_angle = None,
         site = (0.0, 0.0, 0.0), q = None, beta = None, theta = None, window = None,
-        azimuth = "from-x", max_iterations = 20))]
+        lag = None, azimuth = "from-x", max_iterations = 20))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         method: &str,
@@ -200,6 +244,7 @@ impl PyRadarTracker {
         beta: Option<f64>,
         theta: Option<f64>,
         window: Option<usize>,
+        lag: Option<usize>,
         azimuth: &str,
         max_iterations: i64,
     ) -> PyResult<Self> {
@@ -216,7 +261,10 @@ impl PyRadarTracker {
                 return usage("beta and theta apply only to method='fading'")
             }
             "kalman" => TrackMethod::Kalman { q },
-            "smooth" => TrackMethod::Smooth { q },
+            "smooth" => TrackMethod::Smooth {
+                q,
+                lag: lag.unwrap_or(DEFAULT_LAG),
+            },
             "fading" if q.is_some() => return usage("q applies only to 'kalman' and 'smooth'"),
             "fading" => match (beta, theta) {
                 (Some(b), None) => TrackMethod::Fading(Some(Discount::PerTime(b))),
@@ -234,6 +282,9 @@ impl PyRadarTracker {
         };
         if window.is_some() && !matches!(method, TrackMethod::Window { .. }) {
             return usage("window applies only to method='window'");
+        }
+        if lag.is_some() && !matches!(method, TrackMethod::Smooth { .. }) {
+            return usage("lag applies only to method='smooth'");
         }
         let bearing = match azimuth {
             "from-x" => false,
@@ -264,6 +315,7 @@ impl PyRadarTracker {
             inner: RadarTracker::with_solver(radar, method, solver).py()?,
             sigmas: [sigma_range, sigma_angle],
             bearing,
+            given: Given::default(),
         })
     }
 
@@ -277,9 +329,10 @@ impl PyRadarTracker {
     /// component), with per-row σ where given (NaN: the tracker's). Returns ``(states,
     /// covariances, nis, flags)``, ``(n, 6)``, ``(n, 6, 6)``, ``(n,)`` and ``(n,)`` of str:
     /// NaN rows (flag ``""``) where the rows so far do not determine the state, or the
-    /// smoother holds the row (see ``finish``); a NIS is NaN where there is no innovation;
-    /// a flag is ``""``, ``"outlier"`` or ``"misfit"`` (``seqsmooth track``'s ``flag``). On a refused row the rows before it are taken and
-    /// the exception's ``index`` is its position.
+    /// smoother holds the row (its estimate comes ``lag`` rows later from ``smoothed()``, or
+    /// from ``finish``); a NIS is NaN where there is no innovation; a flag is ``""``,
+    /// ``"outlier"`` or ``"misfit"`` (``seqsmooth track``'s ``flag``). On a refused row the
+    /// rows before it are taken and the exception's ``index`` is its position.
     #[pyo3(signature = (t, range, azimuth, elevation, sigma_range = None, sigma_angle = None))]
     #[allow(clippy::too_many_arguments)]
     fn update_many<'py>(
@@ -325,10 +378,19 @@ impl PyRadarTracker {
         let mut flags = vec![""; count];
         let offset = self.inner.rows();
         let tracker = &mut self.inner;
+        let given = &mut self.given;
         let mut taken = 0;
         let failed = py.detach(|| {
             for (i, m) in rows.iter().enumerate() {
                 let tracked = tracker.push(m)?;
+                if let Tracked::Smoothed {
+                    row,
+                    estimate,
+                    flag,
+                } = tracked
+                {
+                    given.push(row, estimate, flag);
+                }
                 write_row(
                     &tracked,
                     &mut states[i * 6..(i + 1) * 6],
@@ -356,36 +418,31 @@ impl PyRadarTracker {
         PyTuple::new(py, [states, covariances, nis, flags])
     }
 
-    /// The smoother's estimates of the rows it held: ``(rows, states, covariances, nis,
-    /// flags)``,
-    /// ``rows`` their numbers counted from the tracker's first row (0); empty for the other
-    /// methods. The smoother takes no more rows after it.
+    /// The smoother's estimates given since the last call (each row's from the ``lag`` rows
+    /// after it): ``(rows, states, covariances, nis, flags)``, ``(n,)``, ``(n, 6)``,
+    /// ``(n, 6, 6)``, ``(n,)``, ``(n,)`` of str: ``update_many``'s arrays after the rows'
+    /// numbers, counted from the tracker's first row (0); ``nis`` and ``flags`` the forward
+    /// filter's (a row the gate left out: its NIS, ``"outlier"``); empty for the other
+    /// methods. Call it after ``update_many`` to keep memory bounded by the lag; rows not
+    /// taken wait for ``finish``.
+    fn smoothed<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        std::mem::take(&mut self.given).arrays(py)
+    }
+
+    /// The smoother's estimates of the rows given and not yet taken by ``smoothed()``, then
+    /// those of the rows it still holds (smoothed by every row): ``(rows, states, covariances,
+    /// nis, flags)`` as ``smoothed()``; empty for the other methods. The smoother takes no
+    /// more rows after it.
     fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
         let tracker = &mut self.inner;
         let smoothed = py
             .detach(|| tracker.finish())
             .map_err(|e| track_error(e, 0))?;
-        let count = smoothed.len();
-        let mut rows = Vec::with_capacity(count);
-        let mut states = Vec::with_capacity(count * 6);
-        let mut covariances = Vec::with_capacity(count * 36);
-        let mut nis = Vec::with_capacity(count);
-        let mut flags = Vec::with_capacity(count);
-        for (row, s, flag) in smoothed {
-            flags.push(flag.name());
-            rows.push(row as i64);
-            states.extend_from_slice(s.state.as_slice());
-            covariances.extend_from_slice(s.covariance.as_slice());
-            nis.push(s.nis.unwrap_or(f64::NAN));
+        let mut given = std::mem::take(&mut self.given);
+        for (row, s, flag) in &smoothed {
+            given.push(*row, s, *flag);
         }
-        let rows = PyArray1::from_vec(py, rows).into_any();
-        let states = matrix(py, states, count, 6)?;
-        let covariances = PyArray1::from_vec(py, covariances)
-            .reshape([count, 6, 6])?
-            .into_any();
-        let nis = PyArray1::from_vec(py, nis).into_any();
-        let flags = flag_array(py, &flags)?;
-        PyTuple::new(py, [rows, states, covariances, nis, flags])
+        given.arrays(py)
     }
 
     fn __repr__(&self) -> String {

@@ -82,6 +82,8 @@ METHODS = [
     ({"method": "fading", "beta": 0.9}, ["--method", "fading", "--beta", "0.9"]),
     ({"method": "fading", "theta": 0.8}, ["--method", "fading", "--theta", "0.8"]),
     ({"method": "smooth", "q": 0.2}, ["--method", "smooth", "--q", "0.2"]),
+    ({"method": "smooth", "q": 0.2, "lag": 7}, ["--method", "smooth", "--q", "0.2", "--lag", "7"]),
+    ({"method": "smooth", "q": 0.2, "lag": 0}, ["--method", "smooth", "--q", "0.2", "--lag", "0"]),
     ({"method": "window", "window": 12}, ["--method", "window", "--window", "12"]),
 ]
 
@@ -228,6 +230,8 @@ def test_refused_rows_name_their_index_and_keep_the_rows_before():
         {"method": "window", "q": 1.0},
         {"method": "window", "window": 1},
         {"method": "kalman", "window": 10},
+        {"method": "kalman", "lag": 10},
+        {"method": "fading", "beta": 0.9, "lag": 10},
         {"method": "ekf"},
         {"method": "kalman", "azimuth": "north"},
         {"method": "kalman", "sigma_range": -1.0},
@@ -265,3 +269,40 @@ def test_flags_name_an_outlier_and_a_manoeuvre():
         assert flags[k] == "outlier" and flags[k + 1] != "outlier", method
         assert (flags[turn] == "misfit").any(), method
         assert (flags != "").mean() < 0.5, method
+
+
+def test_smoothed_streams_with_the_lag():
+    """With `lag` L, `smoothed()` after each batch gives row k once row k + L is in (and only
+    then), in order, each row once; with `finish()` they are every row after the start, the
+    numbers of taking them all at `finish()` (flags too); lag 0 gives the kalman filter's rows and
+    flags, with a given and with the adaptive driving noise."""
+    rng = np.random.default_rng(14)
+    t, rows = radar_pass(rng, n=240)
+    lag = 15
+    whole = ss.RadarTracker("smooth", q=0.5, lag=lag, sigma_range=SR, sigma_angle=SA)
+    x, _, _, _ = whole.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2])
+    start = int(np.flatnonzero(np.isfinite(x[:, 0]))[0])
+    want = whole.finish()
+    assert np.array_equal(want[0], np.arange(start + 1, len(t)))
+    tracker = ss.RadarTracker("smooth", q=0.5, lag=lag, sigma_range=SR, sigma_angle=SA)
+    got, last = [], start  # the last row given so far
+    for a, b in [(0, 1), (1, 70), (70, 71), (71, 200), (200, 240)]:
+        tracker.update_many(t[a:b], rows[a:b, 0], rows[a:b, 1], rows[a:b, 2])
+        part = tracker.smoothed()
+        # Row k is given once row k + lag is in (rows 0..b-1 are in).
+        assert np.array_equal(part[0], np.arange(last + 1, max(last + 1, b - lag))), (a, b)
+        last = max(last, b - lag - 1)
+        got.append(part)
+    assert tracker.smoothed()[0].size == 0
+    got.append(tracker.finish())
+    for k in range(5):
+        assert same(np.concatenate([g[k] for g in got]), want[k]), k
+    for q in [{"q": 0.5}, {}]:
+        kalman = ss.RadarTracker("kalman", **q, sigma_range=SR, sigma_angle=SA)
+        kx, kp, kn, kf = kalman.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2])
+        zero = ss.RadarTracker("smooth", **q, lag=0, sigma_range=SR, sigma_angle=SA)
+        zero.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2])
+        held, xs, ps, ns, fs = zero.smoothed()
+        assert np.array_equal(held, np.arange(start + 1, len(t)))
+        assert same(xs, kx[held]) and same(ps, kp[held]) and same(ns, kn[held]), q
+        assert same(fs, kf[held]), q

@@ -13,7 +13,7 @@ use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::track::{
     window_flag, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, START_WINDOW,
 };
-use seqsmooth::kalman::{smooth, Discount, KalmanFilter};
+use seqsmooth::kalman::{smooth, Discount, FixedLagSmoother, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::radar::Radar;
 
@@ -55,18 +55,34 @@ fn pass(n: usize, site: [f64; 3], seed: u64) -> Vec<Measurement> {
 /// One row's output: `None` undetermined or held, else the state, covariance, NIS and flag.
 type Row = Option<(DVector<f64>, DMatrix<f64>, Option<f64>, TrackFlag)>;
 
-/// Every row of `rows` through a tracker, then its `finish()`.
+/// Every row of `rows` through a tracker, then its `finish()`: the rows' own estimates, and
+/// the smoother's (given with its lag or at the end), each at its row.
 fn tracked(radar: Radar, method: TrackMethod, rows: &[Measurement]) -> (Vec<Row>, Vec<Row>) {
     let mut t = RadarTracker::new(radar, method).unwrap();
+    let mut held = vec![None; rows.len()];
     let out = rows
         .iter()
-        .map(|m| match t.push(m).unwrap() {
+        .enumerate()
+        .map(|(k, m)| match t.push(m).unwrap() {
             Tracked::Estimate(e) => Some((e.state.clone(), e.covariance.clone(), e.nis, e.flag)),
+            Tracked::Smoothed {
+                row,
+                estimate: s,
+                flag,
+            } => {
+                let TrackMethod::Smooth { lag, .. } = method else {
+                    panic!("{method:?} smoothed")
+                };
+                assert_eq!(row, k - lag);
+                assert!(held[row].is_none());
+                held[row] = Some((s.state.clone(), s.covariance.clone(), s.nis, flag));
+                None
+            }
             Tracked::Undetermined | Tracked::Held => None,
         })
         .collect();
-    let mut held = vec![None; rows.len()];
     for (row, s, flag) in t.finish().unwrap() {
+        assert!(held[row].is_none());
         held[row] = Some((s.state, s.covariance, s.nis, flag));
     }
     (out, held)
@@ -165,24 +181,47 @@ fn smooth_is_the_smoother_over_the_rows_after_the_start() {
     let rows = pass(300, [0.0; 3], 2);
     let (k0, c) = start(radar, &rows);
     let q = 0.2;
-    let (out, held) = tracked(radar, TrackMethod::Smooth { q: Some(q) }, &rows);
-    assert!(out
-        .iter()
-        .enumerate()
-        .all(|(k, r)| r.is_some() == (k == k0)));
-    assert!(held
-        .iter()
-        .enumerate()
-        .all(|(k, r)| r.is_some() == (k > k0)));
     let f = filter(radar, &c)
         .with_process_noise(WhiteNoiseDerivative::new(1, 3, q).unwrap())
         .unwrap();
-    let s = smooth(f.clone(), &rows[k0 + 1..]).unwrap();
-    for (k, s) in s.iter().enumerate() {
-        let (x, p, n, flag) = held[k0 + 1 + k].as_ref().unwrap();
-        assert_ne!(*flag, TrackFlag::Outlier, "no row of this pass is left out");
-        assert_eq!((x, p, *n), (&s.state, &s.covariance, s.nis));
+    // An unbounded lag: the whole-interval smoother's; a lag of 25 rows: the fixed-lag
+    // smoother's, each row given 25 rows later.
+    for lag in [usize::MAX, 300, 25, 0] {
+        let method = TrackMethod::Smooth { q: Some(q), lag };
+        let (out, held) = tracked(radar, method, &rows);
+        assert!(out
+            .iter()
+            .enumerate()
+            .all(|(k, r)| r.is_some() == (k == k0)));
+        assert!(held
+            .iter()
+            .enumerate()
+            .all(|(k, r)| r.is_some() == (k > k0)));
+        let s = if lag >= rows.len() {
+            smooth(f.clone(), &rows[k0 + 1..]).unwrap()
+        } else {
+            let mut s = FixedLagSmoother::new(f.clone(), lag);
+            let mut v: Vec<_> = rows[k0 + 1..]
+                .iter()
+                .filter_map(|m| s.push(m).unwrap())
+                .collect();
+            v.extend(s.finish().unwrap());
+            v
+        };
+        for (k, s) in s.iter().enumerate() {
+            let (x, p, n, flag) = held[k0 + 1 + k].as_ref().unwrap();
+            assert_ne!(*flag, TrackFlag::Outlier, "no row of this pass is left out");
+            assert_eq!((x, p, *n), (&s.state, &s.covariance, s.nis), "lag {lag}");
+        }
     }
+    let (_, held) = tracked(
+        radar,
+        TrackMethod::Smooth {
+            q: Some(q),
+            lag: 300,
+        },
+        &rows,
+    );
     // At the last row the smoothed estimate is the filtered one (RTS).
     let (kalman, _) = tracked(radar, TrackMethod::Kalman { q: Some(q) }, &rows);
     let (x, p, ..) = held.last().unwrap().as_ref().unwrap();
@@ -237,7 +276,20 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
         (TrackMethod::Kalman { q: Some(1.0) }, 1),
         (TrackMethod::Kalman { q: Some(1.0) }, 40),
         (TrackMethod::Window { window: 10 }, 30),
-        (TrackMethod::Smooth { q: Some(1.0) }, 50),
+        (
+            TrackMethod::Smooth {
+                q: Some(1.0),
+                lag: 500,
+            },
+            50,
+        ),
+        (
+            TrackMethod::Smooth {
+                q: Some(1.0),
+                lag: 3,
+            },
+            50,
+        ),
     ] {
         let mut t = RadarTracker::new(radar, method).unwrap();
         let mut reference = RadarTracker::new(radar, method).unwrap();
@@ -267,6 +319,7 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
                 .iter()
                 .map(|m| match t.push(m).unwrap() {
                     Tracked::Estimate(e) => Some(e.state.clone()),
+                    Tracked::Smoothed { estimate, .. } => Some(estimate.state.clone()),
                     _ => None,
                 })
                 .collect();
@@ -297,7 +350,11 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
         ));
     }
     // The smoother refuses a row out of order when it comes, and none after its finish.
-    let mut t = RadarTracker::new(radar, TrackMethod::Smooth { q: Some(1.0) }).unwrap();
+    let method = TrackMethod::Smooth {
+        q: Some(1.0),
+        lag: 500,
+    };
+    let mut t = RadarTracker::new(radar, method).unwrap();
     for m in &rows[..60] {
         t.push(m).unwrap();
     }
@@ -324,7 +381,10 @@ fn bad_settings_are_refused() {
     let radar = Radar::new([0.0; 3], 6).unwrap();
     for method in [
         TrackMethod::Kalman { q: Some(-1.0) },
-        TrackMethod::Smooth { q: Some(f64::NAN) },
+        TrackMethod::Smooth {
+            q: Some(f64::NAN),
+            lag: 10,
+        },
         TrackMethod::Kalman {
             q: Some(f64::INFINITY),
         },

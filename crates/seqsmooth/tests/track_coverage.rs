@@ -202,15 +202,30 @@ impl Tally {
     }
 }
 
-/// One method over one track: every row pushed, the smoother's rows at the end.
+/// One method over one track: every row pushed, the smoother's rows as it releases them and
+/// at the end.
 fn run(method: TrackMethod, track: &Track) -> Tally {
     let radar = Radar::new([0.0; 3], 6).unwrap();
     let mut tracker = RadarTracker::new(radar, method).unwrap();
     let mut tally = Tally::default();
     let sigma = |c: &nalgebra::DMatrix<f64>| [0, 1, 2].map(|k| c[(k, k)].sqrt());
     for (m, truth) in track.rows.iter().zip(&track.truth) {
-        if let Tracked::Estimate(e) = tracker.push(m).unwrap() {
-            tally.score(e.state.as_slice(), sigma(e.covariance), truth, e.flag);
+        match tracker.push(m).unwrap() {
+            Tracked::Estimate(e) => {
+                tally.score(e.state.as_slice(), sigma(e.covariance), truth, e.flag)
+            }
+            // The smoother's row `lag` back, as it is released.
+            Tracked::Smoothed {
+                row,
+                estimate: s,
+                flag,
+            } => tally.score(
+                s.state.as_slice(),
+                sigma(&s.covariance),
+                &track.truth[row],
+                flag,
+            ),
+            Tracked::Undetermined | Tracked::Held => {}
         }
     }
     for (row, s, flag) in tracker.finish().unwrap() {

@@ -166,6 +166,7 @@ class RadarTracker:
         beta: float | None = None,
         theta: float | None = None,
         window: int | None = None,
+        lag: int | None = None,
         azimuth: Literal["from-x", "bearing"] = "from-x",
         max_iterations: int = 20,
     ) -> None: ...
@@ -180,6 +181,11 @@ class RadarTracker:
         sigma_range: ArrayLike | None = None,
         sigma_angle: ArrayLike | None = None,
     ) -> tuple[Matrix, npt.NDArray[np.float64], Vector, npt.NDArray[np.str_]]: ...
+    def smoothed(
+        self,
+    ) -> tuple[
+        npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64], Vector, npt.NDArray[np.str_]
+    ]: ...
     def finish(
         self,
     ) -> tuple[

@@ -6,7 +6,7 @@
 //! | [`TrackMethod::Window`] | the Gauss–Newton fit of the last `W` rows (warm started), its innovation against the previous row's fit | §8.5-8.7 ([`SlidingFit`]) |
 //! | [`TrackMethod::Kalman`] | the extended Kalman filter, white noise of density `q` driving the acceleration | ch. 12, (15.2.23) |
 //! | [`TrackMethod::Fading`] | the extended Kalman filter with fading memory (`β` per time or `θ` per update), its true covariance | ch. 14 |
-//! | [`TrackMethod::Smooth`] | the Rauch–Tung–Striebel smoother over the Kalman filter's run, at the end | [`super::smooth`] |
+//! | [`TrackMethod::Smooth`] | the Rauch–Tung–Striebel smoother over the Kalman filter's run with a lag of `L` rows: each row's estimate from the `L` rows after it, given `L` rows later | [`super::fixed_lag`] |
 //!
 //! The Kalman methods start from the first Gauss–Newton fit of the rows so far (at most
 //! [`START_WINDOW`]) that determines the state, started at the radar nominal of §8.5; that
@@ -30,8 +30,9 @@
 pub use super::adaptive::TrackFlag;
 use super::adaptive::{Monitor, MISFIT_ALPHA};
 use super::filter::{Discount, KalmanFilter};
+use super::fixed_lag::FixedLagSmoother;
 use super::noise::WhiteNoiseDerivative;
-use super::smoother::{Smoothed, Smoother};
+use super::smoother::Smoothed;
 use crate::error::Error;
 use crate::estimate::batch::NoiseCovariance;
 use crate::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
@@ -39,6 +40,7 @@ use crate::estimate::sliding::{SlidingFit, Start};
 use crate::model::dynamics::PolynomialDynamics;
 use crate::model::radar::Radar;
 use nalgebra::{DMatrix, DVector};
+use std::collections::VecDeque;
 use std::ops::Range;
 
 /// The window of the Kalman methods' start: the first fit of at most this many last rows that
@@ -56,6 +58,8 @@ pub const DEFAULT_THETA: f64 = 0.9;
 /// `1 − (1 − θ₀) 2^ℓ` for `ℓ` in `FADING_LEVELS`.
 const NOISE_LEVELS: (i32, i32) = (-6, 14);
 const FADING_LEVELS: (i32, i32) = (-4, 3);
+/// The smoother's default lag, in rows ([`TrackMethod::Smooth`]).
+pub const DEFAULT_LAG: usize = 200;
 
 /// How rows become estimates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,11 +77,16 @@ pub enum TrackMethod {
     },
     /// The extended Kalman filter with fading memory; `None` for the adaptive discount.
     Fading(Option<Discount>),
-    /// The smoother over the Kalman filter's run (driving noise `q`, `None` adaptive as for
-    /// [`TrackMethod::Kalman`]); the estimates come at [`RadarTracker::finish`].
+    /// The fixed-lag smoother over the Kalman filter's run (driving noise `q`, `None` adaptive
+    /// as for [`TrackMethod::Kalman`]: the forward filter gated and adapted as that one):
+    /// each row's estimate from the `lag` rows after it, given when the `lag`-th comes
+    /// ([`Tracked::Smoothed`]); the last `lag` rows' at [`RadarTracker::finish`], from every
+    /// row. `lag` 0 is the filter; a lag at least the rows' number the whole-interval smoother.
     Smooth {
         /// `q ≥ 0`, or `None`: adaptive.
         q: Option<f64>,
+        /// `L`, in rows ([`DEFAULT_LAG`] by default): the smoother holds `L + 1` rows.
+        lag: usize,
     },
 }
 
@@ -95,7 +104,10 @@ impl TrackMethod {
         Some(match name {
             "kalman" => TrackMethod::Kalman { q: None },
             "fading" => TrackMethod::Fading(None),
-            "smooth" => TrackMethod::Smooth { q: None },
+            "smooth" => TrackMethod::Smooth {
+                q: None,
+                lag: DEFAULT_LAG,
+            },
             "window" => TrackMethod::Window {
                 window: DEFAULT_WINDOW,
             },
@@ -153,8 +165,20 @@ pub enum Tracked<'a> {
     Undetermined,
     /// The row's estimate.
     Estimate(TrackEstimate<'a>),
-    /// Held for [`RadarTracker::finish`] (the smoother).
+    /// Held by the smoother, which gives no row yet (its first `lag` rows; the rest come at
+    /// [`RadarTracker::finish`]).
     Held,
+    /// Held by the smoother, which gives the estimate of the earlier row `row` (`lag` rows
+    /// back), from the rows up to this one.
+    Smoothed {
+        /// The row given, counted from the tracker's first (0).
+        row: usize,
+        /// Its smoothed estimate (`nis` the forward filter's at that row, also where the gate
+        /// left the row out).
+        estimate: &'a Smoothed,
+        /// The forward pass's flag of that row.
+        flag: TrackFlag,
+    },
 }
 
 /// The filter of the Kalman methods.
@@ -185,10 +209,10 @@ impl Memory {
         rows: impl Iterator<Item = &'a Measurement>,
     ) -> Result<Self, Error> {
         let (kind, adaptive, (lowest, highest)) = match method {
-            TrackMethod::Kalman { q: Some(q) } | TrackMethod::Smooth { q: Some(q) } => {
+            TrackMethod::Kalman { q: Some(q) } | TrackMethod::Smooth { q: Some(q), .. } => {
                 (MemoryKind::Noise(q), false, (0, 0))
             }
-            TrackMethod::Kalman { q: None } | TrackMethod::Smooth { q: None } => {
+            TrackMethod::Kalman { q: None } | TrackMethod::Smooth { q: None, .. } => {
                 (MemoryKind::Noise(base_noise(rows)), true, NOISE_LEVELS)
             }
             TrackMethod::Fading(Some(d)) => (MemoryKind::Fading(d), false, (0, 0)),
@@ -239,32 +263,49 @@ impl Memory {
     }
 
     /// [`Self::step`] for the smoother: the gate decided on a copy of its filter, then the row
-    /// (or, left out, the prediction to its time) pushed.
+    /// (or, left out, the prediction to its time) pushed and the level changed where the
+    /// monitor says so. Returns the row the smoother gave (if any), the NIS and the flag. On
+    /// an error the smoother and the memory are unchanged (the new level is tried on the copy
+    /// before the push).
     fn step_smoother(
         &mut self,
-        s: &mut Smoother<PolynomialDynamics, Radar>,
+        s: &mut FixedLagSmoother<PolynomialDynamics, Radar>,
         m: &Measurement,
-    ) -> Result<(Option<f64>, TrackFlag), Error> {
+    ) -> Result<(Option<Smoothed>, Option<f64>, TrackFlag), Error> {
         let mut probe = s.filter().clone();
         let monitor = &self.monitor;
         let gated = probe.update_gated(m, |s| monitor.accepts(s.nis, s.components))?;
         let Some((stats, used)) = gated else {
-            s.push(m)?;
-            return Ok((None, TrackFlag::None));
+            return Ok((s.push(m)?, None, TrackFlag::None));
         };
-        if used {
-            s.push(m)?;
+        let mut memory = self.clone();
+        let (flag, changed) = memory.monitor.record(stats.nis, stats.components, used);
+        if changed {
+            memory.apply(&mut probe)?;
+        }
+        let given = if used {
+            s.push(m)?
         } else {
             let mut predicted = m.clone();
             predicted.values.iter_mut().for_each(|v| *v = None);
-            s.push(&predicted)?;
-        }
-        let (flag, changed) = self.monitor.record(stats.nis, stats.components, used);
+            s.push(&predicted)?
+        };
         if changed {
-            self.apply(s.filter_mut())?;
+            memory.apply(s.filter_mut())?;
         }
-        Ok((Some(stats.nis), flag))
+        *self = memory;
+        Ok((given, Some(stats.nis), flag))
     }
+}
+
+/// The smooth method's forward pass: the fixed-lag smoother, the memory that gates and adapts
+/// its filter (as the kalman method's), and the NIS and flag of each row the smoother holds,
+/// oldest first (its ring's rows: at most `lag + 1`).
+#[derive(Clone, Debug)]
+struct Lagged {
+    smoother: FixedLagSmoother<PolynomialDynamics, Radar>,
+    memory: Memory,
+    held: VecDeque<(Option<f64>, TrackFlag)>,
 }
 
 /// The adaptive driving noise's level 0, `q₀ = σ_r² / T³`: the range's noise variance (of the
@@ -303,13 +344,13 @@ enum Stage {
     /// kalman and fading: the filter and its memory, and the start's fit for the row that
     /// made it.
     Filtering(Box<(Filter, Memory)>, Option<Correction>),
-    /// smooth: the smoother's forward pass over the rows after the start and its memory, the
-    /// start's fit, its row, and the NIS and flag of each row held.
+    /// smooth: the fixed-lag smoother over the rows after the start and its memory, the
+    /// start's fit, its row, and the row the last push gave.
     Smoothing(
-        Box<(Smoother<PolynomialDynamics, Radar>, Memory)>,
+        Box<Lagged>,
         Option<Correction>,
         usize,
-        Vec<(Option<f64>, TrackFlag)>,
+        Option<(usize, Smoothed, TrackFlag)>,
     ),
     /// smooth after [`RadarTracker::finish`]: no more rows.
     Finished,
@@ -422,7 +463,7 @@ impl RadarTracker {
                     Box::new(Monitor::new(3, false, 0, 0)?),
                 )
             }
-            TrackMethod::Kalman { q } | TrackMethod::Smooth { q } => {
+            TrackMethod::Kalman { q } | TrackMethod::Smooth { q, .. } => {
                 if let Some(q) = q {
                     check("q", q)?;
                 }
@@ -488,13 +529,13 @@ impl RadarTracker {
                     Ok((f, memory))
                 });
                 let (filter, memory) = started.map_err(TrackError::Start)?;
-                self.stage = if matches!(self.method, TrackMethod::Smooth { .. }) {
-                    Stage::Smoothing(
-                        Box::new((Smoother::new(filter), memory)),
-                        Some(c),
-                        row,
-                        Vec::new(),
-                    )
+                self.stage = if let TrackMethod::Smooth { lag, .. } = self.method {
+                    let lagged = Lagged {
+                        smoother: FixedLagSmoother::new(filter, lag),
+                        memory,
+                        held: VecDeque::new(),
+                    };
+                    Stage::Smoothing(Box::new(lagged), Some(c), row, None)
                 } else {
                     Stage::Filtering(Box::new((filter, memory)), Some(c))
                 };
@@ -546,16 +587,25 @@ impl RadarTracker {
                     },
                 })
             }
-            Stage::Smoothing(smoother, start, _, held) => {
-                let (smoother, memory) = &mut **smoother;
-                let before = (smoother.clone(), memory.clone());
-                match memory.step_smoother(smoother, m) {
-                    Ok(taken) => held.push(taken),
-                    Err(source) => {
-                        (*smoother, *memory) = before;
-                        return Err(TrackError::Update { row, source });
-                    }
-                }
+            Stage::Smoothing(lagged, start, first, given) => {
+                let first = *first + 1;
+                let Lagged {
+                    smoother,
+                    memory,
+                    held,
+                } = &mut **lagged;
+                let (out, nis, flag) = memory.step_smoother(smoother, m).map_err(|e| match e {
+                    // The backward pass's (the updates' errors are not in a batch).
+                    Error::InBatch { .. } => smoothing_error(e, first),
+                    source => TrackError::Update { row, source },
+                })?;
+                held.push_back((nis, flag));
+                *given = out.map(|mut s| {
+                    let (nis, flag) = held.pop_front().expect("the row given is held");
+                    s.nis = nis;
+                    (row - smoother.held(), s, flag)
+                });
+                debug_assert_eq!(held.len(), smoother.held());
                 *start = None;
                 None
             }
@@ -563,7 +613,14 @@ impl RadarTracker {
         self.rows += 1;
         self.last_time = m.time;
         let Some((nis, flag)) = taken else {
-            return Ok(Tracked::Held);
+            return Ok(match &self.stage {
+                Stage::Smoothing(.., Some((row, estimate, flag))) => Tracked::Smoothed {
+                    row: *row,
+                    estimate,
+                    flag: *flag,
+                },
+                _ => Tracked::Held,
+            });
         };
         let (state, covariance) = match &self.stage {
             Stage::Window(_, Some(c), _)
@@ -580,26 +637,21 @@ impl RadarTracker {
         }))
     }
 
-    /// The smoother's estimates of the rows it held (from the row after the start on, each
-    /// with its row and the forward pass's flag), smoothed; nothing for the other methods.
-    /// The smoother takes no more rows after it. A row the gate left out has its NIS here
-    /// (the smoothed estimate's `nis` is the forward update's, `None` for it).
+    /// The smoother's estimates of the rows it still holds (its last `lag` rows, each with
+    /// its row and the forward pass's flag), smoothed by every row; nothing for the other
+    /// methods. The smoother takes no more rows after it. A row the gate left out has its
+    /// NIS here (the forward update's, which left it out).
     pub fn finish(&mut self) -> Result<Vec<(usize, Smoothed, TrackFlag)>, TrackError> {
         let stage = std::mem::replace(&mut self.stage, Stage::Finished);
-        let Stage::Smoothing(smoother, _, start, held) = stage else {
+        let Stage::Smoothing(lagged, _, start, _) = stage else {
             self.stage = stage;
             return Ok(Vec::new());
         };
-        let first = start + 1;
-        let smoothed = smoother.0.finish().map_err(|e| {
-            TrackError::Smooth(match e {
-                Error::InBatch { index, source } => Error::InBatch {
-                    index: first + index,
-                    source,
-                },
-                e => e,
-            })
-        })?;
+        let Lagged { smoother, held, .. } = *lagged;
+        let first = start + 1 + smoother.pushed() - smoother.held();
+        let smoothed = smoother
+            .finish()
+            .map_err(|e| smoothing_error(e, start + 1))?;
         Ok(smoothed
             .into_iter()
             .zip(held)
@@ -610,6 +662,33 @@ impl RadarTracker {
             })
             .collect())
     }
+
+    /// The rows the smoother holds at most (`lag + 1`; 0 for the other methods), and the
+    /// bytes they take: a bound of the tracker's memory beyond a few kilobytes, known before
+    /// the first row.
+    pub fn held_bound(&self) -> (usize, usize) {
+        match self.method {
+            TrackMethod::Smooth { lag, .. } => {
+                let rows = lag.saturating_add(1);
+                let each = FixedLagSmoother::<PolynomialDynamics, Radar>::bytes_per_measurement(6)
+                    + std::mem::size_of::<(Option<f64>, TrackFlag)>();
+                (rows, rows.saturating_mul(each))
+            }
+            _ => (0, 0),
+        }
+    }
+}
+
+/// The smoother's error, an [`Error::InBatch`] index (counted from its first row, the tracker's
+/// `first`) counted from the tracker's first row.
+fn smoothing_error(e: Error, first: usize) -> TrackError {
+    TrackError::Smooth(match e {
+        Error::InBatch { index, source } => Error::InBatch {
+            index: first + index,
+            source,
+        },
+        e => e,
+    })
 }
 
 /// A window fit's flag (the window method's, `seqsmooth fit --model radar`'s):
