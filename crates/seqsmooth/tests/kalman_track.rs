@@ -229,6 +229,34 @@ fn smooth_is_the_smoother_over_the_rows_after_the_start() {
     assert!((x - xf).amax() <= 1e-9 * xf.amax() && (p - pf).amax() <= 1e-9 * pf.amax());
 }
 
+/// The adaptive smoother's forward filter is the adaptive kalman method's, gated and adapted
+/// alike at every lag: each smoothed row carries that row's NIS and flag (an injected outlier
+/// named `Outlier` however late it is released), lag 0 is the filter, and the last row of any
+/// lag is the filter's (RTS).
+#[test]
+fn the_adaptive_smoother_carries_the_filters_flags_at_every_lag() {
+    let radar = Radar::new([0.0; 3], 6).unwrap();
+    let mut rows = pass(400, [0.0; 3], 5);
+    let (k0, _) = start(radar, &rows);
+    let bad = k0 + 100;
+    rows[bad].values[0] = Some(rows[bad].values[0].unwrap_or(5e4) + 400.0); // 40σ
+    let (kalman, _) = tracked(radar, TrackMethod::Kalman { q: None }, &rows);
+    assert_eq!(kalman[bad].as_ref().unwrap().3, TrackFlag::Outlier);
+    for lag in [0, 1, 25, 200, usize::MAX] {
+        let (out, held) = tracked(radar, TrackMethod::Smooth { q: None, lag }, &rows);
+        assert_eq!(out[k0], kalman[k0], "lag {lag}: the start's row");
+        for k in k0 + 1..rows.len() {
+            let (x, p, n, flag) = held[k].as_ref().unwrap();
+            let (xk, pk, nk, fk) = kalman[k].as_ref().unwrap();
+            assert_eq!((n, flag), (nk, fk), "lag {lag} row {k}");
+            if lag == 0 || k == rows.len() - 1 {
+                assert!((x - xk).amax() <= 1e-9 * xk.amax(), "lag {lag} row {k}");
+                assert!((p - pk).amax() <= 1e-9 * pk.amax(), "lag {lag} row {k}");
+            }
+        }
+    }
+}
+
 #[test]
 fn window_is_the_sliding_fit_with_the_previous_fits_innovation() {
     let radar = Radar::new([0.0; 3], 6).unwrap();
