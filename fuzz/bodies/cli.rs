@@ -191,7 +191,8 @@ fn output(cli: &Command, text: &[u8], data_rows: usize) {
 }
 
 /// Checks the output of a successful `fit` or `track`: after the echoed cells (`t`, and `y`
-/// for the polynomial model), every cell empty or a finite number, the state cells (up to
+/// for the polynomial model), every cell empty or a finite number (the `flag` column empty,
+/// `outlier` or `misfit`), the state cells (up to
 /// `iterations` or `nis`) all empty or all numbers, at least one row with a state, one row per
 /// data row.
 fn fitted(header: &[String], reader: &mut csv::Reader<&[u8]>, data_rows: usize) {
@@ -210,7 +211,14 @@ fn fitted(header: &[String], reader: &mut csv::Reader<&[u8]>, data_rows: usize) 
         let line = i + 2;
         rows += 1;
         for (c, cell) in record.iter().enumerate().skip(first) {
-            computed(cell, line, &header[c]);
+            if header[c] == "flag" {
+                assert!(
+                    ["", "outlier", "misfit"].contains(&cell),
+                    "line {line}: flag {cell:?}"
+                );
+            } else {
+                computed(cell, line, &header[c]);
+            }
         }
         let empty = (first..states).filter(|&c| record[c].is_empty()).count();
         assert!(

@@ -138,28 +138,46 @@ pub fn parse_segment(s: &str) -> Result<f64, String> {
 const TRACK_AFTER_HELP: &str = concat!(
     "\
 Output: CSV, one row per input row in input order, with the header
-  t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,nis
+  t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,nis,flag
 t echoes the input cell; x..vz is the constant-velocity state at t (in the units of the range \
 and of t; with --azimuth bearing x is east, y north, z up), s.. their 1-sigma errors, and nis \
 the normalised innovation squared of the row's update (chi-squared with as many degrees of \
 freedom as components present when the model holds; Morrison 14.8). Rows before the state is \
 determinable leave their cells empty.
 
---method window: the Gauss-Newton fit of each row's last W rows (--window, default 60; all \
-rows so far while fewer), as 'seqsmooth fit --model radar'; nis is the row's innovation \
-against the previous window's estimate. The model is straight-line motion across the window: \
-for a manoeuvring target keep the window short (6 rows of 2.7 s on an airliner's approach).
+flag says where the sigmas may not cover the error: empty when the tests pass; 'outlier' when \
+the row's NIS is beyond the gate (the 99.9% point of chi-squared) after a row within it: the \
+measurement is left out (the row's estimate is the prediction; window: the fit of the window \
+without it); 'misfit' when the model does \
+not follow the target (a manoeuvre): the NIS summed over the last 5 updates is beyond its 99% \
+point (kalman, fading, smooth), or the window's residual chi-squared is beyond the 99% point \
+for its degrees of freedom (window). Keep the unflagged rows for estimates whose 3-sigma \
+covers the truth (ACCURACY.md, 'The tracker's coverage').
+
+--method window: the Gauss-Newton fit of each row's last W rows (--window, default 8; all rows \
+so far while fewer), as 'seqsmooth fit --model radar'; nis is the row's innovation against the \
+previous window's estimate. The model is straight-line motion across the window; the \
+covariance is scaled by max(1, chi2/dof) so that it carries the window's misfit. A window that \
+does not converge stops the command: allow more iterations (--max-iterations, default 20) or \
+shorten the window.
 --method kalman: the extended Kalman filter (Morrison 12.5) with white-noise acceleration of \
-spectral density --q (m^2/s^3 for metres and seconds; default 0, no driving noise), started \
-from the Gauss-Newton fit of the first rows that determine the state (that row's cells are \
-the fit's, its nis empty). For a manoeuvring target give q about the square of its \
-acceleration times its duration: 10 m^2/s^3 for an airliner's turns and descent.
+spectral density --q (m^2/s^3 for metres and seconds), started from the Gauss-Newton fit of \
+the first rows that determine the state (that row's cells are the fit's, its nis empty). \
+Without --q the driving noise is adaptive: it starts at sigma_range^2/T^3 (T the start's mean \
+step) and is multiplied by 4 at each misfit whose NIS is still high (16 beyond the gate), and \
+divided by 4 after 15 quiet updates whose mean NIS is below its expectation.
 --method fading: the same start, then the fading-memory Kalman filter (Morrison 14.4) with \
---beta B per unit of time or --theta T per update; s.. are the true 1-sigma errors. A shorter \
-memory follows manoeuvres: beta 0.7 per second for an airliner.
---method smooth: the Rauch-Tung-Striebel smoother over the kalman method's run (holds every row \
-after the start, writes at the end); nis is the forward filter's. The other methods stream: \
-each row's output is written as it is read, in memory independent of the input's length.
+--beta B per unit of time or --theta T per update; s.. are the true 1-sigma errors. Without \
+either the discount is adaptive, per update from 0.9: each misfit doubles 1 - theta, quiet \
+updates halve it again.
+--method smooth: the fixed-lag Rauch-Tung-Striebel smoother over the kalman method's run (its \
+--q or adaptive driving noise, its gate and flags): each row's estimate from the rows up to \
+--lag N rows after it (default 200), written N rows later with the flag the forward filter \
+gave it, the last N rows from every row at the end; nis is the forward filter's. It holds N+1 \
+rows (at most 2.8 kB each: 0.6 MB at the default); a lag beyond the input's rows is the \
+whole-interval smoother, and a lag whose rows would take over 100 MB is said on stderr before \
+the first row. The other methods stream: each row's output is written as it is read, in \
+memory independent of the input's length.
 
 Angles in radians; --azimuth from-x (default): from +x towards +y; --azimuth bearing: \
 clockwise from north with x = east, y = north. Elevation from the x-y plane. An empty range, \
@@ -179,10 +197,14 @@ flag it is refused where the row measures a component that sigma weighs.
 const FIT_AFTER_HELP: &str = concat!(
     "\
 Output: CSV, one row per input row in input order, with the header
-  --model radar:       t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,iterations,chi2
+  --model radar:       t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,iterations,chi2,flag
                        (--degree 2: t,x,y,z,vx,vy,vz,ax,ay,az,sx,...,svz,sax,say,saz,...)
   --model polynomial:  t,y,d0..dM,s0..sM,iterations,chi2
-and, with --epoch other than end, a last column epoch: the time the state refers to. The t \
+and, with --epoch other than end, a column epoch before flag: the time the state refers to. \
+The radar's flag is 'misfit' where the window's chi2 lies beyond the 99% point of chi-squared \
+with its degrees of freedom (the model does not follow the window's rows), else empty; its s \
+columns carry the misfit, scaled by sqrt(max(1, chi2/dof)) (as 'seqsmooth track --method \
+window'). The t \
 (and y) cells echo the input cells. Each row's state is the Gauss-Newton differential \
 correction (Morrison 8.6-8.7) of the last W rows up to and including it (all rows so far \
 while fewer have come): the minimum-variance estimate of the state at the epoch, with its \
@@ -223,12 +245,20 @@ transients of the estimates (the residual axis, the rows before the highest deri
 has a value); residuals beyond the range are drawn as triangles at its edge.
 
 With a lead column (filter --lead H) each estimate is drawn at its own time t+H and, in the \
-residual panel, compared with the sample at that time (to a thousandth of the median step); \
+residual panel, compared with the sample at that time (to a thousandth of the median of the \
+first 1,024 steps); \
 rows whose t+H is no sample time have no residual, and the subtitle says how many have one.
 
-A series with more rows than the plot has pixel columns is drawn decimated per pixel column \
-(the first, lowest, highest and last point of each column: every extreme kept), its samples \
-as a thin line instead of dots. An axis whose values share many leading digits, or are very \
+The rows are read one at a time and decimated as they come, in memory set by the image's \
+width, not the input's length (standard input too: one pass). A series with more rows than \
+the plot has pixel columns is drawn decimated per pixel column (the first, lowest, highest and \
+last point of each column: every extreme kept); its samples, too many for dots, as the band \
+from each column's lowest to its highest; many rejected samples as small crosses (at most \
+the lowest and highest per column), their number in the legend; the misfit flag by the share \
+of each column's time it is up. A step between samples longer than 10 times the median step \
+is an outage: hatched, and no line or band is drawn across it. A value beyond an axis (a \
+start-up transient, an outlier) is drawn at its edge and marked by a triangle, and the panel \
+notes how far the lines go. An axis whose values share many leading digits, or are very \
 large or small, is drawn in tick units and its label says how to read them back: 'value = \
 tick x 1e9 + 1.7e18'; a time axis counts from its first time, 't = t0 + tick x 1e9, t0 = \
 1.7e18 (as Unix ns: 2023-11-14 22:13:20 UTC)', with the date when t0 reads as Unix seconds, \
@@ -481,9 +511,9 @@ pub struct FitArgs {
     #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
     pub degree: Option<usize>,
     /// The number of rows in each window, W >= 1 (all rows so far while fewer have come)
-    #[arg(long, value_name = "W", default_value = "60", value_parser = parse_window,
-          allow_hyphen_values = true)]
-    pub window: usize,
+    /// [default: radar 8, polynomial 60]
+    #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
+    pub window: Option<usize>,
     /// The time each row's state refers to: 'end' (the row's own time), 'centre' (the mean
     /// time of its window) or a time T
     #[arg(long, value_name = "EPOCH", default_value = "end", value_parser = parse_epoch,
@@ -553,19 +583,29 @@ pub struct TrackArgs {
     #[arg(long, value_name = "NAME")]
     pub sigma_angle_col: Option<String>,
     /// kalman, smooth: spectral density of the white-noise acceleration on each axis
+    /// [default: adaptive, from the innovations]
     #[arg(long = "q", value_name = "ACCEL_PSD", value_parser = parse_psd, allow_hyphen_values = true)]
     pub q: Option<f64>,
-    /// fading: the discount per unit of time, 0 < B <= 1
+    /// fading: the discount per unit of time, 0 < B <= 1 [default: an adaptive discount per
+    /// update, from the innovations]
     #[arg(long, value_name = "B", value_parser = parse_discount, allow_hyphen_values = true,
           conflicts_with = "theta")]
     pub beta: Option<f64>,
     /// fading: the discount per update, 0 < T <= 1
     #[arg(long, value_name = "T", value_parser = parse_discount, allow_hyphen_values = true)]
     pub theta: Option<f64>,
-    /// window: the number of rows in each window
-    #[arg(long, value_name = "W", default_value = "60", value_parser = parse_window,
-          allow_hyphen_values = true)]
-    pub window: usize,
+    /// window: the number of rows in each window [default: 8]
+    #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
+    pub window: Option<usize>,
+    /// Gauss-Newton iterations allowed per fit (the window method's fits, the Kalman
+    /// methods' start)
+    #[arg(long, value_name = "N", default_value_t = 20,
+          value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub max_iterations: u32,
+    /// smooth: the lag in rows: each row's estimate from the N rows after it, written N rows
+    /// later; the smoother holds N+1 rows (0 is the kalman filter) [default: 200]
+    #[arg(long, value_name = "N")]
+    pub lag: Option<usize>,
     /// The azimuth convention of the input
     #[arg(long, value_enum, default_value_t = AzimuthConvention::FromX)]
     pub azimuth: AzimuthConvention,

@@ -15,21 +15,38 @@
 //! - the residual panel `y − d0`, relative to the estimate: the residuals, the estimate's ±3σ
 //!   band about zero, ±3σ of the noise (dashed) where known, and `truth − d0` where known;
 //!   with a lead, each estimate is compared with the sample at its own time `t + lead`;
-//! - in every panel, the spans without samples (shaded grey), the spans where the misfit flag
-//!   is up (shaded orange), the switches to fading memory (green dashed lines) and the
-//!   restarts (purple lines).
+//! - in every panel, the outages (hatched grey), the spans where the misfit flag is up
+//!   (shaded pink under a solid strip along the top), the switches to fading memory (green dashed lines) and the restarts
+//!   (purple lines).
 //!
-//! A series with more points than the plot has pixel columns is drawn decimated per pixel
-//! column ([`crate::decimate`]), and its samples as a thin line rather than dots. Axes whose
-//! values share many leading digits or are very large or small are drawn in tick units with
-//! an offset and a power of ten, said in the axis label ([`crate::ticks`]).
+//! **Outages.** A step between consecutive samples longer than [`OUTAGE_STEPS`] times the
+//! typical step (the median step) is an outage ([`is_outage`], [`outages`]): it is hatched, and
+//! no line, band or envelope is drawn across it — every curve breaks there, as it does where
+//! its value is missing.
 //!
-//! Axis ranges ignore the start-up transients of the estimates (the 1st-99th percentile of the
-//! estimates widened by the truth); a residual or band beyond the range is clipped to its edge,
-//! where a clipped residual is drawn as a triangle. The PNG's text is drawn with the embedded
-//! DejaVu Sans (no system fonts are read); the SVG names the family `DejaVu Sans, sans-serif`.
+//! **Dense series.** A series with more points than the plot has pixel columns is drawn
+//! decimated per pixel column ([`crate::decimate`]); its samples, too many for dots, as the
+//! band between each column's lowest and highest sample (an envelope, not a zig-zag line that
+//! would fill it solid), and its rejected samples as small crosses, at most the lowest and
+//! highest of each column, their number in the legend. `seqsmooth plot` reads its rows into a
+//! [`Track`] through [`crate::decimate::Reducer`], keeping per half pixel the rows that hold
+//! the extremes of every quantity drawn ([`drawn`]) plus a systematic sample of rows for the
+//! axis ranges' quantiles ([`Track::sampled`]). Axes whose values share many leading digits
+//! or are very large or small are drawn in tick units with an offset and a power of ten, said
+//! in the axis label ([`crate::ticks`]).
+//!
+//! **Beyond the axis.** Axis ranges ignore the start-up transients of the estimates (the
+//! 1st-99th percentile of the estimates widened by the truth). A value beyond the range is
+//! drawn at the axis edge and marked: a clipped sample as a triangle pointing off the axis,
+//! each run of a clipped line (estimate, truth, error) by such a triangle at its farthest
+//! point, and the panel notes how far the line goes ("beyond the axis: …"). The PNG's text is
+//! drawn with the embedded DejaVu Sans (no system fonts are read); the SVG names the family
+//! `DejaVu Sans, sans-serif`.
 
-use crate::decimate::min_max;
+mod panel;
+mod track;
+
+use crate::decimate::{envelope, min_max};
 use crate::error::CliError;
 use crate::ticks::Scale;
 use plotters::coord::Shift;
@@ -76,39 +93,6 @@ impl Format {
     }
 }
 
-/// The rows of a filter run, column by column (every vector has one entry per row).
-#[derive(Clone, Debug, Default)]
-pub struct Track {
-    /// Sample times.
-    pub t: Vec<f64>,
-    /// Measured values.
-    pub y: Vec<f64>,
-    /// `d[k][i]`: the `k`-th derivative estimated at row `i`, where determined.
-    pub d: Vec<Vec<Option<f64>>>,
-    /// `s[k][i]`: its 1σ, where known (`s[k]` may be missing or empty: no band).
-    pub s: Vec<Vec<Option<f64>>>,
-    /// `truth[k][i]`: the true `k`-th derivative (`truth[k]` empty or missing: unknown).
-    pub truth: Vec<Vec<f64>>,
-    /// The noise σ in use at each row (empty: unknown).
-    pub noise: Vec<Option<f64>>,
-    /// Whether each row's sample was rejected as an outlier (empty: no such column).
-    pub rejected: Vec<bool>,
-    /// Whether the misfit flag is up at each row (empty: no such column).
-    pub misfit: Vec<bool>,
-    /// Times at which the output switched from expanding to fading memory.
-    pub switches: Vec<f64>,
-    /// Times at which the memory was restarted on misfit.
-    pub restarts: Vec<f64>,
-    /// Whether each row is past the start-up (its estimate of the full degree; empty: every
-    /// row): the residual and error panels' ranges leave the others out.
-    pub settled: Vec<bool>,
-    /// Spans `(from, to)` with no samples (e.g. a sensor outage), shaded in every panel.
-    pub outages: Vec<(f64, f64)>,
-    /// The estimates are valid at `t + lead`: drawn there, and compared with the sample at
-    /// that time where there is one ([`samples_at_lead`]).
-    pub lead: f64,
-}
-
 /// What to draw and how to label it.
 #[derive(Clone, Debug)]
 pub struct Layout {
@@ -144,9 +128,17 @@ const TRUTH: RGBColor = RGBColor(0, 0, 0);
 const NOISE: RGBColor = RGBColor(230, 120, 0);
 const SWITCH: RGBColor = RGBColor(0, 140, 70);
 const RESTART: RGBColor = RGBColor(140, 40, 170);
-const MISFIT: RGBColor = RGBColor(255, 170, 60);
+const MISFIT: RGBColor = RGBColor(225, 60, 150);
 const TRUTH_ERROR: RGBColor = RGBColor(0, 130, 140);
-const OUTAGE: RGBColor = RGBColor(150, 150, 150);
+const OUTAGE: RGBColor = RGBColor(110, 110, 110);
+/// Opacities of the misfit and outage shading and of a dense series' envelope.
+const MISFIT_ALPHA: f64 = 0.16;
+const OUTAGE_ALPHA: f64 = 0.12;
+const ENVELOPE_ALPHA: f64 = 0.35;
+/// Marks of values beyond the axis at most one per this many pixels along each edge.
+const MARK_SPACING: i64 = 12;
+/// Height in pixels of the solid strip along the top of a misfit span.
+const MISFIT_STRIP: i32 = 4;
 
 fn register() -> Result<(), CliError> {
     static DONE: OnceLock<bool> = OnceLock::new();
@@ -201,14 +193,6 @@ fn font(size: f64) -> TextStyle<'static> {
     TextStyle::from((FAMILY, size).into_font()).color(&BLACK)
 }
 
-/// The value `p`-quantile of the finite `values` (nearest rank), if any.
-fn quantile(values: impl IntoIterator<Item = f64>, p: f64) -> Option<f64> {
-    let mut values: Vec<f64> = values.into_iter().collect();
-    values.sort_by(f64::total_cmp);
-    let k = (values.len().saturating_sub(1) as f64 * p).round() as usize;
-    values.get(k).copied()
-}
-
 /// `[lo, hi]` widened by `pad` of its span on each side (a unit span about a single value).
 fn padded((lo, hi): (f64, f64), pad: f64) -> (f64, f64) {
     let span = hi - lo;
@@ -227,241 +211,9 @@ fn widen(range: &mut Option<(f64, f64)>, values: impl IntoIterator<Item = f64>) 
     }
 }
 
-/// Maximal runs of consecutive indices where `keep` holds.
-pub fn runs(n: usize, keep: impl Fn(usize) -> bool) -> Vec<std::ops::Range<usize>> {
-    let mut out = Vec::new();
-    let mut start = None;
-    for i in 0..=n {
-        match (i < n && keep(i), start) {
-            (true, None) => start = Some(i),
-            (false, Some(s)) => {
-                out.push(s..i);
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    out
-}
-
 pub use crate::ticks::tick;
-
-/// The rows whose estimate has a sample at its own time `t + lead`: for each row, the index
-/// of the sample whose time is within a thousandth of the median step of `t + lead` (every
-/// row itself for `lead = 0`). `t` is strictly increasing.
-///
-/// ```
-/// use seqsmooth_cli::chart::samples_at_lead;
-/// let t = [0.0, 0.1, 0.2, 0.30000000000000004, 0.4];
-/// assert_eq!(samples_at_lead(&t, 0.2), vec![Some(2), Some(3), Some(4), None, None]);
-/// assert_eq!(samples_at_lead(&t, 0.0)[1], Some(1));
-/// ```
-pub fn samples_at_lead(t: &[f64], lead: f64) -> Vec<Option<usize>> {
-    if lead == 0.0 {
-        return (0..t.len()).map(Some).collect();
-    }
-    let steps = t.windows(2).map(|w| w[1] - w[0]);
-    let tol = 1e-3 * quantile(steps, 0.5).unwrap_or(0.0);
-    t.iter()
-        .map(|&ti| {
-            let at = ti + lead;
-            let j = t.partition_point(|&s| s < at);
-            [j.checked_sub(1), Some(j)]
-                .into_iter()
-                .flatten()
-                .filter(|&j| j < t.len() && (t[j] - at).abs() <= tol)
-                .min_by(|&a, &b| (t[a] - at).abs().total_cmp(&(t[b] - at).abs()))
-        })
-        .collect()
-}
-
-/// What a panel shows.
-#[derive(Clone, Copy, PartialEq)]
-enum What {
-    /// The estimate of derivative `k`, with the samples for `k = 0` and the truth.
-    Derivative(usize),
-    /// The error `d_k − truth_k` about zero (the truth), with the samples' `y − truth` for
-    /// `k = 0`.
-    Error(usize),
-    /// `y − d0` about zero (the estimate), with `truth − d0`.
-    Residual,
-}
-
-/// One panel's y data, relative to the estimate (residual panel) or the truth (error panel).
-struct PanelData {
-    label: String,
-    /// Points: (time, value, rejected).
-    points: Vec<(f64, f64, bool)>,
-    /// The row of each point.
-    point_rows: Vec<usize>,
-    /// Whether each row is past the start-up (the relative panels' range is of those only).
-    settled: Vec<bool>,
-    /// The centre line (the estimate, its error, or zero) by row.
-    line: Vec<Option<f64>>,
-    /// The ±3σ half-width by row.
-    band: Vec<Option<f64>>,
-    /// The truth (zero in an error panel, truth − estimate in the residual panel) by row.
-    truth: Vec<Option<f64>>,
-    /// What the truth line is, for the legend.
-    truth_key: Key,
-    /// ±3σ noise lines by row.
-    noise: Vec<Option<f64>>,
-    /// The x offset of the line, band and truth (the lead), and of the truth alone.
-    shift: f64,
-    truth_shift: f64,
-    range: (f64, f64),
-    /// Clip points beyond the range to the edge (residual and error panels).
-    clip_points: bool,
-}
-
-/// The panel showing `what` of `track`; `at[i]` is the sample at row `i`'s estimate time.
-fn panel(track: &Track, what: What, label: &str, at: &[Option<usize>]) -> PanelData {
-    let n = track.t.len();
-    let j = match what {
-        What::Derivative(k) | What::Error(k) => k,
-        What::Residual => 0,
-    };
-    let cell = |v: &[Vec<Option<f64>>], i: usize| v.get(j).and_then(|v| v.get(i)).copied()?;
-    let truth = |i: usize| track.truth.get(j).and_then(|x| x.get(i)).copied();
-    // The sample at row i's estimate time, and the value every row's numbers are relative to.
-    let own = |i: usize| at.get(i).copied().flatten();
-    let base = |i: usize| match what {
-        What::Derivative(_) => Some(0.0),
-        What::Error(_) => own(i).and_then(truth),
-        What::Residual => own(i).and(cell(&track.d, i)),
-    };
-    let rejected = |i: usize| track.rejected.get(i) == Some(&true);
-    // Each point with its row: (row, time, value, rejected).
-    let points: Vec<(usize, (f64, f64, bool))> = match what {
-        What::Derivative(0) => (0..n)
-            .map(|i| (i, (track.t[i], track.y[i], rejected(i))))
-            .collect(),
-        What::Error(0) => (0..n)
-            .filter_map(|i| truth(i).map(|x| (i, (track.t[i], track.y[i] - x, rejected(i)))))
-            .collect(),
-        What::Residual => (0..n)
-            .filter_map(|i| {
-                let s = own(i)?;
-                base(i).map(|b| (i, (track.t[s], track.y[s] - b, rejected(s))))
-            })
-            .collect(),
-        _ => Vec::new(),
-    };
-    let (point_rows, points) = points.into_iter().unzip();
-    // The rows after the start-up (all of them when none is marked settled).
-    let settled = if track.settled.len() == n && track.settled.contains(&true) {
-        track.settled.clone()
-    } else {
-        vec![true; n]
-    };
-    let rows = |f: &dyn Fn(usize, f64) -> Option<f64>| -> Vec<Option<f64>> {
-        (0..n).map(|i| base(i).and_then(|b| f(i, b))).collect()
-    };
-    let relative = what != What::Derivative(j);
-    let noise = |i: usize| {
-        track
-            .noise
-            .get(i)
-            .copied()
-            .flatten()
-            .filter(|_| relative && j == 0)
-    };
-    let mut p = PanelData {
-        label: label.to_string(),
-        points,
-        point_rows,
-        settled,
-        line: rows(&|i, b| cell(&track.d, i).map(|d| d - b)),
-        band: rows(&|i, _| cell(&track.s, i).map(|s| 3.0 * s)),
-        truth: match what {
-            What::Derivative(_) => (0..n).map(truth).collect(),
-            What::Error(_) => rows(&|_, _| Some(0.0)),
-            What::Residual => rows(&|i, b| own(i).and_then(truth).map(|x| x - b)),
-        },
-        truth_key: if what == What::Residual {
-            Key::TruthError
-        } else {
-            Key::Truth
-        },
-        noise: (0..n).map(|i| noise(i).map(|s| 3.0 * s)).collect(),
-        shift: track.lead,
-        truth_shift: if relative { track.lead } else { 0.0 },
-        range: (0.0, 1.0),
-        clip_points: relative,
-    };
-    p.range = if p.clip_points {
-        p.relative_range()
-    } else {
-        p.derivative_range()
-    };
-    p
-}
-
-impl PanelData {
-    /// Every sample, the truth, and the central 98% of the estimates (start-up transients of
-    /// the higher derivatives would squash the panel).
-    fn derivative_range(&self) -> (f64, f64) {
-        let (line, band) = (&self.line, &self.band);
-        let mut range = None;
-        widen(&mut range, self.points.iter().map(|p| p.1));
-        widen(&mut range, self.truth.iter().flatten().copied());
-        let est = || line.iter().flatten().copied().filter(|v| v.is_finite());
-        if let (Some(lo), Some(hi)) = (quantile(est(), 0.01), quantile(est(), 0.99)) {
-            widen(&mut range, [lo, hi]);
-        }
-        // The band where it is no wider than the spread of the panel (not at start-up).
-        if let Some((lo, hi)) = range {
-            let span = (hi - lo).max(f64::MIN_POSITIVE);
-            if let Some(h) = quantile(band.iter().flatten().copied(), 0.9) {
-                if h < 0.25 * span {
-                    for (l, b) in line.iter().zip(band) {
-                        if let (Some(l), Some(b)) = (l, b) {
-                            if *b <= h {
-                                widen(&mut range, [l - b, l + b]);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        padded(range.unwrap_or((0.0, 1.0)), 0.05)
-    }
-
-    /// Symmetric: the 99th percentile of |value| of the accepted samples, every rejected one
-    /// up to twice that, the ±3σ noise and the settled band, the truth's and the line's
-    /// distance from zero; of the rows past the start-up.
-    fn relative_range(&self) -> (f64, f64) {
-        let settled = |k: &usize| self.settled[*k];
-        let points = || {
-            let rows = self.point_rows.iter();
-            rows.zip(&self.points)
-                .filter(|(k, _)| settled(k))
-                .map(|(_, p)| p)
-        };
-        let rows = |v: &[Option<f64>]| -> Vec<f64> {
-            v.iter()
-                .zip(&self.settled)
-                .filter(|r| *r.1)
-                .filter_map(|r| *r.0)
-                .map(f64::abs)
-                .collect()
-        };
-        let q = |v: Vec<f64>, p| quantile(v, p).unwrap_or(0.0);
-        let mut r = q(points().filter(|p| !p.2).map(|p| p.1.abs()).collect(), 0.99)
-            .max(q(rows(&self.noise), 0.9))
-            .max(q(rows(&self.band), 0.9))
-            .max(q(rows(&self.truth), 0.99))
-            .max(q(rows(&self.line), 0.99));
-        let cap = 2.0 * r;
-        for p in points().filter(|p| p.2) {
-            r = r.max(p.1.abs().min(cap));
-        }
-        if r <= 0.0 || !r.is_finite() {
-            r = 1.0;
-        }
-        (-1.08 * r, 1.08 * r)
-    }
-}
+use panel::{panels, PanelData};
+pub use track::*;
 
 /// The legend entries that apply.
 #[derive(Clone, Copy, PartialEq)]
@@ -482,11 +234,17 @@ enum Key {
 }
 
 impl Key {
-    fn label(self) -> &'static str {
-        match self {
+    fn label(self, track: &Track) -> String {
+        let text = match self {
             Key::Data => "samples",
-            Key::DataLine => "samples (too dense for dots: joined)",
-            Key::Rejected => "rejected (outlier)",
+            Key::DataLine => "samples, lowest to highest per pixel (too dense for dots)",
+            Key::Rejected => {
+                let n = match track.counts {
+                    Some(c) => c.rejected,
+                    None => track.rejected.iter().filter(|&&r| r).count(),
+                };
+                return format!("rejected (outlier): {n}");
+            }
             Key::Estimate => "estimate",
             Key::Band => "estimate ±3σ",
             Key::Truth => "truth",
@@ -494,15 +252,21 @@ impl Key {
             Key::Noise => "noise ±3σ",
             Key::Switch => "switch to fading memory",
             Key::Restart => "misfit restart",
+            Key::Misfit if !track.misfit_share.is_empty() => {
+                "misfit flagged (the darker, the more of the time)"
+            }
             Key::Misfit => "misfit flagged",
             Key::Outage => "no samples (outage)",
-            Key::Clipped => "beyond the axis",
-        }
+            Key::Clipped => "beyond the axis (at its edge)",
+        };
+        text.to_string()
     }
 }
 
-/// Samples drawn as dots up to one per this many pixel columns, else joined by a line.
+/// Samples drawn as dots up to one per this many pixel columns, else as their envelope.
 const DOTS_PER_PIXEL: f64 = 0.5;
+/// Rejected samples drawn as large crosses up to one per this many pixel columns, else small.
+const CROSSES_PER_PIXEL: f64 = 0.05;
 
 /// Whether the panel's samples are too many for dots across `columns` pixels.
 fn dense(p: &PanelData, columns: u32) -> bool {
@@ -512,7 +276,9 @@ fn dense(p: &PanelData, columns: u32) -> bool {
 fn legend_keys(panels: &[PanelData], track: &Track, columns: u32) -> Vec<Key> {
     let any = |f: &dyn Fn(&PanelData) -> bool| panels.iter().any(f);
     let clipped = |p: &PanelData| {
-        p.clip_points && p.points.iter().any(|q| q.1 < p.range.0 || q.1 > p.range.1)
+        let out = |v: f64| v < p.range.0 || v > p.range.1;
+        (p.clip_points && p.points.iter().any(|q| out(q.1)))
+            || p.line.iter().chain(&p.truth).flatten().any(|&v| out(v))
     };
     let samples = |p: &PanelData| p.points.iter().any(|q| !q.2);
     let truth =
@@ -529,7 +295,10 @@ fn legend_keys(panels: &[PanelData], track: &Track, columns: u32) -> Vec<Key> {
         (any(&|p| p.noise.iter().any(Option::is_some)), Key::Noise),
         (!track.switches.is_empty(), Key::Switch),
         (!track.restarts.is_empty(), Key::Restart),
-        (track.misfit.iter().any(|&m| m), Key::Misfit),
+        (
+            !track.misfit.is_empty() || !track.misfit_share.is_empty(),
+            Key::Misfit,
+        ),
         (!track.outages.is_empty(), Key::Outage),
     ]
     .into_iter()
@@ -539,6 +308,30 @@ fn legend_keys(panels: &[PanelData], track: &Track, columns: u32) -> Vec<Key> {
 
 /// A drawing error of either backend.
 type Err = Box<dyn std::error::Error>;
+
+/// A triangle at `$at` (a coordinate of the area drawn on) pointing up (`$up`) or down, 9
+/// pixels tall: the mark of a value beyond the top or bottom of the axis.
+macro_rules! edge_mark {
+    ($at:expr, $up:expr, $style:expr) => {{
+        let h = if $up { -9 } else { 9 };
+        EmptyElement::at($at) + Polygon::new(vec![(-6, 0), (6, 0), (0, h)], $style)
+    }};
+}
+
+/// Hatching of the pixel rectangle `(x0, y0)-(x1, y1)`: 45° lines `gap` pixels apart.
+fn hatch((x0, y0): (i32, i32), (x1, y1): (i32, i32), gap: i32) -> Vec<[(i32, i32); 2]> {
+    let (w, h) = (x1 - x0, y1 - y0);
+    let mut out = Vec::new();
+    // Lines x - x0 + (y - y0) = c, from the bottom-left to the top-right.
+    let mut c = gap / 2;
+    while c < w + h {
+        let a = (x0 + (c - h).max(0), y0 + c.min(h));
+        let b = (x0 + c.min(w), y0 + (c - w).max(0));
+        out.push([a, b]);
+        c += gap;
+    }
+    out
+}
 
 /// Draws the legend symbol of `key` centred at `(x, y)`.
 fn symbol<DB: DrawingBackend<ErrorType: 'static>>(
@@ -553,9 +346,11 @@ fn symbol<DB: DrawingBackend<ErrorType: 'static>>(
     let rect = |c: RGBAColor| area.draw(&Rectangle::new(corners, c.filled()));
     match key {
         Key::Data => area.draw(&Circle::new((x, y), 3, DATA.filled())),
-        Key::DataLine => seg((x - 14, y), (x + 14, y), DATA, 1),
+        Key::DataLine => rect(DATA.mix(ENVELOPE_ALPHA)),
         Key::Rejected => area.draw(&Cross::new((x, y), 5, REJECTED.stroke_width(2))),
-        Key::Clipped => area.draw(&TriangleMarker::new((x, y), 5, DATA.filled())),
+        Key::Clipped => area
+            .draw(&edge_mark!((x - 7, y + 4), true, DATA.filled()))
+            .and_then(|_| area.draw(&edge_mark!((x + 7, y - 4), false, DATA.filled()))),
         Key::Estimate => seg((x - 14, y), (x + 14, y), ESTIMATE, 2),
         Key::Band => rect(ESTIMATE.mix(0.22)),
         Key::Truth => seg((x - 14, y), (x + 14, y), TRUTH, 1),
@@ -565,8 +360,15 @@ fn symbol<DB: DrawingBackend<ErrorType: 'static>>(
         Key::Switch => seg((x, y - 8), (x, y - 2), SWITCH, 2)
             .and_then(|_| seg((x, y + 2), (x, y + 8), SWITCH, 2)),
         Key::Restart => seg((x, y - 8), (x, y + 8), RESTART, 2),
-        Key::Misfit => rect(MISFIT.mix(0.3)),
-        Key::Outage => rect(OUTAGE.mix(0.35)),
+        Key::Misfit => rect(MISFIT.mix(MISFIT_ALPHA)).and_then(|_| {
+            let strip = [(x - 14, y - 7), (x + 14, y - 7 + MISFIT_STRIP)];
+            area.draw(&Rectangle::new(strip, MISFIT.filled()))
+        }),
+        Key::Outage => rect(OUTAGE.mix(OUTAGE_ALPHA)).and_then(|_| {
+            hatch(corners[0], corners[1], 6)
+                .into_iter()
+                .try_for_each(|[a, b]| seg(a, b, OUTAGE, 1))
+        }),
     }?;
     Ok(())
 }
@@ -575,13 +377,14 @@ fn symbol<DB: DrawingBackend<ErrorType: 'static>>(
 fn legend_rows<DB: DrawingBackend<ErrorType: 'static>>(
     area: &DrawingArea<DB, Shift>,
     keys: &[Key],
+    track: &Track,
     width: i32,
 ) -> Result<Vec<Vec<(Key, i32)>>, Err> {
     let style = font(15.0);
     // Each row's items (key, x from the row's start) and width.
     let mut rows: Vec<(Vec<(Key, i32)>, i32)> = vec![(Vec::new(), 0)];
     for &k in keys {
-        let item = 32 + area.estimate_text_size(k.label(), &style)?.0 as i32 + 18;
+        let item = 32 + area.estimate_text_size(&k.label(track), &style)?.0 as i32 + 18;
         if rows
             .last()
             .is_some_and(|(row, w)| w + item > width - 40 && !row.is_empty())
@@ -600,22 +403,15 @@ fn legend_rows<DB: DrawingBackend<ErrorType: 'static>>(
     Ok(rows.into_iter().map(|(row, _)| row).collect())
 }
 
-/// The panels of `layout` drawn from `track`, top to bottom.
-fn panels(track: &Track, layout: &Layout) -> Vec<PanelData> {
-    let at = samples_at_lead(&track.t, track.lead);
-    let errors = layout.errors.iter().map(|(k, l)| (What::Error(*k), l));
-    let derivatives = layout.panels.iter().map(|(k, l)| (What::Derivative(*k), l));
-    let residuals = layout.residual_label.iter().map(|l| (What::Residual, l));
-    errors
-        .chain(derivatives)
-        .chain(residuals)
-        .map(|(what, label)| panel(track, what, label, &at))
-        .collect()
-}
-
 /// The plot width in pixels (the image less the axis label area and margins).
 fn plot_columns(layout: &Layout) -> u32 {
-    layout.size.0.saturating_sub(130).max(1)
+    columns_for_width(layout.size.0)
+}
+
+/// The plot's width in pixel columns in an image `width` pixels wide (less the axis label
+/// area and margins).
+pub fn columns_for_width(width: u32) -> u32 {
+    width.saturating_sub(130).max(1)
 }
 
 fn draw<DB: DrawingBackend<ErrorType: 'static>>(
@@ -641,11 +437,11 @@ fn draw<DB: DrawingBackend<ErrorType: 'static>>(
     }
     y += 6;
     let label_style = font(15.0).pos(Pos::new(HPos::Left, VPos::Center));
-    for row in legend_rows(root, &keys, width)? {
+    for row in legend_rows(root, &keys, track, width)? {
         let cy = y + 11;
         for (key, x) in row {
             symbol(root, key, (x + 14, cy))?;
-            root.draw_text(key.label(), &label_style, (x + 32, cy))?;
+            root.draw_text(&key.label(track), &label_style, (x + 32, cy))?;
         }
         y += 26;
     }
@@ -761,21 +557,52 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     let (top, floor) = (ay(y1), ay(y0));
     let shade =
         |a: f64, b: f64, c: RGBAColor| Rectangle::new([(ax(a), top), (ax(b), floor)], c.filled());
+    let spec = chart.as_coord_spec().clone();
+    let pixel = |x: f64, y: f64| spec.translate(&(x, y));
 
-    // Outages, then the misfit spans: from each flagged row to the next row.
+    // Outages (hatched), then the misfit spans.
+    let area = chart.plotting_area().strip_coord_spec();
+    let base = chart.plotting_area().get_base_pixel();
     for &(a, b) in &track.outages {
-        chart.draw_series([shade(a, b, OUTAGE.mix(0.35))])?;
-    }
-    if track.misfit.len() == n {
-        for r in runs(n, |i| track.misfit[i]) {
-            let a = track.t[r.start];
-            let b = track.t[r.end.min(n - 1)].max(a);
-            chart.draw_series([shade(a, b, MISFIT.mix(0.3))])?;
+        chart.draw_series([shade(a, b, OUTAGE.mix(OUTAGE_ALPHA))])?;
+        let (p0, p1) = (pixel(ax(a), top), pixel(ax(b), floor));
+        let local = |p: (i32, i32)| (p.0 - base.0, p.1 - base.1);
+        for [u, v] in hatch(local(p0), local(p1), 8) {
+            area.draw(&PathElement::new(
+                vec![u, v],
+                OUTAGE.mix(0.5).stroke_width(1),
+            ))?;
         }
     }
+    // A decimated track's misfit: per pixel column, the share of its time flagged (in
+    // tenths), shaded the darker the more, with the strip where it is at least half.
+    let shares = misfit_columns(&track.misfit_share, span, columns as usize, &ax);
+    for (a, b, share) in shares {
+        let tint = MISFIT.mix(MISFIT_ALPHA * (0.25 + 0.75 * share));
+        chart.draw_series([Rectangle::new([(a, top), (b, floor)], tint.filled())])?;
+        if share >= 0.5 {
+            let (p0, p1) = (pixel(a, top), pixel(b, top));
+            let local = |p: (i32, i32)| (p.0 - base.0, p.1 - base.1);
+            let (u, v) = (local(p0), local(p1));
+            let strip = [u, (v.0.max(u.0 + 1), v.1 + MISFIT_STRIP)];
+            area.draw(&Rectangle::new(strip, MISFIT.filled()))?;
+        }
+    }
+    for &(a, b) in &track.misfit {
+        chart.draw_series([shade(a, b, MISFIT.mix(MISFIT_ALPHA))])?;
+        let (p0, p1) = (pixel(ax(a), top), pixel(ax(b), top));
+        let local = |p: (i32, i32)| (p.0 - base.0, p.1 - base.1);
+        let (u, v) = (local(p0), local(p1));
+        let strip = [u, (v.0.max(u.0 + 1), v.1 + MISFIT_STRIP)];
+        area.draw(&Rectangle::new(strip, MISFIT.filled()))?;
+    }
+
+    // The runs of rows where `keep` holds, broken at the outages.
+    let after = breaks(track);
+    let runs_of = |keep: &dyn Fn(usize) -> bool| split_runs(runs(n, keep), &after);
 
     // ±3σ band: each edge decimated on its own.
-    for r in runs(n, |i| p.line[i].is_some() && p.band[i].is_some()) {
+    for r in runs_of(&|i| p.line[i].is_some() && p.band[i].is_some()) {
         let edge = |sign: f64| {
             let at = |i: usize| {
                 let (l, b) = (p.line[i].unwrap_or(0.0), p.band[i].unwrap_or(0.0));
@@ -791,7 +618,7 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     // The runs of a row-wise curve, `sign` times its values, at the times moved by `shift`,
     // decimated to the pixel columns.
     let curves = |v: &[Option<f64>], shift: f64, sign: f64| -> Vec<Vec<(f64, f64)>> {
-        runs(n, |i| v[i].is_some())
+        runs_of(&|i| v[i].is_some())
             .into_iter()
             .map(|r| {
                 let at = |i: usize| (ax(track.t[i] + shift), clamp(sign * v[i].unwrap_or(0.0)));
@@ -807,47 +634,140 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
         }
     }
 
-    // Samples: the points `$keep` picks, as `$shape`s at their values clamped to the range;
-    // too many for dots, the accepted ones are joined by a thin line instead.
+    // Samples: dots, or too many for dots, the envelope of the accepted ones between the
+    // outages; those beyond the axis as triangles at its edge, one per pixel column and edge.
     let inside = |v: f64| v >= y0 && v <= y1;
-    macro_rules! points {
-        ($keep:expr, $shape:ident, $size:expr, $style:expr) => {
-            let at = |q: &(f64, f64, bool)| (ax(q.0), clamp(q.1));
-            let shapes = p
-                .points
-                .iter()
-                .filter($keep)
-                .map(|q| $shape::new(at(q), $size, $style));
-            chart.draw_series(shapes)?;
-        };
-    }
+    let column = |x: f64| {
+        let c = (ax(x) - span.0) / (span.1 - span.0) * f64::from(columns);
+        c.floor() as i64
+    };
     if dense(p, columns) {
-        let accepted = p.points.iter().filter(|q| !q.2);
-        let line = thin(accepted.map(|q| (ax(q.0), clamp(q.1))).collect());
-        chart.draw_series(LineSeries::new(line, DATA.stroke_width(1)))?;
+        let accepted: Vec<(f64, f64)> = p
+            .points
+            .iter()
+            .filter(|q| !q.2)
+            .map(|q| (ax(q.0), clamp(q.1)))
+            .collect();
+        let gaps: Vec<(f64, f64)> = track.outages.iter().map(|o| (ax(o.0), ax(o.1))).collect();
+        for poly in envelope(&accepted, span, columns as usize, &gaps) {
+            chart.draw_series([Polygon::new(
+                poly.clone(),
+                DATA.mix(ENVELOPE_ALPHA).filled(),
+            )])?;
+            let mut outline = poly;
+            outline.push(outline[0]);
+            chart.draw_series([PathElement::new(outline, DATA.mix(0.6).stroke_width(1))])?;
+        }
     } else {
-        points!(|q| !q.2 && inside(q.1), Circle, 2, DATA.filled());
+        let dots = p.points.iter().filter(|q| !q.2 && inside(q.1));
+        chart.draw_series(dots.map(|q| Circle::new((ax(q.0), ay(q.1)), 2, DATA.filled())))?;
     }
-    if p.clip_points {
-        points!(|q| !inside(q.1), TriangleMarker, 5, DATA.filled());
+    // Samples beyond the axis: sparse, a mark each (one per MARK_SPACING pixels and edge);
+    // dense, where the envelope runs into the edges of a range made of quantiles, the share
+    // of them in a note (of the sampled rows: a decimated track keeps every extreme).
+    let mut notes = Vec::new();
+    if p.clip_points && dense(p, columns) {
+        for (rejected, what) in [(false, "samples"), (true, "rejected samples")] {
+            let sampled = || {
+                let rows = p.point_rows.iter().zip(&p.points);
+                rows.filter(|(k, q)| p.sampled[**k] && q.2 == rejected)
+                    .map(|(_, q)| q)
+            };
+            let all = sampled().count();
+            let out = sampled().filter(|q| !inside(q.1)).count();
+            if out > 0 {
+                let share = 100.0 * out as f64 / all.max(1) as f64;
+                notes.push(format!("about {share:.1} % of the {what}"));
+            }
+        }
+    } else if p.clip_points {
+        // One mark per MARK_SPACING pixels and edge.
+        let mut marked = std::collections::HashSet::new();
+        let beyond = p.points.iter().filter(|q| !inside(q.1));
+        let marks = beyond.filter(|q| marked.insert((column(q.0) / MARK_SPACING, q.1 > y1)));
+        let marks: Vec<_> = marks
+            .map(|q| edge_mark!((ax(q.0), clamp(q.1)), q.1 > y1, DATA.filled()))
+            .collect();
+        chart.draw_series(marks)?;
     }
 
-    // Truth, then the estimate over it.
+    // Rejected samples: large crosses on top, or when many, small translucent ones, at most
+    // the lowest and highest of each pixel column, under the estimate (which they would hide
+    // where the value's range dwarfs the noise).
+    let rejected: Vec<(f64, f64)> = p
+        .points
+        .iter()
+        .filter(|q| q.2)
+        .map(|q| (ax(q.0), clamp(q.1)))
+        .collect();
+    let many = rejected.len() as f64 > CROSSES_PER_PIXEL * f64::from(columns);
+    if many {
+        let kept = thin(rejected.clone());
+        let style = REJECTED.mix(0.7).stroke_width(1);
+        chart.draw_series(kept.into_iter().map(|q| Cross::new(q, 3, style)))?;
+    }
+
+    // Truth, then the estimate over it; each run beyond the axis marked at its farthest point.
     let truth_style = match p.truth_key {
         Key::TruthError => TRUTH_ERROR.stroke_width(2),
         _ => TRUTH.stroke_width(1),
     };
-    for (v, shift, style) in [
-        (&p.truth, p.truth_shift, truth_style),
-        (&p.line, p.shift, ESTIMATE.stroke_width(2)),
+    for (v, shift, style, name, colour) in [
+        (
+            &p.truth,
+            p.truth_shift,
+            truth_style,
+            p.truth_key.label(track),
+            if p.truth_key == Key::TruthError {
+                TRUTH_ERROR
+            } else {
+                TRUTH
+            },
+        ),
+        (
+            &p.line,
+            p.shift,
+            ESTIMATE.stroke_width(2),
+            p.line_name.to_string(),
+            ESTIMATE,
+        ),
     ] {
         for pts in curves(v, shift, 1.0) {
             chart.draw_series(segments(pts, style, split))?;
         }
+        let mut last_mark: Option<(i32, bool)> = None;
+        let mut far: [Option<(f64, f64)>; 2] = [None, None];
+        for r in runs_of(&|i| v[i].is_some_and(|v| !inside(v))) {
+            let (i, value) = r
+                .map(|i| (i, v[i].unwrap_or(0.0)))
+                .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+                .unwrap_or((0, 0.0));
+            let up = value > y1;
+            let at = (ax(track.t[i] + shift), clamp(value));
+            let x = pixel(at.0, at.1).0;
+            if last_mark.is_none_or(|(px, pu)| pu != up || (x - px).abs() >= MARK_SPACING as i32) {
+                chart.draw_series([edge_mark!(at, up, colour.filled())])?;
+                last_mark = Some((x, up));
+            }
+            let slot = &mut far[usize::from(up)];
+            if slot.is_none_or(|(_, f)| value.abs() > f.abs()) {
+                *slot = Some((track.t[i] + shift, value));
+            }
+        }
+        let reach: Vec<String> = far
+            .iter()
+            .flatten()
+            .map(|&(t, v)| format!("{} at t = {}", significant(v), significant(t)))
+            .collect();
+        if !reach.is_empty() {
+            notes.push(format!("{name} reaches {}", reach.join(" and ")));
+        }
     }
 
-    // Rejected samples on top.
-    points!(|q| q.2, Cross, 5, REJECTED.stroke_width(2));
+    if !many {
+        let style = REJECTED.stroke_width(2);
+        chart.draw_series(rejected.into_iter().map(|q| Cross::new(q, 5, style)))?;
+    }
 
     // Events: switches to fading memory (dashed), restarts.
     let edge = |t: f64| vec![(ax(t), top), (ax(t), floor)];
@@ -857,5 +777,80 @@ fn draw_panel<DB: DrawingBackend<ErrorType: 'static>>(
     for &t in &track.restarts {
         chart.draw_series(LineSeries::new(edge(t), RESTART.stroke_width(2)))?;
     }
+
+    // What lies beyond the axis, in the panel's top left corner.
+    if !notes.is_empty() {
+        let text = format!("beyond the axis: {}", notes.join("; "));
+        let style = font(13.0).color(&RGBColor(60, 60, 60));
+        let (w, h) = area.estimate_text_size(&text, &style)?;
+        let (w, h) = (w as i32, h as i32);
+        area.draw(&Rectangle::new(
+            [(4, 4), (12 + w, 10 + h)],
+            WHITE.mix(0.85).filled(),
+        ))?;
+        area.draw_text(&text, &style, (8, 7))?;
+    }
     Ok(())
+}
+
+/// The pixel columns (of `columns` across the axis span `span`) that `shares` (spans of
+/// time, each with the share of it flagged) cover: runs of columns of the same share in
+/// tenths, as `(from, to, share)` in axis units, the share of each column the mean over it.
+fn misfit_columns(
+    shares: &[(f64, f64, f64)],
+    span: (f64, f64),
+    columns: usize,
+    ax: &dyn Fn(f64) -> f64,
+) -> Vec<(f64, f64, f64)> {
+    let w = (span.1 - span.0) / columns.max(1) as f64;
+    if shares.is_empty() || w.is_nan() || w <= 0.0 {
+        return Vec::new();
+    }
+    let mut col = vec![0.0; columns];
+    for &(a, b, s) in shares {
+        let (xa, xb) = (ax(a), ax(b));
+        let c0 = ((xa - span.0) / w).floor().max(0.0) as usize;
+        let c1 = (((xb - span.0) / w).ceil().max(0.0) as usize).min(columns);
+        for (c, v) in col.iter_mut().enumerate().take(c1).skip(c0) {
+            let lo = span.0 + c as f64 * w;
+            *v += s * (xb.min(lo + w) - xa.max(lo)).max(0.0) / w;
+        }
+    }
+    // in tenths, any flagged time at least one: however little, it shows
+    let tenths = |v: f64| {
+        let t = (v.min(1.0) * 10.0).round() as u8;
+        if v > 0.0 {
+            t.max(1)
+        } else {
+            0
+        }
+    };
+    let mut out = Vec::new();
+    let mut c = 0;
+    while c < columns {
+        let level = tenths(col[c]);
+        let end = (c..columns)
+            .find(|&e| tenths(col[e]) != level)
+            .unwrap_or(columns);
+        if level > 0 {
+            let x = |c: usize| span.0 + c as f64 * w;
+            out.push((x(c), x(end), f64::from(level) / 10.0));
+        }
+        c = end;
+    }
+    out
+}
+
+/// `x` to four significant digits.
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let a = x.abs();
+    if (1e-3..1e6).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.3e}")
+    }
 }

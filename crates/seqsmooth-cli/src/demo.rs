@@ -235,8 +235,13 @@ fn track(data: &[Point], outs: &[AutoOutput], rejected: Vec<bool>) -> Track {
     };
     let fading = |i: usize| outs[i].phase == Phase::Fading;
     let switches = (0..outs.len()).filter(|&i| fading(i) && (i == 0 || !fading(i - 1)));
+    let t: Vec<f64> = data.iter().map(|p| p.t).collect();
+    let misfit: Vec<bool> = outs.iter().map(|o| o.misfit).collect();
     Track {
-        t: data.iter().map(|p| p.t).collect(),
+        // The outages by the plot's own rule (the 12 s one), as `seqsmooth plot` finds them.
+        outages: chart::outages(&t),
+        misfit: chart::flag_spans(&t, &misfit),
+        t,
         y: data.iter().map(|p| p.y).collect(),
         d: (0..=DEGREE)
             .map(|k| rows(&|e| e.derivatives.get(k).copied()))
@@ -250,7 +255,6 @@ fn track(data: &[Point], outs: &[AutoOutput], rejected: Vec<bool>) -> Track {
         ],
         noise: outs.iter().map(|o| o.noise_sigma).collect(),
         rejected,
-        misfit: outs.iter().map(|o| o.misfit).collect(),
         switches: switches.map(|i| outs[i].time).collect(),
         restarts: outs.iter().filter(|o| o.restart).map(|o| o.time).collect(),
         settled: outs
@@ -261,8 +265,7 @@ fn track(data: &[Point], outs: &[AutoOutput], rejected: Vec<bool>) -> Track {
                     .is_some_and(|e| e.derivatives.len() > DEGREE)
             })
             .collect(),
-        outages: vec![(OUTAGE.0, OUTAGE.0 + OUTAGE.1)],
-        lead: 0.0,
+        ..Track::default()
     }
 }
 

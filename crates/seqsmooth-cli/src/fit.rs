@@ -12,7 +12,8 @@ use crate::io::{check_distinct, find_column, open_input, parse_cell, shown, writ
 use crate::io::{Need, Output};
 use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
-use seqsmooth::estimate::sliding::SlidingFit;
+use seqsmooth::estimate::sliding::{SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
+use seqsmooth::kalman::track::window_flag;
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::model::radar::Radar;
@@ -78,11 +79,15 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
     if epoch_column {
         cells.push("epoch".into());
     }
+    let flag_column = a.model == FitModel::Radar;
+    if flag_column {
+        cells.push("flag".into());
+    }
     text.extend_from_slice(cells.join(",").as_bytes());
     text.push(b'\n');
 
     let mut out: Option<Output> = None;
-    let mut lines: VecDeque<u64> = VecDeque::with_capacity(a.window.min(1 << 12));
+    let mut lines: VecDeque<u64> = VecDeque::with_capacity(window(a).min(1 << 12));
     let mut previous: Option<(f64, u64, Vec<u8>)> = None;
     let mut rows = 0usize;
     let n = setup.states.len();
@@ -108,7 +113,7 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
         let values = measured(&csv, line, &setup.columns, a.model)?;
         previous = Some((t, line, t_cell.clone()));
         rows += 1;
-        if lines.len() == a.window {
+        if lines.len() == window(a) {
             lines.pop_front();
         }
         lines.push_back(line);
@@ -125,7 +130,7 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
                 "line {line}: the fitted state holds {value}, beyond the double range; \
                  express the times in a larger unit or rescale the values"
             )),
-            e => window_error(e, &lines, a.window, a.model),
+            e => window_error(e, &lines, window(a), a.model),
         })?;
 
         text.extend_from_slice(&t_cell);
@@ -149,9 +154,13 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
                     text.push(b',');
                     write_f64(&mut text, c.epoch);
                 }
+                if flag_column {
+                    text.push(b',');
+                    text.extend_from_slice(window_flag(c).name().as_bytes());
+                }
             }
             None => {
-                let empty = 2 * n + 2 + usize::from(epoch_column);
+                let empty = 2 * n + 2 + usize::from(epoch_column) + usize::from(flag_column);
                 text.extend(std::iter::repeat_n(b',', empty));
             }
         }
@@ -171,11 +180,21 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
         return Err(CliError::Data(format!(
             "the input's {rows} rows never determine the state: no window of up to {} rows \
              holds enough measured components at enough distinct times ({} needs at least {})",
-            a.window, setup.need.why, setup.need.rows
+            window(a),
+            setup.need.why,
+            setup.need.rows
         )));
     };
     out.write(&text)?;
     out.finish()
+}
+
+/// The rows of each window: `--window`, else the model's default.
+fn window(a: &FitArgs) -> usize {
+    a.window.unwrap_or(match a.model {
+        FitModel::Radar => RADAR_WINDOW,
+        FitModel::Polynomial => POLYNOMIAL_WINDOW,
+    })
 }
 
 /// The fitter, columns and noise of the arguments.
@@ -225,7 +244,7 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
             need.check_header(header)?;
             let states = 3 * (degree + 1);
             let fit =
-                SlidingFit::radar(a.site, degree, a.window, epoch, solver).map_err(library)?;
+                SlidingFit::radar(a.site, degree, window(a), epoch, solver).map_err(library)?;
             let names = ["x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"];
             Ok(Setup {
                 fitter: Fitter::Radar(fit),
@@ -258,17 +277,17 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
                         .into(),
                 ));
             };
-            if a.window < degree + 1 {
+            if window(a) < degree + 1 {
                 return Err(usage(format!(
                     "window {} is too small for degree {degree}: a degree-{degree} fit needs a \
                      window of at least {} rows",
-                    a.window,
+                    window(a),
                     degree + 1
                 )));
             }
             let need = Need::degree(degree);
             need.check_header(header)?;
-            let fit = SlidingFit::polynomial(degree, a.window, epoch, solver).map_err(library)?;
+            let fit = SlidingFit::polynomial(degree, window(a), epoch, solver).map_err(library)?;
             Ok(Setup {
                 fitter: Fitter::Polynomial(fit),
                 columns: vec![column(&a.value_col, "value")?],
@@ -345,6 +364,10 @@ pub(crate) fn window_error(
             } else {
                 ""
             }
+        )),
+        e @ (Error::NotConverged { .. } | Error::Diverged { .. }) => CliError::Data(format!(
+            "lines {first}-{last} (the window): {e} (with this command: --max-iterations N \
+             allows more iterations, a shorter --window W fits fewer rows)"
         )),
         e => CliError::Data(format!("lines {first}-{last} (the window): {e}")),
     }

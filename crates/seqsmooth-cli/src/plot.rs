@@ -7,49 +7,61 @@
 //! panel with the sample at that time where there is one). Empty
 //! cells (no estimate yet, a degree not reached yet) leave gaps. The filter's input file may be
 //! given too, for a truth column. The drawing is [`crate::chart`]'s, the same as the demo's.
+//!
+//! The rows are read one at a time and decimated as they come ([`crate::decimate::Reducer`]:
+//! per half pixel column, the rows holding the extremes of every quantity drawn; time bins
+//! that merge pairwise as the time range grows, since standard input cannot be read twice),
+//! with a systematic sample of rows for the axis ranges, the outages' candidate steps, the
+//! share of each bin's time under the misfit flag and the counts: memory is bounded by the image's width, not the input's
+//! length. With a lead, the rows within the lead wait for the sample at their time
+//! ([`crate::chart::LeadMatcher`]).
 
 use crate::args::PlotArgs;
-use crate::chart::{self, Layout, Track};
+use crate::chart::{self, Counts, Layout, LeadMatcher, Row, Sample, Track};
+use crate::decimate::{Reducer, Stride};
 use crate::error::CliError;
 use crate::io::{
-    find_column, fmt_f64, input_name, named, not_utf8, open_input, parse_cell, plural, shown, CsvIn,
+    find_column, fmt_f64, input_name, named, open_input, parse_cell, plural, shown, CsvIn,
 };
+use std::io::Read;
 use std::path::Path;
 
-/// The cells of a column, or why they are unusable.
-type Column<T> = Result<Vec<T>, CliError>;
+/// Rows kept in the systematic sample the axis ranges' quantiles are taken over, and steps in
+/// the one the typical step (for the outages) is the median of.
+const SAMPLE_ROWS: usize = 20_000;
+const SAMPLE_STEPS: usize = 20_000;
+/// Time bins per pixel column of the plot, and at most this many in all (about 17 KB each
+/// at 10⁷ rows of an automatic filter's output: 90 MB at the default width, 166 MB at most;
+/// wider than 2,048 columns a bin spans more than half a pixel).
+const BINS_PER_COLUMN: usize = 4;
+const MAX_BINS: usize = 8192;
 
-/// A CSV file read in full: the header and the data rows with their 1-based file lines.
-struct Table {
+/// A CSV file read a row at a time.
+struct Source {
     /// The file's name in messages: `'path'` or `standard input`.
     name: String,
+    csv: CsvIn<Box<dyn Read + Send>>,
     header: Vec<String>,
-    rows: Vec<(u64, Vec<String>)>,
+    rows: usize,
 }
 
-impl Table {
-    fn read(path: Option<&Path>) -> Result<Table, CliError> {
+impl Source {
+    fn open(path: Option<&Path>) -> Result<Source, CliError> {
         let name = input_name(path);
         let at = |e: CliError| CliError::Data(format!("{name}: {e}"));
         let mut csv = CsvIn::new(open_input(path)?).map_err(at)?;
         let header = std::mem::take(&mut csv.header);
-        let mut rows = Vec::new();
-        while csv.next_record().map_err(at)? {
-            let line = csv.line;
-            let cells: Result<Vec<String>, _> = (0..header.len())
-                .map(|i| std::str::from_utf8(csv.field(i)).map(str::to_string))
-                .collect();
-            rows.push((line, cells.map_err(|_| at(not_utf8(line)))?));
-        }
         if header.iter().all(String::is_empty) {
             return Err(CliError::Data(format!(
                 "{name}: the file is empty (no header, no data rows)"
             )));
         }
-        if rows.is_empty() {
-            return Err(CliError::Data(format!("{name}: no data rows to plot")));
-        }
-        Ok(Table { name, header, rows })
+        Ok(Source {
+            name,
+            csv,
+            header,
+            rows: 0,
+        })
     }
 
     fn column(&self, col: &str) -> Option<usize> {
@@ -64,106 +76,291 @@ impl Table {
         CliError::Data(format!("{}: {e}", self.name))
     }
 
-    /// The numbers of column `idx`; empty cells are `None` when `empty` allows them.
-    fn numbers(&self, idx: usize, what: &str, empty: bool) -> Column<Option<f64>> {
-        let col = &self.header[idx];
-        self.rows
-            .iter()
-            .map(|(line, r)| {
-                let text = &r[idx];
-                if empty && text.is_empty() {
-                    return Ok(None);
-                }
-                parse_cell(text.as_bytes(), *line, col, what)
-                    .map(Some)
-                    .map_err(|e| self.error(e))
-            })
-            .collect()
+    /// Reads the next row; `false` at the end.
+    fn next(&mut self) -> Result<bool, CliError> {
+        let more = self.csv.next_record().map_err(|e| self.error(e))?;
+        self.rows += usize::from(more);
+        Ok(more)
     }
 
-    /// The numbers of column `idx`, every cell filled.
-    fn filled(&self, idx: usize, what: &str) -> Column<f64> {
-        let v = self.numbers(idx, what, false)?;
-        Ok(v.into_iter().flatten().collect())
+    /// Counts the rows left.
+    fn count_rest(&mut self) -> Result<usize, CliError> {
+        while self.next()? {}
+        Ok(self.rows)
     }
 
-    /// The times of column `idx`: every cell filled, strictly increasing.
-    fn times(&self, idx: usize) -> Column<f64> {
-        let t = self.filled(idx, "time")?;
-        match (1..t.len()).find(|&i| t[i] <= t[i - 1]) {
-            None => Ok(t),
-            Some(i) => Err(self.error(CliError::Data(format!(
-                "line {}, column '{}': time {} is not after the previous time {} (line {}): \
-                 a plot needs one series in time order",
-                self.rows[i].0,
-                shown(self.header[idx].as_bytes()),
-                shown(self.rows[i].1[idx].as_bytes()),
-                shown(self.rows[i - 1].1[idx].as_bytes()),
-                self.rows[i - 1].0
-            )))),
+    fn line(&self) -> u64 {
+        self.csv.line
+    }
+
+    fn cell(&self, idx: usize) -> &[u8] {
+        self.csv.field(idx)
+    }
+
+    /// The number in column `idx` (`what` it is, for messages), or `None` for an empty cell
+    /// where `empty` allows one.
+    fn number(&self, idx: usize, what: &str, empty: bool) -> Result<Option<f64>, CliError> {
+        let text = self.cell(idx);
+        if empty && text.is_empty() {
+            return Ok(None);
         }
+        parse_cell(text, self.line(), &self.header[idx], what)
+            .map(Some)
+            .map_err(|e| self.error(e))
     }
 
-    /// `read` of the column `col`, empty when there is none.
-    fn optional<T>(&self, col: &str, read: fn(&Self, usize) -> Column<T>) -> Column<T> {
-        self.column(col).map_or(Ok(Vec::new()), |i| read(self, i))
+    /// The number in column `idx`, the cell filled.
+    fn filled(&self, idx: usize, what: &str) -> Result<f64, CliError> {
+        Ok(self.number(idx, what, false)?.unwrap_or(0.0))
     }
 
-    /// The lead of the `lead` column (the same in every row), which `--lead` may repeat.
-    fn lead(&self, idx: usize, given: f64) -> Result<f64, CliError> {
-        let v = self.filled(idx, "lead")?;
-        let first = v[0];
-        let bad = |i: usize, why: &str| {
-            let (line, r) = &self.rows[i];
-            Err(CliError::Data(format!(
-                "{}: line {line}, column 'lead': {} {why}",
+    /// A non-negative number (a standard deviation) or an empty cell.
+    fn sigma(&self, idx: usize) -> Result<Option<f64>, CliError> {
+        let v = self.number(idx, "standard deviation", true)?;
+        if v.is_some_and(|s| s < 0.0) {
+            return Err(CliError::Data(format!(
+                "{}: line {}, column '{}': standard deviation {} is negative",
                 self.name,
-                shown(r[idx].as_bytes())
-            )))
-        };
-        if let Some(i) = v.iter().position(|&h| h != first) {
-            return bad(
-                i,
-                "differs from the lead of the first row: one filter run has one lead",
-            );
-        }
-        if !first.is_finite() {
-            return bad(0, "is not a finite lead");
-        }
-        if given != 0.0 && given != first {
-            return bad(0, &format!("is not the --lead {} given", fmt_f64(given)));
-        }
-        Ok(first)
-    }
-
-    /// Non-negative numbers (standard deviations), empty cells allowed.
-    fn sigmas(&self, idx: usize) -> Column<Option<f64>> {
-        let v = self.numbers(idx, "standard deviation", true)?;
-        for ((line, r), s) in self.rows.iter().zip(&v) {
-            if s.is_some_and(|s| s < 0.0) {
-                return Err(CliError::Data(format!(
-                    "{}: line {line}, column '{}': standard deviation {} is negative",
-                    self.name, self.header[idx], &r[idx]
-                )));
-            }
+                self.line(),
+                self.header[idx],
+                shown(self.cell(idx))
+            )));
         }
         Ok(v)
     }
 
-    /// The 0/1 flags of column `idx`.
-    fn flags(&self, idx: usize) -> Column<bool> {
-        let col = &self.header[idx];
-        self.rows
-            .iter()
-            .map(|(line, r)| match r[idx].as_str() {
-                "0" => Ok(false),
-                "1" => Ok(true),
-                other => Err(CliError::Data(format!(
-                    "{}: line {line}, column '{col}': '{other}' is not a flag, expected 0 or 1",
-                    self.name
-                ))),
-            })
-            .collect()
+    /// A 0/1 flag.
+    fn flag(&self, idx: usize) -> Result<bool, CliError> {
+        match self.cell(idx) {
+            b"0" => Ok(false),
+            b"1" => Ok(true),
+            other => Err(CliError::Data(format!(
+                "{}: line {}, column '{}': '{}' is not a flag, expected 0 or 1",
+                self.name,
+                self.line(),
+                self.header[idx],
+                shown(other)
+            ))),
+        }
+    }
+}
+
+/// The previous row's time, its cell and line: each time must come after it.
+#[derive(Default)]
+struct Order(Option<(f64, u64)>, Vec<u8>);
+
+impl Order {
+    fn check(&mut self, src: &Source, idx: usize, t: f64) -> Result<(), CliError> {
+        if let Some((p, line)) = self.0 {
+            let cell = &self.1;
+            if t <= p {
+                return Err(src.error(CliError::Data(format!(
+                    "line {}, column '{}': time {} is not after the previous time {} (line \
+                     {line}): a plot needs one series in time order",
+                    src.line(),
+                    shown(src.header[idx].as_bytes()),
+                    shown(src.cell(idx)),
+                    shown(cell)
+                ))));
+            }
+        }
+        self.0 = Some((t, src.line()));
+        self.1.clear();
+        self.1.extend_from_slice(src.cell(idx));
+        Ok(())
+    }
+}
+
+/// The columns of the filter output a plot reads.
+struct Columns {
+    t: usize,
+    y: usize,
+    /// `d0..d{top}` and `s0..s{top}`, where present.
+    d: Vec<Option<usize>>,
+    s: Vec<Option<usize>>,
+    noise: Option<usize>,
+    outlier: Option<usize>,
+    misfit: Option<usize>,
+    /// The highest derivative of the output: a row with it is past the start-up.
+    highest: Option<usize>,
+    lead: Option<usize>,
+}
+
+impl Columns {
+    fn of(out: &Source, cfg: &PlotArgs) -> Result<Columns, CliError> {
+        let why = " (the output of 'seqsmooth filter' has t,y,d0..dM)";
+        let (t, y) = (out.required("t", why)?, out.required("y", why)?);
+        let top = cfg.derivative.iter().copied().max().unwrap_or(0);
+        let mut d = Vec::new();
+        for k in 0..=top {
+            let name = format!("d{k}");
+            d.push(if cfg.derivative.contains(&k) {
+                let why = format!(
+                    " (derivative {k} was asked for: the filter's degree must be at least {k})"
+                );
+                Some(out.required(&name, &why)?)
+            } else {
+                out.column(&name)
+            });
+        }
+        let s = (0..=top).map(|k| out.column(&format!("s{k}"))).collect();
+        let highest = (0..)
+            .take_while(|k| out.column(&format!("d{k}")).is_some())
+            .last();
+        let highest = match highest {
+            Some(m) => Some(out.required(&format!("d{m}"), "")?),
+            None => None,
+        };
+        Ok(Columns {
+            t,
+            y,
+            d,
+            s,
+            noise: out.column("noise"),
+            outlier: out.column("outlier"),
+            misfit: out.column("misfit"),
+            highest,
+            lead: out.column("lead"),
+        })
+    }
+}
+
+/// The filter's input, read beside its output for the truth.
+struct Input {
+    src: Source,
+    t: usize,
+    y: usize,
+    truth: Option<usize>,
+}
+
+impl Input {
+    fn open(cfg: &PlotArgs) -> Result<Option<Input>, CliError> {
+        let Some(path) = &cfg.input else {
+            return Ok(None);
+        };
+        let src = Source::open(Some(path))?;
+        let t = src.required(&cfg.time_col, " (give its name with --time-col)")?;
+        let y = src.required(&cfg.value_col, " (give its name with --value-col)")?;
+        let truth = match &cfg.truth_col {
+            Some(tc) => Some(src.required(tc, " (the --truth-col)")?),
+            None => None,
+        };
+        Ok(Some(Input { src, t, y, truth }))
+    }
+
+    /// The error that the input and the output have different numbers of rows.
+    fn count_error(&mut self, out: &mut Source) -> Result<CliError, CliError> {
+        let (a, b) = (self.src.count_rest()?, out.count_rest()?);
+        Ok(CliError::Data(format!(
+            "the input {} has {a} data row{} but the filter output {} has {b}: give the input \
+             the output was made from",
+            self.src.name,
+            plural(a),
+            out.name
+        )))
+    }
+
+    /// The truth at the output's current row (the input's next row, which must be the row the
+    /// output's was made from).
+    fn row(
+        &mut self,
+        out: &mut Source,
+        cols: &Columns,
+        cfg: &PlotArgs,
+        (t, y): (f64, f64),
+    ) -> Result<Option<f64>, CliError> {
+        if !self.src.next()? {
+            return Err(self.count_error(out)?);
+        }
+        let it = self.src.filled(self.t, "time")?;
+        let iy = self.src.filled(self.y, "value")?;
+        if it != t || iy != y {
+            let (col, a, b) = if it != t {
+                (&cfg.time_col, self.src.cell(self.t), out.cell(cols.t))
+            } else {
+                (&cfg.value_col, self.src.cell(self.y), out.cell(cols.y))
+            };
+            return Err(CliError::Data(format!(
+                "{}: line {}, column '{col}': {} differs from {} on line {} of the filter \
+                 output {}: give the input the output was made from",
+                self.src.name,
+                self.src.line(),
+                shown(a),
+                shown(b),
+                out.line(),
+                out.name
+            )));
+        }
+        match self.truth {
+            Some(i) => Ok(Some(self.src.filled(i, "truth")?)),
+            None => Ok(None),
+        }
+    }
+}
+
+/// The lead of the `lead` column (the same in every row), which `--lead` may repeat.
+fn check_lead(
+    out: &Source,
+    idx: usize,
+    first: &mut Option<f64>,
+    given: f64,
+) -> Result<(), CliError> {
+    let h = out.filled(idx, "lead")?;
+    let bad = |why: &str| {
+        Err(CliError::Data(format!(
+            "{}: line {}, column 'lead': {} {why}",
+            out.name,
+            out.line(),
+            shown(out.cell(idx))
+        )))
+    };
+    match *first {
+        Some(f) if h != f => {
+            bad("differs from the lead of the first row: one filter run has one lead")
+        }
+        Some(_) => Ok(()),
+        None => {
+            if !h.is_finite() {
+                return bad("is not a finite lead");
+            }
+            if given != 0.0 && given != h {
+                return bad(&format!("is not the --lead {} given", fmt_f64(given)));
+            }
+            *first = Some(h);
+            Ok(())
+        }
+    }
+}
+
+/// What reading the rows gathers besides the decimated track.
+#[derive(Default)]
+struct Tally {
+    /// Rows whose estimate has a sample at its time, and rows with an estimate.
+    compared: usize,
+    with_d0: usize,
+}
+
+/// The rows as they come out of the lead matcher: decimated, sampled and counted.
+struct Gather {
+    reducer: Reducer<Row>,
+    sample: Stride<Row>,
+    values: Vec<f64>,
+    idx: u64,
+    tally: Tally,
+}
+
+impl Gather {
+    fn take(&mut self, mut row: Row, at: Option<Sample>) {
+        row.at = at;
+        let d0 = row.d.first().copied().flatten().is_some();
+        self.tally.with_d0 += usize::from(d0);
+        self.tally.compared += usize::from(d0 && row.at.is_some());
+        chart::drawn(&row, &mut self.values);
+        if self.sample.wants(self.idx) {
+            self.sample.push(self.idx, row.clone());
+        }
+        self.reducer.push(self.idx, row.t, row, &self.values);
+        self.idx += 1;
     }
 }
 
@@ -203,85 +400,144 @@ pub fn derivative_label(k: usize, time_unit: Option<&str>, value_unit: Option<&s
     with_unit(&name, unit.as_deref())
 }
 
-/// Reads the filter output (and input) named in `cfg` into a track.
-fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
-    let out = Table::read(cfg.source.as_deref())?;
-    let n = out.rows.len();
-    let why = " (the output of 'seqsmooth filter' has t,y,d0..dM)";
-    let (t_idx, y_idx) = (out.required("t", why)?, out.required("y", why)?);
-    let t = out.times(t_idx)?;
-    let y = out.filled(y_idx, "value")?;
-    let top = cfg.derivative.iter().copied().max().unwrap_or(0);
-    let mut d = vec![vec![None; n]; top + 1];
-    let mut s = vec![Vec::new(); top + 1];
-    for k in 0..=top {
-        let name = format!("d{k}");
-        let idx = if cfg.derivative.contains(&k) {
-            Some(out.required(
-                &name,
-                &format!(
-                    " (derivative {k} was asked for: the filter's degree must be at least {k})"
-                ),
-            )?)
-        } else {
-            out.column(&name)
+/// Reads the filter output (and input) named in `cfg` into a decimated track, the counts of
+/// compared rows, and the title.
+fn read_track(cfg: &PlotArgs) -> Result<(Track, Tally, String), CliError> {
+    let mut out = Source::open(cfg.source.as_deref())?;
+    let cols = Columns::of(&out, cfg)?;
+    let mut input = Input::open(cfg)?;
+    let columns = chart::columns_for_width(cfg.width) as usize;
+    let bins = (BINS_PER_COLUMN * columns).min(MAX_BINS);
+    let mut gather = Gather {
+        reducer: Reducer::new(bins),
+        sample: Stride::new(SAMPLE_ROWS),
+        values: Vec::new(),
+        idx: 0,
+        tally: Tally::default(),
+    };
+    let mut steps = Stride::new(SAMPLE_STEPS);
+    // The time under the misfit flag, per bin of the reducer's kind.
+    let mut misfit = Reducer::<()>::new(bins);
+    let mut order = Order::default();
+    let (mut lead, mut matcher) = (None, None);
+    let (mut rejected, mut previous, mut was_flagged) = (0, None, false);
+    while out.next()? {
+        let t = out.filled(cols.t, "time")?;
+        order.check(&out, cols.t, t)?;
+        let y = out.filled(cols.y, "value")?;
+        let cell = |idx: Option<usize>, read: &dyn Fn(usize) -> Result<Option<f64>, CliError>| {
+            idx.map_or(Ok(None), read)
         };
-        if let Some(idx) = idx {
-            d[k] = out.numbers(idx, "derivative", true)?;
+        let mut row = Row {
+            t,
+            y,
+            ..Row::default()
+        };
+        for k in 0..cols.d.len() {
+            row.d
+                .push(cell(cols.d[k], &|i| out.number(i, "derivative", true))?);
+            row.s.push(cell(cols.s[k], &|i| out.sigma(i))?);
         }
-        s[k] = out.optional(&format!("s{k}"), Table::sigmas)?;
-    }
-    let noise = out.optional("noise", Table::sigmas)?;
-    let rejected = out.optional("outlier", Table::flags)?;
-    let misfit = out.optional("misfit", Table::flags)?;
-    // Past the start-up: the rows with the highest derivative of the output.
-    let highest = (0..)
-        .take_while(|k| out.column(&format!("d{k}")).is_some())
-        .last();
-    let settled = match highest {
-        Some(m) => out.numbers(out.required(&format!("d{m}"), "")?, "derivative", true)?,
-        None => Vec::new(),
-    };
-    let settled = settled.iter().map(Option::is_some).collect();
-    let lead = match out.column("lead") {
-        Some(idx) => out.lead(idx, cfg.lead)?,
-        None => cfg.lead,
-    };
-    let mut truth = Vec::new();
-    if let Some(path) = &cfg.input {
-        let input = Table::read(Some(path))?;
-        let ti = input.required(&cfg.time_col, " (give its name with --time-col)")?;
-        let yi = input.required(&cfg.value_col, " (give its name with --value-col)")?;
-        let it = input.times(ti)?;
-        let iy = input.filled(yi, "value")?;
-        if input.rows.len() != n {
-            return Err(CliError::Data(format!(
-                "the input {} has {} data row{} but the filter output {} has {n}: give the \
-                 input the output was made from",
-                input.name,
-                input.rows.len(),
-                plural(input.rows.len()),
-                out.name
-            )));
+        row.noise = cell(cols.noise, &|i| out.sigma(i))?;
+        row.rejected = match cols.outlier {
+            Some(i) => out.flag(i)?,
+            None => false,
+        };
+        let flagged = match cols.misfit {
+            Some(i) => out.flag(i)?,
+            None => false,
+        };
+        row.settled = match cols.highest {
+            Some(i) => out.number(i, "derivative", true)?.is_some(),
+            None => false,
+        };
+        if let Some(i) = cols.lead {
+            check_lead(&out, i, &mut lead, cfg.lead)?;
         }
-        if let Some(i) = (0..n).find(|&i| it[i] != t[i] || iy[i] != y[i]) {
-            let (col, a, b) = if it[i] != t[i] {
-                (&cfg.time_col, &input.rows[i].1[ti], &out.rows[i].1[t_idx])
-            } else {
-                (&cfg.value_col, &input.rows[i].1[yi], &out.rows[i].1[y_idx])
-            };
-            return Err(CliError::Data(format!(
-                "{}: line {}, column '{col}': {a} differs from {b} on line {} of the filter \
-                 output {}: give the input the output was made from",
-                input.name, input.rows[i].0, out.rows[i].0, out.name
-            )));
+        if let Some(input) = &mut input {
+            row.truth.extend(input.row(&mut out, &cols, cfg, (t, y))?);
         }
-        if let Some(tc) = &cfg.truth_col {
-            let idx = input.required(tc, " (the --truth-col)")?;
-            truth.push(input.filled(idx, "truth")?);
+        // Per row: the step before it, the misfit flag's time (to the next row, as
+        // `chart::flag_spans` has it), the rejection.
+        if let Some(p) = previous.replace(t) {
+            steps.push(out.rows as u64 - 2, t - p);
+            if was_flagged {
+                misfit.weigh(t - p);
+            }
+        }
+        misfit.push(out.rows as u64, t, (), &[]);
+        was_flagged = flagged;
+        rejected += usize::from(row.rejected);
+        let m = matcher.get_or_insert_with(|| LeadMatcher::new(lead.unwrap_or(cfg.lead)));
+        let sample = row.sample();
+        m.push(t, row, sample);
+        while let Some((row, at)) = m.pop() {
+            gather.take(row, at);
         }
     }
-    let kind = if !misfit.is_empty() || !rejected.is_empty() {
+    if out.rows == 0 {
+        return Err(CliError::Data(format!(
+            "{}: no data rows to plot",
+            out.name
+        )));
+    }
+    if let Some(input) = &mut input {
+        if input.src.next()? {
+            return Err(input.count_error(&mut out)?);
+        }
+    }
+    if let Some(m) = &mut matcher {
+        m.finish();
+        while let Some((row, at)) = m.pop() {
+            gather.take(row, at);
+        }
+    }
+    let rows = out.rows;
+    let Gather {
+        reducer,
+        sample,
+        tally,
+        ..
+    } = gather;
+    let reduced = reducer.finish();
+    let typical = chart::typical_step(steps.into_items().into_iter().map(|s| s.1));
+    let outages = reduced
+        .steps
+        .iter()
+        .copied()
+        .filter(|&(a, b)| typical.is_some_and(|m| chart::is_outage(b - a, m)))
+        .collect();
+    let mut track = Track {
+        misfit_share: misfit
+            .finish()
+            .weights
+            .into_iter()
+            .map(|(a, b, w)| (a, b, w / (b - a)))
+            .collect(),
+        outages,
+        lead: lead.unwrap_or(cfg.lead),
+        counts: Some(Counts { rows, rejected }),
+        ..Track::default()
+    };
+    // The kept rows and the sampled ones, merged in order.
+    let mut kept = reduced.rows.into_iter().peekable();
+    let mut sampled = sample.into_items().into_iter().peekable();
+    loop {
+        let next_kept = kept.peek().map(|r| r.0);
+        let next_sampled = sampled.peek().map(|r| r.0);
+        match (next_kept, next_sampled) {
+            (None, None) => break,
+            (Some(a), Some(b)) if a == b => {
+                kept.next();
+                track.push(sampled.next().map(|r| r.1).unwrap_or_default(), Some(true));
+            }
+            (Some(a), b) if b.is_none_or(|b| a < b) => {
+                track.push(kept.next().map(|r| r.1).unwrap_or_default(), Some(false));
+            }
+            _ => track.push(sampled.next().map(|r| r.1).unwrap_or_default(), Some(true)),
+        }
+    }
+    let kind = if cols.misfit.is_some() || cols.outlier.is_some() {
         "automatic filter"
     } else if out.column("window").is_some() {
         "fixed-memory filter"
@@ -296,35 +552,17 @@ fn read_track(cfg: &PlotArgs) -> Result<(Track, String), CliError> {
         None => "standard input".to_string(),
     };
     let title = format!("seqsmooth {kind} output: {file}");
-    Ok((
-        Track {
-            t,
-            y,
-            d,
-            s,
-            truth,
-            noise,
-            rejected,
-            misfit,
-            lead,
-            settled,
-            ..Track::default()
-        },
-        title,
-    ))
+    Ok((track, tally, title))
 }
 
 pub fn run(cfg: &PlotArgs) -> Result<(), CliError> {
     for p in &cfg.output {
         chart::Format::of(p)?;
     }
-    let (track, default_title) = read_track(cfg)?;
+    let (track, tally, default_title) = read_track(cfg)?;
     let (tu, vu) = (cfg.time_unit.as_deref(), cfg.value_unit.as_deref());
     // With a lead, each estimate is compared with the sample at its own time t + H.
-    let at = chart::samples_at_lead(&track.t, track.lead);
-    let compared = (0..track.t.len())
-        .filter(|&i| at[i].is_some() && track.d[0][i].is_some())
-        .count();
+    let compared = tally.compared;
     let residuals = !cfg.no_residuals && compared > 0;
     let panels: Vec<(usize, String)> = cfg
         .derivative
@@ -333,7 +571,7 @@ pub fn run(cfg: &PlotArgs) -> Result<(), CliError> {
         .collect();
     let unit = tu.map(|u| format!(" {u}")).unwrap_or_default();
     let h = fmt_f64(track.lead);
-    let with_d0 = track.d[0].iter().filter(|d| d.is_some()).count();
+    let with_d0 = tally.with_d0;
     let lead = match compared {
         _ if cfg.no_residuals => format!("estimates drawn at t + {h}{unit}, their time"),
         0 => format!(

@@ -146,7 +146,8 @@ fn library_radar(text: &str, site: [f64; 3], window: usize, epoch: Epoch) -> Vec
         epoch,
         Start::Radar { radar, degree: 2 },
     )
-    .unwrap();
+    .unwrap()
+    .with_misfit_scale();
     text.lines()
         .skip(1)
         .map(|line| {
@@ -200,6 +201,7 @@ fn radar_model_equals_library_and_covers_the_truth() {
         if epoch_arg != "end" {
             want += ",epoch";
         }
+        want += ",flag";
         assert_eq!(header.join(","), want);
         let reference = library_radar(&input, site, 40, epoch);
         assert_eq!(rows.len(), reference.len());
@@ -211,7 +213,9 @@ fn radar_model_equals_library_and_covers_the_truth() {
                     assert!(row[1..].iter().all(String::is_empty));
                 }
                 Some(r) => {
-                    let cells: Vec<f64> = row[1..].iter().map(|c| num(c)).collect();
+                    let last = row.len() - 1;
+                    assert!(["", "misfit"].contains(&row[last].as_str()), "row {i}");
+                    let cells: Vec<f64> = row[1..last].iter().map(|c| num(c)).collect();
                     let n = if epoch_arg == "end" { 14 } else { 15 };
                     assert_eq!(cells[..], r[..n], "row {i}");
                     assert!(r[12] <= 10.0, "row {i}: {} iterations", r[12]);
@@ -517,7 +521,10 @@ fn random_inputs_are_right_or_refused() {
                 let text = std::fs::read_to_string(&output).unwrap();
                 for line in text.lines().skip(1) {
                     for cell in line.split(',').skip(1).filter(|c| !c.is_empty()) {
-                        assert!(num(cell).is_finite(), "{args:?}: {line}");
+                        assert!(
+                            cell == "misfit" || num(cell).is_finite(),
+                            "{args:?}: {line}"
+                        );
                     }
                 }
             }

@@ -725,7 +725,7 @@ fn dense_epoch_series_is_decimated_with_readable_ticks() {
     let plot = ["plot", "dense.csv", "-o", "dense.svg", "--time-unit", "ns"];
     ok_in(&dir, &plot, "");
     let svg = svg_of(&dir.join("dense.svg"));
-    assert!(svg.contains("samples (too dense for dots: joined)"));
+    assert!(svg.contains("samples, lowest to highest per pixel (too dense for dots)"));
     assert!(
         count(&svg, "<circle") <= 2,
         "{} circles",
@@ -748,4 +748,294 @@ fn dense_epoch_series_is_decimated_with_readable_ticks() {
         .collect();
     assert!(labels.len() >= 20, "{labels:?}");
     assert!(labels.iter().all(|l| l.len() <= 10), "{labels:?}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// outages, values beyond the axis, dense automatic output
+
+/// An SVG element: its tag's attributes.
+type Element = std::collections::HashMap<String, String>;
+
+/// The SVG's elements with tag `tag` (`<tag a="…" …/>`).
+fn elements(svg: &str, tag: &str) -> Vec<Element> {
+    let open = format!("<{tag} ");
+    svg.split(open.as_str())
+        .skip(1)
+        .map(|rest| {
+            let body = &rest[..rest.find("/>").unwrap_or(rest.len())];
+            let mut attrs = Element::new();
+            for part in body.split("\" ") {
+                if let Some((k, v)) = part.split_once("=\"") {
+                    attrs.insert(k.trim().to_string(), v.trim_end_matches('"').to_string());
+                }
+            }
+            attrs
+        })
+        .collect()
+}
+
+fn attr(e: &Element, name: &str) -> f64 {
+    e[name].parse().unwrap()
+}
+
+/// The vertices of a polyline or polygon.
+fn vertices(e: &Element) -> Vec<(f64, f64)> {
+    e["points"]
+        .split_whitespace()
+        .map(|p| {
+            let (x, y) = p.split_once(',').unwrap();
+            (x.parse().unwrap(), y.parse().unwrap())
+        })
+        .collect()
+}
+
+/// Colours (SVG) of the estimate and its band, the truth − estimate line, the noise lines and
+/// a dense series' envelope: what must not be drawn across an outage.
+const CURVES: [&str; 4] = ["#1F5AB4", "#00828C", "#E67800", "#787878"];
+const OUTAGE_FILL: &str = "#6E6E6E";
+const MISFIT_FILL: &str = "#E13C96";
+
+/// The outages shaded in the SVG's panels: their pixel spans `(x0, x1)` (one per panel).
+fn outage_spans(svg: &str) -> Vec<(f64, f64)> {
+    elements(svg, "rect")
+        .iter()
+        .filter(|r| r.get("fill").map(String::as_str) == Some(OUTAGE_FILL))
+        .filter(|r| attr(r, "height") > 40.0)
+        .map(|r| (attr(r, "x"), attr(r, "x") + attr(r, "width")))
+        .collect()
+}
+
+/// The segments of curve colours (polylines, polygons with their closing edge, lines) that
+/// span one of `spans`, edge to edge or beyond.
+fn segments_across(svg: &str, spans: &[(f64, f64)]) -> Vec<String> {
+    let curve = |e: &Element| {
+        ["stroke", "fill"]
+            .iter()
+            .any(|a| e.get(*a).is_some_and(|c| CURVES.contains(&c.as_str())))
+    };
+    let mut segs = Vec::new();
+    for e in elements(svg, "polyline").iter().filter(|e| curve(e)) {
+        segs.extend(vertices(e).windows(2).map(|w| (w[0], w[1])));
+    }
+    for e in elements(svg, "polygon").iter().filter(|e| curve(e)) {
+        let v = vertices(e);
+        segs.extend(v.windows(2).map(|w| (w[0], w[1])));
+        if let (Some(&a), Some(&b)) = (v.last(), v.first()) {
+            segs.push((a, b));
+        }
+    }
+    for e in elements(svg, "line").iter().filter(|e| curve(e)) {
+        segs.push((
+            (attr(e, "x1"), attr(e, "y1")),
+            (attr(e, "x2"), attr(e, "y2")),
+        ));
+    }
+    let mut out = Vec::new();
+    for (a, b) in segs {
+        let (lo, hi) = (a.0.min(b.0), a.0.max(b.0));
+        for &(x0, x1) in spans {
+            // (an outage runs from the last sample before to the first after: a segment
+            // drawn across it joins its two edges)
+            if lo <= x0 + 0.5 && hi >= x1 - 0.5 {
+                out.push(format!("{a:?}-{b:?} across {x0}..{x1}"));
+            }
+        }
+    }
+    out
+}
+
+/// The demo's 12 s outage is found by the plot's rule (and nothing else is), hatched, and no
+/// curve is drawn across it: no segment of the estimate, its band, the truth − estimate line,
+/// the noise lines crosses its span in any panel. The misfit shading is a colour of its own,
+/// with its own legend entry. The start-up error beyond the error panel's axis is marked: a
+/// triangle at the edge in the estimate's colour and a note of how far it goes.
+#[test]
+fn demo_breaks_at_the_outage_and_marks_values_beyond_the_axis() {
+    let dir = fresh_dir("demo-outage");
+    ok_in(&dir, &["demo", "--plot", "d.svg"], "");
+    let svg = svg_of(&dir.join("d.svg"));
+    let spans = outage_spans(&svg);
+    // One outage, in each of the three panels, about 13 s of the 400 s wide.
+    assert_eq!(spans.len(), 3, "{spans:?}");
+    for &(x0, x1) in &spans {
+        assert!((x1 - x0 - spans[0].1 + spans[0].0).abs() < 1.0);
+        assert!(x1 - x0 > 30.0 && x1 - x0 < 60.0, "{x0}..{x1}");
+    }
+    // The hatching: lines inside the span.
+    let hatches = elements(&svg, "polyline")
+        .into_iter()
+        .filter(|e| e["stroke"] == OUTAGE_FILL)
+        .count();
+    assert!(hatches >= 3 * 5, "{hatches} hatch lines");
+    let across = segments_across(&svg, &spans);
+    assert!(across.is_empty(), "drawn across the outage: {across:?}");
+    // Misfit spans: their own colour, in the legend beside the outage's.
+    let fills: Vec<String> = elements(&svg, "rect")
+        .iter()
+        .filter_map(|r| r.get("fill").cloned())
+        .collect();
+    assert!(fills.iter().any(|f| f == MISFIT_FILL), "no misfit shading");
+    assert!(svg.contains("misfit flagged") && svg.contains("no samples (outage)"));
+    // Beyond the axis: the note, the legend entry, and triangles of the estimate's colour.
+    assert!(
+        svg.contains("beyond the axis: estimate − truth reaches -"),
+        "{}",
+        svg.lines()
+            .filter(|l| l.contains("beyond"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+    assert!(svg.contains("beyond the axis (at its edge)"));
+    let marks = elements(&svg, "polygon")
+        .into_iter()
+        .filter(|e| e["fill"] == "#1F5AB4" && e["opacity"] == "1" && vertices(e).len() == 3)
+        .count();
+    assert!(marks >= 1, "no mark of the clipped estimate");
+}
+
+/// The same series drawn without the outage rule would cross it: a test of the test. A
+/// series whose steps are all alike has no outage and its estimate is one line.
+#[test]
+fn plot_without_an_outage_draws_one_line() {
+    let dir = fresh_dir("plot-no-outage");
+    std::fs::write(dir.join("data.csv"), series()).unwrap();
+    let out = filter_output(
+        &dir,
+        "f",
+        &[
+            "--kind", "fading", "--degree", "2", "--theta", "0.9", "--sigma", "0.5",
+        ],
+    );
+    ok_in(&dir, &["plot", out.to_str().unwrap(), "-o", "f.svg"], "");
+    let svg = svg_of(&dir.join("f.svg"));
+    assert!(outage_spans(&svg).is_empty());
+    assert!(!svg.contains("no samples (outage)"));
+    let estimate = elements(&svg, "polyline")
+        .into_iter()
+        .filter(|e| e["stroke"] == "#1F5AB4" && e["stroke-width"] == "2")
+        .count();
+    assert_eq!(
+        estimate, 3,
+        "one estimate line per panel, one in the legend"
+    );
+    // A made-up span inside one of the estimate's segments is crossed: the check can fail.
+    let line = elements(&svg, "polyline")
+        .into_iter()
+        .find(|e| e["stroke"] == "#1F5AB4" && vertices(e).len() > 100)
+        .unwrap();
+    let v = vertices(&line);
+    let w = v.windows(2).find(|w| w[1].0 - w[0].0 > 2.0).unwrap();
+    let inside = (w[0].0 + 0.2, w[1].0 - 0.2);
+    assert!(!segments_across(&svg, &[inside]).is_empty(), "{inside:?}");
+}
+
+/// A manoeuvring series of 60,000 rows at irregular 0.01 s steps, with 8-10σ outliers on 1 %
+/// of the samples and a 20 s outage, through the automatic filter and `plot`: the samples and
+/// the residuals are drawn as envelopes (no dots), the outliers as at most the lowest and
+/// highest small crosses per pixel column with their number in the legend (the output's count
+/// of outlier flags), every curve at most four points per pixel column, no segment across the
+/// outage, and the same picture from standard input as from the file.
+#[test]
+fn dense_automatic_output_is_legible() {
+    let dir = fresh_dir("plot-dense-auto");
+    let mut data = String::from("t,y\n");
+    let (mut t, mut x, mut v) = (0.0f64, 0.0f64, 1.0f64);
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut rows = 0;
+    while rows < 60_000 {
+        let h = 0.01 * (1.0 + 0.3 * (2.0 * uniform() - 1.0));
+        let a = match (t / 120.0) as u32 {
+            1 => 0.2,
+            3 => -0.3,
+            _ => 0.0,
+        };
+        x += v * h + 0.5 * a * h * h;
+        v += a * h;
+        t += h;
+        let g = (-2.0 * (1.0 - uniform()).ln()).sqrt() * (std::f64::consts::TAU * uniform()).cos();
+        let e = if uniform() < 0.01 {
+            (if uniform() < 0.5 { -1.0 } else { 1.0 }) * (8.0 + 2.0 * uniform())
+        } else {
+            g
+        };
+        if (300.0..320.0).contains(&t) {
+            continue;
+        }
+        data += &format!("{t},{}\n", x + e);
+        rows += 1;
+    }
+    std::fs::write(dir.join("data.csv"), &data).unwrap();
+    let out = filter_output(
+        &dir,
+        "auto",
+        &["--kind", "auto", "--degree", "2", "--theta", "0.95"],
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "outlier").unwrap();
+    let flagged = text
+        .lines()
+        .skip(1)
+        .filter(|l| l.split(',').nth(col) == Some("1"))
+        .count();
+    assert!(flagged > 300, "{flagged} outliers flagged");
+    ok_in(
+        &dir,
+        &["plot", "auto.csv", "-o", "a.svg", "-o", "a.png"],
+        "",
+    );
+    let svg = svg_of(&dir.join("a.svg"));
+    assert!(
+        svg.contains(&format!("rejected (outlier): {flagged}")),
+        "legend count"
+    );
+    assert!(svg.contains("samples, lowest to highest per pixel (too dense for dots)"));
+    assert!(
+        count(&svg, "<circle") <= 2,
+        "{} dots",
+        count(&svg, "<circle")
+    );
+    let envelopes = elements(&svg, "polygon")
+        .into_iter()
+        .filter(|e| e["fill"] == "#787878")
+        .count();
+    assert!(
+        envelopes >= 4,
+        "{envelopes} envelopes (two panels, split at the outage)"
+    );
+    // Dense samples beyond the axis are noted by their share, not marked per column (the
+    // rejected ones here, 8-10σ, are drawn as crosses at the edge).
+    let marks = elements(&svg, "polygon")
+        .into_iter()
+        .filter(|e| e["fill"] == "#787878" && e["opacity"] == "1" && vertices(e).len() == 3)
+        .count();
+    assert_eq!(marks, 2, "only the legend's marks are grey triangles");
+    // Small crosses, at most 4 per pixel column and panel (each cross is two lines).
+    let crosses = elements(&svg, "line")
+        .into_iter()
+        .filter(|e| e["stroke"] == "#D7191C")
+        .count()
+        / 2;
+    assert!(
+        crosses > 100 && crosses <= 2 * 4 * 1070,
+        "{crosses} crosses"
+    );
+    for e in elements(&svg, "polyline") {
+        assert!(vertices(&e).len() <= 4 * 1070 + 8);
+    }
+    let spans = outage_spans(&svg);
+    assert_eq!(spans.len(), 2, "{spans:?}");
+    let across = segments_across(&svg, &spans);
+    assert!(across.is_empty(), "drawn across the outage: {across:?}");
+    // Standard input: the same picture (but the title's file name).
+    ok_in(&dir, &["plot", "-", "-o", "b.svg"], &text);
+    let piped = svg_of(&dir.join("b.svg")).replace("standard input", "auto.csv");
+    assert!(piped == svg, "the picture from standard input differs");
+    assert!(file_size(&dir.join("a.png")) > 30_000);
 }

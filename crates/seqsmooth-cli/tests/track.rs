@@ -5,6 +5,7 @@
 
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
+use seqsmooth::kalman::track::DEFAULT_LAG;
 use std::path::PathBuf;
 
 mod common;
@@ -40,22 +41,23 @@ fn landing() -> (String, Vec<[f64; 3]>) {
     (csv, truth)
 }
 
+/// `track` on the landing trajectory's noisy rows: the convention and noise of [`landing`].
+const LANDING_ARGS: [&str; 7] = [
+    "track",
+    "--azimuth",
+    "bearing",
+    "--sigma-range",
+    "10",
+    "--sigma-angle",
+    "1e-3",
+];
+
 fn track(input: &str, method: &[&str]) -> Vec<Vec<String>> {
-    let mut args = vec![
-        "track",
-        "--azimuth",
-        "bearing",
-        "--sigma-range",
-        "10",
-        "--sigma-angle",
-        "1e-3",
-        "--method",
-    ];
-    args.extend_from_slice(method);
+    let args: Vec<&str> = [&LANDING_ARGS[..], &["--method"], method].concat();
     let (header, rows) = table(&ok(&args, input));
     assert_eq!(
         header.join(","),
-        "t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,nis"
+        "t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,nis,flag"
     );
     rows
 }
@@ -105,7 +107,10 @@ fn landing_within_three_sigma() {
 }
 
 /// The smoother's last row is the filter's (the backward pass starts there), and its σ are at
-/// most the filter's on every row; the NIS column is the forward filter's.
+/// most the filter's on every row; the NIS column is the forward filter's. Lag 0 is the
+/// filter, byte for byte; a longer lag never raises a σ; any lag at least the rows' number is
+/// the whole-interval smoother (the same output), said on stderr before the first row when its
+/// rows would take over 100 MB.
 #[test]
 fn smoother_and_filter_agree_where_they_must() {
     let (input, _) = landing();
@@ -121,6 +126,118 @@ fn smoother_and_filter_agree_where_they_must() {
             );
         }
     }
+    assert_eq!(
+        track(&input, &["smooth", "--q", "10", "--lag", "0"]),
+        kalman
+    );
+    // With the adaptive driving noise too: the forward filter gated and adapted as kalman's,
+    // each row's flag carried to its smoothed row.
+    let adaptive = track(&input, &["kalman"]);
+    assert_eq!(track(&input, &["smooth", "--lag", "0"]), adaptive);
+    for lag in ["7", "200"] {
+        let lagged = track(&input, &["smooth", "--lag", lag]);
+        assert_eq!(lagged.len(), adaptive.len());
+        for (k, s) in adaptive.iter().zip(&lagged) {
+            assert_eq!((&k[13], &k[14]), (&s[13], &s[14]), "lag {lag}: nis, flag");
+        }
+    }
+    assert!(
+        adaptive.iter().any(|r| !r[14].is_empty()),
+        "the landing rows have flagged rows"
+    );
+    let mut previous = kalman;
+    for lag in ["1", "10", "100"] {
+        let lagged = track(&input, &["smooth", "--q", "10", "--lag", lag]);
+        for (p, s) in previous.iter().zip(&lagged).skip(1) {
+            assert_eq!(p[13], s[13], "nis");
+            assert_eq!(p[14], s[14], "lag {lag}: the flag is the forward filter's");
+            for c in 7..13 {
+                assert!(
+                    num(&s[c]) <= num(&p[c]) * (1.0 + 1e-12),
+                    "lag {lag}: {s:?} against {p:?}"
+                );
+            }
+        }
+        previous = lagged;
+    }
+    let whole = track(&input, &["smooth", "--q", "10", "--lag", "473"]);
+    assert_eq!(
+        track(&input, &["smooth", "--q", "10", "--lag", "5000"]),
+        whole
+    );
+    let args = [
+        &LANDING_ARGS[..],
+        &["--method", "smooth", "--q", "10", "--lag", "100000000"],
+    ]
+    .concat();
+    let o = run(&args, &input);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stderr
+            .contains("--lag 100000000 holds up to 100000001 rows: up to"),
+        "{}",
+        o.stderr
+    );
+    assert_eq!(table(&o.stdout).1, whole);
+    assert!(run(&args[..args.len() - 2], &input).stderr.is_empty());
+    fails(
+        &[
+            "track",
+            "--sigma-range",
+            "10",
+            "--sigma-angle",
+            "1e-3",
+            "--lag",
+            "5",
+        ],
+        &input,
+        2,
+        &["--lag applies only to --method smooth"],
+    );
+}
+
+/// `track --method smooth` streams: fed 30,000 rows on a pipe left open, it has written the
+/// output rows of all but the last few thousand (a batch, the lag, the writer's buffer) before
+/// its input ends.
+#[test]
+fn the_smoother_writes_before_its_input_ends() {
+    use std::io::{BufRead, Write};
+    let input = long_pass(30_000);
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_seqsmooth"))
+        .args(["track", "--sigma-range", "10", "--sigma-angle", "1e-3"])
+        .args(["--method", "smooth", "--q", "1"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    stdin.write_all(input.as_bytes()).unwrap();
+    stdin.flush().unwrap();
+    let stdout = child.stdout.take().unwrap();
+    let (lines, seen) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for (k, _) in std::io::BufReader::new(stdout).lines().enumerate() {
+            if lines.send(k + 1).is_err() {
+                return;
+            }
+        }
+    });
+    let want = 20_000;
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let mut count = 0;
+    while count < want {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        match seen.recv_timeout(left) {
+            Ok(n) => count = n,
+            Err(_) => break,
+        }
+    }
+    assert!(
+        count >= want,
+        "{count} lines written before the input's end"
+    );
+    drop(stdin);
+    assert!(child.wait().unwrap().success());
 }
 
 /// Refusals: usage (exit 2) and data (exit 1) errors with their line and column.
@@ -138,7 +255,18 @@ fn track_refuses_bad_input() {
         &["--sigma-range"],
     );
     fails(&with(&["--sigma-range", "0"]), good, 2, &["sigma"]);
-    fails(&with(&["--method", "fading"]), good, 2, &["--beta"]);
+    fails(
+        &with(&["--method", "kalman", "--window", "5"]),
+        good,
+        2,
+        &["--window"],
+    );
+    fails(
+        &with(&["--max-iterations", "0"]),
+        good,
+        2,
+        &["max-iterations"],
+    );
     fails(
         &with(&["--method", "fading", "--beta", "0.9", "--q", "1"]),
         good,
@@ -250,6 +378,9 @@ fn random_inputs_are_right_or_refused() {
             "--sigma-angle=1e-3".into(),
             ["--azimuth=from-x", "--azimuth=bearing"][rng.gen_range(0..2)].into(),
         ];
+        if method == "smooth" {
+            args.push(format!("--lag={}", [0, 1, 5, 200][rng.gen_range(0..4)]));
+        }
         match method {
             "window" => args.push(format!("--window={}", rng.gen_range(1..30))),
             "fading" => args.push(format!("--beta={}", rng.gen_range(0.01..1.0))),
@@ -267,7 +398,8 @@ fn random_inputs_are_right_or_refused() {
                 let text = std::fs::read_to_string(&output).unwrap();
                 for line in text.lines().skip(1) {
                     for cell in line.split(',').skip(1).filter(|c| !c.is_empty()) {
-                        assert!(num(cell).is_finite(), "{args:?}: {line}");
+                        let flag = ["outlier", "misfit"].contains(&cell);
+                        assert!(flag || num(cell).is_finite(), "{args:?}: {line}");
                     }
                 }
             }
@@ -713,20 +845,7 @@ fn a_late_error_leaves_no_output() {
         let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
         assert_eq!(left.len(), 1, "{method:?}: temporary files left: {left:?}");
     }
-    let o = run(
-        &[
-            "track",
-            "--azimuth",
-            "bearing",
-            "--sigma-range",
-            "10",
-            "--sigma-angle",
-            "1e-3",
-            "--q",
-            "10",
-        ],
-        &bad,
-    );
+    let o = run(&[&LANDING_ARGS[..], &["--q", "10"]].concat(), &bad);
     assert_eq!(o.code, 1);
     assert_eq!(
         o.stdout.lines().count(),
@@ -793,6 +912,28 @@ fn long_inputs_stream_across_batches() {
             "{method:?}"
         );
     }
+    // The smoother: row k's output is the same once row k + lag is in, whatever comes after.
+    for lag in ["0", "37", "200"] {
+        let args: Vec<&str> =
+            [&base[..], &["--method", "smooth", "--q", "1", "--lag", lag]].concat();
+        let whole = ok(&args, &input);
+        assert_eq!(whole.lines().count(), 10_001);
+        let lag: usize = lag.parse().unwrap();
+        for n in [2500, 4096, 4097, 6000] {
+            let part = ok(&args, &prefix(n));
+            let final_rows = |text: &str| -> String {
+                text.lines()
+                    .take(1 + n - lag)
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            };
+            assert_eq!(
+                final_rows(&part),
+                final_rows(&whole),
+                "lag {lag}: the first {n} rows"
+            );
+        }
+    }
     let mut bad = lines.clone();
     bad[9000] = "899.9,NaN,0.1,0.1";
     let bad = bad.join("\n") + "\n";
@@ -809,9 +950,13 @@ fn long_inputs_stream_across_batches() {
             "{}",
             o.stderr
         );
-        if method[1] != "smooth" {
-            assert_eq!(o.stdout.lines().count(), 9000, "{method:?}");
-        }
+        // The smoother writes the rows it gave: all but its last `lag`.
+        let lag = if method[1] == "smooth" {
+            DEFAULT_LAG
+        } else {
+            0
+        };
+        assert_eq!(o.stdout.lines().count(), 9000 - lag, "{method:?}");
         let _ = std::fs::remove_file(&out);
         let to_file = format!("--output={}", out.display());
         fails(&[&args[..], &[&to_file]].concat(), &bad, 1, &["line 9001"]);
@@ -842,4 +987,108 @@ fn output_errors_are_reported() {
             &["cannot write to '/dev/full'"],
         );
     }
+}
+
+/// Every method at its defaults (no --q, --beta, --theta or --window) runs on the landing
+/// trajectory with noise; every flag cell is empty, `outlier` or `misfit`; the unflagged rows
+/// cover the truth within 3σ on at least 95 % of each axis (one run: the Monte Carlo of
+/// `seqsmooth/tests/track_coverage.rs` holds 97 % over 200 runs) and fewer than a third of
+/// the rows are flagged.
+#[test]
+fn defaults_run_on_landing_and_name_their_flags() {
+    let (input, truth) = landing();
+    for method in ["kalman", "fading", "smooth", "window"] {
+        let rows = track(&input, &[method]);
+        assert_eq!(rows.len(), truth.len());
+        let (mut flagged, mut unflagged, mut covered) = (0, 0, [0usize; 3]);
+        for (row, want) in rows.iter().zip(&truth) {
+            if row[1].is_empty() {
+                assert!(row[14].is_empty());
+                continue;
+            }
+            match row[14].as_str() {
+                "" => {
+                    unflagged += 1;
+                    for k in 0..3 {
+                        let (x, s) = (num(&row[1 + k]), num(&row[7 + k]));
+                        covered[k] += usize::from((x - want[k]).abs() <= 3.0 * s);
+                    }
+                }
+                "outlier" | "misfit" => flagged += 1,
+                other => panic!("{method}: flag {other:?}"),
+            }
+        }
+        let share = flagged as f64 / (flagged + unflagged) as f64;
+        println!(
+            "{method}: {:.1}% flagged, covered {covered:?} of {unflagged}",
+            100.0 * share
+        );
+        assert!(share < 1.0 / 3.0, "{method}: {:.1}% flagged", 100.0 * share);
+        for (k, axis) in ["east", "north", "up"].iter().enumerate() {
+            let rate = covered[k] as f64 / unflagged as f64;
+            assert!(rate >= 0.95, "{method} {axis}: {:.2}%", 100.0 * rate);
+        }
+    }
+}
+
+/// A range 30σ off is named: every method flags its row `outlier` and leaves it out (the next
+/// row is not flagged `outlier`).
+#[test]
+fn a_flagged_row_is_named() {
+    let (input, _) = landing();
+    let mut lines: Vec<String> = input.lines().map(str::to_string).collect();
+    let k = 300;
+    let mut cells: Vec<String> = lines[k + 1].split(',').map(str::to_string).collect();
+    cells[1] = (num(&cells[1]) + 300.0).to_string();
+    lines[k + 1] = cells.join(",");
+    let bad = lines.join("\n") + "\n";
+    for method in ["kalman", "fading", "smooth", "window"] {
+        let rows = track(&bad, &[method]);
+        assert_eq!(rows[k][14], "outlier", "{method}");
+        assert_ne!(rows[k + 1][14], "outlier", "{method}");
+    }
+}
+
+/// A window that does not converge names what to change with this command's options.
+#[test]
+fn a_window_that_does_not_converge_says_what_to_change() {
+    let (input, _) = landing();
+    let window = [
+        "--method",
+        "window",
+        "--window",
+        "60",
+        "--max-iterations",
+        "1",
+    ];
+    fails(
+        &[&LANDING_ARGS[..], &window].concat(),
+        &input,
+        1,
+        &["did not converge", "--max-iterations N", "--window W"],
+    );
+}
+
+/// `fit --model radar` at its defaults runs on the landing trajectory and writes its flag
+/// column: `misfit` or empty.
+#[test]
+fn fit_radar_defaults_run_on_landing_with_a_flag_column() {
+    let (input, _) = landing();
+    let args = "fit --model radar --sigma-range 10 --sigma-angle 1e-3";
+    let out = ok(&args.split(' ').collect::<Vec<_>>(), &input);
+    let (header, rows) = table(&out);
+    assert_eq!(header.last().unwrap(), "flag");
+    let flagged = rows
+        .iter()
+        .filter(|r| match r.last().unwrap().as_str() {
+            "misfit" => true,
+            "" => false,
+            other => panic!("flag {other:?}"),
+        })
+        .count();
+    println!(
+        "fit --model radar: {flagged} of {} rows flagged",
+        rows.len()
+    );
+    assert!(flagged > 0 && flagged < rows.len() / 2);
 }

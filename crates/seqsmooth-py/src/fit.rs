@@ -13,8 +13,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
 use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
-use seqsmooth::estimate::sliding::SlidingFit;
+use seqsmooth::estimate::sliding::{SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
 use seqsmooth::kalman::track::radar_row;
+use seqsmooth::kalman::track::window_flag;
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::model::radar::Radar;
@@ -92,7 +93,8 @@ fn epoch_of(epoch: &Bound<'_, PyAny>) -> PyResult<Epoch> {
 ///     ``degree=2``) of a target seen from ``site`` as range, azimuth and elevation;
 ///     ``"polynomial"``: the derivatives ``(d0, …, dM)`` of a degree-M polynomial in t.
 /// window : int
-///     The rows of each fit, W ≥ 1 (default 60; polynomial: at least ``degree + 1``).
+///     The rows of each fit, W ≥ 1 (default: radar 8, polynomial 60; polynomial: at least
+///     ``degree + 1``).
 /// epoch : {"end", "centre"} or float
 ///     The time each row's state refers to: the row's own time (the default; also None),
 ///     the mean time of its window, or this time.
@@ -213,15 +215,15 @@ fn in_batch(e: Error, i: usize) -> PyErr {
 #[pymethods]
 impl PySlidingFit {
     #[new]
-    #[pyo3(signature = (model = "radar", *, window = 60, epoch = None, degree = None,
+    #[pyo3(signature = (model = "radar", *, window = None, epoch = None, degree = None,
         site = None, sigma_range = None, sigma_angle = None, sigma = None, azimuth = "from-x",
         max_iterations = 20),
-        text_signature = "(model='radar', *, window=60, epoch='end', degree=None, site=None, \
+        text_signature = "(model='radar', *, window=None, epoch='end', degree=None, site=None, \
             sigma_range=None, sigma_angle=None, sigma=None, azimuth='from-x', max_iterations=20)")]
     #[allow(clippy::too_many_arguments)]
     fn new(
         model: &str,
-        window: i64,
+        window: Option<i64>,
         epoch: Option<&Bound<'_, PyAny>>,
         degree: Option<i64>,
         site: Option<(f64, f64, f64)>,
@@ -233,6 +235,10 @@ impl PySlidingFit {
     ) -> PyResult<Self> {
         let usage = |m: String| Err(raise(Kind::Parameter, m, None));
         let library = |e: Error| raise(Kind::Parameter, e.to_string(), None);
+        let window = window.unwrap_or(match model {
+            "polynomial" => POLYNOMIAL_WINDOW as i64,
+            _ => RADAR_WINDOW as i64,
+        });
         if window < 1 {
             return usage(format!("window {window} must be at least 1"));
         }
@@ -372,7 +378,9 @@ impl PySlidingFit {
     ///     The command's other columns: ``"iterations"`` (Gauss–Newton iterations taken),
     ///     ``"chi2"`` (the window's residual ``e(X*)``, with degrees of freedom the measured
     ///     components less the states) and ``"epoch"`` (the time the state refers to), all
-    ///     float, NaN where the state is.
+    ///     float, NaN where the state is; radar also ``"flag"``, the command's ``flag``
+    ///     column (str): ``"misfit"`` where the window's χ² fails its test (the covariance
+    ///     carries the misfit, scaled by ``max(1, chi2/dof)``), else ``""``.
     ///
     /// Raises
     /// ------
@@ -435,6 +443,8 @@ impl PySlidingFit {
             vec![f64::NAN; count],
             vec![f64::NAN; count],
         ];
+        let mut flags = vec![""; count];
+        let radar = matches!(self.inner, Fitter::Radar(_));
         let fitter = &mut self.inner;
         let mut taken = 0;
         let failed = py.detach(|| {
@@ -451,6 +461,7 @@ impl PySlidingFit {
                     extra[0][i] = c.iterations.len() as f64;
                     extra[1][i] = c.chi_squared;
                     extra[2][i] = c.epoch;
+                    flags[i] = window_flag(&c).name();
                 }
             }
             Ok::<(), (usize, Error)>(())
@@ -469,6 +480,9 @@ impl PySlidingFit {
         let info = PyDict::new(py);
         for (name, v) in ["iterations", "chi2", "epoch"].into_iter().zip(extra) {
             info.set_item(name, PyArray1::from_vec(py, v))?;
+        }
+        if radar {
+            info.set_item("flag", crate::track::flag_array(py, &flags)?)?;
         }
         PyTuple::new(py, [states, covariances, info.into_any()])
     }

@@ -8,8 +8,12 @@ use crate::errors::{raise, to_py, IntoPy, Kind};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
-use seqsmooth::estimate::gauss_newton::Measurement;
-use seqsmooth::kalman::track::{radar_row, RadarTracker, TrackError, TrackMethod, Tracked};
+use seqsmooth::estimate::gauss_newton::{GaussNewton, Measurement};
+use seqsmooth::kalman::smoother::Smoothed;
+use seqsmooth::kalman::track::{
+    radar_row, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, DEFAULT_LAG,
+    DEFAULT_WINDOW,
+};
 use seqsmooth::kalman::Discount;
 use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
@@ -54,14 +58,30 @@ fn track_error(e: TrackError, offset: usize) -> PyErr {
     }
 }
 
-/// One output row: state, covariance (row-major) and NIS; NaN where none.
-fn write_row(estimate: &Tracked<'_>, states: &mut [f64], covariances: &mut [f64], nis: &mut f64) {
+/// One output row: state, covariance (row-major), NIS and flag; NaN (`""`) where none.
+fn write_row(
+    estimate: &Tracked<'_>,
+    states: &mut [f64],
+    covariances: &mut [f64],
+    nis: &mut f64,
+    flag: &mut &'static str,
+) {
     if let Tracked::Estimate(e) = estimate {
         states.copy_from_slice(e.state.as_slice());
         // Symmetric: column-major is row-major.
         covariances.copy_from_slice(e.covariance.as_slice());
         *nis = e.nis.unwrap_or(f64::NAN);
+        *flag = e.flag.name();
     }
+}
+
+/// The rows' flags (`TrackFlag::name`: `""`, `"outlier"`, `"misfit"`) as a numpy array of str.
+pub(crate) fn flag_array<'py>(py: Python<'py>, flags: &[&str]) -> PyResult<Bound<'py, PyAny>> {
+    let kwargs = pyo3::types::PyDict::new(py);
+    kwargs.set_item("dtype", "<U7")?;
+    py.import("numpy")?
+        .getattr("array")?
+        .call((pyo3::types::PyList::new(py, flags)?,), Some(&kwargs))
 }
 
 /// A radar track (Morrison §8.5-8.7, chs. 12, 14, 15): range, azimuth and elevation seen from
@@ -74,19 +94,35 @@ fn write_row(estimate: &Tracked<'_>, states: &mut [f64], covariances: &mut [f64]
 ///     ``"window"``: the Gauss–Newton fit of each row's last ``window`` rows;
 ///     ``"kalman"``: the extended Kalman filter with white-noise acceleration ``q``;
 ///     ``"fading"``: the fading-memory extended Kalman filter (``beta`` or ``theta``);
-///     ``"smooth"``: the Rauch–Tung–Striebel smoother over the Kalman filter (estimates at
-///     ``finish()``). The Kalman methods start from the first fit of the rows so far (at most
-///     60) that determines the state.
+///     ``"smooth"``: the fixed-lag Rauch–Tung–Striebel smoother over the Kalman filter: each
+///     row's estimate from the ``lag`` rows after it, given ``lag`` rows later (``smoothed()``),
+///     the last ones at ``finish()``. The Kalman methods start from the first fit of the rows
+///     so far (at most 60) that determines the state.
 /// sigma_range, sigma_angle : float, optional
 ///     The range's and the angles' noise σ (radians), for the rows that give none.
 /// site : (float, float, float)
 ///     The radar's position.
-/// q : float
-///     kalman, smooth: the acceleration's spectral density on each axis (default 0).
-/// beta, theta : float
-///     fading: the discount per unit of time, or per update (one of them).
+/// q : float, optional
+///     kalman, smooth: the acceleration's spectral density on each axis; by default
+///     adaptive: from ``σ_range² / T³`` (``T`` the start's mean step), raised by the
+///     innovation test's misfits and lowered when the innovations are quiet (Morrison §14.8).
+/// beta, theta : float, optional
+///     fading: the discount per unit of time, or per update (one of them); by default an
+///     adaptive discount per update from 0.9, shortened by misfits likewise.
 /// window : int
-///     window: the rows of each fit (default 60).
+///     window: the rows of each fit (default 8).
+/// lag : int
+///     smooth: the lag in rows (default 200); the smoother holds ``lag + 1`` rows; 0 is the
+///     filter, a lag beyond the rows the whole-interval smoother.
+/// max_iterations : int
+///     The Gauss–Newton iterations allowed per fit (the window method's, the Kalman methods'
+///     start), 1 to 1000 (default 20).
+///
+/// Every row's estimate has a flag (``update_many``'s fourth array, ``smoothed()``'s and
+/// ``finish()``'s fifth): ``""``; ``"outlier"``, the row's measurement failed the innovation
+/// gate and was left out (the estimate is the prediction); ``"misfit"``, the model does not
+/// follow the target here (the innovation test, or the window's χ²), so the σ may not cover
+/// the error. The smoother's rows carry the flag its forward filter gave them.
 /// azimuth : {"from-x", "bearing"}
 ///     ``"from-x"``: from +x towards +y; ``"bearing"``: clockwise from +y (x east, y north).
 #[pyclass(name = "RadarTracker", module = "seqsmooth")]
@@ -94,6 +130,43 @@ pub struct PyRadarTracker {
     inner: RadarTracker,
     sigmas: [Option<f64>; 2],
     bearing: bool,
+    /// The smoother's rows given and not yet returned.
+    given: Given,
+}
+
+/// Smoothed rows as the arrays `smoothed()` returns: row numbers, states, covariances
+/// (row-major: symmetric), NIS and flags.
+#[derive(Default)]
+struct Given {
+    rows: Vec<i64>,
+    states: Vec<f64>,
+    covariances: Vec<f64>,
+    nis: Vec<f64>,
+    flags: Vec<&'static str>,
+}
+
+impl Given {
+    fn push(&mut self, row: usize, s: &Smoothed, flag: TrackFlag) {
+        self.rows.push(row as i64);
+        self.states.extend_from_slice(s.state.as_slice());
+        self.covariances.extend_from_slice(s.covariance.as_slice());
+        self.nis.push(s.nis.unwrap_or(f64::NAN));
+        self.flags.push(flag.name());
+    }
+
+    /// `(rows, states, covariances, nis, flags)`, `(n,)`, `(n, 6)`, `(n, 6, 6)`, `(n,)`,
+    /// `(n,)`.
+    fn arrays<'py>(self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let count = self.rows.len();
+        let rows = PyArray1::from_vec(py, self.rows).into_any();
+        let states = matrix(py, self.states, count, 6)?;
+        let covariances = PyArray1::from_vec(py, self.covariances)
+            .reshape([count, 6, 6])?
+            .into_any();
+        let nis = PyArray1::from_vec(py, self.nis).into_any();
+        let flags = flag_array(py, &self.flags)?;
+        PyTuple::new(py, [rows, states, covariances, nis, flags])
+    }
 }
 
 impl PyRadarTracker {
@@ -160,7 +233,7 @@ impl PyRadarTracker {
     #[new]
     #[pyo3(signature = (method = "kalman", *, sigma_range = None, sigma_angle = None,
         site = (0.0, 0.0, 0.0), q = None, beta = None, theta = None, window = None,
-        azimuth = "from-x"))]
+        lag = None, azimuth = "from-x", max_iterations = 20))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         method: &str,
@@ -171,7 +244,9 @@ impl PyRadarTracker {
         beta: Option<f64>,
         theta: Option<f64>,
         window: Option<usize>,
+        lag: Option<usize>,
         azimuth: &str,
+        max_iterations: i64,
     ) -> PyResult<Self> {
         let usage = |m: &str| Err(raise(Kind::Parameter, m, None));
         let fading = beta.is_some() || theta.is_some();
@@ -180,23 +255,23 @@ impl PyRadarTracker {
                 return usage("q, beta and theta do not apply to method='window'")
             }
             "window" => TrackMethod::Window {
-                window: window.unwrap_or(60),
+                window: window.unwrap_or(DEFAULT_WINDOW),
             },
             "kalman" | "smooth" if fading => {
                 return usage("beta and theta apply only to method='fading'")
             }
-            "kalman" => TrackMethod::Kalman {
-                q: q.unwrap_or(0.0),
-            },
+            "kalman" => TrackMethod::Kalman { q },
             "smooth" => TrackMethod::Smooth {
-                q: q.unwrap_or(0.0),
+                q,
+                lag: lag.unwrap_or(DEFAULT_LAG),
             },
             "fading" if q.is_some() => return usage("q applies only to 'kalman' and 'smooth'"),
             "fading" => match (beta, theta) {
-                (Some(b), None) => TrackMethod::Fading(Discount::PerTime(b)),
-                (None, Some(t)) => TrackMethod::Fading(Discount::PerUpdate(t)),
+                (Some(b), None) => TrackMethod::Fading(Some(Discount::PerTime(b))),
+                (None, Some(t)) => TrackMethod::Fading(Some(Discount::PerUpdate(t))),
+                (None, None) => TrackMethod::Fading(None),
                 _ => return usage(
-                    "method='fading' needs beta (per unit of time) or theta (per update), not both",
+                    "method='fading' takes beta (per unit of time) or theta (per update), not both",
                 ),
             },
             other => {
@@ -207,6 +282,9 @@ impl PyRadarTracker {
         };
         if window.is_some() && !matches!(method, TrackMethod::Window { .. }) {
             return usage("window applies only to method='window'");
+        }
+        if lag.is_some() && !matches!(method, TrackMethod::Smooth { .. }) {
+            return usage("lag applies only to method='smooth'");
         }
         let bearing = match azimuth {
             "from-x" => false,
@@ -222,12 +300,22 @@ impl PyRadarTracker {
                 crate::fit::check_sigma(name, s)?;
             }
         }
+        if !(1..=1000).contains(&max_iterations) {
+            return usage(&format!(
+                "max_iterations {max_iterations} must be from 1 to 1000"
+            ));
+        }
+        let solver = GaussNewton {
+            max_iterations: max_iterations as usize,
+            ..GaussNewton::default()
+        };
         let radar = Radar::new([site.0, site.1, site.2], 6)
             .map_err(|e| raise(Kind::Parameter, e.to_string(), None))?;
         Ok(Self {
-            inner: RadarTracker::new(radar, method).py()?,
+            inner: RadarTracker::with_solver(radar, method, solver).py()?,
             sigmas: [sigma_range, sigma_angle],
             bearing,
+            given: Given::default(),
         })
     }
 
@@ -239,10 +327,12 @@ impl PyRadarTracker {
 
     /// Tracks the rows ``(t[i], range[i], azimuth[i], elevation[i])`` (NaN: a missing
     /// component), with per-row σ where given (NaN: the tracker's). Returns ``(states,
-    /// covariances, nis)``, ``(n, 6)``, ``(n, 6, 6)`` and ``(n,)``: NaN rows where the rows so
-    /// far do not determine the state, or the smoother holds the row (see ``finish``); a NIS
-    /// is NaN where there is no innovation. On a refused row the rows before it are taken and
-    /// the exception's ``index`` is its position.
+    /// covariances, nis, flags)``, ``(n, 6)``, ``(n, 6, 6)``, ``(n,)`` and ``(n,)`` of str:
+    /// NaN rows (flag ``""``) where the rows so far do not determine the state, or the
+    /// smoother holds the row (its estimate comes ``lag`` rows later from ``smoothed()``, or
+    /// from ``finish``); a NIS is NaN where there is no innovation; a flag is ``""``,
+    /// ``"outlier"`` or ``"misfit"`` (``seqsmooth track``'s ``flag``). On a refused row the
+    /// rows before it are taken and the exception's ``index`` is its position.
     #[pyo3(signature = (t, range, azimuth, elevation, sigma_range = None, sigma_angle = None))]
     #[allow(clippy::too_many_arguments)]
     fn update_many<'py>(
@@ -285,17 +375,28 @@ impl PyRadarTracker {
         let mut states = vec![f64::NAN; count * 6];
         let mut covariances = vec![f64::NAN; count * 36];
         let mut nis = vec![f64::NAN; count];
+        let mut flags = vec![""; count];
         let offset = self.inner.rows();
         let tracker = &mut self.inner;
+        let given = &mut self.given;
         let mut taken = 0;
         let failed = py.detach(|| {
             for (i, m) in rows.iter().enumerate() {
                 let tracked = tracker.push(m)?;
+                if let Tracked::Smoothed {
+                    row,
+                    estimate,
+                    flag,
+                } = tracked
+                {
+                    given.push(row, estimate, flag);
+                }
                 write_row(
                     &tracked,
                     &mut states[i * 6..(i + 1) * 6],
                     &mut covariances[i * 36..(i + 1) * 36],
                     &mut nis[i],
+                    &mut flags[i],
                 );
                 taken = i + 1;
             }
@@ -313,35 +414,35 @@ impl PyRadarTracker {
             .reshape([count, 6, 6])?
             .into_any();
         let nis = PyArray1::from_vec(py, nis).into_any();
-        PyTuple::new(py, [states, covariances, nis])
+        let flags = flag_array(py, &flags)?;
+        PyTuple::new(py, [states, covariances, nis, flags])
     }
 
-    /// The smoother's estimates of the rows it held: ``(rows, states, covariances, nis)``,
-    /// ``rows`` their numbers counted from the tracker's first row (0); empty for the other
-    /// methods. The smoother takes no more rows after it.
+    /// The smoother's estimates given since the last call (each row's from the ``lag`` rows
+    /// after it): ``(rows, states, covariances, nis, flags)``, ``(n,)``, ``(n, 6)``,
+    /// ``(n, 6, 6)``, ``(n,)``, ``(n,)`` of str: ``update_many``'s arrays after the rows'
+    /// numbers, counted from the tracker's first row (0); ``nis`` and ``flags`` the forward
+    /// filter's (a row the gate left out: its NIS, ``"outlier"``); empty for the other
+    /// methods. Call it after ``update_many`` to keep memory bounded by the lag; rows not
+    /// taken wait for ``finish``.
+    fn smoothed<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        std::mem::take(&mut self.given).arrays(py)
+    }
+
+    /// The smoother's estimates of the rows given and not yet taken by ``smoothed()``, then
+    /// those of the rows it still holds (smoothed by every row): ``(rows, states, covariances,
+    /// nis, flags)`` as ``smoothed()``; empty for the other methods. The smoother takes no
+    /// more rows after it.
     fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
         let tracker = &mut self.inner;
         let smoothed = py
             .detach(|| tracker.finish())
             .map_err(|e| track_error(e, 0))?;
-        let count = smoothed.len();
-        let mut rows = Vec::with_capacity(count);
-        let mut states = Vec::with_capacity(count * 6);
-        let mut covariances = Vec::with_capacity(count * 36);
-        let mut nis = Vec::with_capacity(count);
-        for (row, s) in smoothed {
-            rows.push(row as i64);
-            states.extend_from_slice(s.state.as_slice());
-            covariances.extend_from_slice(s.covariance.as_slice());
-            nis.push(s.nis.unwrap_or(f64::NAN));
+        let mut given = std::mem::take(&mut self.given);
+        for (row, s, flag) in &smoothed {
+            given.push(*row, s, *flag);
         }
-        let rows = PyArray1::from_vec(py, rows).into_any();
-        let states = matrix(py, states, count, 6)?;
-        let covariances = PyArray1::from_vec(py, covariances)
-            .reshape([count, 6, 6])?
-            .into_any();
-        let nis = PyArray1::from_vec(py, nis).into_any();
-        PyTuple::new(py, [rows, states, covariances, nis])
+        given.arrays(py)
     }
 
     fn __repr__(&self) -> String {

@@ -198,8 +198,8 @@ def test_ten_thousand_random_bad_calls_never_panic():
                 r = np.abs(values(n)) if rng.random() < 0.7 else values(n)
                 with np.errstate(invalid="ignore"):
                     az, el = values(n) % 7.0, values(n) % 1.6
-                x, p, nis = tracker.update_many(times(n), r, az, el)
-                held, xs, ps, ns = tracker.finish()
+                x, p, nis, _ = tracker.update_many(times(n), r, az, el)
+                held, xs, ps, ns, _ = tracker.finish()
                 assert not np.isinf(x).any() and not np.isinf(p).any()
                 assert np.isfinite(xs).all() and np.isfinite(ps).all()
                 outcomes["ok"] += 1

@@ -51,7 +51,11 @@ def run_fit(tmp_path, header, columns, *args) -> dict:
     rows = list(csv.reader(out.splitlines()))
     head, body = rows[0], rows[1:]
     return {
-        name: np.array([float(r[i]) if r[i] else np.nan for r in body])
+        name: (
+            np.array([r[i] for r in body], dtype="<U7")
+            if name == "flag"
+            else np.array([float(r[i]) if r[i] else np.nan for r in body])
+        )
         for i, name in enumerate(head)
     }
 
@@ -78,6 +82,9 @@ def check_against_command(got, want, names, sigma_names, epoch_column):
     assert same(info["chi2"], want["chi2"])
     if epoch_column:
         assert same(info["epoch"], want["epoch"])
+    if "flag" in want:
+        assert np.array_equal(info["flag"], want["flag"])
+        assert set(info["flag"]) <= {"", "misfit"}
     return len(want["t"])
 
 
@@ -347,7 +354,7 @@ def test_bad_calls_and_repr():
         fit.update_many([], [])
     radar = ss.SlidingFit(sigma_range=SR, sigma_angle=SA, epoch="center")
     assert repr(radar) == (
-        "SlidingFit(model='radar', degree=1, window=60, epoch='centre', rows_taken=0)"
+        "SlidingFit(model='radar', degree=1, window=8, epoch='centre', rows_taken=0)"
     )
     with pytest.raises(InvalidInputError):
         radar.update_many([0.0], [1.0])

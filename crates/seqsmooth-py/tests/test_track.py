@@ -33,7 +33,7 @@ def radar_pass(rng: np.random.Generator, n: int = 300, site=(0.0, 0.0, 0.0), mis
 
 def run_track(tmp_path, t, rows, *args, sigmas=None):
     """`seqsmooth track` on the rows (NaN written as an empty cell); its numbers, NaN where a
-    cell is empty: `(states, sigmas, nis)`."""
+    cell is empty, and its flag column: `(states, sigmas, nis, flags)`."""
     source = tmp_path / "radar.csv"
     cell = lambda v: "" if np.isnan(v) else repr(float(v))  # noqa: E731
     header = "t,range,azimuth,elevation" + (",sr,sa" if sigmas is not None else "")
@@ -53,21 +53,24 @@ def run_track(tmp_path, t, rows, *args, sigmas=None):
         text=True,
     ).stdout
     body = list(csv.reader(out.splitlines()))[1:]
-    table = np.array([[float(c) if c else np.nan for c in r[1:]] for r in body])
-    return table[:, :6], table[:, 6:12], table[:, 12]
+    table = np.array([[float(c) if c else np.nan for c in r[1:-1]] for r in body])
+    flags = np.array([r[-1] for r in body], dtype="<U7")
+    return table[:, :6], table[:, 6:12], table[:, 12], flags
 
 
 def tracked(tracker, t, rows, **kw):
     """Every row through `update_many`, the smoother's rows from `finish()`; σ from the
     covariance's diagonal as the command writes it."""
-    x, p, nis = tracker.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2], **kw)
-    held, xs, ps, ns = tracker.finish()
-    x[held], p[held], nis[held] = xs, ps, ns
+    x, p, nis, flags = tracker.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2], **kw)
+    held, xs, ps, ns, fs = tracker.finish()
+    x[held], p[held], nis[held], flags[held] = xs, ps, ns, fs
     sigma = np.sqrt(np.maximum(np.diagonal(p, axis1=1, axis2=2), 0.0))
-    return x, sigma, nis
+    return x, sigma, nis, flags
 
 
 def same(a, b):
+    if a.dtype.kind == "U" or b.dtype.kind == "U":
+        return a.dtype == b.dtype and np.array_equal(a, b)
     return np.array_equal(np.isnan(a), np.isnan(b)) and np.array_equal(
         np.nan_to_num(a).view(np.int64), np.nan_to_num(b).view(np.int64)
     )
@@ -79,6 +82,8 @@ METHODS = [
     ({"method": "fading", "beta": 0.9}, ["--method", "fading", "--beta", "0.9"]),
     ({"method": "fading", "theta": 0.8}, ["--method", "fading", "--theta", "0.8"]),
     ({"method": "smooth", "q": 0.2}, ["--method", "smooth", "--q", "0.2"]),
+    ({"method": "smooth", "q": 0.2, "lag": 7}, ["--method", "smooth", "--q", "0.2", "--lag", "7"]),
+    ({"method": "smooth", "q": 0.2, "lag": 0}, ["--method", "smooth", "--q", "0.2", "--lag", "0"]),
     ({"method": "window", "window": 12}, ["--method", "window", "--window", "12"]),
 ]
 
@@ -94,6 +99,7 @@ def test_equals_the_command_to_the_last_bit(tmp_path, kw, args):
     for g, w in zip(got, want):
         assert same(g, w)
     assert np.isfinite(got[0][-1]).all() and tracker.rows_taken == len(t)
+    assert set(got[3]) <= {"", "outlier", "misfit"}
 
 
 def test_per_row_sigmas_bearings_and_batches_equal_the_command(tmp_path):
@@ -131,7 +137,8 @@ def test_per_row_sigmas_bearings_and_batches_equal_the_command(tmp_path):
     x = np.concatenate([p[0] for p in parts])
     sigma = np.sqrt(np.maximum(np.diagonal(np.concatenate([p[1] for p in parts]), 0, 1, 2), 0))
     nis = np.concatenate([p[2] for p in parts])
-    for g, w in zip((x, sigma, nis), want):
+    flags = np.concatenate([p[3] for p in parts])
+    for g, w in zip((x, sigma, nis, flags), want):
         assert same(g, w)
 
 
@@ -143,8 +150,8 @@ def test_extended_kalman_equals_filterpy():
 
     rng = np.random.default_rng(13)
     t, rows = radar_pass(rng, n=150, missing=0.0)
-    tracker = ss.RadarTracker("kalman", sigma_range=SR, sigma_angle=SA)
-    x, p, _ = tracker.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2])
+    tracker = ss.RadarTracker("kalman", q=0.0, sigma_range=SR, sigma_angle=SA)
+    x, p, _, flags = tracker.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2])
     k0 = int(np.argmax(np.isfinite(x[:, 0])))
     ekf = ExtendedKalmanFilter(dim_x=6, dim_z=3)
     ekf.x, ekf.P = x[k0].copy(), p[k0].copy()
@@ -176,7 +183,8 @@ def test_extended_kalman_equals_filterpy():
         ekf.F = np.eye(6)
         ekf.F[:3, 3:] = dt * np.eye(3)
         ekf.predict()
-        ekf.update(rows[k], jacobian, hx, residual=residual)
+        if flags[k] != "outlier":  # the gate left the row out: the prediction
+            ekf.update(rows[k], jacobian, hx, residual=residual)
         scale = np.abs(ekf.x).max()
         assert np.abs(ekf.x - x[k]).max() <= 1e-9 * scale, k
         assert np.abs(ekf.P - p[k]).max() <= 1e-9 * np.abs(ekf.P).max(), k
@@ -214,7 +222,7 @@ def test_refused_rows_name_their_index_and_keep_the_rows_before():
 @pytest.mark.parametrize(
     "kw",
     [
-        {"method": "fading"},
+        {"method": "kalman", "max_iterations": 0},
         {"method": "fading", "beta": 0.9, "theta": 0.9},
         {"method": "fading", "theta": 1.5},
         {"method": "kalman", "q": -1.0},
@@ -222,6 +230,8 @@ def test_refused_rows_name_their_index_and_keep_the_rows_before():
         {"method": "window", "q": 1.0},
         {"method": "window", "window": 1},
         {"method": "kalman", "window": 10},
+        {"method": "kalman", "lag": 10},
+        {"method": "fading", "beta": 0.9, "lag": 10},
         {"method": "ekf"},
         {"method": "kalman", "azimuth": "north"},
         {"method": "kalman", "sigma_range": -1.0},
@@ -231,3 +241,68 @@ def test_refused_rows_name_their_index_and_keep_the_rows_before():
 def test_bad_settings_raise_parameter_errors(kw):
     with pytest.raises(ParameterError):
         ss.RadarTracker(**kw)
+
+
+def test_flags_name_an_outlier_and_a_manoeuvre():
+    """A range 30σ off is flagged ``"outlier"`` and left out (the next row is not), by every
+    method at its defaults; a 5g turn the constant-velocity model does not follow is
+    flagged ``"misfit"`` by every method; the flags are the command's ``flag`` column."""
+    rng = np.random.default_rng(21)
+    n = 240
+    t = np.cumsum(rng.uniform(1.0, 3.0, n))
+    # Straight at 200 m/s, then a turn of 0.25 rad/s (50 m/s², about 5g) from t = 200 s.
+    heading = 0.3 + 0.25 * np.clip(t - 200.0, 0.0, 12.0)
+    v = 200.0 * np.column_stack([np.cos(heading), np.sin(heading)])
+    dt = np.diff(t, prepend=0.0)
+    xy = np.array([30_000.0, -5_000.0]) + np.cumsum(v * dt[:, None], axis=0)
+    z = np.full(n, 4_000.0)
+    r = np.sqrt(xy[:, 0] ** 2 + xy[:, 1] ** 2 + z**2)
+    rows = np.column_stack([r, np.arctan2(xy[:, 1], xy[:, 0]), np.arcsin(z / r)])
+    rows += rng.standard_normal((n, 3)) * [SR, SA, SA]
+    k = 60
+    rows[k, 0] += 30 * SR
+    turn = (t > 200.0) & (t < 240.0)
+    for method in ["kalman", "fading", "smooth", "window"]:
+        tracker = ss.RadarTracker(method, sigma_range=SR, sigma_angle=SA)
+        x, sigma, nis, flags = tracked(tracker, t, rows)
+        assert flags.dtype.kind == "U" and set(flags) <= {"", "outlier", "misfit"}
+        assert flags[k] == "outlier" and flags[k + 1] != "outlier", method
+        assert (flags[turn] == "misfit").any(), method
+        assert (flags != "").mean() < 0.5, method
+
+
+def test_smoothed_streams_with_the_lag():
+    """With `lag` L, `smoothed()` after each batch gives row k once row k + L is in (and only
+    then), in order, each row once; with `finish()` they are every row after the start, the
+    numbers of taking them all at `finish()` (flags too); lag 0 gives the kalman filter's rows and
+    flags, with a given and with the adaptive driving noise."""
+    rng = np.random.default_rng(14)
+    t, rows = radar_pass(rng, n=240)
+    lag = 15
+    whole = ss.RadarTracker("smooth", q=0.5, lag=lag, sigma_range=SR, sigma_angle=SA)
+    x, _, _, _ = whole.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2])
+    start = int(np.flatnonzero(np.isfinite(x[:, 0]))[0])
+    want = whole.finish()
+    assert np.array_equal(want[0], np.arange(start + 1, len(t)))
+    tracker = ss.RadarTracker("smooth", q=0.5, lag=lag, sigma_range=SR, sigma_angle=SA)
+    got, last = [], start  # the last row given so far
+    for a, b in [(0, 1), (1, 70), (70, 71), (71, 200), (200, 240)]:
+        tracker.update_many(t[a:b], rows[a:b, 0], rows[a:b, 1], rows[a:b, 2])
+        part = tracker.smoothed()
+        # Row k is given once row k + lag is in (rows 0..b-1 are in).
+        assert np.array_equal(part[0], np.arange(last + 1, max(last + 1, b - lag))), (a, b)
+        last = max(last, b - lag - 1)
+        got.append(part)
+    assert tracker.smoothed()[0].size == 0
+    got.append(tracker.finish())
+    for k in range(5):
+        assert same(np.concatenate([g[k] for g in got]), want[k]), k
+    for q in [{"q": 0.5}, {}]:
+        kalman = ss.RadarTracker("kalman", **q, sigma_range=SR, sigma_angle=SA)
+        kx, kp, kn, kf = kalman.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2])
+        zero = ss.RadarTracker("smooth", **q, lag=0, sigma_range=SR, sigma_angle=SA)
+        zero.update_many(t, rows[:, 0], rows[:, 1], rows[:, 2])
+        held, xs, ps, ns, fs = zero.smoothed()
+        assert np.array_equal(held, np.arange(start + 1, len(t)))
+        assert same(xs, kx[held]) and same(ps, kp[held]) and same(ns, kn[held]), q
+        assert same(fs, kf[held]), q

@@ -10,8 +10,10 @@ use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, Start};
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
-use seqsmooth::kalman::track::{RadarTracker, TrackError, TrackMethod, Tracked, START_WINDOW};
-use seqsmooth::kalman::{smooth, Discount, KalmanFilter};
+use seqsmooth::kalman::track::{
+    window_flag, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, START_WINDOW,
+};
+use seqsmooth::kalman::{smooth, Discount, FixedLagSmoother, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::radar::Radar;
 
@@ -50,22 +52,38 @@ fn pass(n: usize, site: [f64; 3], seed: u64) -> Vec<Measurement> {
         .collect()
 }
 
-/// One row's output: `None` undetermined or held, else the state, covariance and NIS.
-type Row = Option<(DVector<f64>, DMatrix<f64>, Option<f64>)>;
+/// One row's output: `None` undetermined or held, else the state, covariance, NIS and flag.
+type Row = Option<(DVector<f64>, DMatrix<f64>, Option<f64>, TrackFlag)>;
 
-/// Every row of `rows` through a tracker, then its `finish()`.
+/// Every row of `rows` through a tracker, then its `finish()`: the rows' own estimates, and
+/// the smoother's (given with its lag or at the end), each at its row.
 fn tracked(radar: Radar, method: TrackMethod, rows: &[Measurement]) -> (Vec<Row>, Vec<Row>) {
     let mut t = RadarTracker::new(radar, method).unwrap();
+    let mut held = vec![None; rows.len()];
     let out = rows
         .iter()
-        .map(|m| match t.push(m).unwrap() {
-            Tracked::Estimate(e) => Some((e.state.clone(), e.covariance.clone(), e.nis)),
+        .enumerate()
+        .map(|(k, m)| match t.push(m).unwrap() {
+            Tracked::Estimate(e) => Some((e.state.clone(), e.covariance.clone(), e.nis, e.flag)),
+            Tracked::Smoothed {
+                row,
+                estimate: s,
+                flag,
+            } => {
+                let TrackMethod::Smooth { lag, .. } = method else {
+                    panic!("{method:?} smoothed")
+                };
+                assert_eq!(row, k - lag);
+                assert!(held[row].is_none());
+                held[row] = Some((s.state.clone(), s.covariance.clone(), s.nis, flag));
+                None
+            }
             Tracked::Undetermined | Tracked::Held => None,
         })
         .collect();
-    let mut held = vec![None; rows.len()];
-    for (row, s) in t.finish().unwrap() {
-        held[row] = Some((s.state, s.covariance, s.nis));
+    for (row, s, flag) in t.finish().unwrap() {
+        assert!(held[row].is_none());
+        held[row] = Some((s.state, s.covariance, s.nis, flag));
     }
     (out, held)
 }
@@ -80,6 +98,7 @@ fn fit(radar: Radar, w: usize) -> SlidingFit<PolynomialDynamics, Radar> {
         Start::Radar { radar, degree: 2 },
     )
     .unwrap()
+    .with_misfit_scale()
 }
 
 /// A Kalman filter from a fit.
@@ -111,35 +130,48 @@ fn kalman_and_fading_equal_the_filter_from_the_first_fit() {
     let rows = pass(400, [100.0, -50.0, 10.0], 1);
     let (k0, c) = start(radar, &rows);
     for method in [
-        TrackMethod::Kalman { q: 0.5 },
-        TrackMethod::Fading(Discount::PerTime(0.9)),
-        TrackMethod::Fading(Discount::PerUpdate(0.8)),
+        TrackMethod::Kalman { q: Some(0.5) },
+        TrackMethod::Fading(Some(Discount::PerTime(0.9))),
+        TrackMethod::Fading(Some(Discount::PerUpdate(0.8))),
     ] {
         let (out, held) = tracked(radar, method, &rows);
         assert!(held.iter().all(Option::is_none));
         assert!(out[..k0].iter().all(Option::is_none), "{method:?}");
         let first = out[k0].as_ref().unwrap();
         assert_eq!(
-            (&first.0, &first.1, first.2),
-            (&c.state, &c.covariance, None)
+            (&first.0, &first.1, first.2, first.3),
+            (&c.state, &c.covariance, None, TrackFlag::None)
         );
         let mut f = filter(radar, &c);
         f = match method {
-            TrackMethod::Kalman { q } => f
+            TrackMethod::Kalman { q: Some(q) } => f
                 .with_process_noise(WhiteNoiseDerivative::new(1, 3, q).unwrap())
                 .unwrap(),
-            TrackMethod::Fading(d) => f.with_fading(d).unwrap(),
+            TrackMethod::Fading(Some(d)) => f.with_fading(d).unwrap(),
             _ => unreachable!(),
         };
+        // The gate (χ²₃ at 0.999, 16.266) leaves out a lone row beyond it: the reference
+        // takes the prediction there.
+        let gate = seqsmooth::stats::chi_squared_quantile(3.0, 0.999).unwrap();
+        let mut outliers = 0;
         for (k, m) in rows.iter().enumerate().skip(k0 + 1) {
-            let nis = f.update_stats(m).unwrap().map(|i| i.nis);
-            let (x, s, n) = out[k].as_ref().unwrap();
+            let (x, s, n, flag) = out[k].as_ref().unwrap();
+            let nis = if *flag == TrackFlag::Outlier {
+                outliers += 1;
+                assert!(n.unwrap() > gate, "{method:?} row {k}");
+                let (stats, used) = f.update_gated(m, |_| false).unwrap().unwrap();
+                assert!(!used);
+                Some(stats.nis)
+            } else {
+                f.update_stats(m).unwrap().map(|i| i.nis)
+            };
             assert_eq!(
                 (x, s, *n),
                 (f.state(), f.covariance(), nis),
                 "{method:?} row {k}"
             );
         }
+        assert!(outliers <= 2, "{method:?}: {outliers} rows left out");
     }
 }
 
@@ -149,28 +181,80 @@ fn smooth_is_the_smoother_over_the_rows_after_the_start() {
     let rows = pass(300, [0.0; 3], 2);
     let (k0, c) = start(radar, &rows);
     let q = 0.2;
-    let (out, held) = tracked(radar, TrackMethod::Smooth { q }, &rows);
-    assert!(out
-        .iter()
-        .enumerate()
-        .all(|(k, r)| r.is_some() == (k == k0)));
-    assert!(held
-        .iter()
-        .enumerate()
-        .all(|(k, r)| r.is_some() == (k > k0)));
     let f = filter(radar, &c)
         .with_process_noise(WhiteNoiseDerivative::new(1, 3, q).unwrap())
         .unwrap();
-    let s = smooth(f.clone(), &rows[k0 + 1..]).unwrap();
-    for (k, s) in s.iter().enumerate() {
-        let (x, p, n) = held[k0 + 1 + k].as_ref().unwrap();
-        assert_eq!((x, p, *n), (&s.state, &s.covariance, s.nis));
+    // An unbounded lag: the whole-interval smoother's; a lag of 25 rows: the fixed-lag
+    // smoother's, each row given 25 rows later.
+    for lag in [usize::MAX, 300, 25, 0] {
+        let method = TrackMethod::Smooth { q: Some(q), lag };
+        let (out, held) = tracked(radar, method, &rows);
+        assert!(out
+            .iter()
+            .enumerate()
+            .all(|(k, r)| r.is_some() == (k == k0)));
+        assert!(held
+            .iter()
+            .enumerate()
+            .all(|(k, r)| r.is_some() == (k > k0)));
+        let s = if lag >= rows.len() {
+            smooth(f.clone(), &rows[k0 + 1..]).unwrap()
+        } else {
+            let mut s = FixedLagSmoother::new(f.clone(), lag);
+            let mut v: Vec<_> = rows[k0 + 1..]
+                .iter()
+                .filter_map(|m| s.push(m).unwrap())
+                .collect();
+            v.extend(s.finish().unwrap());
+            v
+        };
+        for (k, s) in s.iter().enumerate() {
+            let (x, p, n, flag) = held[k0 + 1 + k].as_ref().unwrap();
+            assert_ne!(*flag, TrackFlag::Outlier, "no row of this pass is left out");
+            assert_eq!((x, p, *n), (&s.state, &s.covariance, s.nis), "lag {lag}");
+        }
     }
+    let (_, held) = tracked(
+        radar,
+        TrackMethod::Smooth {
+            q: Some(q),
+            lag: 300,
+        },
+        &rows,
+    );
     // At the last row the smoothed estimate is the filtered one (RTS).
-    let (kalman, _) = tracked(radar, TrackMethod::Kalman { q }, &rows);
-    let (x, p, _) = held.last().unwrap().as_ref().unwrap();
-    let (xf, pf, _) = kalman.last().unwrap().as_ref().unwrap();
+    let (kalman, _) = tracked(radar, TrackMethod::Kalman { q: Some(q) }, &rows);
+    let (x, p, ..) = held.last().unwrap().as_ref().unwrap();
+    let (xf, pf, ..) = kalman.last().unwrap().as_ref().unwrap();
     assert!((x - xf).amax() <= 1e-9 * xf.amax() && (p - pf).amax() <= 1e-9 * pf.amax());
+}
+
+/// The adaptive smoother's forward filter is the adaptive kalman method's, gated and adapted
+/// alike at every lag: each smoothed row carries that row's NIS and flag (an injected outlier
+/// named `Outlier` however late it is released), lag 0 is the filter, and the last row of any
+/// lag is the filter's (RTS).
+#[test]
+fn the_adaptive_smoother_carries_the_filters_flags_at_every_lag() {
+    let radar = Radar::new([0.0; 3], 6).unwrap();
+    let mut rows = pass(400, [0.0; 3], 5);
+    let (k0, _) = start(radar, &rows);
+    let bad = k0 + 100;
+    rows[bad].values[0] = Some(rows[bad].values[0].unwrap_or(5e4) + 400.0); // 40σ
+    let (kalman, _) = tracked(radar, TrackMethod::Kalman { q: None }, &rows);
+    assert_eq!(kalman[bad].as_ref().unwrap().3, TrackFlag::Outlier);
+    for lag in [0, 1, 25, 200, usize::MAX] {
+        let (out, held) = tracked(radar, TrackMethod::Smooth { q: None, lag }, &rows);
+        assert_eq!(out[k0], kalman[k0], "lag {lag}: the start's row");
+        for k in k0 + 1..rows.len() {
+            let (x, p, n, flag) = held[k].as_ref().unwrap();
+            let (xk, pk, nk, fk) = kalman[k].as_ref().unwrap();
+            assert_eq!((n, flag), (nk, fk), "lag {lag} row {k}");
+            if lag == 0 || k == rows.len() - 1 {
+                assert!((x - xk).amax() <= 1e-9 * xk.amax(), "lag {lag} row {k}");
+                assert!((p - pk).amax() <= 1e-9 * pk.amax(), "lag {lag} row {k}");
+            }
+        }
+    }
 }
 
 #[test]
@@ -186,11 +270,19 @@ fn window_is_the_sliding_fit_with_the_previous_fits_innovation() {
             let mut kf = filter(radar, p);
             kf.update_stats(m).unwrap().map(|i| i.nis)
         });
-        previous = f.push(m.clone()).unwrap();
+        // A row the gate leaves out takes its place in the window unmeasured.
+        let mut taken = m.clone();
+        if out[k].as_ref().is_some_and(|o| o.3 == TrackFlag::Outlier) {
+            taken.values = vec![None; 3];
+        }
+        previous = f.push(taken).unwrap();
         match (&previous, &out[k]) {
             (None, None) => {}
-            (Some(c), Some((x, s, n))) => {
-                assert_eq!((x, s, *n), (&c.state, &c.covariance, nis), "row {k}")
+            (Some(c), Some((x, s, n, flag))) => {
+                assert_eq!((x, s, *n), (&c.state, &c.covariance, nis), "row {k}");
+                if *flag != TrackFlag::Outlier {
+                    assert_eq!(*flag, window_flag(c), "row {k}");
+                }
             }
             (c, o) => panic!("row {k}: fit {:?}, tracker {:?}", c.is_some(), o.is_some()),
         }
@@ -209,10 +301,23 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
     let rows = pass(80, [0.0; 3], 4);
     let (k0, _) = start(radar, &rows);
     for (method, at) in [
-        (TrackMethod::Kalman { q: 1.0 }, 1),
-        (TrackMethod::Kalman { q: 1.0 }, 40),
+        (TrackMethod::Kalman { q: Some(1.0) }, 1),
+        (TrackMethod::Kalman { q: Some(1.0) }, 40),
         (TrackMethod::Window { window: 10 }, 30),
-        (TrackMethod::Smooth { q: 1.0 }, 50),
+        (
+            TrackMethod::Smooth {
+                q: Some(1.0),
+                lag: 500,
+            },
+            50,
+        ),
+        (
+            TrackMethod::Smooth {
+                q: Some(1.0),
+                lag: 3,
+            },
+            50,
+        ),
     ] {
         let mut t = RadarTracker::new(radar, method).unwrap();
         let mut reference = RadarTracker::new(radar, method).unwrap();
@@ -242,18 +347,24 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
                 .iter()
                 .map(|m| match t.push(m).unwrap() {
                     Tracked::Estimate(e) => Some(e.state.clone()),
+                    Tracked::Smoothed { estimate, .. } => Some(estimate.state.clone()),
                     _ => None,
                 })
                 .collect();
-            v.extend(t.finish().unwrap().into_iter().map(|(_, s)| Some(s.state)));
+            v.extend(
+                t.finish()
+                    .unwrap()
+                    .into_iter()
+                    .map(|(_, s, _)| Some(s.state)),
+            );
             v
         };
         assert_eq!(later(&mut t), later(&mut reference), "{method:?} at {at}");
     }
     // Every method refuses a row at or before the previous one.
     for method in [
-        TrackMethod::Kalman { q: 1.0 },
-        TrackMethod::Fading(Discount::PerUpdate(0.9)),
+        TrackMethod::Kalman { q: Some(1.0) },
+        TrackMethod::Fading(Some(Discount::PerUpdate(0.9))),
     ] {
         let mut t = RadarTracker::new(radar, method).unwrap();
         for m in &rows[..30] {
@@ -267,7 +378,11 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
         ));
     }
     // The smoother refuses a row out of order when it comes, and none after its finish.
-    let mut t = RadarTracker::new(radar, TrackMethod::Smooth { q: 1.0 }).unwrap();
+    let method = TrackMethod::Smooth {
+        q: Some(1.0),
+        lag: 500,
+    };
+    let mut t = RadarTracker::new(radar, method).unwrap();
     for m in &rows[..60] {
         t.push(m).unwrap();
     }
@@ -293,12 +408,17 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
 fn bad_settings_are_refused() {
     let radar = Radar::new([0.0; 3], 6).unwrap();
     for method in [
-        TrackMethod::Kalman { q: -1.0 },
-        TrackMethod::Smooth { q: f64::NAN },
-        TrackMethod::Kalman { q: f64::INFINITY },
-        TrackMethod::Fading(Discount::PerTime(0.0)),
-        TrackMethod::Fading(Discount::PerUpdate(1.5)),
-        TrackMethod::Fading(Discount::PerUpdate(f64::NAN)),
+        TrackMethod::Kalman { q: Some(-1.0) },
+        TrackMethod::Smooth {
+            q: Some(f64::NAN),
+            lag: 10,
+        },
+        TrackMethod::Kalman {
+            q: Some(f64::INFINITY),
+        },
+        TrackMethod::Fading(Some(Discount::PerTime(0.0))),
+        TrackMethod::Fading(Some(Discount::PerUpdate(1.5))),
+        TrackMethod::Fading(Some(Discount::PerUpdate(f64::NAN))),
         TrackMethod::Window { window: 1 },
     ] {
         assert!(RadarTracker::new(radar, method).is_err(), "{method:?}");
@@ -443,7 +563,8 @@ fn extreme_scales_end_instead_of_looping() {
         ],
     ];
     let radar = Radar::new([0.0; 3], 6).unwrap();
-    let mut t = RadarTracker::new(radar, TrackMethod::Fading(Discount::PerUpdate(0.9))).unwrap();
+    let mut t =
+        RadarTracker::new(radar, TrackMethod::Fading(Some(Discount::PerUpdate(0.9)))).unwrap();
     let mut refused = Vec::new();
     for (k, [time, r, az, el]) in ROWS.into_iter().enumerate() {
         let m = Measurement {

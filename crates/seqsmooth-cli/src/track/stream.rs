@@ -29,9 +29,9 @@ const QUEUED: usize = 4;
 
 /// What the tracker sends the writer.
 pub(super) enum Block {
-    /// Rows' time cells (`ends` as in [`Batch`]) and their cells; `None` for a row held to the
-    /// end (the smoother's), written by a later block. `cells` may be shorter than `ends`
-    /// (the rows tracked before an error).
+    /// Rows' time cells (`ends` as in [`Batch`]) and their cells; `None` for a row the
+    /// smoother holds, written by a later block (of the rows it gave). `cells` may be shorter
+    /// than `ends` (the rows tracked before an error).
     Rows {
         text: Vec<u8>,
         ends: Vec<usize>,
@@ -146,6 +146,10 @@ fn track(
             ends: batch.ends,
             cells,
         })?;
+        // The smoother's rows given during the batch come after every row of it not held.
+        if let Some(given) = tracker.given() {
+            send(given)?;
+        }
         if let Some(e) = failed {
             return Err(Stop::Error(e));
         }

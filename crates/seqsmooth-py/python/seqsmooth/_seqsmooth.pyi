@@ -186,7 +186,9 @@ class RadarTracker:
         beta: float | None = None,
         theta: float | None = None,
         window: int | None = None,
+        lag: int | None = None,
         azimuth: Literal["from-x", "bearing"] = "from-x",
+        max_iterations: int = 20,
     ) -> None: ...
     @property
     def rows_taken(self) -> int: ...
@@ -198,17 +200,24 @@ class RadarTracker:
         elevation: ArrayLike,
         sigma_range: ArrayLike | None = None,
         sigma_angle: ArrayLike | None = None,
-    ) -> tuple[Matrix, npt.NDArray[np.float64], Vector]: ...
+    ) -> tuple[Matrix, npt.NDArray[np.float64], Vector, npt.NDArray[np.str_]]: ...
+    def smoothed(
+        self,
+    ) -> tuple[
+        npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64], Vector, npt.NDArray[np.str_]
+    ]: ...
     def finish(
         self,
-    ) -> tuple[npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64], Vector]: ...
+    ) -> tuple[
+        npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64], Vector, npt.NDArray[np.str_]
+    ]: ...
 
 class SlidingFit:
     def __init__(
         self,
         model: Literal["radar", "polynomial"] = "radar",
         *,
-        window: int = 60,
+        window: int | None = None,
         epoch: Literal["end", "centre", "center"] | float | None = "end",
         degree: int | None = None,
         site: tuple[float, float, float] | None = None,

@@ -17,6 +17,16 @@ use crate::model::radar::Radar;
 use nalgebra::DVector;
 use std::collections::VecDeque;
 
+/// The rows of a radar fit's window when none is given (`seqsmooth fit --model radar`,
+/// `seqsmooth track --method window`): short enough that a constant-velocity window fits an
+/// airliner's approach at 2.7 s steps most of the time (ACCURACY.md, "The tracker's
+/// coverage"); a window that does not fit is flagged and its covariance carries the misfit.
+pub const RADAR_WINDOW: usize = 8;
+
+/// The rows of a polynomial fit's window when none is given (`seqsmooth fit --model
+/// polynomial`).
+pub const POLYNOMIAL_WINDOW: usize = 60;
+
 /// Where a window's iteration starts when there is no previous estimate to carry forward.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Start {
@@ -68,6 +78,30 @@ pub struct SlidingFit<D: Dynamics, O: Observation> {
     start: Start,
     rows: VecDeque<Measurement>,
     last: Option<Correction>,
+    /// Whether each fit's covariance carries its misfit ([`misfit_scale`]).
+    scaled: bool,
+}
+
+/// The factor `max(1, χ²/ν)` by which a fit's covariance is scaled to carry its misfit: the
+/// residual χ² of a window that fits has mean `ν`, its degrees of freedom (§8.6), and a
+/// residual variance `χ²/ν` times the noise's says the noise alone does not explain the
+/// residuals — a model that does not follow the data over the window (Morrison §7.13), whose
+/// error the scaled covariance takes in; 1 with `ν = 0`.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::estimate::gauss_newton::Correction;
+/// use seqsmooth::estimate::sliding::misfit_scale;
+/// let c = Correction { epoch: 0.0, state: DVector::zeros(1), covariance: DMatrix::identity(1, 1),
+///     chi_squared: 40.0, degrees_of_freedom: 10, condition_number: 1.0, iterations: vec![] };
+/// assert_eq!(misfit_scale(&c), 4.0);
+/// assert_eq!(misfit_scale(&Correction { chi_squared: 5.0, ..c }), 1.0);
+/// ```
+pub fn misfit_scale(c: &Correction) -> f64 {
+    if c.degrees_of_freedom == 0 {
+        return 1.0;
+    }
+    (c.chi_squared / c.degrees_of_freedom as f64).max(1.0)
 }
 
 impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
@@ -145,6 +179,7 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
             start,
             rows: VecDeque::with_capacity(window.min(1 << 12)),
             last: None,
+            scaled: false,
         })
     }
 
@@ -169,6 +204,19 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
     /// ```
     pub fn with_solver(mut self, solver: GaussNewton) -> Self {
         self.solver = solver;
+        self
+    }
+
+    /// With each fit's covariance scaled by [`misfit_scale`] (the radar fits').
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton};
+    /// use seqsmooth::estimate::sliding::SlidingFit;
+    /// let fit = SlidingFit::polynomial(1, 3, Epoch::End, GaussNewton::default()).unwrap();
+    /// assert_eq!(fit.with_misfit_scale().window(), 3);
+    /// ```
+    pub fn with_misfit_scale(mut self) -> Self {
+        self.scaled = true;
         self
     }
 
@@ -294,7 +342,13 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
         };
         self.rows.push_back(measurement);
         self.rows.make_contiguous();
-        match self.fit().and_then(|c| accept(&c).map(|()| c)) {
+        let scaled = |mut c: Correction| {
+            if self.scaled {
+                c.covariance *= misfit_scale(&c);
+            }
+            c
+        };
+        match self.fit().map(scaled).and_then(|c| accept(&c).map(|()| c)) {
             Ok(c) => {
                 self.last = Some(c.clone());
                 Ok(Some(c))
@@ -384,7 +438,8 @@ impl SlidingFit<PolynomialDynamics, Radar> {
     /// towards +y, elevation from the x-y plane). The first window's iteration (and any whose
     /// carried-forward start fails) starts from the nominal of §8.5: polynomial fits of degree
     /// `max(2, degree)` (at most one less than the complete rows) to the range and angles,
-    /// then Gauss–Newton differential correction (§8.6-8.7) with `solver`'s limits.
+    /// then Gauss–Newton differential correction (§8.6-8.7) with `solver`'s limits; each
+    /// fit's covariance carries its misfit ([`misfit_scale`]).
     ///
     /// Errors: a degree other than 1 or 2, a `window` of 0, a site or an [`Epoch::At`] time
     /// not finite ([`Error::InvalidParameter`], [`Error::NonFinite`]).
@@ -423,7 +478,8 @@ impl SlidingFit<PolynomialDynamics, Radar> {
                 degree: 2.max(degree),
             },
         )?
-        .with_solver(solver))
+        .with_solver(solver)
+        .with_misfit_scale())
     }
 }
 

@@ -259,15 +259,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         mut self,
         noise: P,
     ) -> Result<Self, Error> {
-        let n = self.dynamics.dimension();
-        if noise.dimension() != n {
-            return Err(Error::InvalidParameter {
-                name: "process noise",
-                value: format!("for {} states", noise.dimension()),
-                reason: format!("the dynamics have {n} states"),
-            });
-        }
-        self.noise = Some(Arc::new(noise));
+        self.set_process_noise(noise)?;
         Ok(self)
     }
 
@@ -299,12 +291,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// assert!((f.covariance()[(0, 0)] - 1.0 / 3.0).abs() < 1e-12); // (1 − θ)/(1 + θ)
     /// ```
     pub fn with_fading(mut self, discount: Discount) -> Result<Self, Error> {
-        let discount = discount.checked()?;
-        self.fading = Some(Fading {
-            discount,
-            weight: self.covariance.clone(),
-            last_update: self.time,
-        });
+        self.set_fading(discount)?;
         Ok(self)
     }
 
@@ -439,6 +426,94 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         measurement: &Measurement,
     ) -> Result<Option<InnovationStats>, Error> {
         self.update_with(measurement, |_, stats| stats)
+    }
+
+    /// [`Self::update_stats`] with a gate (Morrison §14.8): the update is made only where
+    /// `accept` accepts its statistics; otherwise the filter takes the prediction to the
+    /// measurement's time and leaves the measurement unused. Returns the statistics and
+    /// whether they were accepted (`None` when no component is present: the prediction).
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = KalmanFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2),
+    ///     DVector::from_vec(vec![0.0, 1.0]), DMatrix::identity(2, 2), 0.0).unwrap();
+    /// let far = Measurement { time: 1.0, values: vec![Some(50.0)], noise: NoiseCovariance::Identity };
+    /// let (stats, used) = f.update_gated(&far, |s| s.nis < 16.0).unwrap().unwrap();
+    /// assert!(!used && stats.nis > 16.0);
+    /// assert_eq!((f.time(), f.state()[0]), (1.0, 1.0)); // the prediction only
+    /// ```
+    pub fn update_gated(
+        &mut self,
+        measurement: &Measurement,
+        accept: impl FnOnce(&InnovationStats) -> bool,
+    ) -> Result<Option<(InnovationStats, bool)>, Error> {
+        let Some(t) = self.measure_and_predict(measurement)? else {
+            return Ok(None);
+        };
+        let stats = self.correct(t, false)?;
+        let used = accept(&stats);
+        if used {
+            self.commit_correction(t);
+        } else {
+            self.commit_prediction(t);
+        }
+        Ok(Some((stats, used)))
+    }
+
+    /// Replaces the driving noise from the next prediction on (ch. 15): what an adaptive
+    /// filter changes between updates.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = KalmanFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2),
+    ///     DVector::zeros(2), DMatrix::zeros(2, 2), 0.0).unwrap();
+    /// f.set_process_noise(WhiteNoiseDerivative::new(1, 1, 3.0).unwrap()).unwrap();
+    /// f.predict(1.0).unwrap();
+    /// assert_eq!(f.covariance()[(1, 1)], 3.0);
+    /// ```
+    pub fn set_process_noise<P: ProcessNoise + 'static>(&mut self, noise: P) -> Result<(), Error> {
+        let n = self.dynamics.dimension();
+        if noise.dimension() != n {
+            return Err(Error::InvalidParameter {
+                name: "process noise",
+                value: format!("for {} states", noise.dimension()),
+                reason: format!("the dynamics have {n} states"),
+            });
+        }
+        self.noise = Some(Arc::new(noise));
+        Ok(())
+    }
+
+    /// Switches to fading memory with `discount` from now on, as [`Self::with_fading`] (its
+    /// `P` restarted at the current covariance, §14.5).
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::{Discount, KalmanFilter};
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::zeros(1), DMatrix::identity(1, 1), 0.0).unwrap();
+    /// assert!(f.set_fading(Discount::PerUpdate(0.5)).is_ok());
+    /// assert!(f.set_fading(Discount::PerUpdate(1.5)).is_err());
+    /// ```
+    pub fn set_fading(&mut self, discount: Discount) -> Result<(), Error> {
+        let discount = discount.checked()?;
+        self.fading = Some(Fading {
+            discount,
+            weight: self.covariance.clone(),
+            last_update: self.time,
+        });
+        Ok(())
     }
 
     /// The one update behind [`Self::update`] and [`Self::update_stats`]: `report` reads what

@@ -8,15 +8,21 @@
 //! - [`filter`]: [`KalmanFilter`], prediction, Joseph-form update, the iterated update, the
 //!   generalized fading memory of ch. 14 ([`Discount`]), innovation statistics.
 //! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run.
+//! - [`fixed_lag`]: the same smoother with a fixed lag: each measurement's estimate from the
+//!   `L` after it, in memory bounded by `L`.
 //! - [`track`]: [`track::RadarTracker`], a radar's rows to a Cartesian track by the sliding
 //!   Gauss–Newton fit, the extended Kalman filter (driving noise or fading) or its smoother.
+//! - [`adaptive`]: the tracker's innovation monitor (§14.8): the outlier gate, the window
+//!   test of the NIS, the adaptive memory, and the rows' [`track::TrackFlag`].
 //! - [`steady`]: the fading filter's steady state (§14.7).
 //! - [`noise`]: the driving-noise covariance `Q` over a step (15.2.23), in closed form for the
 //!   polynomial model ([`noise::WhiteNoiseDerivative`]).
 
+pub mod adaptive;
 pub mod bayes;
 mod discount;
 pub mod filter;
+pub mod fixed_lag;
 pub mod noise;
 pub mod smoother;
 pub mod steady;
@@ -24,4 +30,5 @@ pub mod track;
 
 pub use bayes::BayesFilter;
 pub use filter::{Discount, Innovation, KalmanFilter};
+pub use fixed_lag::FixedLagSmoother;
 pub use smoother::{smooth, Smoothed, Smoother};

@@ -13,11 +13,12 @@
 //! [`crate::estimate::gauss_newton`]).
 
 use super::filter::KalmanFilter;
+use super::fixed_lag::FixedLagSmoother;
 use crate::error::Error;
 use crate::estimate::gauss_newton::Measurement;
 use crate::model::dynamics::Dynamics;
 use crate::model::observation::Observation;
-use nalgebra::{Cholesky, DMatrix, DVector};
+use nalgebra::{DMatrix, DVector};
 
 /// The smoothed estimate at one measurement's time.
 #[derive(Clone, Debug, PartialEq)]
@@ -72,7 +73,8 @@ pub fn smooth<D: Dynamics + Clone, O: Observation + Clone>(
 
 /// The smoother a measurement at a time: the forward pass as the measurements come
 /// ([`Smoother::push`]), the backward pass at the end ([`Smoother::finish`]). [`smooth`] is
-/// this over a slice.
+/// this over a slice; it is the [`FixedLagSmoother`] with an unbounded lag (one backward
+/// pass, the same code).
 ///
 /// ```
 /// use nalgebra::{DMatrix, DVector};
@@ -92,97 +94,40 @@ pub fn smooth<D: Dynamics + Clone, O: Observation + Clone>(
 /// assert!((out[0].state[0] - 2.0).abs() < 1e-5); // the mean of both
 /// ```
 #[derive(Clone, Debug)]
-pub struct Smoother<D: Dynamics, O: Observation> {
-    filter: KalmanFilter<D, O>,
-    /// Per measurement: `Φ` from the previous one, `X_{k|k−1}` and `S_{k|k−1}`.
-    predicted: Vec<(DMatrix<f64>, DVector<f64>, DMatrix<f64>)>,
-    out: Vec<Smoothed>,
-}
+pub struct Smoother<D: Dynamics, O: Observation>(FixedLagSmoother<D, O>);
 
 impl<D: Dynamics + Clone, O: Observation + Clone> Smoother<D, O> {
     /// A smoother whose forward pass starts as `filter`.
     pub fn new(filter: KalmanFilter<D, O>) -> Self {
-        Self {
-            filter,
-            predicted: Vec::new(),
-            out: Vec::new(),
-        }
+        Self(FixedLagSmoother::new(filter, usize::MAX))
     }
 
     /// The forward filter so far.
     pub fn filter(&self) -> &KalmanFilter<D, O> {
-        &self.filter
+        self.0.filter()
+    }
+
+    /// The forward filter, to change its driving noise or fading between pushes (an adaptive
+    /// filter): the backward pass uses each step's own prediction, so it stays consistent.
+    pub fn filter_mut(&mut self) -> &mut KalmanFilter<D, O> {
+        self.0.filter_mut()
     }
 
     /// The forward pass over `m` (not before the previous measurement): the prediction and
     /// the update; the update's NIS (`None` where every component is missing). On an error
     /// the smoother is unchanged.
     pub fn push(&mut self, m: &Measurement) -> Result<Option<f64>, Error> {
-        if let Some(previous) = self.out.last() {
-            if m.time.is_finite() && m.time < previous.time {
-                return Err(Error::InvalidParameter {
-                    name: "time",
-                    value: m.time.to_string(),
-                    reason: format!("is before the previous measurement's {}", previous.time),
-                });
-            }
-        }
-        let before = self.filter.clone();
-        let step = |filter: &mut KalmanFilter<D, O>| {
-            let phi = filter.predict_with_transition(m.time)?;
-            let predicted = (phi, filter.state().clone(), filter.covariance().clone());
-            Ok::<_, Error>((predicted, filter.update(m)?.map(|i| i.nis)))
-        };
-        let (predicted, nis) = step(&mut self.filter).inspect_err(|_| self.filter = before)?;
-        self.predicted.push(predicted);
-        self.out.push(Smoothed {
-            time: m.time,
-            state: self.filter.state().clone(),
-            covariance: self.filter.covariance().clone(),
-            filtered_state: self.filter.state().clone(),
-            filtered_covariance: self.filter.covariance().clone(),
-            nis,
-        });
-        Ok(nis)
+        let given = self.0.push(m)?;
+        debug_assert!(
+            given.is_none(),
+            "an unbounded lag gives nothing before finish"
+        );
+        Ok(self.0.nis())
     }
 
     /// The backward pass: every measurement's smoothed estimate, in order. An error names its
     /// measurement ([`Error::InBatch`], counted from the first pushed).
     pub fn finish(self) -> Result<Vec<Smoothed>, Error> {
-        let (predicted, mut out) = (self.predicted, self.out);
-        // Backward.
-        for k in (0..out.len().saturating_sub(1)).rev() {
-            let (phi, x_pred, s_pred) = &predicted[k + 1];
-            let chol = Cholesky::new(s_pred.clone()).ok_or_else(|| Error::InBatch {
-                index: k + 1,
-                source: Box::new(Error::InvalidParameter {
-                    name: "predicted covariance",
-                    value: format!("{s_pred:?}"),
-                    reason: "is not positive definite, so the smoother cannot weigh the later \
-                         measurements (add driving noise, or avoid perfect observations)"
-                        .into(),
-                }),
-            })?;
-            // C = S_{k|k} Φᵀ S_pred⁻¹: solve S_pred Cᵀ = Φ S_{k|k}.
-            let c = chol.solve(&(phi * &out[k].filtered_covariance)).transpose();
-            let dx = &out[k + 1].state - x_pred;
-            let ds = &out[k + 1].covariance - s_pred;
-            let state = &out[k].filtered_state + &c * dx;
-            let covariance = &out[k].filtered_covariance + &c * ds * c.transpose();
-            let covariance = (&covariance + covariance.transpose()) * 0.5;
-            if let Some(&value) = state
-                .iter()
-                .chain(covariance.iter())
-                .find(|v| !v.is_finite())
-            {
-                return Err(Error::NonFinite {
-                    what: "smoothed state or covariance entry",
-                    value,
-                });
-            }
-            out[k].state = state;
-            out[k].covariance = covariance;
-        }
-        Ok(out)
+        self.0.finish()
     }
 }

@@ -6,27 +6,60 @@
 //! | [`TrackMethod::Window`] | the Gauss–Newton fit of the last `W` rows (warm started), its innovation against the previous row's fit | §8.5-8.7 ([`SlidingFit`]) |
 //! | [`TrackMethod::Kalman`] | the extended Kalman filter, white noise of density `q` driving the acceleration | ch. 12, (15.2.23) |
 //! | [`TrackMethod::Fading`] | the extended Kalman filter with fading memory (`β` per time or `θ` per update), its true covariance | ch. 14 |
-//! | [`TrackMethod::Smooth`] | the Rauch–Tung–Striebel smoother over the Kalman filter's run, at the end | [`super::smooth`] |
+//! | [`TrackMethod::Smooth`] | the Rauch–Tung–Striebel smoother over the Kalman filter's run with a lag of `L` rows: each row's estimate from the `L` rows after it, given `L` rows later | [`super::fixed_lag`] |
 //!
 //! The Kalman methods start from the first Gauss–Newton fit of the rows so far (at most
 //! [`START_WINDOW`]) that determines the state, started at the radar nominal of §8.5; that
 //! row's estimate is the fit's. The rows before give no estimate. This is the one tracker of
 //! the `seqsmooth track` command and of the Python binding.
+//!
+//! Every estimate comes with a [`TrackFlag`]: the Kalman methods test each update's NIS and
+//! the NIS of the last few against χ² (Morrison §14.8, [`super::adaptive`]): a lone update
+//! beyond the gate is an outlier, left out (the row's estimate is the prediction); a window
+//! beyond its χ² is a misfit (a manoeuvre the model does not follow), flagged. Without a given
+//! driving noise (`q: None`) or discount (`Fading(None)`) the memory is adaptive: each misfit
+//! shortens it (a larger `q`, a smaller `θ`), quiet updates lengthen it again; the driving
+//! noise starts at `q₀ = σ_r² / T³` (the range's noise variance over the cube of the start's
+//! mean step: a tracking index of 1), the discount at `θ₀ = 0.9` per update. The window
+//! method gates each row likewise, on its NIS against the previous window's estimate (a lone
+//! row beyond the gate takes its place in the window unmeasured), tests each window's
+//! residual χ² against its degrees of freedom (§8.6) and carries
+//! the misfit in its covariance, scaled by `max(1, χ²/ν)` ([`misfit_scale`](crate::estimate::sliding::misfit_scale)); a window beyond
+//! `χ²_ν` at `1 − MISFIT_ALPHA` is flagged.
 
+pub use super::adaptive::TrackFlag;
+use super::adaptive::{Monitor, MISFIT_ALPHA};
 use super::filter::{Discount, KalmanFilter};
+use super::fixed_lag::FixedLagSmoother;
 use super::noise::WhiteNoiseDerivative;
-use super::smoother::{Smoothed, Smoother};
+use super::smoother::Smoothed;
 use crate::error::Error;
-use crate::estimate::gauss_newton::{Correction, Epoch, Measurement};
+use crate::estimate::batch::NoiseCovariance;
+use crate::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use crate::estimate::sliding::{SlidingFit, Start};
 use crate::model::dynamics::PolynomialDynamics;
 use crate::model::radar::Radar;
 use nalgebra::{DMatrix, DVector};
+use std::collections::VecDeque;
 use std::ops::Range;
 
 /// The window of the Kalman methods' start: the first fit of at most this many last rows that
 /// determines the state.
 pub const START_WINDOW: usize = 60;
+
+/// The window method's rows per fit when none is given: the radar fit's
+/// [`RADAR_WINDOW`](crate::estimate::sliding::RADAR_WINDOW).
+pub const DEFAULT_WINDOW: usize = crate::estimate::sliding::RADAR_WINDOW;
+
+/// The adaptive fading filter's discount per update at level 0 (a memory of about 19 updates).
+pub const DEFAULT_THETA: f64 = 0.9;
+
+/// The adaptive levels: the driving noise `q₀ 4^ℓ` for `ℓ` in `NOISE_LEVELS`, the discount
+/// `1 − (1 − θ₀) 2^ℓ` for `ℓ` in `FADING_LEVELS`.
+const NOISE_LEVELS: (i32, i32) = (-6, 14);
+const FADING_LEVELS: (i32, i32) = (-4, 3);
+/// The smoother's default lag, in rows ([`TrackMethod::Smooth`]).
+pub const DEFAULT_LAG: usize = 200;
 
 /// How rows become estimates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,19 +70,50 @@ pub enum TrackMethod {
         window: usize,
     },
     /// The extended Kalman filter with white noise of spectral density `q` (distance²/time³)
-    /// driving each axis's acceleration; 0 for none.
+    /// driving each axis's acceleration; 0 for none, `None` for the adaptive driving noise.
     Kalman {
-        /// `q ≥ 0`.
-        q: f64,
+        /// `q ≥ 0`, or `None`: adaptive.
+        q: Option<f64>,
     },
-    /// The extended Kalman filter with fading memory.
-    Fading(Discount),
-    /// The smoother over the Kalman filter's run (driving noise `q`); the estimates come at
-    /// [`RadarTracker::finish`].
+    /// The extended Kalman filter with fading memory; `None` for the adaptive discount.
+    Fading(Option<Discount>),
+    /// The fixed-lag smoother over the Kalman filter's run (driving noise `q`, `None` adaptive
+    /// as for [`TrackMethod::Kalman`]: the forward filter gated and adapted as that one):
+    /// each row's estimate from the `lag` rows after it, given when the `lag`-th comes
+    /// ([`Tracked::Smoothed`]); the last `lag` rows' at [`RadarTracker::finish`], from every
+    /// row. `lag` 0 is the filter; a lag at least the rows' number the whole-interval smoother.
     Smooth {
-        /// `q ≥ 0`.
-        q: f64,
+        /// `q ≥ 0`, or `None`: adaptive.
+        q: Option<f64>,
+        /// `L`, in rows ([`DEFAULT_LAG`] by default): the smoother holds `L + 1` rows.
+        lag: usize,
     },
+}
+
+impl TrackMethod {
+    /// The method named `kalman`, `fading`, `smooth` or `window` at its defaults: adaptive
+    /// driving noise, adaptive discount, [`DEFAULT_WINDOW`] rows.
+    ///
+    /// ```
+    /// use seqsmooth::kalman::track::{TrackMethod, DEFAULT_WINDOW};
+    /// assert_eq!(TrackMethod::named("window"), Some(TrackMethod::Window { window: DEFAULT_WINDOW }));
+    /// assert_eq!(TrackMethod::named("kalman"), Some(TrackMethod::Kalman { q: None }));
+    /// assert_eq!(TrackMethod::named("other"), None);
+    /// ```
+    pub fn named(name: &str) -> Option<Self> {
+        Some(match name {
+            "kalman" => TrackMethod::Kalman { q: None },
+            "fading" => TrackMethod::Fading(None),
+            "smooth" => TrackMethod::Smooth {
+                q: None,
+                lag: DEFAULT_LAG,
+            },
+            "window" => TrackMethod::Window {
+                window: DEFAULT_WINDOW,
+            },
+            _ => return None,
+        })
+    }
 }
 
 /// Why a row (or the end) failed.
@@ -90,6 +154,8 @@ pub struct TrackEstimate<'a> {
     /// The row's normalised innovation squared against the prediction from the row before
     /// (`None` at the start, or where it could not be formed).
     pub nis: Option<f64>,
+    /// How the estimate stands: [`TrackFlag::None`], or why its σ may not cover its error.
+    pub flag: TrackFlag,
 }
 
 /// What a row gave.
@@ -99,33 +165,201 @@ pub enum Tracked<'a> {
     Undetermined,
     /// The row's estimate.
     Estimate(TrackEstimate<'a>),
-    /// Held for [`RadarTracker::finish`] (the smoother).
+    /// Held by the smoother, which gives no row yet (its first `lag` rows; the rest come at
+    /// [`RadarTracker::finish`]).
     Held,
+    /// Held by the smoother, which gives the estimate of the earlier row `row` (`lag` rows
+    /// back), from the rows up to this one.
+    Smoothed {
+        /// The row given, counted from the tracker's first (0).
+        row: usize,
+        /// Its smoothed estimate (`nis` the forward filter's at that row, also where the gate
+        /// left the row out).
+        estimate: &'a Smoothed,
+        /// The forward pass's flag of that row.
+        flag: TrackFlag,
+    },
 }
 
 /// The filter of the Kalman methods.
 type Filter = KalmanFilter<PolynomialDynamics, Radar>;
+
+/// The memory of a Kalman method: a driving noise or a discount, fixed or adaptive, with the
+/// innovation monitor that flags its rows.
+#[derive(Clone, Debug)]
+struct Memory {
+    kind: MemoryKind,
+    monitor: Monitor,
+}
+
+/// What a level sets.
+#[derive(Clone, Copy, Debug)]
+enum MemoryKind {
+    /// The driving noise `q` at level 0 (`q₀` when adaptive).
+    Noise(f64),
+    /// The discount at level 0.
+    Fading(Discount),
+}
+
+impl Memory {
+    /// The memory of `method` for a filter started from the fit over `rows` (the adaptive
+    /// `q₀` from their steps and range noise).
+    fn new<'a>(
+        method: TrackMethod,
+        rows: impl Iterator<Item = &'a Measurement>,
+    ) -> Result<Self, Error> {
+        let (kind, adaptive, (lowest, highest)) = match method {
+            TrackMethod::Kalman { q: Some(q) } | TrackMethod::Smooth { q: Some(q), .. } => {
+                (MemoryKind::Noise(q), false, (0, 0))
+            }
+            TrackMethod::Kalman { q: None } | TrackMethod::Smooth { q: None, .. } => {
+                (MemoryKind::Noise(base_noise(rows)), true, NOISE_LEVELS)
+            }
+            TrackMethod::Fading(Some(d)) => (MemoryKind::Fading(d), false, (0, 0)),
+            TrackMethod::Fading(None) => (
+                MemoryKind::Fading(Discount::PerUpdate(DEFAULT_THETA)),
+                true,
+                FADING_LEVELS,
+            ),
+            TrackMethod::Window { .. } => (MemoryKind::Noise(0.0), false, (0, 0)),
+        };
+        Ok(Self {
+            kind,
+            monitor: Monitor::new(3, adaptive, lowest, highest)?,
+        })
+    }
+
+    /// Sets the filter's driving noise or discount to the monitor's level.
+    fn apply(&self, f: &mut Filter) -> Result<(), Error> {
+        let level = self.monitor.level();
+        match self.kind {
+            MemoryKind::Noise(q) => {
+                let q = q * 4f64.powi(level);
+                f.set_process_noise(WhiteNoiseDerivative::new(1, 3, q)?)
+            }
+            MemoryKind::Fading(d) if level == 0 => f.set_fading(d),
+            MemoryKind::Fading(d) => {
+                let theta = match d {
+                    Discount::PerUpdate(t) | Discount::PerTime(t) => t,
+                };
+                f.set_fading(Discount::PerUpdate(1.0 - (1.0 - theta) * 2f64.powi(level)))
+            }
+        }
+    }
+
+    /// One row through `filter`: the gated update, the row's flag, and the level changed
+    /// where the monitor says so. Returns the NIS (`None` with no component) and the flag.
+    fn step(&mut self, f: &mut Filter, m: &Measurement) -> Result<(Option<f64>, TrackFlag), Error> {
+        let monitor = &self.monitor;
+        let Some((stats, used)) = f.update_gated(m, |s| monitor.accepts(s.nis, s.components))?
+        else {
+            return Ok((None, TrackFlag::None));
+        };
+        let (flag, changed) = self.monitor.record(stats.nis, stats.components, used);
+        if changed {
+            self.apply(f)?;
+        }
+        Ok((Some(stats.nis), flag))
+    }
+
+    /// [`Self::step`] for the smoother: the gate decided on a copy of its filter, then the row
+    /// (or, left out, the prediction to its time) pushed and the level changed where the
+    /// monitor says so. Returns the row the smoother gave (if any), the NIS and the flag. On
+    /// an error the smoother and the memory are unchanged (the new level is tried on the copy
+    /// before the push).
+    fn step_smoother(
+        &mut self,
+        s: &mut FixedLagSmoother<PolynomialDynamics, Radar>,
+        m: &Measurement,
+    ) -> Result<(Option<Smoothed>, Option<f64>, TrackFlag), Error> {
+        let mut probe = s.filter().clone();
+        let monitor = &self.monitor;
+        let gated = probe.update_gated(m, |s| monitor.accepts(s.nis, s.components))?;
+        let Some((stats, used)) = gated else {
+            return Ok((s.push(m)?, None, TrackFlag::None));
+        };
+        let mut memory = self.clone();
+        let (flag, changed) = memory.monitor.record(stats.nis, stats.components, used);
+        if changed {
+            memory.apply(&mut probe)?;
+        }
+        let given = if used {
+            s.push(m)?
+        } else {
+            let mut predicted = m.clone();
+            predicted.values.iter_mut().for_each(|v| *v = None);
+            s.push(&predicted)?
+        };
+        if changed {
+            memory.apply(s.filter_mut())?;
+        }
+        *self = memory;
+        Ok((given, Some(stats.nis), flag))
+    }
+}
+
+/// The smooth method's forward pass: the fixed-lag smoother, the memory that gates and adapts
+/// its filter (as the kalman method's), and the NIS and flag of each row the smoother holds,
+/// oldest first (its ring's rows: at most `lag + 1`).
+#[derive(Clone, Debug)]
+struct Lagged {
+    smoother: FixedLagSmoother<PolynomialDynamics, Radar>,
+    memory: Memory,
+    held: VecDeque<(Option<f64>, TrackFlag)>,
+}
+
+/// The adaptive driving noise's level 0, `q₀ = σ_r² / T³`: the range's noise variance (of the
+/// last row) over the cube of the rows' mean step, the density whose tracking index
+/// `√(q T³) / σ_r` is 1.
+fn base_noise<'a>(rows: impl Iterator<Item = &'a Measurement>) -> f64 {
+    let (mut first, mut last, mut count, mut variance) = (f64::NAN, f64::NAN, 0usize, 1.0);
+    for m in rows {
+        if count == 0 {
+            first = m.time;
+        }
+        last = m.time;
+        count += 1;
+        if m.values.first().is_some_and(Option::is_some) {
+            variance = match &m.noise {
+                NoiseCovariance::Identity => 1.0,
+                NoiseCovariance::Variances(v) => v.first().copied().unwrap_or(1.0),
+                NoiseCovariance::Full(r) => r[(0, 0)],
+            };
+        }
+    }
+    let step = (last - first) / count.saturating_sub(1).max(1) as f64;
+    let q = variance / (step * step * step);
+    if q.is_finite() && q > 0.0 {
+        q
+    } else {
+        1.0
+    }
+}
 
 /// What the method keeps between rows.
 #[derive(Clone, Debug)]
 enum Stage {
     /// The Kalman methods before the state is determined: the start's fit.
     Starting(Box<SlidingFit<PolynomialDynamics, Radar>>),
-    /// kalman and fading: the filter, and the start's fit for the row that made it.
-    Filtering(Box<Filter>, Option<Correction>),
-    /// smooth: the smoother's forward pass over the rows after the start, the start's fit,
-    /// and its row.
+    /// kalman and fading: the filter and its memory, and the start's fit for the row that
+    /// made it.
+    Filtering(Box<(Filter, Memory)>, Option<Correction>),
+    /// smooth: the fixed-lag smoother over the rows after the start and its memory, the
+    /// start's fit, its row, and the row the last push gave.
     Smoothing(
-        Box<Smoother<PolynomialDynamics, Radar>>,
+        Box<Lagged>,
         Option<Correction>,
         usize,
+        Option<(usize, Smoothed, TrackFlag)>,
     ),
     /// smooth after [`RadarTracker::finish`]: no more rows.
     Finished,
-    /// window: the fit over the last rows, and the previous row's estimate.
+    /// window: the fit over the last rows, the previous row's estimate, and the outlier gate
+    /// on the row's innovation against it.
     Window(
         Box<SlidingFit<PolynomialDynamics, Radar>>,
         Option<Correction>,
+        Box<Monitor>,
     ),
 }
 
@@ -134,11 +368,11 @@ enum Stage {
 /// ```
 /// use seqsmooth::estimate::batch::NoiseCovariance;
 /// use seqsmooth::estimate::gauss_newton::Measurement;
-/// use seqsmooth::kalman::track::{RadarTracker, TrackMethod, Tracked};
+/// use seqsmooth::kalman::track::{RadarTracker, TrackFlag, TrackMethod, Tracked};
 /// use seqsmooth::model::radar::Radar;
 /// // A target at (1000, 2000, 500) moving at (10, -5, 0) per second, seen exactly.
 /// let radar = Radar::new([0.0; 3], 6).unwrap();
-/// let mut tracker = RadarTracker::new(radar, TrackMethod::Kalman { q: 0.0 }).unwrap();
+/// let mut tracker = RadarTracker::new(radar, TrackMethod::Kalman { q: Some(0.0) }).unwrap();
 /// let mut last = None;
 /// for k in 0..10 {
 ///     let t = k as f64;
@@ -150,10 +384,11 @@ enum Stage {
 ///         noise: NoiseCovariance::Variances(vec![1.0, 1e-6, 1e-6]),
 ///     };
 ///     if let Tracked::Estimate(e) = tracker.push(&m).unwrap() {
-///         last = Some(e.state[3]);
+///         last = Some((e.state[3], e.flag));
 ///     }
 /// }
-/// assert!((last.unwrap() - 10.0).abs() < 1e-6);
+/// let (vx, flag) = last.unwrap();
+/// assert!((vx - 10.0).abs() < 1e-6 && flag == TrackFlag::None);
 /// ```
 #[derive(Clone, Debug)]
 pub struct RadarTracker {
@@ -168,9 +403,38 @@ pub struct RadarTracker {
 }
 
 impl RadarTracker {
-    /// A tracker of `radar`'s rows (a six-state radar: [`Radar::new`] with 6) by `method`.
+    /// A tracker of `radar`'s rows (a six-state radar: [`Radar::new`] with 6) by `method`,
+    /// its Gauss–Newton fits with [`GaussNewton::default`]'s limits.
     pub fn new(radar: Radar, method: TrackMethod) -> Result<Self, Error> {
+        Self::with_solver(radar, method, GaussNewton::default())
+    }
+
+    /// [`Self::new`] with the Gauss–Newton limits of every fit (the window method's, the
+    /// Kalman methods' start): `max_iterations` is `seqsmooth track --max-iterations`.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::GaussNewton;
+    /// use seqsmooth::kalman::track::{RadarTracker, TrackMethod};
+    /// use seqsmooth::model::radar::Radar;
+    /// let radar = Radar::new([0.0; 3], 6).unwrap();
+    /// let limits = GaussNewton { max_iterations: 100, ..GaussNewton::default() };
+    /// assert!(RadarTracker::with_solver(radar, TrackMethod::Window { window: 20 }, limits).is_ok());
+    /// let none = GaussNewton { max_iterations: 0, ..GaussNewton::default() };
+    /// assert!(RadarTracker::with_solver(radar, TrackMethod::Window { window: 20 }, none).is_err());
+    /// ```
+    pub fn with_solver(
+        radar: Radar,
+        method: TrackMethod,
+        solver: GaussNewton,
+    ) -> Result<Self, Error> {
         let dynamics = PolynomialDynamics::new(1, 3);
+        if solver.max_iterations == 0 {
+            return Err(Error::InvalidParameter {
+                name: "max_iterations",
+                value: "0".into(),
+                reason: "a fit needs at least 1 iteration".into(),
+            });
+        }
         let check = |name: &'static str, value: f64| {
             if value.is_finite() && value >= 0.0 {
                 Ok(())
@@ -193,15 +457,23 @@ impl RadarTracker {
                             .into(),
                     });
                 }
-                Stage::Window(Box::new(sliding(dynamics, radar, window)?), None)
+                Stage::Window(
+                    Box::new(sliding(dynamics, radar, window, solver)?),
+                    None,
+                    Box::new(Monitor::new(3, false, 0, 0)?),
+                )
             }
-            TrackMethod::Kalman { q } | TrackMethod::Smooth { q } => {
-                check("q", q)?;
-                Stage::Starting(Box::new(sliding(dynamics, radar, START_WINDOW)?))
+            TrackMethod::Kalman { q } | TrackMethod::Smooth { q, .. } => {
+                if let Some(q) = q {
+                    check("q", q)?;
+                }
+                Stage::Starting(Box::new(sliding(dynamics, radar, START_WINDOW, solver)?))
             }
             TrackMethod::Fading(d) => {
-                d.checked()?;
-                Stage::Starting(Box::new(sliding(dynamics, radar, START_WINDOW)?))
+                if let Some(d) = d {
+                    d.checked()?;
+                }
+                Stage::Starting(Box::new(sliding(dynamics, radar, START_WINDOW, solver)?))
             }
         };
         Ok(Self {
@@ -242,43 +514,68 @@ impl RadarTracker {
             rows: (row + 1).saturating_sub(w)..row + 1,
             source,
         };
-        // The row taken: `None` held, else `Some(nis)`; the estimate is borrowed below.
-        let nis = match &mut self.stage {
+        // The row taken: `None` held, else `Some((nis, flag))`; the estimate is borrowed below.
+        let taken = match &mut self.stage {
             Stage::Starting(fit) => {
                 let Some(c) = fit.push(m.clone()).map_err(|e| window(START_WINDOW, e))? else {
                     self.rows += 1;
                     self.last_time = m.time;
                     return Ok(Tracked::Undetermined);
                 };
-                let filter = filter_from(self.dynamics, self.radar, self.method, &c);
-                let filter = Box::new(filter.map_err(TrackError::Start)?);
-                self.stage = if matches!(self.method, TrackMethod::Smooth { .. }) {
-                    Stage::Smoothing(Box::new(Smoother::new(*filter)), Some(c), row)
+                let memory = Memory::new(self.method, fit.measurements());
+                let started = memory.and_then(|memory| {
+                    let mut f = filter_from(self.dynamics, self.radar, &c)?;
+                    memory.apply(&mut f)?;
+                    Ok((f, memory))
+                });
+                let (filter, memory) = started.map_err(TrackError::Start)?;
+                self.stage = if let TrackMethod::Smooth { lag, .. } = self.method {
+                    let lagged = Lagged {
+                        smoother: FixedLagSmoother::new(filter, lag),
+                        memory,
+                        held: VecDeque::new(),
+                    };
+                    Stage::Smoothing(Box::new(lagged), Some(c), row, None)
                 } else {
-                    Stage::Filtering(filter, Some(c))
+                    Stage::Filtering(Box::new((filter, memory)), Some(c))
                 };
-                Some(None)
+                Some((None, TrackFlag::None))
             }
-            Stage::Window(fit, previous) => {
-                let nis = match previous {
-                    Some(p) => filter_from(self.dynamics, self.radar, self.method, p)
+            Stage::Window(fit, previous, gate) => {
+                let stats = match previous {
+                    Some(p) => filter_from(self.dynamics, self.radar, p)
                         .map_err(TrackError::Start)?
                         .update_stats(m)
                         .ok()
-                        .flatten()
-                        .map(|i| i.nis),
+                        .flatten(),
                     None => None,
                 };
+                // The gate: a lone row beyond it takes its place in the window unmeasured.
+                let used = stats.is_none_or(|s| gate.accepts(s.nis, s.components));
+                let mut taken = m.clone();
+                if !used {
+                    taken.values.iter_mut().for_each(|v| *v = None);
+                }
                 let w = fit.window();
-                *previous = fit.push(m.clone()).map_err(|e| window(w, e))?;
-                Some(nis)
+                let fitted = fit.push(taken).map_err(|e| window(w, e))?;
+                if let Some(s) = stats {
+                    gate.record(s.nis, s.components, used);
+                }
+                *previous = fitted;
+                let flag = match previous {
+                    _ if !used => TrackFlag::Outlier,
+                    Some(c) => window_flag(c),
+                    None => TrackFlag::None,
+                };
+                Some((stats.map(|s| s.nis), flag))
             }
-            Stage::Filtering(filter, start) => {
-                let innovation = filter
-                    .update_stats(m)
+            Stage::Filtering(kalman, start) => {
+                let (filter, memory) = &mut **kalman;
+                let taken = memory
+                    .step(filter, m)
                     .map_err(|source| TrackError::Update { row, source })?;
                 *start = None;
-                Some(innovation.map(|i| i.nis))
+                Some(taken)
             }
             Stage::Finished => {
                 return Err(TrackError::Update {
@@ -290,96 +587,167 @@ impl RadarTracker {
                     },
                 })
             }
-            Stage::Smoothing(smoother, start, _) => {
-                smoother
-                    .push(m)
-                    .map_err(|source| TrackError::Update { row, source })?;
+            Stage::Smoothing(lagged, start, first, given) => {
+                let first = *first + 1;
+                let Lagged {
+                    smoother,
+                    memory,
+                    held,
+                } = &mut **lagged;
+                let (out, nis, flag) = memory.step_smoother(smoother, m).map_err(|e| match e {
+                    // The backward pass's (the updates' errors are not in a batch).
+                    Error::InBatch { .. } => smoothing_error(e, first),
+                    source => TrackError::Update { row, source },
+                })?;
+                held.push_back((nis, flag));
+                *given = out.map(|mut s| {
+                    let (nis, flag) = held.pop_front().expect("the row given is held");
+                    s.nis = nis;
+                    (row - smoother.held(), s, flag)
+                });
+                debug_assert_eq!(held.len(), smoother.held());
                 *start = None;
                 None
             }
         };
         self.rows += 1;
         self.last_time = m.time;
-        let Some(nis) = nis else {
-            return Ok(Tracked::Held);
+        let Some((nis, flag)) = taken else {
+            return Ok(match &self.stage {
+                Stage::Smoothing(.., Some((row, estimate, flag))) => Tracked::Smoothed {
+                    row: *row,
+                    estimate,
+                    flag: *flag,
+                },
+                _ => Tracked::Held,
+            });
         };
         let (state, covariance) = match &self.stage {
-            Stage::Window(_, Some(c))
+            Stage::Window(_, Some(c), _)
             | Stage::Filtering(_, Some(c))
             | Stage::Smoothing(_, Some(c), ..) => (&c.state, &c.covariance),
-            Stage::Filtering(filter, None) => (filter.state(), filter.covariance()),
+            Stage::Filtering(kalman, None) => (kalman.0.state(), kalman.0.covariance()),
             _ => return Ok(Tracked::Undetermined),
         };
         Ok(Tracked::Estimate(TrackEstimate {
             state,
             covariance,
             nis,
+            flag,
         }))
     }
 
-    /// The smoother's estimates of the rows it held (from the row after the start on, each
-    /// with its row), smoothed; nothing for the other methods. The smoother takes no more
-    /// rows after it.
-    pub fn finish(&mut self) -> Result<Vec<(usize, Smoothed)>, TrackError> {
+    /// The smoother's estimates of the rows it still holds (its last `lag` rows, each with
+    /// its row and the forward pass's flag), smoothed by every row; nothing for the other
+    /// methods. The smoother takes no more rows after it. A row the gate left out has its
+    /// NIS here (the forward update's, which left it out).
+    pub fn finish(&mut self) -> Result<Vec<(usize, Smoothed, TrackFlag)>, TrackError> {
         let stage = std::mem::replace(&mut self.stage, Stage::Finished);
-        let Stage::Smoothing(smoother, _, start) = stage else {
+        let Stage::Smoothing(lagged, _, start, _) = stage else {
             self.stage = stage;
             return Ok(Vec::new());
         };
-        let first = start + 1;
-        let smoothed = smoother.finish().map_err(|e| {
-            TrackError::Smooth(match e {
-                Error::InBatch { index, source } => Error::InBatch {
-                    index: first + index,
-                    source,
-                },
-                e => e,
-            })
-        })?;
+        let Lagged { smoother, held, .. } = *lagged;
+        let first = start + 1 + smoother.pushed() - smoother.held();
+        let smoothed = smoother
+            .finish()
+            .map_err(|e| smoothing_error(e, start + 1))?;
         Ok(smoothed
             .into_iter()
+            .zip(held)
             .enumerate()
-            .map(|(k, s)| (first + k, s))
+            .map(|(k, (mut s, (nis, flag)))| {
+                s.nis = nis;
+                (first + k, s, flag)
+            })
             .collect())
+    }
+
+    /// The rows the smoother holds at most (`lag + 1`; 0 for the other methods), and the
+    /// bytes they take: a bound of the tracker's memory beyond a few kilobytes, known before
+    /// the first row.
+    pub fn held_bound(&self) -> (usize, usize) {
+        match self.method {
+            TrackMethod::Smooth { lag, .. } => {
+                let rows = lag.saturating_add(1);
+                let each = FixedLagSmoother::<PolynomialDynamics, Radar>::bytes_per_measurement(6)
+                    + std::mem::size_of::<(Option<f64>, TrackFlag)>();
+                (rows, rows.saturating_mul(each))
+            }
+            _ => (0, 0),
+        }
     }
 }
 
-/// A Kalman filter from a fit, with `method`'s driving noise or fading.
+/// The smoother's error, an [`Error::InBatch`] index (counted from its first row, the tracker's
+/// `first`) counted from the tracker's first row.
+fn smoothing_error(e: Error, first: usize) -> TrackError {
+    TrackError::Smooth(match e {
+        Error::InBatch { index, source } => Error::InBatch {
+            index: first + index,
+            source,
+        },
+        e => e,
+    })
+}
+
+/// A window fit's flag (the window method's, `seqsmooth fit --model radar`'s):
+/// [`TrackFlag::Misfit`] where its residual χ² lies above the `1 − MISFIT_ALPHA` point of
+/// `χ²_ν`, `ν` its degrees of freedom (§8.6; no test with `ν = 0`): the model does not follow
+/// the window's rows. Its covariance carries the misfit too ([`misfit_scale`](crate::estimate::sliding::misfit_scale)).
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::estimate::gauss_newton::Correction;
+/// use seqsmooth::kalman::track::{window_flag, TrackFlag};
+/// let c = Correction { epoch: 0.0, state: DVector::zeros(6), covariance: DMatrix::identity(6, 6),
+///     chi_squared: 40.0, degrees_of_freedom: 18, condition_number: 1.0, iterations: vec![] };
+/// assert_eq!(window_flag(&c), TrackFlag::Misfit); // the 99% point of χ²(18) is 34.8
+/// assert_eq!(window_flag(&Correction { chi_squared: 30.0, ..c }), TrackFlag::None);
+/// ```
+pub fn window_flag(c: &Correction) -> TrackFlag {
+    let misfit = c.degrees_of_freedom > 0
+        && crate::stats::chi_squared_quantile(c.degrees_of_freedom as f64, 1.0 - MISFIT_ALPHA)
+            .is_ok_and(|limit| c.chi_squared > limit);
+    if misfit {
+        TrackFlag::Misfit
+    } else {
+        TrackFlag::None
+    }
+}
+
+/// A Kalman filter (no driving noise, no fading) from a fit.
 fn filter_from(
     dynamics: PolynomialDynamics,
     radar: Radar,
-    method: TrackMethod,
     c: &Correction,
 ) -> Result<Filter, Error> {
-    let f = KalmanFilter::new(
+    KalmanFilter::new(
         dynamics,
         radar,
         c.state.clone(),
         c.covariance.clone(),
         c.epoch,
-    )?;
-    match method {
-        TrackMethod::Fading(d) => f.with_fading(d),
-        TrackMethod::Window { .. } => Ok(f),
-        TrackMethod::Kalman { q } | TrackMethod::Smooth { q } => {
-            f.with_process_noise(WhiteNoiseDerivative::new(1, 3, q)?)
-        }
-    }
+    )
 }
 
-/// The sliding fit over `window` rows, started at the radar's nominal (§8.5).
+/// The sliding fit over `window` rows, started at the radar's nominal (§8.5), with `solver`'s
+/// limits and the misfit carried in its covariance ([`misfit_scale`](crate::estimate::sliding::misfit_scale)).
 fn sliding(
     dynamics: PolynomialDynamics,
     radar: Radar,
     window: usize,
+    solver: GaussNewton,
 ) -> Result<SlidingFit<PolynomialDynamics, Radar>, Error> {
-    SlidingFit::new(
+    Ok(SlidingFit::new(
         dynamics,
         radar,
         window,
         Epoch::End,
         Start::Radar { radar, degree: 2 },
-    )
+    )?
+    .with_solver(solver)
+    .with_misfit_scale())
 }
 
 /// A radar row as a [`Measurement`], checked as `seqsmooth track` checks its rows: the time
