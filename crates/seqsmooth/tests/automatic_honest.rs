@@ -21,6 +21,8 @@
 //! RMS of σ̂/σ − 1 over 200 runs is known to ±5% of itself. The thresholds are the issue's,
 //! asserted as they are on every scenario.
 
+mod common;
+
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
@@ -151,15 +153,7 @@ impl Score {
     }
     /// Standard error of the mean per-run coverage over the runs.
     fn coverage_se(&self) -> f64 {
-        let n = self.run_coverage.len() as f64;
-        let mean = self.run_coverage.iter().sum::<f64>() / n;
-        let var = self
-            .run_coverage
-            .iter()
-            .map(|c| (c - mean).powi(2))
-            .sum::<f64>()
-            / (n - 1.0);
-        (var / n).sqrt()
+        common::stats::standard_error_of_mean(&self.run_coverage)
     }
     fn print(&self, what: &str) {
         let p = |a: usize, b: usize| 100.0 * a as f64 / b.max(1) as f64;

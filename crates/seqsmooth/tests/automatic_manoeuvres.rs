@@ -24,6 +24,8 @@
 //! ~115,000 per scenario at 1% have an SE of 0.03%; coverage over ~115,000-285,000 rows at 97%
 //! an SE ≤ 0.05% (the rows of a run are correlated; the per-run spread is printed).
 
+mod common;
+
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
@@ -227,15 +229,7 @@ impl Score {
     }
     /// Standard error of the mean per-run coverage.
     fn coverage_se(&self) -> f64 {
-        let n = self.run_coverage.len() as f64;
-        let mean = self.run_coverage.iter().sum::<f64>() / n;
-        let var = self
-            .run_coverage
-            .iter()
-            .map(|c| (c - mean).powi(2))
-            .sum::<f64>()
-            / (n - 1.0);
-        (var / n).sqrt()
+        common::stats::standard_error_of_mean(&self.run_coverage)
     }
 
     fn print(&self, what: &str) {

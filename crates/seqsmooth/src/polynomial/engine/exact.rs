@@ -284,7 +284,10 @@ impl ExactEngine {
             power *= u;
         }
         let (mut inv, mut var) = ([0.0; MAX_DEGREE + 1], [0.0]);
-        if !self.info.variances_of_rows(&mut h[..p], &mut inv[..p], &mut var) {
+        if !self
+            .info
+            .variances_of_rows(&mut h[..p], &mut inv[..p], &mut var)
+        {
             return None;
         }
         Some((x[0], var[0] * (sigma * sigma)))
