@@ -35,17 +35,7 @@ struct Sample {
     outlier: bool,
 }
 
-fn landing() -> Vec<[f64; 4]> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/landing.csv");
-    let text = std::fs::read_to_string(path).unwrap();
-    text.lines()
-        .skip(1)
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|c| c.parse().unwrap()).collect();
-            [v[0], v[1], v[2], v[3]]
-        })
-        .collect()
-}
+use common::automatic::landing;
 
 fn landing_run(rows: &[[f64; 4]], col: usize, sigma: f64, seed: u64) -> Vec<Sample> {
     let mut r = StdRng::seed_from_u64(seed);

@@ -119,17 +119,7 @@ fn turns_run(seed: u64) -> Vec<Sample> {
     noisy(&mut r, truth.into_iter(), SIGMA)
 }
 
-fn landing() -> Vec<[f64; 4]> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/landing.csv");
-    let text = std::fs::read_to_string(path).unwrap();
-    text.lines()
-        .skip(1)
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|c| c.parse().unwrap()).collect();
-            [v[0], v[1], v[2], v[3]]
-        })
-        .collect()
-}
+use common::automatic::landing;
 
 /// One axis of landing.csv (1 east, 2 north, 3 up) plus noise and outliers.
 fn landing_run(rows: &[[f64; 4]], axis: usize, seed: u64) -> (Vec<Sample>, f64) {

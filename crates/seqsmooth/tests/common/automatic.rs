@@ -225,3 +225,16 @@ pub fn main_defaults() -> AutomaticFilter {
 pub fn main_filter() -> AutomaticFilter {
     main_defaults().with_noise_sigma(SIGMA).unwrap()
 }
+
+/// landing.csv's rows as `[time, east, north, up]`.
+pub fn landing() -> Vec<[f64; 4]> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/landing.csv");
+    let text = std::fs::read_to_string(path).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|c| c.parse().unwrap()).collect();
+            [v[0], v[1], v[2], v[3]]
+        })
+        .collect()
+}
