@@ -13,6 +13,7 @@ pub mod kalman;
 pub mod monte_carlo;
 pub mod paml;
 pub mod python_fixture;
+pub mod radar_tracks;
 pub mod rational;
 pub mod smooth;
 pub mod stats;
