@@ -58,8 +58,8 @@ fn run(track: &Track, ignore_flags: bool) -> Tally {
     ];
     let (header, rows) = table(&ok(&args, &csv(track)));
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
-    let state = ["x", "y", "z"].map(|c| col(c));
-    let sigma = ["sx", "sy", "sz"].map(|c| col(c));
+    let state = ["x", "y", "z"].map(&col);
+    let sigma = ["sx", "sy", "sz"].map(&col);
     let flag = col("flag");
     assert_eq!(
         rows.len(),
