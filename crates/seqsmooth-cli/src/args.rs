@@ -519,16 +519,6 @@ pub struct FitArgs {
     #[arg(long, value_name = "EPOCH", default_value = "end", value_parser = parse_epoch,
           allow_hyphen_values = true)]
     pub epoch: EpochArg,
-    /// Radar: the site's position X,Y,Z in the units of the range
-    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,0", value_parser = parse_site,
-          allow_hyphen_values = true)]
-    pub site: [f64; 3],
-    /// Radar: the range's noise standard deviation (required)
-    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
-    pub sigma_range: Option<f64>,
-    /// Radar: the azimuth's and elevation's noise standard deviation in radians (required)
-    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
-    pub sigma_angle: Option<f64>,
     /// Polynomial: the values' noise standard deviation (required)
     #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
     pub sigma: Option<f64>,
@@ -538,15 +528,8 @@ pub struct FitArgs {
     /// Polynomial: name of the value column
     #[arg(long, value_name = "NAME", default_value = "y")]
     pub value_col: String,
-    /// Radar: name of the range column
-    #[arg(long, value_name = "NAME", default_value = "range")]
-    pub range_col: String,
-    /// Radar: name of the azimuth column
-    #[arg(long, value_name = "NAME", default_value = "azimuth")]
-    pub azimuth_col: String,
-    /// Radar: name of the elevation column
-    #[arg(long, value_name = "NAME", default_value = "elevation")]
-    pub elevation_col: String,
+    #[command(flatten)]
+    pub radar: RadarArgs,
     /// Gauss-Newton iterations allowed per window
     #[arg(long, value_name = "N", default_value_t = 20,
           value_parser = clap::value_parser!(u32).range(1..=1000))]
@@ -564,24 +547,6 @@ pub struct TrackArgs {
     /// The tracking method
     #[arg(long, value_enum, default_value_t = TrackMethod::Kalman)]
     pub method: TrackMethod,
-    /// The site's position X,Y,Z in the units of the range
-    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,0", value_parser = parse_site,
-          allow_hyphen_values = true)]
-    pub site: [f64; 3],
-    /// The range's noise standard deviation (this or --sigma-range-col is required)
-    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
-    pub sigma_range: Option<f64>,
-    /// The azimuth's and elevation's noise standard deviation in radians (this or
-    /// --sigma-angle-col is required)
-    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
-    pub sigma_angle: Option<f64>,
-    /// Name of a column of per-row range sigmas; an empty cell takes --sigma-range
-    #[arg(long, value_name = "NAME")]
-    pub sigma_range_col: Option<String>,
-    /// Name of a column of per-row angle sigmas (azimuth and elevation, radians); an empty
-    /// cell takes --sigma-angle
-    #[arg(long, value_name = "NAME")]
-    pub sigma_angle_col: Option<String>,
     /// kalman, smooth: spectral density of the white-noise acceleration on each axis
     /// [default: adaptive, from the innovations]
     #[arg(long = "q", value_name = "ACCEL_PSD", value_parser = parse_psd, allow_hyphen_values = true)]
@@ -606,24 +571,51 @@ pub struct TrackArgs {
     /// later; the smoother holds N+1 rows (0 is the kalman filter) [default: 200]
     #[arg(long, value_name = "N")]
     pub lag: Option<usize>,
-    /// The azimuth convention of the input
-    #[arg(long, value_enum, default_value_t = AzimuthConvention::FromX)]
-    pub azimuth: AzimuthConvention,
     /// Name of the time column
     #[arg(long, value_name = "NAME", default_value = "t")]
     pub time_col: String,
-    /// Name of the range column
-    #[arg(long, value_name = "NAME", default_value = "range")]
-    pub range_col: String,
-    /// Name of the azimuth column
-    #[arg(long, value_name = "NAME", default_value = "azimuth")]
-    pub azimuth_col: String,
-    /// Name of the elevation column
-    #[arg(long, value_name = "NAME", default_value = "elevation")]
-    pub elevation_col: String,
+    #[command(flatten)]
+    pub radar: RadarArgs,
     /// Output file [default: standard output]
     #[arg(short = 'o', long, value_name = "OUTPUT")]
     pub output: Option<PathBuf>,
+}
+
+/// The radar input of `seqsmooth track` and `seqsmooth fit --model radar`, read by one reader
+/// (`track::rows`) and checked by the library's rule for a radar row
+/// (`seqsmooth::model::radar::check_component`).
+#[derive(Debug, Args)]
+pub struct RadarArgs {
+    /// Radar: the site's position X,Y,Z in the units of the range
+    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,0", value_parser = parse_site,
+          allow_hyphen_values = true)]
+    pub site: [f64; 3],
+    /// Radar: the range's noise standard deviation (this or --sigma-range-col is required)
+    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
+    pub sigma_range: Option<f64>,
+    /// Radar: the azimuth's and elevation's noise standard deviation in radians (this or
+    /// --sigma-angle-col is required)
+    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
+    pub sigma_angle: Option<f64>,
+    /// Radar: name of a column of per-row range sigmas; an empty cell takes --sigma-range
+    #[arg(long, value_name = "NAME")]
+    pub sigma_range_col: Option<String>,
+    /// Radar: name of a column of per-row angle sigmas (azimuth and elevation, radians); an
+    /// empty cell takes --sigma-angle
+    #[arg(long, value_name = "NAME")]
+    pub sigma_angle_col: Option<String>,
+    /// Radar: the azimuth convention of the input
+    #[arg(long, value_enum, default_value_t = AzimuthConvention::FromX)]
+    pub azimuth: AzimuthConvention,
+    /// Radar: name of the range column
+    #[arg(long, value_name = "NAME", default_value = "range")]
+    pub range_col: String,
+    /// Radar: name of the azimuth column
+    #[arg(long, value_name = "NAME", default_value = "azimuth")]
+    pub azimuth_col: String,
+    /// Radar: name of the elevation column
+    #[arg(long, value_name = "NAME", default_value = "elevation")]
+    pub elevation_col: String,
 }
 
 /// The methods of `seqsmooth track`.

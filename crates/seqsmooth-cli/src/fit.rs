@@ -10,6 +10,7 @@ use crate::args::{EpochArg, FitArgs, FitModel};
 use crate::error::CliError;
 use crate::io::{check_distinct, find_column, open_input, parse_cell, shown, write_f64, CsvIn};
 use crate::io::{Need, Output};
+use crate::track::rows::{check_sigmas, Batch, Rows};
 use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
@@ -19,7 +20,7 @@ use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
 use std::collections::VecDeque;
-use std::f64::consts::FRAC_PI_2;
+use std::io::Read;
 
 /// The model's sliding fit.
 enum Fitter {
@@ -36,41 +37,138 @@ impl Fitter {
     }
 }
 
-/// One measured column: its name, index and what it holds (for messages).
-pub(crate) struct Column {
-    pub(crate) name: String,
-    pub(crate) index: usize,
-    pub(crate) what: &'static str,
+/// Where the rows come from: the radar reader that `track` uses (its columns, σ, azimuth
+/// convention and the library's rule for a radar row), or the polynomial's value column.
+enum Source<R: Read> {
+    Radar(Box<Rows<R>>, Batch),
+    Polynomial {
+        csv: CsvIn<R>,
+        time: usize,
+        value: usize,
+        variance: f64,
+        /// The previous row's time, line and time cell (a time must increase).
+        previous: Option<(f64, u64, Vec<u8>)>,
+    },
+}
+
+/// One row read: its time cell as written, the value cell to echo (polynomial), the
+/// measurement and its file line.
+struct Taken {
+    t_cell: Vec<u8>,
+    echo: Option<Vec<u8>>,
+    measurement: Measurement,
+    line: u64,
+}
+
+impl<R: Read> Source<R> {
+    /// The next row, checked; `None` at the end of the input.
+    fn next(&mut self, a: &FitArgs) -> Result<Option<Taken>, CliError> {
+        match self {
+            Source::Radar(rows, batch) => {
+                batch.rows.clear();
+                batch.text.clear();
+                batch.ends.clear();
+                if !rows.next(batch)? {
+                    return Ok(None);
+                }
+                let row = batch.rows[0];
+                Ok(Some(Taken {
+                    t_cell: batch.time_text(0).to_vec(),
+                    echo: None,
+                    measurement: Measurement {
+                        time: row.time,
+                        values: row.values.to_vec(),
+                        noise: NoiseCovariance::Variances(row.variances.to_vec()),
+                    },
+                    line: row.line,
+                }))
+            }
+            Source::Polynomial {
+                csv,
+                time,
+                value,
+                variance,
+                previous,
+            } => {
+                if !csv.next_record()? {
+                    return Ok(None);
+                }
+                let line = csv.line;
+                let t_cell = csv.field(*time).to_vec();
+                let t = parse_cell(&t_cell, line, &a.time_col, "time")?;
+                if let Some((prev, prev_line, prev_text)) = previous.as_ref() {
+                    if t <= *prev {
+                        let why = if t == *prev {
+                            "duplicate time; times must be strictly increasing"
+                        } else {
+                            "times must be strictly increasing"
+                        };
+                        return Err(CliError::Data(format!(
+                            "line {line}: time {} is not after the previous time {} (line \
+                             {prev_line}): {why}",
+                            shown(&t_cell),
+                            shown(prev_text)
+                        )));
+                    }
+                }
+                let cell = csv.field(*value).to_vec();
+                let y = parse_cell(&cell, line, &a.value_col, "value")?;
+                *previous = Some((t, line, t_cell.clone()));
+                Ok(Some(Taken {
+                    t_cell,
+                    echo: Some(cell),
+                    measurement: Measurement {
+                        time: t,
+                        values: vec![Some(y)],
+                        noise: NoiseCovariance::Variances(vec![*variance]),
+                    },
+                    line,
+                }))
+            }
+        }
+    }
 }
 
 /// The settings the arguments resolve to.
 struct Setup {
     fitter: Fitter,
-    /// The measured columns, in the observation's component order.
-    columns: Vec<Column>,
-    /// The noise variance of each component.
-    variances: Vec<f64>,
     /// The data rows the model needs at the least, and why.
     need: Need,
     /// The state's column names, in state order, and those of their 1-sigma errors.
     states: Vec<String>,
     sigmas: Vec<String>,
-    /// Whether the value cell is echoed after the time (polynomial).
-    echo_value: bool,
+    /// The polynomial's noise variance (`--sigma` squared; radar rows carry their own).
+    variance: f64,
 }
 
 /// Runs `seqsmooth fit`.
 pub fn run(a: &FitArgs) -> Result<(), CliError> {
+    if a.model == FitModel::Radar {
+        check_sigmas(&a.radar, "fit --model radar")?;
+    }
     check_distinct(a.input.as_deref(), a.output.as_deref())?;
     let input = open_input(a.input.as_deref())?;
-    let mut csv = CsvIn::new(input)?;
+    let csv = CsvIn::new(input)?;
     let mut setup = setup(a, &csv.header)?;
-    let time = find_column(&csv.header, &a.time_col, "")?;
+    let echo_value = a.model == FitModel::Polynomial;
+    let mut source = match a.model {
+        FitModel::Radar => Source::Radar(
+            Box::new(Rows::of(csv, &a.time_col, &a.radar)?),
+            Batch::default(),
+        ),
+        FitModel::Polynomial => Source::Polynomial {
+            time: find_column(&csv.header, &a.time_col, "")?,
+            value: find_column(&csv.header, &a.value_col, "")?,
+            variance: setup.variance,
+            previous: None,
+            csv,
+        },
+    };
     let epoch_column = !matches!(a.epoch, EpochArg::End);
 
     let mut text = Vec::new();
     let mut cells: Vec<String> = vec!["t".into()];
-    if setup.echo_value {
+    if echo_value {
         cells.push("y".into());
     }
     cells.extend(setup.states.iter().cloned());
@@ -88,41 +186,21 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
 
     let mut out: Option<Output> = None;
     let mut lines: VecDeque<u64> = VecDeque::with_capacity(window(a).min(1 << 12));
-    let mut previous: Option<(f64, u64, Vec<u8>)> = None;
     let mut rows = 0usize;
     let n = setup.states.len();
-    while csv.next_record()? {
-        let line = csv.line;
-        let t_cell = csv.field(time).to_vec();
-        let t = parse_cell(&t_cell, line, &a.time_col, "time")?;
-        if let Some((prev, prev_line, prev_text)) = &previous {
-            if t <= *prev {
-                let why = if t == *prev {
-                    "duplicate time; times must be strictly increasing"
-                } else {
-                    "times must be strictly increasing"
-                };
-                return Err(CliError::Data(format!(
-                    "line {line}: time {} is not after the previous time {} (line {prev_line}): \
-                     {why}",
-                    shown(&t_cell),
-                    shown(prev_text)
-                )));
-            }
-        }
-        let values = measured(&csv, line, &setup.columns, a.model)?;
-        previous = Some((t, line, t_cell.clone()));
+    while let Some(Taken {
+        t_cell,
+        echo,
+        measurement,
+        line,
+    }) = source.next(a)?
+    {
         rows += 1;
         if lines.len() == window(a) {
             lines.pop_front();
         }
         lines.push_back(line);
-        let m = Measurement {
-            time: t,
-            values,
-            noise: NoiseCovariance::Variances(setup.variances.clone()),
-        };
-        let fit = setup.fitter.push(m).map_err(|e| match e {
+        let fit = setup.fitter.push(measurement).map_err(|e| match e {
             Error::NonFinite {
                 what: "fitted state",
                 value,
@@ -134,9 +212,9 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
         })?;
 
         text.extend_from_slice(&t_cell);
-        if setup.echo_value {
+        if let Some(cell) = echo {
             text.push(b',');
-            text.extend_from_slice(csv.field(setup.columns[0].index));
+            text.extend_from_slice(&cell);
         }
         match &fit {
             Some(c) => {
@@ -210,13 +288,6 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
         ..GaussNewton::default()
     };
     let library = |e: Error| usage(e.to_string());
-    let column = |name: &str, what: &'static str| -> Result<Column, CliError> {
-        Ok(Column {
-            name: name.to_string(),
-            index: find_column(header, name, "")?,
-            what,
-        })
-    };
     match a.model {
         FitModel::Radar => {
             if a.sigma.is_some() {
@@ -226,13 +297,6 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
                         .into(),
                 ));
             }
-            let (Some(sr), Some(sa)) = (a.sigma_range, a.sigma_angle) else {
-                return Err(usage(
-                    "--model radar needs --sigma-range S (the range's noise sigma) and \
-                     --sigma-angle S (the angles', in radians)"
-                        .into(),
-                ));
-            };
             let degree = a.degree.unwrap_or(1);
             if !(1..=2).contains(&degree) {
                 return Err(usage(format!(
@@ -243,27 +307,28 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
             let need = Need::rows(2, "the radar model");
             need.check_header(header)?;
             let states = 3 * (degree + 1);
-            let fit =
-                SlidingFit::radar(a.site, degree, window(a), epoch, solver).map_err(library)?;
+            let fit = SlidingFit::radar(a.radar.site, degree, window(a), epoch, solver)
+                .map_err(library)?;
             let names = ["x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"];
             Ok(Setup {
                 fitter: Fitter::Radar(fit),
-                columns: vec![
-                    column(&a.range_col, "range")?,
-                    column(&a.azimuth_col, "azimuth")?,
-                    column(&a.elevation_col, "elevation")?,
-                ],
-                variances: vec![sr * sr, sa * sa, sa * sa],
                 need,
                 states: names[..states].iter().map(|s| s.to_string()).collect(),
                 sigmas: names[..states].iter().map(|s| format!("s{s}")).collect(),
-                echo_value: false,
+                variance: 1.0,
             })
         }
         FitModel::Polynomial => {
-            if a.sigma_range.is_some() || a.sigma_angle.is_some() {
+            let r = &a.radar;
+            if r.sigma_range.is_some()
+                || r.sigma_angle.is_some()
+                || r.sigma_range_col.is_some()
+                || r.sigma_angle_col.is_some()
+            {
                 return Err(usage(
-                    "--sigma-range and --sigma-angle apply only to --model radar".into(),
+                    "--sigma-range, --sigma-angle and their -col columns apply only to --model \
+                     radar"
+                        .into(),
                 ));
             }
             let Some(degree) = a.degree else {
@@ -290,53 +355,13 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
             let fit = SlidingFit::polynomial(degree, window(a), epoch, solver).map_err(library)?;
             Ok(Setup {
                 fitter: Fitter::Polynomial(fit),
-                columns: vec![column(&a.value_col, "value")?],
-                variances: vec![sigma * sigma],
                 need,
                 states: (0..=degree).map(|k| format!("d{k}")).collect(),
                 sigmas: (0..=degree).map(|k| format!("s{k}")).collect(),
-                echo_value: true,
+                variance: sigma * sigma,
             })
         }
     }
-}
-
-/// The measured components of the current row: an empty cell is a missing component (radar),
-/// anything else a finite number in range.
-pub(crate) fn measured<R: std::io::Read>(
-    csv: &CsvIn<R>,
-    line: u64,
-    columns: &[Column],
-    model: FitModel,
-) -> Result<Vec<Option<f64>>, CliError> {
-    let mut values = Vec::with_capacity(columns.len());
-    for c in columns {
-        let cell = csv.field(c.index);
-        if cell.is_empty() && model == FitModel::Radar {
-            values.push(None);
-            continue;
-        }
-        let v = parse_cell(cell, line, &c.name, c.what)?;
-        let bad = |why: &str| {
-            CliError::Data(format!(
-                "line {line}, column '{}': {} {} {why}",
-                c.name,
-                c.what,
-                shown(cell)
-            ))
-        };
-        match c.what {
-            "range" if v <= 0.0 => return Err(bad("is not positive")),
-            "elevation" if v.abs() > FRAC_PI_2 => {
-                return Err(bad(
-                    "is outside [-pi/2, pi/2]: elevations are in radians from the x-y plane",
-                ))
-            }
-            _ => {}
-        }
-        values.push(Some(v));
-    }
-    Ok(values)
 }
 
 /// A window's error with the file lines of its rows (or of the one row it is about).

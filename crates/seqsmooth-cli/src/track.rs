@@ -17,15 +17,15 @@
 //! filter's states in the library) and writes each row when the row `--lag` later is in, the
 //! last ones at the end.
 
-mod rows;
+pub(crate) mod rows;
 mod stream;
 
-use crate::args::{AzimuthConvention, FitModel, TrackArgs, TrackMethod};
+use crate::args::{FitModel, TrackArgs, TrackMethod};
 use crate::error::CliError;
 use crate::fit::window_error;
 use crate::io::{check_distinct, open_input, write_f64, CsvIn, Need, Output};
 use nalgebra::{DMatrix, DVector};
-use rows::{Names, Rows, SigmaSource};
+use rows::Rows;
 use seqsmooth::estimate::gauss_newton::GaussNewton;
 use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::track::{
@@ -73,44 +73,13 @@ pub fn run(a: &TrackArgs) -> Result<(), CliError> {
         }
         _ => {}
     }
-    if a.sigma_range.is_none() && a.sigma_range_col.is_none() {
-        return usage(
-            "track needs --sigma-range S (the range's noise sigma) or --sigma-range-col NAME \
-             (a column of per-row sigmas; with both, the flag serves the rows whose cell is empty)",
-        );
-    }
-    if a.sigma_angle.is_none() && a.sigma_angle_col.is_none() {
-        return usage(
-            "track needs --sigma-angle S (the azimuth's and elevation's noise sigma, in radians) \
-             or --sigma-angle-col NAME (a column of per-row sigmas; with both, the flag serves \
-             the rows whose cell is empty)",
-        );
-    }
+    rows::check_sigmas(&a.radar, "track")?;
     check_distinct(a.input.as_deref(), a.output.as_deref())?;
     let csv = CsvIn::new(open_input(a.input.as_deref())?)?;
     let need = Need::rows(2, "a radar track");
     need.check_header(&csv.header)?;
-    let names = Names {
-        time: &a.time_col,
-        range: &a.range_col,
-        azimuth: &a.azimuth_col,
-        elevation: &a.elevation_col,
-    };
-    let sigmas = [
-        SigmaSource {
-            flag: a.sigma_range,
-            column: a.sigma_range_col.clone(),
-            flag_name: "--sigma-range",
-        },
-        SigmaSource {
-            flag: a.sigma_angle,
-            column: a.sigma_angle_col.clone(),
-            flag_name: "--sigma-angle",
-        },
-    ];
-    let bearing = a.azimuth == AzimuthConvention::Bearing;
-    let rows = Rows::new(csv, &names, sigmas, bearing)?;
-    let radar = Radar::new(a.site, 6).map_err(|e| CliError::Usage(e.to_string()))?;
+    let rows = Rows::of(csv, &a.time_col, &a.radar)?;
+    let radar = Radar::new(a.radar.site, 6).map_err(|e| CliError::Usage(e.to_string()))?;
     let mut tracker = Tracker::new(a, radar)?;
     let (held, bytes) = tracker.inner.held_bound();
     if bytes > HELD_NOTE_BYTES {

@@ -570,3 +570,76 @@ fn far_epochs_and_huge_windows_do_not_panic() {
     );
     assert_eq!(all, window);
 }
+
+/// `fit --model radar` reads its rows as `track` does (one reader, the library's rule for a
+/// radar row): `--azimuth bearing` equals the angle from +x turned by the library
+/// (`from_bearing`), per-row σ columns equal the flags they repeat, and an azimuth beyond
+/// `[-2π, 2π]` is refused with its line and column.
+#[test]
+fn radar_rows_read_as_track_reads_them() {
+    let (input, _) = radar_pass(60, [0.0; 3], 3);
+    let radar = [
+        "fit",
+        "--model",
+        "radar",
+        "--sigma-range",
+        "10",
+        "--sigma-angle",
+        "1e-3",
+    ];
+    let plain = ok(&radar, &input);
+    // Bearings b = π/2 − azimuth; the command turns them back with the library's rule.
+    let mut bearing = String::from("t,range,azimuth,elevation,note\n");
+    let mut turned = bearing.clone();
+    for line in input.lines().skip(1) {
+        let c: Vec<&str> = line.split(',').collect();
+        let b = std::f64::consts::FRAC_PI_2 - c[2].parse::<f64>().unwrap();
+        bearing += &format!("{},{},{b},{},{}\n", c[0], c[1], c[3], c[4]);
+        let a = seqsmooth::model::radar::from_bearing(b);
+        turned += &format!("{},{},{a},{},{}\n", c[0], c[1], c[3], c[4]);
+    }
+    let mut args = radar.to_vec();
+    args.extend(["--azimuth", "bearing"]);
+    let from_bearing = ok(&args, &bearing);
+    assert_eq!(from_bearing, ok(&radar, &turned));
+    assert_ne!(from_bearing, ok(&radar, &bearing), "the bearing is turned");
+    // Per-row σ columns (empty cells take the flag) equal the flags.
+    let mut with_sigmas = String::from("t,range,azimuth,elevation,note,sr,sa\n");
+    for (k, line) in input.lines().skip(1).enumerate() {
+        let sr = if k % 3 == 0 { "" } else { "10" };
+        with_sigmas += &format!("{line},{sr},1e-3\n");
+    }
+    let cols = [
+        "fit",
+        "--model",
+        "radar",
+        "--sigma-range",
+        "10",
+        "--sigma-range-col",
+        "sr",
+        "--sigma-angle-col",
+        "sa",
+    ];
+    assert_eq!(ok(&cols, &with_sigmas), plain);
+    // Without a σ for the angles: the message names both ways to give one.
+    fails(
+        &["fit", "--model", "radar", "--sigma-range", "10"],
+        &input,
+        2,
+        &["--sigma-angle S", "--sigma-angle-col NAME"],
+    );
+    // The azimuth's range, checked as track checks it.
+    let mut lines: Vec<String> = input.lines().map(String::from).collect();
+    let c: Vec<String> = lines[6].split(',').map(String::from).collect();
+    lines[6] = format!("{},{},7,{},x", c[0], c[1], c[3]);
+    fails(
+        &radar,
+        &(lines.join("\n") + "\n"),
+        1,
+        &[
+            "line 7",
+            "column 'azimuth'",
+            "azimuth 7 is outside [-2pi, 2pi]",
+        ],
+    );
+}

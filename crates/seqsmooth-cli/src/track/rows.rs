@@ -11,13 +11,14 @@
 //! The rows go into [`Batch`]es (numbers by row, time cells in one buffer): reading allocates
 //! nothing per row once a batch's buffers have grown.
 
+use crate::args::{AzimuthConvention, RadarArgs};
 use crate::error::CliError;
 use crate::io::{find_column, parse_cell, shown, CsvIn};
-use seqsmooth::model::radar::wrap;
-use std::f64::consts::{FRAC_PI_2, TAU};
+use seqsmooth::model::radar::{check_component, from_bearing, COMPONENTS};
 use std::io::Read;
 
-/// A measured column: its name (for messages), index and what it holds.
+/// A measured column: its name (for messages), index and what it holds (a name of
+/// [`COMPONENTS`] or "time").
 struct Cell {
     name: String,
     index: usize,
@@ -137,9 +138,9 @@ impl<R: Read> Rows<R> {
         Ok(Self {
             time: cell(names.time, "time")?,
             cells: [
-                cell(names.range, "range")?,
-                cell(names.azimuth, "azimuth")?,
-                cell(names.elevation, "elevation")?,
+                cell(names.range, COMPONENTS[0])?,
+                cell(names.azimuth, COMPONENTS[1])?,
+                cell(names.elevation, COMPONENTS[2])?,
             ],
             sigmas: [sigma(range_sigma)?, sigma(angle_sigma)?],
             bearing,
@@ -176,8 +177,8 @@ impl<R: Read> Rows<R> {
             }
         }
         let mut values = [None; 3];
-        for (value, c) in values.iter_mut().zip(&self.cells) {
-            *value = component(self.csv.field(c.index), line, c)?;
+        for (k, (value, c)) in values.iter_mut().zip(&self.cells).enumerate() {
+            *value = component(self.csv.field(c.index), line, c, k)?;
         }
         let mut variances = [1.0; 3];
         let needed = [
@@ -196,7 +197,7 @@ impl<R: Read> Rows<R> {
             }
         }
         if self.bearing {
-            values[1] = values[1].map(|b| wrap(FRAC_PI_2 - b));
+            values[1] = values[1].map(from_bearing);
         }
         let t_cell = self.csv.field(self.time.index);
         self.previous_text.clear();
@@ -248,26 +249,64 @@ impl<R: Read> Rows<R> {
     }
 }
 
-/// A component's cell: `None` when empty, else a finite number in range.
-fn component(cell: &[u8], line: u64, c: &Cell) -> Result<Option<f64>, CliError> {
+/// The `k`-th component's cell: `None` when empty, else a number the library's rule for a
+/// radar row takes ([`check_component`]).
+fn component(cell: &[u8], line: u64, c: &Cell, k: usize) -> Result<Option<f64>, CliError> {
     if cell.is_empty() {
         return Ok(None);
     }
     let v = parse_cell(cell, line, &c.name, c.what)?;
-    let bad = |why: &str| {
-        Err(CliError::Data(format!(
+    check_component(k, v).map(Some).map_err(|why| {
+        CliError::Data(format!(
             "line {line}, column '{}': {} {} {why}",
             c.name,
             c.what,
             shown(cell)
-        )))
-    };
-    match c.what {
-        "range" if v <= 0.0 => bad("is not positive"),
-        "azimuth" if v.abs() > TAU => bad("is outside [-2pi, 2pi]: azimuths are in radians"),
-        "elevation" if v.abs() > FRAC_PI_2 => {
-            bad("is outside [-pi/2, pi/2]: elevations are in radians from the x-y plane")
-        }
-        _ => Ok(Some(v)),
+        ))
+    })
+}
+
+/// Refuses a radar command that gives neither the flag nor a column for the range's σ, or for
+/// the angles' (`command`: how the message names it, e.g. "track").
+pub(crate) fn check_sigmas(a: &RadarArgs, command: &str) -> Result<(), CliError> {
+    if a.sigma_range.is_none() && a.sigma_range_col.is_none() {
+        return Err(CliError::Usage(format!(
+            "{command} needs --sigma-range S (the range's noise sigma) or --sigma-range-col NAME \
+             (a column of per-row sigmas; with both, the flag serves the rows whose cell is empty)"
+        )));
+    }
+    if a.sigma_angle.is_none() && a.sigma_angle_col.is_none() {
+        return Err(CliError::Usage(format!(
+            "{command} needs --sigma-angle S (the azimuth's and elevation's noise sigma, in \
+             radians) or --sigma-angle-col NAME (a column of per-row sigmas; with both, the flag \
+             serves the rows whose cell is empty)"
+        )));
+    }
+    Ok(())
+}
+
+impl<R: Read> Rows<R> {
+    /// The reader of `csv`'s radar rows, with the columns, σ and azimuth convention of `a`
+    /// and the time column `time`.
+    pub(crate) fn of(csv: CsvIn<R>, time: &str, a: &RadarArgs) -> Result<Self, CliError> {
+        let names = Names {
+            time,
+            range: &a.range_col,
+            azimuth: &a.azimuth_col,
+            elevation: &a.elevation_col,
+        };
+        let sigmas = [
+            SigmaSource {
+                flag: a.sigma_range,
+                column: a.sigma_range_col.clone(),
+                flag_name: "--sigma-range",
+            },
+            SigmaSource {
+                flag: a.sigma_angle,
+                column: a.sigma_angle_col.clone(),
+                flag_name: "--sigma-angle",
+            },
+        ];
+        Self::new(csv, &names, sigmas, a.azimuth == AzimuthConvention::Bearing)
     }
 }

@@ -38,7 +38,7 @@ use crate::estimate::batch::NoiseCovariance;
 use crate::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use crate::estimate::sliding::{SlidingFit, Start};
 use crate::model::dynamics::PolynomialDynamics;
-use crate::model::radar::Radar;
+use crate::model::radar::{check_component, from_bearing, Radar, COMPONENTS};
 use nalgebra::{DMatrix, DVector};
 use std::collections::VecDeque;
 use std::ops::Range;
@@ -770,36 +770,19 @@ pub fn radar_row(
     sigma_angle: Option<f64>,
     bearing: bool,
 ) -> Result<Measurement, Error> {
-    use std::f64::consts::{FRAC_PI_2, TAU};
     if !time.is_finite() {
         return Err(Error::NonFinite {
             what: "time",
             value: time,
         });
     }
-    let limits: [(&'static str, f64, &str); 3] = [
-        ("range", f64::INFINITY, "must be a finite number above 0"),
-        (
-            "azimuth",
-            TAU,
-            "must lie in [-2pi, 2pi]: azimuths are in radians",
-        ),
-        (
-            "elevation",
-            FRAC_PI_2,
-            "must lie in [-pi/2, pi/2]: elevations are in radians from the x-y plane",
-        ),
-    ];
-    for (v, (name, limit, reason)) in values.iter().zip(limits) {
+    for (k, v) in values.iter().enumerate() {
         if let Some(v) = *v {
-            let bad = !v.is_finite() || v.abs() > limit || (name == "range" && v <= 0.0);
-            if bad {
-                return Err(Error::InvalidParameter {
-                    name,
-                    value: v.to_string(),
-                    reason: reason.into(),
-                });
-            }
+            check_component(k, v).map_err(|why| Error::InvalidParameter {
+                name: COMPONENTS[k],
+                value: v.to_string(),
+                reason: why.into(),
+            })?;
         }
     }
     let needed = [
@@ -834,7 +817,7 @@ pub fn radar_row(
     }
     let mut values = values;
     if bearing {
-        values[1] = values[1].map(|b| crate::model::radar::wrap(FRAC_PI_2 - b));
+        values[1] = values[1].map(from_bearing);
     }
     Ok(Measurement {
         time,

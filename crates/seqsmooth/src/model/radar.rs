@@ -20,7 +20,7 @@
 use super::observation::{check_state, Observation, Predicted};
 use crate::error::Error;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// A radar at `site` measuring range, azimuth, elevation and, optionally, range rate.
 ///
@@ -186,6 +186,49 @@ pub struct Converted {
     /// `ρ (σ_ψ² cos²θ + σ_θ²)/2`, the conversion's bias to second order, to compare with the
     /// reported standard deviations.
     pub bias: f64,
+}
+
+/// The measured components of a radar row, in the observation's order.
+pub const COMPONENTS: [&str; 3] = ["range", "azimuth", "elevation"];
+
+/// The rule for a measured component of a radar row (`k`: 0 range, 1 azimuth, 2 elevation, as
+/// in [`COMPONENTS`]), the one every front end applies to its input: a finite range above 0,
+/// an azimuth within `[−2π, 2π]` and an elevation within `[−π/2, π/2]`, both in radians (the
+/// table above, with an azimuth of either turn). `Err` holds why, as words that follow the
+/// value (`"range -5 is not positive"`).
+///
+/// ```
+/// use seqsmooth::model::radar::check_component;
+/// assert_eq!(check_component(0, 1000.0), Ok(1000.0));
+/// assert_eq!(check_component(0, -5.0), Err("is not positive"));
+/// assert!(check_component(1, 7.0).unwrap_err().contains("[-2pi, 2pi]"));
+/// assert!(check_component(2, 1.6).unwrap_err().contains("[-pi/2, pi/2]"));
+/// assert!(check_component(1, f64::NAN).is_err());
+/// ```
+pub fn check_component(k: usize, v: f64) -> Result<f64, &'static str> {
+    if !v.is_finite() {
+        return Err("is not a finite number");
+    }
+    match k {
+        0 if v <= 0.0 => Err("is not positive"),
+        1 if v.abs() > TAU => Err("is outside [-2pi, 2pi]: azimuths are in radians"),
+        2 if v.abs() > FRAC_PI_2 => {
+            Err("is outside [-pi/2, pi/2]: elevations are in radians from the x-y plane")
+        }
+        _ => Ok(v),
+    }
+}
+
+/// The azimuth from `+x` towards `+y` of a bearing `b` (from `+y` clockwise: `x` east, `y`
+/// north), wrapped to `(−π, π]`.
+///
+/// ```
+/// use seqsmooth::model::radar::from_bearing;
+/// assert_eq!(from_bearing(0.0), std::f64::consts::FRAC_PI_2); // north
+/// assert_eq!(from_bearing(std::f64::consts::FRAC_PI_2), 0.0); // east
+/// ```
+pub fn from_bearing(b: f64) -> f64 {
+    wrap(FRAC_PI_2 - b)
 }
 
 /// `a` wrapped to `(−π, π]`.
