@@ -9,6 +9,7 @@ use crate::polynomial::{engine as engine_named, fixed_engine, run_rows};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use seqsmooth::polynomial::stream::{Chunk, StreamBank};
+use seqsmooth::polynomial::tau::default_tau;
 use seqsmooth::{Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter};
 
 /// Every series of `chunk` through a copy of `prototype`, the results by column.
@@ -27,11 +28,12 @@ fn run_bank<F: PolynomialFilter + Clone + Send>(
 /// Filters the rows ``(t[i], y[i])`` of series ``codes[i]`` (0-based integers), each series
 /// on its own filter of the given settings, and returns the columns ``d0..dM`` and with
 /// ``sigma`` their 1σ ``s0..sM``, one value per input row, as the rows of one array
-/// ``(columns, rows)`` (NaN while the series is not determined); for ``fixed`` also the ``window`` cell of each row (the rows in its window),
+/// ``(columns, rows)`` (NaN while the series is not determined); without ``tau`` a fading
+/// memory's is the median time step within series (the library's ``default_tau``); for ``fixed`` also the ``window`` cell of each row (the rows in its window),
 /// as a pair. Errors are those of the earliest bad row, with its index.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (codes, t, y, kind, degree, theta = None, tau = 1.0, window = None, engine = None, sigma = None))]
+#[pyo3(signature = (codes, t, y, kind, degree, theta = None, tau = None, window = None, engine = None, sigma = None))]
 pub fn filter_series<'py>(
     py: Python<'py>,
     codes: &Bound<'py, PyAny>,
@@ -40,7 +42,7 @@ pub fn filter_series<'py>(
     kind: &str,
     degree: usize,
     theta: Option<f64>,
-    tau: f64,
+    tau: Option<f64>,
     window: Option<usize>,
     engine: Option<&str>,
     sigma: Option<f64>,
@@ -106,6 +108,12 @@ pub fn filter_series<'py>(
         }
         "fading" => {
             let theta = theta.ok_or_else(|| needs("theta"))?;
+            // Without tau, the library's default: the median time step within series, as
+            // `seqsmooth filter` takes it without --tau.
+            let tau = match tau {
+                Some(tau) => tau,
+                None => default_tau(t, &channels, true).py()?,
+            };
             let mut f = FadingMemory::new(degree, theta, tau, engine_of(engine)?).py()?;
             if let Some(s) = sigma {
                 f = f.with_noise_sigma(s).py()?;

@@ -63,6 +63,11 @@ SETTINGS = [
         dict(kind="fading", degree=2, theta=0.9, tau=1.0, sigma=0.3),
         ["--kind", "fading", "--degree", "2", "--theta", "0.9", "--tau", "1", "--sigma", "0.3"],
     ),
+    # Without tau, the library's default (the median time step within series) on both sides.
+    (
+        dict(kind="fading", degree=1, theta=0.8),
+        ["--kind", "fading", "--degree", "1", "--theta", "0.8"],
+    ),
     (dict(kind="expanding", degree=1), ["--kind", "expanding", "--degree", "1"]),
     (
         dict(kind="fixed", degree=2, window=7),
@@ -71,7 +76,14 @@ SETTINGS = [
 ]
 
 
-@pytest.mark.parametrize("settings,flags", SETTINGS, ids=[s[0]["kind"] for s in SETTINGS])
+@pytest.mark.parametrize(
+    "settings,flags",
+    SETTINGS,
+    ids=[
+        s[0]["kind"] + ("" if "tau" in s[0] or s[0]["kind"] != "fading" else "-default-tau")
+        for s in SETTINGS
+    ],
+)
 @pytest.mark.parametrize("library", ["pandas", "polars", "pyarrow", "dict"])
 def test_same_rows_as_the_command(tmp_path, rng, settings, flags, library):
     names, t, y = interleaved(rng)
@@ -101,7 +113,9 @@ def test_same_rows_as_the_command(tmp_path, rng, settings, flags, library):
 
 def test_one_series_without_by(rng):
     _, t, y = interleaved(rng, series=1, rows=300)
-    got = ss.filter_frame(pd.DataFrame({"t": t, "y": y}), kind="fading", degree=1, theta=0.8)
+    got = ss.filter_frame(
+        pd.DataFrame({"t": t, "y": y}), kind="fading", degree=1, theta=0.8, tau=1.0
+    )
     want = ss.FadingMemory(1, 0.8).update_many(t, y)
     np.testing.assert_array_equal(got[["d0", "d1"]].to_numpy(), want)
 

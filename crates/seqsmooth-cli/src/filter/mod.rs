@@ -19,7 +19,7 @@ pub mod runner;
 
 use crate::args::{check_window, name, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
 use crate::error::CliError;
-use crate::io::{check_distinct, fmt_f64, input_size, named, open_input, CsvIn, Need, Output};
+use crate::io::{check_distinct, input_size, named, open_input, CsvIn, Need, Output};
 use crate::io::{IdType, Records};
 use crate::parquet::{is_parquet, ParquetRows, ParquetTable};
 use crate::progress::{self, Progress};
@@ -27,19 +27,15 @@ use rayon::prelude::*;
 use rows::{Chunk, RowReader};
 use runner::Runner;
 use seqsmooth::polynomial::stream::{self, StreamBank};
-use std::collections::HashMap;
+use seqsmooth::polynomial::tau;
 use std::sync::mpsc;
 
-/// Data rows buffered before output starts: up to 100 time steps for the `τ` median.
-pub const LOOKAHEAD: usize = 101;
+/// Data rows buffered before output starts: the time steps of the `τ` median.
+pub const LOOKAHEAD: usize = tau::TAU_STEPS + 1;
 
 /// Rows of the first chunk, unless the first rows held back or scanned need more: the chunks
 /// then double in size up to `--chunk-rows`, so that filtering starts early.
 const FIRST_CHUNK_ROWS: usize = 1 << 12;
-
-/// With `--id-col`, the default `τ` is the median of the first 100 steps within series among
-/// this many first rows.
-const TAU_SCAN_ROWS: usize = 1 << 16;
 
 /// Rows formatted per piece (on one thread).
 const PIECE: usize = 4096;
@@ -86,54 +82,23 @@ fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
     Ok(theta)
 }
 
-/// The median of `values` (the mean of the middle two for an even count); `None` for none.
-pub fn median(mut values: Vec<f64>) -> Option<f64> {
-    values.sort_by(f64::total_cmp);
-    let k = values.len();
-    match k {
-        0 => None,
-        _ if k % 2 == 1 => Some(values[k / 2]),
-        _ => Some(0.5 * values[k / 2 - 1] + 0.5 * values[k / 2]),
-    }
-}
-
-/// The median of the first `LOOKAHEAD - 1` time steps within the series of the first `rows`
-/// rows of `chunk` (each row's time minus the previous time of its series), in input order;
-/// `None` when no series has two rows. For one series, the steps of its first `LOOKAHEAD` rows.
-pub fn median_series_step(times: &[f64], series: &[usize]) -> Option<f64> {
-    let mut last: HashMap<usize, f64> = HashMap::new();
-    let mut steps = Vec::with_capacity(LOOKAHEAD - 1);
-    for (&t, &s) in times.iter().zip(series) {
-        if let Some(prev) = last.insert(s, t) {
-            steps.push(t - prev);
-            if steps.len() == LOOKAHEAD - 1 {
-                break;
-            }
-        }
-    }
-    median(steps)
-}
-
-/// The default `τ`: the median step of the first rows, `head` of them scanned.
+/// The default `τ`: the library's rule ([`seqsmooth::polynomial::tau::default_tau`]) over the
+/// first `head` rows of `chunk`, which are all of the input when the chunk is the last and
+/// holds no more; its refusals name `--tau`.
 fn default_tau(chunk: &Chunk, head: usize) -> Result<f64, CliError> {
-    let tau = match median_series_step(&chunk.t[..head], &chunk.series[..head]) {
-        Some(tau) => tau,
-        // One row (per series) in all: τ does not matter.
-        None if chunk.done && chunk.len() <= head => 1.0,
-        None => {
-            return Err(CliError::Data(format!(
+    let complete = chunk.done && chunk.len() <= head;
+    tau::default_tau(&chunk.t[..head], &chunk.series[..head], complete).map_err(|e| match e {
+        seqsmooth::Error::InvalidParameter { value, .. } if value == "none" => {
+            CliError::Data(format!(
                 "no series has two rows among the first {head} data rows, so there is no \
                  median time step for the default tau; give --tau"
-            )))
+            ))
         }
-    };
-    if !(tau.is_finite() && tau > 0.0) {
-        return Err(CliError::Data(format!(
-            "the median time step of the first rows, {}, is not a usable tau; give --tau",
-            fmt_f64(tau)
-        )));
-    }
-    Ok(tau)
+        seqsmooth::Error::InvalidParameter { value, .. } => CliError::Data(format!(
+            "the median time step of the first rows, {value}, is not a usable tau; give --tau"
+        )),
+        e => CliError::Data(e.to_string()),
+    })
 }
 
 /// Runs `seqsmooth filter`.
@@ -170,7 +135,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     // TAU_SCAN_ROWS rows: they are all in the first chunk, whatever the chunk size.
     let tau_needed = a.tau.is_none() && matches!(a.kind, Kind::Fading | Kind::Auto);
     let scan = if tau_needed && a.id_col.is_some() {
-        TAU_SCAN_ROWS
+        tau::TAU_SCAN_ROWS
     } else {
         0
     };

@@ -91,7 +91,7 @@ def filter_frame(
     kind: str = "fading",
     degree: int = 1,
     theta: float | None = None,
-    tau: float = 1.0,
+    tau: float | None = None,
     window: int | None = None,
     engine: str | None = None,
     sigma: float | None = None,
@@ -109,9 +109,14 @@ def filter_frame(
     by : str, optional
         The column naming each row's series (any type); without it the frame is one series.
     kind : {"expanding", "fading", "fixed"}
-    degree, theta, tau, window, engine, sigma
+    degree, theta, window, engine, sigma
         As for :class:`ExpandingMemory`, :class:`FadingMemory` and :class:`FixedMemory`
         (``engine`` defaults to ``"exact"``, for ``fixed`` to ``"adaptive"``).
+    tau : float, optional
+        ``fading``: the time interval ``theta`` discounts over. Default: the median of the
+        first 100 time steps within series among the first 65536 rows, as ``seqsmooth
+        filter`` takes it without ``--tau`` (so ``theta`` is the discount per typical step);
+        :class:`FadingMemory`'s own default is ``1.0``, a unit of time.
 
     Returns
     -------

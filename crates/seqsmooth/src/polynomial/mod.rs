@@ -8,6 +8,7 @@
 //! |---|---|---|
 //! | what every filter does: [`PolynomialFilter`]; batch checks | `filter` | — |
 //! | engines, discounting, largest degree: [`Engine`], [`DiscountMode`], [`MAX_DEGREE`], [`GAIN_MAX_DEGREE`] | `options` | — |
+//! | the default interval `τ` of a fading memory: [`tau::default_tau`], the median time step | [`tau`] | Morrison (13.2.1); Reyneke §6.5 |
 //! | current / predictor form of gains and VRFs: [`form::GainForm`], [`form::EstimateForm`], [`form::unscale`] | [`form`] | Morrison (9.7.4), (13.6.22) |
 //! | expanding memory: [`ExpandingMemory`], gains, VRF | [`expanding`] | Morrison ch. 9, Tables 9.1-9.2; Reyneke §6.3-6.4 |
 //! | fading memory: [`FadingMemory`], gains, VRF, the switch [`SwitchRule`] | [`fading`] | Morrison ch. 13, Tables 13.1-13.4, §13.8; Reyneke §6.5-6.6, Table 1 |
@@ -93,6 +94,7 @@ pub mod fixed;
 pub mod form;
 mod options;
 pub mod stream;
+pub mod tau;
 
 pub use automatic::{AutoConfig, AutoOutput, AutomaticFilter};
 pub use expanding::ExpandingMemory;

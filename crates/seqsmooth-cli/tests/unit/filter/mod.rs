@@ -1,5 +1,4 @@
 //! Unit tests of `filter` and its submodules.
 
-mod median;
 mod rows;
 mod runner;
