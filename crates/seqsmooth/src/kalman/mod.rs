@@ -6,7 +6,8 @@
 //!   recursion of the exact polynomial engine over any linear model; it starts from nothing;
 //!   with fading memory (ch. 14, [`Discount`]) it reports its true covariance.
 //! - [`filter`]: [`KalmanFilter`], prediction, Joseph-form update, the iterated update, the
-//!   generalized fading memory of ch. 14 ([`Discount`]), innovation statistics.
+//!   generalized fading memory of ch. 14 ([`Discount`]), innovation statistics; its arithmetic
+//!   on preallocated buffers (the covariance's prediction, one correction) in `correct`.
 //! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run.
 //! - [`fixed_lag`]: the same smoother with a fixed lag: each measurement's estimate from the
 //!   `L` after it, in memory bounded by `L`.
@@ -20,6 +21,7 @@
 
 pub mod adaptive;
 pub mod bayes;
+mod correct;
 mod discount;
 pub mod filter;
 pub mod fixed_lag;
