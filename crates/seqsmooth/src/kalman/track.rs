@@ -31,10 +31,9 @@ pub use super::adaptive::TrackFlag;
 use super::adaptive::{Monitor, MISFIT_ALPHA};
 use super::filter::{Discount, KalmanFilter};
 use super::fixed_lag::FixedLagSmoother;
-use super::noise::WhiteNoiseDerivative;
+use super::memory::{base_noise, Filter, Memory, MemoryKind};
 use super::smoother::Smoothed;
 use crate::error::Error;
-use crate::estimate::batch::NoiseCovariance;
 use crate::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use crate::estimate::sliding::{SlidingFit, Start};
 use crate::model::dynamics::PolynomialDynamics;
@@ -181,121 +180,28 @@ pub enum Tracked<'a> {
     },
 }
 
-/// The filter of the Kalman methods.
-type Filter = KalmanFilter<PolynomialDynamics, Radar>;
-
-/// The memory of a Kalman method: a driving noise or a discount, fixed or adaptive, with the
-/// innovation monitor that flags its rows.
-#[derive(Clone, Debug)]
-struct Memory {
-    kind: MemoryKind,
-    monitor: Monitor,
-}
-
-/// What a level sets.
-#[derive(Clone, Copy, Debug)]
-enum MemoryKind {
-    /// The driving noise `q` at level 0 (`q₀` when adaptive).
-    Noise(f64),
-    /// The discount at level 0.
-    Fading(Discount),
-}
-
-impl Memory {
-    /// The memory of `method` for a filter started from the fit over `rows` (the adaptive
-    /// `q₀` from their steps and range noise).
-    fn new<'a>(
-        method: TrackMethod,
-        rows: impl Iterator<Item = &'a Measurement>,
-    ) -> Result<Self, Error> {
-        let (kind, adaptive, (lowest, highest)) = match method {
-            TrackMethod::Kalman { q: Some(q) } | TrackMethod::Smooth { q: Some(q), .. } => {
-                (MemoryKind::Noise(q), false, (0, 0))
-            }
-            TrackMethod::Kalman { q: None } | TrackMethod::Smooth { q: None, .. } => {
-                (MemoryKind::Noise(base_noise(rows)), true, NOISE_LEVELS)
-            }
-            TrackMethod::Fading(Some(d)) => (MemoryKind::Fading(d), false, (0, 0)),
-            TrackMethod::Fading(None) => (
-                MemoryKind::Fading(Discount::PerUpdate(DEFAULT_THETA)),
-                true,
-                FADING_LEVELS,
-            ),
-            TrackMethod::Window { .. } => (MemoryKind::Noise(0.0), false, (0, 0)),
-        };
-        Ok(Self {
-            kind,
-            monitor: Monitor::new(3, adaptive, lowest, highest)?,
-        })
-    }
-
-    /// Sets the filter's driving noise or discount to the monitor's level.
-    fn apply(&self, f: &mut Filter) -> Result<(), Error> {
-        let level = self.monitor.level();
-        match self.kind {
-            MemoryKind::Noise(q) => {
-                let q = q * 4f64.powi(level);
-                f.set_process_noise(WhiteNoiseDerivative::new(1, 3, q)?)
-            }
-            MemoryKind::Fading(d) if level == 0 => f.set_fading(d),
-            MemoryKind::Fading(d) => {
-                let theta = match d {
-                    Discount::PerUpdate(t) | Discount::PerTime(t) => t,
-                };
-                f.set_fading(Discount::PerUpdate(1.0 - (1.0 - theta) * 2f64.powi(level)))
-            }
+/// The memory of `method` for a filter started from the fit over `rows` (the adaptive `q₀`
+/// from their steps and range noise, [`base_noise`]).
+fn memory_of<'a>(
+    method: TrackMethod,
+    rows: impl Iterator<Item = &'a Measurement>,
+) -> Result<Memory, Error> {
+    let (kind, adaptive, levels) = match method {
+        TrackMethod::Kalman { q: Some(q) } | TrackMethod::Smooth { q: Some(q), .. } => {
+            (MemoryKind::Noise(q), false, (0, 0))
         }
-    }
-
-    /// One row through `filter`: the gated update, the row's flag, and the level changed
-    /// where the monitor says so. Returns the NIS (`None` with no component) and the flag.
-    fn step(&mut self, f: &mut Filter, m: &Measurement) -> Result<(Option<f64>, TrackFlag), Error> {
-        let monitor = &self.monitor;
-        let Some((stats, used)) = f.update_gated(m, |s| monitor.accepts(s.nis, s.components))?
-        else {
-            return Ok((None, TrackFlag::None));
-        };
-        let (flag, changed) = self.monitor.record(stats.nis, stats.components, used);
-        if changed {
-            self.apply(f)?;
+        TrackMethod::Kalman { q: None } | TrackMethod::Smooth { q: None, .. } => {
+            (MemoryKind::Noise(base_noise(rows)), true, NOISE_LEVELS)
         }
-        Ok((Some(stats.nis), flag))
-    }
-
-    /// [`Self::step`] for the smoother: the gate decided on a copy of its filter, then the row
-    /// (or, left out, the prediction to its time) pushed and the level changed where the
-    /// monitor says so. Returns the row the smoother gave (if any), the NIS and the flag. On
-    /// an error the smoother and the memory are unchanged (the new level is tried on the copy
-    /// before the push).
-    fn step_smoother(
-        &mut self,
-        s: &mut FixedLagSmoother<PolynomialDynamics, Radar>,
-        m: &Measurement,
-    ) -> Result<(Option<Smoothed>, Option<f64>, TrackFlag), Error> {
-        let mut probe = s.filter().clone();
-        let monitor = &self.monitor;
-        let gated = probe.update_gated(m, |s| monitor.accepts(s.nis, s.components))?;
-        let Some((stats, used)) = gated else {
-            return Ok((s.push(m)?, None, TrackFlag::None));
-        };
-        let mut memory = self.clone();
-        let (flag, changed) = memory.monitor.record(stats.nis, stats.components, used);
-        if changed {
-            memory.apply(&mut probe)?;
-        }
-        let given = if used {
-            s.push(m)?
-        } else {
-            let mut predicted = m.clone();
-            predicted.values.iter_mut().for_each(|v| *v = None);
-            s.push(&predicted)?
-        };
-        if changed {
-            memory.apply(s.filter_mut())?;
-        }
-        *self = memory;
-        Ok((given, Some(stats.nis), flag))
-    }
+        TrackMethod::Fading(Some(d)) => (MemoryKind::Fading(d), false, (0, 0)),
+        TrackMethod::Fading(None) => (
+            MemoryKind::Fading(Discount::PerUpdate(DEFAULT_THETA)),
+            true,
+            FADING_LEVELS,
+        ),
+        TrackMethod::Window { .. } => (MemoryKind::Noise(0.0), false, (0, 0)),
+    };
+    Memory::new(kind, adaptive, levels)
 }
 
 /// The smooth method's forward pass: the fixed-lag smoother, the memory that gates and adapts
@@ -306,34 +212,6 @@ struct Lagged {
     smoother: FixedLagSmoother<PolynomialDynamics, Radar>,
     memory: Memory,
     held: VecDeque<(Option<f64>, TrackFlag)>,
-}
-
-/// The adaptive driving noise's level 0, `q₀ = σ_r² / T³`: the range's noise variance (of the
-/// last row) over the cube of the rows' mean step, the density whose tracking index
-/// `√(q T³) / σ_r` is 1.
-fn base_noise<'a>(rows: impl Iterator<Item = &'a Measurement>) -> f64 {
-    let (mut first, mut last, mut count, mut variance) = (f64::NAN, f64::NAN, 0usize, 1.0);
-    for m in rows {
-        if count == 0 {
-            first = m.time;
-        }
-        last = m.time;
-        count += 1;
-        if m.values.first().is_some_and(Option::is_some) {
-            variance = match &m.noise {
-                NoiseCovariance::Identity => 1.0,
-                NoiseCovariance::Variances(v) => v.first().copied().unwrap_or(1.0),
-                NoiseCovariance::Full(r) => r[(0, 0)],
-            };
-        }
-    }
-    let step = (last - first) / count.saturating_sub(1).max(1) as f64;
-    let q = variance / (step * step * step);
-    if q.is_finite() && q > 0.0 {
-        q
-    } else {
-        1.0
-    }
 }
 
 /// What the method keeps between rows.
@@ -522,7 +400,7 @@ impl RadarTracker {
                     self.last_time = m.time;
                     return Ok(Tracked::Undetermined);
                 };
-                let memory = Memory::new(self.method, fit.measurements());
+                let memory = memory_of(self.method, fit.measurements());
                 let started = memory.and_then(|memory| {
                     let mut f = filter_from(self.dynamics, self.radar, &c)?;
                     memory.apply(&mut f)?;
