@@ -37,8 +37,10 @@
 //! - [`calculus`]: factorials, binomials, Stirling and link matrices, polynomials.
 //! - [`basis`]: discrete Legendre and Laguerre polynomials, classical Legendre.
 //! - [`model`]: state scaling, `Φ` and `Ψ`, propagation ([`PolynomialState::at`]).
-//! - [`estimate`]: batch weighted least-squares polynomial fits (QR).
-//! - [`polynomial`]: the filters, one module per concept (table in its docs):
+//! - [`estimate`]: batch least squares (QR): polynomial fits, the minimum-variance estimate of
+//!   any linear model, Gauss–Newton differential correction (§8.5-8.7, ch. 11), the sliding
+//!   fit of each measurement's window, curve fits with their Cramér–Rao bound.
+//! - [`polynomial`]: the polynomial filters, one module per concept (table in its docs):
 //!   - [`polynomial::expanding`]: [`ExpandingMemory`], its gains and VRF (Morrison ch. 9);
 //!   - [`polynomial::fading`]: [`FadingMemory`], its gains, VRF and the expanding → fading
 //!     switch (Morrison ch. 13);
@@ -47,12 +49,19 @@
 //!   - [`polynomial::automatic`]: the automatic filter (start-up, outliers, noise, misfit,
 //!     degree settling; Morrison §13.8, §14.8; Reyneke et al. §7);
 //!   - [`polynomial::bank`], [`polynomial::stream`]: many channels at once;
+//!   - [`polynomial::tau`]: the default `τ` of a fading memory (the median time step);
 //!   - every filter implements [`PolynomialFilter`], configured as `Type::new(required)?`
 //!     (the automatic filter: `AutomaticFilter::new(m, θ, τ)`) then `.with_x(v)?` builders.
-//! - [`stats`]: chi-squared tests, noise estimation, residual calibration.
+//! - [`kalman`]: recursive filters over any dynamic and observation model (Morrison chs. 10,
+//!   12, 14, 15): the Bayes filter in information form, the Kalman filter (extended, iterated,
+//!   driving noise, fading memory), the Rauch–Tung–Striebel and fixed-lag smoothers, and the
+//!   radar tracker ([`kalman::track::RadarTracker`]) with its innovation monitor (§14.8).
+//! - [`paml`]: polynomial samples and the PAML estimate (Villien & Ostertag 2009).
+//! - [`stats`]: chi-squared tests, noise estimation, residual calibration, NIS/NEES.
 //! - [`recursive`]: the square-root information (Bayes) recursion the exact engines run on.
 //! - [`scalar`]: the `f64` / exact-rational abstraction every formula is generic over.
 //! - [`linalg`]: the small dense linear algebra the formulas share.
+//! - [`error`]: the one error type, [`Error`], of every fallible call.
 //! - `numeric`: the numerical building blocks of the engines (double-word arithmetic, the
 //!   step tolerance).
 //!

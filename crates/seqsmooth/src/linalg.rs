@@ -1,5 +1,5 @@
 //! Small dense linear algebra the library needs beyond nalgebra: exact (field-generic) inversion
-//! for the rational oracles, triangular solves, and ([`dense`]) the column-major kernels and
+//! for the rational oracles, triangular solves, and (`dense`) the column-major kernels and
 //! `L D Lᵀ` factorisation of the Kalman filter's covariance arithmetic.
 
 pub(crate) mod dense;
