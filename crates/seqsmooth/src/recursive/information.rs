@@ -332,6 +332,84 @@ impl InformationFilter {
         true
     }
 
+    /// [`Self::variances_of_rows`] for the `p` rows of an upper-triangular `J` (`p × p`,
+    /// row-major in `rows`, read only on and above the diagonal): the variances of `(J x)_i`
+    /// into `out`, for a dimension `p ≤ N` (`N`, the size of the kernel's stack arrays, is `p`
+    /// itself where the caller knows it at compile time: its loops then unroll). `false` while
+    /// not determined.
+    ///
+    /// With `R = D^½ U`, `(RᵀR)⁻¹ Jᵀ = U⁻¹ D⁻¹ Y` for `Y = U⁻ᵀ Jᵀ`, which is lower triangular
+    /// (both factors are), so each of its columns is a forward substitution that starts at its
+    /// diagonal (`p³/6` in all). The plain covariance's diagonal is then `Σ_k Y_ki²/d_k`; the
+    /// true (sandwich) covariance's, `‖Q (RᵀR)⁻¹ Jᵀ‖²` column by column with `Q = D_Q^½ U_Q`,
+    /// is `Σ_r (D_Q)_r (T D⁻¹ Y)_ri²` with the unit upper triangle `T = U_Q U⁻¹` formed once
+    /// (`p³/6`; the product with the triangle `D⁻¹ Y`, `p³/3`): no square root, and `p`
+    /// divisions independent of each other. The lazy scale cancels as in
+    /// [`Self::covariance_of`].
+    #[inline(always)]
+    pub(crate) fn variances_of_upper_rows<const N: usize>(
+        &self,
+        p: usize,
+        rows: &[f64],
+        out: &mut [f64],
+    ) -> bool {
+        assert!(p <= N && p == self.dim(), "rows of the wrong size");
+        let rows = &rows[..p * p];
+        let out = &mut out[..p];
+        let mut inv_d = [0.0; N];
+        if !self.info.inverse_pivots(&mut inv_d[..p]) {
+            return false;
+        }
+        let u = self.info.unit_triangle(p);
+        let mut y = [0.0; N];
+        match &self.spread {
+            None => {
+                let s2 = self.scale * self.scale;
+                for (i, o) in out.iter_mut().enumerate() {
+                    lower_column(u, p, rows, i, &mut y);
+                    let sum = y[i..p]
+                        .iter()
+                        .zip(&inv_d[i..p])
+                        .fold(0.0, |acc, (yk, ek)| acc + yk * yk * ek);
+                    *o = sum * s2;
+                }
+            }
+            Some(q) => {
+                let mut dq = [0.0; N];
+                q.pivots_into(&mut dq[..p]);
+                // T = U_Q U⁻¹, row by row: `T_r U = (U_Q)_r`, a forward substitution from the
+                // diagonal (`T_rr = 1`, implied).
+                let uq = q.unit_triangle(p);
+                let mut t = [[0.0; N]; N];
+                for (r, t_row) in t[..p].iter_mut().enumerate() {
+                    t_row[r] = 1.0;
+                    for k in r + 1..p {
+                        t_row[k] = column_dot(u, p, k, r, t_row, uq[r * p + k]);
+                    }
+                }
+                let mut w = [0.0; N];
+                for (i, o) in out.iter_mut().enumerate() {
+                    lower_column(u, p, rows, i, &mut y);
+                    for k in i..p {
+                        w[k] = y[k] * inv_d[k];
+                    }
+                    // z_r = Σ_(k ≥ max(r, i)) T_rk w_k, the variance Σ_r (D_Q)_r z_r².
+                    let mut sum = 0.0;
+                    for (r, t_row) in t[..p].iter().enumerate() {
+                        let from = r.max(i);
+                        let z = t_row[from..p]
+                            .iter()
+                            .zip(&w[from..p])
+                            .fold(0.0, |z, (trk, wk)| z + trk * wk);
+                        sum += dq[r] * z * z;
+                    }
+                    *o = sum;
+                }
+            }
+        }
+        true
+    }
+
     /// The largest variance inflation `max_i P_ii (RᵀR)_ii` (`P = (RᵀR)⁻¹`): 1 for a component
     /// whose information is independent of the others', `1/(1 − ρ_i²)` for one whose estimate
     /// correlates with the rest by the multiple correlation `ρ_i`, and without bound as a
@@ -422,4 +500,35 @@ impl InformationFilter {
             }
         }
     }
+}
+
+/// Column `i` of `Y = U⁻ᵀ Jᵀ` (entries `k ≥ i`; lower triangular) into `y`:
+/// `Uᵀ y = (row i of J)ᵀ` by forward substitution from the diagonal, for the unit triangle
+/// `u` and the upper-triangular `rows` of `J`, both `p × p` row-major.
+#[inline(always)]
+fn lower_column<const N: usize>(u: &[f64], p: usize, rows: &[f64], i: usize, y: &mut [f64; N]) {
+    for k in i..p {
+        y[k] = column_dot(u, p, k, i, y, rows[i * p + k]);
+    }
+}
+
+/// `init − Σ_(j in from..k) U_jk x_j` for the unit triangle `u` of dimension `p` (row-major):
+/// column `k` of `U` from row `from` down to above the diagonal, against `x`, in the order of
+/// `j` (one accumulator in a register).
+#[inline(always)]
+fn column_dot<const N: usize>(
+    u: &[f64],
+    p: usize,
+    k: usize,
+    from: usize,
+    x: &[f64; N],
+    init: f64,
+) -> f64 {
+    let mut s = init;
+    let mut at = from * p + k;
+    for xj in &x[from..k] {
+        s -= u[at] * xj;
+        at += p;
+    }
+    s
 }
