@@ -332,8 +332,8 @@ impl InformationFilter {
         true
     }
 
-    /// [`Self::variances_of_rows`] for the `p` rows of an upper-triangular `J` (`p × p`,
-    /// row-major in `rows`, read only on and above the diagonal): the variances of `(J x)_i`
+    /// [`Self::variances_of_rows`] for the `p` rows of an upper-triangular `J` (`p × p`, its
+    /// entry `J_ik`, `k ≥ i`, given by `entry(i, k)`): the variances of `(J x)_i`
     /// into `out`, for a dimension `p ≤ N` (`N`, the size of the kernel's stack arrays, is `p`
     /// itself where the caller knows it at compile time: its loops then unroll). `false` while
     /// not determined.
@@ -350,11 +350,10 @@ impl InformationFilter {
     pub(crate) fn variances_of_upper_rows<const N: usize>(
         &self,
         p: usize,
-        rows: &[f64],
+        entry: impl Fn(usize, usize) -> f64 + Copy,
         out: &mut [f64],
     ) -> bool {
         assert!(p <= N && p == self.dim(), "rows of the wrong size");
-        let rows = &rows[..p * p];
         let out = &mut out[..p];
         let mut inv_d = [0.0; N];
         if !self.info.inverse_pivots(&mut inv_d[..p]) {
@@ -366,7 +365,7 @@ impl InformationFilter {
             None => {
                 let s2 = self.scale * self.scale;
                 for (i, o) in out.iter_mut().enumerate() {
-                    lower_column(u, p, rows, i, &mut y);
+                    lower_column(u, p, entry, i, &mut y);
                     let sum = y[i..p]
                         .iter()
                         .zip(&inv_d[i..p])
@@ -389,7 +388,7 @@ impl InformationFilter {
                 }
                 let mut w = [0.0; N];
                 for (i, o) in out.iter_mut().enumerate() {
-                    lower_column(u, p, rows, i, &mut y);
+                    lower_column(u, p, entry, i, &mut y);
                     for k in i..p {
                         w[k] = y[k] * inv_d[k];
                     }
@@ -504,11 +503,17 @@ impl InformationFilter {
 
 /// Column `i` of `Y = U⁻ᵀ Jᵀ` (entries `k ≥ i`; lower triangular) into `y`:
 /// `Uᵀ y = (row i of J)ᵀ` by forward substitution from the diagonal, for the unit triangle
-/// `u` and the upper-triangular `rows` of `J`, both `p × p` row-major.
+/// `u` (`p × p`, row-major) and the upper-triangular `J` (`entry(i, k) = J_ik`).
 #[inline(always)]
-fn lower_column<const N: usize>(u: &[f64], p: usize, rows: &[f64], i: usize, y: &mut [f64; N]) {
+fn lower_column<const N: usize>(
+    u: &[f64],
+    p: usize,
+    entry: impl Fn(usize, usize) -> f64,
+    i: usize,
+    y: &mut [f64; N],
+) {
     for k in i..p {
-        y[k] = column_dot(u, p, k, i, y, rows[i * p + k]);
+        y[k] = column_dot(u, p, k, i, y, entry(i, k));
     }
 }
 

@@ -33,6 +33,25 @@ use nalgebra::DMatrix;
 /// The largest state size, `MAX_DEGREE + 1` (stack tables).
 const MAX_SIZE: usize = MAX_DEGREE + 1;
 
+/// Pascal's triangle, `PASCAL[k][i] = C(k, i)` for `k, i < MAX_SIZE` (exact: at most
+/// `C(24, 12) < 2^53`).
+static PASCAL: [[f64; MAX_SIZE]; MAX_SIZE] = pascal();
+
+const fn pascal() -> [[f64; MAX_SIZE]; MAX_SIZE] {
+    let mut c = [[0.0; MAX_SIZE]; MAX_SIZE];
+    let mut k = 0;
+    while k < MAX_SIZE {
+        c[k][0] = 1.0;
+        let mut i = 1;
+        while i <= k {
+            c[k][i] = c[k - 1][i - 1] + c[k - 1][i];
+            i += 1;
+        }
+        k += 1;
+    }
+    c
+}
+
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Discount {
     pub theta: f64,
@@ -324,35 +343,21 @@ impl ExactEngine {
         self.std_devs_with::<MAX_SIZE>(p, t, out)
     }
 
-    /// [`Self::std_devs_into`] for the size `p ≤ N`, its tables `N × N` on the stack.
+    /// [`Self::std_devs_into`] for the size `p ≤ N` (its tables on the stack).
     #[inline(always)]
     fn std_devs_with<const N: usize>(&self, p: usize, t: f64, out: &mut [f64]) -> bool {
         let Some(sigma) = self.sigma.filter(|_| self.n > self.m as u64) else {
             return false;
         };
-        let mut table = [[0.0; N]; N];
-        let rows = &mut table.as_flattened_mut()[..p * p];
         let v = (t - self.centre) * self.inv_unit;
-        // The rows of Φ(v): Φ_ik = C(k, i) v^(k-i), k ≥ i (below the diagonal not read).
-        let mut powers = [1.0; MAX_SIZE];
-        let powers = &mut powers[..p];
+        // Φ(v)_ik = C(k, i) v^(k-i), k ≥ i.
+        let mut powers = [1.0; N];
         for k in 1..p {
             powers[k] = powers[k - 1] * v;
         }
-        let mut binomial = [0.0; MAX_SIZE];
-        let binomial = &mut binomial[..p];
-        for k in 0..p {
-            // Row k of Pascal's triangle from row k-1, in place.
-            binomial[k] = 1.0;
-            for i in (1..k).rev() {
-                binomial[i] += binomial[i - 1];
-            }
-            for i in 0..=k {
-                rows[i * p + k] = binomial[i] * powers[k - i];
-            }
-        }
+        let phi = |i: usize, k: usize| PASCAL[k][i] * powers[k - i];
         let out = &mut out[..p];
-        if !self.info.variances_of_upper_rows::<N>(p, rows, out) {
+        if !self.info.variances_of_upper_rows::<N>(p, phi, out) {
             return false;
         }
         for (i, o) in out.iter_mut().enumerate() {
