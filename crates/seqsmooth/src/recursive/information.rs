@@ -1,26 +1,6 @@
 //! The square-root information (Bayes) recursion, with fading memory and its true covariance:
-//! the one recursion under the exact polynomial engine and the Bayes filter.
-//!
-//! | step | | source |
-//! |---|---|---|
-//! | observe `y = hᵀx + ν` with weight `c` (`1/σ²`) | a row `√c·[hᵀ ∣ y]` folded into `[R ∣ d]` | (10.2.42)-(10.2.44), (11.3.4) |
-//! | change of state variables `x_old = A x_new` (a transition) | `R ← R A` | (10.2.40)-(10.2.41), (11.3.3) |
-//! | fade: all information so far times `f ∈ (0, 1]` | `RᵀR ← f RᵀR` (lazily) | (14.4.26)-(14.4.27), (13.2.1) |
-//! | estimate | `R x = d` | (10.2.33) |
-//! | covariance, plain | `(RᵀR)⁻¹` | (10.2.34) |
-//! | covariance, fading (true) | `(RᵀR)⁻¹ (QᵀQ) (RᵀR)⁻¹`, `QᵀQ = Σ c_k w_k² h_k h_kᵀ` | (14.3.11)-(14.3.13), (13.6.4) |
-//!
-//! With fading memory each row's information weighs `w_k c_k`, where `w_k` is the product of
-//! the discounts since it came in, so `(RᵀR)⁻¹` is the recursion's own matrix `P` (14.3.13),
-//! not the estimate's covariance; the estimate's is the sandwich above, whose middle factor
-//! `Q` is kept alongside `R` (rows `√c·w_k·hᵀ`, no right-hand side) when asked
-//! ([`InformationFilter::with_true_covariance`]).
-//!
-//! The discount is applied lazily: instead of multiplying `R` by `√f` at each step, new rows get
-//! the weight `1/Π f` (a scale folded back into the factors when its square root passes 1e30:
-//! the rows' weights are its square, `Q`'s its fourth power, ≤ 1e120, far from overflow in the
-//! squares the square-root-free rotations form). The estimate and the sandwich do not depend on
-//! that common scale.
+//! the one recursion under the exact polynomial engine and the Bayes filter
+//! ([`InformationFilter`]: its steps, their sources in Morrison (1969), the lazy discount).
 
 use super::factor::TriangularFactor;
 use crate::linalg::{solve_upper_in_place, solve_upper_transpose_in_place};
@@ -29,9 +9,29 @@ use nalgebra::{DMatrix, DVector};
 /// When the lazy discount's row scale exceeds this, it is folded into the factors.
 const RENORMALISE: f64 = 1e30;
 
-/// The square-root information filter (see the [module docs](self)): estimate `x = R⁻¹d` of a
-/// linear model observed through rows `y_k = h_kᵀ x + ν_k` with weights `c_k`, optionally
-/// fading.
+/// The square-root information filter: estimate `x = R⁻¹d` of a linear model observed through
+/// rows `y_k = h_kᵀ x + ν_k` with weights `c_k`, optionally fading.
+///
+/// | step | | source |
+/// |---|---|---|
+/// | observe `y = hᵀx + ν` with weight `c` (`1/σ²`) | a row `√c·[hᵀ ∣ y]` folded into `[R ∣ d]` | (10.2.42)-(10.2.44), (11.3.4) |
+/// | change of state variables `x_old = A x_new` (a transition) | `R ← R A` | (10.2.40)-(10.2.41), (11.3.3) |
+/// | fade: all information so far times `f ∈ (0, 1]` | `RᵀR ← f RᵀR` (lazily) | (14.4.26)-(14.4.27), (13.2.1) |
+/// | estimate | `R x = d` | (10.2.33) |
+/// | covariance, plain | `(RᵀR)⁻¹` | (10.2.34) |
+/// | covariance, fading (true) | `(RᵀR)⁻¹ (QᵀQ) (RᵀR)⁻¹`, `QᵀQ = Σ c_k w_k² h_k h_kᵀ` | (14.3.11)-(14.3.13), (13.6.4) |
+///
+/// With fading memory each row's information weighs `w_k c_k`, where `w_k` is the product of
+/// the discounts since it came in, so `(RᵀR)⁻¹` is the recursion's own matrix `P` (14.3.13),
+/// not the estimate's covariance; the estimate's is the sandwich above, whose middle factor
+/// `Q` is kept alongside `R` (rows `√c·w_k·hᵀ`, no right-hand side) when asked
+/// ([`InformationFilter::with_true_covariance`]).
+///
+/// The discount is applied lazily: instead of multiplying `R` by `√f` at each step, new rows get
+/// the weight `1/Π f` (a scale folded back into the factors when its square root passes 1e30:
+/// the rows' weights are its square, `Q`'s its fourth power, ≤ 1e120, far from overflow in the
+/// squares the square-root-free rotations form). The estimate and the sandwich do not depend on
+/// that common scale.
 ///
 /// ```
 /// use seqsmooth::recursive::InformationFilter;
