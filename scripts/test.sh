@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# The whole test suite (the README's test command; .ci/run runs it): the Rust workspace, then
-# the Python package, built and installed into its own virtual environment (target/py-venv,
+# The whole test suite (the README's test command; .ci/run runs it): the Rust workspace and its
+# API docs (every warning an error: a broken or ambiguous intra-doc link fails), then the
+# Python package, built and installed into its own virtual environment (target/py-venv,
 # made from crates/seqsmooth-py/requirements-test.txt on first use), linted and tested with
 # pytest against the `seqsmooth` binary built here.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 cargo test --workspace --release
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps
 cargo build --release -p seqsmooth-cli
 
 venv=target/py-venv

@@ -1,13 +1,17 @@
 """`update_many(t, y, return_sigma=True)` against `update_many(t, y)` on 10⁷ unit-step samples
 (BENCHMARKS.md, "The batch σ path"): each filter constructed with a noise ``sigma`` (the plain
-call then also keeps its covariance), degree 2, best of 2 calls on fresh filters, in seconds,
-and the ratio. Run in target/py-venv after installing the package:
+call then also keeps its covariance), degree 2 (or ``--degree M``), best of 2 calls on fresh
+filters (or ``--repeat K``), in seconds of wall time and of the calling thread's CPU time (the
+figure that a busy machine disturbs least), and their ratios; ``--exact`` runs the exact
+engine's filters only. Run in target/py-venv after installing the package:
 
     target/py-venv/bin/python crates/seqsmooth-py/bench/return_sigma.py
+    target/py-venv/bin/python crates/seqsmooth-py/bench/return_sigma.py --exact --degree 8
 """
 
 from __future__ import annotations
 
+import argparse
 import time
 
 import numpy as np
@@ -18,28 +22,39 @@ N = 10_000_000
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--degree", type=int, default=2)
+    parser.add_argument("--repeat", type=int, default=2)
+    parser.add_argument("--exact", action="store_true", help="the exact engine's filters only")
+    args = parser.parse_args()
+    m = args.degree
     rng = np.random.default_rng(1)
     t = np.arange(N, dtype=np.float64)
     y = 10 * np.sin(t * 1e-3) + rng.uniform(-0.5, 0.5, N)
     makers = {
-        "fading gain": lambda: ss.FadingMemory(2, 0.9, 1.0, engine="gain", sigma=0.3),
-        "fading exact": lambda: ss.FadingMemory(2, 0.9, 1.0, engine="exact", sigma=0.3),
-        "expanding gain": lambda: ss.ExpandingMemory(2, engine="gain", sigma=0.3),
-        "expanding exact": lambda: ss.ExpandingMemory(2, engine="exact", sigma=0.3),
-        "fixed adaptive W=21": lambda: ss.FixedMemory(2, 21, sigma=0.3),
+        "fading gain": lambda: ss.FadingMemory(m, 0.9, 1.0, engine="gain", sigma=0.3),
+        "fading exact": lambda: ss.FadingMemory(m, 0.9, 1.0, engine="exact", sigma=0.3),
+        "expanding gain": lambda: ss.ExpandingMemory(m, engine="gain", sigma=0.3),
+        "expanding exact": lambda: ss.ExpandingMemory(m, engine="exact", sigma=0.3),
+        "fixed adaptive W=21": lambda: ss.FixedMemory(m, 21, sigma=0.3),
     }
+    if args.exact:
+        makers = {name: make for name, make in makers.items() if name.endswith("exact")}
+    print(f"degree {m}, {N} samples, best of {args.repeat}", flush=True)
     for name, make in makers.items():
-        best = {}
+        wall, cpu = {}, {}
         for sigma in (False, True):
-            best[sigma] = float("inf")
-            for _ in range(2):
+            wall[sigma] = cpu[sigma] = float("inf")
+            for _ in range(args.repeat):
                 f = make()
-                start = time.perf_counter()
+                start, start_cpu = time.perf_counter(), time.thread_time()
                 f.update_many(t, y, return_sigma=sigma)
-                best[sigma] = min(best[sigma], time.perf_counter() - start)
+                wall[sigma] = min(wall[sigma], time.perf_counter() - start)
+                cpu[sigma] = min(cpu[sigma], time.thread_time() - start_cpu)
         print(
-            f"{name:20s} plain {best[False]:.3f} s  return_sigma {best[True]:.3f} s  "
-            f"ratio {best[True] / best[False]:.2f}",
+            f"{name:20s} plain {wall[False]:.3f} s  return_sigma {wall[True]:.3f} s  "
+            f"ratio {wall[True] / wall[False]:.2f}  |  CPU {cpu[False]:.3f} s  {cpu[True]:.3f} s  "
+            f"ratio {cpu[True] / cpu[False]:.2f}",
             flush=True,
         )
 

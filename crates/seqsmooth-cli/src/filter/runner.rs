@@ -41,7 +41,7 @@ fn store_decisions(verdicts: &[bool], cells: &mut [f64]) {
     cells[2] = (bits >> 32) as f64;
 }
 
-/// The decisions stored in `cells` by [`store_decisions`].
+/// The decisions stored in `cells` by `store_decisions`.
 pub fn decisions(cells: &[f64]) -> Vec<bool> {
     let bits = cells[1] as u64 | ((cells[2] as u64) << 32);
     (0..cells[0] as usize).map(|i| bits >> i & 1 == 1).collect()

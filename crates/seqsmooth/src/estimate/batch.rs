@@ -10,7 +10,7 @@
 //! variance: `L⁻¹ T`, `L⁻¹ Y`), never by forming the normal equations, whose condition number is
 //! the square of `T`'s. The numerical rank of `T` is checked first (singular values of the QR
 //! factor; a singular value at most `max(N, n) ε σ_max` counts as zero, as numpy's
-//! `matrix_rank` does; [`super::observability`]): a `T` that does not determine the state is [`Error::Unobservable`],
+//! `matrix_rank` does; [`observability`](mod@super::observability)): a `T` that does not determine the state is [`Error::Unobservable`],
 //! naming the rank. The residual `χ² = (Y − T X)ᵀ R⁻¹ (Y − T X)` has `N − n` degrees of
 //! freedom for the minimum-variance estimate (6.10.x). [`correlation_determinant`] is §8.8's
 //! conditioning test of a covariance, `det R'`.

@@ -1,7 +1,7 @@
 //! Batch estimation: weighted least-squares polynomial fits on arbitrary timestamps, and the
 //! minimum-variance and least-squares estimates of any state from stacked linear observations
 //! ([`batch`]), and whether linear observations of linear dynamics determine the state
-//! ([`observability`]).
+//! ([`observability`](mod@observability)).
 //!
 //! [`PolynomialFit`] solves the weighted least-squares problem by a Householder QR factorisation
 //! in the Legendre basis on the data interval mapped to `[-1, 1]` (condition number of order

@@ -129,6 +129,34 @@ impl TriangularFactor {
         true
     }
 
+    /// `1/d_i` for every pivot into `out`, or `false` when a pivot is not positive (the factor
+    /// does not determine the state); no square roots, the divisions independent of each other.
+    #[inline(always)]
+    pub(crate) fn inverse_pivots(&self, out: &mut [f64]) -> bool {
+        let mut ok = true;
+        for (o, d) in out.iter_mut().zip(&self.d) {
+            // NaN fails too; no early exit, so that the divisions overlap.
+            ok &= d.0 > 0.0;
+            *o = 1.0 / d.0;
+        }
+        ok
+    }
+
+    /// The pivots `d_i` (`D`) into `out`.
+    #[inline(always)]
+    pub(crate) fn pivots_into(&self, out: &mut [f64]) {
+        for (o, d) in out.iter_mut().zip(&self.d) {
+            *o = d.0;
+        }
+    }
+
+    /// The first `p²` entries of `U`, row-major: `u[i·p + j]` for `j > i` (the unit diagonal
+    /// and the zeros below it are not stored there), `p` the dimension.
+    #[inline(always)]
+    pub(crate) fn unit_triangle(&self, p: usize) -> &[f64] {
+        &self.u[..p * p]
+    }
+
     /// `x ← D^-½ U⁻ᵀ x`, i.e. `(x R⁻¹)ᵀ` for a row `x` (forward substitution with the unit
     /// triangular `Uᵀ`, then the pivots' `inv` from [`Self::inverse_sqrt_pivots`]), without
     /// allocating.

@@ -1,26 +1,6 @@
 //! The square-root information (Bayes) recursion, with fading memory and its true covariance:
-//! the one recursion under the exact polynomial engine and the Bayes filter.
-//!
-//! | step | | source |
-//! |---|---|---|
-//! | observe `y = hᵀx + ν` with weight `c` (`1/σ²`) | a row `√c·[hᵀ ∣ y]` folded into `[R ∣ d]` | (10.2.42)-(10.2.44), (11.3.4) |
-//! | change of state variables `x_old = A x_new` (a transition) | `R ← R A` | (10.2.40)-(10.2.41), (11.3.3) |
-//! | fade: all information so far times `f ∈ (0, 1]` | `RᵀR ← f RᵀR` (lazily) | (14.4.26)-(14.4.27), (13.2.1) |
-//! | estimate | `R x = d` | (10.2.33) |
-//! | covariance, plain | `(RᵀR)⁻¹` | (10.2.34) |
-//! | covariance, fading (true) | `(RᵀR)⁻¹ (QᵀQ) (RᵀR)⁻¹`, `QᵀQ = Σ c_k w_k² h_k h_kᵀ` | (14.3.11)-(14.3.13), (13.6.4) |
-//!
-//! With fading memory each row's information weighs `w_k c_k`, where `w_k` is the product of
-//! the discounts since it came in, so `(RᵀR)⁻¹` is the recursion's own matrix `P` (14.3.13),
-//! not the estimate's covariance; the estimate's is the sandwich above, whose middle factor
-//! `Q` is kept alongside `R` (rows `√c·w_k·hᵀ`, no right-hand side) when asked
-//! ([`InformationFilter::with_true_covariance`]).
-//!
-//! The discount is applied lazily: instead of multiplying `R` by `√f` at each step, new rows get
-//! the weight `1/Π f` (a scale folded back into the factors when its square root passes 1e30:
-//! the rows' weights are its square, `Q`'s its fourth power, ≤ 1e120, far from overflow in the
-//! squares the square-root-free rotations form). The estimate and the sandwich do not depend on
-//! that common scale.
+//! the one recursion under the exact polynomial engine and the Bayes filter
+//! ([`InformationFilter`]: its steps, their sources in Morrison (1969), the lazy discount).
 
 use super::factor::TriangularFactor;
 use crate::linalg::{solve_upper_in_place, solve_upper_transpose_in_place};
@@ -29,9 +9,29 @@ use nalgebra::{DMatrix, DVector};
 /// When the lazy discount's row scale exceeds this, it is folded into the factors.
 const RENORMALISE: f64 = 1e30;
 
-/// The square-root information filter (see the [module docs](self)): estimate `x = R⁻¹d` of a
-/// linear model observed through rows `y_k = h_kᵀ x + ν_k` with weights `c_k`, optionally
-/// fading.
+/// The square-root information filter: estimate `x = R⁻¹d` of a linear model observed through
+/// rows `y_k = h_kᵀ x + ν_k` with weights `c_k`, optionally fading.
+///
+/// | step | | source |
+/// |---|---|---|
+/// | observe `y = hᵀx + ν` with weight `c` (`1/σ²`) | a row `√c·[hᵀ ∣ y]` folded into `[R ∣ d]` | (10.2.42)-(10.2.44), (11.3.4) |
+/// | change of state variables `x_old = A x_new` (a transition) | `R ← R A` | (10.2.40)-(10.2.41), (11.3.3) |
+/// | fade: all information so far times `f ∈ (0, 1]` | `RᵀR ← f RᵀR` (lazily) | (14.4.26)-(14.4.27), (13.2.1) |
+/// | estimate | `R x = d` | (10.2.33) |
+/// | covariance, plain | `(RᵀR)⁻¹` | (10.2.34) |
+/// | covariance, fading (true) | `(RᵀR)⁻¹ (QᵀQ) (RᵀR)⁻¹`, `QᵀQ = Σ c_k w_k² h_k h_kᵀ` | (14.3.11)-(14.3.13), (13.6.4) |
+///
+/// With fading memory each row's information weighs `w_k c_k`, where `w_k` is the product of
+/// the discounts since it came in, so `(RᵀR)⁻¹` is the recursion's own matrix `P` (14.3.13),
+/// not the estimate's covariance; the estimate's is the sandwich above, whose middle factor
+/// `Q` is kept alongside `R` (rows `√c·w_k·hᵀ`, no right-hand side) when asked
+/// ([`InformationFilter::with_true_covariance`]).
+///
+/// The discount is applied lazily: instead of multiplying `R` by `√f` at each step, new rows get
+/// the weight `1/Π f` (a scale folded back into the factors when its square root passes 1e30:
+/// the rows' weights are its square, `Q`'s its fourth power, ≤ 1e120, far from overflow in the
+/// squares the square-root-free rotations form). The estimate and the sandwich do not depend on
+/// that common scale.
 ///
 /// ```
 /// use seqsmooth::recursive::InformationFilter;
@@ -332,6 +332,83 @@ impl InformationFilter {
         true
     }
 
+    /// [`Self::variances_of_rows`] for the `p` rows of an upper-triangular `J` (`p × p`, its
+    /// entry `J_ik`, `k ≥ i`, given by `entry(i, k)`): the variances of `(J x)_i`
+    /// into `out`, for a dimension `p ≤ N` (`N`, the size of the kernel's stack arrays, is `p`
+    /// itself where the caller knows it at compile time: its loops then unroll). `false` while
+    /// not determined.
+    ///
+    /// With `R = D^½ U`, `(RᵀR)⁻¹ Jᵀ = U⁻¹ D⁻¹ Y` for `Y = U⁻ᵀ Jᵀ`, which is lower triangular
+    /// (both factors are), so each of its columns is a forward substitution that starts at its
+    /// diagonal (`p³/6` in all). The plain covariance's diagonal is then `Σ_k Y_ki²/d_k`; the
+    /// true (sandwich) covariance's, `‖Q (RᵀR)⁻¹ Jᵀ‖²` column by column with `Q = D_Q^½ U_Q`,
+    /// is `Σ_r (D_Q)_r (T D⁻¹ Y)_ri²` with the unit upper triangle `T = U_Q U⁻¹` formed once
+    /// (`p³/6`; the product with the triangle `D⁻¹ Y`, `p³/3`): no square root, and `p`
+    /// divisions independent of each other. The lazy scale cancels as in
+    /// [`Self::covariance_of`].
+    #[inline(always)]
+    pub(crate) fn variances_of_upper_rows<const N: usize>(
+        &self,
+        p: usize,
+        entry: impl Fn(usize, usize) -> f64 + Copy,
+        out: &mut [f64],
+    ) -> bool {
+        assert!(p <= N && p == self.dim(), "rows of the wrong size");
+        let out = &mut out[..p];
+        let mut inv_d = [0.0; N];
+        if !self.info.inverse_pivots(&mut inv_d[..p]) {
+            return false;
+        }
+        let u = self.info.unit_triangle(p);
+        let mut y = [0.0; N];
+        match &self.spread {
+            None => {
+                let s2 = self.scale * self.scale;
+                for (i, o) in out.iter_mut().enumerate() {
+                    lower_column(u, p, entry, i, &mut y);
+                    let sum = y[i..p]
+                        .iter()
+                        .zip(&inv_d[i..p])
+                        .fold(0.0, |acc, (yk, ek)| acc + yk * yk * ek);
+                    *o = sum * s2;
+                }
+            }
+            Some(q) => {
+                let mut dq = [0.0; N];
+                q.pivots_into(&mut dq[..p]);
+                // T = U_Q U⁻¹, row by row: `T_r U = (U_Q)_r`, a forward substitution from the
+                // diagonal (`T_rr = 1`, implied).
+                let uq = q.unit_triangle(p);
+                let mut t = [[0.0; N]; N];
+                for (r, t_row) in t[..p].iter_mut().enumerate() {
+                    t_row[r] = 1.0;
+                    for k in r + 1..p {
+                        t_row[k] = column_dot(u, p, k, r, t_row, uq[r * p + k]);
+                    }
+                }
+                let mut w = [0.0; N];
+                for (i, o) in out.iter_mut().enumerate() {
+                    lower_column(u, p, entry, i, &mut y);
+                    for k in i..p {
+                        w[k] = y[k] * inv_d[k];
+                    }
+                    // z_r = Σ_(k ≥ max(r, i)) T_rk w_k, the variance Σ_r (D_Q)_r z_r².
+                    let mut sum = 0.0;
+                    for (r, t_row) in t[..p].iter().enumerate() {
+                        let from = r.max(i);
+                        let z = t_row[from..p]
+                            .iter()
+                            .zip(&w[from..p])
+                            .fold(0.0, |z, (trk, wk)| z + trk * wk);
+                        sum += dq[r] * z * z;
+                    }
+                    *o = sum;
+                }
+            }
+        }
+        true
+    }
+
     /// The largest variance inflation `max_i P_ii (RᵀR)_ii` (`P = (RᵀR)⁻¹`): 1 for a component
     /// whose information is independent of the others', `1/(1 − ρ_i²)` for one whose estimate
     /// correlates with the rest by the multiple correlation `ρ_i`, and without bound as a
@@ -422,4 +499,41 @@ impl InformationFilter {
             }
         }
     }
+}
+
+/// Column `i` of `Y = U⁻ᵀ Jᵀ` (entries `k ≥ i`; lower triangular) into `y`:
+/// `Uᵀ y = (row i of J)ᵀ` by forward substitution from the diagonal, for the unit triangle
+/// `u` (`p × p`, row-major) and the upper-triangular `J` (`entry(i, k) = J_ik`).
+#[inline(always)]
+fn lower_column<const N: usize>(
+    u: &[f64],
+    p: usize,
+    entry: impl Fn(usize, usize) -> f64,
+    i: usize,
+    y: &mut [f64; N],
+) {
+    for k in i..p {
+        y[k] = column_dot(u, p, k, i, y, entry(i, k));
+    }
+}
+
+/// `init − Σ_(j in from..k) U_jk x_j` for the unit triangle `u` of dimension `p` (row-major):
+/// column `k` of `U` from row `from` down to above the diagonal, against `x`, in the order of
+/// `j` (one accumulator in a register).
+#[inline(always)]
+fn column_dot<const N: usize>(
+    u: &[f64],
+    p: usize,
+    k: usize,
+    from: usize,
+    x: &[f64; N],
+    init: f64,
+) -> f64 {
+    let mut s = init;
+    let mut at = from * p + k;
+    for xj in &x[from..k] {
+        s -= u[at] * xj;
+        at += p;
+    }
+    s
 }

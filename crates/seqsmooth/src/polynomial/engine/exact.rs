@@ -30,6 +30,28 @@ use crate::recursive::InformationFilter;
 use crate::recursive::TriangularFactor;
 use nalgebra::DMatrix;
 
+/// The largest state size, `MAX_DEGREE + 1` (stack tables).
+const MAX_SIZE: usize = MAX_DEGREE + 1;
+
+/// Pascal's triangle, `PASCAL[k][i] = C(k, i)` for `k, i < MAX_SIZE` (exact: at most
+/// `C(24, 12) < 2^53`).
+static PASCAL: [[f64; MAX_SIZE]; MAX_SIZE] = pascal();
+
+const fn pascal() -> [[f64; MAX_SIZE]; MAX_SIZE] {
+    let mut c = [[0.0; MAX_SIZE]; MAX_SIZE];
+    let mut k = 0;
+    while k < MAX_SIZE {
+        c[k][0] = 1.0;
+        let mut i = 1;
+        while i <= k {
+            c[k][i] = c[k - 1][i - 1] + c[k - 1][i];
+            i += 1;
+        }
+        k += 1;
+    }
+    c
+}
+
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Discount {
     pub theta: f64,
@@ -308,47 +330,38 @@ impl ExactEngine {
 
     /// The 1σ of the unscaled derivatives at `t` into `out` without allocating: row `i` of
     /// `J = D(s) Φ(v)` (`v` the time in the basis' units) through the information factor
-    /// ([`InformationFilter::variances_of_rows`]), times σ. `false` (and `out` unspecified)
-    /// without a tracked covariance or while not determined.
+    /// ([`InformationFilter::variances_of_upper_rows`]: `Φ(v)` is upper triangular), times σ.
+    /// `false` (and `out` unspecified) without a tracked covariance or while not determined.
     pub fn std_devs_into(&self, t: f64, out: &mut [f64]) -> bool {
-        let p = self.m + 1;
-        // A stack table of p² values for the sizes compiled in, else one on the heap.
-        unrolled_sizes!(p, N => self.std_devs_with(t, [[0.0; N]; N].as_flattened_mut(), out), _ => self.std_devs_with(t, &mut vec![0.0; p * p], out))
+        // The sizes compiled in with their loops unrolled, the rest in a frame of their own.
+        unrolled_sizes!(self.m + 1, N => self.std_devs_with::<N>(N, t, out), p => self.std_devs_any(p, t, out))
     }
 
-    /// [`Self::std_devs_into`] with `rows` (`p²` zeros) for the rows of `Φ(v)`.
+    /// [`Self::std_devs_into`] for any size (up to `MAX_DEGREE + 1`).
+    #[inline(never)]
+    fn std_devs_any(&self, p: usize, t: f64, out: &mut [f64]) -> bool {
+        self.std_devs_with::<MAX_SIZE>(p, t, out)
+    }
+
+    /// [`Self::std_devs_into`] for the size `p ≤ N` (its tables on the stack).
     #[inline(always)]
-    fn std_devs_with(&self, t: f64, rows: &mut [f64], out: &mut [f64]) -> bool {
+    fn std_devs_with<const N: usize>(&self, p: usize, t: f64, out: &mut [f64]) -> bool {
         let Some(sigma) = self.sigma.filter(|_| self.n > self.m as u64) else {
             return false;
         };
-        let p = self.m + 1;
         let v = (t - self.centre) * self.inv_unit;
-        // The rows of Φ(v): Φ_ik = C(k, i) v^(k-i), k ≥ i (zero below the diagonal).
-        let mut powers = [1.0; MAX_DEGREE + 1];
+        // Φ(v)_ik = C(k, i) v^(k-i), k ≥ i.
+        let mut powers = [1.0; N];
         for k in 1..p {
             powers[k] = powers[k - 1] * v;
         }
-        let mut binomial = [0.0; MAX_DEGREE + 1];
-        for k in 0..p {
-            // Row k of Pascal's triangle from row k-1, in place.
-            binomial[k] = 1.0;
-            for i in (1..k).rev() {
-                binomial[i] += binomial[i - 1];
-            }
-            for i in 0..=k {
-                rows[i * p + k] = binomial[i] * powers[k - i];
-            }
-        }
-        let (mut inv, mut var) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
-        if !self
-            .info
-            .variances_of_rows(rows, &mut inv[..p], &mut var[..p])
-        {
+        let phi = |i: usize, k: usize| PASCAL[k][i] * powers[k - i];
+        let out = &mut out[..p];
+        if !self.info.variances_of_upper_rows::<N>(p, phi, out) {
             return false;
         }
-        for (i, (o, var)) in out[..p].iter_mut().zip(&var[..p]).enumerate() {
-            let sd = sigma * var.max(0.0).sqrt();
+        for (i, o) in out.iter_mut().enumerate() {
+            let sd = sigma * o.max(0.0).sqrt();
             *o = if self.unscale_in_range {
                 sd * self.unscale[i]
             } else {

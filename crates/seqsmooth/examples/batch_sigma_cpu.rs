@@ -1,0 +1,89 @@
+//! The exact engine's batch σ call against its plain batch call in the calling thread's CPU
+//! time, which a busy machine disturbs less than the wall time of `benches/batch_sigma.rs`:
+//! `update_many_sigma_into` (derivatives and their 1σ, `2(m + 1)` cells a sample) against
+//! `update_many_into` (derivatives, `m + 1`), each on a fresh filter with a noise σ (fading
+//! θ = 0.9 per τ = 1, and expanding) into a new zeroed buffer, best of 3, for each degree.
+//!
+//! Run: `cargo run --release -p seqsmooth --example batch_sigma_cpu -- [SAMPLES] [DEGREES]`
+//! (defaults 10⁷ and `1,2,8`; e.g. `-- 10000000 0,1,2,4,8,9,12`). The CPU time is read from
+//! `/proc/thread-self/schedstat` (Linux); elsewhere the wall time is measured instead.
+
+use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
+use std::time::Instant;
+
+/// Nanoseconds this thread has run (user and system), or `None` without the Linux file.
+fn cpu_ns() -> Option<u64> {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+/// Seconds `f` takes: CPU time where it can be read, else wall time.
+fn seconds(f: impl FnOnce()) -> f64 {
+    let (wall, cpu) = (Instant::now(), cpu_ns());
+    f();
+    match (cpu, cpu_ns()) {
+        (Some(a), Some(b)) => (b - a) as f64 * 1e-9,
+        _ => wall.elapsed().as_secs_f64(),
+    }
+}
+
+fn filter(fading: bool, m: usize) -> Box<dyn PolynomialFilter> {
+    if fading {
+        Box::new(
+            FadingMemory::new(m, 0.9, 1.0, Engine::Exact)
+                .unwrap()
+                .with_noise_sigma(0.3)
+                .unwrap(),
+        )
+    } else {
+        Box::new(
+            ExpandingMemory::new(m, Engine::Exact)
+                .unwrap()
+                .with_noise_sigma(0.3)
+                .unwrap(),
+        )
+    }
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let n: usize = args
+        .next()
+        .map_or(10_000_000, |s| s.parse().expect("SAMPLES"));
+    let degrees: Vec<usize> = args.next().map_or(vec![1, 2, 8], |s| {
+        s.split(',').map(|d| d.parse().expect("DEGREES")).collect()
+    });
+    let t: Vec<f64> = (0..n).map(|k| k as f64).collect();
+    let y: Vec<f64> = t
+        .iter()
+        .map(|&t| 10.0 * (t * 1e-3).sin() + 0.01 * ((t * 7.0) % 13.0))
+        .collect();
+    let unit = if cpu_ns().is_some() { "CPU" } else { "wall" };
+    println!("{n} samples, best of 3, {unit} time");
+    for &m in &degrees {
+        for fading in [true, false] {
+            let w = m + 1;
+            let (mut plain, mut sigma) = (f64::INFINITY, f64::INFINITY);
+            for _ in 0..3 {
+                let (mut f, mut out) = (filter(fading, m), vec![0.0; n * w]);
+                plain = plain.min(seconds(|| f.update_many_into(&t, &y, &mut out).unwrap()));
+                let (mut f, mut out) = (filter(fading, m), vec![0.0; n * 2 * w]);
+                sigma = sigma.min(seconds(|| {
+                    f.update_many_sigma_into(&t, &y, &mut out).unwrap()
+                }));
+            }
+            println!(
+                "{:9} degree {m:2}: plain {plain:.3} s, sigma {sigma:.3} s, ratio {:.2} \
+                 ({:.1} / {:.1} ns a sample)",
+                if fading { "fading" } else { "expanding" },
+                sigma / plain,
+                plain * 1e9 / n as f64,
+                sigma * 1e9 / n as f64
+            );
+        }
+    }
+}
