@@ -1,12 +1,14 @@
 """docs/guide.md runs as printed: its Python and shell blocks, in the page's order, in one
 scratch directory (a block may read the files an earlier one wrote), the shell blocks with
 `seqsmooth` the command under test; and every picture it shows is made by a command it
-prints."""
+prints and equal to it byte for byte: after a change to `seqsmooth plot`, re-make them with
+`SEQSMOOTH_GUIDE_PICTURES=write` (the test then writes the pictures it made into docs/images)."""
 
 from __future__ import annotations
 
 import os
 import re
+import shutil
 import subprocess
 
 from conftest import ROOT, cli_path
@@ -52,6 +54,13 @@ def test_blocks_run(tmp_path, monkeypatch):
     for picture in made:
         size = picture.stat().st_size
         assert 0 < size < MAX_PICTURE_BYTES, f"{picture.name}: {size} bytes"
+        stored = ROOT / "docs" / "images" / picture.name
+        if os.environ.get("SEQSMOOTH_GUIDE_PICTURES") == "write":
+            shutil.copyfile(picture, stored)
+        assert stored.exists() and stored.read_bytes() == picture.read_bytes(), (
+            f"docs/images/{picture.name} is not what its command in docs/guide.md makes: "
+            "re-make it with SEQSMOOTH_GUIDE_PICTURES=write"
+        )
 
 
 def test_pictures_have_their_commands():
