@@ -84,6 +84,21 @@ impl TriangularFactor {
         }
     }
 
+    /// Makes this the zero factor of dimension `p`, keeping its storage (no allocation once it
+    /// has held a factor of that size).
+    pub(crate) fn reset(&mut self, p: usize) {
+        self.d.clear();
+        self.d.resize(p, Pivot(0.0));
+        self.u.clear();
+        self.u.resize(p * p, 0.0);
+        self.ubar.clear();
+        self.ubar.resize(p, 0.0);
+        self.residual_sq = 0.0;
+        self.positive = p == 0;
+        self.scratch.clear();
+        self.scratch.resize(4 * p, 0.0);
+    }
+
     /// Recomputes [`positive`](Self::positive) after `d` changed other than by a row in the
     /// reciprocal form (which only increases `d`).
     fn refresh_positive(&mut self) {

@@ -77,7 +77,7 @@ pub(super) struct Entry {
 pub(super) struct Review {
     entries: VecDeque<Entry>,
     accepted: VecDeque<(f64, f64)>,
-    calibration: Calibration,
+    scratch: Scratch,
 }
 
 /// The windows' residuals about their fits over the last [`CALIBRATION_WINDOWS`] decisions, in
@@ -188,8 +188,10 @@ fn gate_rms(out: &AutoOutput) -> Option<f64> {
 
 /// A least-squares polynomial through the samples of a review window: the square-root-free
 /// QR factor of the rows `(1, u, …, u^d)`, `u = (t − c)/h` centred and scaled on the window
-/// (so `|u| ≤ 1`), without allocating beyond the factor.
-struct WindowFit {
+/// (so `|u| ≤ 1`). Refitted in place ([`WindowFit::fit`]): the review keeps two and allocates
+/// nothing per sample.
+#[derive(Clone, Debug)]
+pub(super) struct WindowFit {
     factor: TriangularFactor,
     /// The coefficients of `u^k`.
     coefficients: [f64; MAX_FIT],
@@ -198,31 +200,39 @@ struct WindowFit {
     degree: usize,
 }
 
+impl Default for WindowFit {
+    fn default() -> Self {
+        Self {
+            factor: TriangularFactor::new(0),
+            coefficients: [0.0; MAX_FIT],
+            centre: 0.0,
+            inv_half: 1.0,
+            degree: 0,
+        }
+    }
+}
+
 impl WindowFit {
-    /// The fit of degree `d` through `(ts, ys)` (at least `d + 1` distinct times); `None` when
-    /// it is not determined.
-    fn new(ts: &[f64], ys: &[f64], degree: usize) -> Option<Self> {
+    /// Fits degree `d` through `(ts, ys)` (at least `d + 1` distinct times), replacing the fit
+    /// held; false when it is not determined.
+    fn fit(&mut self, ts: &[f64], ys: &[f64], degree: usize) -> bool {
         let (lo, hi) = ts
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
                 (a.min(t), b.max(t))
             });
         let half = 0.5 * (hi - lo);
-        let mut fit = Self {
-            factor: TriangularFactor::new(degree + 1),
-            coefficients: [0.0; MAX_FIT],
-            centre: 0.5 * (lo + hi),
-            inv_half: if half > 0.0 { 1.0 / half } else { 1.0 },
-            degree,
-        };
+        self.factor.reset(degree + 1);
+        self.coefficients = [0.0; MAX_FIT];
+        self.centre = 0.5 * (lo + hi);
+        self.inv_half = if half > 0.0 { 1.0 / half } else { 1.0 };
+        self.degree = degree;
         for (&t, &y) in ts.iter().zip(ys) {
-            fit.factor
-                .add_row_powers((t - fit.centre) * fit.inv_half, y, 1.0);
+            self.factor
+                .add_row_powers((t - self.centre) * self.inv_half, y, 1.0);
         }
         let p = degree + 1;
-        fit.factor
-            .solve_into(&mut fit.coefficients[..p])
-            .then_some(fit)
+        self.factor.solve_into(&mut self.coefficients[..p])
     }
 
     /// `p(t)` and its variance for unit noise `h(t)ᵀ(AᵀA)⁻¹h(t)`.
@@ -259,16 +269,29 @@ pub(super) fn interpolation_verdict(
     degree: usize,
     sigma: f64,
     k: f64,
-    calibration: &mut Calibration,
+    scratch: &mut Scratch,
 ) -> Option<(bool, f64)> {
-    let (mut ts, mut ys): (Vec<f64>, Vec<f64>) = around.iter().copied().unzip();
-    let mut fit = WindowFit::new(&ts, &ys, degree)?;
+    let Scratch {
+        fit,
+        up,
+        calibration,
+    } = scratch;
+    let mut ts = [0.0; WINDOW];
+    let mut ys = [0.0; WINDOW];
+    let mut n = around.len().min(WINDOW);
+    for (i, &(t, y)) in around[..n].iter().enumerate() {
+        ts[i] = t;
+        ys[i] = y;
+    }
+    if !fit.fit(&ts[..n], &ys[..n], degree) {
+        return None;
+    }
     for _ in 0..2 {
-        if ts.len() < degree + 4 {
+        if n < degree + 4 {
             break;
         }
         let mut worst = (f64::NEG_INFINITY, 0);
-        for j in 0..ts.len() {
+        for j in 0..n {
             let (p, h) = fit.value_and_vrf_at(ts[j])?;
             let r = (ys[j] - p).abs() / (sigma * (1.0 - h).max(f64::EPSILON).sqrt());
             if r.is_nan() {
@@ -281,18 +304,20 @@ pub(super) fn interpolation_verdict(
         if worst.0 <= k {
             break;
         }
-        ts.remove(worst.1);
-        ys.remove(worst.1);
-        fit = WindowFit::new(&ts, &ys, degree)?;
+        ts.copy_within(worst.1 + 1..n, worst.1);
+        ys.copy_within(worst.1 + 1..n, worst.1);
+        n -= 1;
+        if !fit.fit(&ts[..n], &ys[..n], degree) {
+            return None;
+        }
     }
     let (p, v) = fit.value_and_vrf_at(t)?;
     let v = v.max(0.0);
     // The fit's bias at t, from one degree up on the same samples (nested least squares:
     // E{Δ²} = b² + σ²(v₊ − v), as for the filter's own bias).
-    let up = (ts.len() >= degree + 3)
-        .then(|| WindowFit::new(&ts, &ys, degree + 1))
-        .flatten()
-        .and_then(|up| up.value_and_vrf_at(t));
+    let up = (n >= degree + 3 && up.fit(&ts[..n], &ys[..n], degree + 1))
+        .then(|| up.value_and_vrf_at(t))
+        .flatten();
     let b2 = match up {
         Some((pu, vu)) => {
             let d = p - pu;
@@ -300,13 +325,25 @@ pub(super) fn interpolation_verdict(
         }
         None => 0.0,
     };
-    let spare = ts.len() - (degree + 1);
+    let spare = n - (degree + 1);
     let scale = calibration.factor();
     let var = sigma * sigma * scale;
     let r = y - p;
     let rms = (var * (1.0 + v) + b2).sqrt();
     calibration.push(fit.residual_sq() / (sigma * sigma), spare);
     (r.is_finite() && rms.is_finite()).then_some((r.abs() > k * rms, rms))
+}
+
+/// The most samples of a review window: `L` on each side.
+const WINDOW: usize = 2 * MAX_REVIEW_WINDOW;
+
+/// What the review's fits keep between samples: the calibration, and the two fits refitted in
+/// place (no allocation per sample).
+#[derive(Clone, Debug, Default)]
+pub(super) struct Scratch {
+    fit: WindowFit,
+    up: WindowFit,
+    calibration: Calibration,
 }
 
 impl AutomaticFilter {
@@ -387,15 +424,20 @@ impl AutomaticFilter {
         let mut newest = None;
         while let Some(f) = self.review.first_undecided() {
             let front = &self.review.entries[f];
-            let after: Vec<(f64, f64)> = self
+            // The accepted samples after it (at most 2L), on the stack.
+            let mut after_buf = [(0.0, 0.0); WINDOW];
+            let mut n_after = 0;
+            let later = self
                 .review
                 .entries
                 .iter()
                 .skip(f + 1)
-                .filter(|u| !u.rejected)
-                .map(|u| (u.t, u.y))
-                .take(2 * l.max(1))
-                .collect();
+                .filter(|u| !u.rejected);
+            for u in later.take(2 * l.max(1)) {
+                after_buf[n_after] = (u.t, u.y);
+                n_after += 1;
+            }
+            let after = &after_buf[..n_after];
             let overflow = self.review.entries.len() - f > MAX_UNDECIDED;
             let (before_wanted, ready) = if l == 0 {
                 (0, !front.rejected || !after.is_empty() || finishing)
@@ -415,18 +457,19 @@ impl AutomaticFilter {
             let verdict = match (l, self.noise_sigma(), overflow) {
                 (1.., Some(sigma), false) if k > 0.0 && sigma > 0.0 => {
                     let before = self.review.accepted.len().min(before_wanted);
-                    let mut around: Vec<(f64, f64)> = self
-                        .review
-                        .accepted
-                        .iter()
-                        .skip(self.review.accepted.len() - before)
-                        .copied()
-                        .collect();
-                    around.extend(after.iter().take(2 * l - before));
+                    let mut around_buf = [(0.0, 0.0); WINDOW];
+                    let accepted = &self.review.accepted;
+                    let earlier = accepted.iter().skip(accepted.len() - before);
+                    let mut n = 0;
+                    for &s in earlier.chain(after.iter().take(2 * l - before)) {
+                        around_buf[n] = s;
+                        n += 1;
+                    }
+                    let around = &around_buf[..n];
                     let review = (around.len() >= degree + 2)
                         .then(|| {
-                            let c = &mut self.review.calibration;
-                            interpolation_verdict(&around, sample, degree, sigma, k, c)
+                            let c = &mut self.review.scratch;
+                            interpolation_verdict(around, sample, degree, sigma, k, c)
                         })
                         .flatten();
                     // The judge of the smaller mean square: the gate's prediction where the
