@@ -187,6 +187,22 @@ impl TriangularFactor {
             .sum()
     }
 
+    /// `x ← U x` (the unit upper triangular part of `R = D^½ U`), without allocating: with
+    /// [`Self::pivot`], `(R x)ᵀ(R y) = Σ_i d_i (U x)_i (U y)_i` needs no square root.
+    pub(crate) fn unit_upper_times(&self, x: &mut [f64]) {
+        let p = self.dim();
+        for i in 0..p {
+            let (head, later) = x.split_at_mut(i + 1);
+            let u = &self.u[i * p + i + 1..(i + 1) * p];
+            head[i] = later.iter().zip(u).fold(head[i], |v, (xk, uk)| v + uk * xk);
+        }
+    }
+
+    /// The pivot `d_i` (the square of `R`'s diagonal entry `i`).
+    pub(crate) fn pivot(&self, i: usize) -> f64 {
+        self.d[i].0
+    }
+
     /// The factor `R = D^½ U` (computed).
     pub fn r(&self) -> DMatrix<f64> {
         let p = self.dim();

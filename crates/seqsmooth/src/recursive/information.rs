@@ -332,6 +332,46 @@ impl InformationFilter {
         true
     }
 
+    /// The covariance `J C Jᵀ` of the `n` rows `j` of `rows` (`p` values each, row-major;
+    /// overwritten) into `out` (`n × n`, row-major): [`Self::covariance_of`] without allocating
+    /// (the true covariance's when it is kept: `Σ_i q_i (U_Q k_a)_i (U_Q k_b)_i` for
+    /// `k = (RᵀR)⁻¹ jᵀ` and `Q = D_Q^½ U_Q`). `false` while not determined. `inv` is scratch of
+    /// `p` values.
+    pub(crate) fn covariance_of_rows(
+        &self,
+        rows: &mut [f64],
+        inv: &mut [f64],
+        out: &mut [f64],
+    ) -> bool {
+        let p = self.dim();
+        if !self.info.inverse_sqrt_pivots(&mut inv[..p]) {
+            return false;
+        }
+        for j in rows.chunks_exact_mut(p) {
+            // J R⁻¹ as a column, from the stored factor (R times the lazy scale).
+            self.info.right_divide_row(j, inv);
+            match &self.spread {
+                None => j.iter_mut().for_each(|v| *v *= self.scale),
+                Some(q) => {
+                    // kᵀ = R⁻¹ (J R⁻¹)ᵀ, then U_Q k (the lazy scale cancels).
+                    self.info.left_solve(j, inv);
+                    q.unit_upper_times(j);
+                }
+            }
+        }
+        let n = rows.len() / p;
+        let weight = |i: usize| self.spread.as_ref().map_or(1.0, |q| q.pivot(i));
+        for a in 0..n {
+            for b in 0..=a {
+                let (ra, rb) = (&rows[a * p..(a + 1) * p], &rows[b * p..(b + 1) * p]);
+                let v = (0..p).map(|i| weight(i) * ra[i] * rb[i]).sum();
+                out[a * n + b] = v;
+                out[b * n + a] = v;
+            }
+        }
+        true
+    }
+
     /// The largest variance inflation `max_i P_ii (RᵀR)_ii` (`P = (RᵀR)⁻¹`): 1 for a component
     /// whose information is independent of the others', `1/(1 − ρ_i²)` for one whose estimate
     /// correlates with the rest by the multiple correlation `ρ_i`, and without bound as a

@@ -279,8 +279,10 @@ impl AutomaticFilter {
         };
         let bias = self.bias_of(&raw, sigma);
         let factor = self.calibration_factor();
-        let covariance = raw.covariance.as_ref().map(|c| {
-            let mut c = c * (sigma * sigma);
+        let mut raw = raw;
+        if let Some(c) = &mut raw.covariance {
+            // In place: the raw covariance is this call's own.
+            *c *= sigma * sigma;
             if let Some(b) = &bias {
                 for i in 0..c.nrows() {
                     for j in 0..c.ncols() {
@@ -288,8 +290,8 @@ impl AutomaticFilter {
                     }
                 }
             }
-            c * factor
-        });
-        (PolynomialState { covariance, ..raw }, bias)
+            *c *= factor;
+        }
+        (raw, bias)
     }
 }

@@ -324,22 +324,7 @@ impl ExactEngine {
         };
         let p = self.m + 1;
         let v = (t - self.centre) * self.inv_unit;
-        // The rows of Φ(v): Φ_ik = C(k, i) v^(k-i), k ≥ i (zero below the diagonal).
-        let mut powers = [1.0; MAX_DEGREE + 1];
-        for k in 1..p {
-            powers[k] = powers[k - 1] * v;
-        }
-        let mut binomial = [0.0; MAX_DEGREE + 1];
-        for k in 0..p {
-            // Row k of Pascal's triangle from row k-1, in place.
-            binomial[k] = 1.0;
-            for i in (1..k).rev() {
-                binomial[i] += binomial[i - 1];
-            }
-            for i in 0..=k {
-                rows[i * p + k] = binomial[i] * powers[k - i];
-            }
-        }
+        phi_rows(v, p, rows);
         let (mut inv, mut var) = ([0.0; MAX_DEGREE + 1], [0.0; MAX_DEGREE + 1]);
         if !self
             .info
@@ -370,11 +355,61 @@ impl ExactEngine {
         let v = (t - self.centre) * self.inv_unit;
         let cov = match self.sigma {
             None => None,
+            Some(sigma) if self.unscale_in_range => {
+                let p = self.m + 1;
+                // Stack tables of p² values for the sizes compiled in, else on the heap.
+                unrolled_sizes!(p, N => self.covariance_with(v, sigma, [[0.0; N]; N].as_flattened_mut(), [[0.0; N]; N].as_flattened_mut()), _ => self.covariance_with(v, sigma, &mut vec![0.0; p * p], &mut vec![0.0; p * p]))
+            }
             Some(sigma) => {
                 let j = crate::model::scaling(self.m, self.unit) * crate::model::phi(self.m, v);
                 Some(self.info.covariance_of(&j)? * (sigma * sigma))
             }
         };
         Some((x, cov))
+    }
+
+    /// The covariance of the unscaled derivatives at `v` (in the basis' units) with one
+    /// allocation, its own: `σ² D(s) Φ(v) C Φ(v)ᵀ D(s)`
+    /// ([`InformationFilter::covariance_of_rows`]); `rows` and `cov` are `p²` scratch values.
+    #[inline(always)]
+    fn covariance_with(
+        &self,
+        v: f64,
+        sigma: f64,
+        rows: &mut [f64],
+        cov: &mut [f64],
+    ) -> Option<DMatrix<f64>> {
+        let p = self.m + 1;
+        phi_rows(v, p, rows);
+        let mut inv = [0.0; MAX_DEGREE + 1];
+        if !self.info.covariance_of_rows(rows, &mut inv[..p], cov) {
+            return None;
+        }
+        let s2 = sigma * sigma;
+        let d = &self.unscale;
+        Some(DMatrix::from_fn(p, p, |i, j| {
+            cov[i * p + j] * s2 * d[i] * d[j]
+        }))
+    }
+}
+
+/// The rows of `Φ(v)` into `rows` (`p²` values, row-major): `Φ_ik = C(k, i) v^(k−i)`, `k ≥ i`
+/// (zero below the diagonal), Morrison (4.2.5) in the basis' units.
+#[inline(always)]
+fn phi_rows(v: f64, p: usize, rows: &mut [f64]) {
+    let mut powers = [1.0; MAX_DEGREE + 1];
+    for k in 1..p {
+        powers[k] = powers[k - 1] * v;
+    }
+    let mut binomial = [0.0; MAX_DEGREE + 1];
+    for k in 0..p {
+        // Row k of Pascal's triangle from row k-1, in place.
+        binomial[k] = 1.0;
+        for i in (1..k).rev() {
+            binomial[i] += binomial[i - 1];
+        }
+        for i in 0..=k {
+            rows[i * p + k] = binomial[i] * powers[k - i];
+        }
     }
 }
