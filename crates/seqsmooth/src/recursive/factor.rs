@@ -80,7 +80,8 @@ impl TriangularFactor {
             ubar: vec![0.0; p],
             residual_sq: 0.0,
             positive: p == 0,
-            scratch: vec![0.0; 4 * p],
+            // Grown on first use, by the sizes without unrolled code only.
+            scratch: Vec::new(),
         }
     }
 
@@ -96,7 +97,6 @@ impl TriangularFactor {
         self.residual_sq = 0.0;
         self.positive = p == 0;
         self.scratch.clear();
-        self.scratch.resize(4 * p, 0.0);
     }
 
     /// Recomputes [`positive`](Self::positive) after `d` changed other than by a row in the

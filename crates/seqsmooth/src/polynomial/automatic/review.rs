@@ -347,11 +347,14 @@ pub(super) struct Scratch {
 }
 
 impl AutomaticFilter {
-    /// The filter without its review (the state a decision may go back to).
+    /// The filter without its review and its last output (the state a decision may go back
+    /// to; the output is the newest update's whatever state it came from).
     pub(super) fn snapshot(&mut self) -> Box<AutomaticFilter> {
         let review = std::mem::take(&mut self.review);
+        let last = self.last_output.take();
         let s = Box::new(self.clone());
         self.review = review;
+        self.last_output = last;
         s
     }
 
@@ -377,11 +380,13 @@ impl AutomaticFilter {
         }
     }
 
-    /// Goes back to `state`, keeping the review.
+    /// Goes back to `state`, keeping the review and the last output.
     pub(super) fn restore(&mut self, state: AutomaticFilter) {
         let review = std::mem::take(&mut self.review);
+        let last = self.last_output.take();
         *self = state;
         self.review = review;
+        self.last_output = last;
     }
 
     /// Takes the newest sample into the review and makes every decision it can; returns the

@@ -59,8 +59,9 @@ pub(crate) struct ExactEngine {
     /// The effective memory span `3/(-ln θ)`, in updates (per update) or times `τ` (per time).
     span_updates: f64,
     span_per_time: f64,
-    /// `k!/s^k` for the unit `s` (unscaled derivatives from the coefficients).
-    unscale: Vec<f64>,
+    /// `k!/s^k` for the unit `s` (unscaled derivatives from the coefficients), `k ≤ m` (an
+    /// array: a copy of the engine allocates only its factors).
+    unscale: [f64; MAX_DEGREE + 1],
     /// Whether every `unscale` entry is a normal double; else the derivatives are unscaled one
     /// factor at a time ([`crate::model::taylor`]'s `unscale_stepwise`).
     unscale_in_range: bool,
@@ -84,7 +85,7 @@ impl ExactEngine {
             half_rate: discount.map_or(0.0, |d| -d.theta.ln() / (2.0 * d.tau)),
             span_updates: discount.map_or(0.0, |d| 3.0 / -d.theta.ln()),
             span_per_time: discount.map_or(0.0, |d| 3.0 * d.tau / -d.theta.ln()),
-            unscale: vec![0.0; m + 1],
+            unscale: [0.0; MAX_DEGREE + 1],
             unscale_in_range: true,
         }
     }
@@ -192,7 +193,10 @@ impl ExactEngine {
     /// `k!/s^k` and `1/s` for the current unit `s`.
     fn set_unscale(&mut self) {
         self.inv_unit = 1.0 / self.unit;
-        for (c, d) in self.unscale.iter_mut().zip(derivative_scale(self.unit)) {
+        for (c, d) in self.unscale[..=self.m]
+            .iter_mut()
+            .zip(derivative_scale(self.unit))
+        {
             *c = d;
         }
         self.unscale_in_range = unscale_in_range(self.m, self.unit);
@@ -202,7 +206,7 @@ impl ExactEngine {
     #[inline(always)]
     fn unscale_into(&self, a: &[f64], out: &mut [f64]) {
         if self.unscale_in_range {
-            for ((x, z), c) in out.iter_mut().zip(a).zip(&self.unscale) {
+            for ((x, z), c) in out.iter_mut().zip(a).zip(&self.unscale[..=self.m]) {
                 *x = z * c;
             }
         } else {
