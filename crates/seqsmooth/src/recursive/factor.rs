@@ -278,36 +278,28 @@ impl TriangularFactor {
         true
     }
 
-    /// `z = (RᵀR)⁻¹ h` into `z` (`UᵀDU z = h`: a forward and a back substitution, no
-    /// allocation), returning `hᵀ z = Σ g_i²/d_i` (`Uᵀ g = h`); `None` while not determined.
-    pub(crate) fn solve_gram(&self, h: &[f64], z: &mut [f64]) -> Option<f64> {
+    /// `hᵀ(RᵀR)⁻¹h = Σ_i g_i²/d_i` with `Uᵀ g = h` (a forward substitution into `g`, no
+    /// allocation); `None` while not determined.
+    pub(crate) fn inverse_gram_quad(&self, h: &[f64], g: &mut [f64]) -> Option<f64> {
         if !self.is_determined() {
             return None;
         }
         let p = self.dim();
         let u = &self.u[..p * p];
-        let mut quad = 0.0;
-        // Uᵀ g = h (unit lower triangular), then w = g/d into z.
+        // Uᵀ g = h (unit lower triangular).
         for i in 0..p {
-            let mut g = h[i];
+            let mut gi = h[i];
             for k in 0..i {
-                g -= u[k * p + i] * z[k];
+                gi -= u[k * p + i] * g[k];
             }
-            z[i] = g;
+            g[i] = gi;
         }
-        for (zi, d) in z[..p].iter_mut().zip(&self.d) {
-            quad += *zi * *zi / d.0;
-            *zi /= d.0;
-        }
-        // U z = w (unit upper triangular).
-        for i in (0..p).rev() {
-            let mut s = z[i];
-            for j in i + 1..p {
-                s -= u[i * p + j] * z[j];
-            }
-            z[i] = s;
-        }
-        Some(quad)
+        Some(
+            g[..p]
+                .iter()
+                .zip(&self.d)
+                .fold(0.0, |q, (gi, d)| q + *gi * *gi / d.0),
+        )
     }
 
     /// Folds the row `√c·[a | b]` into `[R | d]`: `O(p²)`, no square roots.

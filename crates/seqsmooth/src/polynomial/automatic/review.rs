@@ -241,14 +241,14 @@ impl WindowFit {
         let u = (t - self.centre) * self.inv_half;
         let a = &self.coefficients;
         let mut h = [0.0; MAX_FIT];
-        let mut z = [0.0; MAX_FIT];
+        let mut g = [0.0; MAX_FIT];
         let mut power = 1.0;
         for hk in &mut h[..p] {
             *hk = power;
             power *= u;
         }
         let value = a[..p].iter().zip(&h[..p]).map(|(a, h)| a * h).sum();
-        let vrf = self.factor.solve_gram(&h[..p], &mut z[..p])?;
+        let vrf = self.factor.inverse_gram_quad(&h[..p], &mut g[..p])?;
         Some((value, vrf))
     }
 
@@ -260,17 +260,22 @@ impl WindowFit {
 /// The most coefficients of a [`WindowFit`]: degree `MAX_DEGREE + 2`.
 const MAX_FIT: usize = MAX_DEGREE + 3;
 
-/// The verdict on `(t, y)` from the samples around it (`true`: an outlier) and the root mean
-/// square of the deleted residual it judged, `√(σ²(1 + v_p) + b²)`; `None` when the fit cannot
-/// say (too few samples, or numbers beyond the double range).
+/// The final verdict on `(t, y)` (`true`: an outlier) from the samples around it and the
+/// gate's: the interpolation's, judged against the root mean square of its deleted residual
+/// `√(c σ²(1 + v_p) + b²)`, where that is below the gate's `σ_ε` (`gate_rms`, `None` when the
+/// gate was off), else the gate's; the gate's (`None`) too when the fit cannot say (too few
+/// samples, or numbers beyond the double range). The fit one degree up (for `b²`) is left out
+/// where `σ_ε ≤ √(c σ²(1 + v_p))`: the root mean square is at least that, so the gate decides
+/// whatever `b²` is.
 pub(super) fn interpolation_verdict(
     around: &[(f64, f64)],
     (t, y): (f64, f64),
     degree: usize,
     sigma: f64,
     k: f64,
+    gate_rms: Option<f64>,
     scratch: &mut Scratch,
-) -> Option<(bool, f64)> {
+) -> Option<bool> {
     let Scratch {
         fit,
         up,
@@ -313,6 +318,16 @@ pub(super) fn interpolation_verdict(
     }
     let (p, v) = fit.value_and_vrf_at(t)?;
     let v = v.max(0.0);
+    let spare = n - (degree + 1);
+    let scale = calibration.factor();
+    let var = sigma * sigma * scale;
+    calibration.push(fit.residual_sq() / (sigma * sigma), spare);
+    // The judge of the smaller mean square: the gate's prediction where the memory is long
+    // and fits (the root mean square below is at least √(var(1 + v))), the interpolation
+    // where it is short.
+    if gate_rms.is_some_and(|g| g <= (var * (1.0 + v)).sqrt()) {
+        return None;
+    }
     // The fit's bias at t, from one degree up on the same samples (nested least squares:
     // E{Δ²} = b² + σ²(v₊ − v), as for the filter's own bias).
     let up = (n >= degree + 3 && up.fit(&ts[..n], &ys[..n], degree + 1))
@@ -325,13 +340,10 @@ pub(super) fn interpolation_verdict(
         }
         None => 0.0,
     };
-    let spare = n - (degree + 1);
-    let scale = calibration.factor();
-    let var = sigma * sigma * scale;
     let r = y - p;
     let rms = (var * (1.0 + v) + b2).sqrt();
-    calibration.push(fit.residual_sq() / (sigma * sigma), spare);
-    (r.is_finite() && rms.is_finite()).then_some((r.abs() > k * rms, rms))
+    let decides = r.is_finite() && rms.is_finite() && gate_rms.is_none_or(|g| g > rms);
+    decides.then_some(r.abs() > k * rms)
 }
 
 /// The most samples of a review window: `L` on each side.
@@ -471,19 +483,13 @@ impl AutomaticFilter {
                         n += 1;
                     }
                     let around = &around_buf[..n];
-                    let review = (around.len() >= degree + 2)
+                    (around.len() >= degree + 2)
                         .then(|| {
                             let c = &mut self.review.scratch;
-                            interpolation_verdict(around, sample, degree, sigma, k, c)
+                            interpolation_verdict(around, sample, degree, sigma, k, gate_rms, c)
                         })
-                        .flatten();
-                    // The judge of the smaller mean square: the gate's prediction where the
-                    // memory is long and fits, the interpolation where it is short.
-                    match (review, gate_rms) {
-                        (Some((_, rms)), Some(g)) if g <= rms => gate,
-                        (Some((verdict, _)), _) => verdict,
-                        (None, _) => gate,
-                    }
+                        .flatten()
+                        .unwrap_or(gate)
                 }
                 _ => gate,
             };
