@@ -178,9 +178,17 @@ impl AutomaticFilter {
 
     /// The position bias `b₀` of the active filter's position `(x, v)` at `t` (the first entry
     /// of [`bias_of`](Self::bias_of), without allocating): 0 while the companion is not
-    /// determined.
-    pub(super) fn position_bias_of(&self, position: (f64, f64), t: f64, sigma: f64) -> f64 {
-        let Some(upper) = self.companion_position(t) else {
+    /// determined. `companion`: the companion's position at `t` when already computed
+    /// ([`choose_memory`](Self::choose_memory)'s).
+    pub(super) fn position_bias_of(
+        &self,
+        position: (f64, f64),
+        companion: Option<Option<(f64, f64)>>,
+        t: f64,
+        sigma: f64,
+    ) -> f64 {
+        let upper = companion.unwrap_or_else(|| self.companion_position(t));
+        let Some(upper) = upper else {
             return 0.0;
         };
         let b = position_bias(position, upper, sigma, SIGNIFICANCE);

@@ -942,9 +942,12 @@ impl AutomaticFilter {
     /// The prediction of the sample `(t, y)` by the memory of least estimated error, its
     /// innovation and honest `σ_ε`, and the gate's verdict (Morrison (14.8.1)-(14.8.4)).
     fn judge(&mut self, t: f64, y: f64) -> Judged {
-        self.choose_memory(t);
+        let chosen = self.choose_memory(t);
         let sigma = self.noise_sigma();
-        let prediction = self.active_position(t);
+        let prediction = match chosen {
+            Some((position, _)) => position,
+            None => self.active_position(t),
+        };
         let (innovation, vrf) = match prediction {
             Some((x, v)) => (Some(y - x), Some(v.max(0.0))),
             None => (None, None),
@@ -955,7 +958,7 @@ impl AutomaticFilter {
         };
         // The prediction's estimated bias: the honest innovation variance σ²(1 + v) + b₀².
         let bias0 = match (prediction, sigma) {
-            (Some(p), Some(s)) => self.position_bias_of(p, t, s),
+            (Some(p), Some(s)) => self.position_bias_of(p, chosen.map(|c| c.1), t, s),
             _ => 0.0,
         };
         let bias0 = self.with_pending(bias0, innovation, sigma);
