@@ -799,6 +799,13 @@ impl AutomaticFilter {
     /// assert_eq!(f.samples(), 1);
     /// ```
     pub fn update(&mut self, t: f64, y: f64) -> Result<AutoOutput, Error> {
+        self.update_kept(t, y)?;
+        Ok(self.last_output.clone().expect("kept by the update"))
+    }
+
+    /// [`update`](Self::update) keeping the output in [`last_output`](Self::last_output) only
+    /// (the trait's update: no copy of it).
+    fn update_kept(&mut self, t: f64, y: f64) -> Result<(), Error> {
         crate::error::check_sample(t, y, self.last_time)?;
         // With the input checked, the steps below cannot fail on the data; should an internal
         // step still fail, go back to the state before the sample so that an error never
@@ -807,9 +814,8 @@ impl AutomaticFilter {
         let before = self.review.keeps_next().then(|| self.snapshot());
         match self.step(t, y, None) {
             Ok(out) => {
-                let out = self.review(t, y, out, before);
-                self.last_output = Some(out.clone());
-                Ok(out)
+                self.last_output = Some(self.review(t, y, out, before));
+                Ok(())
             }
             Err(e) => {
                 self.recover(before);
@@ -1090,7 +1096,7 @@ impl PolynomialFilter for AutomaticFilter {
         AutomaticFilter::samples(self)
     }
     fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
-        AutomaticFilter::update(self, t, y).map(drop)
+        self.update_kept(t, y)
     }
     fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
         AutomaticFilter::estimate_at(self, t)
