@@ -181,7 +181,11 @@ impl Runner {
                     // The output's estimate is at t: the update's own, or across a rejected
                     // sample the prediction; with a lead the active filter's, the same way.
                     if lead == 0.0 {
-                        store(o.estimate.as_ref(), sigma, &mut row[..w << usize::from(sigma)]);
+                        store(
+                            o.estimate.as_ref(),
+                            sigma,
+                            &mut row[..w << usize::from(sigma)],
+                        );
                         continue;
                     }
                     f.estimate_at(t + lead)

@@ -1,5 +1,11 @@
+use crate::numeric::inline::InlineVec;
 use crate::numeric::unrolled::unrolled_sizes;
 use nalgebra::{DMatrix, DVector};
+
+/// The largest dimension whose factor is stored inline ([`InlineVec`]): a copy of it allocates
+/// nothing (the automatic filter copies its filters' state, degree `m + 1 ≤ 4` for its
+/// companions, where a decision may go back).
+const INLINE_P: usize = 5;
 
 /// An upper-triangular factor `R` of an accumulated Gram matrix `RᵀR = Σ_k c_k a_k a_kᵀ`, kept
 /// up to date row by row, with a right-hand column `d` (`Rᵀd = Σ_k c_k a_k b_k`).
@@ -50,11 +56,11 @@ use nalgebra::{DMatrix, DVector};
 #[derive(Clone, Debug)]
 pub struct TriangularFactor {
     /// `D`, the squares of `R`'s diagonal, each in its own 16-byte slot ([`Pivot`]).
-    d: Vec<Pivot>,
+    d: InlineVec<Pivot, INLINE_P>,
     /// `U`, unit upper triangular, row-major (`u[i·p + j]`, `j > i`; the rest unused).
-    u: Vec<f64>,
+    u: InlineVec<f64, { INLINE_P * INLINE_P }>,
     /// `ū = D^-½ d`.
-    ubar: Vec<f64>,
+    ubar: InlineVec<f64, INLINE_P>,
     residual_sq: f64,
     /// Every `d_i` is a normal positive number (the rows' reciprocal form applies).
     positive: bool,
@@ -75,9 +81,9 @@ impl TriangularFactor {
     /// The zero factor of dimension `p`.
     pub fn new(p: usize) -> Self {
         Self {
-            d: vec![Pivot(0.0); p],
-            u: vec![0.0; p * p],
-            ubar: vec![0.0; p],
+            d: InlineVec::filled(Pivot(0.0), p),
+            u: InlineVec::filled(0.0, p * p),
+            ubar: InlineVec::filled(0.0, p),
             residual_sq: 0.0,
             positive: p == 0,
             // Grown on first use, by the sizes without unrolled code only.
@@ -88,12 +94,9 @@ impl TriangularFactor {
     /// Makes this the zero factor of dimension `p`, keeping its storage (no allocation once it
     /// has held a factor of that size).
     pub(crate) fn reset(&mut self, p: usize) {
-        self.d.clear();
-        self.d.resize(p, Pivot(0.0));
-        self.u.clear();
-        self.u.resize(p * p, 0.0);
-        self.ubar.clear();
-        self.ubar.resize(p, 0.0);
+        self.d.refill(Pivot(0.0), p);
+        self.u.refill(0.0, p * p);
+        self.ubar.refill(0.0, p);
         self.residual_sq = 0.0;
         self.positive = p == 0;
         self.scratch.clear();
