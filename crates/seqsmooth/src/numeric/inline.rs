@@ -5,13 +5,8 @@
 
 use std::ops::{Deref, DerefMut};
 
-/// Up to `N` values inline, more on the heap; reads and writes as a slice.
-///
-/// ```ignore
-/// let mut v = InlineVec::<f64, 4>::filled(0.0, 3);
-/// v[2] = 1.0;
-/// assert_eq!(&v[..], &[0.0, 0.0, 1.0]);
-/// ```
+/// Up to `N` values inline, more on the heap; reads and writes as a slice (crate-internal: its
+/// checks are the unit tests below).
 #[derive(Clone, Debug)]
 pub(crate) struct InlineVec<T: Copy, const N: usize> {
     len: usize,

@@ -7,6 +7,7 @@ use super::config::AutoConfig;
 use super::memory::{shorter_memories, Shorter};
 use super::misfit::{Kept, MisfitResponse};
 use super::noise::{NoiseSource, NoiseState};
+use super::outlier::Judged;
 use super::outlier::OutlierRule;
 use super::output::{AutoOutput, Withheld};
 use super::phase::Phase;
@@ -945,54 +946,6 @@ impl AutomaticFilter {
         })
     }
 
-    /// The prediction of the sample `(t, y)` by the memory of least estimated error, its
-    /// innovation and honest `σ_ε`, and the gate's verdict (Morrison (14.8.1)-(14.8.4)).
-    fn judge(&mut self, t: f64, y: f64) -> Judged {
-        let chosen = self.choose_memory(t);
-        let sigma = self.noise_sigma();
-        let prediction = match chosen {
-            Some((position, _)) => position,
-            None => self.active_position(t),
-        };
-        let (innovation, vrf) = match prediction {
-            Some((x, v)) => (Some(y - x), Some(v.max(0.0))),
-            None => (None, None),
-        };
-        self.excess = match (sigma, vrf) {
-            (Some(s), Some(v)) => self.innovation_excess(s * s * (1.0 + v)),
-            _ => 0.0,
-        };
-        // The prediction's estimated bias: the honest innovation variance σ²(1 + v) + b₀².
-        let bias0 = match (prediction, sigma) {
-            (Some(p), Some(s)) => self.position_bias_of(p, chosen.map(|c| c.1), t, s),
-            _ => 0.0,
-        };
-        let bias0 = self.with_pending(bias0, innovation, sigma);
-        let innovation_sigma = match (sigma, vrf) {
-            (Some(s), Some(v)) => Some((s * s * (1.0 + v) + bias0 * bias0).sqrt()),
-            _ => None,
-        };
-        // The misfit test judges the model: the innovation against its noise-only variance.
-        let k2 = match (innovation, sigma, vrf) {
-            (Some(nu), Some(s), Some(v)) if s > 0.0 => Some(nu * nu / (s * s * (1.0 + v))),
-            _ => None,
-        };
-        let gate = self.gate(sigma, vrf, bias0, t);
-        let rejected = match (gate, innovation) {
-            (Some(g), Some(nu)) => nu.abs() > g,
-            _ => false,
-        };
-        Judged {
-            sigma,
-            innovation,
-            vrf,
-            innovation_sigma,
-            k2,
-            gate,
-            rejected,
-        }
-    }
-
     /// Applies an accepted sample to every filter, the noise estimate and the misfit window;
     /// then lets the ladder step up. `truncation` is `(a, v)`, the gate half-width in units of
     /// `σ_ε` and the prediction VRF, when the gate was active (the noise estimates correct for
@@ -1058,17 +1011,6 @@ impl AutomaticFilter {
         self.settle();
         Ok(chi_out)
     }
-}
-
-/// What [`AutomaticFilter::judge`] found for one sample.
-struct Judged {
-    sigma: Option<f64>,
-    innovation: Option<f64>,
-    vrf: Option<f64>,
-    innovation_sigma: Option<f64>,
-    k2: Option<f64>,
-    gate: Option<f64>,
-    rejected: bool,
 }
 
 /// The automatic filter through the common trait: the same estimates as its own methods
