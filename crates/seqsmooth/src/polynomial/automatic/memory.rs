@@ -157,12 +157,13 @@ impl AutomaticFilter {
         self.predictions.clear();
         self.predictions.resize(self.shorter.len() + 1, None);
         let mut positions = [(None, None); MAX_MEMORY_LEVELS + 1];
-        for j in 0..=self.shorter.len() {
+        let memories = self.shorter.len() + 1;
+        for (j, slot) in positions.iter_mut().enumerate().take(memories) {
             let Some(est) = self.memory_position(j, t) else {
                 continue;
             };
             let upper = self.memory_companion_position(j, t);
-            positions[j] = (Some(est), upper);
+            *slot = (Some(est), upper);
             let (b0, honest) = match upper {
                 Some(u) => (
                     position_bias(est, u, sigma, CHOICE_SIGNIFICANCE),
