@@ -313,23 +313,15 @@ impl InformationFilter {
         inv: &mut [f64],
         out: &mut [f64],
     ) -> bool {
-        let p = self.dim();
-        if !self.info.inverse_sqrt_pivots(&mut inv[..p]) {
-            return false;
-        }
-        for (j, o) in rows.chunks_exact_mut(p).zip(out.iter_mut()) {
-            // J R⁻¹ as a column, from the stored factor (R times the lazy scale).
-            self.info.right_divide_row(j, inv);
-            *o = match &self.spread {
+        let mut out = out.iter_mut();
+        self.for_each_solved_row(rows, inv, |j, spread| {
+            let Some(o) = out.next() else { return };
+            *o = match spread {
                 None => j.iter().map(|v| v * v).sum::<f64>() * (self.scale * self.scale),
-                Some(q) => {
-                    // kᵀ = R⁻¹ (J R⁻¹)ᵀ, the variance ‖Q k‖² (the lazy scale cancels).
-                    self.info.left_solve(j, inv);
-                    q.norm_sq_of(j)
-                }
+                // The variance ‖Q k‖² (the lazy scale cancels).
+                Some(q) => q.norm_sq_of(j),
             };
-        }
-        true
+        })
     }
 
     /// The covariance `J C Jᵀ` of the `n` rows `j` of `rows` (`p` values each, row-major;
@@ -344,20 +336,13 @@ impl InformationFilter {
         out: &mut [f64],
     ) -> bool {
         let p = self.dim();
-        if !self.info.inverse_sqrt_pivots(&mut inv[..p]) {
+        let solved = self.for_each_solved_row(rows, inv, |j, spread| match spread {
+            None => j.iter_mut().for_each(|v| *v *= self.scale),
+            // U_Q k (the lazy scale cancels).
+            Some(q) => q.unit_upper_times(j),
+        });
+        if !solved {
             return false;
-        }
-        for j in rows.chunks_exact_mut(p) {
-            // J R⁻¹ as a column, from the stored factor (R times the lazy scale).
-            self.info.right_divide_row(j, inv);
-            match &self.spread {
-                None => j.iter_mut().for_each(|v| *v *= self.scale),
-                Some(q) => {
-                    // kᵀ = R⁻¹ (J R⁻¹)ᵀ, then U_Q k (the lazy scale cancels).
-                    self.info.left_solve(j, inv);
-                    q.unit_upper_times(j);
-                }
-            }
         }
         let n = rows.len() / p;
         let weight = |i: usize| self.spread.as_ref().map_or(1.0, |q| q.pivot(i));
@@ -368,6 +353,30 @@ impl InformationFilter {
                 out[a * n + b] = v;
                 out[b * n + a] = v;
             }
+        }
+        true
+    }
+
+    /// Each row `j` of `rows` (`p` values) replaced by `(J R⁻¹)ᵀ` from the stored factor (`R`
+    /// times the lazy scale), or with the true covariance kept by `kᵀ = R⁻¹ (J R⁻¹)ᵀ`, and
+    /// handed to `f` with `Q` when it is kept; `false` (and no row touched) while not
+    /// determined. `inv` is scratch of `p` values.
+    fn for_each_solved_row(
+        &self,
+        rows: &mut [f64],
+        inv: &mut [f64],
+        mut f: impl FnMut(&mut [f64], Option<&TriangularFactor>),
+    ) -> bool {
+        let p = self.dim();
+        if !self.info.inverse_sqrt_pivots(&mut inv[..p]) {
+            return false;
+        }
+        for j in rows.chunks_exact_mut(p) {
+            self.info.right_divide_row(j, inv);
+            if self.spread.is_some() {
+                self.info.left_solve(j, inv);
+            }
+            f(j, self.spread.as_ref());
         }
         true
     }
