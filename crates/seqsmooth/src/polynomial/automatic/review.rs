@@ -13,7 +13,7 @@
 //! | step | rule | source |
 //! |---|---|---|
 //! | neighbours not caught yet | the fit drops up to two of its samples whose studentised residual `\|r_j\|/(σ√(1 − h_j))` exceeds `k`, the largest first | Morrison (6.10.24) |
-//! | fit's bias at `t` | `b² = max(0, Δ² − σ²(v₊ − v_p))`, `Δ` against the fit one degree up on the same samples | Morrison (7.13.5), §13.9 |
+//! | fit's bias at `t` | `b² = max(0, Δ² − σ²(v₊ − v_p))`, `Δ` against the fit one degree up on the same samples (not fitted where the gate decides whatever `b²` is) | Morrison (7.13.5), §13.9 |
 //! | residuals not white | `c = max(1, Σ RSS/σ² / Σ(n − p))` over the last 20 windows ([`Calibration`]) | Morrison §14.8 |
 //! | verdict | reject when `\|y − p(t)\| > k √(c σ²(1 + v_p) + b²)` (`k` the gate's multiplier) | Morrison §14.8 |
 //! | judge | the gate's verdict stands where its `σ_ε` was at most the interpolation's root mean square (a long memory that fits), the interpolation's otherwise | Morrison §7.13 |
