@@ -181,10 +181,14 @@ impl Runner {
                     // The output's estimate is at t: the update's own, or across a rejected
                     // sample the prediction; with a lead the active filter's, the same way.
                     if lead == 0.0 {
-                        o.estimate.clone()
-                    } else {
-                        f.estimate_at(t + lead)
+                        store(
+                            o.estimate.as_ref(),
+                            sigma,
+                            &mut row[..w << usize::from(sigma)],
+                        );
+                        continue;
                     }
+                    f.estimate_at(t + lead)
                 }
                 other => reasoned(other.try_estimate_at(t + lead), index)?,
             };

@@ -8,6 +8,7 @@
 
 pub mod double_word;
 pub mod epoch;
+pub(crate) mod inline;
 pub(crate) mod memo;
 pub mod power;
 pub mod steps;

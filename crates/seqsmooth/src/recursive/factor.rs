@@ -1,5 +1,11 @@
+use crate::numeric::inline::InlineVec;
 use crate::numeric::unrolled::unrolled_sizes;
 use nalgebra::{DMatrix, DVector};
+
+/// The largest dimension whose factor is stored inline ([`InlineVec`]): a copy of it allocates
+/// nothing (the automatic filter copies its filters' state, degree `m + 1 ≤ 4` for its
+/// companions, where a decision may go back).
+const INLINE_P: usize = 5;
 
 /// An upper-triangular factor `R` of an accumulated Gram matrix `RᵀR = Σ_k c_k a_k a_kᵀ`, kept
 /// up to date row by row, with a right-hand column `d` (`Rᵀd = Σ_k c_k a_k b_k`).
@@ -50,11 +56,11 @@ use nalgebra::{DMatrix, DVector};
 #[derive(Clone, Debug)]
 pub struct TriangularFactor {
     /// `D`, the squares of `R`'s diagonal, each in its own 16-byte slot ([`Pivot`]).
-    d: Vec<Pivot>,
+    d: InlineVec<Pivot, INLINE_P>,
     /// `U`, unit upper triangular, row-major (`u[i·p + j]`, `j > i`; the rest unused).
-    u: Vec<f64>,
+    u: InlineVec<f64, { INLINE_P * INLINE_P }>,
     /// `ū = D^-½ d`.
-    ubar: Vec<f64>,
+    ubar: InlineVec<f64, INLINE_P>,
     residual_sq: f64,
     /// Every `d_i` is a normal positive number (the rows' reciprocal form applies).
     positive: bool,
@@ -75,13 +81,25 @@ impl TriangularFactor {
     /// The zero factor of dimension `p`.
     pub fn new(p: usize) -> Self {
         Self {
-            d: vec![Pivot(0.0); p],
-            u: vec![0.0; p * p],
-            ubar: vec![0.0; p],
+            d: InlineVec::filled(Pivot(0.0), p),
+            u: InlineVec::filled(0.0, p * p),
+            ubar: InlineVec::filled(0.0, p),
             residual_sq: 0.0,
             positive: p == 0,
-            scratch: vec![0.0; 4 * p],
+            // Grown on first use, by the sizes without unrolled code only.
+            scratch: Vec::new(),
         }
+    }
+
+    /// Makes this the zero factor of dimension `p`, keeping its storage (no allocation once it
+    /// has held a factor of that size).
+    pub(crate) fn reset(&mut self, p: usize) {
+        self.d.refill(Pivot(0.0), p);
+        self.u.refill(0.0, p * p);
+        self.ubar.refill(0.0, p);
+        self.residual_sq = 0.0;
+        self.positive = p == 0;
+        self.scratch.clear();
     }
 
     /// Recomputes [`positive`](Self::positive) after `d` changed other than by a row in the
@@ -200,6 +218,22 @@ impl TriangularFactor {
             .sum()
     }
 
+    /// `x ← U x` (the unit upper triangular part of `R = D^½ U`), without allocating: with
+    /// [`Self::pivot`], `(R x)ᵀ(R y) = Σ_i d_i (U x)_i (U y)_i` needs no square root.
+    pub(crate) fn unit_upper_times(&self, x: &mut [f64]) {
+        let p = self.dim();
+        for i in 0..p {
+            let (head, later) = x.split_at_mut(i + 1);
+            let u = &self.u[i * p + i + 1..(i + 1) * p];
+            head[i] = later.iter().zip(u).fold(head[i], |v, (xk, uk)| v + uk * xk);
+        }
+    }
+
+    /// The pivot `d_i` (the square of `R`'s diagonal entry `i`).
+    pub(crate) fn pivot(&self, i: usize) -> f64 {
+        self.d[i].0
+    }
+
     /// The factor `R = D^½ U` (computed).
     pub fn r(&self) -> DMatrix<f64> {
         let p = self.dim();
@@ -275,36 +309,28 @@ impl TriangularFactor {
         true
     }
 
-    /// `z = (RᵀR)⁻¹ h` into `z` (`UᵀDU z = h`: a forward and a back substitution, no
-    /// allocation), returning `hᵀ z = Σ g_i²/d_i` (`Uᵀ g = h`); `None` while not determined.
-    pub(crate) fn solve_gram(&self, h: &[f64], z: &mut [f64]) -> Option<f64> {
+    /// `hᵀ(RᵀR)⁻¹h = Σ_i g_i²/d_i` with `Uᵀ g = h` (a forward substitution into `g`, no
+    /// allocation); `None` while not determined.
+    pub(crate) fn inverse_gram_quad(&self, h: &[f64], g: &mut [f64]) -> Option<f64> {
         if !self.is_determined() {
             return None;
         }
         let p = self.dim();
         let u = &self.u[..p * p];
-        let mut quad = 0.0;
-        // Uᵀ g = h (unit lower triangular), then w = g/d into z.
+        // Uᵀ g = h (unit lower triangular).
         for i in 0..p {
-            let mut g = h[i];
+            let mut gi = h[i];
             for k in 0..i {
-                g -= u[k * p + i] * z[k];
+                gi -= u[k * p + i] * g[k];
             }
-            z[i] = g;
+            g[i] = gi;
         }
-        for (zi, d) in z[..p].iter_mut().zip(&self.d) {
-            quad += *zi * *zi / d.0;
-            *zi /= d.0;
-        }
-        // U z = w (unit upper triangular).
-        for i in (0..p).rev() {
-            let mut s = z[i];
-            for j in i + 1..p {
-                s -= u[i * p + j] * z[j];
-            }
-            z[i] = s;
-        }
-        Some(quad)
+        Some(
+            g[..p]
+                .iter()
+                .zip(&self.d)
+                .fold(0.0, |q, (gi, d)| q + *gi * *gi / d.0),
+        )
     }
 
     /// Folds the row `√c·[a | b]` into `[R | d]`: `O(p²)`, no square roots.

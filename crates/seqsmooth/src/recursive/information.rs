@@ -313,21 +313,70 @@ impl InformationFilter {
         inv: &mut [f64],
         out: &mut [f64],
     ) -> bool {
+        let mut out = out.iter_mut();
+        self.for_each_solved_row(rows, inv, |j, spread| {
+            let Some(o) = out.next() else { return };
+            *o = match spread {
+                None => j.iter().map(|v| v * v).sum::<f64>() * (self.scale * self.scale),
+                // The variance ‖Q k‖² (the lazy scale cancels).
+                Some(q) => q.norm_sq_of(j),
+            };
+        })
+    }
+
+    /// The covariance `J C Jᵀ` of the `n` rows `j` of `rows` (`p` values each, row-major;
+    /// overwritten) into `out` (`n × n`, row-major): [`Self::covariance_of`] without allocating
+    /// (the true covariance's when it is kept: `Σ_i q_i (U_Q k_a)_i (U_Q k_b)_i` for
+    /// `k = (RᵀR)⁻¹ jᵀ` and `Q = D_Q^½ U_Q`). `false` while not determined. `inv` is scratch of
+    /// `p` values.
+    pub(crate) fn covariance_of_rows(
+        &self,
+        rows: &mut [f64],
+        inv: &mut [f64],
+        out: &mut [f64],
+    ) -> bool {
+        let p = self.dim();
+        let solved = self.for_each_solved_row(rows, inv, |j, spread| match spread {
+            None => j.iter_mut().for_each(|v| *v *= self.scale),
+            // U_Q k (the lazy scale cancels).
+            Some(q) => q.unit_upper_times(j),
+        });
+        if !solved {
+            return false;
+        }
+        let n = rows.len() / p;
+        let weight = |i: usize| self.spread.as_ref().map_or(1.0, |q| q.pivot(i));
+        for a in 0..n {
+            for b in 0..=a {
+                let (ra, rb) = (&rows[a * p..(a + 1) * p], &rows[b * p..(b + 1) * p]);
+                let v = (0..p).map(|i| weight(i) * ra[i] * rb[i]).sum();
+                out[a * n + b] = v;
+                out[b * n + a] = v;
+            }
+        }
+        true
+    }
+
+    /// Each row `j` of `rows` (`p` values) replaced by `(J R⁻¹)ᵀ` from the stored factor (`R`
+    /// times the lazy scale), or with the true covariance kept by `kᵀ = R⁻¹ (J R⁻¹)ᵀ`, and
+    /// handed to `f` with `Q` when it is kept; `false` (and no row touched) while not
+    /// determined. `inv` is scratch of `p` values.
+    fn for_each_solved_row(
+        &self,
+        rows: &mut [f64],
+        inv: &mut [f64],
+        mut f: impl FnMut(&mut [f64], Option<&TriangularFactor>),
+    ) -> bool {
         let p = self.dim();
         if !self.info.inverse_sqrt_pivots(&mut inv[..p]) {
             return false;
         }
-        for (j, o) in rows.chunks_exact_mut(p).zip(out.iter_mut()) {
-            // J R⁻¹ as a column, from the stored factor (R times the lazy scale).
+        for j in rows.chunks_exact_mut(p) {
             self.info.right_divide_row(j, inv);
-            *o = match &self.spread {
-                None => j.iter().map(|v| v * v).sum::<f64>() * (self.scale * self.scale),
-                Some(q) => {
-                    // kᵀ = R⁻¹ (J R⁻¹)ᵀ, the variance ‖Q k‖² (the lazy scale cancels).
-                    self.info.left_solve(j, inv);
-                    q.norm_sq_of(j)
-                }
-            };
+            if self.spread.is_some() {
+                self.info.left_solve(j, inv);
+            }
+            f(j, self.spread.as_ref());
         }
         true
     }

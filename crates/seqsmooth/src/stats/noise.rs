@@ -321,6 +321,8 @@ pub struct DifferenceNoise {
     squares: SlidingSum,
     /// The screen `c` (`|d| > c σ̂` leaves a difference out), if any.
     screen: Option<f64>,
+    /// The variance of a unit Gaussian truncated at the screen (1 without one), computed once.
+    kept: f64,
     /// Differences still to leave out after a screened one (they share its samples).
     holdoff: usize,
     /// The first [`SCREEN_REFERENCE_TERMS`] squared differences (for the startup reference).
@@ -363,6 +365,7 @@ impl DifferenceNoise {
             factors: VecDeque::with_capacity(order + 1),
             squares: SlidingSum::new(window),
             screen: None,
+            kept: 1.0,
             holdoff: 0,
             early: Vec::new(),
             left_out: 0,
@@ -404,6 +407,7 @@ impl DifferenceNoise {
             });
         }
         self.screen = c.is_finite().then_some(c);
+        self.kept = self.screen.map_or(1.0, truncated_variance);
         Ok(self)
     }
 
@@ -577,8 +581,7 @@ impl DifferenceNoise {
     /// ```
     pub fn variance(&self) -> Option<f64> {
         let n = self.len();
-        let kept = self.screen.map_or(1.0, truncated_variance);
-        (n > 0).then(|| self.squares.sum() / n as f64 / kept)
+        (n > 0).then(|| self.squares.sum() / n as f64 / self.kept)
     }
 
     /// `√variance`.

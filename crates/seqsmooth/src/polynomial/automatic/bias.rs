@@ -178,9 +178,17 @@ impl AutomaticFilter {
 
     /// The position bias `b₀` of the active filter's position `(x, v)` at `t` (the first entry
     /// of [`bias_of`](Self::bias_of), without allocating): 0 while the companion is not
-    /// determined.
-    pub(super) fn position_bias_of(&self, position: (f64, f64), t: f64, sigma: f64) -> f64 {
-        let Some(upper) = self.companion_position(t) else {
+    /// determined. `companion`: the companion's position at `t` when already computed
+    /// ([`choose_memory`](Self::choose_memory)'s).
+    pub(super) fn position_bias_of(
+        &self,
+        position: (f64, f64),
+        companion: Option<Option<(f64, f64)>>,
+        t: f64,
+        sigma: f64,
+    ) -> f64 {
+        let upper = companion.unwrap_or_else(|| self.companion_position(t));
+        let Some(upper) = upper else {
             return 0.0;
         };
         let b = position_bias(position, upper, sigma, SIGNIFICANCE);
@@ -279,8 +287,10 @@ impl AutomaticFilter {
         };
         let bias = self.bias_of(&raw, sigma);
         let factor = self.calibration_factor();
-        let covariance = raw.covariance.as_ref().map(|c| {
-            let mut c = c * (sigma * sigma);
+        let mut raw = raw;
+        if let Some(c) = &mut raw.covariance {
+            // In place: the raw covariance is this call's own.
+            *c *= sigma * sigma;
             if let Some(b) = &bias {
                 for i in 0..c.nrows() {
                     for j in 0..c.ncols() {
@@ -288,8 +298,8 @@ impl AutomaticFilter {
                     }
                 }
             }
-            c * factor
-        });
-        (PolynomialState { covariance, ..raw }, bias)
+            *c *= factor;
+        }
+        (raw, bias)
     }
 }

@@ -7,6 +7,7 @@ use super::config::AutoConfig;
 use super::memory::{shorter_memories, Shorter};
 use super::misfit::{Kept, MisfitResponse};
 use super::noise::{NoiseSource, NoiseState};
+use super::outlier::Judged;
 use super::outlier::OutlierRule;
 use super::output::{AutoOutput, Withheld};
 use super::phase::Phase;
@@ -799,6 +800,13 @@ impl AutomaticFilter {
     /// assert_eq!(f.samples(), 1);
     /// ```
     pub fn update(&mut self, t: f64, y: f64) -> Result<AutoOutput, Error> {
+        self.update_kept(t, y)?;
+        Ok(self.last_output.clone().expect("kept by the update"))
+    }
+
+    /// [`update`](Self::update) keeping the output in [`last_output`](Self::last_output) only
+    /// (the trait's update: no copy of it).
+    fn update_kept(&mut self, t: f64, y: f64) -> Result<(), Error> {
         crate::error::check_sample(t, y, self.last_time)?;
         // With the input checked, the steps below cannot fail on the data; should an internal
         // step still fail, go back to the state before the sample so that an error never
@@ -807,9 +815,8 @@ impl AutomaticFilter {
         let before = self.review.keeps_next().then(|| self.snapshot());
         match self.step(t, y, None) {
             Ok(out) => {
-                let out = self.review(t, y, out, before);
-                self.last_output = Some(out.clone());
-                Ok(out)
+                self.last_output = Some(self.review(t, y, out, before));
+                Ok(())
             }
             Err(e) => {
                 self.recover(before);
@@ -939,51 +946,6 @@ impl AutomaticFilter {
         })
     }
 
-    /// The prediction of the sample `(t, y)` by the memory of least estimated error, its
-    /// innovation and honest `σ_ε`, and the gate's verdict (Morrison (14.8.1)-(14.8.4)).
-    fn judge(&mut self, t: f64, y: f64) -> Judged {
-        self.choose_memory(t);
-        let sigma = self.noise_sigma();
-        let prediction = self.active_position(t);
-        let (innovation, vrf) = match prediction {
-            Some((x, v)) => (Some(y - x), Some(v.max(0.0))),
-            None => (None, None),
-        };
-        self.excess = match (sigma, vrf) {
-            (Some(s), Some(v)) => self.innovation_excess(s * s * (1.0 + v)),
-            _ => 0.0,
-        };
-        // The prediction's estimated bias: the honest innovation variance σ²(1 + v) + b₀².
-        let bias0 = match (prediction, sigma) {
-            (Some(p), Some(s)) => self.position_bias_of(p, t, s),
-            _ => 0.0,
-        };
-        let bias0 = self.with_pending(bias0, innovation, sigma);
-        let innovation_sigma = match (sigma, vrf) {
-            (Some(s), Some(v)) => Some((s * s * (1.0 + v) + bias0 * bias0).sqrt()),
-            _ => None,
-        };
-        // The misfit test judges the model: the innovation against its noise-only variance.
-        let k2 = match (innovation, sigma, vrf) {
-            (Some(nu), Some(s), Some(v)) if s > 0.0 => Some(nu * nu / (s * s * (1.0 + v))),
-            _ => None,
-        };
-        let gate = self.gate(sigma, vrf, bias0, t);
-        let rejected = match (gate, innovation) {
-            (Some(g), Some(nu)) => nu.abs() > g,
-            _ => false,
-        };
-        Judged {
-            sigma,
-            innovation,
-            vrf,
-            innovation_sigma,
-            k2,
-            gate,
-            rejected,
-        }
-    }
-
     /// Applies an accepted sample to every filter, the noise estimate and the misfit window;
     /// then lets the ladder step up. `truncation` is `(a, v)`, the gate half-width in units of
     /// `σ_ε` and the prediction VRF, when the gate was active (the noise estimates correct for
@@ -1051,17 +1013,6 @@ impl AutomaticFilter {
     }
 }
 
-/// What [`AutomaticFilter::judge`] found for one sample.
-struct Judged {
-    sigma: Option<f64>,
-    innovation: Option<f64>,
-    vrf: Option<f64>,
-    innovation_sigma: Option<f64>,
-    k2: Option<f64>,
-    gate: Option<f64>,
-    rejected: bool,
-}
-
 /// The automatic filter through the common trait: the same estimates as its own methods
 /// ([`AutomaticFilter::estimate`] is the estimate at the newest *accepted* sample), `samples`
 /// counts accepted samples, and the estimates have the active degree's `d+1` derivatives
@@ -1087,7 +1038,7 @@ impl PolynomialFilter for AutomaticFilter {
         AutomaticFilter::samples(self)
     }
     fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
-        AutomaticFilter::update(self, t, y).map(drop)
+        self.update_kept(t, y)
     }
     fn estimate_at(&self, t: f64) -> Option<PolynomialState> {
         AutomaticFilter::estimate_at(self, t)

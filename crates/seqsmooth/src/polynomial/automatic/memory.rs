@@ -28,10 +28,15 @@ use super::misfit::MisfitResponse;
 #[cfg(doc)]
 use super::AutoConfig;
 use super::AutoConfig as Config;
+use super::MAX_MEMORY_LEVELS;
 use crate::error::Error;
 use crate::polynomial::fading::FadingMemory;
 use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::options::Engine;
+
+/// A memory's position at the prediction's time and its companion's, each `(x, v)` with its
+/// unit variance `v` (`None`: not determined).
+pub(super) type Positions = (Option<(f64, f64)>, Option<(f64, f64)>);
 
 /// A shorter memory never discounts by less than this per `τ` (a memory of well under one
 /// sample says nothing more).
@@ -132,26 +137,33 @@ impl AutomaticFilter {
     /// use; a longer one only one level at a time, once it has been the least for
     /// [`LENGTHEN_AFTER`] predictions in a row (Morrison §14.8: the memory is lengthened again
     /// once the crossings cease; a single low `b̂` is not evidence enough). Memory 0 while the
-    /// ladder settles or without `σ`.
-    pub(super) fn choose_memory(&mut self, t: f64) {
+    /// ladder settles or without `σ`. Returns, when it compared the memories, the chosen one's
+    /// position at `t` and its companion's (each with its unit variance, as
+    /// [`memory_position`](Self::memory_position) and
+    /// [`memory_companion_position`](Self::memory_companion_position) give them): the
+    /// prediction's, computed once.
+    pub(super) fn choose_memory(&mut self, t: f64) -> Option<Positions> {
         let Some(sigma) = self.noise_sigma() else {
             self.memory = 0;
-            return;
+            return None;
         };
         let responds = matches!(self.cfg.misfit_response, MisfitResponse::Restart { .. });
         if self.active < self.cfg.degree || self.shorter.is_empty() || !responds {
             self.memory = 0;
-            return;
+            return None;
         }
         let s2 = sigma * sigma;
         let mut best = (f64::INFINITY, self.memory);
         self.predictions.clear();
         self.predictions.resize(self.shorter.len() + 1, None);
-        for j in 0..=self.shorter.len() {
+        let mut positions = [(None, None); MAX_MEMORY_LEVELS + 1];
+        let memories = self.shorter.len() + 1;
+        for (j, slot) in positions.iter_mut().enumerate().take(memories) {
             let Some(est) = self.memory_position(j, t) else {
                 continue;
             };
             let upper = self.memory_companion_position(j, t);
+            *slot = (Some(est), upper);
             let (b0, honest) = match upper {
                 Some(u) => (
                     position_bias(est, u, sigma, CHOICE_SIGNIFICANCE),
@@ -179,6 +191,7 @@ impl AutomaticFilter {
                 self.longer_runs = 0;
             }
         }
+        Some(positions[self.memory])
     }
 
     /// Adds the accepted sample `y` to each memory's calibration: the running mean (over about

@@ -1,6 +1,7 @@
 //! The outlier gate (Morrison §14.8, (14.8.4); Reyneke et al. §7.4): when an innovation `ν` is
-//! too large for the noise `σ` and the prediction's own variance, and the variance of the noise
-//! that passes a gate.
+//! too large for the noise `σ` and the prediction's own variance, the judgement of each sample
+//! by the prediction of the memory chosen for it, and the variance of the noise that passes a
+//! gate.
 
 use super::config::check_positive;
 use super::filter::AutomaticFilter;
@@ -137,7 +138,66 @@ impl OutlierRule {
     }
 }
 
+/// What [`AutomaticFilter::judge`] found for one sample.
+pub(super) struct Judged {
+    pub(super) sigma: Option<f64>,
+    pub(super) innovation: Option<f64>,
+    pub(super) vrf: Option<f64>,
+    pub(super) innovation_sigma: Option<f64>,
+    pub(super) k2: Option<f64>,
+    pub(super) gate: Option<f64>,
+    pub(super) rejected: bool,
+}
+
 impl AutomaticFilter {
+    /// The prediction of the sample `(t, y)` by the memory of least estimated error, its
+    /// innovation and honest `σ_ε`, and the gate's verdict (Morrison (14.8.1)-(14.8.4)).
+    pub(super) fn judge(&mut self, t: f64, y: f64) -> Judged {
+        let chosen = self.choose_memory(t);
+        let sigma = self.noise_sigma();
+        let prediction = match chosen {
+            Some((position, _)) => position,
+            None => self.active_position(t),
+        };
+        let (innovation, vrf) = match prediction {
+            Some((x, v)) => (Some(y - x), Some(v.max(0.0))),
+            None => (None, None),
+        };
+        self.excess = match (sigma, vrf) {
+            (Some(s), Some(v)) => self.innovation_excess(s * s * (1.0 + v)),
+            _ => 0.0,
+        };
+        // The prediction's estimated bias: the honest innovation variance σ²(1 + v) + b₀².
+        let bias0 = match (prediction, sigma) {
+            (Some(p), Some(s)) => self.position_bias_of(p, chosen.map(|c| c.1), t, s),
+            _ => 0.0,
+        };
+        let bias0 = self.with_pending(bias0, innovation, sigma);
+        let innovation_sigma = match (sigma, vrf) {
+            (Some(s), Some(v)) => Some((s * s * (1.0 + v) + bias0 * bias0).sqrt()),
+            _ => None,
+        };
+        // The misfit test judges the model: the innovation against its noise-only variance.
+        let k2 = match (innovation, sigma, vrf) {
+            (Some(nu), Some(s), Some(v)) if s > 0.0 => Some(nu * nu / (s * s * (1.0 + v))),
+            _ => None,
+        };
+        let gate = self.gate(sigma, vrf, bias0, t);
+        let rejected = match (gate, innovation) {
+            (Some(g), Some(nu)) => nu.abs() > g,
+            _ => false,
+        };
+        Judged {
+            sigma,
+            innovation,
+            vrf,
+            innovation_sigma,
+            k2,
+            gate,
+            rejected,
+        }
+    }
+
     /// The gate half-width for the sample at `t`, given the noise `σ`, the prediction's VRF
     /// `v` and its estimated bias `b₀`: the rule's `g(σ, v, N)` widened to `√(g² + k²b₀²)`
     /// (for Morrison's rule `k √(σ²(1 + v) + b₀²)`, `k` times the honest `σ_ε`). Active only at

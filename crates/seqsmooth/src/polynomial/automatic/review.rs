@@ -13,7 +13,7 @@
 //! | step | rule | source |
 //! |---|---|---|
 //! | neighbours not caught yet | the fit drops up to two of its samples whose studentised residual `\|r_j\|/(σ√(1 − h_j))` exceeds `k`, the largest first | Morrison (6.10.24) |
-//! | fit's bias at `t` | `b² = max(0, Δ² − σ²(v₊ − v_p))`, `Δ` against the fit one degree up on the same samples | Morrison (7.13.5), §13.9 |
+//! | fit's bias at `t` | `b² = max(0, Δ² − σ²(v₊ − v_p))`, `Δ` against the fit one degree up on the same samples (not fitted where the gate decides whatever `b²` is) | Morrison (7.13.5), §13.9 |
 //! | residuals not white | `c = max(1, Σ RSS/σ² / Σ(n − p))` over the last 20 windows ([`Calibration`]) | Morrison §14.8 |
 //! | verdict | reject when `\|y − p(t)\| > k √(c σ²(1 + v_p) + b²)` (`k` the gate's multiplier) | Morrison §14.8 |
 //! | judge | the gate's verdict stands where its `σ_ε` was at most the interpolation's root mean square (a long memory that fits), the interpolation's otherwise | Morrison §7.13 |
@@ -77,7 +77,7 @@ pub(super) struct Entry {
 pub(super) struct Review {
     entries: VecDeque<Entry>,
     accepted: VecDeque<(f64, f64)>,
-    calibration: Calibration,
+    scratch: Scratch,
 }
 
 /// The windows' residuals about their fits over the last [`CALIBRATION_WINDOWS`] decisions, in
@@ -188,8 +188,10 @@ fn gate_rms(out: &AutoOutput) -> Option<f64> {
 
 /// A least-squares polynomial through the samples of a review window: the square-root-free
 /// QR factor of the rows `(1, u, …, u^d)`, `u = (t − c)/h` centred and scaled on the window
-/// (so `|u| ≤ 1`), without allocating beyond the factor.
-struct WindowFit {
+/// (so `|u| ≤ 1`). Refitted in place ([`WindowFit::fit`]): the review keeps two and allocates
+/// nothing per sample.
+#[derive(Clone, Debug)]
+pub(super) struct WindowFit {
     factor: TriangularFactor,
     /// The coefficients of `u^k`.
     coefficients: [f64; MAX_FIT],
@@ -198,31 +200,39 @@ struct WindowFit {
     degree: usize,
 }
 
+impl Default for WindowFit {
+    fn default() -> Self {
+        Self {
+            factor: TriangularFactor::new(0),
+            coefficients: [0.0; MAX_FIT],
+            centre: 0.0,
+            inv_half: 1.0,
+            degree: 0,
+        }
+    }
+}
+
 impl WindowFit {
-    /// The fit of degree `d` through `(ts, ys)` (at least `d + 1` distinct times); `None` when
-    /// it is not determined.
-    fn new(ts: &[f64], ys: &[f64], degree: usize) -> Option<Self> {
+    /// Fits degree `d` through `(ts, ys)` (at least `d + 1` distinct times), replacing the fit
+    /// held; false when it is not determined.
+    fn fit(&mut self, ts: &[f64], ys: &[f64], degree: usize) -> bool {
         let (lo, hi) = ts
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
                 (a.min(t), b.max(t))
             });
         let half = 0.5 * (hi - lo);
-        let mut fit = Self {
-            factor: TriangularFactor::new(degree + 1),
-            coefficients: [0.0; MAX_FIT],
-            centre: 0.5 * (lo + hi),
-            inv_half: if half > 0.0 { 1.0 / half } else { 1.0 },
-            degree,
-        };
+        self.factor.reset(degree + 1);
+        self.coefficients = [0.0; MAX_FIT];
+        self.centre = 0.5 * (lo + hi);
+        self.inv_half = if half > 0.0 { 1.0 / half } else { 1.0 };
+        self.degree = degree;
         for (&t, &y) in ts.iter().zip(ys) {
-            fit.factor
-                .add_row_powers((t - fit.centre) * fit.inv_half, y, 1.0);
+            self.factor
+                .add_row_powers((t - self.centre) * self.inv_half, y, 1.0);
         }
         let p = degree + 1;
-        fit.factor
-            .solve_into(&mut fit.coefficients[..p])
-            .then_some(fit)
+        self.factor.solve_into(&mut self.coefficients[..p])
     }
 
     /// `p(t)` and its variance for unit noise `h(t)ᵀ(AᵀA)⁻¹h(t)`.
@@ -231,14 +241,14 @@ impl WindowFit {
         let u = (t - self.centre) * self.inv_half;
         let a = &self.coefficients;
         let mut h = [0.0; MAX_FIT];
-        let mut z = [0.0; MAX_FIT];
+        let mut g = [0.0; MAX_FIT];
         let mut power = 1.0;
         for hk in &mut h[..p] {
             *hk = power;
             power *= u;
         }
         let value = a[..p].iter().zip(&h[..p]).map(|(a, h)| a * h).sum();
-        let vrf = self.factor.solve_gram(&h[..p], &mut z[..p])?;
+        let vrf = self.factor.inverse_gram_quad(&h[..p], &mut g[..p])?;
         Some((value, vrf))
     }
 
@@ -250,25 +260,43 @@ impl WindowFit {
 /// The most coefficients of a [`WindowFit`]: degree `MAX_DEGREE + 2`.
 const MAX_FIT: usize = MAX_DEGREE + 3;
 
-/// The verdict on `(t, y)` from the samples around it (`true`: an outlier) and the root mean
-/// square of the deleted residual it judged, `√(σ²(1 + v_p) + b²)`; `None` when the fit cannot
-/// say (too few samples, or numbers beyond the double range).
+/// The final verdict on `(t, y)` (`true`: an outlier) from the samples around it and the
+/// gate's: the interpolation's, judged against the root mean square of its deleted residual
+/// `√(c σ²(1 + v_p) + b²)`, where that is below the gate's `σ_ε` (`gate_rms`, `None` when the
+/// gate was off), else the gate's; the gate's (`None`) too when the fit cannot say (too few
+/// samples, or numbers beyond the double range). The fit one degree up (for `b²`) is left out
+/// where `σ_ε ≤ √(c σ²(1 + v_p))`: the root mean square is at least that, so the gate decides
+/// whatever `b²` is.
 pub(super) fn interpolation_verdict(
     around: &[(f64, f64)],
     (t, y): (f64, f64),
     degree: usize,
     sigma: f64,
     k: f64,
-    calibration: &mut Calibration,
-) -> Option<(bool, f64)> {
-    let (mut ts, mut ys): (Vec<f64>, Vec<f64>) = around.iter().copied().unzip();
-    let mut fit = WindowFit::new(&ts, &ys, degree)?;
+    gate_rms: Option<f64>,
+    scratch: &mut Scratch,
+) -> Option<bool> {
+    let Scratch {
+        fit,
+        up,
+        calibration,
+    } = scratch;
+    let mut ts = [0.0; WINDOW];
+    let mut ys = [0.0; WINDOW];
+    let mut n = around.len().min(WINDOW);
+    for (i, &(t, y)) in around[..n].iter().enumerate() {
+        ts[i] = t;
+        ys[i] = y;
+    }
+    if !fit.fit(&ts[..n], &ys[..n], degree) {
+        return None;
+    }
     for _ in 0..2 {
-        if ts.len() < degree + 4 {
+        if n < degree + 4 {
             break;
         }
         let mut worst = (f64::NEG_INFINITY, 0);
-        for j in 0..ts.len() {
+        for j in 0..n {
             let (p, h) = fit.value_and_vrf_at(ts[j])?;
             let r = (ys[j] - p).abs() / (sigma * (1.0 - h).max(f64::EPSILON).sqrt());
             if r.is_nan() {
@@ -281,18 +309,30 @@ pub(super) fn interpolation_verdict(
         if worst.0 <= k {
             break;
         }
-        ts.remove(worst.1);
-        ys.remove(worst.1);
-        fit = WindowFit::new(&ts, &ys, degree)?;
+        ts.copy_within(worst.1 + 1..n, worst.1);
+        ys.copy_within(worst.1 + 1..n, worst.1);
+        n -= 1;
+        if !fit.fit(&ts[..n], &ys[..n], degree) {
+            return None;
+        }
     }
     let (p, v) = fit.value_and_vrf_at(t)?;
     let v = v.max(0.0);
+    let spare = n - (degree + 1);
+    let scale = calibration.factor();
+    let var = sigma * sigma * scale;
+    calibration.push(fit.residual_sq() / (sigma * sigma), spare);
+    // The judge of the smaller mean square: the gate's prediction where the memory is long
+    // and fits (the root mean square below is at least √(var(1 + v))), the interpolation
+    // where it is short.
+    if gate_rms.is_some_and(|g| g <= (var * (1.0 + v)).sqrt()) {
+        return None;
+    }
     // The fit's bias at t, from one degree up on the same samples (nested least squares:
     // E{Δ²} = b² + σ²(v₊ − v), as for the filter's own bias).
-    let up = (ts.len() >= degree + 3)
-        .then(|| WindowFit::new(&ts, &ys, degree + 1))
-        .flatten()
-        .and_then(|up| up.value_and_vrf_at(t));
+    let up = (n >= degree + 3 && up.fit(&ts[..n], &ys[..n], degree + 1))
+        .then(|| up.value_and_vrf_at(t))
+        .flatten();
     let b2 = match up {
         Some((pu, vu)) => {
             let d = p - pu;
@@ -300,21 +340,33 @@ pub(super) fn interpolation_verdict(
         }
         None => 0.0,
     };
-    let spare = ts.len() - (degree + 1);
-    let scale = calibration.factor();
-    let var = sigma * sigma * scale;
     let r = y - p;
     let rms = (var * (1.0 + v) + b2).sqrt();
-    calibration.push(fit.residual_sq() / (sigma * sigma), spare);
-    (r.is_finite() && rms.is_finite()).then_some((r.abs() > k * rms, rms))
+    let decides = r.is_finite() && rms.is_finite() && gate_rms.is_none_or(|g| g > rms);
+    decides.then_some(r.abs() > k * rms)
+}
+
+/// The most samples of a review window: `L` on each side.
+const WINDOW: usize = 2 * MAX_REVIEW_WINDOW;
+
+/// What the review's fits keep between samples: the calibration, and the two fits refitted in
+/// place (no allocation per sample).
+#[derive(Clone, Debug, Default)]
+pub(super) struct Scratch {
+    fit: WindowFit,
+    up: WindowFit,
+    calibration: Calibration,
 }
 
 impl AutomaticFilter {
-    /// The filter without its review (the state a decision may go back to).
+    /// The filter without its review and its last output (the state a decision may go back
+    /// to; the output is the newest update's whatever state it came from).
     pub(super) fn snapshot(&mut self) -> Box<AutomaticFilter> {
         let review = std::mem::take(&mut self.review);
+        let last = self.last_output.take();
         let s = Box::new(self.clone());
         self.review = review;
+        self.last_output = last;
         s
     }
 
@@ -340,11 +392,13 @@ impl AutomaticFilter {
         }
     }
 
-    /// Goes back to `state`, keeping the review.
+    /// Goes back to `state`, keeping the review and the last output.
     pub(super) fn restore(&mut self, state: AutomaticFilter) {
         let review = std::mem::take(&mut self.review);
+        let last = self.last_output.take();
         *self = state;
         self.review = review;
+        self.last_output = last;
     }
 
     /// Takes the newest sample into the review and makes every decision it can; returns the
@@ -387,15 +441,20 @@ impl AutomaticFilter {
         let mut newest = None;
         while let Some(f) = self.review.first_undecided() {
             let front = &self.review.entries[f];
-            let after: Vec<(f64, f64)> = self
+            // The accepted samples after it (at most 2L), on the stack.
+            let mut after_buf = [(0.0, 0.0); WINDOW];
+            let mut n_after = 0;
+            let later = self
                 .review
                 .entries
                 .iter()
                 .skip(f + 1)
-                .filter(|u| !u.rejected)
-                .map(|u| (u.t, u.y))
-                .take(2 * l.max(1))
-                .collect();
+                .filter(|u| !u.rejected);
+            for u in later.take(2 * l.max(1)) {
+                after_buf[n_after] = (u.t, u.y);
+                n_after += 1;
+            }
+            let after = &after_buf[..n_after];
             let overflow = self.review.entries.len() - f > MAX_UNDECIDED;
             let (before_wanted, ready) = if l == 0 {
                 (0, !front.rejected || !after.is_empty() || finishing)
@@ -415,27 +474,22 @@ impl AutomaticFilter {
             let verdict = match (l, self.noise_sigma(), overflow) {
                 (1.., Some(sigma), false) if k > 0.0 && sigma > 0.0 => {
                     let before = self.review.accepted.len().min(before_wanted);
-                    let mut around: Vec<(f64, f64)> = self
-                        .review
-                        .accepted
-                        .iter()
-                        .skip(self.review.accepted.len() - before)
-                        .copied()
-                        .collect();
-                    around.extend(after.iter().take(2 * l - before));
-                    let review = (around.len() >= degree + 2)
-                        .then(|| {
-                            let c = &mut self.review.calibration;
-                            interpolation_verdict(&around, sample, degree, sigma, k, c)
-                        })
-                        .flatten();
-                    // The judge of the smaller mean square: the gate's prediction where the
-                    // memory is long and fits, the interpolation where it is short.
-                    match (review, gate_rms) {
-                        (Some((_, rms)), Some(g)) if g <= rms => gate,
-                        (Some((verdict, _)), _) => verdict,
-                        (None, _) => gate,
+                    let mut around_buf = [(0.0, 0.0); WINDOW];
+                    let accepted = &self.review.accepted;
+                    let earlier = accepted.iter().skip(accepted.len() - before);
+                    let mut n = 0;
+                    for &s in earlier.chain(after.iter().take(2 * l - before)) {
+                        around_buf[n] = s;
+                        n += 1;
                     }
+                    let around = &around_buf[..n];
+                    (around.len() >= degree + 2)
+                        .then(|| {
+                            let c = &mut self.review.scratch;
+                            interpolation_verdict(around, sample, degree, sigma, k, gate_rms, c)
+                        })
+                        .flatten()
+                        .unwrap_or(gate)
                 }
                 _ => gate,
             };

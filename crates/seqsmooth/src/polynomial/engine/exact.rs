@@ -81,8 +81,9 @@ pub(crate) struct ExactEngine {
     /// The effective memory span `3/(-ln θ)`, in updates (per update) or times `τ` (per time).
     span_updates: f64,
     span_per_time: f64,
-    /// `k!/s^k` for the unit `s` (unscaled derivatives from the coefficients).
-    unscale: Vec<f64>,
+    /// `k!/s^k` for the unit `s` (unscaled derivatives from the coefficients), `k ≤ m` (an
+    /// array: a copy of the engine allocates only its factors).
+    unscale: [f64; MAX_DEGREE + 1],
     /// Whether every `unscale` entry is a normal double; else the derivatives are unscaled one
     /// factor at a time ([`crate::model::taylor`]'s `unscale_stepwise`).
     unscale_in_range: bool,
@@ -106,7 +107,7 @@ impl ExactEngine {
             half_rate: discount.map_or(0.0, |d| -d.theta.ln() / (2.0 * d.tau)),
             span_updates: discount.map_or(0.0, |d| 3.0 / -d.theta.ln()),
             span_per_time: discount.map_or(0.0, |d| 3.0 * d.tau / -d.theta.ln()),
-            unscale: vec![0.0; m + 1],
+            unscale: [0.0; MAX_DEGREE + 1],
             unscale_in_range: true,
         }
     }
@@ -214,7 +215,10 @@ impl ExactEngine {
     /// `k!/s^k` and `1/s` for the current unit `s`.
     fn set_unscale(&mut self) {
         self.inv_unit = 1.0 / self.unit;
-        for (c, d) in self.unscale.iter_mut().zip(derivative_scale(self.unit)) {
+        for (c, d) in self.unscale[..=self.m]
+            .iter_mut()
+            .zip(derivative_scale(self.unit))
+        {
             *c = d;
         }
         self.unscale_in_range = unscale_in_range(self.m, self.unit);
@@ -224,7 +228,7 @@ impl ExactEngine {
     #[inline(always)]
     fn unscale_into(&self, a: &[f64], out: &mut [f64]) {
         if self.unscale_in_range {
-            for ((x, z), c) in out.iter_mut().zip(a).zip(&self.unscale) {
+            for ((x, z), c) in out.iter_mut().zip(a).zip(&self.unscale[..=self.m]) {
                 *x = z * c;
             }
         } else {
@@ -383,11 +387,61 @@ impl ExactEngine {
         let v = (t - self.centre) * self.inv_unit;
         let cov = match self.sigma {
             None => None,
+            Some(sigma) if self.unscale_in_range => {
+                let p = self.m + 1;
+                // Stack tables of p² values for the sizes compiled in, else on the heap.
+                unrolled_sizes!(p, N => self.covariance_with(v, sigma, [[0.0; N]; N].as_flattened_mut(), [[0.0; N]; N].as_flattened_mut()), _ => self.covariance_with(v, sigma, &mut vec![0.0; p * p], &mut vec![0.0; p * p]))
+            }
             Some(sigma) => {
                 let j = crate::model::scaling(self.m, self.unit) * crate::model::phi(self.m, v);
                 Some(self.info.covariance_of(&j)? * (sigma * sigma))
             }
         };
         Some((x, cov))
+    }
+
+    /// The covariance of the unscaled derivatives at `v` (in the basis' units) with one
+    /// allocation, its own: `σ² D(s) Φ(v) C Φ(v)ᵀ D(s)`
+    /// ([`InformationFilter::covariance_of_rows`]); `rows` and `cov` are `p²` scratch values.
+    #[inline(always)]
+    fn covariance_with(
+        &self,
+        v: f64,
+        sigma: f64,
+        rows: &mut [f64],
+        cov: &mut [f64],
+    ) -> Option<DMatrix<f64>> {
+        let p = self.m + 1;
+        phi_rows(v, p, rows);
+        let mut inv = [0.0; MAX_DEGREE + 1];
+        if !self.info.covariance_of_rows(rows, &mut inv[..p], cov) {
+            return None;
+        }
+        let s2 = sigma * sigma;
+        let d = &self.unscale;
+        Some(DMatrix::from_fn(p, p, |i, j| {
+            cov[i * p + j] * s2 * d[i] * d[j]
+        }))
+    }
+}
+
+/// The rows of `Φ(v)` into `rows` (`p²` values, row-major): `Φ_ik = C(k, i) v^(k−i)`, `k ≥ i`
+/// (zero below the diagonal), Morrison (4.2.5) in the basis' units.
+#[inline(always)]
+fn phi_rows(v: f64, p: usize, rows: &mut [f64]) {
+    let mut powers = [1.0; MAX_DEGREE + 1];
+    for k in 1..p {
+        powers[k] = powers[k - 1] * v;
+    }
+    let mut binomial = [0.0; MAX_DEGREE + 1];
+    for k in 0..p {
+        // Row k of Pascal's triangle from row k-1, in place.
+        binomial[k] = 1.0;
+        for i in (1..k).rev() {
+            binomial[i] += binomial[i - 1];
+        }
+        for i in 0..=k {
+            rows[i * p + k] = binomial[i] * powers[k - i];
+        }
     }
 }

@@ -37,6 +37,10 @@ pub(crate) const SINGULAR: &str = "the fit is not determined: the weights of the
 /// run and the marking.
 const FUSED_CHUNK: usize = 1024;
 
+// The exact engine keeps a low degree's factors inline (`numeric::inline`), so that a copy of a
+// filter allocates nothing (the automatic filter copies its filters' state where a decision may
+// go back); boxing it would put one allocation back per copy.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub(crate) enum EngineState {
     Exact(ExactEngine),
