@@ -34,3 +34,15 @@ impl CliError {
         }
     }
 }
+
+/// A library error by its kind ([`seqsmooth::error::ErrorKind`], the library's rule): a
+/// setting out of range is a usage error (exit code 2, as for a bad argument), anything else a
+/// data error (1).
+impl From<seqsmooth::Error> for CliError {
+    fn from(e: seqsmooth::Error) -> Self {
+        match e.kind() {
+            seqsmooth::error::ErrorKind::Parameter => CliError::Usage(e.to_string()),
+            _ => CliError::Data(e.to_string()),
+        }
+    }
+}

@@ -6,6 +6,7 @@
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyType;
+use seqsmooth::error::ErrorKind;
 use seqsmooth::Error;
 
 /// The Python class of each kind of error (its name in `seqsmooth.errors`).
@@ -31,47 +32,33 @@ impl Kind {
         }
     }
 
-    /// The kind of a library error (inside a batch, the kind of its cause).
+    /// The class of a library error: its [`ErrorKind`] (the library's rule; inside a batch,
+    /// its cause's).
     pub fn of(error: &Error) -> Kind {
-        match error {
-            Error::NonFinite { .. } | Error::TimeNotIncreasing { .. } => Kind::InvalidInput,
-            // The library's parameter errors about the data handed in rather than a setting.
-            Error::InvalidParameter { name, .. } if DATA.contains(name) => Kind::InvalidInput,
-            Error::ThetaOutOfRange { .. }
-            | Error::TauOutOfRange { .. }
-            | Error::DegreeOutOfRange { .. }
-            | Error::GainDegreeOutOfRange { .. }
-            | Error::GainValueOutOfRange { .. }
-            | Error::InvalidParameter { .. } => Kind::Parameter,
-            Error::TooFewSamples { .. } => Kind::TooFewSamples,
-            Error::NotDetermined { .. } => Kind::NotDetermined,
-            Error::InBatch { source, .. } | Error::InChannel { source, .. } => Kind::of(source),
-            _ => Kind::Numerical,
+        Kind::of_kind(error.kind())
+    }
+
+    /// The class of each library [`ErrorKind`], one for one.
+    fn of_kind(kind: ErrorKind) -> Kind {
+        match kind {
+            ErrorKind::InvalidInput => Kind::InvalidInput,
+            ErrorKind::Parameter => Kind::Parameter,
+            ErrorKind::TooFewSamples => Kind::TooFewSamples,
+            ErrorKind::NotDetermined => Kind::NotDetermined,
+            ErrorKind::Numerical => Kind::Numerical,
         }
     }
 }
 
-/// The names of [`Error::InvalidParameter`] that describe the data passed (a sample, the
-/// shape of the arrays), not a setting: [`Kind::InvalidInput`].
-const DATA: &[&str] = &[
-    "input value",
-    "input length",
-    "matrix length",
-    "batch lengths",
-    "chunk lengths",
-    "estimates length",
-    "time",
-    "range",
-    "azimuth",
-    "elevation",
-    "sigma_range",
-    "sigma_angle",
-    "row",
-    "weight",
-    "weights",
-    "segment",
-    "sigmas",
-];
+/// The library's error kinds and the name of each one's Python class, for the test that walks
+/// every kind to its class.
+#[pyfunction]
+pub fn error_kinds() -> Vec<(&'static str, &'static str)> {
+    ErrorKind::ALL
+        .iter()
+        .map(|&k| (k.name(), Kind::of_kind(k).class_name()))
+        .collect()
+}
 
 /// An exception of `kind` with `message` and `index` (the offending sample's position).
 pub fn raise(kind: Kind, message: impl Into<String>, index: Option<usize>) -> PyErr {

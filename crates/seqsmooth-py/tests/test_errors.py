@@ -17,6 +17,30 @@ def test_the_hierarchy_is_value_error():
     assert issubclass(ss.InvalidTypeError, ss.InvalidInputError)
 
 
+def test_every_error_kind_has_its_class():
+    """The class of an error is chosen by the library's kind (``seqsmooth::error::ErrorKind``),
+    one class per kind, each a SeqsmoothError; and a call of each kind raises its class."""
+    from seqsmooth._seqsmooth import error_kinds
+
+    kinds = error_kinds()
+    assert [k for k, _ in kinds] == [
+        "InvalidInput",
+        "Parameter",
+        "TooFewSamples",
+        "NotDetermined",
+        "Numerical",
+    ]
+    for kind, cls in kinds:
+        assert cls == kind + "Error" and issubclass(getattr(errors, cls), errors.SeqsmoothError)
+    assert len({cls for _, cls in kinds}) == len(kinds)
+    with pytest.raises(ss.ParameterError):
+        ss.FadingMemory(degree=1, theta=2.0)
+    with pytest.raises(ss.InvalidInputError):
+        ss.FadingMemory(degree=1, theta=0.9).update_many(np.arange(3.0), [1.0, np.nan, 1.0])
+    with pytest.raises(ss.TooFewSamplesError):
+        ss.smooth(np.ones(5), 7, 2)
+
+
 @pytest.mark.parametrize("where", [0, 3, 9])
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
 def test_a_non_finite_value_is_named_with_its_index(where, bad):

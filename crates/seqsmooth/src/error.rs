@@ -223,6 +223,104 @@ pub enum Error {
     },
 }
 
+/// What kind of failure an [`Error`] is: the front ends choose by it, the Python exception
+/// class (`seqsmooth.errors`, named [`ErrorKind::name`] + `Error`) and the command's exit code
+/// (2 for [`ErrorKind::Parameter`], as for a bad argument; 1 for the others).
+///
+/// ```
+/// use seqsmooth::error::{Error, ErrorKind};
+/// assert_eq!(Error::ThetaOutOfRange { theta: 2.0 }.kind(), ErrorKind::Parameter);
+/// assert_eq!(Error::NonFinite { what: "value", value: f64::NAN }.kind(), ErrorKind::InvalidInput);
+/// assert_eq!(ErrorKind::TooFewSamples.name(), "TooFewSamples");
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ErrorKind {
+    /// The data handed in: a sample, a timestamp, a row's component or σ, the arrays' lengths.
+    InvalidInput,
+    /// A setting out of its range: degree, θ, τ, a window, an engine, a σ, a model's shape.
+    Parameter,
+    /// Too few samples for what was asked.
+    TooFewSamples,
+    /// No estimate yet: the samples so far do not determine it.
+    NotDetermined,
+    /// A numerical failure on valid input: a number beyond the double range, a fit that did
+    /// not converge, an unobservable state.
+    Numerical,
+}
+
+impl ErrorKind {
+    /// Every kind, in the order of their declaration.
+    pub const ALL: [ErrorKind; 5] = [
+        ErrorKind::InvalidInput,
+        ErrorKind::Parameter,
+        ErrorKind::TooFewSamples,
+        ErrorKind::NotDetermined,
+        ErrorKind::Numerical,
+    ];
+
+    /// The kind's name, the same in every front end (`InvalidInput`, `Parameter`,
+    /// `TooFewSamples`, `NotDetermined`, `Numerical`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ErrorKind::InvalidInput => "InvalidInput",
+            ErrorKind::Parameter => "Parameter",
+            ErrorKind::TooFewSamples => "TooFewSamples",
+            ErrorKind::NotDetermined => "NotDetermined",
+            ErrorKind::Numerical => "Numerical",
+        }
+    }
+}
+
+/// The names of [`Error::InvalidParameter`] that describe the data handed in (a sample, a
+/// row's component or σ, the shape of the arrays), not a setting: [`ErrorKind::InvalidInput`].
+const DATA_NAMES: &[&str] = &[
+    "input value",
+    "input length",
+    "matrix length",
+    "batch lengths",
+    "chunk lengths",
+    "estimates length",
+    "time",
+    "range",
+    "azimuth",
+    "elevation",
+    "sigma_range",
+    "sigma_angle",
+    "row",
+    "weight",
+    "weights",
+    "segment",
+    "sigmas",
+];
+
+impl Error {
+    /// The error's [`ErrorKind`] (inside a batch or a channel, its cause's).
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            Error::NonFinite { .. } | Error::TimeNotIncreasing { .. } => ErrorKind::InvalidInput,
+            Error::InvalidParameter { name, .. } if DATA_NAMES.contains(name) => {
+                ErrorKind::InvalidInput
+            }
+            Error::ThetaOutOfRange { .. }
+            | Error::TauOutOfRange { .. }
+            | Error::DegreeOutOfRange { .. }
+            | Error::GainDegreeOutOfRange { .. }
+            | Error::GainValueOutOfRange { .. }
+            | Error::InvalidParameter { .. } => ErrorKind::Parameter,
+            Error::TooFewSamples { .. } => ErrorKind::TooFewSamples,
+            Error::NotDetermined { .. } => ErrorKind::NotDetermined,
+            Error::InBatch { source, .. } | Error::InChannel { source, .. } => source.kind(),
+            Error::EstimateOutOfRange { .. }
+            | Error::Unobservable { .. }
+            | Error::NotConverged { .. }
+            | Error::Diverged { .. }
+            | Error::FitNotConverged { .. }
+            | Error::SvdNotConverged { .. }
+            | Error::EigenNotConverged { .. } => ErrorKind::Numerical,
+        }
+    }
+}
+
 fn also_failed_note(others: &[usize]) -> String {
     if others.is_empty() {
         String::new()

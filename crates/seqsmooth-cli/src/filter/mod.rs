@@ -158,7 +158,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             (Runner::Auto(f), Some(n)) => Ok(Runner::Auto(Box::new(f.with_review_window(n)?))),
             (r, _) => Ok(r),
         })
-        .map_err(|e| CliError::Usage(e.to_string()))?;
+        .map_err(CliError::from)?;
     // The automatic filter always writes s0..sM (from the given or the estimated noise).
     let sigma = a.sigma.is_some() || a.kind == Kind::Auto;
     let extra = prototype.extra_columns();
@@ -168,7 +168,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     let shown = ((a.degree + 1) << usize::from(sigma)) + extra.len();
     let stride = shown + if auto { runner::DECISION_CELLS } else { 0 };
     let mut held = held::Held::default();
-    let mut bank = StreamBank::growing(prototype).map_err(|e| CliError::Usage(e.to_string()))?;
+    let mut bank = StreamBank::growing(prototype).map_err(CliError::from)?;
     let (mut ids, mut values, mut out) = (Vec::new(), Vec::new(), None);
     let mut progress = Progress::hidden();
     // The rest of the input is read on a thread of its own, a chunk ahead.

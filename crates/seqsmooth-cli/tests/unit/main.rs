@@ -5,6 +5,7 @@ mod args;
 mod chart;
 mod decimate;
 mod demo;
+mod error;
 mod filter;
 mod io;
 mod plot;

@@ -282,6 +282,10 @@ def vrf(
     *,
     exact: Literal[True],
 ) -> list[list[Fraction]]: ...
+def error_kinds() -> list[tuple[str, str]]:
+    """The library's error kinds, each with the name of its class in ``seqsmooth.errors``."""
+    ...
+
 def gauss_rule(
     n: int,
     t: ArrayLike | None = None,
