@@ -23,7 +23,8 @@
 //! restart rebuilds them all from the onset.
 
 use super::bias::position_bias;
-use super::filter::{unit_fading_on, upper_degree, AutomaticFilter};
+use super::build::{unit_fading_on, upper_degree};
+use super::filter::AutomaticFilter;
 use super::misfit::MisfitResponse;
 #[cfg(doc)]
 use super::AutoConfig;

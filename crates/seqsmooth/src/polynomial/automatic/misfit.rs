@@ -2,7 +2,8 @@
 //! innovation chi-squared test, and the restart of the final-degree memory from the estimated
 //! onset of the manoeuvre (a CUSUM change point).
 
-use super::filter::{unit_expanding, unit_fading, upper_pair, AutomaticFilter};
+use super::build::{unit_expanding, unit_fading, upper_pair};
+use super::filter::AutomaticFilter;
 use super::memory::shorter_memories;
 use crate::error::Error;
 use crate::polynomial::filter::PolynomialFilter;

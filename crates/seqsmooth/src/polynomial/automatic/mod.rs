@@ -134,6 +134,7 @@
 //! | concept | module | source |
 //! |---|---|---|
 //! | settings and their checks: [`AutoConfig`], [`GATE_MAX_VRF`] | `config` | — |
+//! | building: [`AutomaticFilter::new`], the `with_*` builders, the filters a configuration runs | `build` | — |
 //! | the filters it runs, one update, acceptance: [`AutomaticFilter`] | `filter` | Morrison (14.8.1)-(14.8.4) |
 //! | what each sample did: [`AutoOutput`]; the final decisions, [`final_outliers`] | `output` | — |
 //! | the final outlier decision by interpolation, going back: [`MAX_REVIEW_WINDOW`] | `review` | Morrison ch. 7, (6.10.24), (7.13.5), §14.8 |
@@ -170,6 +171,7 @@ use crate::polynomial::fading::FadingMemory;
 use crate::polynomial::options::{DiscountMode, Engine};
 
 mod bias;
+mod build;
 mod config;
 mod filter;
 mod memory;
