@@ -223,9 +223,9 @@ pub enum Error {
     },
 }
 
-/// What kind of failure an [`Error`] is: the front ends choose by it, the Python exception
-/// class (`seqsmooth.errors`, named [`ErrorKind::name`] + `Error`) and the command's exit code
-/// (2 for [`ErrorKind::Parameter`], as for a bad argument; 1 for the others).
+/// What kind of failure an [`Error`](enum@Error) is: the front ends choose by it, the Python
+/// exception class (`seqsmooth.errors`, named [`ErrorKind::name`] + `Error`) and the command's
+/// exit code (2 for [`ErrorKind::Parameter`], as for a bad argument; 1 for the others).
 ///
 /// ```
 /// use seqsmooth::error::{Error, ErrorKind};

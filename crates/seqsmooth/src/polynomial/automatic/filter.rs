@@ -6,6 +6,8 @@
 use super::config::AutoConfig;
 use super::memory::Shorter;
 use super::misfit::Kept;
+#[cfg(doc)]
+use super::misfit::MisfitResponse;
 use super::noise::NoiseState;
 use super::outlier::Judged;
 use super::output::{AutoOutput, Withheld};
