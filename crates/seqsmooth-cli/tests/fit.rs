@@ -99,6 +99,17 @@ fn polynomial_model_equals_filter_fixed() {
     println!("worst relative difference: {worst:e}");
 }
 
+/// `seqsmooth fit --model radar` with the noise of [`radar_pass`] (10 m, 1 mrad).
+const RADAR: [&str; 7] = [
+    "fit",
+    "--model",
+    "radar",
+    "--sigma-range",
+    "10",
+    "--sigma-angle",
+    "1e-3",
+];
+
 /// A constant-velocity target seen from `site`, irregular times, 10 m and 1 mrad noise; every
 /// fifth row lacks its elevation. Returns the CSV and the true states.
 fn radar_pass(n: usize, site: [f64; 3], seed: u64) -> (String, Vec<(f64, [f64; 6])>) {
@@ -255,15 +266,7 @@ fn radar_model_equals_library_and_covers_the_truth() {
 /// window's lines; nothing written to an existing output file.
 #[test]
 fn fit_refuses_bad_input() {
-    let radar = [
-        "fit",
-        "--model",
-        "radar",
-        "--sigma-range",
-        "10",
-        "--sigma-angle",
-        "1e-3",
-    ];
+    let radar = RADAR;
     fn with<'a>(radar: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
         radar.iter().chain(extra).copied().collect()
     }
@@ -578,15 +581,7 @@ fn far_epochs_and_huge_windows_do_not_panic() {
 #[test]
 fn radar_rows_read_as_track_reads_them() {
     let (input, _) = radar_pass(60, [0.0; 3], 3);
-    let radar = [
-        "fit",
-        "--model",
-        "radar",
-        "--sigma-range",
-        "10",
-        "--sigma-angle",
-        "1e-3",
-    ];
+    let radar = RADAR;
     let plain = ok(&radar, &input);
     // Bearings b = π/2 − azimuth; the command turns them back with the library's rule.
     let mut bearing = String::from("t,range,azimuth,elevation,note\n");
