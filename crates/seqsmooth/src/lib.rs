@@ -23,9 +23,10 @@
 //!   relate by `Γ_Ψ[k] = k! Γ_Φ[k]`.
 //! - **Sample index** `n` is 0-based: after the sample with index `n` the filter has seen `n+1`
 //!   samples (Morrison ch. 9: "in all cases n starts at zero").
-//! - **Fading memory**: `θ ∈ (0,1)` is the discount per nominal interval `τ`; a sample of age
-//!   `Δt` weighs `θ^(Δt/τ)` ([`DiscountMode::PerTime`]) or `θ` per later sample
-//!   ([`DiscountMode::PerUpdate`]).
+//! - **Fading memory**: one type, [`discount::Discount`], for every filter that forgets
+//!   (polynomial, Bayes, Kalman): `θ ∈ (0,1)` per span `τ` of time, a sample of age `Δt`
+//!   weighing `θ^(Δt/τ)` ([`discount::Discount::PerTime`]), or `θ` per later sample
+//!   ([`discount::Discount::PerUpdate`]).
 //! - **Right or refused**: every number of an estimate is finite. Where there is none,
 //!   [`PolynomialFilter::try_estimate_at`] says why: too few samples, a fit singular in doubles
 //!   (with what to change), or a derivative or variance beyond the double range in the caller's
@@ -62,6 +63,7 @@
 //! - [`scalar`]: the `f64` / exact-rational abstraction every formula is generic over.
 //! - [`linalg`]: the small dense linear algebra the formulas share.
 //! - [`error`]: the one error type, [`Error`], of every fallible call.
+//! - [`discount`]: the discount of every fading memory, [`discount::Discount`].
 //! - `numeric`: the numerical building blocks of the engines (double-word arithmetic, the
 //!   step tolerance).
 //!
@@ -83,6 +85,7 @@
 
 pub mod basis;
 pub mod calculus;
+pub mod discount;
 pub mod error;
 pub mod estimate;
 pub mod kalman;

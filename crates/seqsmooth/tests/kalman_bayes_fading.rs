@@ -51,9 +51,15 @@ fn fading_bayes_equals_fading_kalman() {
     let mut worst: f64 = 0.0;
     for m in 0..=3 {
         for discount in [
-            Discount::PerTime(0.7),
-            Discount::PerTime(0.95),
-            Discount::PerUpdate(0.8),
+            Discount::PerTime {
+                theta: 0.7,
+                tau: 1.0,
+            },
+            Discount::PerTime {
+                theta: 0.95,
+                tau: 1.0,
+            },
+            Discount::PerUpdate { theta: 0.8 },
         ] {
             let n = 2 * (m + 1);
             let dynamics = PolynomialDynamics::new(m, 2);
@@ -132,7 +138,10 @@ fn fading_bayes_is_the_exact_fading_memory_polynomial_filter() {
             0.0,
         )
         .unwrap()
-        .with_fading(Discount::PerTime(beta))
+        .with_fading(Discount::PerTime {
+            theta: beta,
+            tau: 1.0,
+        })
         .unwrap();
         let mut t: f64 = 0.0;
         for k in 0..(4 * m + 60) {
@@ -165,44 +174,38 @@ fn fading_bayes_is_the_exact_fading_memory_polynomial_filter() {
     println!("fading Bayes against the exact fading-memory polynomial filter: worst {worst:.2e} σ");
 }
 
-/// `β = 1` and `θ = 1` are the plain Bayes filter: the estimate to the last bit (the same
-/// rows into the same factor), the covariance (now the sandwich `P P⁻¹ P`) within rounding.
+/// `θ = 1` is no fading memory: refused with the one range of every discount, `0 < θ < 1`
+/// (the filter without `with_fading` is the plain one), as is `τ ≤ 0`.
 #[test]
-fn no_discount_is_the_plain_bayes_filter() {
-    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
-    for discount in [Discount::PerTime(1.0), Discount::PerUpdate(1.0)] {
-        let dynamics = PolynomialDynamics::new(2, 1);
-        let observe = LinearObservation::value_of(3);
-        let mut plain = BayesFilter::new(dynamics, observe.clone(), 0.0).unwrap();
-        let mut fading = BayesFilter::new(dynamics, observe, 0.0)
-            .unwrap()
-            .with_fading(discount)
-            .unwrap();
-        let mut t: f64 = 0.0;
-        for k in 0..50 {
-            t += rng.gen_range(0.1..2.0);
-            let meas = Measurement {
-                time: t,
-                values: vec![Some(rng.gen_range(-3.0..3.0))],
-                noise: NoiseCovariance::Variances(vec![rng.gen_range(0.5..2.0)]),
-            };
-            plain.update(&meas).unwrap();
-            fading.update(&meas).unwrap();
-            if k < 3 {
-                continue;
-            }
-            assert_eq!(plain.estimate(), fading.estimate(), "{discount:?} k {k}");
-            let (a, b) = (plain.covariance().unwrap(), fading.covariance().unwrap());
-            assert!(
-                worst_difference(
-                    &plain.estimate().unwrap(),
-                    &b,
-                    &plain.estimate().unwrap(),
-                    &a
-                ) <= 1e-11
-            );
-        }
+fn no_discount_is_refused() {
+    let new = || {
+        BayesFilter::new(
+            PolynomialDynamics::new(2, 1),
+            LinearObservation::value_of(3),
+            0.0,
+        )
+        .unwrap()
+    };
+    for discount in [
+        Discount::PerTime {
+            theta: 1.0,
+            tau: 1.0,
+        },
+        Discount::PerUpdate { theta: 1.0 },
+    ] {
+        assert_eq!(
+            new().with_fading(discount).unwrap_err(),
+            seqsmooth::Error::ThetaOutOfRange { theta: 1.0 }
+        );
     }
+    let zero_tau = Discount::PerTime {
+        theta: 0.9,
+        tau: 0.0,
+    };
+    assert_eq!(
+        new().with_fading(zero_tau).unwrap_err(),
+        seqsmooth::Error::TauOutOfRange { tau: 0.0 }
+    );
 }
 
 /// The reported true covariance covers the actual error: 4,000 runs of a constant-velocity
@@ -222,7 +225,10 @@ fn true_covariance_covers_the_error() {
             0.0,
         )
         .unwrap()
-        .with_fading(Discount::PerTime(0.6))
+        .with_fading(Discount::PerTime {
+            theta: 0.6,
+            tau: 1.0,
+        })
         .unwrap();
         let (x0, v) = (rng.gen_range(-10.0..10.0), rng.gen_range(-2.0..2.0));
         let mut t: f64 = 0.0;
@@ -271,7 +277,7 @@ fn ex_14_9a_unobserved_direction_is_refused_once_it_has_faded() {
     .unwrap()
     .with_prior(&DVector::zeros(2), &DMatrix::identity(2, 2))
     .unwrap()
-    .with_fading(Discount::PerUpdate(theta))
+    .with_fading(Discount::PerUpdate { theta: theta })
     .unwrap();
     let (mut z, mut u, mut s_u) = (1.0, 0.0, 1.0);
     let (mut worst, mut worst_ratio): (f64, f64) = (0.0, 0.0);
@@ -352,7 +358,10 @@ fn the_first_update_does_not_discount_nothing() {
             t0,
         )
         .unwrap()
-        .with_fading(Discount::PerTime(0.9))
+        .with_fading(Discount::PerTime {
+            theta: 0.9,
+            tau: 1.0,
+        })
         .unwrap();
         rows.iter()
             .map(|m| {

@@ -110,7 +110,7 @@ fn run_fading<D: Dynamics>(
         0.0,
     )
     .unwrap()
-    .with_fading(Discount::PerUpdate(theta))
+    .with_fading(Discount::PerUpdate { theta: theta })
     .unwrap();
     let mut gain = DMatrix::zeros(n, p);
     for k in 1..=updates {
@@ -281,7 +281,7 @@ fn ex_14_9a_singular_z_infinity() {
         0.0,
     )
     .unwrap()
-    .with_fading(Discount::PerUpdate(theta))
+    .with_fading(Discount::PerUpdate { theta: theta })
     .unwrap();
     let (mut z, mut s_u) = (1.0, 1.0);
     let mut worst: f64 = 0.0;
@@ -353,7 +353,12 @@ fn scalar_run(
     )
     .unwrap();
     if beta < 1.0 {
-        f = f.with_fading(Discount::PerTime(beta)).unwrap();
+        f = f
+            .with_fading(Discount::PerTime {
+                theta: beta,
+                tau: 1.0,
+            })
+            .unwrap();
     }
     let c = beta * (-2.0 * a).exp();
     let (mut zinv, mut s) = (0.5, 2.0);
@@ -431,7 +436,10 @@ fn ex_14_14_stable_scalar() {
         0.0,
     )
     .unwrap()
-    .with_fading(Discount::PerTime(0.5))
+    .with_fading(Discount::PerTime {
+        theta: 0.5,
+        tau: 1.0,
+    })
     .unwrap();
     for n in 1..=60 {
         let none = Measurement {

@@ -45,7 +45,7 @@ fn count_based_fading_is_the_fading_memory_polynomial_filter() {
                 0.0,
             )
             .unwrap()
-            .with_fading(Discount::PerUpdate(theta))
+            .with_fading(Discount::PerUpdate { theta: theta })
             .unwrap();
             let mut gain = DMatrix::zeros(n, 1);
             for k in 1..=2000 {
@@ -93,7 +93,7 @@ fn notes_cross_check_theta_0_9() {
         0.0,
     )
     .unwrap()
-    .with_fading(Discount::PerUpdate(0.9))
+    .with_fading(Discount::PerUpdate { theta: 0.9 })
     .unwrap();
     let mut gain = DMatrix::zeros(3, 1);
     for k in 1..=500 {
@@ -143,7 +143,10 @@ fn time_based_fading_equals_the_discounted_batch_estimate() {
                 0.0,
             )
             .unwrap()
-            .with_fading(Discount::PerTime(beta))
+            .with_fading(Discount::PerTime {
+                theta: beta,
+                tau: 1.0,
+            })
             .unwrap();
             let (mut times, mut ys, mut rs) = (vec![], vec![], vec![]);
             let mut t = 0.0;
@@ -201,10 +204,12 @@ fn time_based_fading_equals_the_discounted_batch_estimate() {
     println!("worst: {worst:e}");
 }
 
-/// `β = 1` is the plain filter, to the last bit; on even steps of τ the time-based discount
-/// `β` is the count-based `θ = β^τ` (within rounding of the power).
+/// On even steps of `δ` the discount per span of time, `θ` per `τ`, is the discount per update
+/// `θ^(δ/τ)`: within rounding of the power for `τ = 1`, to the last bit for `τ = δ` (the
+/// exponent is exactly 1). `θ = 1` is no fading memory, refused: the filter without
+/// `with_fading` is the plain one.
 #[test]
-fn no_discount_and_even_steps() {
+fn discount_per_time_on_even_steps_is_per_update() {
     let new = || {
         KalmanFilter::new(
             PolynomialDynamics::new(2, 1),
@@ -215,29 +220,67 @@ fn no_discount_and_even_steps() {
         )
         .unwrap()
     };
-    let (mut plain, mut unit) = (new(), new().with_fading(Discount::PerTime(1.0)).unwrap());
-    let tau = 0.25;
-    let (mut by_time, mut by_count) = (
-        new().with_fading(Discount::PerTime(0.7)).unwrap(),
+    let delta = 0.25;
+    let per_update = Discount::PerUpdate {
+        theta: 0.7_f64.powf(delta),
+    };
+    let (mut by_time, mut by_count, mut by_span) = (
         new()
-            .with_fading(Discount::PerUpdate(0.7_f64.powf(tau)))
+            .with_fading(Discount::PerTime {
+                theta: 0.7,
+                tau: 1.0,
+            })
+            .unwrap(),
+        new().with_fading(per_update).unwrap(),
+        new()
+            .with_fading(Discount::PerTime {
+                theta: per_update.theta(),
+                tau: delta,
+            })
             .unwrap(),
     );
     for k in 1..200 {
-        let z = scalar(k as f64 * tau, (k as f64 * 0.1).cos(), 0.3);
-        let (a, b) = (
-            plain.update(&z).unwrap().unwrap(),
-            unit.update(&z).unwrap().unwrap(),
-        );
-        assert_eq!(plain.state(), unit.state());
-        assert_eq!(plain.covariance(), unit.covariance());
-        assert_eq!(a.nis, b.nis);
+        let z = scalar(k as f64 * delta, (k as f64 * 0.1).cos(), 0.3);
         by_time.update(&z).unwrap();
-        by_count.update(&z).unwrap();
+        let a = by_count.update(&z).unwrap().unwrap();
+        let b = by_span.update(&z).unwrap().unwrap();
+        assert_eq!(by_count.state(), by_span.state());
+        assert_eq!(by_count.covariance(), by_span.covariance());
+        assert_eq!(a.nis, b.nis);
     }
     assert!((by_time.state() - by_count.state()).amax() < 1e-12);
     assert!((by_time.covariance() - by_count.covariance()).amax() < 1e-12);
-    assert!(new().with_fading(Discount::PerTime(0.0)).is_err());
-    assert!(new().with_fading(Discount::PerUpdate(1.5)).is_err());
-    assert!(new().with_fading(Discount::PerUpdate(f64::NAN)).is_err());
+    for one in [
+        Discount::PerTime {
+            theta: 1.0,
+            tau: 1.0,
+        },
+        Discount::PerUpdate { theta: 1.0 },
+    ] {
+        assert_eq!(
+            new().with_fading(one).unwrap_err(),
+            seqsmooth::Error::ThetaOutOfRange { theta: 1.0 }
+        );
+    }
+    assert_eq!(
+        new()
+            .with_fading(Discount::PerTime {
+                theta: 0.7,
+                tau: -1.0
+            })
+            .unwrap_err(),
+        seqsmooth::Error::TauOutOfRange { tau: -1.0 }
+    );
+    assert!(new()
+        .with_fading(Discount::PerTime {
+            theta: 0.0,
+            tau: 1.0
+        })
+        .is_err());
+    assert!(new()
+        .with_fading(Discount::PerUpdate { theta: 1.5 })
+        .is_err());
+    assert!(new()
+        .with_fading(Discount::PerUpdate { theta: f64::NAN })
+        .is_err());
 }

@@ -73,7 +73,7 @@ fn fixture() -> String {
     }
     let mut bayes = BayesFilter::new(dynamics, observation, 0.0)
         .unwrap()
-        .with_fading(Discount::PerUpdate(0.9))
+        .with_fading(Discount::PerUpdate { theta: 0.9 })
         .unwrap();
     for m in &rows {
         bayes.update(m).unwrap();

@@ -24,7 +24,7 @@
 //!   at which it was determined: after 2-3 rows), `KalmanFilter` on the same model and the
 //!   radar `.with_process_noise(WhiteNoiseDerivative::new(1, 3, 1))`, `update` with each later
 //!   row; truth `q = 1` m²/s³ (a velocity random walk of ~9 m/s over a pass).
-//! - *fading*: the same start, `.with_fading(Discount::PerTime(0.95))`, no driving noise; it
+//! - *fading*: the same start, `.with_fading(Discount::PerTime { theta: 0.95, tau: 1.0 })`, no driving noise; it
 //!   reports the true covariance of its estimate only when its model holds, so truth `q = 0`.
 //!   (Measured on a `q = 1` truth: mean NEES ~3,200 at the middle row, ~25,000 at the last.)
 //! - *smooth*: `kalman::smooth` of the Kalman filter above (same start, same driving noise)
@@ -468,7 +468,10 @@ fn fading_filter_is_consistent_on_a_constant_velocity_truth() {
         tally.start_nees.0 += v;
         tally.start_nees.1 += 1;
         let mut f = filter_from(radar, &c)
-            .with_fading(Discount::PerTime(BETA))
+            .with_fading(Discount::PerTime {
+                theta: BETA,
+                tau: 1.0,
+            })
             .unwrap();
         for k in k0 + 1..ROWS {
             if let Some(i) = f.update(&pass.rows[k]).unwrap() {

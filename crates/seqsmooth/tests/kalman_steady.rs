@@ -182,7 +182,10 @@ fn the_fading_filter_reaches_it() {
         0.0,
     )
     .unwrap()
-    .with_fading(Discount::PerTime(0.9))
+    .with_fading(Discount::PerTime {
+        theta: 0.9,
+        tau: 1.0,
+    })
     .unwrap();
     let mut gain = DMatrix::zeros(2, 1);
     for k in 1..=600 {

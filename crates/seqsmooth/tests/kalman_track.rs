@@ -131,8 +131,11 @@ fn kalman_and_fading_equal_the_filter_from_the_first_fit() {
     let (k0, c) = start(radar, &rows);
     for method in [
         TrackMethod::Kalman { q: Some(0.5) },
-        TrackMethod::Fading(Some(Discount::PerTime(0.9))),
-        TrackMethod::Fading(Some(Discount::PerUpdate(0.8))),
+        TrackMethod::Fading(Some(Discount::PerTime {
+            theta: 0.9,
+            tau: 1.0,
+        })),
+        TrackMethod::Fading(Some(Discount::PerUpdate { theta: 0.8 })),
     ] {
         let (out, held) = tracked(radar, method, &rows);
         assert!(held.iter().all(Option::is_none));
@@ -364,7 +367,7 @@ fn a_refused_row_names_its_rows_and_changes_nothing() {
     // Every method refuses a row at or before the previous one.
     for method in [
         TrackMethod::Kalman { q: Some(1.0) },
-        TrackMethod::Fading(Some(Discount::PerUpdate(0.9))),
+        TrackMethod::Fading(Some(Discount::PerUpdate { theta: 0.9 })),
     ] {
         let mut t = RadarTracker::new(radar, method).unwrap();
         for m in &rows[..30] {
@@ -416,9 +419,12 @@ fn bad_settings_are_refused() {
         TrackMethod::Kalman {
             q: Some(f64::INFINITY),
         },
-        TrackMethod::Fading(Some(Discount::PerTime(0.0))),
-        TrackMethod::Fading(Some(Discount::PerUpdate(1.5))),
-        TrackMethod::Fading(Some(Discount::PerUpdate(f64::NAN))),
+        TrackMethod::Fading(Some(Discount::PerTime {
+            theta: 0.0,
+            tau: 1.0,
+        })),
+        TrackMethod::Fading(Some(Discount::PerUpdate { theta: 1.5 })),
+        TrackMethod::Fading(Some(Discount::PerUpdate { theta: f64::NAN })),
         TrackMethod::Window { window: 1 },
     ] {
         assert!(RadarTracker::new(radar, method).is_err(), "{method:?}");
@@ -563,8 +569,11 @@ fn extreme_scales_end_instead_of_looping() {
         ],
     ];
     let radar = Radar::new([0.0; 3], 6).unwrap();
-    let mut t =
-        RadarTracker::new(radar, TrackMethod::Fading(Some(Discount::PerUpdate(0.9)))).unwrap();
+    let mut t = RadarTracker::new(
+        radar,
+        TrackMethod::Fading(Some(Discount::PerUpdate { theta: 0.9 })),
+    )
+    .unwrap();
     let mut refused = Vec::new();
     for (k, [time, r, az, el]) in ROWS.into_iter().enumerate() {
         let m = Measurement {

@@ -13,7 +13,7 @@
 //! (10.3.5)); the estimate exists once the observations determine it.
 //!
 //! With fading memory ([`BayesFilter::with_fading`], the fading-memory Bayes filter of
-//! (14.4.26)-(14.4.32)) the information so far is multiplied by `β^(t_n − t_(n−1))` or `θ`
+//! (14.4.26)-(14.4.32)) the information so far is multiplied by `θ^((t_n − t_(n−1))/τ)` or `θ`
 //! before each update, so the estimate minimises the discounted criterion (14.2.10) or
 //! (14.2.12); [`BayesFilter::covariance`] is then the estimate's true covariance `S*`
 //! (14.3.11)-(14.3.13), and [`BayesFilter::information_covariance`] the recursion's own `P`. A nonlinear
@@ -21,7 +21,7 @@
 //! (zero variance) cannot be weighed in this form and is refused (§12.4 item 4: the Bayes
 //! filter fails visibly).
 
-use super::filter::Discount;
+use crate::discount::Discount;
 use crate::error::Error;
 use crate::estimate::batch::NoiseCovariance;
 use crate::estimate::gauss_newton::Measurement;
@@ -59,7 +59,7 @@ pub struct BayesFilter<D: Dynamics, O: Observation> {
     observation: O,
     info: InformationFilter,
     time: f64,
-    /// The discount and the time of the last update (from which `β` counts).
+    /// The discount and the time of the last update (from which a discount per time counts).
     fading: Option<(Discount, f64)>,
     /// Whether there is information to discount (a prior or an update).
     informed: bool,
@@ -177,9 +177,10 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     }
 
     /// The fading-memory Bayes filter (14.4.26)-(14.4.32): before each update the information
-    /// so far is multiplied by the discount over the step ([`Discount`]: `β` per unit of time
-    /// since the last update, or `θ` per update); [`Self::covariance`] becomes the true
-    /// covariance. `β = 1` or `θ = 1` is the plain filter.
+    /// so far is multiplied by the discount over the step ([`Discount`]: `θ^(Δt/τ)` for `θ`
+    /// per span `τ` of time, `Δt` since the last update, or `θ` per update);
+    /// [`Self::covariance`] becomes the true covariance. `0 < θ < 1`: without fading memory the
+    /// filter is the plain one.
     ///
     /// ```
     /// use seqsmooth::estimate::batch::NoiseCovariance;
@@ -191,7 +192,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     /// // variance tends to (1 − θ)/(1 + θ) = 1/3 (Table 13.2).
     /// let mut f = BayesFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 0.0)
     ///     .unwrap()
-    ///     .with_fading(Discount::PerUpdate(0.5))
+    ///     .with_fading(Discount::PerUpdate { theta: 0.5 })
     ///     .unwrap();
     /// for k in 0..60 {
     ///     f.update(&Measurement { time: k as f64, values: vec![Some(1.0)], noise: NoiseCovariance::Identity }).unwrap();
@@ -252,7 +253,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     /// use seqsmooth::model::observation::LinearObservation;
     /// let mut f = BayesFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 0.0)
     ///     .unwrap()
-    ///     .with_fading(Discount::PerTime(0.25))
+    ///     .with_fading(Discount::PerTime { theta: 0.25, tau: 1.0 })
     ///     .unwrap();
     /// for t in [0.0, 1.0] {
     ///     f.update(&Measurement { time: t, values: vec![Some(t)], noise: NoiseCovariance::Identity }).unwrap();

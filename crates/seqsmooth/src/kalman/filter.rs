@@ -55,6 +55,7 @@
 
 use super::correct::{carry, correct_kernel, finite, noise_entries, Work};
 use super::noise::ProcessNoise;
+use crate::discount::Discount;
 use crate::error::Error;
 use crate::estimate::batch::NoiseCovariance;
 use crate::estimate::gauss_newton::Measurement;
@@ -136,18 +137,8 @@ pub struct KalmanFilter<D: Dynamics, O: Observation> {
     work: Work,
 }
 
-/// How old observations are discounted (Morrison ch. 14): by time, `β^(t_n − t_k)`
-/// (14.2.10), or by count, `θ^(n−k)` (14.2.12). `β = 1` or `θ = 1` is the plain filter.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Discount {
-    /// `0 < β ≤ 1` per unit of time.
-    PerTime(f64),
-    /// `0 < θ ≤ 1` per update.
-    PerUpdate(f64),
-}
-
 /// The fading filter's own matrix `P` (14.3.13), not the covariance when the discount is
-/// below 1, and the time of the last update (from which `β` counts).
+/// below 1, and the time of the last update (from which a discount per time counts).
 #[derive(Clone, Debug)]
 struct Fading {
     discount: Discount,
@@ -156,7 +147,7 @@ struct Fading {
 }
 
 impl Fading {
-    /// `β^(t − t_last)` or `θ`, in `(0, 1]` ([`Discount`]'s factor over the step).
+    /// `θ^((t − t_last)/τ)` or `θ`, in `(0, 1)` ([`Discount`]'s factor over the step).
     fn factor(&self, t: f64) -> Result<f64, Error> {
         self.discount.factor_over(t - self.last_update)
     }
@@ -266,11 +257,13 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
 
     /// The generalized fading-memory filter of ch. 14 ((14.4.34)-(14.4.40)): the gain from
     /// the recursion's own matrix `P`, `H = P Mᵀ (f R + M P Mᵀ)⁻¹`, `P ← (1/f)(I − H M) P` (in
-    /// Joseph's form), with `f = β^(t_n − t_{n−1})` (time since the previous update) or `θ`;
+    /// Joseph's form), with `f = θ^((t_n − t_{n−1})/τ)` (time since the previous update;
+    /// Morrison's `β^(t_n − t_{n−1})` with `β = θ^(1/τ)`) or `θ` per update ([`Discount`]);
     /// the covariance reported, [`Self::covariance`], is the true one of the estimate
     /// ((14.4.31)-(14.4.32), (14.3.19)), and the innovation statistics use it (§14.8). `P`
-    /// starts as the current covariance, counted from the current time (start at `β = 1` and
-    /// switch, §14.5). The discount must lie in `(0, 1]`.
+    /// starts as the current covariance, counted from the current time (start without fading
+    /// and switch, §14.5). `θ` must lie in `(0, 1)` and `τ` be positive: without fading memory
+    /// the filter is the plain one.
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
@@ -282,7 +275,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// // Degree 0, θ = 0.5, vague prior: the gain settles at 1 − θ = 0.5 (Table 13.1).
     /// let mut f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
     ///     DVector::zeros(1), DMatrix::from_element(1, 1, 1e9), 0.0).unwrap()
-    ///     .with_fading(Discount::PerUpdate(0.5)).unwrap();
+    ///     .with_fading(Discount::PerUpdate { theta: 0.5 }).unwrap();
     /// let mut gain = 0.0;
     /// for k in 1..60 {
     ///     let m = Measurement { time: k as f64, values: vec![Some(1.0)], noise: NoiseCovariance::Identity };
@@ -504,8 +497,9 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// use seqsmooth::model::observation::LinearObservation;
     /// let mut f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
     ///     DVector::zeros(1), DMatrix::identity(1, 1), 0.0).unwrap();
-    /// assert!(f.set_fading(Discount::PerUpdate(0.5)).is_ok());
-    /// assert!(f.set_fading(Discount::PerUpdate(1.5)).is_err());
+    /// assert!(f.set_fading(Discount::PerUpdate { theta: 0.5 }).is_ok());
+    /// assert!(f.set_fading(Discount::PerUpdate { theta: 1.5 }).is_err());
+    /// assert!(f.set_fading(Discount::PerTime { theta: 0.5, tau: 0.0 }).is_err());
     /// ```
     pub fn set_fading(&mut self, discount: Discount) -> Result<(), Error> {
         let discount = discount.checked()?;

@@ -4,10 +4,11 @@
 //! chooses: `q₀ 4^ℓ` or `θ = 1 − (1 − θ₀) 2^ℓ`; and the gated update of each row through it.
 
 use super::adaptive::{Monitor, TrackFlag};
-use super::filter::{Discount, KalmanFilter};
+use super::filter::KalmanFilter;
 use super::fixed_lag::FixedLagSmoother;
 use super::noise::WhiteNoiseDerivative;
 use super::smoother::Smoothed;
+use crate::discount::Discount;
 use crate::error::Error;
 use crate::estimate::batch::NoiseCovariance;
 use crate::estimate::gauss_newton::Measurement;
@@ -57,10 +58,7 @@ impl Memory {
             }
             MemoryKind::Fading(d) if level == 0 => f.set_fading(d),
             MemoryKind::Fading(d) => {
-                let theta = match d {
-                    Discount::PerUpdate(t) | Discount::PerTime(t) => t,
-                };
-                f.set_fading(Discount::PerUpdate(1.0 - (1.0 - theta) * 2f64.powi(level)))
+                f.set_fading(d.with_theta(1.0 - (1.0 - d.theta()) * 2f64.powi(level))?)
             }
         }
     }

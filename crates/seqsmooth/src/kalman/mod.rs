@@ -24,7 +24,6 @@
 pub mod adaptive;
 pub mod bayes;
 mod correct;
-mod discount;
 pub mod filter;
 pub mod fixed_lag;
 mod memory;
@@ -33,7 +32,8 @@ pub mod smoother;
 pub mod steady;
 pub mod track;
 
+pub use crate::discount::Discount;
 pub use bayes::BayesFilter;
-pub use filter::{Discount, Innovation, KalmanFilter};
+pub use filter::{Innovation, KalmanFilter};
 pub use fixed_lag::FixedLagSmoother;
 pub use smoother::{smooth, Smoothed, Smoother};

@@ -5,7 +5,7 @@
 //! |---|---|---|
 //! | [`TrackMethod::Window`] | the Gauss–Newton fit of the last `W` rows (warm started), its innovation against the previous row's fit | §8.5-8.7 ([`SlidingFit`]) |
 //! | [`TrackMethod::Kalman`] | the extended Kalman filter, white noise of density `q` driving the acceleration | ch. 12, (15.2.23) |
-//! | [`TrackMethod::Fading`] | the extended Kalman filter with fading memory (`β` per time or `θ` per update), its true covariance | ch. 14 |
+//! | [`TrackMethod::Fading`] | the extended Kalman filter with fading memory (`θ` per span `τ` of time or `θ` per update, [`Discount`]), its true covariance | ch. 14 |
 //! | [`TrackMethod::Smooth`] | the Rauch–Tung–Striebel smoother over the Kalman filter's run with a lag of `L` rows: each row's estimate from the `L` rows after it, given `L` rows later | [`super::fixed_lag`] |
 //!
 //! The Kalman methods start from the first Gauss–Newton fit of the rows so far (at most
@@ -29,10 +29,11 @@
 
 pub use super::adaptive::TrackFlag;
 use super::adaptive::{Monitor, MISFIT_ALPHA};
-use super::filter::{Discount, KalmanFilter};
+use super::filter::KalmanFilter;
 use super::fixed_lag::FixedLagSmoother;
 use super::memory::{base_noise, Filter, Memory, MemoryKind};
 use super::smoother::Smoothed;
+use crate::discount::Discount;
 use crate::error::Error;
 use crate::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use crate::estimate::sliding::{SlidingFit, Start};
@@ -195,7 +196,9 @@ fn memory_of<'a>(
         }
         TrackMethod::Fading(Some(d)) => (MemoryKind::Fading(d), false, (0, 0)),
         TrackMethod::Fading(None) => (
-            MemoryKind::Fading(Discount::PerUpdate(DEFAULT_THETA)),
+            MemoryKind::Fading(Discount::PerUpdate {
+                theta: DEFAULT_THETA,
+            }),
             true,
             FADING_LEVELS,
         ),

@@ -1,5 +1,5 @@
 //! The shared vocabulary of the expanding- and fading-memory filters: which [`Engine`] a filter
-//! runs on, how fading memory discounts ([`DiscountMode`]), the largest degree, and the checks of
+//! runs on, how fading memory discounts ([`DiscountMode`], the tag of [`Discount`]), the largest degree, and the checks of
 //! their parameters.
 
 use crate::error::Error;
@@ -39,7 +39,8 @@ pub enum Engine {
     Gain,
 }
 
-/// How a fading-memory filter discounts old samples.
+/// How a fading-memory filter discounts old samples: the tag of the one [`Discount`] type of
+/// every fading memory (defined in [`crate::discount`]).
 ///
 /// ```
 /// use seqsmooth::{DiscountMode, Engine, FadingMemory, PolynomialFilter};
@@ -50,14 +51,7 @@ pub enum Engine {
 /// // weights 1/2 and 1 whatever the gap: (0·½ + 3·1)/(½ + 1) = 2
 /// assert!((f.estimate().unwrap().derivatives[0] - 2.0).abs() < 1e-12);
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum DiscountMode {
-    /// By `θ` per `τ` of elapsed time: weight `θ^((t_n - t_k)/τ)` (`θ_eff = θ^ζ` per update).
-    #[default]
-    PerTime,
-    /// By `θ` per sample whatever the spacing: weight `θ^(n-k)`.
-    PerUpdate,
-}
+pub use crate::discount::{Discount, DiscountMode};
 
 /// The highest degree of the gain engine and of the banks, which run the same fixed-gain
 /// recursion (Morrison Tables 9.1, 13.1). The recursion's transition `(I − h e₀ᵀ) Φ` has one
@@ -119,12 +113,7 @@ pub(crate) fn check_degree(m: usize) -> Result<(), Error> {
     Ok(())
 }
 
-pub(crate) fn check_tau(tau: f64) -> Result<(), Error> {
-    if !(tau.is_finite() && tau > 0.0) {
-        return Err(Error::TauOutOfRange { tau });
-    }
-    Ok(())
-}
+pub(crate) use crate::discount::{check_tau, check_theta};
 
 /// The measurement noise's 1σ: a positive finite number whose variance `σ²` is a normal,
 /// finite double (`1.5e-154 ≲ σ ≲ 1.3e154`): below, the variance is zero or subnormal and the
@@ -147,13 +136,6 @@ pub(crate) fn check_noise_sigma(sigma: f64) -> Result<(), Error> {
         value: format!("{sigma:?}"),
         reason: reason.into(),
     })
-}
-
-pub(crate) fn check_theta(theta: f64) -> Result<(), Error> {
-    if !(theta > 0.0 && theta < 1.0) {
-        return Err(Error::ThetaOutOfRange { theta });
-    }
-    Ok(())
 }
 
 /// Settings are fixed once a filter has taken its first sample: an error naming `what` to set

@@ -21,10 +21,11 @@
 //! in Gentleman's square-root-free form ([`TriangularFactor`]): no square roots per sample,
 //! and once every pivot is positive none of its `2m+3` divisions per sample waits for another.
 
+use crate::discount::{Discount, DiscountMode};
 use crate::model::taylor::{unscale_in_range, unscale_stepwise};
 use crate::model::{derivative_scale, shift_scaled, shift_scaled_array};
 use crate::numeric::unrolled::unrolled_sizes;
-use crate::polynomial::options::{DiscountMode, MAX_DEGREE};
+use crate::polynomial::options::MAX_DEGREE;
 use crate::recursive::InformationFilter;
 #[cfg(doc)]
 use crate::recursive::TriangularFactor;
@@ -50,13 +51,6 @@ const fn pascal() -> [[f64; MAX_SIZE]; MAX_SIZE] {
         k += 1;
     }
     c
-}
-
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Discount {
-    pub theta: f64,
-    pub tau: f64,
-    pub mode: DiscountMode,
 }
 
 #[derive(Clone, Debug)]
@@ -103,10 +97,10 @@ impl ExactEngine {
             n: 0,
             sigma: None,
             step_cached: f64::NAN,
-            inv_root: discount.map_or(1.0, |d| 1.0 / d.theta.sqrt()),
-            half_rate: discount.map_or(0.0, |d| -d.theta.ln() / (2.0 * d.tau)),
-            span_updates: discount.map_or(0.0, |d| 3.0 / -d.theta.ln()),
-            span_per_time: discount.map_or(0.0, |d| 3.0 * d.tau / -d.theta.ln()),
+            inv_root: discount.map_or(1.0, |d| 1.0 / d.theta().sqrt()),
+            half_rate: discount.map_or(0.0, |d| -d.theta().ln() / (2.0 * d.tau().unwrap_or(1.0))),
+            span_updates: discount.map_or(0.0, |d| 3.0 / -d.theta().ln()),
+            span_per_time: discount.map_or(0.0, |d| 3.0 * d.tau().unwrap_or(1.0) / -d.theta().ln()),
             unscale: [0.0; MAX_DEGREE + 1],
             unscale_in_range: true,
         }
@@ -142,7 +136,7 @@ impl ExactEngine {
             self.set_unscale();
         } else {
             if let Some(d) = self.discount {
-                if d.mode == DiscountMode::PerTime {
+                if d.mode() == DiscountMode::PerTime {
                     let dt = t - self.t_last;
                     if dt != self.step_cached {
                         self.step_cached = dt;
@@ -182,7 +176,7 @@ impl ExactEngine {
         let elapsed = t - self.t_first;
         let (s_num, q) = match self.discount {
             None => (0.5 * elapsed, 1.0),
-            Some(d) => match d.mode {
+            Some(d) => match d.mode() {
                 DiscountMode::PerTime => (0.5 * elapsed.min(self.span_per_time), 1.0),
                 DiscountMode::PerUpdate => {
                     let n = self.n as f64;

@@ -22,7 +22,7 @@ use crate::model::PolynomialState;
 #[cfg(doc)]
 use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::options::GAIN_MAX_VALUE;
-pub(crate) use exact::{Discount, ExactEngine};
+pub(crate) use exact::ExactEngine;
 pub(crate) use gain::{FadingGains, GainEngine};
 
 /// Why a least-squares fit with at least `m+1` samples is not determined: its information

@@ -4,11 +4,11 @@ use super::switch::SwitchRule;
 use crate::error::Error;
 use crate::model::PolynomialState;
 use crate::polynomial::engine::{
-    impl_polynomial_filter, Discount, EngineState, ExactEngine, FadingGains, GainEngine,
+    impl_polynomial_filter, EngineState, ExactEngine, FadingGains, GainEngine,
 };
 use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::options::{
-    check_engine_degree, check_not_started, check_tau, check_theta, DiscountMode, Engine,
+    check_engine_degree, check_not_started, check_tau, check_theta, Discount, DiscountMode, Engine,
 };
 
 /// Fading-memory polynomial filter of degree `m` and discount `θ` per `τ` (Morrison ch. 13;
@@ -49,7 +49,8 @@ impl FadingMemory {
         self.core.variances_at(self.m, t, x, var)
     }
 
-    /// A filter of degree `m`, discount `θ ∈ (0,1)` per nominal interval `τ > 0`.
+    /// A filter of degree `m`, discount `θ ∈ (0,1)` per span `τ > 0` of time
+    /// ([`Discount::PerTime`]; [`Self::from_discount`] takes either meaning).
     ///
     /// ```
     /// use seqsmooth::{Engine, Error, FadingMemory, PolynomialFilter};
@@ -66,7 +67,7 @@ impl FadingMemory {
         let rule = SwitchRule::default();
         let core = match engine {
             Engine::Exact => {
-                EngineState::Exact(ExactEngine::new(m, Some(Discount { theta, tau, mode })))
+                EngineState::Exact(ExactEngine::new(m, Some(Discount::PerTime { theta, tau })))
             }
             Engine::Gain => EngineState::Gain(GainEngine::new(
                 m,
@@ -85,18 +86,45 @@ impl FadingMemory {
         })
     }
 
+    /// A filter of degree `m` with `discount`, either meaning ([`Discount`]): the one type the
+    /// fading Bayes and Kalman filters take too, so that the same discount is the same
+    /// estimator (`θ` per update runs the engines in units of `τ = 1`).
+    ///
+    /// ```
+    /// use seqsmooth::discount::Discount;
+    /// use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
+    /// let d = Discount::per_time(0.9, 0.5).unwrap();
+    /// let f = FadingMemory::from_discount(1, d, Engine::Exact).unwrap();
+    /// assert_eq!((f.theta(), f.tau(), f.discount()), (0.9, 0.5, d));
+    /// let g = FadingMemory::from_discount(1, Discount::PerUpdate { theta: 0.9 }, Engine::Gain).unwrap();
+    /// assert_eq!(g.discount(), Discount::PerUpdate { theta: 0.9 });
+    /// assert!(FadingMemory::from_discount(1, Discount::PerUpdate { theta: 1.0 }, Engine::Gain).is_err());
+    /// ```
+    pub fn from_discount(m: usize, discount: Discount, engine: Engine) -> Result<Self, Error> {
+        let d = discount.checked()?;
+        let f = Self::new(m, d.theta(), d.tau().unwrap_or(1.0), engine)?;
+        match d.mode() {
+            DiscountMode::PerTime => Ok(f),
+            DiscountMode::PerUpdate => f.with_discount_mode(DiscountMode::PerUpdate),
+        }
+    }
+
+    /// The discount, with its meaning.
+    pub fn discount(&self) -> Discount {
+        match self.mode {
+            DiscountMode::PerTime => Discount::PerTime {
+                theta: self.theta,
+                tau: self.tau,
+            },
+            DiscountMode::PerUpdate => Discount::PerUpdate { theta: self.theta },
+        }
+    }
+
     fn rebuild(&mut self) -> Result<(), Error> {
         check_not_started(self.core.samples() > 0, "the discount mode and switch rule")?;
         match &mut self.core {
             EngineState::Exact(_) => {
-                self.core = EngineState::Exact(ExactEngine::new(
-                    self.m,
-                    Some(Discount {
-                        theta: self.theta,
-                        tau: self.tau,
-                        mode: self.mode,
-                    }),
-                ));
+                self.core = EngineState::Exact(ExactEngine::new(self.m, Some(self.discount())));
             }
             EngineState::Gain(_) => {
                 self.core = EngineState::Gain(GainEngine::new(
