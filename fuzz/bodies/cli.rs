@@ -58,7 +58,7 @@ const FIT_OPTIONS: [(&str, &[&str]); 14] = [
 ];
 
 /// The options of `track`.
-const TRACK_OPTIONS: [(&str, &[&str]); 12] = [
+const TRACK_OPTIONS: [(&str, &[&str]); 13] = [
     (
         "--method",
         &["window", "kalman", "fading", "smooth", "bayes"],
@@ -66,8 +66,9 @@ const TRACK_OPTIONS: [(&str, &[&str]); 12] = [
     ("--sigma-range", &["10", "1e-300", "0"]),
     ("--sigma-angle", &["1e-3", "1", "1e300"]),
     ("--q", &["0", "1", "10", "1e300", "-1"]),
-    ("--beta", &["0.7", "1", "1e-300", "0"]),
-    ("--theta", &["0.9", "0.5"]),
+    ("--theta", &["0.7", "1", "1e-300", "0", "0.9", "0.5"]),
+    ("--tau", &["1", "0.5", "0"]),
+    ("--theta-per-update", &["0.9", "0.5"]),
     ("--window", &["1", "2", "6", "60", "0"]),
     ("--azimuth", &["from-x", "bearing"]),
     ("--site", &["0,0,0", "1,2,3", "1e300,0,0"]),

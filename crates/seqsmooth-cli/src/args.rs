@@ -167,9 +167,9 @@ Without --q the driving noise is adaptive: it starts at sigma_range^2/T^3 (T the
 step) and is multiplied by 4 at each misfit whose NIS is still high (16 beyond the gate), and \
 divided by 4 after 15 quiet updates whose mean NIS is below its expectation.
 --method fading: the same start, then the fading-memory Kalman filter (Morrison 14.4) with \
---beta B per unit of time or --theta T per update; s.. are the true 1-sigma errors. Without \
-either the discount is adaptive, per update from 0.9: each misfit doubles 1 - theta, quiet \
-updates halve it again.
+--theta T per --tau TAU of time (a row dt older weighs T^(dt/TAU), as in 'seqsmooth filter') \
+or --theta-per-update T; s.. are the true 1-sigma errors. Without either the discount is \
+adaptive, per update from 0.9: each misfit doubles 1 - theta, quiet updates halve it again.
 --method smooth: the fixed-lag Rauch-Tung-Striebel smoother over the kalman method's run (its \
 --q or adaptive driving noise, its gate and flags): each row's estimate from the rows up to \
 --lag N rows after it (default 200), written N rows later with the flag the forward filter \
@@ -551,14 +551,21 @@ pub struct TrackArgs {
     /// [default: adaptive, from the innovations]
     #[arg(long = "q", value_name = "ACCEL_PSD", value_parser = parse_psd, allow_hyphen_values = true)]
     pub q: Option<f64>,
-    /// fading: the discount per unit of time, 0 < B <= 1 [default: an adaptive discount per
-    /// update, from the innovations]
-    #[arg(long, value_name = "B", value_parser = parse_discount, allow_hyphen_values = true,
-          conflicts_with = "theta")]
-    pub beta: Option<f64>,
-    /// fading: the discount per update, 0 < T <= 1
-    #[arg(long, value_name = "T", value_parser = parse_discount, allow_hyphen_values = true)]
+    /// fading: the discount per span --tau of time, 0 < T < 1 (with --tau) [default: an
+    /// adaptive discount per update, from the innovations]
+    #[arg(long, value_name = "T", value_parser = parse_number, allow_hyphen_values = true,
+          requires = "tau", conflicts_with = "theta_per_update")]
     pub theta: Option<f64>,
+    /// fading: the span of time --theta applies to, TAU > 0 in the times' units
+    #[arg(long, value_name = "TAU", value_parser = parse_number, allow_hyphen_values = true,
+          requires = "theta")]
+    pub tau: Option<f64>,
+    /// fading: the discount per update whatever the spacing, 0 < T < 1
+    #[arg(long, value_name = "T", value_parser = parse_number, allow_hyphen_values = true)]
+    pub theta_per_update: Option<f64>,
+    /// Refused: '--beta B' (per unit of time) is now '--theta B --tau 1'
+    #[arg(long, value_name = "B", hide = true, value_parser = refuse_beta)]
+    pub beta: Option<f64>,
     /// window: the number of rows in each window [default: 8]
     #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
     pub window: Option<usize>,
@@ -625,7 +632,7 @@ pub enum TrackMethod {
     Window,
     /// The extended Kalman filter with white-noise acceleration (--q).
     Kalman,
-    /// The fading-memory Kalman filter (--beta or --theta).
+    /// The fading-memory Kalman filter (--theta with --tau, or --theta-per-update).
     Fading,
     /// The Rauch-Tung-Striebel smoother over the Kalman filter.
     Smooth,
@@ -652,13 +659,17 @@ pub fn parse_psd(s: &str) -> Result<f64, String> {
     )
 }
 
-/// Parses `--beta` and `--theta` of `track`: `0 < v <= 1`.
-pub fn parse_discount(s: &str) -> Result<f64, String> {
-    parse_f64(
-        "discount",
-        s,
-        (|v| v > 0.0 && v <= 1.0, "a number with 0 < value <= 1"),
-    )
+/// Parses a number the library checks (`track`'s `--theta`, `--tau`, `--theta-per-update`).
+pub fn parse_number(s: &str) -> Result<f64, String> {
+    parse_f64("number", s, (|v| !v.is_nan(), "a number"))
+}
+
+/// `track --beta`, refused with its new spelling.
+pub fn refuse_beta(s: &str) -> Result<f64, String> {
+    Err(format!(
+        "--beta is gone: a discount of {s} per unit of time is now '--theta {s} --tau 1' \
+         (and '--theta T' alone meant per update: now '--theta-per-update T')"
+    ))
 }
 
 /// The models of `seqsmooth fit`.

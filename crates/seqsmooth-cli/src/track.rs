@@ -61,9 +61,9 @@ pub fn run(a: &TrackArgs) -> Result<(), CliError> {
             return usage("--q applies only to --method kalman and smooth")
         }
         TrackMethod::Window | TrackMethod::Kalman | TrackMethod::Smooth
-            if a.beta.is_some() || a.theta.is_some() =>
+            if a.theta.is_some() || a.theta_per_update.is_some() =>
         {
-            return usage("--beta and --theta apply only to --method fading")
+            return usage("--theta, --tau and --theta-per-update apply only to --method fading")
         }
         TrackMethod::Kalman | TrackMethod::Fading | TrackMethod::Smooth if a.window.is_some() => {
             return usage("--window applies only to --method window")
@@ -256,11 +256,10 @@ impl Tracker {
                 q: a.q,
                 lag: a.lag.unwrap_or(DEFAULT_LAG),
             },
-            TrackMethod::Fading => Method::Fading(match (a.beta, a.theta) {
-                (Some(b), _) => Some(Discount::PerTime(b)),
-                (_, Some(t)) => Some(Discount::PerUpdate(t)),
-                _ => None,
-            }),
+            TrackMethod::Fading => Method::Fading(
+                Discount::from_names(a.theta, a.tau, a.theta_per_update)
+                    .map_err(|e| CliError::Usage(e.to_string()))?,
+            ),
         };
         let solver = GaussNewton {
             max_iterations: a.max_iterations as usize,

@@ -63,7 +63,7 @@ fn track(input: &str, method: &[&str]) -> Vec<Vec<String>> {
 }
 
 /// Every method, with the settings the help recommends for a manoeuvring target (kalman and
-/// smooth --q 10 m²/s³, fading --beta 0.7 per second, window --window 6), covers the truth
+/// smooth --q 10 m²/s³, fading --theta 0.7 --tau 1 (per second), window --window 6), covers the truth
 /// within its reported 3σ on at least 97% of the determinable rows on each of east, north
 /// and up, turn included; the rows before the first determination are empty (only the first).
 #[test]
@@ -72,7 +72,7 @@ fn landing_within_three_sigma() {
     for method in [
         &["kalman", "--q", "10"][..],
         &["smooth", "--q", "10"],
-        &["fading", "--beta", "0.7"],
+        &["fading", "--theta", "0.7", "--tau", "1"],
         &["window", "--window", "6"],
     ] {
         let rows = track(&input, method);
@@ -268,22 +268,47 @@ fn track_refuses_bad_input() {
         &["max-iterations"],
     );
     fails(
-        &with(&["--method", "fading", "--beta", "0.9", "--q", "1"]),
+        &with(&["--method", "fading", "--theta", "0.9", "--tau", "1", "--q", "1"]),
         good,
         2,
         &["--q applies only"],
     );
     fails(
-        &with(&["--method", "kalman", "--theta", "0.9"]),
+        &with(&["--method", "kalman", "--theta-per-update", "0.9"]),
         good,
         2,
-        &["--beta and --theta apply only"],
+        &["--theta, --tau and --theta-per-update apply only"],
+    );
+    // One range and one vocabulary with `filter`: θ in (0, 1) per --tau, or per update.
+    fails(
+        &with(&["--method", "fading", "--theta", "1.5", "--tau", "1"]),
+        good,
+        2,
+        &["theta 1.5 is out of range"],
     );
     fails(
-        &with(&["--method", "fading", "--beta", "1.5"]),
+        &with(&["--method", "fading", "--theta-per-update", "1"]),
         good,
         2,
-        &["discount"],
+        &["theta 1 is out of range"],
+    );
+    fails(
+        &with(&["--method", "fading", "--theta", "0.9", "--tau", "0"]),
+        good,
+        2,
+        &["tau"],
+    );
+    fails(
+        &with(&["--method", "fading", "--theta", "0.9"]),
+        good,
+        2,
+        &["--tau"],
+    );
+    fails(
+        &with(&["--method", "fading", "--beta", "0.9"]),
+        good,
+        2,
+        &["--theta 0.9 --tau 1", "--theta-per-update"],
     );
     fails(
         &with(&[]),
@@ -383,7 +408,10 @@ fn random_inputs_are_right_or_refused() {
         }
         match method {
             "window" => args.push(format!("--window={}", rng.gen_range(1..30))),
-            "fading" => args.push(format!("--beta={}", rng.gen_range(0.01..1.0))),
+            "fading" => {
+                args.push(format!("--theta={}", rng.gen_range(0.01..1.0)));
+                args.push("--tau=1".into());
+            }
             _ => args.push(format!(
                 "--q={}",
                 [0.0, 1.0, 10.0, 1e6][rng.gen_range(0..4)]
@@ -453,7 +481,7 @@ fn track_text(input: &str, args: &[&str]) -> String {
 const METHODS: [&[&str]; 4] = [
     &["--method", "kalman", "--q", "10"],
     &["--method", "smooth", "--q", "10"],
-    &["--method", "fading", "--beta", "0.7"],
+    &["--method", "fading", "--theta", "0.7", "--tau", "1"],
     &["--method", "window", "--window", "6"],
 ];
 
@@ -895,7 +923,7 @@ fn long_inputs_stream_across_batches() {
     let base = ["track", "--sigma-range", "10", "--sigma-angle", "1e-3"];
     for method in [
         &["--method", "kalman", "--q", "1"][..],
-        &["--method", "fading", "--beta", "0.9"],
+        &["--method", "fading", "--theta", "0.9", "--tau", "1"],
     ] {
         let args: Vec<&str> = [&base[..], method].concat();
         let whole = ok(&args, &input);
@@ -939,7 +967,7 @@ fn long_inputs_stream_across_batches() {
     let bad = bad.join("\n") + "\n";
     for method in [
         &["--method", "kalman", "--q", "1"][..],
-        &["--method", "fading", "--beta", "0.9"],
+        &["--method", "fading", "--theta", "0.9", "--tau", "1"],
         &["--method", "smooth", "--q", "1"],
     ] {
         let args: Vec<&str> = [&base[..], method].concat();
