@@ -268,7 +268,9 @@ fn track_refuses_bad_input() {
         &["max-iterations"],
     );
     fails(
-        &with(&["--method", "fading", "--theta", "0.9", "--tau", "1", "--q", "1"]),
+        &with(&[
+            "--method", "fading", "--theta", "0.9", "--tau", "1", "--q", "1",
+        ]),
         good,
         2,
         &["--q applies only"],

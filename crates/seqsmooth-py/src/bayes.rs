@@ -37,8 +37,12 @@ type Filter = BayesFilter<PolynomialDynamics, LinearObservation>;
 ///     The observation matrix ``M``, components × states; default the positions.
 /// x0, P0 : array_like, optional
 ///     A prior state and covariance at ``t0`` (both or neither).
-/// beta, theta : float, optional
-///     Fading memory: the discount per unit of time, or per update, in (0, 1].
+/// theta, tau : float, optional
+///     Fading memory: the discount ``theta`` in (0, 1) per span ``tau`` of time, both or
+///     neither (as ``FadingMemory``'s).
+/// theta_per_update : float, optional
+///     Fading memory with the discount in (0, 1) per update (what ``theta`` alone meant
+///     before; ``beta`` per unit of time is now ``theta``, ``tau=1.0``).
 #[pyclass(name = "BayesFilter", module = "seqsmooth")]
 pub struct PyBayesFilter {
     filter: Filter,
@@ -52,7 +56,7 @@ pub struct PyBayesFilter {
 impl PyBayesFilter {
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
-    #[pyo3(signature = (degree, t0 = 0.0, axes = 1, observation = None, x0 = None, P0 = None, beta = None, theta = None))]
+    #[pyo3(signature = (degree, t0 = 0.0, axes = 1, observation = None, x0 = None, P0 = None, theta = None, tau = None, theta_per_update = None, beta = None))]
     fn new(
         degree: usize,
         t0: f64,
@@ -60,8 +64,10 @@ impl PyBayesFilter {
         observation: Option<&Bound<'_, PyAny>>,
         x0: Option<&Bound<'_, PyAny>>,
         P0: Option<&Bound<'_, PyAny>>,
-        beta: Option<f64>,
         theta: Option<f64>,
+        tau: Option<f64>,
+        theta_per_update: Option<f64>,
+        beta: Option<f64>,
     ) -> PyResult<Self> {
         if axes == 0 {
             return Err(raise(
@@ -85,7 +91,7 @@ impl PyBayesFilter {
         let components = observe.components();
         let mut filter =
             BayesFilter::new(PolynomialDynamics::new(degree, axes), observe, t0).py()?;
-        if let Some(d) = discount_from(beta, theta)? {
+        if let Some(d) = discount_from(theta, tau, theta_per_update, beta)? {
             filter = filter.with_fading(d).py()?;
         }
         match (x0, P0) {

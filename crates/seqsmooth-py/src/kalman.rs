@@ -11,9 +11,10 @@ use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
+use seqsmooth::discount::Discount;
 use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::Measurement;
-use seqsmooth::kalman::filter::{Discount, Innovation};
+use seqsmooth::kalman::filter::Innovation;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::{smoother, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
@@ -173,18 +174,26 @@ pub(crate) fn observation_from(
     }
 }
 
-/// The fading discount from `beta` (per unit of time) or `theta` (per update), at most one.
-pub(crate) fn discount_from(beta: Option<f64>, theta: Option<f64>) -> PyResult<Option<Discount>> {
-    match (beta, theta) {
-        (Some(_), Some(_)) => Err(raise(
+/// The fading discount by the names of every front end (docs/names.md): `theta` per `tau` of
+/// time, or `theta_per_update`, by the library's rule (`Discount::from_names`); `beta`, the
+/// old discount per unit of time, refused with its new spelling.
+pub(crate) fn discount_from(
+    theta: Option<f64>,
+    tau: Option<f64>,
+    theta_per_update: Option<f64>,
+    beta: Option<f64>,
+) -> PyResult<Option<Discount>> {
+    if let Some(b) = beta {
+        return Err(raise(
             Kind::Parameter,
-            "beta and theta are both given: fading memory takes one of them",
+            format!(
+                "beta is gone: a discount of {b} per unit of time is now theta={b}, tau=1.0 \
+                 (and theta alone meant per update: now theta_per_update)"
+            ),
             None,
-        )),
-        (Some(b), None) => Ok(Some(Discount::PerTime(b))),
-        (None, Some(t)) => Ok(Some(Discount::PerUpdate(t))),
-        (None, None) => Ok(None),
+        ));
     }
+    Discount::from_names(theta, tau, theta_per_update).py()
 }
 
 /// One measurement `(t, z)` of `p` components (a number, or one value per component; NaN
@@ -269,9 +278,13 @@ pub(crate) fn out_of_order(start: f64, rows: &[Measurement]) -> Option<(usize, f
 /// observation : array_like, optional
 ///     The observation matrix ``M``, components × states; default the positions
 ///     (``[I_axes, 0, …]``).
-/// beta, theta : float, optional
-///     Fading memory (ch. 14): the discount per unit time, or per update, in (0, 1]; the
-///     covariance reported is then the true one, not the recursion's internal matrix.
+/// theta, tau : float, optional
+///     Fading memory (ch. 14): the discount ``theta`` in (0, 1) per span ``tau`` of time (an
+///     observation ``dt`` old weighs ``theta ** (dt / tau)``, as in ``FadingMemory``); both or
+///     neither. The covariance reported is then the true one, not the recursion's own matrix.
+/// theta_per_update : float, optional
+///     Fading memory with the discount in (0, 1) per update, whatever the spacing (what
+///     ``theta`` alone meant before; ``beta`` per unit of time is now ``theta``, ``tau=1.0``).
 ///
 /// The update is Joseph's form (12.3.7); a missing component (NaN) is left out, a time with
 /// none is a prediction only.
@@ -286,7 +299,7 @@ pub struct PyKalmanFilter {
 impl PyKalmanFilter {
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
-    #[pyo3(signature = (degree, x0, P0, t0 = 0.0, axes = 1, q = 0.0, observation = None, beta = None, theta = None))]
+    #[pyo3(signature = (degree, x0, P0, t0 = 0.0, axes = 1, q = 0.0, observation = None, theta = None, tau = None, theta_per_update = None, beta = None))]
     fn new(
         degree: usize,
         x0: &Bound<'_, PyAny>,
@@ -295,8 +308,10 @@ impl PyKalmanFilter {
         axes: usize,
         q: f64,
         observation: Option<&Bound<'_, PyAny>>,
-        beta: Option<f64>,
         theta: Option<f64>,
+        tau: Option<f64>,
+        theta_per_update: Option<f64>,
+        beta: Option<f64>,
     ) -> PyResult<Self> {
         if axes == 0 {
             return Err(raise(
@@ -333,7 +348,7 @@ impl PyKalmanFilter {
                 .with_process_noise(WhiteNoiseDerivative::new(degree, axes, q).py()?)
                 .py()?;
         }
-        if let Some(d) = discount_from(beta, theta)? {
+        if let Some(d) = discount_from(theta, tau, theta_per_update, beta)? {
             filter = filter.with_fading(d).py()?;
         }
         Ok(Self { filter, components })

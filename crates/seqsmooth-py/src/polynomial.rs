@@ -10,6 +10,7 @@ use crate::errors::{raise, IntoPy, Kind};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PySlice;
+use seqsmooth::discount::Discount;
 use seqsmooth::polynomial::fixed::FixedEngine;
 use seqsmooth::{
     Engine, Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter, PolynomialState,
@@ -381,28 +382,43 @@ impl PyExpandingMemory {
 /// degree : int
 ///     ``m``, 0 to 24 (0 to 10 with ``engine="gain"``).
 /// theta : float
-///     The discount per ``tau`` of time, ``0 < theta < 1``.
-/// tau : float
-///     The time interval ``theta`` applies to (default 1).
+///     The discount per span ``tau`` of time, ``0 < theta < 1`` (this or
+///     ``theta_per_update``).
+/// tau : float, optional
+///     The span of time ``theta`` applies to (default 1 with ``theta``).
 /// engine : {"exact", "gain"}
 ///     As for :class:`ExpandingMemory`.
 /// sigma : float, optional
 ///     The white noise's standard deviation: the estimates then carry their covariance.
+/// theta_per_update : float, optional
+///     The discount per sample whatever the spacing, ``0 < theta_per_update < 1``, instead of
+///     ``theta``: weight ``theta_per_update**(n − k)`` (the same names as ``KalmanFilter``'s).
 #[pyclass(name = "FadingMemory", module = "seqsmooth", extends = PyPolynomialFilter)]
 pub struct PyFadingMemory;
 
 #[pymethods]
 impl PyFadingMemory {
     #[new]
-    #[pyo3(signature = (degree, theta, tau = 1.0, engine = "exact", sigma = None))]
+    #[pyo3(signature = (degree, theta = None, tau = None, engine = "exact", sigma = None,
+        theta_per_update = None))]
     fn new(
         degree: usize,
-        theta: f64,
-        tau: f64,
+        theta: Option<f64>,
+        tau: Option<f64>,
         engine: &str,
         sigma: Option<f64>,
+        theta_per_update: Option<f64>,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let mut f = FadingMemory::new(degree, theta, tau, self::engine(engine)?).py()?;
+        // `tau` defaults to 1 with `theta` (as it always did).
+        let tau = tau.or(theta.map(|_| 1.0));
+        let Some(discount) = Discount::from_names(theta, tau, theta_per_update).py()? else {
+            return Err(raise(
+                Kind::Parameter,
+                "FadingMemory needs a discount: theta (per tau of time) or theta_per_update",
+                None,
+            ));
+        };
+        let mut f = FadingMemory::from_discount(degree, discount, self::engine(engine)?).py()?;
         if let Some(s) = sigma {
             f = f.with_noise_sigma(s).py()?;
         }

@@ -5,6 +5,7 @@
 
 use crate::arrays::{matrix, series, times, Series};
 use crate::errors::{raise, to_py, IntoPy, Kind};
+use crate::kalman::discount_from;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -14,7 +15,6 @@ use seqsmooth::kalman::track::{
     radar_row, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, DEFAULT_LAG,
     DEFAULT_WINDOW,
 };
-use seqsmooth::kalman::Discount;
 use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
 
@@ -93,7 +93,8 @@ pub(crate) fn flag_array<'py>(py: Python<'py>, flags: &[&str]) -> PyResult<Bound
 /// method : {"kalman", "fading", "smooth", "window"}
 ///     ``"window"``: the Gauss–Newton fit of each row's last ``window`` rows;
 ///     ``"kalman"``: the extended Kalman filter with white-noise acceleration ``q``;
-///     ``"fading"``: the fading-memory extended Kalman filter (``beta`` or ``theta``);
+///     ``"fading"``: the fading-memory extended Kalman filter (``theta`` with ``tau``, or
+///     ``theta_per_update``);
 ///     ``"smooth"``: the fixed-lag Rauch–Tung–Striebel smoother over the Kalman filter: each
 ///     row's estimate from the ``lag`` rows after it, given ``lag`` rows later (``smoothed()``),
 ///     the last ones at ``finish()``. The Kalman methods start from the first fit of the rows
@@ -106,9 +107,13 @@ pub(crate) fn flag_array<'py>(py: Python<'py>, flags: &[&str]) -> PyResult<Bound
 ///     kalman, smooth: the acceleration's spectral density on each axis; by default
 ///     adaptive: from ``σ_range² / T³`` (``T`` the start's mean step), raised by the
 ///     innovation test's misfits and lowered when the innovations are quiet (Morrison §14.8).
-/// beta, theta : float, optional
-///     fading: the discount per unit of time, or per update (one of them); by default an
-///     adaptive discount per update from 0.9, shortened by misfits likewise.
+/// theta, tau : float, optional
+///     fading: the discount ``theta`` in (0, 1) per span ``tau`` of time, both or neither (as
+///     ``FadingMemory``'s and ``seqsmooth track --theta T --tau TAU``).
+/// theta_per_update : float, optional
+///     fading: the discount in (0, 1) per update (what ``theta`` alone meant before; ``beta``
+///     per unit of time is now ``theta``, ``tau=1.0``). Without a discount, an adaptive
+///     discount per update from 0.9, shortened by misfits likewise.
 /// window : int
 ///     window: the rows of each fit (default 8).
 /// lag : int
@@ -232,7 +237,8 @@ fn sigma_series<'py>(
 impl PyRadarTracker {
     #[new]
     #[pyo3(signature = (method = "kalman", *, sigma_range = None, sigma_angle = None,
-        site = (0.0, 0.0, 0.0), q = None, beta = None, theta = None, window = None,
+        site = (0.0, 0.0, 0.0), q = None, theta = None, tau = None, theta_per_update = None,
+        beta = None, window = None,
         lag = None, azimuth = "from-x", max_iterations = 20))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -241,24 +247,29 @@ impl PyRadarTracker {
         sigma_angle: Option<f64>,
         site: (f64, f64, f64),
         q: Option<f64>,
-        beta: Option<f64>,
         theta: Option<f64>,
+        tau: Option<f64>,
+        theta_per_update: Option<f64>,
+        beta: Option<f64>,
         window: Option<usize>,
         lag: Option<usize>,
         azimuth: &str,
         max_iterations: i64,
     ) -> PyResult<Self> {
         let usage = |m: &str| Err(raise(Kind::Parameter, m, None));
-        let fading = beta.is_some() || theta.is_some();
+        let discount = discount_from(theta, tau, theta_per_update, beta)?;
+        let fading = discount.is_some();
         let method = match method {
-            "window" if q.is_some() || fading => {
-                return usage("q, beta and theta do not apply to method='window'")
-            }
+            "window" if q.is_some() || fading => return usage(
+                "q and the discount (theta, tau, theta_per_update) do not apply to method='window'",
+            ),
             "window" => TrackMethod::Window {
                 window: window.unwrap_or(DEFAULT_WINDOW),
             },
             "kalman" | "smooth" if fading => {
-                return usage("beta and theta apply only to method='fading'")
+                return usage(
+                    "the discount (theta, tau, theta_per_update) applies only to method='fading'",
+                )
             }
             "kalman" => TrackMethod::Kalman { q },
             "smooth" => TrackMethod::Smooth {
@@ -266,14 +277,7 @@ impl PyRadarTracker {
                 lag: lag.unwrap_or(DEFAULT_LAG),
             },
             "fading" if q.is_some() => return usage("q applies only to 'kalman' and 'smooth'"),
-            "fading" => match (beta, theta) {
-                (Some(b), None) => TrackMethod::Fading(Some(Discount::PerTime(b))),
-                (None, Some(t)) => TrackMethod::Fading(Some(Discount::PerUpdate(t))),
-                (None, None) => TrackMethod::Fading(None),
-                _ => return usage(
-                    "method='fading' takes beta (per unit of time) or theta (per update), not both",
-                ),
-            },
+            "fading" => TrackMethod::Fading(discount),
             other => {
                 return usage(&format!(
                     "method {other:?} is not one of 'kalman', 'fading', 'smooth', 'window'"

@@ -55,7 +55,7 @@ def test_equals_the_exact_expanding_and_fading_filters(rng, degree):
     assert np.all(np.abs(states[ok] - d[ok]) <= 1e-7 * sig[ok])
     assert np.allclose(sig[ok], s[ok], rtol=1e-8, atol=0)
     theta, tau = 0.9, 2.0
-    states, cov = ss.BayesFilter(degree, beta=theta ** (1 / tau)).update_many(t, y, SIGMA**2)
+    states, cov = ss.BayesFilter(degree, theta=theta, tau=tau).update_many(t, y, SIGMA**2)
     fm = ss.FadingMemory(degree=degree, theta=theta, tau=tau, engine="exact", sigma=SIGMA)
     d, s = fm.update_many(t, y, return_sigma=True)
     sig = np.sqrt(np.diagonal(cov, 0, 1, 2))
@@ -79,8 +79,8 @@ def test_with_a_prior_equals_the_kalman_filter(rng):
     assert np.abs(bx - kx).max() <= 1e-9 * np.abs(kx).max()
     assert np.abs(bp - kp).max() <= 1e-9 * np.abs(kp).max()
     # Fading memory per update from the same prior: the fading Kalman filter's true covariance.
-    bx, bp = ss.BayesFilter(**kw, x0=x0, P0=p0, theta=0.8).update_many(t, z, r)
-    kx, kp, _ = ss.KalmanFilter(**kw, x0=x0, P0=p0, theta=0.8).update_many(t, z, r)
+    bx, bp = ss.BayesFilter(**kw, x0=x0, P0=p0, theta_per_update=0.8).update_many(t, z, r)
+    kx, kp, _ = ss.KalmanFilter(**kw, x0=x0, P0=p0, theta_per_update=0.8).update_many(t, z, r)
     assert np.abs(bx - kx).max() <= 1e-9 * np.abs(kx).max()
     assert np.abs(bp - kp).max() <= 1e-9 * np.abs(kp).max()
 
@@ -117,9 +117,13 @@ def test_refusals_name_the_sample(rng):
 @pytest.mark.parametrize(
     "kw",
     [
-        {"degree": 1, "theta": 0.0},
-        {"degree": 1, "theta": 1.5},
-        {"degree": 1, "beta": 0.9, "theta": 0.9},
+        {"degree": 1, "theta": 0.0, "tau": 1.0},
+        {"degree": 1, "theta_per_update": 1.5},
+        {"degree": 1, "theta_per_update": 1.0},
+        {"degree": 1, "theta": 0.9, "tau": 0.0},
+        {"degree": 1, "theta": 0.9},
+        {"degree": 1, "beta": 0.9},
+        {"degree": 1, "theta": 0.9, "tau": 1.0, "theta_per_update": 0.9},
         {"degree": 1, "x0": [0.0, 0.0]},
         {"degree": 1, "axes": 0},
         {"degree": 99},

@@ -205,7 +205,9 @@ def test_ten_thousand_random_bad_calls_never_panic():
                     x0=values(m + 1),
                     P0=float(rng.choice([1.0, 1e300, 0.0, -1.0, np.nan])),
                     q=float(rng.choice([0.0, 1.0, -1.0, 1e300])),
-                    theta=float(rng.choice([0.5, 1.0, 2.0])) if rng.random() < 0.3 else None,
+                    theta_per_update=float(rng.choice([0.5, 1.0, 2.0]))
+                    if rng.random() < 0.3
+                    else None,
                 )
                 x, p, nis = f.update_many(times(n), values(n), float(rng.choice([1.0, 0.0, -1.0])))
                 assert np.isfinite(x).all() and np.isfinite(p).all()
@@ -216,7 +218,7 @@ def test_ten_thousand_random_bad_calls_never_panic():
                     str(rng.choice(["kalman", "fading", "smooth", "window"])),
                     sigma_range=float(rng.choice([10.0, 0.0, -1.0, np.nan])),
                     sigma_angle=float(rng.choice([1e-3, 0.0, 1e300])),
-                    theta=float(rng.choice([0.9, 1.5])) if rng.random() < 0.5 else None,
+                    theta_per_update=float(rng.choice([0.9, 1.5])) if rng.random() < 0.5 else None,
                     window=window if rng.random() < 0.3 else None,
                 )
                 r = np.abs(values(n)) if rng.random() < 0.7 else values(n)
@@ -268,7 +270,11 @@ def test_ten_thousand_random_bad_calls_never_panic():
                     t0=float(rng.choice([0.0, 1.7e9, np.nan])),
                     x0=values(m + 1) if prior else None,
                     P0=float(rng.choice([1.0, 1e300, 0.0, -1.0])) if prior else None,
-                    beta=float(rng.choice([0.9, 0.0, 1.5, np.nan])) if rng.random() < 0.3 else None,
+                    **(
+                        {"theta": float(rng.choice([0.9, 0.0, 1.5, np.nan])), "tau": 1.0}
+                        if rng.random() < 0.3
+                        else {}
+                    ),
                 )
                 x, p = f.update_many(times(n), values(n), float(rng.choice([1.0, 0.0, -1.0])))
                 assert not np.isinf(x).any() and not np.isinf(p).any()

@@ -89,7 +89,7 @@ def test_fading_memory_per_update_equals_filterpy_alpha():
     dt, theta, steps = 0.5, 0.8, 300
     t = dt * np.arange(1, steps + 1)
     z = 3.0 + 2.0 * t - 0.05 * t**2 + rng.standard_normal(steps)
-    ours = ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=100.0, theta=theta)
+    ours = ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=100.0, theta_per_update=theta)
     x, _, _ = ours.update_many(t, z, 1.0)
     peer = Peer(dim_x=2, dim_z=1)
     peer.x = np.zeros((2, 1))
@@ -153,10 +153,15 @@ def test_the_smoother_is_the_batch_least_squares_estimate():
         (lambda: ss.KalmanFilter(degree=1, x0=[0.0, np.nan], P0=1.0), ss.InvalidInputError),
         (lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, q=-1.0), ss.ParameterError),
         (
-            lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, beta=0.9, theta=0.9),
+            lambda: ss.KalmanFilter(
+                degree=1, x0=[0.0, 0.0], P0=1.0, theta=0.9, tau=1.0, theta_per_update=0.9
+            ),
             ss.ParameterError,
         ),
-        (lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, theta=1.5), ss.ParameterError),
+        (
+            lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, theta_per_update=1.5),
+            ss.ParameterError,
+        ),
         (lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, axes=0), ss.ParameterError),
     ],
 )
@@ -218,10 +223,65 @@ def test_kalman_and_bayes_equal_the_librarys_run_to_the_last_bit():
         )
 
     assert same_bits(got, np.array(rows["kalman"]))
-    x, p = ss.BayesFilter(1, axes=2, observation=m, theta=0.9).update_many(t, z, r)
+    x, p = ss.BayesFilter(1, axes=2, observation=m, theta_per_update=0.9).update_many(t, z, r)
     got = np.column_stack([x, p.reshape(len(t), 16)])
     want = np.array(rows["bayes"])
     assert np.array_equal(
         got.view(np.int64)[np.isfinite(got)], want.view(np.int64)[np.isfinite(want)]
     )
     assert np.array_equal(np.isnan(got), np.isnan(want))
+
+
+def test_old_discount_names_are_refused_with_the_new_ones():
+    """``theta`` alone meant per update in the Kalman filters and per ``tau`` in ``FadingMemory``:
+    it now means per ``tau`` everywhere, so a call without ``tau`` is refused naming
+    ``theta_per_update``; ``beta`` (per unit of time) is refused naming ``theta``, ``tau=1.0``."""
+    with pytest.raises(ss.ParameterError, match="theta_per_update"):
+        ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, theta=0.9)
+    with pytest.raises(ss.ParameterError, match=r"theta=0.9, tau=1.0"):
+        ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, beta=0.9)
+    with pytest.raises(ss.ParameterError, match="theta_per_update"):
+        ss.BayesFilter(1, theta=0.9)
+    with pytest.raises(ss.ParameterError, match="theta_per_update"):
+        ss.RadarTracker("fading", sigma_range=10.0, sigma_angle=1e-3, theta=0.9)
+    # FadingMemory's theta keeps its meaning (per tau, default 1): the same bits as before.
+    t = np.cumsum(np.random.default_rng(5).uniform(0.2, 0.8, 50))
+    a = ss.FadingMemory(2, 0.9).update_many(t, np.sin(t))
+    b = ss.FadingMemory(2, theta=0.9, tau=1.0).update_many(t, np.sin(t))
+    assert np.array_equal(a, b, equal_nan=True)
+    for bad in [{}, {"theta": 0.9, "theta_per_update": 0.9}, {"tau": 2.0, "theta_per_update": 0.9}]:
+        with pytest.raises(ss.ParameterError):
+            ss.FadingMemory(2, **bad)
+
+
+@pytest.mark.parametrize(
+    "discount",
+    [{"theta": 0.9, "tau": 0.5}, {"theta": 0.8, "tau": 2.0}, {"theta_per_update": 0.85}],
+)
+@pytest.mark.parametrize("degree", [0, 1, 2, 3])
+def test_fading_kalman_equals_fading_memory_given_one_discount(degree, discount):
+    """The same discount by the same names: the fading Kalman filter over the polynomial model
+    and ``FadingMemory`` give the same estimates within 1e-10 relative (each component against
+    its size plus its σ) on irregular times. The Kalman filter starts at the (m+1)-th sample
+    from the interpolating polynomial with ``P0 = R⁻¹ diag(σ²/w) R⁻ᵀ`` (``R`` the Taylor rows,
+    ``w`` the discount's weights, from its definition here), where ``FadingMemory``, started
+    from nothing, holds the same fit."""
+    rng = np.random.default_rng(31 + degree)
+    m, sigma, n = degree, 0.3, 4 * degree + 80
+    t = np.cumsum(rng.uniform(0.2, 0.8, n))
+    y = 10.0 * np.sin(0.3 * t) + 2.0 * t + rng.uniform(-1.0, 1.0, n)
+    poly = ss.FadingMemory(degree=m, engine="exact", sigma=sigma, **discount)
+    d, s = poly.update_many(t, y, return_sigma=True)
+    dt = t[: m + 1] - t[m]
+    rows = np.array([[x**j / math.factorial(j) for j in range(m + 1)] for x in dt])
+    if "tau" in discount:
+        w = discount["theta"] ** ((t[m] - t[: m + 1]) / discount["tau"])
+    else:
+        w = discount["theta_per_update"] ** np.arange(m, -1, -1.0)
+    r_inv = np.linalg.inv(rows)
+    x0 = r_inv @ y[: m + 1]
+    p0 = r_inv @ np.diag(sigma**2 / w) @ r_inv.T
+    kf = ss.KalmanFilter(degree=m, x0=x0, P0=0.5 * (p0 + p0.T), t0=t[m], **discount)
+    x, _, _ = kf.update_many(t[m + 1 :], y[m + 1 :], sigma**2)
+    rel = np.abs(x - d[m + 1 :]) / (np.abs(d[m + 1 :]) + s[m + 1 :])
+    assert rel.max() <= 1e-10, rel.max()

@@ -59,10 +59,11 @@ class FadingMemory(PolynomialFilter):
     def __init__(
         self,
         degree: int,
-        theta: float,
-        tau: float = 1.0,
+        theta: float | None = None,
+        tau: float | None = None,
         engine: Literal["exact", "gain"] = "exact",
         sigma: float | None = None,
+        theta_per_update: float | None = None,
     ) -> None: ...
 
 class FixedMemory(PolynomialFilter):
@@ -128,8 +129,9 @@ class KalmanFilter:
         axes: int = 1,
         q: float = 0.0,
         observation: ArrayLike | None = None,
-        beta: float | None = None,
         theta: float | None = None,
+        tau: float | None = None,
+        theta_per_update: float | None = None,
     ) -> None: ...
     @property
     def state(self) -> Vector: ...
@@ -155,8 +157,9 @@ class BayesFilter:
         observation: ArrayLike | None = None,
         x0: ArrayLike | None = None,
         P0: ArrayLike | float | None = None,
-        beta: float | None = None,
         theta: float | None = None,
+        tau: float | None = None,
+        theta_per_update: float | None = None,
     ) -> None: ...
     @property
     def is_determined(self) -> bool: ...
@@ -183,8 +186,9 @@ class RadarTracker:
         sigma_angle: float | None = None,
         site: tuple[float, float, float] = (0.0, 0.0, 0.0),
         q: float | None = None,
-        beta: float | None = None,
         theta: float | None = None,
+        tau: float | None = None,
+        theta_per_update: float | None = None,
         window: int | None = None,
         lag: int | None = None,
         azimuth: Literal["from-x", "bearing"] = "from-x",
