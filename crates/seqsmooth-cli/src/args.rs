@@ -106,8 +106,10 @@ pub struct PamlArgs {
     #[arg(value_name = "INPUT")]
     pub input: Option<PathBuf>,
     /// Polynomial degree N of each segment (0 to 30): N+1 polynomial samples per segment
-    #[arg(long, value_name = "N", value_parser = parse_order, allow_hyphen_values = true)]
-    pub order: usize,
+    /// (--order, the paper's word, is an alias)
+    #[arg(long, alias = "order", value_name = "N", value_parser = parse_paml_degree,
+          allow_hyphen_values = true)]
+    pub degree: usize,
     /// Segment length in the time column's units
     #[arg(long, value_name = "SECONDS", value_parser = parse_segment, allow_hyphen_values = true)]
     pub segment: f64,
@@ -125,9 +127,9 @@ pub struct PamlArgs {
     pub output: Option<PathBuf>,
 }
 
-/// Parses `--order`: a whole number from 0 to 30.
-pub fn parse_order(s: &str) -> Result<usize, String> {
-    parse_whole("order", s, "", 0, 30).map(|v| v as usize)
+/// Parses `paml --degree`: a whole number from 0 to 30.
+pub fn parse_paml_degree(s: &str) -> Result<usize, String> {
+    parse_whole("degree", s, "", 0, 30).map(|v| v as usize)
 }
 
 /// Parses `--segment`: a positive finite number.

@@ -30,7 +30,7 @@ struct Segment {
 /// Runs `seqsmooth paml`.
 pub fn run(a: &PamlArgs) -> Result<(), CliError> {
     check_distinct(a.input.as_deref(), a.output.as_deref())?;
-    let need = Need::degree(a.order);
+    let need = Need::degree(a.degree);
     let input = open_input(a.input.as_deref())?;
     let mut reader = RowReader::new(
         input,
@@ -108,14 +108,14 @@ fn finish(
     t0: f64,
     text: &mut Vec<u8>,
 ) -> Result<(), CliError> {
-    let n = a.order;
+    let n = a.degree;
     let (from, to) = (
         t0 + segment.index as f64 * a.segment,
         t0 + (segment.index + 1) as f64 * a.segment,
     );
     if segment.t.len() <= n {
         eprintln!(
-            "seqsmooth paml: segment {} [{from}, {to}) has {} sample{}, order {n} needs {}: left out",
+            "seqsmooth paml: segment {} [{from}, {to}) has {} sample{}, degree {n} needs {}: left out",
             segment.index,
             segment.t.len(),
             if segment.t.len() == 1 { "" } else { "s" },

@@ -55,7 +55,7 @@ fn segments_are_the_librarys_polynomial_samples() {
         let got = ok(
             &[
                 "paml",
-                "--order",
+                "--degree",
                 &order.to_string(),
                 "--segment",
                 &segment.to_string(),
@@ -72,7 +72,7 @@ fn segments_are_the_librarys_polynomial_samples() {
         let got = ok(
             &[
                 "paml",
-                "--order",
+                "--degree",
                 &order.to_string(),
                 "--segment",
                 &segment.to_string(),
@@ -84,7 +84,7 @@ fn segments_are_the_librarys_polynomial_samples() {
         assert_eq!(got, expected(&rows, segment, order, Some(0.5)));
     }
     // no sigma: unit noise
-    let got = ok(&["paml", "--order", "2", "--segment", "2"], &text);
+    let got = ok(&["paml", "--order", "2", "--segment", "2"], &text); // the paper's word, an alias
     assert_eq!(got, expected(&rows, 2.0, 2, Some(1.0)));
     // the gap: segment 3 is empty, the numbering keeps time
     assert!(got.contains("\n2,") && !got.contains("\n3,") && got.contains("\n4,"));
@@ -93,11 +93,11 @@ fn segments_are_the_librarys_polynomial_samples() {
 #[test]
 fn a_short_segment_is_named_and_left_out() {
     let text = "t,y\n0,1\n0.5,2\n1,3\n1.5,4\n10,5\n10.5,6\n";
-    let o = run(&["paml", "--order", "2", "--segment", "5"], text);
+    let o = run(&["paml", "--degree", "2", "--segment", "5"], text);
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(
         o.stderr
-            .contains("segment 2 [10, 15) has 2 samples, order 2 needs 3: left out"),
+            .contains("segment 2 [10, 15) has 2 samples, degree 2 needs 3: left out"),
         "{}",
         o.stderr
     );
@@ -110,19 +110,19 @@ fn a_short_segment_is_named_and_left_out() {
 #[test]
 fn bad_input_is_refused_with_its_place() {
     fails(
-        &["paml", "--order", "2", "--segment", "0"],
+        &["paml", "--degree", "2", "--segment", "0"],
         "t,y\n",
         2,
         &["segment 0 is out of range"],
     );
     fails(
-        &["paml", "--order", "31", "--segment", "1"],
+        &["paml", "--degree", "31", "--segment", "1"],
         "t,y\n",
         2,
-        &["order 31"],
+        &["degree 31"],
     );
     fails(
-        &["paml", "--order", "1", "--segment", "1", "--sigma", "-1"],
+        &["paml", "--degree", "1", "--segment", "1", "--sigma", "-1"],
         "t,y\n",
         2,
         &["sigma"],
@@ -130,7 +130,7 @@ fn bad_input_is_refused_with_its_place() {
     fails(
         &[
             "paml",
-            "--order",
+            "--degree",
             "1",
             "--segment",
             "1",
@@ -144,13 +144,13 @@ fn bad_input_is_refused_with_its_place() {
         &["cannot be used with"],
     );
     fails(
-        &["paml", "--order", "1", "--segment", "1"],
+        &["paml", "--degree", "1", "--segment", "1"],
         "t,y\n0,1\n1,nan\n",
         1,
         &["line 3"],
     );
     fails(
-        &["paml", "--order", "1", "--segment", "10"],
+        &["paml", "--degree", "1", "--segment", "10"],
         "t,y\n0,1\n2,1\n1,1\n",
         1,
         &["line 4", "not after"],
@@ -158,7 +158,7 @@ fn bad_input_is_refused_with_its_place() {
     fails(
         &[
             "paml",
-            "--order",
+            "--degree",
             "1",
             "--segment",
             "10",
@@ -170,13 +170,21 @@ fn bad_input_is_refused_with_its_place() {
         &["line 3", "noise sigma 0"],
     );
     fails(
-        &["paml", "--order", "1", "--segment", "1", "--sigma-col", "s"],
+        &[
+            "paml",
+            "--degree",
+            "1",
+            "--segment",
+            "1",
+            "--sigma-col",
+            "s",
+        ],
         "t,y\n0,1\n",
         1,
         &["'s'"],
     );
     fails(
-        &["paml", "--order", "3", "--segment", "10"],
+        &["paml", "--degree", "3", "--segment", "10"],
         "t,y\n0,1\n1,2\n",
         1,
         &["degree 3", "4"],

@@ -149,6 +149,13 @@ impl PyBayesFilter {
         self.filter.covariance().map(|c| square(py, &c)).transpose()
     }
 
+    /// The 1σ of each state component, the square roots of ``covariance``'s diagonal;
+    /// ``None`` while not determined.
+    #[getter]
+    fn std_devs<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        self.filter.std_devs().map(|s| PyArray1::from_vec(py, s))
+    }
+
     /// With fading memory, the recursion's own matrix ``P`` (not the covariance); without,
     /// the covariance. ``None`` while not determined.
     #[getter]

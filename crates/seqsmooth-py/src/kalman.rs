@@ -366,6 +366,12 @@ impl PyKalmanFilter {
         square(py, self.filter.covariance())
     }
 
+    /// The 1σ of each state component, the square roots of ``covariance``'s diagonal.
+    #[getter]
+    fn std_devs<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.filter.std_devs())
+    }
+
     /// The time the estimate is valid at.
     #[getter]
     fn time(&self) -> f64 {

@@ -61,7 +61,7 @@ pub fn gauss_rule<'py>(
     if n > MAX_GAUSS_DEGREE {
         return Err(raise(
             Kind::Parameter,
-            format!("n {n} is out of range: at most {MAX_GAUSS_DEGREE}"),
+            format!("degree {n} is out of range: at most {MAX_GAUSS_DEGREE}"),
             None,
         ));
     }
@@ -116,20 +116,23 @@ pub fn gauss_rule<'py>(
 ///     The segment's times (any order, at least ``n+1`` distinct) and values.
 /// sigma : float or array_like
 ///     The noise standard deviation, one for all or one per sample.
-/// n : int
-///     The polynomial's degree.
+/// degree : int
+///     The polynomial's degree ``n`` (``n=``, the paper's name, is an alias).
 ///
 /// Returns
 /// -------
 /// (times, values, variances) : three numpy arrays of ``n+1``.
 #[pyfunction]
+#[pyo3(signature = (t, y, sigma, degree = None, *, n = None))]
 pub fn polynomial_samples<'py>(
     py: Python<'py>,
     t: &Bound<'py, PyAny>,
     y: &Bound<'py, PyAny>,
     sigma: &Bound<'py, PyAny>,
-    n: usize,
+    degree: Option<usize>,
+    n: Option<usize>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let n = degree_of(degree, n)?;
     let (ts, ys) = crate::arrays::pair(t, y)?;
     let (ts, ys) = (ts.as_slice().to_vec(), ys.as_slice().to_vec());
     let sigmas = sigmas(sigma, ts.len())?;
@@ -146,6 +149,23 @@ fn sigmas(sigma: &Bound<'_, PyAny>, samples: usize) -> PyResult<Vec<f64>> {
         Ok(s) => vec![s; samples],
         Err(_) => series(sigma, "sigma")?.as_slice().to_vec(),
     })
+}
+
+/// The degree, given as `degree` or by the paper's `n` (one of them).
+fn degree_of(degree: Option<usize>, n: Option<usize>) -> PyResult<usize> {
+    match (degree, n) {
+        (Some(d), None) | (None, Some(d)) => Ok(d),
+        (Some(_), Some(_)) => Err(raise(
+            Kind::Parameter,
+            "degree and n are both given: n is the paper's name of degree; give one",
+            None,
+        )),
+        (None, None) => Err(raise(
+            Kind::Parameter,
+            "the degree is missing: give degree",
+            None,
+        )),
+    }
 }
 
 fn check_degree(n: usize) -> PyResult<()> {
@@ -182,8 +202,8 @@ fn samples_tuple(py: Python<'_>, ps: PolynomialSamples) -> PyResult<Bound<'_, Py
 ///     The segment's sample times, increasing (at least ``n+1``).
 /// sigma : float or array_like
 ///     The noise standard deviation, one for all or one per sample.
-/// n : int
-///     The polynomial's degree.
+/// degree : int
+///     The polynomial's degree ``n`` (``n=``, the paper's name, is an alias).
 #[pyclass(name = "OnlineSmoother", module = "seqsmooth")]
 pub struct PyOnlineSmoother {
     inner: OnlineSmoother<Arc<SmootherGains>>,
@@ -192,12 +212,15 @@ pub struct PyOnlineSmoother {
 #[pymethods]
 impl PyOnlineSmoother {
     #[new]
+    #[pyo3(signature = (t, sigma, degree = None, *, n = None))]
     fn new(
         py: Python<'_>,
         t: &Bound<'_, PyAny>,
         sigma: &Bound<'_, PyAny>,
-        n: usize,
+        degree: Option<usize>,
+        n: Option<usize>,
     ) -> PyResult<Self> {
+        let n = degree_of(degree, n)?;
         let ts = times(t, "t")?.as_slice().to_vec();
         let sigmas = sigmas(sigma, ts.len())?;
         check_degree(n)?;
@@ -435,10 +458,16 @@ impl PyCurveFit {
         square(py, c)
     }
 
-    /// The square roots of the covariance's diagonal.
+    /// The 1σ of each parameter, the square roots of the covariance's diagonal.
+    #[getter]
+    fn std_devs<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        array(py, self.inner.std_devs())
+    }
+
+    /// ``std_devs`` by its old name (kept: the same numbers).
     #[getter]
     fn standard_deviations<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        array(py, self.inner.standard_deviations())
+        self.std_devs(py)
     }
 
     /// ``Σ ((y − h(theta, t))/σ)²`` at the estimate.

@@ -66,8 +66,14 @@ impl State {
     /// The 1σ error of each derivative (the square roots of the covariance's diagonal), or
     /// ``None`` without a covariance.
     #[getter]
-    fn sigma<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+    fn std_devs<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
         self.state.std_devs().map(|s| PyArray1::from_vec(py, s))
+    }
+
+    /// ``std_devs`` by its old name (kept: the same numbers).
+    #[getter]
+    fn sigma<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        self.std_devs(py)
     }
 
     fn __repr__(&self) -> String {

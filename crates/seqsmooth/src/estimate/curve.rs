@@ -185,17 +185,23 @@ impl CurveFit {
     /// let line = Curve::new(2, |th: &[f64], t| th[0] + th[1] * t);
     /// let t = [-1.0, 0.0, 1.0];
     /// let fit = fit_curve(&line, &t, &[1.0, 2.0, 3.0], &[1.0; 3], &[0.0, 0.0])?;
-    /// let s = fit.standard_deviations();
+    /// let s = fit.std_devs();
     /// // 1/3 and 1/Σt²; to 1e-11, the differenced Jacobian's rounding
     /// assert!((s[0] - (1.0f64 / 3.0).sqrt()).abs() < 1e-10 && (s[1] - 0.5f64.sqrt()).abs() < 1e-10);
     /// # Ok::<(), seqsmooth::Error>(())
     /// ```
-    pub fn standard_deviations(&self) -> Vec<f64> {
+    pub fn std_devs(&self) -> Vec<f64> {
         self.covariance
             .diagonal()
             .iter()
             .map(|v| v.sqrt())
             .collect()
+    }
+
+    /// [`Self::std_devs`], by its old name.
+    #[deprecated(note = "use std_devs, the one name of an estimate's 1σ")]
+    pub fn standard_deviations(&self) -> Vec<f64> {
+        self.std_devs()
     }
 }
 

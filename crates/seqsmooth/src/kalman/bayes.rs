@@ -242,6 +242,12 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
         self.determined().then(|| self.info.covariance()).flatten()
     }
 
+    /// The 1σ of each state component, `√diag(S)` of [`Self::covariance`], once determined.
+    pub fn std_devs(&self) -> Option<Vec<f64>> {
+        let s = self.covariance()?;
+        Some(s.diagonal().iter().map(|v| v.sqrt()).collect())
+    }
+
     /// The recursion's own matrix `P = (RᵀR)⁻¹` (14.3.13), the inverse of the discounted
     /// information: the covariance itself without fading memory.
     ///

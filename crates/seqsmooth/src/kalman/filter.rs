@@ -319,6 +319,15 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         &self.covariance
     }
 
+    /// The 1σ of each state component, `√diag(S)` (as `PolynomialState::std_devs`).
+    pub fn std_devs(&self) -> Vec<f64> {
+        self.covariance
+            .diagonal()
+            .iter()
+            .map(|v| v.sqrt())
+            .collect()
+    }
+
     /// The time the estimate refers to.
     ///
     /// ```
