@@ -100,9 +100,8 @@ fn worst_relative(m: usize, poly: Discount, kalman: Discount, seed: u64) -> f64 
         .unwrap();
         let est = f.estimate().unwrap();
         let sigma = est.std_devs().unwrap();
-        for j in 0..=m {
-            let (a, b) = (kf.state()[j], est.derivatives[j]);
-            worst = worst.max((a - b).abs() / (b.abs() + sigma[j]));
+        for ((a, b), s) in kf.state().iter().zip(&est.derivatives).zip(&sigma) {
+            worst = worst.max((a - b).abs() / (b.abs() + s));
         }
     }
     worst

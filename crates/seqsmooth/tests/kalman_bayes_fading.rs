@@ -277,7 +277,7 @@ fn ex_14_9a_unobserved_direction_is_refused_once_it_has_faded() {
     .unwrap()
     .with_prior(&DVector::zeros(2), &DMatrix::identity(2, 2))
     .unwrap()
-    .with_fading(Discount::PerUpdate { theta: theta })
+    .with_fading(Discount::PerUpdate { theta })
     .unwrap();
     let (mut z, mut u, mut s_u) = (1.0, 0.0, 1.0);
     let (mut worst, mut worst_ratio): (f64, f64) = (0.0, 0.0);

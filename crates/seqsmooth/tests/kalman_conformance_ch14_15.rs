@@ -110,7 +110,7 @@ fn run_fading<D: Dynamics>(
         0.0,
     )
     .unwrap()
-    .with_fading(Discount::PerUpdate { theta: theta })
+    .with_fading(Discount::PerUpdate { theta })
     .unwrap();
     let mut gain = DMatrix::zeros(n, p);
     for k in 1..=updates {
@@ -281,7 +281,7 @@ fn ex_14_9a_singular_z_infinity() {
         0.0,
     )
     .unwrap()
-    .with_fading(Discount::PerUpdate { theta: theta })
+    .with_fading(Discount::PerUpdate { theta })
     .unwrap();
     let (mut z, mut s_u) = (1.0, 1.0);
     let mut worst: f64 = 0.0;

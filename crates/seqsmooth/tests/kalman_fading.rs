@@ -45,7 +45,7 @@ fn count_based_fading_is_the_fading_memory_polynomial_filter() {
                 0.0,
             )
             .unwrap()
-            .with_fading(Discount::PerUpdate { theta: theta })
+            .with_fading(Discount::PerUpdate { theta })
             .unwrap();
             let mut gain = DMatrix::zeros(n, 1);
             for k in 1..=2000 {
