@@ -141,3 +141,15 @@ pub fn singular_values(m: &DMatrix<f64>) -> Result<DVector<f64>, Error> {
             iterations: SVD_ITERATIONS,
         })
 }
+
+/// The 1σ of each component of an estimate of covariance `S`: `√max(0, S_ii)` (a rounding
+/// below zero reads as 0). The one rule behind every `std_devs` of the library.
+///
+/// ```
+/// use nalgebra::DMatrix;
+/// use seqsmooth::linalg::std_devs;
+/// assert_eq!(std_devs(&DMatrix::from_row_slice(2, 2, &[4.0, 1.0, 1.0, -0.0])), vec![2.0, 0.0]);
+/// ```
+pub fn std_devs(s: &DMatrix<f64>) -> Vec<f64> {
+    s.diagonal().iter().map(|v| v.max(0.0).sqrt()).collect()
+}

@@ -191,11 +191,7 @@ impl CurveFit {
     /// # Ok::<(), seqsmooth::Error>(())
     /// ```
     pub fn std_devs(&self) -> Vec<f64> {
-        self.covariance
-            .diagonal()
-            .iter()
-            .map(|v| v.sqrt())
-            .collect()
+        crate::linalg::std_devs(&self.covariance)
     }
 
     /// [`Self::std_devs`], by its old name.

@@ -244,8 +244,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
 
     /// The 1σ of each state component, `√diag(S)` of [`Self::covariance`], once determined.
     pub fn std_devs(&self) -> Option<Vec<f64>> {
-        let s = self.covariance()?;
-        Some(s.diagonal().iter().map(|v| v.sqrt()).collect())
+        self.covariance().map(|s| crate::linalg::std_devs(&s))
     }
 
     /// The recursion's own matrix `P = (RᵀR)⁻¹` (14.3.13), the inverse of the discounted

@@ -262,8 +262,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// the covariance reported, [`Self::covariance`], is the true one of the estimate
     /// ((14.4.31)-(14.4.32), (14.3.19)), and the innovation statistics use it (§14.8). `P`
     /// starts as the current covariance, counted from the current time (start without fading
-    /// and switch, §14.5). `θ` must lie in `(0, 1)` and `τ` be positive: without fading memory
-    /// the filter is the plain one.
+    /// and switch, §14.5). `0 < θ < 1`, `τ > 0`: without fading memory, the plain filter.
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
@@ -321,11 +320,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
 
     /// The 1σ of each state component, `√diag(S)` (as `PolynomialState::std_devs`).
     pub fn std_devs(&self) -> Vec<f64> {
-        self.covariance
-            .diagonal()
-            .iter()
-            .map(|v| v.sqrt())
-            .collect()
+        crate::linalg::std_devs(&self.covariance)
     }
 
     /// The time the estimate refers to.
@@ -508,7 +503,6 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///     DVector::zeros(1), DMatrix::identity(1, 1), 0.0).unwrap();
     /// assert!(f.set_fading(Discount::PerUpdate { theta: 0.5 }).is_ok());
     /// assert!(f.set_fading(Discount::PerUpdate { theta: 1.5 }).is_err());
-    /// assert!(f.set_fading(Discount::PerTime { theta: 0.5, tau: 0.0 }).is_err());
     /// ```
     pub fn set_fading(&mut self, discount: Discount) -> Result<(), Error> {
         let discount = discount.checked()?;

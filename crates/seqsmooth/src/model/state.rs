@@ -72,9 +72,7 @@ impl PolynomialState {
 
     /// 1σ of each derivative, when the covariance is known.
     pub fn std_devs(&self) -> Option<Vec<f64>> {
-        self.covariance
-            .as_ref()
-            .map(|c| (0..c.nrows()).map(|i| c[(i, i)].max(0.0).sqrt()).collect())
+        self.covariance.as_ref().map(crate::linalg::std_devs)
     }
 
     /// The same trajectory propagated to `time` (prediction for a later time, retrodiction for an
