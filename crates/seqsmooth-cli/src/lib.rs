@@ -3,7 +3,7 @@
 //! filter, and whole-series (Savitzky–Golay) smoothing; Gauss–Newton fits of radar and polynomial
 //! windows; their gains and variance-reduction
 //! matrices, and a demo on built-in data. The library behind the binary (`src/main.rs` only dispatches), a thin layer over the `seqsmooth` library: argument
-//! parsing ([`args`]), files ([`io`], [`parquet`]), one module per subcommand, and messages ([`error`]).
+//! parsing ([`args`]), files ([`io`], [`io::parquet`]), one module per subcommand, and messages ([`error`]).
 
 pub mod args;
 pub mod chart;
@@ -15,9 +15,7 @@ pub mod fit;
 pub mod gains;
 pub mod io;
 pub mod paml;
-pub mod parquet;
 pub mod plot;
-pub mod progress;
 pub mod smooth;
 pub mod ticks;
 pub mod track;

@@ -9,7 +9,7 @@
 
 use crate::args::PamlArgs;
 use crate::error::CliError;
-use crate::filter::rows::{Chunk, RowReader};
+use crate::io::rows::{Chunk, RowReader};
 use crate::io::{check_distinct, open_input, write_f64, Need, Output};
 use seqsmooth::paml::PolynomialSamples;
 

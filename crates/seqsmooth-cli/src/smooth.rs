@@ -9,7 +9,7 @@
 
 use crate::args::{check_window, SmoothArgs};
 use crate::error::CliError;
-use crate::filter::rows::{Chunk, RowReader};
+use crate::io::rows::{Chunk, RowReader};
 use crate::io::{check_distinct, open_input, Need, Output};
 use seqsmooth::polynomial::fixed::{CentredSmoother, SmoothSigma, SmoothedRow};
 use seqsmooth::Error;

@@ -1,10 +1,10 @@
 //! `seqsmooth filter`: streams a CSV time series — or many, told apart by an id column —
 //! through polynomial filters. A `.parquet` input or output is a Parquet file
-//! ([`crate::parquet`]): its rows are read as records into the same chunks, and the output rows
+//! ([`crate::io::parquet`]): its rows are read as records into the same chunks, and the output rows
 //! written as a table, so everything in between is the CSV path's.
 //!
 //! The command reads, filters and writes chunks of rows ([`CHUNK_ROWS`]): a reader thread
-//! reads and validates ([`rows`]) the next chunk while the current one is run through the
+//! reads and validates ([`crate::io::rows`]) the next chunk while the current one is run through the
 //! filters of its series, the series in parallel (the library's
 //! [`seqsmooth::polynomial::bank::StreamBank`]), then formatted in parallel pieces
 //! and written in input order. Memory is a few chunks plus one filter per series, whatever the
@@ -14,17 +14,16 @@
 //! decision is final, a few samples of their series later (`held`).
 
 mod held;
-pub mod rows;
 pub mod runner;
 
 use crate::args::{check_window, name, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
 use crate::error::CliError;
 use crate::io::{check_distinct, input_size, named, open_input, CsvIn, Need, Output};
 use crate::io::{IdType, Records};
-use crate::parquet::{is_parquet, ParquetRows, ParquetTable};
-use crate::progress::{self, Progress};
+use crate::io::parquet::{is_parquet, ParquetRows, ParquetTable};
+use crate::io::progress::{self, Progress};
+use crate::io::rows::{Chunk, RowReader};
 use rayon::prelude::*;
-use rows::{Chunk, RowReader};
 use runner::Runner;
 use seqsmooth::polynomial::stream::{self, StreamBank};
 use seqsmooth::polynomial::tau;

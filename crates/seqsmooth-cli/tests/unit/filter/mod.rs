@@ -1,4 +1,3 @@
 //! Unit tests of `filter` and its submodules.
 
-mod rows;
 mod runner;

@@ -1,5 +1,7 @@
 //! Unit tests of `io`: CSV line numbers, number cells and round-trip number output.
 
+mod rows;
+
 use seqsmooth_cli::io::*;
 
 fn lines(text: &str) -> Vec<u64> {

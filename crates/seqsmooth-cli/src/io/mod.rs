@@ -1,8 +1,12 @@
 //! The command's files: opening inputs and outputs, the one CSV reader (records with their
 //! 1-based file lines, header checks, column lookup, number cells) and the one CSV writer
 //! (cells, numbers with round-trip precision) of every subcommand. Other formats come in as
-//! [`Records`] and go out as a [`Table`] of [`Output`] (Parquet: `crate::parquet`). Imports no
+//! [`Records`] and go out as a [`Table`] of [`Output`] (Parquet: [`parquet`]). Imports no
 //! subcommand.
+
+pub mod parquet;
+pub mod progress;
+pub mod rows;
 
 use crate::error::CliError;
 use std::fs::File;
@@ -663,7 +667,7 @@ pub fn named(path: Option<&Path>) -> Option<&Path> {
 /// input and output (`None`, `-`) are CSV.
 ///
 /// ```
-/// use seqsmooth_cli::parquet::is_parquet;
+/// use seqsmooth_cli::io::parquet::is_parquet;
 /// use std::path::Path;
 /// assert!(is_parquet(Some(Path::new("a/b.PARQUET"))));
 /// assert!(!is_parquet(Some(Path::new("b.csv"))));

@@ -1,6 +1,6 @@
-//! Unit tests of `filter::rows`: chunks of rows, their lines, cells and series.
+//! Unit tests of `io::rows`: chunks of rows, their lines, cells and series.
 
-use seqsmooth_cli::filter::rows::*;
+use seqsmooth_cli::io::rows::*;
 use seqsmooth_cli::io::Need;
 
 fn read_all(text: &str, id: Option<&str>, max: usize) -> (Vec<Chunk>, Vec<Vec<u8>>) {

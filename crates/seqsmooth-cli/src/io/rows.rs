@@ -1,6 +1,6 @@
 //! The rows of a time series, one series or many (`--id-col`), read and validated in
 //! chunks, and echoed to the output. The rows come from any [`Records`]: a CSV text, or a
-//! Parquet file's rows (`crate::parquet`), through the same checks.
+//! Parquet file's rows (`crate::io::parquet`), through the same checks.
 //!
 //! Every row is validated as it is read — the time and value cells are numbers, finite, and
 //! the time is strictly after the previous time of the same series — with its 1-based file
