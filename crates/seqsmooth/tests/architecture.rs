@@ -373,3 +373,42 @@ fn the_checker_sees_braced_relative_and_inline_paths() {
         .1;
     assert!(to > from);
 }
+
+/// In the command, no subcommand (`commands::<name>`) imports another: what two of them use is
+/// in `commands::shared`. (Subcommands share a level, so the level check alone lets them.)
+#[test]
+fn no_subcommand_imports_another() {
+    let src = root().join("crates/seqsmooth-cli/src");
+    let mut files = Vec::new();
+    rust_files(&src.join("commands"), &mut files);
+    files.sort();
+    assert!(
+        files.len() > 10,
+        "the subcommands are in crates/seqsmooth-cli/src/commands/"
+    );
+    let mut violations = Vec::new();
+    for file in &files {
+        let module = module_of(&src, file);
+        // `commands` itself (commands/mod.rs) declares the modules; `shared` is below them.
+        let Some(own) = module.get(1).filter(|own| *own != "shared") else {
+            continue;
+        };
+        let code = without_test_modules(&code_only(&fs::read_to_string(file).unwrap()));
+        for target in imports(&code, &module) {
+            if let [first, other, ..] = target.as_slice() {
+                if first == "commands" && other != own && other != "shared" {
+                    violations.push(format!(
+                        "{}: `commands::{own}` imports `{}`",
+                        file.strip_prefix(root()).unwrap_or(file).display(),
+                        target.join("::")
+                    ));
+                }
+            }
+        }
+    }
+    assert!(
+        violations.is_empty(),
+        "a subcommand imports another (move what they share into commands::shared):\n{}",
+        violations.join("\n")
+    );
+}

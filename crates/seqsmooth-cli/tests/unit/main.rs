@@ -3,10 +3,8 @@
 
 mod args;
 mod chart;
+mod commands;
 mod decimate;
-mod demo;
 mod error;
-mod filter;
 mod io;
-mod plot;
 mod ticks;

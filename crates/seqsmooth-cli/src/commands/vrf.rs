@@ -3,8 +3,8 @@
 //! (7.5.22)-(7.5.26)), in `f64` or exact rationals.
 
 use crate::args::{check_window, only, Format, Memory, TableKind, VrfArgs, VrfKind};
+use crate::commands::shared::table::{cells, write_table};
 use crate::error::CliError;
-use crate::gains::{cells, write_table};
 use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
 use seqsmooth::polynomial::fading::vrf::fading_vrf;
 use seqsmooth::polynomial::fixed::covariance;

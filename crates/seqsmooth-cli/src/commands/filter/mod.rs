@@ -14,23 +14,20 @@
 //! decision is final, a few samples of their series later (`held`).
 
 mod held;
-pub mod runner;
 
 use crate::args::{check_window, name, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
+use crate::commands::shared::runner::{self, Runner};
+use crate::commands::shared::LOOKAHEAD;
 use crate::error::CliError;
-use crate::io::{check_distinct, input_size, named, open_input, CsvIn, Need, Output};
-use crate::io::{IdType, Records};
 use crate::io::parquet::{is_parquet, ParquetRows, ParquetTable};
 use crate::io::progress::{self, Progress};
 use crate::io::rows::{Chunk, RowReader};
+use crate::io::{check_distinct, input_size, named, open_input, CsvIn, Need, Output};
+use crate::io::{IdType, Records};
 use rayon::prelude::*;
-use runner::Runner;
 use seqsmooth::polynomial::stream::{self, StreamBank};
 use seqsmooth::polynomial::tau;
 use std::sync::mpsc;
-
-/// Data rows buffered before output starts: the time steps of the `τ` median.
-pub const LOOKAHEAD: usize = tau::TAU_STEPS + 1;
 
 /// Rows of the first chunk, unless the first rows held back or scanned need more: the chunks
 /// then double in size up to `--chunk-rows`, so that filtering starts early.

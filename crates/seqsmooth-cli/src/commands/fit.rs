@@ -7,10 +7,11 @@
 //! state writes nothing.
 
 use crate::args::{EpochArg, FitArgs, FitModel};
+use crate::commands::shared::radar_rows::{check_sigmas, Batch, Rows};
+use crate::commands::shared::window::window_error;
 use crate::error::CliError;
 use crate::io::{check_distinct, find_column, open_input, parse_cell, shown, write_f64, CsvIn};
 use crate::io::{Need, Output};
-use crate::track::rows::{check_sigmas, Batch, Rows};
 use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
@@ -361,39 +362,5 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
                 variance: sigma * sigma,
             })
         }
-    }
-}
-
-/// A window's error with the file lines of its rows (or of the one row it is about).
-pub(crate) fn window_error(
-    e: Error,
-    lines: &VecDeque<u64>,
-    window: usize,
-    model: FitModel,
-) -> CliError {
-    let (first, last) = (
-        lines.front().copied().unwrap_or(0),
-        lines.back().copied().unwrap_or(0),
-    );
-    match e {
-        Error::InBatch { index, source } => {
-            let line = lines.get(index).copied().unwrap_or(last);
-            CliError::Data(format!("line {line}: {source}"))
-        }
-        Error::Unobservable { .. } | Error::TooFewSamples { .. } => CliError::Data(format!(
-            "lines {first}-{last}: the window of {} rows does not determine the state: {e}{}",
-            lines.len().min(window),
-            if model == FitModel::Radar {
-                " (a radar window needs at least as many measured components as states, and \
-                 its first fit two rows with range, azimuth and elevation)"
-            } else {
-                ""
-            }
-        )),
-        e @ (Error::NotConverged { .. } | Error::Diverged { .. }) => CliError::Data(format!(
-            "lines {first}-{last} (the window): {e} (with this command: --max-iterations N \
-             allows more iterations, a shorter --window W fits fewer rows)"
-        )),
-        e => CliError::Data(format!("lines {first}-{last} (the window): {e}")),
     }
 }

@@ -12,9 +12,9 @@
 
 use crate::args::{name, DemoArgs, EngineArg, Kind};
 use crate::chart::{self, Layout, Track};
+use crate::commands::shared::runner::Runner;
+use crate::commands::shared::LOOKAHEAD;
 use crate::error::CliError;
-use crate::filter::runner::Runner;
-use crate::filter::LOOKAHEAD;
 use crate::io::{fmt_f64, Output};
 use seqsmooth::polynomial::automatic::{final_outliers, AutoOutput, AutomaticFilter, Phase};
 use seqsmooth::polynomial::tau::median_series_step;

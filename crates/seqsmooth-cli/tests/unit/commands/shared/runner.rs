@@ -1,4 +1,4 @@
-//! Unit tests of `filter::runner`'s fixed-memory filter ([`FixedEngine::Adaptive`], what
+//! Unit tests of `commands::shared::runner`'s fixed-memory filter ([`FixedEngine::Adaptive`], what
 //! `Runner::Fixed` runs): the switch from the sliding to the irregular engine.
 
 use seqsmooth::{FixedEngine, FixedMemory, PolynomialFilter};

@@ -1,6 +1,6 @@
-//! Unit tests of `demo`: the built-in track and the plot paths.
+//! Unit tests of `commands::demo`: the built-in track and the plot paths.
 
-use seqsmooth_cli::demo::*;
+use seqsmooth_cli::commands::demo::*;
 use std::path::Path;
 
 /// The track is what the module docs say: 400 samples, increasing times, jittered steps,

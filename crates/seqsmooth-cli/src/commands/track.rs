@@ -4,7 +4,7 @@
 //! (`kalman::fixed_lag`). The Kalman methods start from the first Gauss–Newton fit that
 //! determines the state.
 //!
-//! Rows are read and checked one at a time (`track/rows.rs`: line and column in every
+//! Rows are read and checked one at a time (`shared/radar_rows.rs`: line and column in every
 //! message; each component's noise σ from the row's σ column or the flag). The window, kalman
 //! and fading methods stream: each row is tracked and its output row written as it is read, in
 //! memory independent of the input's length. Reading, tracking and writing run on three threads
@@ -17,15 +17,14 @@
 //! filter's states in the library) and writes each row when the row `--lag` later is in, the
 //! last ones at the end.
 
-pub(crate) mod rows;
 mod stream;
 
 use crate::args::{FitModel, TrackArgs, TrackMethod};
+use crate::commands::shared::radar_rows::{self as rows, Rows};
+use crate::commands::shared::window::window_error;
 use crate::error::CliError;
-use crate::fit::window_error;
 use crate::io::{check_distinct, open_input, write_f64, CsvIn, Need, Output};
 use nalgebra::{DMatrix, DVector};
-use rows::Rows;
 use seqsmooth::estimate::gauss_newton::GaussNewton;
 use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::track::{

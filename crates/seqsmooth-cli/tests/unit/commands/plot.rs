@@ -1,6 +1,6 @@
-//! Unit tests of `plot`: axis labels.
+//! Unit tests of `commands::plot`: axis labels.
 
-use seqsmooth_cli::plot::*;
+use seqsmooth_cli::commands::plot::*;
 
 #[test]
 fn labels_carry_units() {

@@ -11,8 +11,8 @@
 //! created or written) stops the writer, whose closed channel stops the tracker; the writer's
 //! error is reported.
 
-use super::rows::{Batch, Rows};
 use super::{Cells, Step, Tracker, Writer};
+use crate::commands::shared::radar_rows::{Batch, Rows};
 use crate::error::CliError;
 use crate::io::Need;
 use seqsmooth::estimate::batch::NoiseCovariance;

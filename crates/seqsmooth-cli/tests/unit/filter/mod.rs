@@ -1,3 +1,0 @@
-//! Unit tests of `filter` and its submodules.
-
-mod runner;
