@@ -6,9 +6,7 @@
 //! parsing ([`args`]), files ([`io`], [`io::parquet`]), one module per subcommand ([`commands`]), and messages ([`error`]).
 
 pub mod args;
-pub mod chart;
 pub mod commands;
-pub mod decimate;
 pub mod error;
 pub mod io;
-pub mod ticks;
+pub mod plot;

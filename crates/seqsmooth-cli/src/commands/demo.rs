@@ -11,11 +11,11 @@
 //! (noise σ given), on both engines, are shown beside it for comparison.
 
 use crate::args::{name, DemoArgs, EngineArg, Kind};
-use crate::chart::{self, Layout, Track};
 use crate::commands::shared::runner::Runner;
 use crate::commands::shared::LOOKAHEAD;
 use crate::error::CliError;
 use crate::io::{fmt_f64, Output};
+use crate::plot::chart::{self, Layout, Track};
 use seqsmooth::polynomial::automatic::{final_outliers, AutoOutput, AutomaticFilter, Phase};
 use seqsmooth::polynomial::tau::median_series_step;
 use seqsmooth::{PolynomialFilter, PolynomialState};

@@ -6,23 +6,23 @@
 //! with `--lead H` (the estimates are drawn at `t + H`, and each is compared in the residual
 //! panel with the sample at that time where there is one). Empty
 //! cells (no estimate yet, a degree not reached yet) leave gaps. The filter's input file may be
-//! given too, for a truth column. The drawing is [`crate::chart`]'s, the same as the demo's.
+//! given too, for a truth column. The drawing is [`crate::plot::chart`]'s, the same as the demo's.
 //!
-//! The rows are read one at a time and decimated as they come ([`crate::decimate::Reducer`]:
+//! The rows are read one at a time and decimated as they come ([`crate::plot::decimate::Reducer`]:
 //! per half pixel column, the rows holding the extremes of every quantity drawn; time bins
 //! that merge pairwise as the time range grows, since standard input cannot be read twice),
 //! with a systematic sample of rows for the axis ranges, the outages' candidate steps, the
 //! share of each bin's time under the misfit flag and the counts: memory is bounded by the image's width, not the input's
 //! length. With a lead, the rows within the lead wait for the sample at their time
-//! ([`crate::chart::LeadMatcher`]).
+//! ([`crate::plot::chart::LeadMatcher`]).
 
 use crate::args::PlotArgs;
-use crate::chart::{self, Counts, Layout, LeadMatcher, Row, Sample, Track};
-use crate::decimate::{Reducer, Stride};
 use crate::error::CliError;
 use crate::io::{
     find_column, fmt_f64, input_name, named, open_input, parse_cell, plural, shown, CsvIn,
 };
+use crate::plot::chart::{self, Counts, Layout, LeadMatcher, Row, Sample, Track};
+use crate::plot::decimate::{Reducer, Stride};
 use std::io::Read;
 use std::path::Path;
 

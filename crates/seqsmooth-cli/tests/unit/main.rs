@@ -2,9 +2,7 @@
 //! behaviour end to end is in the other test targets).
 
 mod args;
-mod chart;
 mod commands;
-mod decimate;
 mod error;
 mod io;
-mod ticks;
+mod plot;

@@ -1,6 +1,6 @@
-//! Unit tests of `ticks`: short, distinct tick labels at any magnitude, epoch dates.
+//! Unit tests of `plot::ticks`: short, distinct tick labels at any magnitude, epoch dates.
 
-use seqsmooth_cli::ticks::{tick, unix_date, Scale};
+use seqsmooth_cli::plot::ticks::{tick, unix_date, Scale};
 
 /// The labels of the ticks of `lo..hi` as the chart draws them: in tick units, at the
 /// multiples of a 1-2-5 step in it of about a tenth of the span, with the decimals of that.

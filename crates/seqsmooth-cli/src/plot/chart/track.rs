@@ -141,7 +141,7 @@ impl Track {
 /// the rows holding each one's lowest and highest value.
 ///
 /// ```
-/// use seqsmooth_cli::chart::{drawn, Row};
+/// use seqsmooth_cli::plot::chart::{drawn, Row};
 /// let row = Row { t: 1.0, y: 5.0, d: vec![Some(4.5)], s: vec![Some(0.5)], ..Row::default() };
 /// let mut v = Vec::new();
 /// drawn(&row, &mut v);
@@ -217,7 +217,7 @@ pub fn typical_step(steps: impl IntoIterator<Item = f64>) -> Option<f64> {
 /// `typical`: longer than [`OUTAGE_STEPS`] of them. No curve is drawn across an outage.
 ///
 /// ```
-/// use seqsmooth_cli::chart::is_outage;
+/// use seqsmooth_cli::plot::chart::is_outage;
 /// assert!(is_outage(12.5, 1.0) && !is_outage(9.0, 1.0));
 /// ```
 pub fn is_outage(step: f64, typical: f64) -> bool {
@@ -228,7 +228,7 @@ pub fn is_outage(step: f64, typical: f64) -> bool {
 /// against the median step.
 ///
 /// ```
-/// use seqsmooth_cli::chart::outages;
+/// use seqsmooth_cli::plot::chart::outages;
 /// let mut t: Vec<f64> = (0..50).map(f64::from).collect();
 /// t.extend((0..50).map(|i| 70.0 + f64::from(i)));
 /// assert_eq!(outages(&t), vec![(49.0, 70.0)]);
@@ -291,7 +291,7 @@ impl Spans {
 /// The spans of `flags` over the rows at times `t` ([`Spans`], none joined).
 ///
 /// ```
-/// use seqsmooth_cli::chart::flag_spans;
+/// use seqsmooth_cli::plot::chart::flag_spans;
 /// let t = [0.0, 1.0, 2.0, 3.0, 4.0];
 /// assert_eq!(flag_spans(&t, &[false, true, true, false, true]), vec![(1.0, 3.0), (4.0, 4.0)]);
 /// ```
@@ -410,7 +410,7 @@ impl<R, S: Clone> LeadMatcher<R, S> {
 /// increasing.
 ///
 /// ```
-/// use seqsmooth_cli::chart::samples_at_lead;
+/// use seqsmooth_cli::plot::chart::samples_at_lead;
 /// let t = [0.0, 0.1, 0.2, 0.30000000000000004, 0.4];
 /// assert_eq!(samples_at_lead(&t, 0.2), vec![Some(2), Some(3), Some(4), None, None]);
 /// assert_eq!(samples_at_lead(&t, 0.0)[1], Some(1));

@@ -1,7 +1,7 @@
-//! Unit tests of `decimate`: per-pixel min/max decimation keeps the shape of the series.
+//! Unit tests of `plot::decimate`: per-pixel min/max decimation keeps the shape of the series.
 
 use rand::{Rng, SeedableRng};
-use seqsmooth_cli::decimate::{envelope, min_max, Reducer, Stride};
+use seqsmooth_cli::plot::decimate::{envelope, min_max, Reducer, Stride};
 
 /// The pixel column of `x` as `min_max` defines it.
 fn column(x: f64, (x0, x1): (f64, f64), columns: usize) -> usize {

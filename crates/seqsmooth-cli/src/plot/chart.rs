@@ -25,15 +25,15 @@
 //! its value is missing.
 //!
 //! **Dense series.** A series with more points than the plot has pixel columns is drawn
-//! decimated per pixel column ([`crate::decimate`]); its samples, too many for dots, as the
+//! decimated per pixel column ([`crate::plot::decimate`]); its samples, too many for dots, as the
 //! band between each column's lowest and highest sample (an envelope, not a zig-zag line that
 //! would fill it solid), and its rejected samples as small crosses, at most the lowest and
 //! highest of each column, their number in the legend. `seqsmooth plot` reads its rows into a
-//! [`Track`] through [`crate::decimate::Reducer`], keeping per half pixel the rows that hold
+//! [`Track`] through [`crate::plot::decimate::Reducer`], keeping per half pixel the rows that hold
 //! the extremes of every quantity drawn ([`drawn`]) plus a systematic sample of rows for the
 //! axis ranges' quantiles ([`Track::sampled`]). Axes whose values share many leading digits
 //! or are very large or small are drawn in tick units with an offset and a power of ten, said
-//! in the axis label ([`crate::ticks`]).
+//! in the axis label ([`crate::plot::ticks`]).
 //!
 //! **Beyond the axis.** Axis ranges ignore the start-up transients of the estimates (the
 //! 1st-99th percentile of the estimates widened by the truth). A value beyond the range is
@@ -46,9 +46,9 @@
 mod panel;
 mod track;
 
-use crate::decimate::{envelope, min_max};
 use crate::error::CliError;
-use crate::ticks::Scale;
+use crate::plot::decimate::{envelope, min_max};
+use crate::plot::ticks::Scale;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -57,7 +57,7 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 /// DejaVu Sans (Bitstream Vera licence, see `assets/LICENSE-DejaVu.txt`).
-static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 /// The family name the embedded font is registered under: the PNG is drawn with it; the SVG
 /// names it, with the viewer's `sans-serif` where DejaVu Sans is not installed.
 const FAMILY: &str = "DejaVu Sans, sans-serif";
@@ -211,7 +211,7 @@ fn widen(range: &mut Option<(f64, f64)>, values: impl IntoIterator<Item = f64>) 
     }
 }
 
-pub use crate::ticks::tick;
+pub use crate::plot::ticks::tick;
 use panel::{panels, PanelData};
 pub use track::*;
 

@@ -25,7 +25,7 @@
 /// The column of `x` is `⌊(x − x0)/(x1 − x0) · columns⌋`, clamped to the plot.
 ///
 /// ```
-/// use seqsmooth_cli::decimate::min_max;
+/// use seqsmooth_cli::plot::decimate::min_max;
 /// // 1000 points of a triangle wave drawn in 10 columns: ≤ 40 points, the peaks kept.
 /// let pts: Vec<(f64, f64)> = (0..1000)
 ///     .map(|i| (i as f64, (i % 100) as f64))
@@ -80,7 +80,7 @@ pub fn min_max(points: &[(f64, f64)], (x0, x1): (f64, f64), columns: usize) -> V
 /// neighbouring columns' points; a polygon of one column is half a column wide on each side.
 ///
 /// ```
-/// use seqsmooth_cli::decimate::envelope;
+/// use seqsmooth_cli::plot::decimate::envelope;
 /// let pts: Vec<(f64, f64)> = (0..100).map(|i| (i as f64, (i % 2) as f64)).collect();
 /// let polys = envelope(&pts, (0.0, 100.0), 10, &[(49.0, 50.0)]);
 /// assert_eq!(polys.len(), 2);
@@ -145,7 +145,7 @@ pub fn envelope(
 /// are held. Every item is kept while the stream is no longer than the capacity.
 ///
 /// ```
-/// use seqsmooth_cli::decimate::Stride;
+/// use seqsmooth_cli::plot::decimate::Stride;
 /// let mut s = Stride::new(4);
 /// for i in 0..10u64 {
 ///     s.push(i, i);
@@ -309,7 +309,7 @@ impl<R> Bin<R> {
 /// Streaming per-bin min/max decimation of rows in increasing time (see the module docs).
 ///
 /// ```
-/// use seqsmooth_cli::decimate::Reducer;
+/// use seqsmooth_cli::plot::decimate::Reducer;
 /// // 10⁵ rows of a sawtooth into 100 bins: the first and last rows, and each bin's peak.
 /// let mut r = Reducer::new(100);
 /// for i in 0..100_000u64 {

@@ -38,7 +38,7 @@ impl Scale {
     /// is `t₀`, otherwise the round number nearest the middle, to the digit above the span's.
     ///
     /// ```
-    /// use seqsmooth_cli::ticks::Scale;
+    /// use seqsmooth_cli::plot::ticks::Scale;
     /// let s = Scale::for_range(1.7e18, 1.7e18 + 1e9, None);
     /// assert_eq!((s.offset, s.exponent), (1.7e18, 9));
     /// assert_eq!(s.note("value"), "value = tick × 1e9 + 1.7e18");
@@ -80,7 +80,7 @@ impl Scale {
     /// How to read a tick back as the value `name`; empty for the identity.
     ///
     /// ```
-    /// use seqsmooth_cli::ticks::Scale;
+    /// use seqsmooth_cli::plot::ticks::Scale;
     /// let s = Scale::for_range(0.0, 3e-9, None);
     /// assert_eq!(s.note("value"), "value = tick × 1e-9");
     /// assert!((s.to_axis(2e-9) - 2.0).abs() < 1e-12);
@@ -113,7 +113,7 @@ impl Scale {
 /// Tick label text with the decimals the axis step needs (`-0` written `0`).
 ///
 /// ```
-/// use seqsmooth_cli::ticks::tick;
+/// use seqsmooth_cli::plot::ticks::tick;
 /// assert_eq!(tick(0.25, 0.05), "0.25");
 /// assert_eq!(tick(-0.0001, 0.5), "0.0");
 /// ```
@@ -147,7 +147,7 @@ fn short(x: f64) -> String {
 /// puts it between 1980 and 2100 — and its UTC date and time (to the second).
 ///
 /// ```
-/// use seqsmooth_cli::ticks::unix_date;
+/// use seqsmooth_cli::plot::ticks::unix_date;
 /// let (unit, date) = unix_date(1.7e12).unwrap();
 /// assert_eq!((unit, date.as_str()), ("ms", "2023-11-14 22:13:20 UTC"));
 /// assert_eq!(unix_date(42.0), None);

@@ -1,6 +1,6 @@
-//! Unit tests of `chart`: gaps, tick labels and image formats.
+//! Unit tests of `plot::chart`: gaps, tick labels and image formats.
 
-use seqsmooth_cli::chart::*;
+use seqsmooth_cli::plot::chart::*;
 use std::path::Path;
 
 #[test]
