@@ -1,17 +1,42 @@
 //! The command line: the subcommands' arguments (clap), their help texts, the parsers of the
 //! numeric arguments and the checks that tie arguments together. Imports no subcommand.
 //!
+//! Here: [`Cli`] and [`Command`] (with each subcommand's help text), the arguments that several
+//! subcommands share ([`Columns`], [`MemoryArgs`], [`Kind`], …) and the shared parsers; each
+//! subcommand's own arguments and parsers in a file of its own (`args/<subcommand>.rs`, and
+//! `args/radar.rs`, the radar options of `track` and `fit`), re-exported here.
+//!
 //! The argument parsers return `Err(message)`; clap prints it as
 //! `error: invalid value 'V' for '--name <X>': message` and exits with code 2.
 
 use crate::error::CliError;
 use clap::{Args, Parser, Subcommand};
 use num_traits::{One, Zero};
-use seqsmooth::polynomial::form::EstimateForm;
 use seqsmooth::polynomial::MAX_DEGREE;
 use seqsmooth::scalar::{parse_rational, Rational};
 use seqsmooth::Engine;
-use std::path::PathBuf;
+
+mod demo;
+mod filter;
+mod fit;
+mod gains;
+mod paml;
+mod plot;
+mod radar;
+mod smooth;
+mod track;
+mod vrf;
+
+pub use demo::DemoArgs;
+pub use filter::FilterArgs;
+pub use fit::{parse_epoch, EpochArg, FitArgs, FitModel};
+pub use gains::GainsArgs;
+pub use paml::{parse_order, parse_segment, PamlArgs};
+pub use plot::PlotArgs;
+pub use radar::{parse_site, AzimuthConvention, RadarArgs};
+pub use smooth::SmoothArgs;
+pub use track::{parse_discount, parse_psd, TrackArgs, TrackMethod};
+pub use vrf::{parse_lead_steps, FormArg, LeadSteps, VrfArgs, VrfKind};
 
 /// Rows per chunk of `seqsmooth filter`'s streaming pipeline (read, filter, write).
 pub const CHUNK_ROWS: u32 = 1 << 16;
@@ -98,42 +123,6 @@ segment's weighted least-squares polynomial there and variance its variance (in 
 sigma^2; the N+1 values are uncorrelated). A segment with fewer than N+1 samples is named on \
 standard error by its time span and left out. Without --sigma or --sigma-col every sample's \
 sigma is 1 (the variances are then per unit noise variance).";
-
-#[derive(Debug, Args)]
-pub struct PamlArgs {
-    /// Input CSV with a header row; omitted or '-' reads standard input. Times strictly
-    /// increasing; read segment by segment
-    #[arg(value_name = "INPUT")]
-    pub input: Option<PathBuf>,
-    /// Polynomial degree N of each segment (0 to 30): N+1 polynomial samples per segment
-    #[arg(long, value_name = "N", value_parser = parse_order, allow_hyphen_values = true)]
-    pub order: usize,
-    /// Segment length in the time column's units
-    #[arg(long, value_name = "SECONDS", value_parser = parse_segment, allow_hyphen_values = true)]
-    pub segment: f64,
-    /// The values' noise standard deviation, the same for every sample
-    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true,
-          conflicts_with = "sigma_col")]
-    pub sigma: Option<f64>,
-    /// The column holding each sample's noise standard deviation
-    #[arg(long, value_name = "NAME")]
-    pub sigma_col: Option<String>,
-    #[command(flatten)]
-    pub columns: Columns,
-    /// Output file [default: standard output]
-    #[arg(short = 'o', long, value_name = "OUTPUT")]
-    pub output: Option<PathBuf>,
-}
-
-/// Parses `--order`: a whole number from 0 to 30.
-pub fn parse_order(s: &str) -> Result<usize, String> {
-    parse_whole("order", s, "", 0, 30).map(|v| v as usize)
-}
-
-/// Parses `--segment`: a positive finite number.
-pub fn parse_segment(s: &str) -> Result<f64, String> {
-    parse_f64("segment", s, POSITIVE)
-}
 
 const TRACK_AFTER_HELP: &str = concat!(
     "\
@@ -360,357 +349,6 @@ output is left untouched (standard output keeps the rows already written, a mega
     exit_status!("fewer rows than the window")
 );
 
-#[derive(Debug, Args)]
-pub struct FilterArgs {
-    /// Input CSV with a header row, or a Parquet file if the name ends in .parquet (any case):
-    /// numbers of any integer, float or decimal type, the time also a timestamp or date (as
-    /// seconds since the Unix epoch), the id text or integers; omitted or '-' reads CSV from
-    /// standard input. Columns other than the time, value and id columns are ignored
-    #[arg(value_name = "INPUT")]
-    pub input: Option<PathBuf>,
-    /// Filter kind
-    #[arg(long, value_enum)]
-    pub kind: Kind,
-    /// Polynomial degree M (0 to 24; with --engine gain 0 to 10)
-    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
-    pub degree: usize,
-    /// Fading memory and auto: discount per tau, 0 < T < 1 (e.g. 0.9 or 9/10)
-    #[arg(long, value_name = "T", value_parser = parse_theta, allow_hyphen_values = true)]
-    pub theta: Option<Theta>,
-    /// Fading memory and auto: the time interval theta applies to [default: the median time
-    /// step of the first 101 rows, so theta is the discount per typical sample; 1 for a single
-    /// row]
-    #[arg(long, value_name = "TAU", value_parser = parse_tau, allow_hyphen_values = true)]
-    pub tau: Option<f64>,
-    /// Fixed memory: the number of samples in the window, W >= M+1 (Morrison's L+1, savgol's
-    /// window_length)
-    #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
-    pub window: Option<usize>,
-    /// Engine of the expanding, fading and auto filters: 'exact' is least squares on any
-    /// timestamps; 'gain' is Morrison's fixed-gain recursion, exact on evenly spaced times and
-    /// approximate on irregular ones. The fixed-memory filter is always the exact fit of its
-    /// window [default: exact]
-    #[arg(long, value_enum)]
-    pub engine: Option<EngineArg>,
-    /// Lead H in time units: each row's estimate is valid at t+H (negative = retrodiction)
-    #[arg(long, value_name = "H", default_value = "0", value_parser = parse_lead,
-          allow_hyphen_values = true)]
-    pub lead: f64,
-    #[command(flatten)]
-    pub columns: Columns,
-    /// White-noise standard deviation S of the values: adds the columns s0..sM, the 1-sigma
-    /// errors of d0..dM from the filter's covariance. With --kind auto (which always writes
-    /// s0..sM) the noise is taken to be S instead of estimated
-    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
-    pub sigma: Option<f64>,
-    /// The automatic filter's final outlier decision on each sample waits for N accepted
-    /// samples after it (0 to 31; 0: the gate's decision at the time, final once a later sample
-    /// is taken) [default: degree + 4]
-    #[arg(long, value_name = "N")]
-    pub review_window: Option<usize>,
-    /// Output file: CSV, or Parquet if the name ends in .parquet (any case; the CSV output's
-    /// columns, numbers as Float64 with null for an empty cell, the time in seconds, the id
-    /// column text or integers as in the input) [default: CSV on standard output]
-    #[arg(short = 'o', long, value_name = "OUTPUT")]
-    pub output: Option<PathBuf>,
-    /// Name of a column naming the series: the rows of each id (any text) are a series of
-    /// their own, filtered on its own with the same settings, and the column is written first
-    #[arg(long, value_name = "NAME")]
-    pub id_col: Option<String>,
-    /// Never show the progress display (shown on standard error only when it is a terminal
-    /// and the input is larger than one chunk of rows)
-    #[arg(long)]
-    pub no_progress: bool,
-    /// Rows read, filtered and written at a time (testing aid)
-    #[arg(long, value_name = "N", hide = true, default_value_t = CHUNK_ROWS,
-          value_parser = clap::value_parser!(u32).range(1..))]
-    pub chunk_rows: u32,
-}
-
-#[derive(Debug, Args)]
-pub struct SmoothArgs {
-    /// Input CSV with a header row; omitted or '-' reads standard input. Columns other than the
-    /// time and value columns are ignored. Times are numbers or ISO-8601 (2024-03-01T12:00:00Z,
-    /// fractional seconds, an offset, a date alone; UTC without an offset), read as seconds
-    /// since the Unix epoch
-    #[arg(value_name = "INPUT")]
-    pub input: Option<PathBuf>,
-    /// Polynomial degree M (0 to 24)
-    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
-    pub degree: usize,
-    /// The number of samples in each window, M+1 <= W <= the number of rows (savgol's
-    /// window_length, Morrison's L+1); odd W centres every window on its row
-    #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
-    pub window: usize,
-    #[command(flatten)]
-    pub columns: Columns,
-    /// White-noise standard deviation S of the values, for the 1-sigma columns s0..sM
-    /// [default: estimated from each window's residuals]
-    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
-    pub sigma: Option<f64>,
-    /// Output file [default: standard output]
-    #[arg(short = 'o', long, value_name = "OUTPUT")]
-    pub output: Option<PathBuf>,
-}
-
-#[derive(Debug, Args)]
-pub struct GainsArgs {
-    /// Filter kind
-    #[arg(long, value_enum)]
-    pub kind: TableKind,
-    #[command(flatten)]
-    pub memory: MemoryArgs,
-    /// Print exact rationals in lowest terms, p/q (an integer as p), instead of doubles.
-    /// Without it θ is rounded to the nearest double before the computation
-    #[arg(long)]
-    pub exact: bool,
-    /// Output format
-    #[arg(long, value_enum, default_value_t = Format::Csv)]
-    pub format: Format,
-}
-
-#[derive(Debug, Args)]
-pub struct VrfArgs {
-    /// Filter kind
-    #[arg(long, value_enum)]
-    pub kind: VrfKind,
-    #[command(flatten)]
-    pub memory: MemoryArgs,
-    /// Fixed memory: the number of samples in the window, W >= M+1 (Morrison's L+1)
-    #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
-    pub window: Option<usize>,
-    /// Fixed memory: the lead H in samples after the newest one: 0 the current estimate
-    /// (default), 1 the 1-step prediction, -(W-1)/2 the centre of the window; any number, e.g.
-    /// -2.5 or -5/2 (exact with --exact)
-    #[arg(long, value_name = "H", value_parser = parse_lead_steps, allow_hyphen_values = true)]
-    pub lead: Option<LeadSteps>,
-    /// Expanding and fading memory: which estimate, the current one (Z*_{n,n}) or the 1-step
-    /// prediction (Z*_{n+1,n}) [default: current]
-    #[arg(long, value_enum)]
-    pub form: Option<FormArg>,
-    /// Print exact rationals in lowest terms, p/q (an integer as p), instead of doubles.
-    /// Without it θ (or H) is rounded to the nearest double before the computation
-    #[arg(long)]
-    pub exact: bool,
-    /// Output format
-    #[arg(long, value_enum, default_value_t = Format::Csv)]
-    pub format: Format,
-}
-
-#[derive(Debug, Args)]
-pub struct FitArgs {
-    /// Input CSV with a header row; omitted or '-' reads standard input. Columns other than the
-    /// ones named are ignored
-    #[arg(value_name = "INPUT")]
-    pub input: Option<PathBuf>,
-    /// The dynamic and observation model
-    #[arg(long, value_enum)]
-    pub model: FitModel,
-    /// Degree of the motion: polynomial, the polynomial's degree M (0 to 24, required); radar,
-    /// 1 for constant velocity or 2 for constant acceleration [radar default: 1]
-    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
-    pub degree: Option<usize>,
-    /// The number of rows in each window, W >= 1 (all rows so far while fewer have come)
-    /// [default: radar 8, polynomial 60]
-    #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
-    pub window: Option<usize>,
-    /// The time each row's state refers to: 'end' (the row's own time), 'centre' (the mean
-    /// time of its window) or a time T
-    #[arg(long, value_name = "EPOCH", default_value = "end", value_parser = parse_epoch,
-          allow_hyphen_values = true)]
-    pub epoch: EpochArg,
-    /// Polynomial: the values' noise standard deviation (required)
-    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
-    pub sigma: Option<f64>,
-    /// Name of the time column
-    #[arg(long, value_name = "NAME", default_value = "t")]
-    pub time_col: String,
-    /// Polynomial: name of the value column
-    #[arg(long, value_name = "NAME", default_value = "y")]
-    pub value_col: String,
-    #[command(flatten)]
-    pub radar: RadarArgs,
-    /// Gauss-Newton iterations allowed per window
-    #[arg(long, value_name = "N", default_value_t = 20,
-          value_parser = clap::value_parser!(u32).range(1..=1000))]
-    pub max_iterations: u32,
-    /// Output file [default: standard output]
-    #[arg(short = 'o', long, value_name = "OUTPUT")]
-    pub output: Option<PathBuf>,
-}
-
-#[derive(Debug, Args)]
-pub struct TrackArgs {
-    /// Input CSV with a header row; omitted or '-' reads standard input
-    #[arg(value_name = "INPUT")]
-    pub input: Option<PathBuf>,
-    /// The tracking method
-    #[arg(long, value_enum, default_value_t = TrackMethod::Kalman)]
-    pub method: TrackMethod,
-    /// kalman, smooth: spectral density of the white-noise acceleration on each axis
-    /// [default: adaptive, from the innovations]
-    #[arg(long = "q", value_name = "ACCEL_PSD", value_parser = parse_psd, allow_hyphen_values = true)]
-    pub q: Option<f64>,
-    /// fading: the discount per unit of time, 0 < B <= 1 [default: an adaptive discount per
-    /// update, from the innovations]
-    #[arg(long, value_name = "B", value_parser = parse_discount, allow_hyphen_values = true,
-          conflicts_with = "theta")]
-    pub beta: Option<f64>,
-    /// fading: the discount per update, 0 < T <= 1
-    #[arg(long, value_name = "T", value_parser = parse_discount, allow_hyphen_values = true)]
-    pub theta: Option<f64>,
-    /// window: the number of rows in each window [default: 8]
-    #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
-    pub window: Option<usize>,
-    /// Gauss-Newton iterations allowed per fit (the window method's fits, the Kalman
-    /// methods' start)
-    #[arg(long, value_name = "N", default_value_t = 20,
-          value_parser = clap::value_parser!(u32).range(1..=1000))]
-    pub max_iterations: u32,
-    /// smooth: the lag in rows: each row's estimate from the N rows after it, written N rows
-    /// later; the smoother holds N+1 rows (0 is the kalman filter) [default: 200]
-    #[arg(long, value_name = "N")]
-    pub lag: Option<usize>,
-    /// Name of the time column
-    #[arg(long, value_name = "NAME", default_value = "t")]
-    pub time_col: String,
-    #[command(flatten)]
-    pub radar: RadarArgs,
-    /// Output file [default: standard output]
-    #[arg(short = 'o', long, value_name = "OUTPUT")]
-    pub output: Option<PathBuf>,
-}
-
-/// The radar input of `seqsmooth track` and `seqsmooth fit --model radar`, read by one reader
-/// (`track::rows`) and checked by the library's rule for a radar row
-/// (`seqsmooth::model::radar::check_component`).
-#[derive(Debug, Args)]
-pub struct RadarArgs {
-    /// Radar: the site's position X,Y,Z in the units of the range
-    #[arg(long, value_name = "X,Y,Z", default_value = "0,0,0", value_parser = parse_site,
-          allow_hyphen_values = true)]
-    pub site: [f64; 3],
-    /// Radar: the range's noise standard deviation (this or --sigma-range-col is required)
-    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
-    pub sigma_range: Option<f64>,
-    /// Radar: the azimuth's and elevation's noise standard deviation in radians (this or
-    /// --sigma-angle-col is required)
-    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
-    pub sigma_angle: Option<f64>,
-    /// Radar: name of a column of per-row range sigmas; an empty cell takes --sigma-range
-    #[arg(long, value_name = "NAME")]
-    pub sigma_range_col: Option<String>,
-    /// Radar: name of a column of per-row angle sigmas (azimuth and elevation, radians); an
-    /// empty cell takes --sigma-angle
-    #[arg(long, value_name = "NAME")]
-    pub sigma_angle_col: Option<String>,
-    /// Radar: the azimuth convention of the input
-    #[arg(long, value_enum, default_value_t = AzimuthConvention::FromX)]
-    pub azimuth: AzimuthConvention,
-    /// Radar: name of the range column
-    #[arg(long, value_name = "NAME", default_value = "range")]
-    pub range_col: String,
-    /// Radar: name of the azimuth column
-    #[arg(long, value_name = "NAME", default_value = "azimuth")]
-    pub azimuth_col: String,
-    /// Radar: name of the elevation column
-    #[arg(long, value_name = "NAME", default_value = "elevation")]
-    pub elevation_col: String,
-}
-
-/// The methods of `seqsmooth track`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum TrackMethod {
-    /// Gauss-Newton over each row's last W rows.
-    Window,
-    /// The extended Kalman filter with white-noise acceleration (--q).
-    Kalman,
-    /// The fading-memory Kalman filter (--beta or --theta).
-    Fading,
-    /// The Rauch-Tung-Striebel smoother over the Kalman filter.
-    Smooth,
-}
-
-/// How the input's azimuth is measured.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum AzimuthConvention {
-    /// From +x towards +y.
-    FromX,
-    /// Clockwise from north, with x = east and y = north.
-    Bearing,
-}
-
-/// Parses `--q`: a non-negative finite number.
-pub fn parse_psd(s: &str) -> Result<f64, String> {
-    parse_f64(
-        "q",
-        s,
-        (
-            |v| v.is_finite() && v >= 0.0,
-            "a non-negative finite number",
-        ),
-    )
-}
-
-/// Parses `--beta` and `--theta` of `track`: `0 < v <= 1`.
-pub fn parse_discount(s: &str) -> Result<f64, String> {
-    parse_f64(
-        "discount",
-        s,
-        (|v| v > 0.0 && v <= 1.0, "a number with 0 < value <= 1"),
-    )
-}
-
-/// The models of `seqsmooth fit`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum FitModel {
-    /// A Cartesian target seen by a radar: range, azimuth, elevation.
-    Radar,
-    /// A scalar polynomial in time, observed directly.
-    Polynomial,
-}
-
-/// `--epoch`: the window's end, its centre, or a time.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum EpochArg {
-    End,
-    Centre,
-    At(f64),
-}
-
-/// Parses `--epoch`: `end`, `centre` (or `center`), or a finite time.
-pub fn parse_epoch(s: &str) -> Result<EpochArg, String> {
-    match s.trim() {
-        "end" => Ok(EpochArg::End),
-        "centre" | "center" => Ok(EpochArg::Centre),
-        text => match text.parse::<f64>() {
-            Ok(t) if t.is_finite() => Ok(EpochArg::At(t)),
-            _ => Err(format!(
-                "epoch '{text}' is neither 'end', 'centre' nor a finite time"
-            )),
-        },
-    }
-}
-
-/// Parses `--site`: three finite numbers `X,Y,Z`.
-pub fn parse_site(s: &str) -> Result<[f64; 3], String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    let [x, y, z] = parts[..] else {
-        return Err(format!(
-            "site '{}' must be three numbers X,Y,Z separated by commas",
-            s.trim()
-        ));
-    };
-    let mut site = [0.0; 3];
-    for (slot, (axis, text)) in site.iter_mut().zip([("X", x), ("Y", y), ("Z", z)]) {
-        *slot = match text.parse::<f64>() {
-            Ok(v) if v.is_finite() => v,
-            _ => return Err(format!("site {axis} '{text}' is not a finite number")),
-        };
-    }
-    Ok(site)
-}
-
 /// The time and value columns of an input (`seqsmooth filter`, `seqsmooth smooth`).
 #[derive(Debug, Args)]
 pub struct Columns {
@@ -734,75 +372,6 @@ pub struct MemoryArgs {
     /// Fading memory: discount per sample, 0 < T < 1 (e.g. 0.9 or 9/10; exact with --exact)
     #[arg(long, value_name = "T", value_parser = parse_theta, allow_hyphen_values = true)]
     pub theta: Option<Theta>,
-}
-
-#[derive(Debug, Args)]
-pub struct DemoArgs {
-    /// Also write the plain fading-memory (exact engine) filter's CSV output
-    /// (t,y,d0..d2,s0..s2) here
-    #[arg(short = 'o', long, value_name = "FILE")]
-    pub output: Option<PathBuf>,
-    /// Path prefix of the plot: writes PREFIX.png and PREFIX.svg
-    #[arg(long, value_name = "PREFIX", default_value = "seqsmooth-demo")]
-    pub plot: PathBuf,
-    /// Write no plot
-    #[arg(long, conflicts_with = "plot")]
-    pub no_plot: bool,
-}
-
-#[derive(Debug, Args)]
-pub struct PlotArgs {
-    /// The output of 'seqsmooth filter' (CSV with header t,y,d0..dM[,s0..sM][,...]); omitted
-    /// or '-' reads standard input
-    // The brackets are --help text, not links.
-    #[allow(rustdoc::broken_intra_doc_links)]
-    #[arg(value_name = "FILTER_OUTPUT")]
-    pub source: Option<PathBuf>,
-    /// Image file to write, PNG or SVG by its extension (.png, .svg); repeat for both
-    #[arg(short = 'o', long, value_name = "IMAGE", required = true)]
-    pub output: Vec<PathBuf>,
-    /// Derivative to plot, one panel each, in the order given (0 the value, 1 the rate, ...);
-    /// repeat for several
-    #[arg(long, value_name = "K", default_value = "0", value_parser = parse_derivative,
-          allow_hyphen_values = true)]
-    pub derivative: Vec<usize>,
-    /// Leave out the residual panel
-    #[arg(long)]
-    pub no_residuals: bool,
-    /// Title [default: the filter kind and the file name]
-    #[arg(long, value_name = "TEXT")]
-    pub title: Option<String>,
-    /// Image width in pixels
-    #[arg(long, value_name = "PX", default_value_t = 1200,
-          value_parser = clap::value_parser!(u32).range(300..=10000))]
-    pub width: u32,
-    /// Image height in pixels [default: 330 per derivative panel, 250 for the residuals, 120
-    /// for the title and legend]
-    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(300..=10000))]
-    pub height: Option<u32>,
-    /// Unit of the times, for the axis labels (e.g. s)
-    #[arg(long, value_name = "UNIT")]
-    pub time_unit: Option<String>,
-    /// Unit of the values, for the axis labels (e.g. m)
-    #[arg(long, value_name = "UNIT")]
-    pub value_unit: Option<String>,
-    /// The --lead H the output was made with, for an output without a lead column (one with
-    /// it must agree): the estimates are drawn at t+H and compared with the samples at t+H
-    #[arg(long, value_name = "H", default_value = "0", value_parser = parse_lead,
-          allow_hyphen_values = true)]
-    pub lead: f64,
-    /// The filter's input file, to draw its truth column (--truth-col)
-    #[arg(long, value_name = "FILE")]
-    pub input: Option<PathBuf>,
-    /// Name of the input's time column
-    #[arg(long, value_name = "NAME", default_value = "t")]
-    pub time_col: String,
-    /// Name of the input's value column
-    #[arg(long, value_name = "NAME", default_value = "y")]
-    pub value_col: String,
-    /// Column of the input holding the true values, drawn as a line (needs --input)
-    #[arg(long, value_name = "NAME", requires = "input")]
-    pub truth_col: Option<String>,
 }
 
 /// Which filter `seqsmooth filter` runs.
@@ -861,36 +430,6 @@ pub enum TableKind {
     Expanding,
     /// Fading memory (--theta T).
     Fading,
-}
-
-/// The filter kinds with a variance-reduction matrix.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum VrfKind {
-    /// Expanding memory (--n N, --form).
-    Expanding,
-    /// Fading memory (--theta T, --form).
-    Fading,
-    /// Fixed memory over W samples (--window W, --lead H).
-    Fixed,
-}
-
-/// Which estimate a variance-reduction matrix describes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
-pub enum FormArg {
-    /// The current estimate Z*_{n,n}.
-    #[default]
-    Current,
-    /// The 1-step prediction Z*_{n+1,n}.
-    Predictor,
-}
-
-impl From<FormArg> for EstimateForm {
-    fn from(f: FormArg) -> Self {
-        match f {
-            FormArg::Current => EstimateForm::Current,
-            FormArg::Predictor => EstimateForm::Predictor,
-        }
-    }
 }
 
 /// The filter memory a table is for, after argument checking: expanding memory at the 0-based
@@ -1070,38 +609,4 @@ pub fn parse_lead(s: &str) -> Result<f64, String> {
 pub fn parse_window(s: &str) -> Result<usize, String> {
     let max = i128::from(i64::MAX).min(usize::MAX as i128);
     parse_whole("window", s, " of samples", 1, max).map(|w| w as usize)
-}
-
-/// A lead in sampling intervals as given on the command line (`seqsmooth vrf --kind fixed`):
-/// exact, and rounded to `f64`; zero by default.
-#[derive(Clone, Debug, Default)]
-pub struct LeadSteps {
-    /// The lead exactly (`-2.5` is `-5/2`).
-    pub exact: Rational,
-    /// The lead rounded to the nearest `f64`.
-    pub value: f64,
-}
-
-/// Parses `--lead` of `seqsmooth vrf`: `0`, `1`, `-2.5`, `-5/2` or `25e-1`, in samples, exactly;
-/// finite in double precision.
-pub fn parse_lead_steps(s: &str) -> Result<LeadSteps, String> {
-    let text = s.trim();
-    let not_a_number = || format!("lead '{text}' is not a number (write it as -2.5 or -5/2)");
-    let out_of_range = || {
-        format!("lead {text} is out of range: it must be a finite number of samples (|H| < 1e300)")
-    };
-    // An exponent this large would take unbounded time to expand exactly.
-    if let Some((_, e)) = text.split_once(['e', 'E']) {
-        if e.parse::<i64>().is_ok_and(|e| e.unsigned_abs() > 400) {
-            return Err(format!(
-                "lead {text} is out of range: write it with an exponent from -400 to 400"
-            ));
-        }
-    }
-    let exact = parse_rational(text).ok_or_else(not_a_number)?;
-    let value = seqsmooth::scalar::ratio_to_f64(&exact);
-    if !(value.is_finite() && value.abs() < 1e300) {
-        return Err(out_of_range());
-    }
-    Ok(LeadSteps { exact, value })
 }
