@@ -14,7 +14,7 @@ use crate::track::rows::{check_sigmas, Batch, Rows};
 use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
-use seqsmooth::kalman::track::window_flag;
+use seqsmooth::track::window_flag;
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::model::radar::Radar;

@@ -28,7 +28,7 @@ use nalgebra::{DMatrix, DVector};
 use rows::Rows;
 use seqsmooth::estimate::gauss_newton::GaussNewton;
 use seqsmooth::estimate::gauss_newton::Measurement;
-use seqsmooth::kalman::track::{
+use seqsmooth::track::{
     RadarTracker, TrackError, TrackFlag, TrackMethod as Method, Tracked, DEFAULT_LAG,
     DEFAULT_WINDOW, START_WINDOW,
 };

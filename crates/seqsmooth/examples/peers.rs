@@ -57,8 +57,8 @@
 //! [`feed_fixed_and_read`]), so a batch update API can replace the per-sample loop in one place.
 
 use nalgebra::{DMatrix, DVector};
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
+use seqsmooth::model::measurement::Measurement;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};

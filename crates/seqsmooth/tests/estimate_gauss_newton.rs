@@ -5,7 +5,7 @@
 
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
-use seqsmooth::estimate::batch::NoiseCovariance;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement, Prior};
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
 use seqsmooth::model::nonlinear::NonlinearDynamics;

@@ -56,7 +56,7 @@ use nalgebra::{Cholesky, DVector};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
-use seqsmooth::estimate::batch::NoiseCovariance;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::estimate::bootstrap;
 use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};

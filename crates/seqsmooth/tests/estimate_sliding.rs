@@ -6,7 +6,7 @@
 use nalgebra::DVector;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
-use seqsmooth::estimate::batch::NoiseCovariance;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::estimate::bootstrap;
 use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, Start};

@@ -8,8 +8,8 @@
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
+use seqsmooth::model::measurement::Measurement;
 use seqsmooth::kalman::bayes::MAX_VARIANCE_INFLATION;
 use seqsmooth::kalman::{BayesFilter, Discount, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;

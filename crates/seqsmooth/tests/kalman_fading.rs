@@ -7,8 +7,8 @@
 
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
+use seqsmooth::model::measurement::Measurement;
 use seqsmooth::kalman::{Discount, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::LinearObservation;

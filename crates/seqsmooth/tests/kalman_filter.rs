@@ -6,7 +6,7 @@
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
-use seqsmooth::estimate::batch::NoiseCovariance;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement, Prior};
 use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};
 use seqsmooth::kalman::KalmanFilter;

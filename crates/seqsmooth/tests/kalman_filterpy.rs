@@ -25,8 +25,8 @@
 //! (Cholesky solve here, an explicit inverse in filterpy) shows at that level, not above it.
 
 use nalgebra::{DMatrix, DVector};
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
+use seqsmooth::model::measurement::Measurement;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::PolynomialDynamics;

@@ -79,7 +79,7 @@ use nalgebra::{Cholesky, DMatrix, DVector};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal, StandardNormal};
-use seqsmooth::estimate::batch::NoiseCovariance;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, Start};
 use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};

@@ -4,8 +4,8 @@
 //! limit on a non-polynomial model.
 
 use nalgebra::{DMatrix, DVector};
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
+use seqsmooth::model::measurement::Measurement;
 use seqsmooth::kalman::steady::steady_state;
 use seqsmooth::kalman::{Discount, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;

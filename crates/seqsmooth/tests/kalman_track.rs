@@ -1,4 +1,4 @@
-//! `kalman::track::RadarTracker` against the same methods composed by hand from their parts
+//! `track::RadarTracker` against the same methods composed by hand from their parts
 //! (`SlidingFit`, `KalmanFilter`, `kalman::smooth`), bit for bit, on a noisy pass with
 //! irregular steps and missing components; the smoother's last row against the filter's (the
 //! RTS property); refused rows leaving the tracker as it was; refused settings.
@@ -6,11 +6,11 @@
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
-use seqsmooth::estimate::batch::NoiseCovariance;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, Start};
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
-use seqsmooth::kalman::track::{
+use seqsmooth::track::{
     window_flag, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, START_WINDOW,
 };
 use seqsmooth::kalman::{smooth, Discount, FixedLagSmoother, KalmanFilter};
@@ -429,9 +429,9 @@ fn bad_settings_are_refused() {
 /// fit's SVD once looped forever; now every row is taken or refused, each quickly.
 #[test]
 fn extreme_scales_end_instead_of_looping() {
-    use seqsmooth::estimate::batch::NoiseCovariance;
-    use seqsmooth::estimate::gauss_newton::Measurement;
-    use seqsmooth::kalman::track::{RadarTracker, TrackMethod};
+    use seqsmooth::model::measurement::NoiseCovariance;
+    use seqsmooth::model::measurement::Measurement;
+    use seqsmooth::track::{RadarTracker, TrackMethod};
     use seqsmooth::kalman::Discount;
     use seqsmooth::model::radar::Radar;
     const ROWS: [[f64; 4]; 21] = [

@@ -14,7 +14,7 @@
 
 use crate::radar;
 use nalgebra::{DMatrix, DVector, Matrix3};
-use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::model::measurement::Measurement;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::PolynomialDynamics;

@@ -12,7 +12,7 @@
 //! windows are the same on every machine and in every target that includes this file.
 
 use nalgebra::DVector;
-use seqsmooth::estimate::batch::NoiseCovariance;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::estimate::bootstrap;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use seqsmooth::model::dynamics::PolynomialDynamics;

@@ -5,7 +5,7 @@
 //! [`crate::linalg::dense`].
 
 use crate::error::Error;
-use crate::estimate::batch::NoiseCovariance;
+use crate::model::measurement::NoiseCovariance;
 use crate::linalg::dense::{
     all_finite, combine, ldl, log_det, symmetrize, times_transpose, transpose,
 };

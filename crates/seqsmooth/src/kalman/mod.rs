@@ -21,17 +21,14 @@
 //! - [`noise`]: the driving-noise covariance `Q` over a step (15.2.23), in closed form for the
 //!   polynomial model ([`noise::WhiteNoiseDerivative`]).
 
-pub mod adaptive;
 pub mod bayes;
 mod correct;
 mod discount;
 pub mod filter;
 pub mod fixed_lag;
-mod memory;
 pub mod noise;
 pub mod smoother;
 pub mod steady;
-pub mod track;
 
 pub use bayes::BayesFilter;
 pub use filter::{Discount, Innovation, KalmanFilter};
