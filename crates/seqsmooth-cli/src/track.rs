@@ -28,12 +28,12 @@ use nalgebra::{DMatrix, DVector};
 use rows::Rows;
 use seqsmooth::estimate::gauss_newton::GaussNewton;
 use seqsmooth::estimate::gauss_newton::Measurement;
+use seqsmooth::kalman::Discount;
+use seqsmooth::model::radar::Radar;
 use seqsmooth::track::{
     RadarTracker, TrackError, TrackFlag, TrackMethod as Method, Tracked, DEFAULT_LAG,
     DEFAULT_WINDOW, START_WINDOW,
 };
-use seqsmooth::kalman::Discount;
-use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
 use std::collections::VecDeque;
 use stream::Block;

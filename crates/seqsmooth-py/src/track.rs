@@ -10,12 +10,12 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::estimate::gauss_newton::{GaussNewton, Measurement};
 use seqsmooth::kalman::smoother::Smoothed;
+use seqsmooth::kalman::Discount;
+use seqsmooth::model::radar::Radar;
 use seqsmooth::track::{
     radar_row, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, DEFAULT_LAG,
     DEFAULT_WINDOW,
 };
-use seqsmooth::kalman::Discount;
-use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
 
 /// A tracker's error as its exception; `offset` is the batch's first row in the tracker's

@@ -395,7 +395,11 @@ fn import_circles(src: &Path) -> Vec<Vec<String>> {
             let code = without_test_modules(&code_only(&fs::read_to_string(file).unwrap()));
             let mut to: Vec<usize> = imports(&code, module)
                 .iter()
-                .filter_map(|t| (0..=t.len()).rev().find_map(|n| index.get(&t[..n].join("::"))))
+                .filter_map(|t| {
+                    (0..=t.len())
+                        .rev()
+                        .find_map(|n| index.get(&t[..n].join("::")))
+                })
                 .copied()
                 .filter(|&j| j != i)
                 .collect();

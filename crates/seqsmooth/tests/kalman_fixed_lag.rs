@@ -9,11 +9,11 @@
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
-use seqsmooth::model::measurement::NoiseCovariance;
-use seqsmooth::model::measurement::Measurement;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::{smooth, FixedLagSmoother, KalmanFilter, Smoothed};
 use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::Error;
 
@@ -317,8 +317,8 @@ fn refusals_leave_the_smoother_unchanged() {
 /// The radar tracker's smoother at lag `lag` on `rows`: every row's σ (the six components), `None`
 /// for the rows before the smoother's.
 fn tracker_sigmas(rows: &[Measurement], q: Option<f64>, lag: usize) -> Vec<Option<[f64; 6]>> {
-    use seqsmooth::track::{RadarTracker, TrackMethod, Tracked};
     use seqsmooth::model::radar::Radar;
+    use seqsmooth::track::{RadarTracker, TrackMethod, Tracked};
     let radar = Radar::new([0.0; 3], 6).unwrap();
     let mut t = RadarTracker::new(radar, TrackMethod::Smooth { q, lag }).unwrap();
     let mut out = vec![None; rows.len()];

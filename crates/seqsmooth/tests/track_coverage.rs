@@ -19,8 +19,8 @@ use common::radar_tracks::{
     landing, landing_truth, report, turning, Tally, Track, LANDING_RUNS, TURNING_RUNS,
 };
 use rayon::prelude::*;
-use seqsmooth::track::{RadarTracker, TrackMethod, Tracked, DEFAULT_WINDOW};
 use seqsmooth::model::radar::Radar;
+use seqsmooth::track::{RadarTracker, TrackMethod, Tracked, DEFAULT_WINDOW};
 
 /// One method over one track: every row pushed, the smoother's rows as it releases them and
 /// at the end.

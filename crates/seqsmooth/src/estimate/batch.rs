@@ -20,7 +20,6 @@ use crate::error::Error;
 pub use crate::model::measurement::{is_usable_sigma, NoiseCovariance};
 use nalgebra::{Cholesky, DMatrix, DVector};
 
-
 /// A batch estimate: the state, its covariance, and how well the data fit.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BatchEstimate {

@@ -20,13 +20,12 @@
 //! nonlinear model it is the first-order approximation the book warns of (§11.4).
 
 use super::batch::solve_whitened;
-pub use crate::model::measurement::{Measurement, NoiseCovariance};
 use crate::error::Error;
 use crate::model::dynamics::Dynamics;
+pub use crate::model::measurement::{Measurement, NoiseCovariance};
 use crate::model::observation::Observation;
 use crate::numeric::unrolled::unrolled_sizes;
 use nalgebra::{Cholesky, DMatrix, DMatrixViewMut, DVector, DVectorViewMut, Dyn};
-
 
 /// The instant the estimate refers to.
 #[derive(Clone, Copy, Debug, PartialEq)]

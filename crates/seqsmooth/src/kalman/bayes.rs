@@ -23,9 +23,9 @@
 
 use super::filter::Discount;
 use crate::error::Error;
-use crate::model::measurement::NoiseCovariance;
-use crate::model::measurement::Measurement;
 use crate::model::dynamics::Dynamics;
+use crate::model::measurement::Measurement;
+use crate::model::measurement::NoiseCovariance;
 use crate::model::observation::Observation;
 use crate::recursive::InformationFilter;
 use nalgebra::{Cholesky, DMatrix, DVector};

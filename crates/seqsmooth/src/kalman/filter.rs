@@ -56,9 +56,9 @@
 use super::correct::{carry, correct_kernel, finite, noise_entries, Work};
 use super::noise::ProcessNoise;
 use crate::error::Error;
-use crate::model::measurement::NoiseCovariance;
-use crate::model::measurement::Measurement;
 use crate::model::dynamics::Dynamics;
+use crate::model::measurement::Measurement;
+use crate::model::measurement::NoiseCovariance;
 use crate::model::observation::Observation;
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed};
 use nalgebra::{Cholesky, DMatrix, DVector};

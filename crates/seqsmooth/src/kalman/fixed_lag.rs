@@ -28,8 +28,8 @@
 use super::filter::KalmanFilter;
 use super::smoother::Smoothed;
 use crate::error::Error;
-use crate::model::measurement::Measurement;
 use crate::model::dynamics::Dynamics;
+use crate::model::measurement::Measurement;
 use crate::model::observation::Observation;
 use nalgebra::{Cholesky, DMatrix, DVector};
 use std::collections::VecDeque;

@@ -15,8 +15,8 @@
 use super::filter::KalmanFilter;
 use super::fixed_lag::FixedLagSmoother;
 use crate::error::Error;
-use crate::model::measurement::Measurement;
 use crate::model::dynamics::Dynamics;
+use crate::model::measurement::Measurement;
 use crate::model::observation::Observation;
 use nalgebra::{DMatrix, DVector};
 

@@ -30,17 +30,17 @@
 pub mod adaptive;
 mod memory;
 
-pub use adaptive::TrackFlag;
-use adaptive::{Monitor, MISFIT_ALPHA};
-use crate::kalman::filter::{Discount, KalmanFilter};
-use crate::kalman::fixed_lag::FixedLagSmoother;
-use memory::{base_noise, Filter, Memory, MemoryKind};
-use crate::kalman::smoother::Smoothed;
 use crate::error::Error;
 use crate::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use crate::estimate::sliding::{SlidingFit, Start};
+use crate::kalman::filter::{Discount, KalmanFilter};
+use crate::kalman::fixed_lag::FixedLagSmoother;
+use crate::kalman::smoother::Smoothed;
 use crate::model::dynamics::PolynomialDynamics;
 use crate::model::radar::{check_component, from_bearing, Radar, COMPONENTS};
+pub use adaptive::TrackFlag;
+use adaptive::{Monitor, MISFIT_ALPHA};
+use memory::{base_noise, Filter, Memory, MemoryKind};
 use nalgebra::{DMatrix, DVector};
 use std::collections::VecDeque;
 use std::ops::Range;
