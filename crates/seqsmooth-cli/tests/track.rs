@@ -5,7 +5,7 @@
 
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use seqsmooth::kalman::track::DEFAULT_LAG;
+use seqsmooth::track::DEFAULT_LAG;
 use std::path::PathBuf;
 
 mod common;

@@ -27,12 +27,12 @@ use crate::io::{check_distinct, open_input, write_f64, CsvIn, Need, Output};
 use nalgebra::{DMatrix, DVector};
 use seqsmooth::estimate::gauss_newton::GaussNewton;
 use seqsmooth::estimate::gauss_newton::Measurement;
-use seqsmooth::kalman::track::{
+use seqsmooth::kalman::Discount;
+use seqsmooth::model::radar::Radar;
+use seqsmooth::track::{
     RadarTracker, TrackError, TrackFlag, TrackMethod as Method, Tracked, DEFAULT_LAG,
     DEFAULT_WINDOW, START_WINDOW,
 };
-use seqsmooth::kalman::Discount;
-use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
 use std::collections::VecDeque;
 use stream::Block;

@@ -4,14 +4,14 @@
 //! chooses: `q₀ 4^ℓ` or `θ = 1 − (1 − θ₀) 2^ℓ`; and the gated update of each row through it.
 
 use super::adaptive::{Monitor, TrackFlag};
-use super::filter::{Discount, KalmanFilter};
-use super::fixed_lag::FixedLagSmoother;
-use super::noise::WhiteNoiseDerivative;
-use super::smoother::Smoothed;
 use crate::error::Error;
-use crate::estimate::batch::NoiseCovariance;
-use crate::estimate::gauss_newton::Measurement;
+use crate::kalman::filter::{Discount, KalmanFilter};
+use crate::kalman::fixed_lag::FixedLagSmoother;
+use crate::kalman::noise::WhiteNoiseDerivative;
+use crate::kalman::smoother::Smoothed;
 use crate::model::dynamics::PolynomialDynamics;
+use crate::model::measurement::Measurement;
+use crate::model::measurement::NoiseCovariance;
 use crate::model::radar::Radar;
 
 /// The filter of the Kalman methods.

@@ -34,7 +34,7 @@ pub const GATE_ALPHA: f64 = 1e-3;
 /// tracker's `flags`, name.
 ///
 /// ```
-/// use seqsmooth::kalman::track::TrackFlag;
+/// use seqsmooth::track::TrackFlag;
 /// assert_eq!(TrackFlag::Misfit.name(), "misfit");
 /// assert_eq!(TrackFlag::None.name(), "");
 /// ```
@@ -56,7 +56,7 @@ impl TrackFlag {
     /// The flag's name in the front ends: `""`, `"outlier"` or `"misfit"`.
     ///
     /// ```
-    /// use seqsmooth::kalman::track::TrackFlag;
+    /// use seqsmooth::track::TrackFlag;
     /// assert_eq!(TrackFlag::Outlier.name(), "outlier");
     /// ```
     pub fn name(self) -> &'static str {

@@ -6,7 +6,7 @@
 //! | [`TrackMethod::Window`] | the Gauss–Newton fit of the last `W` rows (warm started), its innovation against the previous row's fit | §8.5-8.7 ([`SlidingFit`]) |
 //! | [`TrackMethod::Kalman`] | the extended Kalman filter, white noise of density `q` driving the acceleration | ch. 12, (15.2.23) |
 //! | [`TrackMethod::Fading`] | the extended Kalman filter with fading memory (`β` per time or `θ` per update), its true covariance | ch. 14 |
-//! | [`TrackMethod::Smooth`] | the Rauch–Tung–Striebel smoother over the Kalman filter's run with a lag of `L` rows: each row's estimate from the `L` rows after it, given `L` rows later | [`super::fixed_lag`] |
+//! | [`TrackMethod::Smooth`] | the Rauch–Tung–Striebel smoother over the Kalman filter's run with a lag of `L` rows: each row's estimate from the `L` rows after it, given `L` rows later | [`crate::kalman::fixed_lag`] |
 //!
 //! The Kalman methods start from the first Gauss–Newton fit of the rows so far (at most
 //! [`START_WINDOW`]) that determines the state, started at the radar nominal of §8.5; that
@@ -14,7 +14,7 @@
 //! the `seqsmooth track` command and of the Python binding.
 //!
 //! Every estimate comes with a [`TrackFlag`]: the Kalman methods test each update's NIS and
-//! the NIS of the last few against χ² (Morrison §14.8, [`super::adaptive`]): a lone update
+//! the NIS of the last few against χ² (Morrison §14.8, [`adaptive`]): a lone update
 //! beyond the gate is an outlier, left out (the row's estimate is the prediction); a window
 //! beyond its χ² is a misfit (a manoeuvre the model does not follow), flagged. Without a given
 //! driving noise (`q: None`) or discount (`Fading(None)`) the memory is adaptive: each misfit
@@ -27,17 +27,20 @@
 //! the misfit in its covariance, scaled by `max(1, χ²/ν)` ([`misfit_scale`](crate::estimate::sliding::misfit_scale)); a window beyond
 //! `χ²_ν` at `1 − MISFIT_ALPHA` is flagged.
 
-pub use super::adaptive::TrackFlag;
-use super::adaptive::{Monitor, MISFIT_ALPHA};
-use super::filter::{Discount, KalmanFilter};
-use super::fixed_lag::FixedLagSmoother;
-use super::memory::{base_noise, Filter, Memory, MemoryKind};
-use super::smoother::Smoothed;
+pub mod adaptive;
+mod memory;
+
 use crate::error::Error;
 use crate::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use crate::estimate::sliding::{SlidingFit, Start};
+use crate::kalman::filter::{Discount, KalmanFilter};
+use crate::kalman::fixed_lag::FixedLagSmoother;
+use crate::kalman::smoother::Smoothed;
 use crate::model::dynamics::PolynomialDynamics;
 use crate::model::radar::{check_component, from_bearing, Radar, COMPONENTS};
+pub use adaptive::TrackFlag;
+use adaptive::{Monitor, MISFIT_ALPHA};
+use memory::{base_noise, Filter, Memory, MemoryKind};
 use nalgebra::{DMatrix, DVector};
 use std::collections::VecDeque;
 use std::ops::Range;
@@ -94,7 +97,7 @@ impl TrackMethod {
     /// driving noise, adaptive discount, [`DEFAULT_WINDOW`] rows.
     ///
     /// ```
-    /// use seqsmooth::kalman::track::{TrackMethod, DEFAULT_WINDOW};
+    /// use seqsmooth::track::{TrackMethod, DEFAULT_WINDOW};
     /// assert_eq!(TrackMethod::named("window"), Some(TrackMethod::Window { window: DEFAULT_WINDOW }));
     /// assert_eq!(TrackMethod::named("kalman"), Some(TrackMethod::Kalman { q: None }));
     /// assert_eq!(TrackMethod::named("other"), None);
@@ -244,9 +247,9 @@ enum Stage {
 /// A radar's rows to a track, row by row.
 ///
 /// ```
-/// use seqsmooth::estimate::batch::NoiseCovariance;
-/// use seqsmooth::estimate::gauss_newton::Measurement;
-/// use seqsmooth::kalman::track::{RadarTracker, TrackFlag, TrackMethod, Tracked};
+/// use seqsmooth::model::measurement::NoiseCovariance;
+/// use seqsmooth::model::measurement::Measurement;
+/// use seqsmooth::track::{RadarTracker, TrackFlag, TrackMethod, Tracked};
 /// use seqsmooth::model::radar::Radar;
 /// // A target at (1000, 2000, 500) moving at (10, -5, 0) per second, seen exactly.
 /// let radar = Radar::new([0.0; 3], 6).unwrap();
@@ -292,7 +295,7 @@ impl RadarTracker {
     ///
     /// ```
     /// use seqsmooth::estimate::gauss_newton::GaussNewton;
-    /// use seqsmooth::kalman::track::{RadarTracker, TrackMethod};
+    /// use seqsmooth::track::{RadarTracker, TrackMethod};
     /// use seqsmooth::model::radar::Radar;
     /// let radar = Radar::new([0.0; 3], 6).unwrap();
     /// let limits = GaussNewton { max_iterations: 100, ..GaussNewton::default() };
@@ -577,7 +580,7 @@ fn smoothing_error(e: Error, first: usize) -> TrackError {
 /// ```
 /// use nalgebra::{DMatrix, DVector};
 /// use seqsmooth::estimate::gauss_newton::Correction;
-/// use seqsmooth::kalman::track::{window_flag, TrackFlag};
+/// use seqsmooth::track::{window_flag, TrackFlag};
 /// let c = Correction { epoch: 0.0, state: DVector::zeros(6), covariance: DMatrix::identity(6, 6),
 ///     chi_squared: 40.0, degrees_of_freedom: 18, condition_number: 1.0, iterations: vec![] };
 /// assert_eq!(window_flag(&c), TrackFlag::Misfit); // the 99% point of χ²(18) is 34.8
@@ -636,7 +639,7 @@ fn sliding(
 /// north) and is turned into the angle from +x.
 ///
 /// ```
-/// use seqsmooth::kalman::track::radar_row;
+/// use seqsmooth::track::radar_row;
 /// let m = radar_row(0.0, [Some(1000.0), Some(0.0), None], Some(5.0), Some(1e-3), true).unwrap();
 /// assert!((m.values[1].unwrap() - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
 /// assert!(radar_row(0.0, [Some(-1.0), None, None], Some(5.0), None, false).is_err());
@@ -674,7 +677,7 @@ pub fn radar_row(
     let mut variances = [1.0; 2];
     for (k, (name, sigma, needed)) in needed.into_iter().enumerate() {
         match sigma {
-            Some(s) if crate::estimate::batch::is_usable_sigma(s) => variances[k] = s * s,
+            Some(s) if crate::model::measurement::is_usable_sigma(s) => variances[k] = s * s,
             Some(s) => {
                 return Err(Error::InvalidParameter {
                     name,
@@ -700,7 +703,7 @@ pub fn radar_row(
     Ok(Measurement {
         time,
         values: values.to_vec(),
-        noise: crate::estimate::batch::NoiseCovariance::Variances(vec![
+        noise: crate::model::measurement::NoiseCovariance::Variances(vec![
             variances[0],
             variances[1],
             variances[1],
