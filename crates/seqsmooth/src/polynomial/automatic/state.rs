@@ -178,16 +178,10 @@ impl State {
     ) -> Result<AutoOutput, Error> {
         self.last_time = Some(t);
         self.memories.switch_if_due(&self.cfg, t, self.accepted)?;
-        let Judged {
-            sigma,
-            innovation,
-            vrf,
-            innovation_sigma,
-            k2,
-            gate,
-            rejected,
-        } = self.judge(t, y);
-        let rejected = force.unwrap_or(rejected);
+        let judged = self.judge(t, y);
+        let (sigma, innovation, vrf) = (judged.sigma, judged.innovation, judged.vrf);
+        let (k2, gate) = (judged.k2, judged.gate);
+        let rejected = force.unwrap_or(judged.rejected);
         let mut manoeuvre = false;
         let mut restart = false;
         let mut chi_out = None;
@@ -271,7 +265,7 @@ impl State {
             phase: self.phase(),
             noise_sigma: self.noise_sigma(),
             innovation,
-            innovation_sigma,
+            innovation_sigma: judged.innovation_sigma,
             gate,
             bias,
             outlier,
