@@ -8,7 +8,7 @@
 //! The input (`target/tmp/track_cli_2e5.csv`, written once, seed 2026): a target in straight
 //! flight at (−40, 25, −1) m/s from (20, −15, 3) km, seen from the origin at steps
 //! U(0.05, 0.15) s, range noise σ 10 m and angle noise σ 1 mrad, columns
-//! `t,range,azimuth,elevation` (azimuth from +x). Methods: `kalman --q 1`, `fading --beta 0.9`,
+//! `t,range,azimuth,elevation` (azimuth from +x). Methods: `kalman --q 1`, `fading --theta 0.9 --tau 1`,
 //! `smooth --q 1` (the window method fits 60 rows per row, ~10^4 rows/s; not benched).
 //!
 //! Throughput is in rows (criterion's elements/s).
@@ -71,7 +71,7 @@ fn track_cli(c: &mut Criterion) {
     generate(&input).expect("write the bench input");
     let configs: [(&str, &[&str]); 3] = [
         ("kalman", &["--method", "kalman", "--q", "1"]),
-        ("fading", &["--method", "fading", "--beta", "0.9"]),
+        ("fading", &["--method", "fading", "--theta", "0.9", "--tau", "1"]),
         ("smooth", &["--method", "smooth", "--q", "1"]),
     ];
     let mut group = c.benchmark_group("track_cli");

@@ -23,9 +23,9 @@
 
 use crate::discount::Discount;
 use crate::error::Error;
-use crate::estimate::batch::NoiseCovariance;
-use crate::estimate::gauss_newton::Measurement;
 use crate::model::dynamics::Dynamics;
+use crate::model::measurement::Measurement;
+use crate::model::measurement::NoiseCovariance;
 use crate::model::observation::Observation;
 use crate::recursive::InformationFilter;
 use nalgebra::{Cholesky, DMatrix, DVector};
@@ -40,8 +40,8 @@ pub const MAX_VARIANCE_INFLATION: f64 = 1e11;
 ///
 /// ```
 /// use nalgebra::DVector;
-/// use seqsmooth::estimate::batch::NoiseCovariance;
-/// use seqsmooth::estimate::gauss_newton::Measurement;
+/// use seqsmooth::model::measurement::NoiseCovariance;
+/// use seqsmooth::model::measurement::Measurement;
 /// use seqsmooth::kalman::BayesFilter;
 /// use seqsmooth::model::dynamics::PolynomialDynamics;
 /// use seqsmooth::model::observation::LinearObservation;
@@ -183,8 +183,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     /// filter is the plain one.
     ///
     /// ```
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::{BayesFilter, Discount};
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -211,8 +211,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::DVector;
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::BayesFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -229,8 +229,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::DVector;
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::BayesFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -251,8 +251,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     /// information: the covariance itself without fading memory.
     ///
     /// ```
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::{BayesFilter, Discount};
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -289,8 +289,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::DVector;
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::BayesFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -342,8 +342,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::DVector;
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::BayesFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;

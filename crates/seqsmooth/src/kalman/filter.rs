@@ -57,9 +57,9 @@ use super::correct::{carry, correct_kernel, finite, noise_entries, Work};
 use super::noise::ProcessNoise;
 use crate::discount::Discount;
 use crate::error::Error;
-use crate::estimate::batch::NoiseCovariance;
-use crate::estimate::gauss_newton::Measurement;
 use crate::model::dynamics::Dynamics;
+use crate::model::measurement::Measurement;
+use crate::model::measurement::NoiseCovariance;
 use crate::model::observation::Observation;
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed};
 use nalgebra::{Cholesky, DMatrix, DVector};
@@ -105,8 +105,8 @@ pub struct InnovationStats {
 ///
 /// ```
 /// use nalgebra::{DMatrix, DVector};
-/// use seqsmooth::estimate::batch::NoiseCovariance;
-/// use seqsmooth::estimate::gauss_newton::Measurement;
+/// use seqsmooth::model::measurement::NoiseCovariance;
+/// use seqsmooth::model::measurement::Measurement;
 /// use seqsmooth::kalman::KalmanFilter;
 /// use seqsmooth::model::dynamics::PolynomialDynamics;
 /// use seqsmooth::model::observation::LinearObservation;
@@ -266,8 +266,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::{Discount, KalmanFilter};
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -344,8 +344,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::KalmanFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -378,8 +378,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::KalmanFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -405,8 +405,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::KalmanFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -433,8 +433,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::KalmanFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -542,8 +542,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::KalmanFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::NonlinearObservation;
