@@ -71,7 +71,10 @@ fn track_cli(c: &mut Criterion) {
     generate(&input).expect("write the bench input");
     let configs: [(&str, &[&str]); 3] = [
         ("kalman", &["--method", "kalman", "--q", "1"]),
-        ("fading", &["--method", "fading", "--theta", "0.9", "--tau", "1"]),
+        (
+            "fading",
+            &["--method", "fading", "--theta", "0.9", "--tau", "1"],
+        ),
         ("smooth", &["--method", "smooth", "--q", "1"]),
     ];
     let mut group = c.benchmark_group("track_cli");
