@@ -95,7 +95,7 @@ pub mod recursive;
 pub mod scalar;
 pub mod stats;
 
-pub use error::Error;
+pub use error::{Error, Param};
 
 /// The README's Rust example, compiled and run as a doctest.
 #[cfg(doctest)]

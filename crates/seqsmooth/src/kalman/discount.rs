@@ -3,14 +3,14 @@
 //! `θ` per update (14.2.12).
 
 use super::filter::Discount;
-use crate::error::Error;
+use crate::error::{Error, Param};
 
 impl Discount {
     /// Refuses a discount outside `(0, 1]`.
     pub(crate) fn checked(self) -> Result<Self, Error> {
         let (name, value) = match self {
-            Discount::PerTime(b) => ("beta", b),
-            Discount::PerUpdate(t) => ("theta", t),
+            Discount::PerTime(b) => (Param::Beta, b),
+            Discount::PerUpdate(t) => (Param::Theta, t),
         };
         if value > 0.0 && value <= 1.0 {
             Ok(self)
@@ -34,7 +34,7 @@ impl Discount {
             Ok(f)
         } else {
             Err(Error::InvalidParameter {
-                name: "discount over the step",
+                name: Param::DiscountOverStep,
                 value: format!("{f:e} over {elapsed} since the last update"),
                 reason: "underflows: the memory holds nothing; raise beta or update more often"
                     .into(),

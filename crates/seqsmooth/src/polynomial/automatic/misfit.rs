@@ -5,7 +5,7 @@
 use super::build::{unit_expanding, unit_fading, upper_pair};
 use super::filter::AutomaticFilter;
 use super::memory::shorter_memories;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::polynomial::filter::PolynomialFilter;
 
 /// What the filter does when its innovations say the model no longer fits (Morrison §14.8).
@@ -78,7 +78,7 @@ impl MisfitResponse {
         if let MisfitResponse::Restart { alpha } = *self {
             if !(alpha > 0.0 && alpha < 1.0) {
                 return Err(Error::InvalidParameter {
-                    name: "restart significance",
+                    name: Param::RestartSignificance,
                     value: alpha.to_string(),
                     reason: "must lie strictly between 0 and 1".into(),
                 });

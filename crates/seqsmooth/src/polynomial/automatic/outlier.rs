@@ -7,7 +7,7 @@ use super::config::check_positive;
 use super::filter::AutomaticFilter;
 #[cfg(doc)]
 use super::AutoConfig;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::stats::two_sided_tail;
 
 /// Morrison's gate multiplier: `|ν| > 3 σ_ε` (Reyneke §7.4 citing Morrison).
@@ -132,7 +132,7 @@ impl OutlierRule {
         match *self {
             OutlierRule::Off => Ok(()),
             OutlierRule::Innovation { k } | OutlierRule::Reyneke { k } => {
-                check_positive("outlier gate multiplier", k)
+                check_positive(Param::OutlierGateMultiplier, k)
             }
         }
     }
