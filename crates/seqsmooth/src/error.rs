@@ -293,14 +293,17 @@ impl Error {
     /// The error's [`ErrorKind`] (inside a batch or a channel, its cause's).
     pub fn kind(&self) -> ErrorKind {
         match self {
-            Error::NonFinite { .. } | Error::TimeNotIncreasing { .. } => ErrorKind::InvalidInput,
+            // A sample's value beyond the gain engine's range is the data's (the command has
+            // always reported it so, exit code 1), though the exact engine would take it.
+            Error::NonFinite { .. }
+            | Error::TimeNotIncreasing { .. }
+            | Error::GainValueOutOfRange { .. } => ErrorKind::InvalidInput,
             Error::InvalidParameter { name, .. } => name.kind(),
             Error::NoDefault { .. } => ErrorKind::InvalidInput,
             Error::ThetaOutOfRange { .. }
             | Error::TauOutOfRange { .. }
             | Error::DegreeOutOfRange { .. }
-            | Error::GainDegreeOutOfRange { .. }
-            | Error::GainValueOutOfRange { .. } => ErrorKind::Parameter,
+            | Error::GainDegreeOutOfRange { .. } => ErrorKind::Parameter,
             Error::TooFewSamples { .. } | Error::TooFewSamplesFor { .. } => {
                 ErrorKind::TooFewSamples
             }
