@@ -201,13 +201,15 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
         }
         lines.push_back(line);
         let fit = setup.fitter.push(measurement).map_err(|e| match e {
-            Error::NonFinite {
+            e @ Error::NonFinite {
                 what: "fitted state",
                 value,
-            } => CliError::Data(format!(
-                "line {line}: the fitted state holds {value}, beyond the double range; \
-                 express the times in a larger unit or rescale the values"
-            )),
+            } => CliError::from(e).reworded(|_| {
+                format!(
+                    "line {line}: the fitted state holds {value}, beyond the double range; \
+                     express the times in a larger unit or rescale the values"
+                )
+            }),
             e => window_error(e, &lines, window(a), a.model),
         })?;
 
@@ -287,7 +289,7 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
         max_iterations: a.max_iterations as usize,
         ..GaussNewton::default()
     };
-    let library = |e: Error| usage(e.to_string());
+    let library = CliError::from;
     match a.model {
         FitModel::Radar => {
             if a.sigma.is_some() {
@@ -378,22 +380,30 @@ pub(crate) fn window_error(
     match e {
         Error::InBatch { index, source } => {
             let line = lines.get(index).copied().unwrap_or(last);
-            CliError::Data(format!("line {line}: {source}"))
+            CliError::from(*source).reworded(|m| format!("line {line}: {m}"))
         }
-        Error::Unobservable { .. } | Error::TooFewSamples { .. } => CliError::Data(format!(
-            "lines {first}-{last}: the window of {} rows does not determine the state: {e}{}",
-            lines.len().min(window),
-            if model == FitModel::Radar {
-                " (a radar window needs at least as many measured components as states, and \
-                 its first fit two rows with range, azimuth and elevation)"
-            } else {
-                ""
-            }
-        )),
-        e @ (Error::NotConverged { .. } | Error::Diverged { .. }) => CliError::Data(format!(
-            "lines {first}-{last} (the window): {e} (with this command: --max-iterations N \
-             allows more iterations, a shorter --window W fits fewer rows)"
-        )),
-        e => CliError::Data(format!("lines {first}-{last} (the window): {e}")),
+        e @ (Error::Unobservable { .. } | Error::TooFewSamples { .. }) => CliError::from(e)
+            .reworded(|e| {
+                format!(
+                    "lines {first}-{last}: the window of {} rows does not determine the state: \
+                     {e}{}",
+                    lines.len().min(window),
+                    if model == FitModel::Radar {
+                        " (a radar window needs at least as many measured components as states, \
+                         and its first fit two rows with range, azimuth and elevation)"
+                    } else {
+                        ""
+                    }
+                )
+            }),
+        e @ (Error::NotConverged { .. } | Error::Diverged { .. }) => {
+            CliError::from(e).reworded(|e| {
+                format!(
+                    "lines {first}-{last} (the window): {e} (with this command: --max-iterations \
+                     N allows more iterations, a shorter --window W fits fewer rows)"
+                )
+            })
+        }
+        e => CliError::from(e).reworded(|e| format!("lines {first}-{last} (the window): {e}")),
     }
 }
