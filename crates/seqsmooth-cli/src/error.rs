@@ -52,6 +52,7 @@ pub fn flag(p: Param) -> Option<&'static str> {
         Param::Q => "--q",
         Param::MaxIterations => "--max-iterations",
         Param::ReviewWindow => "--review-window",
+        Param::Site => "--site",
         _ => return None,
     })
 }

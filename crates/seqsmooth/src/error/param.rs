@@ -196,6 +196,8 @@ pub enum Param {
     Axes,
     /// A radar's site and geometry.
     RadarGeometry,
+    /// A radar's site, its east, north and up coordinates.
+    Site,
     /// The start-up of a radar track.
     RadarStart,
     /// The iterations a fit may take.
@@ -346,6 +348,7 @@ impl Param {
         Param::Shapes,
         Param::Axes,
         Param::RadarGeometry,
+        Param::Site,
         Param::RadarStart,
         Param::MaxIterations,
         Param::IterationLimits,
@@ -467,6 +470,7 @@ impl Param {
             Param::Shapes => "shapes",
             Param::Axes => "axes",
             Param::RadarGeometry => "radar geometry",
+            Param::Site => "site",
             Param::RadarStart => "radar start",
             Param::MaxIterations => "max_iterations",
             Param::IterationLimits => "iteration limits",

@@ -51,9 +51,10 @@ impl Radar {
     /// ```
     pub fn new(site: [f64; 3], states: usize) -> Result<Self, Error> {
         if let Some(&value) = site.iter().find(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                what: "radar site coordinate",
-                value,
+            return Err(Error::InvalidParameter {
+                name: Param::Site,
+                value: value.to_string(),
+                reason: "a radar site's coordinates must be finite".into(),
             });
         }
         if states < 3 {
