@@ -234,7 +234,7 @@ impl PySlidingFit {
         max_iterations: i64,
     ) -> PyResult<Self> {
         let usage = |m: String| Err(raise(Kind::Parameter, m, None));
-        let library = |e: Error| raise(Kind::Parameter, e.to_string(), None);
+        let library = |e: Error| to_py(e, 0);
         let window = window.unwrap_or(match model {
             "polynomial" => POLYNOMIAL_WINDOW as i64,
             _ => RADAR_WINDOW as i64,
