@@ -191,11 +191,11 @@ impl PySlidingFit {
 /// estimate beyond the double range with the command's message and advice.
 fn in_batch(e: Error, i: usize) -> PyErr {
     match e {
-        Error::NonFinite {
+        e @ Error::NonFinite {
             what: "fitted state",
             value,
         } => raise(
-            Kind::InvalidInput,
+            Kind::of(&e),
             format!(
                 "sample {i} of the batch: the fitted state holds {value}, beyond the double \
                  range; express the times in a larger unit or rescale the values"

@@ -331,7 +331,16 @@ fn refusals_are_typed() {
         "{e}"
     );
     let e = Radar::new([0.0, f64::INFINITY, 0.0], 6).unwrap_err();
-    assert!(matches!(e, Error::NonFinite { .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            Error::InvalidParameter {
+                name: Param::Site,
+                ..
+            }
+        ),
+        "{e}"
+    );
     let e = Radar::new([0.0; 3], 2).unwrap_err();
     assert!(
         matches!(

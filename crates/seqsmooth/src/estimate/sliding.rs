@@ -267,7 +267,7 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
     /// use seqsmooth::estimate::batch::NoiseCovariance;
     /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
     /// use seqsmooth::estimate::sliding::SlidingFit;
-    /// use seqsmooth::Error;
+    /// use seqsmooth::{Error, Param};
     /// let mut fit = SlidingFit::polynomial(1, 3, Epoch::End, GaussNewton::default()).unwrap();
     /// let m = |t: f64, y: f64| Measurement { time: t, values: vec![Some(y)], noise: NoiseCovariance::Variances(vec![1.0]) };
     /// assert!(fit.push_finite(m(0.0, 1.0)).unwrap().is_none()); // one value: no line yet
