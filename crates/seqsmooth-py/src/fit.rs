@@ -14,11 +14,11 @@ use pyo3::types::{PyDict, PyString, PyTuple};
 use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
-use seqsmooth::kalman::track::radar_row;
-use seqsmooth::kalman::track::window_flag;
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::model::radar::Radar;
+use seqsmooth::track::radar_row;
+use seqsmooth::track::window_flag;
 use seqsmooth::Error;
 
 /// The model's sliding fit.
