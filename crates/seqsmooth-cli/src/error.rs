@@ -1,5 +1,6 @@
 //! The command's errors and their exit codes.
 
+use seqsmooth::error::{ErrorKind, Param};
 use thiserror::Error;
 
 /// Why a command failed. The message is printed after `error: ` on stderr.
@@ -35,14 +36,52 @@ impl CliError {
     }
 }
 
+/// The command's word for each parameter the library's errors name ([`seqsmooth::Param`]):
+/// its flag. The one table of the command's spelling; a parameter no flag sets (the data's, a
+/// model's) keeps the library's word.
+pub fn flag(p: Param) -> Option<&'static str> {
+    Some(match p {
+        Param::Degree => "--degree",
+        Param::Theta => "--theta",
+        Param::Beta => "--beta",
+        Param::Tau => "--tau",
+        Param::Window => "--window",
+        Param::Lead => "--lead",
+        Param::Derivative => "--derivative",
+        Param::Sigma => "--sigma",
+        Param::Q => "--q",
+        Param::MaxIterations => "--max-iterations",
+        Param::ReviewWindow => "--review-window",
+        Param::Site => "--site",
+        _ => return None,
+    })
+}
+
 /// A library error by its kind ([`seqsmooth::error::ErrorKind`], the library's rule): a
 /// setting out of range is a usage error (exit code 2, as for a bad argument), anything else a
-/// data error (1).
+/// data error (1). The message names a parameter by its flag ([`flag`]). Every library error
+/// the command reports becomes a `CliError` here (with [`CliError::reworded`] for context).
 impl From<seqsmooth::Error> for CliError {
     fn from(e: seqsmooth::Error) -> Self {
+        let message = e.message_in(&flag);
         match e.kind() {
-            seqsmooth::error::ErrorKind::Parameter => CliError::Usage(e.to_string()),
-            _ => CliError::Data(e.to_string()),
+            ErrorKind::Parameter => CliError::Usage(message),
+            ErrorKind::InvalidInput
+            | ErrorKind::TooFewSamples
+            | ErrorKind::NotDetermined
+            | ErrorKind::Numerical => CliError::Data(message),
+        }
+    }
+}
+
+impl CliError {
+    /// The same error (so the same exit code) with its message rewritten by `f`: a library
+    /// error put in context (`line 7: …`).
+    pub fn reworded(self, f: impl FnOnce(String) -> String) -> Self {
+        match self {
+            CliError::Usage(m) => CliError::Usage(f(m)),
+            CliError::Data(m) => CliError::Data(f(m)),
+            CliError::BrokenPipe => CliError::BrokenPipe,
         }
     }
 }

@@ -721,7 +721,7 @@ fn filter_auto_review_window() {
         ],
         &input,
         2,
-        &["review window 2", "from 3 to 31"],
+        &["--review-window 2", "from 3 to 31"],
     );
     fails(
         &[

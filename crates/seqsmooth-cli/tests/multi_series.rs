@@ -366,7 +366,7 @@ fn default_tau_is_median_step_within_series() {
     assert_eq!(o.code, 1, "{}", o.stderr);
     assert!(
         o.stderr
-            .contains("no series has two rows among the first 65536 data rows")
+            .contains("no series has two rows among the first 65536 rows")
             && o.stderr.contains("give --tau"),
         "{}",
         o.stderr

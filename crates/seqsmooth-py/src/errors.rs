@@ -6,7 +6,7 @@
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyType;
-use seqsmooth::error::ErrorKind;
+use seqsmooth::error::{ErrorKind, Param};
 use seqsmooth::Error;
 
 /// The Python class of each kind of error (its name in `seqsmooth.errors`).
@@ -60,6 +60,23 @@ pub fn error_kinds() -> Vec<(&'static str, &'static str)> {
         .collect()
 }
 
+/// Every parameter the library's errors name, its kind and the name of its Python class, for
+/// the test that walks every parameter to its class.
+#[pyfunction]
+pub fn parameter_kinds() -> Vec<(&'static str, &'static str, &'static str)> {
+    Param::ALL
+        .iter()
+        .map(|&p| {
+            let e = Error::InvalidParameter {
+                name: p,
+                value: String::new(),
+                reason: String::new(),
+            };
+            (p.name(), e.kind().name(), Kind::of(&e).class_name())
+        })
+        .collect()
+}
+
 /// An exception of `kind` with `message` and `index` (the offending sample's position).
 pub fn raise(kind: Kind, message: impl Into<String>, index: Option<usize>) -> PyErr {
     let message = message.into();
@@ -76,9 +93,38 @@ pub fn raise(kind: Kind, message: impl Into<String>, index: Option<usize>) -> Py
     })
 }
 
+/// The package's word for a parameter the library's errors name: its keyword where it differs
+/// from the library's word ([`Param::name`]). The spelling of every call but `smooth`'s.
+pub fn keyword(p: Param) -> Option<&'static str> {
+    match p {
+        Param::ReviewWindow => Some("review_window"),
+        _ => None,
+    }
+}
+
+/// The words of `smooth`, scipy's `savgol_filter` names: `window_length`, `polyorder`,
+/// `deriv`.
+pub fn scipy(p: Param) -> Option<&'static str> {
+    match p {
+        Param::Window => Some("window_length"),
+        Param::Degree => Some("polyorder"),
+        Param::Derivative => Some("deriv"),
+        _ => keyword(p),
+    }
+}
+
 /// A library error as its Python exception; `offset` is added to a batch index (the batch
 /// was a slice of the caller's arrays starting there).
 pub fn to_py(error: Error, offset: usize) -> PyErr {
+    to_py_in(error, offset, &keyword)
+}
+
+/// [`to_py`], the parameter named by `spell` (the words of the call: [`keyword`], [`scipy`]).
+pub fn to_py_in(
+    error: Error,
+    offset: usize,
+    spell: &dyn Fn(Param) -> Option<&'static str>,
+) -> PyErr {
     // A bank's error is its channel's: the row's index and the cause.
     let error = match error {
         Error::InChannel { source, .. } if matches!(*source, Error::InBatch { .. }) => *source,
@@ -89,8 +135,10 @@ pub fn to_py(error: Error, offset: usize) -> PyErr {
         _ => None,
     };
     let message = match (&error, index) {
-        (Error::InBatch { source, .. }, Some(i)) => format!("sample {i} of the batch: {source}"),
-        _ => error.to_string(),
+        (Error::InBatch { source, .. }, Some(i)) => {
+            format!("sample {i} of the batch: {}", source.message_in(spell))
+        }
+        _ => error.message_in(spell),
     };
     raise(Kind::of(&error), message, index)
 }
@@ -101,6 +149,8 @@ pub trait IntoPy<T> {
     fn py_at(self, offset: usize) -> PyResult<T>;
     /// The error as its Python exception.
     fn py(self) -> PyResult<T>;
+    /// The error as its Python exception, its parameter in the words of `spell`.
+    fn py_in(self, spell: &dyn Fn(Param) -> Option<&'static str>) -> PyResult<T>;
 }
 
 impl<T> IntoPy<T> for Result<T, Error> {
@@ -109,5 +159,8 @@ impl<T> IntoPy<T> for Result<T, Error> {
     }
     fn py(self) -> PyResult<T> {
         self.py_at(0)
+    }
+    fn py_in(self, spell: &dyn Fn(Param) -> Option<&'static str>) -> PyResult<T> {
+        self.map_err(|e| to_py_in(e, 0, spell))
     }
 }

@@ -191,11 +191,11 @@ impl PySlidingFit {
 /// estimate beyond the double range with the command's message and advice.
 fn in_batch(e: Error, i: usize) -> PyErr {
     match e {
-        Error::NonFinite {
+        e @ Error::NonFinite {
             what: "fitted state",
             value,
         } => raise(
-            Kind::InvalidInput,
+            Kind::of(&e),
             format!(
                 "sample {i} of the batch: the fitted state holds {value}, beyond the double \
                  range; express the times in a larger unit or rescale the values"
@@ -234,7 +234,7 @@ impl PySlidingFit {
         max_iterations: i64,
     ) -> PyResult<Self> {
         let usage = |m: String| Err(raise(Kind::Parameter, m, None));
-        let library = |e: Error| raise(Kind::Parameter, e.to_string(), None);
+        let library = |e: Error| to_py(e, 0);
         let window = window.unwrap_or(match model {
             "polynomial" => POLYNOMIAL_WINDOW as i64,
             _ => RADAR_WINDOW as i64,

@@ -38,6 +38,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
     m.add_function(wrap_pyfunction!(frame::filter_series, m)?)?;
     m.add_function(wrap_pyfunction!(errors::error_kinds, m)?)?;
+    m.add_function(wrap_pyfunction!(errors::parameter_kinds, m)?)?;
     m.add_function(wrap_pyfunction!(tables::gains, m)?)?;
     m.add_function(wrap_pyfunction!(tables::vrf, m)?)?;
     m.add_function(wrap_pyfunction!(paml::gauss_rule, m)?)?;

@@ -11,6 +11,7 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyList;
 use seqsmooth::basis::{GaussRule, Jacobi};
+use seqsmooth::error::Param;
 use seqsmooth::estimate::curve::{self, CurveFit, CurveModel};
 use seqsmooth::paml::{OnlineSmoother, PolynomialSamples, SmootherGains};
 use seqsmooth::polynomial::expanding::continuous::{hilbert_gains, luenberger_gains as gains};
@@ -288,7 +289,7 @@ impl<'py> PyCurve<'_, 'py> {
         let message = e.to_string();
         self.raised.borrow_mut().get_or_insert(e);
         Error::InvalidParameter {
-            name: "model",
+            name: Param::Model,
             value: "raised".into(),
             reason: message,
         }

@@ -2,7 +2,7 @@
 //! library's centred fixed-memory fit ([`seqsmooth::polynomial::fixed::smooth_into`]).
 
 use crate::arrays::{series, times};
-use crate::errors::{raise, IntoPy, Kind};
+use crate::errors::{raise, scipy, IntoPy, Kind};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use seqsmooth::polynomial::fixed::{smooth_into, smooth_with_sigma_into};
@@ -106,12 +106,12 @@ pub fn smooth<'py>(
     };
     if !return_sigma {
         py.detach(|| smooth_into(t, y, polyorder, window_length, &mut out))
-            .py()?;
+            .py_in(&scipy)?;
         return Ok(PyArray1::from_vec(py, column(&out)).into_any());
     }
     let mut sd = vec![0.0; n * w];
     py.detach(|| smooth_with_sigma_into(t, y, polyorder, window_length, sigma, &mut out, &mut sd))
-        .py()?;
+        .py_in(&scipy)?;
     let (d, s) = (
         PyArray1::from_vec(py, column(&out)),
         PyArray1::from_vec(py, column(&sd)),

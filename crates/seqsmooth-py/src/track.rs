@@ -54,7 +54,15 @@ fn track_error(e: TrackError, offset: usize) -> PyErr {
             },
             0,
         ),
-        e => raise(Kind::Numerical, e.to_string(), None),
+        e => {
+            // The class by the cause's kind, the message the tracker's.
+            let message = e.to_string();
+            let (TrackError::Window { source, .. }
+            | TrackError::Start(source)
+            | TrackError::Update { source, .. }
+            | TrackError::Smooth(source)) = e;
+            raise(Kind::of(&source), message, None)
+        }
     }
 }
 
@@ -313,8 +321,7 @@ impl PyRadarTracker {
             max_iterations: max_iterations as usize,
             ..GaussNewton::default()
         };
-        let radar = Radar::new([site.0, site.1, site.2], 6)
-            .map_err(|e| raise(Kind::Parameter, e.to_string(), None))?;
+        let radar = Radar::new([site.0, site.1, site.2], 6).py()?;
         Ok(Self {
             inner: RadarTracker::with_solver(radar, method, solver).py()?,
             sigmas: [sigma_range, sigma_angle],

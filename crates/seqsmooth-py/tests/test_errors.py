@@ -41,6 +41,42 @@ def test_every_error_kind_has_its_class():
         ss.smooth(np.ones(5), 7, 2)
 
 
+def test_every_parameter_takes_its_kind_and_the_callers_words():
+    """Each library parameter's refusal raises its kind's class (``error_kinds`` walks the
+    kinds, ``parameter_kinds`` every parameter), with no class chosen by a name string."""
+    from seqsmooth._seqsmooth import error_kinds, parameter_kinds
+
+    classes = dict(error_kinds())
+    params = parameter_kinds()
+    assert len(params) > 50 and len({name for name, _, _ in params}) == len(params)
+    for name, kind, cls in params:
+        assert kind in ("Parameter", "InvalidInput"), name
+        assert cls == classes[kind], name
+    kinds = {name: kind for name, kind, _ in params}
+    assert kinds["theta"] == "Parameter" and kinds["azimuth"] == "InvalidInput"
+
+
+def test_smooth_names_scipys_arguments():
+    """``smooth`` takes scipy's names, and its errors say them: a series shorter than the
+    window names ``window_length``, a degree out of range ``polyorder``."""
+    with pytest.raises(ss.TooFewSamplesError) as e:
+        ss.smooth(np.ones(30), 31, 2)
+    assert str(e.value) == "too few samples for window_length 31: 30 given, at least 31 needed"
+    with pytest.raises(ss.TooFewSamplesError) as e:
+        ss.smooth(np.ones(30), 31, 2, return_sigma=True, sigma=1.0)
+    assert "window_length 31" in str(e.value)
+    with pytest.raises(ss.ParameterError) as e:
+        ss.smooth(np.ones(30), 5, 30)
+    assert str(e.value).startswith("polyorder 30 is out of range")
+    with pytest.raises(ss.ParameterError) as e:
+        ss.smooth(np.ones(30), 2, 2)
+    assert str(e.value).startswith("window_length 2 is invalid")
+    # The classes' own keywords keep the library's words.
+    with pytest.raises(ss.ParameterError) as e:
+        ss.FixedMemory(degree=3, window=3)
+    assert str(e.value).startswith("window 3 is invalid")
+
+
 @pytest.mark.parametrize("where", [0, 3, 9])
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
 def test_a_non_finite_value_is_named_with_its_index(where, bad):

@@ -15,7 +15,7 @@
 //! The same names on the command line (`--theta T --tau TAU`, `--theta-per-update T`) and in
 //! Python (`theta=…, tau=…`, `theta_per_update=…`); docs/names.md lists them.
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 
 /// A fading memory's discount: `θ` per span `τ` of time, or `θ` per update (the module docs).
 /// Built by [`Discount::per_time`] and [`Discount::per_update`], which check `0 < θ < 1` and
@@ -107,7 +107,7 @@ impl Discount {
     ) -> Result<Option<Self>, Error> {
         let refuse = |value: String, reason: &str| {
             Err(Error::InvalidParameter {
-                name: "discount",
+                name: Param::Discount,
                 value,
                 reason: reason.into(),
             })
@@ -184,7 +184,7 @@ impl Discount {
             Ok(f)
         } else {
             Err(Error::InvalidParameter {
-                name: "discount over the step",
+                name: Param::DiscountOverStep,
                 value: format!("{f:e} over {elapsed} since the last update"),
                 reason: "underflows: the memory holds nothing; raise theta or tau, or update \
                          more often"

@@ -2,6 +2,9 @@
 
 use thiserror::Error;
 
+pub mod param;
+pub use param::Param;
+
 /// What went wrong, with the value that caused it.
 ///
 /// ```
@@ -31,19 +34,19 @@ pub enum Error {
         previous: f64,
     },
     /// The discount factor is outside `(0, 1)`.
-    #[error("theta {theta} is out of range: it must lie strictly between 0 and 1")]
+    #[error("{}", self.named("theta"))]
     ThetaOutOfRange {
         /// The rejected θ.
         theta: f64,
     },
     /// The nominal sampling interval is not a positive finite number.
-    #[error("tau {tau} is out of range: it must be a positive finite number")]
+    #[error("{}", self.named("tau"))]
     TauOutOfRange {
         /// The rejected τ.
         tau: f64,
     },
     /// The degree is larger than the library supports.
-    #[error("degree {degree} is out of range: the largest supported degree is {max}")]
+    #[error("{}", self.named("degree"))]
     DegreeOutOfRange {
         /// The rejected degree.
         degree: usize,
@@ -51,11 +54,7 @@ pub enum Error {
         max: usize,
     },
     /// The degree is beyond what the gain engine supports (the exact engine supports it).
-    #[error(
-        "degree {degree} is too high for the gain engine: it is supported to degree {max} \
-         (above it its fixed-gain recursion is numerically unstable on irregular timestamps); \
-         use the exact engine"
-    )]
+    #[error("{}", self.named("degree"))]
     GainDegreeOutOfRange {
         /// The rejected degree.
         degree: usize,
@@ -80,6 +79,25 @@ pub enum Error {
         needed: usize,
         /// Samples available.
         got: usize,
+    },
+    /// Fewer samples than a parameter asks for (a window longer than the series).
+    #[error("{}", self.named(param.name()))]
+    TooFewSamplesFor {
+        /// The parameter that asks for them (a window).
+        param: Param,
+        /// Samples required (the parameter's value).
+        needed: usize,
+        /// Samples available.
+        got: usize,
+    },
+    /// The data give no default for a parameter the caller left out (the default `τ`, the
+    /// median time step, of rows with no step): the caller must give it.
+    #[error("{}", self.named(param.name()))]
+    NoDefault {
+        /// The parameter left out.
+        param: Param,
+        /// Why the data give no default.
+        why: String,
     },
     /// A sample of a batch ([`PolynomialFilter::update_many`](crate::PolynomialFilter::update_many))
     /// was rejected; the samples before it were processed, it and the rest were not.
@@ -212,10 +230,10 @@ pub enum Error {
         iterations: usize,
     },
     /// Some other parameter is out of range.
-    #[error("{name} {value} is invalid: {reason}")]
+    #[error("{}", self.named(name.name()))]
     InvalidParameter {
-        /// The parameter.
-        name: &'static str,
+        /// The parameter (its kind says whether it is a setting or the data).
+        name: Param,
         /// Its value, as text.
         value: String,
         /// Why it is rejected.
@@ -271,43 +289,24 @@ impl ErrorKind {
     }
 }
 
-/// The names of [`Error::InvalidParameter`] that describe the data handed in (a sample, a
-/// row's component or σ, the shape of the arrays), not a setting: [`ErrorKind::InvalidInput`].
-const DATA_NAMES: &[&str] = &[
-    "input value",
-    "input length",
-    "matrix length",
-    "batch lengths",
-    "chunk lengths",
-    "estimates length",
-    "time",
-    "range",
-    "azimuth",
-    "elevation",
-    "sigma_range",
-    "sigma_angle",
-    "row",
-    "weight",
-    "weights",
-    "segment",
-    "sigmas",
-];
-
 impl Error {
     /// The error's [`ErrorKind`] (inside a batch or a channel, its cause's).
     pub fn kind(&self) -> ErrorKind {
         match self {
-            Error::NonFinite { .. } | Error::TimeNotIncreasing { .. } => ErrorKind::InvalidInput,
-            Error::InvalidParameter { name, .. } if DATA_NAMES.contains(name) => {
-                ErrorKind::InvalidInput
-            }
+            // A sample's value beyond the gain engine's range is the data's (the command has
+            // always reported it so, exit code 1), though the exact engine would take it.
+            Error::NonFinite { .. }
+            | Error::TimeNotIncreasing { .. }
+            | Error::GainValueOutOfRange { .. } => ErrorKind::InvalidInput,
+            Error::InvalidParameter { name, .. } => name.kind(),
+            Error::NoDefault { .. } => ErrorKind::InvalidInput,
             Error::ThetaOutOfRange { .. }
             | Error::TauOutOfRange { .. }
             | Error::DegreeOutOfRange { .. }
-            | Error::GainDegreeOutOfRange { .. }
-            | Error::GainValueOutOfRange { .. }
-            | Error::InvalidParameter { .. } => ErrorKind::Parameter,
-            Error::TooFewSamples { .. } => ErrorKind::TooFewSamples,
+            | Error::GainDegreeOutOfRange { .. } => ErrorKind::Parameter,
+            Error::TooFewSamples { .. } | Error::TooFewSamplesFor { .. } => {
+                ErrorKind::TooFewSamples
+            }
             Error::NotDetermined { .. } => ErrorKind::NotDetermined,
             Error::InBatch { source, .. } | Error::InChannel { source, .. } => source.kind(),
             Error::EstimateOutOfRange { .. }
@@ -317,6 +316,95 @@ impl Error {
             | Error::FitNotConverged { .. }
             | Error::SvdNotConverged { .. }
             | Error::EigenNotConverged { .. } => ErrorKind::Numerical,
+        }
+    }
+}
+
+impl Error {
+    /// The parameter the error names (inside a batch or a channel, its cause's): the one a
+    /// front end names in its own words ([`Error::message_in`]).
+    ///
+    /// ```
+    /// use seqsmooth::error::{Error, Param};
+    /// assert_eq!(Error::ThetaOutOfRange { theta: 2.0 }.param(), Some(Param::Theta));
+    /// assert_eq!(Error::TooFewSamples { needed: 3, got: 1 }.param(), None);
+    /// ```
+    pub fn param(&self) -> Option<Param> {
+        match self {
+            Error::ThetaOutOfRange { .. } => Some(Param::Theta),
+            Error::TauOutOfRange { .. } => Some(Param::Tau),
+            Error::DegreeOutOfRange { .. } | Error::GainDegreeOutOfRange { .. } => {
+                Some(Param::Degree)
+            }
+            Error::InvalidParameter { name: param, .. }
+            | Error::TooFewSamplesFor { param, .. }
+            | Error::NoDefault { param, .. } => Some(*param),
+            Error::InBatch { source, .. } | Error::InChannel { source, .. } => source.param(),
+            _ => None,
+        }
+    }
+
+    /// The message with the parameter it names ([`Error::param`]) spelled by `spell` (a front
+    /// end's word for it: the command's flag, a Python keyword), or by its
+    /// [`Param::name`] where `spell` gives none.
+    ///
+    /// ```
+    /// use seqsmooth::error::{Error, Param};
+    /// let e = Error::InBatch { index: 2, source: Box::new(Error::ThetaOutOfRange { theta: 2.0 }) };
+    /// let flag = |p: Param| (p == Param::Theta).then_some("--theta");
+    /// assert_eq!(
+    ///     e.message_in(&flag),
+    ///     "sample 2 of the batch: --theta 2 is out of range: it must lie strictly between 0 and 1"
+    /// );
+    /// let short = Error::TooFewSamplesFor { param: Param::Window, needed: 31, got: 30 };
+    /// let scipy = |p: Param| (p == Param::Window).then_some("window_length");
+    /// assert_eq!(
+    ///     short.message_in(&scipy),
+    ///     "too few samples for window_length 31: 30 given, at least 31 needed"
+    /// );
+    /// ```
+    pub fn message_in(&self, spell: &dyn Fn(Param) -> Option<&'static str>) -> String {
+        let message = self.to_string();
+        let Some(word) = self.param().and_then(spell) else {
+            return message;
+        };
+        // The cause's message stands whole inside its batch's or channel's.
+        let mut cause = self;
+        while let Error::InBatch { source, .. } | Error::InChannel { source, .. } = cause {
+            cause = source;
+        }
+        message.replacen(&cause.to_string(), &cause.named(word), 1)
+    }
+
+    /// The message of an error that names a parameter, the parameter called `name`.
+    fn named(&self, name: &str) -> String {
+        match self {
+            Error::ThetaOutOfRange { theta } => {
+                format!("{name} {theta} is out of range: it must lie strictly between 0 and 1")
+            }
+            Error::TauOutOfRange { tau } => {
+                format!("{name} {tau} is out of range: it must be a positive finite number")
+            }
+            Error::DegreeOutOfRange { degree, max } => {
+                format!("{name} {degree} is out of range: the largest supported degree is {max}")
+            }
+            Error::GainDegreeOutOfRange { degree, max } => format!(
+                "{name} {degree} is too high for the gain engine: it is supported to degree \
+                 {max} (above it its fixed-gain recursion is numerically unstable on irregular \
+                 timestamps); use the exact engine"
+            ),
+            Error::InvalidParameter { value, reason, .. } => {
+                format!("{name} {value} is invalid: {reason}")
+            }
+            Error::TooFewSamplesFor { needed, got, .. } => {
+                format!(
+                    "too few samples for {name} {needed}: {got} given, at least {needed} needed"
+                )
+            }
+            Error::NoDefault { why, .. } => {
+                format!("the data give no default {name}: {why}; give {name}")
+            }
+            other => other.to_string(),
         }
     }
 }
@@ -368,7 +456,7 @@ pub(crate) fn check_finite(what: &'static str, xs: &[f64]) -> Result<(), Error> 
 
 /// One time per value, or an [`Error::InvalidParameter`] called `name` giving `reason`.
 pub(crate) fn check_lengths(
-    name: &'static str,
+    name: Param,
     times: &[f64],
     values: &[f64],
     reason: &str,

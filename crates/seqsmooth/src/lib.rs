@@ -101,7 +101,7 @@ pub mod scalar;
 pub mod stats;
 pub mod track;
 
-pub use error::Error;
+pub use error::{Error, Param};
 
 /// The README's Rust example, compiled and run as a doctest.
 #[cfg(doctest)]

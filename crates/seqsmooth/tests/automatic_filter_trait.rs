@@ -10,6 +10,7 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
+use seqsmooth::error::Param;
 use seqsmooth::polynomial::automatic::{
     AutoConfig, AutoOutput, AutomaticFilter, MisfitResponse, NoiseSource, OutlierRule, Phase,
 };
@@ -252,7 +253,7 @@ fn builders_equal_the_configuration_they_record() {
     assert!(matches!(
         built.with_noise_sigma(1.0),
         Err(Error::InvalidParameter {
-            name: "configuration",
+            name: Param::Configuration,
             ..
         })
     ));

@@ -4,6 +4,7 @@
 mod common;
 
 use common::batch::*;
+use seqsmooth::error::Param;
 use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, PolynomialFilter};
 
 #[test]
@@ -72,7 +73,7 @@ fn update_many_reports_the_first_bad_sample_and_keeps_the_ones_before() {
         matches!(
             err,
             Error::InvalidParameter {
-                name: "batch lengths",
+                name: Param::BatchLengths,
                 ..
             }
         ),
@@ -172,7 +173,7 @@ fn update_many_into_checks_lengths_and_stops_at_a_bad_sample() {
             matches!(
                 err,
                 Error::InvalidParameter {
-                    name: "estimates length",
+                    name: Param::EstimatesLength,
                     ..
                 }
             ),

@@ -7,6 +7,7 @@ use nalgebra::{DMatrix, DVector};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::StandardNormal;
+use seqsmooth::error::Param;
 use seqsmooth::estimate::curve::{cramer_rao_bound, fit_curve, Curve, CurveModel};
 use seqsmooth::Error;
 
@@ -161,14 +162,17 @@ fn bad_input_is_refused_by_name() {
     assert!(matches!(
         lengths,
         Err(Error::InvalidParameter {
-            name: "input lengths",
+            name: Param::InputLengths,
             ..
         })
     ));
     let sigma = fit_curve(&model, &t, &y, &[0.1, 0.0, 0.1, 0.1], &start);
     assert!(matches!(
         sigma,
-        Err(Error::InvalidParameter { name: "sigmas", .. })
+        Err(Error::InvalidParameter {
+            name: Param::Sigmas,
+            ..
+        })
     ));
     let nan = fit_curve(&model, &t, &[1.0, f64::NAN, 1.0, 1.0], &s, &start);
     assert!(matches!(nan, Err(Error::NonFinite { what: "value", .. })));
@@ -183,7 +187,7 @@ fn bad_input_is_refused_by_name() {
     assert!(matches!(
         start_len,
         Err(Error::InvalidParameter {
-            name: "parameters",
+            name: Param::Parameters,
             ..
         })
     ));
@@ -220,7 +224,13 @@ fn bad_input_is_refused_by_name() {
     }
     let r = fit_curve(&Short, &t, &y, &s, &[1.0]);
     assert!(
-        matches!(r, Err(Error::InvalidParameter { name: "model", .. })),
+        matches!(
+            r,
+            Err(Error::InvalidParameter {
+                name: Param::Model,
+                ..
+            })
+        ),
         "{r:?}"
     );
     // parameters the data cannot separate
@@ -263,7 +273,7 @@ fn bad_input_is_refused_by_name() {
         }
         fn values(&self, _th: &[f64], _times: &[f64]) -> Result<Vec<f64>, Error> {
             Err(Error::InvalidParameter {
-                name: "model",
+                name: Param::Model,
                 value: "refused".into(),
                 reason: "test".into(),
             })

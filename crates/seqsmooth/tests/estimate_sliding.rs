@@ -6,6 +6,7 @@
 use nalgebra::DVector;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
+use seqsmooth::error::Param;
 use seqsmooth::estimate::bootstrap;
 use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, Start};
@@ -178,7 +179,10 @@ fn refusals() {
     assert!(fit.push(scalar(0.0, 1.0)).unwrap().is_none());
     assert!(matches!(
         fit.push(scalar(0.0, 2.0)),
-        Err(Error::InvalidParameter { name: "time", .. })
+        Err(Error::InvalidParameter {
+            name: Param::Time,
+            ..
+        })
     ));
     assert!(matches!(
         fit.push(scalar(1.0, f64::NAN)),

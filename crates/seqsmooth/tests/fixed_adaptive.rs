@@ -6,6 +6,7 @@
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
+use seqsmooth::error::Param;
 use seqsmooth::estimate::PolynomialFit;
 use seqsmooth::polynomial::fixed::{FixedEngine, FixedMemory};
 use seqsmooth::{Error, PolynomialFilter};
@@ -117,7 +118,7 @@ fn adaptive_runs_the_sliding_then_the_irregular_engine_bit_for_bit() {
                     assert!(matches!(
                         sliding.update(t, y),
                         Err(Error::InvalidParameter {
-                            name: "sample time",
+                            name: Param::SampleTime,
                             ..
                         })
                     ));

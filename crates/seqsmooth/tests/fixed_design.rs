@@ -3,6 +3,7 @@
 //! Ex 7.26, each search checked on both sides of its answer against the exact covariance and
 //! bias.
 
+use seqsmooth::error::Param;
 use seqsmooth::polynomial::fixed::{
     covariance_unscaled, dominant_bias, tau_for_derivative_sigma, Design, Lead,
 };
@@ -118,6 +119,9 @@ fn balance_span_ex_7_26_t7_23() {
             sigma_nu: 1.0
         }
         .balance_span(1.0, 1.0),
-        Err(Error::InvalidParameter { name: "lead", .. })
+        Err(Error::InvalidParameter {
+            name: Param::Lead,
+            ..
+        })
     ));
 }

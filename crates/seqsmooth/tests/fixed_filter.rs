@@ -8,6 +8,7 @@ mod common;
 use common::fixed::*;
 use common::{dyadic, exact_discounted_even, exact_ls_derivatives, jittered_times, random_times};
 use num_traits::Signed;
+use seqsmooth::error::Param;
 use seqsmooth::polynomial::fixed::{
     bias, covariance, covariance_unscaled, dominant_bias, end_point_bias_bound, smooth,
     tau_for_derivative_sigma, vrf_limit, weights, weights_unscaled, Design, FixedEngine,
@@ -228,7 +229,7 @@ fn filters_say_so_before_the_window_fills_and_reject_bad_input() {
             // The error names the sample (0-based index 6) and both steps.
             match uneven {
                 Err(Error::InvalidParameter {
-                    name: "sample time",
+                    name: Param::SampleTime,
                     value,
                     reason,
                 }) => {
@@ -250,7 +251,10 @@ fn filters_say_so_before_the_window_fills_and_reject_bad_input() {
     }
     assert!(matches!(
         FixedMemory::new(3, 3, FixedEngine::Sliding),
-        Err(Error::InvalidParameter { name: "window", .. })
+        Err(Error::InvalidParameter {
+            name: Param::Window,
+            ..
+        })
     ));
     assert!(matches!(
         FixedMemory::new(MAX_DEGREE + 1, 100, FixedEngine::Direct),
@@ -266,11 +270,17 @@ fn filters_say_so_before_the_window_fills_and_reject_bad_input() {
     // Windows too long to store are refused rather than attempted.
     assert!(matches!(
         weights(1, 1 << 32, 0.0),
-        Err(Error::InvalidParameter { name: "span", .. })
+        Err(Error::InvalidParameter {
+            name: Param::Span,
+            ..
+        })
     ));
     assert!(matches!(
         FixedMemory::new(1, (1usize << 32) + 1, FixedEngine::Sliding),
-        Err(Error::InvalidParameter { name: "window", .. })
+        Err(Error::InvalidParameter {
+            name: Param::Window,
+            ..
+        })
     ));
     // The analytic functions.
     assert!(matches!(
@@ -357,7 +367,7 @@ fn even_spacing_rule_allows_for_the_rounding_of_the_timestamps() {
     assert!(matches!(
         filt.update(last + 1e-3 + 2e-6, 0.0),
         Err(Error::InvalidParameter {
-            name: "sample time",
+            name: Param::SampleTime,
             ..
         })
     ));

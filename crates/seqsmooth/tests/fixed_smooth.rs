@@ -10,7 +10,7 @@ use seqsmooth::polynomial::fixed::{
     smooth, smooth_detrended, smooth_into, weights_unscaled, Nominal,
 };
 use seqsmooth::polynomial::MAX_DEGREE;
-use seqsmooth::Error;
+use seqsmooth::{Error, Param};
 
 /// The window rule of savgol's "interp" mode: the window of `w` samples centred on `n`
 /// (`⌊(w-1)/2⌋` before it), clamped to the series.
@@ -138,11 +138,18 @@ fn smooth_rejects_bad_input() {
     let y = [1.0, 2.0, 3.0, 4.0];
     assert!(matches!(
         smooth(&t, &y, 1, 5),
-        Err(Error::TooFewSamples { needed: 5, got: 4 })
+        Err(Error::TooFewSamplesFor {
+            param: Param::Window,
+            needed: 5,
+            got: 4
+        })
     ));
     assert!(matches!(
         smooth(&t, &y, 2, 2),
-        Err(Error::InvalidParameter { name: "window", .. })
+        Err(Error::InvalidParameter {
+            name: Param::Window,
+            ..
+        })
     ));
     assert!(matches!(
         smooth(&t, &y[..3], 1, 3),
@@ -218,7 +225,7 @@ fn smooth_rejects_bad_input_anywhere_in_long_series() {
     assert!(matches!(
         smooth_into(&t, &y, 2, 11, &mut short),
         Err(Error::InvalidParameter {
-            name: "estimates length",
+            name: Param::EstimatesLength,
             ..
         })
     ));

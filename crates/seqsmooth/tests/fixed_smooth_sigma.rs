@@ -10,7 +10,7 @@ use rand_distr::{Distribution, Normal};
 use seqsmooth::polynomial::fixed::{
     smooth, smooth_into, smooth_with_sigma_into, CentredSmoother, SmoothSigma,
 };
-use seqsmooth::Error;
+use seqsmooth::{Error, Param};
 use statrs::distribution::{ContinuousCDF, StudentsT};
 
 /// Evenly spaced, irregular, and even with one irregular stretch (windows of both engines).
@@ -236,7 +236,11 @@ fn refusals() {
     assert_eq!(s.samples(), 1);
     assert!(matches!(
         s.finish(|_| Ok::<(), Error>(())),
-        Err(Error::TooFewSamples { needed: 5, got: 1 })
+        Err(Error::TooFewSamplesFor {
+            param: Param::Window,
+            needed: 5,
+            got: 1
+        })
     ));
     let (mut d, mut sd) = (vec![0.0; 6], vec![0.0; 6]);
     let t = [0.0, 1.0, 2.0];

@@ -24,6 +24,7 @@ use common::kalman::cov_err;
 use common::rational::{mm, to_f64};
 use nalgebra::{DMatrix, DVector};
 use num_traits::Zero;
+use seqsmooth::error::Param;
 use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};
 use seqsmooth::kalman::{Discount, KalmanFilter};
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics, Propagation};
@@ -61,7 +62,7 @@ impl Dynamics for Flip {
         let steps = t_b - t_a;
         if steps != steps.round() {
             return Err(Error::InvalidParameter {
-                name: "step",
+                name: Param::Step,
                 value: steps.to_string(),
                 reason: "Ex. 14.9b's model is defined on whole steps".into(),
             });

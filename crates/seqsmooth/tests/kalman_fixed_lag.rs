@@ -9,6 +9,7 @@
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
+use seqsmooth::error::Param;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::{smooth, FixedLagSmoother, KalmanFilter, Smoothed};
 use seqsmooth::model::dynamics::PolynomialDynamics;
@@ -289,7 +290,10 @@ fn refusals_leave_the_smoother_unchanged() {
     bad.time = rows[1].time;
     assert!(matches!(
         s.push(&bad),
-        Err(Error::InvalidParameter { name: "time", .. })
+        Err(Error::InvalidParameter {
+            name: Param::Time,
+            ..
+        })
     ));
     bad.time = f64::NAN;
     assert!(s.push(&bad).is_err());

@@ -13,6 +13,7 @@ use common::rational::*;
 use nalgebra::{DMatrix, DVector};
 use num_traits::Zero;
 use rand::{Rng, SeedableRng};
+use seqsmooth::error::Param;
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
 use seqsmooth::model::linear::LinearDynamics;
 use seqsmooth::scalar::rational_from_f64;
@@ -324,7 +325,13 @@ fn refusals_are_typed() {
     let x = DVector::from_element(4, 1.0);
     let e = model.propagate(&DVector::zeros(3), 0.0, 1.0).unwrap_err();
     assert!(
-        matches!(e, Error::InvalidParameter { name: "state", .. }),
+        matches!(
+            e,
+            Error::InvalidParameter {
+                name: Param::State,
+                ..
+            }
+        ),
         "{e}"
     );
     let mut bad = x.clone();
@@ -372,7 +379,7 @@ fn refusals_are_typed() {
         matches!(
             e,
             Error::InvalidParameter {
-                name: "covariance",
+                name: Param::Covariance,
                 ..
             }
         ),
@@ -399,7 +406,13 @@ fn refusals_are_typed() {
     let growth = LinearDynamics::new(DMatrix::from_element(1, 1, 1000.0)).unwrap();
     let e = growth.propagate(&DVector::zeros(2), 0.0, 1.0).unwrap_err();
     assert!(
-        matches!(e, Error::InvalidParameter { name: "state", .. }),
+        matches!(
+            e,
+            Error::InvalidParameter {
+                name: Param::State,
+                ..
+            }
+        ),
         "{e}"
     );
     let e =

@@ -13,6 +13,7 @@ mod common;
 
 use common::book::assert_printed;
 use nalgebra::{DMatrix, DVector};
+use seqsmooth::error::Param;
 use seqsmooth::model::dynamics::Dynamics;
 use seqsmooth::model::nonlinear::NonlinearDynamics;
 use seqsmooth::Error;
@@ -411,7 +412,7 @@ fn bad_input_and_bad_fields_are_refused_by_type() {
         matches!(
             e,
             Error::InvalidParameter {
-                name: "dynamics",
+                name: Param::Dynamics,
                 ..
             }
         )
@@ -419,7 +420,13 @@ fn bad_input_and_bad_fields_are_refused_by_type() {
     // The caller's input.
     let e = drag.propagate(&v(&[1.0]), 0.0, 1.0).unwrap_err();
     assert!(
-        matches!(e, Error::InvalidParameter { name: "state", .. }),
+        matches!(
+            e,
+            Error::InvalidParameter {
+                name: Param::State,
+                ..
+            }
+        ),
         "{e}"
     );
     let e = drag.propagate(&v(&[1.0, f64::NAN]), 0.0, 1.0).unwrap_err();
@@ -448,7 +455,7 @@ fn bad_input_and_bad_fields_are_refused_by_type() {
         matches!(
             e,
             Error::InvalidParameter {
-                name: "covariance",
+                name: Param::Covariance,
                 ..
             }
         ),

@@ -12,6 +12,7 @@ use common::rational::*;
 use nalgebra::{DMatrix, DVector};
 use num_traits::Zero;
 use rand::{Rng, SeedableRng};
+use seqsmooth::error::Param;
 use seqsmooth::model::observation::{LinearObservation, NonlinearObservation, Observation};
 use seqsmooth::scalar::rational_from_f64;
 use seqsmooth::Error;
@@ -184,7 +185,7 @@ fn refusals_are_typed() {
         matches!(
             e,
             Error::InvalidParameter {
-                name: "observation matrix M",
+                name: Param::ObservationMatrixM,
                 ..
             }
         ),
@@ -195,7 +196,13 @@ fn refusals_are_typed() {
     let m = LinearObservation::new(DMatrix::from_element(1, 2, 1e308)).unwrap();
     let e = m.predict(&v(&[1.0]), 0.0).unwrap_err();
     assert!(
-        matches!(e, Error::InvalidParameter { name: "state", .. }),
+        matches!(
+            e,
+            Error::InvalidParameter {
+                name: Param::State,
+                ..
+            }
+        ),
         "{e}"
     );
     let e = m.predict(&v(&[1.0, f64::NAN]), 0.0).unwrap_err();
@@ -226,7 +233,7 @@ fn refusals_are_typed() {
         matches!(
             e,
             Error::InvalidParameter {
-                name: "observation model",
+                name: Param::ObservationModel,
                 ..
             }
         )
@@ -269,7 +276,13 @@ fn refusals_are_typed() {
     let ok = &cases[4].1;
     let e = ok.predict(&v(&[1.0]), 0.0).unwrap_err();
     assert!(
-        matches!(e, Error::InvalidParameter { name: "state", .. }),
+        matches!(
+            e,
+            Error::InvalidParameter {
+                name: Param::State,
+                ..
+            }
+        ),
         "{e}"
     );
     let e = ok.predict(&v(&[f64::NEG_INFINITY, 0.0]), 0.0).unwrap_err();

@@ -13,6 +13,7 @@
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_distr::StandardNormal;
+use seqsmooth::error::Param;
 use seqsmooth::model::observation::Observation;
 use seqsmooth::model::radar::{wrap, Radar};
 use seqsmooth::Error;
@@ -276,7 +277,7 @@ fn refusals_are_typed() {
         matches!(
             e,
             Error::InvalidParameter {
-                name: "radar geometry",
+                name: Param::RadarGeometry,
                 ..
             }
         )
@@ -307,7 +308,13 @@ fn refusals_are_typed() {
         .is_ok());
     let e = radar.predict(&DVector::zeros(3), 0.0).unwrap_err();
     assert!(
-        matches!(e, Error::InvalidParameter { name: "state", .. }),
+        matches!(
+            e,
+            Error::InvalidParameter {
+                name: Param::State,
+                ..
+            }
+        ),
         "{e}"
     );
     let e = radar
@@ -324,13 +331,22 @@ fn refusals_are_typed() {
         "{e}"
     );
     let e = Radar::new([0.0, f64::INFINITY, 0.0], 6).unwrap_err();
-    assert!(matches!(e, Error::NonFinite { .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            Error::InvalidParameter {
+                name: Param::Site,
+                ..
+            }
+        ),
+        "{e}"
+    );
     let e = Radar::new([0.0; 3], 2).unwrap_err();
     assert!(
         matches!(
             e,
             Error::InvalidParameter {
-                name: "state dimension",
+                name: Param::StateDimension,
                 ..
             }
         ),
@@ -344,7 +360,7 @@ fn refusals_are_typed() {
         matches!(
             e,
             Error::InvalidParameter {
-                name: "state dimension",
+                name: Param::StateDimension,
                 ..
             }
         ),
@@ -358,7 +374,13 @@ fn refusals_are_typed() {
     for rho in [0.0, -5.0] {
         let e = radar.to_cartesian([rho, 0.1, 0.1], &r).unwrap_err();
         assert!(
-            matches!(e, Error::InvalidParameter { name: "range", .. }),
+            matches!(
+                e,
+                Error::InvalidParameter {
+                    name: Param::Range,
+                    ..
+                }
+            ),
             "{e}"
         );
     }
@@ -379,7 +401,7 @@ fn refusals_are_typed() {
             matches!(
                 e,
                 Error::InvalidParameter {
-                    name: "measurement covariance",
+                    name: Param::MeasurementCovariance,
                     ..
                 }
             ),

@@ -150,11 +150,10 @@ fn run_plain(
     tau: f64,
 ) -> Result<Estimates, CliError> {
     let mut f = Runner::build(kind, DEGREE, Some(THETA), tau, None, engine, Some(SIGMA))
-        .map_err(|e| CliError::Data(e.to_string()))?;
+        .map_err(CliError::from)?;
     let mut estimates = Vec::with_capacity(data.len());
     for p in data {
-        f.update(p.t, p.y)
-            .map_err(|e| CliError::Data(e.to_string()))?;
+        f.update(p.t, p.y).map_err(CliError::from)?;
         estimates.push(f.estimate_at(p.t));
     }
     Ok(estimates)
@@ -299,14 +298,10 @@ pub fn run(cfg: &DemoArgs) -> Result<(), CliError> {
     let head: Vec<f64> = data.iter().take(LOOKAHEAD).map(|p| p.t).collect();
     let tau = median_series_step(&head, &vec![0; head.len()]).unwrap_or(1.0);
 
-    let mut auto =
-        AutomaticFilter::new(DEGREE, THETA, tau).map_err(|e| CliError::Data(e.to_string()))?;
+    let mut auto = AutomaticFilter::new(DEGREE, THETA, tau).map_err(CliError::from)?;
     let mut outs = Vec::with_capacity(data.len());
     for p in &data {
-        outs.push(
-            auto.update(p.t, p.y)
-                .map_err(|e| CliError::Data(e.to_string()))?,
-        );
+        outs.push(auto.update(p.t, p.y).map_err(CliError::from)?);
     }
     let auto_estimates: Estimates = outs.iter().map(|o| o.estimate.clone()).collect();
     let header = [

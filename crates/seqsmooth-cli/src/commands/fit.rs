@@ -202,13 +202,15 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
         }
         lines.push_back(line);
         let fit = setup.fitter.push(measurement).map_err(|e| match e {
-            Error::NonFinite {
+            e @ Error::NonFinite {
                 what: "fitted state",
                 value,
-            } => CliError::Data(format!(
-                "line {line}: the fitted state holds {value}, beyond the double range; \
-                 express the times in a larger unit or rescale the values"
-            )),
+            } => CliError::from(e).reworded(|_| {
+                format!(
+                    "line {line}: the fitted state holds {value}, beyond the double range; \
+                     express the times in a larger unit or rescale the values"
+                )
+            }),
             e => window_error(e, &lines, window(a), a.model),
         })?;
 
@@ -288,7 +290,7 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
         max_iterations: a.max_iterations as usize,
         ..GaussNewton::default()
     };
-    let library = |e: Error| usage(e.to_string());
+    let library = CliError::from;
     match a.model {
         FitModel::Radar => {
             if a.sigma.is_some() {

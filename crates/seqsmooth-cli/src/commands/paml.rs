@@ -124,10 +124,12 @@ fn finish(
     } else {
         let ps = PolynomialSamples::from_segment(&segment.t, &segment.y, &segment.sigma, n)
             .map_err(|e| {
-                CliError::Data(format!(
-                    "segment {} [{from}, {to}) from line {}: {e}",
-                    segment.index, segment.first_line
-                ))
+                CliError::from(e).reworded(|e| {
+                    format!(
+                        "segment {} [{from}, {to}) from line {}: {e}",
+                        segment.index, segment.first_line
+                    )
+                })
             })?;
         let id = segment.index.to_string();
         for ((t, v), var) in ps.times().iter().zip(&ps.values).zip(&ps.variances) {

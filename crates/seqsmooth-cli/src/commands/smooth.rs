@@ -83,11 +83,15 @@ pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
     check_window(Some(a.window), a.degree)?;
     check_distinct(a.input.as_deref(), a.output.as_deref())?;
     let sigma = a.sigma.map_or(SmoothSigma::Estimated, SmoothSigma::Given);
-    let mut smoother = CentredSmoother::new(a.degree, a.window, sigma).map_err(|e| match e {
-        Error::InvalidParameter { reason, .. } if a.sigma.is_none() => CliError::Usage(format!(
-            "{reason} (--sigma S; without it sigma is estimated from the residuals)"
-        )),
-        e => CliError::Usage(e.to_string()),
+    let mut smoother = CentredSmoother::new(a.degree, a.window, sigma).map_err(|e| {
+        let reason = match &e {
+            Error::InvalidParameter { reason, .. } if a.sigma.is_none() => Some(reason.clone()),
+            _ => None,
+        };
+        CliError::from(e).reworded(|m| match reason {
+            Some(r) => format!("{r} (--sigma S; without it sigma is estimated from the residuals)"),
+            None => m,
+        })
     })?;
     let need = Need::window(a.window.max(a.degree + 1));
     let input = open_input(a.input.as_deref())?;
@@ -126,10 +130,10 @@ pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
                 Ok(()) => {}
                 Err(Stop::Command(e)) => return Err(e),
                 Err(Stop::Library(e)) => {
-                    return Err(CliError::Data(format!(
-                        "line {}: cannot smooth the window ending here: {e}",
-                        pending.locate(base + k).0.lines[k]
-                    )))
+                    let line = pending.locate(base + k).0.lines[k];
+                    return Err(CliError::from(e).reworded(|e| {
+                        format!("line {line}: cannot smooth the window ending here: {e}")
+                    }));
                 }
             }
         }
@@ -156,7 +160,7 @@ pub fn run(a: &SmoothArgs) -> Result<(), CliError> {
         Ok(()) => {}
         Err(Stop::Command(e)) => return Err(e),
         Err(Stop::Library(e)) => {
-            return Err(CliError::Data(format!("cannot smooth the input: {e}")))
+            return Err(CliError::from(e).reworded(|e| format!("cannot smooth the input: {e}")))
         }
     }
     out.write(&text)?;

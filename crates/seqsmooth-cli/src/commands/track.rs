@@ -78,7 +78,7 @@ pub fn run(a: &TrackArgs) -> Result<(), CliError> {
     let need = Need::rows(2, "a radar track");
     need.check_header(&csv.header)?;
     let rows = Rows::of(csv, &a.time_col, &a.radar)?;
-    let radar = Radar::new(a.radar.site, 6).map_err(|e| CliError::Usage(e.to_string()))?;
+    let radar = Radar::new(a.radar.site, 6).map_err(CliError::from)?;
     let mut tracker = Tracker::new(a, radar)?;
     let (held, bytes) = tracker.inner.held_bound();
     if bytes > HELD_NOTE_BYTES {
@@ -264,8 +264,7 @@ impl Tracker {
             max_iterations: a.max_iterations as usize,
             ..GaussNewton::default()
         };
-        let inner = RadarTracker::with_solver(radar, method, solver)
-            .map_err(|e| CliError::Usage(e.to_string()))?;
+        let inner = RadarTracker::with_solver(radar, method, solver).map_err(CliError::from)?;
         let keep = match method {
             Method::Window { window } => window,
             _ => START_WINDOW,
@@ -305,9 +304,10 @@ impl Tracker {
                 self.held.give(given, c, &mut self.given);
                 Ok(Step::Held)
             }
-            Err(TrackError::Smooth(Error::InBatch { index, source })) => Err(CliError::Data(
-                format!("line {}: {source}", self.held.line(index, line)),
-            )),
+            Err(TrackError::Smooth(Error::InBatch { index, source })) => {
+                let at = self.held.line(index, line);
+                Err(CliError::from(*source).reworded(|m| format!("line {at}: {m}")))
+            }
             Err(TrackError::Window { rows, source }) => {
                 let lines: VecDeque<u64> = self
                     .lines
@@ -317,10 +317,9 @@ impl Tracker {
                     .collect();
                 Err(window_error(source, &lines, rows.len(), FitModel::Radar))
             }
-            Err(TrackError::Update { source, .. }) => Err(CliError::Data(format!(
-                "line {line}: the filter's update failed: {source}"
-            ))),
-            Err(e) => Err(CliError::Data(e.to_string())),
+            Err(TrackError::Update { source, .. }) => Err(CliError::from(source)
+                .reworded(|m| format!("line {line}: the filter's update failed: {m}"))),
+            Err(e) => Err(tracker_error(e)),
         }
     }
 
@@ -334,9 +333,10 @@ impl Tracker {
         let held = &mut self.held;
         let smoothed = self.inner.finish().map_err(|e| match e {
             TrackError::Smooth(Error::InBatch { index, source }) => {
-                CliError::Data(format!("line {}: {source}", held.line(index, 0)))
+                let at = held.line(index, 0);
+                CliError::from(*source).reworded(|m| format!("line {at}: {m}"))
             }
-            e => CliError::Data(e.to_string()),
+            e => tracker_error(e),
         })?;
         for (row, s, flag) in smoothed {
             let c = cells(&s.state, &s.covariance, s.nis, flag);
@@ -355,4 +355,15 @@ fn cells(x: &DVector<f64>, s: &DMatrix<f64>, nis: Option<f64>, flag: TrackFlag) 
         sigma[k] = s[(k, k)].max(0.0).sqrt();
     }
     (state, sigma, nis, flag)
+}
+
+/// The tracker's error `e` as the command's: its exit code by its cause's kind (the one
+/// `From<seqsmooth::Error>`), its message the tracker's.
+fn tracker_error(e: TrackError) -> CliError {
+    let message = e.to_string();
+    let (TrackError::Window { source, .. }
+    | TrackError::Start(source)
+    | TrackError::Update { source, .. }
+    | TrackError::Smooth(source)) = e;
+    CliError::from(source).reworded(|_| message)
 }

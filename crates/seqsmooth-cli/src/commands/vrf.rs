@@ -14,12 +14,7 @@ use seqsmooth::scalar::{ratio_to_f64, Rational};
 /// The cells of the library's matrix result, row-major (nalgebra iterates column-major).
 macro_rules! row_major {
     ($matrix:expr) => {
-        cells(
-            $matrix
-                .map_err(|e| CliError::Usage(e.to_string()))?
-                .transpose()
-                .iter(),
-        )
+        cells($matrix.map_err(CliError::from)?.transpose().iter())
     };
 }
 

@@ -143,11 +143,15 @@ fn parse_cell_text(cell: &[u8], line: u64, column: &str, what: &str) -> Result<f
                 "{at}: '{text}' is not a number or an ISO-8601 time"
             ))
         })?;
-        return seqsmooth::numeric::epoch::parse_iso8601(iso).map_err(|e| match e {
-            seqsmooth::Error::InvalidParameter { reason, .. } => {
-                CliError::Data(format!("{at}: '{text}' is not an ISO-8601 time: {reason}"))
-            }
-            e => CliError::Data(format!("{at}: '{text}': {e}")),
+        return seqsmooth::numeric::epoch::parse_iso8601(iso).map_err(|e| {
+            let reason = match &e {
+                seqsmooth::Error::InvalidParameter { reason, .. } => Some(reason.clone()),
+                _ => None,
+            };
+            CliError::from(e).reworded(|m| match reason {
+                Some(reason) => format!("{at}: '{text}' is not an ISO-8601 time: {reason}"),
+                None => format!("{at}: '{text}': {m}"),
+            })
         });
     }
     let v: f64 = std::str::from_utf8(cell)

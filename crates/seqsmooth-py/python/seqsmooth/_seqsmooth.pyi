@@ -297,6 +297,10 @@ def error_kinds() -> list[tuple[str, str]]:
     """The library's error kinds, each with the name of its class in ``seqsmooth.errors``."""
     ...
 
+def parameter_kinds() -> list[tuple[str, str, str]]:
+    """Every parameter the library's errors name, with its error kind and its class."""
+    ...
+
 def gauss_rule(
     n: int,
     t: ArrayLike | None = None,

@@ -20,7 +20,7 @@
 //! earlier vector) is backward stable where the Stieltjes procedure on moments is not.
 
 use super::gauss::GaussRule;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::numeric::double_word::{self as dw, DoubleWord};
 
 /// The recurrence of the polynomials `b_0 … b_n` orthonormal for a measure, in the variable
@@ -61,7 +61,7 @@ const DISCRETISATION_TOLERANCE: f64 = 1e-14;
 fn check_interval(a: f64, b: f64) -> Result<(f64, f64), Error> {
     if !(a.is_finite() && b.is_finite() && a < b && ((b - a) / 2.0).is_normal()) {
         return Err(Error::InvalidParameter {
-            name: "interval",
+            name: Param::Interval,
             value: format!("[{a}, {b}]"),
             reason: "needs finite ends a < b".into(),
         });
@@ -138,7 +138,7 @@ impl Jacobi {
     pub fn discrete(times: &[f64], weights: &[f64], n: usize) -> Result<Self, Error> {
         if times.len() != weights.len() {
             return Err(Error::InvalidParameter {
-                name: "weights",
+                name: Param::Weights,
                 value: weights.len().to_string(),
                 reason: format!("one per time ({} times)", times.len()),
             });
@@ -150,7 +150,7 @@ impl Jacobi {
             .find(|(_, w)| !(w.is_finite() && **w > 0.0))
         {
             return Err(Error::InvalidParameter {
-                name: "weight",
+                name: Param::Weight,
                 value: w.to_string(),
                 reason: format!("weight {j} must be finite and above 0"),
             });
@@ -179,7 +179,7 @@ impl Jacobi {
         let mass: f64 = w.iter().sum();
         if !mass.is_normal() {
             return Err(Error::InvalidParameter {
-                name: "weights",
+                name: Param::Weights,
                 value: mass.to_string(),
                 reason: "their sum must be a normal double".into(),
             });
@@ -229,7 +229,7 @@ impl Jacobi {
             previous = Some(j);
         }
         Err(Error::InvalidParameter {
-            name: "weight",
+            name: Param::Weight,
             value: format!("on [{a}, {b}]"),
             reason: format!(
                 "its recurrence did not settle to {DISCRETISATION_TOLERANCE:e} with {} points \
@@ -303,7 +303,7 @@ fn discretise(
         let v = f(t);
         if !(v.is_finite() && v > 0.0) {
             return Err(Error::InvalidParameter {
-                name: "weight",
+                name: Param::Weight,
                 value: v.to_string(),
                 reason: format!("ω({t}) must be finite and above 0 inside the interval"),
             });

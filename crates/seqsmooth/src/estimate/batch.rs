@@ -16,7 +16,7 @@
 //! conditioning test of a covariance, `det R'`.
 
 use super::observability::numerical_rank;
-use crate::error::Error;
+use crate::error::{Error, Param};
 pub use crate::model::measurement::{is_usable_sigma, NoiseCovariance};
 use nalgebra::{Cholesky, DMatrix, DVector};
 
@@ -126,7 +126,7 @@ pub fn least_squares(
 /// ```
 pub fn correlation_determinant(r: &DMatrix<f64>) -> Result<f64, Error> {
     let bad = |reason: &str| Error::InvalidParameter {
-        name: "covariance",
+        name: Param::Covariance,
         value: format!("{r:?}"),
         reason: reason.into(),
     };
@@ -352,7 +352,7 @@ impl Whitener {
             NoiseCovariance::Full(r) => Self::Cholesky(
                 Cholesky::new(r.clone())
                     .ok_or_else(|| Error::InvalidParameter {
-                        name: "noise covariance",
+                        name: Param::NoiseCovariance,
                         value: format!("{r}").trim().replace('\n', " "),
                         reason: "must be symmetric positive definite (its Cholesky \
                                  factorisation failed)"
@@ -389,7 +389,7 @@ impl Whitener {
 
 /// Shapes agree, every number is finite, variances are positive, `R` is symmetric.
 fn check(t: &DMatrix<f64>, y: &DVector<f64>, noise: &NoiseCovariance) -> Result<(), Error> {
-    let bad = |name: &'static str, value: String, reason: &str| Error::InvalidParameter {
+    let bad = |name: Param, value: String, reason: &str| Error::InvalidParameter {
         name,
         value,
         reason: reason.into(),
@@ -397,14 +397,14 @@ fn check(t: &DMatrix<f64>, y: &DVector<f64>, noise: &NoiseCovariance) -> Result<
     let (rows, states) = t.shape();
     if states == 0 || rows == 0 {
         return Err(bad(
-            "observation matrix T",
+            Param::ObservationMatrixT,
             format!("{rows}x{states}"),
             "must have at least one row and one column",
         ));
     }
     if y.len() != rows {
         return Err(bad(
-            "observations Y",
+            Param::ObservationsY,
             format!("of length {}", y.len()),
             &format!("must have one value per row of T ({rows})"),
         ));
@@ -412,14 +412,14 @@ fn check(t: &DMatrix<f64>, y: &DVector<f64>, noise: &NoiseCovariance) -> Result<
     if let Some((k, v)) = t.iter().enumerate().find(|(_, v)| !v.is_finite()) {
         let (i, j) = (k % rows, k / rows);
         return Err(bad(
-            "observation matrix T",
+            Param::ObservationMatrixT,
             format!("entry [{i}, {j}] = {v}"),
             "must be finite",
         ));
     }
     if let Some((k, v)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
         return Err(bad(
-            "observations Y",
+            Param::ObservationsY,
             format!("entry {k} = {v}"),
             "must be finite",
         ));
@@ -429,7 +429,7 @@ fn check(t: &DMatrix<f64>, y: &DVector<f64>, noise: &NoiseCovariance) -> Result<
         NoiseCovariance::Variances(v) => {
             if v.len() != rows {
                 return Err(bad(
-                    "noise variances",
+                    Param::NoiseVariances,
                     format!("of length {}", v.len()),
                     &format!("must have one variance per row of T ({rows})"),
                 ));
@@ -440,7 +440,7 @@ fn check(t: &DMatrix<f64>, y: &DVector<f64>, noise: &NoiseCovariance) -> Result<
                 .find(|(_, v)| !(v.is_finite() && **v > 0.0))
             {
                 return Err(bad(
-                    "noise variance",
+                    Param::NoiseVariance,
                     format!("{v} (observation {k})"),
                     "must be positive and finite",
                 ));
@@ -449,14 +449,14 @@ fn check(t: &DMatrix<f64>, y: &DVector<f64>, noise: &NoiseCovariance) -> Result<
         NoiseCovariance::Full(r) => {
             if r.shape() != (rows, rows) {
                 return Err(bad(
-                    "noise covariance",
+                    Param::NoiseCovariance,
                     format!("{}x{}", r.nrows(), r.ncols()),
                     &format!("must be {rows}x{rows}, one row and column per row of T"),
                 ));
             }
             if let Some((k, v)) = r.iter().enumerate().find(|(_, v)| !v.is_finite()) {
                 return Err(bad(
-                    "noise covariance",
+                    Param::NoiseCovariance,
                     format!("entry [{}, {}] = {v}", k % rows, k / rows),
                     "must be finite",
                 ));
@@ -464,7 +464,7 @@ fn check(t: &DMatrix<f64>, y: &DVector<f64>, noise: &NoiseCovariance) -> Result<
             let asymmetry = (r - r.transpose()).amax();
             if asymmetry > 1e-12 * r.amax() {
                 return Err(bad(
-                    "noise covariance",
+                    Param::NoiseCovariance,
                     format!("with |R - Rᵀ| = {asymmetry:e}"),
                     "must be symmetric",
                 ));

@@ -18,7 +18,7 @@
 //! makes unnecessary.
 
 use super::PolynomialFit;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::observation::Observation;
 use crate::model::radar::Radar;
 use nalgebra::DVector;
@@ -53,14 +53,14 @@ pub fn radar(
 ) -> Result<DVector<f64>, Error> {
     if times.len() != measured.len() {
         return Err(Error::InvalidParameter {
-            name: "input lengths",
+            name: Param::InputLengths,
             value: format!("{} times, {} measurements", times.len(), measured.len()),
             reason: "must be equal".into(),
         });
     }
     if radar.state_dimension() < 6 {
         return Err(Error::InvalidParameter {
-            name: "state dimension",
+            name: Param::StateDimension,
             value: radar.state_dimension().to_string(),
             reason: "the nominal state needs the velocity as states 3-5".into(),
         });

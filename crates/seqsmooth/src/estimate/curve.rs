@@ -27,7 +27,7 @@
 //! undetermined ([`Error::Unobservable`]): differences resolve no finer.
 
 use super::batch::{is_usable_sigma, Factored, Solved};
-use crate::error::{check_finite, Error};
+use crate::error::{check_finite, Error, Param};
 use crate::model::nonlinear::central_differences;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt, TerminationReason};
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
@@ -218,7 +218,7 @@ impl<'a> Samples<'a> {
         let n = times.len();
         if sigmas.len() != n || values.is_some_and(|v| v.len() != n) {
             return Err(Error::InvalidParameter {
-                name: "input lengths",
+                name: Param::InputLengths,
                 value: format!(
                     "{n} times, {} values, {} sigmas",
                     values.map_or(n, <[f64]>::len),
@@ -229,7 +229,7 @@ impl<'a> Samples<'a> {
         }
         if parameters == 0 {
             return Err(Error::InvalidParameter {
-                name: "model",
+                name: Param::Model,
                 value: "with 0 parameters".into(),
                 reason: "there is nothing to estimate".into(),
             });
@@ -246,7 +246,7 @@ impl<'a> Samples<'a> {
         }
         if let Some(&s) = sigmas.iter().find(|&&s| !is_usable_sigma(s)) {
             return Err(Error::InvalidParameter {
-                name: "sigmas",
+                name: Param::Sigmas,
                 value: s.to_string(),
                 reason: "each sigma must be positive and finite, with a normal square".into(),
             });
@@ -267,7 +267,7 @@ impl<'a> Samples<'a> {
         let h = model.values(theta, self.times)?;
         if h.len() != self.times.len() {
             return Err(Error::InvalidParameter {
-                name: "model",
+                name: Param::Model,
                 value: format!("gave {} values", h.len()),
                 reason: format!("{} times were asked for", self.times.len()),
             });
@@ -316,7 +316,7 @@ impl<'a> Samples<'a> {
         };
         if j.shape() != (self.times.len(), m) {
             return Err(Error::InvalidParameter {
-                name: "model",
+                name: Param::Model,
                 value: format!("gave a {}x{} Jacobian", j.nrows(), j.ncols()),
                 reason: format!("{} times and {m} parameters", self.times.len()),
             });
@@ -624,7 +624,7 @@ const DIFFERENCED_RANK: f64 = 1e-8;
 fn check_start(theta: &[f64], m: usize) -> Result<(), Error> {
     if theta.len() != m {
         return Err(Error::InvalidParameter {
-            name: "parameters",
+            name: Param::Parameters,
             value: format!("{} of them", theta.len()),
             reason: format!("the model has {m}"),
         });

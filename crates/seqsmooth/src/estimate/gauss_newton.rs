@@ -20,7 +20,7 @@
 //! nonlinear model it is the first-order approximation the book warns of (§11.4).
 
 use super::batch::solve_whitened;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::dynamics::Dynamics;
 pub use crate::model::measurement::{Measurement, NoiseCovariance};
 use crate::model::observation::Observation;
@@ -209,14 +209,14 @@ impl GaussNewton {
         let n = dynamics.dimension();
         if observation.state_dimension() != n {
             return Err(Error::InvalidParameter {
-                name: "observation model",
+                name: Param::ObservationModel,
                 value: format!("for {} states", observation.state_dimension()),
                 reason: format!("the dynamics have {n} states"),
             });
         }
         if nominal.len() != n {
             return Err(Error::InvalidParameter {
-                name: "nominal state",
+                name: Param::NominalState,
                 value: format!("of length {}", nominal.len()),
                 reason: format!("must have the model's dimension {n}"),
             });
@@ -345,14 +345,14 @@ impl GaussNewton {
     fn check(&self) -> Result<(), Error> {
         if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
             return Err(Error::InvalidParameter {
-                name: "tolerance",
+                name: Param::Tolerance,
                 value: self.tolerance.to_string(),
                 reason: "must be positive and finite".into(),
             });
         }
         if self.max_iterations == 0 {
             return Err(Error::InvalidParameter {
-                name: "max_iterations",
+                name: Param::MaxIterations,
                 value: "0".into(),
                 reason: "must be at least 1".into(),
             });
@@ -382,7 +382,7 @@ fn prepare<O: Observation>(
 fn prepare_one(p: usize, m: &Measurement) -> Result<Rows, Error> {
     let (present, values) = m.present(p)?;
     let bad = |value: String, reason: &str| Error::InvalidParameter {
-        name: "measurement noise",
+        name: Param::MeasurementNoise,
         value,
         reason: reason.into(),
     };
@@ -445,7 +445,7 @@ struct PriorRows {
 
 fn prepare_prior(p: &Prior, n: usize) -> Result<PriorRows, Error> {
     let bad = |value: String, reason: &str| Error::InvalidParameter {
-        name: "prior",
+        name: Param::Prior,
         value,
         reason: reason.into(),
     };

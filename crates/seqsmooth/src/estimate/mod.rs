@@ -20,7 +20,7 @@ pub use batch::{least_squares, minimum_variance, BatchEstimate, NoiseCovariance}
 pub use observability::{observability, Observability};
 
 use crate::basis::legendre::taylor_table;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::taylor::scaling_diagonal;
 use nalgebra::{DMatrix, DVector};
 
@@ -65,7 +65,7 @@ impl PolynomialFit {
         let n = times.len();
         if values.len() != n || weights.is_some_and(|w| w.len() != n) {
             return Err(Error::InvalidParameter {
-                name: "input lengths",
+                name: Param::InputLengths,
                 value: format!("{} times, {} values", n, values.len()),
                 reason: "times, values and weights must have the same length".into(),
             });

@@ -6,7 +6,7 @@
 //! to the minimal polynomial's degree suffice; `n − 1` covers every `A`). The rank is the count
 //! of singular values above `max(rows, n) ε σ_max`, the tolerance [`super::batch`] uses for `T`.
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::linear::LinearDynamics;
 use nalgebra::DMatrix;
 
@@ -94,14 +94,14 @@ pub fn observability(dynamics: &LinearDynamics, m: &DMatrix<f64>) -> Result<Obse
     let (components, cols) = m.shape();
     if cols != n || components == 0 {
         return Err(Error::InvalidParameter {
-            name: "observation matrix M",
+            name: Param::ObservationMatrixM,
             value: format!("{components}x{cols}"),
             reason: format!("must have at least one row and one column per state ({n})"),
         });
     }
     if let Some((k, v)) = m.iter().enumerate().find(|(_, v)| !v.is_finite()) {
         return Err(Error::InvalidParameter {
-            name: "observation matrix M",
+            name: Param::ObservationMatrixM,
             value: format!("entry [{}, {}] = {v}", k % components, k / components),
             reason: "must be finite".into(),
         });
@@ -115,7 +115,7 @@ pub fn observability(dynamics: &LinearDynamics, m: &DMatrix<f64>) -> Result<Obse
     }
     if !g.iter().all(|v| v.is_finite()) {
         return Err(Error::InvalidParameter {
-            name: "dynamics matrix A",
+            name: Param::DynamicsMatrixA,
             value: format!("{a}").trim().replace('\n', " "),
             reason: "its powers up to n - 1 leave the double range".into(),
         });

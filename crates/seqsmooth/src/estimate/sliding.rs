@@ -10,7 +10,7 @@
 
 use super::bootstrap;
 use super::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::dynamics::{Dynamics, PolynomialDynamics};
 use crate::model::observation::{LinearObservation, Observation};
 use crate::model::radar::Radar;
@@ -133,14 +133,14 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
         let n = dynamics.dimension();
         if window == 0 {
             return Err(Error::InvalidParameter {
-                name: "window",
+                name: Param::Window,
                 value: "0".into(),
                 reason: "must hold at least one measurement".into(),
             });
         }
         if observation.state_dimension() != n {
             return Err(Error::InvalidParameter {
-                name: "observation model",
+                name: Param::ObservationModel,
                 value: format!("for {} states", observation.state_dimension()),
                 reason: format!("the dynamics have {n} states"),
             });
@@ -148,14 +148,14 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
         match &start {
             Start::State(x) if x.len() != n || x.iter().any(|v| !v.is_finite()) => {
                 return Err(Error::InvalidParameter {
-                    name: "start state",
+                    name: Param::StartState,
                     value: format!("{:?}", x.as_slice()),
                     reason: format!("must have {n} finite entries"),
                 })
             }
             Start::Radar { radar, degree } if radar.state_dimension() != n || *degree == 0 => {
                 return Err(Error::InvalidParameter {
-                    name: "radar start",
+                    name: Param::RadarStart,
                     value: format!("degree {degree} for {} states", radar.state_dimension()),
                     reason: format!("needs degree 1 or more and the model's {n} states"),
                 })
@@ -267,13 +267,13 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
     /// use seqsmooth::model::measurement::NoiseCovariance;
     /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
     /// use seqsmooth::estimate::sliding::SlidingFit;
-    /// use seqsmooth::Error;
+    /// use seqsmooth::{Error, Param};
     /// let mut fit = SlidingFit::polynomial(1, 3, Epoch::End, GaussNewton::default()).unwrap();
     /// let m = |t: f64, y: f64| Measurement { time: t, values: vec![Some(y)], noise: NoiseCovariance::Variances(vec![1.0]) };
     /// assert!(fit.push_finite(m(0.0, 1.0)).unwrap().is_none()); // one value: no line yet
     /// let c = fit.push_finite(m(1.0, 3.0)).unwrap().unwrap();
     /// assert!((c.state[1] - 2.0).abs() < 1e-12);
-    /// assert!(matches!(fit.push_finite(m(1.0, 5.0)), Err(Error::InvalidParameter { name: "time", .. })));
+    /// assert!(matches!(fit.push_finite(m(1.0, 5.0)), Err(Error::InvalidParameter { name: Param::Time, .. })));
     /// assert_eq!(fit.measurements().count(), 2);
     /// ```
     ///
@@ -326,7 +326,7 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
         if let Some(previous) = self.rows.back() {
             if measurement.time <= previous.time {
                 return Err(Error::InvalidParameter {
-                    name: "time",
+                    name: Param::Time,
                     value: measurement.time.to_string(),
                     reason: format!(
                         "must be after the previous measurement's time {}",
@@ -460,7 +460,7 @@ impl SlidingFit<PolynomialDynamics, Radar> {
     ) -> Result<Self, Error> {
         if !(1..=2).contains(&degree) {
             return Err(Error::InvalidParameter {
-                name: "degree",
+                name: Param::Degree,
                 value: degree.to_string(),
                 reason: "must be 1 (constant velocity) or 2 (constant acceleration) for the \
                          radar model"
@@ -508,7 +508,7 @@ impl SlidingFit<PolynomialDynamics, LinearObservation> {
     ) -> Result<Self, Error> {
         if window < degree + 1 {
             return Err(Error::InvalidParameter {
-                name: "window",
+                name: Param::Window,
                 value: window.to_string(),
                 reason: format!(
                     "is too small for degree {degree}: a degree-{degree} fit needs a window of \

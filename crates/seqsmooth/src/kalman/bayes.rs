@@ -22,7 +22,7 @@
 //! filter fails visibly).
 
 use crate::discount::Discount;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::Measurement;
 use crate::model::measurement::NoiseCovariance;
@@ -80,7 +80,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
         let n = dynamics.dimension();
         if !dynamics.is_linear() {
             return Err(Error::InvalidParameter {
-                name: "dynamics",
+                name: Param::Dynamics,
                 value: "a nonlinear model".into(),
                 reason: "the Bayes filter here needs Φ independent of the state (linear \
                          dynamics); use the extended Kalman filter"
@@ -89,7 +89,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
         }
         if observation.state_dimension() != n {
             return Err(Error::InvalidParameter {
-                name: "observation model",
+                name: Param::ObservationModel,
                 value: format!("for {} states", observation.state_dimension()),
                 reason: format!("the dynamics have {n} states"),
             });
@@ -132,7 +132,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
         let n = self.dynamics.dimension();
         if state.len() != n || covariance.shape() != (n, n) {
             return Err(Error::InvalidParameter {
-                name: "prior",
+                name: Param::Prior,
                 value: format!(
                     "state of length {}, covariance {}x{}",
                     state.len(),
@@ -153,7 +153,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
             });
         }
         let refuse = || Error::InvalidParameter {
-            name: "prior covariance",
+            name: Param::PriorCovariance,
             value: format!("{covariance:?}"),
             reason: "must be symmetric positive definite".into(),
         };
@@ -416,7 +416,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
             DVector::zeros(n)
         } else {
             self.estimate().ok_or_else(|| Error::InvalidParameter {
-                name: "observation model",
+                name: Param::ObservationModel,
                 value: "nonlinear".into(),
                 reason: "the Bayes filter linearises it about its estimate, which the \
                          information so far does not determine: give a prior"
@@ -471,14 +471,14 @@ fn whitener(p: usize, noise: &NoiseCovariance, present: &[usize]) -> Result<DMat
         }
         other => {
             return Err(Error::InvalidParameter {
-                name: "measurement noise",
+                name: Param::MeasurementNoise,
                 value: format!("{other:?}"),
                 reason: format!("needs {p} components"),
             })
         }
     };
     let refuse = || Error::InvalidParameter {
-        name: "measurement noise",
+        name: Param::MeasurementNoise,
         value: format!("{r:?}"),
         reason: "must be finite, symmetric and positive definite (the Bayes filter weighs by \
                  R⁻¹; a perfect observation needs the Kalman filter)"

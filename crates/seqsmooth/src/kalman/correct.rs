@@ -4,7 +4,7 @@
 //! sizes the caller dispatches as constants (`unrolled_sizes!`), over the dense kernels of
 //! [`crate::linalg::dense`].
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::linalg::dense::{
     all_finite, combine, ldl, log_det, symmetrize, times_transpose, transpose,
 };
@@ -26,7 +26,7 @@ pub(super) fn noise_entries(
         NoiseCovariance::Full(r) if r.shape() == (p, p) => {}
         other => {
             return Err(Error::InvalidParameter {
-                name: "measurement noise",
+                name: Param::MeasurementNoise,
                 value: format!("{other:?}"),
                 reason: format!("needs {p} components"),
             })
@@ -265,7 +265,7 @@ pub(super) fn correct_kernel<S: Size, C: Size>(
     let (r, vp, lp) = (&w.r[..kk], &mut w.vp[..kk], &mut w.lp[..kk]);
     times_transpose(n, p, k, |c, l| mt[l + c * n], u);
     let not_pd = |v: &[f64]| Error::InvalidParameter {
-        name: "innovation covariance M S Mᵀ + R",
+        name: Param::InnovationCovariance,
         value: format!("{:?}", DMatrix::from_column_slice(k, k, v)),
         reason: "is not positive definite: the observation adds nothing the filter can weigh \
                  (a perfect observation of a component already known exactly)"

@@ -56,7 +56,7 @@
 use super::correct::{carry, correct_kernel, finite, noise_entries, Work};
 use super::noise::ProcessNoise;
 use crate::discount::Discount;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::Measurement;
 use crate::model::measurement::NoiseCovariance;
@@ -174,21 +174,21 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         time: f64,
     ) -> Result<Self, Error> {
         let n = dynamics.dimension();
-        let bad = |name: &'static str, value: String, reason: String| Error::InvalidParameter {
+        let bad = |name: Param, value: String, reason: String| Error::InvalidParameter {
             name,
             value,
             reason,
         };
         if observation.state_dimension() != n {
             return Err(bad(
-                "observation model",
+                Param::ObservationModel,
                 format!("for {} states", observation.state_dimension()),
                 format!("the dynamics have {n} states"),
             ));
         }
         if state.len() != n || covariance.shape() != (n, n) {
             return Err(bad(
-                "prior",
+                Param::Prior,
                 format!(
                     "state of length {}, covariance {}x{}",
                     state.len(),
@@ -213,7 +213,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             || covariance.diagonal().iter().any(|&v| v < 0.0)
         {
             return Err(bad(
-                "prior covariance",
+                Param::PriorCovariance,
                 format!("{covariance:?}"),
                 "must be symmetric with a non-negative diagonal".into(),
             ));
@@ -482,7 +482,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         let n = self.dynamics.dimension();
         if noise.dimension() != n {
             return Err(Error::InvalidParameter {
-                name: "process noise",
+                name: Param::ProcessNoise,
                 value: format!("for {} states", noise.dimension()),
                 reason: format!("the dynamics have {n} states"),
             });
@@ -563,7 +563,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ) -> Result<Option<Innovation>, Error> {
         if !(tolerance.is_finite() && tolerance > 0.0) || max_iterations == 0 {
             return Err(Error::InvalidParameter {
-                name: "iteration limits",
+                name: Param::IterationLimits,
                 value: format!("tolerance {tolerance}, {max_iterations} iterations"),
                 reason: "the tolerance must be positive and finite, the iterations at least 1"
                     .into(),
@@ -722,7 +722,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         }
         if asymmetry > 1e-12 * largest || negative {
             return Err(Error::InvalidParameter {
-                name: "measurement noise",
+                name: Param::MeasurementNoise,
                 value: format!("{:?}", DMatrix::from_fn(p, p, entry)),
                 reason: "must be symmetric with non-negative variances".into(),
             });

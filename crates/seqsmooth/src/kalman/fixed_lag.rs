@@ -27,7 +27,7 @@
 
 use super::filter::KalmanFilter;
 use super::smoother::Smoothed;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::Measurement;
 use crate::model::observation::Observation;
@@ -149,7 +149,7 @@ fn step(
     let chol = Cholesky::new(s_pred.clone()).ok_or_else(|| Error::InBatch {
         index,
         source: Box::new(Error::InvalidParameter {
-            name: "predicted covariance",
+            name: Param::PredictedCovariance,
             value: format!("{s_pred:?}"),
             reason: "is not positive definite, so the smoother cannot weigh the later \
                      measurements (add driving noise, or avoid perfect observations)"
@@ -321,7 +321,7 @@ impl<D: Dynamics + Clone, O: Observation + Clone> FixedLagSmoother<D, O> {
         if let Some((previous, _)) = self.last {
             if m.time.is_finite() && m.time < previous {
                 return Err(Error::InvalidParameter {
-                    name: "time",
+                    name: Param::Time,
                     value: m.time.to_string(),
                     reason: format!("is before the previous measurement's {previous}"),
                 });

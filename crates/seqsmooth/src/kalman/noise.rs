@@ -15,7 +15,7 @@
 //! accumulated over the interval either way.
 
 use crate::calculus::factorial;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::numeric::power::powi;
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size, UNROLLED_MAX_SIZE};
 use nalgebra::DMatrix;
@@ -74,14 +74,14 @@ impl WhiteNoiseDerivative {
     pub fn new(degree: usize, axes: usize, psd: f64) -> Result<Self, Error> {
         if !(psd.is_finite() && psd >= 0.0) {
             return Err(Error::InvalidParameter {
-                name: "driving-noise spectral density q",
+                name: Param::DrivingNoiseQ,
                 value: psd.to_string(),
                 reason: "must be finite and at least 0".into(),
             });
         }
         if axes == 0 {
             return Err(Error::InvalidParameter {
-                name: "axes",
+                name: Param::Axes,
                 value: "0".into(),
                 reason: "must be at least 1".into(),
             });

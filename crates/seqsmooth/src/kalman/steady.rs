@@ -15,7 +15,7 @@
 //! `V` of `Φ` (Lemma 14.6); then `P = Z⁻¹`, the gain `H = P Mᵀ R⁻¹` (14.4.29) and the true
 //! covariance `S = P Z(β²) P` ((14.3.19) in the limit), `Z(β²)` the same equation at `β²`.
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 use nalgebra::{Cholesky, DMatrix};
 
 /// The fading filter's limit.
@@ -49,21 +49,21 @@ pub fn steady_state(
     beta: f64,
 ) -> Result<SteadyState, Error> {
     let n = phi.nrows();
-    let bad = |name: &'static str, value: String, reason: &str| Error::InvalidParameter {
+    let bad = |name: Param, value: String, reason: &str| Error::InvalidParameter {
         name,
         value,
         reason: reason.into(),
     };
     if !(beta > 0.0 && beta < 1.0) {
         return Err(bad(
-            "beta",
+            Param::Beta,
             beta.to_string(),
             "the steady state needs 0 < β < 1 (at β = 1 the covariance goes to 0)",
         ));
     }
     if n == 0 || phi.ncols() != n || m.ncols() != n || r.shape() != (m.nrows(), m.nrows()) {
         return Err(bad(
-            "shapes",
+            Param::Shapes,
             format!(
                 "Φ {}x{}, M {}x{}, R {}x{}",
                 phi.nrows(),
@@ -87,12 +87,17 @@ pub fn steady_state(
             value,
         });
     }
-    let r_chol = Cholesky::new(r.clone())
-        .ok_or_else(|| bad("R", format!("{r:?}"), "must be symmetric positive definite"))?;
+    let r_chol = Cholesky::new(r.clone()).ok_or_else(|| {
+        bad(
+            Param::R,
+            format!("{r:?}"),
+            "must be symmetric positive definite",
+        )
+    })?;
     let phi_inv = phi
         .clone()
         .try_inverse()
-        .ok_or_else(|| bad("Φ", format!("{phi:?}"), "must be nonsingular"))?;
+        .ok_or_else(|| bad(Param::Phi, format!("{phi:?}"), "must be nonsingular"))?;
     let g = m.transpose() * r_chol.solve(m);
     let z = information(&phi_inv, &g, beta)?;
     let z2 = information(&phi_inv, &g, beta * beta)?;
@@ -145,7 +150,7 @@ fn information(phi_inv: &DMatrix<f64>, g: &DMatrix<f64>, beta: f64) -> Result<DM
         .lu()
         .solve(&rhs)
         .ok_or_else(|| Error::InvalidParameter {
-            name: "Φ",
+            name: Param::Phi,
             value: format!("{phi_inv:?} (inverse)"),
             reason: "the steady-state equation is singular: an eigenvalue of Φ lies inside the \
                  disc of radius β^(1/2) (§14.7: no steady state)"

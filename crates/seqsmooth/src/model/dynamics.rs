@@ -14,7 +14,7 @@
 
 use super::linear::LinearDynamics;
 use super::transition::psi_term;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
 use nalgebra::{DMatrix, DVector};
 
@@ -104,7 +104,7 @@ pub trait Dynamics {
         let n = self.dimension();
         if covariance.shape() != (n, n) {
             return Err(Error::InvalidParameter {
-                name: "covariance",
+                name: Param::Covariance,
                 value: format!("{}x{}", covariance.nrows(), covariance.ncols()),
                 reason: format!("must be {n}x{n}, the state dimension"),
             });
@@ -132,7 +132,7 @@ pub(crate) fn check_propagation(
 ) -> Result<(), Error> {
     if state.len() != n {
         return Err(Error::InvalidParameter {
-            name: "state",
+            name: Param::State,
             value: format!("of length {}", state.len()),
             reason: format!("must have the model's dimension {n}"),
         });

@@ -10,7 +10,7 @@
 //! `Matrix::exp` of `ζA` (scaling and squaring with a Padé approximant of degree 3 to 13 chosen
 //! by the norm, Al-Mohy and Higham 2009).
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 use nalgebra::DMatrix;
 
 /// `dX/dt = A X` with a constant square `A`.
@@ -41,7 +41,7 @@ impl LinearDynamics {
     pub fn new(a: DMatrix<f64>) -> Result<Self, Error> {
         let (n, cols) = a.shape();
         let bad = |value: String, reason: &str| Error::InvalidParameter {
-            name: "dynamics matrix A",
+            name: Param::DynamicsMatrixA,
             value,
             reason: reason.into(),
         };
@@ -122,7 +122,7 @@ impl LinearDynamics {
     /// ```
     pub fn transition(&self, zeta: f64) -> Result<DMatrix<f64>, Error> {
         let refuse = |reason: &str| Error::InvalidParameter {
-            name: "step",
+            name: Param::Step,
             value: zeta.to_string(),
             reason: reason.into(),
         };

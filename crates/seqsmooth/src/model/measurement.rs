@@ -2,7 +2,7 @@
 //! library takes (the batch estimates of ch. 6 and §8.2, Gauss–Newton of ch. 8 and 11, the Bayes
 //! and Kalman filters of ch. 10 and 12). `Y_k` with `Cov(N_k) = R_k` (Morrison (6.2.x)).
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 use nalgebra::DMatrix;
 
 /// Whether `sigma` can be a noise standard deviation: above 0 with a normal double square
@@ -65,7 +65,7 @@ impl Measurement {
         }
         if self.values.len() != p {
             return Err(Error::InvalidParameter {
-                name: "measurement",
+                name: Param::Measurement,
                 value: format!("with {} components", self.values.len()),
                 reason: format!("the observation model has {p}"),
             });

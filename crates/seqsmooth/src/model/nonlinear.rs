@@ -22,7 +22,7 @@
 //! `O(ε^{2/3}) ≈ 4e-11` relative for a smooth `F` of unit scale.
 
 use super::dynamics::{check_propagation, Dynamics, Propagation};
-use crate::error::Error;
+use crate::error::{Error, Param};
 use nalgebra::{DMatrix, DVector};
 use ode_solvers::{Dop853, OutputType, System};
 use std::cell::Cell;
@@ -165,8 +165,8 @@ impl NonlinearDynamics {
     /// ```
     pub fn with_tolerances(mut self, relative: f64, absolute: f64) -> Result<Self, Error> {
         for (name, v) in [
-            ("relative tolerance", relative),
-            ("absolute tolerance", absolute),
+            (Param::RelativeTolerance, relative),
+            (Param::AbsoluteTolerance, absolute),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Error::InvalidParameter {
@@ -313,7 +313,7 @@ impl Dynamics for NonlinearDynamics {
         let reached = solver.x_out().last().copied().unwrap_or(0.0);
         if let Err(e) = outcome {
             return Err(Error::InvalidParameter {
-                name: "dynamics",
+                name: Param::Dynamics,
                 value: format!("integrated from t = {t_a} to t = {t_b}"),
                 reason: format!("the integrator failed: {e}"),
             });
@@ -336,7 +336,7 @@ impl Dynamics for NonlinearDynamics {
 
 fn non_finite_field(t: f64) -> Error {
     Error::InvalidParameter {
-        name: "dynamics",
+        name: Param::Dynamics,
         value: format!("at t = {t}"),
         reason: "F(X, t) or its Jacobian has a non-finite entry or the wrong size there".into(),
     }

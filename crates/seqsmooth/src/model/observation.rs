@@ -11,7 +11,7 @@
 //! A residual `Y − G` is taken by [`Observation::residual`], where an angle is wrapped.
 
 use super::nonlinear::central_differences;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
 
@@ -119,7 +119,7 @@ impl<O: Observation + ?Sized> Observation for &O {
 pub(crate) fn check_state(n: usize, state: &DVector<f64>) -> Result<(), Error> {
     if state.len() != n {
         return Err(Error::InvalidParameter {
-            name: "state",
+            name: Param::State,
             value: format!("of length {}", state.len()),
             reason: format!("the observation model needs {n} states"),
         });
@@ -150,7 +150,7 @@ impl LinearObservation {
     pub fn new(m: DMatrix<f64>) -> Result<Self, Error> {
         if m.is_empty() {
             return Err(Error::InvalidParameter {
-                name: "observation matrix M",
+                name: Param::ObservationMatrixM,
                 value: format!("{}x{}", m.nrows(), m.ncols()),
                 reason: "must not be empty".into(),
             });
@@ -333,7 +333,7 @@ impl Observation for NonlinearObservation {
     fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error> {
         check_state(self.states, state)?;
         let refuse = || Error::InvalidParameter {
-            name: "observation model",
+            name: Param::ObservationModel,
             value: format!("at t = {t}"),
             reason: format!(
                 "G(X, t) or its Jacobian has a non-finite entry or is not {} x {}",

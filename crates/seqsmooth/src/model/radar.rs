@@ -18,7 +18,7 @@
 //! 0`) the azimuth is undefined and a prediction there is refused.
 
 use super::observation::{check_state, Observation, Predicted};
-use crate::error::Error;
+use crate::error::{Error, Param};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -51,14 +51,15 @@ impl Radar {
     /// ```
     pub fn new(site: [f64; 3], states: usize) -> Result<Self, Error> {
         if let Some(&value) = site.iter().find(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                what: "radar site coordinate",
-                value,
+            return Err(Error::InvalidParameter {
+                name: Param::Site,
+                value: value.to_string(),
+                reason: "a radar site's coordinates must be finite".into(),
             });
         }
         if states < 3 {
             return Err(Error::InvalidParameter {
-                name: "state dimension",
+                name: Param::StateDimension,
                 value: states.to_string(),
                 reason: "a radar needs the position (x, y, z) as the first three states".into(),
             });
@@ -81,7 +82,7 @@ impl Radar {
     pub fn with_range_rate(mut self) -> Result<Self, Error> {
         if self.states < 6 {
             return Err(Error::InvalidParameter {
-                name: "state dimension",
+                name: Param::StateDimension,
                 value: self.states.to_string(),
                 reason: "the range rate needs the velocity as states 3-5".into(),
             });
@@ -136,7 +137,7 @@ impl Radar {
         let [rho, psi, theta] = measured;
         if rho <= 0.0 {
             return Err(Error::InvalidParameter {
-                name: "range",
+                name: Param::Range,
                 value: rho.to_string(),
                 reason: "must be positive".into(),
             });
@@ -145,7 +146,7 @@ impl Radar {
             || (covariance - covariance.transpose()).abs().max() > 1e-12 * covariance.abs().max()
         {
             return Err(Error::InvalidParameter {
-                name: "measurement covariance",
+                name: Param::MeasurementCovariance,
                 value: format!("{covariance:?}"),
                 reason: "must be symmetric positive definite".into(),
             });
@@ -291,7 +292,7 @@ impl Observation for Radar {
         let (h, rho) = (h2.sqrt(), rho2.sqrt());
         if !(h > 0.0 && h.is_finite() && rho.is_finite()) {
             return Err(Error::InvalidParameter {
-                name: "radar geometry",
+                name: Param::RadarGeometry,
                 value: format!(
                     "position ({}, {}, {}) at t = {t}",
                     state[0], state[1], state[2]

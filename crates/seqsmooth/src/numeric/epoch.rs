@@ -7,7 +7,7 @@
 //! Gregorian calendar). A time written without an offset is UTC. Seconds at 1.7e9 are resolved
 //! to about 2.4e-7 s (a double's spacing there): finer ticks are rounded to it.
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 
 /// Seconds in a day.
 const DAY: i64 = 86_400;
@@ -30,7 +30,7 @@ const DAY: i64 = 86_400;
 /// ```
 pub fn seconds_from_ticks(ticks: i64, num: i64, den: i64) -> Result<f64, Error> {
     let unit = || Error::InvalidParameter {
-        name: "time unit",
+        name: Param::TimeUnit,
         value: format!("{num}/{den} s"),
         reason: "a tick must be a positive whole number of seconds over a power of ten".into(),
     };
@@ -181,7 +181,7 @@ pub fn looks_like_date(text: &[u8]) -> bool {
 /// ```
 pub fn parse_iso8601(text: &str) -> Result<f64, Error> {
     let bad = |reason: &str| Error::InvalidParameter {
-        name: "time",
+        name: Param::Time,
         value: text.to_string(),
         reason: format!(
             "{reason}; an ISO-8601 time is YYYY-MM-DD[THH:MM[:SS[.fff]]][Z|+HH:MM] (UTC without \

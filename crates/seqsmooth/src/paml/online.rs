@@ -19,7 +19,7 @@
 
 use super::samples::PolynomialSamples;
 use crate::basis::{GaussRule, Jacobi};
-use crate::error::{check_finite, Error};
+use crate::error::{check_finite, Error, Param};
 use std::ops::Deref;
 
 /// The offline part of [`OnlineSmoother`] for one layout of sample times and noise: each
@@ -41,7 +41,7 @@ impl SmootherGains {
     pub fn new(times: &[f64], sigmas: &[f64], n: usize) -> Result<Self, Error> {
         if sigmas.len() != times.len() {
             return Err(Error::InvalidParameter {
-                name: "sigmas",
+                name: Param::Sigmas,
                 value: sigmas.len().to_string(),
                 reason: format!("one per time ({} times)", times.len()),
             });
@@ -67,7 +67,7 @@ impl SmootherGains {
             .find(|(_, &s)| !crate::model::measurement::is_usable_sigma(s))
         {
             return Err(Error::InvalidParameter {
-                name: "sigmas",
+                name: Param::Sigmas,
                 value: s.to_string(),
                 reason: format!("sample {j}: a noise sigma must be above 0 with a normal square"),
             });
@@ -175,7 +175,7 @@ impl<G: Deref<Target = SmootherGains>> OnlineSmoother<G> {
         }
         if self.taken >= g.len() {
             return Err(Error::InvalidParameter {
-                name: "segment",
+                name: Param::Segment,
                 value: (self.taken + 1).to_string(),
                 reason: format!("the layout has {} samples", g.len()),
             });
@@ -194,7 +194,7 @@ impl<G: Deref<Target = SmootherGains>> OnlineSmoother<G> {
         let g = &*self.gains;
         if self.taken + values.len() > g.len() {
             return Err(Error::InvalidParameter {
-                name: "segment",
+                name: Param::Segment,
                 value: (self.taken + values.len()).to_string(),
                 reason: format!("the layout has {} samples", g.len()),
             });

@@ -7,7 +7,7 @@
 //! discrete form of their eq. 6).
 
 use super::online::SmootherGains;
-use crate::error::{check_finite, Error};
+use crate::error::{check_finite, Error, Param};
 use crate::estimate::curve::{fit_curve, CurveFit, CurveModel};
 
 /// A segment's `n+1` polynomial samples: at `centre + offsets[k]`, the values of the segment's
@@ -49,7 +49,7 @@ impl PolynomialSamples {
     ) -> Result<Self, Error> {
         if values.len() != times.len() || sigmas.len() != times.len() {
             return Err(Error::InvalidParameter {
-                name: "segment",
+                name: Param::Segment,
                 value: format!(
                     "{} times, {} values, {} sigmas",
                     times.len(),

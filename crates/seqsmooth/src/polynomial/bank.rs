@@ -43,7 +43,7 @@ use super::fading::gains::fading_gains;
 use super::fading::switch::SwitchRule;
 use super::form::GainForm;
 use super::options::{check_engine_degree, check_tau, check_theta, Engine};
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::{derivative_scale, for_each_shift_step};
 use rayon::prelude::*;
 
@@ -74,7 +74,7 @@ impl BankState {
         check_tau(tau)?;
         if channels == 0 {
             return Err(Error::InvalidParameter {
-                name: "channels",
+                name: Param::Channels,
                 value: "0".into(),
                 reason: "a bank needs at least one channel".into(),
             });
@@ -94,14 +94,14 @@ impl BankState {
     fn check(&self, y: &[f64]) -> Result<(), Error> {
         if y.len() != self.channels {
             return Err(Error::InvalidParameter {
-                name: "input length",
+                name: Param::InputLength,
                 value: y.len().to_string(),
                 reason: format!("the bank has {} channels", self.channels),
             });
         }
         if let Some((c, v)) = y.iter().enumerate().find(|(_, v)| !v.is_finite()) {
             return Err(Error::InvalidParameter {
-                name: "input value",
+                name: Param::InputValue,
                 value: v.to_string(),
                 reason: format!("channel {c}: samples must be finite"),
             });
@@ -162,14 +162,14 @@ impl BankState {
     fn derivative_into(&self, k: usize, out: &mut [f64]) -> Result<(), Error> {
         if k > self.m {
             return Err(Error::InvalidParameter {
-                name: "derivative order",
+                name: Param::DerivativeOrder,
                 value: k.to_string(),
                 reason: format!("must be at most the degree {}", self.m),
             });
         }
         if out.len() != self.channels {
             return Err(Error::InvalidParameter {
-                name: "output length",
+                name: Param::OutputLength,
                 value: out.len().to_string(),
                 reason: format!("the bank has {} channels", self.channels),
             });
@@ -299,7 +299,7 @@ macro_rules! bank_accessors {
                 let k = self.core.channels;
                 if matrix.len() % k != 0 {
                     return Err(Error::InvalidParameter {
-                        name: "matrix length",
+                        name: Param::MatrixLength,
                         value: matrix.len().to_string(),
                         reason: format!("not a whole number of rows of {k} channels"),
                     });

@@ -1,7 +1,7 @@
 //! [`PolynomialFilter`]: what every polynomial filter does (take timestamped samples, give
 //! estimates), and the one-pass validation of a batch of samples.
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::PolynomialState;
 
 /// What every polynomial filter does: take timestamped samples, give estimates. Implemented by
@@ -228,7 +228,7 @@ pub trait PolynomialFilter: std::fmt::Debug + Send {
 pub(crate) fn check_sigma_rows_length(times: &[f64], m: usize, rows: &[f64]) -> Result<(), Error> {
     if rows.len() != times.len() * 2 * (m + 1) {
         return Err(Error::InvalidParameter {
-            name: "rows length",
+            name: Param::RowsLength,
             value: rows.len().to_string(),
             reason: format!(
                 "{} samples of degree {m} need {} values (one row of m+1 derivatives and their \
@@ -244,7 +244,7 @@ pub(crate) fn check_sigma_rows_length(times: &[f64], m: usize, rows: &[f64]) -> 
 /// The error of a filter asked for 1σ without a noise σ.
 pub(crate) fn no_noise_sigma() -> Error {
     Error::InvalidParameter {
-        name: "sigma",
+        name: Param::Sigma,
         value: "None".into(),
         reason: "the filter has no noise sigma for the 1σ: construct it with one \
                  (with_noise_sigma, sigma=...)"
@@ -269,7 +269,7 @@ pub(crate) fn check_estimates_length(
 ) -> Result<(), Error> {
     if estimates.len() != times.len() * (m + 1) {
         return Err(Error::InvalidParameter {
-            name: "estimates length",
+            name: Param::EstimatesLength,
             value: estimates.len().to_string(),
             reason: format!(
                 "{} samples of degree {m} need {} values (one row of m+1 derivatives per sample)",
@@ -284,7 +284,7 @@ pub(crate) fn check_estimates_length(
 /// One time per value in a batch.
 pub(crate) fn check_batch_lengths(times: &[f64], values: &[f64]) -> Result<(), Error> {
     crate::error::check_lengths(
-        "batch lengths",
+        Param::BatchLengths,
         times,
         values,
         "a batch needs one time per value",

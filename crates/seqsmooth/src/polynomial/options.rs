@@ -2,7 +2,7 @@
 //! runs on, how fading memory discounts ([`DiscountMode`], the tag of [`Discount`]), the largest degree, and the checks of
 //! their parameters.
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 
 /// The largest degree the filters accept. The exact engine's accuracy against an independent
 /// batch QR fit is measured in the tests up to this degree.
@@ -131,7 +131,7 @@ pub(crate) fn check_noise_sigma(sigma: f64) -> Result<(), Error> {
         "must be a positive finite number"
     };
     Err(Error::InvalidParameter {
-        name: "noise sigma",
+        name: Param::NoiseSigma,
         // `{:?}`: 1e-300 as such, not as 300 digits.
         value: format!("{sigma:?}"),
         reason: reason.into(),
@@ -143,7 +143,7 @@ pub(crate) fn check_noise_sigma(sigma: f64) -> Result<(), Error> {
 pub(crate) fn check_not_started(started: bool, what: &str) -> Result<(), Error> {
     if started {
         return Err(Error::InvalidParameter {
-            name: "configuration",
+            name: Param::Configuration,
             value: "change after the first sample".into(),
             reason: format!("set {what} before the first update"),
         });

@@ -1,7 +1,7 @@
 //! Independent filters of one configuration, one per channel, each on its own timestamps:
 //! [`StreamBank`] (the multi-series engine: any [`PolynomialFilter`] per channel).
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::polynomial::filter::PolynomialFilter;
 use rayon::prelude::*;
 
@@ -122,14 +122,14 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
     pub fn new(prototype: F, channels: usize) -> Result<Self, Error> {
         if channels == 0 {
             return Err(Error::InvalidParameter {
-                name: "channels",
+                name: Param::Channels,
                 value: "0".into(),
                 reason: "a bank needs at least one channel".into(),
             });
         }
         if prototype.samples() > 0 {
             return Err(Error::InvalidParameter {
-                name: "prototype",
+                name: Param::Prototype,
                 value: format!("a filter with {} samples", prototype.samples()),
                 reason: "the channels must start empty".into(),
             });
@@ -231,7 +231,7 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
         let n = channels.len();
         if times.len() != n || values.len() != n || estimates.len() != n * stride {
             return Err(Error::InvalidParameter {
-                name: "chunk lengths",
+                name: Param::ChunkLengths,
                 value: format!(
                     "{n} channels, {} times, {} values",
                     times.len(),
@@ -341,7 +341,7 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
             .filters
             .get_mut(c)
             .ok_or_else(|| Error::InvalidParameter {
-                name: "channel",
+                name: Param::Channel,
                 value: c.to_string(),
                 reason: format!("the bank has {n} channels"),
             })?;
@@ -375,7 +375,7 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
     fn check_batches(&self, batches: &[(&[f64], &[f64])]) -> Result<(), Error> {
         if batches.len() != self.filters.len() {
             return Err(Error::InvalidParameter {
-                name: "batches",
+                name: Param::Batches,
                 value: batches.len().to_string(),
                 reason: format!("one batch per channel: the bank has {}", self.filters.len()),
             });
@@ -390,7 +390,7 @@ fn failure(failed: Vec<(usize, usize, Box<Error>)>) -> Error {
     let mut failed = failed.into_iter();
     let Some((index, channel, source)) = failed.next() else {
         return Error::InvalidParameter {
-            name: "failure",
+            name: Param::Failure,
             value: "none".into(),
             reason: "no row failed".into(),
         };

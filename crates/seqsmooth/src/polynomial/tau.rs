@@ -11,7 +11,7 @@
 //! matter and is 1; when the rows scanned are not all of them, there is no default and the
 //! caller must give `τ`.
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 use std::collections::HashMap;
 
 /// Time steps the default `τ` is the median of.
@@ -66,8 +66,8 @@ pub fn median_series_step(times: &[f64], series: &[usize]) -> Option<f64> {
 /// The default `τ` of the rows `times` (row `i` in series `series[i]`): the median step of
 /// [`median_series_step`] over the first [`TAU_SCAN_ROWS`] rows; 1 when no series has two rows
 /// and `complete` says these are all the rows. An error when there is no step among the rows
-/// scanned of an input that goes on (`InvalidParameter` named `tau`, value `"none"`), or when
-/// the median is not a positive finite number (repeated times).
+/// scanned of an input that goes on, or when the median is not a positive finite number
+/// (repeated times): [`Error::NoDefault`] of [`Param::Tau`], the data's fault.
 ///
 /// ```
 /// use seqsmooth::polynomial::tau::default_tau;
@@ -83,23 +83,21 @@ pub fn default_tau(times: &[f64], series: &[usize], complete: bool) -> Result<f6
         Some(tau) => tau,
         None if complete && rows <= head => return Ok(1.0),
         None => {
-            return Err(Error::InvalidParameter {
-                name: "tau",
-                value: "none".into(),
-                reason: format!(
+            return Err(Error::NoDefault {
+                param: Param::Tau,
+                why: format!(
                     "no series has two rows among the first {head} rows, so there is no median \
-                     time step for the default tau; give tau"
+                     time step"
                 ),
             })
         }
     };
     if !(tau.is_finite() && tau > 0.0) {
-        return Err(Error::InvalidParameter {
-            name: "tau",
-            value: tau.to_string(),
-            reason: "the median time step of the first rows is not a usable tau (a positive \
-                     finite interval); give tau"
-                .into(),
+        return Err(Error::NoDefault {
+            param: Param::Tau,
+            why: format!(
+                "the median time step of the first rows, {tau}, is not a positive finite interval"
+            ),
         });
     }
     Ok(tau)

@@ -6,20 +6,20 @@
 //! to full precision (statrs' generic `inverse_cdf` for the chi-squared distribution is a
 //! 16-step bisection, good to about 3 digits only).
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 use statrs::distribution::{ChiSquared, Continuous, ContinuousCDF};
 use statrs::function::erf::{erfc, erfc_inv};
 
 fn check_dof(dof: f64) -> Result<ChiSquared, Error> {
     if !(dof.is_finite() && dof > 0.0) {
         return Err(Error::InvalidParameter {
-            name: "degrees of freedom",
+            name: Param::DegreesOfFreedom,
             value: dof.to_string(),
             reason: "must be a positive finite number".into(),
         });
     }
     ChiSquared::new(dof).map_err(|e| Error::InvalidParameter {
-        name: "degrees of freedom",
+        name: Param::DegreesOfFreedom,
         value: dof.to_string(),
         reason: e.to_string(),
     })
@@ -35,7 +35,7 @@ fn check_statistic(x: f64) -> Result<(), Error> {
     Ok(())
 }
 
-fn check_probability(name: &'static str, p: f64) -> Result<(), Error> {
+fn check_probability(name: Param, p: f64) -> Result<(), Error> {
     if !(p > 0.0 && p < 1.0) {
         return Err(Error::InvalidParameter {
             name,
@@ -88,7 +88,7 @@ pub fn chi_squared_sf(dof: f64, x: f64) -> Result<f64, Error> {
 /// ```
 pub fn chi_squared_quantile(dof: f64, p: f64) -> Result<f64, Error> {
     let d = check_dof(dof)?;
-    check_probability("probability", p)?;
+    check_probability(Param::Probability, p)?;
     let upper = p > 0.5;
     let target = if upper { 1.0 - p } else { p };
     // F(x) increasing in x, with F(x) = cdf - p (lower) or (1-p) - sf (upper).
@@ -149,7 +149,7 @@ pub fn chi_squared_quantile(dof: f64, p: f64) -> Result<f64, Error> {
 /// assert!((normal_quantile(0.975).unwrap() - 1.959963984540054).abs() < 1e-12);
 /// ```
 pub fn normal_quantile(p: f64) -> Result<f64, Error> {
-    check_probability("probability", p)?;
+    check_probability(Param::Probability, p)?;
     Ok(-std::f64::consts::SQRT_2 * erfc_inv(2.0 * p))
 }
 
@@ -163,7 +163,7 @@ pub fn normal_quantile(p: f64) -> Result<f64, Error> {
 pub fn two_sided_tail(k: f64) -> Result<f64, Error> {
     if k.is_nan() || k < 0.0 {
         return Err(Error::InvalidParameter {
-            name: "gate multiplier",
+            name: Param::GateMultiplier,
             value: k.to_string(),
             reason: "must be a non-negative number".into(),
         });
@@ -178,7 +178,7 @@ pub fn two_sided_tail(k: f64) -> Result<f64, Error> {
 /// assert!((two_sided_threshold(0.01).unwrap() - 2.5758293035489).abs() < 1e-10);
 /// ```
 pub fn two_sided_threshold(alpha: f64) -> Result<f64, Error> {
-    check_probability("false-alarm rate", alpha)?;
+    check_probability(Param::FalseAlarmRate, alpha)?;
     Ok(std::f64::consts::SQRT_2 * erfc_inv(alpha))
 }
 
@@ -208,7 +208,7 @@ impl ChiSquaredTest {
     /// assert!(ChiSquaredTest::new(3.0, 1.5).is_err());
     /// ```
     pub fn new(dof: f64, alpha: f64) -> Result<Self, Error> {
-        check_probability("significance", alpha)?;
+        check_probability(Param::Significance, alpha)?;
         let threshold = chi_squared_quantile(dof, 1.0 - alpha)?;
         Ok(Self {
             dof,

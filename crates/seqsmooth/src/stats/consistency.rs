@@ -16,7 +16,7 @@
 //! the chi-squared distribution is a 16-step bisection).
 
 use super::chi_squared::chi_squared_quantile;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use nalgebra::{DMatrix, DVector};
 
 /// Entries `S_ij` and `S_ji` of a covariance may differ by this fraction of `√(S_ii S_jj)`
@@ -50,28 +50,28 @@ pub fn nees(
     truth: &DVector<f64>,
 ) -> Result<f64, Error> {
     let n = estimate.len();
-    let bad = |name: &'static str, value: String, reason: String| Error::InvalidParameter {
+    let bad = |name: Param, value: String, reason: String| Error::InvalidParameter {
         name,
         value,
         reason,
     };
     if n == 0 {
         return Err(bad(
-            "estimate",
+            Param::Estimate,
             "of length 0".into(),
             "must have at least one component".into(),
         ));
     }
     if truth.len() != n {
         return Err(bad(
-            "truth",
+            Param::Truth,
             format!("of length {}", truth.len()),
             format!("the estimate has {n} components"),
         ));
     }
     if covariance.shape() != (n, n) {
         return Err(bad(
-            "covariance",
+            Param::Covariance,
             format!("{}x{}", covariance.nrows(), covariance.ncols()),
             format!("must be {n}x{n}: the estimate has {n} components"),
         ));
@@ -91,7 +91,7 @@ pub fn nees(
             let scale = (covariance[(i, i)] * covariance[(j, j)]).abs().sqrt();
             if (a - b).abs() > SYMMETRY_TOLERANCE * scale {
                 return Err(bad(
-                    "covariance",
+                    Param::Covariance,
                     format!("entries ({i}, {j}) = {a:e} and ({j}, {i}) = {b:e}"),
                     format!(
                         "must be symmetric (to {SYMMETRY_TOLERANCE:e} of the square root of \
@@ -109,7 +109,7 @@ pub fn nees(
         let pivot = variance - (0..j).map(|k| l[(j, k)] * l[(j, k)]).sum::<f64>();
         if pivot.is_nan() || pivot <= floor * variance {
             return Err(bad(
-                "covariance",
+                Param::Covariance,
                 format!(
                     "with variance {variance:e} of component {j} and {pivot:e} of it given \
                      components 0..{j}"
@@ -145,7 +145,7 @@ pub fn nees(
 fn check_confidence(confidence: f64) -> Result<(), Error> {
     if !(confidence > 0.0 && confidence < 1.0) {
         return Err(Error::InvalidParameter {
-            name: "confidence",
+            name: Param::Confidence,
             value: confidence.to_string(),
             reason: "must lie strictly between 0 and 1".into(),
         });
@@ -156,7 +156,7 @@ fn check_confidence(confidence: f64) -> Result<(), Error> {
 fn check_dof(dof: usize) -> Result<(), Error> {
     if dof == 0 {
         return Err(Error::InvalidParameter {
-            name: "degrees of freedom",
+            name: Param::DegreesOfFreedom,
             value: "0".into(),
             reason: "must be at least 1".into(),
         });
@@ -200,7 +200,7 @@ pub fn mean_interval(
     let total = dof_per_run
         .checked_mul(runs)
         .ok_or_else(|| Error::InvalidParameter {
-            name: "runs",
+            name: Param::Runs,
             value: runs.to_string(),
             reason: format!("times {dof_per_run} degrees of freedom overflows"),
         })?;
@@ -286,7 +286,7 @@ impl ConsistencyTest {
         }
         if value < 0.0 {
             return Err(Error::InvalidParameter {
-                name: "NEES or NIS value",
+                name: Param::NeesOrNisValue,
                 value: value.to_string(),
                 reason: "must be non-negative (a quadratic form in a positive definite matrix)"
                     .into(),
@@ -296,7 +296,7 @@ impl ConsistencyTest {
             .total_dof
             .checked_add(dof)
             .ok_or_else(|| Error::InvalidParameter {
-                name: "degrees of freedom",
+                name: Param::DegreesOfFreedom,
                 value: dof.to_string(),
                 reason: "overflow the test's running total".into(),
             })?;

@@ -17,7 +17,7 @@
 
 use super::chi_squared::chi_squared_quantile;
 use super::window::SlidingSum;
-use crate::error::Error;
+use crate::error::{Error, Param};
 
 /// One step of the windowed innovation test.
 ///
@@ -84,14 +84,14 @@ impl InnovationChiSquared {
     pub fn new(window: usize, alpha: f64) -> Result<Self, Error> {
         if window == 0 {
             return Err(Error::InvalidParameter {
-                name: "chi-squared window",
+                name: Param::ChiSquaredWindow,
                 value: window.to_string(),
                 reason: "must be at least 1 sample".into(),
             });
         }
         if !(alpha > 0.0 && alpha < 1.0) {
             return Err(Error::InvalidParameter {
-                name: "chi-squared significance",
+                name: Param::ChiSquaredSignificance,
                 value: alpha.to_string(),
                 reason: "must lie strictly between 0 and 1".into(),
             });
@@ -146,7 +146,7 @@ impl InnovationChiSquared {
         }
         if !(variance.is_finite() && variance > 0.0) {
             return Err(Error::InvalidParameter {
-                name: "innovation variance",
+                name: Param::InnovationVariance,
                 value: variance.to_string(),
                 reason: "must be a positive finite number".into(),
             });
@@ -167,7 +167,7 @@ impl InnovationChiSquared {
     pub fn push_normalised(&mut self, k2: f64) -> Result<ChiSquaredOutcome, Error> {
         if !(k2.is_finite() && k2 >= 0.0) {
             return Err(Error::InvalidParameter {
-                name: "normalised squared innovation",
+                name: Param::NormalisedInnovationSquared,
                 value: k2.to_string(),
                 reason: "must be a non-negative finite number".into(),
             });
@@ -193,14 +193,14 @@ impl InnovationChiSquared {
     pub fn push_nis(&mut self, nis: f64, components: usize) -> Result<ChiSquaredOutcome, Error> {
         if components == 0 {
             return Err(Error::InvalidParameter {
-                name: "innovation components",
+                name: Param::InnovationComponents,
                 value: "0".into(),
                 reason: "an update has at least one component".into(),
             });
         }
         if !(nis.is_finite() && nis >= 0.0) {
             return Err(Error::InvalidParameter {
-                name: "normalised innovation squared",
+                name: Param::NormalisedInnovationSquared,
                 value: nis.to_string(),
                 reason: "must be a non-negative finite number".into(),
             });

@@ -36,7 +36,7 @@ use super::chi_squared::two_sided_tail;
 use super::welford::Welford;
 use super::window::SlidingSum;
 use crate::calculus::choose;
-use crate::error::{check_finite, Error};
+use crate::error::{check_finite, Error, Param};
 use std::collections::VecDeque;
 
 fn check_values(values: &[f64]) -> Result<(), Error> {
@@ -103,7 +103,7 @@ pub fn reyneke_stddw(values: &[f64], window: usize) -> Result<Vec<f64>, Error> {
     check_values(values)?;
     if window == 0 {
         return Err(Error::InvalidParameter {
-            name: "window",
+            name: Param::Window,
             value: window.to_string(),
             reason: "must be at least 1 sample".into(),
         });
@@ -170,7 +170,7 @@ pub const MAX_DIFFERENCE_ORDER: usize = 25;
 fn check_order(order: usize) -> Result<(), Error> {
     if order == 0 || order > MAX_DIFFERENCE_ORDER {
         return Err(Error::InvalidParameter {
-            name: "difference order",
+            name: Param::DifferenceOrder,
             value: order.to_string(),
             reason: format!("must be between 1 and {MAX_DIFFERENCE_ORDER}"),
         });
@@ -194,7 +194,7 @@ pub fn residual_variance(
 ) -> Result<f64, Error> {
     if !(residual_sq.is_finite() && residual_sq >= 0.0) {
         return Err(Error::InvalidParameter {
-            name: "residual sum of squares",
+            name: Param::ResidualSumOfSquares,
             value: residual_sq.to_string(),
             reason: "must be a non-negative finite number".into(),
         });
@@ -226,7 +226,7 @@ pub fn residual_variance(
 pub fn normalised_divided_difference(times: &[f64], values: &[f64]) -> Result<f64, Error> {
     if times.len() != values.len() || times.len() < 2 {
         return Err(Error::InvalidParameter {
-            name: "input lengths",
+            name: Param::InputLengths,
             value: format!("{} times, {} values", times.len(), values.len()),
             reason: "need the same number (at least 2) of times and values".into(),
         });
@@ -336,7 +336,7 @@ impl DifferenceNoise {
         check_order(order)?;
         if window == Some(0) {
             return Err(Error::InvalidParameter {
-                name: "window",
+                name: Param::Window,
                 value: "0".into(),
                 reason: "must be at least 1 difference".into(),
             });
@@ -384,7 +384,7 @@ impl DifferenceNoise {
     pub fn with_screen(mut self, c: f64) -> Result<Self, Error> {
         if c.is_nan() || c <= 0.0 {
             return Err(Error::InvalidParameter {
-                name: "noise screen",
+                name: Param::NoiseScreen,
                 value: c.to_string(),
                 reason: "must be positive (infinity: no screen)".into(),
             });
@@ -499,7 +499,7 @@ impl DifferenceNoise {
     ) -> Result<Option<f64>, Error> {
         if !(factor.is_finite() && factor > 0.0) {
             return Err(Error::InvalidParameter {
-                name: "variance factor",
+                name: Param::VarianceFactor,
                 value: factor.to_string(),
                 reason: "must be a positive finite number".into(),
             });

@@ -31,14 +31,14 @@ pub mod adaptive;
 mod memory;
 
 use crate::discount::Discount;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use crate::estimate::sliding::{SlidingFit, Start};
 use crate::kalman::filter::KalmanFilter;
 use crate::kalman::fixed_lag::FixedLagSmoother;
 use crate::kalman::smoother::Smoothed;
 use crate::model::dynamics::PolynomialDynamics;
-use crate::model::radar::{check_component, from_bearing, Radar, COMPONENTS};
+use crate::model::radar::{check_component, from_bearing, Radar};
 pub use adaptive::TrackFlag;
 use adaptive::{Monitor, MISFIT_ALPHA};
 use memory::{base_noise, Filter, Memory, MemoryKind};
@@ -314,12 +314,12 @@ impl RadarTracker {
         let dynamics = PolynomialDynamics::new(1, 3);
         if solver.max_iterations == 0 {
             return Err(Error::InvalidParameter {
-                name: "max_iterations",
+                name: Param::MaxIterations,
                 value: "0".into(),
                 reason: "a fit needs at least 1 iteration".into(),
             });
         }
-        let check = |name: &'static str, value: f64| {
+        let check = |name: Param, value: f64| {
             if value.is_finite() && value >= 0.0 {
                 Ok(())
             } else {
@@ -334,7 +334,7 @@ impl RadarTracker {
             TrackMethod::Window { window } => {
                 if window < 2 {
                     return Err(Error::InvalidParameter {
-                        name: "window",
+                        name: Param::Window,
                         value: window.to_string(),
                         reason: "a radar track's fit needs at least 2 rows (6 states, 3 \
                                  components a row)"
@@ -349,7 +349,7 @@ impl RadarTracker {
             }
             TrackMethod::Kalman { q } | TrackMethod::Smooth { q, .. } => {
                 if let Some(q) = q {
-                    check("q", q)?;
+                    check(Param::Q, q)?;
                 }
                 Stage::Starting(Box::new(sliding(dynamics, radar, START_WINDOW, solver)?))
             }
@@ -388,7 +388,7 @@ impl RadarTracker {
             return Err(TrackError::Update {
                 row,
                 source: Error::InvalidParameter {
-                    name: "time",
+                    name: Param::Time,
                     value: m.time.to_string(),
                     reason: format!("must be after the previous row's time {}", self.last_time),
                 },
@@ -465,7 +465,7 @@ impl RadarTracker {
                 return Err(TrackError::Update {
                     row,
                     source: Error::InvalidParameter {
-                        name: "row",
+                        name: Param::Row,
                         value: row.to_string(),
                         reason: "comes after finish(): the smoother has given its estimates".into(),
                     },
@@ -663,16 +663,16 @@ pub fn radar_row(
     for (k, v) in values.iter().enumerate() {
         if let Some(v) = *v {
             check_component(k, v).map_err(|why| Error::InvalidParameter {
-                name: COMPONENTS[k],
+                name: [Param::Range, Param::Azimuth, Param::Elevation][k],
                 value: v.to_string(),
                 reason: why.into(),
             })?;
         }
     }
     let needed = [
-        ("sigma_range", sigma_range, values[0].is_some()),
+        (Param::SigmaRange, sigma_range, values[0].is_some()),
         (
-            "sigma_angle",
+            Param::SigmaAngle,
             sigma_angle,
             values[1].is_some() || values[2].is_some(),
         ),

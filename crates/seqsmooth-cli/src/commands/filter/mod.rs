@@ -83,18 +83,7 @@ fn check_args(a: &FilterArgs) -> Result<Option<f64>, CliError> {
 /// holds no more; its refusals name `--tau`.
 fn default_tau(chunk: &Chunk, head: usize) -> Result<f64, CliError> {
     let complete = chunk.done && chunk.len() <= head;
-    tau::default_tau(&chunk.t[..head], &chunk.series[..head], complete).map_err(|e| match e {
-        seqsmooth::Error::InvalidParameter { value, .. } if value == "none" => {
-            CliError::Data(format!(
-                "no series has two rows among the first {head} data rows, so there is no \
-                 median time step for the default tau; give --tau"
-            ))
-        }
-        seqsmooth::Error::InvalidParameter { value, .. } => CliError::Data(format!(
-            "the median time step of the first rows, {value}, is not a usable tau; give --tau"
-        )),
-        e => CliError::Data(e.to_string()),
-    })
+    tau::default_tau(&chunk.t[..head], &chunk.series[..head], complete).map_err(CliError::from)
 }
 
 /// Runs `seqsmooth filter`.
@@ -385,11 +374,13 @@ fn row_error(e: seqsmooth::Error, chunk: &Chunk) -> (usize, CliError) {
         },
         other => (0, other),
     };
-    let why = match source {
-        seqsmooth::Error::EstimateOutOfRange { what } => too_large(&what),
-        other => other.to_string(),
+    let at = chunk.at(index);
+    let too = match &source {
+        seqsmooth::Error::EstimateOutOfRange { what } => Some(too_large(what)),
+        _ => None,
     };
-    (index, CliError::Data(format!("{}: {why}", chunk.at(index))))
+    let e = CliError::from(source).reworded(|m| format!("{at}: {}", too.unwrap_or(m)));
+    (index, e)
 }
 
 /// Why a number of an estimate cannot be written, in the command line's terms.

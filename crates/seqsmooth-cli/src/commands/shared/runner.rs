@@ -11,7 +11,7 @@
 
 use crate::args::{name, EngineArg, Kind};
 use seqsmooth::polynomial::automatic::AutomaticFilter;
-use seqsmooth::{Error, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory};
+use seqsmooth::{Error, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory, Param};
 use seqsmooth::{PolynomialFilter, PolynomialState};
 
 /// A running filter of any kind. Cloning a new one is how each series gets its filter.
@@ -48,7 +48,7 @@ pub fn decisions(cells: &[f64]) -> Vec<bool> {
 }
 
 /// A missing parameter of a filter kind.
-fn needs(name: &'static str, what: &str) -> Error {
+fn needs(name: Param, what: &str) -> Error {
     Error::InvalidParameter {
         name,
         value: "(none)".into(),
@@ -75,7 +75,7 @@ impl Runner {
         ) -> Result<Box<F>, Error> {
             Ok(Box::new(if let Some(s) = sigma { with(f, s)? } else { f }))
         }
-        let theta = || theta.ok_or_else(|| needs("theta", &name(kind)));
+        let theta = || theta.ok_or_else(|| needs(Param::Theta, &name(kind)));
         Ok(match kind {
             Kind::Expanding => Runner::Expanding(noise(
                 ExpandingMemory::new(degree, engine.into())?,
@@ -88,7 +88,7 @@ impl Runner {
                 FadingMemory::with_noise_sigma,
             )?),
             Kind::Fixed => {
-                let window = window.ok_or_else(|| needs("window", &name(kind)))?;
+                let window = window.ok_or_else(|| needs(Param::Window, &name(kind)))?;
                 let f = FixedMemory::new(degree, window, FixedEngine::Adaptive)?;
                 Runner::Fixed(noise(f, sigma, FixedMemory::with_noise_sigma)?, window)
             }

@@ -20,22 +20,30 @@ pub(crate) fn window_error(
     match e {
         Error::InBatch { index, source } => {
             let line = lines.get(index).copied().unwrap_or(last);
-            CliError::Data(format!("line {line}: {source}"))
+            CliError::from(*source).reworded(|m| format!("line {line}: {m}"))
         }
-        Error::Unobservable { .. } | Error::TooFewSamples { .. } => CliError::Data(format!(
-            "lines {first}-{last}: the window of {} rows does not determine the state: {e}{}",
-            lines.len().min(window),
-            if model == FitModel::Radar {
-                " (a radar window needs at least as many measured components as states, and \
-                 its first fit two rows with range, azimuth and elevation)"
-            } else {
-                ""
-            }
-        )),
-        e @ (Error::NotConverged { .. } | Error::Diverged { .. }) => CliError::Data(format!(
-            "lines {first}-{last} (the window): {e} (with this command: --max-iterations N \
-             allows more iterations, a shorter --window W fits fewer rows)"
-        )),
-        e => CliError::Data(format!("lines {first}-{last} (the window): {e}")),
+        e @ (Error::Unobservable { .. } | Error::TooFewSamples { .. }) => CliError::from(e)
+            .reworded(|e| {
+                format!(
+                    "lines {first}-{last}: the window of {} rows does not determine the state: \
+                     {e}{}",
+                    lines.len().min(window),
+                    if model == FitModel::Radar {
+                        " (a radar window needs at least as many measured components as states, \
+                         and its first fit two rows with range, azimuth and elevation)"
+                    } else {
+                        ""
+                    }
+                )
+            }),
+        e @ (Error::NotConverged { .. } | Error::Diverged { .. }) => {
+            CliError::from(e).reworded(|e| {
+                format!(
+                    "lines {first}-{last} (the window): {e} (with this command: --max-iterations \
+                     N allows more iterations, a shorter --window W fits fewer rows)"
+                )
+            })
+        }
+        e => CliError::from(e).reworded(|e| format!("lines {first}-{last} (the window): {e}")),
     }
 }

@@ -6,7 +6,7 @@
 use super::misfit::MisfitResponse;
 use super::noise::NoiseSource;
 use super::outlier::OutlierRule;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::polynomial::fading::switch::SwitchRule;
 use crate::polynomial::options::{check_engine_degree, check_tau, check_theta};
 use crate::polynomial::options::{DiscountMode, Engine};
@@ -161,21 +161,21 @@ impl AutoConfig {
         }
         if self.noise_source.window() == Some(0) {
             return Err(Error::InvalidParameter {
-                name: "noise window",
+                name: Param::NoiseWindow,
                 value: "0".into(),
                 reason: "must be at least 1".into(),
             });
         }
         if self.noise_screen.is_nan() || self.noise_screen <= 0.0 {
             return Err(Error::InvalidParameter {
-                name: "noise screen",
+                name: Param::NoiseScreen,
                 value: self.noise_screen.to_string(),
                 reason: "must be positive (infinity: no screen)".into(),
             });
         }
         if self.memory_levels > MAX_MEMORY_LEVELS {
             return Err(Error::InvalidParameter {
-                name: "memory levels",
+                name: Param::MemoryLevels,
                 value: self.memory_levels.to_string(),
                 reason: format!("must be at most {MAX_MEMORY_LEVELS}"),
             });
@@ -183,7 +183,7 @@ impl AutoConfig {
         self.outliers.validate()?;
         if self.gate_max_vrf.is_nan() || self.gate_max_vrf <= 0.0 {
             return Err(Error::InvalidParameter {
-                name: "gate VRF limit",
+                name: Param::GateVrfLimit,
                 value: self.gate_max_vrf.to_string(),
                 reason: "must be positive (infinity: always gate)".into(),
             });
@@ -191,7 +191,7 @@ impl AutoConfig {
         let l = self.review_window;
         if l > MAX_REVIEW_WINDOW || (l > 0 && 2 * l < self.degree + 4) {
             return Err(Error::InvalidParameter {
-                name: "review window",
+                name: Param::ReviewWindow,
                 value: l.to_string(),
                 reason: format!(
                     "must be 0 (no review) or from {} to {MAX_REVIEW_WINDOW} at degree {}: the \
@@ -206,17 +206,17 @@ impl AutoConfig {
         self.switch_rule.switch_index(self.degree, self.theta)?;
         if self.start_degree > self.degree {
             return Err(Error::InvalidParameter {
-                name: "start degree",
+                name: Param::StartDegree,
                 value: self.start_degree.to_string(),
                 reason: format!("must be at most the degree {}", self.degree),
             });
         }
-        check_positive("settle VRF", self.settle_vrf)
+        check_positive(Param::SettleVrf, self.settle_vrf)
     }
 }
 
 /// `x` is a positive finite number, or an [`Error::InvalidParameter`] naming it.
-pub(super) fn check_positive(name: &'static str, x: f64) -> Result<(), Error> {
+pub(super) fn check_positive(name: Param, x: f64) -> Result<(), Error> {
     if x.is_finite() && x > 0.0 {
         Ok(())
     } else {

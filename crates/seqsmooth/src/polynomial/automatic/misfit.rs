@@ -2,7 +2,7 @@
 //! innovation chi-squared test, and the restart of the final-degree memory from the estimated
 //! onset of the manoeuvre (a CUSUM change point).
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::stats::{ChiSquaredOutcome, InnovationChiSquared};
 use std::collections::VecDeque;
 
@@ -76,7 +76,7 @@ impl MisfitResponse {
         if let MisfitResponse::Restart { alpha } = *self {
             if !(alpha > 0.0 && alpha < 1.0) {
                 return Err(Error::InvalidParameter {
-                    name: "restart significance",
+                    name: Param::RestartSignificance,
                     value: alpha.to_string(),
                     reason: "must lie strictly between 0 and 1".into(),
                 });

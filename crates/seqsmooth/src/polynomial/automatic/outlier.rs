@@ -7,7 +7,7 @@ use super::config::check_positive;
 #[cfg(doc)]
 use super::config::AutoConfig;
 use super::misfit::Kept;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::polynomial::filter::PolynomialFilter;
 use crate::stats::two_sided_tail;
 
@@ -133,7 +133,7 @@ impl OutlierRule {
         match *self {
             OutlierRule::Off => Ok(()),
             OutlierRule::Innovation { k } | OutlierRule::Reyneke { k } => {
-                check_positive("outlier gate multiplier", k)
+                check_positive(Param::OutlierGateMultiplier, k)
             }
         }
     }

@@ -23,7 +23,7 @@
 //! on it.
 
 use crate::calculus::{choose, factorial};
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::linalg::inverse_exact;
 use crate::scalar::{Rational, Scalar};
 use nalgebra::DMatrix;
@@ -149,14 +149,14 @@ impl ContinuousExpandingMemory {
         crate::error::check_finite("start", &[start])?;
         if !(elapsed.is_finite() && elapsed > 0.0) {
             return Err(Error::InvalidParameter {
-                name: "elapsed",
+                name: Param::Elapsed,
                 value: elapsed.to_string(),
                 reason: "the law is singular at T = 0: start from a fit over some T > 0".into(),
             });
         }
         if derivatives.len() != m + 1 {
             return Err(Error::InvalidParameter {
-                name: "derivatives",
+                name: Param::Derivatives,
                 value: derivatives.len().to_string(),
                 reason: format!("degree {m} needs {} (x, x', …)", m + 1),
             });
@@ -199,7 +199,7 @@ impl ContinuousExpandingMemory {
     ) -> Result<(), Error> {
         if !(duration.is_finite() && duration > 0.0) || steps == 0 {
             return Err(Error::InvalidParameter {
-                name: "duration",
+                name: Param::Duration,
                 value: format!("{duration} in {steps} steps"),
                 reason: "needs a duration above 0 and at least one step".into(),
             });

@@ -9,7 +9,7 @@
 
 use super::vrf::{fading_vrf, fading_vrf_limit};
 use crate::calculus::{choose_integer, falling_factorial};
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::numeric::memo::Memo;
 use crate::polynomial::expanding::gains::ExpandingGainSchedule;
 use crate::polynomial::form::EstimateForm;
@@ -124,7 +124,7 @@ impl SwitchRule {
         if let SwitchRule::Derivative(i) = *self {
             if i > m {
                 return Err(Error::InvalidParameter {
-                    name: "switch derivative",
+                    name: Param::SwitchDerivative,
                     value: i.to_string(),
                     reason: format!("must be at most the degree {m}"),
                 });

@@ -9,7 +9,7 @@ use super::sliding::{smoothing_refreshes, SlidingMoments};
 use super::weights::{inverse_norms, legendre_values};
 use super::{check_window, steps_agree};
 use crate::basis::DiscreteLegendre;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::estimate::PolynomialFit;
 
 /// Where the 1σ of each smoothed row comes from (Morrison §7.5: the covariance of a window's
@@ -116,14 +116,14 @@ impl CentredSmoother {
         match sigma {
             SmoothSigma::Given(s) if !(s.is_finite() && s > 0.0) => {
                 return Err(Error::InvalidParameter {
-                    name: "sigma",
+                    name: Param::Sigma,
                     value: s.to_string(),
                     reason: "the noise sigma must be positive and finite".into(),
                 })
             }
             SmoothSigma::Estimated if window <= m + 1 => {
                 return Err(Error::InvalidParameter {
-                    name: "window",
+                    name: Param::Window,
                     value: window.to_string(),
                     reason: format!(
                         "a window of {window} samples has no residuals about its degree-{m} fit \
@@ -215,13 +215,14 @@ impl CentredSmoother {
 
     /// Gives `emit` the rows after the last window's centre: the end of the series.
     ///
-    /// Errors: fewer samples than the window ([`Error::TooFewSamples`]), and `emit`'s own.
+    /// Errors: fewer samples than the window ([`Error::TooFewSamplesFor`] the window), and `emit`'s own.
     pub fn finish<E: From<Error>>(
         mut self,
         mut emit: impl FnMut(SmoothedRow<'_>) -> Result<(), E>,
     ) -> Result<(), E> {
         if self.n < self.window {
-            return Err(Error::TooFewSamples {
+            return Err(Error::TooFewSamplesFor {
+                param: Param::Window,
                 needed: self.window,
                 got: self.n,
             }

@@ -6,7 +6,7 @@ use super::weights::{inverse_norms, taylor_at};
 use super::{check_finite, check_span, check_tau_scalar, span_scalar};
 use crate::basis::DiscreteLegendre;
 use crate::calculus::Polynomial;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::linalg::{congruence, mul};
 use crate::model::scaling;
 use crate::scalar::Scalar;
@@ -89,7 +89,7 @@ pub fn correlated_covariance<T: Scalar>(
 ) -> Result<DMatrix<T>, Error> {
     if r.nrows() != w.ncols() || r.ncols() != w.ncols() {
         return Err(Error::InvalidParameter {
-            name: "error covariance R",
+            name: Param::ErrorCovarianceR,
             value: format!("{} x {}", r.nrows(), r.ncols()),
             reason: format!(
                 "must be {n} x {n} to match a weight matrix over {n} samples",

@@ -6,7 +6,7 @@
 use super::bias::dominant_bias;
 use super::covariance::covariance;
 use super::{check_span, Lead};
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::polynomial::options::{check_degree, check_tau};
 
 /// A span design problem: a fixed-memory filter of degree `degree` whose estimate is wanted at
@@ -35,7 +35,7 @@ impl Design {
     fn check(&self) -> Result<(), Error> {
         check_degree(self.degree)?;
         check_tau(self.tau)?;
-        check_positive("noise sigma", self.sigma_nu)?;
+        check_positive(Param::NoiseSigma, self.sigma_nu)?;
         self.lead.check()
     }
 
@@ -54,7 +54,7 @@ impl Design {
         self.check()?;
         let m = self.degree;
         check_derivative(m, derivative)?;
-        check_positive("target sigma", target_sigma)?;
+        check_positive(Param::TargetSigma, target_sigma)?;
         let ok = |l: u64| -> Result<bool, Error> {
             let v = unscaled_variance(m, l, self.lead, derivative, self.tau)?;
             Ok(self.sigma_nu * v.sqrt() <= target_sigma)
@@ -66,7 +66,7 @@ impl Design {
         match last_holding(first, |l| Ok(!ok(l)?))? {
             Some(last_short) => Ok(last_short + 1),
             None => Err(Error::InvalidParameter {
-                name: "target sigma",
+                name: Param::TargetSigma,
                 value: target_sigma.to_string(),
                 reason: format!("not reached with a window of up to 2^40 samples (degree {m})"),
             }),
@@ -92,7 +92,7 @@ impl Design {
     pub fn balance_span(&self, a_next: f64, ratio: f64) -> Result<Balance, Error> {
         self.check()?;
         let m = self.degree;
-        for (name, v) in [("a_next", a_next.abs()), ("ratio", ratio)] {
+        for (name, v) in [(Param::ANext, a_next.abs()), (Param::Ratio, ratio)] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Error::InvalidParameter {
                     name,
@@ -103,7 +103,7 @@ impl Design {
         }
         if matches!(self.lead, Lead::Centre) && m.is_multiple_of(2) {
             return Err(Error::InvalidParameter {
-                name: "lead",
+                name: Param::Lead,
                 value: "centre".into(),
                 reason: format!(
                     "the dominant bias p_{}(L/2) vanishes at the centre for even degree {m}",
@@ -125,7 +125,7 @@ impl Design {
         let first = eval(m as u64)?;
         if !ok(&first) {
             return Err(Error::InvalidParameter {
-                name: "a_next",
+                name: Param::ANext,
                 value: a_next.to_string(),
                 reason: format!(
                     "even the shortest window (L = {m}) has bias {} above {ratio} × σ = {}",
@@ -138,7 +138,7 @@ impl Design {
             Some(span) if span == first.span => Ok(first),
             Some(span) => eval(span),
             None => Err(Error::InvalidParameter {
-                name: "a_next",
+                name: Param::ANext,
                 value: a_next.to_string(),
                 reason: "the bias stays below the random error up to 2^40 samples".into(),
             }),
@@ -188,14 +188,14 @@ pub fn tau_for_derivative_sigma(
     check_derivative(m, derivative)?;
     if derivative == 0 {
         return Err(Error::InvalidParameter {
-            name: "derivative",
+            name: Param::Derivative,
             value: "0".into(),
             reason: "the variance of the value does not depend on τ; choose a derivative ≥ 1"
                 .into(),
         });
     }
-    check_positive("noise sigma", sigma_nu)?;
-    check_positive("target sigma", target_sigma)?;
+    check_positive(Param::NoiseSigma, sigma_nu)?;
+    check_positive(Param::TargetSigma, target_sigma)?;
     lead.check()?;
     let v = unscaled_variance(m, span, lead, derivative, 1.0)?;
     let ratio = sigma_nu * sigma_nu * v / (target_sigma * target_sigma);
@@ -250,7 +250,7 @@ fn unscaled_variance(
 fn check_derivative(m: usize, derivative: usize) -> Result<(), Error> {
     if derivative > m {
         return Err(Error::InvalidParameter {
-            name: "derivative",
+            name: Param::Derivative,
             value: derivative.to_string(),
             reason: format!("a degree-{m} filter estimates derivatives 0..={m}"),
         });
@@ -258,7 +258,7 @@ fn check_derivative(m: usize, derivative: usize) -> Result<(), Error> {
     Ok(())
 }
 
-fn check_positive(name: &'static str, v: f64) -> Result<(), Error> {
+fn check_positive(name: Param, v: f64) -> Result<(), Error> {
     if !(v.is_finite() && v > 0.0) {
         return Err(Error::InvalidParameter {
             name,

@@ -6,7 +6,7 @@ use super::irregular::IrregularWindow;
 use super::ring::Ring;
 use super::sliding::default_refreshes;
 use super::{check_window, steps_agree, steps_equal, EVEN_STEP_TOLERANCE};
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::PolynomialState;
 use crate::polynomial::filter::PolynomialFilter;
 
@@ -172,7 +172,7 @@ impl FixedMemory {
     pub fn with_refreshes(mut self, q: usize) -> Result<Self, Error> {
         if self.n > 0 || q == 0 {
             return Err(Error::InvalidParameter {
-                name: "refreshes",
+                name: Param::Refreshes,
                 value: q.to_string(),
                 reason: "must be at least 1 and set before the first sample".into(),
             });
@@ -270,7 +270,7 @@ impl FixedMemory {
 
     fn uneven_step_error(&self, t: f64) -> Error {
         Error::InvalidParameter {
-            name: "sample time",
+            name: Param::SampleTime,
             value: t.to_string(),
             reason: format!(
                 "sample {} (0-based) follows the previous one after {}, which differs from the \

@@ -106,7 +106,7 @@ pub use trend::{smooth_detrended, Detrended, Nominal};
 pub use weights::{weights, weights_unscaled};
 pub use window_vrf::{fixed_memory_vrf_limit, window_covariance};
 
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::scalar::{Rational, Scalar};
 
 /// Steps of evenly spaced samples must agree with the first step to this relative tolerance.
@@ -202,7 +202,7 @@ pub(crate) const MAX_WINDOW: u64 = 1 << 32;
 fn check_materialised(span: u64) -> Result<(), Error> {
     if span >= MAX_WINDOW {
         return Err(Error::InvalidParameter {
-            name: "span",
+            name: Param::Span,
             value: span.to_string(),
             reason: format!("windows of more than {MAX_WINDOW} samples are not materialised"),
         });
@@ -215,14 +215,14 @@ fn check_window(m: usize, window: usize) -> Result<(), Error> {
     crate::polynomial::options::check_degree(m)?;
     if window as u64 > MAX_WINDOW {
         return Err(Error::InvalidParameter {
-            name: "window",
+            name: Param::Window,
             value: window.to_string(),
             reason: format!("at most {MAX_WINDOW} samples"),
         });
     }
     if window < m + 1 {
         return Err(Error::InvalidParameter {
-            name: "window",
+            name: Param::Window,
             value: window.to_string(),
             reason: format!(
                 "a degree-{m} fit needs a window of at least {} samples",

@@ -3,14 +3,14 @@
 
 use super::centred::{CentredSmoother, SmoothSigma};
 use super::check_window;
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::polynomial::filter::{check_estimates_length, first_invalid};
 
 /// Checks lengths, finiteness and strictly increasing times: the first sample that
 /// [`crate::error::check_sample`] rejects is the error.
 pub(crate) fn check_series(times: &[f64], values: &[f64]) -> Result<(), Error> {
     crate::error::check_lengths(
-        "input lengths",
+        Param::InputLengths,
         times,
         values,
         "times and values must have the same length",
@@ -98,7 +98,8 @@ pub fn smooth_into(
     check_series(times, values)?;
     let len = times.len();
     if window > len {
-        return Err(Error::TooFewSamples {
+        return Err(Error::TooFewSamplesFor {
+            param: Param::Window,
             needed: window,
             got: len,
         });
@@ -145,7 +146,8 @@ pub fn smooth_with_sigma_into(
     check_window(m, window)?;
     check_series(times, values)?;
     if window > times.len() {
-        return Err(Error::TooFewSamples {
+        return Err(Error::TooFewSamplesFor {
+            param: Param::Window,
             needed: window,
             got: times.len(),
         });

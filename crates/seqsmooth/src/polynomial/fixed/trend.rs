@@ -2,7 +2,7 @@
 //! nominal back.
 
 use super::smooth::{check_series, smooth};
-use crate::error::Error;
+use crate::error::{Error, Param};
 use crate::model::PolynomialState;
 use crate::polynomial::filter::PolynomialFilter;
 
@@ -50,7 +50,7 @@ impl Nominal<'_> {
 fn check_nominal_row(row: &[f64]) -> Result<(), Error> {
     if row.is_empty() {
         return Err(Error::InvalidParameter {
-            name: "nominal",
+            name: Param::Nominal,
             value: "[]".into(),
             reason: "each nominal row needs at least the value".into(),
         });
@@ -89,7 +89,7 @@ pub fn smooth_detrended(
     if let Nominal::Samples(s) = nominal {
         if s.len() != times.len() {
             return Err(Error::InvalidParameter {
-                name: "nominal",
+                name: Param::Nominal,
                 value: format!("{} rows", s.len()),
                 reason: format!("one row per sample is needed ({} samples)", times.len()),
             });
