@@ -93,6 +93,8 @@ mod filter;
 pub mod fixed;
 pub mod form;
 mod options;
+pub mod rows;
+pub mod spec;
 pub mod stream;
 pub mod tau;
 
