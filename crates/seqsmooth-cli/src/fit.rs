@@ -12,30 +12,12 @@ use crate::io::{check_distinct, find_column, open_input, parse_cell, shown, writ
 use crate::io::{Need, Output};
 use crate::track::rows::{check_sigmas, Batch, Rows};
 use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
-use seqsmooth::estimate::sliding::{SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
+use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
+use seqsmooth::estimate::sliding::{Fitter, SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
 use seqsmooth::kalman::track::window_flag;
-use seqsmooth::model::dynamics::PolynomialDynamics;
-use seqsmooth::model::observation::LinearObservation;
-use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
 use std::collections::VecDeque;
 use std::io::Read;
-
-/// The model's sliding fit.
-enum Fitter {
-    Radar(SlidingFit<PolynomialDynamics, Radar>),
-    Polynomial(SlidingFit<PolynomialDynamics, LinearObservation>),
-}
-
-impl Fitter {
-    fn push(&mut self, m: Measurement) -> Result<Option<Correction>, Error> {
-        match self {
-            Fitter::Radar(f) => f.push_finite(m),
-            Fitter::Polynomial(f) => f.push_finite(m),
-        }
-    }
-}
 
 /// Where the rows come from: the radar reader that `track` uses (its columns, σ, azimuth
 /// convention and the library's rule for a radar row), or the polynomial's value column.
@@ -200,7 +182,7 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
             lines.pop_front();
         }
         lines.push_back(line);
-        let fit = setup.fitter.push(measurement).map_err(|e| match e {
+        let fit = setup.fitter.push_finite(measurement).map_err(|e| match e {
             Error::NonFinite {
                 what: "fitted state",
                 value,

@@ -12,31 +12,11 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
 use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
-use seqsmooth::estimate::sliding::{SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
+use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
+use seqsmooth::estimate::sliding::{Fitter, SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
 use seqsmooth::kalman::track::radar_row;
 use seqsmooth::kalman::track::window_flag;
-use seqsmooth::model::dynamics::PolynomialDynamics;
-use seqsmooth::model::observation::LinearObservation;
-use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
-
-/// The model's sliding fit.
-enum Fitter {
-    Radar(SlidingFit<PolynomialDynamics, Radar>),
-    Polynomial(SlidingFit<PolynomialDynamics, LinearObservation>),
-}
-
-impl Fitter {
-    /// The library's `push_finite`: the row taken and the window fitted, or the row refused
-    /// and the fit as before it.
-    fn push(&mut self, m: Measurement) -> Result<Option<Correction>, Error> {
-        match self {
-            Fitter::Radar(f) => f.push_finite(m),
-            Fitter::Polynomial(f) => f.push_finite(m),
-        }
-    }
-}
 
 /// A σ as `seqsmooth fit` accepts it: above 0, its square (the variance) a normal double.
 pub(crate) fn check_sigma(name: &str, s: f64) -> PyResult<f64> {
@@ -449,7 +429,7 @@ impl PySlidingFit {
         let mut taken = 0;
         let failed = py.detach(|| {
             for (i, m) in rows.into_iter().enumerate() {
-                let fit = fitter.push(m).map_err(|e| (i, e))?;
+                let fit = fitter.push_finite(m).map_err(|e| (i, e))?;
                 taken = i + 1;
                 if let Some(c) = fit {
                     states[i * d..(i + 1) * d].copy_from_slice(c.state.as_slice());
