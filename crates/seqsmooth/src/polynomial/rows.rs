@@ -125,18 +125,12 @@ impl AnyFilter {
         out.fill(f64::NAN);
         let before = self.rows;
         let written = self.write_rows(t, y, out, layout, stride);
-        let done = match &written {
-            Ok(()) => t.len(),
+        // The rows up to a refused sample, or up to the row refused while writing, are taken;
+        // those before it are checked first, so that the earliest refusal is the batch's.
+        let done = ((self.rows - before) as usize).min(match &written {
             Err(Error::InBatch { index, .. }) => *index,
-            Err(_) => 0,
-        };
-        if matches!(self.inner, Inner::Expanding(_) | Inner::Fading(_)) && layout.lead == 0.0 {
-            // The batch kernels' rows, up to a refused sample, are taken (`update` counts the
-            // others).
-            self.rows += done as u64;
-        }
-        // The rows before a refused sample are checked first: the earliest refusal is the
-        // batch's.
+            _ => t.len(),
+        });
         self.check_rows(&out[..done * stride], stride, layout, before)?;
         written
     }
@@ -153,8 +147,8 @@ impl AnyFilter {
         let RowLayout { sigma, lead, .. } = layout;
         if let (Inner::Expanding(_) | Inner::Fading(_), 0.0) = (&self.inner, lead) {
             return match sigma {
-                false => self.filter_mut().update_many_into(t, y, out),
-                true => self.filter_mut().update_many_sigma_into(t, y, out),
+                false => self.update_many_into(t, y, out),
+                true => self.update_many_sigma_into(t, y, out),
             };
         }
         let width = (self.degree() + 1) << usize::from(sigma);

@@ -263,4 +263,42 @@ impl PolynomialFilter for AnyFilter {
     fn last_time(&self) -> Option<f64> {
         self.filter().last_time()
     }
+    fn estimate(&self) -> Option<PolynomialState> {
+        self.filter().estimate()
+    }
+    fn try_estimate(&self) -> Result<PolynomialState, Error> {
+        self.filter().try_estimate()
+    }
+    fn is_determined(&self) -> bool {
+        self.filter().is_determined()
+    }
+    fn update_many(&mut self, times: &[f64], values: &[f64]) -> Result<(), Error> {
+        let done = self.filter_mut().update_many(times, values);
+        self.count(times.len(), done)
+    }
+    fn update_many_into(&mut self, t: &[f64], y: &[f64], out: &mut [f64]) -> Result<(), Error> {
+        let done = self.filter_mut().update_many_into(t, y, out);
+        self.count(t.len(), done)
+    }
+    fn update_many_sigma_into(
+        &mut self,
+        t: &[f64],
+        y: &[f64],
+        rows: &mut [f64],
+    ) -> Result<(), Error> {
+        let done = self.filter_mut().update_many_sigma_into(t, y, rows);
+        self.count(t.len(), done)
+    }
+}
+
+impl AnyFilter {
+    /// Counts the rows a batch of `n` took (up to a refused one) and passes its result on.
+    pub(crate) fn count(&mut self, n: usize, result: Result<(), Error>) -> Result<(), Error> {
+        self.rows += match &result {
+            Ok(()) => n,
+            Err(Error::InBatch { index, .. }) => *index,
+            Err(_) => 0,
+        } as u64;
+        result
+    }
 }
