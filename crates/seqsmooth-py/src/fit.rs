@@ -16,6 +16,7 @@ use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
 use seqsmooth::estimate::sliding::{Fitter, SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
 use seqsmooth::kalman::track::radar_row;
 use seqsmooth::kalman::track::window_flag;
+use seqsmooth::polynomial::check_degree;
 use seqsmooth::Error;
 
 /// A σ as `seqsmooth fit` accepts it: above 0, its square (the variance) a normal double.
@@ -247,7 +248,9 @@ impl PySlidingFit {
         };
         let max = seqsmooth::polynomial::MAX_DEGREE;
         if let Some(d) = degree {
-            if d < 0 || d as u64 > max as u64 {
+            // The library's range of a polynomial degree.
+            let in_range = usize::try_from(d).is_ok_and(|d| check_degree(d).is_ok());
+            if !in_range {
                 return usage(format!(
                     "degree {d} is out of range: 0 to {max} (radar: 1 or 2)"
                 ));
