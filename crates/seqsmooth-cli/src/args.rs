@@ -1015,13 +1015,9 @@ fn parse_whole(name: &str, s: &str, unit: &str, lo: i128, hi: i128) -> Result<i1
 
 /// Parses `--degree`: a whole number, in the library's range ([`check_degree`]).
 pub fn parse_degree(s: &str) -> Result<usize, String> {
-    let d = parse_whole("degree", s, "", 0, i128::from(i64::MAX)).map_err(|e| match s.trim() {
-        text if text.starts_with('-') => {
-            format!("degree {text} is out of range: it must be a whole number from 0 to {MAX_DEGREE}")
-        }
-        _ => e,
-    })?;
-    let d = usize::try_from(d).unwrap_or(usize::MAX);
+    // Not a whole number ≥ 0 (a sign, a fraction, text): said in the words of the range.
+    let whole = |_| parse_whole("degree", s, "", 0, MAX_DEGREE as i128).map(|d| d as usize);
+    let d = s.trim().parse::<usize>().or_else(whole)?;
     check_degree(d).map_err(|e| match e {
         seqsmooth::Error::DegreeOutOfRange { max, .. } => format!(
             "degree {} is out of range: the largest supported degree is {max}",

@@ -223,6 +223,22 @@ impl AnyFilter {
         }
     }
 
+    /// The automatic filter itself; `None` for the other kinds.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::spec::{FilterKind, FilterSpec};
+    /// let spec = FilterSpec { theta: Some(0.9), tau: Some(1.0), review_window: Some(9), ..FilterSpec::new(FilterKind::Automatic, 2) };
+    /// assert_eq!(spec.build()?.into_automatic().unwrap().config().review_window, 9);
+    /// assert!(FilterSpec::new(FilterKind::Expanding, 2).build()?.into_automatic().is_none());
+    /// # Ok::<(), seqsmooth::Error>(())
+    /// ```
+    pub fn into_automatic(self) -> Option<AutomaticFilter> {
+        match self.inner {
+            Inner::Automatic(f) => Some(*f),
+            _ => None,
+        }
+    }
+
     pub(crate) fn filter(&self) -> &dyn PolynomialFilter {
         match &self.inner {
             Inner::Expanding(f) => f.as_ref(),
