@@ -122,7 +122,6 @@ impl AnyFilter {
                 reason: format!("{} samples need {} cells", t.len(), t.len() * stride),
             });
         }
-        out.fill(f64::NAN);
         let before = self.rows;
         let written = self.write_rows(t, y, out, layout, stride);
         // The rows up to a refused sample, or up to the row refused while writing, are taken;
@@ -151,6 +150,8 @@ impl AnyFilter {
                 true => self.update_many_sigma_into(t, y, out),
             };
         }
+        // The batch kernels write every cell; here a cell not written is empty.
+        out.fill(f64::NAN);
         let width = (self.degree() + 1) << usize::from(sigma);
         let at = |index: usize| move |e: Error| Error::InBatch {
             index,
