@@ -6,11 +6,11 @@
 
 use crate::arrays::{matrix, pair};
 use crate::errors::IntoPy;
+use crate::errors::{raise, Kind};
 use crate::polynomial::{engine as engine_named, state_of, State};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use crate::errors::{raise, Kind};
 use seqsmooth::polynomial::automatic::AutomaticFilter;
 use seqsmooth::polynomial::spec::{FilterKind, FilterSpec};
 use seqsmooth::Error;
@@ -65,7 +65,8 @@ impl PyAutomaticFilter {
             ..FilterSpec::new(FilterKind::Automatic, degree)
         };
         let filter = spec.build().py()?.into_automatic();
-        let filter = filter.ok_or_else(|| raise(Kind::Parameter, "not an automatic filter", None))?;
+        let filter =
+            filter.ok_or_else(|| raise(Kind::Parameter, "not an automatic filter", None))?;
         Ok(Self {
             filter,
             decided: Vec::new(),

@@ -125,9 +125,10 @@ pub fn filter_series<'py>(
     };
     py.detach(|| {
         let mut bank = StreamBank::growing(prototype)?;
-        bank.update_par_columns(chunk, |f: &mut AnyFilter, t: &[f64], y: &[f64], o: &mut [f64]| {
-            f.run_rows(t, y, o, layout)
-        })
+        bank.update_par_columns(
+            chunk,
+            |f: &mut AnyFilter, t: &[f64], y: &[f64], o: &mut [f64]| f.run_rows(t, y, o, layout),
+        )
     })
     .py()?;
     // Column by column already (each derivative's column contiguous, for the frame's columns).

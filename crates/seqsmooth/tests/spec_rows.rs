@@ -48,15 +48,27 @@ fn direct(spec: &FilterSpec) -> Box<dyn PolynomialFilter> {
     match spec.kind {
         FilterKind::Expanding => {
             let f = ExpandingMemory::new(m, spec.engine).unwrap();
-            Box::new(sigma.map_or(Ok(f.clone()), |s| f.with_noise_sigma(s)).unwrap())
+            Box::new(
+                sigma
+                    .map_or(Ok(f.clone()), |s| f.with_noise_sigma(s))
+                    .unwrap(),
+            )
         }
         FilterKind::Fading => {
             let f = FadingMemory::new(m, theta, tau, spec.engine).unwrap();
-            Box::new(sigma.map_or(Ok(f.clone()), |s| f.with_noise_sigma(s)).unwrap())
+            Box::new(
+                sigma
+                    .map_or(Ok(f.clone()), |s| f.with_noise_sigma(s))
+                    .unwrap(),
+            )
         }
         FilterKind::Fixed => {
             let f = FixedMemory::new(m, spec.window.unwrap(), spec.fixed_engine).unwrap();
-            Box::new(sigma.map_or(Ok(f.clone()), |s| f.with_noise_sigma(s)).unwrap())
+            Box::new(
+                sigma
+                    .map_or(Ok(f.clone()), |s| f.with_noise_sigma(s))
+                    .unwrap(),
+            )
         }
         FilterKind::Automatic => Box::new(automatic(spec)),
     }
@@ -82,7 +94,10 @@ const KINDS: [FilterKind; 4] = [
 fn bits(s: &Option<PolynomialState>) -> Option<(Vec<u64>, Option<Vec<u64>>)> {
     s.as_ref().map(|s| {
         let d = s.derivatives.iter().map(|v| v.to_bits()).collect();
-        let c = s.covariance.as_ref().map(|c| c.iter().map(|v| v.to_bits()).collect());
+        let c = s
+            .covariance
+            .as_ref()
+            .map(|c| c.iter().map(|v| v.to_bits()).collect());
         (d, c)
     })
 }
@@ -108,7 +123,11 @@ fn a_spec_builds_the_filter_its_constructor_makes() {
                     assert_eq!(a.is_determined(), b.is_determined());
                     assert_eq!(bits(&a.estimate()), bits(&b.estimate()));
                     for at in [t, t + 0.7] {
-                        assert_eq!(bits(&a.estimate_at(at)), bits(&b.estimate_at(at)), "{spec:?}");
+                        assert_eq!(
+                            bits(&a.estimate_at(at)),
+                            bits(&b.estimate_at(at)),
+                            "{spec:?}"
+                        );
                     }
                 }
             }
@@ -116,7 +135,11 @@ fn a_spec_builds_the_filter_its_constructor_makes() {
     }
     // Fixed memory on each of its engines.
     let (t, y) = (Vec::from_iter((0..40).map(f64::from)), data(40).1);
-    for fixed_engine in [FixedEngine::Sliding, FixedEngine::Direct, FixedEngine::Irregular] {
+    for fixed_engine in [
+        FixedEngine::Sliding,
+        FixedEngine::Direct,
+        FixedEngine::Irregular,
+    ] {
         let spec = FilterSpec {
             fixed_engine,
             ..spec(FilterKind::Fixed, Some(0.2))
@@ -161,7 +184,10 @@ fn a_spec_refuses_what_its_kind_lacks() {
     let (t, _) = data(30);
     let series = vec![0; t.len()];
     let expanding = FilterSpec::new(FilterKind::Expanding, 1);
-    let resolved = expanding.clone().with_default_tau(&t, &series, true).unwrap();
+    let resolved = expanding
+        .clone()
+        .with_default_tau(&t, &series, true)
+        .unwrap();
     assert_eq!(resolved, expanding);
     // A fading memory without tau takes the library's default, a given one stays.
     let spec = no_tau.with_default_tau(&t, &series, true).unwrap();
@@ -170,7 +196,10 @@ fn a_spec_refuses_what_its_kind_lacks() {
         tau: Some(3.0),
         ..spec
     };
-    assert_eq!(given.clone().with_default_tau(&t, &series, true).unwrap(), given);
+    assert_eq!(
+        given.clone().with_default_tau(&t, &series, true).unwrap(),
+        given
+    );
 }
 
 /// The rows a filter writes, computed from the filter run directly: the batch kernels for the
@@ -211,7 +240,11 @@ fn expected_rows(spec: &FilterSpec, t: &[f64], y: &[f64], layout: RowLayout) -> 
                 row[sd + 1] = f64::from(u8::from(o.outlier));
                 row[sd + 2] = f64::from(u8::from(o.misfit));
                 row[sd + 3] = o.bias.as_ref().map_or(f64::NAN, |b| b[0]);
-                let bits = o.decided.iter().rev().fold(0u64, |b, &r| b << 1 | u64::from(r));
+                let bits = o
+                    .decided
+                    .iter()
+                    .rev()
+                    .fold(0u64, |b, &r| b << 1 | u64::from(r));
                 row[sd + 4] = o.decided.len() as f64;
                 row[sd + 5] = (bits & 0xffff_ffff) as f64;
                 row[sd + 6] = (bits >> 32) as f64;
@@ -339,12 +372,17 @@ fn undetermined_and_refused_rows() {
     let (index, e, out) = refusal(&fading, &t, layout);
     assert_eq!(index, 2);
     assert!(matches!(e, Error::NotDetermined { samples: 3, .. }), "{e}");
-    assert!(out.iter().all(|v| v.is_nan()), "the first two rows: empty, not refused");
+    assert!(
+        out.iter().all(|v| v.is_nan()),
+        "the first two rows: empty, not refused"
+    );
     // In pieces, the count of rows carries: the refusal is the second piece's row 0.
     let mut f = fading.build().unwrap();
     let mut out = vec![0.0; 6];
     f.run_rows(&t[..2], &y[..2], &mut out, layout).unwrap();
-    let e = f.run_rows(&t[2..4], &y[2..4], &mut out, layout).unwrap_err();
+    let e = f
+        .run_rows(&t[2..4], &y[2..4], &mut out, layout)
+        .unwrap_err();
     assert!(matches!(e, Error::InBatch { index: 0, .. }), "{e}");
     // A lead beyond the double range.
     let lead = RowLayout {
@@ -365,8 +403,14 @@ fn undetermined_and_refused_rows() {
         ..spec(FilterKind::Fixed, None)
     };
     let (index, e, out) = refusal(&fixed, &tiny, layout);
-    assert_eq!(index, 3, "rows 0-2 are a line (d2 = 0): the first curved window ends at 3");
-    assert!(matches!(e, Error::EstimateOutOfRange { ref what } if what == "d2"), "{e}");
+    assert_eq!(
+        index, 3,
+        "rows 0-2 are a line (d2 = 0): the first curved window ends at 3"
+    );
+    assert!(
+        matches!(e, Error::EstimateOutOfRange { ref what } if what == "d2"),
+        "{e}"
+    );
     assert!(out[..6].iter().all(|v| v.is_nan()) && out[6..9].iter().all(|v| v.is_finite()));
     // An earlier refused row comes before a later refused sample.
     let mut f = fading.build().unwrap();
@@ -380,7 +424,9 @@ fn undetermined_and_refused_rows() {
         ..layout
     };
     let mut out = vec![0.0; 9 * 6];
-    let e = f.run_rows(&data(9).0, &data(9).1, &mut out, sigma).unwrap_err();
+    let e = f
+        .run_rows(&data(9).0, &data(9).1, &mut out, sigma)
+        .unwrap_err();
     assert!(matches!(e, Error::InBatch { index: 6, .. }), "{e}");
 }
 
@@ -401,8 +447,15 @@ fn refused_samples_and_lengths() {
             let stride = f.stride(layout);
             let mut out = vec![0.0; t.len() * stride];
             let e = f.run_rows(&t, &y, &mut out, layout).unwrap_err();
-            assert!(matches!(e, Error::InBatch { index: 12, .. }), "{kind:?}: {e}");
-            let taken = if kind == FilterKind::Automatic { f.samples() } else { 12 };
+            assert!(
+                matches!(e, Error::InBatch { index: 12, .. }),
+                "{kind:?}: {e}"
+            );
+            let taken = if kind == FilterKind::Automatic {
+                f.samples()
+            } else {
+                12
+            };
             assert_eq!(f.samples(), taken, "{kind:?}");
             let want = expected_rows(&spec(kind, Some(0.2)), &t[..12], &y[..12], layout);
             assert!(same_bits(&out[..12 * stride], &want), "{kind:?}");

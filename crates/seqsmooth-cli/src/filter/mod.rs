@@ -205,9 +205,8 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         values.resize(chunk.len() * stride, 0.0);
         // The library's rows, each refused row (no estimate once determined, a number beyond
         // the double range) the error of its row: right or refused.
-        let run = |f: &mut AnyFilter, t: &[f64], y: &[f64], o: &mut [f64]| {
-            f.run_rows(t, y, o, layout)
-        };
+        let run =
+            |f: &mut AnyFilter, t: &[f64], y: &[f64], o: &mut [f64]| f.run_rows(t, y, o, layout);
         let rows = stream::Chunk {
             channels: &chunk.series,
             times: &chunk.t,

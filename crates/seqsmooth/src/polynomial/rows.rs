@@ -153,11 +153,17 @@ impl AnyFilter {
         // The batch kernels write every cell; here a cell not written is empty.
         out.fill(f64::NAN);
         let width = (self.degree() + 1) << usize::from(sigma);
-        let at = |index: usize| move |e: Error| Error::InBatch {
-            index,
-            source: Box::new(e),
+        let at = |index: usize| {
+            move |e: Error| Error::InBatch {
+                index,
+                source: Box::new(e),
+            }
         };
-        for (index, ((&t, &y), row)) in t.iter().zip(y).zip(out.chunks_exact_mut(stride)).enumerate()
+        for (index, ((&t, &y), row)) in t
+            .iter()
+            .zip(y)
+            .zip(out.chunks_exact_mut(stride))
+            .enumerate()
         {
             self.update(t, y).map_err(at(index))?;
             let (values, extra) = row.split_at_mut(width);
@@ -210,16 +216,17 @@ impl AnyFilter {
             // The automatic filter's estimate is withheld while its noise cell is empty; its
             // derivatives above the degree it has reached are empty by design. Without its
             // trailing cells a withheld estimate cannot be told: only infinities are refused.
-            Inner::Automatic(_) if layout.trailing => {
-                (w, 1, Some(w << usize::from(layout.sigma)))
-            }
+            Inner::Automatic(_) if layout.trailing => (w, 1, Some(w << usize::from(layout.sigma))),
             Inner::Automatic(_) => (usize::MAX, 1, None),
             _ => (w, w, None),
         };
         // Fast path, one branch-free pass (vectorised) over the determined rows: every cell
         // finite. Only a batch with empty or infinite cells there is searched row by row.
         let undetermined = usize::try_from((needed as u64).saturating_sub(before + 1));
-        let first = undetermined.unwrap_or(usize::MAX).saturating_mul(stride).min(rows.len());
+        let first = undetermined
+            .unwrap_or(usize::MAX)
+            .saturating_mul(stride)
+            .min(rows.len());
         if !rows[..first].iter().any(|v| v.is_infinite())
             && rows[first..].iter().fold(true, |ok, v| ok & v.is_finite())
         {
@@ -230,7 +237,9 @@ impl AnyFilter {
             match k {
                 k if k < w => format!("d{k}"),
                 k if k < sd => format!("s{}", k - w),
-                k => (self.trailing_columns().get(k - sd)).map_or("decisions", |c| c).into(),
+                k => (self.trailing_columns().get(k - sd))
+                    .map_or("decisions", |c| c)
+                    .into(),
             }
         };
         for (i, row) in rows.chunks_exact(stride).enumerate() {

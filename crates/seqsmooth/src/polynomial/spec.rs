@@ -139,12 +139,20 @@ impl FilterSpec {
         let inner = match self.kind {
             FilterKind::Expanding => {
                 let f = ExpandingMemory::new(m, self.engine)?;
-                Inner::Expanding(Box::new(noise(f, self.sigma, ExpandingMemory::with_noise_sigma)?))
+                Inner::Expanding(Box::new(noise(
+                    f,
+                    self.sigma,
+                    ExpandingMemory::with_noise_sigma,
+                )?))
             }
             FilterKind::Fading => {
                 let (theta, tau) = (need(self.theta, "theta")?, need(self.tau, "tau")?);
                 let f = FadingMemory::new(m, theta, tau, self.engine)?;
-                Inner::Fading(Box::new(noise(f, self.sigma, FadingMemory::with_noise_sigma)?))
+                Inner::Fading(Box::new(noise(
+                    f,
+                    self.sigma,
+                    FadingMemory::with_noise_sigma,
+                )?))
             }
             FilterKind::Fixed => {
                 let window = self.window.ok_or_else(|| needs("window", self.kind))?;
