@@ -279,13 +279,8 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
                         .into(),
                 ));
             }
+            // Its range (1 or 2) is the library's: `SlidingFit::radar` refuses the others.
             let degree = a.degree.unwrap_or(1);
-            if !(1..=2).contains(&degree) {
-                return Err(usage(format!(
-                    "degree {degree} is out of range for --model radar: 1 (constant velocity) \
-                     or 2 (constant acceleration)"
-                )));
-            }
             let need = Need::rows(2, "the radar model");
             need.check_header(header)?;
             let states = 3 * (degree + 1);

@@ -277,13 +277,8 @@ impl PySlidingFit {
                     check_sigma("sigma_range", sr)?,
                     check_sigma("sigma_angle", sa)?,
                 ];
+                // Its range (1 or 2) is the library's: `SlidingFit::radar` refuses the others.
                 let degree = degree.unwrap_or(1);
-                if !(1..=2).contains(&degree) {
-                    return usage(format!(
-                        "degree {degree} is out of range for model='radar': 1 (constant \
-                         velocity) or 2 (constant acceleration)"
-                    ));
-                }
                 let site = site.unwrap_or((0.0, 0.0, 0.0));
                 let fit =
                     SlidingFit::radar([site.0, site.1, site.2], degree, window, epoch, solver)
