@@ -20,7 +20,7 @@
 
 use crate::error::Error;
 use crate::model::PolynomialState;
-use crate::polynomial::filter::{no_noise_sigma, PolynomialFilter};
+use crate::polynomial::filter::{finite, no_noise_sigma, PolynomialFilter};
 use crate::polynomial::spec::{AnyFilter, Inner};
 
 /// The automatic filter's cells after its written ones (with [`RowLayout::trailing`]): how
@@ -228,7 +228,7 @@ impl AnyFilter {
             .saturating_mul(stride)
             .min(rows.len());
         if !rows[..first].iter().any(|v| v.is_infinite())
-            && rows[first..].iter().fold(true, |ok, v| ok & v.is_finite())
+            && rows[first..].iter().fold(true, |ok, &v| ok & finite(v))
         {
             return Ok(());
         }
