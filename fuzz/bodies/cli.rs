@@ -15,8 +15,8 @@ use super::check;
 use super::input::Input;
 use clap::Parser;
 use seqsmooth_cli::args::{Cli, Command, Kind};
+use seqsmooth_cli::commands::{filter, fit, smooth, track};
 use seqsmooth_cli::error::CliError;
-use seqsmooth_cli::{filter, fit, smooth, track};
 use std::collections::HashMap;
 use std::path::Path;
 

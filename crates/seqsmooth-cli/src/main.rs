@@ -3,8 +3,8 @@
 
 use clap::Parser;
 use seqsmooth_cli::args::{Cli, Command};
+use seqsmooth_cli::commands::{demo, filter, fit, gains, paml, plot, smooth, track, vrf};
 use seqsmooth_cli::error::CliError;
-use seqsmooth_cli::{demo, filter, fit, gains, paml, plot, smooth, track, vrf};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {

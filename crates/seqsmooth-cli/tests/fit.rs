@@ -518,7 +518,7 @@ fn random_inputs_are_right_or_refused() {
         let Command::Fit(a) = Cli::try_parse_from(&args).unwrap().command else {
             unreachable!()
         };
-        match seqsmooth_cli::fit::run(&a) {
+        match seqsmooth_cli::commands::fit::run(&a) {
             Ok(()) => {
                 succeeded += 1;
                 let text = std::fs::read_to_string(&output).unwrap();

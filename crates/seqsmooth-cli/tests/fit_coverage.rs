@@ -24,7 +24,7 @@ use radar_tracks::{
     TURNING_RUNS,
 };
 use rayon::prelude::*;
-use seqsmooth::kalman::track::TrackFlag;
+use seqsmooth::track::TrackFlag;
 use std::fmt::Write;
 
 /// The track as the command's input: one row per measurement, empty cells where missing.

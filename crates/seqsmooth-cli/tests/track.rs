@@ -5,7 +5,7 @@
 
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use seqsmooth::kalman::track::DEFAULT_LAG;
+use seqsmooth::track::DEFAULT_LAG;
 use std::path::PathBuf;
 
 mod common;
@@ -392,7 +392,7 @@ fn random_inputs_are_right_or_refused() {
         let Command::Track(a) = Cli::try_parse_from(&args).unwrap().command else {
             unreachable!()
         };
-        match seqsmooth_cli::track::run(&a) {
+        match seqsmooth_cli::commands::track::run(&a) {
             Ok(()) => {
                 succeeded += 1;
                 let text = std::fs::read_to_string(&output).unwrap();

@@ -14,9 +14,9 @@ use pyo3::types::{PyDict, PyString, PyTuple};
 use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
 use seqsmooth::estimate::sliding::{Fitter, SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
-use seqsmooth::kalman::track::radar_row;
-use seqsmooth::kalman::track::window_flag;
 use seqsmooth::polynomial::check_degree;
+use seqsmooth::track::radar_row;
+use seqsmooth::track::window_flag;
 use seqsmooth::Error;
 
 /// A σ as `seqsmooth fit` accepts it: above 0, its square (the variance) a normal double.

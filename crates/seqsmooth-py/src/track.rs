@@ -1,4 +1,4 @@
-//! The radar tracker (`kalman::track::RadarTracker`) as a Python class, `RadarTracker`: a
+//! The radar tracker (`track::RadarTracker`) as a Python class, `RadarTracker`: a
 //! radar's range, azimuth and elevation to a constant-velocity Cartesian track by the sliding
 //! Gauss–Newton fit, the extended Kalman filter (driving noise or fading memory) or its
 //! smoother; the rows checked by the library's `radar_row`, as `seqsmooth track` checks them.
@@ -10,12 +10,12 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::estimate::gauss_newton::{GaussNewton, Measurement};
 use seqsmooth::kalman::smoother::Smoothed;
-use seqsmooth::kalman::track::{
+use seqsmooth::kalman::Discount;
+use seqsmooth::model::radar::Radar;
+use seqsmooth::track::{
     radar_row, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, DEFAULT_LAG,
     DEFAULT_WINDOW,
 };
-use seqsmooth::kalman::Discount;
-use seqsmooth::model::radar::Radar;
 use seqsmooth::Error;
 
 /// A tracker's error as its exception; `offset` is the batch's first row in the tracker's

@@ -54,8 +54,10 @@
 //!     (the automatic filter: `AutomaticFilter::new(m, θ, τ)`) then `.with_x(v)?` builders.
 //! - [`kalman`]: recursive filters over any dynamic and observation model (Morrison chs. 10,
 //!   12, 14, 15): the Bayes filter in information form, the Kalman filter (extended, iterated,
-//!   driving noise, fading memory), the Rauch–Tung–Striebel and fixed-lag smoothers, and the
-//!   radar tracker ([`kalman::track::RadarTracker`]) with its innovation monitor (§14.8).
+//!   driving noise, fading memory), the Rauch–Tung–Striebel and fixed-lag smoothers.
+//! - [`track`]: the radar tracking application over them: a radar's rows to a track
+//!   ([`track::RadarTracker`]: start-up fit, sliding fit, Kalman filter or fixed-lag
+//!   smoother) with its innovation monitor (§14.8).
 //! - [`paml`]: polynomial samples and the PAML estimate (Villien & Ostertag 2009).
 //! - [`stats`]: chi-squared tests, noise estimation, residual calibration, NIS/NEES.
 //! - [`recursive`]: the square-root information (Bayes) recursion the exact engines run on.
@@ -94,6 +96,7 @@ pub mod polynomial;
 pub mod recursive;
 pub mod scalar;
 pub mod stats;
+pub mod track;
 
 pub use error::Error;
 

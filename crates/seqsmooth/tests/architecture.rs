@@ -373,3 +373,138 @@ fn the_checker_sees_braced_relative_and_inline_paths() {
         .1;
     assert!(to > from);
 }
+
+/// In the command, no subcommand (`commands::<name>`) imports another: what two of them use is
+/// in `commands::shared`. (Subcommands share a level, so the level check alone lets them.)
+#[test]
+fn no_subcommand_imports_another() {
+    let src = root().join("crates/seqsmooth-cli/src");
+    let mut files = Vec::new();
+    rust_files(&src.join("commands"), &mut files);
+    files.sort();
+    assert!(
+        files.len() > 10,
+        "the subcommands are in crates/seqsmooth-cli/src/commands/"
+    );
+    let mut violations = Vec::new();
+    for file in &files {
+        let module = module_of(&src, file);
+        // `commands` itself (commands/mod.rs) declares the modules; `shared` is below them.
+        let Some(own) = module.get(1).filter(|own| *own != "shared") else {
+            continue;
+        };
+        let code = without_test_modules(&code_only(&fs::read_to_string(file).unwrap()));
+        for target in imports(&code, &module) {
+            if let [first, other, ..] = target.as_slice() {
+                if first == "commands" && other != own && other != "shared" {
+                    violations.push(format!(
+                        "{}: `commands::{own}` imports `{}`",
+                        file.strip_prefix(root()).unwrap_or(file).display(),
+                        target.join("::")
+                    ));
+                }
+            }
+        }
+    }
+    assert!(
+        violations.is_empty(),
+        "a subcommand imports another (move what they share into commands::shared):\n{}",
+        violations.join("\n")
+    );
+}
+
+/// The files of `src` that import each other in a circle: the strongly connected components of
+/// the graph "file `a` names a path in file `b`" (a path goes to the file whose module is its
+/// longest prefix) with more than one file, each as its files' module paths.
+fn import_circles(src: &Path) -> Vec<Vec<String>> {
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    files.sort();
+    let modules: Vec<Vec<String>> = files.iter().map(|f| module_of(src, f)).collect();
+    let index: BTreeMap<String, usize> = modules
+        .iter()
+        .enumerate()
+        .map(|(i, m)| (m.join("::"), i))
+        .collect();
+    let edges: Vec<Vec<usize>> = files
+        .iter()
+        .zip(&modules)
+        .enumerate()
+        .map(|(i, (file, module))| {
+            let code = without_test_modules(&code_only(&fs::read_to_string(file).unwrap()));
+            let mut to: Vec<usize> = imports(&code, module)
+                .iter()
+                .filter_map(|t| {
+                    (0..=t.len())
+                        .rev()
+                        .find_map(|n| index.get(&t[..n].join("::")))
+                })
+                .copied()
+                .filter(|&j| j != i)
+                .collect();
+            to.sort_unstable();
+            to.dedup();
+            to
+        })
+        .collect();
+    // reach[i]: the files reachable from file i
+    let reach: Vec<Vec<bool>> = (0..files.len())
+        .map(|start| {
+            let mut seen = vec![false; files.len()];
+            let mut stack = vec![start];
+            while let Some(i) = stack.pop() {
+                for &j in &edges[i] {
+                    if !seen[j] {
+                        seen[j] = true;
+                        stack.push(j);
+                    }
+                }
+            }
+            seen
+        })
+        .collect();
+    let mut done = vec![false; files.len()];
+    let mut circles = Vec::new();
+    for i in 0..files.len() {
+        if done[i] || !reach[i][i] {
+            continue;
+        }
+        let members: Vec<usize> = (0..files.len())
+            .filter(|&j| reach[i][j] && reach[j][i])
+            .collect();
+        for &j in &members {
+            done[j] = true;
+        }
+        circles.push(members.iter().map(|&j| modules[j].join("::")).collect());
+    }
+    circles
+}
+
+#[test]
+fn no_library_file_is_in_an_import_circle_with_more_than_one_other() {
+    let wide: Vec<Vec<String>> = import_circles(&root().join("crates/seqsmooth/src"))
+        .into_iter()
+        .filter(|c| c.len() > 2)
+        .collect();
+    assert!(
+        wide.is_empty(),
+        "files importing each other in a circle of more than two:\n{wide:#?}"
+    );
+}
+
+#[test]
+fn the_circle_finder_finds_a_circle_of_three_and_not_a_chain() {
+    let dir = std::env::temp_dir().join(format!("seqsmooth-circles-{}", std::process::id()));
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(dir.join("m")).unwrap();
+    let write = |p: &str, s: &str| fs::write(dir.join(p), s).unwrap();
+    write("lib.rs", "pub mod m;\n");
+    write("m/mod.rs", "mod a; mod b; mod c; mod d;\n");
+    write("m/a.rs", "use super::b::B;\n");
+    write("m/b.rs", "use crate::m::c::C;\n");
+    write("m/c.rs", "use super::a::A; use super::d::D;\n");
+    write("m/d.rs", "pub struct D;\n");
+    let circles = import_circles(&dir);
+    fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(circles, vec![vec!["m::a", "m::b", "m::c"]]);
+}

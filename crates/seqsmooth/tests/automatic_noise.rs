@@ -18,7 +18,6 @@ use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
 use seqsmooth::polynomial::fading::switch::memory_length_constant;
 use seqsmooth::polynomial::fading::vrf::fading_vrf;
 use seqsmooth::polynomial::form::EstimateForm;
-use seqsmooth::stats::fit_residual_variance;
 
 #[test]
 fn estimated_noise_from_differences_and_innovations() {
@@ -118,7 +117,7 @@ fn innovation_noise_estimate_equals_the_residual_variance_before_the_switch() {
     }
     assert_eq!(f.switched_at(), None);
     let fit = PolynomialFit::new(&ts, &ys, None, 2).unwrap();
-    let want = fit_residual_variance(&fit).unwrap();
+    let want = fit.residual_variance().unwrap();
     let got = f.noise_sigma().unwrap().powi(2);
     assert!((got - want).abs() < 1e-9 * want, "{got} vs {want}");
 }

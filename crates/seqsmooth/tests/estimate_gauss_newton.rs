@@ -5,9 +5,9 @@
 
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
-use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement, Prior};
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::nonlinear::NonlinearDynamics;
 use seqsmooth::model::observation::{LinearObservation, NonlinearObservation};
 use seqsmooth::model::radar::Radar;

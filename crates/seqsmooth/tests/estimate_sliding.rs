@@ -6,11 +6,11 @@
 use nalgebra::DVector;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
-use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::bootstrap;
 use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, Start};
 use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::model::radar::Radar;
 use seqsmooth::polynomial::fixed::{FixedEngine, FixedMemory};

@@ -5,10 +5,10 @@
 
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
-use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
 use seqsmooth::kalman::{BayesFilter, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::{LinearObservation, NonlinearObservation};
 
 fn m(rows: usize, cols: usize, v: &[f64]) -> DMatrix<f64> {
@@ -309,10 +309,10 @@ fn refusals() {
 /// time) is refused with the value, and the filter is as before it.
 #[test]
 fn an_estimate_beyond_the_double_range_is_refused() {
-    use seqsmooth::estimate::batch::NoiseCovariance;
-    use seqsmooth::estimate::gauss_newton::Measurement;
     use seqsmooth::kalman::BayesFilter;
     use seqsmooth::model::dynamics::PolynomialDynamics;
+    use seqsmooth::model::measurement::Measurement;
+    use seqsmooth::model::measurement::NoiseCovariance;
     use seqsmooth::model::observation::LinearObservation;
     use seqsmooth::Error;
     let row = |time: f64, y: f64| Measurement {

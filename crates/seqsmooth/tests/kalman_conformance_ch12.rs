@@ -14,12 +14,12 @@ use common::kalman::cov_err;
 use common::rational::{eye, inv, mm, to_f64, z, Q};
 use nalgebra::{DMatrix, DVector};
 use num_traits::Zero;
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};
 use seqsmooth::kalman::{BayesFilter, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::linear::LinearDynamics;
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::Error;
 

@@ -7,10 +7,10 @@
 
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::{Discount, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::polynomial::fading::gains::fading_gains;
 use seqsmooth::polynomial::fading::vrf::fading_vrf;

@@ -6,12 +6,12 @@
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
-use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement, Prior};
 use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};
 use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
 use seqsmooth::model::linear::LinearDynamics;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::stats::consistency::mean_interval;
 use seqsmooth::Error;

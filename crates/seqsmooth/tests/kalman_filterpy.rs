@@ -25,11 +25,11 @@
 //! (Cholesky solve here, an explicit inverse in filterpy) shows at that level, not above it.
 
 use nalgebra::{DMatrix, DVector};
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::LinearObservation;
 use std::collections::BTreeMap;
 

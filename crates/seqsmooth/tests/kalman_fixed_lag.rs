@@ -9,11 +9,11 @@
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::{smooth, FixedLagSmoother, KalmanFilter, Smoothed};
 use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::Error;
 
@@ -317,8 +317,8 @@ fn refusals_leave_the_smoother_unchanged() {
 /// The radar tracker's smoother at lag `lag` on `rows`: every row's σ (the six components), `None`
 /// for the rows before the smoother's.
 fn tracker_sigmas(rows: &[Measurement], q: Option<f64>, lag: usize) -> Vec<Option<[f64; 6]>> {
-    use seqsmooth::kalman::track::{RadarTracker, TrackMethod, Tracked};
     use seqsmooth::model::radar::Radar;
+    use seqsmooth::track::{RadarTracker, TrackMethod, Tracked};
     let radar = Radar::new([0.0; 3], 6).unwrap();
     let mut t = RadarTracker::new(radar, TrackMethod::Smooth { q, lag }).unwrap();
     let mut out = vec![None; rows.len()];
@@ -337,7 +337,7 @@ fn tracker_sigmas(rows: &[Measurement], q: Option<f64>, lag: usize) -> Vec<Optio
 /// landing.csv (bearing convention) with N(0, 10 m) range and N(0, 1 mrad) angle noise, seed
 /// fixed: 474 rows 2.72 s apart at 11-200 km.
 fn landing_rows() -> Vec<Measurement> {
-    use seqsmooth::kalman::track::radar_row;
+    use seqsmooth::track::radar_row;
     let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/landing.csv");
     let text = std::fs::read_to_string(path).unwrap();
     let mut rng = rand::rngs::StdRng::seed_from_u64(2026);
@@ -356,7 +356,7 @@ fn landing_rows() -> Vec<Measurement> {
 /// The straight pass of `scripts/track_memory.sh`: from (20, −15, 3) km at (−40, 25, −1) m/s,
 /// steps U(0.05, 0.15) s, σ 10 m and 1 mrad.
 fn straight_rows(n: usize) -> Vec<Measurement> {
-    use seqsmooth::kalman::track::radar_row;
+    use seqsmooth::track::radar_row;
     let mut rng = rand::rngs::StdRng::seed_from_u64(2027);
     let mut t: f64 = 0.0;
     (0..n)
@@ -383,7 +383,7 @@ fn straight_rows(n: usize) -> Vec<Measurement> {
 /// `DEFAULT_LAG` was chosen).
 #[test]
 fn the_default_lag_is_within_one_percent_of_the_whole_smoother() {
-    use seqsmooth::kalman::track::DEFAULT_LAG;
+    use seqsmooth::track::DEFAULT_LAG;
     let cases = [
         ("landing.csv, q 10", landing_rows(), Some(10.0)),
         ("straight pass, q 1", straight_rows(3000), Some(1.0)),

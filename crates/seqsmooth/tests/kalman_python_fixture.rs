@@ -7,11 +7,11 @@
 //! `crates/seqsmooth-py/tests/test_kalman.py` reads it.
 
 use nalgebra::{DMatrix, DVector};
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::{BayesFilter, Discount, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::LinearObservation;
 mod common;
 

@@ -6,11 +6,11 @@
 
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
-use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement, Prior};
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::{smooth, KalmanFilter};
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::Error;
 

@@ -4,12 +4,12 @@
 //! limit on a non-polynomial model.
 
 use nalgebra::{DMatrix, DVector};
-use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::steady::steady_state;
 use seqsmooth::kalman::{Discount, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::linear::LinearDynamics;
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::polynomial::fading::gains::fading_gains;
 use seqsmooth::polynomial::fading::vrf::fading_vrf;

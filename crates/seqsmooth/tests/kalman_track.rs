@@ -1,4 +1,4 @@
-//! `kalman::track::RadarTracker` against the same methods composed by hand from their parts
+//! `track::RadarTracker` against the same methods composed by hand from their parts
 //! (`SlidingFit`, `KalmanFilter`, `kalman::smooth`), bit for bit, on a noisy pass with
 //! irregular steps and missing components; the smoother's last row against the filter's (the
 //! RTS property); refused rows leaving the tracker as it was; refused settings.
@@ -6,16 +6,16 @@
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
-use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, Measurement};
 use seqsmooth::estimate::sliding::{SlidingFit, Start};
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
-use seqsmooth::kalman::track::{
-    window_flag, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, START_WINDOW,
-};
 use seqsmooth::kalman::{smooth, Discount, FixedLagSmoother, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::radar::Radar;
+use seqsmooth::track::{
+    window_flag, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, START_WINDOW,
+};
 
 /// `n` rows of a constant-velocity target seen from `site`, steps `U(0.5, 1.5)` s from a
 /// Unix-epoch start, σ 10 m and 1 mrad, 5% of components missing.
@@ -429,11 +429,11 @@ fn bad_settings_are_refused() {
 /// fit's SVD once looped forever; now every row is taken or refused, each quickly.
 #[test]
 fn extreme_scales_end_instead_of_looping() {
-    use seqsmooth::estimate::batch::NoiseCovariance;
-    use seqsmooth::estimate::gauss_newton::Measurement;
-    use seqsmooth::kalman::track::{RadarTracker, TrackMethod};
     use seqsmooth::kalman::Discount;
+    use seqsmooth::model::measurement::Measurement;
+    use seqsmooth::model::measurement::NoiseCovariance;
     use seqsmooth::model::radar::Radar;
+    use seqsmooth::track::{RadarTracker, TrackMethod};
     const ROWS: [[f64; 4]; 21] = [
         [
             5.189989720259441e+153,

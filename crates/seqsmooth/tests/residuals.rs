@@ -1,4 +1,4 @@
-//! The residual variance of a least-squares fit (`seqsmooth::stats::fit_residual_variance`):
+//! The residual variance of a least-squares fit (`seqsmooth::estimate::PolynomialFit::residual_variance`):
 //! unbiased and χ²-distributed, and the recursive residuals sum to the batch residual.
 //!
 //! Monte Carlo tolerances come from the sample size: a mean of `R` independent terms is checked
@@ -12,7 +12,7 @@ use common::stats::*;
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
 use seqsmooth::estimate::PolynomialFit;
-use seqsmooth::stats::{chi_squared_quantile, fit_residual_variance, residual_variance, Welford};
+use seqsmooth::stats::{chi_squared_quantile, residual_variance, Welford};
 use seqsmooth::{Engine, Error, ExpandingMemory, PolynomialFilter};
 
 #[test]
@@ -32,7 +32,7 @@ fn residual_variance_is_unbiased_and_chi_squared() {
             .map(|t| 1.0 + 0.2 * t - 0.05 * t * t + noise.sample(&mut r))
             .collect();
         let fit = PolynomialFit::new(&t, &y, None, m).unwrap();
-        let s2 = fit_residual_variance(&fit).unwrap();
+        let s2 = fit.residual_variance().unwrap();
         w.push(s2).unwrap();
         if s2 * dof / (sigma * sigma) > q95 {
             above += 1;

@@ -1,4 +1,4 @@
-//! Monte Carlo of `kalman::track::RadarTracker` at its defaults (every method): is the σ of
+//! Monte Carlo of `track::RadarTracker` at its defaults (every method): is the σ of
 //! every row it does not flag honest? (`seqsmooth fit --model radar`, the command's sliding fit
 //! without the tracker's gate, has its own run over the same tracks in
 //! `seqsmooth-cli/tests/fit_coverage.rs`.)
@@ -19,8 +19,8 @@ use common::radar_tracks::{
     landing, landing_truth, report, turning, Tally, Track, LANDING_RUNS, TURNING_RUNS,
 };
 use rayon::prelude::*;
-use seqsmooth::kalman::track::{RadarTracker, TrackMethod, Tracked, DEFAULT_WINDOW};
 use seqsmooth::model::radar::Radar;
+use seqsmooth::track::{RadarTracker, TrackMethod, Tracked, DEFAULT_WINDOW};
 
 /// One method over one track: every row pushed, the smoother's rows as it releases them and
 /// at the end.

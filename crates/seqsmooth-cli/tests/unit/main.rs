@@ -2,11 +2,7 @@
 //! behaviour end to end is in the other test targets).
 
 mod args;
-mod chart;
-mod decimate;
-mod demo;
+mod commands;
 mod error;
-mod filter;
 mod io;
 mod plot;
-mod ticks;

@@ -14,10 +14,10 @@
 
 use crate::radar;
 use nalgebra::{DMatrix, DVector, Matrix3};
-use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::Measurement;
 use seqsmooth::model::radar::Radar;
 
 /// The driving noise's spectral density on each axis, m²/s³.

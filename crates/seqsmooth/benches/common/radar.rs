@@ -12,10 +12,10 @@
 //! windows are the same on every machine and in every target that includes this file.
 
 use nalgebra::DVector;
-use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::bootstrap;
 use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::radar::{wrap, Radar};
 use seqsmooth::Error;
 use std::f64::consts::PI;

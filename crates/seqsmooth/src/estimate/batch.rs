@@ -17,34 +17,8 @@
 
 use super::observability::numerical_rank;
 use crate::error::Error;
+pub use crate::model::measurement::{is_usable_sigma, NoiseCovariance};
 use nalgebra::{Cholesky, DMatrix, DVector};
-
-/// Whether `sigma` can be a noise standard deviation: above 0 with a normal double square
-/// (the variance `σ²`, `1.5e-154 ≲ σ ≲ 1.3e154`); below, the variance is zero or subnormal and
-/// weighing by it is meaningless; above, it is infinite. The one rule of every σ the library,
-/// the command and the Python package take.
-///
-/// ```
-/// use seqsmooth::estimate::batch::is_usable_sigma;
-/// assert!(is_usable_sigma(0.5) && is_usable_sigma(1e150));
-/// assert!(!is_usable_sigma(0.0) && !is_usable_sigma(1e-160) && !is_usable_sigma(1e160));
-/// assert!(!is_usable_sigma(f64::NAN) && !is_usable_sigma(f64::INFINITY));
-/// ```
-pub fn is_usable_sigma(sigma: f64) -> bool {
-    let variance = sigma * sigma;
-    sigma > 0.0 && variance.is_finite() && variance >= f64::MIN_POSITIVE
-}
-
-/// The covariance `R` of the stacked observation errors.
-#[derive(Clone, Debug, PartialEq)]
-pub enum NoiseCovariance {
-    /// `R = I`.
-    Identity,
-    /// `R = diag(σ_k²)`, one variance per observation, each positive and finite.
-    Variances(Vec<f64>),
-    /// A full symmetric positive definite `R`.
-    Full(DMatrix<f64>),
-}
 
 /// A batch estimate: the state, its covariance, and how well the data fit.
 #[derive(Clone, Debug, PartialEq)]

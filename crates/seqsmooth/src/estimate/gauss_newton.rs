@@ -19,68 +19,13 @@
 //! of `e` still to come. The covariance reported is `S` of the last linearisation (8.6.38); for a
 //! nonlinear model it is the first-order approximation the book warns of (§11.4).
 
-use super::batch::{solve_whitened, NoiseCovariance};
+use super::batch::solve_whitened;
 use crate::error::Error;
 use crate::model::dynamics::Dynamics;
+pub use crate::model::measurement::{Measurement, NoiseCovariance};
 use crate::model::observation::Observation;
 use crate::numeric::unrolled::unrolled_sizes;
 use nalgebra::{Cholesky, DMatrix, DMatrixViewMut, DVector, DVectorViewMut, Dyn};
-
-/// One observation: its time, its components (`None` for a missing one: its row is dropped),
-/// and the covariance of its errors (of all components; the missing ones' rows and columns are
-/// dropped).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Measurement {
-    /// The time `t_k`.
-    pub time: f64,
-    /// `Y_k`, one entry per component of the observation model.
-    pub values: Vec<Option<f64>>,
-    /// `R_k`: [`NoiseCovariance::Variances`] (one per component) or [`NoiseCovariance::Full`].
-    pub noise: NoiseCovariance,
-}
-
-impl Measurement {
-    /// The present components (indices into the observation's `p`) and their values, after
-    /// the checks every estimator makes: a finite time, `p` values, each present one finite.
-    ///
-    /// ```
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
-    /// let m = Measurement { time: 1.0, values: vec![Some(2.0), None, Some(4.0)], noise: NoiseCovariance::Identity };
-    /// assert_eq!(m.present(3).unwrap(), (vec![0, 2], vec![2.0, 4.0]));
-    /// assert!(m.present(2).is_err());
-    /// ```
-    pub fn present(&self, p: usize) -> Result<(Vec<usize>, Vec<f64>), Error> {
-        if !self.time.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: self.time,
-            });
-        }
-        if self.values.len() != p {
-            return Err(Error::InvalidParameter {
-                name: "measurement",
-                value: format!("with {} components", self.values.len()),
-                reason: format!("the observation model has {p}"),
-            });
-        }
-        let mut present = Vec::with_capacity(p);
-        let mut values = Vec::with_capacity(p);
-        for (k, v) in self.values.iter().enumerate() {
-            if let Some(v) = *v {
-                if !v.is_finite() {
-                    return Err(Error::NonFinite {
-                        what: "measured value",
-                        value: v,
-                    });
-                }
-                present.push(k);
-                values.push(v);
-            }
-        }
-        Ok((present, values))
-    }
-}
 
 /// The instant the estimate refers to.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -236,7 +181,7 @@ impl GaussNewton {
     ///
     /// ```
     /// use nalgebra::DVector;
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
     /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;

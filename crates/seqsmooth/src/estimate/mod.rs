@@ -141,6 +141,22 @@ impl PolynomialFit {
         self.residual_sq
     }
 
+    /// The residual variance `e°/(N − m − 1)` of an unweighted fit of degree `m`
+    /// ([`crate::stats::residual_variance`] of this fit; for a weighted fit, the variance of
+    /// unit weight).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::PolynomialFit;
+    /// let t = [0.0, 1.0, 2.0, 3.0];
+    /// let y = [0.0, 1.0, 1.0, 2.0];
+    /// let fit = PolynomialFit::new(&t, &y, None, 1).unwrap();
+    /// // residuals -0.1, 0.3, -0.3, 0.1: e° = 0.2 over 4 − 2 dof
+    /// assert!((fit.residual_variance().unwrap() - 0.1).abs() < 1e-12);
+    /// ```
+    pub fn residual_variance(&self) -> Result<f64, Error> {
+        crate::stats::residual_variance(self.residual_sq, self.samples, self.degree + 1)
+    }
+
     /// Number of samples fitted.
     ///
     /// ```

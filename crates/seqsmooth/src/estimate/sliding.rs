@@ -46,7 +46,7 @@ pub enum Start {
 ///
 /// ```
 /// use nalgebra::DVector;
-/// use seqsmooth::estimate::batch::NoiseCovariance;
+/// use seqsmooth::model::measurement::NoiseCovariance;
 /// use seqsmooth::estimate::gauss_newton::{Epoch, Measurement};
 /// use seqsmooth::estimate::sliding::{SlidingFit, Start};
 /// use seqsmooth::model::dynamics::PolynomialDynamics;
@@ -240,7 +240,7 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
     ///
     /// ```
     /// use nalgebra::DVector;
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
     /// use seqsmooth::estimate::gauss_newton::{Epoch, Measurement};
     /// use seqsmooth::estimate::sliding::{SlidingFit, Start};
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
@@ -264,7 +264,7 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
     /// as before the measurement.
     ///
     /// ```
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
     /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
     /// use seqsmooth::estimate::sliding::SlidingFit;
     /// use seqsmooth::Error;
@@ -570,7 +570,7 @@ impl Fitter {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::estimate::batch::NoiseCovariance;
+    use crate::model::measurement::NoiseCovariance;
 
     fn value(t: f64, y: f64) -> Measurement {
         Measurement {

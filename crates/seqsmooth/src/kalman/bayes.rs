@@ -23,9 +23,9 @@
 
 use super::filter::Discount;
 use crate::error::Error;
-use crate::estimate::batch::NoiseCovariance;
-use crate::estimate::gauss_newton::Measurement;
 use crate::model::dynamics::Dynamics;
+use crate::model::measurement::Measurement;
+use crate::model::measurement::NoiseCovariance;
 use crate::model::observation::Observation;
 use crate::recursive::InformationFilter;
 use nalgebra::{Cholesky, DMatrix, DVector};
@@ -40,8 +40,8 @@ pub const MAX_VARIANCE_INFLATION: f64 = 1e11;
 ///
 /// ```
 /// use nalgebra::DVector;
-/// use seqsmooth::estimate::batch::NoiseCovariance;
-/// use seqsmooth::estimate::gauss_newton::Measurement;
+/// use seqsmooth::model::measurement::NoiseCovariance;
+/// use seqsmooth::model::measurement::Measurement;
 /// use seqsmooth::kalman::BayesFilter;
 /// use seqsmooth::model::dynamics::PolynomialDynamics;
 /// use seqsmooth::model::observation::LinearObservation;
@@ -182,8 +182,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     /// covariance. `β = 1` or `θ = 1` is the plain filter.
     ///
     /// ```
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::{BayesFilter, Discount};
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -210,8 +210,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::DVector;
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::BayesFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -228,8 +228,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::DVector;
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::BayesFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -245,8 +245,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     /// information: the covariance itself without fading memory.
     ///
     /// ```
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::{BayesFilter, Discount};
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -283,8 +283,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::DVector;
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::BayesFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -336,8 +336,8 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::DVector;
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::BayesFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;

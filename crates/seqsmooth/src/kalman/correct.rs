@@ -5,10 +5,10 @@
 //! [`crate::linalg::dense`].
 
 use crate::error::Error;
-use crate::estimate::batch::NoiseCovariance;
 use crate::linalg::dense::{
     all_finite, combine, ldl, log_det, symmetrize, times_transpose, transpose,
 };
+use crate::model::measurement::NoiseCovariance;
 use crate::numeric::unrolled::Size;
 use nalgebra::{DMatrix, DVector};
 

@@ -56,9 +56,9 @@
 use super::correct::{carry, correct_kernel, finite, noise_entries, Work};
 use super::noise::ProcessNoise;
 use crate::error::Error;
-use crate::estimate::batch::NoiseCovariance;
-use crate::estimate::gauss_newton::Measurement;
 use crate::model::dynamics::Dynamics;
+use crate::model::measurement::Measurement;
+use crate::model::measurement::NoiseCovariance;
 use crate::model::observation::Observation;
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed};
 use nalgebra::{Cholesky, DMatrix, DVector};
@@ -104,8 +104,8 @@ pub struct InnovationStats {
 ///
 /// ```
 /// use nalgebra::{DMatrix, DVector};
-/// use seqsmooth::estimate::batch::NoiseCovariance;
-/// use seqsmooth::estimate::gauss_newton::Measurement;
+/// use seqsmooth::model::measurement::NoiseCovariance;
+/// use seqsmooth::model::measurement::Measurement;
 /// use seqsmooth::kalman::KalmanFilter;
 /// use seqsmooth::model::dynamics::PolynomialDynamics;
 /// use seqsmooth::model::observation::LinearObservation;
@@ -274,8 +274,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::{Discount, KalmanFilter};
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -347,8 +347,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::KalmanFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -381,8 +381,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::KalmanFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -408,8 +408,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::KalmanFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -436,8 +436,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::KalmanFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::LinearObservation;
@@ -545,8 +545,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
-    /// use seqsmooth::estimate::batch::NoiseCovariance;
-    /// use seqsmooth::estimate::gauss_newton::Measurement;
+    /// use seqsmooth::model::measurement::NoiseCovariance;
+    /// use seqsmooth::model::measurement::Measurement;
     /// use seqsmooth::kalman::KalmanFilter;
     /// use seqsmooth::model::dynamics::PolynomialDynamics;
     /// use seqsmooth::model::observation::NonlinearObservation;

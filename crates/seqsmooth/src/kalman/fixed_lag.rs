@@ -28,8 +28,8 @@
 use super::filter::KalmanFilter;
 use super::smoother::Smoothed;
 use crate::error::Error;
-use crate::estimate::gauss_newton::Measurement;
 use crate::model::dynamics::Dynamics;
+use crate::model::measurement::Measurement;
 use crate::model::observation::Observation;
 use nalgebra::{Cholesky, DMatrix, DVector};
 use std::collections::VecDeque;
@@ -221,8 +221,8 @@ impl Window {
 ///
 /// ```
 /// use nalgebra::{DMatrix, DVector};
-/// use seqsmooth::estimate::batch::NoiseCovariance;
-/// use seqsmooth::estimate::gauss_newton::Measurement;
+/// use seqsmooth::model::measurement::NoiseCovariance;
+/// use seqsmooth::model::measurement::Measurement;
 /// use seqsmooth::kalman::fixed_lag::FixedLagSmoother;
 /// use seqsmooth::kalman::KalmanFilter;
 /// use seqsmooth::model::dynamics::PolynomialDynamics;

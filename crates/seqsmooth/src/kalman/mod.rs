@@ -11,27 +11,20 @@
 //! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run.
 //! - [`fixed_lag`]: the same smoother with a fixed lag: each measurement's estimate from the
 //!   `L` after it, in memory bounded by `L`.
-//! - [`track`]: [`track::RadarTracker`], a radar's rows to a Cartesian track by the sliding
-//!   Gauss–Newton fit, the extended Kalman filter (driving noise or fading) or its smoother.
-//! - [`adaptive`]: the tracker's innovation monitor (§14.8): the outlier gate, the window
-//!   test of the NIS, the adaptive memory, and the rows' [`track::TrackFlag`]; `memory`, the
-//!   Kalman methods' driving noise or discount at the monitor's level, and each row's gated
-//!   update through it.
 //! - [`steady`]: the fading filter's steady state (§14.7).
 //! - [`noise`]: the driving-noise covariance `Q` over a step (15.2.23), in closed form for the
 //!   polynomial model ([`noise::WhiteNoiseDerivative`]).
+//!
+//! The radar tracking application over these filters is [`crate::track`].
 
-pub mod adaptive;
 pub mod bayes;
 mod correct;
 mod discount;
 pub mod filter;
 pub mod fixed_lag;
-mod memory;
 pub mod noise;
 pub mod smoother;
 pub mod steady;
-pub mod track;
 
 pub use bayes::BayesFilter;
 pub use filter::{Discount, Innovation, KalmanFilter};

@@ -15,8 +15,8 @@
 use super::filter::KalmanFilter;
 use super::fixed_lag::FixedLagSmoother;
 use crate::error::Error;
-use crate::estimate::gauss_newton::Measurement;
 use crate::model::dynamics::Dynamics;
+use crate::model::measurement::Measurement;
 use crate::model::observation::Observation;
 use nalgebra::{DMatrix, DVector};
 
@@ -43,8 +43,8 @@ pub struct Smoothed {
 ///
 /// ```
 /// use nalgebra::{DMatrix, DVector};
-/// use seqsmooth::estimate::batch::NoiseCovariance;
-/// use seqsmooth::estimate::gauss_newton::Measurement;
+/// use seqsmooth::model::measurement::NoiseCovariance;
+/// use seqsmooth::model::measurement::Measurement;
 /// use seqsmooth::kalman::{smoother, KalmanFilter};
 /// use seqsmooth::model::dynamics::PolynomialDynamics;
 /// use seqsmooth::model::observation::LinearObservation;
@@ -78,8 +78,8 @@ pub fn smooth<D: Dynamics + Clone, O: Observation + Clone>(
 ///
 /// ```
 /// use nalgebra::{DMatrix, DVector};
-/// use seqsmooth::estimate::batch::NoiseCovariance;
-/// use seqsmooth::estimate::gauss_newton::Measurement;
+/// use seqsmooth::model::measurement::NoiseCovariance;
+/// use seqsmooth::model::measurement::Measurement;
 /// use seqsmooth::kalman::smoother::Smoother;
 /// use seqsmooth::kalman::KalmanFilter;
 /// use seqsmooth::model::dynamics::PolynomialDynamics;

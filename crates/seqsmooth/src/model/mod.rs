@@ -27,6 +27,7 @@
 
 pub mod dynamics;
 pub mod linear;
+pub mod measurement;
 pub mod nonlinear;
 pub mod observation;
 pub mod radar;

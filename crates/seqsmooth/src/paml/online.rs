@@ -64,7 +64,7 @@ impl SmootherGains {
         if let Some((j, &s)) = sigmas
             .iter()
             .enumerate()
-            .find(|(_, &s)| !crate::estimate::batch::is_usable_sigma(s))
+            .find(|(_, &s)| !crate::model::measurement::is_usable_sigma(s))
         {
             return Err(Error::InvalidParameter {
                 name: "sigmas",

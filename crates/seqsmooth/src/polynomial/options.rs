@@ -144,7 +144,7 @@ pub fn check_tau(tau: f64) -> Result<(), Error> {
 /// want rescaling (other units), not a filter. (Inside the range a covariance `σ² · VRF`,
 /// scaled by `k!/τ^k`, can still leave the double range at extreme scales.)
 pub(crate) fn check_noise_sigma(sigma: f64) -> Result<(), Error> {
-    if crate::estimate::batch::is_usable_sigma(sigma) {
+    if crate::model::measurement::is_usable_sigma(sigma) {
         return Ok(());
     }
     let reason = if sigma.is_finite() && sigma > 0.0 {

@@ -40,7 +40,7 @@ pub use chi_squared::{
 };
 pub use innovation::{ChiSquaredOutcome, InnovationChiSquared};
 pub use noise::{
-    difference_variance, fit_residual_variance, normalised_divided_difference, residual_variance,
-    reyneke_eq39_variance, reyneke_stdd, reyneke_stddw, DifferenceNoise, MAX_DIFFERENCE_ORDER,
+    difference_variance, normalised_divided_difference, residual_variance, reyneke_eq39_variance,
+    reyneke_stdd, reyneke_stddw, DifferenceNoise, MAX_DIFFERENCE_ORDER,
 };
 pub use welford::Welford;

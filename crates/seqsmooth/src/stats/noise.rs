@@ -37,7 +37,6 @@ use super::welford::Welford;
 use super::window::SlidingSum;
 use crate::calculus::choose;
 use crate::error::{check_finite, Error};
-use crate::estimate::PolynomialFit;
 use std::collections::VecDeque;
 
 fn check_values(values: &[f64]) -> Result<(), Error> {
@@ -207,22 +206,6 @@ pub fn residual_variance(
         });
     }
     Ok(residual_sq / (observations - parameters) as f64)
-}
-
-/// [`residual_variance`] of an unweighted [`PolynomialFit`] of degree `m`: `e°/(N − m − 1)`.
-/// (For a weighted fit this is the variance of unit weight.)
-///
-/// ```
-/// use seqsmooth::estimate::PolynomialFit;
-/// use seqsmooth::stats::fit_residual_variance;
-/// let t = [0.0, 1.0, 2.0, 3.0];
-/// let y = [0.0, 1.0, 1.0, 2.0];
-/// let fit = PolynomialFit::new(&t, &y, None, 1).unwrap();
-/// // residuals -0.1, 0.3, -0.3, 0.1: e° = 0.2 over 4 − 2 dof
-/// assert!((fit_residual_variance(&fit).unwrap() - 0.1).abs() < 1e-12);
-/// ```
-pub fn fit_residual_variance(fit: &PolynomialFit) -> Result<f64, Error> {
-    residual_variance(fit.residual_sq(), fit.samples(), fit.degree() + 1)
 }
 
 /// The normalised `k`-th divided difference of `k+1` samples with distinct times:

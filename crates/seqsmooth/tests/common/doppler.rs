@@ -13,11 +13,11 @@
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use rand_distr::StandardNormal;
-use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::curve::CurveModel;
-use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::NonlinearObservation;
 use seqsmooth::Error;
 

@@ -16,8 +16,8 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
-use seqsmooth::estimate::gauss_newton::Measurement;
-use seqsmooth::kalman::track::{radar_row, TrackFlag};
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::track::{radar_row, TrackFlag};
 
 pub const SIGMA_RANGE: f64 = 10.0;
 pub const SIGMA_ANGLE: f64 = 1e-3;

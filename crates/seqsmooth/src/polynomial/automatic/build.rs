@@ -1,76 +1,19 @@
 //! Building the automatic filter: [`AutomaticFilter::new`] from the required degree, discount
 //! and interval, the checked `with_*` builders (each changes its [`AutoConfig`] fields and
-//! checks every setting again), and the filters a configuration runs.
+//! checks every setting again); the filters a configuration runs are its parts' (see
+//! [`super::state`]).
 
 use super::config::AutoConfig;
 use super::filter::AutomaticFilter;
-use super::memory::shorter_memories;
 use super::misfit::MisfitResponse;
-use super::noise::{NoiseSource, NoiseState};
+use super::noise::NoiseSource;
 use super::outlier::OutlierRule;
 use super::review::Review;
+use super::state::State;
 use crate::error::Error;
-use crate::polynomial::expanding::ExpandingMemory;
-use crate::polynomial::fading::switch::memory_length_constant;
 use crate::polynomial::fading::switch::SwitchRule;
-use crate::polynomial::fading::FadingMemory;
-use crate::polynomial::options::{check_not_started, GAIN_MAX_DEGREE, MAX_DEGREE};
+use crate::polynomial::options::check_not_started;
 use crate::polynomial::options::{DiscountMode, Engine};
-use crate::stats::InnovationChiSquared;
-use std::collections::VecDeque;
-
-/// An expanding-memory filter of degree `m` tracking its covariance for unit noise (its VRF).
-pub(super) fn unit_expanding(m: usize, engine: Engine) -> Result<ExpandingMemory, Error> {
-    ExpandingMemory::new(m, engine)?.with_noise_sigma(1.0)
-}
-
-/// The fading-memory filter of degree `m` with the settings of `cfg`, tracking its VRF.
-pub(super) fn unit_fading(cfg: &AutoConfig, m: usize) -> Result<FadingMemory, Error> {
-    unit_fading_on(cfg, m, cfg.engine, cfg.theta)
-}
-
-/// [`unit_fading`] on the given engine and discount `θ` per `τ`.
-pub(super) fn unit_fading_on(
-    cfg: &AutoConfig,
-    m: usize,
-    engine: Engine,
-    theta: f64,
-) -> Result<FadingMemory, Error> {
-    FadingMemory::new(m, theta, cfg.tau, engine)?
-        .with_discount_mode(cfg.discount)?
-        .with_switch_rule(cfg.switch_rule)?
-        .with_noise_sigma(1.0)
-}
-
-/// The degree `m + 1` of the companions and their engine, when `m + 1` is a supported degree;
-/// the exact engine where the configured gain engine stops ([`GAIN_MAX_DEGREE`]): they only
-/// measure the bias.
-pub(super) fn upper_degree(cfg: &AutoConfig) -> Option<(usize, Engine)> {
-    let u = cfg.degree + 1;
-    if u > MAX_DEGREE {
-        return None;
-    }
-    let engine = if cfg.engine == Engine::Gain && u > GAIN_MAX_DEGREE {
-        Engine::Exact
-    } else {
-        cfg.engine
-    };
-    Some((u, engine))
-}
-
-/// The degree `m + 1` companions (expanding, fading) of the final degree (see
-/// [`upper_degree`]).
-pub(super) fn upper_pair(
-    cfg: &AutoConfig,
-) -> Result<(Option<ExpandingMemory>, Option<FadingMemory>), Error> {
-    let Some((u, engine)) = upper_degree(cfg) else {
-        return Ok((None, None));
-    };
-    Ok((
-        Some(unit_expanding(u, engine)?),
-        Some(unit_fading_on(cfg, u, engine, cfg.theta)?),
-    ))
-}
 
 /// The `with_*` builders of [`AutomaticFilter`]: each changes the fields of its
 /// [`AutoConfig`] given on the right, and checks every setting again (an error after the first
@@ -92,66 +35,11 @@ impl AutomaticFilter {
     /// The filter of a checked configuration.
     pub(super) fn build(config: AutoConfig) -> Result<Self, Error> {
         config.validate()?;
-        let chi = InnovationChiSquared::new(config.misfit_window, config.misfit_alpha)?;
-        let restart_test = match config.misfit_response {
-            MisfitResponse::Flag => None,
-            MisfitResponse::Restart { alpha } => {
-                Some(InnovationChiSquared::new(config.misfit_window, alpha)?)
-            }
-        };
-        let m = config.degree;
-        let ladder = (0..m)
-            .map(|d| {
-                if d >= config.start_degree {
-                    unit_expanding(d, config.engine).map(Some)
-                } else {
-                    Ok(None)
-                }
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let expanding = Some(unit_expanding(m, config.engine)?);
-        let fading = unit_fading(&config, m)?;
-        let (upper_expanding, upper_fading) = upper_pair(&config)?;
-        let shorter = shorter_memories(&config)?;
-        let noise = NoiseState::new(
-            config.noise_sigma,
-            config.noise_source,
-            m,
-            config.noise_screen,
-        )?;
+        let review = Review::new(&config);
         Ok(Self {
-            active: config.start_degree,
-            memory_constant: memory_length_constant(0, m),
-            switch_constant: config.switch_rule.asymptotic_constant(m),
-            cfg: config,
-            ladder,
-            expanding,
-            fading,
-            upper_expanding,
-            upper_fading,
-            shorter,
-            memory: 0,
-            longer_runs: 0,
-            predictions: Vec::new(),
-            calibration: Vec::new(),
-            switched_at: None,
-            switched: false,
-            memory_t_first: None,
-            accepted: 0,
-            rejected: 0,
-            restarts: 0,
-            last_restart: None,
-            last_time: None,
-            noise,
-            chi,
-            restart_test,
-            recent: VecDeque::new(),
-            pending: Vec::new(),
-            stable_runs: 0,
-            prev_top: None,
+            state: State::new(config)?,
+            review,
             last_output: None,
-            excess: 0.0,
-            review: Review::default(),
         })
     }
 
@@ -179,8 +67,11 @@ impl AutomaticFilter {
     /// The same filter with one setting changed and every setting checked again; an error
     /// after the first sample.
     fn reconfigure(self, change: impl FnOnce(&mut AutoConfig)) -> Result<Self, Error> {
-        check_not_started(self.last_time.is_some(), "the automatic filter's settings")?;
-        let mut config = self.cfg;
+        check_not_started(
+            self.state.last_time().is_some(),
+            "the automatic filter's settings",
+        )?;
+        let mut config = self.state.config().clone();
         change(&mut config);
         Self::build(config)
     }

@@ -6,7 +6,6 @@
 use super::misfit::MisfitResponse;
 use super::noise::NoiseSource;
 use super::outlier::OutlierRule;
-use super::review::MAX_REVIEW_WINDOW;
 use crate::error::Error;
 use crate::polynomial::fading::switch::SwitchRule;
 use crate::polynomial::options::{check_engine_degree, check_tau, check_theta};
@@ -32,6 +31,16 @@ pub const GATE_MAX_VRF: f64 = 1.0;
 /// assert!(f.with_memory_levels(MAX_MEMORY_LEVELS + 1).is_err());
 /// ```
 pub const MAX_MEMORY_LEVELS: usize = 16;
+
+/// The largest [`AutoConfig::review_window`].
+///
+/// ```
+/// use seqsmooth::polynomial::automatic::{AutomaticFilter, MAX_REVIEW_WINDOW};
+/// let f = AutomaticFilter::new(2, 0.9, 1.0).unwrap();
+/// assert!(f.clone().with_review_window(MAX_REVIEW_WINDOW).is_ok());
+/// assert!(f.with_review_window(MAX_REVIEW_WINDOW + 1).is_err());
+/// ```
+pub const MAX_REVIEW_WINDOW: usize = 31;
 
 /// Every setting of the [`AutomaticFilter`](super::AutomaticFilter), as its builders set them
 /// (read with [`AutomaticFilter::config`](super::AutomaticFilter::config)).

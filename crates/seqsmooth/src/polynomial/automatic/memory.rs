@@ -20,20 +20,25 @@
 //! `1 − θ → ≈ 2(1 − θ)`) divides the bias by `≈ 2^(m+1)` and about doubles the VRF. Memory
 //! `j = 0` is the configured one (expanding until the switch, then fading); the shorter memories
 //! are fading from the first sample (exact discounted least squares, on the exact engine always); a
-//! restart rebuilds them all from the onset.
+//! restart rebuilds them all from the onset
+//! ([`Memories::rebuild`]). The expanding → fading switch of memory 0 is here too (Morrison
+//! §13.8, (13.8.8); Reyneke et al. §7.2, Table 1): the rule's sample index for the discount per
+//! sample so far, re-evaluated at each sample until the switch.
 
 use super::bias::position_bias;
-use super::build::{unit_fading_on, upper_degree};
-use super::filter::AutomaticFilter;
-use super::misfit::MisfitResponse;
-#[cfg(doc)]
-use super::AutoConfig;
-use super::AutoConfig as Config;
-use super::MAX_MEMORY_LEVELS;
+use super::config::{AutoConfig, MAX_MEMORY_LEVELS};
+use super::misfit::{Kept, MisfitResponse};
 use crate::error::Error;
+use crate::polynomial::expanding::vrf::expanding_vrf;
+use crate::polynomial::expanding::ExpandingMemory;
+use crate::polynomial::fading::switch::memory_length_constant;
+#[cfg(doc)]
+use crate::polynomial::fading::switch::SwitchRule;
+use crate::polynomial::fading::vrf::fading_vrf;
 use crate::polynomial::fading::FadingMemory;
 use crate::polynomial::filter::PolynomialFilter;
-use crate::polynomial::options::Engine;
+use crate::polynomial::form::EstimateForm;
+use crate::polynomial::options::{DiscountMode, Engine, GAIN_MAX_DEGREE, MAX_DEGREE};
 
 /// A memory's position at the prediction's time and its companion's, each `(x, v)` with its
 /// unit variance `v` (`None`: not determined).
@@ -49,7 +54,7 @@ const MIN_THETA: f64 = 1e-3;
 /// times the noise of the estimate, near Morrison §7.13's balance).
 const CHOICE_SIGNIFICANCE: f64 = 2.5;
 
-/// The calibration of [`AutomaticFilter::calibrate`] averages over about this many samples.
+/// The calibration of [`Memories::calibrate`] averages over about this many samples.
 const CALIBRATION_MEMORY: u64 = 20;
 
 /// Samples a memory's calibration needs before it widens the reported error.
@@ -59,19 +64,68 @@ const CALIBRATION_MIN: u64 = 5;
 /// predictions in a row.
 pub(super) const LENGTHEN_AFTER: usize = 10;
 
+/// An expanding-memory filter of degree `m` tracking its covariance for unit noise (its VRF).
+pub(super) fn unit_expanding(m: usize, engine: Engine) -> Result<ExpandingMemory, Error> {
+    ExpandingMemory::new(m, engine)?.with_noise_sigma(1.0)
+}
+
+/// The fading-memory filter of degree `m` with the settings of `cfg` on the given engine and
+/// discount `θ` per `τ`, tracking its VRF.
+fn unit_fading_on(
+    cfg: &AutoConfig,
+    m: usize,
+    engine: Engine,
+    theta: f64,
+) -> Result<FadingMemory, Error> {
+    FadingMemory::new(m, theta, cfg.tau, engine)?
+        .with_discount_mode(cfg.discount)?
+        .with_switch_rule(cfg.switch_rule)?
+        .with_noise_sigma(1.0)
+}
+
+/// The degree `m + 1` of the companions and their engine, when `m + 1` is a supported degree;
+/// the exact engine where the configured gain engine stops ([`GAIN_MAX_DEGREE`]): they only
+/// measure the bias.
+fn upper_degree(cfg: &AutoConfig) -> Option<(usize, Engine)> {
+    let u = cfg.degree + 1;
+    if u > MAX_DEGREE {
+        return None;
+    }
+    let engine = if cfg.engine == Engine::Gain && u > GAIN_MAX_DEGREE {
+        Engine::Exact
+    } else {
+        cfg.engine
+    };
+    Some((u, engine))
+}
+
+/// The degree `m + 1` companions (expanding, fading) of the final degree (see
+/// [`upper_degree`]).
+type UpperPair = (Option<ExpandingMemory>, Option<FadingMemory>);
+
+fn upper_pair(cfg: &AutoConfig) -> Result<UpperPair, Error> {
+    let Some((u, engine)) = upper_degree(cfg) else {
+        return Ok((None, None));
+    };
+    Ok((
+        Some(unit_expanding(u, engine)?),
+        Some(unit_fading_on(cfg, u, engine, cfg.theta)?),
+    ))
+}
+
 /// A shorter memory of the final degree: the degree-`m` fading-memory filter of discount
 /// `θ^(2^j)` per `τ` and its degree `m + 1` companion.
 #[derive(Clone, Debug)]
-pub(super) struct Shorter {
-    pub(super) fading: FadingMemory,
-    pub(super) upper: FadingMemory,
+struct Shorter {
+    fading: FadingMemory,
+    upper: FadingMemory,
 }
 
 /// The shorter memories of `cfg` (none when `m + 1` is not a supported degree: without the
 /// companion there is no bias estimate to choose by), on the exact engine whatever the
 /// configured one: exact discounted least squares from the first sample, whose short memories
 /// the gain engine's step-by-step gains would follow less accurately on irregular steps.
-pub(super) fn shorter_memories(cfg: &Config) -> Result<Vec<Shorter>, Error> {
+fn shorter_memories(cfg: &AutoConfig) -> Result<Vec<Shorter>, Error> {
     let Some((u, _)) = upper_degree(cfg) else {
         return Ok(Vec::new());
     };
@@ -90,9 +144,138 @@ pub(super) fn shorter_memories(cfg: &Config) -> Result<Vec<Shorter>, Error> {
     Ok(out)
 }
 
-impl AutomaticFilter {
+/// The final degree's memories (see the module docs): memory 0 (expanding until the switch,
+/// then fading) and the shorter ones, each with its degree `m + 1` companion; which one is in
+/// use, and each one's calibration.
+#[derive(Clone, Debug)]
+pub(super) struct Memories {
+    /// The final-degree expanding-memory filter of the current memory, until the switch.
+    expanding: Option<ExpandingMemory>,
+    /// The final-degree fading-memory filter of the current memory.
+    fading: FadingMemory,
+    /// Degree `m + 1` companions of `expanding` and `fading` on the same samples (for the bias
+    /// of the final degree; `None` at `m = MAX_DEGREE`, the expanding one after the switch).
+    upper_expanding: Option<ExpandingMemory>,
+    upper_fading: Option<FadingMemory>,
+    /// The shorter memories `θ^(2^j)`, `j = 1 … J`, of the final degree.
+    shorter: Vec<Shorter>,
+    /// The memory in use (0: the configured `θ`).
+    memory: usize,
+    /// Predictions in a row for which a longer memory had the least estimated error.
+    longer_runs: usize,
+    /// Each memory's prediction of the newest sample and its honest mean square.
+    predictions: Vec<Option<(f64, f64)>>,
+    /// Each memory's running mean of `ν²/σ_ε²` and its count ([`Memories::calibrate`]).
+    calibration: Vec<(f64, u64)>,
+    /// Global index (accepted samples) of the latest expanding → fading switch.
+    switched_at: Option<u64>,
+    /// The current memory 0 has switched to fading.
+    switched: bool,
+    /// Time of the first sample of the current memories.
+    t_first: Option<f64>,
+    /// `c` of a constant switch rule (`n_s = ⌊c/(1-θ)⌋`), and `c_0m` for Reyneke's `N`.
+    switch_constant: Option<f64>,
+    memory_constant: f64,
+}
+
+impl Memories {
+    /// The memories of `cfg`'s final degree, before the first sample.
+    pub(super) fn new(cfg: &AutoConfig) -> Result<Self, Error> {
+        let m = cfg.degree;
+        let expanding = Some(unit_expanding(m, cfg.engine)?);
+        let fading = unit_fading_on(cfg, m, cfg.engine, cfg.theta)?;
+        let (upper_expanding, upper_fading) = upper_pair(cfg)?;
+        Ok(Self {
+            expanding,
+            fading,
+            upper_expanding,
+            upper_fading,
+            shorter: shorter_memories(cfg)?,
+            memory: 0,
+            longer_runs: 0,
+            predictions: Vec::new(),
+            calibration: Vec::new(),
+            switched_at: None,
+            switched: false,
+            t_first: None,
+            switch_constant: cfg.switch_rule.asymptotic_constant(m),
+            memory_constant: memory_length_constant(0, m),
+        })
+    }
+
+    /// The memories rebuilt from the `kept` samples (a restart, [`MisfitResponse::Restart`]):
+    /// memory 0 expanding again, the calibration cleared.
+    pub(super) fn rebuild(&mut self, cfg: &AutoConfig, kept: &[Kept]) -> Result<(), Error> {
+        let mut expanding = unit_expanding(cfg.degree, cfg.engine)?;
+        let mut fading = unit_fading_on(cfg, cfg.degree, cfg.engine, cfg.theta)?;
+        let (mut upper_expanding, mut upper_fading) = upper_pair(cfg)?;
+        let mut shorter = shorter_memories(cfg)?;
+        for k in kept {
+            for s in &mut shorter {
+                s.fading.update(k.t, k.y)?;
+                s.upper.update(k.t, k.y)?;
+            }
+            expanding.update(k.t, k.y)?;
+            fading.update(k.t, k.y)?;
+            if let Some(f) = &mut upper_expanding {
+                f.update(k.t, k.y)?;
+            }
+            if let Some(f) = &mut upper_fading {
+                f.update(k.t, k.y)?;
+            }
+        }
+        self.expanding = Some(expanding);
+        self.fading = fading;
+        self.upper_expanding = upper_expanding;
+        self.upper_fading = upper_fading;
+        self.shorter = shorter;
+        self.memory = 0;
+        self.longer_runs = 0;
+        self.calibration.clear();
+        self.switched = false;
+        self.t_first = kept.first().map(|k| k.t);
+        Ok(())
+    }
+
+    /// Applies an accepted sample to every memory and companion.
+    pub(super) fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
+        if let Some(f) = &mut self.expanding {
+            f.update(t, y)?;
+        }
+        self.fading.update(t, y)?;
+        if let Some(f) = &mut self.upper_expanding {
+            f.update(t, y)?;
+        }
+        if let Some(f) = &mut self.upper_fading {
+            f.update(t, y)?;
+        }
+        for s in &mut self.shorter {
+            s.fading.update(t, y)?;
+            s.upper.update(t, y)?;
+        }
+        if self.t_first.is_none() {
+            self.t_first = Some(t);
+        }
+        Ok(())
+    }
+
+    /// The index `j` of the memory in use.
+    pub(super) fn in_use(&self) -> usize {
+        self.memory
+    }
+
+    /// Memory 0 has switched to fading.
+    pub(super) fn switched(&self) -> bool {
+        self.switched
+    }
+
+    /// The index (in accepted samples) of the latest switch.
+    pub(super) fn switched_at(&self) -> Option<u64> {
+        self.switched_at
+    }
+
     /// The final-degree filter of memory `j` (0: the configured `θ`, expanding until the switch).
-    pub(super) fn memory_filter(&self, j: usize) -> &dyn PolynomialFilter {
+    pub(super) fn filter(&self, j: usize) -> &dyn PolynomialFilter {
         match (j, &self.expanding, self.switched) {
             (0, Some(e), false) => e,
             (0, _, _) => &self.fading,
@@ -101,7 +284,7 @@ impl AutomaticFilter {
     }
 
     /// The position at `t` and its unit variance from memory `j`'s filter, without allocating.
-    pub(super) fn memory_position(&self, j: usize, t: f64) -> Option<(f64, f64)> {
+    pub(super) fn position(&self, j: usize, t: f64) -> Option<(f64, f64)> {
         match (j, &self.expanding, self.switched) {
             (0, Some(e), false) => e.position_at(t),
             (0, _, _) => self.fading.position_at(t),
@@ -109,8 +292,18 @@ impl AutomaticFilter {
         }
     }
 
+    /// The derivatives at `t` of memory `j`'s filter and their variances into `x` and `var`
+    /// (false when it is not determined or has no such path).
+    pub(super) fn variances(&self, j: usize, t: f64, x: &mut [f64], var: &mut [f64]) -> bool {
+        match (j, &self.expanding, self.switched) {
+            (0, Some(e), false) => e.variances_at(t, x, var),
+            (0, _, _) => self.fading.variances_at(t, x, var),
+            (j, _, _) => self.shorter[j - 1].fading.variances_at(t, x, var),
+        }
+    }
+
     /// The position at `t` and its unit variance from memory `j`'s companion.
-    pub(super) fn memory_companion_position(&self, j: usize, t: f64) -> Option<(f64, f64)> {
+    pub(super) fn companion_position(&self, j: usize, t: f64) -> Option<(f64, f64)> {
         if j > 0 {
             return self.shorter[j - 1].upper.position_at(t);
         }
@@ -121,8 +314,26 @@ impl AutomaticFilter {
         }
     }
 
+    /// [`variances`](Self::variances) of memory `j`'s companion.
+    pub(super) fn companion_variances(
+        &self,
+        j: usize,
+        t: f64,
+        x: &mut [f64],
+        var: &mut [f64],
+    ) -> bool {
+        if j > 0 {
+            return self.shorter[j - 1].upper.variances_at(t, x, var);
+        }
+        match (&self.upper_expanding, &self.upper_fading, self.switched) {
+            (Some(e), _, false) => e.variances_at(t, x, var),
+            (_, Some(f), _) => f.variances_at(t, x, var),
+            _ => false,
+        }
+    }
+
     /// The degree `m + 1` companion of memory `j`.
-    pub(super) fn memory_companion(&self, j: usize) -> Option<&dyn PolynomialFilter> {
+    pub(super) fn companion(&self, j: usize) -> Option<&dyn PolynomialFilter> {
         if j > 0 {
             return Some(&self.shorter[j - 1].upper);
         }
@@ -138,18 +349,24 @@ impl AutomaticFilter {
     /// use; a longer one only one level at a time, once it has been the least for
     /// [`LENGTHEN_AFTER`] predictions in a row (Morrison §14.8: the memory is lengthened again
     /// once the crossings cease; a single low `b̂` is not evidence enough). Memory 0 while the
-    /// ladder settles or without `σ`. Returns, when it compared the memories, the chosen one's
-    /// position at `t` and its companion's (each with its unit variance, as
-    /// [`memory_position`](Self::memory_position) and
-    /// [`memory_companion_position`](Self::memory_companion_position) give them): the
-    /// prediction's, computed once.
-    pub(super) fn choose_memory(&mut self, t: f64) -> Option<Positions> {
-        let Some(sigma) = self.noise_sigma() else {
+    /// ladder settles (`settled` false), without `σ` or with the flag-only response. Returns,
+    /// when it compared the memories, the chosen one's position at `t` and its companion's
+    /// (each with its unit variance, as [`position`](Self::position) and
+    /// [`companion_position`](Self::companion_position) give them): the prediction's, computed
+    /// once.
+    pub(super) fn choose(
+        &mut self,
+        cfg: &AutoConfig,
+        t: f64,
+        sigma: Option<f64>,
+        settled: bool,
+    ) -> Option<Positions> {
+        let Some(sigma) = sigma else {
             self.memory = 0;
             return None;
         };
-        let responds = matches!(self.cfg.misfit_response, MisfitResponse::Restart { .. });
-        if self.active < self.cfg.degree || self.shorter.is_empty() || !responds {
+        let responds = matches!(cfg.misfit_response, MisfitResponse::Restart { .. });
+        if !settled || self.shorter.is_empty() || !responds {
             self.memory = 0;
             return None;
         }
@@ -160,10 +377,10 @@ impl AutomaticFilter {
         let mut positions = [(None, None); MAX_MEMORY_LEVELS + 1];
         let memories = self.shorter.len() + 1;
         for (j, slot) in positions.iter_mut().enumerate().take(memories) {
-            let Some(est) = self.memory_position(j, t) else {
+            let Some(est) = self.position(j, t) else {
                 continue;
             };
-            let upper = self.memory_companion_position(j, t);
+            let upper = self.companion_position(j, t);
             *slot = (Some(est), upper);
             let (b0, honest) = match upper {
                 Some(u) => (
@@ -214,12 +431,12 @@ impl AutomaticFilter {
 
     /// The factor of the reported mean squared error of the memory in use:
     /// `max(1, mean(ν²/σ_ε²))` over its recent accepted samples ([`calibrate`](Self::calibrate)),
-    /// once it has [`CALIBRATION_MIN`] of them, while the final degree is active; 1 otherwise.
-    /// The honest covariance `σ² V + b̂ b̂ᵀ` is an estimate; where the memory's own innovations
-    /// say its predictions err more than it, the reported error is widened by the same ratio
-    /// (the gate is not: it keeps its false-alarm rate by the noise model alone).
-    pub(super) fn calibration_factor(&self) -> f64 {
-        if self.active < self.cfg.degree {
+    /// once it has [`CALIBRATION_MIN`] of them, while the final degree is active (`settled`); 1
+    /// otherwise. The honest covariance `σ² V + b̂ b̂ᵀ` is an estimate; where the memory's own
+    /// innovations say its predictions err more than it, the reported error is widened by the
+    /// same ratio (the gate is not: it keeps its false-alarm rate by the noise model alone).
+    pub(super) fn calibration_factor(&self, settled: bool) -> f64 {
+        if !settled {
             return 1.0;
         }
         match self.calibration.get(self.memory) {
@@ -228,25 +445,64 @@ impl AutomaticFilter {
         }
     }
 
-    /// The index `j` of the memory in use: the final degree's discount is `θ^(2^j)` per `τ`
-    /// (0: the configured `θ`; see the [module docs](super) and
-    /// [`AutoConfig::memory_levels`]).
-    ///
-    /// ```
-    /// use seqsmooth::polynomial::automatic::AutomaticFilter;
-    /// let mut f = AutomaticFilter::new(1, 0.95, 1.0).unwrap().with_noise_sigma(0.1).unwrap();
-    /// let mut shortest = 0;
-    /// for n in 0..400 {
-    ///     let t = n as f64;
-    ///     // a straight line, then a turn (0.02 t² from t = 200) that degree 1 does not model
-    ///     let y = 0.5 * t + if t > 200.0 { 0.02 * (t - 200.0).powi(2) } else { 0.0 };
-    ///     f.update(t, y).unwrap();
-    ///     if n == 199 { assert_eq!(f.memory(), 0); } // the line: the longest memory
-    ///     shortest = shortest.max(f.memory());
-    /// }
-    /// assert!(shortest > 0); // the turn: a shorter memory
-    /// ```
-    pub fn memory(&self) -> usize {
-        self.memory
+    /// Reyneke's memory length `N = c_0m/(1-θ_s)` of the memory in use at `t`, once it fades
+    /// (switched, or a shorter memory); `None` before (the caller counts samples).
+    pub(super) fn faded_length(&self, cfg: &AutoConfig, t: f64) -> Option<f64> {
+        (self.switched || self.memory > 0).then(|| {
+            // The memory in use discounts by θ^(2^j) per sample.
+            let theta = self.theta_per_sample(cfg, t).powi(1 << self.memory);
+            self.memory_constant / (1.0 - theta)
+        })
+    }
+
+    /// The discount per sample the switch rules use: `θ` per update, or `θ^ζ̄` with `ζ̄` the mean
+    /// step of the current memory so far (including `t`) in units of `τ`.
+    fn theta_per_sample(&self, cfg: &AutoConfig, t: f64) -> f64 {
+        let n = self.fading.samples();
+        let th = match (cfg.discount, self.t_first) {
+            (DiscountMode::PerTime, Some(t0)) if n > 0 => {
+                let zeta = (t - t0) / (n as f64 * cfg.tau);
+                cfg.theta.powf(zeta)
+            }
+            _ => cfg.theta,
+        };
+        th.clamp(1e-300, 1.0 - 1e-15)
+    }
+
+    /// Switches memory 0 from expanding to fading when the rule says so for its next sample at
+    /// time `t` (`accepted` samples so far): the rule's index for the per-sample discount so
+    /// far, exactly as [`SwitchRule::switch_index`] (and the gain engine) computes it.
+    pub(super) fn switch_if_due(
+        &mut self,
+        cfg: &AutoConfig,
+        t: f64,
+        accepted: u64,
+    ) -> Result<(), Error> {
+        if self.switched {
+            return Ok(());
+        }
+        let m = cfg.degree;
+        let n = self.fading.samples();
+        if n <= m as u64 {
+            return Ok(());
+        }
+        let theta_s = self.theta_per_sample(cfg, t);
+        // The exact crossover: the expanding-memory current position VRF reaches the
+        // fading-memory one.
+        let due = cfg
+            .switch_rule
+            .switches(m, n, theta_s, self.switch_constant, || {
+                Ok((
+                    expanding_vrf::<f64>(m, n, EstimateForm::Current)?[(0, 0)],
+                    fading_vrf(m, theta_s, EstimateForm::Current)?[(0, 0)],
+                ))
+            })?;
+        if due {
+            self.switched = true;
+            self.switched_at = Some(accepted);
+            self.expanding = None;
+            self.upper_expanding = None;
+        }
+        Ok(())
     }
 }

@@ -2,11 +2,9 @@
 //! innovation chi-squared test, and the restart of the final-degree memory from the estimated
 //! onset of the manoeuvre (a CUSUM change point).
 
-use super::build::{unit_expanding, unit_fading, upper_pair};
-use super::filter::AutomaticFilter;
-use super::memory::shorter_memories;
 use crate::error::Error;
-use crate::polynomial::filter::PolynomialFilter;
+use crate::stats::{ChiSquaredOutcome, InnovationChiSquared};
+use std::collections::VecDeque;
 
 /// What the filter does when its innovations say the model no longer fits (Morrison §14.8).
 ///
@@ -118,52 +116,119 @@ fn misfit_onset(recent: &[Kept], window: usize, m: usize) -> usize {
     best.1.min(len.saturating_sub(m + 1))
 }
 
-impl AutomaticFilter {
-    /// Restarts the final-degree memory from the samples since the estimated onset of the
-    /// misfit ([`misfit_onset`]), with at least `m + 1` samples (so the state stays determined).
-    pub(super) fn restart(&mut self) -> Result<(), Error> {
-        let m = self.cfg.degree;
-        let recent: Vec<Kept> = self.recent.iter().copied().collect();
-        // m + 2 samples at least: the degree m + 1 companion is determined (its bias estimate).
-        let start = misfit_onset(&recent, self.cfg.misfit_window, m + 1);
-        let kept = &recent[start..];
-        let mut expanding = unit_expanding(m, self.cfg.engine)?;
-        let mut fading = unit_fading(&self.cfg, m)?;
-        let (mut upper_expanding, mut upper_fading) = upper_pair(&self.cfg)?;
-        let mut shorter = shorter_memories(&self.cfg)?;
-        for k in kept {
-            for s in &mut shorter {
-                s.fading.update(k.t, k.y)?;
-                s.upper.update(k.t, k.y)?;
-            }
-            expanding.update(k.t, k.y)?;
-            fading.update(k.t, k.y)?;
-            if let Some(f) = &mut upper_expanding {
-                f.update(k.t, k.y)?;
-            }
-            if let Some(f) = &mut upper_fading {
-                f.update(k.t, k.y)?;
-            }
+/// The misfit tests and what a restart needs (Morrison §14.8): the innovation chi-squared
+/// window of the flag, the stricter one of the restart ([`MisfitResponse::Restart`]), the
+/// newest accepted samples, and the restarts so far.
+#[derive(Clone, Debug)]
+pub(super) struct Misfit {
+    chi: InnovationChiSquared,
+    restart_test: Option<InnovationChiSquared>,
+    /// The newest accepted samples (for a restart), at most `keep`.
+    recent: VecDeque<Kept>,
+    keep: usize,
+    /// The misfit window `K` (the onset is looked for in its last `K` samples).
+    window: usize,
+    restarts: u64,
+    last_restart: Option<u64>,
+}
+
+impl Misfit {
+    /// The tests of window `window` and false-alarm rate `alpha`, the restart's per
+    /// `response`, keeping the newest `keep` accepted samples.
+    pub(super) fn new(
+        window: usize,
+        alpha: f64,
+        response: MisfitResponse,
+        keep: usize,
+    ) -> Result<Self, Error> {
+        let chi = InnovationChiSquared::new(window, alpha)?;
+        let restart_test = match response {
+            MisfitResponse::Flag => None,
+            MisfitResponse::Restart { alpha } => Some(InnovationChiSquared::new(window, alpha)?),
+        };
+        Ok(Self {
+            chi,
+            restart_test,
+            recent: VecDeque::new(),
+            keep,
+            window,
+            restarts: 0,
+            last_restart: None,
+        })
+    }
+
+    /// Keeps an accepted sample and adds its `ν²/σ_ε²` (when it has one) to both tests; the
+    /// flag's window after it.
+    pub(super) fn push(&mut self, sample: Kept) -> Result<Option<ChiSquaredOutcome>, Error> {
+        self.recent.push_back(sample);
+        while self.recent.len() > self.keep {
+            self.recent.pop_front();
         }
-        self.expanding = Some(expanding);
-        self.fading = fading;
-        self.upper_expanding = upper_expanding;
-        self.upper_fading = upper_fading;
-        self.shorter = shorter;
-        self.memory = 0;
-        self.longer_runs = 0;
-        self.calibration.clear();
-        self.switched = false;
-        self.memory_t_first = kept.first().map(|k| k.t);
+        match sample.k2 {
+            Some(k2) => {
+                if let Some(r) = &mut self.restart_test {
+                    r.push_normalised(k2)?;
+                }
+                Ok(Some(self.chi.push_normalised(k2)?))
+            }
+            None => Ok(None),
+        }
+    }
+
+    /// The flag's test says the model no longer fits.
+    pub(super) fn is_misfit(&self) -> bool {
+        self.chi.is_misfit()
+    }
+
+    /// The flag's window (for the innovations' excess).
+    pub(super) fn chi(&self) -> &InnovationChiSquared {
+        &self.chi
+    }
+
+    /// The response restarts the memory ([`MisfitResponse::Restart`]).
+    pub(super) fn restarts_memory(&self) -> bool {
+        self.restart_test.is_some()
+    }
+
+    /// The restart's test says the memory must restart.
+    pub(super) fn restart_due(&self) -> bool {
+        self.restart_test.as_ref().is_some_and(|r| r.is_misfit())
+    }
+
+    /// Both windows start again (a new degree or memory).
+    pub(super) fn reset(&mut self) {
         self.chi.reset();
         if let Some(r) = &mut self.restart_test {
             r.reset();
         }
-        // The kept samples' innovations belong to the old memory.
+    }
+
+    /// The samples since the estimated onset of the misfit ([`misfit_onset`]), at least
+    /// `m + 2` of them (so that the degree `m + 1` companion is determined: its bias estimate).
+    pub(super) fn since_onset(&self, m: usize) -> Vec<Kept> {
+        let recent: Vec<Kept> = self.recent.iter().copied().collect();
+        let start = misfit_onset(&recent, self.window, m + 1);
+        recent[start..].to_vec()
+    }
+
+    /// The memory restarted from `kept` ([`since_onset`](Self::since_onset)) when `accepted`
+    /// samples were in: the windows start again, and the kept samples' innovations, which
+    /// belong to the old memory, are forgotten.
+    pub(super) fn restarted(&mut self, kept: &[Kept], accepted: u64) {
+        self.reset();
         self.recent = kept.iter().map(|k| Kept { k2: None, ..*k }).collect();
         self.restarts += 1;
-        self.last_restart = Some(self.accepted.saturating_sub(1));
-        Ok(())
+        self.last_restart = Some(accepted.saturating_sub(1));
+    }
+
+    /// Restarts so far.
+    pub(super) fn restarts(&self) -> u64 {
+        self.restarts
+    }
+
+    /// The index (in accepted samples) of the newest sample at the latest restart.
+    pub(super) fn last_restart(&self) -> Option<u64> {
+        self.last_restart
     }
 }
 

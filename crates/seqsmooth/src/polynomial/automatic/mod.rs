@@ -182,12 +182,12 @@ mod output;
 mod phase;
 mod review;
 mod settle;
+mod state;
 
-pub use config::{AutoConfig, GATE_MAX_VRF, MAX_MEMORY_LEVELS};
+pub use config::{AutoConfig, GATE_MAX_VRF, MAX_MEMORY_LEVELS, MAX_REVIEW_WINDOW};
 pub use filter::AutomaticFilter;
 pub use misfit::MisfitResponse;
 pub use noise::{NoiseSource, MIN_NOISE_TERMS};
 pub use outlier::{OutlierRule, MORRISON_K, REYNEKE_DEFAULT_K};
 pub use output::{final_outliers, AutoOutput, Withheld};
 pub use phase::Phase;
-pub use review::MAX_REVIEW_WINDOW;

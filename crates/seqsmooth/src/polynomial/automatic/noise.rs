@@ -3,8 +3,8 @@
 //! normalised innovations of the final-degree filter (Morrison (14.8.4), (6.10.24)), each
 //! corrected for the truncation of the outlier gate.
 
-use super::outlier::truncated_variance;
 use crate::error::Error;
+use crate::stats::noise::truncated_variance;
 use crate::stats::DifferenceNoise;
 use std::collections::VecDeque;
 

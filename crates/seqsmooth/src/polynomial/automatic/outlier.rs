@@ -1,13 +1,14 @@
 //! The outlier gate (Morrison §14.8, (14.8.4); Reyneke et al. §7.4): when an innovation `ν` is
 //! too large for the noise `σ` and the prediction's own variance, the judgement of each sample
 //! by the prediction of the memory chosen for it, and the variance of the noise that passes a
-//! gate.
+//! gate; the current run of rejections, and what it says of the prediction's bias.
 
 use super::config::check_positive;
-use super::filter::AutomaticFilter;
 #[cfg(doc)]
-use super::AutoConfig;
+use super::config::AutoConfig;
+use super::misfit::Kept;
 use crate::error::Error;
+use crate::polynomial::filter::PolynomialFilter;
 use crate::stats::two_sided_tail;
 
 /// Morrison's gate multiplier: `|ν| > 3 σ_ε` (Reyneke §7.4 citing Morrison).
@@ -138,7 +139,8 @@ impl OutlierRule {
     }
 }
 
-/// What [`AutomaticFilter::judge`] found for one sample.
+/// What the judgement of one sample found (the prediction by the memory chosen for it, its
+/// innovation and honest `σ_ε`, and the gate's verdict; Morrison (14.8.1)-(14.8.4)).
 pub(super) struct Judged {
     pub(super) sigma: Option<f64>,
     pub(super) innovation: Option<f64>,
@@ -149,95 +151,145 @@ pub(super) struct Judged {
     pub(super) rejected: bool,
 }
 
-impl AutomaticFilter {
-    /// The prediction of the sample `(t, y)` by the memory of least estimated error, its
-    /// innovation and honest `σ_ε`, and the gate's verdict (Morrison (14.8.1)-(14.8.4)).
-    pub(super) fn judge(&mut self, t: f64, y: f64) -> Judged {
-        let chosen = self.choose_memory(t);
-        let sigma = self.noise_sigma();
-        let prediction = match chosen {
-            Some((position, _)) => position,
-            None => self.active_position(t),
-        };
-        let (innovation, vrf) = match prediction {
-            Some((x, v)) => (Some(y - x), Some(v.max(0.0))),
-            None => (None, None),
-        };
-        self.excess = match (sigma, vrf) {
-            (Some(s), Some(v)) => self.innovation_excess(s * s * (1.0 + v)),
-            _ => 0.0,
-        };
-        // The prediction's estimated bias: the honest innovation variance σ²(1 + v) + b₀².
-        let bias0 = match (prediction, sigma) {
-            (Some(p), Some(s)) => self.position_bias_of(p, chosen.map(|c| c.1), t, s),
-            _ => 0.0,
-        };
-        let bias0 = self.with_pending(bias0, innovation, sigma);
-        let innovation_sigma = match (sigma, vrf) {
-            (Some(s), Some(v)) => Some((s * s * (1.0 + v) + bias0 * bias0).sqrt()),
-            _ => None,
-        };
-        // The misfit test judges the model: the innovation against its noise-only variance.
-        let k2 = match (innovation, sigma, vrf) {
-            (Some(nu), Some(s), Some(v)) if s > 0.0 => Some(nu * nu / (s * s * (1.0 + v))),
-            _ => None,
-        };
-        let gate = self.gate(sigma, vrf, bias0, t);
-        let rejected = match (gate, innovation) {
-            (Some(g), Some(nu)) => nu.abs() > g,
-            _ => false,
-        };
-        Judged {
-            sigma,
-            innovation,
-            vrf,
-            innovation_sigma,
-            k2,
-            gate,
-            rejected,
+/// The gate half-width for a sample, given the noise `σ`, the prediction's VRF `v`, its
+/// estimated bias `b₀` and the memory length `N` (Reyneke's rule): the rule's `g(σ, v, N)`
+/// widened to `√(g² + k²b₀²)` (for Morrison's rule `k √(σ²(1 + v) + b₀²)`, `k` times the honest
+/// `σ_ε`). Active only at the final degree (`settled`), with `σ` known and the prediction at
+/// least as good as [`AutoConfig::gate_max_vrf`] says.
+pub(super) fn gate_width(
+    rule: &OutlierRule,
+    gate_max_vrf: f64,
+    settled: bool,
+    (sigma, vrf): (Option<f64>, Option<f64>),
+    bias: f64,
+    memory: impl FnOnce() -> f64,
+) -> Option<f64> {
+    match (sigma, vrf) {
+        (Some(s), Some(v)) if settled && v <= gate_max_vrf => {
+            let g = rule.threshold(s, v, memory())?;
+            let kb = rule.multiplier() * bias;
+            Some((g * g + kb * kb).sqrt())
         }
-    }
-
-    /// The gate half-width for the sample at `t`, given the noise `σ`, the prediction's VRF
-    /// `v` and its estimated bias `b₀`: the rule's `g(σ, v, N)` widened to `√(g² + k²b₀²)`
-    /// (for Morrison's rule `k √(σ²(1 + v) + b₀²)`, `k` times the honest `σ_ε`). Active only at
-    /// the final degree, with `σ` known and the prediction at least as good as
-    /// [`AutoConfig::gate_max_vrf`] says.
-    pub(super) fn gate(
-        &self,
-        sigma: Option<f64>,
-        vrf: Option<f64>,
-        bias: f64,
-        t: f64,
-    ) -> Option<f64> {
-        match (sigma, vrf) {
-            (Some(s), Some(v)) if self.active == self.cfg.degree && v <= self.cfg.gate_max_vrf => {
-                let g = self.cfg.outliers.threshold(s, v, self.memory_length(t))?;
-                let kb = self.cfg.outliers.multiplier() * bias;
-                Some((g * g + kb * kb).sqrt())
-            }
-            _ => None,
-        }
-    }
-
-    /// Reyneke's memory length `N` at `t`: `c_0m/(1-θ_s)` once faded, else the active filter's
-    /// sample count.
-    fn memory_length(&self, t: f64) -> f64 {
-        if self.active == self.cfg.degree && (self.switched || self.memory > 0) {
-            // The memory in use discounts by θ^(2^j) per sample.
-            let theta = self.theta_per_sample(t).powi(1 << self.memory);
-            self.memory_constant / (1.0 - theta)
-        } else {
-            self.active_filter().samples().max(1) as f64
-        }
+        _ => None,
     }
 }
 
-pub(super) use crate::stats::noise::truncated_variance;
+/// A rejected sample is a marginal crossing (evidence of bias when the next sample crosses on
+/// the same side) up to this many gate widths.
+const MARGINAL: f64 = 1.25;
+
+/// The current run of rejected samples (the gate's, not yet applied as a manoeuvre), and the
+/// count of rejections.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Run {
+    pending: Vec<Kept>,
+    rejected: u64,
+}
+
+impl Run {
+    /// Samples rejected so far (not counting runs applied as manoeuvres).
+    pub(super) fn rejected(&self) -> u64 {
+        self.rejected
+    }
+
+    /// A final rejection (a review's decision): not part of a run.
+    pub(super) fn reject_final(&mut self) {
+        self.pending.clear();
+        self.rejected += 1;
+    }
+
+    /// The gate rejected `sample`: it joins the run (counted by [`count`](Self::count) unless
+    /// the run is taken for a manoeuvre).
+    pub(super) fn push(&mut self, sample: Kept) {
+        self.pending.push(sample);
+    }
+
+    /// Counts the newest sample of the run as a rejection.
+    pub(super) fn count(&mut self) {
+        self.rejected += 1;
+    }
+
+    /// Samples in the run.
+    pub(super) fn len(&self) -> usize {
+        self.pending.len()
+    }
+
+    /// The run is a manoeuvre: its samples, to be applied after all, of which all but the
+    /// newest had been counted as rejections (they are not).
+    pub(super) fn take(&mut self) -> Vec<Kept> {
+        let run = std::mem::take(&mut self.pending);
+        self.rejected -= run.len().saturating_sub(1) as u64;
+        run
+    }
+
+    /// An accepted sample ends the run.
+    pub(super) fn clear(&mut self) {
+        self.pending.clear();
+    }
+
+    /// The prediction's position bias `b₀` raised by the current run: a rejected sample on the
+    /// same side as the innovation `ν` and within [`MARGINAL`] gate widths
+    /// (`|r| ≤ 1.25 k√(σ²(1+v) + b₀²)`, a marginal crossing, not a jump) is taken as evidence of
+    /// bias (Morrison §14.8: repeated crossings mean bias), `b₀² ≥ r² − σ²(1+v)` with `r` its
+    /// residual against `active`'s prediction and `v` that prediction's VRF; `k` the gate's
+    /// multiplier.
+    pub(super) fn with_pending(
+        &self,
+        active: &dyn PolynomialFilter,
+        k: f64,
+        b0: f64,
+        nu: Option<f64>,
+        sigma: Option<f64>,
+    ) -> f64 {
+        let (Some(nu), Some(s)) = (nu, sigma) else {
+            return b0;
+        };
+        let mut b2 = b0 * b0;
+        for p in &self.pending {
+            let Some(pred) = active.estimate_at(p.t) else {
+                continue;
+            };
+            let v = pred.covariance.as_ref().map_or(0.0, |c| c[(0, 0)].max(0.0));
+            let r = p.y - pred.derivatives[0];
+            let noise = s * s * (1.0 + v);
+            let marginal = r.abs() <= MARGINAL * k * (noise + b0 * b0).sqrt();
+            if marginal && r.signum() == nu.signum() && r * r - noise > b2 {
+                b2 = r * r - noise;
+            }
+        }
+        if b2.is_finite() {
+            b2.sqrt().copysign(b0)
+        } else {
+            b0
+        }
+    }
+
+    /// True when the run ends with `n =` [`AutoConfig::same_side_rejections`] `≥ 2` samples
+    /// all on the same side of `active`'s prediction (Morrison §14.8: repeated crossings on one
+    /// side mean bias, not outliers; two outliers in a row on one side at an outlier rate `p`
+    /// happen at `p²/2` per sample).
+    pub(super) fn same_side(&self, active: &dyn PolynomialFilter, n: usize) -> bool {
+        if n < 2 || self.pending.len() < n {
+            return false;
+        }
+        let mut side = 0.0;
+        for p in &self.pending[self.pending.len() - n..] {
+            let Some(pred) = active.estimate_at(p.t) else {
+                return false;
+            };
+            let r = (p.y - pred.derivatives[0]).signum();
+            if side != 0.0 && r != side {
+                return false;
+            }
+            side = r;
+        }
+        true
+    }
+}
 
 #[cfg(test)]
 mod tests {
-    use super::truncated_variance;
+    use crate::stats::noise::truncated_variance;
 
     /// Against the variance of the truncated density by Simpson's rule,
     /// `∫ z² φ(z) dz / ∫ φ(z) dz` over `[−a, a]`, and the limits.

@@ -19,7 +19,7 @@
 //! | judge | the gate's verdict stands where its `σ_ε` was at most the interpolation's root mean square (a long memory that fits), the interpolation's otherwise | Morrison §7.13 |
 //!
 //! Near the start the window takes more samples after; at the end of a series
-//! ([`AutomaticFilter::finish`]) more before.
+//! ([`AutomaticFilter::finish`](super::AutomaticFilter::finish)) more before.
 //!
 //! When the verdict differs from the gate's, the filter goes back to its state before the
 //! sample and takes the samples since again (the gate judging them anew): from then on the
@@ -28,10 +28,8 @@
 //! `L = 0` a decision is the gate's, final once a later sample is accepted (a run of rejections
 //! applied as a manoeuvre's onset is not rejected). The measured rates are in ACCURACY.md.
 
-use super::filter::AutomaticFilter;
+use super::config::{AutoConfig, MAX_REVIEW_WINDOW};
 use super::output::AutoOutput;
-#[cfg(doc)]
-use super::AutoConfig;
 use crate::error::Error;
 use crate::polynomial::options::MAX_DEGREE;
 use crate::recursive::TriangularFactor;
@@ -42,25 +40,31 @@ use std::collections::VecDeque;
 /// update thus makes at most 64 decisions.
 pub(super) const MAX_UNDECIDED: usize = 63;
 
-/// The largest [`AutoConfig::review_window`].
-///
-/// ```
-/// use seqsmooth::polynomial::automatic::{AutomaticFilter, MAX_REVIEW_WINDOW};
-/// let f = AutomaticFilter::new(2, 0.9, 1.0).unwrap();
-/// assert!(f.clone().with_review_window(MAX_REVIEW_WINDOW).is_ok());
-/// assert!(f.with_review_window(MAX_REVIEW_WINDOW + 1).is_err());
-/// ```
-pub const MAX_REVIEW_WINDOW: usize = 31;
-
-/// One sample in eight keeps the filter's state before it: going back restores the nearest kept
-/// state at or before the sample and takes the samples from there (at most seven more), so a
-/// filter holds one or two copies of its state rather than one per sample waiting.
+/// One sample in eight keeps the update's state before it: going back restores the nearest kept
+/// state at or before the sample and replays the kept samples from there (at most seven more
+/// before it), so the review holds one or two copies of the state rather than one per sample
+/// waiting.
 const SNAPSHOT_EVERY: usize = 8;
 
+/// What the review goes back to and replays: the state one update changes (the filter without
+/// its review, [`super::state::State`]).
+pub(super) trait Replay: Clone {
+    /// One sample through the gate and the filters; `force` overrides the gate's verdict (a
+    /// decision taken again: a forced rejection is final, not part of a run).
+    fn step(&mut self, t: f64, y: f64, force: Option<bool>) -> Result<AutoOutput, Error>;
+    /// The noise `σ` in use.
+    fn noise_sigma(&self) -> Option<f64>;
+    /// The noise estimate is still the start-up one (the review waits for it).
+    fn noise_is_early(&self) -> bool;
+    /// Forgets the current run of rejections (the samples before a replay's sample are
+    /// decided: none of them is part of a run).
+    fn end_run(&mut self);
+}
+
 /// A sample of the review: the gate's verdict so far (or the final decision), and for one in
-/// [`SNAPSHOT_EVERY`] the filter's state before the sample (without its own review).
+/// [`SNAPSHOT_EVERY`] the state `S` before the sample.
 #[derive(Clone, Debug)]
-pub(super) struct Entry {
+struct Entry<S> {
     t: f64,
     y: f64,
     rejected: bool,
@@ -68,16 +72,20 @@ pub(super) struct Entry {
     decided: bool,
     /// The root mean square `σ_ε` of the innovation the gate judged, when the gate was on.
     gate_rms: Option<f64>,
-    before: Option<Box<AutomaticFilter>>,
+    before: Option<Box<S>>,
 }
 
 /// The samples waiting for their decision, oldest first, after the decided ones still needed
-/// for the state the first of them keeps; and the newest accepted samples decided.
-#[derive(Clone, Debug, Default)]
-pub(super) struct Review {
-    entries: VecDeque<Entry>,
+/// for the state the first of them keeps; and the newest accepted samples decided. `L`, `k` and
+/// the fit's degree `m + 1` are the configuration's.
+#[derive(Clone, Debug)]
+pub(super) struct Review<S> {
+    entries: VecDeque<Entry<S>>,
     accepted: VecDeque<(f64, f64)>,
     scratch: Scratch,
+    window: usize,
+    k: f64,
+    degree: usize,
 }
 
 /// The windows' residuals about their fits over the last [`CALIBRATION_WINDOWS`] decisions, in
@@ -119,11 +127,23 @@ impl Calibration {
     }
 }
 
-impl Review {
+impl<S: Replay> Review<S> {
+    /// The review of `cfg`'s filter, before the first sample.
+    pub(super) fn new(cfg: &AutoConfig) -> Self {
+        Self {
+            entries: VecDeque::new(),
+            accepted: VecDeque::new(),
+            scratch: Scratch::default(),
+            window: cfg.review_window,
+            k: cfg.outliers.multiplier(),
+            degree: cfg.degree + 1,
+        }
+    }
+
     /// Takes the newest sample with the gate's verdict in `out` and the state before it (kept
     /// for one sample in [`SNAPSHOT_EVERY`]); the `out.reinstated` newest rejections waiting
     /// before it were applied after all.
-    fn push(&mut self, t: f64, y: f64, out: &AutoOutput, before: Option<Box<AutomaticFilter>>) {
+    fn push(&mut self, t: f64, y: f64, out: &AutoOutput, before: Option<Box<S>>) {
         self.reinstate(out.reinstated);
         self.entries.push_back(Entry {
             t,
@@ -170,7 +190,7 @@ impl Review {
 /// The newest `n` of `entries` rejected and waiting are not rejected (a run just applied).
 /// The gate did not pass them: it judged them against a model the run says no longer fits
 /// (Morrison §14.8), so its verdict does not stand for them; the interpolation decides.
-fn reinstate<'a>(entries: impl DoubleEndedIterator<Item = &'a mut Entry>, n: usize) {
+fn reinstate<'a, S: 'a>(entries: impl DoubleEndedIterator<Item = &'a mut Entry<S>>, n: usize) {
     for e in entries.rev().filter(|e| !e.decided && e.rejected).take(n) {
         e.rejected = false;
         e.gate_rms = None;
@@ -358,60 +378,44 @@ pub(super) struct Scratch {
     calibration: Calibration,
 }
 
-impl AutomaticFilter {
-    /// The filter without its review and its last output (the state a decision may go back
-    /// to; the output is the newest update's whatever state it came from).
-    pub(super) fn snapshot(&mut self) -> Box<AutomaticFilter> {
-        let review = std::mem::take(&mut self.review);
-        let last = self.last_output.take();
-        let s = Box::new(self.clone());
-        self.review = review;
-        self.last_output = last;
-        s
-    }
-
-    /// After an internal step failed on the newest sample (not yet in the review): back to
-    /// `before`, the state before it, or when that was not kept, to the newest state the review
-    /// keeps, taking the samples since again with their decisions so far (the gate judging the
-    /// undecided ones anew, as it did).
-    pub(super) fn recover(&mut self, before: Option<Box<AutomaticFilter>>) {
-        if let Some(state) = before {
-            self.restore(*state);
+impl<S: Replay> Review<S> {
+    /// After an internal step failed on the newest sample (not yet in the review): `state`
+    /// back to `before`, the state before it, or when that was not kept, to the newest state
+    /// the review keeps, replaying the samples since with their decisions so far (the gate
+    /// judging the undecided ones anew, as it did).
+    pub(super) fn recover(&self, state: &mut S, before: Option<Box<S>>) {
+        if let Some(s) = before {
+            *state = *s;
             return;
         }
-        let entries = self.review.entries.clone();
-        let Some(start) = entries.iter().rposition(|e| e.before.is_some()) else {
+        let Some(start) = self.entries.iter().rposition(|e| e.before.is_some()) else {
             return;
         };
-        let state = entries[start].before.as_deref().expect("found").clone();
-        self.restore(state);
-        for e in entries.range(start..) {
+        *state = self.entries[start]
+            .before
+            .as_deref()
+            .expect("found")
+            .clone();
+        for e in self.entries.range(start..) {
             let force = e.decided.then_some(e.rejected);
             // The same samples from the same state: it cannot fail where it did not.
-            let _ = self.step(e.t, e.y, force);
+            let _ = state.step(e.t, e.y, force);
         }
     }
 
-    /// Goes back to `state`, keeping the review and the last output.
-    pub(super) fn restore(&mut self, state: AutomaticFilter) {
-        let review = std::mem::take(&mut self.review);
-        let last = self.last_output.take();
-        *self = state;
-        self.review = review;
-        self.last_output = last;
-    }
-
-    /// Takes the newest sample into the review and makes every decision it can; returns the
-    /// newest sample's output (taken again when a decision went back) with the decisions.
+    /// Takes the newest sample into the review (its output `out` from `state`, and the state
+    /// before it when [`keeps_next`](Self::keeps_next)) and makes every decision it can;
+    /// returns the newest sample's output (taken again when a decision went back) with the
+    /// decisions.
     pub(super) fn review(
         &mut self,
-        t: f64,
-        y: f64,
+        state: &mut S,
+        (t, y): (f64, f64),
         mut out: AutoOutput,
-        before: Option<Box<AutomaticFilter>>,
+        before: Option<Box<S>>,
     ) -> AutoOutput {
-        self.review.push(t, y, &out, before);
-        let (decided, newest) = self.decide(false);
+        self.push(t, y, &out, before);
+        let (decided, newest) = self.decide(state, false);
         if let Some(newest) = newest {
             out = newest;
         }
@@ -420,10 +424,12 @@ impl AutomaticFilter {
     }
 
     /// Decides every sample still waiting, with the samples there are (at the end of a
-    /// series: the window takes more samples before); the decisions, oldest first.
-    pub(super) fn decide_all(&mut self) -> Vec<bool> {
-        let (decided, newest) = self.decide(true);
-        if let (Some(newest), Some(last)) = (newest, self.last_output.as_mut()) {
+    /// series: the window takes more samples before); the decisions, oldest first. `last`, the
+    /// newest output, becomes the newest sample's output taken again if a decision went back
+    /// (keeping its decisions).
+    pub(super) fn decide_all(&mut self, state: &mut S, last: Option<&mut AutoOutput>) -> Vec<bool> {
+        let (decided, newest) = self.decide(state, true);
+        if let (Some(newest), Some(last)) = (newest, last) {
             let keep = std::mem::take(&mut last.decided);
             *last = newest;
             last.decided = keep;
@@ -433,29 +439,22 @@ impl AutomaticFilter {
 
     /// The oldest waiting samples' decisions, in order, and the newest sample's output if a
     /// decision went back and took the samples again.
-    fn decide(&mut self, finishing: bool) -> (Vec<bool>, Option<AutoOutput>) {
-        let l = self.cfg.review_window;
-        let k = self.cfg.outliers.multiplier();
-        let degree = self.cfg.degree + 1;
+    fn decide(&mut self, state: &mut S, finishing: bool) -> (Vec<bool>, Option<AutoOutput>) {
+        let (l, k, degree) = (self.window, self.k, self.degree);
         let mut decided = Vec::new();
         let mut newest = None;
-        while let Some(f) = self.review.first_undecided() {
-            let front = &self.review.entries[f];
+        while let Some(f) = self.first_undecided() {
+            let front = &self.entries[f];
             // The accepted samples after it (at most 2L), on the stack.
             let mut after_buf = [(0.0, 0.0); WINDOW];
             let mut n_after = 0;
-            let later = self
-                .review
-                .entries
-                .iter()
-                .skip(f + 1)
-                .filter(|u| !u.rejected);
+            let later = self.entries.iter().skip(f + 1).filter(|u| !u.rejected);
             for u in later.take(2 * l.max(1)) {
                 after_buf[n_after] = (u.t, u.y);
                 n_after += 1;
             }
             let after = &after_buf[..n_after];
-            let overflow = self.review.entries.len() - f > MAX_UNDECIDED;
+            let overflow = self.entries.len() - f > MAX_UNDECIDED;
             let (before_wanted, ready) = if l == 0 {
                 (0, !front.rejected || !after.is_empty() || finishing)
             } else if finishing {
@@ -463,19 +462,19 @@ impl AutomaticFilter {
             } else {
                 // At start-up the noise estimate waits for its first samples (see
                 // `NoiseState::is_early`).
-                let before = self.review.accepted.len().min(l);
+                let before = self.accepted.len().min(l);
                 let enough = after.len() >= l && after.len() >= 2 * l - before;
-                (before, enough && !self.noise.is_early())
+                (before, enough && !state.noise_is_early())
             };
             if !ready && !overflow {
                 break;
             }
             let (gate, gate_rms, sample) = (front.rejected, front.gate_rms, (front.t, front.y));
-            let verdict = match (l, self.noise_sigma(), overflow) {
+            let verdict = match (l, state.noise_sigma(), overflow) {
                 (1.., Some(sigma), false) if k > 0.0 && sigma > 0.0 => {
-                    let before = self.review.accepted.len().min(before_wanted);
+                    let before = self.accepted.len().min(before_wanted);
                     let mut around_buf = [(0.0, 0.0); WINDOW];
-                    let accepted = &self.review.accepted;
+                    let accepted = &self.accepted;
                     let earlier = accepted.iter().skip(accepted.len() - before);
                     let mut n = 0;
                     for &s in earlier.chain(after.iter().take(2 * l - before)) {
@@ -485,7 +484,7 @@ impl AutomaticFilter {
                     let around = &around_buf[..n];
                     (around.len() >= degree + 2)
                         .then(|| {
-                            let c = &mut self.review.scratch;
+                            let c = &mut self.scratch;
                             interpolation_verdict(around, sample, degree, sigma, k, gate_rms, c)
                         })
                         .flatten()
@@ -494,46 +493,45 @@ impl AutomaticFilter {
                 _ => gate,
             };
             if verdict != gate {
-                if let Ok(out) = self.take_again(f, verdict) {
+                if let Ok(out) = self.take_again(state, f, verdict) {
                     newest = Some(out);
                 }
             }
             // Going back failed (it cannot on checked samples): the gate's verdict stands.
-            let entry = &mut self.review.entries[f];
+            let entry = &mut self.entries[f];
             entry.decided = true;
             let rejected = entry.rejected;
             if !rejected {
-                self.review.accepted.push_back(sample);
-                while self.review.accepted.len() > 2 * l.max(1) {
-                    self.review.accepted.pop_front();
+                self.accepted.push_back(sample);
+                while self.accepted.len() > 2 * l.max(1) {
+                    self.accepted.pop_front();
                 }
             }
             decided.push(rejected);
-            self.review.trim();
+            self.trim();
         }
         (decided, newest)
     }
 
-    /// Goes back to the nearest state kept at or before the sample `f` waiting, takes the
+    /// Goes back to the nearest state kept at or before the sample `f` waiting, replays the
     /// decided samples from there with their decisions, `f` with the decision `rejected`, and
-    /// the samples after it again (the gate judging them anew). Returns the newest sample's
-    /// output; on an error the state is as before the call.
-    fn take_again(&mut self, f: usize, rejected: bool) -> Result<AutoOutput, Error> {
-        let current = self.snapshot();
-        let mut entries = self.review.entries.clone();
+    /// the samples after it (the gate judging them anew). Returns the newest sample's output;
+    /// on an error `state` is as before the call.
+    fn take_again(&mut self, state: &mut S, f: usize, rejected: bool) -> Result<AutoOutput, Error> {
+        let current = state.clone();
+        let mut entries = self.entries.clone();
         let result = (|| {
             let start = (0..=f)
                 .rev()
                 .find(|&j| entries[j].before.is_some())
                 .expect("the first entry keeps its state");
-            let state = entries[start].before.as_deref().expect("found").clone();
-            self.restore(state);
+            *state = entries[start].before.as_deref().expect("found").clone();
             // Every sample before `f` is decided: none of them is part of a run.
-            self.pending.clear();
+            state.end_run();
             let mut out = None;
             for j in start..entries.len() {
                 if j > start && entries[j].before.is_some() {
-                    entries[j].before = Some(self.snapshot());
+                    entries[j].before = Some(Box::new(state.clone()));
                 }
                 let (t, y) = (entries[j].t, entries[j].y);
                 let force = match j.cmp(&f) {
@@ -541,7 +539,7 @@ impl AutomaticFilter {
                     std::cmp::Ordering::Equal => Some(rejected),
                     std::cmp::Ordering::Greater => None,
                 };
-                let o = self.step(t, y, force)?;
+                let o = state.step(t, y, force)?;
                 if j == f {
                     entries[j].rejected = rejected;
                     entries[j].gate_rms = None;
@@ -556,11 +554,11 @@ impl AutomaticFilter {
         })();
         match result {
             Ok(out) => {
-                self.review.entries = entries;
+                self.entries = entries;
                 Ok(out)
             }
             Err(e) => {
-                self.restore(*current);
+                *state = current;
                 Err(e)
             }
         }

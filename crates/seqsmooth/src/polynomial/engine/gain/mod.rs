@@ -29,6 +29,8 @@ use nalgebra::DMatrix;
 use std::sync::Arc;
 
 mod batch;
+mod expanding_run;
+mod plain;
 mod steady_block;
 #[cfg(test)]
 mod tests;

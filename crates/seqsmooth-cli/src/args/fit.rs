@@ -1,0 +1,78 @@
+//! The arguments of `seqsmooth fit`.
+
+use super::{parse_degree, parse_sigma, parse_window, RadarArgs};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct FitArgs {
+    /// Input CSV with a header row; omitted or '-' reads standard input. Columns other than the
+    /// ones named are ignored
+    #[arg(value_name = "INPUT")]
+    pub input: Option<PathBuf>,
+    /// The dynamic and observation model
+    #[arg(long, value_enum)]
+    pub model: FitModel,
+    /// Degree of the motion: polynomial, the polynomial's degree M (0 to 24, required); radar,
+    /// 1 for constant velocity or 2 for constant acceleration [radar default: 1]
+    #[arg(long, value_name = "M", value_parser = parse_degree, allow_hyphen_values = true)]
+    pub degree: Option<usize>,
+    /// The number of rows in each window, W >= 1 (all rows so far while fewer have come)
+    /// [default: radar 8, polynomial 60]
+    #[arg(long, value_name = "W", value_parser = parse_window, allow_hyphen_values = true)]
+    pub window: Option<usize>,
+    /// The time each row's state refers to: 'end' (the row's own time), 'centre' (the mean
+    /// time of its window) or a time T
+    #[arg(long, value_name = "EPOCH", default_value = "end", value_parser = parse_epoch,
+          allow_hyphen_values = true)]
+    pub epoch: EpochArg,
+    /// Polynomial: the values' noise standard deviation (required)
+    #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
+    pub sigma: Option<f64>,
+    /// Name of the time column
+    #[arg(long, value_name = "NAME", default_value = "t")]
+    pub time_col: String,
+    /// Polynomial: name of the value column
+    #[arg(long, value_name = "NAME", default_value = "y")]
+    pub value_col: String,
+    #[command(flatten)]
+    pub radar: RadarArgs,
+    /// Gauss-Newton iterations allowed per window
+    #[arg(long, value_name = "N", default_value_t = 20,
+          value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub max_iterations: u32,
+    /// Output file [default: standard output]
+    #[arg(short = 'o', long, value_name = "OUTPUT")]
+    pub output: Option<PathBuf>,
+}
+
+/// The models of `seqsmooth fit`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FitModel {
+    /// A Cartesian target seen by a radar: range, azimuth, elevation.
+    Radar,
+    /// A scalar polynomial in time, observed directly.
+    Polynomial,
+}
+
+/// `--epoch`: the window's end, its centre, or a time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EpochArg {
+    End,
+    Centre,
+    At(f64),
+}
+
+/// Parses `--epoch`: `end`, `centre` (or `center`), or a finite time.
+pub fn parse_epoch(s: &str) -> Result<EpochArg, String> {
+    match s.trim() {
+        "end" => Ok(EpochArg::End),
+        "centre" | "center" => Ok(EpochArg::Centre),
+        text => match text.parse::<f64>() {
+            Ok(t) if t.is_finite() => Ok(EpochArg::At(t)),
+            _ => Err(format!(
+                "epoch '{text}' is neither 'end', 'centre' nor a finite time"
+            )),
+        },
+    }
+}

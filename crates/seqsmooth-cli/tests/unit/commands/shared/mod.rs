@@ -1,0 +1,3 @@
+//! Unit tests of `commands::shared`.
+
+mod runner;

@@ -1,4 +1,0 @@
-//! Unit tests of `filter` and its submodules.
-
-mod rows;
-mod runner;

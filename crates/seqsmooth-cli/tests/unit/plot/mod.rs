@@ -1,0 +1,5 @@
+//! Unit tests of `plot`: the chart, decimation and tick labels.
+
+mod chart;
+mod decimate;
+mod ticks;
