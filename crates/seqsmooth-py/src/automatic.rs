@@ -6,11 +6,13 @@
 
 use crate::arrays::{matrix, pair};
 use crate::errors::IntoPy;
+use crate::errors::{raise, Kind};
 use crate::polynomial::{engine as engine_named, state_of, State};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use seqsmooth::polynomial::automatic::AutomaticFilter;
+use seqsmooth::polynomial::spec::{FilterKind, FilterSpec};
 use seqsmooth::Error;
 
 /// The automatic polynomial filter of degree up to ``degree`` (Reyneke et al. 2012; Morrison
@@ -53,17 +55,18 @@ impl PyAutomaticFilter {
         sigma: Option<f64>,
         review_window: Option<usize>,
     ) -> PyResult<Self> {
-        let engine = engine_named(engine)?;
-        let mut filter = AutomaticFilter::new(degree, theta, tau)
-            .py()?
-            .with_engine(engine)
-            .py()?;
-        if let Some(s) = sigma {
-            filter = filter.with_noise_sigma(s).py()?;
-        }
-        if let Some(n) = review_window {
-            filter = filter.with_review_window(n).py()?;
-        }
+        // The library's filter of this description.
+        let spec = FilterSpec {
+            theta: Some(theta),
+            tau: Some(tau),
+            engine: engine_named(engine)?,
+            sigma,
+            review_window,
+            ..FilterSpec::new(FilterKind::Automatic, degree)
+        };
+        let filter = spec.build().py()?.into_automatic();
+        let filter =
+            filter.ok_or_else(|| raise(Kind::Parameter, "not an automatic filter", None))?;
         Ok(Self {
             filter,
             decided: Vec::new(),

@@ -76,16 +76,8 @@ impl PyBayesFilter {
                 None,
             ));
         }
-        if degree > seqsmooth::polynomial::MAX_DEGREE {
-            return Err(raise(
-                Kind::Parameter,
-                format!(
-                    "degree {degree} is above {}, the largest the polynomial model takes",
-                    seqsmooth::polynomial::MAX_DEGREE
-                ),
-                None,
-            ));
-        }
+        // The library's range of a polynomial degree.
+        seqsmooth::polynomial::check_degree(degree).py()?;
         let n = (degree + 1) * axes;
         let observe = observation_from(observation, axes, n)?;
         let components = observe.components();

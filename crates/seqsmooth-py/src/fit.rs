@@ -12,31 +12,12 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
 use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
-use seqsmooth::estimate::sliding::{SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
-use seqsmooth::model::dynamics::PolynomialDynamics;
-use seqsmooth::model::observation::LinearObservation;
-use seqsmooth::model::radar::Radar;
+use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
+use seqsmooth::estimate::sliding::{Fitter, SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
+use seqsmooth::polynomial::check_degree;
 use seqsmooth::track::radar_row;
 use seqsmooth::track::window_flag;
 use seqsmooth::Error;
-
-/// The model's sliding fit.
-enum Fitter {
-    Radar(SlidingFit<PolynomialDynamics, Radar>),
-    Polynomial(SlidingFit<PolynomialDynamics, LinearObservation>),
-}
-
-impl Fitter {
-    /// The library's `push_finite`: the row taken and the window fitted, or the row refused
-    /// and the fit as before it.
-    fn push(&mut self, m: Measurement) -> Result<Option<Correction>, Error> {
-        match self {
-            Fitter::Radar(f) => f.push_finite(m),
-            Fitter::Polynomial(f) => f.push_finite(m),
-        }
-    }
-}
 
 /// A σ as `seqsmooth fit` accepts it: above 0, its square (the variance) a normal double.
 pub(crate) fn check_sigma(name: &str, s: f64) -> PyResult<f64> {
@@ -267,7 +248,9 @@ impl PySlidingFit {
         };
         let max = seqsmooth::polynomial::MAX_DEGREE;
         if let Some(d) = degree {
-            if d < 0 || d as u64 > max as u64 {
+            // The library's range of a polynomial degree.
+            let in_range = usize::try_from(d).is_ok_and(|d| check_degree(d).is_ok());
+            if !in_range {
                 return usage(format!(
                     "degree {d} is out of range: 0 to {max} (radar: 1 or 2)"
                 ));
@@ -294,13 +277,8 @@ impl PySlidingFit {
                     check_sigma("sigma_range", sr)?,
                     check_sigma("sigma_angle", sa)?,
                 ];
+                // Its range (1 or 2) is the library's: `SlidingFit::radar` refuses the others.
                 let degree = degree.unwrap_or(1);
-                if !(1..=2).contains(&degree) {
-                    return usage(format!(
-                        "degree {degree} is out of range for model='radar': 1 (constant \
-                         velocity) or 2 (constant acceleration)"
-                    ));
-                }
                 let site = site.unwrap_or((0.0, 0.0, 0.0));
                 let fit =
                     SlidingFit::radar([site.0, site.1, site.2], degree, window, epoch, solver)
@@ -449,7 +427,7 @@ impl PySlidingFit {
         let mut taken = 0;
         let failed = py.detach(|| {
             for (i, m) in rows.into_iter().enumerate() {
-                let fit = fitter.push(m).map_err(|e| (i, e))?;
+                let fit = fitter.push_finite(m).map_err(|e| (i, e))?;
                 taken = i + 1;
                 if let Some(c) = fit {
                     states[i * d..(i + 1) * d].copy_from_slice(c.state.as_slice());

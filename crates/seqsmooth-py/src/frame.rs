@@ -1,29 +1,17 @@
 //! `filter_series`, the engine of `seqsmooth.filter_frame`: many series in one set of columns,
 //! each row tagged with its series (`codes`, 0-based), run through the library's
 //! `StreamBank` (one filter per series, grouped by a counting sort, the series on the rayon
-//! pool) with the rows of [`run_rows`], the same as `seqsmooth filter --id-col`.
+//! pool) with the library's rows (`AnyFilter::run_rows`), the same as `seqsmooth filter
+//! --id-col`.
 
 use crate::arrays::{matrix, series, times};
 use crate::errors::{raise, IntoPy, Kind};
-use crate::polynomial::{engine as engine_named, fixed_engine, run_rows};
+use crate::polynomial::{engine as engine_named, fixed_engine};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
+use seqsmooth::polynomial::rows::RowLayout;
+use seqsmooth::polynomial::spec::{AnyFilter, FilterKind, FilterSpec};
 use seqsmooth::polynomial::stream::{Chunk, StreamBank};
-use seqsmooth::polynomial::tau::default_tau;
-use seqsmooth::{Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter};
-
-/// Every series of `chunk` through a copy of `prototype`, the results by column.
-fn run_bank<F: PolynomialFilter + Clone + Send>(
-    prototype: F,
-    batch: bool,
-    chunk: Chunk<'_>,
-    sigma: bool,
-) -> Result<(), Error> {
-    let mut bank = StreamBank::growing(prototype)?;
-    bank.update_par_columns(chunk, |f: &mut F, t: &[f64], y: &[f64], out: &mut [f64]| {
-        run_rows(f, batch, t, y, out, sigma)
-    })
-}
 
 /// Filters the rows ``(t[i], y[i])`` of series ``codes[i]`` (0-based integers), each series
 /// on its own filter of the given settings, and returns the columns ``d0..dM`` and with
@@ -86,9 +74,47 @@ pub fn filter_series<'py>(
             }
         }
     }
-    let engine_of = |e: Option<&str>| engine_named(e.unwrap_or("exact"));
-    let with_sigma = sigma.is_some();
-    let stride = (degree + 1) << usize::from(with_sigma);
+    let kind = match kind {
+        "expanding" => FilterKind::Expanding,
+        "fading" => FilterKind::Fading,
+        "fixed" => FilterKind::Fixed,
+        other => {
+            return Err(raise(
+                Kind::Parameter,
+                format!("kind {other:?} is not one of 'expanding', 'fading', 'fixed'"),
+                None,
+            ))
+        }
+    };
+    let spec = FilterSpec {
+        theta,
+        tau,
+        window,
+        sigma,
+        ..FilterSpec::new(kind, degree)
+    };
+    let spec = match kind {
+        FilterKind::Fixed => FilterSpec {
+            fixed_engine: fixed_engine(engine.unwrap_or("adaptive"))?,
+            ..spec
+        },
+        // Without tau, the library's default: the median time step within series, as
+        // `seqsmooth filter` takes it without --tau.
+        _ => FilterSpec {
+            engine: engine_named(engine.unwrap_or("exact"))?,
+            ..spec
+        }
+        .with_default_tau(t, &channels, true)
+        .py()?,
+    };
+    let prototype = spec.build().py()?;
+    // The fixed-memory filter's rows carry its `window` cell (the rows in each row's window).
+    let layout = RowLayout {
+        sigma: sigma.is_some(),
+        lead: 0.0,
+        trailing: kind == FilterKind::Fixed,
+    };
+    let stride = prototype.stride(layout);
     let mut out = vec![0.0; n * stride];
     let chunk = Chunk {
         channels: &channels,
@@ -97,62 +123,20 @@ pub fn filter_series<'py>(
         estimates: &mut out,
         stride,
     };
-    let needs = |what: &str| raise(Kind::Parameter, format!("kind {kind:?} needs {what}"), None);
-    match kind {
-        "expanding" => {
-            let mut f = ExpandingMemory::new(degree, engine_of(engine)?).py()?;
-            if let Some(s) = sigma {
-                f = f.with_noise_sigma(s).py()?;
-            }
-            py.detach(|| run_bank(f, true, chunk, with_sigma))
-        }
-        "fading" => {
-            let theta = theta.ok_or_else(|| needs("theta"))?;
-            // Without tau, the library's default: the median time step within series, as
-            // `seqsmooth filter` takes it without --tau.
-            let tau = match tau {
-                Some(tau) => tau,
-                None => default_tau(t, &channels, true).py()?,
-            };
-            let mut f = FadingMemory::new(degree, theta, tau, engine_of(engine)?).py()?;
-            if let Some(s) = sigma {
-                f = f.with_noise_sigma(s).py()?;
-            }
-            py.detach(|| run_bank(f, true, chunk, with_sigma))
-        }
-        "fixed" => {
-            let window = window.ok_or_else(|| needs("window"))?;
-            let engine = fixed_engine(engine.unwrap_or("adaptive"))?;
-            let mut f = FixedMemory::new(degree, window, engine).py()?;
-            if let Some(s) = sigma {
-                f = f.with_noise_sigma(s).py()?;
-            }
-            py.detach(|| run_bank(f, false, chunk, with_sigma))
-        }
-        other => {
-            return Err(raise(
-                Kind::Parameter,
-                format!("kind {other:?} is not one of 'expanding', 'fading', 'fixed'"),
-                None,
-            ))
-        }
-    }
+    py.detach(|| {
+        let mut bank = StreamBank::growing(prototype)?;
+        bank.update_par_columns(
+            chunk,
+            |f: &mut AnyFilter, t: &[f64], y: &[f64], o: &mut [f64]| f.run_rows(t, y, o, layout),
+        )
+    })
     .py()?;
     // Column by column already (each derivative's column contiguous, for the frame's columns).
-    let values = matrix(py, out, stride, n)?;
-    if kind != "fixed" {
+    let cells = out.split_off(((degree + 1) << usize::from(layout.sigma)) * n);
+    let values = matrix(py, out, stride - usize::from(layout.trailing), n)?;
+    if !layout.trailing {
         return Ok(values);
     }
-    // The fixed-memory filter's `window` cell: the rows in each row's window.
-    let window = window.unwrap_or(0) as f64;
-    let mut seen = vec![0.0f64; channels.iter().max().map_or(0, |&c| c + 1)];
-    let cells: Vec<f64> = channels
-        .iter()
-        .map(|&c| {
-            seen[c] += 1.0;
-            seen[c].min(window)
-        })
-        .collect();
     let cells = PyArray1::from_vec(py, cells).into_any();
     Ok((values, cells).into_pyobject(py)?.into_any())
 }

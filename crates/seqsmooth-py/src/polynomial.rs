@@ -1,9 +1,9 @@
 //! The polynomial filters as Python classes: `ExpandingMemory`, `FadingMemory` and
 //! `FixedMemory`, each a subclass of `PolynomialFilter`, which holds the library's filter and
 //! owns every method (`update`, `update_many`, `estimate`, `estimate_at`). The numbers are the
-//! library's: `update_many` runs the same path as `seqsmooth filter` (the batch kernels of the
-//! expanding- and fading-memory filters without σ; otherwise a sample at a time, each
-//! estimate from `try_estimate_at`), so the same input gives the same bits.
+//! library's: each class is built by the library's `FilterSpec`, and `update_many` runs the
+//! library's row runner (`AnyFilter::run_rows`), as `seqsmooth filter` does, so the same
+//! input gives the same bits.
 
 use crate::arrays::{matrix, pair};
 use crate::errors::{raise, IntoPy, Kind};
@@ -12,15 +12,12 @@ use pyo3::prelude::*;
 use pyo3::types::PySlice;
 use seqsmooth::discount::Discount;
 use seqsmooth::polynomial::fixed::FixedEngine;
-use seqsmooth::{
-    Engine, Error, ExpandingMemory, FadingMemory, FixedMemory, PolynomialFilter, PolynomialState,
-};
+use seqsmooth::polynomial::rows::RowLayout;
+use seqsmooth::polynomial::spec::{AnyFilter, FilterKind, FilterSpec};
+use seqsmooth::{Engine, PolynomialFilter, PolynomialState};
 
 /// Samples run between two checks for Ctrl-C (each run without the GIL).
 const CHUNK: usize = 1 << 16;
-
-/// A filter the binding can run on another thread while Python goes on.
-type Filter = Box<dyn PolynomialFilter + Sync>;
 
 /// The estimate of a polynomial filter at one time.
 #[pyclass(name = "State", module = "seqsmooth", frozen)]
@@ -104,105 +101,15 @@ pub(crate) fn state_of(filter: &dyn PolynomialFilter, t: Option<f64>) -> PyResul
 /// ``estimate_at`` (Morrison chs. 9, 13; Reyneke et al. 2012 on irregular times).
 #[pyclass(name = "PolynomialFilter", module = "seqsmooth", subclass)]
 pub struct PyPolynomialFilter {
-    filter: Filter,
-    /// Whether `update_many` without σ may take the library's batch kernels (expanding and
-    /// fading memory, as `seqsmooth filter` does).
-    batch: bool,
+    filter: AnyFilter,
 }
 
 impl PyPolynomialFilter {
-    fn new(filter: Filter, batch: bool) -> PyClassInitializer<Self> {
-        PyClassInitializer::from(Self { filter, batch })
+    /// The filter `spec` describes.
+    fn new(spec: FilterSpec) -> PyResult<PyClassInitializer<Self>> {
+        let filter = spec.build().py()?;
+        Ok(PyClassInitializer::from(Self { filter }))
     }
-}
-
-/// Runs the samples `(t[i], y[i])` and writes row `i` of `out`: the derivatives at `t[i]`
-/// (`m+1` cells), then with `sigma` their 1σ (`m+1` more), as `seqsmooth filter` computes
-/// them: with `batch` (expanding and fading memory without σ) by the library's batch kernels
-/// (`update_many_into`, its rows checked by [`check_batch_rows`]), otherwise a sample at a
-/// time, each estimate from `try_estimate_at(t)`: NaN while the filter has too few samples,
-/// any other reason for no estimate the sample's error. Errors are [`Error::InBatch`] with the
-/// index within the slice. The one row runner of `update_many` and `filter_series`.
-pub(crate) fn run_rows(
-    filter: &mut dyn PolynomialFilter,
-    batch: bool,
-    t: &[f64],
-    y: &[f64],
-    out: &mut [f64],
-    sigma: bool,
-) -> Result<(), Error> {
-    let w = filter.degree() + 1;
-    if batch && !sigma {
-        let before = filter.samples();
-        filter.update_many_into(t, y, out)?;
-        return check_batch_rows(out, w, before);
-    }
-    if sigma {
-        // The library's batch σ path: rows of d0..dM, s0..sM.
-        return filter.update_many_sigma_into(t, y, out);
-    }
-    for (i, ((&t, &y), row)) in t.iter().zip(y).zip(out.chunks_exact_mut(w)).enumerate() {
-        filter.update(t, y).map_err(|e| Error::InBatch {
-            index: i,
-            source: Box::new(e),
-        })?;
-        match filter.try_estimate_at(t) {
-            Ok(state) => {
-                let x = &state.derivatives;
-                row[..x.len()].copy_from_slice(x);
-                row[x.len()..].fill(f64::NAN);
-            }
-            Err(Error::TooFewSamples { .. }) => row.fill(f64::NAN),
-            Err(e) => {
-                return Err(Error::InBatch {
-                    index: i,
-                    source: Box::new(e),
-                })
-            }
-        }
-    }
-    Ok(())
-}
-
-/// The rows the batch kernels wrote (`update_many_into`), checked as `seqsmooth filter`
-/// checks them: NaN marks a row whose estimate the library could not give, which is an error
-/// once the filter has `m+1` samples (before, the fit is not determined): a row all NaN is a
-/// fit not determined (a fading discount that underflowed), one NaN a derivative beyond the
-/// double range. `before` is the filter's sample count before the rows.
-fn check_batch_rows(rows: &[f64], w: usize, before: u64) -> Result<(), Error> {
-    // Fast path, one branch-free pass (vectorised): every row from the determined ones on
-    // finite. Only a failing batch is searched row by row.
-    let undetermined = usize::try_from((w as u64).saturating_sub(before + 1)).unwrap_or(usize::MAX);
-    let first = undetermined.saturating_mul(w).min(rows.len());
-    if rows[first..].iter().fold(true, |ok, v| ok & v.is_finite()) {
-        return Ok(());
-    }
-    for (i, row) in rows.chunks_exact(w).enumerate() {
-        let samples = before + i as u64 + 1;
-        if samples < w as u64 {
-            continue;
-        }
-        let error = if row.iter().all(|v| v.is_nan()) {
-            Error::NotDetermined {
-                samples,
-                why: "the fit is not determined in doubles (with fading memory, a tau far \
-                      shorter than the steps, or a gap of many tau, lets the discount \
-                      theta**(step/tau) underflow): use a larger tau"
-                    .into(),
-            }
-        } else if let Some(k) = row.iter().position(|v| !v.is_finite()) {
-            Error::EstimateOutOfRange {
-                what: format!("d{k}"),
-            }
-        } else {
-            continue;
-        };
-        return Err(Error::InBatch {
-            index: i,
-            source: Box::new(error),
-        });
-    }
-    Ok(())
 }
 
 #[pymethods]
@@ -248,7 +155,9 @@ impl PyPolynomialFilter {
     /// needs its noise ``sigma``): the two are views of one ``(len(t), 2(m+1))`` buffer, the
     /// rows ``d0..dM, s0..sM`` of ``seqsmooth filter --sigma``, written by the library's batch
     /// σ path (no covariance matrix per sample; within about 2× of the plain call's time, the
-    /// output being twice as large: BENCHMARKS.md).
+    /// output being twice as large: BENCHMARKS.md). The rows are the library's row runner's,
+    /// with its rule: a row the determined fit cannot give (a fading discount that
+    /// underflowed, a number beyond the double range) is refused with its index.
     ///
     /// The work runs without the GIL; Ctrl-C stops it between blocks of 65,536 samples, the
     /// samples before the block taken.
@@ -260,6 +169,8 @@ impl PyPolynomialFilter {
     ///     position; the samples before it are taken), mismatched or empty arrays.
     /// InvalidTypeError
     ///     arrays that do not hold real numbers.
+    /// NotDeterminedError, NumericalError
+    ///     a row refused (``.index`` its position).
     #[pyo3(signature = (t, y, return_sigma = false))]
     fn update_many<'py>(
         &mut self,
@@ -271,14 +182,18 @@ impl PyPolynomialFilter {
         let (ts, ys) = pair(t, y)?;
         let (t, y) = (ts.as_slice(), ys.as_slice());
         let (n, w) = (t.len(), self.filter.degree() + 1);
-        let stride = w << usize::from(return_sigma);
+        let layout = RowLayout {
+            sigma: return_sigma,
+            ..RowLayout::default()
+        };
+        let stride = self.filter.stride(layout);
         let mut out = vec![0.0; n * stride];
         for start in (0..n).step_by(CHUNK) {
             let end = (start + CHUNK).min(n);
             let (tc, yc) = (&t[start..end], &y[start..end]);
             let oc = &mut out[start * stride..end * stride];
-            let (filter, batch) = (&mut *self.filter, self.batch);
-            py.detach(|| run_rows(filter, batch, tc, yc, oc, return_sigma))
+            let filter = &mut self.filter;
+            py.detach(|| filter.run_rows(tc, yc, oc, layout))
                 .py_at(start)?;
             py.check_signals()?;
         }
@@ -300,13 +215,13 @@ impl PyPolynomialFilter {
     /// TooFewSamplesError, NumericalError
     ///     no estimate yet, or none to working accuracy (the reason in the message).
     fn estimate(&self) -> PyResult<State> {
-        state_of(&*self.filter, None)
+        state_of(&self.filter, None)
     }
 
     /// The estimate carried to time ``t`` (a prediction ahead of the newest sample, a
     /// retrodiction before it), its covariance carried with it.
     fn estimate_at(&self, t: f64) -> PyResult<State> {
-        state_of(&*self.filter, Some(t))
+        state_of(&self.filter, Some(t))
     }
 
     fn __repr__(slf: &Bound<'_, Self>) -> PyResult<String> {
@@ -371,11 +286,12 @@ impl PyExpandingMemory {
     #[new]
     #[pyo3(signature = (degree, engine = "exact", sigma = None))]
     fn new(degree: usize, engine: &str, sigma: Option<f64>) -> PyResult<PyClassInitializer<Self>> {
-        let mut f = ExpandingMemory::new(degree, self::engine(engine)?).py()?;
-        if let Some(s) = sigma {
-            f = f.with_noise_sigma(s).py()?;
-        }
-        Ok(PyPolynomialFilter::new(Box::new(f), true).add_subclass(Self))
+        let spec = FilterSpec {
+            engine: self::engine(engine)?,
+            sigma,
+            ..FilterSpec::new(FilterKind::Expanding, degree)
+        };
+        Ok(PyPolynomialFilter::new(spec)?.add_subclass(Self))
     }
 }
 
@@ -417,18 +333,25 @@ impl PyFadingMemory {
     ) -> PyResult<PyClassInitializer<Self>> {
         // `tau` defaults to 1 with `theta` (as it always did).
         let tau = tau.or(theta.map(|_| 1.0));
-        let Some(discount) = Discount::from_names(theta, tau, theta_per_update).py()? else {
+        if Discount::from_names(theta, tau, theta_per_update)
+            .py()?
+            .is_none()
+        {
             return Err(raise(
                 Kind::Parameter,
                 "FadingMemory needs a discount: theta (per tau of time) or theta_per_update",
                 None,
             ));
-        };
-        let mut f = FadingMemory::from_discount(degree, discount, self::engine(engine)?).py()?;
-        if let Some(s) = sigma {
-            f = f.with_noise_sigma(s).py()?;
         }
-        Ok(PyPolynomialFilter::new(Box::new(f), true).add_subclass(Self))
+        let spec = FilterSpec {
+            theta,
+            tau,
+            theta_per_update,
+            engine: self::engine(engine)?,
+            sigma,
+            ..FilterSpec::new(FilterKind::Fading, degree)
+        };
+        Ok(PyPolynomialFilter::new(spec)?.add_subclass(Self))
     }
 }
 
@@ -461,11 +384,12 @@ impl PyFixedMemory {
         engine: &str,
         sigma: Option<f64>,
     ) -> PyResult<PyClassInitializer<Self>> {
-        let engine = fixed_engine(engine)?;
-        let mut f = FixedMemory::new(degree, window, engine).py()?;
-        if let Some(s) = sigma {
-            f = f.with_noise_sigma(s).py()?;
-        }
-        Ok(PyPolynomialFilter::new(Box::new(f), false).add_subclass(Self))
+        let spec = FilterSpec {
+            window: Some(window),
+            fixed_engine: fixed_engine(engine)?,
+            sigma,
+            ..FilterSpec::new(FilterKind::Fixed, degree)
+        };
+        Ok(PyPolynomialFilter::new(spec)?.add_subclass(Self))
     }
 }

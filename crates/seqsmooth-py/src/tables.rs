@@ -15,7 +15,6 @@ use seqsmooth::polynomial::fading::gains::fading_gains;
 use seqsmooth::polynomial::fading::vrf::fading_vrf;
 use seqsmooth::polynomial::fixed::covariance;
 use seqsmooth::polynomial::form::{EstimateForm, GainForm};
-use seqsmooth::polynomial::MAX_DEGREE;
 use seqsmooth::scalar::{parse_rational, ratio_to_f64, Rational};
 
 /// A number given exactly: a `Fraction`, an `int`, a `str` (`"9/10"`, `"0.9"`) or a `float`,
@@ -46,28 +45,20 @@ fn theta_of(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Rational> {
         ));
     };
     let theta = exact(obj, "theta")?;
-    let zero = Rational::from_integer(0.into());
-    let one = Rational::from_integer(1.into());
-    if theta <= zero || theta >= one {
-        return Err(raise(
+    // The library's range of θ, exactly.
+    seqsmooth::polynomial::check_theta_of(&theta).map_err(|_| {
+        raise(
             Kind::Parameter,
             format!("theta {theta} is out of range: it must lie strictly between 0 and 1"),
             None,
-        ));
-    }
+        )
+    })?;
     Ok(theta)
 }
 
 fn degree_of(degree: usize) -> PyResult<usize> {
-    if degree > MAX_DEGREE {
-        return Err(raise(
-            Kind::Parameter,
-            format!(
-                "degree {degree} is out of range: the largest supported degree is {MAX_DEGREE}"
-            ),
-            None,
-        ));
-    }
+    // The library's range of a polynomial degree.
+    seqsmooth::polynomial::check_degree(degree).py()?;
     Ok(degree)
 }
 

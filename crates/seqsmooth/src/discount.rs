@@ -194,16 +194,42 @@ impl Discount {
     }
 }
 
-/// `0 < θ < 1`.
-pub(crate) fn check_theta(theta: f64) -> Result<(), Error> {
-    if !(theta > 0.0 && theta < 1.0) {
-        return Err(Error::ThetaOutOfRange { theta });
+/// The range of a fading memory's discount `θ` in doubles: `0 < θ < 1` ([`check_theta_of`]).
+///
+/// ```
+/// use seqsmooth::discount::check_theta;
+/// assert!(check_theta(0.9).is_ok() && check_theta(1.0).is_err() && check_theta(0.0).is_err());
+/// ```
+pub fn check_theta(theta: f64) -> Result<(), Error> {
+    check_theta_of(&theta)
+}
+
+/// The range of a discount `θ` of any scalar (exact for the tables, Morrison (13.1.1)):
+/// `0 < θ < 1`; the error holds `θ` rounded to a double.
+///
+/// ```
+/// use seqsmooth::discount::check_theta_of;
+/// use seqsmooth::scalar::parse_rational;
+/// assert!(check_theta_of(&parse_rational("9/10").unwrap()).is_ok());
+/// assert!(check_theta_of(&parse_rational("1").unwrap()).is_err());
+/// assert!(check_theta_of(&0.0_f64).is_err());
+/// ```
+pub fn check_theta_of<T: crate::scalar::Scalar>(theta: &T) -> Result<(), Error> {
+    if !(*theta > T::zero() && *theta < T::one()) {
+        return Err(Error::ThetaOutOfRange {
+            theta: theta.to_f64(),
+        });
     }
     Ok(())
 }
 
-/// `τ > 0`, finite.
-pub(crate) fn check_tau(tau: f64) -> Result<(), Error> {
+/// The range of the time `τ` a discount applies to: positive and finite.
+///
+/// ```
+/// use seqsmooth::discount::check_tau;
+/// assert!(check_tau(0.5).is_ok() && check_tau(0.0).is_err() && check_tau(f64::INFINITY).is_err());
+/// ```
+pub fn check_tau(tau: f64) -> Result<(), Error> {
     if !(tau.is_finite() && tau > 0.0) {
         return Err(Error::TauOutOfRange { tau });
     }

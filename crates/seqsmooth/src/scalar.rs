@@ -81,10 +81,30 @@ pub fn ratio_to_f64(r: &BigRational) -> f64 {
     ToPrimitive::to_f64(r).unwrap_or(f64::NAN)
 }
 
-/// The largest decimal exponent [`parse_rational`] takes (`1e-4000` … `1e4000`): beyond it the
-/// exact value has tens of thousands of digits and every operation on it is slow (a
-/// `1e7161213` took minutes), while no parameter it parses is meaningful there.
-pub const MAX_DECIMAL_EXPONENT: i32 = 4000;
+/// The largest decimal exponent [`parse_rational`] takes (`1e-400` … `1e400`): beyond it the
+/// exact value has hundreds of digits and more, and every operation on it is slower (a
+/// `1e7161213` took minutes), while no parameter it parses is meaningful there (every double
+/// is inside it).
+pub const MAX_DECIMAL_EXPONENT: i32 = 400;
+
+/// Whether the decimal exponent written in `text` (after an `e` or `E`), if any, is within
+/// [`MAX_DECIMAL_EXPONENT`] in magnitude: the one rule of every front end that reads a
+/// number exactly (beyond it the exact value would take unbounded time to expand, while every
+/// double, subnormals included, is written with an exponent inside it).
+///
+/// ```
+/// use seqsmooth::scalar::decimal_exponent_in_range;
+/// assert!(decimal_exponent_in_range("0.9") && decimal_exponent_in_range("1e-400"));
+/// assert!(!decimal_exponent_in_range("1e-401") && !decimal_exponent_in_range("5e6999999"));
+/// ```
+pub fn decimal_exponent_in_range(text: &str) -> bool {
+    match text.trim().split_once(['e', 'E']) {
+        Some((_, e)) => !e
+            .parse::<i64>()
+            .is_ok_and(|e| e.unsigned_abs() > MAX_DECIMAL_EXPONENT as u64),
+        None => true,
+    }
+}
 
 /// Parses a rational written as `p/q`, an integer, or a finite decimal such as `0.95`, with a
 /// decimal exponent of at most [`MAX_DECIMAL_EXPONENT`] in magnitude (after the digits).
@@ -95,8 +115,8 @@ pub const MAX_DECIMAL_EXPONENT: i32 = 4000;
 /// assert_eq!(parse_rational("0.95").unwrap().to_string(), "19/20");
 /// assert_eq!(parse_rational("95e-2").unwrap().to_string(), "19/20");
 /// assert!(parse_rational("x").is_none());
-/// assert!(parse_rational("1e4000").is_some() && parse_rational("1e-4000").is_some());
-/// assert!(parse_rational("1e4001").is_none() && parse_rational("5e6999999").is_none());
+/// assert!(parse_rational("1e400").is_some() && parse_rational("1e-400").is_some());
+/// assert!(parse_rational("1e401").is_none() && parse_rational("5e6999999").is_none());
 /// ```
 pub fn parse_rational(text: &str) -> Option<BigRational> {
     let s = text.trim();

@@ -11,9 +11,8 @@
 
 use crate::error::CliError;
 use clap::{Args, Parser, Subcommand};
-use num_traits::{One, Zero};
-use seqsmooth::polynomial::MAX_DEGREE;
-use seqsmooth::scalar::{parse_rational, Rational};
+use seqsmooth::polynomial::{check_degree, check_tau, MAX_DEGREE};
+use seqsmooth::scalar::{parse_rational, Rational, MAX_DECIMAL_EXPONENT};
 use seqsmooth::Engine;
 
 mod demo;
@@ -472,11 +471,18 @@ pub fn check_window(window: Option<usize>, degree: usize) -> Result<usize, CliEr
             "--kind fixed needs --window W, the number of samples in the window (at least M+1 \
              = {need})"
         ))),
-        Some(w) if w < need => Err(CliError::Usage(format!(
-            "window {w} is too small for degree {degree}: a degree-{degree} fit needs a window \
-             of at least {need} samples"
-        ))),
-        Some(w) => Ok(w),
+        // The library's rule of a window, its reason in the message.
+        Some(w) => seqsmooth::polynomial::fixed::check_window(degree, w)
+            .map(|()| w)
+            .map_err(|e| match e {
+                seqsmooth::Error::InvalidParameter { reason, .. } if w < need => CliError::Usage(
+                    format!("window {w} is too small for degree {degree}: {reason}"),
+                ),
+                seqsmooth::Error::InvalidParameter { reason, .. } => {
+                    CliError::Usage(format!("window {w} is out of range: {reason}"))
+                }
+                other => CliError::from(other),
+            }),
     }
 }
 
@@ -494,7 +500,7 @@ pub struct Theta {
 impl Theta {
     /// θ as an `f64` strictly inside `(0, 1)`, for the computations that run in `f64`.
     pub fn value_f64(&self) -> Result<f64, CliError> {
-        if self.value > 0.0 && self.value < 1.0 {
+        if seqsmooth::polynomial::check_theta(self.value).is_ok() {
             Ok(self.value)
         } else {
             Err(CliError::Usage(format!(
@@ -510,18 +516,16 @@ impl Theta {
 pub fn parse_theta(s: &str) -> Result<Theta, String> {
     let text = s.trim();
     // An exponent this large would take unbounded time to expand exactly (a fuzz campaign's
-    // `--theta 5e6999999` took minutes).
-    if let Some((_, e)) = text.split_once(['e', 'E']) {
-        if e.parse::<i64>().is_ok_and(|e| e.unsigned_abs() > 400) {
-            return Err(format!(
-                "theta {text} is out of range: it must lie strictly between 0 and 1 (write it \
-                 with an exponent from -400 to 400)"
-            ));
-        }
+    // `--theta 5e6999999` took minutes): the library's rule.
+    if !seqsmooth::scalar::decimal_exponent_in_range(text) {
+        return Err(format!(
+            "theta {text} is out of range: it must lie strictly between 0 and 1 (write it with \
+             an exponent from -{MAX_DECIMAL_EXPONENT} to {MAX_DECIMAL_EXPONENT})"
+        ));
     }
     let exact = parse_rational(text)
         .ok_or_else(|| format!("theta '{text}' is not a number (write it as 0.9 or 9/10)"))?;
-    if !(exact > Rational::zero() && exact < Rational::one()) {
+    if seqsmooth::polynomial::check_theta_of(&exact).is_err() {
         return Err(format!(
             "theta {text} is out of range: it must lie strictly between 0 and 1"
         ));
@@ -548,15 +552,19 @@ fn parse_whole(name: &str, s: &str, unit: &str, lo: i128, hi: i128) -> Result<i1
     }
 }
 
-/// Parses `--degree`: a whole number from 0 to [`MAX_DEGREE`].
+/// Parses `--degree`: a whole number, in the library's range ([`check_degree`]).
 pub fn parse_degree(s: &str) -> Result<usize, String> {
-    match s.trim().parse::<i128>() {
-        Ok(d) if d > MAX_DEGREE as i128 => Err(format!(
-            "degree {} is out of range: the largest supported degree is {MAX_DEGREE}",
+    // Not a whole number ≥ 0 (a sign, a fraction, text): said in the words of the range.
+    let whole = |_| parse_whole("degree", s, "", 0, MAX_DEGREE as i128).map(|d| d as usize);
+    let d = s.trim().parse::<usize>().or_else(whole)?;
+    check_degree(d).map_err(|e| match e {
+        seqsmooth::Error::DegreeOutOfRange { max, .. } => format!(
+            "degree {} is out of range: the largest supported degree is {max}",
             s.trim()
-        )),
-        _ => parse_whole("degree", s, "", 0, MAX_DEGREE as i128).map(|d| d as usize),
-    }
+        ),
+        other => other.to_string(),
+    })?;
+    Ok(d)
 }
 
 /// Parses `plot --derivative`: a whole number from 0 to [`MAX_DEGREE`].
@@ -584,9 +592,10 @@ fn parse_f64(name: &str, s: &str, (ok, range): (fn(f64) -> bool, &str)) -> Resul
     }
 }
 
-/// Parses `--tau`: a positive finite number.
+/// Parses `--tau`: a number in the library's range ([`check_tau`]).
 pub fn parse_tau(s: &str) -> Result<f64, String> {
-    parse_f64("tau", s, POSITIVE)
+    const TAU: (fn(f64) -> bool, &str) = (|v| check_tau(v).is_ok(), "a positive finite number");
+    parse_f64("tau", s, TAU)
 }
 
 /// Parses `--sigma`: a positive finite number.

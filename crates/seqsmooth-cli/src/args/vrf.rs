@@ -3,8 +3,8 @@
 use super::{parse_window, Format, MemoryArgs};
 use clap::Args;
 use seqsmooth::polynomial::form::EstimateForm;
-use seqsmooth::scalar::parse_rational;
 use seqsmooth::scalar::Rational;
+use seqsmooth::scalar::{parse_rational, MAX_DECIMAL_EXPONENT};
 
 #[derive(Debug, Args)]
 pub struct VrfArgs {
@@ -82,13 +82,12 @@ pub fn parse_lead_steps(s: &str) -> Result<LeadSteps, String> {
     let out_of_range = || {
         format!("lead {text} is out of range: it must be a finite number of samples (|H| < 1e300)")
     };
-    // An exponent this large would take unbounded time to expand exactly.
-    if let Some((_, e)) = text.split_once(['e', 'E']) {
-        if e.parse::<i64>().is_ok_and(|e| e.unsigned_abs() > 400) {
-            return Err(format!(
-                "lead {text} is out of range: write it with an exponent from -400 to 400"
-            ));
-        }
+    // An exponent this large would take unbounded time to expand exactly: the library's rule.
+    if !seqsmooth::scalar::decimal_exponent_in_range(text) {
+        return Err(format!(
+            "lead {text} is out of range: write it with an exponent from \
+             -{MAX_DECIMAL_EXPONENT} to {MAX_DECIMAL_EXPONENT}"
+        ));
     }
     let exact = parse_rational(text).ok_or_else(not_a_number)?;
     let value = seqsmooth::scalar::ratio_to_f64(&exact);

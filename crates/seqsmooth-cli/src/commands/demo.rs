@@ -11,12 +11,12 @@
 //! (noise σ given), on both engines, are shown beside it for comparison.
 
 use crate::args::{name, DemoArgs, EngineArg, Kind};
-use crate::commands::shared::runner::Runner;
-use crate::commands::shared::LOOKAHEAD;
+use crate::commands::shared::{filter_kind, LOOKAHEAD};
 use crate::error::CliError;
 use crate::io::{fmt_f64, Output};
 use crate::plot::chart::{self, Layout, Track};
 use seqsmooth::polynomial::automatic::{final_outliers, AutoOutput, AutomaticFilter, Phase};
+use seqsmooth::polynomial::spec::FilterSpec;
 use seqsmooth::polynomial::tau::median_series_step;
 use seqsmooth::{PolynomialFilter, PolynomialState};
 use std::f64::consts::PI;
@@ -149,8 +149,14 @@ fn run_plain(
     engine: EngineArg,
     tau: f64,
 ) -> Result<Estimates, CliError> {
-    let mut f = Runner::build(kind, DEGREE, Some(THETA), tau, None, engine, Some(SIGMA))
-        .map_err(CliError::from)?;
+    let spec = FilterSpec {
+        theta: Some(THETA),
+        tau: Some(tau),
+        engine: engine.into(),
+        sigma: Some(SIGMA),
+        ..FilterSpec::new(filter_kind(kind), DEGREE)
+    };
+    let mut f = spec.build().map_err(CliError::from)?;
     let mut estimates = Vec::with_capacity(data.len());
     for p in data {
         f.update(p.t, p.y).map_err(CliError::from)?;

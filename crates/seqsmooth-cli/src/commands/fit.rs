@@ -13,30 +13,12 @@ use crate::error::CliError;
 use crate::io::{check_distinct, find_column, open_input, parse_cell, shown, write_f64, CsvIn};
 use crate::io::{Need, Output};
 use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
-use seqsmooth::estimate::sliding::{SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
-use seqsmooth::model::dynamics::PolynomialDynamics;
-use seqsmooth::model::observation::LinearObservation;
-use seqsmooth::model::radar::Radar;
+use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
+use seqsmooth::estimate::sliding::{Fitter, SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
 use seqsmooth::track::window_flag;
 use seqsmooth::Error;
 use std::collections::VecDeque;
 use std::io::Read;
-
-/// The model's sliding fit.
-enum Fitter {
-    Radar(SlidingFit<PolynomialDynamics, Radar>),
-    Polynomial(SlidingFit<PolynomialDynamics, LinearObservation>),
-}
-
-impl Fitter {
-    fn push(&mut self, m: Measurement) -> Result<Option<Correction>, Error> {
-        match self {
-            Fitter::Radar(f) => f.push_finite(m),
-            Fitter::Polynomial(f) => f.push_finite(m),
-        }
-    }
-}
 
 /// Where the rows come from: the radar reader that `track` uses (its columns, σ, azimuth
 /// convention and the library's rule for a radar row), or the polynomial's value column.
@@ -201,7 +183,7 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
             lines.pop_front();
         }
         lines.push_back(line);
-        let fit = setup.fitter.push(measurement).map_err(|e| match e {
+        let fit = setup.fitter.push_finite(measurement).map_err(|e| match e {
             e @ Error::NonFinite {
                 what: "fitted state",
                 value,
@@ -300,13 +282,8 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
                         .into(),
                 ));
             }
+            // Its range (1 or 2) is the library's: `SlidingFit::radar` refuses the others.
             let degree = a.degree.unwrap_or(1);
-            if !(1..=2).contains(&degree) {
-                return Err(usage(format!(
-                    "degree {degree} is out of range for --model radar: 1 (constant velocity) \
-                     or 2 (constant acceleration)"
-                )));
-            }
             let need = Need::rows(2, "the radar model");
             need.check_header(header)?;
             let states = 3 * (degree + 1);

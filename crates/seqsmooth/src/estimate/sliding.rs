@@ -528,6 +528,45 @@ impl SlidingFit<PolynomialDynamics, LinearObservation> {
     }
 }
 
+/// The sliding fit of either model of `seqsmooth fit` and of Python's `SlidingFit`: a radar's
+/// Cartesian target ([`SlidingFit::radar`]) or a scalar polynomial
+/// ([`SlidingFit::polynomial`]).
+///
+/// ```
+/// use seqsmooth::estimate::batch::NoiseCovariance;
+/// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
+/// use seqsmooth::estimate::sliding::{Fitter, SlidingFit};
+/// let fit = SlidingFit::polynomial(1, 3, Epoch::End, GaussNewton::default())?;
+/// let mut fitter = Fitter::Polynomial(fit);
+/// let row = |t: f64| Measurement {
+///     time: t,
+///     values: vec![Some(1.0 + 2.0 * t)],
+///     noise: NoiseCovariance::Variances(vec![0.01]),
+/// };
+/// assert!(fitter.push_finite(row(0.0))?.is_none()); // one row does not determine a line
+/// let c = fitter.push_finite(row(1.0))?.unwrap();
+/// assert!((c.state[1] - 2.0).abs() < 1e-9);
+/// # Ok::<(), seqsmooth::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub enum Fitter {
+    /// Range, azimuth and elevation of a target of constant velocity or acceleration.
+    Radar(SlidingFit<PolynomialDynamics, Radar>),
+    /// A scalar polynomial in time, observed directly.
+    Polynomial(SlidingFit<PolynomialDynamics, LinearObservation>),
+}
+
+impl Fitter {
+    /// [`SlidingFit::push_finite`] of the model's fit: the row taken and the window fitted,
+    /// or the row refused and the fit as before it.
+    pub fn push_finite(&mut self, m: Measurement) -> Result<Option<Correction>, Error> {
+        match self {
+            Fitter::Radar(f) => f.push_finite(m),
+            Fitter::Polynomial(f) => f.push_finite(m),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -296,7 +296,7 @@ pub(crate) fn check_batch_lengths(times: &[f64], values: &[f64]) -> Result<(), E
 /// BENCHMARKS.md).
 #[inline(always)]
 #[allow(clippy::eq_op)]
-fn finite(x: f64) -> bool {
+pub(crate) fn finite(x: f64) -> bool {
     x - x == 0.0
 }
 

@@ -7,7 +7,7 @@
 //! | concept | module | source |
 //! |---|---|---|
 //! | what every filter does: [`PolynomialFilter`]; batch checks | `filter` | — |
-//! | engines, discounting, largest degree: [`Engine`], [`DiscountMode`], [`MAX_DEGREE`], [`GAIN_MAX_DEGREE`] | `options` | — |
+//! | engines, discounting, largest degree, the parameters' ranges: [`Engine`], [`DiscountMode`], [`MAX_DEGREE`], [`GAIN_MAX_DEGREE`], [`check_degree`], [`check_theta`], [`check_tau`] | `options` | — |
 //! | the default interval `τ` of a fading memory: [`tau::default_tau`], the median time step | [`tau`] | Morrison (13.2.1); Reyneke §6.5 |
 //! | current / predictor form of gains and VRFs: [`form::GainForm`], [`form::EstimateForm`], [`form::unscale`] | [`form`] | Morrison (9.7.4), (13.6.22) |
 //! | expanding memory: [`ExpandingMemory`], gains, VRF | [`expanding`] | Morrison ch. 9, Tables 9.1-9.2; Reyneke §6.3-6.4 |
@@ -16,6 +16,8 @@
 //! | fixed memory and whole-series smoothing | [`fixed`] | Morrison ch. 7, §9.5 |
 //! | the automatic filter: [`AutomaticFilter`] | [`automatic`] | Morrison §13.8, §14.8; Reyneke §7 |
 //! | many channels at once | [`bank`], [`stream`] | — |
+//! | any filter from one description: [`spec::FilterSpec`], [`spec::AnyFilter`] | [`spec`] | — |
+//! | a batch to output rows, and what an undetermined or refused row holds: [`spec::AnyFilter::run_rows`] | [`rows`] | — |
 //!
 //! ## Engines
 //!
@@ -93,6 +95,8 @@ mod filter;
 pub mod fixed;
 pub mod form;
 mod options;
+pub mod rows;
+pub mod spec;
 pub mod stream;
 pub mod tau;
 
@@ -100,4 +104,5 @@ pub use automatic::{AutoConfig, AutoOutput, AutomaticFilter};
 pub use expanding::ExpandingMemory;
 pub use fading::{FadingMemory, SwitchRule};
 pub use filter::PolynomialFilter;
+pub use options::{check_degree, check_tau, check_theta, check_theta_of};
 pub use options::{DiscountMode, Engine, GAIN_MAX_DEGREE, GAIN_MAX_VALUE, MAX_DEGREE};

@@ -103,7 +103,13 @@ pub(crate) fn check_engine_degree(m: usize, engine: Engine) -> Result<(), Error>
     Ok(())
 }
 
-pub(crate) fn check_degree(m: usize) -> Result<(), Error> {
+/// The polynomial degree's range: `m ≤ MAX_DEGREE` (every front end's check).
+///
+/// ```
+/// use seqsmooth::polynomial::{check_degree, MAX_DEGREE};
+/// assert!(check_degree(MAX_DEGREE).is_ok() && check_degree(MAX_DEGREE + 1).is_err());
+/// ```
+pub fn check_degree(m: usize) -> Result<(), Error> {
     if m > MAX_DEGREE {
         return Err(Error::DegreeOutOfRange {
             degree: m,
@@ -113,7 +119,7 @@ pub(crate) fn check_degree(m: usize) -> Result<(), Error> {
     Ok(())
 }
 
-pub(crate) use crate::discount::{check_tau, check_theta};
+pub use crate::discount::{check_tau, check_theta, check_theta_of};
 
 /// The measurement noise's 1σ: a positive finite number whose variance `σ²` is a normal,
 /// finite double (`1.5e-154 ≲ σ ≲ 1.3e154`): below, the variance is zero or subnormal and the

@@ -16,8 +16,7 @@
 mod held;
 
 use crate::args::{check_window, name, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
-use crate::commands::shared::runner::{self, Runner};
-use crate::commands::shared::LOOKAHEAD;
+use crate::commands::shared::{filter_kind, LOOKAHEAD};
 use crate::error::CliError;
 use crate::io::parquet::{is_parquet, ParquetRows, ParquetTable};
 use crate::io::progress::{self, Progress};
@@ -25,6 +24,8 @@ use crate::io::rows::{Chunk, RowReader};
 use crate::io::{check_distinct, input_size, named, open_input, CsvIn, Need, Output};
 use crate::io::{IdType, Records};
 use rayon::prelude::*;
+use seqsmooth::polynomial::rows::{decisions, RowLayout};
+use seqsmooth::polynomial::spec::{AnyFilter, FilterSpec};
 use seqsmooth::polynomial::stream::{self, StreamBank};
 use seqsmooth::polynomial::tau;
 use std::sync::mpsc;
@@ -137,21 +138,30 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         None if tau_needed => default_tau(&chunk, chunk.len().min(hold.max(scan)))?,
         None => 1.0,
     };
-    let engine = a.engine.unwrap_or(EngineArg::Exact);
-    let prototype = Runner::build(a.kind, a.degree, theta, tau, a.window, engine, a.sigma)
-        .and_then(|r| match (r, a.review_window) {
-            (Runner::Auto(f), Some(n)) => Ok(Runner::Auto(Box::new(f.with_review_window(n)?))),
-            (r, _) => Ok(r),
-        })
-        .map_err(CliError::from)?;
+    let spec = FilterSpec {
+        theta,
+        tau: Some(tau),
+        window: a.window,
+        engine: a.engine.unwrap_or(EngineArg::Exact).into(),
+        sigma: a.sigma,
+        review_window: a.review_window,
+        ..FilterSpec::new(filter_kind(a.kind), a.degree)
+    };
+    let prototype = spec.build().map_err(CliError::from)?;
     // The automatic filter always writes s0..sM (from the given or the estimated noise).
-    let sigma = a.sigma.is_some() || a.kind == Kind::Auto;
-    let extra = prototype.extra_columns();
+    let sigma = spec.writes_sigma();
+    let lead = a.lead;
+    let layout = RowLayout {
+        sigma,
+        lead,
+        trailing: true,
+    };
+    let extra = prototype.trailing_columns();
     // The automatic filter's rows carry cells more, not written: the final outlier decisions
     // each row's update made (see `held`).
     let auto = a.kind == Kind::Auto;
     let shown = ((a.degree + 1) << usize::from(sigma)) + extra.len();
-    let stride = shown + if auto { runner::DECISION_CELLS } else { 0 };
+    let stride = prototype.stride(layout);
     let mut held = held::Held::default();
     let mut bank = StreamBank::growing(prototype).map_err(CliError::from)?;
     let (mut ids, mut values, mut out) = (Vec::new(), Vec::new(), None);
@@ -161,32 +171,18 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         let sizes = (1..).map(move |k| first_rows.saturating_mul(1 << k.min(16)));
         Pipeline::start(reader, sizes.map(move |rows| rows.min(chunk_rows)))
     });
-    let lead = a.lead;
     // A lead is recorded in a trailing column, so that the output says where its estimates are.
     let lead_cell = [lead];
     let lead_cells = &lead_cell[..usize::from(lead != 0.0)];
     let mut columns = extra.to_vec();
     columns.extend(lead_cells.iter().map(|_| "lead"));
-    // The names of the estimate columns, for messages, and the rows of each series so far.
-    let mut names: Vec<String> = (0..=a.degree).map(|k| format!("d{k}")).collect();
-    if sigma {
-        names.extend((0..=a.degree).map(|k| format!("s{k}")));
-    }
-    names.extend(extra.iter().map(|c| c.to_string()));
-    let mut counts: Vec<usize> = Vec::new();
-    // Every d cell is written once a series is determined; the automatic filter's above the
-    // degree it has reached are empty by design.
-    let cells = if a.kind == Kind::Auto {
-        1
-    } else {
-        a.degree + 1
-    };
-    // The automatic filter's noise cell, after d0..dM and s0..sM: empty, no estimate.
-    let withheld_cell = (a.kind == Kind::Auto).then_some(2 * (a.degree + 1));
     for first in std::iter::once(true).chain(std::iter::repeat(false)) {
         ids.append(&mut chunk.new_ids);
         values.resize(chunk.len() * stride, 0.0);
-        let run = |f: &mut Runner, t: &[f64], y: &[f64], o: &mut [f64]| f.run(t, y, o, lead, sigma);
+        // The library's rows, each refused row (no estimate once determined, a number beyond
+        // the double range) the error of its row: right or refused.
+        let run =
+            |f: &mut AnyFilter, t: &[f64], y: &[f64], o: &mut [f64]| f.run_rows(t, y, o, layout);
         let rows = stream::Chunk {
             channels: &chunk.series,
             times: &chunk.t,
@@ -195,23 +191,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             stride,
         };
         let failed = bank.update_par(rows, run).err();
-        let mut failed = failed.map(|e| row_error(e, &chunk));
-        let limit = failed.as_ref().map_or(chunk.len(), |(i, _)| *i);
-        // Right or refused: a row the library could not represent ends the run here.
-        let unwritable = check_estimates(
-            &values,
-            stride,
-            &names,
-            cells,
-            &chunk,
-            limit,
-            &need,
-            &mut counts,
-            withheld_cell,
-        );
-        if let Some(bad) = unwritable {
-            failed = Some(bad);
-        }
+        let mut failed = failed.map(|e| row_error(e, &chunk, &need, a.kind));
         let limit = failed.as_ref().map_or(chunk.len(), |(i, _)| *i);
         if let Some((_, e)) = failed.take_if(|_| first && limit < hold) {
             return Err(e);
@@ -234,13 +214,13 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
                 let row = &values[i * stride..(i + 1) * stride];
                 let mut buf = Vec::with_capacity(stride * 20);
                 chunk.row_with(&mut buf, i, id(i), &row[..shown], lead_cells);
-                let decided = runner::decisions(&row[shown..]);
+                let decided = decisions(&row[shown..]);
                 held.push(chunk.series[i], buf, 2 + lead_cells.len(), &decided);
             }
             if failed.is_none() && chunk.error.is_none() && chunk.done {
                 // The input is complete: every series decides its samples still waiting.
                 for series in 0..bank.channels() {
-                    if let Some(Runner::Auto(f)) = bank.channel_mut(series) {
+                    if let Some(f) = bank.channel_mut(series).and_then(AnyFilter::automatic_mut) {
                         held.decide(series, &f.finish());
                     }
                 }
@@ -306,67 +286,9 @@ fn create_output(
     }
 }
 
-/// The first of the rows `..limit` that cannot be written as it is, and why, from the
-/// `need`-th row of its series on: no estimate (the fit is not determined), or one of its first
-/// `cells` numbers marked NaN by the library because it is beyond the double range (the time
-/// unit too small for the degree, the values too large, or a lead too long), or any number
-/// infinite. `counts` holds,
-/// per series, the rows seen so far; a row whose cell `withheld` is empty has no estimate for
-/// that stated reason (the automatic filter's noise cell).
-#[allow(clippy::too_many_arguments)]
-fn check_estimates(
-    values: &[f64],
-    stride: usize,
-    names: &[String],
-    cells: usize,
-    chunk: &Chunk,
-    limit: usize,
-    need: &Need,
-    counts: &mut Vec<usize>,
-    withheld: Option<usize>,
-) -> Option<(usize, CliError)> {
-    let fail = |i: usize, why: String| Some((i, CliError::Data(format!("{}: {why}", chunk.at(i)))));
-    for i in 0..limit {
-        let row = &values[i * stride..(i + 1) * stride];
-        // The library marks what it cannot represent as NaN; anything infinite (the automatic
-        // filter's σ, bias or noise columns) is refused the same way.
-        if let Some(k) = row.iter().position(|v| v.is_infinite()) {
-            return fail(i, too_large(&names[k]));
-        }
-        let series = chunk.series[i];
-        if counts.len() <= series {
-            counts.resize(series + 1, 0);
-        }
-        counts[series] += 1;
-        if counts[series] < need.rows {
-            continue;
-        }
-        // The automatic filter's estimate is withheld, empty cells, while its noise cell is
-        // empty (no estimate without its σ: the σ is not estimated yet).
-        if withheld.is_some_and(|k| row[k].is_nan()) {
-            continue;
-        }
-        if row[0].is_nan() && row[1..cells].iter().all(|v| v.is_nan()) {
-            return fail(
-                i,
-                format!(
-                    "no estimate for this row, sample {} of its series ({} needs {}): the \
-                     filter's fit is not determined (with --kind fading, a tau far shorter \
-                     than the steps, or a gap of many tau, lets the discount θ^(step/τ) \
-                     underflow); use a larger --tau",
-                    counts[series], need.why, need.rows
-                ),
-            );
-        }
-        if let Some(k) = row[..cells].iter().position(|v| !v.is_finite()) {
-            return fail(i, too_large(&names[k]));
-        }
-    }
-    None
-}
-
-/// The row and message of the bank's error `e` on `chunk`.
-fn row_error(e: seqsmooth::Error, chunk: &Chunk) -> (usize, CliError) {
+/// The row and message of the bank's error `e` on `chunk` (a series of `kind` needing `need`
+/// rows for its fit).
+fn row_error(e: seqsmooth::Error, chunk: &Chunk, need: &Need, kind: Kind) -> (usize, CliError) {
     let (index, source) = match e {
         seqsmooth::Error::InChannel { source, .. } => match *source {
             seqsmooth::Error::InBatch { index, source } => (index, *source),
@@ -375,11 +297,21 @@ fn row_error(e: seqsmooth::Error, chunk: &Chunk) -> (usize, CliError) {
         other => (0, other),
     };
     let at = chunk.at(index);
-    let too = match &source {
+    let why = match &source {
         seqsmooth::Error::EstimateOutOfRange { what } => Some(too_large(what)),
+        // A row the library refuses for want of an estimate once the fit is determined.
+        seqsmooth::Error::NotDetermined { samples, why } => Some(format!(
+            "no estimate for this row, sample {samples} of its series ({} needs {}): {why}{}",
+            need.why,
+            need.rows,
+            match kind {
+                Kind::Fading | Kind::Auto => "; use a larger --tau",
+                Kind::Expanding | Kind::Fixed => "",
+            }
+        )),
         _ => None,
     };
-    let e = CliError::from(source).reworded(|m| format!("{at}: {}", too.unwrap_or(m)));
+    let e = CliError::from(source).reworded(|m| format!("{at}: {}", why.unwrap_or(m)));
     (index, e)
 }
 

@@ -20,11 +20,7 @@ use nalgebra::DMatrix;
 /// assert!((s[(0, 0)] - 0.137192010).abs() < 1e-9); // (13.7.1)
 /// ```
 pub fn fading_vrf<T: Scalar>(m: usize, theta: T, form: EstimateForm) -> Result<DMatrix<T>, Error> {
-    if !(theta > T::zero() && theta < T::one()) {
-        return Err(Error::ThetaOutOfRange {
-            theta: theta.to_f64(),
-        });
-    }
+    crate::polynomial::options::check_theta_of(&theta)?;
     let r = match form {
         EstimateForm::Current => T::zero(),
         EstimateForm::Predictor => -T::one(),

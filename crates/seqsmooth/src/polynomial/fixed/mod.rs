@@ -210,8 +210,14 @@ fn check_materialised(span: u64) -> Result<(), Error> {
     Ok(())
 }
 
-/// Degree within range and `m+1 ≤ window ≤ MAX_WINDOW`.
-fn check_window(m: usize, window: usize) -> Result<(), Error> {
+/// A fixed memory's window (Morrison's `L + 1` samples, ch. 7): the degree within range and
+/// `m+1 ≤ window ≤ MAX_WINDOW` (every front end's check).
+///
+/// ```
+/// use seqsmooth::polynomial::fixed::check_window;
+/// assert!(check_window(2, 3).is_ok() && check_window(2, 2).is_err());
+/// ```
+pub fn check_window(m: usize, window: usize) -> Result<(), Error> {
     crate::polynomial::options::check_degree(m)?;
     if window as u64 > MAX_WINDOW {
         return Err(Error::InvalidParameter {

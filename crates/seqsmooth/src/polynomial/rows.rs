@@ -1,0 +1,305 @@
+//! The row runner: a batch of samples through an [`AnyFilter`] to output rows, and the one rule
+//! for what a row holds when there is no estimate — the rows of `seqsmooth filter` (and so of
+//! `smooth` and `demo`), of Python's `update_many` and of `filter_frame`.
+//!
+//! Row `i` holds `d0..dM`, the derivatives `x, x', …, x^(m)` at `t_i + lead` from the samples up
+//! to `i`; with σ their 1σ `s0..sM` (the square roots of the covariance's diagonal, Morrison
+//! (5.5.22) carried to the time); then, with [`RowLayout::trailing`], the kind's cells
+//! ([`AnyFilter::trailing_columns`]: fixed memory the rows in the window; the automatic filter
+//! the noise σ in use, the outlier and misfit flags as 0/1 and the estimated bias of `d0` that
+//! `s0` includes; then [`DECISION_CELLS`] cells, the final outlier decisions the update made).
+//!
+//! The rule: a row is NaN (an empty cell) where there is no number yet — before the filter has
+//! the samples its fit needs (`m + 1`, fixed memory its window), above the degree an estimate
+//! has (the automatic filter's while its degree settles), and while the automatic filter
+//! withholds its estimate (its noise σ not estimated yet: no estimate without its σ). Once
+//! the fit is determined, a row without an estimate is refused ([`Error::NotDetermined`]:
+//! with fading memory a discount `θ^(step/τ)` that underflows) and so is a number beyond the
+//! double range ([`Error::EstimateOutOfRange`] naming its column); no row holds an infinity.
+//! A refusal is [`Error::InBatch`] with its row's index, the rows before it written.
+
+use crate::error::{Error, Param};
+use crate::model::PolynomialState;
+use crate::polynomial::filter::{finite, no_noise_sigma, PolynomialFilter};
+use crate::polynomial::spec::{AnyFilter, Inner};
+
+/// The automatic filter's cells after its written ones (with [`RowLayout::trailing`]): how
+/// many final outlier decisions the row's update made (on the series' oldest samples still
+/// undecided, in order), and their verdicts as bits (`1`: rejected), 32 to a cell, oldest in
+/// the lowest bit; read by [`decisions`].
+pub const DECISION_CELLS: usize = 3;
+
+/// What a row holds besides `d0..dM`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RowLayout {
+    /// The 1σ `s0..sM` after the derivatives.
+    pub sigma: bool,
+    /// The estimates are at each sample's time plus `lead` (negative: retrodiction).
+    pub lead: f64,
+    /// The kind's cells after them ([`AnyFilter::trailing_columns`], and the automatic
+    /// filter's [`DECISION_CELLS`]).
+    pub trailing: bool,
+}
+
+/// The final outlier decisions stored in a row's [`DECISION_CELLS`] cells.
+///
+/// ```
+/// use seqsmooth::polynomial::rows::decisions;
+/// assert_eq!(decisions(&[3.0, 5.0, 0.0]), vec![true, false, true]);
+/// assert!(decisions(&[f64::NAN; 3]).is_empty()); // no update made
+/// ```
+pub fn decisions(cells: &[f64]) -> Vec<bool> {
+    let bits = cells[1] as u64 | ((cells[2] as u64) << 32);
+    (0..cells[0] as usize).map(|i| bits >> i & 1 == 1).collect()
+}
+
+/// The decisions `verdicts` (at most 64) in the [`DECISION_CELLS`] cells.
+fn store_decisions(verdicts: &[bool], cells: &mut [f64]) {
+    let bits = verdicts
+        .iter()
+        .enumerate()
+        .fold(0u64, |b, (i, &r)| b | (u64::from(r) << i));
+    cells[0] = verdicts.len() as f64;
+    cells[1] = (bits & 0xffff_ffff) as f64;
+    cells[2] = (bits >> 32) as f64;
+}
+
+impl AnyFilter {
+    /// The names of the cells after `d0..dM` and `s0..sM` this kind writes with
+    /// [`RowLayout::trailing`].
+    pub fn trailing_columns(&self) -> &'static [&'static str] {
+        match &self.inner {
+            Inner::Expanding(_) | Inner::Fading(_) => &[],
+            Inner::Fixed(..) => &["window"],
+            Inner::Automatic(_) => &["noise", "outlier", "misfit", "bias"],
+        }
+    }
+
+    /// The cells of a row of `layout`, the automatic filter's [`DECISION_CELLS`] included.
+    pub fn stride(&self, layout: RowLayout) -> usize {
+        let trailing = match (&self.inner, layout.trailing) {
+            (_, false) => 0,
+            (Inner::Automatic(_), true) => self.trailing_columns().len() + DECISION_CELLS,
+            (_, true) => self.trailing_columns().len(),
+        };
+        ((self.degree() + 1) << usize::from(layout.sigma)) + trailing
+    }
+
+    /// Runs the samples `(t[i], y[i])` and writes row `i` of `out` ([`stride`](Self::stride)
+    /// cells each) by the module's rule. The expanding- and fading-memory filters without lead
+    /// take the batch kernels ([`PolynomialFilter::update_many_into`], with σ
+    /// [`PolynomialFilter::update_many_sigma_into`]); the others a sample at a time, each
+    /// estimate from [`try_estimate_at`](PolynomialFilter::try_estimate_at). An error is
+    /// [`Error::InBatch`] of its row (a sample refused, or a row's estimate refused), the rows
+    /// before it written and the samples before it taken.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::rows::RowLayout;
+    /// use seqsmooth::polynomial::spec::{FilterKind, FilterSpec};
+    /// let spec = FilterSpec { window: Some(3), sigma: Some(0.1), ..FilterSpec::new(FilterKind::Fixed, 1) };
+    /// let mut f = spec.build()?;
+    /// let layout = RowLayout { sigma: true, lead: 0.0, trailing: true };
+    /// assert_eq!(f.stride(layout), 5); // d0 d1 s0 s1 window
+    /// let mut out = [0.0; 20];
+    /// f.run_rows(&[0.0, 1.0, 2.0, 3.0], &[1.0, 3.0, 5.0, 7.0], &mut out, layout)?;
+    /// assert!(out[5].is_nan() && out[9] == 2.0); // row 1: the window not full yet
+    /// assert!((out[16] - 2.0).abs() < 1e-12 && out[19] == 3.0); // row 3: slope 2
+    /// # Ok::<(), seqsmooth::Error>(())
+    /// ```
+    pub fn run_rows(
+        &mut self,
+        t: &[f64],
+        y: &[f64],
+        out: &mut [f64],
+        layout: RowLayout,
+    ) -> Result<(), Error> {
+        let stride = self.stride(layout);
+        crate::polynomial::filter::check_batch_lengths(t, y)?;
+        if out.len() != t.len() * stride {
+            return Err(Error::InvalidParameter {
+                name: Param::RowsLength,
+                value: out.len().to_string(),
+                reason: format!("{} samples need {} cells", t.len(), t.len() * stride),
+            });
+        }
+        let before = self.rows;
+        let written = self.write_rows(t, y, out, layout, stride);
+        // The rows up to a refused sample, or up to the row refused while writing, are taken;
+        // those before it are checked first, so that the earliest refusal is the batch's.
+        let done = ((self.rows - before) as usize).min(match &written {
+            Err(Error::InBatch { index, .. }) => *index,
+            _ => t.len(),
+        });
+        self.check_rows(&out[..done * stride], stride, layout, before)?;
+        written
+    }
+
+    /// The rows' numbers, before their check.
+    fn write_rows(
+        &mut self,
+        t: &[f64],
+        y: &[f64],
+        out: &mut [f64],
+        layout: RowLayout,
+        stride: usize,
+    ) -> Result<(), Error> {
+        let RowLayout { sigma, lead, .. } = layout;
+        if let (Inner::Expanding(_) | Inner::Fading(_), 0.0) = (&self.inner, lead) {
+            return match sigma {
+                false => self.update_many_into(t, y, out),
+                true => self.update_many_sigma_into(t, y, out),
+            };
+        }
+        // The batch kernels write every cell; here a cell not written is empty.
+        out.fill(f64::NAN);
+        let width = (self.degree() + 1) << usize::from(sigma);
+        let at = |index: usize| {
+            move |e: Error| Error::InBatch {
+                index,
+                source: Box::new(e),
+            }
+        };
+        for (index, ((&t, &y), row)) in t
+            .iter()
+            .zip(y)
+            .zip(out.chunks_exact_mut(stride))
+            .enumerate()
+        {
+            self.update(t, y).map_err(at(index))?;
+            let (values, extra) = row.split_at_mut(width);
+            let trailing = layout.trailing;
+            let estimate = match &mut self.inner {
+                Inner::Fixed(f, window) => {
+                    if trailing {
+                        extra[0] = (f.samples() as usize).min(*window) as f64;
+                    }
+                    reasoned(f.try_estimate_at(t + lead)).map_err(at(index))?
+                }
+                Inner::Automatic(f) => {
+                    let Some(o) = f.last_output() else { continue };
+                    if trailing {
+                        extra[..4].copy_from_slice(&[
+                            o.noise_sigma.unwrap_or(f64::NAN),
+                            f64::from(u8::from(o.outlier)),
+                            f64::from(u8::from(o.misfit)),
+                            o.bias.as_ref().map_or(f64::NAN, |b| b[0]),
+                        ]);
+                        store_decisions(&o.decided, &mut extra[4..4 + DECISION_CELLS]);
+                    }
+                    // The estimate is at t: the update's own, or across a rejected sample the
+                    // prediction; with a lead the active filter's, the same way.
+                    if lead == 0.0 {
+                        store(o.estimate.as_ref(), sigma, values).map_err(at(index))?;
+                        continue;
+                    }
+                    f.estimate_at(t + lead)
+                }
+                _ => reasoned(self.try_estimate_at(t + lead)).map_err(at(index))?,
+            };
+            store(estimate.as_ref(), sigma, values).map_err(at(index))?;
+        }
+        Ok(())
+    }
+
+    /// The module's rule over the `rows` written (the filter's rows before them `before`): the
+    /// first refused row as [`Error::InBatch`].
+    fn check_rows(
+        &self,
+        rows: &[f64],
+        stride: usize,
+        layout: RowLayout,
+        before: u64,
+    ) -> Result<(), Error> {
+        let w = self.degree() + 1;
+        let (needed, cells, withheld) = match &self.inner {
+            Inner::Fixed(_, window) => ((*window).max(w), w, None),
+            // The automatic filter's estimate is withheld while its noise cell is empty; its
+            // derivatives above the degree it has reached are empty by design. Without its
+            // trailing cells a withheld estimate cannot be told: only infinities are refused.
+            Inner::Automatic(_) if layout.trailing => (w, 1, Some(w << usize::from(layout.sigma))),
+            Inner::Automatic(_) => (usize::MAX, 1, None),
+            _ => (w, w, None),
+        };
+        // Fast path, one branch-free pass (vectorised) over the determined rows: every cell
+        // finite. Only a batch with empty or infinite cells there is searched row by row.
+        let undetermined = usize::try_from((needed as u64).saturating_sub(before + 1));
+        let first = undetermined
+            .unwrap_or(usize::MAX)
+            .saturating_mul(stride)
+            .min(rows.len());
+        if !rows[..first].iter().any(|v| v.is_infinite())
+            && rows[first..].iter().fold(true, |ok, &v| ok & finite(v))
+        {
+            return Ok(());
+        }
+        let name = |k: usize| {
+            let sd = w << usize::from(layout.sigma);
+            match k {
+                k if k < w => format!("d{k}"),
+                k if k < sd => format!("s{}", k - w),
+                k => (self.trailing_columns().get(k - sd))
+                    .map_or("decisions", |c| c)
+                    .into(),
+            }
+        };
+        for (i, row) in rows.chunks_exact(stride).enumerate() {
+            let refused = |e: Error| {
+                Err(Error::InBatch {
+                    index: i,
+                    source: Box::new(e),
+                })
+            };
+            let out_of_range = |k: usize| refused(Error::EstimateOutOfRange { what: name(k) });
+            if let Some(k) = row.iter().position(|v| v.is_infinite()) {
+                return out_of_range(k);
+            }
+            let samples = before + i as u64 + 1;
+            if samples < needed as u64 || withheld.is_some_and(|k| row[k].is_nan()) {
+                continue;
+            }
+            if row[..cells].iter().all(|v| v.is_nan()) {
+                return refused(Error::NotDetermined {
+                    samples,
+                    why: "the fit is not determined in doubles (with fading memory, a tau far \
+                          shorter than the steps, or a gap of many tau, lets the discount \
+                          theta^(step/tau) underflow)"
+                        .into(),
+                });
+            }
+            if let Some(k) = row[..cells].iter().position(|v| !v.is_finite()) {
+                return out_of_range(k);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The estimate, `None` before the fit is determined, or, once it is, why there is none (the
+/// fit singular in doubles, a number beyond the double range).
+fn reasoned(estimate: Result<PolynomialState, Error>) -> Result<Option<PolynomialState>, Error> {
+    match estimate {
+        Ok(s) => Ok(Some(s)),
+        Err(Error::TooFewSamples { .. }) => Ok(None),
+        Err(e) => Err(e),
+    }
+}
+
+/// Copies an estimate into a row's cells: derivatives into `values[..m+1]`, and with `sigma`
+/// their 1σ into `values[m+1..]` (an estimate without a covariance is refused then). The
+/// estimate may be of a lower degree than the cells.
+fn store(estimate: Option<&PolynomialState>, sigma: bool, values: &mut [f64]) -> Result<(), Error> {
+    let Some(s) = estimate else { return Ok(()) };
+    let width = values.len() >> usize::from(sigma);
+    let nd = s.derivatives.len().min(width);
+    values[..nd].copy_from_slice(&s.derivatives[..nd]);
+    if sigma {
+        let c = s.covariance.as_ref().ok_or_else(no_noise_sigma)?;
+        for (i, v) in values[width..width + c.nrows().min(width)]
+            .iter_mut()
+            .enumerate()
+        {
+            *v = c[(i, i)].max(0.0).sqrt();
+        }
+    }
+    Ok(())
+}
