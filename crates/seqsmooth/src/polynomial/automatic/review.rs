@@ -492,7 +492,15 @@ impl<S: Replay> Review<S> {
                     (around.len() >= degree + 2)
                         .then(|| {
                             let c = &mut self.scratch;
-                            interpolation_verdict(around, sample, degree, sigma, k, (gate, gate_rms), c)
+                            interpolation_verdict(
+                                around,
+                                sample,
+                                degree,
+                                sigma,
+                                k,
+                                (gate, gate_rms),
+                                c,
+                            )
                         })
                         .flatten()
                         .unwrap_or(gate)
