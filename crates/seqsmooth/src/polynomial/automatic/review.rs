@@ -284,16 +284,19 @@ const MAX_FIT: usize = MAX_DEGREE + 3;
 /// gate's: the interpolation's, judged against the root mean square of its deleted residual
 /// `√(c σ²(1 + v_p) + b²)`, where that is below the gate's `σ_ε` (`gate_rms`, `None` when the
 /// gate was off), else the gate's; the gate's (`None`) too when the fit cannot say (too few
-/// samples, or numbers beyond the double range). The fit one degree up (for `b²`) is left out
-/// where `σ_ε ≤ √(c σ²(1 + v_p))`: the root mean square is at least that, so the gate decides
-/// whatever `b²` is.
+/// samples, or numbers beyond the double range). `gate` is the gate's verdict and the `σ_ε` it
+/// judged against (`None` when the gate was off). The fit one degree up (for `b²`) is left out
+/// where `σ_ε ≤ √(c σ²(1 + v_p))` (the root mean square is at least that, so the gate decides
+/// whatever `b²` is), and where the gate passed the sample and `|y − p(t)| ≤ k √(c σ²(1 + v_p))`
+/// (a larger `b²` only widens the interpolation's bound: it passes the sample too, or leaves
+/// the decision to the gate, which passed it).
 pub(super) fn interpolation_verdict(
     around: &[(f64, f64)],
     (t, y): (f64, f64),
     degree: usize,
     sigma: f64,
     k: f64,
-    gate_rms: Option<f64>,
+    (gate, gate_rms): (bool, Option<f64>),
     scratch: &mut Scratch,
 ) -> Option<bool> {
     let Scratch {
@@ -345,7 +348,12 @@ pub(super) fn interpolation_verdict(
     // The judge of the smaller mean square: the gate's prediction where the memory is long
     // and fits (the root mean square below is at least √(var(1 + v))), the interpolation
     // where it is short.
-    if gate_rms.is_some_and(|g| g <= (var * (1.0 + v)).sqrt()) {
+    let rms_noise = (var * (1.0 + v)).sqrt();
+    if gate_rms.is_some_and(|g| g <= rms_noise) {
+        return None;
+    }
+    let r = y - p;
+    if !gate && r.abs() <= k * rms_noise {
         return None;
     }
     // The fit's bias at t, from one degree up on the same samples (nested least squares:
@@ -360,7 +368,6 @@ pub(super) fn interpolation_verdict(
         }
         None => 0.0,
     };
-    let r = y - p;
     let rms = (var * (1.0 + v) + b2).sqrt();
     let decides = r.is_finite() && rms.is_finite() && gate_rms.is_none_or(|g| g > rms);
     decides.then_some(r.abs() > k * rms)
@@ -485,7 +492,15 @@ impl<S: Replay> Review<S> {
                     (around.len() >= degree + 2)
                         .then(|| {
                             let c = &mut self.scratch;
-                            interpolation_verdict(around, sample, degree, sigma, k, gate_rms, c)
+                            interpolation_verdict(
+                                around,
+                                sample,
+                                degree,
+                                sigma,
+                                k,
+                                (gate, gate_rms),
+                                c,
+                            )
                         })
                         .flatten()
                         .unwrap_or(gate)
