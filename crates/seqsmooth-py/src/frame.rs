@@ -9,19 +9,22 @@ use crate::errors::{raise, IntoPy, Kind};
 use crate::polynomial::{engine as engine_named, fixed_engine};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
-use seqsmooth::polynomial::rows::RowLayout;
+use seqsmooth::polynomial::rows::{decisions, RowLayout, Undecided, DECISION_CELLS};
 use seqsmooth::polynomial::spec::{AnyFilter, FilterKind, FilterSpec};
 use seqsmooth::polynomial::stream::{Chunk, StreamBank};
 
 /// Filters the rows ``(t[i], y[i])`` of series ``codes[i]`` (0-based integers), each series
-/// on its own filter of the given settings, and returns the columns ``d0..dM`` and with
-/// ``sigma`` their 1σ ``s0..sM``, one value per input row, as the rows of one array
-/// ``(columns, rows)`` (NaN while the series is not determined); without ``tau`` a fading
-/// memory's is the median time step within series (the library's ``default_tau``); for ``fixed`` also the ``window`` cell of each row (the rows in its window),
-/// as a pair. Errors are those of the earliest bad row, with its index.
+/// on its own filter of the given settings (``kind`` ``"expanding"``, ``"fading"``,
+/// ``"fixed"`` or ``"auto"``), and returns the columns of ``seqsmooth filter``'s rows, one
+/// value per input row, as the rows of one array ``(columns, rows)``, and their names:
+/// ``d0..dM``, with ``sigma`` (always for ``auto``) their 1σ ``s0..sM``, then the kind's cells
+/// (``fixed``: ``window``; ``auto``: ``noise``, ``outlier`` — the final decision —,
+/// ``misfit``, ``bias``); NaN where the command leaves a cell empty. Without ``tau`` the
+/// ``τ`` of ``fading`` and ``auto`` is the median time step within series (the library's
+/// ``default_tau``). Errors are those of the earliest bad row, with its index.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (codes, t, y, kind, degree, theta = None, tau = None, window = None, engine = None, sigma = None))]
+#[pyo3(signature = (codes, t, y, kind, degree, theta = None, tau = None, window = None, engine = None, sigma = None, review_window = None))]
 pub fn filter_series<'py>(
     py: Python<'py>,
     codes: &Bound<'py, PyAny>,
@@ -34,6 +37,7 @@ pub fn filter_series<'py>(
     window: Option<usize>,
     engine: Option<&str>,
     sigma: Option<f64>,
+    review_window: Option<usize>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (ts, ys) = (times(t, "t")?, series(y, "y")?);
     let (t, y) = (ts.as_slice(), ys.as_slice());
@@ -78,10 +82,11 @@ pub fn filter_series<'py>(
         "expanding" => FilterKind::Expanding,
         "fading" => FilterKind::Fading,
         "fixed" => FilterKind::Fixed,
+        "auto" => FilterKind::Automatic,
         other => {
             return Err(raise(
                 Kind::Parameter,
-                format!("kind {other:?} is not one of 'expanding', 'fading', 'fixed'"),
+                format!("kind {other:?} is not one of 'expanding', 'fading', 'fixed', 'auto'"),
                 None,
             ))
         }
@@ -91,6 +96,7 @@ pub fn filter_series<'py>(
         tau,
         window,
         sigma,
+        review_window,
         ..FilterSpec::new(kind, degree)
     };
     let spec = match kind {
@@ -108,35 +114,80 @@ pub fn filter_series<'py>(
         .py()?,
     };
     let prototype = spec.build().py()?;
-    // The fixed-memory filter's rows carry its `window` cell (the rows in each row's window).
+    // The kind's cells (fixed memory's `window`, the automatic filter's `noise`, `outlier`,
+    // `misfit`, `bias`); the automatic filter always has its 1σ.
+    let extra = prototype.trailing_columns();
     let layout = RowLayout {
-        sigma: sigma.is_some(),
+        sigma: spec.writes_sigma(),
         lead: 0.0,
-        trailing: kind == FilterKind::Fixed,
+        trailing: !extra.is_empty(),
     };
+    let width = degree + 1;
+    let mut names: Vec<String> = (0..width).map(|k| format!("d{k}")).collect();
+    if layout.sigma {
+        names.extend((0..width).map(|k| format!("s{k}")));
+    }
+    names.extend(extra.iter().map(|c| c.to_string()));
+    let shown = names.len();
     let stride = prototype.stride(layout);
     let mut out = vec![0.0; n * stride];
-    let chunk = Chunk {
-        channels: &channels,
-        times: t,
-        values: y,
-        estimates: &mut out,
-        stride,
-    };
     py.detach(|| {
         let mut bank = StreamBank::growing(prototype)?;
+        let chunk = Chunk {
+            channels: &channels,
+            times: t,
+            values: y,
+            estimates: &mut out,
+            stride,
+        };
         bank.update_par_columns(
             chunk,
             |f: &mut AnyFilter, t: &[f64], y: &[f64], o: &mut [f64]| f.run_rows(t, y, o, layout),
-        )
+        )?;
+        if let Some(k) = extra.iter().position(|&c| c == "outlier") {
+            let (cells, decided) = out.split_at_mut(shown * n);
+            let flags = &mut cells[(shown - extra.len() + k) * n..][..n];
+            final_outliers(&mut bank, &channels, decided, flags);
+        }
+        Ok::<_, seqsmooth::Error>(())
     })
     .py()?;
-    // Column by column already (each derivative's column contiguous, for the frame's columns).
-    let cells = out.split_off(((degree + 1) << usize::from(layout.sigma)) * n);
-    let values = matrix(py, out, stride - usize::from(layout.trailing), n)?;
-    if !layout.trailing {
-        return Ok(values);
+    // Column by column already (each column contiguous, for the frame's columns); the
+    // automatic filter's decision cells dropped.
+    out.truncate(shown * n);
+    let values = matrix(py, out, shown, n)?;
+    Ok((values, names).into_pyobject(py)?.into_any())
+}
+
+/// Sets each row's `outlier` cell in `flags` (by row; empty where the filter withheld the
+/// row) to the automatic filter's final decision, as `seqsmooth filter` writes it: the
+/// decisions of each row's update (`decided`: the [`DECISION_CELLS`] columns, by row), then
+/// those of each series' [`finish`](seqsmooth::polynomial::AutomaticFilter::finish), the whole
+/// input being here, each on its series' oldest undecided row ([`Undecided`], the library's
+/// rule).
+fn final_outliers(
+    bank: &mut StreamBank<AnyFilter>,
+    channels: &[usize],
+    decided: &[f64],
+    flags: &mut [f64],
+) {
+    let n = channels.len();
+    let mut set = |row: usize, rejected: bool| {
+        if !flags[row].is_nan() {
+            flags[row] = f64::from(u8::from(rejected));
+        }
+    };
+    let mut open = Undecided::default();
+    let mut cells = [0.0; DECISION_CELLS];
+    for (i, &c) in channels.iter().enumerate() {
+        for (k, cell) in cells.iter_mut().enumerate() {
+            *cell = decided[k * n + i];
+        }
+        open.push(c, i, &decisions(&cells), &mut set);
     }
-    let cells = PyArray1::from_vec(py, cells).into_any();
-    Ok((values, cells).into_pyobject(py)?.into_any())
+    for c in 0..bank.channels() {
+        if let Some(f) = bank.channel_mut(c).and_then(AnyFilter::automatic_mut) {
+            open.decide(c, &f.finish(), &mut set);
+        }
+    }
 }

@@ -18,7 +18,7 @@ from conftest import cli_path
 
 def interleaved(rng: np.random.Generator, series: int = 25, rows: int = 1200):
     """`rows` rows of `series` series with string ids, interleaved at random; each series'
-    times increase (irregular steps, Unix-epoch origin)."""
+    times increase (irregular steps, Unix-epoch origin); one row in 40 an outlier (+5)."""
     ids = rng.integers(0, series, rows)
     t = np.empty(rows)
     clock = 1.7e9 + rng.uniform(0, 100, series)
@@ -26,6 +26,7 @@ def interleaved(rng: np.random.Generator, series: int = 25, rows: int = 1200):
         clock[k] += rng.uniform(0.5, 1.5)
         t[i] = clock[k]
     y = np.sin(t / 50.0) * 10 + ids + 0.3 * rng.standard_normal(rows)
+    y[rng.uniform(size=rows) < 1 / 40] += 5.0
     names = np.array([f"sensor-{k:02d}" for k in ids], dtype=object)
     return names, t, y
 
@@ -73,6 +74,17 @@ SETTINGS = [
         dict(kind="fixed", degree=2, window=7),
         ["--kind", "fixed", "--degree", "2", "--window", "7"],
     ),
+    # The automatic filter: its noise σ estimated, τ the library's default; then with tau, σ
+    # and a review window. Its `outlier` column is the final decision on both sides.
+    (
+        dict(kind="auto", degree=1, theta=0.9),
+        ["--kind", "auto", "--degree", "1", "--theta", "0.9"],
+    ),
+    (
+        dict(kind="auto", degree=2, theta=0.8, tau=2.0, sigma=0.3, review_window=5),
+        ["--kind", "auto", "--degree", "2", "--theta", "0.8", "--tau", "2"]
+        + ["--sigma", "0.3", "--review-window", "5"],
+    ),
 ]
 
 
@@ -80,7 +92,8 @@ SETTINGS = [
     "settings,flags",
     SETTINGS,
     ids=[
-        s[0]["kind"] + ("" if "tau" in s[0] or s[0]["kind"] != "fading" else "-default-tau")
+        s[0]["kind"]
+        + ("" if "tau" in s[0] or s[0]["kind"] not in ("fading", "auto") else "-default-tau")
         for s in SETTINGS
     ],
 )
@@ -118,6 +131,28 @@ def test_one_series_without_by(rng):
     )
     want = ss.FadingMemory(1, 0.8).update_many(t, y)
     np.testing.assert_array_equal(got[["d0", "d1"]].to_numpy(), want)
+
+
+def test_auto_outliers_are_the_final_decisions(rng):
+    """The `outlier` column of kind "auto" is each series' final decision, as
+    `AutomaticFilter.finish` gives it series by series (the review may overturn the gate)."""
+    names, t, y = interleaved(rng, series=6, rows=900)
+    got = ss.filter_frame(
+        {"id": names, "t": t, "y": y}, by="id", kind="auto", degree=1, theta=0.9, tau=1.0
+    )
+    overturned = 0
+    for name in np.unique(names):
+        rows = names == name
+        f = ss.AutomaticFilter(1, 0.9, tau=1.0)
+        out = f.update_many(t[rows], y[rows])
+        final = np.asarray(f.finish(), dtype=float)
+        np.testing.assert_array_equal(got["noise"][rows], out["noise"])
+        flags = got["outlier"][rows]
+        shown = ~np.isnan(flags)
+        np.testing.assert_array_equal(flags[shown], final[shown])
+        overturned += int(np.sum(flags[shown] != np.asarray(out["outlier"], float)[shown]))
+    assert overturned > 0  # the decisions matter here: the gate's flags are not the answer
+    assert np.nansum(got["outlier"]) > 0
 
 
 def test_errors_name_the_row_of_the_frame(rng):

@@ -101,6 +101,25 @@ def smooth(
     *,
     return_sigma: Literal[True],
 ) -> tuple[Vector, Vector]: ...
+def filter_series(
+    codes: npt.NDArray[np.int64],
+    t: ArrayLike,
+    y: ArrayLike,
+    kind: Literal["expanding", "fading", "fixed", "auto"],
+    degree: int,
+    theta: float | None = None,
+    tau: float | None = None,
+    window: int | None = None,
+    engine: str | None = None,
+    sigma: float | None = None,
+    review_window: int | None = None,
+) -> tuple[Matrix, list[str]]:
+    """The engine of ``filter_frame``: row ``i`` of series ``codes[i]`` through its series'
+    filter; the columns of ``seqsmooth filter``'s rows as an array ``(columns, rows)`` and
+    their names (``d0..dM``, ``s0..sM``, the kind's cells: ``window``; ``noise``,
+    ``outlier`` (final), ``misfit``, ``bias``)."""
+    ...
+
 def seconds(t: ArrayLike, name: str = "t") -> Vector:
     """Times as every entry point reads them: numbers as they are; dates (numpy datetime64 of
     any unit, pandas datetime columns, tz-aware too, Polars Datetime/Date, Arrow timestamps and

@@ -12,7 +12,7 @@ estimates back in the input's row order.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -88,13 +88,14 @@ def filter_frame(
     time: str = "t",
     value: str = "y",
     by: str | None = None,
-    kind: str = "fading",
+    kind: Literal["expanding", "fading", "fixed", "auto"] = "fading",
     degree: int = 1,
     theta: float | None = None,
     tau: float | None = None,
     window: int | None = None,
     engine: str | None = None,
     sigma: float | None = None,
+    review_window: int | None = None,
 ) -> Any:
     """Filters every series of a frame, as ``seqsmooth filter [--id-col BY]`` does.
 
@@ -108,23 +109,31 @@ def filter_frame(
         timestamps), read as seconds since the Unix epoch (naive dates are UTC).
     by : str, optional
         The column naming each row's series (any type); without it the frame is one series.
-    kind : {"expanding", "fading", "fixed"}
-    degree, theta, window, engine, sigma
-        As for :class:`ExpandingMemory`, :class:`FadingMemory` and :class:`FixedMemory`
-        (``engine`` defaults to ``"exact"``, for ``fixed`` to ``"adaptive"``).
+    kind : {"expanding", "fading", "fixed", "auto"}
+        ``"auto"``: the automatic filter (:class:`AutomaticFilter`, ``seqsmooth filter --kind
+        auto``).
+    degree, theta, window, engine, sigma, review_window
+        As for :class:`ExpandingMemory`, :class:`FadingMemory`, :class:`FixedMemory` and
+        :class:`AutomaticFilter` (``engine`` defaults to ``"exact"``, for ``fixed`` to
+        ``"adaptive"``; ``review_window`` only for ``auto``).
     tau : float, optional
-        ``fading``: the time interval ``theta`` discounts over. Default: the median of the
-        first 100 time steps within series among the first 65536 rows, as ``seqsmooth
-        filter`` takes it without ``--tau`` (so ``theta`` is the discount per typical step);
-        :class:`FadingMemory`'s own default is ``1.0``, a unit of time.
+        ``fading`` and ``auto``: the time interval ``theta`` discounts over. Default: the
+        median of the first 100 time steps within series among the first 65536 rows, as
+        ``seqsmooth filter`` takes it without ``--tau`` (so ``theta`` is the discount per
+        typical step); :class:`FadingMemory`'s and :class:`AutomaticFilter`'s own default is
+        ``1.0``, a unit of time.
 
     Returns
     -------
     The kind of ``df`` with the columns of ``seqsmooth filter``'s CSV: ``[by,] time, value,
     d0..dM`` (``time`` in seconds, as the filter read it; ``dk`` the estimate at each row's
     time, from its series up to that row), then
-    ``s0..sM`` (their 1σ) with ``sigma``, then ``window`` (rows in the window) for ``fixed``;
-    NaN where the series is not yet determined. Rows in input order.
+    ``s0..sM`` (their 1σ) with ``sigma`` (always for ``auto``), then ``window`` (rows in the
+    window) for ``fixed``; for ``auto`` ``noise`` (the noise σ in use), ``outlier`` (the
+    final decision, the whole series being there: 1 rejected), ``misfit`` (0/1) and ``bias``
+    (the estimated bias of ``d0``, included in ``s0``); NaN where the command leaves a cell
+    empty (the series not yet determined, the automatic filter's estimate withheld). Rows in
+    input order.
 
     Raises
     ------
@@ -151,6 +160,7 @@ def filter_frame(
             window=window,
             engine=engine,
             sigma=sigma,
+            review_window=review_window,
         )
     except SeqsmoothError as e:
         if e.index is None:
@@ -160,18 +170,12 @@ def filter_frame(
             message = message.split(": ", 1)[1]  # the row is named below
         series = "" if by is None else f" (series {names[codes[e.index]]!r} of column {by!r})"
         raise type(e)(f"row {e.index}{series}: {message}", e.index) from e
-    values, cells = result if kind == "fixed" else (result, None)
-    width = degree + 1
+    values, names_out = result
     columns: dict[str, np.ndarray] = {}
     if keys is not None:
         columns[by] = keys
     columns[time] = t
     columns[value] = y
-    for k in range(width):
-        columns[f"d{k}"] = values[k]
-    if sigma is not None:
-        for k in range(width):
-            columns[f"s{k}"] = values[width + k]
-    if cells is not None:
-        columns["window"] = cells
+    for name, column in zip(names_out, values):
+        columns[name] = column
     return _like(df, columns)

@@ -22,6 +22,7 @@ use crate::error::{Error, Param};
 use crate::model::PolynomialState;
 use crate::polynomial::filter::{finite, no_noise_sigma, PolynomialFilter};
 use crate::polynomial::spec::{AnyFilter, Inner};
+use std::collections::VecDeque;
 
 /// The automatic filter's cells after its written ones (with [`RowLayout::trailing`]): how
 /// many final outlier decisions the row's update made (on the series' oldest samples still
@@ -51,6 +52,69 @@ pub struct RowLayout {
 pub fn decisions(cells: &[f64]) -> Vec<bool> {
     let bits = cells[1] as u64 | ((cells[2] as u64) << 32);
     (0..cells[0] as usize).map(|i| bits >> i & 1 == 1).collect()
+}
+
+/// The rule of the automatic filter's final outlier flags over rows: per series, the rows not
+/// finally decided yet, oldest first. Each series' decisions (those of each row's update,
+/// [`decisions`] of its [`DECISION_CELLS`], then at the end of the series
+/// [`AutomaticFilter::finish`](crate::polynomial::AutomaticFilter::finish)) come in its sample
+/// order (the review's interpolation test, Morrison §14.8, §7.13), so each one is the verdict
+/// on the series' oldest undecided row. Rows are named by any number the caller chooses
+/// (their index among all rows, say); the rows of `seqsmooth filter` and of `filter_frame` are flagged by this rule.
+///
+/// ```
+/// use seqsmooth::polynomial::rows::Undecided;
+/// let mut open = Undecided::default();
+/// let mut flags = [false; 4];
+/// open.push(0, 0, &[], |row, r| flags[row] = r); // series 0, row 0: undecided
+/// open.push(1, 1, &[], |row, r| flags[row] = r); // series 1, row 1
+/// open.push(0, 2, &[true], |row, r| flags[row] = r); // row 2's update rejects row 0
+/// open.push(1, 3, &[], |row, r| flags[row] = r);
+/// open.decide(1, &[false, true], |row, r| flags[row] = r); // series 1's finish
+/// assert_eq!(flags, [true, false, false, true]); // row 2 still waits
+/// ```
+#[derive(Clone, Debug, Default)]
+pub struct Undecided {
+    /// Per series, its undecided rows, oldest first.
+    open: Vec<VecDeque<usize>>,
+}
+
+impl Undecided {
+    /// Row `row` of `series` waits for its decision; then the `decided` verdicts its update made
+    /// (this row's included) go to the series' oldest waiting rows, through `apply(row,
+    /// rejected)`.
+    pub fn push(
+        &mut self,
+        series: usize,
+        row: usize,
+        decided: &[bool],
+        apply: impl FnMut(usize, bool),
+    ) {
+        if self.open.len() <= series {
+            self.open.resize_with(series + 1, VecDeque::new);
+        }
+        self.open[series].push_back(row);
+        self.decide(series, decided, apply);
+    }
+
+    /// The `verdicts` (`true`: rejected) on the oldest waiting rows of `series`, in order, each
+    /// given to `apply(row, rejected)`; verdicts beyond the waiting rows are ignored.
+    pub fn decide(&mut self, series: usize, verdicts: &[bool], mut apply: impl FnMut(usize, bool)) {
+        let Some(open) = self.open.get_mut(series) else {
+            return;
+        };
+        for &rejected in verdicts {
+            let Some(row) = open.pop_front() else {
+                return;
+            };
+            apply(row, rejected);
+        }
+    }
+
+    /// Forgets every waiting row (their flags stay the gate's).
+    pub fn clear(&mut self) {
+        self.open.clear();
+    }
 }
 
 /// The decisions `verdicts` (at most 64) in the [`DECISION_CELLS`] cells.

@@ -10,6 +10,7 @@
 
 use crate::error::CliError;
 use crate::io::Output;
+use seqsmooth::polynomial::rows::Undecided;
 use std::collections::VecDeque;
 
 /// One formatted row and where its `outlier` cell is.
@@ -21,14 +22,25 @@ struct Row {
     waiting: bool,
 }
 
+impl Row {
+    /// The verdict (`true`: rejected) in the row's `outlier` cell.
+    fn decide(&mut self, rejected: bool) {
+        if let Some(at) = self.open.take() {
+            self.bytes[at] = if rejected { b'1' } else { b'0' };
+        }
+        self.waiting = false;
+    }
+}
+
 /// Formatted rows not written yet, and per series those among them still undecided.
 #[derive(Default)]
 pub struct Held {
     rows: VecDeque<Row>,
     /// Index of `rows[0]` among all rows pushed.
     first: usize,
-    /// Per series, the indices (among all rows pushed) of its undecided rows, oldest first.
-    open: Vec<VecDeque<usize>>,
+    /// Per series, the indices (among all rows pushed) of its undecided rows: the library's
+    /// rule of which row a decision is on.
+    open: Undecided,
 }
 
 impl Held {
@@ -36,34 +48,21 @@ impl Held {
     /// before the row's end), then the `decided` verdicts its update made on the series'
     /// oldest undecided rows (this one included).
     pub fn push(&mut self, series: usize, bytes: Vec<u8>, trailing: usize, decided: &[bool]) {
-        if self.open.len() <= series {
-            self.open.resize_with(series + 1, VecDeque::new);
-        }
         let open = outlier_offset(&bytes, trailing);
-        self.open[series].push_back(self.first + self.rows.len());
+        let index = self.first + self.rows.len();
         self.rows.push_back(Row {
             bytes,
             open,
             waiting: true,
         });
-        self.decide(series, decided);
+        let (rows, first) = (&mut self.rows, self.first);
+        (self.open).push(series, index, decided, |i, r| rows[i - first].decide(r));
     }
 
     /// The verdicts (`true`: rejected) on the oldest undecided rows of `series`, in order.
     pub fn decide(&mut self, series: usize, verdicts: &[bool]) {
-        let Some(open) = self.open.get_mut(series) else {
-            return;
-        };
-        for &rejected in verdicts {
-            let Some(index) = open.pop_front() else {
-                return;
-            };
-            let row = &mut self.rows[index - self.first];
-            if let Some(at) = row.open.take() {
-                row.bytes[at] = if rejected { b'1' } else { b'0' };
-            }
-            row.waiting = false;
-        }
+        let (rows, first) = (&mut self.rows, self.first);
+        (self.open).decide(series, verdicts, |i, r| rows[i - first].decide(r));
     }
 
     /// Writes the rows up to the first undecided one.
