@@ -465,3 +465,39 @@ fn refused_samples_and_lengths() {
         }
     }
 }
+
+/// A batch longer than the runner's block of rows: the same rows as the filters run directly,
+/// and a refused sample beyond the first block named by its index in the whole batch.
+#[test]
+fn long_batches_run_in_blocks_as_one() {
+    let n = 12_000;
+    let (t, mut y) = data(n);
+    for kind in KINDS {
+        let spec = spec(kind, Some(0.2));
+        let layout = RowLayout {
+            sigma: true,
+            lead: 0.0,
+            trailing: true,
+        };
+        let want = expected_rows(&spec, &t, &y, layout);
+        let mut f = spec.build().unwrap();
+        let stride = f.stride(layout);
+        let mut got = vec![0.0; n * stride];
+        f.run_rows(&t, &y, &mut got, layout).unwrap();
+        assert!(same_bits(&got, &want), "{kind:?}");
+        let bad = 9_001;
+        let keep = y[bad];
+        y[bad] = f64::NAN;
+        let mut f = spec.build().unwrap();
+        let e = f.run_rows(&t, &y, &mut got, layout).unwrap_err();
+        assert!(
+            matches!(e, Error::InBatch { index, .. } if index == bad),
+            "{kind:?}: {e}"
+        );
+        assert!(
+            same_bits(&got[..bad * stride], &want[..bad * stride]),
+            "{kind:?}"
+        );
+        y[bad] = keep;
+    }
+}

@@ -27,6 +27,10 @@ use std::collections::VecDeque;
 /// The automatic filter's cells after its written ones (with [`RowLayout::trailing`]): how
 /// many final outlier decisions the row's update made (on the series' oldest samples still
 /// undecided, in order), and their verdicts as bits (`1`: rejected), 32 to a cell, oldest in
+/// The cells of the rows [`AnyFilter::run_rows`] writes and checks at a time (128 KiB: the
+/// block's rows are still in the core's cache when they are checked).
+const BLOCK_CELLS: usize = 16_384;
+
 /// the lowest bit; read by [`decisions`].
 pub const DECISION_CELLS: usize = 3;
 
@@ -186,6 +190,36 @@ impl AnyFilter {
                 reason: format!("{} samples need {} cells", t.len(), t.len() * stride),
             });
         }
+        // In blocks, so that each block's check reads the rows while they are in cache (the
+        // filters give the same numbers in any pieces).
+        let block = (BLOCK_CELLS / stride).max(1);
+        for (k, (ts, (ys, rows))) in t
+            .chunks(block)
+            .zip(y.chunks(block).zip(out.chunks_mut(block * stride)))
+            .enumerate()
+        {
+            let offset = k * block;
+            self.run_block(ts, ys, rows, layout, stride)
+                .map_err(|e| match e {
+                    Error::InBatch { index, source } => Error::InBatch {
+                        index: index + offset,
+                        source,
+                    },
+                    e => e,
+                })?;
+        }
+        Ok(())
+    }
+
+    /// [`run_rows`](Self::run_rows) on one block, the indices of its errors the block's.
+    fn run_block(
+        &mut self,
+        t: &[f64],
+        y: &[f64],
+        out: &mut [f64],
+        layout: RowLayout,
+        stride: usize,
+    ) -> Result<(), Error> {
         let before = self.rows;
         let written = self.write_rows(t, y, out, layout, stride);
         // The rows up to a refused sample, or up to the row refused while writing, are taken;
