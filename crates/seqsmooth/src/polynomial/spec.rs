@@ -150,21 +150,22 @@ impl FilterSpec {
                     ExpandingMemory::with_noise_sigma,
                 )?))
             }
-            FilterKind::Fading if self.theta_per_update.is_some() => {
-                // Per update: a `τ` filled in by the default rule means nothing here.
-                let tau = self.theta.and(self.tau);
-                let discount = Discount::from_names(self.theta, tau, self.theta_per_update)?
-                    .expect("theta_per_update is given");
-                let f = FadingMemory::from_discount(m, discount, self.engine)?;
-                Inner::Fading(Box::new(noise(
-                    f,
-                    self.sigma,
-                    FadingMemory::with_noise_sigma,
-                )?))
-            }
             FilterKind::Fading => {
-                let (theta, tau) = (need(self.theta, Param::Theta)?, need(self.tau, Param::Tau)?);
-                let f = FadingMemory::new(m, theta, tau, self.engine)?;
+                let f = match self.theta_per_update {
+                    // Per update: a `τ` filled in by the default rule means nothing here.
+                    Some(_) => {
+                        let tau = self.theta.and(self.tau);
+                        let discount =
+                            Discount::from_names(self.theta, tau, self.theta_per_update)?
+                                .expect("theta_per_update is given");
+                        FadingMemory::from_discount(m, discount, self.engine)?
+                    }
+                    None => {
+                        let (theta, tau) =
+                            (need(self.theta, Param::Theta)?, need(self.tau, Param::Tau)?);
+                        FadingMemory::new(m, theta, tau, self.engine)?
+                    }
+                };
                 Inner::Fading(Box::new(noise(
                     f,
                     self.sigma,
