@@ -3,7 +3,7 @@
 # tree in one run: the earlier commit's criterion benches first (saved as baseline `before`),
 # then the working tree's, each compared with its own, and a table of the two and their ratio.
 #
-#   bash scripts/summary_bench.sh BEFORE_COMMIT      # ≈ 25 min on the 2-vCPU VM
+#   bash scripts/summary_bench.sh BEFORE_COMMIT      # ≈ 12 min on the 2-vCPU VM (measured)
 #
 # BEFORE_TARGET (default: a fresh target/ beside the earlier commit's worktree) is the cargo
 # target directory of the earlier build; seed it with a copy of target/ to skip building the
