@@ -10,7 +10,7 @@
 //! Parquet timestamps and ISO-8601 cells); a `timedelta64` as its seconds. A naive date is UTC.
 
 use crate::errors::{raise, Kind};
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::IntoPyDict;
 
@@ -222,6 +222,14 @@ pub fn matrix<'py>(
     PyArray1::from_vec(py, values)
         .reshape([rows, cols])
         .map(Bound::into_any)
+}
+
+/// A new `rows × cols` array of zeros allocated by numpy, for the library to write into: numpy's
+/// allocator asks the kernel for huge pages for a large array (where the system allows it), so
+/// its first writes take one page fault per 2 MiB rather than per 4 KiB — for a batch's rows
+/// the larger part of the time of a fast filter (BENCHMARKS.md, "The batch σ path").
+pub fn zeros(py: Python<'_>, rows: usize, cols: usize) -> Bound<'_, PyArray2<f64>> {
+    PyArray2::zeros(py, [rows, cols], false)
 }
 
 /// `obj` as a row-major table of reals, named `name` in errors: a 2-D array as it is, a 1-D

@@ -5,9 +5,9 @@
 //! library's row runner (`AnyFilter::run_rows`), as `seqsmooth filter` does, so the same
 //! input gives the same bits.
 
-use crate::arrays::{matrix, pair};
+use crate::arrays::{matrix, pair, zeros};
 use crate::errors::{raise, IntoPy, Kind};
-use numpy::PyArray1;
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PySlice;
 use seqsmooth::discount::Discount;
@@ -187,21 +187,24 @@ impl PyPolynomialFilter {
             ..RowLayout::default()
         };
         let stride = self.filter.stride(layout);
-        let mut out = vec![0.0; n * stride];
-        for start in (0..n).step_by(CHUNK) {
-            let end = (start + CHUNK).min(n);
-            let (tc, yc) = (&t[start..end], &y[start..end]);
-            let oc = &mut out[start * stride..end * stride];
-            let filter = &mut self.filter;
-            py.detach(|| filter.run_rows(tc, yc, oc, layout))
-                .py_at(start)?;
-            py.check_signals()?;
+        let rows = zeros(py, n, stride);
+        {
+            let mut buffer = rows.readwrite();
+            let out = buffer.as_slice_mut().expect("a new array is contiguous");
+            for start in (0..n).step_by(CHUNK) {
+                let end = (start + CHUNK).min(n);
+                let (tc, yc) = (&t[start..end], &y[start..end]);
+                let oc = &mut out[start * stride..end * stride];
+                let filter = &mut self.filter;
+                py.detach(|| filter.run_rows(tc, yc, oc, layout))
+                    .py_at(start)?;
+                py.check_signals()?;
+            }
         }
         if !return_sigma {
-            return matrix(py, out, n, w);
+            return Ok(rows.into_any());
         }
         // Rows [d, s]: the two arrays are views of the one buffer (no copy).
-        let rows = matrix(py, out, n, stride)?;
         let all = PySlice::full(py);
         let d = rows.get_item((&all, PySlice::new(py, 0, w as isize, 1)))?;
         let s = rows.get_item((&all, PySlice::new(py, w as isize, stride as isize, 1)))?;

@@ -291,6 +291,70 @@ pub(crate) fn check_batch_lengths(times: &[f64], values: &[f64]) -> Result<(), E
     )
 }
 
+/// The row rule's parameters for [`check_rows`]: rows of `stride` cells, the first
+/// `needed − 1` of a filter's rows undetermined; from there a row whose first `blank` cells are
+/// all NaN is a fit not determined (skipped while its cell `withheld`, if any, is NaN), and its
+/// first `checked` cells must be finite.
+pub(crate) struct RowRule<'a> {
+    pub stride: usize,
+    pub needed: usize,
+    pub blank: usize,
+    pub checked: usize,
+    pub withheld: Option<usize>,
+    /// Why a fit is not determined.
+    pub why: &'a str,
+}
+
+/// The row rule over `rows` (the filter's rows before them `before`): no cell infinite, and
+/// the determined rows as [`RowRule`] says; the first refused row as [`Error::InBatch`] with
+/// its index in `rows` (a refused cell named by `name(k)`). The fast path is one branch-free
+/// pass (vectorised); only a batch with an empty or infinite cell where it may not be is
+/// searched row by row.
+pub(crate) fn check_rows(
+    rows: &[f64],
+    rule: &RowRule<'_>,
+    before: u64,
+    name: impl Fn(usize) -> String,
+) -> Result<(), Error> {
+    let stride = rule.stride;
+    let undetermined = usize::try_from((rule.needed as u64).saturating_sub(before + 1));
+    let first = undetermined
+        .unwrap_or(usize::MAX)
+        .saturating_mul(stride)
+        .min(rows.len());
+    if !rows[..first].iter().any(|v| v.is_infinite())
+        && rows[first..].iter().fold(true, |ok, &v| ok & finite(v))
+    {
+        return Ok(());
+    }
+    for (i, row) in rows.chunks_exact(stride).enumerate() {
+        let refused = |e: Error| {
+            Err(Error::InBatch {
+                index: i,
+                source: Box::new(e),
+            })
+        };
+        let out_of_range = |k: usize| refused(Error::EstimateOutOfRange { what: name(k) });
+        if let Some(k) = row.iter().position(|v| v.is_infinite()) {
+            return out_of_range(k);
+        }
+        let samples = before + i as u64 + 1;
+        if samples < rule.needed as u64 || rule.withheld.is_some_and(|k| row[k].is_nan()) {
+            continue;
+        }
+        if row[..rule.blank].iter().all(|v| v.is_nan()) {
+            return refused(Error::NotDetermined {
+                samples,
+                why: rule.why.into(),
+            });
+        }
+        if let Some(k) = row[..rule.checked].iter().position(|v| !v.is_finite()) {
+            return out_of_range(k);
+        }
+    }
+    Ok(())
+}
+
 /// `x` is neither NaN nor infinite: `x − x` is `0` exactly then (`NaN` otherwise); as
 /// arithmetic it vectorises better in [`first_invalid`] than `f64::is_finite` (speed: see
 /// BENCHMARKS.md).

@@ -20,7 +20,7 @@
 
 use crate::error::{Error, Param};
 use crate::model::PolynomialState;
-use crate::polynomial::filter::{finite, no_noise_sigma, PolynomialFilter};
+use crate::polynomial::filter::{check_rows, no_noise_sigma, PolynomialFilter, RowRule};
 use crate::polynomial::spec::{AnyFilter, Inner};
 use std::collections::VecDeque;
 
@@ -228,8 +228,21 @@ impl AnyFilter {
             Err(Error::InBatch { index, .. }) => *index,
             _ => t.len(),
         });
-        self.check_rows(&out[..done * stride], stride, layout, before)?;
+        // The batch σ kernels check their rows by this rule as they write them, while they
+        // are in cache ([`PolynomialFilter::update_many_sigma_into`]): not twice.
+        if !self.sigma_kernel_writes(layout) {
+            self.check_rows(&out[..done * stride], stride, layout, before)?;
+        }
         written
+    }
+
+    /// Whether [`write_rows`](Self::write_rows) runs the batch σ kernel
+    /// ([`PolynomialFilter::update_many_sigma_into`] of the expanding- and fading-memory
+    /// filters), which checks its rows by the module's rule (the same [`RowRule`]: every cell
+    /// of a determined row a number, a row without derivatives refused as not determined).
+    fn sigma_kernel_writes(&self, layout: RowLayout) -> bool {
+        let direct = matches!(self.inner, Inner::Expanding(_) | Inner::Fading(_));
+        direct && layout.sigma && layout.lead == 0.0
     }
 
     /// The rows' numbers, before their check.
@@ -309,66 +322,36 @@ impl AnyFilter {
         before: u64,
     ) -> Result<(), Error> {
         let w = self.degree() + 1;
-        let (needed, cells, withheld) = match &self.inner {
-            Inner::Fixed(_, window) => ((*window).max(w), w, None),
+        // Once determined, a row's derivatives (and their 1σ) are all numbers, except the
+        // automatic filter's.
+        let all = w << usize::from(layout.sigma);
+        let (needed, cells, checked, withheld) = match &self.inner {
+            Inner::Fixed(_, window) => ((*window).max(w), w, all, None),
             // The automatic filter's estimate is withheld while its noise cell is empty; its
             // derivatives above the degree it has reached are empty by design. Without its
             // trailing cells a withheld estimate cannot be told: only infinities are refused.
-            Inner::Automatic(_) if layout.trailing => (w, 1, Some(w << usize::from(layout.sigma))),
-            Inner::Automatic(_) => (usize::MAX, 1, None),
-            _ => (w, w, None),
+            Inner::Automatic(_) if layout.trailing => (w, 1, 1, Some(all)),
+            Inner::Automatic(_) => (usize::MAX, 1, 1, None),
+            _ => (w, w, all, None),
         };
-        // Fast path, one branch-free pass (vectorised) over the determined rows: every cell
-        // finite. Only a batch with empty or infinite cells there is searched row by row.
-        let undetermined = usize::try_from((needed as u64).saturating_sub(before + 1));
-        let first = undetermined
-            .unwrap_or(usize::MAX)
-            .saturating_mul(stride)
-            .min(rows.len());
-        if !rows[..first].iter().any(|v| v.is_infinite())
-            && rows[first..].iter().fold(true, |ok, &v| ok & finite(v))
-        {
-            return Ok(());
-        }
-        let name = |k: usize| {
-            let sd = w << usize::from(layout.sigma);
-            match k {
-                k if k < w => format!("d{k}"),
-                k if k < sd => format!("s{}", k - w),
-                k => (self.trailing_columns().get(k - sd))
-                    .map_or("decisions", |c| c)
-                    .into(),
-            }
+        let rule = RowRule {
+            stride,
+            needed,
+            blank: cells,
+            checked,
+            withheld,
+            why: "the fit is not determined in doubles (with fading memory, a tau far shorter \
+                  than the steps, or a gap of many tau, lets the discount theta^(step/tau) \
+                  underflow)",
         };
-        for (i, row) in rows.chunks_exact(stride).enumerate() {
-            let refused = |e: Error| {
-                Err(Error::InBatch {
-                    index: i,
-                    source: Box::new(e),
-                })
-            };
-            let out_of_range = |k: usize| refused(Error::EstimateOutOfRange { what: name(k) });
-            if let Some(k) = row.iter().position(|v| v.is_infinite()) {
-                return out_of_range(k);
-            }
-            let samples = before + i as u64 + 1;
-            if samples < needed as u64 || withheld.is_some_and(|k| row[k].is_nan()) {
-                continue;
-            }
-            if row[..cells].iter().all(|v| v.is_nan()) {
-                return refused(Error::NotDetermined {
-                    samples,
-                    why: "the fit is not determined in doubles (with fading memory, a tau far \
-                          shorter than the steps, or a gap of many tau, lets the discount \
-                          theta^(step/tau) underflow)"
-                        .into(),
-                });
-            }
-            if let Some(k) = row[..cells].iter().position(|v| !v.is_finite()) {
-                return out_of_range(k);
-            }
-        }
-        Ok(())
+        let name = |k: usize| match k {
+            k if k < w => format!("d{k}"),
+            k if k < all => format!("s{}", k - w),
+            k => (self.trailing_columns().get(k - all))
+                .map_or("decisions", |c| c)
+                .into(),
+        };
+        check_rows(rows, &rule, before, name)
     }
 }
 

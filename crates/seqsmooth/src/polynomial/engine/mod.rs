@@ -14,8 +14,8 @@ pub(crate) mod gain;
 pub(crate) mod recursion;
 
 use super::filter::{
-    check_batch_lengths, check_estimates_length, check_sigma_rows_length, first_invalid,
-    no_noise_sigma,
+    check_batch_lengths, check_estimates_length, check_rows, check_sigma_rows_length,
+    first_invalid, no_noise_sigma, RowRule,
 };
 use crate::error::Error;
 use crate::model::PolynomialState;
@@ -253,12 +253,11 @@ impl EngineState {
             }
             return Ok(());
         }
-        let mut scratch = Vec::new();
         for start in (0..times.len()).step_by(FUSED_CHUNK) {
             let end = (start + FUSED_CHUNK).min(times.len());
             let (ts, ys) = (&times[start..end], &values[start..end]);
             let out = &mut rows[start * 2 * w..end * 2 * w];
-            let valid = start + self.run_valid_sigma(m, ts, ys, out, &mut scratch);
+            let valid = start + self.run_valid_sigma(m, ts, ys, out);
             check_sigma_rows(
                 &rows[start * 2 * w..valid * 2 * w],
                 w,
@@ -279,7 +278,6 @@ impl EngineState {
         times: &[f64],
         values: &[f64],
         rows: &mut [f64],
-        scratch: &mut Vec<f64>,
     ) -> usize {
         let previous = (self.samples() > 0).then(|| self.last_time());
         let mut valid = first_invalid(times, values, previous);
@@ -292,9 +290,7 @@ impl EngineState {
         let (ts, ys) = (&times[..valid], &values[..valid]);
         let w = m + 1;
         match self {
-            EngineState::Gain(g) => {
-                g.update_many_sigma_into(ts, ys, &mut rows[..valid * 2 * w], scratch)
-            }
+            EngineState::Gain(g) => g.update_many_sigma_into(ts, ys, &mut rows[..valid * 2 * w]),
             EngineState::Exact(e) => {
                 for ((&t, &y), row) in ts.iter().zip(ys).zip(rows.chunks_exact_mut(2 * w)) {
                     e.update(t, y);
@@ -351,39 +347,31 @@ impl EngineState {
     }
 }
 
-/// The rows of [`EngineState::update_many_sigma`] checked as an estimate is: from the
-/// determined ones on (`before` samples before the first row, which is sample `first` of the
-/// batch), a row all NaN is a fit not determined, any other number that is not finite one
-/// beyond the double range — the row's error.
+/// The rows of [`EngineState::update_many_sigma`] checked by the row rule ([`check_rows`]),
+/// as an estimate is: from the determined ones on (`before` samples before the first row,
+/// which is sample `first` of the batch), a row whose derivatives are all NaN is a fit not
+/// determined, any other number that is not finite (a 1σ included) one beyond the double
+/// range — the row's error.
 fn check_sigma_rows(rows: &[f64], w: usize, before: u64, first: usize) -> Result<(), Error> {
-    let undetermined = usize::try_from((w as u64).saturating_sub(before + 1)).unwrap_or(usize::MAX);
-    let from = undetermined.saturating_mul(2 * w).min(rows.len());
-    if rows[from..].iter().fold(true, |ok, v| ok & v.is_finite()) {
-        return Ok(());
-    }
-    for (i, row) in rows.chunks_exact(2 * w).enumerate().skip(undetermined) {
-        let error = if row[..w].iter().all(|v| v.is_nan()) {
-            Error::NotDetermined {
-                samples: before + i as u64 + 1,
-                why: SINGULAR.into(),
-            }
-        } else if let Some(k) = row.iter().position(|v| !v.is_finite()) {
-            Error::EstimateOutOfRange {
-                what: if k < w {
-                    format!("d{k}")
-                } else {
-                    format!("s{}", k - w)
-                },
-            }
-        } else {
-            continue;
-        };
-        return Err(Error::InBatch {
-            index: first + i,
-            source: Box::new(error),
-        });
-    }
-    Ok(())
+    let rule = RowRule {
+        stride: 2 * w,
+        needed: w,
+        blank: w,
+        checked: 2 * w,
+        withheld: None,
+        why: SINGULAR,
+    };
+    let name = |k: usize| match k < w {
+        true => format!("d{k}"),
+        false => format!("s{}", k - w),
+    };
+    check_rows(rows, &rule, before, name).map_err(|e| match e {
+        Error::InBatch { index, source } => Error::InBatch {
+            index: index + first,
+            source,
+        },
+        e => e,
+    })
 }
 
 /// Marks each number of `rows` beyond the double range (infinite) as NaN, "no estimate", as

@@ -94,7 +94,7 @@ impl GainEngine {
                 } else {
                     &mut [][..]
                 };
-                i += self.steady_run(&ts[i..], &ys[i..], rows, write);
+                i += self.steady_run(&ts[i..], &ys[i..], rows, write, &[]);
                 if i == ts.len() {
                     break;
                 }

@@ -210,36 +210,19 @@ impl GainEngine {
 
     /// [`update_many_into`](Self::update_many_into) with each row's 1σ: rows of `2(m+1)`
     /// (derivatives, then 1σ). The plain kernels run where they apply — with a tracked
-    /// covariance, once it is steady ([`Self::update`]), its 1σ then the same for the run —
-    /// the per-sample recursion elsewhere. `scratch` holds `ts.len()·(m+1)` derivatives.
-    pub fn update_many_sigma_into(
-        &mut self,
-        ts: &[f64],
-        ys: &[f64],
-        rows: &mut [f64],
-        scratch: &mut Vec<f64>,
-    ) {
+    /// covariance, once it is steady ([`Self::update`]), its 1σ then the same for the run, and
+    /// written with each row by the kernel — the per-sample recursion elsewhere.
+    pub fn update_many_sigma_into(&mut self, ts: &[f64], ys: &[f64], rows: &mut [f64]) {
         let w = self.m + 1;
         let mut i = 0;
         while i < ts.len() {
             if self.plain_kernel_applies() {
-                scratch.clear();
-                scratch.resize((ts.len() - i) * w, 0.0);
-                let done = self.steady_run(&ts[i..], &ys[i..], scratch, true);
-                if done > 0 {
-                    let mut sd = [0.0; MAX_DEGREE + 1];
-                    self.std_devs_into(&mut sd[..w]);
-                    for (row, d) in rows[i * 2 * w..(i + done) * 2 * w]
-                        .chunks_exact_mut(2 * w)
-                        .zip(scratch.chunks_exact(w))
-                    {
-                        row[..w].copy_from_slice(d);
-                        row[w..].copy_from_slice(&sd[..w]);
-                    }
-                    i += done;
-                    if i == ts.len() {
-                        break;
-                    }
+                let mut sd = [0.0; MAX_DEGREE + 1];
+                self.std_devs_into(&mut sd[..w]);
+                let out = &mut rows[i * 2 * w..];
+                i += self.steady_run(&ts[i..], &ys[i..], out, true, &sd[..w]);
+                if i == ts.len() {
+                    break;
                 }
             }
             self.update(ts[i], ys[i]);

@@ -44,13 +44,16 @@ impl GainEngine {
     /// The steady-state fading recursion on a run of (nearly) even steps in plain `f64`, with
     /// the state in registers: `Z ← Φ(ζ) Z`, `ε = y − z₀`, `Z ← Z + K ε`, the gains `K` those
     /// of the typical step. Returns how many samples it took (it stops at the first step that
-    /// differs from the typical one ([`crate::numeric::steps`]).
+    /// differs from the typical one ([`crate::numeric::steps`]). With `write`, each sample's
+    /// derivatives go to `out`, followed in each row by `sd` (the run's constant 1σ, empty for
+    /// rows of derivatives alone): rows of `(m+1) + sd.len()` values.
     pub(super) fn steady_run(
         &mut self,
         ts: &[f64],
         ys: &[f64],
         out: &mut [f64],
         write: bool,
+        sd: &[f64],
     ) -> usize {
         // Without per-sample outputs, whole blocks of the steady fading recursion first.
         let blocks = if self.fading.is_none() && !write && self.m <= EXPANDING_BLOCK_MAX_DEGREE {
@@ -63,9 +66,9 @@ impl GainEngine {
         let (ts, ys) = (&ts[blocks..], &ys[blocks..]);
         let steady = self.fading.is_some() && !write;
         let rest = if write {
-            unrolled_sizes!(self.m + 1, N => self.plain_run_n::<N, true>(ts, ys, out), _ => 0)
+            unrolled_sizes!(self.m + 1, N => self.plain_run_n::<N, true>(ts, ys, out, sd), _ => 0)
         } else {
-            unrolled_sizes!(self.m + 1, N => self.plain_run_n::<N, false>(ts, ys, out), _ => 0)
+            unrolled_sizes!(self.m + 1, N => self.plain_run_n::<N, false>(ts, ys, out, sd), _ => 0)
         };
         if steady {
             self.block_credit = self.block_credit.saturating_add(rest);
@@ -99,7 +102,8 @@ impl GainEngine {
     /// The plain-`f64` kernels on a run after the exact start, the state in registers, both
     /// generated from one loop ([`plain_run`](Self::plain_run)) and tested against the
     /// reference recursion ([`predict_correct`]); with `W`, each sample's derivatives go to
-    /// `out`. Returns how many samples it took.
+    /// `out`, each row followed by `sd` if it is not empty ([`plain_run`](Self::plain_run)).
+    /// Returns how many samples it took.
     ///
     /// - Expanding memory, any steps: the same operations as [`update`](Self::update) (gains
     ///   `h_k(n)` of Table 9.1 scaled for the mean step) without the compensation, the
@@ -111,13 +115,14 @@ impl GainEngine {
         ts: &[f64],
         ys: &[f64],
         out: &mut [f64],
+        sd: &[f64],
     ) -> usize {
         if self.fading.is_none() {
             let mut g = [0.0; N];
             let (tau, t_first, schedule) = (self.unit, self.t_first, &self.schedule);
             let mut n = self.n;
             let mut last_step = self.step_mean;
-            let run = self.plain_run::<N, W>(ts, ys, out, |z, t, zeta, y| {
+            let run = self.plain_run::<N, W>(ts, ys, out, sd, |z, t, zeta, y| {
                 let mut step = (t - t_first) / (n as f64 * tau);
                 if snaps_to(step, zeta) {
                     step = zeta;
@@ -145,7 +150,7 @@ impl GainEngine {
             let mut zeta_m = f64::NAN;
             let mut mk = [[0.0; N]; N];
             let (g0y, one_minus_g0) = (g[0], 1.0 - g[0]);
-            let run = self.plain_run::<N, W>(ts, ys, out, |z, t, zeta, y| {
+            let run = self.plain_run::<N, W>(ts, ys, out, sd, |z, t, zeta, y| {
                 if !check.agrees(zeta, t) {
                     return false;
                 }
@@ -193,17 +198,23 @@ impl GainEngine {
     /// The plain kernels' common loop: from the state folded to `f64`, for each sample the
     /// step `ζ = (t − t_last)/τ` and `step(z, t, ζ, y)`, which advances `z` over the sample or
     /// returns false to stop before it; with `W`, the derivatives after each sample go to
-    /// `out`. The caller stores the result ([`end_plain_run`](Self::end_plain_run)).
+    /// `out`, and with a non-empty `sd` (`N` values, the 1σ of a steady covariance) the row
+    /// goes on with them (rows of `2N`: the batch σ path written in place, no second pass).
+    /// The caller stores the result ([`end_plain_run`](Self::end_plain_run)).
     #[inline(always)]
     pub(super) fn plain_run<const N: usize, const W: bool>(
         &self,
         ts: &[f64],
         ys: &[f64],
         out: &mut [f64],
+        sd: &[f64],
         mut step: impl FnMut(&mut [f64; N], f64, f64, f64) -> bool,
     ) -> PlainRun<N> {
         let c = self.derivative_factors::<N>();
-        let mut rows = out.chunks_exact_mut(N);
+        let sigma = !sd.is_empty();
+        let s: [f64; N] = std::array::from_fn(|k| sd.get(k).copied().unwrap_or(0.0));
+        let stride = if sigma { 2 * N } else { N };
+        let mut rows = out.chunks_exact_mut(stride);
         let mut z = self.plain_state::<N>();
         let (tau, mut t_last, mut done) = (self.unit, self.t_last, 0);
         let mut probe = 0.0;
@@ -213,14 +224,22 @@ impl GainEngine {
                 break;
             }
             if W {
-                probe += write_row(rows.next(), &z, &c);
+                let row = rows.next();
+                if sigma {
+                    if let Some(row) = row {
+                        row[N..].copy_from_slice(&s);
+                        probe += write_row(Some(&mut row[..N]), &z, &c);
+                    }
+                } else {
+                    probe += write_row(row, &z, &c);
+                }
             }
             t_last = t;
             done += 1;
         }
         if W && probe != 0.0 {
             // A number beyond the double range (rare): marked NaN, "no estimate".
-            for x in &mut out[..done * N] {
+            for x in &mut out[..done * stride] {
                 *x = out_of_range_as_nan(*x);
             }
         }

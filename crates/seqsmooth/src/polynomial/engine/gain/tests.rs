@@ -65,10 +65,10 @@ fn steady_fast_paths_match_the_reference() {
                 let mut e = start.clone();
                 let done = match write {
                     false => {
-                        unrolled_sizes!(m + 1, N => e.plain_run_n::<N, false>(ts, ys, &mut out), _ => 0)
+                        unrolled_sizes!(m + 1, N => e.plain_run_n::<N, false>(ts, ys, &mut out, &[]), _ => 0)
                     }
                     true => {
-                        unrolled_sizes!(m + 1, N => e.plain_run_n::<N, true>(ts, ys, &mut out), _ => 0)
+                        unrolled_sizes!(m + 1, N => e.plain_run_n::<N, true>(ts, ys, &mut out, &[]), _ => 0)
                     }
                 };
                 assert_eq!(done, ts.len(), "m {m}: the kernel stopped early");
@@ -121,7 +121,8 @@ fn expanding_fast_paths_match_the_reference() {
         let want = reference(&start, ts, ys, gains);
         let span = n as f64;
         let mut e = start.clone();
-        let done = unrolled_sizes!(m + 1, N => e.plain_run_n::<N, false>(ts, ys, &mut []), _ => 0);
+        let done =
+            unrolled_sizes!(m + 1, N => e.plain_run_n::<N, false>(ts, ys, &mut [], &[]), _ => 0);
         assert_eq!(done, ts.len());
         let err = scaled_error(&e.z, &want, span);
         assert!(err <= 1e-12, "m {m} per sample: {err:e}");
