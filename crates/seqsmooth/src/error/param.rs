@@ -258,6 +258,12 @@ pub enum Param {
     Measurement,
     /// The stacked observations `Y`.
     ObservationsY,
+    /// The white noise's spectral density matrix `Q_c` of a continuous model.
+    SpectralDensity,
+    /// The Singer model's manoeuvre rate `α` (the reciprocal of its time constant).
+    ManoeuvreAlpha,
+    /// The Singer model's manoeuvre variance `σ_m²`.
+    ManoeuvreVariance,
 }
 
 impl Param {
@@ -381,6 +387,9 @@ impl Param {
         Param::Sigmas,
         Param::Measurement,
         Param::ObservationsY,
+        Param::SpectralDensity,
+        Param::ManoeuvreAlpha,
+        Param::ManoeuvreVariance,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -504,6 +513,9 @@ impl Param {
             Param::Sigmas => "sigmas",
             Param::Measurement => "measurement",
             Param::ObservationsY => "observations Y",
+            Param::SpectralDensity => "spectral density Q_c",
+            Param::ManoeuvreAlpha => "manoeuvre alpha",
+            Param::ManoeuvreVariance => "manoeuvre variance",
         }
     }
 

@@ -16,6 +16,7 @@
 
 use crate::calculus::factorial;
 use crate::error::{Error, Param};
+use crate::model::continuous::ContinuousModel;
 use crate::numeric::power::powi;
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size, UNROLLED_MAX_SIZE};
 use nalgebra::DMatrix;
@@ -175,4 +176,43 @@ fn fill<S: Size>(size: S, d: usize, psd: f64, zeta: f64, out: &mut [f64]) -> boo
         }
     }
     finite
+}
+
+/// A continuous model's driving noise over the step, `Q(|t_b − t_a|)`
+/// ([`ContinuousModel::noise_covariance`]: Van Loan's `∫₀^ζ e^{As} Q_c e^{Aᵀs} ds`); a step
+/// backwards uses `|ζ|`, as [`WhiteNoiseDerivative`] does. The model is also the filter's
+/// [`Dynamics`](crate::model::dynamics::Dynamics).
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};
+/// use seqsmooth::kalman::KalmanFilter;
+/// use seqsmooth::model::continuous::ContinuousModel;
+/// use seqsmooth::model::observation::LinearObservation;
+/// let model = ContinuousModel::singer(1, 0.2, 9.0).unwrap();
+/// let q = model.covariance(1.0, 1.5).unwrap();
+/// assert!((q[(2, 2)] - 9.0 * (1.0 - (-0.2_f64).exp())).abs() < 1e-14); // σ_m² (1 − e^{−2αζ})
+/// // The model as a Kalman filter's dynamics and driving noise.
+/// let mut f = KalmanFilter::new(model.clone(), LinearObservation::value_of(3),
+///     DVector::zeros(3), DMatrix::zeros(3, 3), 0.0).unwrap()
+///     .with_process_noise(model).unwrap();
+/// f.predict(0.5).unwrap();
+/// assert!((f.covariance() - q).amax() < 1e-15);
+/// ```
+impl ProcessNoise for ContinuousModel {
+    fn dimension(&self) -> usize {
+        crate::model::dynamics::Dynamics::dimension(self)
+    }
+
+    fn covariance(&self, t_a: f64, t_b: f64) -> Result<DMatrix<f64>, Error> {
+        for t in [t_a, t_b] {
+            if !t.is_finite() {
+                return Err(Error::NonFinite {
+                    what: "time",
+                    value: t,
+                });
+            }
+        }
+        self.noise_covariance((t_b - t_a).abs())
+    }
 }

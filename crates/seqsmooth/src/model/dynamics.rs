@@ -6,6 +6,7 @@
 //! |---|---|---|
 //! | [`PolynomialDynamics`] (degree `m`, `d` axes) | `Ψ(t_b − t_a) ⊗ I_d`, exact | (4.2.5), [`super::psi`] |
 //! | [`super::linear::LinearDynamics`] `dX/dt = A X` | `e^{(t_b − t_a) A}` | (4.6.24)-(4.6.28) |
+//! | [`super::continuous::ContinuousModel`] `dX/dt = A X + w` | `e^{(t_b − t_a) A}`, with the noise's `Q` | (15.2.23), Van Loan 1978 |
 //! | [`super::nonlinear::NonlinearDynamics`] `dX/dt = F(X, t)` | variational equations `dΦ/dt = (∂F/∂X) Φ` | (4.7.x), (8.6.6) |
 //!
 //! For a linear model `Φ` does not depend on the state; for a nonlinear one it is the

@@ -18,6 +18,9 @@
 //! - [`dynamics`]: the [`dynamics::Dynamics`] trait (the state at any time from any other, with
 //!   `Φ(t_b, t_a)`) and [`dynamics::PolynomialDynamics`] (degree `m` on `d` axes, through [`psi`]).
 //! - [`linear`]: constant-coefficient linear dynamics `dX/dt = A X`, `Φ(ζ) = e^{ζA}` (§4.6).
+//! - [`continuous`]: `dX/dt = A X + w` with white noise of spectral density `Q_c`, discretised
+//!   exactly on each step (`e^{Aζ}` and Van Loan's `Q(ζ)`, (15.2.23)); the polynomial, nearly
+//!   constant velocity and acceleration, and Singer models.
 //! - [`nonlinear`]: `dX/dt = F(X, t)` and `dX/dt = A(t) X` with `Φ` from the variational
 //!   equations (§4.7, §8.6), integrated by an embedded Runge–Kutta 8(5,3) pair.
 //! - [`observation`]: the [`observation::Observation`] trait `Y = G(X, t) + N`, `M = ∂G/∂X`,
@@ -25,6 +28,7 @@
 //! - [`radar`]: range, azimuth, elevation (and range rate) from a site; polar to Cartesian
 //!   with covariance; the nominal state of §8.5.
 
+pub mod continuous;
 pub mod dynamics;
 pub mod linear;
 pub mod measurement;
