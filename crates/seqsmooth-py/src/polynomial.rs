@@ -154,8 +154,9 @@ impl PyPolynomialFilter {
     /// ``return_sigma=True`` also the 1σ errors, a second array of the same shape (the filter
     /// needs its noise ``sigma``): the two are views of one ``(len(t), 2(m+1))`` buffer, the
     /// rows ``d0..dM, s0..sM`` of ``seqsmooth filter --sigma``, written by the library's batch
-    /// σ path (no covariance matrix per sample; within about 2× of the plain call's time, the
-    /// output being twice as large: BENCHMARKS.md). The rows are the library's row runner's,
+    /// σ path (no covariance matrix per sample; 1.1-1.6× the plain call's time for the gain
+    /// engines and fixed memory, the output being twice as large; more for the exact engine's
+    /// fading filter at degree 4 and up: BENCHMARKS.md). The rows are the library's row runner's,
     /// with its rule: a row the determined fit cannot give (a fading discount that
     /// underflowed, a number beyond the double range) is refused with its index.
     ///
