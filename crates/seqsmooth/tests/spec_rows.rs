@@ -430,6 +430,49 @@ fn undetermined_and_refused_rows() {
     assert!(matches!(e, Error::InBatch { index: 6, .. }), "{e}");
 }
 
+/// The σ kernel's rows (expanding and fading memory, no lead) are checked by the same rule as
+/// every other row, once, while the kernel writes them: a fit that the discount leaves
+/// undetermined (the exact engine's weighted fit) is refused with its row's index, the rows
+/// before it empty; a determined run's every cell is a number, with either engine, across the
+/// runner's blocks.
+#[test]
+fn sigma_kernel_rows_follow_the_rule() {
+    let t: Vec<f64> = (0..5000).map(f64::from).collect();
+    let y: Vec<f64> = t.iter().map(|t| 1.0 + 0.5 * t).collect();
+    let sigma = RowLayout {
+        sigma: true,
+        ..RowLayout::default()
+    };
+    // θ^(1/1e-300) = 0: the exact engine's fit undetermined from the third sample (degree 2).
+    let fading = FilterSpec {
+        tau: Some(1e-300),
+        ..spec(FilterKind::Fading, Some(0.1))
+    };
+    let mut f = fading.build().unwrap();
+    let mut out = vec![0.0; 3 * f.stride(sigma)];
+    match f.run_rows(&t[..3], &y[..3], &mut out, sigma) {
+        Err(Error::InBatch { index: 2, source }) => {
+            assert!(
+                matches!(*source, Error::NotDetermined { samples: 3, .. }),
+                "{source}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(out[..12].iter().all(|v| v.is_nan()));
+    for engine in [Engine::Exact, Engine::Gain] {
+        let ok = FilterSpec {
+            engine,
+            ..spec(FilterKind::Fading, Some(0.1))
+        };
+        let mut f = ok.build().unwrap();
+        let mut out = vec![0.0; t.len() * f.stride(sigma)];
+        f.run_rows(&t, &y, &mut out, sigma).unwrap();
+        assert!(out[..12].iter().all(|v| v.is_nan()));
+        assert!(out[12..].iter().all(|v| v.is_finite()), "{engine:?}");
+    }
+}
+
 /// Samples the filter refuses are its own errors, with their index and the rows before them
 /// written; a mismatched output is refused before any sample is taken.
 #[test]
