@@ -258,6 +258,12 @@ pub enum Param {
     Measurement,
     /// The stacked observations `Y`.
     ObservationsY,
+    /// The unscented transform's spread `α` of its sigma points.
+    SigmaPointAlpha,
+    /// The unscented transform's `β` (the prior's fourth moment; 2 for a Gaussian).
+    SigmaPointBeta,
+    /// The unscented transform's secondary spread `κ`.
+    SigmaPointKappa,
 }
 
 impl Param {
@@ -381,6 +387,9 @@ impl Param {
         Param::Sigmas,
         Param::Measurement,
         Param::ObservationsY,
+        Param::SigmaPointAlpha,
+        Param::SigmaPointBeta,
+        Param::SigmaPointKappa,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -504,6 +513,9 @@ impl Param {
             Param::Sigmas => "sigmas",
             Param::Measurement => "measurement",
             Param::ObservationsY => "observations Y",
+            Param::SigmaPointAlpha => "sigma-point alpha",
+            Param::SigmaPointBeta => "sigma-point beta",
+            Param::SigmaPointKappa => "sigma-point kappa",
         }
     }
 
