@@ -5,9 +5,9 @@
 //!
 //! | step | | Wan and van der Merwe 2000 |
 //! |---|---|---|
-//! | `𝒳 = x ± √((n + λ) S)`, each point carried to `t_n` by the dynamics: `𝒴_i` | [`Dynamics::propagate_into`] | (15), (18) |
+//! | `𝒳 = x ± √((n + λ) S)`, each point carried to `t_n` by the dynamics: `𝒴_i` | [`Dynamics::propagate_state`] | (15), (18) |
 //! | `x̄ = Σ W^(m) 𝒴_i`, `S̄ = Σ W^(c) (𝒴_i − x̄)(𝒴_i − x̄)ᵀ + Q(t_n, t_{n−1})` | [`ProcessNoise`] | (19)-(20) |
-//! | `𝒵 = x̄ ± √((n + λ) S̄)` (points redrawn about the prediction), `𝒢_i = G(𝒵_i, t_n)` | [`Observation::predict`] | (21)-(22), redrawn as their footnote |
+//! | `𝒵 = x̄ ± √((n + λ) S̄)` (points redrawn about the prediction), `𝒢_i = G(𝒵_i, t_n)` | [`Observation::value`] | (21)-(22), redrawn as their footnote |
 //! | `ŷ = Σ W^(m) 𝒢_i`, `V = Σ W^(c) (𝒢_i − ŷ)(𝒢_i − ŷ)ᵀ + R`, `C_xy = Σ W^(c) (𝒵_i − x̄)(𝒢_i − ŷ)ᵀ` | present components only | (23), (25)-(26) |
 //! | `H = C_xy V⁻¹`, `x = x̄ + H (Y − ŷ)`, `S = S̄ − H V Hᵀ` | `V` by its Cholesky factor | (27)-(29) |
 //!
@@ -229,16 +229,46 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
     }
 
     /// The sigma points' parameters.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::UnscentedKalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = UnscentedKalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::from_vec(vec![4.0]), DMatrix::from_element(1, 1, 2.0), 1.5).unwrap();
+    /// assert_eq!(f.sigma_points().alpha(), 1.0); // the default
+    /// ```
     pub fn sigma_points(&self) -> SigmaPoints {
         self.points
     }
 
     /// The current estimate `x`.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::UnscentedKalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = UnscentedKalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::from_vec(vec![4.0]), DMatrix::from_element(1, 1, 2.0), 1.5).unwrap();
+    /// assert_eq!(f.state()[0], 4.0);
+    /// ```
     pub fn state(&self) -> &DVector<f64> {
         &self.state
     }
 
     /// The covariance `S` of [`Self::state`].
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::UnscentedKalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = UnscentedKalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::from_vec(vec![4.0]), DMatrix::from_element(1, 1, 2.0), 1.5).unwrap();
+    /// assert_eq!(f.covariance()[(0, 0)], 2.0);
+    /// ```
     pub fn covariance(&self) -> &DMatrix<f64> {
         &self.covariance
     }
@@ -259,6 +289,16 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
     }
 
     /// The time the estimate refers to.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::UnscentedKalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = UnscentedKalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::from_vec(vec![4.0]), DMatrix::from_element(1, 1, 2.0), 1.5).unwrap();
+    /// assert_eq!(f.time(), 1.5);
+    /// ```
     pub fn time(&self) -> f64 {
         self.time
     }
@@ -307,6 +347,21 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
 
     /// [`Self::update`], also returning the step's [`Prediction`]: what the smoother stores.
     /// On an error the filter is unchanged.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::UnscentedKalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = UnscentedKalmanFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2),
+    ///     DVector::from_vec(vec![0.0, 1.0]), DMatrix::identity(2, 2), 0.0).unwrap();
+    /// let m = Measurement { time: 1.0, values: vec![None], noise: NoiseCovariance::Identity };
+    /// let (p, innovation) = f.step(&m).unwrap();
+    /// assert!(innovation.is_none() && (p.from, p.time) == (0.0, 1.0));
+    /// // D = Cov(x(0), x̄(1)) = S Φᵀ for a linear model: Φᵀ = [[1, 0], [1, 1]] here.
+    /// assert!((p.cross[(0, 1)] - 0.0).abs() < 1e-15 && (p.cross[(0, 0)] - 1.0).abs() < 1e-15);
+    /// ```
     pub fn step(
         &mut self,
         measurement: &Measurement,
@@ -356,11 +411,16 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
         let n = x.len();
         let points = w.points(x, s, Param::Covariance, self.time)?;
         let mut carried = DMatrix::zeros(n, 2 * n + 1);
-        let (mut out, mut phi) = (DVector::zeros(n), DMatrix::zeros(n, n));
         for i in 0..2 * n + 1 {
             let point = points.column(i).into_owned();
-            self.dynamics
-                .propagate_into(&point, self.time, t, &mut out, &mut phi)?;
+            let out = self.dynamics.propagate_state(&point, self.time, t)?;
+            if out.len() != n {
+                return Err(Error::InvalidParameter {
+                    name: Param::Dynamics,
+                    value: format!("a state of length {}", out.len()),
+                    reason: format!("the dynamics have {n} states"),
+                });
+            }
             carried.column_mut(i).copy_from(&out);
         }
         let plain = |_: usize, a: f64, b: f64| a - b;
@@ -400,10 +460,14 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
         let points = w.points(x, s, Param::PredictedCovariance, t)?;
         let mut seen = DMatrix::zeros(k, 2 * n + 1);
         for i in 0..2 * n + 1 {
-            let g = self
-                .observation
-                .predict(&points.column(i).into_owned(), t)?
-                .value;
+            let g = self.observation.value(&points.column(i).into_owned(), t)?;
+            if g.len() != self.observation.components() {
+                return Err(Error::InvalidParameter {
+                    name: Param::ObservationModel,
+                    value: format!("{} values", g.len()),
+                    reason: format!("the observation has {}", self.observation.components()),
+                });
+            }
             for (c, &a) in present.iter().enumerate() {
                 seen[(c, i)] = g[a];
             }
