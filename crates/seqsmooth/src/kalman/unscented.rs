@@ -32,7 +32,7 @@
 //! definite, and any output that is not finite.
 
 use super::correct::noise_entries;
-use super::filter::Innovation;
+use super::filter::{Innovation, KalmanFilter};
 use super::noise::ProcessNoise;
 use super::sigma_points::{SigmaPoints, Weights};
 use crate::error::{Error, Param};
@@ -118,53 +118,25 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
         covariance: DMatrix<f64>,
         time: f64,
     ) -> Result<Self, Error> {
-        let n = dynamics.dimension();
-        let bad = |name: Param, value: String, reason: String| Error::InvalidParameter {
-            name,
-            value,
-            reason,
-        };
-        if observation.state_dimension() != n {
-            return Err(bad(
-                Param::ObservationModel,
-                format!("for {} states", observation.state_dimension()),
-                format!("the dynamics have {n} states"),
-            ));
-        }
-        if state.len() != n || covariance.shape() != (n, n) {
-            return Err(bad(
-                Param::Prior,
-                format!(
-                    "state of length {}, covariance {}x{}",
-                    state.len(),
-                    covariance.nrows(),
-                    covariance.ncols()
-                ),
-                format!("the model has {n} states"),
-            ));
-        }
-        if let Some(&value) = state
-            .iter()
-            .chain(covariance.iter())
-            .chain([&time])
-            .find(|v| !v.is_finite())
-        {
-            return Err(Error::NonFinite {
-                what: "prior state, covariance or time",
-                value,
+        // The Kalman filter's checks of the prior (shapes, finite, symmetric), on borrowed
+        // models; then positive definiteness, which the sigma points need.
+        KalmanFilter::new(
+            &dynamics,
+            &observation,
+            state.clone(),
+            covariance.clone(),
+            time,
+        )?;
+        if Cholesky::new(covariance.clone()).is_none() {
+            return Err(Error::InvalidParameter {
+                name: Param::PriorCovariance,
+                value: format!("{covariance:?}"),
+                reason: "must be positive definite (the unscented filter draws its sigma points \
+                         from its Cholesky factor)"
+                    .into(),
             });
         }
-        if (&covariance - covariance.transpose()).abs().max() > 1e-12 * covariance.abs().max()
-            || Cholesky::new(covariance.clone()).is_none()
-        {
-            return Err(bad(
-                Param::PriorCovariance,
-                format!("{covariance:?}"),
-                "must be symmetric and positive definite (the unscented filter draws its \
-                 sigma points from its Cholesky factor)"
-                    .into(),
-            ));
-        }
+        let n = state.len();
         let points = SigmaPoints::default();
         let weights = points.weights(n)?;
         Ok(Self {
