@@ -352,3 +352,90 @@ fn smoother_rows_hold_their_parts() {
     }
     assert_eq!(PolynomialDynamics::new(1, 3).dimension(), 6);
 }
+
+/// 10⁴ seeded random calls with bad and extreme numbers (NaN, ±∞, ±1e300, 1e-300, wrong
+/// lengths, asymmetric or indefinite matrices, negative variances): no panic; a refused update
+/// leaves the filter as it was; an accepted one leaves only finite numbers.
+#[test]
+fn random_bad_calls_never_panic_and_leave_the_filter_whole() {
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+    let pool = [
+        0.0,
+        1.0,
+        -1.0,
+        2.5,
+        1e300,
+        -1e300,
+        1e-300,
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    let mut r = StdRng::seed_from_u64(0x0b5e_55ed);
+    let pick = |r: &mut StdRng, bad: f64| {
+        if r.gen::<f64>() < bad {
+            pool[r.gen_range(0..pool.len())]
+        } else {
+            r.gen_range(-3.0..3.0)
+        }
+    };
+    let (mut built, mut accepted, mut refused) = (0, 0, 0);
+    for _ in 0..10_000 {
+        let n = 6;
+        let len = if r.gen::<f64>() < 0.05 { 5 } else { n };
+        let x = DVector::from_fn(len, |_, _| pick(&mut r, 0.05) * 1e3);
+        let a = DMatrix::from_fn(n, n, |_, _| pick(&mut r, 0.02));
+        let mut s = &a * a.transpose() + DMatrix::identity(n, n) * 0.1;
+        if r.gen::<f64>() < 0.05 {
+            s[(0, 1)] += 1.0; // asymmetric
+        }
+        if r.gen::<f64>() < 0.05 {
+            s[(2, 2)] = -1.0; // indefinite
+        }
+        let radar = Radar::new([0.0; 3], n).unwrap();
+        let Ok(mut f) = UnscentedKalmanFilter::new(PolynomialDynamics::new(1, 3), radar, x, s, 0.0)
+        else {
+            continue;
+        };
+        built += 1;
+        for k in 0..4 {
+            let values: Vec<Option<f64>> = (0..if r.gen::<f64>() < 0.05 { 2 } else { 3 })
+                .map(|_| (r.gen::<f64>() > 0.2).then(|| pick(&mut r, 0.05) * 1e3))
+                .collect();
+            let variances = (0..3).map(|_| pick(&mut r, 0.05).abs() + 1e-6).collect();
+            let noise = if r.gen::<f64>() < 0.1 {
+                NoiseCovariance::Full(DMatrix::from_fn(3, 3, |_, _| pick(&mut r, 0.2)))
+            } else {
+                NoiseCovariance::Variances(variances)
+            };
+            let time = k as f64 + 1.0 + pick(&mut r, 0.05).abs() * 0.1;
+            let m = Measurement {
+                time,
+                values,
+                noise,
+            };
+            let before = (f.state().clone(), f.covariance().clone(), f.time());
+            match f.update(&m) {
+                Ok(i) => {
+                    accepted += 1;
+                    assert!(f
+                        .state()
+                        .iter()
+                        .chain(f.covariance().iter())
+                        .all(|v| v.is_finite()));
+                    assert!(i.is_none_or(|i| i.nis.is_finite() && i.nis >= 0.0));
+                }
+                Err(_) => {
+                    refused += 1;
+                    assert_eq!(
+                        (f.state().clone(), f.covariance().clone(), f.time()),
+                        before
+                    );
+                }
+            }
+        }
+    }
+    println!("{built} filters built, {accepted} updates accepted, {refused} refused");
+    assert!(built > 5_000 && accepted > 1_000 && refused > 1_000);
+}
