@@ -439,3 +439,48 @@ fn random_bad_calls_never_panic_and_leave_the_filter_whole() {
     println!("{built} filters built, {accepted} updates accepted, {refused} refused");
     assert!(built > 5_000 && accepted > 1_000 && refused > 1_000);
 }
+
+/// Any `Dynamics` and `Observation`: constant velocity written as an ODE `dX/dt = F(X)`
+/// (`NonlinearDynamics`, integrated) and observed through a closure (`NonlinearObservation`,
+/// `G` without its differenced Jacobian) gives the Kalman filter's numbers on the closed-form
+/// model, to the integrator's tolerance.
+#[test]
+fn ode_dynamics_and_closure_observation_give_the_kalman_filter() {
+    use seqsmooth::model::nonlinear::NonlinearDynamics;
+    use seqsmooth::model::observation::NonlinearObservation;
+    let fx = read("linear");
+    let s = setup(&fx);
+    let rows = measurements(&fx, &s);
+    let ode = NonlinearDynamics::new(4, |_t, x: &DVector<f64>| {
+        DVector::from_vec(vec![x[2], x[3], 0.0, 0.0])
+    })
+    .with_tolerances(1e-12, 1e-12)
+    .unwrap();
+    let seen = NonlinearObservation::new(2, 4, |_t, x: &DVector<f64>| {
+        DVector::from_vec(vec![x[0], x[1]])
+    });
+    let mut u = UnscentedKalmanFilter::new(ode, seen, s.x0.clone(), s.p0.clone(), s.t0)
+        .unwrap()
+        .with_process_noise(s.noise)
+        .unwrap();
+    let mut k = KalmanFilter::new(
+        s.dynamics,
+        positions(2, 4),
+        s.x0.clone(),
+        s.p0.clone(),
+        s.t0,
+    )
+    .unwrap()
+    .with_process_noise(s.noise)
+    .unwrap();
+    let mut most = (0.0_f64, 0.0_f64);
+    for m in &rows {
+        u.update(m).unwrap();
+        k.update(m).unwrap();
+        let want = k.state().as_slice().to_vec();
+        let (x, c) = worst(u.state(), u.covariance(), &want, k.covariance());
+        most = (most.0.max(x), most.1.max(c));
+    }
+    println!("ODE and closure against the Kalman filter: {most:?}");
+    assert!(most.0 <= 1e-9 && most.1 <= 1e-9, "{most:?}");
+}
