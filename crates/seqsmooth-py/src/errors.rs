@@ -98,6 +98,9 @@ pub fn raise(kind: Kind, message: impl Into<String>, index: Option<usize>) -> Py
 pub fn keyword(p: Param) -> Option<&'static str> {
     match p {
         Param::ReviewWindow => Some("review_window"),
+        Param::SigmaPointAlpha => Some("alpha"),
+        Param::SigmaPointBeta => Some("beta"),
+        Param::SigmaPointKappa => Some("kappa"),
         _ => None,
     }
 }

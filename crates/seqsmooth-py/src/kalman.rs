@@ -26,7 +26,7 @@ type Linear = KalmanFilter<PolynomialDynamics, LinearObservation>;
 /// covariance `V = M S Mᵀ + R`, the gain, the NIS `νᵀ V⁻¹ ν` and the log-likelihood.
 #[pyclass(name = "Innovation", module = "seqsmooth", frozen)]
 pub struct PyInnovation {
-    inner: Innovation,
+    pub(crate) inner: Innovation,
 }
 
 #[pymethods]

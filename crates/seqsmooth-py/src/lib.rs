@@ -16,6 +16,7 @@ mod polynomial;
 mod smooth;
 mod tables;
 mod track;
+mod unscented;
 
 use pyo3::prelude::*;
 
@@ -33,6 +34,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<kalman::PyKalmanFilter>()?;
     m.add_class::<kalman::PyInnovation>()?;
     m.add_class::<bayes::PyBayesFilter>()?;
+    m.add_class::<unscented::PyUnscentedKalmanFilter>()?;
     m.add_class::<track::PyRadarTracker>()?;
     m.add_class::<fit::PySlidingFit>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;

@@ -172,6 +172,40 @@ class KalmanFilter:
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
 
+class UnscentedKalmanFilter:
+    def __init__(
+        self,
+        degree: int,
+        x0: ArrayLike,
+        P0: ArrayLike | float,
+        t0: float = 0.0,
+        axes: int = 1,
+        q: float = 0.0,
+        observation: ArrayLike | Literal["radar"] | None = None,
+        site: tuple[float, float, float] | None = None,
+        alpha: float = 1.0,
+        beta: float = 2.0,
+        kappa: float = 0.0,
+    ) -> None: ...
+    @property
+    def state(self) -> Vector: ...
+    @property
+    def covariance(self) -> Matrix: ...
+    @property
+    def std_devs(self) -> Vector: ...
+    @property
+    def time(self) -> float: ...
+    @property
+    def sigma_points(self) -> tuple[float, float, float]: ...
+    def predict(self, t: float) -> None: ...
+    def update(self, t: float, z: ArrayLike | float, R: ArrayLike | float) -> Innovation | None: ...
+    def update_many(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
+    ) -> tuple[Matrix, npt.NDArray[np.float64], Vector]: ...
+    def smooth(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
+    ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
+
 class BayesFilter:
     def __init__(
         self,

@@ -258,6 +258,12 @@ pub enum Param {
     Measurement,
     /// The stacked observations `Y`.
     ObservationsY,
+    /// The unscented transform's spread `α` of its sigma points.
+    SigmaPointAlpha,
+    /// The unscented transform's `β` (the prior's fourth moment; 2 for a Gaussian).
+    SigmaPointBeta,
+    /// The unscented transform's secondary spread `κ`.
+    SigmaPointKappa,
     /// The white noise's spectral density matrix `Q_c` of a continuous model.
     SpectralDensity,
     /// The Singer model's manoeuvre rate `α` (the reciprocal of its time constant).
@@ -387,6 +393,9 @@ impl Param {
         Param::Sigmas,
         Param::Measurement,
         Param::ObservationsY,
+        Param::SigmaPointAlpha,
+        Param::SigmaPointBeta,
+        Param::SigmaPointKappa,
         Param::SpectralDensity,
         Param::ManoeuvreAlpha,
         Param::ManoeuvreVariance,
@@ -513,6 +522,9 @@ impl Param {
             Param::Sigmas => "sigmas",
             Param::Measurement => "measurement",
             Param::ObservationsY => "observations Y",
+            Param::SigmaPointAlpha => "sigma-point alpha",
+            Param::SigmaPointBeta => "sigma-point beta",
+            Param::SigmaPointKappa => "sigma-point kappa",
             Param::SpectralDensity => "spectral density Q_c",
             Param::ManoeuvreAlpha => "manoeuvre alpha",
             Param::ManoeuvreVariance => "manoeuvre variance",

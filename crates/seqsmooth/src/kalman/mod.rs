@@ -12,6 +12,13 @@
 //! - [`fixed_lag`]: the same smoother with a fixed lag: each measurement's estimate from the
 //!   `L` after it, in memory bounded by `L`.
 //! - [`steady`]: the fading filter's steady state (§14.7).
+//! - [`sigma_points`]: the scaled unscented transform (Julier, Uhlmann; Wan, van der Merwe):
+//!   the sigma points of a mean and covariance, their weights, and the weighted moments.
+//! - [`unscented`]: [`UnscentedKalmanFilter`], the unscented Kalman filter over any
+//!   [`Dynamics`](crate::model::dynamics::Dynamics) and
+//!   [`Observation`](crate::model::observation::Observation), its predictions kept with their
+//!   cross-covariances; [`unscented_smoother`], the unscented RTS smoother (Särkkä 2008) over
+//!   them.
 //! - [`noise`]: the driving-noise covariance `Q` over a step (15.2.23), in closed form for the
 //!   polynomial model ([`noise::WhiteNoiseDerivative`]).
 //!
@@ -22,11 +29,16 @@ mod correct;
 pub mod filter;
 pub mod fixed_lag;
 pub mod noise;
+pub mod sigma_points;
 pub mod smoother;
 pub mod steady;
+pub mod unscented;
+pub mod unscented_smoother;
 
 pub use crate::discount::Discount;
 pub use bayes::BayesFilter;
 pub use filter::{Innovation, KalmanFilter};
 pub use fixed_lag::FixedLagSmoother;
 pub use smoother::{smooth, Smoothed, Smoother};
+pub use unscented::UnscentedKalmanFilter;
+pub use unscented_smoother::{smooth_unscented, UnscentedSmoother};

@@ -84,6 +84,25 @@ pub trait Dynamics {
         Ok(())
     }
 
+    /// `X(t_b)` alone, without `Φ`: what the unscented filter evaluates at each sigma point
+    /// (Wan and van der Merwe (18)). By default [`Dynamics::propagate`]'s state; a model whose
+    /// `Φ` costs more than `X` (variational equations) may give `X` alone.
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+    /// let x = PolynomialDynamics::new(1, 1).propagate_state(&DVector::from_vec(vec![5.0, 3.0]), 10.0, 8.0).unwrap();
+    /// assert_eq!(x.as_slice(), &[-1.0, 3.0]);
+    /// ```
+    fn propagate_state(
+        &self,
+        state: &DVector<f64>,
+        t_a: f64,
+        t_b: f64,
+    ) -> Result<DVector<f64>, Error> {
+        Ok(self.propagate(state, t_a, t_b)?.state)
+    }
+
     /// `X(t_b)` and, to first order, its covariance `Φ S Φᵀ` from `X(t_a)` with covariance `S`.
     ///
     /// ```
@@ -377,5 +396,14 @@ impl<D: Dynamics + ?Sized> Dynamics for &D {
         transition_out: &mut DMatrix<f64>,
     ) -> Result<(), Error> {
         (**self).propagate_into(state, t_a, t_b, state_out, transition_out)
+    }
+
+    fn propagate_state(
+        &self,
+        state: &DVector<f64>,
+        t_a: f64,
+        t_b: f64,
+    ) -> Result<DVector<f64>, Error> {
+        (**self).propagate_state(state, t_a, t_b)
     }
 }

@@ -80,6 +80,20 @@ pub trait Observation {
         Ok(())
     }
 
+    /// `G(X, t)` alone, without `M`: what the unscented filter evaluates at each sigma point
+    /// (Wan and van der Merwe (22)). By default [`Observation::predict`]'s value; a model whose
+    /// `M` costs more than `G` (differenced) gives `G` alone.
+    ///
+    /// ```
+    /// use nalgebra::DVector;
+    /// use seqsmooth::model::observation::{LinearObservation, Observation};
+    /// let m = LinearObservation::value_of(2);
+    /// assert_eq!(m.value(&DVector::from_vec(vec![3.0, 4.0]), 0.0).unwrap()[0], 3.0);
+    /// ```
+    fn value(&self, state: &DVector<f64>, t: f64) -> Result<DVector<f64>, Error> {
+        Ok(self.predict(state, t)?.value)
+    }
+
     /// The residual of component `component`, `measured − predicted` (an angle's wrapped to
     /// `(−π, π]`).
     fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {
@@ -109,6 +123,9 @@ impl<O: Observation + ?Sized> Observation for &O {
         jacobian: &mut DMatrix<f64>,
     ) -> Result<(), Error> {
         (**self).predict_into(state, t, value, jacobian)
+    }
+    fn value(&self, state: &DVector<f64>, t: f64) -> Result<DVector<f64>, Error> {
+        (**self).value(state, t)
     }
     fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {
         (**self).residual(component, measured, predicted)
@@ -329,6 +346,19 @@ impl Observation for NonlinearObservation {
     }
     fn state_dimension(&self) -> usize {
         self.states
+    }
+    /// `G(X, t)` without differencing `M` (`2n` evaluations fewer).
+    fn value(&self, state: &DVector<f64>, t: f64) -> Result<DVector<f64>, Error> {
+        check_state(self.states, state)?;
+        self.value_at(t, state)
+            .ok_or_else(|| Error::InvalidParameter {
+                name: Param::ObservationModel,
+                value: format!("at t = {t}"),
+                reason: format!(
+                    "G(X, t) has a non-finite entry or is not {} long",
+                    self.components
+                ),
+            })
     }
     fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error> {
         check_state(self.states, state)?;

@@ -1,0 +1,353 @@
+//! The unscented Kalman filter over the built-in models as a Python class,
+//! `UnscentedKalmanFilter`: the library's `kalman::UnscentedKalmanFilter` with
+//! `PolynomialDynamics` (degree `m` on `axes` axes, the state ordered derivative then axis),
+//! white-noise driving of the highest derivative (`q`), and a linear observation (the
+//! positions by default, or the caller's `M`) or a radar's range, azimuth and elevation
+//! (`model::radar::Radar`, the azimuth residual wrapped); and the unscented RTS smoother
+//! (`kalman::unscented_smoother`).
+
+use crate::arrays::{matrix, series};
+use crate::errors::{raise, IntoPy, Kind};
+use crate::kalman::{
+    before, measurement, measurements, observation_from, out_of_order, square, square_from,
+    PyInnovation,
+};
+use nalgebra::DVector;
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+use seqsmooth::kalman::sigma_points::SigmaPoints;
+use seqsmooth::kalman::{smooth_unscented, UnscentedKalmanFilter};
+use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::model::observation::{LinearObservation, Observation};
+use seqsmooth::model::radar::Radar;
+use seqsmooth::Error;
+
+/// The filter on one of the built-in observations.
+#[derive(Clone, Debug)]
+enum Model {
+    Linear(UnscentedKalmanFilter<PolynomialDynamics, LinearObservation>),
+    Radar(UnscentedKalmanFilter<PolynomialDynamics, Radar>),
+}
+
+/// `$body` with `$f` the filter, whichever the observation.
+macro_rules! each {
+    ($model:expr, $f:ident => $body:expr) => {
+        match $model {
+            Model::Linear($f) => $body,
+            Model::Radar($f) => $body,
+        }
+    };
+}
+
+/// A filter of `D` and `O` from the prior, the sigma points and the driving noise.
+fn build<O: Observation>(
+    dynamics: PolynomialDynamics,
+    observation: O,
+    x0: DVector<f64>,
+    p0: nalgebra::DMatrix<f64>,
+    t0: f64,
+    points: SigmaPoints,
+    q: f64,
+) -> PyResult<UnscentedKalmanFilter<PolynomialDynamics, O>> {
+    let mut f = UnscentedKalmanFilter::new(dynamics, observation, x0, p0, t0)
+        .py()?
+        .with_sigma_points(points)
+        .py()?;
+    if q != 0.0 {
+        let noise = WhiteNoiseDerivative::new(dynamics.degree(), dynamics.axes(), q).py()?;
+        f = f.with_process_noise(noise).py()?;
+    }
+    Ok(f)
+}
+
+/// The unscented Kalman filter (Julier and Uhlmann 1997; Wan and van der Merwe 2000) over the
+/// polynomial model: degree ``degree`` on ``axes`` axes, the state ``(x, y, …, x', y', …)``
+/// (derivative, then axis), unscaled derivatives in the caller's time units, observed in a
+/// linear ``M`` or by a radar.
+///
+/// Parameters
+/// ----------
+/// degree : int
+///     The polynomial degree of the motion on each axis (1: constant velocity).
+/// x0, P0 : array_like
+///     The prior state and covariance (a number: that variance on every state; a vector: the
+///     diagonal) at time ``t0``; ``P0`` positive definite (the sigma points come from its
+///     Cholesky factor).
+/// t0 : float
+///     The prior's time.
+/// axes : int
+///     The number of axes (default 1; 3 for ``observation="radar"``).
+/// q : float
+///     The spectral density of the white noise driving the highest derivative of each axis
+///     (value²/time^(2m+1)); 0 for none. ``Q`` is integrated over each actual step.
+/// observation : array_like or "radar", optional
+///     The observation matrix ``M``, components × states (default the positions,
+///     ``[I_axes, 0, …]``), or ``"radar"``: range, azimuth and elevation (radians; azimuth
+///     from +x towards +y, elevation from the x-y plane) of the position ``(x, y, z)`` seen
+///     from ``site``, the azimuth's residual wrapped to (−π, π].
+/// site : (float, float, float)
+///     The radar's position (``observation="radar"`` only; default the origin).
+/// alpha, beta, kappa : float
+///     The scaled sigma points (Wan and van der Merwe (15); filterpy's
+///     ``MerweScaledSigmaPoints(n, alpha, beta, kappa)``): ``λ = alpha² (n + kappa) − n``,
+///     points at ``x ± √(n + λ)`` times the Cholesky columns of ``P``. Default ``alpha=1``,
+///     ``beta=2``, ``kappa=0``: points at ``±√n σ`` with every covariance weight
+///     non-negative (a small ``alpha`` such as 1e-3 weighs the central point by about
+///     ``−1/alpha²``).
+///
+/// A missing component (NaN) is left out, a time with none is a prediction only.
+#[pyclass(name = "UnscentedKalmanFilter", module = "seqsmooth")]
+#[derive(Clone)]
+pub struct PyUnscentedKalmanFilter {
+    model: Model,
+    /// The observation's components `p`.
+    components: usize,
+}
+
+#[pymethods]
+impl PyUnscentedKalmanFilter {
+    #[new]
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    #[pyo3(signature = (degree, x0, P0, t0 = 0.0, axes = 1, q = 0.0, observation = None, site = None, alpha = 1.0, beta = 2.0, kappa = 0.0))]
+    fn new(
+        degree: usize,
+        x0: &Bound<'_, PyAny>,
+        P0: &Bound<'_, PyAny>,
+        t0: f64,
+        axes: usize,
+        q: f64,
+        observation: Option<&Bound<'_, PyAny>>,
+        site: Option<(f64, f64, f64)>,
+        alpha: f64,
+        beta: f64,
+        kappa: f64,
+    ) -> PyResult<Self> {
+        if axes == 0 {
+            return Err(raise(
+                Kind::Parameter,
+                "axes 0 is invalid: at least 1",
+                None,
+            ));
+        }
+        let n = (degree + 1) * axes;
+        let x = series(x0, "x0")?;
+        if x.as_slice().len() != n {
+            return Err(raise(
+                Kind::InvalidInput,
+                format!(
+                    "x0 has {} values: degree {degree} on {axes} axes has {n} states",
+                    x.as_slice().len()
+                ),
+                None,
+            ));
+        }
+        let x = DVector::from_column_slice(x.as_slice());
+        let p0 = square_from(P0, n, "P0")?;
+        let points = SigmaPoints::new(alpha, beta, kappa).py()?;
+        let dynamics = PolynomialDynamics::new(degree, axes);
+        let radar = match observation {
+            Some(o) => o.extract::<String>().ok(),
+            None => None,
+        };
+        let (model, components) = match radar.as_deref() {
+            Some("radar") => {
+                let [a, b, c] = site.map_or([0.0; 3], |(a, b, c)| [a, b, c]);
+                let radar = Radar::new([a, b, c], n).py()?;
+                let p = radar.components();
+                (
+                    Model::Radar(build(dynamics, radar, x, p0, t0, points, q)?),
+                    p,
+                )
+            }
+            Some(other) => {
+                return Err(raise(
+                    Kind::Parameter,
+                    format!("observation {other:?} is not a matrix or 'radar'"),
+                    None,
+                ))
+            }
+            None if site.is_some() => {
+                return Err(raise(
+                    Kind::Parameter,
+                    "site applies only to observation='radar'",
+                    None,
+                ))
+            }
+            None => {
+                let linear = observation_from(observation, axes, n)?;
+                let p = linear.components();
+                (
+                    Model::Linear(build(dynamics, linear, x, p0, t0, points, q)?),
+                    p,
+                )
+            }
+        };
+        Ok(Self { model, components })
+    }
+
+    /// The current estimate ``X``.
+    #[getter]
+    fn state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        each!(&self.model, f => PyArray1::from_slice(py, f.state().as_slice()))
+    }
+
+    /// The covariance of ``X``'s errors.
+    #[getter]
+    fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        each!(&self.model, f => square(py, f.covariance()))
+    }
+
+    /// The 1σ of each state component, the square roots of ``covariance``'s diagonal.
+    #[getter]
+    fn std_devs<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        each!(&self.model, f => PyArray1::from_vec(py, f.std_devs()))
+    }
+
+    /// The time the estimate is valid at.
+    #[getter]
+    fn time(&self) -> f64 {
+        each!(&self.model, f => f.time())
+    }
+
+    /// The sigma points' ``(alpha, beta, kappa)``.
+    #[getter]
+    fn sigma_points(&self) -> (f64, f64, f64) {
+        let s = each!(&self.model, f => f.sigma_points());
+        (s.alpha(), s.beta(), s.kappa())
+    }
+
+    /// Carries the estimate and its covariance to time ``t`` through the sigma points (no
+    /// measurement).
+    fn predict(&mut self, t: f64) -> PyResult<()> {
+        each!(&mut self.model, f => f.predict(t).py())
+    }
+
+    /// Predicts to ``t`` and updates with ``z`` (a number, or one value per component; NaN
+    /// for a missing one) of noise ``R`` (a variance for every component, the variances, or
+    /// the covariance). Returns the :class:`Innovation`, or ``None`` when every component is
+    /// missing (a prediction only). On an error the filter is unchanged.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R))]
+    fn update(
+        &mut self,
+        t: f64,
+        z: &Bound<'_, PyAny>,
+        R: &Bound<'_, PyAny>,
+    ) -> PyResult<Option<PyInnovation>> {
+        let m = measurement(t, z, R, self.components, self.time())?;
+        let innovation = each!(&mut self.model, f => f.update(&m).py()?);
+        Ok(innovation.map(|inner| PyInnovation { inner }))
+    }
+
+    /// Runs the measurements ``(t[i], z[i])`` (``z`` of shape ``(n,)`` or ``(n, p)``, NaN for
+    /// a missing component) with noise ``R`` on every one. Returns ``(states, covariances,
+    /// nis)``: ``(n, dim)``, ``(n, dim, dim)`` and ``(n,)`` (NaN where nothing was measured).
+    /// The work runs without the GIL. On an error (``.index`` names the measurement) the
+    /// measurements before it are taken.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R))]
+    fn update_many<'py>(
+        &mut self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        R: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let mut rows = measurements(t, z, R, self.components)?;
+        let disorder = out_of_order(self.time(), &rows);
+        if let Some((k, _, _)) = disorder {
+            rows.truncate(k);
+        }
+        let n = self.state_len();
+        let mut states = vec![0.0; rows.len() * n];
+        let mut covariances = vec![0.0; rows.len() * n * n];
+        let mut nis = vec![f64::NAN; rows.len()];
+        let model = &mut self.model;
+        py.detach(|| {
+            each!(model, f => {
+                for (i, m) in rows.iter().enumerate() {
+                    let innovation = f.update(m).map_err(|e| Error::InBatch {
+                        index: i,
+                        source: Box::new(e),
+                    })?;
+                    if let Some(s) = innovation {
+                        nis[i] = s.nis;
+                    }
+                    states[i * n..(i + 1) * n].copy_from_slice(f.state().as_slice());
+                    // Symmetric: column-major is row-major.
+                    covariances[i * n * n..(i + 1) * n * n]
+                        .copy_from_slice(f.covariance().as_slice());
+                }
+            });
+            Ok::<(), Error>(())
+        })
+        .py()?;
+        if let Some((k, t, previous)) = disorder {
+            return Err(before(t, previous, Some(k)));
+        }
+        let count = rows.len();
+        let states = matrix(py, states, count, n)?;
+        let covariances = PyArray1::from_vec(py, covariances)
+            .reshape([count, n, n])?
+            .into_any();
+        let nis = PyArray1::from_vec(py, nis).into_any();
+        PyTuple::new(py, [states, covariances, nis])
+    }
+
+    /// The unscented Rauch–Tung–Striebel smoother (Särkkä 2008) over the measurements, from
+    /// this filter's current state (the filter itself is not changed): at each measurement's
+    /// time the estimate from all of them, from the forward pass's own predictions and
+    /// cross-covariances. Returns ``(states, covariances)``, ``(n, dim)`` and
+    /// ``(n, dim, dim)``.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R))]
+    fn smooth<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        R: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let rows: Vec<Measurement> = measurements(t, z, R, self.components)?;
+        if let Some((k, t, previous)) = out_of_order(self.time(), &rows) {
+            return Err(before(t, previous, Some(k)));
+        }
+        let model = self.model.clone();
+        let smoothed = py
+            .detach(|| each!(model, f => smooth_unscented(f, &rows)))
+            .py()?;
+        let n = self.state_len();
+        let states: Vec<f64> = smoothed
+            .iter()
+            .flat_map(|s| s.state.iter().copied())
+            .collect();
+        let covariances: Vec<f64> = smoothed
+            .iter()
+            .flat_map(|s| s.covariance.iter().copied())
+            .collect();
+        let count = smoothed.len();
+        let states = matrix(py, states, count, n)?;
+        let covariances = PyArray1::from_vec(py, covariances)
+            .reshape([count, n, n])?
+            .into_any();
+        PyTuple::new(py, [states, covariances])
+    }
+
+    fn __repr__(&self) -> String {
+        let (a, b, k) = self.sigma_points();
+        format!(
+            "UnscentedKalmanFilter(states={}, time={:?}, alpha={a:?}, beta={b:?}, kappa={k:?})",
+            self.state_len(),
+            self.time()
+        )
+    }
+}
+
+impl PyUnscentedKalmanFilter {
+    fn state_len(&self) -> usize {
+        each!(&self.model, f => f.state().len())
+    }
+}
