@@ -22,7 +22,7 @@ use nalgebra::{DMatrix, DVector};
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::sigma_points::SigmaPoints;
 use seqsmooth::kalman::{smooth, smooth_unscented, KalmanFilter, UnscentedKalmanFilter};
-use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
 use seqsmooth::model::observation::{LinearObservation, Observation};
 use seqsmooth::model::radar::Radar;
@@ -271,11 +271,12 @@ fn a_covariance_without_sigma_points_is_refused_naming_its_sample() {
         values: vec![Some(1.0)],
         noise: NoiseCovariance::Variances(vec![variance]),
     };
-    // A perfect measurement leaves S = 0: the next update has no sigma points.
+    // A perfect measurement would leave S = 0, a covariance without sigma points: the update
+    // that makes it is refused (not the next one), and the filter keeps the row before.
     let rows = [row(1.0, 1.0), row(2.0, 0.0), row(3.0, 1.0)];
     let e = smooth_unscented(f.clone(), &rows).unwrap_err();
     match e {
-        Error::InBatch { index: 2, source } => assert!(
+        Error::InBatch { index: 1, source } => assert!(
             matches!(
                 *source,
                 Error::InvalidParameter {
@@ -289,13 +290,14 @@ fn a_covariance_without_sigma_points_is_refused_naming_its_sample() {
     }
     let mut g = f;
     g.update(&rows[0]).unwrap();
-    g.update(&rows[1]).unwrap();
     let before = (g.state().clone(), g.covariance().clone(), g.time());
-    assert!(g.update(&rows[2]).is_err());
+    assert!(g.update(&rows[1]).is_err());
     assert_eq!(
         (g.state().clone(), g.covariance().clone(), g.time()),
         before
     );
+    // It goes on from there with the next row.
+    g.update(&rows[2]).unwrap();
 }
 
 /// Non-finite input is refused and nothing non-finite comes out: a NaN measurement, an
@@ -350,7 +352,49 @@ fn smoother_rows_hold_their_parts() {
             assert!(r.covariance[(i, i)] <= r.filtered_covariance[(i, i)] * (1.0 + 1e-12));
         }
     }
-    assert_eq!(PolynomialDynamics::new(1, 3).dimension(), 6);
+}
+
+/// Sigma points with a negative central covariance weight (α 0.2, β −1, κ −3 on six states:
+/// W₀ᶜ = −49.04) can make the updated covariance indefinite: the update is refused, naming the
+/// weight, and the filter keeps its estimate — never a covariance whose σ would read as zero.
+/// (Without the check this update was accepted with a diagonal of −2620, −290, … and every
+/// later step refused.)
+#[test]
+fn an_indefinite_update_is_refused_and_the_filter_kept() {
+    let build = |points: SigmaPoints| {
+        let p0 = DMatrix::from_diagonal(&DVector::from_vec(vec![
+            400.0, 400.0, 400.0, 25.0, 25.0, 25.0,
+        ]));
+        let x0 = DVector::from_vec(vec![20.0, 5.0, 0.0, 1.0, 0.0, 0.0]);
+        let radar = Radar::new([0.0; 3], 6).unwrap();
+        UnscentedKalmanFilter::new(PolynomialDynamics::new(1, 3), radar, x0, p0, 0.0)
+            .unwrap()
+            .with_process_noise(WhiteNoiseDerivative::new(1, 3, 1.0).unwrap())
+            .unwrap()
+            .with_sigma_points(points)
+            .unwrap()
+    };
+    let m = Measurement {
+        time: 1.0,
+        values: vec![Some(20.0), Some(0.2), Some(0.0)],
+        noise: NoiseCovariance::Variances(vec![4.0, 0.0025, 0.0025]),
+    };
+    let mut f = build(SigmaPoints::new(0.2, -1.0, -3.0).unwrap());
+    let before = (f.state().clone(), f.covariance().clone(), f.time());
+    let e = f.update(&m).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name: Param::Covariance, reason, .. }
+            if reason.contains("W0c") && reason.contains("negative")),
+        "{e}"
+    );
+    assert_eq!(
+        (f.state().clone(), f.covariance().clone(), f.time()),
+        before
+    );
+    // The same update with the default weights is accepted, its covariance positive definite.
+    let mut g = build(SigmaPoints::default());
+    g.update(&m).unwrap();
+    assert!(nalgebra::Cholesky::new(g.covariance().clone()).is_some());
 }
 
 /// 10⁴ seeded random calls with bad and extreme numbers (NaN, ±∞, ±1e300, 1e-300, wrong
@@ -394,9 +438,23 @@ fn random_bad_calls_never_panic_and_leave_the_filter_whole() {
             s[(2, 2)] = -1.0; // indefinite
         }
         let radar = Radar::new([0.0; 3], n).unwrap();
-        let Ok(mut f) = UnscentedKalmanFilter::new(PolynomialDynamics::new(1, 3), radar, x, s, 0.0)
+        let Ok(f) = UnscentedKalmanFilter::new(PolynomialDynamics::new(1, 3), radar, x, s, 0.0)
         else {
             continue;
+        };
+        // A third of the filters with random sigma points, negative central weights included.
+        let mut f = if r.gen::<f64>() < 0.3 {
+            let points = SigmaPoints::new(
+                r.gen_range(0.05..1.5),
+                r.gen_range(-2.0..3.0),
+                r.gen_range(-5.0..3.0),
+            );
+            match points.and_then(|p| f.with_sigma_points(p)) {
+                Ok(f) => f,
+                Err(_) => continue,
+            }
+        } else {
+            f
         };
         built += 1;
         for k in 0..4 {
@@ -425,6 +483,8 @@ fn random_bad_calls_never_panic_and_leave_the_filter_whole() {
                         .chain(f.covariance().iter())
                         .all(|v| v.is_finite()));
                     assert!(i.is_none_or(|i| i.nis.is_finite() && i.nis >= 0.0));
+                    // An accepted covariance has its Cholesky factor: its σ are never zero.
+                    assert!(nalgebra::Cholesky::new(f.covariance().clone()).is_some());
                 }
                 Err(_) => {
                     refused += 1;

@@ -232,7 +232,7 @@ fn polynomial_model_equals_the_closed_form() {
     for m in 0..=8 {
         for axes in 1..=3 {
             let psd = [0.4, 2.0, 11.0];
-            for &q in &psd[..1] {
+            for &q in &psd {
                 let model = ContinuousModel::polynomial(m, &vec![q; axes]).unwrap();
                 let closed = WhiteNoiseDerivative::new(m, axes, q).unwrap();
                 for zeta in STEPS {
@@ -291,6 +291,13 @@ fn refusals_are_typed() {
     let mut inf_a = a.clone();
     inf_a[(0, 0)] = f64::INFINITY;
     assert_eq!(new(inf_a, ok.clone()), Param::DynamicsMatrixA);
+    // Finite entries whose column sum overflows: refused, where the scaling would halve every
+    // step to zero and give Q = 0.
+    let mut huge = DMatrix::zeros(3, 3);
+    huge[(0, 2)] = 1e308;
+    huge[(1, 2)] = 1e308;
+    let qc3 = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1.0, 0.0, 0.0]));
+    assert_eq!(new(huge, qc3), Param::DynamicsMatrixA);
     let model = ContinuousModel::new(a, ok).unwrap();
     for zeta in [-1e-9, -1.0, f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
         assert_eq!(param(model.discretise(zeta).unwrap_err()), Param::Step);

@@ -179,8 +179,12 @@ fn fill<S: Size>(size: S, d: usize, psd: f64, zeta: f64, out: &mut [f64]) -> boo
 }
 
 /// A continuous model's driving noise over the step, `Q(|t_b − t_a|)`
-/// ([`ContinuousModel::noise_covariance`]: Van Loan's `∫₀^ζ e^{As} Q_c e^{Aᵀs} ds`); a step
-/// backwards uses `|ζ|`, as [`WhiteNoiseDerivative`] does. The model is also the filter's
+/// ([`ContinuousModel::noise_covariance`]: Van Loan's `∫₀^ζ e^{As} Q_c e^{Aᵀs} ds`). A step
+/// backwards uses `Q(|ζ|)`, the convention of [`WhiteNoiseDerivative`]: the uncertainty added
+/// grows with the span whichever way it is crossed. It is a convention, not the backward
+/// model's own noise `Φ(−ζ) Q(ζ) Φ(−ζ)ᵀ`, which differs (for constant velocity its
+/// position–velocity term is `−qζ²/2`; for the Singer model its acceleration variance is
+/// `σ_m² (e^{2α|ζ|} − 1)`). The model is also the filter's
 /// [`Dynamics`](crate::model::dynamics::Dynamics).
 ///
 /// ```

@@ -123,6 +123,10 @@ impl SigmaPoints {
     /// let w = SigmaPoints::new(0.5, 2.0, 0.0).unwrap().weights(6).unwrap();
     /// assert_eq!((w.lambda, w.mean[0], w.mean[12]), (-4.5, -3.0, 1.0 / 3.0));
     /// assert!(SigmaPoints::new(1.0, 2.0, -6.0).unwrap().weights(6).is_err());
+    /// // α² underflows: α is named, not κ.
+    /// let e = SigmaPoints::new(1e-170, 2.0, 0.0).unwrap().weights(6).unwrap_err();
+    /// assert!(matches!(e, seqsmooth::Error::InvalidParameter {
+    ///     name: seqsmooth::Param::SigmaPointAlpha, .. }));
     /// ```
     pub fn weights(&self, n: usize) -> Result<Weights, Error> {
         let nf = n as f64;
@@ -132,9 +136,20 @@ impl SigmaPoints {
         let w0 = lambda / spread;
         let w0c = w0 + (1.0 - self.alpha * self.alpha + self.beta);
         if n == 0 || !(spread > 0.0 && c.is_finite() && w0.is_finite() && w0c.is_finite()) {
+            // n + κ > 0 with α² (n + κ) not a positive normal number: α is at fault (its
+            // square underflows or overflows); otherwise κ is.
+            let alpha_at_fault = n > 0 && nf + self.kappa > 0.0;
             return Err(Error::InvalidParameter {
-                name: Param::SigmaPointKappa,
-                value: self.kappa.to_string(),
+                name: if alpha_at_fault {
+                    Param::SigmaPointAlpha
+                } else {
+                    Param::SigmaPointKappa
+                },
+                value: if alpha_at_fault {
+                    self.alpha.to_string()
+                } else {
+                    self.kappa.to_string()
+                },
                 reason: format!(
                     "n + lambda = alpha^2 (n + kappa) must be positive with finite weights \
                      (n = {n}, alpha = {})",

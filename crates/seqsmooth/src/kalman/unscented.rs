@@ -407,6 +407,7 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
         finite(state.as_slice(), "predicted state entry")?;
         finite(covariance.as_slice(), "predicted covariance")?;
         finite(cross.as_slice(), "predicted cross-covariance")?;
+        positive_definite(&covariance, Param::PredictedCovariance, t, w)?;
         Ok(Prediction {
             from: self.time,
             time: t,
@@ -476,6 +477,7 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
         let log_likelihood = -0.5 * (nis + log_det + k as f64 * TAU.ln());
         finite(state.as_slice(), "updated state entry")?;
         finite(covariance.as_slice(), "updated covariance")?;
+        positive_definite(&covariance, Param::Covariance, t, w)?;
         if !(nis.is_finite() && log_likelihood.is_finite()) {
             return Err(Error::EstimateOutOfRange {
                 what: "normalised innovation squared".into(),
@@ -513,6 +515,30 @@ fn measurement_noise(p: usize, m: &Measurement, present: &[usize]) -> Result<DMa
         });
     }
     Ok(full.select_rows(present).select_columns(present))
+}
+
+/// Refuses a covariance `s` (named `name`, at time `t`) without a Cholesky factor: a negative
+/// central weight `W₀ᶜ` can make the weighted sum of outer products indefinite (Julier
+/// (2002) §III), and the next sigma points need the factor, so the filter keeps its last
+/// estimate rather than one whose σ would be read as zero.
+fn positive_definite(s: &DMatrix<f64>, name: Param, t: f64, w: &Weights) -> Result<(), Error> {
+    if Cholesky::new(s.clone()).is_some() {
+        return Ok(());
+    }
+    let w0c = w.covariance[0];
+    let why = if w0c < 0.0 {
+        format!(
+            "is not positive definite; the central covariance weight W0c = {w0c} is negative \
+             (choose alpha, beta and kappa with W0c >= 0, e.g. the defaults 1, 2, 0)"
+        )
+    } else {
+        "is not positive definite".into()
+    };
+    Err(Error::InvalidParameter {
+        name,
+        value: format!("at t = {t}"),
+        reason: why,
+    })
 }
 
 fn finite(values: &[f64], what: &'static str) -> Result<(), Error> {

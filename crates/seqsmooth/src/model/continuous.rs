@@ -81,6 +81,15 @@ impl ContinuousModel {
         let norm = (0..n)
             .map(|j| dynamics.matrix().column(j).iter().map(|v| v.abs()).sum())
             .fold(0.0, f64::max);
+        if !norm.is_finite() {
+            // Finite entries whose column sum overflows: no step could be scaled into the
+            // series' range (ζ would halve to zero and give Q = 0).
+            return Err(Error::InvalidParameter {
+                name: Param::DynamicsMatrixA,
+                value: format!("a column sum of |A| of {norm}"),
+                reason: "must be finite (rescale the time unit)".into(),
+            });
+        }
         Ok(Self { dynamics, qc, norm })
     }
 
@@ -287,6 +296,10 @@ impl ContinuousModel {
         while h * self.norm > BASE_NORM {
             h *= 0.5;
             squarings += 1;
+        }
+        if h > 0.0 && h < f64::MIN_POSITIVE {
+            // A subnormal h: its halvings were not exact and its series would lose digits.
+            return Err(refuse(BEYOND));
         }
         let (mut phi_h, mut q) = self.taylor(h);
         for _ in 0..squarings {
