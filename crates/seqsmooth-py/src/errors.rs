@@ -98,6 +98,7 @@ pub fn raise(kind: Kind, message: impl Into<String>, index: Option<usize>) -> Py
 pub fn keyword(p: Param) -> Option<&'static str> {
     match p {
         Param::ReviewWindow => Some("review_window"),
+        Param::AzimuthConvention => Some("azimuth"),
         _ => None,
     }
 }
@@ -109,6 +110,7 @@ pub fn scipy(p: Param) -> Option<&'static str> {
         Param::Window => Some("window_length"),
         Param::Degree => Some("polyorder"),
         Param::Derivative => Some("deriv"),
+        Param::Step => Some("delta"),
         _ => keyword(p),
     }
 }

@@ -20,9 +20,6 @@ use seqsmooth::Error;
 use std::cell::RefCell;
 use std::sync::Arc;
 
-/// The largest number of nodes minus one [`gauss_rule`] takes.
-const MAX_GAUSS_DEGREE: usize = 1_000;
-
 fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyAny> {
     PyArray1::from_vec(py, v).into_any()
 }
@@ -59,13 +56,7 @@ pub fn gauss_rule<'py>(
     a: f64,
     b: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if n > MAX_GAUSS_DEGREE {
-        return Err(raise(
-            Kind::Parameter,
-            format!("degree {n} is out of range: at most {MAX_GAUSS_DEGREE}"),
-            None,
-        ));
-    }
+    // The degree's range is the library's (`basis::MAX_JACOBI_DEGREE`).
     let rule: GaussRule = match t {
         Some(t) => {
             let ts = times(t, "t")?;
@@ -137,7 +128,6 @@ pub fn polynomial_samples<'py>(
     let (ts, ys) = crate::arrays::pair(t, y)?;
     let (ts, ys) = (ts.as_slice().to_vec(), ys.as_slice().to_vec());
     let sigmas = sigmas(sigma, ts.len())?;
-    check_degree(n)?;
     let ps = py
         .detach(|| PolynomialSamples::from_segment(&ts, &ys, &sigmas, n))
         .py()?;
@@ -167,17 +157,6 @@ fn degree_of(degree: Option<usize>, n: Option<usize>) -> PyResult<usize> {
             None,
         )),
     }
-}
-
-fn check_degree(n: usize) -> PyResult<()> {
-    if n > MAX_GAUSS_DEGREE {
-        return Err(raise(
-            Kind::Parameter,
-            format!("n {n} is out of range: at most {MAX_GAUSS_DEGREE}"),
-            None,
-        ));
-    }
-    Ok(())
 }
 
 /// `(times, values, variances)`.
@@ -224,7 +203,6 @@ impl PyOnlineSmoother {
         let n = degree_of(degree, n)?;
         let ts = times(t, "t")?.as_slice().to_vec();
         let sigmas = sigmas(sigma, ts.len())?;
-        check_degree(n)?;
         let gains = py.detach(|| SmootherGains::new(&ts, &sigmas, n)).py()?;
         Ok(Self {
             inner: OnlineSmoother::new(Arc::new(gains)),

@@ -1,7 +1,8 @@
 //! The arguments of `seqsmooth fit`.
 
-use super::{parse_degree, parse_sigma, parse_window, RadarArgs};
+use super::{parse_degree, parse_max_iterations, parse_sigma, parse_window, RadarArgs};
 use clap::Args;
+use seqsmooth::estimate::gauss_newton::GaussNewton;
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -38,9 +39,9 @@ pub struct FitArgs {
     #[command(flatten)]
     pub radar: RadarArgs,
     /// Gauss-Newton iterations allowed per window
-    #[arg(long, value_name = "N", default_value_t = 20,
-          value_parser = clap::value_parser!(u32).range(1..=1000))]
-    pub max_iterations: u32,
+    #[arg(long, value_name = "N", default_value_t = GaussNewton::default().max_iterations,
+          value_parser = parse_max_iterations, allow_hyphen_values = true)]
+    pub max_iterations: usize,
     /// Output file [default: standard output]
     #[arg(short = 'o', long, value_name = "OUTPUT")]
     pub output: Option<PathBuf>,

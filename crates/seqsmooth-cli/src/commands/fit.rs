@@ -268,11 +268,8 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
         EpochArg::Centre => Epoch::Centre,
         EpochArg::At(t) => Epoch::At(t),
     };
-    let solver = GaussNewton {
-        max_iterations: a.max_iterations as usize,
-        ..GaussNewton::default()
-    };
     let library = CliError::from;
+    let solver = GaussNewton::with_max_iterations(a.max_iterations).map_err(library)?;
     match a.model {
         FitModel::Radar => {
             if a.sigma.is_some() {
@@ -322,17 +319,10 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
                         .into(),
                 ));
             };
-            if window(a) < degree + 1 {
-                return Err(usage(format!(
-                    "window {} is too small for degree {degree}: a degree-{degree} fit needs a \
-                     window of at least {} rows",
-                    window(a),
-                    degree + 1
-                )));
-            }
+            // The window's range for the degree is the library's.
+            let fit = SlidingFit::polynomial(degree, window(a), epoch, solver).map_err(library)?;
             let need = Need::degree(degree);
             need.check_header(header)?;
-            let fit = SlidingFit::polynomial(degree, window(a), epoch, solver).map_err(library)?;
             Ok(Setup {
                 fitter: Fitter::Polynomial(fit),
                 need,

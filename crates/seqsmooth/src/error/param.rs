@@ -258,6 +258,12 @@ pub enum Param {
     Measurement,
     /// The stacked observations `Y`.
     ObservationsY,
+    /// The length of the segments a series is cut into (PAML's).
+    SegmentLength,
+    /// How a radar's azimuth is measured ([`crate::model::radar::AzimuthConvention`]).
+    AzimuthConvention,
+    /// The 0-based index `n` of the newest sample of an expanding memory's table.
+    NewestIndex,
 }
 
 impl Param {
@@ -381,6 +387,9 @@ impl Param {
         Param::Sigmas,
         Param::Measurement,
         Param::ObservationsY,
+        Param::SegmentLength,
+        Param::AzimuthConvention,
+        Param::NewestIndex,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -504,6 +513,9 @@ impl Param {
             Param::Sigmas => "sigmas",
             Param::Measurement => "measurement",
             Param::ObservationsY => "observations Y",
+            Param::SegmentLength => "segment length",
+            Param::AzimuthConvention => "azimuth convention",
+            Param::NewestIndex => "n",
         }
     }
 

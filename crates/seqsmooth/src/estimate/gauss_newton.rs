@@ -101,6 +101,30 @@ pub struct Correction {
     pub iterations: Vec<Iteration>,
 }
 
+/// The most linearisations a fit may be allowed ([`GaussNewton::max_iterations`]): a bound on
+/// the work of one window, far beyond what a fit that converges needs (two or three where the
+/// windows overlap, Morrison §8.7).
+pub const MAX_ITERATIONS: usize = 1000;
+
+/// The range of [`GaussNewton::max_iterations`]: `1 ≤ n ≤ MAX_ITERATIONS` (every front end's
+/// check, and the fit's own).
+///
+/// ```
+/// use seqsmooth::estimate::gauss_newton::{check_max_iterations, MAX_ITERATIONS};
+/// assert!(check_max_iterations(1).is_ok() && check_max_iterations(MAX_ITERATIONS).is_ok());
+/// assert!(check_max_iterations(0).is_err() && check_max_iterations(MAX_ITERATIONS + 1).is_err());
+/// ```
+pub fn check_max_iterations(n: usize) -> Result<(), Error> {
+    if !(1..=MAX_ITERATIONS).contains(&n) {
+        return Err(Error::InvalidParameter {
+            name: Param::MaxIterations,
+            value: n.to_string(),
+            reason: format!("must be from 1 to {MAX_ITERATIONS}"),
+        });
+    }
+    Ok(())
+}
+
 /// The iteration's limits.
 ///
 /// ```
@@ -125,6 +149,24 @@ impl Default for GaussNewton {
             tolerance: 1e-6,
             max_halvings: 30,
         }
+    }
+}
+
+impl GaussNewton {
+    /// The default limits with `max_iterations` linearisations, checked
+    /// ([`check_max_iterations`]).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::GaussNewton;
+    /// assert_eq!(GaussNewton::with_max_iterations(5).unwrap().max_iterations, 5);
+    /// assert!(GaussNewton::with_max_iterations(0).is_err());
+    /// ```
+    pub fn with_max_iterations(max_iterations: usize) -> Result<Self, Error> {
+        check_max_iterations(max_iterations)?;
+        Ok(Self {
+            max_iterations,
+            ..Self::default()
+        })
     }
 }
 
@@ -350,14 +392,7 @@ impl GaussNewton {
                 reason: "must be positive and finite".into(),
             });
         }
-        if self.max_iterations == 0 {
-            return Err(Error::InvalidParameter {
-                name: Param::MaxIterations,
-                value: "0".into(),
-                reason: "must be at least 1".into(),
-            });
-        }
-        Ok(())
+        check_max_iterations(self.max_iterations)
     }
 }
 

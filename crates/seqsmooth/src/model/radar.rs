@@ -220,6 +220,63 @@ pub fn check_component(k: usize, v: f64) -> Result<f64, &'static str> {
     }
 }
 
+/// How an input's azimuths are measured: from `+x` towards `+y` (the library's, the default),
+/// or as bearings (from `+y` clockwise: `x` east, `y` north; [`from_bearing`]). Its
+/// [`name`](Self::name)s are the words of every front end (`--azimuth bearing`,
+/// `azimuth="bearing"`).
+///
+/// ```
+/// use seqsmooth::model::radar::AzimuthConvention;
+/// assert_eq!(AzimuthConvention::from_name("bearing").unwrap(), AzimuthConvention::Bearing);
+/// assert_eq!(AzimuthConvention::default().name(), "from-x");
+/// assert!(AzimuthConvention::from_name("north").is_err());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum AzimuthConvention {
+    /// From `+x` towards `+y`.
+    #[default]
+    FromX,
+    /// Clockwise from north (`+y`), with `x` east and `y` north.
+    Bearing,
+}
+
+impl AzimuthConvention {
+    /// Every convention, in the order of their declaration.
+    pub const ALL: [AzimuthConvention; 2] = [AzimuthConvention::FromX, AzimuthConvention::Bearing];
+
+    /// Every convention's name, in the order of [`ALL`](Self::ALL).
+    pub const NAMES: [&'static str; 2] = ["from-x", "bearing"];
+
+    /// The convention's name (`from-x`, `bearing`).
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+
+    /// The convention called `name`; any other name refused
+    /// ([`Param::AzimuthConvention`]).
+    pub fn from_name(name: &str) -> Result<Self, Error> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name() == name)
+            .ok_or_else(|| Error::InvalidParameter {
+                name: Param::AzimuthConvention,
+                value: format!("{name:?}"),
+                reason: format!("must be one of '{}'", Self::NAMES.join("', '")),
+            })
+    }
+
+    /// Whether the azimuths are bearings (to be turned by [`from_bearing`]).
+    pub fn is_bearing(self) -> bool {
+        self == AzimuthConvention::Bearing
+    }
+}
+
+impl std::fmt::Display for AzimuthConvention {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// The azimuth from `+x` towards `+y` of a bearing `b` (from `+y` clockwise: `x` east, `y`
 /// north), wrapped to `(−π, π]`.
 ///

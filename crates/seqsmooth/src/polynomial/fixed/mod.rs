@@ -101,7 +101,7 @@ pub use centred::{CentredSmoother, SmoothSigma, SmoothedRow};
 pub use covariance::{correlated_covariance, covariance, covariance_unscaled, vrf_limit};
 pub use design::{tau_for_derivative_sigma, Balance, Design};
 pub use filter::{FixedEngine, FixedMemory};
-pub use smooth::{smooth, smooth_into, smooth_with_sigma_into};
+pub use smooth::{even_times, smooth, smooth_into, smooth_with_sigma_into};
 pub use trend::{smooth_detrended, Detrended, Nominal};
 pub use weights::{weights, weights_unscaled};
 pub use window_vrf::{fixed_memory_vrf_limit, window_covariance};
