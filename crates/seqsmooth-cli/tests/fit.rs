@@ -325,7 +325,8 @@ fn fit_refuses_bad_input() {
         ],
         "t,y\n0,1\n",
         2,
-        &["window 3 is too small for degree 3"],
+        &["error: --window 3 is invalid: too small for degree 3: a degree-3 fit needs a window of \
+           at least 4 rows\n"],
     );
     // Data: cells, with line and column.
     let line7 = good.lines().nth(6).unwrap().to_string();
