@@ -56,6 +56,7 @@ pub fn flag(p: Param) -> Option<&'static str> {
         Param::SegmentLength => "--segment",
         Param::AzimuthConvention => "--azimuth",
         Param::NewestIndex => "--n",
+        Param::Epoch => "--epoch",
         _ => return None,
     })
 }

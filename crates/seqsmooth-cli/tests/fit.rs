@@ -291,7 +291,21 @@ fn fit_refuses_bad_input() {
         2,
         &["site", "X,Y,Z"],
     );
-    fails(&with(&radar, &["--site", "1,nan,2"]), &good, 2, &["site Y"]);
+    fails(
+        &with(&radar, &["--site", "1,nan,2"]),
+        &good,
+        2,
+        &[
+            "error: invalid value '1,nan,2' for '--site <X,Y,Z>': --site NaN is invalid: a radar \
+           site's coordinates must be finite\n",
+        ],
+    );
+    fails(
+        &with(&radar, &["--site", "1,x,2"]),
+        &good,
+        2,
+        &["error: invalid value '1,x,2' for '--site <X,Y,Z>': site Y 'x' is not a number\n"],
+    );
     fails(
         &with(&radar, &["--epoch", "later"]),
         &good,

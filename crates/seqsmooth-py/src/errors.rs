@@ -99,6 +99,7 @@ pub fn keyword(p: Param) -> Option<&'static str> {
     match p {
         Param::ReviewWindow => Some("review_window"),
         Param::AzimuthConvention => Some("azimuth"),
+        Param::Coefficients => Some("n"),
         _ => None,
     }
 }

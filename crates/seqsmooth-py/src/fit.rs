@@ -63,22 +63,20 @@ fn epoch_of(epoch: &Bound<'_, PyAny>) -> PyResult<Epoch> {
     let bad = |shown: String| {
         raise(
             Kind::Parameter,
-            format!("epoch {shown} is neither 'end', 'centre' nor a finite time"),
+            format!("epoch {shown} is neither 'end', 'centre' nor a time"),
             None,
         )
     };
     if let Ok(s) = epoch.cast::<PyString>() {
         let text: String = s.extract()?;
-        return match text.as_str() {
-            "end" => Ok(Epoch::End),
-            "centre" | "center" => Ok(Epoch::Centre),
-            other => Err(bad(format!("{other:?}"))),
-        };
+        return Epoch::from_name(&text).ok_or_else(|| bad(format!("{text:?}")));
     }
-    match epoch.extract::<f64>() {
-        Ok(t) if t.is_finite() => Ok(Epoch::At(t)),
-        _ => Err(bad(epoch.repr()?.to_string())),
-    }
+    // A time, in the library's range.
+    let t = epoch
+        .extract::<f64>()
+        .map_err(|_| bad(epoch.repr().map_or_else(|_| "?".into(), |r| r.to_string())))?;
+    Epoch::At(t).check().map_err(|e| to_py(e, 0))?;
+    Ok(Epoch::At(t))
 }
 
 /// Gauss–Newton differential correction over a sliding window (Morrison §8.5-8.7): after each

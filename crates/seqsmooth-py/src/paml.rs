@@ -14,7 +14,9 @@ use seqsmooth::basis::{GaussRule, Jacobi};
 use seqsmooth::error::Param;
 use seqsmooth::estimate::curve::{self, CurveFit, CurveModel};
 use seqsmooth::paml::{OnlineSmoother, PolynomialSamples, SmootherGains};
-use seqsmooth::polynomial::expanding::continuous::{hilbert_gains, luenberger_gains as gains};
+use seqsmooth::polynomial::expanding::continuous::{
+    check_coefficients, hilbert_gains, luenberger_gains as gains,
+};
 use seqsmooth::scalar::Rational;
 use seqsmooth::Error;
 use std::cell::RefCell;
@@ -504,13 +506,7 @@ pub fn luenberger_gains<'py>(
     n: usize,
     exact: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if n == 0 || n > 60 {
-        return Err(raise(
-            Kind::Parameter,
-            format!("n {n} is out of range: 1 to 60 coefficients"),
-            None,
-        ));
-    }
+    check_coefficients(n).py()?;
     if !exact {
         return Ok(array(py, gains::<f64>(n)));
     }

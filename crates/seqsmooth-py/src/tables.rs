@@ -13,7 +13,7 @@ use seqsmooth::polynomial::expanding::gains::expanding_gains;
 use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
 use seqsmooth::polynomial::fading::gains::fading_gains;
 use seqsmooth::polynomial::fading::vrf::fading_vrf;
-use seqsmooth::polynomial::fixed::{check_window, covariance};
+use seqsmooth::polynomial::fixed::{check_lead_steps, check_window, covariance};
 use seqsmooth::polynomial::form::{EstimateForm, GainForm};
 use seqsmooth::scalar::{parse_rational, ratio_to_f64, Rational};
 
@@ -246,6 +246,8 @@ pub fn vrf<'py>(
                 Some(l) => self::exact(l, "lead")?,
                 None => Rational::from_integer(0.into()),
             };
+            // The library's range of a lead in samples.
+            check_lead_steps(ratio_to_f64(&h)).py()?;
             if !exact {
                 let h = ratio_to_f64(&h);
                 let s = py.detach(|| covariance::<f64>(m, span, h)).py()?;

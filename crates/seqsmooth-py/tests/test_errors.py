@@ -129,6 +129,14 @@ def test_ranges_are_the_librarys_in_pythons_words():
             "matrix needs n >= 3 (at least 4 samples)",
         ),
         (
+            lambda: ss.SlidingFit(epoch=np.inf, **radar),
+            "epoch inf is invalid: must be 'end', 'centre' or a finite time",
+        ),
+        (
+            lambda: ss.luenberger_gains(61),
+            "n 61 is invalid: must be from 1 to 60 coefficients",
+        ),
+        (
             lambda: ss.vrf("fixed", 3, window=3),
             "window 3 is invalid: a degree-3 fit needs a window of at least 4 samples",
         ),

@@ -30,7 +30,7 @@ mod vrf;
 
 pub use demo::DemoArgs;
 pub use filter::FilterArgs;
-pub use fit::{parse_epoch, EpochArg, FitArgs, FitModel};
+pub use fit::{parse_epoch, FitArgs, FitModel};
 pub use gains::GainsArgs;
 pub use paml::{parse_paml_degree, parse_segment, PamlArgs};
 pub use plot::PlotArgs;

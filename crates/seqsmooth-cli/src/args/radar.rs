@@ -4,7 +4,7 @@
 use super::{parse_sigma, refused};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use clap::Args;
-use seqsmooth::model::radar::AzimuthConvention;
+use seqsmooth::model::radar::{check_site, AzimuthConvention};
 
 /// The radar input of `seqsmooth track` and `seqsmooth fit --model radar`, read by one reader
 /// (`track::rows`) and checked by the library's rule for a radar row
@@ -63,10 +63,11 @@ pub fn parse_site(s: &str) -> Result<[f64; 3], String> {
     };
     let mut site = [0.0; 3];
     for (slot, (axis, text)) in site.iter_mut().zip([("X", x), ("Y", y), ("Z", z)]) {
-        *slot = match text.parse::<f64>() {
-            Ok(v) if v.is_finite() => v,
-            _ => return Err(format!("site {axis} '{text}' is not a finite number")),
-        };
+        *slot = text
+            .parse::<f64>()
+            .map_err(|_| format!("site {axis} '{text}' is not a number"))?;
     }
+    // The library's range of a site.
+    check_site(site).map_err(refused)?;
     Ok(site)
 }

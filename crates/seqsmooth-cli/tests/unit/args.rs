@@ -83,6 +83,22 @@ fn ranges_are_the_librarys() {
         parse_index("-1").unwrap_err(),
         "n '-1' is not a whole number (0, 1, 2, ...)"
     );
+    assert_eq!(
+        parse_epoch("center"),
+        Ok(seqsmooth::estimate::gauss_newton::Epoch::Centre)
+    );
+    assert_eq!(
+        parse_epoch("inf").unwrap_err(),
+        "--epoch inf is invalid: must be 'end', 'centre' or a finite time"
+    );
+    assert_eq!(
+        parse_epoch("x").unwrap_err(),
+        "epoch 'x' is neither 'end', 'centre' nor a time"
+    );
+    assert_eq!(
+        parse_site("1,inf,2").unwrap_err(),
+        "--site inf is invalid: a radar site's coordinates must be finite"
+    );
     let azimuth = |s: &str| {
         let cmd = clap::Command::new("t").arg(
             clap::Arg::new("azimuth")
@@ -128,6 +144,11 @@ fn lead_steps_forms() {
     assert!(parse_lead_steps("1e999")
         .unwrap_err()
         .contains("out of range"));
+    assert_eq!(
+        parse_lead_steps("1e399").unwrap_err(),
+        "--lead inf is invalid: must be a finite number of samples, |H| < 1e300"
+    );
+    assert!(parse_lead_steps("-1e300").is_err() && parse_lead_steps("-9.9e299").is_ok());
     assert!(parse_lead_steps("1e-99999999")
         .unwrap_err()
         .contains("out of range"));

@@ -264,6 +264,10 @@ pub enum Param {
     AzimuthConvention,
     /// The 0-based index `n` of the newest sample of an expanding memory's table.
     NewestIndex,
+    /// The coefficients `n` of a continuous-time expanding memory's gains (Luenberger's).
+    Coefficients,
+    /// The time a fit's state refers to.
+    Epoch,
 }
 
 impl Param {
@@ -390,6 +394,8 @@ impl Param {
         Param::SegmentLength,
         Param::AzimuthConvention,
         Param::NewestIndex,
+        Param::Coefficients,
+        Param::Epoch,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -516,6 +522,8 @@ impl Param {
             Param::SegmentLength => "segment length",
             Param::AzimuthConvention => "azimuth convention",
             Param::NewestIndex => "n",
+            Param::Coefficients => "coefficients",
+            Param::Epoch => "epoch",
         }
     }
 

@@ -39,6 +39,40 @@ pub enum Epoch {
 }
 
 impl Epoch {
+    /// The epoch a front end names: `end`, `centre` (or `center`); `None` for any other name
+    /// (a time, which the front end parses as a number).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::Epoch;
+    /// assert_eq!(Epoch::from_name("center"), Some(Epoch::Centre));
+    /// assert_eq!(Epoch::from_name("12.5"), None);
+    /// ```
+    pub fn from_name(name: &str) -> Option<Epoch> {
+        match name {
+            "end" => Some(Epoch::End),
+            "centre" | "center" => Some(Epoch::Centre),
+            _ => None,
+        }
+    }
+
+    /// The range of an epoch: a given time must be finite ([`Param::Epoch`]; every front
+    /// end's check, and the sliding fit's).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::Epoch;
+    /// assert!(Epoch::At(1.5).check().is_ok() && Epoch::At(f64::INFINITY).check().is_err());
+    /// ```
+    pub fn check(self) -> Result<(), Error> {
+        match self {
+            Epoch::At(t) if !t.is_finite() => Err(Error::InvalidParameter {
+                name: Param::Epoch,
+                value: t.to_string(),
+                reason: "must be 'end', 'centre' or a finite time".into(),
+            }),
+            _ => Ok(()),
+        }
+    }
+
     /// The time, for observations at `times` (not empty).
     ///
     /// ```

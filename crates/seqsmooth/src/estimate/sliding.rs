@@ -175,14 +175,7 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
             }
             _ => {}
         }
-        if let Epoch::At(t) = epoch {
-            if !t.is_finite() {
-                return Err(Error::NonFinite {
-                    what: "epoch",
-                    value: t,
-                });
-            }
-        }
+        epoch.check()?;
         Ok(Self {
             dynamics,
             observation,

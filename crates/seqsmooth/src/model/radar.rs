@@ -50,13 +50,7 @@ impl Radar {
     /// assert!(Radar::new([0.0; 3], 2).is_err());
     /// ```
     pub fn new(site: [f64; 3], states: usize) -> Result<Self, Error> {
-        if let Some(&value) = site.iter().find(|v| !v.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: Param::Site,
-                value: value.to_string(),
-                reason: "a radar site's coordinates must be finite".into(),
-            });
-        }
+        check_site(site)?;
         if states < 3 {
             return Err(Error::InvalidParameter {
                 name: Param::StateDimension,
@@ -218,6 +212,24 @@ pub fn check_component(k: usize, v: f64) -> Result<f64, &'static str> {
         }
         _ => Ok(v),
     }
+}
+
+/// The range of a radar's site: three finite coordinates ([`Radar::new`]'s check, and every
+/// front end's).
+///
+/// ```
+/// use seqsmooth::model::radar::check_site;
+/// assert!(check_site([1.0, -2.0, 0.5]).is_ok() && check_site([0.0, f64::NAN, 0.0]).is_err());
+/// ```
+pub fn check_site(site: [f64; 3]) -> Result<(), Error> {
+    if let Some(&value) = site.iter().find(|v| !v.is_finite()) {
+        return Err(Error::InvalidParameter {
+            name: Param::Site,
+            value: value.to_string(),
+            reason: "a radar site's coordinates must be finite".into(),
+        });
+    }
+    Ok(())
 }
 
 /// How an input's azimuths are measured: from `+x` towards `+y` (the library's, the default),
