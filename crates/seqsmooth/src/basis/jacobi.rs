@@ -76,13 +76,7 @@ const _: () =
 /// The range of a [`Jacobi`] recurrence's degree: `n ≤ MAX_JACOBI_DEGREE` (every
 /// constructor's check).
 pub fn check_jacobi_degree(n: usize) -> Result<(), Error> {
-    if n > MAX_JACOBI_DEGREE {
-        return Err(Error::DegreeOutOfRange {
-            degree: n,
-            max: MAX_JACOBI_DEGREE,
-        });
-    }
-    Ok(())
+    crate::error::check_degree_at_most(n, MAX_JACOBI_DEGREE)
 }
 
 fn check_interval(a: f64, b: f64) -> Result<(f64, f64), Error> {

@@ -43,13 +43,7 @@ pub const MAX_DEGREE: usize = 30;
 /// assert!(check_degree(MAX_DEGREE).is_ok() && check_degree(MAX_DEGREE + 1).is_err());
 /// ```
 pub fn check_degree(n: usize) -> Result<(), Error> {
-    if n > MAX_DEGREE {
-        return Err(Error::DegreeOutOfRange {
-            degree: n,
-            max: MAX_DEGREE,
-        });
-    }
-    Ok(())
+    crate::error::check_degree_at_most(n, MAX_DEGREE)
 }
 
 /// The range of the length of the segments a series is cut into (in its time units, the

@@ -110,13 +110,7 @@ pub(crate) fn check_engine_degree(m: usize, engine: Engine) -> Result<(), Error>
 /// assert!(check_degree(MAX_DEGREE).is_ok() && check_degree(MAX_DEGREE + 1).is_err());
 /// ```
 pub fn check_degree(m: usize) -> Result<(), Error> {
-    if m > MAX_DEGREE {
-        return Err(Error::DegreeOutOfRange {
-            degree: m,
-            max: MAX_DEGREE,
-        });
-    }
-    Ok(())
+    crate::error::check_degree_at_most(m, MAX_DEGREE)
 }
 
 /// The range of a derivative `k` asked of a filter's estimate without its degree at hand (the
