@@ -29,8 +29,8 @@ pub struct RadarArgs {
     /// empty cell takes --sigma-angle
     #[arg(long, value_name = "NAME")]
     pub sigma_angle_col: Option<String>,
-    /// Radar: the azimuth convention of the input: from-x, from +x towards +y; bearing,
-    /// clockwise from north, with x = east and y = north
+    /// Radar: how the input's azimuths are measured: from +x towards +y, or as a bearing
+    /// (clockwise from north, with x = east and y = north)
     #[arg(long, value_name = "AZIMUTH", default_value_t = AzimuthConvention::default(),
           value_parser = azimuth_parser())]
     pub azimuth: AzimuthConvention,
