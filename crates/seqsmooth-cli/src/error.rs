@@ -53,6 +53,10 @@ pub fn flag(p: Param) -> Option<&'static str> {
         Param::MaxIterations => "--max-iterations",
         Param::ReviewWindow => "--review-window",
         Param::Site => "--site",
+        Param::SegmentLength => "--segment",
+        Param::AzimuthConvention => "--azimuth",
+        Param::NewestIndex => "--n",
+        Param::Epoch => "--epoch",
         _ => return None,
     })
 }

@@ -291,7 +291,8 @@ fn error_vrf_n_below_degree() {
         &["vrf", "--kind", "expanding", "--degree", "3", "--n", "2"],
         "",
         2,
-        &["n 2 is too small for degree 3", "n >= 3"],
+        &["error: --n 2 is invalid: too small for degree 3: the expanding-memory variance-reduction \
+           matrix needs n >= 3 (at least 4 samples)\n"],
     );
 }
 
@@ -340,7 +341,7 @@ fn error_window_below_degree() {
         &["smooth", "--degree", "1", "--window", "0"],
         T7_08,
         2,
-        &["window 0 is out of range"],
+        &["error: invalid value '0' for '--window <W>': --window 0 is invalid: must hold at least 1 sample\n"],
     );
 }
 

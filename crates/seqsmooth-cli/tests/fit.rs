@@ -291,7 +291,21 @@ fn fit_refuses_bad_input() {
         2,
         &["site", "X,Y,Z"],
     );
-    fails(&with(&radar, &["--site", "1,nan,2"]), &good, 2, &["site Y"]);
+    fails(
+        &with(&radar, &["--site", "1,nan,2"]),
+        &good,
+        2,
+        &[
+            "error: invalid value '1,nan,2' for '--site <X,Y,Z>': --site NaN is invalid: a radar \
+           site's coordinates must be finite\n",
+        ],
+    );
+    fails(
+        &with(&radar, &["--site", "1,x,2"]),
+        &good,
+        2,
+        &["error: invalid value '1,x,2' for '--site <X,Y,Z>': site Y 'x' is not a number\n"],
+    );
     fails(
         &with(&radar, &["--epoch", "later"]),
         &good,
@@ -325,7 +339,8 @@ fn fit_refuses_bad_input() {
         ],
         "t,y\n0,1\n",
         2,
-        &["window 3 is too small for degree 3"],
+        &["error: --window 3 is invalid: too small for degree 3: a degree-3 fit needs a window of \
+           at least 4 rows\n"],
     );
     // Data: cells, with line and column.
     let line7 = good.lines().nth(6).unwrap().to_string();

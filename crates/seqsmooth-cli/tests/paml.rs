@@ -113,13 +113,15 @@ fn bad_input_is_refused_with_its_place() {
         &["paml", "--degree", "2", "--segment", "0"],
         "t,y\n",
         2,
-        &["segment 0 is out of range"],
+        &["error: invalid value '0' for '--segment <SECONDS>': --segment 0 is invalid: must be a \
+           positive finite number\n"],
     );
     fails(
         &["paml", "--degree", "31", "--segment", "1"],
         "t,y\n",
         2,
-        &["degree 31"],
+        &["error: invalid value '31' for '--degree <N>': --degree 31 is out of range: the largest \
+           supported degree is 30\n"],
     );
     fails(
         &["paml", "--degree", "1", "--segment", "1", "--sigma", "-1"],

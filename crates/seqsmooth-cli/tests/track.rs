@@ -265,7 +265,10 @@ fn track_refuses_bad_input() {
         &with(&["--max-iterations", "0"]),
         good,
         2,
-        &["max-iterations"],
+        &[
+            "error: invalid value '0' for '--max-iterations <N>': --max-iterations 0 is invalid: \
+           must be from 1 to 1000\n",
+        ],
     );
     fails(
         &with(&[

@@ -6,14 +6,14 @@
 
 use crate::arrays::{matrix, pair};
 use crate::errors::IntoPy;
-use crate::errors::{raise, Kind};
 use crate::polynomial::{engine as engine_named, state_of, State};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use seqsmooth::polynomial::automatic::AutomaticFilter;
-use seqsmooth::polynomial::spec::{FilterKind, FilterSpec};
-use seqsmooth::Error;
+use seqsmooth::polynomial::rows::{decisions, degree_in_use, RowLayout};
+use seqsmooth::polynomial::spec::{AnyFilter, FilterKind, FilterSpec};
+use seqsmooth::{Error, PolynomialFilter};
 
 /// The automatic polynomial filter of degree up to ``degree`` (Reyneke et al. 2012; Morrison
 /// chs. 9, 13): it starts on expanding memory, switches to fading memory with ``theta`` per
@@ -38,7 +38,8 @@ use seqsmooth::Error;
 ///     + 4).
 #[pyclass(name = "AutomaticFilter", module = "seqsmooth")]
 pub struct PyAutomaticFilter {
-    filter: AutomaticFilter,
+    /// The library's automatic filter, run by its row runner.
+    filter: AnyFilter,
     /// The final outlier decisions reported so far, in sample order.
     decided: Vec<bool>,
 }
@@ -64,11 +65,8 @@ impl PyAutomaticFilter {
             review_window,
             ..FilterSpec::new(FilterKind::Automatic, degree)
         };
-        let filter = spec.build().py()?.into_automatic();
-        let filter =
-            filter.ok_or_else(|| raise(Kind::Parameter, "not an automatic filter", None))?;
         Ok(Self {
-            filter,
+            filter: spec.build().py()?,
             decided: Vec::new(),
         })
     }
@@ -100,50 +98,58 @@ impl PyAutomaticFilter {
     ) -> PyResult<Bound<'py, PyDict>> {
         let (ts, ys) = pair(t, y)?;
         let (t, y) = (ts.as_slice(), ys.as_slice());
-        let (n, w) = (t.len(), self.filter.degree() + 1);
-        let mut d = vec![f64::NAN; n * w];
-        let mut s = vec![f64::NAN; n * w];
-        let mut noise = vec![f64::NAN; n];
-        let mut bias = vec![f64::NAN; n];
-        let mut degree = vec![0usize; n];
-        let mut outlier = vec![false; n];
-        let mut misfit = vec![false; n];
-        let (filter, decided) = (&mut self.filter, &mut self.decided);
-        py.detach(|| {
-            for (i, (&t, &y)) in t.iter().zip(y).enumerate() {
-                let o = filter.update(t, y).map_err(|e| Error::InBatch {
-                    index: i,
-                    source: Box::new(e),
-                })?;
-                decided.extend_from_slice(&o.decided);
-                if let Some(x) = o.derivatives() {
-                    d[i * w..i * w + x.len()].copy_from_slice(x);
-                }
-                if let Some(sd) = o.std_devs() {
-                    s[i * w..i * w + sd.len()].copy_from_slice(&sd);
-                }
-                noise[i] = o.noise_sigma.unwrap_or(f64::NAN);
-                bias[i] = o.bias.as_ref().map_or(f64::NAN, |b| b[0]);
-                (degree[i], outlier[i], misfit[i]) = (o.degree, o.outlier, o.misfit);
-            }
-            Ok::<(), Error>(())
-        })
-        .py()?;
+        // The library's rows (`seqsmooth filter --kind auto`'s): d, s, noise, outlier, misfit,
+        // bias, then the update's cells (its final decisions, the degree in use).
+        let layout = RowLayout {
+            sigma: true,
+            lead: 0.0,
+            trailing: true,
+        };
+        let (n, w, stride) = (
+            t.len(),
+            self.filter.degree() + 1,
+            self.filter.stride(layout),
+        );
+        let mut rows = vec![0.0; n * stride];
+        let filter = &mut self.filter;
+        let run = py.detach(|| filter.run_rows(t, y, &mut rows, layout));
+        // The decisions of the rows taken, up to a refused one.
+        let taken = match &run {
+            Err(Error::InBatch { index, .. }) => *index,
+            _ => n,
+        };
+        let cells = |i: usize| &rows[i * stride + 2 * w + 4..(i + 1) * stride];
+        for i in 0..taken {
+            self.decided.extend(decisions(cells(i)));
+        }
+        run.py()?;
+        let column = |k: usize| (0..n).map(|i| rows[i * stride + k]).collect::<Vec<f64>>();
+        let flag = |k: usize| {
+            (0..n)
+                .map(|i| rows[i * stride + k] == 1.0)
+                .collect::<Vec<_>>()
+        };
+        let part = |from: usize| {
+            let cells = rows.chunks_exact(stride).flat_map(|r| &r[from..from + w]);
+            cells.copied().collect::<Vec<f64>>()
+        };
+        let degree: Vec<usize> = (0..n).map(|i| degree_in_use(cells(i))).collect();
         let out = PyDict::new(py);
-        out.set_item("d", matrix(py, d, n, w)?)?;
-        out.set_item("s", matrix(py, s, n, w)?)?;
-        out.set_item("noise", PyArray1::from_vec(py, noise))?;
-        out.set_item("bias", PyArray1::from_vec(py, bias))?;
+        out.set_item("d", matrix(py, part(0), n, w)?)?;
+        out.set_item("s", matrix(py, part(w), n, w)?)?;
+        out.set_item("noise", PyArray1::from_vec(py, column(2 * w)))?;
+        out.set_item("bias", PyArray1::from_vec(py, column(2 * w + 3)))?;
         out.set_item("degree", PyArray1::from_vec(py, degree))?;
-        out.set_item("outlier", PyArray1::from_vec(py, outlier))?;
-        out.set_item("misfit", PyArray1::from_vec(py, misfit))?;
+        out.set_item("outlier", PyArray1::from_vec(py, flag(2 * w + 1)))?;
+        out.set_item("misfit", PyArray1::from_vec(py, flag(2 * w + 2)))?;
         Ok(out)
     }
 
     /// Decides every sample still waiting for its review and returns the final outlier
     /// decision of every sample taken so far (``True``: rejected), in order.
     fn finish<'py>(&mut self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        let tail = self.filter.finish();
+        let tail = self.filter.automatic_mut().map(AutomaticFilter::finish);
+        let tail = tail.unwrap_or_default();
         self.decided.extend_from_slice(&tail);
         PyArray1::from_slice(py, &self.decided)
     }

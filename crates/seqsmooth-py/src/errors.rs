@@ -101,6 +101,8 @@ pub fn keyword(p: Param) -> Option<&'static str> {
         Param::SigmaPointAlpha => Some("alpha"),
         Param::SigmaPointBeta => Some("beta"),
         Param::SigmaPointKappa => Some("kappa"),
+        Param::AzimuthConvention => Some("azimuth"),
+        Param::Coefficients => Some("n"),
         _ => None,
     }
 }
@@ -112,6 +114,7 @@ pub fn scipy(p: Param) -> Option<&'static str> {
         Param::Window => Some("window_length"),
         Param::Degree => Some("polyorder"),
         Param::Derivative => Some("deriv"),
+        Param::Step => Some("delta"),
         _ => keyword(p),
     }
 }

@@ -12,12 +12,15 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
 use seqsmooth::estimate::batch::NoiseCovariance;
-use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton, Measurement};
-use seqsmooth::estimate::sliding::{Fitter, SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW};
+use seqsmooth::estimate::gauss_newton::{check_max_iterations, Epoch, GaussNewton, Measurement};
+use seqsmooth::estimate::sliding::{
+    check_window_length, Fitter, SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW,
+};
+use seqsmooth::model::radar::AzimuthConvention;
 use seqsmooth::polynomial::check_degree;
 use seqsmooth::track::radar_row;
 use seqsmooth::track::window_flag;
-use seqsmooth::Error;
+use seqsmooth::{Error, Param};
 
 /// A σ as `seqsmooth fit` accepts it: above 0, its square (the variance) a normal double.
 pub(crate) fn check_sigma(name: &str, s: f64) -> PyResult<f64> {
@@ -32,27 +35,48 @@ pub(crate) fn check_sigma(name: &str, s: f64) -> PyResult<f64> {
     }
 }
 
+/// A whole number `param` given to Python, for the library's `check` of a count: a negative
+/// `v` is refused as the library refuses 0 (named as given), or as no count where it takes 0.
+pub(crate) fn count(
+    param: Param,
+    v: i64,
+    check: impl Fn(usize) -> Result<(), Error>,
+) -> PyResult<usize> {
+    let refused = |e: Error| to_py(e, 0);
+    let Ok(n) = usize::try_from(v) else {
+        let reason = match check(0) {
+            Err(Error::InvalidParameter { reason, .. }) => reason,
+            _ => "must not be negative".into(),
+        };
+        return Err(refused(Error::InvalidParameter {
+            name: param,
+            value: v.to_string(),
+            reason,
+        }));
+    };
+    check(n).map_err(refused)?;
+    Ok(n)
+}
+
 /// `epoch` as given: ``"end"``, ``"centre"`` (``"center"``) or a finite time.
 fn epoch_of(epoch: &Bound<'_, PyAny>) -> PyResult<Epoch> {
     let bad = |shown: String| {
         raise(
             Kind::Parameter,
-            format!("epoch {shown} is neither 'end', 'centre' nor a finite time"),
+            format!("epoch {shown} is neither 'end', 'centre' nor a time"),
             None,
         )
     };
     if let Ok(s) = epoch.cast::<PyString>() {
         let text: String = s.extract()?;
-        return match text.as_str() {
-            "end" => Ok(Epoch::End),
-            "centre" | "center" => Ok(Epoch::Centre),
-            other => Err(bad(format!("{other:?}"))),
-        };
+        return Epoch::from_name(&text).ok_or_else(|| bad(format!("{text:?}")));
     }
-    match epoch.extract::<f64>() {
-        Ok(t) if t.is_finite() => Ok(Epoch::At(t)),
-        _ => Err(bad(epoch.repr()?.to_string())),
-    }
+    // A time, in the library's range.
+    let t = epoch
+        .extract::<f64>()
+        .map_err(|_| bad(epoch.repr().map_or_else(|_| "?".into(), |r| r.to_string())))?;
+    Epoch::At(t).check().map_err(|e| to_py(e, 0))?;
+    Ok(Epoch::At(t))
 }
 
 /// Gauss–Newton differential correction over a sliding window (Morrison §8.5-8.7): after each
@@ -220,32 +244,17 @@ impl PySlidingFit {
             "polynomial" => POLYNOMIAL_WINDOW as i64,
             _ => RADAR_WINDOW as i64,
         });
-        if window < 1 {
-            return usage(format!("window {window} must be at least 1"));
-        }
-        let window = window as usize;
-        if !(1..=1000).contains(&max_iterations) {
-            return usage(format!(
-                "max_iterations {max_iterations} must be from 1 to 1000"
-            ));
-        }
-        let solver = GaussNewton {
-            max_iterations: max_iterations as usize,
-            ..GaussNewton::default()
-        };
+        // The ranges are the library's.
+        let window = count(Param::Window, window, check_window_length)?;
+        let max_iterations = count(Param::MaxIterations, max_iterations, check_max_iterations)?;
+        let solver = GaussNewton::with_max_iterations(max_iterations).map_err(library)?;
         let epoch = match epoch {
             Some(e) => epoch_of(e)?,
             None => Epoch::End,
         };
-        let bearing = match azimuth {
-            "from-x" => false,
-            "bearing" => true,
-            other => {
-                return usage(format!(
-                    "azimuth {other:?} is not one of 'from-x', 'bearing'"
-                ))
-            }
-        };
+        let bearing = AzimuthConvention::from_name(azimuth)
+            .map_err(library)?
+            .is_bearing();
         let max = seqsmooth::polynomial::MAX_DEGREE;
         if let Some(d) = degree {
             // The library's range of a polynomial degree.

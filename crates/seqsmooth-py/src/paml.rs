@@ -14,14 +14,13 @@ use seqsmooth::basis::{GaussRule, Jacobi};
 use seqsmooth::error::Param;
 use seqsmooth::estimate::curve::{self, CurveFit, CurveModel};
 use seqsmooth::paml::{OnlineSmoother, PolynomialSamples, SmootherGains};
-use seqsmooth::polynomial::expanding::continuous::{hilbert_gains, luenberger_gains as gains};
+use seqsmooth::polynomial::expanding::continuous::{
+    check_coefficients, hilbert_gains, luenberger_gains as gains,
+};
 use seqsmooth::scalar::Rational;
 use seqsmooth::Error;
 use std::cell::RefCell;
 use std::sync::Arc;
-
-/// The largest number of nodes minus one [`gauss_rule`] takes.
-const MAX_GAUSS_DEGREE: usize = 1_000;
 
 fn array<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyAny> {
     PyArray1::from_vec(py, v).into_any()
@@ -59,13 +58,7 @@ pub fn gauss_rule<'py>(
     a: f64,
     b: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if n > MAX_GAUSS_DEGREE {
-        return Err(raise(
-            Kind::Parameter,
-            format!("degree {n} is out of range: at most {MAX_GAUSS_DEGREE}"),
-            None,
-        ));
-    }
+    // The degree's range is the library's (`basis::MAX_JACOBI_DEGREE`).
     let rule: GaussRule = match t {
         Some(t) => {
             let ts = times(t, "t")?;
@@ -137,7 +130,6 @@ pub fn polynomial_samples<'py>(
     let (ts, ys) = crate::arrays::pair(t, y)?;
     let (ts, ys) = (ts.as_slice().to_vec(), ys.as_slice().to_vec());
     let sigmas = sigmas(sigma, ts.len())?;
-    check_degree(n)?;
     let ps = py
         .detach(|| PolynomialSamples::from_segment(&ts, &ys, &sigmas, n))
         .py()?;
@@ -167,17 +159,6 @@ fn degree_of(degree: Option<usize>, n: Option<usize>) -> PyResult<usize> {
             None,
         )),
     }
-}
-
-fn check_degree(n: usize) -> PyResult<()> {
-    if n > MAX_GAUSS_DEGREE {
-        return Err(raise(
-            Kind::Parameter,
-            format!("n {n} is out of range: at most {MAX_GAUSS_DEGREE}"),
-            None,
-        ));
-    }
-    Ok(())
 }
 
 /// `(times, values, variances)`.
@@ -224,7 +205,6 @@ impl PyOnlineSmoother {
         let n = degree_of(degree, n)?;
         let ts = times(t, "t")?.as_slice().to_vec();
         let sigmas = sigmas(sigma, ts.len())?;
-        check_degree(n)?;
         let gains = py.detach(|| SmootherGains::new(&ts, &sigmas, n)).py()?;
         Ok(Self {
             inner: OnlineSmoother::new(Arc::new(gains)),
@@ -526,13 +506,7 @@ pub fn luenberger_gains<'py>(
     n: usize,
     exact: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if n == 0 || n > 60 {
-        return Err(raise(
-            Kind::Parameter,
-            format!("n {n} is out of range: 1 to 60 coefficients"),
-            None,
-        ));
-    }
+    check_coefficients(n).py()?;
     if !exact {
         return Ok(array(py, gains::<f64>(n)));
     }

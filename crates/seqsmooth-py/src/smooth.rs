@@ -5,7 +5,7 @@ use crate::arrays::{series, times};
 use crate::errors::{raise, scipy, IntoPy, Kind};
 use numpy::PyArray1;
 use pyo3::prelude::*;
-use seqsmooth::polynomial::fixed::{smooth_into, smooth_with_sigma_into};
+use seqsmooth::polynomial::fixed::{even_times, smooth_into, smooth_with_sigma_into};
 
 /// Smooths (and differentiates) a whole series: at each sample, the least-squares polynomial
 /// of degree ``polyorder`` through the ``window_length`` samples most nearly centred on it,
@@ -81,14 +81,7 @@ pub fn smooth<'py>(
             t
         }
         None => {
-            if !(delta.is_finite() && delta > 0.0) {
-                return Err(raise(
-                    Kind::Parameter,
-                    format!("delta {delta} is invalid: it must be positive and finite"),
-                    None,
-                ));
-            }
-            times = (0..n).map(|i| i as f64 * delta).collect();
+            times = even_times(n, delta).py_in(&scipy)?;
             &times
         }
     };

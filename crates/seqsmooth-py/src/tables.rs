@@ -13,7 +13,7 @@ use seqsmooth::polynomial::expanding::gains::expanding_gains;
 use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
 use seqsmooth::polynomial::fading::gains::fading_gains;
 use seqsmooth::polynomial::fading::vrf::fading_vrf;
-use seqsmooth::polynomial::fixed::covariance;
+use seqsmooth::polynomial::fixed::{check_lead_steps, check_window, covariance};
 use seqsmooth::polynomial::form::{EstimateForm, GainForm};
 use seqsmooth::scalar::{parse_rational, ratio_to_f64, Rational};
 
@@ -212,16 +212,7 @@ pub fn vrf<'py>(
             if kind == "expanding" {
                 only(&theta, "theta", "'fading'")?;
                 let n = n_of(n)?;
-                if n < m as u64 {
-                    return Err(raise(
-                        Kind::Parameter,
-                        format!(
-                            "n {n} is too small for degree {m}: the expanding-memory \
-                             variance-reduction matrix needs n >= {m}"
-                        ),
-                        None,
-                    ));
-                }
+                // The range of n for the degree is the library's (`expanding_vrf` checks it).
                 // Exact, then rounded (the f64 recursion overflows for large n at high degree).
                 rational = py.detach(|| expanding_vrf::<Rational>(m, n, form)).py()?;
             } else {
@@ -240,14 +231,8 @@ pub fn vrf<'py>(
             only(&theta, "theta", "'fading'")?;
             only(&form, "form", "'expanding' and 'fading' (fixed takes lead)")?;
             let window = match window {
-                Some(w) if w > m => w,
-                Some(w) => {
-                    return Err(raise(
-                        Kind::Parameter,
-                        format!("window {w} is too small for degree {m}: at least {}", m + 1),
-                        None,
-                    ))
-                }
+                // The window's range for the degree is the library's.
+                Some(w) => check_window(m, w).map(|()| w).py()?,
                 None => {
                     return Err(raise(
                         Kind::Parameter,
@@ -261,6 +246,8 @@ pub fn vrf<'py>(
                 Some(l) => self::exact(l, "lead")?,
                 None => Rational::from_integer(0.into()),
             };
+            // The library's range of a lead in samples.
+            check_lead_steps(ratio_to_f64(&h)).py()?;
             if !exact {
                 let h = ratio_to_f64(&h);
                 let s = py.detach(|| covariance::<f64>(m, span, h)).py()?;

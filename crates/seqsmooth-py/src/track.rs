@@ -9,14 +9,14 @@ use crate::kalman::discount_from;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
-use seqsmooth::estimate::gauss_newton::{GaussNewton, Measurement};
+use seqsmooth::estimate::gauss_newton::{check_max_iterations, GaussNewton, Measurement};
 use seqsmooth::kalman::smoother::Smoothed;
-use seqsmooth::model::radar::Radar;
+use seqsmooth::model::radar::{AzimuthConvention, Radar};
 use seqsmooth::track::{
     radar_row, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, DEFAULT_LAG,
     DEFAULT_WINDOW,
 };
-use seqsmooth::Error;
+use seqsmooth::{Error, Param};
 
 /// A tracker's error as its exception; `offset` is the batch's first row in the tracker's
 /// count, so that an index names the caller's position in the batch.
@@ -298,29 +298,15 @@ impl PyRadarTracker {
         if lag.is_some() && !matches!(method, TrackMethod::Smooth { .. }) {
             return usage("lag applies only to method='smooth'");
         }
-        let bearing = match azimuth {
-            "from-x" => false,
-            "bearing" => true,
-            other => {
-                return usage(&format!(
-                    "azimuth {other:?} is not one of 'from-x', 'bearing'"
-                ))
-            }
-        };
+        let bearing = AzimuthConvention::from_name(azimuth).py()?.is_bearing();
         for (name, sigma) in [("sigma_range", sigma_range), ("sigma_angle", sigma_angle)] {
             if let Some(s) = sigma {
                 crate::fit::check_sigma(name, s)?;
             }
         }
-        if !(1..=1000).contains(&max_iterations) {
-            return usage(&format!(
-                "max_iterations {max_iterations} must be from 1 to 1000"
-            ));
-        }
-        let solver = GaussNewton {
-            max_iterations: max_iterations as usize,
-            ..GaussNewton::default()
-        };
+        let max_iterations =
+            crate::fit::count(Param::MaxIterations, max_iterations, check_max_iterations)?;
+        let solver = GaussNewton::with_max_iterations(max_iterations).py()?;
         let radar = Radar::new([site.0, site.1, site.2], 6).py()?;
         Ok(Self {
             inner: RadarTracker::with_solver(radar, method, solver).py()?,

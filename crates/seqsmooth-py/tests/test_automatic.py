@@ -40,7 +40,18 @@ def test_equals_the_command(tmp_path, rng, sigma):
     assert final[[100, 400]].all() and final.sum() < 20
     assert len(final) == len(t) and f.samples <= len(t)  # samples counts the accepted ones
     assert set(got["degree"]) <= set(range(m + 1))
+    # The degree in use is the estimate's: d is NaN above it, and it settles from 0 to m.
+    shown = ~np.isnan(got["d"][:, 0])
+    assert shown.sum() > 500
+    assert np.array_equal(np.isfinite(got["d"][shown]).sum(axis=1) - 1, got["degree"][shown])
+    assert got["degree"][0] == 0 and got["degree"][-1] == m
     assert np.isfinite(f.estimate().derivatives).all()
+    # In pieces: the same rows, degrees and final decisions.
+    g = ss.AutomaticFilter(degree=m, theta=0.95, tau=1.0, sigma=sigma)
+    parts = [g.update_many(t[k], y[k]) for k in (slice(0, 251), slice(251, None))]
+    for key in got:
+        same_bits(np.concatenate([p[key] for p in parts]), got[key], key)
+    assert np.array_equal(g.finish(), final)
 
 
 def test_errors():

@@ -77,6 +77,77 @@ def test_smooth_names_scipys_arguments():
     assert str(e.value).startswith("window 3 is invalid")
 
 
+def test_ranges_are_the_librarys_in_pythons_words():
+    """Every range a call is refused by is the library's check, in Python's keywords (scipy's
+    ``delta`` for ``smooth``): no range is written in the binding."""
+    radar = {"sigma_range": 10.0, "sigma_angle": 1e-3}
+    cases = [
+        (
+            lambda: ss.smooth(np.arange(10.0), 5, 2, delta=0.0),
+            "delta 0 is invalid: must be a positive finite number",
+        ),
+        (
+            lambda: ss.SlidingFit(window=-3, **radar),
+            "window -3 is invalid: must hold at least 1 sample",
+        ),
+        (
+            lambda: ss.SlidingFit(window=0, **radar),
+            "window 0 is invalid: must hold at least 1 sample",
+        ),
+        (
+            lambda: ss.SlidingFit("polynomial", degree=2, sigma=0.3, window=2),
+            "window 2 is invalid: too small for degree 2: a degree-2 fit needs a window of at "
+            "least 3 rows",
+        ),
+        (
+            lambda: ss.SlidingFit(max_iterations=1001, **radar),
+            "max_iterations 1001 is invalid: must be from 1 to 1000",
+        ),
+        (
+            lambda: ss.RadarTracker("kalman", max_iterations=0),
+            "max_iterations 0 is invalid: must be from 1 to 1000",
+        ),
+        (
+            lambda: ss.RadarTracker("kalman", azimuth="north"),
+            "azimuth \"north\" is invalid: must be one of 'from-x', 'bearing'",
+        ),
+        (
+            lambda: ss.SlidingFit(azimuth="north", **radar),
+            "azimuth \"north\" is invalid: must be one of 'from-x', 'bearing'",
+        ),
+        (
+            lambda: ss.RadarTracker("kalman", q=-1.0),
+            "q -1 is invalid: must be a finite number at least 0",
+        ),
+        (
+            lambda: ss.polynomial_samples(np.arange(40.0), np.arange(40.0), 1.0, 31),
+            "degree 31 is out of range: the largest supported degree is 30",
+        ),
+        (
+            lambda: ss.vrf("expanding", 3, n=2),
+            "n 2 is invalid: too small for degree 3: the expanding-memory variance-reduction "
+            "matrix needs n >= 3 (at least 4 samples)",
+        ),
+        (
+            lambda: ss.SlidingFit(epoch=np.inf, **radar),
+            "epoch inf is invalid: must be 'end', 'centre' or a finite time",
+        ),
+        (
+            lambda: ss.luenberger_gains(61),
+            "n 61 is invalid: must be from 1 to 60 coefficients",
+        ),
+        (
+            lambda: ss.vrf("fixed", 3, window=3),
+            "window 3 is invalid: a degree-3 fit needs a window of at least 4 samples",
+        ),
+    ]
+    for call, message in cases:
+        with pytest.raises(ss.ParameterError) as e:
+            call()
+        assert str(e.value) == message
+    assert len(ss.polynomial_samples(np.arange(40.0), np.arange(40.0), 1.0, 30)[0]) == 31
+
+
 @pytest.mark.parametrize("where", [0, 3, 9])
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
 def test_a_non_finite_value_is_named_with_its_index(where, bad):

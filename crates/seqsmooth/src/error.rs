@@ -447,6 +447,15 @@ pub fn check_sample(t: f64, y: f64, previous: Option<f64>) -> Result<(), Error> 
 
 /// The first non-finite number of `xs` as an [`Error::NonFinite`] naming it `what` (`"time"` or
 /// `"value"`).
+/// A degree's range `degree ≤ max` ([`Error::DegreeOutOfRange`]): the shape of every cap on a
+/// degree (the filters', PAML's, the Gauss rules').
+pub(crate) fn check_degree_at_most(degree: usize, max: usize) -> Result<(), Error> {
+    if degree > max {
+        return Err(Error::DegreeOutOfRange { degree, max });
+    }
+    Ok(())
+}
+
 pub(crate) fn check_finite(what: &'static str, xs: &[f64]) -> Result<(), Error> {
     match xs.iter().find(|x| !x.is_finite()) {
         Some(&value) => Err(Error::NonFinite { what, value }),

@@ -5,7 +5,7 @@
 //! the one rule for undetermined and refused rows.
 
 use seqsmooth::polynomial::automatic::AutomaticFilter;
-use seqsmooth::polynomial::rows::{decisions, RowLayout, DECISION_CELLS};
+use seqsmooth::polynomial::rows::{decisions, degree_in_use, RowLayout, UPDATE_CELLS};
 use seqsmooth::polynomial::spec::{AnyFilter, FilterKind, FilterSpec};
 use seqsmooth::polynomial::tau::default_tau;
 use seqsmooth::{Engine, Error, ExpandingMemory, FadingMemory, FixedEngine, FixedMemory};
@@ -210,7 +210,7 @@ fn expected_rows(spec: &FilterSpec, t: &[f64], y: &[f64], layout: RowLayout) -> 
     let sd = w << usize::from(layout.sigma);
     let trailing = match (spec.kind, layout.trailing) {
         (FilterKind::Fixed, true) => 1,
-        (FilterKind::Automatic, true) => 4 + DECISION_CELLS,
+        (FilterKind::Automatic, true) => 4 + UPDATE_CELLS,
         _ => 0,
     };
     let stride = sd + trailing;
@@ -248,6 +248,7 @@ fn expected_rows(spec: &FilterSpec, t: &[f64], y: &[f64], layout: RowLayout) -> 
                 row[sd + 4] = o.decided.len() as f64;
                 row[sd + 5] = (bits & 0xffff_ffff) as f64;
                 row[sd + 6] = (bits >> 32) as f64;
+                row[sd + 7] = o.degree as f64;
             }
             let estimate = match layout.lead {
                 0.0 => o.estimate.clone(),
@@ -315,7 +316,7 @@ fn the_runner_writes_the_direct_filters_rows() {
 
 /// The automatic filter's decision cells give back the final decisions its updates made.
 #[test]
-fn the_decision_cells_hold_the_final_outlier_decisions() {
+fn the_update_cells_hold_the_final_outlier_decisions_and_the_degree() {
     let (t, y) = data(150);
     let spec = FilterSpec {
         sigma: None,
@@ -332,16 +333,25 @@ fn the_decision_cells_hold_the_final_outlier_decisions() {
     f.run_rows(&t, &y, &mut rows, layout).unwrap();
     let mut decided: Vec<bool> = rows
         .chunks_exact(stride)
-        .flat_map(|r| decisions(&r[stride - DECISION_CELLS..]))
+        .flat_map(|r| decisions(&r[stride - UPDATE_CELLS..]))
+        .collect();
+    let degrees: Vec<usize> = rows
+        .chunks_exact(stride)
+        .map(|r| degree_in_use(&r[stride - UPDATE_CELLS..]))
         .collect();
     decided.extend(f.automatic_mut().unwrap().finish());
     let mut g = automatic(&spec);
-    let mut want = Vec::new();
+    let (mut want, mut want_degrees) = (Vec::new(), Vec::new());
     for (&t, &y) in t.iter().zip(&y) {
-        want.extend(g.update(t, y).unwrap().decided.iter());
+        let o = g.update(t, y).unwrap();
+        want.extend(o.decided.iter());
+        want_degrees.push(o.degree);
     }
     want.extend(g.finish());
     assert_eq!(decided, want);
+    // The degree in use at each update, as it settles.
+    assert_eq!(degrees, want_degrees);
+    assert!(degrees[0] < degrees[degrees.len() - 1], "{degrees:?}");
     assert_eq!(decided.len(), t.len());
     assert!(decided[40] && decided[71], "the two spikes are rejected");
 }

@@ -1,7 +1,8 @@
 //! The arguments of `seqsmooth fit`.
 
-use super::{parse_degree, parse_sigma, parse_window, RadarArgs};
+use super::{parse_degree, parse_max_iterations, parse_sigma, parse_window, refused, RadarArgs};
 use clap::Args;
+use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -25,7 +26,7 @@ pub struct FitArgs {
     /// time of its window) or a time T
     #[arg(long, value_name = "EPOCH", default_value = "end", value_parser = parse_epoch,
           allow_hyphen_values = true)]
-    pub epoch: EpochArg,
+    pub epoch: Epoch,
     /// Polynomial: the values' noise standard deviation (required)
     #[arg(long, value_name = "S", value_parser = parse_sigma, allow_hyphen_values = true)]
     pub sigma: Option<f64>,
@@ -38,9 +39,9 @@ pub struct FitArgs {
     #[command(flatten)]
     pub radar: RadarArgs,
     /// Gauss-Newton iterations allowed per window
-    #[arg(long, value_name = "N", default_value_t = 20,
-          value_parser = clap::value_parser!(u32).range(1..=1000))]
-    pub max_iterations: u32,
+    #[arg(long, value_name = "N", default_value_t = GaussNewton::default().max_iterations,
+          value_parser = parse_max_iterations, allow_hyphen_values = true)]
+    pub max_iterations: usize,
     /// Output file [default: standard output]
     #[arg(short = 'o', long, value_name = "OUTPUT")]
     pub output: Option<PathBuf>,
@@ -55,24 +56,17 @@ pub enum FitModel {
     Polynomial,
 }
 
-/// `--epoch`: the window's end, its centre, or a time.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum EpochArg {
-    End,
-    Centre,
-    At(f64),
-}
-
-/// Parses `--epoch`: `end`, `centre` (or `center`), or a finite time.
-pub fn parse_epoch(s: &str) -> Result<EpochArg, String> {
-    match s.trim() {
-        "end" => Ok(EpochArg::End),
-        "centre" | "center" => Ok(EpochArg::Centre),
-        text => match text.parse::<f64>() {
-            Ok(t) if t.is_finite() => Ok(EpochArg::At(t)),
-            _ => Err(format!(
-                "epoch '{text}' is neither 'end', 'centre' nor a finite time"
-            )),
-        },
-    }
+/// Parses `--epoch`: a name of the library's ([`Epoch::from_name`]: `end`, `centre`, `center`),
+/// or a time in its range ([`Epoch::check`]).
+pub fn parse_epoch(s: &str) -> Result<Epoch, String> {
+    let text = s.trim();
+    let epoch = match Epoch::from_name(text) {
+        Some(epoch) => epoch,
+        None => Epoch::At(
+            text.parse::<f64>()
+                .map_err(|_| format!("epoch '{text}' is neither 'end', 'centre' nor a time"))?,
+        ),
+    };
+    epoch.check().map_err(refused)?;
+    Ok(epoch)
 }

@@ -9,9 +9,11 @@
 //! The argument parsers return `Err(message)`; clap prints it as
 //! `error: invalid value 'V' for '--name <X>': message` and exits with code 2.
 
-use crate::error::CliError;
+use crate::error::{flag, CliError};
 use clap::{Args, Parser, Subcommand};
-use seqsmooth::polynomial::{check_degree, check_tau, MAX_DEGREE};
+use seqsmooth::estimate::gauss_newton::check_max_iterations;
+use seqsmooth::estimate::sliding::check_window_length;
+use seqsmooth::polynomial::{check_degree, check_derivative, check_lead, check_tau, MAX_DEGREE};
 use seqsmooth::scalar::{parse_rational, Rational, MAX_DECIMAL_EXPONENT};
 use seqsmooth::Engine;
 
@@ -28,11 +30,11 @@ mod vrf;
 
 pub use demo::DemoArgs;
 pub use filter::FilterArgs;
-pub use fit::{parse_epoch, EpochArg, FitArgs, FitModel};
+pub use fit::{parse_epoch, FitArgs, FitModel};
 pub use gains::GainsArgs;
 pub use paml::{parse_paml_degree, parse_segment, PamlArgs};
 pub use plot::PlotArgs;
-pub use radar::{parse_site, AzimuthConvention, RadarArgs};
+pub use radar::{azimuth_parser, parse_site, RadarArgs};
 pub use smooth::SmoothArgs;
 pub use track::{parse_number, parse_psd, refuse_beta, TrackArgs, TrackMethod};
 pub use vrf::{parse_lead_steps, FormArg, LeadSteps, VrfArgs, VrfKind};
@@ -538,84 +540,124 @@ pub fn parse_theta(s: &str) -> Result<Theta, String> {
     })
 }
 
-/// Parses the whole number `name` of `unit` (e.g. " of samples") from `lo` to `hi`.
-fn parse_whole(name: &str, s: &str, unit: &str, lo: i128, hi: i128) -> Result<i128, String> {
+/// A library refusal of an argument, in the command's words (the flag it names, [`flag`]).
+fn refused(e: seqsmooth::Error) -> String {
+    e.message_in(&flag)
+}
+
+/// Parses a whole number `name` (of `unit`, e.g. " of samples") for the library, which checks
+/// its range (`check`, refusing in the command's words). Text that is no `usize` is refused
+/// here: a negative number by the library's rule of the smallest (where it refuses 0, named
+/// as given), else with `range`, the library's range from its constants, where one is given.
+fn parse_count(
+    name: &str,
+    s: &str,
+    unit: &str,
+    range: Option<String>,
+    check: impl Fn(usize) -> Result<(), seqsmooth::Error>,
+) -> Result<usize, String> {
     let text = s.trim();
-    match text.parse::<i128>() {
-        Ok(v) if (lo..=hi).contains(&v) => Ok(v),
-        Ok(_) => Err(format!(
-            "{name} {text} is out of range: it must be a whole number{unit} from {lo} to {hi}"
-        )),
-        Err(_) => Err(format!(
-            "{name} '{text}' is not a whole number{unit}; it must be one from {lo} to {hi}"
-        )),
-    }
+    let Ok(n) = text.parse::<usize>() else {
+        let whole = text.parse::<i128>();
+        if whole.as_ref().is_ok_and(|v| *v < 0) {
+            if let Err(seqsmooth::Error::InvalidParameter { name, reason, .. }) = check(0) {
+                let value = text.to_string();
+                return Err(refused(seqsmooth::Error::InvalidParameter {
+                    name,
+                    value,
+                    reason,
+                }));
+            }
+        }
+        let (one, within) = range.map_or_else(Default::default, |r| {
+            (format!("; it must be one {r}"), format!(" {r}"))
+        });
+        return Err(match whole {
+            Ok(_) => {
+                format!("{name} {text} is out of range: it must be a whole number{unit}{within}")
+            }
+            Err(_) => format!("{name} '{text}' is not a whole number{unit}{one}"),
+        });
+    };
+    check(n).map_err(refused)?;
+    Ok(n)
 }
 
 /// Parses `--degree`: a whole number, in the library's range ([`check_degree`]).
 pub fn parse_degree(s: &str) -> Result<usize, String> {
-    // Not a whole number ≥ 0 (a sign, a fraction, text): said in the words of the range.
-    let whole = |_| parse_whole("degree", s, "", 0, MAX_DEGREE as i128).map(|d| d as usize);
-    let d = s.trim().parse::<usize>().or_else(whole)?;
-    check_degree(d).map_err(|e| match e {
-        seqsmooth::Error::DegreeOutOfRange { max, .. } => format!(
-            "degree {} is out of range: the largest supported degree is {max}",
-            s.trim()
-        ),
-        other => other.to_string(),
-    })?;
-    Ok(d)
+    let range = format!("from 0 to {MAX_DEGREE}");
+    parse_count("degree", s, "", Some(range), check_degree)
 }
 
-/// Parses `plot --derivative`: a whole number from 0 to [`MAX_DEGREE`].
+/// Parses `plot --derivative`: a whole number, in the library's range ([`check_derivative`]).
 pub fn parse_derivative(s: &str) -> Result<usize, String> {
-    parse_whole("derivative", s, "", 0, MAX_DEGREE as i128).map(|d| d as usize)
+    let range = format!("from 0 to {MAX_DEGREE}");
+    parse_count("derivative", s, "", Some(range), check_derivative)
 }
 
-/// Parses `--n`: the 0-based index of the newest sample, a whole number from 0 to `i64::MAX`.
+/// Parses `--n`: the 0-based index of the newest sample, a whole number (any `u64`: the tables
+/// are exact; the library checks it against the degree where it must).
 pub fn parse_index(s: &str) -> Result<u64, String> {
-    parse_whole("n", s, "", 0, i64::MAX.into()).map(|n| n as u64)
+    let text = s.trim();
+    text.parse::<u64>()
+        .map_err(|_| format!("n '{text}' is not a whole number (0, 1, 2, ...)"))
 }
 
-/// A positive finite number (`--tau`, `--sigma`).
-const POSITIVE: (fn(f64) -> bool, &str) =
-    (|v| v.is_finite() && v > 0.0, "a positive finite number");
-
-/// Parses the number `name` that must be `range` (`ok` says whether it is).
-fn parse_f64(name: &str, s: &str, (ok, range): (fn(f64) -> bool, &str)) -> Result<f64, String> {
+/// Parses the number `name`: any `f64`, NaN and infinities too (the library refuses them where
+/// they are out of its range).
+pub fn parse_f64(name: &str, s: &str) -> Result<f64, String> {
     let text = s.trim();
-    let v = (text.parse::<f64>()).map_err(|_| format!("{name} '{text}' is not a number"))?;
-    if ok(v) {
-        Ok(v)
-    } else {
-        Err(format!("{name} {text} is out of range: it must be {range}"))
-    }
+    text.parse::<f64>()
+        .map_err(|_| format!("{name} '{text}' is not a number"))
+}
+
+/// Parses the number `name` and checks it by the library's rule `check` (refusing in the
+/// command's words).
+fn parse_checked(
+    name: &str,
+    s: &str,
+    check: impl Fn(f64) -> Result<(), seqsmooth::Error>,
+) -> Result<f64, String> {
+    let v = parse_f64(name, s)?;
+    check(v).map_err(refused)?;
+    Ok(v)
 }
 
 /// Parses `--tau`: a number in the library's range ([`check_tau`]).
 pub fn parse_tau(s: &str) -> Result<f64, String> {
-    const TAU: (fn(f64) -> bool, &str) = (|v| check_tau(v).is_ok(), "a positive finite number");
-    parse_f64("tau", s, TAU)
+    parse_checked("tau", s, check_tau)
 }
 
-/// Parses `--sigma`: a positive finite number.
+/// Parses `--sigma`: a number in the range of a noise σ (the library's
+/// [`is_usable_sigma`](seqsmooth::estimate::batch::is_usable_sigma)).
 pub fn parse_sigma(s: &str) -> Result<f64, String> {
-    const SIGMA: (fn(f64) -> bool, &str) = (
-        seqsmooth::estimate::batch::is_usable_sigma,
-        "a positive number from about 1.5e-154 to 1.3e154 (its square, the noise variance, must \
-         be a normal double; rescale the values otherwise)",
-    );
-    parse_f64("sigma", s, SIGMA)
+    let v = parse_f64("sigma", s)?;
+    if seqsmooth::estimate::batch::is_usable_sigma(v) {
+        Ok(v)
+    } else {
+        Err(format!(
+            "sigma {} is out of range: it must be a positive number from about 1.5e-154 to \
+             1.3e154 (its square, the noise variance, must be a normal double; rescale the \
+             values otherwise)",
+            s.trim()
+        ))
+    }
 }
 
-/// Parses `--lead`: any finite number (negative = retrodiction).
+/// Parses `--lead`: a number in the library's range ([`check_lead`]; negative = retrodiction).
 pub fn parse_lead(s: &str) -> Result<f64, String> {
-    parse_f64("lead", s, (f64::is_finite, "a finite number"))
+    parse_checked("lead", s, check_lead)
 }
 
 /// Parses `--window`: the number of samples in the window (Morrison's `L+1`), a whole number
-/// from 1 to `i64::MAX`. Whether it suits the degree is checked by the command.
+/// in the library's range of a window ([`check_window_length`]). Whether it suits the degree
+/// is checked by the command, with the library's rule of each model.
 pub fn parse_window(s: &str) -> Result<usize, String> {
-    let max = i128::from(i64::MAX).min(usize::MAX as i128);
-    parse_whole("window", s, " of samples", 1, max).map(|w| w as usize)
+    parse_count("window", s, " of samples", None, check_window_length)
+}
+
+/// Parses `--max-iterations`: a whole number in the library's range
+/// ([`check_max_iterations`]).
+pub fn parse_max_iterations(s: &str) -> Result<usize, String> {
+    parse_count("max-iterations", s, "", None, check_max_iterations)
 }

@@ -1,7 +1,8 @@
 //! The arguments of `seqsmooth paml`.
 
-use super::{parse_f64, parse_sigma, parse_whole, Columns, POSITIVE};
+use super::{parse_checked, parse_count, parse_sigma, Columns};
 use clap::Args;
+use seqsmooth::paml::{check_degree, check_segment_length, MAX_DEGREE};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -32,12 +33,15 @@ pub struct PamlArgs {
     pub output: Option<PathBuf>,
 }
 
-/// Parses `paml --degree`: a whole number from 0 to 30.
+/// Parses `paml --degree`: a whole number in the library's range of a segment's degree
+/// ([`check_degree`]).
 pub fn parse_paml_degree(s: &str) -> Result<usize, String> {
-    parse_whole("degree", s, "", 0, 30).map(|v| v as usize)
+    let range = format!("from 0 to {MAX_DEGREE}");
+    parse_count("degree", s, "", Some(range), check_degree)
 }
 
-/// Parses `--segment`: a positive finite number.
+/// Parses `--segment`: a number in the library's range of a segment's length
+/// ([`check_segment_length`]).
 pub fn parse_segment(s: &str) -> Result<f64, String> {
-    parse_f64("segment", s, POSITIVE)
+    parse_checked("segment", s, check_segment_length)
 }

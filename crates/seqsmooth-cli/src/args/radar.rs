@@ -1,8 +1,10 @@
 //! The radar arguments that `seqsmooth track` and `seqsmooth fit` share: the site, the azimuth
 //! convention and each component's noise σ (a flag, or a column).
 
-use super::parse_sigma;
+use super::{parse_sigma, refused};
+use clap::builder::{PossibleValuesParser, TypedValueParser};
 use clap::Args;
+use seqsmooth::model::radar::{check_site, AzimuthConvention};
 
 /// The radar input of `seqsmooth track` and `seqsmooth fit --model radar`, read by one reader
 /// (`track::rows`) and checked by the library's rule for a radar row
@@ -27,8 +29,10 @@ pub struct RadarArgs {
     /// empty cell takes --sigma-angle
     #[arg(long, value_name = "NAME")]
     pub sigma_angle_col: Option<String>,
-    /// Radar: the azimuth convention of the input
-    #[arg(long, value_enum, default_value_t = AzimuthConvention::FromX)]
+    /// Radar: how the input's azimuths are measured: from +x towards +y, or as a bearing
+    /// (clockwise from north, with x = east and y = north)
+    #[arg(long, value_name = "AZIMUTH", default_value_t = AzimuthConvention::default(),
+          value_parser = azimuth_parser())]
     pub azimuth: AzimuthConvention,
     /// Radar: name of the range column
     #[arg(long, value_name = "NAME", default_value = "range")]
@@ -41,13 +45,11 @@ pub struct RadarArgs {
     pub elevation_col: String,
 }
 
-/// How the input's azimuth is measured.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum AzimuthConvention {
-    /// From +x towards +y.
-    FromX,
-    /// Clockwise from north, with x = east and y = north.
-    Bearing,
+/// Parses `--azimuth`: one of the library's names of a convention
+/// ([`AzimuthConvention::from_name`]), listed in `--help`.
+pub fn azimuth_parser() -> impl TypedValueParser<Value = AzimuthConvention> {
+    PossibleValuesParser::new(AzimuthConvention::NAMES)
+        .try_map(|name| AzimuthConvention::from_name(&name).map_err(refused))
 }
 
 /// Parses `--site`: three finite numbers `X,Y,Z`.
@@ -61,10 +63,11 @@ pub fn parse_site(s: &str) -> Result<[f64; 3], String> {
     };
     let mut site = [0.0; 3];
     for (slot, (axis, text)) in site.iter_mut().zip([("X", x), ("Y", y), ("Z", z)]) {
-        *slot = match text.parse::<f64>() {
-            Ok(v) if v.is_finite() => v,
-            _ => return Err(format!("site {axis} '{text}' is not a finite number")),
-        };
+        *slot = text
+            .parse::<f64>()
+            .map_err(|_| format!("site {axis} '{text}' is not a number"))?;
     }
+    // The library's range of a site.
+    check_site(site).map_err(refused)?;
     Ok(site)
 }

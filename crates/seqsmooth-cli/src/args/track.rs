@@ -1,7 +1,9 @@
 //! The arguments of `seqsmooth track`.
 
-use super::{parse_f64, parse_window, RadarArgs};
+use super::{parse_checked, parse_f64, parse_max_iterations, parse_window, RadarArgs};
 use clap::Args;
+use seqsmooth::estimate::gauss_newton::GaussNewton;
+use seqsmooth::kalman::noise::check_psd;
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -36,9 +38,9 @@ pub struct TrackArgs {
     pub window: Option<usize>,
     /// Gauss-Newton iterations allowed per fit (the window method's fits, the Kalman
     /// methods' start)
-    #[arg(long, value_name = "N", default_value_t = 20,
-          value_parser = clap::value_parser!(u32).range(1..=1000))]
-    pub max_iterations: u32,
+    #[arg(long, value_name = "N", default_value_t = GaussNewton::default().max_iterations,
+          value_parser = parse_max_iterations, allow_hyphen_values = true)]
+    pub max_iterations: usize,
     /// smooth: the lag in rows: each row's estimate from the N rows after it, written N rows
     /// later; the smoother holds N+1 rows (0 is the kalman filter) [default: 200]
     #[arg(long, value_name = "N")]
@@ -66,21 +68,14 @@ pub enum TrackMethod {
     Smooth,
 }
 
-/// Parses `--q`: a non-negative finite number.
+/// Parses `--q`: a number in the library's range of a spectral density ([`check_psd`]).
 pub fn parse_psd(s: &str) -> Result<f64, String> {
-    parse_f64(
-        "q",
-        s,
-        (
-            |v| v.is_finite() && v >= 0.0,
-            "a non-negative finite number",
-        ),
-    )
+    parse_checked("q", s, check_psd)
 }
 
 /// Parses a number the library checks (`track`'s `--theta`, `--tau`, `--theta-per-update`).
 pub fn parse_number(s: &str) -> Result<f64, String> {
-    parse_f64("number", s, (|v| !v.is_nan(), "a number"))
+    parse_f64("number", s)
 }
 
 /// `track --beta`, refused with its new spelling.

@@ -1,7 +1,8 @@
 //! The arguments of `seqsmooth vrf`.
 
-use super::{parse_window, Format, MemoryArgs};
+use super::{parse_window, refused, Format, MemoryArgs};
 use clap::Args;
+use seqsmooth::polynomial::fixed::check_lead_steps;
 use seqsmooth::polynomial::form::EstimateForm;
 use seqsmooth::scalar::Rational;
 use seqsmooth::scalar::{parse_rational, MAX_DECIMAL_EXPONENT};
@@ -79,9 +80,6 @@ pub struct LeadSteps {
 pub fn parse_lead_steps(s: &str) -> Result<LeadSteps, String> {
     let text = s.trim();
     let not_a_number = || format!("lead '{text}' is not a number (write it as -2.5 or -5/2)");
-    let out_of_range = || {
-        format!("lead {text} is out of range: it must be a finite number of samples (|H| < 1e300)")
-    };
     // An exponent this large would take unbounded time to expand exactly: the library's rule.
     if !seqsmooth::scalar::decimal_exponent_in_range(text) {
         return Err(format!(
@@ -91,8 +89,7 @@ pub fn parse_lead_steps(s: &str) -> Result<LeadSteps, String> {
     }
     let exact = parse_rational(text).ok_or_else(not_a_number)?;
     let value = seqsmooth::scalar::ratio_to_f64(&exact);
-    if !(value.is_finite() && value.abs() < 1e300) {
-        return Err(out_of_range());
-    }
+    // The library's range of a lead in samples.
+    check_lead_steps(value).map_err(refused)?;
     Ok(LeadSteps { exact, value })
 }

@@ -6,7 +6,7 @@
 //! The rows before the first estimate are held, so that an input that never determines the
 //! state writes nothing.
 
-use crate::args::{EpochArg, FitArgs, FitModel};
+use crate::args::{FitArgs, FitModel};
 use crate::commands::shared::radar_rows::{check_sigmas, Batch, Rows};
 use crate::commands::shared::window::window_error;
 use crate::error::CliError;
@@ -147,7 +147,7 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
             csv,
         },
     };
-    let epoch_column = !matches!(a.epoch, EpochArg::End);
+    let epoch_column = !matches!(a.epoch, Epoch::End);
 
     let mut text = Vec::new();
     let mut cells: Vec<String> = vec!["t".into()];
@@ -263,16 +263,9 @@ fn window(a: &FitArgs) -> usize {
 /// The fitter, columns and noise of the arguments.
 fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
     let usage = |s: String| CliError::Usage(s);
-    let epoch = match a.epoch {
-        EpochArg::End => Epoch::End,
-        EpochArg::Centre => Epoch::Centre,
-        EpochArg::At(t) => Epoch::At(t),
-    };
-    let solver = GaussNewton {
-        max_iterations: a.max_iterations as usize,
-        ..GaussNewton::default()
-    };
+    let epoch = a.epoch;
     let library = CliError::from;
+    let solver = GaussNewton::with_max_iterations(a.max_iterations).map_err(library)?;
     match a.model {
         FitModel::Radar => {
             if a.sigma.is_some() {
@@ -322,17 +315,10 @@ fn setup(a: &FitArgs, header: &[String]) -> Result<Setup, CliError> {
                         .into(),
                 ));
             };
-            if window(a) < degree + 1 {
-                return Err(usage(format!(
-                    "window {} is too small for degree {degree}: a degree-{degree} fit needs a \
-                     window of at least {} rows",
-                    window(a),
-                    degree + 1
-                )));
-            }
+            // The window's range for the degree is the library's.
+            let fit = SlidingFit::polynomial(degree, window(a), epoch, solver).map_err(library)?;
             let need = Need::degree(degree);
             need.check_header(header)?;
-            let fit = SlidingFit::polynomial(degree, window(a), epoch, solver).map_err(library)?;
             Ok(Setup {
                 fitter: Fitter::Polynomial(fit),
                 need,

@@ -260,10 +260,7 @@ impl Tracker {
                     .map_err(|e| CliError::Usage(e.to_string()))?,
             ),
         };
-        let solver = GaussNewton {
-            max_iterations: a.max_iterations as usize,
-            ..GaussNewton::default()
-        };
+        let solver = GaussNewton::with_max_iterations(a.max_iterations).map_err(CliError::from)?;
         let inner = RadarTracker::with_solver(radar, method, solver).map_err(CliError::from)?;
         let keep = match method {
             Method::Window { window } => window,

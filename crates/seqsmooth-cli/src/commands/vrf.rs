@@ -5,7 +5,7 @@
 use crate::args::{check_window, only, Format, Memory, TableKind, VrfArgs, VrfKind};
 use crate::commands::shared::table::{cells, write_table};
 use crate::error::CliError;
-use seqsmooth::polynomial::expanding::vrf::expanding_vrf;
+use seqsmooth::polynomial::expanding::vrf::{check_index, expanding_vrf};
 use seqsmooth::polynomial::fading::vrf::fading_vrf;
 use seqsmooth::polynomial::fixed::covariance;
 use seqsmooth::polynomial::form::EstimateForm;
@@ -36,13 +36,8 @@ pub fn run(a: &VrfArgs) -> Result<(), CliError> {
     let m = a.memory.degree;
     let mem = a.memory.of(kind)?;
     if let Memory::Expanding(n) = mem {
-        if n < m as u64 {
-            return Err(CliError::Usage(format!(
-                "n {n} is too small for degree {m}: the expanding-memory variance-reduction \
-                 matrix needs n >= {m} (at least {} samples)",
-                m + 1
-            )));
-        }
+        // The library's range of n for the degree, checked before any output.
+        check_index(m, n)?;
     }
     let form = EstimateForm::from(a.form.unwrap_or_default());
     let values = match (mem, a.exact) {

@@ -6,3 +6,4 @@ mod commands;
 mod error;
 mod io;
 mod plot;
+mod ranges;

@@ -58,6 +58,27 @@ const DISCRETISATION_POINTS: [usize; 5] = [64, 128, 256, 512, 1024];
 /// coefficients must be for [`Jacobi::continuous`] to take the finer one.
 const DISCRETISATION_TOLERANCE: f64 = 1e-14;
 
+/// The largest degree `n` of a [`Jacobi`] recurrence (its Gauss rule has `n + 1` nodes, found
+/// in `O(n²)` by Golub–Welsch): that of the finest Legendre rule the continuous measures are
+/// discretised by (1,024 points), far beyond PAML's segments (`paml::MAX_DEGREE`), and a bound
+/// on the work and memory one call may ask for.
+///
+/// ```
+/// use seqsmooth::basis::{Jacobi, MAX_JACOBI_DEGREE};
+/// assert!(Jacobi::legendre(MAX_JACOBI_DEGREE, -1.0, 1.0).is_ok());
+/// assert!(Jacobi::legendre(MAX_JACOBI_DEGREE + 1, -1.0, 1.0).is_err());
+/// ```
+pub const MAX_JACOBI_DEGREE: usize = 1_023;
+
+const _: () =
+    assert!(DISCRETISATION_POINTS[DISCRETISATION_POINTS.len() - 1] == MAX_JACOBI_DEGREE + 1);
+
+/// The range of a [`Jacobi`] recurrence's degree: `n ≤ MAX_JACOBI_DEGREE` (every
+/// constructor's check).
+pub fn check_jacobi_degree(n: usize) -> Result<(), Error> {
+    crate::error::check_degree_at_most(n, MAX_JACOBI_DEGREE)
+}
+
 fn check_interval(a: f64, b: f64) -> Result<(f64, f64), Error> {
     if !(a.is_finite() && b.is_finite() && a < b && ((b - a) / 2.0).is_normal()) {
         return Err(Error::InvalidParameter {
@@ -81,6 +102,7 @@ impl Jacobi {
     /// # Ok::<(), seqsmooth::Error>(())
     /// ```
     pub fn legendre(n: usize, a: f64, b: f64) -> Result<Self, Error> {
+        check_jacobi_degree(n)?;
         let (centre, half) = check_interval(a, b)?;
         let beta = (1..=n)
             .map(|k| {
@@ -107,6 +129,7 @@ impl Jacobi {
     /// # Ok::<(), seqsmooth::Error>(())
     /// ```
     pub fn chebyshev(n: usize, a: f64, b: f64) -> Result<Self, Error> {
+        check_jacobi_degree(n)?;
         let (centre, half) = check_interval(a, b)?;
         let beta = (1..=n)
             .map(|k| if k == 1 { 0.5f64.sqrt() } else { 0.5 })
@@ -136,6 +159,7 @@ impl Jacobi {
     /// # Ok::<(), seqsmooth::Error>(())
     /// ```
     pub fn discrete(times: &[f64], weights: &[f64], n: usize) -> Result<Self, Error> {
+        check_jacobi_degree(n)?;
         if times.len() != weights.len() {
             return Err(Error::InvalidParameter {
                 name: Param::Weights,
@@ -209,6 +233,7 @@ impl Jacobi {
     /// # Ok::<(), seqsmooth::Error>(())
     /// ```
     pub fn continuous(weight: Weight<'_>, a: f64, b: f64, n: usize) -> Result<Self, Error> {
+        check_jacobi_degree(n)?;
         let (centre, half) = check_interval(a, b)?;
         let mut previous: Option<Self> = None;
         for points in DISCRETISATION_POINTS {

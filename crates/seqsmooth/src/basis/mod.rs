@@ -20,4 +20,4 @@ pub mod legendre;
 pub use discrete_laguerre::DiscreteLaguerre;
 pub use discrete_legendre::DiscreteLegendre;
 pub use gauss::GaussRule;
-pub use jacobi::{Jacobi, Weight};
+pub use jacobi::{check_jacobi_degree, Jacobi, Weight, MAX_JACOBI_DEGREE};

@@ -270,6 +270,16 @@ pub enum Param {
     ManoeuvreAlpha,
     /// The Singer model's manoeuvre variance `σ_m²`.
     ManoeuvreVariance,
+    /// The length of the segments a series is cut into (PAML's).
+    SegmentLength,
+    /// How a radar's azimuth is measured ([`crate::model::radar::AzimuthConvention`]).
+    AzimuthConvention,
+    /// The 0-based index `n` of the newest sample of an expanding memory's table.
+    NewestIndex,
+    /// The coefficients `n` of a continuous-time expanding memory's gains (Luenberger's).
+    Coefficients,
+    /// The time a fit's state refers to.
+    Epoch,
 }
 
 impl Param {
@@ -399,6 +409,11 @@ impl Param {
         Param::SpectralDensity,
         Param::ManoeuvreAlpha,
         Param::ManoeuvreVariance,
+        Param::SegmentLength,
+        Param::AzimuthConvention,
+        Param::NewestIndex,
+        Param::Coefficients,
+        Param::Epoch,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -528,6 +543,11 @@ impl Param {
             Param::SpectralDensity => "spectral density Q_c",
             Param::ManoeuvreAlpha => "manoeuvre alpha",
             Param::ManoeuvreVariance => "manoeuvre variance",
+            Param::SegmentLength => "segment length",
+            Param::AzimuthConvention => "azimuth convention",
+            Param::NewestIndex => "n",
+            Param::Coefficients => "coefficients",
+            Param::Epoch => "epoch",
         }
     }
 

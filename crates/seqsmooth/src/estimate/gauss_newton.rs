@@ -39,6 +39,40 @@ pub enum Epoch {
 }
 
 impl Epoch {
+    /// The epoch a front end names: `end`, `centre` (or `center`); `None` for any other name
+    /// (a time, which the front end parses as a number).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::Epoch;
+    /// assert_eq!(Epoch::from_name("center"), Some(Epoch::Centre));
+    /// assert_eq!(Epoch::from_name("12.5"), None);
+    /// ```
+    pub fn from_name(name: &str) -> Option<Epoch> {
+        match name {
+            "end" => Some(Epoch::End),
+            "centre" | "center" => Some(Epoch::Centre),
+            _ => None,
+        }
+    }
+
+    /// The range of an epoch: a given time must be finite ([`Param::Epoch`]; every front
+    /// end's check, and the sliding fit's).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::Epoch;
+    /// assert!(Epoch::At(1.5).check().is_ok() && Epoch::At(f64::INFINITY).check().is_err());
+    /// ```
+    pub fn check(self) -> Result<(), Error> {
+        match self {
+            Epoch::At(t) if !t.is_finite() => Err(Error::InvalidParameter {
+                name: Param::Epoch,
+                value: t.to_string(),
+                reason: "must be 'end', 'centre' or a finite time".into(),
+            }),
+            _ => Ok(()),
+        }
+    }
+
     /// The time, for observations at `times` (not empty).
     ///
     /// ```
@@ -101,6 +135,30 @@ pub struct Correction {
     pub iterations: Vec<Iteration>,
 }
 
+/// The most linearisations a fit may be allowed ([`GaussNewton::max_iterations`]): a bound on
+/// the work of one window, far beyond what a fit that converges needs (two or three where the
+/// windows overlap, Morrison §8.7).
+pub const MAX_ITERATIONS: usize = 1000;
+
+/// The range of [`GaussNewton::max_iterations`]: `1 ≤ n ≤ MAX_ITERATIONS` (every front end's
+/// check, and the fit's own).
+///
+/// ```
+/// use seqsmooth::estimate::gauss_newton::{check_max_iterations, MAX_ITERATIONS};
+/// assert!(check_max_iterations(1).is_ok() && check_max_iterations(MAX_ITERATIONS).is_ok());
+/// assert!(check_max_iterations(0).is_err() && check_max_iterations(MAX_ITERATIONS + 1).is_err());
+/// ```
+pub fn check_max_iterations(n: usize) -> Result<(), Error> {
+    if !(1..=MAX_ITERATIONS).contains(&n) {
+        return Err(Error::InvalidParameter {
+            name: Param::MaxIterations,
+            value: n.to_string(),
+            reason: format!("must be from 1 to {MAX_ITERATIONS}"),
+        });
+    }
+    Ok(())
+}
+
 /// The iteration's limits.
 ///
 /// ```
@@ -125,6 +183,24 @@ impl Default for GaussNewton {
             tolerance: 1e-6,
             max_halvings: 30,
         }
+    }
+}
+
+impl GaussNewton {
+    /// The default limits with `max_iterations` linearisations, checked
+    /// ([`check_max_iterations`]).
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::GaussNewton;
+    /// assert_eq!(GaussNewton::with_max_iterations(5).unwrap().max_iterations, 5);
+    /// assert!(GaussNewton::with_max_iterations(0).is_err());
+    /// ```
+    pub fn with_max_iterations(max_iterations: usize) -> Result<Self, Error> {
+        check_max_iterations(max_iterations)?;
+        Ok(Self {
+            max_iterations,
+            ..Self::default()
+        })
     }
 }
 
@@ -350,14 +426,7 @@ impl GaussNewton {
                 reason: "must be positive and finite".into(),
             });
         }
-        if self.max_iterations == 0 {
-            return Err(Error::InvalidParameter {
-                name: Param::MaxIterations,
-                value: "0".into(),
-                reason: "must be at least 1".into(),
-            });
-        }
-        Ok(())
+        check_max_iterations(self.max_iterations)
     }
 }
 

@@ -27,6 +27,25 @@ pub const RADAR_WINDOW: usize = 8;
 /// polynomial`).
 pub const POLYNOMIAL_WINDOW: usize = 60;
 
+/// The range of a window's length in samples (rows), whatever the model: at least one, the
+/// rule every window of the command and of Python shares before the model's own (a
+/// fixed-memory fit's `m + 1`, [`crate::polynomial::fixed::check_window`]; a radar track's 2).
+///
+/// ```
+/// use seqsmooth::estimate::sliding::check_window_length;
+/// assert!(check_window_length(1).is_ok() && check_window_length(0).is_err());
+/// ```
+pub fn check_window_length(window: usize) -> Result<(), Error> {
+    if window == 0 {
+        return Err(Error::InvalidParameter {
+            name: Param::Window,
+            value: "0".into(),
+            reason: "must hold at least 1 sample".into(),
+        });
+    }
+    Ok(())
+}
+
 /// Where a window's iteration starts when there is no previous estimate to carry forward.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Start {
@@ -131,13 +150,7 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
         start: Start,
     ) -> Result<Self, Error> {
         let n = dynamics.dimension();
-        if window == 0 {
-            return Err(Error::InvalidParameter {
-                name: Param::Window,
-                value: "0".into(),
-                reason: "must hold at least one measurement".into(),
-            });
-        }
+        check_window_length(window)?;
         if observation.state_dimension() != n {
             return Err(Error::InvalidParameter {
                 name: Param::ObservationModel,
@@ -162,14 +175,7 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
             }
             _ => {}
         }
-        if let Epoch::At(t) = epoch {
-            if !t.is_finite() {
-                return Err(Error::NonFinite {
-                    what: "epoch",
-                    value: t,
-                });
-            }
-        }
+        epoch.check()?;
         Ok(Self {
             dynamics,
             observation,
@@ -492,7 +498,8 @@ impl SlidingFit<PolynomialDynamics, LinearObservation> {
     ///
     /// Errors: a `window` shorter than `degree + 1`, an [`Epoch::At`] time not finite. The
     /// degree is not bounded here (the command and the Python binding bound it by the
-    /// polynomial filters' largest degree; beyond ~20 the window's design is ill-conditioned).
+    /// polynomial filters' largest degree, `polynomial::check_degree`; beyond ~20 the window's
+    /// design is ill-conditioned).
     ///
     /// ```
     /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton};
@@ -511,8 +518,8 @@ impl SlidingFit<PolynomialDynamics, LinearObservation> {
                 name: Param::Window,
                 value: window.to_string(),
                 reason: format!(
-                    "is too small for degree {degree}: a degree-{degree} fit needs a window of \
-                     at least {} rows",
+                    "too small for degree {degree}: a degree-{degree} fit needs a window of at \
+                     least {} rows",
                     degree + 1
                 ),
             });

@@ -47,6 +47,25 @@ pub trait ProcessNoise: std::fmt::Debug + Send + Sync {
     }
 }
 
+/// The range of a driving noise's power spectral density `q` (ch. 15): finite and at least 0
+/// (0: no driving noise). The one check of `q` ([`WhiteNoiseDerivative::new`], the radar
+/// tracker, the command's `--q`, Python's `q`).
+///
+/// ```
+/// use seqsmooth::kalman::noise::check_psd;
+/// assert!(check_psd(0.0).is_ok() && check_psd(-1.0).is_err() && check_psd(f64::INFINITY).is_err());
+/// ```
+pub fn check_psd(q: f64) -> Result<(), Error> {
+    if !(q.is_finite() && q >= 0.0) {
+        return Err(Error::InvalidParameter {
+            name: Param::Q,
+            value: q.to_string(),
+            reason: "must be a finite number at least 0".into(),
+        });
+    }
+    Ok(())
+}
+
 /// White noise of power spectral density `q` on the highest derivative of a degree-`m`
 /// polynomial model on `d` axes (the state order of
 /// [`crate::model::dynamics::PolynomialDynamics`]): `q` in (value unit)² / (time unit)^(2m+1).
@@ -73,13 +92,7 @@ impl WhiteNoiseDerivative {
     /// assert!(WhiteNoiseDerivative::new(2, 0, 1.0).is_err());
     /// ```
     pub fn new(degree: usize, axes: usize, psd: f64) -> Result<Self, Error> {
-        if !(psd.is_finite() && psd >= 0.0) {
-            return Err(Error::InvalidParameter {
-                name: Param::DrivingNoiseQ,
-                value: psd.to_string(),
-                reason: "must be finite and at least 0".into(),
-            });
-        }
+        check_psd(psd)?;
         if axes == 0 {
             return Err(Error::InvalidParameter {
                 name: Param::Axes,

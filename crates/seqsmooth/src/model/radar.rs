@@ -50,13 +50,7 @@ impl Radar {
     /// assert!(Radar::new([0.0; 3], 2).is_err());
     /// ```
     pub fn new(site: [f64; 3], states: usize) -> Result<Self, Error> {
-        if let Some(&value) = site.iter().find(|v| !v.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: Param::Site,
-                value: value.to_string(),
-                reason: "a radar site's coordinates must be finite".into(),
-            });
-        }
+        check_site(site)?;
         if states < 3 {
             return Err(Error::InvalidParameter {
                 name: Param::StateDimension,
@@ -217,6 +211,81 @@ pub fn check_component(k: usize, v: f64) -> Result<f64, &'static str> {
             Err("is outside [-pi/2, pi/2]: elevations are in radians from the x-y plane")
         }
         _ => Ok(v),
+    }
+}
+
+/// The range of a radar's site: three finite coordinates ([`Radar::new`]'s check, and every
+/// front end's).
+///
+/// ```
+/// use seqsmooth::model::radar::check_site;
+/// assert!(check_site([1.0, -2.0, 0.5]).is_ok() && check_site([0.0, f64::NAN, 0.0]).is_err());
+/// ```
+pub fn check_site(site: [f64; 3]) -> Result<(), Error> {
+    if let Some(&value) = site.iter().find(|v| !v.is_finite()) {
+        return Err(Error::InvalidParameter {
+            name: Param::Site,
+            value: value.to_string(),
+            reason: "a radar site's coordinates must be finite".into(),
+        });
+    }
+    Ok(())
+}
+
+/// How an input's azimuths are measured: from `+x` towards `+y` (the library's, the default),
+/// or as bearings (from `+y` clockwise: `x` east, `y` north; [`from_bearing`]). Its
+/// [`name`](Self::name)s are the words of every front end (`--azimuth bearing`,
+/// `azimuth="bearing"`).
+///
+/// ```
+/// use seqsmooth::model::radar::AzimuthConvention;
+/// assert_eq!(AzimuthConvention::from_name("bearing").unwrap(), AzimuthConvention::Bearing);
+/// assert_eq!(AzimuthConvention::default().name(), "from-x");
+/// assert!(AzimuthConvention::from_name("north").is_err());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum AzimuthConvention {
+    /// From `+x` towards `+y`.
+    #[default]
+    FromX,
+    /// Clockwise from north (`+y`), with `x` east and `y` north.
+    Bearing,
+}
+
+impl AzimuthConvention {
+    /// Every convention, in the order of their declaration.
+    pub const ALL: [AzimuthConvention; 2] = [AzimuthConvention::FromX, AzimuthConvention::Bearing];
+
+    /// Every convention's name, in the order of [`ALL`](Self::ALL).
+    pub const NAMES: [&'static str; 2] = ["from-x", "bearing"];
+
+    /// The convention's name (`from-x`, `bearing`).
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+
+    /// The convention called `name`; any other name refused
+    /// ([`Param::AzimuthConvention`]).
+    pub fn from_name(name: &str) -> Result<Self, Error> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name() == name)
+            .ok_or_else(|| Error::InvalidParameter {
+                name: Param::AzimuthConvention,
+                value: format!("{name:?}"),
+                reason: format!("must be one of '{}'", Self::NAMES.join("', '")),
+            })
+    }
+
+    /// Whether the azimuths are bearings (to be turned by [`from_bearing`]).
+    pub fn is_bearing(self) -> bool {
+        self == AzimuthConvention::Bearing
+    }
+}
+
+impl std::fmt::Display for AzimuthConvention {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 

@@ -37,7 +37,7 @@ pub struct SmootherGains {
 
 impl SmootherGains {
     /// The layout of samples at `times` (strictly increasing, at least `n+1`) with noise
-    /// standard deviations `sigmas`, degree `n`.
+    /// standard deviations `sigmas`, degree `n` (at most [`MAX_DEGREE`](super::MAX_DEGREE)).
     pub fn new(times: &[f64], sigmas: &[f64], n: usize) -> Result<Self, Error> {
         if sigmas.len() != times.len() {
             return Err(Error::InvalidParameter {
@@ -61,6 +61,7 @@ impl SmootherGains {
 
     /// [`new`](Self::new) for times in any order (the order `push` follows).
     pub(super) fn layout(times: &[f64], sigmas: &[f64], n: usize) -> Result<Self, Error> {
+        super::check_degree(n)?;
         if let Some((j, &s)) = sigmas
             .iter()
             .enumerate()

@@ -104,5 +104,7 @@ pub use automatic::{AutoConfig, AutoOutput, AutomaticFilter};
 pub use expanding::ExpandingMemory;
 pub use fading::{FadingMemory, SwitchRule};
 pub use filter::PolynomialFilter;
-pub use options::{check_degree, check_tau, check_theta, check_theta_of};
+pub use options::{
+    check_degree, check_derivative, check_lead, check_tau, check_theta, check_theta_of,
+};
 pub use options::{DiscountMode, Engine, GAIN_MAX_DEGREE, GAIN_MAX_VALUE, MAX_DEGREE};

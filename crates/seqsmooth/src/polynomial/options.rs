@@ -110,10 +110,40 @@ pub(crate) fn check_engine_degree(m: usize, engine: Engine) -> Result<(), Error>
 /// assert!(check_degree(MAX_DEGREE).is_ok() && check_degree(MAX_DEGREE + 1).is_err());
 /// ```
 pub fn check_degree(m: usize) -> Result<(), Error> {
-    if m > MAX_DEGREE {
-        return Err(Error::DegreeOutOfRange {
-            degree: m,
-            max: MAX_DEGREE,
+    crate::error::check_degree_at_most(m, MAX_DEGREE)
+}
+
+/// The range of a derivative `k` asked of a filter's estimate without its degree at hand (the
+/// command's `plot --derivative`): `k ≤ MAX_DEGREE`, as no filter estimates more.
+///
+/// ```
+/// use seqsmooth::polynomial::{check_derivative, MAX_DEGREE};
+/// assert!(check_derivative(MAX_DEGREE).is_ok() && check_derivative(MAX_DEGREE + 1).is_err());
+/// ```
+pub fn check_derivative(k: usize) -> Result<(), Error> {
+    if k > MAX_DEGREE {
+        return Err(Error::InvalidParameter {
+            name: Param::Derivative,
+            value: k.to_string(),
+            reason: format!("at most {MAX_DEGREE}, the largest supported degree"),
+        });
+    }
+    Ok(())
+}
+
+/// The range of a lead `H` in time units (an estimate at `t + H`; negative: retrodiction):
+/// finite. The row runner's check ([`crate::polynomial::rows`]) and the command's `--lead`.
+///
+/// ```
+/// use seqsmooth::polynomial::check_lead;
+/// assert!(check_lead(-2.5).is_ok() && check_lead(f64::INFINITY).is_err() && check_lead(f64::NAN).is_err());
+/// ```
+pub fn check_lead(lead: f64) -> Result<(), Error> {
+    if !lead.is_finite() {
+        return Err(Error::InvalidParameter {
+            name: Param::Lead,
+            value: lead.to_string(),
+            reason: "must be a finite number".into(),
         });
     }
     Ok(())

@@ -7,7 +7,8 @@
 //! (5.5.22) carried to the time); then, with [`RowLayout::trailing`], the kind's cells
 //! ([`AnyFilter::trailing_columns`]: fixed memory the rows in the window; the automatic filter
 //! the noise σ in use, the outlier and misfit flags as 0/1 and the estimated bias of `d0` that
-//! `s0` includes; then [`DECISION_CELLS`] cells, the final outlier decisions the update made).
+//! `s0` includes; then [`UPDATE_CELLS`] cells: the final outlier decisions the update made
+//! ([`DECISION_CELLS`]) and the degree in use, [`degree_in_use`]).
 //!
 //! The rule: a row is NaN (an empty cell) where there is no number yet — before the filter has
 //! the samples its fit needs (`m + 1`, fixed memory its window), above the degree an estimate
@@ -24,15 +25,32 @@ use crate::polynomial::filter::{check_rows, no_noise_sigma, PolynomialFilter, Ro
 use crate::polynomial::spec::{AnyFilter, Inner};
 use std::collections::VecDeque;
 
-/// The automatic filter's cells after its written ones (with [`RowLayout::trailing`]): how
-/// many final outlier decisions the row's update made (on the series' oldest samples still
-/// undecided, in order), and their verdicts as bits (`1`: rejected), 32 to a cell, oldest in
 /// The cells of the rows [`AnyFilter::run_rows`] writes and checks at a time (128 KiB: the
 /// block's rows are still in the core's cache when they are checked).
 const BLOCK_CELLS: usize = 16_384;
 
+/// The automatic filter's first cells after its written ones (with [`RowLayout::trailing`]):
+/// how many final outlier decisions the row's update made (on the series' oldest samples still
+/// undecided, in order), and their verdicts as bits (`1`: rejected), 32 to a cell, oldest in
 /// the lowest bit; read by [`decisions`].
 pub const DECISION_CELLS: usize = 3;
+
+/// The automatic filter's cells after its written ones: the [`DECISION_CELLS`], then the degree
+/// in use at the row's update (the active degree while it settles; read by
+/// [`degree_in_use`]).
+pub const UPDATE_CELLS: usize = DECISION_CELLS + 1;
+
+/// The degree in use stored in a row's [`UPDATE_CELLS`] cells (0 where the row holds no
+/// update).
+///
+/// ```
+/// use seqsmooth::polynomial::rows::degree_in_use;
+/// assert_eq!(degree_in_use(&[1.0, 1.0, 0.0, 2.0]), 2);
+/// assert_eq!(degree_in_use(&[f64::NAN; 4]), 0);
+/// ```
+pub fn degree_in_use(cells: &[f64]) -> usize {
+    cells[DECISION_CELLS] as usize
+}
 
 /// What a row holds besides `d0..dM`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -42,7 +60,7 @@ pub struct RowLayout {
     /// The estimates are at each sample's time plus `lead` (negative: retrodiction).
     pub lead: f64,
     /// The kind's cells after them ([`AnyFilter::trailing_columns`], and the automatic
-    /// filter's [`DECISION_CELLS`]).
+    /// filter's [`UPDATE_CELLS`]).
     pub trailing: bool,
 }
 
@@ -143,11 +161,11 @@ impl AnyFilter {
         }
     }
 
-    /// The cells of a row of `layout`, the automatic filter's [`DECISION_CELLS`] included.
+    /// The cells of a row of `layout`, the automatic filter's [`UPDATE_CELLS`] included.
     pub fn stride(&self, layout: RowLayout) -> usize {
         let trailing = match (&self.inner, layout.trailing) {
             (_, false) => 0,
-            (Inner::Automatic(_), true) => self.trailing_columns().len() + DECISION_CELLS,
+            (Inner::Automatic(_), true) => self.trailing_columns().len() + UPDATE_CELLS,
             (_, true) => self.trailing_columns().len(),
         };
         ((self.degree() + 1) << usize::from(layout.sigma)) + trailing
@@ -183,6 +201,7 @@ impl AnyFilter {
     ) -> Result<(), Error> {
         let stride = self.stride(layout);
         crate::polynomial::filter::check_batch_lengths(t, y)?;
+        crate::polynomial::options::check_lead(layout.lead)?;
         if out.len() != t.len() * stride {
             return Err(Error::InvalidParameter {
                 name: Param::RowsLength,
@@ -296,6 +315,7 @@ impl AnyFilter {
                             o.bias.as_ref().map_or(f64::NAN, |b| b[0]),
                         ]);
                         store_decisions(&o.decided, &mut extra[4..4 + DECISION_CELLS]);
+                        extra[4 + DECISION_CELLS] = o.degree as f64;
                     }
                     // The estimate is at t: the update's own, or across a rejected sample the
                     // prediction; with a lead the active filter's, the same way.

@@ -32,10 +32,13 @@ mod memory;
 
 use crate::discount::Discount;
 use crate::error::{Error, Param};
-use crate::estimate::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
+use crate::estimate::gauss_newton::{
+    check_max_iterations, Correction, Epoch, GaussNewton, Measurement,
+};
 use crate::estimate::sliding::{SlidingFit, Start};
 use crate::kalman::filter::KalmanFilter;
 use crate::kalman::fixed_lag::FixedLagSmoother;
+use crate::kalman::noise::check_psd;
 use crate::kalman::smoother::Smoothed;
 use crate::model::dynamics::PolynomialDynamics;
 use crate::model::radar::{check_component, from_bearing, Radar};
@@ -312,24 +315,7 @@ impl RadarTracker {
         solver: GaussNewton,
     ) -> Result<Self, Error> {
         let dynamics = PolynomialDynamics::new(1, 3);
-        if solver.max_iterations == 0 {
-            return Err(Error::InvalidParameter {
-                name: Param::MaxIterations,
-                value: "0".into(),
-                reason: "a fit needs at least 1 iteration".into(),
-            });
-        }
-        let check = |name: Param, value: f64| {
-            if value.is_finite() && value >= 0.0 {
-                Ok(())
-            } else {
-                Err(Error::InvalidParameter {
-                    name,
-                    value: value.to_string(),
-                    reason: "must be a finite number at least 0".into(),
-                })
-            }
-        };
+        check_max_iterations(solver.max_iterations)?;
         let stage = match method {
             TrackMethod::Window { window } => {
                 if window < 2 {
@@ -349,7 +335,7 @@ impl RadarTracker {
             }
             TrackMethod::Kalman { q } | TrackMethod::Smooth { q, .. } => {
                 if let Some(q) = q {
-                    check(Param::Q, q)?;
+                    check_psd(q)?;
                 }
                 Stage::Starting(Box::new(sliding(dynamics, radar, START_WINDOW, solver)?))
             }

@@ -11,7 +11,7 @@
 //! The rows go into [`Batch`]es (numbers by row, time cells in one buffer): reading allocates
 //! nothing per row once a batch's buffers have grown.
 
-use crate::args::{AzimuthConvention, RadarArgs};
+use crate::args::RadarArgs;
 use crate::error::CliError;
 use crate::io::{find_column, parse_cell, shown, CsvIn};
 use seqsmooth::model::radar::{check_component, from_bearing, COMPONENTS};
@@ -307,6 +307,6 @@ impl<R: Read> Rows<R> {
                 flag_name: "--sigma-angle",
             },
         ];
-        Self::new(csv, &names, sigmas, a.azimuth == AzimuthConvention::Bearing)
+        Self::new(csv, &names, sigmas, a.azimuth.is_bearing())
     }
 }

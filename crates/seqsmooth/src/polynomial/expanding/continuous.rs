@@ -29,6 +29,30 @@ use crate::scalar::{Rational, Scalar};
 use nalgebra::DMatrix;
 use num_traits::Zero;
 
+/// The most coefficients `n` of the gain tables ([`hilbert_gains`], [`luenberger_gains`]) a
+/// front end asks for: degree 59, where the exact inverse of the Hilbert matrix already holds
+/// integers of over a hundred digits (a bound on one call's work).
+pub const MAX_COEFFICIENTS: usize = 60;
+
+/// The range of the coefficients `n` of a gain table: `1 ≤ n ≤ MAX_COEFFICIENTS` (every
+/// front end's check).
+///
+/// ```
+/// use seqsmooth::polynomial::expanding::continuous::{check_coefficients, MAX_COEFFICIENTS};
+/// assert!(check_coefficients(1).is_ok() && check_coefficients(MAX_COEFFICIENTS).is_ok());
+/// assert!(check_coefficients(0).is_err() && check_coefficients(MAX_COEFFICIENTS + 1).is_err());
+/// ```
+pub fn check_coefficients(n: usize) -> Result<(), Error> {
+    if !(1..=MAX_COEFFICIENTS).contains(&n) {
+        return Err(Error::InvalidParameter {
+            name: Param::Coefficients,
+            value: n.to_string(),
+            reason: format!("must be from 1 to {MAX_COEFFICIENTS} coefficients"),
+        });
+    }
+    Ok(())
+}
+
 /// `b = H⁻¹·1` by exact inversion of the `n × n` Hilbert matrix (use `T = Rational`; in `f64`
 /// the inversion loses accuracy from `n ≈ 10`).
 ///

@@ -12,6 +12,30 @@ use crate::model::scaling;
 use crate::scalar::Scalar;
 use nalgebra::DMatrix;
 
+/// The largest lead `|h|` in samples a front end's table takes ([`covariance`] at a lead
+/// given as a number): the size of the exact rational such a lead makes in the tables.
+pub const MAX_LEAD_STEPS: f64 = 1e300;
+
+/// The range of a lead `h` in samples given for a table: finite, `|h| < MAX_LEAD_STEPS`.
+/// (In doubles the matrix's entries, of order `h^(2m)`, may still leave the double range well
+/// inside it; the exact tables hold them.)
+///
+/// ```
+/// use seqsmooth::polynomial::fixed::check_lead_steps;
+/// assert!(check_lead_steps(-2.5).is_ok());
+/// assert!(check_lead_steps(1e300).is_err() && check_lead_steps(f64::NAN).is_err());
+/// ```
+pub fn check_lead_steps(h: f64) -> Result<(), Error> {
+    if !(h.is_finite() && h.abs() < MAX_LEAD_STEPS) {
+        return Err(Error::InvalidParameter {
+            name: Param::Lead,
+            value: h.to_string(),
+            reason: format!("must be a finite number of samples, |H| < {MAX_LEAD_STEPS:e}"),
+        });
+    }
+    Ok(())
+}
+
 /// Scaled covariance of the fixed-memory estimate per unit input variance,
 /// `S*_{n+h,n}/σ² = W(h) W(h)ᵀ = Q(L+h) Q(L+h)ᵀ` with `[Q(r)]_ij = (1/i!) dⁱφ_j(r)/drⁱ`
 /// (Morrison (7.5.22)-(7.5.23), (7.5.26)), for white errors of equal variance.

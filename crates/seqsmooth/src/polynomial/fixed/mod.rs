@@ -98,10 +98,13 @@ mod window_vrf;
 
 pub use bias::{bias, dominant_bias, end_point_bias_bound};
 pub use centred::{CentredSmoother, SmoothSigma, SmoothedRow};
-pub use covariance::{correlated_covariance, covariance, covariance_unscaled, vrf_limit};
+pub use covariance::{
+    check_lead_steps, correlated_covariance, covariance, covariance_unscaled, vrf_limit,
+    MAX_LEAD_STEPS,
+};
 pub use design::{tau_for_derivative_sigma, Balance, Design};
 pub use filter::{FixedEngine, FixedMemory};
-pub use smooth::{smooth, smooth_into, smooth_with_sigma_into};
+pub use smooth::{even_times, smooth, smooth_into, smooth_with_sigma_into};
 pub use trend::{smooth_detrended, Detrended, Nominal};
 pub use weights::{weights, weights_unscaled};
 pub use window_vrf::{fixed_memory_vrf_limit, window_covariance};

@@ -22,6 +22,25 @@ pub(crate) fn check_series(times: &[f64], values: &[f64]) -> Result<(), Error> {
     }
 }
 
+/// The times `0, δ, 2δ, …` of `n` evenly spaced samples (`savgol_filter`'s `delta`), the step
+/// `δ` positive and finite ([`Param::Step`]).
+///
+/// ```
+/// use seqsmooth::polynomial::fixed::even_times;
+/// assert_eq!(even_times(3, 0.5).unwrap(), [0.0, 0.5, 1.0]);
+/// assert!(even_times(3, 0.0).is_err() && even_times(3, f64::NAN).is_err());
+/// ```
+pub fn even_times(n: usize, step: f64) -> Result<Vec<f64>, Error> {
+    if !(step.is_finite() && step > 0.0) {
+        return Err(Error::InvalidParameter {
+            name: Param::Step,
+            value: step.to_string(),
+            reason: "must be a positive finite number".into(),
+        });
+    }
+    Ok((0..n).map(|i| i as f64 * step).collect())
+}
+
 /// Smooths a whole series: at each sample, the least-squares polynomial of degree `m` through
 /// the `window` samples most nearly centred on it, evaluated at that sample's time. Returns,
 /// for every sample, the unscaled derivatives `[x, x', …, x^(m)]` in the caller's time units.
