@@ -14,7 +14,10 @@
 //! counted where it is significant), is estimated before each sample, and the least one is
 //! used (a shorter one at once, a longer one a level at a time once it has been the least for
 //! [`LENGTHEN_AFTER`] predictions in a row): its prediction is gated, and its state after the
-//! sample is reported with its honest covariance. Only with
+//! sample is reported with its honest covariance. While memory 0 is in use and its bias is not
+//! significant, its `σ² v_0` is the least (the VRF falls as the memory lengthens), so the
+//! shorter memories are not compared (they keep running); compared again, their calibrations
+//! start from memory 0's. Only with
 //! [`MisfitResponse::Restart`](super::MisfitResponse::Restart) (the flag-only response keeps
 //! the memory). Halving the memory (`θ → θ²`, so
 //! `1 − θ → ≈ 2(1 − θ)`) divides the bias by `≈ 2^(m+1)` and about doubles the VRF. Memory
@@ -163,6 +166,8 @@ pub(super) struct Memories {
     memory: usize,
     /// Predictions in a row for which a longer memory had the least estimated error.
     longer_runs: usize,
+    /// The shorter memories were compared at the latest prediction (see [`Memories::choose`]).
+    compared: bool,
     /// Each memory's prediction of the newest sample and its honest mean square.
     predictions: Vec<Option<(f64, f64)>>,
     /// Each memory's running mean of `ν²/σ_ε²` and its count ([`Memories::calibrate`]).
@@ -193,6 +198,7 @@ impl Memories {
             shorter: shorter_memories(cfg)?,
             memory: 0,
             longer_runs: 0,
+            compared: true,
             predictions: Vec::new(),
             calibration: Vec::new(),
             switched_at: None,
@@ -349,7 +355,9 @@ impl Memories {
     /// use; a longer one only one level at a time, once it has been the least for
     /// [`LENGTHEN_AFTER`] predictions in a row (Morrison §14.8: the memory is lengthened again
     /// once the crossings cease; a single low `b̂` is not evidence enough). Memory 0 while the
-    /// ladder settles (`settled` false), without `σ` or with the flag-only response. Returns,
+    /// ladder settles (`settled` false), without `σ` or with the flag-only response; memory 0,
+    /// without comparing the shorter ones, while it is in use and its bias not significant
+    /// (its VRF is the least, Morrison (13.4.4)). Returns,
     /// when it compared the memories, the chosen one's position at `t` and its companion's
     /// (each with its unit variance, as [`position`](Self::position) and
     /// [`companion_position`](Self::companion_position) give them): the prediction's, computed
@@ -397,6 +405,25 @@ impl Memories {
             if mse.is_finite() && mse < best.0 {
                 best = (mse, j);
             }
+            if j == 0 && self.memory == 0 && b0 == 0.0 && mse.is_finite() {
+                // Memory 0 in use without a significant bias: its `σ² V₀` is the least (a
+                // shorter memory's VRF is larger, Morrison (13.4.4), and its `b̂²` is not
+                // negative), so the shorter memories are not compared.
+                self.compared = false;
+                self.longer_runs = 0;
+                return Some(positions[0]);
+            }
+        }
+        if !self.compared {
+            // Compared again after a pause: their calibrations restart from memory 0's, the
+            // memory in use through the pause (its innovations' mean square against its
+            // predicted value, Morrison §14.8, stands for theirs).
+            if let Some(&first) = self.calibration.first() {
+                for c in self.calibration.iter_mut().skip(1) {
+                    *c = first;
+                }
+            }
+            self.compared = true;
         }
         let j = best.1;
         if j >= self.memory {
