@@ -219,6 +219,10 @@ pub(super) struct WindowFit {
     centre: f64,
     inv_half: f64,
     degree: usize,
+    /// `1/d_i` of the factor's pivots (every VRF of the fit without a division), when they are
+    /// all positive (`determined`).
+    inv_d: [f64; MAX_FIT],
+    determined: bool,
 }
 
 impl Default for WindowFit {
@@ -229,6 +233,8 @@ impl Default for WindowFit {
             centre: 0.0,
             inv_half: 1.0,
             degree: 0,
+            inv_d: [0.0; MAX_FIT],
+            determined: false,
         }
     }
 }
@@ -253,6 +259,7 @@ impl WindowFit {
                 .add_row_powers((t - self.centre) * self.inv_half, y, 1.0);
         }
         let p = degree + 1;
+        self.determined = self.factor.inverse_pivots(&mut self.inv_d[..p]);
         self.factor.solve_into(&mut self.coefficients[..p])
     }
 
@@ -262,15 +269,35 @@ impl WindowFit {
         let u = (t - self.centre) * self.inv_half;
         let a = &self.coefficients;
         let mut h = [0.0; MAX_FIT];
-        let mut g = [0.0; MAX_FIT];
         let mut power = 1.0;
         for hk in &mut h[..p] {
             *hk = power;
             power *= u;
         }
         let value = a[..p].iter().zip(&h[..p]).map(|(a, h)| a * h).sum();
-        let vrf = self.factor.inverse_gram_quad(&h[..p], &mut g[..p])?;
-        Some((value, vrf))
+        Some((value, self.vrf_of(&h[..p])?))
+    }
+
+    /// `hᵀ(AᵀA)⁻¹h = Σ_i g_i²/d_i` with `Uᵀ g = h` (`AᵀA = Uᵀ D U`, the factor's
+    /// square-root-free form): a forward substitution and the pivots' reciprocals kept by
+    /// [`fit`](Self::fit); `None` while not determined.
+    fn vrf_of(&self, h: &[f64]) -> Option<f64> {
+        if !self.determined {
+            return None;
+        }
+        let p = h.len();
+        let u = self.factor.unit_triangle(p);
+        let mut g = [0.0; MAX_FIT];
+        let mut q = 0.0;
+        for i in 0..p {
+            let mut gi = h[i];
+            for k in 0..i {
+                gi -= u[k * p + i] * g[k];
+            }
+            g[i] = gi;
+            q += gi * gi * self.inv_d[i];
+        }
+        Some(q)
     }
 
     fn residual_sq(&self) -> f64 {
