@@ -42,6 +42,7 @@ use crate::polynomial::fading::FadingMemory;
 use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::form::EstimateForm;
 use crate::polynomial::options::{DiscountMode, Engine, GAIN_MAX_DEGREE, MAX_DEGREE};
+use std::sync::Arc;
 
 /// A memory's position at the prediction's time and its companion's, each `(x, v)` with its
 /// unit variance `v` (`None`: not determined).
@@ -147,6 +148,27 @@ fn shorter_memories(cfg: &AutoConfig) -> Result<Vec<Shorter>, Error> {
     Ok(out)
 }
 
+/// The final degree's filters before their first sample, built once (a restart starts from
+/// copies of them: no settings checked again, no allocation to build them).
+#[derive(Debug)]
+struct Fresh {
+    expanding: ExpandingMemory,
+    fading: FadingMemory,
+    upper: UpperPair,
+    shorter: Vec<Shorter>,
+}
+
+impl Fresh {
+    fn new(cfg: &AutoConfig) -> Result<Self, Error> {
+        Ok(Self {
+            expanding: unit_expanding(cfg.degree, cfg.engine)?,
+            fading: unit_fading_on(cfg, cfg.degree, cfg.engine, cfg.theta)?,
+            upper: upper_pair(cfg)?,
+            shorter: shorter_memories(cfg)?,
+        })
+    }
+}
+
 /// The final degree's memories (see the module docs): memory 0 (expanding until the switch,
 /// then fading) and the shorter ones, each with its degree `m + 1` companion; which one is in
 /// use, and each one's calibration.
@@ -181,21 +203,22 @@ pub(super) struct Memories {
     /// `c` of a constant switch rule (`n_s = ⌊c/(1-θ)⌋`), and `c_0m` for Reyneke's `N`.
     switch_constant: Option<f64>,
     memory_constant: f64,
+    /// The filters before their first sample (shared by every copy of the state).
+    fresh: Arc<Fresh>,
 }
 
 impl Memories {
     /// The memories of `cfg`'s final degree, before the first sample.
     pub(super) fn new(cfg: &AutoConfig) -> Result<Self, Error> {
         let m = cfg.degree;
-        let expanding = Some(unit_expanding(m, cfg.engine)?);
-        let fading = unit_fading_on(cfg, m, cfg.engine, cfg.theta)?;
-        let (upper_expanding, upper_fading) = upper_pair(cfg)?;
+        let fresh = Arc::new(Fresh::new(cfg)?);
+        let (upper_expanding, upper_fading) = fresh.upper.clone();
         Ok(Self {
-            expanding,
-            fading,
+            expanding: Some(fresh.expanding.clone()),
+            fading: fresh.fading.clone(),
             upper_expanding,
             upper_fading,
-            shorter: shorter_memories(cfg)?,
+            shorter: fresh.shorter.clone(),
             memory: 0,
             longer_runs: 0,
             compared: true,
@@ -206,16 +229,18 @@ impl Memories {
             t_first: None,
             switch_constant: cfg.switch_rule.asymptotic_constant(m),
             memory_constant: memory_length_constant(0, m),
+            fresh,
         })
     }
 
     /// The memories rebuilt from the `kept` samples (a restart, [`MisfitResponse::Restart`]):
     /// memory 0 expanding again, the calibration cleared.
-    pub(super) fn rebuild(&mut self, cfg: &AutoConfig, kept: &[Kept]) -> Result<(), Error> {
-        let mut expanding = unit_expanding(cfg.degree, cfg.engine)?;
-        let mut fading = unit_fading_on(cfg, cfg.degree, cfg.engine, cfg.theta)?;
-        let (mut upper_expanding, mut upper_fading) = upper_pair(cfg)?;
-        let mut shorter = shorter_memories(cfg)?;
+    pub(super) fn rebuild(&mut self, kept: &[Kept]) -> Result<(), Error> {
+        let fresh = &self.fresh;
+        let mut expanding = fresh.expanding.clone();
+        let mut fading = fresh.fading.clone();
+        let (mut upper_expanding, mut upper_fading) = fresh.upper.clone();
+        let mut shorter = fresh.shorter.clone();
         for k in kept {
             for s in &mut shorter {
                 s.fading.update(k.t, k.y)?;
