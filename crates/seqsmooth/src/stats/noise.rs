@@ -516,10 +516,15 @@ impl DifferenceNoise {
         if self.times.len() < self.order + 1 {
             return Ok(None);
         }
-        let ts: Vec<f64> = self.times.iter().copied().collect();
-        let ys: Vec<f64> = self.values.iter().copied().collect();
-        let fs: Vec<f64> = self.factors.iter().copied().collect();
-        let (d, expected) = divided_difference_with_factors(&ts, &ys, &fs);
+        // The windows as slices, in place (no copy per sample).
+        self.times.make_contiguous();
+        self.values.make_contiguous();
+        self.factors.make_contiguous();
+        let (d, expected) = divided_difference_with_factors(
+            self.times.as_slices().0,
+            self.values.as_slices().0,
+            self.factors.as_slices().0,
+        );
         let d2 = d * d / expected;
         if !self.screened_out(d2) {
             self.squares.push(d2);

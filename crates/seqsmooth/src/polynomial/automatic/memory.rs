@@ -14,7 +14,10 @@
 //! counted where it is significant), is estimated before each sample, and the least one is
 //! used (a shorter one at once, a longer one a level at a time once it has been the least for
 //! [`LENGTHEN_AFTER`] predictions in a row): its prediction is gated, and its state after the
-//! sample is reported with its honest covariance. Only with
+//! sample is reported with its honest covariance. While memory 0 is in use and its bias is not
+//! significant, its `σ² v_0` is the least (the VRF falls as the memory lengthens), so the
+//! shorter memories are not compared (they keep running); compared again, their calibrations
+//! start from memory 0's. Only with
 //! [`MisfitResponse::Restart`](super::MisfitResponse::Restart) (the flag-only response keeps
 //! the memory). Halving the memory (`θ → θ²`, so
 //! `1 − θ → ≈ 2(1 − θ)`) divides the bias by `≈ 2^(m+1)` and about doubles the VRF. Memory
@@ -39,6 +42,7 @@ use crate::polynomial::fading::FadingMemory;
 use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::form::EstimateForm;
 use crate::polynomial::options::{DiscountMode, Engine, GAIN_MAX_DEGREE, MAX_DEGREE};
+use std::sync::Arc;
 
 /// A memory's position at the prediction's time and its companion's, each `(x, v)` with its
 /// unit variance `v` (`None`: not determined).
@@ -144,6 +148,27 @@ fn shorter_memories(cfg: &AutoConfig) -> Result<Vec<Shorter>, Error> {
     Ok(out)
 }
 
+/// The final degree's filters before their first sample, built once (a restart starts from
+/// copies of them: no settings checked again, no allocation to build them).
+#[derive(Debug)]
+struct Fresh {
+    expanding: ExpandingMemory,
+    fading: FadingMemory,
+    upper: UpperPair,
+    shorter: Vec<Shorter>,
+}
+
+impl Fresh {
+    fn new(cfg: &AutoConfig) -> Result<Self, Error> {
+        Ok(Self {
+            expanding: unit_expanding(cfg.degree, cfg.engine)?,
+            fading: unit_fading_on(cfg, cfg.degree, cfg.engine, cfg.theta)?,
+            upper: upper_pair(cfg)?,
+            shorter: shorter_memories(cfg)?,
+        })
+    }
+}
+
 /// The final degree's memories (see the module docs): memory 0 (expanding until the switch,
 /// then fading) and the shorter ones, each with its degree `m + 1` companion; which one is in
 /// use, and each one's calibration.
@@ -163,6 +188,8 @@ pub(super) struct Memories {
     memory: usize,
     /// Predictions in a row for which a longer memory had the least estimated error.
     longer_runs: usize,
+    /// The shorter memories were compared at the latest prediction (see [`Memories::choose`]).
+    compared: bool,
     /// Each memory's prediction of the newest sample and its honest mean square.
     predictions: Vec<Option<(f64, f64)>>,
     /// Each memory's running mean of `ν²/σ_ε²` and its count ([`Memories::calibrate`]).
@@ -176,23 +203,25 @@ pub(super) struct Memories {
     /// `c` of a constant switch rule (`n_s = ⌊c/(1-θ)⌋`), and `c_0m` for Reyneke's `N`.
     switch_constant: Option<f64>,
     memory_constant: f64,
+    /// The filters before their first sample (shared by every copy of the state).
+    fresh: Arc<Fresh>,
 }
 
 impl Memories {
     /// The memories of `cfg`'s final degree, before the first sample.
     pub(super) fn new(cfg: &AutoConfig) -> Result<Self, Error> {
         let m = cfg.degree;
-        let expanding = Some(unit_expanding(m, cfg.engine)?);
-        let fading = unit_fading_on(cfg, m, cfg.engine, cfg.theta)?;
-        let (upper_expanding, upper_fading) = upper_pair(cfg)?;
+        let fresh = Arc::new(Fresh::new(cfg)?);
+        let (upper_expanding, upper_fading) = fresh.upper.clone();
         Ok(Self {
-            expanding,
-            fading,
+            expanding: Some(fresh.expanding.clone()),
+            fading: fresh.fading.clone(),
             upper_expanding,
             upper_fading,
-            shorter: shorter_memories(cfg)?,
+            shorter: fresh.shorter.clone(),
             memory: 0,
             longer_runs: 0,
+            compared: true,
             predictions: Vec::new(),
             calibration: Vec::new(),
             switched_at: None,
@@ -200,16 +229,18 @@ impl Memories {
             t_first: None,
             switch_constant: cfg.switch_rule.asymptotic_constant(m),
             memory_constant: memory_length_constant(0, m),
+            fresh,
         })
     }
 
     /// The memories rebuilt from the `kept` samples (a restart, [`MisfitResponse::Restart`]):
     /// memory 0 expanding again, the calibration cleared.
-    pub(super) fn rebuild(&mut self, cfg: &AutoConfig, kept: &[Kept]) -> Result<(), Error> {
-        let mut expanding = unit_expanding(cfg.degree, cfg.engine)?;
-        let mut fading = unit_fading_on(cfg, cfg.degree, cfg.engine, cfg.theta)?;
-        let (mut upper_expanding, mut upper_fading) = upper_pair(cfg)?;
-        let mut shorter = shorter_memories(cfg)?;
+    pub(super) fn rebuild(&mut self, kept: &[Kept]) -> Result<(), Error> {
+        let fresh = &self.fresh;
+        let mut expanding = fresh.expanding.clone();
+        let mut fading = fresh.fading.clone();
+        let (mut upper_expanding, mut upper_fading) = fresh.upper.clone();
+        let mut shorter = fresh.shorter.clone();
         for k in kept {
             for s in &mut shorter {
                 s.fading.update(k.t, k.y)?;
@@ -349,7 +380,9 @@ impl Memories {
     /// use; a longer one only one level at a time, once it has been the least for
     /// [`LENGTHEN_AFTER`] predictions in a row (Morrison §14.8: the memory is lengthened again
     /// once the crossings cease; a single low `b̂` is not evidence enough). Memory 0 while the
-    /// ladder settles (`settled` false), without `σ` or with the flag-only response. Returns,
+    /// ladder settles (`settled` false), without `σ` or with the flag-only response; memory 0,
+    /// without comparing the shorter ones, while it is in use and its bias not significant
+    /// (its VRF is the least, Morrison (13.4.4)). Returns,
     /// when it compared the memories, the chosen one's position at `t` and its companion's
     /// (each with its unit variance, as [`position`](Self::position) and
     /// [`companion_position`](Self::companion_position) give them): the prediction's, computed
@@ -397,6 +430,25 @@ impl Memories {
             if mse.is_finite() && mse < best.0 {
                 best = (mse, j);
             }
+            if j == 0 && self.memory == 0 && b0 == 0.0 && mse.is_finite() {
+                // Memory 0 in use without a significant bias: its `σ² V₀` is the least (a
+                // shorter memory's VRF is larger, Morrison (13.4.4), and its `b̂²` is not
+                // negative), so the shorter memories are not compared.
+                self.compared = false;
+                self.longer_runs = 0;
+                return Some(positions[0]);
+            }
+        }
+        if !self.compared {
+            // Compared again after a pause: their calibrations restart from memory 0's, the
+            // memory in use through the pause (its innovations' mean square against its
+            // predicted value, Morrison §14.8, stands for theirs).
+            if let Some(&first) = self.calibration.first() {
+                for c in self.calibration.iter_mut().skip(1) {
+                    *c = first;
+                }
+            }
+            self.compared = true;
         }
         let j = best.1;
         if j >= self.memory {

@@ -12,9 +12,10 @@
 //!
 //! | step | rule | source |
 //! |---|---|---|
-//! | neighbours not caught yet | the fit drops up to two of its samples whose studentised residual `\|r_j\|/(σ√(1 − h_j))` exceeds `k`, the largest first | Morrison (6.10.24) |
+//! | gate decides at once | where the gate's `σ_ε` is at most `√(c σ²(1 + v_p))` of the fit through every neighbour, the gate's verdict stands and the steps below are skipped (dropping neighbours only raises `v_p`) | Morrison §7.13 |
+//! | neighbours not caught yet | the fit drops up to two of its samples whose studentised residual `\|r_j\|/(σ√(1 − h_j))` exceeds `k`, the largest first (where the gate does not decide at once) | Morrison (6.10.24) |
 //! | fit's bias at `t` | `b² = max(0, Δ² − σ²(v₊ − v_p))`, `Δ` against the fit one degree up on the same samples (not fitted where the gate decides whatever `b²` is) | Morrison (7.13.5), §13.9 |
-//! | residuals not white | `c = max(1, Σ RSS/σ² / Σ(n − p))` over the last 20 windows ([`Calibration`]) | Morrison §14.8 |
+//! | residuals not white | `c = max(1, Σ RSS/σ² / Σ(n − p))` over the last 20 windows ([`Calibration`]; a window the gate decides at once enters with every neighbour) | Morrison §14.8 |
 //! | verdict | reject when `\|y − p(t)\| > k √(c σ²(1 + v_p) + b²)` (`k` the gate's multiplier) | Morrison §14.8 |
 //! | judge | the gate's verdict stands where its `σ_ε` was at most the interpolation's root mean square (a long memory that fits), the interpolation's otherwise | Morrison §7.13 |
 //!
@@ -218,6 +219,10 @@ pub(super) struct WindowFit {
     centre: f64,
     inv_half: f64,
     degree: usize,
+    /// `1/d_i` of the factor's pivots (every VRF of the fit without a division), when they are
+    /// all positive (`determined`).
+    inv_d: [f64; MAX_FIT],
+    determined: bool,
 }
 
 impl Default for WindowFit {
@@ -228,6 +233,8 @@ impl Default for WindowFit {
             centre: 0.0,
             inv_half: 1.0,
             degree: 0,
+            inv_d: [0.0; MAX_FIT],
+            determined: false,
         }
     }
 }
@@ -252,6 +259,7 @@ impl WindowFit {
                 .add_row_powers((t - self.centre) * self.inv_half, y, 1.0);
         }
         let p = degree + 1;
+        self.determined = self.factor.inverse_pivots(&mut self.inv_d[..p]);
         self.factor.solve_into(&mut self.coefficients[..p])
     }
 
@@ -261,15 +269,35 @@ impl WindowFit {
         let u = (t - self.centre) * self.inv_half;
         let a = &self.coefficients;
         let mut h = [0.0; MAX_FIT];
-        let mut g = [0.0; MAX_FIT];
         let mut power = 1.0;
         for hk in &mut h[..p] {
             *hk = power;
             power *= u;
         }
         let value = a[..p].iter().zip(&h[..p]).map(|(a, h)| a * h).sum();
-        let vrf = self.factor.inverse_gram_quad(&h[..p], &mut g[..p])?;
-        Some((value, vrf))
+        Some((value, self.vrf_of(&h[..p])?))
+    }
+
+    /// `hᵀ(AᵀA)⁻¹h = Σ_i g_i²/d_i` with `Uᵀ g = h` (`AᵀA = Uᵀ D U`, the factor's
+    /// square-root-free form): a forward substitution and the pivots' reciprocals kept by
+    /// [`fit`](Self::fit); `None` while not determined.
+    fn vrf_of(&self, h: &[f64]) -> Option<f64> {
+        if !self.determined {
+            return None;
+        }
+        let p = h.len();
+        let u = self.factor.unit_triangle(p);
+        let mut g = [0.0; MAX_FIT];
+        let mut q = 0.0;
+        for i in 0..p {
+            let mut gi = h[i];
+            for k in 0..i {
+                gi -= u[k * p + i] * g[k];
+            }
+            g[i] = gi;
+            q += gi * gi * self.inv_d[i];
+        }
+        Some(q)
     }
 
     fn residual_sq(&self) -> f64 {
@@ -289,7 +317,8 @@ const MAX_FIT: usize = MAX_DEGREE + 3;
 /// where `σ_ε ≤ √(c σ²(1 + v_p))` (the root mean square is at least that, so the gate decides
 /// whatever `b²` is), and where the gate passed the sample and `|y − p(t)| ≤ k √(c σ²(1 + v_p))`
 /// (a larger `b²` only widens the interpolation's bound: it passes the sample too, or leaves
-/// the decision to the gate, which passed it).
+/// the decision to the gate, which passed it). Where the fit through every neighbour already
+/// leaves the decision to the gate, no neighbour is dropped (dropping only raises `v_p`).
 pub(super) fn interpolation_verdict(
     around: &[(f64, f64)],
     (t, y): (f64, f64),
@@ -314,6 +343,18 @@ pub(super) fn interpolation_verdict(
     if !fit.fit(&ts[..n], &ys[..n], degree) {
         return None;
     }
+    // The gate decides where its σ_ε is at most the interpolation's noise-only root mean square
+    // (below). Dropping neighbours only raises the fit's VRF at `t` (less information), so
+    // where the fit through every neighbour already says so, the neighbours are not studied:
+    // the window's residuals enter the calibration as they are.
+    if let Some(g) = gate_rms {
+        let (_, v) = fit.value_and_vrf_at(t)?;
+        let rms_noise = (sigma * sigma * calibration.factor() * (1.0 + v.max(0.0))).sqrt();
+        if g <= rms_noise {
+            calibration.push(fit.residual_sq() / (sigma * sigma), n - (degree + 1));
+            return None;
+        }
+    }
     for _ in 0..2 {
         if n < degree + 4 {
             break;
@@ -321,15 +362,17 @@ pub(super) fn interpolation_verdict(
         let mut worst = (f64::NEG_INFINITY, 0);
         for j in 0..n {
             let (p, h) = fit.value_and_vrf_at(ts[j])?;
-            let r = (ys[j] - p).abs() / (sigma * (1.0 - h).max(f64::EPSILON).sqrt());
-            if r.is_nan() {
+            // The squared studentised residual.
+            let e = ys[j] - p;
+            let r2 = e * e / (sigma * sigma * (1.0 - h).max(f64::EPSILON));
+            if r2.is_nan() {
                 return None;
             }
-            if r > worst.0 {
-                worst = (r, j);
+            if r2 > worst.0 {
+                worst = (r2, j);
             }
         }
-        if worst.0 <= k {
+        if worst.0 <= k * k {
             break;
         }
         ts.copy_within(worst.1 + 1..n, worst.1);

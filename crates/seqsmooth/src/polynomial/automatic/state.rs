@@ -319,7 +319,7 @@ impl State {
     /// misfit ([`Misfit::since_onset`]).
     fn restart(&mut self) -> Result<(), Error> {
         let kept = self.misfit.since_onset(self.cfg.degree);
-        self.memories.rebuild(&self.cfg, &kept)?;
+        self.memories.rebuild(&kept)?;
         self.misfit.restarted(&kept, self.accepted);
         Ok(())
     }

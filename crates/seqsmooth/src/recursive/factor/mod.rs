@@ -309,30 +309,6 @@ impl TriangularFactor {
         true
     }
 
-    /// `hᵀ(RᵀR)⁻¹h = Σ_i g_i²/d_i` with `Uᵀ g = h` (a forward substitution into `g`, no
-    /// allocation); `None` while not determined.
-    pub(crate) fn inverse_gram_quad(&self, h: &[f64], g: &mut [f64]) -> Option<f64> {
-        if !self.is_determined() {
-            return None;
-        }
-        let p = self.dim();
-        let u = &self.u[..p * p];
-        // Uᵀ g = h (unit lower triangular).
-        for i in 0..p {
-            let mut gi = h[i];
-            for k in 0..i {
-                gi -= u[k * p + i] * g[k];
-            }
-            g[i] = gi;
-        }
-        Some(
-            g[..p]
-                .iter()
-                .zip(&self.d)
-                .fold(0.0, |q, (gi, d)| q + *gi * *gi / d.0),
-        )
-    }
-
     /// Folds the row `√c·[a | b]` into `[R | d]`: `O(p²)`, no square roots.
     pub fn add_row(&mut self, a: &[f64], b: f64, weight: f64) {
         let p = self.dim();
