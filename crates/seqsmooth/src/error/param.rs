@@ -258,6 +258,20 @@ pub enum Param {
     Measurement,
     /// The stacked observations `Y`.
     ObservationsY,
+    /// A discrete-time model's transition matrix `F` (`x_k = F x_{k−1} + B u + w`).
+    TransitionMatrixF,
+    /// A discrete-time model's observation matrix `H` (`z = H x + v`).
+    ObservationMatrixH,
+    /// A discrete-time model's process-noise covariance `Q` over one step.
+    ProcessNoiseQ,
+    /// A discrete-time model's measurement-noise covariance `R`.
+    MeasurementNoiseR,
+    /// A discrete-time model's control matrix `B`.
+    ControlMatrixB,
+    /// A discrete-time model's control input `u`.
+    ControlInputU,
+    /// A fixed-lag smoother's lag, in measurements.
+    Lag,
 }
 
 impl Param {
@@ -381,6 +395,13 @@ impl Param {
         Param::Sigmas,
         Param::Measurement,
         Param::ObservationsY,
+        Param::TransitionMatrixF,
+        Param::ObservationMatrixH,
+        Param::ProcessNoiseQ,
+        Param::MeasurementNoiseR,
+        Param::ControlMatrixB,
+        Param::ControlInputU,
+        Param::Lag,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -504,6 +525,13 @@ impl Param {
             Param::Sigmas => "sigmas",
             Param::Measurement => "measurement",
             Param::ObservationsY => "observations Y",
+            Param::TransitionMatrixF => "transition matrix F",
+            Param::ObservationMatrixH => "observation matrix H",
+            Param::ProcessNoiseQ => "process noise Q",
+            Param::MeasurementNoiseR => "measurement noise R",
+            Param::ControlMatrixB => "control matrix B",
+            Param::ControlInputU => "control input u",
+            Param::Lag => "lag",
         }
     }
 
@@ -533,7 +561,8 @@ impl Param {
             | Param::Segment
             | Param::Sigmas
             | Param::Measurement
-            | Param::ObservationsY => ErrorKind::InvalidInput,
+            | Param::ObservationsY
+            | Param::ControlInputU => ErrorKind::InvalidInput,
             _ => ErrorKind::Parameter,
         }
     }
