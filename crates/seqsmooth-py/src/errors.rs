@@ -98,6 +98,13 @@ pub fn raise(kind: Kind, message: impl Into<String>, index: Option<usize>) -> Py
 pub fn keyword(p: Param) -> Option<&'static str> {
     match p {
         Param::ReviewWindow => Some("review_window"),
+        Param::TransitionMatrixF => Some("F"),
+        Param::ObservationMatrixH => Some("H"),
+        Param::ProcessNoiseQ => Some("Q"),
+        Param::MeasurementNoiseR => Some("R"),
+        Param::ControlMatrixB => Some("B"),
+        Param::ControlInputU => Some("u"),
+        Param::StateCovarianceP => Some("P"),
         _ => None,
     }
 }

@@ -15,6 +15,10 @@ FadingBank, ExpandingBank
 KalmanFilter
     The Kalman filter over the polynomial model (Morrison chs. 12, 14, 15): driving noise,
     fading memory, missing components, ``update_many`` and the RTS ``smooth``.
+LinearKalmanFilter
+    The Kalman filter on your own matrices ``F``, ``H``, ``Q``, ``R``, ``B u`` (filterpy's
+    ``KalmanFilter``), constant or one per step: ``update_many`` (``batch_filter``), the RTS
+    smoother over that pass with its gains, and the fixed-lag smoother.
 BayesFilter
     The Bayes filter (Morrison ch. 10) in square-root information form over the same model:
     starts from no information, fading memory with the true covariance.
@@ -61,6 +65,7 @@ from ._seqsmooth import (
     FixedMemory,
     Innovation,
     KalmanFilter,
+    LinearKalmanFilter,
     OnlineSmoother,
     PolynomialFilter,
     RadarTracker,
@@ -99,6 +104,7 @@ __all__ = [
     "FadingMemory",
     "FixedMemory",
     "KalmanFilter",
+    "LinearKalmanFilter",
     "RadarTracker",
     "SlidingFit",
     "Innovation",

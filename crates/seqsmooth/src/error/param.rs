@@ -272,6 +272,8 @@ pub enum Param {
     ControlInputU,
     /// A fixed-lag smoother's lag, in measurements.
     Lag,
+    /// A discrete-time model's state covariance `P` set or handed in.
+    StateCovarianceP,
 }
 
 impl Param {
@@ -402,6 +404,7 @@ impl Param {
         Param::ControlMatrixB,
         Param::ControlInputU,
         Param::Lag,
+        Param::StateCovarianceP,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -532,6 +535,7 @@ impl Param {
             Param::ControlMatrixB => "control matrix B",
             Param::ControlInputU => "control input u",
             Param::Lag => "lag",
+            Param::StateCovarianceP => "state covariance P",
         }
     }
 

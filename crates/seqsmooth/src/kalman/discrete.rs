@@ -304,7 +304,7 @@ impl LinearKalmanFilter {
                 reason: format!("must be {n} finite numbers"),
             });
         }
-        check_covariance(&p, n, Param::Covariance)?;
+        check_covariance(&p, n, Param::StateCovarianceP)?;
         let time = self.filter.time();
         let mut filter = self.filter.clone();
         filter.set_estimate(x, p, time)?;
@@ -442,33 +442,29 @@ impl LinearKalmanFilter {
         pass.nis.reserve(rows);
         for (k, z) in zs.chunks_exact(p).enumerate() {
             let s = step(k);
-            let one = |this: &mut Self| -> Result<(DVector<f64>, DMatrix<f64>, f64), Error> {
-                this.check(&s, true)?;
-                let before = this.filter.clone();
-                predict_on(&mut this.filter, &this.model, &s, |f, t| f.predict(t))?;
-                let predicted = (
-                    this.filter.state().clone(),
-                    this.filter.covariance().clone(),
-                );
-                let m = this.measurement(z, s.r)?;
-                match update_on(&mut this.filter, &this.model, &s, |f| f.update_stats(&m)) {
-                    Ok(stats) => Ok((predicted.0, predicted.1, stats.map_or(f64::NAN, |s| s.nis))),
-                    Err(e) => {
-                        this.filter = before;
-                        Err(e)
-                    }
-                }
-            };
-            let (xp, pp, nis) = one(self).map_err(|e| Error::InBatch {
+            let in_batch = |e: Error| Error::InBatch {
                 index: k,
                 source: Box::new(e),
-            })?;
+            };
+            self.check(&s, true).map_err(in_batch)?;
+            let mut m = self.measurement(z, s.r).map_err(in_batch)?;
+            m.time += 1.0;
+            // The prediction and the update in one call: both or neither.
+            apply_prediction(&mut self.filter, &self.model, &s);
+            let stats = apply_update(&mut self.filter, &self.model, &s)
+                .and_then(|()| self.filter.update_stats(&m));
+            restore(&mut self.filter, &self.model, &s);
+            let nis = stats.map_err(in_batch)?.map(|s| s.nis);
+            let (xp, pp) = match nis {
+                Some(_) => self.filter.last_prediction(),
+                None => (self.filter.state(), self.filter.covariance()),
+            };
             pass.predicted_states.extend_from_slice(xp.as_slice());
             pass.predicted_covariances.extend_from_slice(pp.as_slice());
             pass.states.extend_from_slice(self.state().as_slice());
             pass.covariances
                 .extend_from_slice(self.covariance().as_slice());
-            pass.nis.push(nis);
+            pass.nis.push(nis.unwrap_or(f64::NAN));
         }
         Ok(())
     }
@@ -517,7 +513,7 @@ impl LinearKalmanFilter {
             let s = step(k);
             self.check(&s, true).map_err(in_batch(k))?;
             let (x0, p0) = &filtered[k - 1];
-            check_covariance(p0, n, Param::Covariance).map_err(in_batch(k - 1))?;
+            check_covariance(p0, n, Param::StateCovarianceP).map_err(in_batch(k - 1))?;
             let mut filter = self.filter.clone();
             filter
                 .set_estimate(x0.clone(), p0.clone(), 0.0)

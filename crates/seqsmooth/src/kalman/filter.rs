@@ -371,6 +371,12 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         Ok(())
     }
 
+    /// The prediction `X_{n,n−1}`, `S_{n,n−1}` that the last update corrected (valid right
+    /// after an update that made its correction).
+    pub(crate) fn last_prediction(&self) -> (&DVector<f64>, &DMatrix<f64>) {
+        (&self.work.x, &self.work.s)
+    }
+
     /// The dynamics, to change a step's matrices in place (the caller keeps its dimension).
     pub(crate) fn dynamics_mut(&mut self) -> &mut D {
         &mut self.dynamics
