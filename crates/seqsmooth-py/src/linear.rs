@@ -10,7 +10,7 @@ use crate::kalman::{square, PyInnovation};
 use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
+use pyo3::types::{IntoPyDict, PyTuple};
 use seqsmooth::kalman::discrete::{LinearKalmanFilter, Pass, StepMatrices};
 
 /// `obj` as a C-contiguous float64 array: its values (row-major) and shape, named `name`.
@@ -32,7 +32,12 @@ fn nd(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<(Vec<f64>, Vec<usize>)> {
             None,
         ));
     }
-    let a = np.call_method1("ascontiguousarray", (a, "float64"))?;
+    // `asarray` (not `ascontiguousarray`, which makes a number one-dimensional) in C order.
+    let a = np.call_method(
+        "asarray",
+        (a, "float64"),
+        Some(&[("order", "C")].into_py_dict(obj.py())?),
+    )?;
     let a = a.cast::<PyArrayDyn<f64>>()?.readonly();
     Ok((a.as_slice()?.to_vec(), a.shape().to_vec()))
 }
@@ -185,16 +190,25 @@ impl Steps {
 /// Rows × `p` measurements from `zs` (`(N,)` for one component, or `(N, p)`; NaN a missing
 /// component, `None` in a list a missing measurement).
 fn measurements(zs: &Bound<'_, PyAny>, p: usize) -> PyResult<(Vec<f64>, usize)> {
-    let zs = match zs.extract::<Vec<Option<Vec<f64>>>>() {
-        Ok(rows) if rows.iter().any(Option::is_none) => {
+    // A list may hold None for a missing measurement (filterpy's convention); an array is
+    // taken as it is.
+    let listed = zs.is_instance_of::<pyo3::types::PyList>();
+    let zs = match listed
+        .then(|| zs.extract::<Vec<Option<Vec<f64>>>>().ok())
+        .flatten()
+    {
+        Some(rows) if rows.iter().any(Option::is_none) => {
             let filled: Vec<Vec<f64>> = rows
                 .into_iter()
                 .map(|r| r.unwrap_or_else(|| vec![f64::NAN; p]))
                 .collect();
             filled.into_pyobject(zs.py())?.into_any()
         }
-        _ => match zs.extract::<Vec<Option<f64>>>() {
-            Ok(rows) if rows.iter().any(Option::is_none) => rows
+        _ => match listed
+            .then(|| zs.extract::<Vec<Option<f64>>>().ok())
+            .flatten()
+        {
+            Some(rows) if rows.iter().any(Option::is_none) => rows
                 .into_iter()
                 .map(|v| v.unwrap_or(f64::NAN))
                 .collect::<Vec<f64>>()

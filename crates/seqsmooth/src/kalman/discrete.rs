@@ -399,6 +399,22 @@ impl LinearKalmanFilter {
 
     /// One measurement of `z` at the filter's time with `r` or the constant `R`.
     fn measurement(&self, z: &[f64], r: Option<&DMatrix<f64>>) -> Result<Measurement, Error> {
+        let mut m = Measurement {
+            time: 0.0,
+            values: Vec::new(),
+            noise: NoiseCovariance::Identity,
+        };
+        self.fill_measurement(z, r, &mut m)?;
+        Ok(m)
+    }
+
+    /// [`Self::measurement`] into `m`, reusing its buffers (a batch's hot path).
+    fn fill_measurement(
+        &self,
+        z: &[f64],
+        r: Option<&DMatrix<f64>>,
+        m: &mut Measurement,
+    ) -> Result<(), Error> {
         let p = self.components();
         if z.len() != p {
             return Err(Error::InvalidParameter {
@@ -413,11 +429,16 @@ impl LinearKalmanFilter {
                 value: v,
             });
         }
-        Ok(Measurement {
-            time: self.filter.time(),
-            values: z.iter().map(|&v| (!v.is_nan()).then_some(v)).collect(),
-            noise: NoiseCovariance::Full(r.unwrap_or(&self.model.r).clone()),
-        })
+        m.time = self.filter.time();
+        m.values.clear();
+        m.values
+            .extend(z.iter().map(|&v| (!v.is_nan()).then_some(v)));
+        let r = r.unwrap_or(&self.model.r);
+        match &mut m.noise {
+            NoiseCovariance::Full(held) if held.shape() == r.shape() => held.copy_from(r),
+            noise => *noise = NoiseCovariance::Full(r.clone()),
+        }
+        Ok(())
     }
 
     /// `predict` and `update` for each row of `zs` (`steps × p`, row-major; NaN missing) with
@@ -440,6 +461,11 @@ impl LinearKalmanFilter {
             v.reserve(rows * n * n);
         }
         pass.nis.reserve(rows);
+        let mut m = Measurement {
+            time: 0.0,
+            values: Vec::with_capacity(p),
+            noise: NoiseCovariance::Identity,
+        };
         for (k, z) in zs.chunks_exact(p).enumerate() {
             let s = step(k);
             let in_batch = |e: Error| Error::InBatch {
@@ -447,7 +473,7 @@ impl LinearKalmanFilter {
                 source: Box::new(e),
             };
             self.check(&s, true).map_err(in_batch)?;
-            let mut m = self.measurement(z, s.r).map_err(in_batch)?;
+            self.fill_measurement(z, s.r, &mut m).map_err(in_batch)?;
             m.time += 1.0;
             // The prediction and the update in one call: both or neither.
             apply_prediction(&mut self.filter, &self.model, &s);
