@@ -373,13 +373,7 @@ impl PyLinearKalmanFilter {
 
     #[setter(F)]
     fn set_f(&mut self, m: &Bound<'_, PyAny>) -> PyResult<()> {
-        let m = matrix_from(m, "F", None, false)?;
-        self.inner
-            .set_matrices(&StepMatrices {
-                f: Some(&m),
-                ..Default::default()
-            })
-            .py()
+        self.set_matrix("F", m)
     }
 
     /// The constant ``H``; settable (checked).
@@ -390,13 +384,7 @@ impl PyLinearKalmanFilter {
 
     #[setter(H)]
     fn set_h(&mut self, m: &Bound<'_, PyAny>) -> PyResult<()> {
-        let m = matrix_from(m, "H", None, true)?;
-        self.inner
-            .set_matrices(&StepMatrices {
-                h: Some(&m),
-                ..Default::default()
-            })
-            .py()
+        self.set_matrix("H", m)
     }
 
     /// The constant ``Q``; settable (checked).
@@ -407,13 +395,7 @@ impl PyLinearKalmanFilter {
 
     #[setter(Q)]
     fn set_q(&mut self, m: &Bound<'_, PyAny>) -> PyResult<()> {
-        let m = matrix_from(m, "Q", Some(self.inner.dimension()), false)?;
-        self.inner
-            .set_matrices(&StepMatrices {
-                q: Some(&m),
-                ..Default::default()
-            })
-            .py()
+        self.set_matrix("Q", m)
     }
 
     /// The constant ``R``; settable (checked).
@@ -424,13 +406,7 @@ impl PyLinearKalmanFilter {
 
     #[setter(R)]
     fn set_r(&mut self, m: &Bound<'_, PyAny>) -> PyResult<()> {
-        let m = matrix_from(m, "R", Some(self.inner.components()), false)?;
-        self.inner
-            .set_matrices(&StepMatrices {
-                r: Some(&m),
-                ..Default::default()
-            })
-            .py()
+        self.set_matrix("R", m)
     }
 
     /// Predicts one step: ``x = F x + B u``, ``P = F P Fᵀ + Q``, with this step's ``F``,
@@ -631,5 +607,26 @@ impl PyLinearKalmanFilter {
             self.inner.components(),
             self.inner.steps()
         )
+    }
+}
+
+impl PyLinearKalmanFilter {
+    /// Sets the constant matrix `name` (`F`, `H`, `Q` or `R`) to `m`, checked by the library.
+    fn set_matrix(&mut self, name: &str, m: &Bound<'_, PyAny>) -> PyResult<()> {
+        let (n, p) = (self.inner.dimension(), self.inner.components());
+        let square = match name {
+            "Q" => Some(n),
+            "R" => Some(p),
+            _ => None,
+        };
+        let m = matrix_from(m, name, square, name == "H")?;
+        let mut step = StepMatrices::default();
+        match name {
+            "F" => step.f = Some(&m),
+            "H" => step.h = Some(&m),
+            "Q" => step.q = Some(&m),
+            _ => step.r = Some(&m),
+        }
+        self.inner.set_matrices(&step).py()
     }
 }

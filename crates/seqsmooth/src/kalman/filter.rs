@@ -186,19 +186,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
                 format!("the dynamics have {n} states"),
             ));
         }
-        if state.len() != n || covariance.shape() != (n, n) {
-            return Err(bad(
-                Param::Prior,
-                format!(
-                    "state of length {}, covariance {}x{}",
-                    state.len(),
-                    covariance.nrows(),
-                    covariance.ncols()
-                ),
-                format!("the model has {n} states"),
-            ));
-        }
-        check_prior(&state, &covariance, time)?;
+        check_prior(n, &state, &covariance, time)?;
         let work = Work::new(n, observation.components());
         Ok(Self {
             dynamics,
@@ -325,20 +313,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         covariance: DMatrix<f64>,
         time: f64,
     ) -> Result<(), Error> {
-        let n = self.state.len();
-        if state.len() != n || covariance.shape() != (n, n) {
-            return Err(Error::InvalidParameter {
-                name: Param::State,
-                value: format!(
-                    "state of length {}, covariance {}x{}",
-                    state.len(),
-                    covariance.nrows(),
-                    covariance.ncols()
-                ),
-                reason: format!("the model has {n} states"),
-            });
-        }
-        check_prior(&state, &covariance, time)?;
+        check_prior(self.state.len(), &state, &covariance, time)?;
         if let Some(f) = &mut self.fading {
             f.weight.copy_from(&covariance);
             f.last_update = time;
@@ -857,14 +832,31 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     }
 }
 
-/// Refuses a prior with a number that is not finite, or a covariance that is not symmetric
-/// with a non-negative diagonal (the shapes checked by the caller).
-fn check_prior(state: &DVector<f64>, covariance: &DMatrix<f64>, time: f64) -> Result<(), Error> {
+/// Refuses a prior of other than `n` states, with a number that is not finite, or with a
+/// covariance that is not symmetric with a non-negative diagonal.
+fn check_prior(
+    n: usize,
+    state: &DVector<f64>,
+    covariance: &DMatrix<f64>,
+    time: f64,
+) -> Result<(), Error> {
     let bad = |name: Param, value: String, reason: String| Error::InvalidParameter {
         name,
         value,
         reason,
     };
+    if state.len() != n || covariance.shape() != (n, n) {
+        return Err(bad(
+            Param::Prior,
+            format!(
+                "state of length {}, covariance {}x{}",
+                state.len(),
+                covariance.nrows(),
+                covariance.ncols()
+            ),
+            format!("the model has {n} states"),
+        ));
+    }
     if let Some(&value) = state
         .iter()
         .chain(covariance.iter())
