@@ -8,8 +8,8 @@ axes (n = 4, state x, x', y, y'), dt = 1, Q from filterpy's Q_discrete_white_noi
 both positions observed with a full 2 x 2 R; constant matrices; measurements from numpy
 (float64), in batches of SHORT steps (best of SHORT_REPEATS: the output arrays' memory comes
 back from the allocator) and of STEPS (best of REPEATS: each call's 64 MB of new output is
-fresh memory, paid for in page faults). Each side: best of REPEATS calls on a fresh filter, timed by the calling thread's
-CPU time (time.thread_time: both run in that one thread; on a shared machine the wall time
+fresh memory, paid for in page faults). Each call on a fresh filter, timed by the calling
+thread's CPU time (time.thread_time: both run in that one thread; on a shared machine the wall time
 counts the other processes too) and by the wall clock; filterpy's batch_filter on the
 first PEER_STEPS measurements (its cost per step does not depend on the length). Both return
 every step's updated and predicted state and covariance. Checks that both give the same
