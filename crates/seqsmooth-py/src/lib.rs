@@ -34,6 +34,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<kalman::PyKalmanFilter>()?;
     m.add_class::<kalman::PyInnovation>()?;
     m.add_class::<linear::PyLinearKalmanFilter>()?;
+    m.add_class::<linear::PyLinearFixedLagSmoother>()?;
     m.add_class::<bayes::PyBayesFilter>()?;
     m.add_class::<track::PyRadarTracker>()?;
     m.add_class::<fit::PySlidingFit>()?;

@@ -11,7 +11,8 @@ use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{IntoPyDict, PyTuple};
-use seqsmooth::kalman::discrete::{LinearKalmanFilter, Pass, StepMatrices};
+use seqsmooth::kalman::discrete::{LinearFixedLag, LinearKalmanFilter, Pass, StepMatrices};
+use seqsmooth::kalman::Smoothed;
 
 /// `obj` as a C-contiguous float64 array: its values (row-major) and shape, named `name`.
 fn nd(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<(Vec<f64>, Vec<usize>)> {
@@ -628,5 +629,143 @@ impl PyLinearKalmanFilter {
             _ => step.r = Some(&m),
         }
         self.inner.set_matrices(&step).py()
+    }
+}
+
+/// The fixed-lag smoother on a :class:`LinearKalmanFilter`'s model, a measurement at a time
+/// (filterpy's ``FixedLagSmoother.smooth``, with the exact fixed-lag estimates): each step's
+/// estimate from the ``lag`` steps after it, given once they are in, in memory bounded by the
+/// lag however long it runs.
+///
+/// Parameters
+/// ----------
+/// filter : LinearKalmanFilter
+///     The model and the estimate to start from (not changed).
+/// lag : int
+///     The lag, in measurements.
+#[pyclass(name = "LinearFixedLagSmoother", module = "seqsmooth")]
+pub struct PyLinearFixedLagSmoother {
+    inner: Option<LinearFixedLag>,
+    n: usize,
+}
+
+/// `(index, state, covariance)` of a smoothed step.
+fn smoothed_tuple<'py>(
+    py: Python<'py>,
+    index: usize,
+    s: &Smoothed,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let state = PyArray1::from_slice(py, s.state.as_slice()).into_any();
+    let covariance = square(py, &s.covariance)?;
+    PyTuple::new(py, [index.into_pyobject(py)?.into_any(), state, covariance])
+}
+
+#[pymethods]
+impl PyLinearFixedLagSmoother {
+    #[new]
+    fn new(filter: PyRef<'_, PyLinearKalmanFilter>, lag: usize) -> Self {
+        Self {
+            inner: Some(LinearFixedLag::new(&filter.inner, lag)),
+            n: filter.inner.dimension(),
+        }
+    }
+
+    /// The measurements pushed so far.
+    #[getter]
+    fn pushed(&self) -> PyResult<usize> {
+        Ok(self.smoother()?.pushed())
+    }
+
+    /// The lag, in measurements.
+    #[getter]
+    fn lag(&self) -> PyResult<usize> {
+        Ok(self.smoother()?.lag())
+    }
+
+    /// One step: the prediction and the update with ``z`` (NaN a missing component) and this
+    /// step's matrices where given. Returns ``(index, state, covariance)``, the step ``lag``
+    /// before smoothed by every step since, or ``None`` while fewer than ``lag`` are in. On an
+    /// error the smoother is unchanged.
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    #[pyo3(signature = (z, u = None, B = None, F = None, Q = None, H = None, R = None))]
+    fn update<'py>(
+        &mut self,
+        py: Python<'py>,
+        z: &Bound<'py, PyAny>,
+        u: Option<&Bound<'py, PyAny>>,
+        B: Option<&Bound<'py, PyAny>>,
+        F: Option<&Bound<'py, PyAny>>,
+        Q: Option<&Bound<'py, PyAny>>,
+        H: Option<&Bound<'py, PyAny>>,
+        R: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Option<Bound<'py, PyTuple>>> {
+        let n = self.n;
+        let smoother = self.smoother_mut()?;
+        let index = smoother.pushed().checked_sub(smoother.lag());
+        let z = nd(z, "z")?.0;
+        let opt = |o: Option<&Bound<'_, PyAny>>, name, sq, row| {
+            o.filter(|o| !o.is_none())
+                .map(|o| matrix_from(o, name, sq, row))
+                .transpose()
+        };
+        let p = z.len();
+        let (b, f, q) = (
+            opt(B, "B", None, false)?,
+            opt(F, "F", Some(n), false)?,
+            opt(Q, "Q", Some(n), false)?,
+        );
+        let (h, r) = (opt(H, "H", None, true)?, opt(R, "R", Some(p), false)?);
+        let u = match u.filter(|u| !u.is_none()) {
+            Some(u) => Some(DVector::from_vec(nd(u, "u")?.0)),
+            None => None,
+        };
+        let step = StepMatrices {
+            f: f.as_ref(),
+            q: q.as_ref(),
+            b: b.as_ref(),
+            u: u.as_ref(),
+            h: h.as_ref(),
+            r: r.as_ref(),
+        };
+        match smoother.push(&z, &step).py()? {
+            Some(s) => Ok(Some(smoothed_tuple(py, index.unwrap_or(0), &s)?)),
+            None => Ok(None),
+        }
+    }
+
+    /// The steps held (the last ``lag``), each smoothed by every step pushed: ``(indices,
+    /// states, covariances)``, ``(m,)``, ``(m, n)`` and ``(m, n, n)``. The smoother is spent.
+    fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let smoother = self.inner.take().ok_or_else(spent)?;
+        let first = smoother.pushed() - smoother.pushed().min(smoother.lag());
+        let out = smoother.finish().py()?;
+        let n = self.n;
+        let x: Vec<f64> = out.iter().flat_map(|s| s.state.iter().copied()).collect();
+        let p: Vec<f64> = out
+            .iter()
+            .flat_map(|s| s.covariance.iter().copied())
+            .collect();
+        let indices: Vec<usize> = (first..first + out.len()).collect();
+        let (x, p) = states_and_covariances(py, x, p, n)?;
+        PyTuple::new(py, [PyArray1::from_vec(py, indices).into_any(), x, p])
+    }
+}
+
+/// The error of a smoother used after `finish`.
+fn spent() -> PyErr {
+    raise(
+        Kind::InvalidInput,
+        "the smoother is finished: make a new one",
+        None,
+    )
+}
+
+impl PyLinearFixedLagSmoother {
+    fn smoother(&self) -> PyResult<&LinearFixedLag> {
+        self.inner.as_ref().ok_or_else(spent)
+    }
+
+    fn smoother_mut(&mut self) -> PyResult<&mut LinearFixedLag> {
+        self.inner.as_mut().ok_or_else(spent)
     }
 }

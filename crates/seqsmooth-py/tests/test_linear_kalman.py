@@ -115,6 +115,31 @@ def test_fixed_lag_is_exact_and_filterpys_is_not():
     assert rel(p["filterpy_fls_x"], p["exact_x"]) > 1e-3
 
 
+def test_streamed_fixed_lag_is_the_batch():
+    """LinearFixedLagSmoother, a measurement at a time with this step's matrices, gives
+    fixed_lag_smoother's numbers bit for bit, each step once, the last lag at finish."""
+    p = PROBLEMS["per_step"]
+    lag = 3
+    xs, ps = make(p).fixed_lag_smoother(zs_of(p), lag, **per_step(p))
+    s = ss.LinearFixedLagSmoother(make(p), lag)
+    seen = []
+    for k, z in enumerate(zs_of(p)):
+        out = s.update(z, F=p["Fs"][k], Q=p["Qs"][k], H=p["Hs"][k], R=p["Rs"][k])
+        assert (out is None) == (k < lag)
+        if out is not None:
+            i, x, P = out
+            assert i == k - lag and np.array_equal(x, xs[i]) and np.array_equal(P, ps[i])
+            seen.append(i)
+    with pytest.raises(ss.ParameterError):
+        s.update(zs_of(p)[0], R=[[1.0, 2.0], [2.0, 1.0]])  # refused, the smoother unchanged
+    indices, x, P = s.finish()
+    assert list(indices) == list(range(len(xs) - lag, len(xs)))
+    assert np.array_equal(x, xs[-lag:]) and np.array_equal(P, ps[-lag:])
+    assert seen == list(range(len(xs) - lag))
+    with pytest.raises(ss.SeqsmoothError):
+        s.update(zs_of(p)[0])
+
+
 def test_polynomial_model_from_matrices():
     """The polynomial KalmanFilter on unit steps and the same model as matrices agree."""
     F = np.array([[1.0, 1.0], [0.0, 1.0]])

@@ -18,7 +18,8 @@ KalmanFilter
 LinearKalmanFilter
     The Kalman filter on your own matrices ``F``, ``H``, ``Q``, ``R``, ``B u`` (filterpy's
     ``KalmanFilter``), constant or one per step: ``update_many`` (``batch_filter``), the RTS
-    smoother over that pass with its gains, and the fixed-lag smoother.
+    smoother over that pass with its gains, and the fixed-lag smoother (streamed:
+    ``LinearFixedLagSmoother``).
 BayesFilter
     The Bayes filter (Morrison ch. 10) in square-root information form over the same model:
     starts from no information, fading memory with the true covariance.
@@ -65,6 +66,7 @@ from ._seqsmooth import (
     FixedMemory,
     Innovation,
     KalmanFilter,
+    LinearFixedLagSmoother,
     LinearKalmanFilter,
     OnlineSmoother,
     PolynomialFilter,
@@ -105,6 +107,7 @@ __all__ = [
     "FixedMemory",
     "KalmanFilter",
     "LinearKalmanFilter",
+    "LinearFixedLagSmoother",
     "RadarTracker",
     "SlidingFit",
     "Innovation",

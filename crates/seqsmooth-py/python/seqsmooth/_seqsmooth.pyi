@@ -267,6 +267,29 @@ class LinearKalmanFilter:
     ) -> tuple[Matrix, npt.NDArray[np.float64]]:
         """Each measurement's estimate from the ``lag`` after it: ``(states, covariances)``."""
 
+class LinearFixedLagSmoother:
+    """The fixed-lag smoother on a LinearKalmanFilter's model, a measurement at a time, in
+    memory bounded by the lag."""
+
+    def __init__(self, filter: LinearKalmanFilter, lag: int) -> None: ...
+    @property
+    def pushed(self) -> int: ...
+    @property
+    def lag(self) -> int: ...
+    def update(
+        self,
+        z: ArrayLike | float,
+        u: ArrayLike | None = None,
+        B: ArrayLike | None = None,
+        F: ArrayLike | None = None,
+        Q: ArrayLike | float | None = None,
+        H: ArrayLike | None = None,
+        R: ArrayLike | float | None = None,
+    ) -> tuple[int, Vector, Matrix] | None:
+        """One step; ``(index, state, covariance)`` of the step ``lag`` before, or ``None``."""
+    def finish(self) -> tuple[npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64]]:
+        """The last ``lag`` steps: ``(indices, states, covariances)``."""
+
 class BayesFilter:
     def __init__(
         self,

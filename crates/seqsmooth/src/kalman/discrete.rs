@@ -565,10 +565,9 @@ impl LinearKalmanFilter {
         mut out: impl FnMut(usize, Smoothed),
     ) -> Result<(), Error> {
         let p = self.components();
-        let mut smoother = FixedLagSmoother::new(self.filter.clone(), lag);
+        let mut smoother = LinearFixedLag::new(self, lag);
         let mut given = 0;
         for (k, z) in zs.chunks_exact(p).enumerate() {
-            let s = step(k);
             let in_batch = |e: Error| match e {
                 Error::InBatch { .. } => e,
                 e => Error::InBatch {
@@ -576,14 +575,7 @@ impl LinearKalmanFilter {
                     source: Box::new(e),
                 },
             };
-            self.check(&s, true).map_err(in_batch)?;
-            let mut m = self.measurement(z, s.r).map_err(in_batch)?;
-            m.time = smoother.filter().time() + 1.0;
-            let filter = smoother.filter_mut();
-            apply_prediction(filter, &self.model, &s);
-            let pushed = apply_update(filter, &self.model, &s).and_then(|()| smoother.push(&m));
-            restore(smoother.filter_mut(), &self.model, &s);
-            if let Some(smoothed) = pushed.map_err(in_batch)? {
+            if let Some(smoothed) = smoother.push(z, &step(k)).map_err(in_batch)? {
                 out(given, smoothed);
                 given += 1;
             }
@@ -593,6 +585,68 @@ impl LinearKalmanFilter {
             given += 1;
         }
         Ok(())
+    }
+}
+
+/// The fixed-lag smoother ([`FixedLagSmoother`]) on a [`LinearKalmanFilter`]'s model, a
+/// measurement at a time: each step's estimate from the `lag` steps after it, given once they
+/// are in, in memory bounded by the lag (`lag + 1` steps' estimates and backward maps).
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::kalman::discrete::{LinearFixedLag, LinearKalmanFilter, StepMatrices};
+/// let kf = LinearKalmanFilter::new(DVector::zeros(1), DMatrix::identity(1, 1) * 1e12,
+///     DMatrix::identity(1, 1), DMatrix::identity(1, 1), DMatrix::zeros(1, 1),
+///     DMatrix::identity(1, 1)).unwrap();
+/// let mut s = LinearFixedLag::new(&kf, 1);
+/// assert!(s.push(&[1.0], &StepMatrices::default()).unwrap().is_none());
+/// let first = s.push(&[3.0], &StepMatrices::default()).unwrap().unwrap();
+/// assert!((first.state[0] - 2.0).abs() < 1e-9); // a constant: the mean of both
+/// assert_eq!(s.finish().unwrap().len(), 1);
+/// ```
+#[derive(Clone, Debug)]
+pub struct LinearFixedLag {
+    smoother: FixedLagSmoother<DiscreteDynamics, LinearObservation>,
+    model: LinearKalmanFilter,
+}
+
+impl LinearFixedLag {
+    /// A smoother of lag `lag` measurements starting from `filter`'s estimate and model.
+    pub fn new(filter: &LinearKalmanFilter, lag: usize) -> Self {
+        Self {
+            smoother: FixedLagSmoother::new(filter.filter.clone(), lag),
+            model: filter.clone(),
+        }
+    }
+
+    /// The lag, in measurements.
+    pub fn lag(&self) -> usize {
+        self.smoother.lag()
+    }
+
+    /// The measurements pushed.
+    pub fn pushed(&self) -> usize {
+        self.smoother.pushed()
+    }
+
+    /// One step: the prediction and the update with `z` (NaN a missing component) and
+    /// `step`'s matrices, and the smoothed estimate of the step `lag` before, if there is
+    /// one. On an error the smoother is unchanged.
+    pub fn push(&mut self, z: &[f64], step: &StepMatrices<'_>) -> Result<Option<Smoothed>, Error> {
+        let model = &self.model;
+        model.check(step, true)?;
+        let mut m = model.measurement(z, step.r)?;
+        m.time = self.smoother.filter().time() + 1.0;
+        let filter = self.smoother.filter_mut();
+        apply_prediction(filter, &model.model, step);
+        let pushed = apply_update(filter, &model.model, step).and_then(|()| self.smoother.push(&m));
+        restore(self.smoother.filter_mut(), &model.model, step);
+        pushed
+    }
+
+    /// The steps held, each smoothed by every step pushed, in order.
+    pub fn finish(self) -> Result<Vec<Smoothed>, Error> {
+        self.smoother.finish()
     }
 }
 
