@@ -233,6 +233,52 @@ fn measurements(zs: &Bound<'_, PyAny>, p: usize) -> PyResult<(Vec<f64>, usize)> 
     Ok((v, rows))
 }
 
+/// One step's matrices from Python (`None` where not given): `F`, `Q`, `B`, `u`, `H`, `R` for a
+/// model of `n` states and `p` components (a number for `Q` or `R`: times the identity).
+#[derive(Default)]
+struct OneStep {
+    f: Option<DMatrix<f64>>,
+    q: Option<DMatrix<f64>>,
+    b: Option<DMatrix<f64>>,
+    u: Option<DVector<f64>>,
+    h: Option<DMatrix<f64>>,
+    r: Option<DMatrix<f64>>,
+}
+
+type Arg<'a, 'py> = Option<&'a Bound<'py, PyAny>>;
+
+impl OneStep {
+    /// `[u, B, F, Q, H, R]` as given.
+    fn parse(n: usize, p: usize, args: [Arg<'_, '_>; 6]) -> PyResult<Self> {
+        let [u, b, f, q, h, r] = args.map(|o| o.filter(|o| !o.is_none()));
+        let m = |o: Arg<'_, '_>, name, square, row| {
+            o.map(|o| matrix_from(o, name, square, row)).transpose()
+        };
+        Ok(Self {
+            f: m(f, "F", Some(n), false)?,
+            q: m(q, "Q", Some(n), false)?,
+            b: m(b, "B", None, false)?,
+            u: match u {
+                Some(u) => Some(DVector::from_vec(nd(u, "u")?.0)),
+                None => None,
+            },
+            h: m(h, "H", None, true)?,
+            r: m(r, "R", Some(p), false)?,
+        })
+    }
+
+    fn matrices(&self) -> StepMatrices<'_> {
+        StepMatrices {
+            f: self.f.as_ref(),
+            q: self.q.as_ref(),
+            b: self.b.as_ref(),
+            u: self.u.as_ref(),
+            h: self.h.as_ref(),
+            r: self.r.as_ref(),
+        }
+    }
+}
+
 /// `(N, n)` and `(N, n, n)` arrays from row-major values.
 fn states_and_covariances<'py>(
     py: Python<'py>,
@@ -421,29 +467,9 @@ impl PyLinearKalmanFilter {
         F: Option<&Bound<'_, PyAny>>,
         Q: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let n = self.inner.dimension();
-        let opt = |o: Option<&Bound<'_, PyAny>>, name, sq| {
-            o.filter(|o| !o.is_none())
-                .map(|o| matrix_from(o, name, sq, false))
-                .transpose()
-        };
-        let (b, f, q) = (
-            opt(B, "B", None)?,
-            opt(F, "F", Some(n))?,
-            opt(Q, "Q", Some(n))?,
-        );
-        let u = match u.filter(|u| !u.is_none()) {
-            Some(u) => Some(DVector::from_vec(nd(u, "u")?.0)),
-            None => None,
-        };
-        let step = StepMatrices {
-            f: f.as_ref(),
-            q: q.as_ref(),
-            b: b.as_ref(),
-            u: u.as_ref(),
-            ..Default::default()
-        };
-        self.inner.predict(&step).py()
+        let (n, p) = (self.inner.dimension(), self.inner.components());
+        let step = OneStep::parse(n, p, [u, B, F, Q, None, None])?;
+        self.inner.predict(&step.matrices()).py()
     }
 
     /// Updates with ``z`` (``p`` values, or a number for one component; NaN a missing
@@ -462,20 +488,12 @@ impl PyLinearKalmanFilter {
             Some(z) => nd(z, "z")?.0,
             None => vec![f64::NAN; p],
         };
-        let r = R
-            .filter(|o| !o.is_none())
-            .map(|o| matrix_from(o, "R", Some(p), false))
-            .transpose()?;
-        let h = H
-            .filter(|o| !o.is_none())
-            .map(|o| matrix_from(o, "H", None, true))
-            .transpose()?;
-        let step = StepMatrices {
-            r: r.as_ref(),
-            h: h.as_ref(),
-            ..Default::default()
-        };
-        Ok(self.inner.update(&z, &step).py()?.map(PyInnovation::from))
+        let step = OneStep::parse(self.inner.dimension(), p, [None, None, None, None, H, R])?;
+        Ok(self
+            .inner
+            .update(&z, &step.matrices())
+            .py()?
+            .map(PyInnovation::from))
     }
 
     /// ``predict`` then ``update`` for each measurement of ``zs`` (``(N, p)``, or ``(N,)`` for
@@ -703,31 +721,8 @@ impl PyLinearFixedLagSmoother {
         let smoother = self.smoother_mut()?;
         let index = smoother.pushed().checked_sub(smoother.lag());
         let z = nd(z, "z")?.0;
-        let opt = |o: Option<&Bound<'_, PyAny>>, name, sq, row| {
-            o.filter(|o| !o.is_none())
-                .map(|o| matrix_from(o, name, sq, row))
-                .transpose()
-        };
-        let p = z.len();
-        let (b, f, q) = (
-            opt(B, "B", None, false)?,
-            opt(F, "F", Some(n), false)?,
-            opt(Q, "Q", Some(n), false)?,
-        );
-        let (h, r) = (opt(H, "H", None, true)?, opt(R, "R", Some(p), false)?);
-        let u = match u.filter(|u| !u.is_none()) {
-            Some(u) => Some(DVector::from_vec(nd(u, "u")?.0)),
-            None => None,
-        };
-        let step = StepMatrices {
-            f: f.as_ref(),
-            q: q.as_ref(),
-            b: b.as_ref(),
-            u: u.as_ref(),
-            h: h.as_ref(),
-            r: r.as_ref(),
-        };
-        match smoother.push(&z, &step).py()? {
+        let step = OneStep::parse(n, z.len(), [u, B, F, Q, H, R])?;
+        match smoother.push(&z, &step.matrices()).py()? {
             Some(s) => Ok(Some(smoothed_tuple(py, index.unwrap_or(0), &s)?)),
             None => Ok(None),
         }
