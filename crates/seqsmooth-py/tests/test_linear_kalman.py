@@ -211,9 +211,10 @@ def test_bad_per_step_matrix_names_the_step():
 
 
 def test_ten_thousand_random_bad_calls_never_panic():
-    """10⁴ seeded random calls with bad shapes, values and matrices: each either works or
-    raises a SeqsmoothError (never a panic or another exception); a refused call leaves the
-    filter's estimate as it was."""
+    """10⁴ seeded random calls with bad shapes, values and matrices (the filter, its batch and
+    smoothers, the streamed fixed-lag smoother): each either works or raises a SeqsmoothError
+    (never a panic or another exception); a refused call leaves the filter's estimate (the
+    smoother's count) as it was."""
     rng = np.random.default_rng(32)
     specials = [np.nan, np.inf, -np.inf, -1.0, 0.0, 1e308, 1e-308]
 
@@ -231,9 +232,10 @@ def test_ten_thousand_random_bad_calls_never_panic():
         return a
 
     kf = cv()
+    lagged = ss.LinearFixedLagSmoother(kf, 3)
     refused = 0
     for _ in range(10_000):
-        call = rng.integers(7)
+        call = rng.integers(8)
         x, P = kf.x, kf.P
         try:
             if call == 0:
@@ -248,8 +250,15 @@ def test_ten_thousand_random_bad_calls_never_panic():
                 kf.x = junk()
             elif call == 5:
                 ss.LinearKalmanFilter(junk(), junk(), junk(), junk(), junk(), junk())
-            else:
+            elif call == 6:
                 kf.rts_smoother(junk(), junk(), Fs=junk() if rng.random() < 0.5 else None)
+            else:
+                pushed = lagged.pushed
+                try:
+                    lagged.update(junk(), R=junk() if rng.random() < 0.5 else None)
+                except ss.SeqsmoothError:
+                    assert lagged.pushed == pushed
+                    raise
         except ss.SeqsmoothError:
             refused += 1
             if call in (0, 1, 3, 4):
