@@ -270,8 +270,6 @@ pub enum Param {
     ControlMatrixB,
     /// A discrete-time model's control input `u`.
     ControlInputU,
-    /// A fixed-lag smoother's lag, in measurements.
-    Lag,
     /// A discrete-time model's state covariance `P` set or handed in.
     StateCovarianceP,
 }
@@ -403,7 +401,6 @@ impl Param {
         Param::MeasurementNoiseR,
         Param::ControlMatrixB,
         Param::ControlInputU,
-        Param::Lag,
         Param::StateCovarianceP,
     ];
 
@@ -534,7 +531,6 @@ impl Param {
             Param::MeasurementNoiseR => "measurement noise R",
             Param::ControlMatrixB => "control matrix B",
             Param::ControlInputU => "control input u",
-            Param::Lag => "lag",
             Param::StateCovarianceP => "state covariance P",
         }
     }
