@@ -103,6 +103,13 @@ pub fn keyword(p: Param) -> Option<&'static str> {
         Param::SigmaPointKappa => Some("kappa"),
         Param::AzimuthConvention => Some("azimuth"),
         Param::Coefficients => Some("n"),
+        Param::TransitionMatrixF => Some("F"),
+        Param::ObservationMatrixH => Some("H"),
+        Param::ProcessNoiseQ => Some("Q"),
+        Param::MeasurementNoiseR => Some("R"),
+        Param::ControlMatrixB => Some("B"),
+        Param::ControlInputU => Some("u"),
+        Param::StateCovarianceP => Some("P"),
         _ => None,
     }
 }

@@ -70,6 +70,12 @@ impl PyInnovation {
     }
 }
 
+impl From<Innovation> for PyInnovation {
+    fn from(inner: Innovation) -> Self {
+        Self { inner }
+    }
+}
+
 /// A symmetric (or any square) matrix as a numpy array.
 pub(crate) fn square<'py>(py: Python<'py>, m: &DMatrix<f64>) -> PyResult<Bound<'py, PyAny>> {
     matrix(py, m.transpose().as_slice().to_vec(), m.nrows(), m.ncols())

@@ -11,6 +11,7 @@ mod errors;
 mod fit;
 mod frame;
 mod kalman;
+mod linear;
 mod paml;
 mod polynomial;
 mod smooth;
@@ -33,6 +34,8 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<bank::PyExpandingBank>()?;
     m.add_class::<kalman::PyKalmanFilter>()?;
     m.add_class::<kalman::PyInnovation>()?;
+    m.add_class::<linear::PyLinearKalmanFilter>()?;
+    m.add_class::<linear::PyLinearFixedLagSmoother>()?;
     m.add_class::<bayes::PyBayesFilter>()?;
     m.add_class::<unscented::PyUnscentedKalmanFilter>()?;
     m.add_class::<track::PyRadarTracker>()?;

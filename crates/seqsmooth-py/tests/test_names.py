@@ -70,3 +70,9 @@ def test_the_old_discount_names_are_gone():
     )
     assert "--beta" not in out.stdout
     assert "--theta-per-update" in out.stdout
+
+
+def test_the_linear_kalman_filters_keywords_are_in_the_table():
+    """Every keyword of ``LinearKalmanFilter`` has its row (F, H, Q, R, B, x0, P0)."""
+    listed = {kw for _, e in cells(5) for kw in re.findall(r"LinearKalmanFilter\((\w+)=\)", e)}
+    assert set(inspect.signature(ss.LinearKalmanFilter).parameters) <= listed

@@ -15,6 +15,11 @@ FadingBank, ExpandingBank
 KalmanFilter
     The Kalman filter over the polynomial model (Morrison chs. 12, 14, 15): driving noise,
     fading memory, missing components, ``update_many`` and the RTS ``smooth``.
+LinearKalmanFilter
+    The Kalman filter on your own matrices ``F``, ``H``, ``Q``, ``R``, ``B u`` (filterpy's
+    ``KalmanFilter``), constant or one per step: ``update_many`` (``batch_filter``), the RTS
+    smoother over that pass with its gains, and the fixed-lag smoother (streamed:
+    ``LinearFixedLagSmoother``).
 BayesFilter
     The Bayes filter (Morrison ch. 10) in square-root information form over the same model:
     starts from no information, fading memory with the true covariance.
@@ -61,6 +66,8 @@ from ._seqsmooth import (
     FixedMemory,
     Innovation,
     KalmanFilter,
+    LinearFixedLagSmoother,
+    LinearKalmanFilter,
     OnlineSmoother,
     PolynomialFilter,
     RadarTracker,
@@ -101,6 +108,8 @@ __all__ = [
     "FixedMemory",
     "KalmanFilter",
     "UnscentedKalmanFilter",
+    "LinearKalmanFilter",
+    "LinearFixedLagSmoother",
     "RadarTracker",
     "SlidingFit",
     "Innovation",

@@ -188,6 +188,29 @@ class UnscentedKalmanFilter:
         kappa: float = 0.0,
     ) -> None: ...
     @property
+class LinearKalmanFilter:
+    """The Kalman filter on a discrete-time linear model given by its matrices (filterpy's
+    ``KalmanFilter``): ``x_k = F x_{k-1} + B u_k + w``, ``z_k = H x_k + v``."""
+
+    def __init__(
+        self,
+        x0: ArrayLike,
+        P0: ArrayLike | float,
+        F: ArrayLike,
+        H: ArrayLike,
+        Q: ArrayLike | float,
+        R: ArrayLike | float,
+        B: ArrayLike | None = None,
+    ) -> None: ...
+    @property
+    def x(self) -> Vector: ...
+    @x.setter
+    def x(self, value: ArrayLike) -> None: ...
+    @property
+    def P(self) -> Matrix: ...
+    @P.setter
+    def P(self, value: ArrayLike | float) -> None: ...
+    @property
     def state(self) -> Vector: ...
     @property
     def covariance(self) -> Matrix: ...
@@ -205,6 +228,94 @@ class UnscentedKalmanFilter:
     def smooth(
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
+    def steps(self) -> int: ...
+    @property
+    def F(self) -> Matrix: ...
+    @F.setter
+    def F(self, value: ArrayLike) -> None: ...
+    @property
+    def H(self) -> Matrix: ...
+    @H.setter
+    def H(self, value: ArrayLike) -> None: ...
+    @property
+    def Q(self) -> Matrix: ...
+    @Q.setter
+    def Q(self, value: ArrayLike | float) -> None: ...
+    @property
+    def R(self) -> Matrix: ...
+    @R.setter
+    def R(self, value: ArrayLike | float) -> None: ...
+    def predict(
+        self,
+        u: ArrayLike | None = None,
+        B: ArrayLike | None = None,
+        F: ArrayLike | None = None,
+        Q: ArrayLike | float | None = None,
+    ) -> None:
+        """One step: ``x = F x + B u``, ``P = F P Fᵀ + Q`` (this step's matrices where given)."""
+    def update(
+        self,
+        z: ArrayLike | float | None,
+        R: ArrayLike | float | None = None,
+        H: ArrayLike | None = None,
+    ) -> Innovation | None:
+        """The update with ``z`` (NaN a missing component), Joseph's form."""
+    def update_many(
+        self,
+        zs: ArrayLike,
+        Fs: ArrayLike | None = None,
+        Qs: ArrayLike | None = None,
+        Hs: ArrayLike | None = None,
+        Rs: ArrayLike | None = None,
+        Bs: ArrayLike | None = None,
+        us: ArrayLike | None = None,
+    ) -> tuple[Matrix, npt.NDArray[np.float64], Matrix, npt.NDArray[np.float64]]:
+        """filterpy's ``batch_filter``: ``(means, covariances, means_p, covariances_p)``."""
+    def rts_smoother(
+        self,
+        Xs: ArrayLike,
+        Ps: ArrayLike,
+        Fs: ArrayLike | None = None,
+        Qs: ArrayLike | None = None,
+        Bs: ArrayLike | None = None,
+        us: ArrayLike | None = None,
+    ) -> tuple[Matrix, npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """filterpy's ``rts_smoother`` over a pass: ``(x, P, K, Pp)``."""
+    def fixed_lag_smoother(
+        self,
+        zs: ArrayLike,
+        lag: int,
+        Fs: ArrayLike | None = None,
+        Qs: ArrayLike | None = None,
+        Hs: ArrayLike | None = None,
+        Rs: ArrayLike | None = None,
+        Bs: ArrayLike | None = None,
+        us: ArrayLike | None = None,
+    ) -> tuple[Matrix, npt.NDArray[np.float64]]:
+        """Each measurement's estimate from the ``lag`` after it: ``(states, covariances)``."""
+
+class LinearFixedLagSmoother:
+    """The fixed-lag smoother on a LinearKalmanFilter's model, a measurement at a time, in
+    memory bounded by the lag."""
+
+    def __init__(self, filter: LinearKalmanFilter, lag: int) -> None: ...
+    @property
+    def pushed(self) -> int: ...
+    @property
+    def lag(self) -> int: ...
+    def update(
+        self,
+        z: ArrayLike | float,
+        u: ArrayLike | None = None,
+        B: ArrayLike | None = None,
+        F: ArrayLike | None = None,
+        Q: ArrayLike | float | None = None,
+        H: ArrayLike | None = None,
+        R: ArrayLike | float | None = None,
+    ) -> tuple[int, Vector, Matrix] | None:
+        """One step; ``(index, state, covariance)`` of the step ``lag`` before, or ``None``."""
+    def finish(self) -> tuple[npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64]]:
+        """The last ``lag`` steps: ``(indices, states, covariances)``."""
 
 class BayesFilter:
     def __init__(

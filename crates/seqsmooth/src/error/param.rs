@@ -280,6 +280,20 @@ pub enum Param {
     Coefficients,
     /// The time a fit's state refers to.
     Epoch,
+    /// A discrete-time model's transition matrix `F` (`x_k = F x_{k−1} + B u + w`).
+    TransitionMatrixF,
+    /// A discrete-time model's observation matrix `H` (`z = H x + v`).
+    ObservationMatrixH,
+    /// A discrete-time model's process-noise covariance `Q` over one step.
+    ProcessNoiseQ,
+    /// A discrete-time model's measurement-noise covariance `R`.
+    MeasurementNoiseR,
+    /// A discrete-time model's control matrix `B`.
+    ControlMatrixB,
+    /// A discrete-time model's control input `u`.
+    ControlInputU,
+    /// A discrete-time model's state covariance `P` set or handed in.
+    StateCovarianceP,
 }
 
 impl Param {
@@ -414,6 +428,13 @@ impl Param {
         Param::NewestIndex,
         Param::Coefficients,
         Param::Epoch,
+        Param::TransitionMatrixF,
+        Param::ObservationMatrixH,
+        Param::ProcessNoiseQ,
+        Param::MeasurementNoiseR,
+        Param::ControlMatrixB,
+        Param::ControlInputU,
+        Param::StateCovarianceP,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -548,6 +569,13 @@ impl Param {
             Param::NewestIndex => "n",
             Param::Coefficients => "coefficients",
             Param::Epoch => "epoch",
+            Param::TransitionMatrixF => "transition matrix F",
+            Param::ObservationMatrixH => "observation matrix H",
+            Param::ProcessNoiseQ => "process noise Q",
+            Param::MeasurementNoiseR => "measurement noise R",
+            Param::ControlMatrixB => "control matrix B",
+            Param::ControlInputU => "control input u",
+            Param::StateCovarianceP => "state covariance P",
         }
     }
 
@@ -577,7 +605,8 @@ impl Param {
             | Param::Segment
             | Param::Sigmas
             | Param::Measurement
-            | Param::ObservationsY => ErrorKind::InvalidInput,
+            | Param::ObservationsY
+            | Param::ControlInputU => ErrorKind::InvalidInput,
             _ => ErrorKind::Parameter,
         }
     }

@@ -186,38 +186,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
                 format!("the dynamics have {n} states"),
             ));
         }
-        if state.len() != n || covariance.shape() != (n, n) {
-            return Err(bad(
-                Param::Prior,
-                format!(
-                    "state of length {}, covariance {}x{}",
-                    state.len(),
-                    covariance.nrows(),
-                    covariance.ncols()
-                ),
-                format!("the model has {n} states"),
-            ));
-        }
-        if let Some(&value) = state
-            .iter()
-            .chain(covariance.iter())
-            .chain([&time])
-            .find(|v| !v.is_finite())
-        {
-            return Err(Error::NonFinite {
-                what: "prior state, covariance or time",
-                value,
-            });
-        }
-        if (&covariance - covariance.transpose()).abs().max() > 1e-12 * covariance.abs().max()
-            || covariance.diagonal().iter().any(|&v| v < 0.0)
-        {
-            return Err(bad(
-                Param::PriorCovariance,
-                format!("{covariance:?}"),
-                "must be symmetric with a non-negative diagonal".into(),
-            ));
-        }
+        check_prior(n, &state, &covariance, time)?;
         let work = Work::new(n, observation.components());
         Ok(Self {
             dynamics,
@@ -321,6 +290,71 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// The 1σ of each state component, `√diag(S)` (as `PolynomialState::std_devs`).
     pub fn std_devs(&self) -> Vec<f64> {
         crate::linalg::std_devs(&self.covariance)
+    }
+
+    /// Replaces the estimate: `state` and `covariance` at `time`, checked as
+    /// [`Self::new`] checks the prior (a fading filter's own matrix `P` restarts at the
+    /// covariance, §14.5). On an error the filter is unchanged.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::zeros(1), DMatrix::identity(1, 1), 0.0).unwrap();
+    /// f.set_estimate(DVector::from_vec(vec![2.0]), DMatrix::identity(1, 1) * 4.0, 1.0).unwrap();
+    /// assert_eq!((f.state()[0], f.std_devs()[0], f.time()), (2.0, 2.0, 1.0));
+    /// assert!(f.set_estimate(DVector::zeros(2), DMatrix::identity(2, 2), 1.0).is_err());
+    /// ```
+    pub fn set_estimate(
+        &mut self,
+        state: DVector<f64>,
+        covariance: DMatrix<f64>,
+        time: f64,
+    ) -> Result<(), Error> {
+        check_prior(self.state.len(), &state, &covariance, time)?;
+        if let Some(f) = &mut self.fading {
+            f.weight.copy_from(&covariance);
+            f.last_update = time;
+        }
+        (self.state, self.covariance, self.time) = (state, covariance, time);
+        Ok(())
+    }
+
+    /// The observation model.
+    pub fn observation(&self) -> &O {
+        &self.observation
+    }
+
+    /// Replaces the observation model by one of the same state dimension and components
+    /// (a time-varying `H`). On an error the filter is unchanged.
+    pub fn set_observation(&mut self, observation: O) -> Result<(), Error> {
+        let (n, p) = (self.state.len(), self.observation.components());
+        if observation.state_dimension() != n || observation.components() != p {
+            return Err(Error::InvalidParameter {
+                name: Param::ObservationModel,
+                value: format!(
+                    "of {} components for {} states",
+                    observation.components(),
+                    observation.state_dimension()
+                ),
+                reason: format!("the filter's has {p} components for {n} states"),
+            });
+        }
+        self.observation = observation;
+        Ok(())
+    }
+
+    /// The prediction `X_{n,n−1}`, `S_{n,n−1}` that the last update corrected (valid right
+    /// after an update that made its correction).
+    pub(crate) fn last_prediction(&self) -> (&DVector<f64>, &DMatrix<f64>) {
+        (&self.work.x, &self.work.s)
+    }
+
+    /// The dynamics, to change a step's matrices in place (the caller keeps its dimension).
+    pub(crate) fn dynamics_mut(&mut self) -> &mut D {
+        &mut self.dynamics
     }
 
     /// The time the estimate refers to.
@@ -796,4 +830,52 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             log_likelihood,
         })
     }
+}
+
+/// Refuses a prior of other than `n` states, with a number that is not finite, or with a
+/// covariance that is not symmetric with a non-negative diagonal.
+fn check_prior(
+    n: usize,
+    state: &DVector<f64>,
+    covariance: &DMatrix<f64>,
+    time: f64,
+) -> Result<(), Error> {
+    let bad = |name: Param, value: String, reason: String| Error::InvalidParameter {
+        name,
+        value,
+        reason,
+    };
+    if state.len() != n || covariance.shape() != (n, n) {
+        return Err(bad(
+            Param::Prior,
+            format!(
+                "state of length {}, covariance {}x{}",
+                state.len(),
+                covariance.nrows(),
+                covariance.ncols()
+            ),
+            format!("the model has {n} states"),
+        ));
+    }
+    if let Some(&value) = state
+        .iter()
+        .chain(covariance.iter())
+        .chain([&time])
+        .find(|v| !v.is_finite())
+    {
+        return Err(Error::NonFinite {
+            what: "prior state, covariance or time",
+            value,
+        });
+    }
+    if (covariance - covariance.transpose()).abs().max() > 1e-12 * covariance.abs().max()
+        || covariance.diagonal().iter().any(|&v| v < 0.0)
+    {
+        return Err(bad(
+            Param::PriorCovariance,
+            format!("{covariance:?}"),
+            "must be symmetric with a non-negative diagonal".into(),
+        ));
+    }
+    Ok(())
 }

@@ -36,27 +36,27 @@ use std::collections::VecDeque;
 
 /// One measurement's filtered estimate, until it is given.
 #[derive(Clone, Debug)]
-struct Row {
-    time: f64,
+pub(super) struct Row {
+    pub(super) time: f64,
     /// `X_{k|k}`, `S_{k|k}`.
-    state: DVector<f64>,
-    covariance: DMatrix<f64>,
+    pub(super) state: DVector<f64>,
+    pub(super) covariance: DMatrix<f64>,
     /// The update's NIS (`None` where every component was missing).
-    nis: Option<f64>,
+    pub(super) nis: Option<f64>,
 }
 
 /// `(X, S) ↦ (a + C X, D + C S Cᵀ)`: a backward step, a composition of them, or (`c` `None`)
 /// the constant `(a, D)`, an estimate.
 #[derive(Clone, Debug)]
-struct Map {
-    a: DVector<f64>,
-    d: DMatrix<f64>,
-    c: Option<DMatrix<f64>>,
+pub(super) struct Map {
+    pub(super) a: DVector<f64>,
+    pub(super) d: DMatrix<f64>,
+    pub(super) c: Option<DMatrix<f64>>,
 }
 
 impl Map {
     /// The estimate `(x, s)` as a constant map.
-    fn point(x: &DVector<f64>, s: &DMatrix<f64>) -> Self {
+    pub(super) fn point(x: &DVector<f64>, s: &DMatrix<f64>) -> Self {
         Self {
             a: x.clone(),
             d: s.clone(),
@@ -66,7 +66,7 @@ impl Map {
 
     /// `self ∘ inner`: `(a + C a', D + C D' Cᵀ, C C')` (`D` kept exactly symmetric); a constant
     /// `self` is itself, and a constant `inner` gives a constant (the backward step applied).
-    fn then(&self, inner: &Map) -> Map {
+    pub(super) fn then(&self, inner: &Map) -> Map {
         let Some(c) = &self.c else {
             return self.clone();
         };
@@ -95,7 +95,7 @@ impl Map {
     }
 
     /// An error naming measurement `index` if the map holds a number that is not finite.
-    fn finite(self, index: usize) -> Result<Self, Error> {
+    pub(super) fn finite(self, index: usize) -> Result<Self, Error> {
         match self.a.iter().chain(self.d.iter()).find(|v| !v.is_finite()) {
             Some(&value) => Err(Error::InBatch {
                 index,
@@ -141,7 +141,7 @@ fn symmetrise(m: &mut DMatrix<f64>) {
 /// The backward step `T_k` from measurement `k + 1` to `k`: `C = S_{k|k} Φᵀ S_{k+1|k}⁻¹` by the
 /// Cholesky factor of `S_{k+1|k}`, `a = X_{k|k} − C X_{k+1|k}`, `D = S_{k|k} − C Φ S_{k|k}` (that
 /// is, `S_{k|k} − C S_{k+1|k} Cᵀ`); an error names measurement `index` (`k + 1`).
-fn step(
+pub(super) fn step(
     row: &Row,
     (phi, x_pred, s_pred): (&DMatrix<f64>, &DVector<f64>, &DMatrix<f64>),
     index: usize,

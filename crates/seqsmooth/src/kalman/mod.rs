@@ -8,7 +8,10 @@
 //! - [`filter`]: [`KalmanFilter`], prediction, Joseph-form update, the iterated update, the
 //!   generalized fading memory of ch. 14 ([`Discount`]), innovation statistics; its arithmetic
 //!   on preallocated buffers (the covariance's prediction, one correction) in `correct`.
-//! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run.
+//! - [`discrete`]: [`LinearKalmanFilter`], the filter on a discrete-time linear model given by
+//!   its matrices `F`, `H`, `Q`, `R`, `B u` (constant or one per step), its batch and smoothers.
+//! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run, or
+//!   over a forward pass already made ([`rts`]: gains and predicted covariances too).
 //! - [`fixed_lag`]: the same smoother with a fixed lag: each measurement's estimate from the
 //!   `L` after it, in memory bounded by `L`.
 //! - [`steady`]: the fading filter's steady state (§14.7).
@@ -20,12 +23,13 @@
 //!   cross-covariances; [`unscented_smoother`], the unscented RTS smoother (Särkkä 2008) over
 //!   them.
 //! - [`noise`]: the driving-noise covariance `Q` over a step (15.2.23), in closed form for the
-//!   polynomial model ([`noise::WhiteNoiseDerivative`]).
+//!   polynomial model ([`noise::WhiteNoiseDerivative`]), or given per step ([`noise::MatrixNoise`]).
 //!
 //! The radar tracking application over these filters is [`crate::track`].
 
 pub mod bayes;
 mod correct;
+pub mod discrete;
 pub mod filter;
 pub mod fixed_lag;
 pub mod noise;
@@ -37,8 +41,9 @@ pub mod unscented_smoother;
 
 pub use crate::discount::Discount;
 pub use bayes::BayesFilter;
+pub use discrete::LinearKalmanFilter;
 pub use filter::{Innovation, KalmanFilter};
 pub use fixed_lag::FixedLagSmoother;
-pub use smoother::{smooth, Smoothed, Smoother};
+pub use smoother::{rts, smooth, RtsStep, Smoothed, Smoother};
 pub use unscented::UnscentedKalmanFilter;
 pub use unscented_smoother::{smooth_unscented, UnscentedSmoother};

@@ -233,3 +233,110 @@ impl ProcessNoise for ContinuousModel {
         self.noise_covariance((t_b - t_a).abs())
     }
 }
+/// A given `Q` over each step, the same whatever the step's length: the process noise of a
+/// discrete-time model ([`super::discrete`]), symmetric positive semidefinite and finite.
+///
+/// ```
+/// use nalgebra::DMatrix;
+/// use seqsmooth::kalman::noise::{MatrixNoise, ProcessNoise};
+/// let q = DMatrix::from_row_slice(2, 2, &[0.25, 0.5, 0.5, 1.0]);
+/// assert_eq!(MatrixNoise::new(q.clone()).unwrap().covariance(0.0, 1.0).unwrap(), q);
+/// assert!(MatrixNoise::new(DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, -1.0])).is_err());
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct MatrixNoise {
+    q: DMatrix<f64>,
+}
+
+impl MatrixNoise {
+    /// `Q`, checked by [`check_covariance`] ([`Param::ProcessNoiseQ`]).
+    pub fn new(q: DMatrix<f64>) -> Result<Self, Error> {
+        check_covariance(&q, q.nrows(), Param::ProcessNoiseQ)?;
+        Ok(Self { q })
+    }
+
+    /// `Q` already checked by the caller.
+    pub(crate) fn unchecked(q: DMatrix<f64>) -> Self {
+        Self { q }
+    }
+}
+
+impl ProcessNoise for MatrixNoise {
+    fn dimension(&self) -> usize {
+        self.q.nrows()
+    }
+
+    fn covariance(&self, _t_a: f64, _t_b: f64) -> Result<DMatrix<f64>, Error> {
+        Ok(self.q.clone())
+    }
+
+    fn covariance_into(&self, _t_a: f64, _t_b: f64, out: &mut DMatrix<f64>) -> Result<(), Error> {
+        if out.shape() != self.q.shape() {
+            *out = self.q.clone();
+        } else {
+            out.copy_from(&self.q);
+        }
+        Ok(())
+    }
+}
+
+/// Refuses a matrix that is not `shape` or holds a number that is not finite, naming it.
+///
+/// ```
+/// use nalgebra::DMatrix;
+/// use seqsmooth::error::Param;
+/// use seqsmooth::kalman::noise::check_matrix;
+/// assert!(check_matrix(&DMatrix::zeros(2, 3), (2, 2), Param::TransitionMatrixF).is_err());
+/// ```
+pub fn check_matrix(m: &DMatrix<f64>, shape: (usize, usize), name: Param) -> Result<(), Error> {
+    if m.shape() != shape || m.is_empty() {
+        return Err(Error::InvalidParameter {
+            name,
+            value: format!("of shape {}x{}", m.nrows(), m.ncols()),
+            reason: format!("must be {}x{}", shape.0, shape.1),
+        });
+    }
+    if let Some(&v) = m.iter().find(|v| !v.is_finite()) {
+        return Err(Error::InvalidParameter {
+            name,
+            value: format!("holding {v}"),
+            reason: "must be finite".into(),
+        });
+    }
+    Ok(())
+}
+
+/// Refuses a covariance that is not `n × n`, finite, symmetric (to `10⁻¹²` of its largest
+/// entry) and positive semidefinite (no eigenvalue below `−10⁻¹²` of the largest in size, the
+/// symmetric eigendecomposition's rounding), naming it.
+///
+/// ```
+/// use nalgebra::DMatrix;
+/// use seqsmooth::error::Param;
+/// use seqsmooth::kalman::noise::check_covariance;
+/// let indefinite = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+/// assert!(check_covariance(&indefinite, 2, Param::ProcessNoiseQ).is_err());
+/// assert!(check_covariance(&DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 1.0, 1.0]), 2, Param::ProcessNoiseQ).is_ok());
+/// ```
+pub fn check_covariance(m: &DMatrix<f64>, n: usize, name: Param) -> Result<(), Error> {
+    check_matrix(m, (n, n), name)?;
+    let largest = m.amax();
+    if (m - m.transpose()).amax() > 1e-12 * largest {
+        return Err(Error::InvalidParameter {
+            name,
+            value: format!("{m:?}"),
+            reason: "must be symmetric".into(),
+        });
+    }
+    let eigen = nalgebra::SymmetricEigen::new((m + m.transpose()) * 0.5).eigenvalues;
+    let scale = eigen.amax();
+    let least = eigen.min();
+    if least < -1e-12 * scale {
+        return Err(Error::InvalidParameter {
+            name,
+            value: format!("{m:?}"),
+            reason: format!("must be positive semidefinite (an eigenvalue is {least:e})"),
+        });
+    }
+    Ok(())
+}

@@ -13,7 +13,7 @@
 //! [`crate::estimate::gauss_newton`]).
 
 use super::filter::KalmanFilter;
-use super::fixed_lag::FixedLagSmoother;
+use super::fixed_lag::{step, FixedLagSmoother, Map, Row};
 use crate::error::Error;
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::Measurement;
@@ -130,4 +130,81 @@ impl<D: Dynamics + Clone, O: Observation + Clone> Smoother<D, O> {
     pub fn finish(self) -> Result<Vec<Smoothed>, Error> {
         self.0.finish()
     }
+}
+
+/// One step of [`rts`]: the smoothed estimate, the smoother gain `C_k` into it and the
+/// prediction's covariance `S_{k+1|k}` it used (filterpy's `rts_smoother` outputs `x`, `P`,
+/// `K`, `Pp`; for the last step `C = 0` and `S_{k+1|k}` is its own filtered covariance, as
+/// filterpy gives them).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RtsStep {
+    /// `X_{k|N}`.
+    pub state: DVector<f64>,
+    /// `S_{k|N}`.
+    pub covariance: DMatrix<f64>,
+    /// `C_k = S_{k|k} Φᵀ S_{k+1|k}⁻¹`.
+    pub gain: DMatrix<f64>,
+    /// `S_{k+1|k}`.
+    pub predicted_covariance: DMatrix<f64>,
+}
+
+/// The Rauch–Tung–Striebel backward pass over a forward pass already run: `filtered[k]` the
+/// updated `(X_{k|k}, S_{k|k})`, `predicted[k]` the prediction from step `k` into step `k + 1`,
+/// `(Φ(t_{k+1}, t_k), X_{k+1|k}, S_{k+1|k})` (one fewer). The same backward step as the
+/// whole-interval and fixed-lag smoothers ([`FixedLagSmoother`]); an error names its step
+/// ([`Error::InBatch`]).
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::kalman::smoother::rts;
+/// // A constant (Φ = 1, no driving noise) seen twice with unit variance from a vague prior:
+/// // both smoothed estimates are the mean, variance 1/2.
+/// let one = |v: f64| DMatrix::from_element(1, 1, v);
+/// let filtered = [(DVector::from_vec(vec![1.0]), one(1.0)), (DVector::from_vec(vec![2.0]), one(0.5))];
+/// let predicted = [(one(1.0), DVector::from_vec(vec![1.0]), one(1.0))];
+/// let s = rts(&filtered, &predicted).unwrap();
+/// assert_eq!((s[0].state[0], s[0].covariance[(0, 0)], s[0].gain[(0, 0)]), (2.0, 0.5, 1.0));
+/// ```
+pub fn rts(
+    filtered: &[(DVector<f64>, DMatrix<f64>)],
+    predicted: &[(DMatrix<f64>, DVector<f64>, DMatrix<f64>)],
+) -> Result<Vec<RtsStep>, Error> {
+    let Some((x, s)) = filtered.last() else {
+        return Ok(Vec::new());
+    };
+    if predicted.len() + 1 != filtered.len() {
+        return Err(Error::InvalidParameter {
+            name: crate::error::Param::MatrixLength,
+            value: format!("{} predictions", predicted.len()),
+            reason: format!("need one fewer than the {} steps", filtered.len()),
+        });
+    }
+    let n = x.len();
+    let mut point = Map::point(x, s);
+    let mut out = vec![RtsStep {
+        state: x.clone(),
+        covariance: s.clone(),
+        gain: DMatrix::zeros(n, n),
+        predicted_covariance: s.clone(),
+    }];
+    for k in (0..predicted.len()).rev() {
+        let (x, s) = &filtered[k];
+        let row = Row {
+            time: k as f64,
+            state: x.clone(),
+            covariance: s.clone(),
+            nis: None,
+        };
+        let (phi, x_pred, s_pred) = &predicted[k];
+        let map = step(&row, (phi, x_pred, s_pred), k + 1)?;
+        point = map.then(&point).finite(k)?;
+        out.push(RtsStep {
+            state: point.a.clone(),
+            covariance: point.d.clone(),
+            gain: map.c.expect("a backward step has its gain"),
+            predicted_covariance: s_pred.clone(),
+        });
+    }
+    out.reverse();
+    Ok(out)
 }
