@@ -69,16 +69,8 @@ impl PyBayesFilter {
         theta_per_update: Option<f64>,
         beta: Option<f64>,
     ) -> PyResult<Self> {
-        if axes == 0 {
-            return Err(raise(
-                Kind::Parameter,
-                "axes 0 is invalid: at least 1",
-                None,
-            ));
-        }
-        // The library's range of a polynomial degree.
-        seqsmooth::polynomial::check_degree(degree).py()?;
-        let n = (degree + 1) * axes;
+        // The library's polynomial model: its degree, axes and states.
+        let n = seqsmooth::polynomial::check_model(degree, axes).py()?;
         let observe = observation_from(observation, axes, n)?;
         let components = observe.components();
         let mut filter =

@@ -319,14 +319,8 @@ impl PyKalmanFilter {
         theta_per_update: Option<f64>,
         beta: Option<f64>,
     ) -> PyResult<Self> {
-        if axes == 0 {
-            return Err(raise(
-                Kind::Parameter,
-                "axes 0 is invalid: at least 1",
-                None,
-            ));
-        }
-        let n = (degree + 1) * axes;
+        // The library's polynomial model: its degree, axes and states.
+        let n = seqsmooth::polynomial::check_model(degree, axes).py()?;
         let x = series(x0, "x0")?;
         if x.as_slice().len() != n {
             return Err(raise(

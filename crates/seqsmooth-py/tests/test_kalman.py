@@ -163,6 +163,14 @@ def test_the_smoother_is_the_batch_least_squares_estimate():
             ss.ParameterError,
         ),
         (lambda: ss.KalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, axes=0), ss.ParameterError),
+        # The library's model range: a degree beyond MAX_DEGREE (2**63 overflowed (m + 1) axes
+        # into a two-state model that panicked on its first prediction).
+        (lambda: ss.KalmanFilter(degree=2**63, x0=[0.0, 0.0], P0=1.0, axes=2), ss.ParameterError),
+        (
+            lambda: ss.KalmanFilter(degree=ss.MAX_DEGREE + 1, x0=[0.0] * 26, P0=1.0),
+            ss.ParameterError,
+        ),
+        (lambda: ss.BayesFilter(degree=2**63, axes=2), ss.ParameterError),
     ],
 )
 def test_bad_settings(call, kind):

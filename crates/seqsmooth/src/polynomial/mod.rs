@@ -105,6 +105,6 @@ pub use expanding::ExpandingMemory;
 pub use fading::{FadingMemory, SwitchRule};
 pub use filter::PolynomialFilter;
 pub use options::{
-    check_degree, check_derivative, check_lead, check_tau, check_theta, check_theta_of,
+    check_degree, check_derivative, check_lead, check_model, check_tau, check_theta, check_theta_of,
 };
 pub use options::{DiscountMode, Engine, GAIN_MAX_DEGREE, GAIN_MAX_VALUE, MAX_DEGREE};

@@ -113,6 +113,31 @@ pub fn check_degree(m: usize) -> Result<(), Error> {
     crate::error::check_degree_at_most(m, MAX_DEGREE)
 }
 
+/// The polynomial model of degree `m` on `axes` axes (the Kalman, Bayes and unscented filters'
+/// `PolynomialDynamics`): `m ≤ MAX_DEGREE` ([`check_degree`]), at least one axis; its number
+/// of states `(m + 1) · axes`.
+///
+/// ```
+/// use seqsmooth::polynomial::{check_model, MAX_DEGREE};
+/// assert_eq!(check_model(1, 3).unwrap(), 6);
+/// assert!(check_model(1, 0).is_err() && check_model(MAX_DEGREE + 1, 1).is_err());
+/// assert!(check_model(2, usize::MAX).is_err()); // its states would not fit a usize
+/// ```
+pub fn check_model(m: usize, axes: usize) -> Result<usize, Error> {
+    check_degree(m)?;
+    let refuse = |reason: &str| Error::InvalidParameter {
+        name: Param::Axes,
+        value: axes.to_string(),
+        reason: reason.into(),
+    };
+    if axes == 0 {
+        return Err(refuse("at least 1"));
+    }
+    (m + 1)
+        .checked_mul(axes)
+        .ok_or_else(|| refuse("too many: the model's states must fit in memory"))
+}
+
 /// The range of a derivative `k` asked of a filter's estimate without its degree at hand (the
 /// command's `plot --derivative`): `k ≤ MAX_DEGREE`, as no filter estimates more.
 ///
