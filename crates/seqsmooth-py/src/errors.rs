@@ -101,6 +101,12 @@ pub fn keyword(p: Param) -> Option<&'static str> {
         Param::SigmaPointAlpha => Some("alpha"),
         Param::SigmaPointBeta => Some("beta"),
         Param::SigmaPointKappa => Some("kappa"),
+        Param::TransitionFunction => Some("f"),
+        Param::TransitionJacobian => Some("F_jacobian"),
+        Param::ObservationFunction => Some("h"),
+        Param::ObservationJacobian => Some("H_jacobian"),
+        Param::ProcessNoiseFunction => Some("Q"),
+        Param::AngleComponents => Some("angles"),
         _ => None,
     }
 }

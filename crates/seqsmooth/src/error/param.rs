@@ -264,6 +264,18 @@ pub enum Param {
     SigmaPointBeta,
     /// The unscented transform's secondary spread `κ`.
     SigmaPointKappa,
+    /// A user's state transition `f(x, t0, t1)`.
+    TransitionFunction,
+    /// The Jacobian `∂f/∂x` of a user's state transition.
+    TransitionJacobian,
+    /// A user's observation function `h(x, t)`.
+    ObservationFunction,
+    /// The Jacobian `∂h/∂x` of a user's observation function.
+    ObservationJacobian,
+    /// A user's driving-noise covariance `Q(t0, t1)`.
+    ProcessNoiseFunction,
+    /// The observation components that are angles (their residuals wrapped to `(−π, π]`).
+    AngleComponents,
 }
 
 impl Param {
@@ -390,6 +402,12 @@ impl Param {
         Param::SigmaPointAlpha,
         Param::SigmaPointBeta,
         Param::SigmaPointKappa,
+        Param::TransitionFunction,
+        Param::TransitionJacobian,
+        Param::ObservationFunction,
+        Param::ObservationJacobian,
+        Param::ProcessNoiseFunction,
+        Param::AngleComponents,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -516,6 +534,12 @@ impl Param {
             Param::SigmaPointAlpha => "sigma-point alpha",
             Param::SigmaPointBeta => "sigma-point beta",
             Param::SigmaPointKappa => "sigma-point kappa",
+            Param::TransitionFunction => "transition function",
+            Param::TransitionJacobian => "transition Jacobian",
+            Param::ObservationFunction => "observation function",
+            Param::ObservationJacobian => "observation Jacobian",
+            Param::ProcessNoiseFunction => "process noise function",
+            Param::AngleComponents => "angle components",
         }
     }
 
