@@ -165,7 +165,12 @@ pub(crate) struct UserDynamics {
 }
 
 impl UserDynamics {
-    fn transition_state(&self, x: &DVector<f64>, t_a: f64, t_b: f64) -> Result<DVector<f64>, Error> {
+    fn transition_state(
+        &self,
+        x: &DVector<f64>,
+        t_a: f64,
+        t_b: f64,
+    ) -> Result<DVector<f64>, Error> {
         let at = || format!("over t = {t_a} to {t_b}");
         let v = self.f.call(Some(x), &[t_a, t_b], self.n, None, at)?;
         Ok(DVector::from_vec(v))

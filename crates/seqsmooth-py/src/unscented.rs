@@ -152,11 +152,8 @@ impl PyUnscentedKalmanFilter {
             return Err(raise(Kind::Parameter, "x0 and P0 are required", None));
         };
         let points = SigmaPoints::new(alpha, beta, kappa).py()?;
-        let polynomial = degree.is_some()
-            || axes != 1
-            || q != 0.0
-            || observation.is_some()
-            || site.is_some();
+        let polynomial =
+            degree.is_some() || axes != 1 || q != 0.0 || observation.is_some() || site.is_some();
         let degree = match (degree, f, h) {
             (None, Some(f), Some(h)) if !polynomial => {
                 let x = DVector::from_column_slice(series(x0, "x0")?.as_slice());
