@@ -69,7 +69,7 @@ impl Callable {
     }
 
     /// The callable on `x` (if any) and the times, its result read as `rows × cols` in
-    /// column-major order (`cols` `None`: a vector of `rows`, also `rows × 1` or a number for
+    /// row-major order (`cols` `None`: a vector of `rows`, also `rows × 1` or a number for
     /// one row); `at` words the call's time in errors.
     fn call(
         &self,
@@ -96,7 +96,7 @@ impl Callable {
     }
 }
 
-/// A result as `rows × cols` numbers (column-major), or why not.
+/// A result as `rows × cols` numbers (row-major), or why not.
 fn read(out: &Bound<'_, PyAny>, rows: usize, cols: Option<usize>) -> Result<Vec<f64>, String> {
     let converted;
     let array = match out.cast::<PyArrayDyn<f64>>() {
@@ -111,8 +111,9 @@ fn read(out: &Bound<'_, PyAny>, rows: usize, cols: Option<usize>) -> Result<Vec<
                 .map_err(|e| e.to_string())?
         }
     };
-    let array = array.readonly();
-    let shape = array.shape().to_vec();
+    // A copy in logical (row-major) order, whatever the strides (no borrow to register).
+    let owned = array.to_owned_array();
+    let shape = owned.shape().to_vec();
     let want_cols = cols.unwrap_or(1);
     let fits = match (shape.as_slice(), cols) {
         ([r, c], _) => *r == rows && *c == want_cols,
@@ -127,18 +128,12 @@ fn read(out: &Bound<'_, PyAny>, rows: usize, cols: Option<usize>) -> Result<Vec<
         };
         return Err(format!("returned shape {shape:?}, not {want}"));
     }
-    let view = array.as_array();
-    let flat: Vec<f64> = if shape.len() == 2 {
-        // Column-major, as nalgebra stores it.
-        (0..want_cols)
-            .flat_map(|c| (0..rows).map(move |r| (r, c)))
-            .map(|(r, c)| view[[r, c]])
-            .collect()
-    } else {
-        view.iter().copied().collect()
+    let flat: Vec<f64> = match owned.as_slice() {
+        Some(s) => s.to_vec(),
+        None => owned.iter().copied().collect(),
     };
     if let Some(i) = flat.iter().position(|v| !v.is_finite()) {
-        let (r, c) = (i % rows, i / rows);
+        let (r, c) = (i / want_cols, i % want_cols);
         let entry = if cols.is_some() {
             format!("({r}, {c})")
         } else {
@@ -188,7 +183,7 @@ impl Dynamics for UserDynamics {
         let transition = match &self.jacobian {
             Some(j) => {
                 let at = || format!("over t = {t_a} to {t_b}");
-                DMatrix::from_vec(n, n, j.call(Some(state), &[t_a, t_b], n, Some(n), at)?)
+                DMatrix::from_row_slice(n, n, &j.call(Some(state), &[t_a, t_b], n, Some(n), at)?)
             }
             None => differenced_jacobian(n, state, |x| self.transition_state(x, t_a, t_b))?,
         };
@@ -234,7 +229,7 @@ impl Observation for UserObservation {
             Some(j) => {
                 let at = || format!("at t = {t}");
                 let m = j.call(Some(state), &[t], self.p, Some(self.n), at)?;
-                DMatrix::from_vec(self.p, self.n, m)
+                DMatrix::from_row_slice(self.p, self.n, &m)
             }
             None => differenced_jacobian(self.p, state, |x| self.value(x, t))?,
         };
@@ -282,7 +277,8 @@ impl ProcessNoise for UserNoise {
             UserNoise::Constant(q) => Ok(q.clone()),
             UserNoise::Callable(c, n) => {
                 let at = || format!("over t = {t_a} to {t_b}");
-                let q = DMatrix::from_vec(*n, *n, c.call(None, &[t_a, t_b], *n, Some(*n), at)?);
+                let q =
+                    DMatrix::from_row_slice(*n, *n, &c.call(None, &[t_a, t_b], *n, Some(*n), at)?);
                 match not_covariance(&q) {
                     Some(reason) => Err(c.refuse(at(), format!("returned a matrix that {reason}"))),
                     None => Ok(q),
