@@ -18,7 +18,7 @@ use crate::arrays::matrix;
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{before, measurement, measurements, out_of_order, square, PyInnovation};
 use nalgebra::{DMatrix, DVector};
-use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::error::Param;
@@ -551,13 +551,7 @@ impl PyExtendedKalmanFilter {
         if let Some((k, t, previous)) = disorder {
             return Err(before(t, previous, Some(k)));
         }
-        let count = rows.len();
-        let states = matrix(py, states, count, n)?;
-        let covariances = PyArray1::from_vec(py, covariances)
-            .reshape([count, n, n])?
-            .into_any();
-        let nis = PyArray1::from_vec(py, nis).into_any();
-        PyTuple::new(py, [states, covariances, nis])
+        batch_tuple(py, states, covariances, nis, n)
     }
 
     /// The Rauch–Tung–Striebel smoother over the measurements, from this filter's current
@@ -627,4 +621,22 @@ pub(crate) fn stacked<'py, 'a>(
         .reshape([count, n, n])?
         .into_any();
     PyTuple::new(py, [states, covariances])
+}
+
+/// `update_many`'s `(states, covariances, nis)` from its row-major buffers: `(count, n)`,
+/// `(count, n, n)` and `(count,)`.
+pub(crate) fn batch_tuple<'py>(
+    py: Python<'py>,
+    states: Vec<f64>,
+    covariances: Vec<f64>,
+    nis: Vec<f64>,
+    n: usize,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let count = nis.len();
+    let states = matrix(py, states, count, n)?;
+    let covariances = PyArray1::from_vec(py, covariances)
+        .reshape([count, n, n])?
+        .into_any();
+    let nis = PyArray1::from_vec(py, nis).into_any();
+    PyTuple::new(py, [states, covariances, nis])
 }

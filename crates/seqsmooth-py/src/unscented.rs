@@ -7,15 +7,15 @@
 //! (`kalman::unscented_smoother`). With `f=` and `h=` it runs over the caller's own model, the
 //! Python callables of [`crate::callables`].
 
-use crate::arrays::{matrix, series};
-use crate::callables::{user_model, UserDynamics, UserObservation};
+use crate::arrays::series;
+use crate::callables::{batch_tuple, stacked, user_model, UserDynamics, UserObservation};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{
     before, measurement, measurements, observation_from, out_of_order, square, square_from,
     PyInnovation,
 };
 use nalgebra::DVector;
-use numpy::{PyArray1, PyArrayMethods};
+use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
@@ -345,13 +345,7 @@ impl PyUnscentedKalmanFilter {
         if let Some((k, t, previous)) = disorder {
             return Err(before(t, previous, Some(k)));
         }
-        let count = rows.len();
-        let states = matrix(py, states, count, n)?;
-        let covariances = PyArray1::from_vec(py, covariances)
-            .reshape([count, n, n])?
-            .into_any();
-        let nis = PyArray1::from_vec(py, nis).into_any();
-        PyTuple::new(py, [states, covariances, nis])
+        batch_tuple(py, states, covariances, nis, n)
     }
 
     /// The unscented Rauch–Tung–Striebel smoother (Särkkä 2008) over the measurements, from
@@ -376,21 +370,7 @@ impl PyUnscentedKalmanFilter {
         let smoothed = py
             .detach(|| each!(model, f => smooth_unscented(f, &rows)))
             .py()?;
-        let n = self.state_len();
-        let states: Vec<f64> = smoothed
-            .iter()
-            .flat_map(|s| s.state.iter().copied())
-            .collect();
-        let covariances: Vec<f64> = smoothed
-            .iter()
-            .flat_map(|s| s.covariance.iter().copied())
-            .collect();
-        let count = smoothed.len();
-        let states = matrix(py, states, count, n)?;
-        let covariances = PyArray1::from_vec(py, covariances)
-            .reshape([count, n, n])?
-            .into_any();
-        PyTuple::new(py, [states, covariances])
+        stacked(py, smoothed.iter().map(|s| (&s.state, &s.covariance)))
     }
 
     fn __repr__(&self) -> String {
