@@ -29,13 +29,41 @@ use seqsmooth::model::measurement::Measurement;
 use seqsmooth::model::nonlinear::differenced_jacobian;
 use seqsmooth::model::observation::{Angles, Observation, Predicted};
 use seqsmooth::Error;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
+
+/// The first exception a model's callables raised since the last call of the filter, kept to
+/// be the `__cause__` of the error that refuses the update.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Raised(Arc<Mutex<Option<PyErr>>>);
+
+impl Raised {
+    fn keep(&self, e: PyErr) {
+        let mut slot = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        slot.get_or_insert(e);
+    }
+
+    fn take(&self) -> Option<PyErr> {
+        self.0.lock().unwrap_or_else(|p| p.into_inner()).take()
+    }
+
+    /// `result` of one call of the filter as Python's: its error the library's, with the
+    /// exception a callable raised (if any) as its cause; the slot emptied either way.
+    pub(crate) fn py<T>(&self, result: Result<T, Error>) -> PyResult<T> {
+        let kept = self.take();
+        result.py().inspect_err(|err| {
+            if let Some(cause) = kept {
+                Python::attach(|py| err.set_cause(py, Some(cause)));
+            }
+        })
+    }
+}
 
 /// A Python callable of the user's model, named in errors by its parameter.
 #[derive(Clone)]
 pub(crate) struct Callable {
     func: Arc<Py<PyAny>>,
     param: Param,
+    raised: Raised,
 }
 
 impl std::fmt::Debug for Callable {
@@ -46,7 +74,7 @@ impl std::fmt::Debug for Callable {
 
 impl Callable {
     /// `obj`, refused unless callable.
-    fn new(obj: &Bound<'_, PyAny>, param: Param, keyword: &str) -> PyResult<Self> {
+    fn new(obj: &Bound<'_, PyAny>, param: Param, keyword: &str, raised: &Raised) -> PyResult<Self> {
         if !obj.is_callable() {
             return Err(raise(
                 Kind::InvalidType,
@@ -57,6 +85,7 @@ impl Callable {
         Ok(Self {
             func: Arc::new(obj.clone().unbind()),
             param,
+            raised: raised.clone(),
         })
     }
 
@@ -90,7 +119,11 @@ impl Callable {
                 (_, [a, b]) => self.func.call1(py, (*a, *b)),
                 _ => unreachable!("every call has a time or two"),
             };
-            let out = out.map_err(|e| self.refuse(at(), format!("raised {e}")))?;
+            let out = out.map_err(|e| {
+                let error = self.refuse(at(), format!("raised {e}"));
+                self.raised.keep(e);
+                error
+            })?;
             read(out.bind(py), rows, cols).map_err(|reason| self.refuse(at(), reason))
         })
     }
@@ -300,19 +333,20 @@ pub(crate) fn user_model(
     H_jacobian: Option<&Bound<'_, PyAny>>,
     Q: Option<&Bound<'_, PyAny>>,
     angles: Option<Vec<usize>>,
-) -> PyResult<(UserDynamics, UserObservation, Option<UserNoise>)> {
+) -> PyResult<UserModel> {
     let n = x0.len();
+    let raised = Raised::default();
     let optional = |obj: Option<&Bound<'_, PyAny>>, param, keyword| {
         obj.filter(|o| !o.is_none())
-            .map(|o| Callable::new(o, param, keyword))
+            .map(|o| Callable::new(o, param, keyword, &raised))
             .transpose()
     };
     let dynamics = UserDynamics {
         n,
-        f: Callable::new(f, Param::TransitionFunction, "f")?,
+        f: Callable::new(f, Param::TransitionFunction, "f", &raised)?,
         jacobian: optional(F_jacobian, Param::TransitionJacobian, "F_jacobian")?,
     };
-    let h = Callable::new(h, Param::ObservationFunction, "h")?;
+    let h = Callable::new(h, Param::ObservationFunction, "h", &raised)?;
     // The components: what h gives at the prior (any length at least 1).
     let first = Python::attach(|py| {
         h.func
@@ -346,7 +380,7 @@ pub(crate) fn user_model(
     let noise = match Q.filter(|q| !q.is_none()) {
         None => None,
         Some(q) if q.is_callable() => Some(UserNoise::Callable(
-            Callable::new(q, Param::ProcessNoiseFunction, "Q")?,
+            Callable::new(q, Param::ProcessNoiseFunction, "Q", &raised)?,
             n,
         )),
         Some(q) => {
@@ -364,7 +398,21 @@ pub(crate) fn user_model(
             Some(UserNoise::Constant(q))
         }
     };
-    Ok((dynamics, observation, noise))
+    Ok(UserModel {
+        dynamics,
+        observation,
+        noise,
+        raised,
+    })
+}
+
+/// The user's model: its dynamics, observation, driving noise and the slot its callables
+/// keep their first exception in.
+pub(crate) struct UserModel {
+    pub(crate) dynamics: UserDynamics,
+    pub(crate) observation: UserObservation,
+    pub(crate) noise: Option<UserNoise>,
+    pub(crate) raised: Raised,
 }
 
 type Extended = KalmanFilter<UserDynamics, UserObservation>;
@@ -406,12 +454,13 @@ type Extended = KalmanFilter<UserDynamics, UserObservation>;
 ///
 /// A callable that raises, returns the wrong shape, a NaN or an infinity is refused with a
 /// ``ParameterError`` naming it (``f``, ``h``, ``F_jacobian``, ``H_jacobian``, ``Q``), the
-/// time and, in ``update_many``, the measurement's index (``.index``); the filter is left as
-/// it was.
+/// time and, in ``update_many``, the measurement's index (``.index``), a raised exception as
+/// its ``__cause__``; the filter is left as it was.
 #[pyclass(name = "ExtendedKalmanFilter", module = "seqsmooth")]
 #[derive(Clone)]
 pub struct PyExtendedKalmanFilter {
     filter: Extended,
+    raised: Raised,
     /// The observation's components `p`.
     components: usize,
     iterations: usize,
@@ -448,15 +497,15 @@ impl PyExtendedKalmanFilter {
         }
         let x = DVector::from_column_slice(crate::arrays::series(x0, "x0")?.as_slice());
         let p0 = crate::kalman::square_from(P0, x.len(), "P0")?;
-        let (dynamics, observation, noise) =
-            user_model(&x, t0, f, h, F_jacobian, H_jacobian, Q, angles)?;
-        let components = observation.components();
-        let mut filter = KalmanFilter::new(dynamics, observation, x, p0, t0).py()?;
-        if let Some(q) = noise {
+        let model = user_model(&x, t0, f, h, F_jacobian, H_jacobian, Q, angles)?;
+        let components = model.observation.components();
+        let mut filter = KalmanFilter::new(model.dynamics, model.observation, x, p0, t0).py()?;
+        if let Some(q) = model.noise {
             filter = filter.with_process_noise(q).py()?;
         }
         Ok(Self {
             filter,
+            raised: model.raised,
             components,
             iterations,
             tolerance,
@@ -490,7 +539,8 @@ impl PyExtendedKalmanFilter {
     /// Carries the estimate to time ``t`` by ``f`` and its covariance by ``Φ S Φᵀ + Q`` (no
     /// measurement). On an error the filter is unchanged.
     fn predict(&mut self, t: f64) -> PyResult<()> {
-        self.filter.predict(t).py()
+        let result = self.filter.predict(t);
+        self.raised.py(result)
     }
 
     /// Predicts to ``t`` and updates with ``z`` (a number, or one value per component; NaN for
@@ -506,7 +556,8 @@ impl PyExtendedKalmanFilter {
         R: &Bound<'_, PyAny>,
     ) -> PyResult<Option<PyInnovation>> {
         let m = measurement(t, z, R, self.filter_components(), self.filter.time())?;
-        let innovation = self.step(&m).py()?;
+        let result = self.step(&m);
+        let innovation = self.raised.py(result)?;
         Ok(innovation.map(|inner| PyInnovation { inner }))
     }
 
@@ -547,7 +598,7 @@ impl PyExtendedKalmanFilter {
                 .copy_from_slice(self.filter.covariance().as_slice());
             Ok::<(), Error>(())
         });
-        outcome.py()?;
+        self.raised.py(outcome)?;
         if let Some((k, t, previous)) = disorder {
             return Err(before(t, previous, Some(k)));
         }
@@ -572,7 +623,9 @@ impl PyExtendedKalmanFilter {
         if let Some((k, t, previous)) = out_of_order(self.filter.time(), &rows) {
             return Err(before(t, previous, Some(k)));
         }
-        let smoothed = smoother::smooth(self.filter.clone(), &rows).py()?;
+        let smoothed = self
+            .raised
+            .py(smoother::smooth(self.filter.clone(), &rows))?;
         stacked(py, smoothed.iter().map(|s| (&s.state, &s.covariance)))
     }
 

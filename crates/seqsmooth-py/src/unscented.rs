@@ -8,7 +8,7 @@
 //! Python callables of [`crate::callables`].
 
 use crate::arrays::series;
-use crate::callables::{batch_tuple, stacked, user_model, UserDynamics, UserObservation};
+use crate::callables::{batch_tuple, stacked, user_model, Raised, UserDynamics, UserObservation};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{
     before, measurement, measurements, observation_from, out_of_order, square, square_from,
@@ -124,6 +124,8 @@ pub struct PyUnscentedKalmanFilter {
     model: Model,
     /// The observation's components `p`.
     components: usize,
+    /// The exception a callable of the user's model raised (empty for the built-in models).
+    raised: Raised,
 }
 
 #[pymethods]
@@ -158,19 +160,20 @@ impl PyUnscentedKalmanFilter {
             (None, Some(f), Some(h)) if !polynomial => {
                 let x = DVector::from_column_slice(series(x0, "x0")?.as_slice());
                 let p0 = square_from(P0, x.len(), "P0")?;
-                let (dynamics, observation, noise) =
-                    user_model(&x, t0, f, h, None, None, Q, angles)?;
-                let components = observation.components();
-                let mut filter = UnscentedKalmanFilter::new(dynamics, observation, x, p0, t0)
-                    .py()?
-                    .with_sigma_points(points)
-                    .py()?;
-                if let Some(noise) = noise {
+                let user = user_model(&x, t0, f, h, None, None, Q, angles)?;
+                let components = user.observation.components();
+                let mut filter =
+                    UnscentedKalmanFilter::new(user.dynamics, user.observation, x, p0, t0)
+                        .py()?
+                        .with_sigma_points(points)
+                        .py()?;
+                if let Some(noise) = user.noise {
                     filter = filter.with_process_noise(noise).py()?;
                 }
                 return Ok(Self {
                     model: Model::User(filter),
                     components,
+                    raised: user.raised,
                 });
             }
             (Some(degree), None, None) if Q.is_none() && angles.is_none() => degree,
@@ -242,7 +245,11 @@ impl PyUnscentedKalmanFilter {
                 )
             }
         };
-        Ok(Self { model, components })
+        Ok(Self {
+            model,
+            components,
+            raised: Raised::default(),
+        })
     }
 
     /// The current estimate ``X``.
@@ -279,7 +286,8 @@ impl PyUnscentedKalmanFilter {
     /// Carries the estimate and its covariance to time ``t`` through the sigma points (no
     /// measurement).
     fn predict(&mut self, t: f64) -> PyResult<()> {
-        each!(&mut self.model, f => f.predict(t).py())
+        let result = each!(&mut self.model, f => f.predict(t));
+        self.raised.py(result)
     }
 
     /// Predicts to ``t`` and updates with ``z`` (a number, or one value per component; NaN
@@ -295,7 +303,8 @@ impl PyUnscentedKalmanFilter {
         R: &Bound<'_, PyAny>,
     ) -> PyResult<Option<PyInnovation>> {
         let m = measurement(t, z, R, self.components, self.time())?;
-        let innovation = each!(&mut self.model, f => f.update(&m).py()?);
+        let result = each!(&mut self.model, f => f.update(&m));
+        let innovation = self.raised.py(result)?;
         Ok(innovation.map(|inner| PyInnovation { inner }))
     }
 
@@ -323,7 +332,7 @@ impl PyUnscentedKalmanFilter {
         let mut covariances = vec![0.0; rows.len() * n * n];
         let mut nis = vec![f64::NAN; rows.len()];
         let model = &mut self.model;
-        py.detach(|| {
+        let outcome = py.detach(|| {
             each!(model, f => {
                 for (i, m) in rows.iter().enumerate() {
                     let innovation = f.update(m).map_err(|e| Error::InBatch {
@@ -340,8 +349,8 @@ impl PyUnscentedKalmanFilter {
                 }
             });
             Ok::<(), Error>(())
-        })
-        .py()?;
+        });
+        self.raised.py(outcome)?;
         if let Some((k, t, previous)) = disorder {
             return Err(before(t, previous, Some(k)));
         }
@@ -367,9 +376,8 @@ impl PyUnscentedKalmanFilter {
             return Err(before(t, previous, Some(k)));
         }
         let model = self.model.clone();
-        let smoothed = py
-            .detach(|| each!(model, f => smooth_unscented(f, &rows)))
-            .py()?;
+        let smoothed = py.detach(|| each!(model, f => smooth_unscented(f, &rows)));
+        let smoothed = self.raised.py(smoothed)?;
         stacked(py, smoothed.iter().map(|s| (&s.state, &s.covariance)))
     }
 

@@ -341,6 +341,11 @@ def test_bad_callable_is_named_and_leaves_the_filter(which, how, kind):
         f"{which} over t = " if which in ("f", "F_jacobian", "Q") else f"{which} at t = "
     ), message
     assert WORDS[how] in message, message
+    # The callable's own exception is the cause; none where it raised nothing.
+    if how == "raises":
+        assert isinstance(e.value.__cause__, RuntimeError) and str(e.value.__cause__) == "boom"
+    else:
+        assert e.value.__cause__ is None
     assert unchanged(flt, before)
     # In a batch: sample 2 is the first bad one.
     kw = {k: spoiled(v, how, lambda t: t >= ts[2]) if k == which else v for k, v in good.items()}
