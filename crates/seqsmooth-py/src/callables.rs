@@ -580,29 +580,22 @@ impl PyExtendedKalmanFilter {
             rows.truncate(k);
         }
         let n = self.filter.state().len();
-        let mut states = vec![0.0; rows.len() * n];
-        let mut covariances = vec![0.0; rows.len() * n * n];
-        let mut nis = vec![f64::NAN; rows.len()];
+        let mut run = Run::new(rows.len(), n);
         // The GIL is kept: every step calls Python.
         let outcome = rows.iter().enumerate().try_for_each(|(i, m)| {
             let innovation = self.step(m).map_err(|e| Error::InBatch {
                 index: i,
                 source: Box::new(e),
             })?;
-            if let Some(s) = innovation {
-                nis[i] = s.nis;
-            }
-            states[i * n..(i + 1) * n].copy_from_slice(self.filter.state().as_slice());
-            // Symmetric: column-major is row-major.
-            covariances[i * n * n..(i + 1) * n * n]
-                .copy_from_slice(self.filter.covariance().as_slice());
+            let nis = innovation.map(|s| s.nis);
+            run.record(i, self.filter.state(), self.filter.covariance(), nis);
             Ok::<(), Error>(())
         });
         self.raised.py(outcome)?;
         if let Some((k, t, previous)) = disorder {
             return Err(before(t, previous, Some(k)));
         }
-        batch_tuple(py, states, covariances, nis, n)
+        run.into_tuple(py)
     }
 
     /// The Rauch–Tung–Striebel smoother over the measurements, from this filter's current
@@ -676,20 +669,49 @@ pub(crate) fn stacked<'py, 'a>(
     PyTuple::new(py, [states, covariances])
 }
 
-/// `update_many`'s `(states, covariances, nis)` from its row-major buffers: `(count, n)`,
-/// `(count, n, n)` and `(count,)`.
-pub(crate) fn batch_tuple<'py>(
-    py: Python<'py>,
+/// `update_many`'s outputs, filled a measurement at a time: `(states, covariances, nis)`,
+/// `(count, n)`, `(count, n, n)` and `(count,)` (NaN where nothing was measured).
+pub(crate) struct Run {
+    n: usize,
     states: Vec<f64>,
     covariances: Vec<f64>,
     nis: Vec<f64>,
-    n: usize,
-) -> PyResult<Bound<'py, PyTuple>> {
-    let count = nis.len();
-    let states = matrix(py, states, count, n)?;
-    let covariances = PyArray1::from_vec(py, covariances)
-        .reshape([count, n, n])?
-        .into_any();
-    let nis = PyArray1::from_vec(py, nis).into_any();
-    PyTuple::new(py, [states, covariances, nis])
+}
+
+impl Run {
+    pub(crate) fn new(count: usize, n: usize) -> Self {
+        Self {
+            n,
+            states: vec![0.0; count * n],
+            covariances: vec![0.0; count * n * n],
+            nis: vec![f64::NAN; count],
+        }
+    }
+
+    /// Measurement `i`'s row: the filter's state and covariance after it, and its NIS.
+    pub(crate) fn record(
+        &mut self,
+        i: usize,
+        state: &DVector<f64>,
+        covariance: &DMatrix<f64>,
+        nis: Option<f64>,
+    ) {
+        let n = self.n;
+        if let Some(v) = nis {
+            self.nis[i] = v;
+        }
+        self.states[i * n..(i + 1) * n].copy_from_slice(state.as_slice());
+        // Symmetric: column-major is row-major.
+        self.covariances[i * n * n..(i + 1) * n * n].copy_from_slice(covariance.as_slice());
+    }
+
+    pub(crate) fn into_tuple(self, py: Python<'_>) -> PyResult<Bound<'_, PyTuple>> {
+        let (count, n) = (self.nis.len(), self.n);
+        let states = matrix(py, self.states, count, n)?;
+        let covariances = PyArray1::from_vec(py, self.covariances)
+            .reshape([count, n, n])?
+            .into_any();
+        let nis = PyArray1::from_vec(py, self.nis).into_any();
+        PyTuple::new(py, [states, covariances, nis])
+    }
 }

@@ -8,7 +8,7 @@
 //! Python callables of [`crate::callables`].
 
 use crate::arrays::series;
-use crate::callables::{batch_tuple, stacked, user_model, Raised, UserDynamics, UserObservation};
+use crate::callables::{stacked, user_model, Raised, Run, UserDynamics, UserObservation};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{
     before, measurement, measurements, observation_from, out_of_order, square, square_from,
@@ -328,9 +328,7 @@ impl PyUnscentedKalmanFilter {
             rows.truncate(k);
         }
         let n = self.state_len();
-        let mut states = vec![0.0; rows.len() * n];
-        let mut covariances = vec![0.0; rows.len() * n * n];
-        let mut nis = vec![f64::NAN; rows.len()];
+        let mut run = Run::new(rows.len(), n);
         let model = &mut self.model;
         let outcome = py.detach(|| {
             each!(model, f => {
@@ -339,13 +337,7 @@ impl PyUnscentedKalmanFilter {
                         index: i,
                         source: Box::new(e),
                     })?;
-                    if let Some(s) = innovation {
-                        nis[i] = s.nis;
-                    }
-                    states[i * n..(i + 1) * n].copy_from_slice(f.state().as_slice());
-                    // Symmetric: column-major is row-major.
-                    covariances[i * n * n..(i + 1) * n * n]
-                        .copy_from_slice(f.covariance().as_slice());
+                    run.record(i, f.state(), f.covariance(), innovation.map(|s| s.nis));
                 }
             });
             Ok::<(), Error>(())
@@ -354,7 +346,7 @@ impl PyUnscentedKalmanFilter {
         if let Some((k, t, previous)) = disorder {
             return Err(before(t, previous, Some(k)));
         }
-        batch_tuple(py, states, covariances, nis, n)
+        run.into_tuple(py)
     }
 
     /// The unscented Rauch–Tung–Striebel smoother (Särkkä 2008) over the measurements, from

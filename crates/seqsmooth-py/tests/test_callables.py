@@ -215,18 +215,17 @@ def test_ukf_equals_filterpy(alpha, beta, kappa):
         zs.append(h(x) + rng.normal(0.0, np.sqrt(np.diag(R))))
     zs = np.array(zs)
     points = MerweScaledSigmaPoints(4, alpha=alpha, beta=beta, kappa=kappa)
-    fp = FilterpyUKF(dim_x=4, dim_z=2, dt=1.0, hx=h, fx=fx_drag, points=points)
-    fp.x, fp.P, fp.Q, fp.R = x0.copy(), P0.copy(), Q, R
-    ukf = ss.UnscentedKalmanFilter(
-        x0=x0,
-        P0=P0,
-        f=lambda x, a, b: fx_drag(x, b - a),
-        h=h,
-        Q=Q,
-        alpha=alpha,
-        beta=beta,
-        kappa=kappa,
-    )
+
+    def both():
+        fp = FilterpyUKF(dim_x=4, dim_z=2, dt=1.0, hx=h, fx=fx_drag, points=points)
+        fp.x, fp.P, fp.Q, fp.R = x0.copy(), P0.copy(), Q, R
+        f = lambda x, a, b: fx_drag(x, b - a)  # noqa: E731
+        ours = ss.UnscentedKalmanFilter(
+            x0=x0, P0=P0, f=f, h=h, Q=Q, alpha=alpha, beta=beta, kappa=kappa
+        )
+        return fp, ours
+
+    fp, ukf = both()
     prev = 0.0
     for t, z in zip(ts, zs):
         fp.predict(dt=t - prev)
@@ -238,20 +237,9 @@ def test_ukf_equals_filterpy(alpha, beta, kappa):
         assert abs(i.nis - nis) <= TOL * max(nis, 1.0)
     # The smoother on a regular run.
     tr = np.arange(1.0, 21.0)
-    fp = FilterpyUKF(dim_x=4, dim_z=2, dt=1.0, hx=h, fx=fx_drag, points=points)
-    fp.x, fp.P, fp.Q, fp.R = x0.copy(), P0.copy(), Q, R
+    fp, ukf = both()
     mu, cov = fp.batch_filter(zs[:20])
     xs, ps, _ = fp.rts_smoother(mu, cov)
-    ukf = ss.UnscentedKalmanFilter(
-        x0=x0,
-        P0=P0,
-        f=lambda x, a, b: fx_drag(x, b - a),
-        h=h,
-        Q=Q,
-        alpha=alpha,
-        beta=beta,
-        kappa=kappa,
-    )
     sx, sp = ukf.smooth(tr, zs[:20], R)
     assert close(sx, xs) and close(sp, ps)
 
