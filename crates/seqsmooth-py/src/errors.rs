@@ -110,6 +110,12 @@ pub fn keyword(p: Param) -> Option<&'static str> {
         Param::ControlMatrixB => Some("B"),
         Param::ControlInputU => Some("u"),
         Param::StateCovarianceP => Some("P"),
+        Param::TransitionFunction => Some("f"),
+        Param::TransitionJacobian => Some("F_jacobian"),
+        Param::ObservationFunction => Some("h"),
+        Param::ObservationJacobian => Some("H_jacobian"),
+        Param::ProcessNoiseFunction => Some("Q"),
+        Param::AngleComponents => Some("angles"),
         _ => None,
     }
 }

@@ -7,6 +7,7 @@ mod arrays;
 mod automatic;
 mod bank;
 mod bayes;
+mod callables;
 mod errors;
 mod fit;
 mod frame;
@@ -38,6 +39,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<linear::PyLinearFixedLagSmoother>()?;
     m.add_class::<bayes::PyBayesFilter>()?;
     m.add_class::<unscented::PyUnscentedKalmanFilter>()?;
+    m.add_class::<callables::PyExtendedKalmanFilter>()?;
     m.add_class::<track::PyRadarTracker>()?;
     m.add_class::<fit::PySlidingFit>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;

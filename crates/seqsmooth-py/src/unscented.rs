@@ -4,16 +4,18 @@
 //! white-noise driving of the highest derivative (`q`), and a linear observation (the
 //! positions by default, or the caller's `M`) or a radar's range, azimuth and elevation
 //! (`model::radar::Radar`, the azimuth residual wrapped); and the unscented RTS smoother
-//! (`kalman::unscented_smoother`).
+//! (`kalman::unscented_smoother`). With `f=` and `h=` it runs over the caller's own model, the
+//! Python callables of [`crate::callables`].
 
-use crate::arrays::{matrix, series};
+use crate::arrays::series;
+use crate::callables::{stacked, user_model, Raised, Run, UserDynamics, UserObservation};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{
     before, measurement, measurements, observation_from, out_of_order, square, square_from,
     PyInnovation,
 };
 use nalgebra::DVector;
-use numpy::{PyArray1, PyArrayMethods};
+use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
@@ -30,6 +32,7 @@ use seqsmooth::Error;
 enum Model {
     Linear(UnscentedKalmanFilter<PolynomialDynamics, LinearObservation>),
     Radar(UnscentedKalmanFilter<PolynomialDynamics, Radar>),
+    User(UnscentedKalmanFilter<UserDynamics, UserObservation>),
 }
 
 /// `$body` with `$f` the filter, whichever the observation.
@@ -38,6 +41,7 @@ macro_rules! each {
         match $model {
             Model::Linear($f) => $body,
             Model::Radar($f) => $body,
+            Model::User($f) => $body,
         }
     };
 }
@@ -98,24 +102,41 @@ fn build<O: Observation>(
 ///     non-negative (a small ``alpha`` such as 1e-3 weighs the central point by about
 ///     ``−1/alpha²``).
 ///
-/// A missing component (NaN) is left out, a time with none is a prediction only.
+/// f, h : callable, optional
+///     The caller's own model instead of the polynomial one (then no ``degree``, ``axes``,
+///     ``q``, ``observation`` or ``site``): ``f(x, t0, t1) -> x1`` carries each sigma point
+///     over the step, ``h(x, t) -> z`` observes it (``p`` values, counted by one call
+///     ``h(x0, t0)``), as for :class:`ExtendedKalmanFilter` (no Jacobians are needed).
+/// Q : array_like or callable, optional
+///     With ``f``: the driving-noise covariance over each step, one ``n × n`` matrix (or a
+///     number or diagonal) or ``Q(t0, t1)``. Default none.
+/// angles : sequence of int, optional
+///     With ``h``: the components of ``z`` that are angles in radians (residuals and the
+///     predicted mean wrapped to (−π, π]).
+///
+/// A missing component (NaN) is left out, a time with none is a prediction only. A callable
+/// that raises, returns the wrong shape, a NaN or an infinity is refused with a
+/// ``ParameterError`` naming it and the time (in ``update_many`` also ``.index``), the filter
+/// left as it was.
 #[pyclass(name = "UnscentedKalmanFilter", module = "seqsmooth")]
 #[derive(Clone)]
 pub struct PyUnscentedKalmanFilter {
     model: Model,
     /// The observation's components `p`.
     components: usize,
+    /// The exception a callable of the user's model raised (empty for the built-in models).
+    raised: Raised,
 }
 
 #[pymethods]
 impl PyUnscentedKalmanFilter {
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
-    #[pyo3(signature = (degree, x0, P0, t0 = 0.0, axes = 1, q = 0.0, observation = None, site = None, alpha = 1.0, beta = 2.0, kappa = 0.0))]
+    #[pyo3(signature = (degree = None, x0 = None, P0 = None, t0 = 0.0, axes = 1, q = 0.0, observation = None, site = None, alpha = 1.0, beta = 2.0, kappa = 0.0, *, f = None, h = None, Q = None, angles = None))]
     fn new(
-        degree: usize,
-        x0: &Bound<'_, PyAny>,
-        P0: &Bound<'_, PyAny>,
+        degree: Option<usize>,
+        x0: Option<&Bound<'_, PyAny>>,
+        P0: Option<&Bound<'_, PyAny>>,
         t0: f64,
         axes: usize,
         q: f64,
@@ -124,7 +145,47 @@ impl PyUnscentedKalmanFilter {
         alpha: f64,
         beta: f64,
         kappa: f64,
+        f: Option<&Bound<'_, PyAny>>,
+        h: Option<&Bound<'_, PyAny>>,
+        Q: Option<&Bound<'_, PyAny>>,
+        angles: Option<Vec<usize>>,
     ) -> PyResult<Self> {
+        let (Some(x0), Some(P0)) = (x0, P0) else {
+            return Err(raise(Kind::Parameter, "x0 and P0 are required", None));
+        };
+        let points = SigmaPoints::new(alpha, beta, kappa).py()?;
+        let polynomial =
+            degree.is_some() || axes != 1 || q != 0.0 || observation.is_some() || site.is_some();
+        let degree = match (degree, f, h) {
+            (None, Some(f), Some(h)) if !polynomial => {
+                let x = DVector::from_column_slice(series(x0, "x0")?.as_slice());
+                let p0 = square_from(P0, x.len(), "P0")?;
+                let user = user_model(&x, t0, f, h, None, None, Q, angles)?;
+                let components = user.observation.components();
+                let mut filter =
+                    UnscentedKalmanFilter::new(user.dynamics, user.observation, x, p0, t0)
+                        .py()?
+                        .with_sigma_points(points)
+                        .py()?;
+                if let Some(noise) = user.noise {
+                    filter = filter.with_process_noise(noise).py()?;
+                }
+                return Ok(Self {
+                    model: Model::User(filter),
+                    components,
+                    raised: user.raised,
+                });
+            }
+            (Some(degree), None, None) if Q.is_none() && angles.is_none() => degree,
+            _ => {
+                return Err(raise(
+                    Kind::Parameter,
+                    "give either degree (the polynomial model, with axes, q, observation, \
+                     site) or both f and h (the caller's model, with Q and angles)",
+                    None,
+                ))
+            }
+        };
         if axes == 0 {
             return Err(raise(
                 Kind::Parameter,
@@ -146,7 +207,6 @@ impl PyUnscentedKalmanFilter {
         }
         let x = DVector::from_column_slice(x.as_slice());
         let p0 = square_from(P0, n, "P0")?;
-        let points = SigmaPoints::new(alpha, beta, kappa).py()?;
         let dynamics = PolynomialDynamics::new(degree, axes);
         let radar = match observation {
             Some(o) => o.extract::<String>().ok(),
@@ -185,7 +245,11 @@ impl PyUnscentedKalmanFilter {
                 )
             }
         };
-        Ok(Self { model, components })
+        Ok(Self {
+            model,
+            components,
+            raised: Raised::default(),
+        })
     }
 
     /// The current estimate ``X``.
@@ -222,7 +286,8 @@ impl PyUnscentedKalmanFilter {
     /// Carries the estimate and its covariance to time ``t`` through the sigma points (no
     /// measurement).
     fn predict(&mut self, t: f64) -> PyResult<()> {
-        each!(&mut self.model, f => f.predict(t).py())
+        let result = each!(&mut self.model, f => f.predict(t));
+        self.raised.py(result)
     }
 
     /// Predicts to ``t`` and updates with ``z`` (a number, or one value per component; NaN
@@ -238,7 +303,8 @@ impl PyUnscentedKalmanFilter {
         R: &Bound<'_, PyAny>,
     ) -> PyResult<Option<PyInnovation>> {
         let m = measurement(t, z, R, self.components, self.time())?;
-        let innovation = each!(&mut self.model, f => f.update(&m).py()?);
+        let result = each!(&mut self.model, f => f.update(&m));
+        let innovation = self.raised.py(result)?;
         Ok(innovation.map(|inner| PyInnovation { inner }))
     }
 
@@ -262,39 +328,25 @@ impl PyUnscentedKalmanFilter {
             rows.truncate(k);
         }
         let n = self.state_len();
-        let mut states = vec![0.0; rows.len() * n];
-        let mut covariances = vec![0.0; rows.len() * n * n];
-        let mut nis = vec![f64::NAN; rows.len()];
+        let mut run = Run::new(rows.len(), n);
         let model = &mut self.model;
-        py.detach(|| {
+        let outcome = py.detach(|| {
             each!(model, f => {
                 for (i, m) in rows.iter().enumerate() {
                     let innovation = f.update(m).map_err(|e| Error::InBatch {
                         index: i,
                         source: Box::new(e),
                     })?;
-                    if let Some(s) = innovation {
-                        nis[i] = s.nis;
-                    }
-                    states[i * n..(i + 1) * n].copy_from_slice(f.state().as_slice());
-                    // Symmetric: column-major is row-major.
-                    covariances[i * n * n..(i + 1) * n * n]
-                        .copy_from_slice(f.covariance().as_slice());
+                    run.record(i, f.state(), f.covariance(), innovation.map(|s| s.nis));
                 }
             });
             Ok::<(), Error>(())
-        })
-        .py()?;
+        });
+        self.raised.py(outcome)?;
         if let Some((k, t, previous)) = disorder {
             return Err(before(t, previous, Some(k)));
         }
-        let count = rows.len();
-        let states = matrix(py, states, count, n)?;
-        let covariances = PyArray1::from_vec(py, covariances)
-            .reshape([count, n, n])?
-            .into_any();
-        let nis = PyArray1::from_vec(py, nis).into_any();
-        PyTuple::new(py, [states, covariances, nis])
+        run.into_tuple(py)
     }
 
     /// The unscented Rauch–Tung–Striebel smoother (Särkkä 2008) over the measurements, from
@@ -316,24 +368,9 @@ impl PyUnscentedKalmanFilter {
             return Err(before(t, previous, Some(k)));
         }
         let model = self.model.clone();
-        let smoothed = py
-            .detach(|| each!(model, f => smooth_unscented(f, &rows)))
-            .py()?;
-        let n = self.state_len();
-        let states: Vec<f64> = smoothed
-            .iter()
-            .flat_map(|s| s.state.iter().copied())
-            .collect();
-        let covariances: Vec<f64> = smoothed
-            .iter()
-            .flat_map(|s| s.covariance.iter().copied())
-            .collect();
-        let count = smoothed.len();
-        let states = matrix(py, states, count, n)?;
-        let covariances = PyArray1::from_vec(py, covariances)
-            .reshape([count, n, n])?
-            .into_any();
-        PyTuple::new(py, [states, covariances])
+        let smoothed = py.detach(|| each!(model, f => smooth_unscented(f, &rows)));
+        let smoothed = self.raised.py(smoothed)?;
+        stacked(py, smoothed.iter().map(|s| (&s.state, &s.covariance)))
     }
 
     fn __repr__(&self) -> String {

@@ -172,12 +172,16 @@ class KalmanFilter:
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
 
+Transition = Callable[[Vector, float, float], ArrayLike]
+Observe = Callable[[Vector, float], ArrayLike]
+StepNoise = ArrayLike | float | Callable[[float, float], ArrayLike]
+
 class UnscentedKalmanFilter:
     def __init__(
         self,
-        degree: int,
-        x0: ArrayLike,
-        P0: ArrayLike | float,
+        degree: int | None = None,
+        x0: ArrayLike | None = None,
+        P0: ArrayLike | float | None = None,
         t0: float = 0.0,
         axes: int = 1,
         q: float = 0.0,
@@ -186,6 +190,11 @@ class UnscentedKalmanFilter:
         alpha: float = 1.0,
         beta: float = 2.0,
         kappa: float = 0.0,
+        *,
+        f: Transition | None = None,
+        h: Observe | None = None,
+        Q: StepNoise | None = None,
+        angles: list[int] | None = None,
     ) -> None: ...
     @property
 class LinearKalmanFilter:
@@ -316,6 +325,38 @@ class LinearFixedLagSmoother:
         """One step; ``(index, state, covariance)`` of the step ``lag`` before, or ``None``."""
     def finish(self) -> tuple[npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64]]:
         """The last ``lag`` steps: ``(indices, states, covariances)``."""
+
+class ExtendedKalmanFilter:
+    def __init__(
+        self,
+        x0: ArrayLike,
+        P0: ArrayLike | float,
+        f: Transition,
+        h: Observe,
+        Q: StepNoise | None = None,
+        t0: float = 0.0,
+        F_jacobian: Transition | None = None,
+        H_jacobian: Observe | None = None,
+        angles: list[int] | None = None,
+        iterations: int = 1,
+        tolerance: float = 1e-9,
+    ) -> None: ...
+    @property
+    def state(self) -> Vector: ...
+    @property
+    def covariance(self) -> Matrix: ...
+    @property
+    def std_devs(self) -> Vector: ...
+    @property
+    def time(self) -> float: ...
+    def predict(self, t: float) -> None: ...
+    def update(self, t: float, z: ArrayLike | float, R: ArrayLike | float) -> Innovation | None: ...
+    def update_many(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
+    ) -> tuple[Matrix, npt.NDArray[np.float64], Vector]: ...
+    def smooth(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
+    ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
 
 class BayesFilter:
     def __init__(

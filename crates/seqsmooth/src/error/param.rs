@@ -294,6 +294,18 @@ pub enum Param {
     ControlInputU,
     /// A discrete-time model's state covariance `P` set or handed in.
     StateCovarianceP,
+    /// A user's state transition `f(x, t0, t1)`.
+    TransitionFunction,
+    /// The Jacobian `∂f/∂x` of a user's state transition.
+    TransitionJacobian,
+    /// A user's observation function `h(x, t)`.
+    ObservationFunction,
+    /// The Jacobian `∂h/∂x` of a user's observation function.
+    ObservationJacobian,
+    /// A user's driving-noise covariance `Q(t0, t1)`.
+    ProcessNoiseFunction,
+    /// The observation components that are angles (their residuals wrapped to `(−π, π]`).
+    AngleComponents,
 }
 
 impl Param {
@@ -435,6 +447,12 @@ impl Param {
         Param::ControlMatrixB,
         Param::ControlInputU,
         Param::StateCovarianceP,
+        Param::TransitionFunction,
+        Param::TransitionJacobian,
+        Param::ObservationFunction,
+        Param::ObservationJacobian,
+        Param::ProcessNoiseFunction,
+        Param::AngleComponents,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -576,6 +594,12 @@ impl Param {
             Param::ControlMatrixB => "control matrix B",
             Param::ControlInputU => "control input u",
             Param::StateCovarianceP => "state covariance P",
+            Param::TransitionFunction => "transition function",
+            Param::TransitionJacobian => "transition Jacobian",
+            Param::ObservationFunction => "observation function",
+            Param::ObservationJacobian => "observation Jacobian",
+            Param::ProcessNoiseFunction => "process noise function",
+            Param::AngleComponents => "angle components",
         }
     }
 

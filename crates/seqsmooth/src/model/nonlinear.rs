@@ -205,6 +205,28 @@ pub(crate) fn central_differences(
     x: &DVector<f64>,
     f: impl Fn(&DVector<f64>) -> Option<DVector<f64>>,
 ) -> Option<DMatrix<f64>> {
+    differenced_jacobian(rows, x, |probe| f(probe).ok_or(())).ok()
+}
+
+/// The library's differencing rule for a Jacobian `∂f/∂x` (`rows × n`) that the caller does
+/// not give: central differences `(f(x + h_j e_j) − f(x − h_j e_j)) / 2h_j` with the step
+/// `h_j = ε^{1/3} max(|x_j|, 1)` rounded so that `x_j ± h_j` are exact (error `O(ε^{2/3})`
+/// relative for a smooth `f` of unit scale; Morrison §8.6's `M` and `Φ` when no closed form
+/// is at hand). `f`'s first error is returned as it is; a value that has not `rows` entries
+/// makes its column NaN (never a panic), for the caller's finiteness check to refuse.
+///
+/// ```
+/// use nalgebra::DVector;
+/// use seqsmooth::model::nonlinear::differenced_jacobian;
+/// let x = DVector::from_vec(vec![2.0, 3.0]);
+/// let j = differenced_jacobian(1, &x, |p| Ok::<_, ()>(DVector::from_vec(vec![p[0] * p[1]]))).unwrap();
+/// assert!((j[(0, 0)] - 3.0).abs() < 1e-9 && (j[(0, 1)] - 2.0).abs() < 1e-9);
+/// ```
+pub fn differenced_jacobian<E>(
+    rows: usize,
+    x: &DVector<f64>,
+    mut f: impl FnMut(&DVector<f64>) -> Result<DVector<f64>, E>,
+) -> Result<DMatrix<f64>, E> {
     let step = f64::EPSILON.cbrt();
     let mut out = DMatrix::zeros(rows, x.len());
     let mut probe = x.clone();
@@ -216,9 +238,13 @@ pub(crate) fn central_differences(
         probe[c] = xc - h;
         let down = f(&probe)?;
         probe[c] = xc;
-        out.set_column(c, &((up - down) / (2.0 * h)));
+        if up.len() == rows && down.len() == rows {
+            out.set_column(c, &((up - down) / (2.0 * h)));
+        } else {
+            out.column_mut(c).fill(f64::NAN);
+        }
     }
-    Some(out)
+    Ok(out)
 }
 
 /// The state, `Φ` (by columns) and the time offset `ζ` side by side (`n + n² + 1` numbers) for

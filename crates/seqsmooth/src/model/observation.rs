@@ -11,6 +11,7 @@
 //! A residual `Y − G` is taken by [`Observation::residual`], where an angle is wrapped.
 
 use super::nonlinear::central_differences;
+use super::radar::wrap;
 use crate::error::{Error, Param};
 use nalgebra::{DMatrix, DVector};
 use std::sync::Arc;
@@ -147,6 +148,63 @@ pub(crate) fn check_state(n: usize, state: &DVector<f64>) -> Result<(), Error> {
             value,
         }),
         None => Ok(()),
+    }
+}
+
+/// Which of an observation's components are angles: their residuals `measured − predicted`
+/// are wrapped to `(−π, π]` ([`wrap`], as [`super::radar::Radar`]'s azimuth), so that a
+/// measured 179° against a predicted −179° is a residual of −2°, not 358°. What a model of
+/// the caller's own ([`Observation::residual`]) gives for its angle components.
+///
+/// ```
+/// use seqsmooth::model::observation::Angles;
+/// let a = Angles::new(2, &[1]).unwrap();
+/// assert_eq!(a.residual(0, 3.0, 1.0), 2.0);
+/// assert!((a.residual(1, 3.1, -3.1) - (6.2 - std::f64::consts::TAU)).abs() < 1e-15);
+/// assert!(Angles::new(2, &[2]).is_err()); // no component 2
+/// ```
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Angles {
+    is_angle: Vec<bool>,
+}
+
+impl Angles {
+    /// The components `indices` (each below `components`, none twice) of a `components`-long
+    /// observation are angles, in radians.
+    pub fn new(components: usize, indices: &[usize]) -> Result<Self, Error> {
+        let mut is_angle = vec![false; components];
+        for &i in indices {
+            if i >= components || is_angle[i] {
+                return Err(Error::InvalidParameter {
+                    name: Param::AngleComponents,
+                    value: format!("{indices:?}"),
+                    reason: format!(
+                        "each must be a distinct component below {components}, the observation's count"
+                    ),
+                });
+            }
+            is_angle[i] = true;
+        }
+        Ok(Self { is_angle })
+    }
+
+    /// Whether component `c` is an angle.
+    ///
+    /// ```
+    /// use seqsmooth::model::observation::Angles;
+    /// assert!(Angles::new(3, &[0, 2]).unwrap().is_angle(2));
+    /// ```
+    pub fn is_angle(&self, c: usize) -> bool {
+        self.is_angle.get(c).copied().unwrap_or(false)
+    }
+
+    /// `measured − predicted`, wrapped to `(−π, π]` for an angle component.
+    pub fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {
+        if self.is_angle(component) {
+            wrap(measured - predicted)
+        } else {
+            measured - predicted
+        }
     }
 }
 

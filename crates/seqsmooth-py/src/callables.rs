@@ -1,0 +1,717 @@
+//! The user's own nonlinear model from Python: the library's [`Dynamics`], [`Observation`] and
+//! [`ProcessNoise`] traits over Python callables — a state transition `f(x, t0, t1) -> x1`
+//! and its optional Jacobian `F_jacobian(x, t0, t1) -> Φ`, an observation `h(x, t) -> z` and
+//! its optional Jacobian `H_jacobian(x, t) -> M`, `Q` constant or `Q(t0, t1)` — with the
+//! library's differencing rule (`model::nonlinear::differenced_jacobian`) for a Jacobian not
+//! given and its angle rule (`model::observation::Angles`) for the residuals; and the class
+//! `ExtendedKalmanFilter` over them (the library's `kalman::KalmanFilter`, its iterated update
+//! and its Rauch–Tung–Striebel smoother). `UnscentedKalmanFilter` takes the same callables
+//! ([`crate::unscented`]).
+//!
+//! Every call takes the GIL, hands the state as a fresh `float64` array and reads the result
+//! back; an exception, a result of the wrong shape or with a NaN or infinity becomes the
+//! library's typed error naming the callable (its keyword, `Param`) and the time, and the
+//! filter refuses the update and stays as it was. Inside `update_many` the error also names
+//! the measurement's index.
+
+use crate::arrays::matrix;
+use crate::errors::{raise, IntoPy, Kind};
+use crate::kalman::{before, measurement, measurements, out_of_order, square, PyInnovation};
+use nalgebra::{DMatrix, DVector};
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use seqsmooth::error::Param;
+use seqsmooth::kalman::noise::ProcessNoise;
+use seqsmooth::kalman::{smoother, KalmanFilter};
+use seqsmooth::model::dynamics::{Dynamics, Propagation};
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::model::nonlinear::differenced_jacobian;
+use seqsmooth::model::observation::{Angles, Observation, Predicted};
+use seqsmooth::Error;
+use std::sync::{Arc, Mutex};
+
+/// The first exception a model's callables raised since the last call of the filter, kept to
+/// be the `__cause__` of the error that refuses the update.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Raised(Arc<Mutex<Option<PyErr>>>);
+
+impl Raised {
+    fn keep(&self, e: PyErr) {
+        let mut slot = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        slot.get_or_insert(e);
+    }
+
+    fn take(&self) -> Option<PyErr> {
+        self.0.lock().unwrap_or_else(|p| p.into_inner()).take()
+    }
+
+    /// `result` of one call of the filter as Python's: its error the library's, with the
+    /// exception a callable raised (if any) as its cause; the slot emptied either way.
+    pub(crate) fn py<T>(&self, result: Result<T, Error>) -> PyResult<T> {
+        let kept = self.take();
+        result.py().inspect_err(|err| {
+            if let Some(cause) = kept {
+                Python::attach(|py| err.set_cause(py, Some(cause)));
+            }
+        })
+    }
+}
+
+/// A Python callable of the user's model, named in errors by its parameter.
+#[derive(Clone)]
+pub(crate) struct Callable {
+    func: Arc<Py<PyAny>>,
+    param: Param,
+    raised: Raised,
+}
+
+impl std::fmt::Debug for Callable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Callable({})", self.param)
+    }
+}
+
+impl Callable {
+    /// `obj`, refused unless callable.
+    fn new(obj: &Bound<'_, PyAny>, param: Param, keyword: &str, raised: &Raised) -> PyResult<Self> {
+        if !obj.is_callable() {
+            return Err(raise(
+                Kind::InvalidType,
+                format!("{keyword} must be callable"),
+                None,
+            ));
+        }
+        Ok(Self {
+            func: Arc::new(obj.clone().unbind()),
+            param,
+            raised: raised.clone(),
+        })
+    }
+
+    fn refuse(&self, at: String, reason: String) -> Error {
+        Error::InvalidParameter {
+            name: self.param,
+            value: at,
+            reason,
+        }
+    }
+
+    /// The callable on `x` (if any) and the times, its result read as `rows × cols` in
+    /// row-major order (`cols` `None`: a vector of `rows`, also `rows × 1` or a number for
+    /// one row); `at` words the call's time in errors.
+    fn call(
+        &self,
+        x: Option<&DVector<f64>>,
+        times: &[f64],
+        rows: usize,
+        cols: Option<usize>,
+        at: impl Fn() -> String,
+    ) -> Result<Vec<f64>, Error> {
+        Python::attach(|py| {
+            let out = match (x, times) {
+                (Some(x), [t]) => self
+                    .func
+                    .call1(py, (PyArray1::from_slice(py, x.as_slice()), *t)),
+                (Some(x), [a, b]) => self
+                    .func
+                    .call1(py, (PyArray1::from_slice(py, x.as_slice()), *a, *b)),
+                (_, [a, b]) => self.func.call1(py, (*a, *b)),
+                _ => unreachable!("every call has a time or two"),
+            };
+            let out = out.map_err(|e| {
+                let error = self.refuse(at(), format!("raised {e}"));
+                self.raised.keep(e);
+                error
+            })?;
+            read(out.bind(py), rows, cols).map_err(|reason| self.refuse(at(), reason))
+        })
+    }
+}
+
+/// A result as `rows × cols` numbers (row-major), or why not.
+fn read(out: &Bound<'_, PyAny>, rows: usize, cols: Option<usize>) -> Result<Vec<f64>, String> {
+    let converted;
+    let array = match out.cast::<PyArrayDyn<f64>>() {
+        Ok(a) => a,
+        Err(_) => {
+            let np = out.py().import("numpy").map_err(|e| e.to_string())?;
+            converted = np
+                .call_method1("asarray", (out, "float64"))
+                .map_err(|e| format!("returned {}, not an array of numbers ({e})", kind(out)))?;
+            converted
+                .cast::<PyArrayDyn<f64>>()
+                .map_err(|e| e.to_string())?
+        }
+    };
+    // A copy in logical (row-major) order, whatever the strides (no borrow to register).
+    let owned = array.to_owned_array();
+    let shape = owned.shape().to_vec();
+    let want_cols = cols.unwrap_or(1);
+    let fits = match (shape.as_slice(), cols) {
+        ([r, c], _) => *r == rows && *c == want_cols,
+        ([r], None) => *r == rows,
+        ([], None) => rows == 1,
+        _ => false,
+    };
+    if !fits {
+        let want = match cols {
+            Some(c) => format!("({rows}, {c})"),
+            None => format!("({rows},)"),
+        };
+        return Err(format!("returned shape {shape:?}, not {want}"));
+    }
+    let flat: Vec<f64> = match owned.as_slice() {
+        Some(s) => s.to_vec(),
+        None => owned.iter().copied().collect(),
+    };
+    if let Some(i) = flat.iter().position(|v| !v.is_finite()) {
+        let (r, c) = (i / want_cols, i % want_cols);
+        let entry = if cols.is_some() {
+            format!("({r}, {c})")
+        } else {
+            r.to_string()
+        };
+        return Err(format!("returned {} at entry {entry}", flat[i]));
+    }
+    Ok(flat)
+}
+
+/// The Python type's name of `obj`, for an error.
+fn kind(obj: &Bound<'_, PyAny>) -> String {
+    obj.get_type()
+        .name()
+        .map_or_else(|_| "an object".into(), |n| n.to_string())
+}
+
+/// `X(t1) = f(X(t0), t0, t1)`, `Φ` the caller's `F_jacobian` or the library's differences.
+#[derive(Clone, Debug)]
+pub(crate) struct UserDynamics {
+    n: usize,
+    f: Callable,
+    jacobian: Option<Callable>,
+}
+
+impl UserDynamics {
+    fn transition_state(
+        &self,
+        x: &DVector<f64>,
+        t_a: f64,
+        t_b: f64,
+    ) -> Result<DVector<f64>, Error> {
+        let at = || format!("over t = {t_a} to {t_b}");
+        let v = self.f.call(Some(x), &[t_a, t_b], self.n, None, at)?;
+        Ok(DVector::from_vec(v))
+    }
+}
+
+impl Dynamics for UserDynamics {
+    fn dimension(&self) -> usize {
+        self.n
+    }
+
+    fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
+        let n = self.n;
+        let new_state = self.transition_state(state, t_a, t_b)?;
+        let transition = match &self.jacobian {
+            Some(j) => {
+                let at = || format!("over t = {t_a} to {t_b}");
+                DMatrix::from_row_slice(n, n, &j.call(Some(state), &[t_a, t_b], n, Some(n), at)?)
+            }
+            None => differenced_jacobian(n, state, |x| self.transition_state(x, t_a, t_b))?,
+        };
+        Ok(Propagation {
+            state: new_state,
+            transition,
+        })
+    }
+
+    fn propagate_state(
+        &self,
+        state: &DVector<f64>,
+        t_a: f64,
+        t_b: f64,
+    ) -> Result<DVector<f64>, Error> {
+        self.transition_state(state, t_a, t_b)
+    }
+}
+
+/// `z = h(X, t)`, `M` the caller's `H_jacobian` or the library's differences; the `angles`
+/// components' residuals wrapped.
+#[derive(Clone, Debug)]
+pub(crate) struct UserObservation {
+    n: usize,
+    p: usize,
+    h: Callable,
+    jacobian: Option<Callable>,
+    angles: Angles,
+}
+
+impl Observation for UserObservation {
+    fn components(&self) -> usize {
+        self.p
+    }
+
+    fn state_dimension(&self) -> usize {
+        self.n
+    }
+
+    fn predict(&self, state: &DVector<f64>, t: f64) -> Result<Predicted, Error> {
+        let value = self.value(state, t)?;
+        let jacobian = match &self.jacobian {
+            Some(j) => {
+                let at = || format!("at t = {t}");
+                let m = j.call(Some(state), &[t], self.p, Some(self.n), at)?;
+                DMatrix::from_row_slice(self.p, self.n, &m)
+            }
+            None => differenced_jacobian(self.p, state, |x| self.value(x, t))?,
+        };
+        Ok(Predicted { value, jacobian })
+    }
+
+    fn value(&self, state: &DVector<f64>, t: f64) -> Result<DVector<f64>, Error> {
+        let v = self
+            .h
+            .call(Some(state), &[t], self.p, None, || format!("at t = {t}"))?;
+        Ok(DVector::from_vec(v))
+    }
+
+    fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {
+        self.angles.residual(component, measured, predicted)
+    }
+}
+
+/// `Q` over a step: one matrix for every step, or the caller's `Q(t0, t1)`, checked at every
+/// call (`n × n`, finite, symmetric, non-negative variances).
+#[derive(Clone, Debug)]
+pub(crate) enum UserNoise {
+    Constant(DMatrix<f64>),
+    Callable(Callable, usize),
+}
+
+/// Why `q` is not a driving-noise covariance (symmetric to 1e-12 of its largest entry, with
+/// non-negative variances, the Kalman filter's rule for its prior), or `None`.
+fn not_covariance(q: &DMatrix<f64>) -> Option<String> {
+    let asymmetric = (q - q.transpose()).amax() > 1e-12 * q.amax();
+    let negative = q.diagonal().iter().any(|&v| v < 0.0);
+    (asymmetric || negative).then(|| "is not symmetric with non-negative variances".into())
+}
+
+impl ProcessNoise for UserNoise {
+    fn dimension(&self) -> usize {
+        match self {
+            UserNoise::Constant(q) => q.nrows(),
+            UserNoise::Callable(_, n) => *n,
+        }
+    }
+
+    fn covariance(&self, t_a: f64, t_b: f64) -> Result<DMatrix<f64>, Error> {
+        match self {
+            UserNoise::Constant(q) => Ok(q.clone()),
+            UserNoise::Callable(c, n) => {
+                let at = || format!("over t = {t_a} to {t_b}");
+                let q =
+                    DMatrix::from_row_slice(*n, *n, &c.call(None, &[t_a, t_b], *n, Some(*n), at)?);
+                match not_covariance(&q) {
+                    Some(reason) => Err(c.refuse(at(), format!("returned a matrix that {reason}"))),
+                    None => Ok(q),
+                }
+            }
+        }
+    }
+}
+
+/// The user's model from the keywords of `ExtendedKalmanFilter` and `UnscentedKalmanFilter`:
+/// `n` states, the observation's components counted by one call of `h(x0, t0)`.
+#[allow(non_snake_case, clippy::too_many_arguments)]
+pub(crate) fn user_model(
+    x0: &DVector<f64>,
+    t0: f64,
+    f: &Bound<'_, PyAny>,
+    h: &Bound<'_, PyAny>,
+    F_jacobian: Option<&Bound<'_, PyAny>>,
+    H_jacobian: Option<&Bound<'_, PyAny>>,
+    Q: Option<&Bound<'_, PyAny>>,
+    angles: Option<Vec<usize>>,
+) -> PyResult<UserModel> {
+    let n = x0.len();
+    let raised = Raised::default();
+    let optional = |obj: Option<&Bound<'_, PyAny>>, param, keyword| {
+        obj.filter(|o| !o.is_none())
+            .map(|o| Callable::new(o, param, keyword, &raised))
+            .transpose()
+    };
+    let dynamics = UserDynamics {
+        n,
+        f: Callable::new(f, Param::TransitionFunction, "f", &raised)?,
+        jacobian: optional(F_jacobian, Param::TransitionJacobian, "F_jacobian")?,
+    };
+    let h = Callable::new(h, Param::ObservationFunction, "h", &raised)?;
+    // The components: what h gives at the prior (any length at least 1).
+    let first = Python::attach(|py| {
+        h.func
+            .call1(py, (PyArray1::from_slice(py, x0.as_slice()), t0))
+            .and_then(|v| {
+                let np = py.import("numpy")?;
+                np.call_method1("size", (v,))?.extract::<usize>()
+            })
+    })
+    .map_err(|e| {
+        raise(
+            Kind::Parameter,
+            format!("h at the prior (t0 = {t0}) gave no array of numbers: {e}"),
+            None,
+        )
+    })?;
+    if first == 0 {
+        return Err(raise(
+            Kind::Parameter,
+            "h at the prior gave no values: the observation needs at least one component",
+            None,
+        ));
+    }
+    let observation = UserObservation {
+        n,
+        p: first,
+        h,
+        jacobian: optional(H_jacobian, Param::ObservationJacobian, "H_jacobian")?,
+        angles: Angles::new(first, &angles.unwrap_or_default()).py()?,
+    };
+    let noise = match Q.filter(|q| !q.is_none()) {
+        None => None,
+        Some(q) if q.is_callable() => Some(UserNoise::Callable(
+            Callable::new(q, Param::ProcessNoiseFunction, "Q", &raised)?,
+            n,
+        )),
+        Some(q) => {
+            let q = crate::kalman::square_from(q, n, "Q")?;
+            if let Some(&v) = q.iter().find(|v| !v.is_finite()) {
+                return Err(raise(
+                    Kind::Parameter,
+                    format!("Q has {v}: every entry must be finite"),
+                    None,
+                ));
+            }
+            if let Some(reason) = not_covariance(&q) {
+                return Err(raise(Kind::Parameter, format!("Q {reason}"), None));
+            }
+            Some(UserNoise::Constant(q))
+        }
+    };
+    Ok(UserModel {
+        dynamics,
+        observation,
+        noise,
+        raised,
+    })
+}
+
+/// The user's model: its dynamics, observation, driving noise and the slot its callables
+/// keep their first exception in.
+pub(crate) struct UserModel {
+    pub(crate) dynamics: UserDynamics,
+    pub(crate) observation: UserObservation,
+    pub(crate) noise: Option<UserNoise>,
+    pub(crate) raised: Raised,
+}
+
+type Extended = KalmanFilter<UserDynamics, UserObservation>;
+
+/// The extended Kalman filter (Morrison §12.5; with driving noise ch. 15) over the caller's
+/// own model, given as Python callables; with ``iterations > 1`` the iterated extended Kalman
+/// filter (Morrison §12.5, (12.5.10)-(12.5.17)).
+///
+/// Parameters
+/// ----------
+/// x0, P0 : array_like
+///     The prior state (``n`` values) and its covariance (a number: that variance on every
+///     state; a vector: the diagonal; or ``n × n``) at time ``t0``.
+/// f : callable
+///     ``f(x, t0, t1) -> x1``: the state at ``t1`` from the state ``x`` at ``t0`` (a step
+///     forwards or backwards).
+/// h : callable
+///     ``h(x, t) -> z``: the observation of the state ``x`` at ``t``, ``p`` values (counted by
+///     one call ``h(x0, t0)``).
+/// Q : array_like or callable, optional
+///     The driving-noise covariance added over each step: one ``n × n`` matrix (or a number or
+///     diagonal) for every step, or ``Q(t0, t1) -> n × n``. Default none.
+/// t0 : float
+///     The prior's time.
+/// F_jacobian : callable, optional
+///     ``F_jacobian(x, t0, t1) -> Φ`` (``n × n``), ``∂f/∂x``; default central differences
+///     (step ``ε^(1/3) max(|x_j|, 1)``).
+/// H_jacobian : callable, optional
+///     ``H_jacobian(x, t) -> M`` (``p × n``), ``∂h/∂x``; default central differences.
+/// angles : sequence of int, optional
+///     The components of ``z`` that are angles in radians: their residuals are wrapped to
+///     (−π, π].
+/// iterations : int
+///     1 (default): the extended filter; more: the iterated update, relinearised about each
+///     new estimate until the change is at most ``tolerance`` of its σ, at most
+///     ``iterations`` times (``NotDeterminedError`` otherwise).
+/// tolerance : float
+///     The iterated update's convergence test (default 1e-9).
+///
+/// A callable that raises, returns the wrong shape, a NaN or an infinity is refused with a
+/// ``ParameterError`` naming it (``f``, ``h``, ``F_jacobian``, ``H_jacobian``, ``Q``), the
+/// time and, in ``update_many``, the measurement's index (``.index``), a raised exception as
+/// its ``__cause__``; the filter is left as it was.
+#[pyclass(name = "ExtendedKalmanFilter", module = "seqsmooth")]
+#[derive(Clone)]
+pub struct PyExtendedKalmanFilter {
+    filter: Extended,
+    raised: Raised,
+    /// The observation's components `p`.
+    components: usize,
+    iterations: usize,
+    tolerance: f64,
+}
+
+#[pymethods]
+impl PyExtendedKalmanFilter {
+    #[new]
+    #[allow(non_snake_case, clippy::too_many_arguments)]
+    #[pyo3(signature = (x0, P0, f, h, Q = None, t0 = 0.0, F_jacobian = None, H_jacobian = None, angles = None, iterations = 1, tolerance = 1e-9))]
+    fn new(
+        x0: &Bound<'_, PyAny>,
+        P0: &Bound<'_, PyAny>,
+        f: &Bound<'_, PyAny>,
+        h: &Bound<'_, PyAny>,
+        Q: Option<&Bound<'_, PyAny>>,
+        t0: f64,
+        F_jacobian: Option<&Bound<'_, PyAny>>,
+        H_jacobian: Option<&Bound<'_, PyAny>>,
+        angles: Option<Vec<usize>>,
+        iterations: usize,
+        tolerance: f64,
+    ) -> PyResult<Self> {
+        if iterations == 0 || !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(raise(
+                Kind::Parameter,
+                format!(
+                    "iterations {iterations}, tolerance {tolerance}: at least 1 iteration and a \
+                     positive finite tolerance"
+                ),
+                None,
+            ));
+        }
+        let x = DVector::from_column_slice(crate::arrays::series(x0, "x0")?.as_slice());
+        let p0 = crate::kalman::square_from(P0, x.len(), "P0")?;
+        let model = user_model(&x, t0, f, h, F_jacobian, H_jacobian, Q, angles)?;
+        let components = model.observation.components();
+        let mut filter = KalmanFilter::new(model.dynamics, model.observation, x, p0, t0).py()?;
+        if let Some(q) = model.noise {
+            filter = filter.with_process_noise(q).py()?;
+        }
+        Ok(Self {
+            filter,
+            raised: model.raised,
+            components,
+            iterations,
+            tolerance,
+        })
+    }
+
+    /// The current estimate ``X``.
+    #[getter]
+    fn state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, self.filter.state().as_slice())
+    }
+
+    /// The covariance of ``X``'s errors.
+    #[getter]
+    fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        square(py, self.filter.covariance())
+    }
+
+    /// The 1σ of each state component, the square roots of ``covariance``'s diagonal.
+    #[getter]
+    fn std_devs<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.filter.std_devs())
+    }
+
+    /// The time the estimate is valid at.
+    #[getter]
+    fn time(&self) -> f64 {
+        self.filter.time()
+    }
+
+    /// Carries the estimate to time ``t`` by ``f`` and its covariance by ``Φ S Φᵀ + Q`` (no
+    /// measurement). On an error the filter is unchanged.
+    fn predict(&mut self, t: f64) -> PyResult<()> {
+        let result = self.filter.predict(t);
+        self.raised.py(result)
+    }
+
+    /// Predicts to ``t`` and updates with ``z`` (a number, or one value per component; NaN for
+    /// a missing one) of noise ``R`` (a variance for every component, the variances, or the
+    /// covariance). Returns the :class:`Innovation`, or ``None`` when every component is
+    /// missing (a prediction only). On an error the filter is unchanged.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R))]
+    fn update(
+        &mut self,
+        t: f64,
+        z: &Bound<'_, PyAny>,
+        R: &Bound<'_, PyAny>,
+    ) -> PyResult<Option<PyInnovation>> {
+        let m = measurement(t, z, R, self.filter_components(), self.filter.time())?;
+        let result = self.step(&m);
+        let innovation = self.raised.py(result)?;
+        Ok(innovation.map(|inner| PyInnovation { inner }))
+    }
+
+    /// Runs the measurements ``(t[i], z[i])`` (``z`` of shape ``(n,)`` or ``(n, p)``, NaN for
+    /// a missing component) with noise ``R`` on every one. Returns ``(states, covariances,
+    /// nis)``: ``(n, dim)``, ``(n, dim, dim)`` and ``(n,)`` (NaN where nothing was measured).
+    /// On an error (``.index`` names the measurement) the measurements before it are taken.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R))]
+    fn update_many<'py>(
+        &mut self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        R: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let mut rows = measurements(t, z, R, self.filter_components())?;
+        let disorder = out_of_order(self.filter.time(), &rows);
+        if let Some((k, _, _)) = disorder {
+            rows.truncate(k);
+        }
+        let n = self.filter.state().len();
+        let mut run = Run::new(rows.len(), n);
+        // The GIL is kept: every step calls Python.
+        let outcome = rows.iter().enumerate().try_for_each(|(i, m)| {
+            let innovation = self.step(m).map_err(|e| Error::InBatch {
+                index: i,
+                source: Box::new(e),
+            })?;
+            let nis = innovation.map(|s| s.nis);
+            run.record(i, self.filter.state(), self.filter.covariance(), nis);
+            Ok::<(), Error>(())
+        });
+        self.raised.py(outcome)?;
+        if let Some((k, t, previous)) = disorder {
+            return Err(before(t, previous, Some(k)));
+        }
+        run.into_tuple(py)
+    }
+
+    /// The Rauch–Tung–Striebel smoother over the measurements, from this filter's current
+    /// state (the filter itself is not changed): the extended filter forwards (one
+    /// linearisation per measurement), then the backward pass with each step's ``Φ`` along the
+    /// forward trajectory. Returns ``(states, covariances)``, ``(n, dim)`` and
+    /// ``(n, dim, dim)``.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R))]
+    fn smooth<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        R: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let rows = measurements(t, z, R, self.filter_components())?;
+        if let Some((k, t, previous)) = out_of_order(self.filter.time(), &rows) {
+            return Err(before(t, previous, Some(k)));
+        }
+        let smoothed = self
+            .raised
+            .py(smoother::smooth(self.filter.clone(), &rows))?;
+        stacked(py, smoothed.iter().map(|s| (&s.state, &s.covariance)))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "ExtendedKalmanFilter(states={}, components={}, time={:?}, iterations={})",
+            self.filter.state().len(),
+            self.filter_components(),
+            self.filter.time(),
+            self.iterations
+        )
+    }
+}
+
+impl PyExtendedKalmanFilter {
+    fn filter_components(&self) -> usize {
+        self.components
+    }
+
+    /// One update, iterated when asked.
+    fn step(&mut self, m: &Measurement) -> Result<Option<seqsmooth::kalman::Innovation>, Error> {
+        if self.iterations > 1 {
+            self.filter
+                .update_iterated(m, self.tolerance, self.iterations)
+        } else {
+            self.filter.update(m)
+        }
+    }
+}
+
+/// Smoothed states and covariances as `(states, covariances)`, `(count, n)` and
+/// `(count, n, n)`.
+pub(crate) fn stacked<'py, 'a>(
+    py: Python<'py>,
+    rows: impl ExactSizeIterator<Item = (&'a DVector<f64>, &'a DMatrix<f64>)>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let count = rows.len();
+    let (mut states, mut covariances, mut n) = (Vec::new(), Vec::new(), 0);
+    for (x, s) in rows {
+        n = x.len();
+        states.extend_from_slice(x.as_slice());
+        covariances.extend_from_slice(s.as_slice());
+    }
+    let states = matrix(py, states, count, n)?;
+    let covariances = PyArray1::from_vec(py, covariances)
+        .reshape([count, n, n])?
+        .into_any();
+    PyTuple::new(py, [states, covariances])
+}
+
+/// `update_many`'s outputs, filled a measurement at a time: `(states, covariances, nis)`,
+/// `(count, n)`, `(count, n, n)` and `(count,)` (NaN where nothing was measured).
+pub(crate) struct Run {
+    n: usize,
+    states: Vec<f64>,
+    covariances: Vec<f64>,
+    nis: Vec<f64>,
+}
+
+impl Run {
+    pub(crate) fn new(count: usize, n: usize) -> Self {
+        Self {
+            n,
+            states: vec![0.0; count * n],
+            covariances: vec![0.0; count * n * n],
+            nis: vec![f64::NAN; count],
+        }
+    }
+
+    /// Measurement `i`'s row: the filter's state and covariance after it, and its NIS.
+    pub(crate) fn record(
+        &mut self,
+        i: usize,
+        state: &DVector<f64>,
+        covariance: &DMatrix<f64>,
+        nis: Option<f64>,
+    ) {
+        let n = self.n;
+        if let Some(v) = nis {
+            self.nis[i] = v;
+        }
+        self.states[i * n..(i + 1) * n].copy_from_slice(state.as_slice());
+        // Symmetric: column-major is row-major.
+        self.covariances[i * n * n..(i + 1) * n * n].copy_from_slice(covariance.as_slice());
+    }
+
+    pub(crate) fn into_tuple(self, py: Python<'_>) -> PyResult<Bound<'_, PyTuple>> {
+        let (count, n) = (self.nis.len(), self.n);
+        let states = matrix(py, self.states, count, n)?;
+        let covariances = PyArray1::from_vec(py, self.covariances)
+            .reshape([count, n, n])?
+            .into_any();
+        let nis = PyArray1::from_vec(py, self.nis).into_any();
+        PyTuple::new(py, [states, covariances, nis])
+    }
+}
