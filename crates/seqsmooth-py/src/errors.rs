@@ -98,9 +98,9 @@ pub fn raise(kind: Kind, message: impl Into<String>, index: Option<usize>) -> Py
 pub fn keyword(p: Param) -> Option<&'static str> {
     match p {
         Param::ReviewWindow => Some("review_window"),
-        Param::SigmaPointAlpha => Some("alpha"),
-        Param::SigmaPointBeta => Some("beta"),
-        Param::SigmaPointKappa => Some("kappa"),
+        Param::SigmaPointAlpha => Some("sigma_points alpha"),
+        Param::SigmaPointBeta => Some("sigma_points beta"),
+        Param::SigmaPointKappa => Some("sigma_points kappa"),
         Param::AzimuthConvention => Some("azimuth"),
         Param::Coefficients => Some("n"),
         Param::TransitionMatrixF => Some("F"),

@@ -83,7 +83,8 @@ fn build<O: Observation>(
 /// t0 : float
 ///     The prior's time.
 /// axes : int
-///     The number of axes (default 1; 3 for ``observation="radar"``).
+///     The number of axes (default 1; ``observation="radar"`` needs 3: it observes the
+///     position ``(x, y, z)``).
 /// q : float
 ///     The spectral density of the white noise driving the highest derivative of each axis
 ///     (value²/time^(2m+1)); 0 for none. ``Q`` is integrated over each actual step.
@@ -94,13 +95,15 @@ fn build<O: Observation>(
 ///     from ``site``, the azimuth's residual wrapped to (−π, π].
 /// site : (float, float, float)
 ///     The radar's position (``observation="radar"`` only; default the origin).
-/// alpha, beta, kappa : float
-///     The scaled sigma points (Wan and van der Merwe (15); filterpy's
-///     ``MerweScaledSigmaPoints(n, alpha, beta, kappa)``): ``λ = alpha² (n + kappa) − n``,
-///     points at ``x ± √(n + λ)`` times the Cholesky columns of ``P``. Default ``alpha=1``,
-///     ``beta=2``, ``kappa=0``: points at ``±√n σ`` with every covariance weight
+/// sigma_points : (float, float, float)
+///     The scaled sigma points' ``(alpha, beta, kappa)`` (Wan and van der Merwe (15);
+///     filterpy's ``MerweScaledSigmaPoints(n, alpha, beta, kappa)``):
+///     ``λ = alpha² (n + kappa) − n``, points at ``x ± √(n + λ)`` times the Cholesky columns
+///     of ``P``. Default ``(1, 2, 0)``: points at ``±√n σ`` with every covariance weight
 ///     non-negative (a small ``alpha`` such as 1e-3 weighs the central point by about
-///     ``−1/alpha²``).
+///     ``−1/alpha²``; a negative central weight can make a covariance indefinite, and such an
+///     update is refused). One tuple, not three keywords: ``beta`` elsewhere in the package
+///     was a fading discount, and ``alpha`` is filterpy's fading factor.
 ///
 /// f, h : callable, optional
 ///     The caller's own model instead of the polynomial one (then no ``degree``, ``axes``,
@@ -132,7 +135,7 @@ pub struct PyUnscentedKalmanFilter {
 impl PyUnscentedKalmanFilter {
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
-    #[pyo3(signature = (degree = None, x0 = None, P0 = None, t0 = 0.0, axes = 1, q = 0.0, observation = None, site = None, alpha = 1.0, beta = 2.0, kappa = 0.0, *, f = None, h = None, Q = None, angles = None))]
+    #[pyo3(signature = (degree = None, x0 = None, P0 = None, t0 = 0.0, axes = 1, q = 0.0, observation = None, site = None, sigma_points = (1.0, 2.0, 0.0), *, f = None, h = None, Q = None, angles = None))]
     fn new(
         degree: Option<usize>,
         x0: Option<&Bound<'_, PyAny>>,
@@ -142,9 +145,7 @@ impl PyUnscentedKalmanFilter {
         q: f64,
         observation: Option<&Bound<'_, PyAny>>,
         site: Option<(f64, f64, f64)>,
-        alpha: f64,
-        beta: f64,
-        kappa: f64,
+        sigma_points: (f64, f64, f64),
         f: Option<&Bound<'_, PyAny>>,
         h: Option<&Bound<'_, PyAny>>,
         Q: Option<&Bound<'_, PyAny>>,
@@ -153,6 +154,7 @@ impl PyUnscentedKalmanFilter {
         let (Some(x0), Some(P0)) = (x0, P0) else {
             return Err(raise(Kind::Parameter, "x0 and P0 are required", None));
         };
+        let (alpha, beta, kappa) = sigma_points;
         let points = SigmaPoints::new(alpha, beta, kappa).py()?;
         let polynomial =
             degree.is_some() || axes != 1 || q != 0.0 || observation.is_some() || site.is_some();
@@ -186,14 +188,8 @@ impl PyUnscentedKalmanFilter {
                 ))
             }
         };
-        if axes == 0 {
-            return Err(raise(
-                Kind::Parameter,
-                "axes 0 is invalid: at least 1",
-                None,
-            ));
-        }
-        let n = (degree + 1) * axes;
+        // The library's polynomial model: its degree, axes and states.
+        let n = seqsmooth::polynomial::check_model(degree, axes).py()?;
         let x = series(x0, "x0")?;
         if x.as_slice().len() != n {
             return Err(raise(
@@ -215,7 +211,7 @@ impl PyUnscentedKalmanFilter {
         let (model, components) = match radar.as_deref() {
             Some("radar") => {
                 let [a, b, c] = site.map_or([0.0; 3], |(a, b, c)| [a, b, c]);
-                let radar = Radar::new([a, b, c], n).py()?;
+                let radar = Radar::of_polynomial([a, b, c], &dynamics).py()?;
                 let p = radar.components();
                 (
                     Model::Radar(build(dynamics, radar, x, p0, t0, points, q)?),
@@ -376,7 +372,7 @@ impl PyUnscentedKalmanFilter {
     fn __repr__(&self) -> String {
         let (a, b, k) = self.sigma_points();
         format!(
-            "UnscentedKalmanFilter(states={}, time={:?}, alpha={a:?}, beta={b:?}, kappa={k:?})",
+            "UnscentedKalmanFilter(states={}, time={:?}, sigma_points=({a:?}, {b:?}, {k:?}))",
             self.state_len(),
             self.time()
         )

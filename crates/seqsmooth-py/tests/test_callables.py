@@ -216,14 +216,14 @@ def test_ukf_equals_filterpy(alpha, beta, kappa):
         prev = t
         zs.append(h(x) + rng.normal(0.0, np.sqrt(np.diag(R))))
     zs = np.array(zs)
-    points = MerweScaledSigmaPoints(4, alpha=alpha, beta=beta, kappa=kappa)
+    points = MerweScaledSigmaPoints(4, sigma_points=(alpha, beta, kappa))
 
     def both():
         fp = FilterpyUKF(dim_x=4, dim_z=2, dt=1.0, hx=h, fx=fx_drag, points=points)
         fp.x, fp.P, fp.Q, fp.R = x0.copy(), P0.copy(), Q, R
         f = lambda x, a, b: fx_drag(x, b - a)  # noqa: E731
         ours = ss.UnscentedKalmanFilter(
-            x0=x0, P0=P0, f=f, h=h, Q=Q, alpha=alpha, beta=beta, kappa=kappa
+            x0=x0, P0=P0, f=f, h=h, Q=Q, sigma_points=(alpha, beta, kappa)
         )
         return fp, ours
 

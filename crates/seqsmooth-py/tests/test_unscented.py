@@ -136,9 +136,9 @@ def test_linear_model_equals_filterpy():
     p0 = np.kron(np.array([[9.0, 1.0], [1.0, 4.0]]), np.eye(2))
     R = np.array([[0.5, 0.2], [0.2, 0.8]])
     f = ss.UnscentedKalmanFilter(
-        degree=1, axes=2, q=0.2, t0=2.0, x0=x0, P0=p0, alpha=0.5, beta=2.0, kappa=1.0
+        degree=1, axes=2, q=0.2, t0=2.0, x0=x0, P0=p0, sigma_points=(0.5, 2.0, 1.0)
     )
-    points = MerweScaledSigmaPoints(4, alpha=0.5, beta=2.0, kappa=1.0)
+    points = MerweScaledSigmaPoints(4, sigma_points=(0.5, 2.0, 1.0))
     want = filterpy_run(1, 2, 0.2, 2.0, x0, p0, R, lambda x: x[:2], [], points, t, z)
     sx, sp = f.smooth(t, z, R)
     x, p, nis = f.update_many(t, z, R)
@@ -212,17 +212,17 @@ def test_defaults_and_repr():
     "call,kind,word",
     [
         (
-            lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, alpha=0.0),
+            lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, sigma_points=(0.0, 2.0, 0.0)),
             ss.ParameterError,
             "alpha",
         ),
         (
-            lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, beta=math.inf),
+            lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, sigma_points=(1.0, math.inf, 0.0)),
             ss.ParameterError,
             "beta",
         ),
         (
-            lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, kappa=-2.0),
+            lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, sigma_points=(1.0, 2.0, -2.0)),
             ss.ParameterError,
             "kappa",
         ),
@@ -247,6 +247,25 @@ def test_defaults_and_repr():
             ss.ParameterError,
             "position",
         ),
+        # On one axis the radar would read (x, x', x'') as (x, y, z): refused, not built.
+        (
+            lambda: ss.UnscentedKalmanFilter(
+                degree=2, x0=[10.0, 1.0, 0.0], P0=1.0, observation="radar"
+            ),
+            ss.ParameterError,
+            "axes 1 is invalid: a radar observes the position",
+        ),
+        (
+            lambda: ss.UnscentedKalmanFilter(degree=2**63, x0=[0.0, 0.0], P0=1.0, axes=2),
+            ss.ParameterError,
+            "degree",
+        ),
+        # One tuple of sigma-point settings: beta (once a fading discount) is no keyword.
+        (
+            lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, beta=0.9),
+            TypeError,
+            "beta",
+        ),
     ],
 )
 def test_bad_settings(call, kind, word):
@@ -256,11 +275,12 @@ def test_bad_settings(call, kind, word):
 
 def test_bad_measurements_name_their_index_and_leave_the_filter():
     f = ss.UnscentedKalmanFilter(degree=0, x0=[0.0], P0=1.0)
-    # A perfect measurement (R = 0) leaves P = 0: the next update has no sigma points.
+    # A perfect measurement (R = 0) would leave P = 0, a covariance without sigma points: the
+    # update that makes it is refused (the first), the filter left as it was.
     with pytest.raises(ss.SeqsmoothError, match="positive definite") as e:
         f.update_many([1.0, 2.0, 3.0], [1.0, 1.0, 1.0], 0.0)
-    assert e.value.index == 1
-    assert f.time == 1.0 and f.covariance[0, 0] == 0.0  # the first one was taken
+    assert e.value.index == 0
+    assert f.time == 0.0 and f.covariance[0, 0] == 1.0
     g = ss.UnscentedKalmanFilter(degree=0, x0=[0.0], P0=1.0)
     g.update(1.0, 1.0, 1.0)
     before = (g.state.copy(), g.covariance.copy(), g.time)

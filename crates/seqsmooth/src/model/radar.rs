@@ -65,6 +65,31 @@ impl Radar {
         })
     }
 
+    /// A radar at `site` observing the polynomial model `dynamics` (the state ordered
+    /// derivative, then axis): its first three states are the position `(x, y, z)` only on
+    /// three axes, so any other number of axes is refused (on one axis the radar would read
+    /// `(x, x', x'')` as `(x, y, z)`).
+    ///
+    /// ```
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::radar::Radar;
+    /// assert!(Radar::of_polynomial([0.0; 3], &PolynomialDynamics::new(1, 3)).is_ok());
+    /// assert!(Radar::of_polynomial([0.0; 3], &PolynomialDynamics::new(2, 1)).is_err());
+    /// ```
+    pub fn of_polynomial(
+        site: [f64; 3],
+        dynamics: &super::dynamics::PolynomialDynamics,
+    ) -> Result<Self, Error> {
+        if dynamics.axes() != 3 {
+            return Err(Error::InvalidParameter {
+                name: Param::Axes,
+                value: dynamics.axes().to_string(),
+                reason: "a radar observes the position (x, y, z): the model needs 3 axes".into(),
+            });
+        }
+        Self::new(site, (dynamics.degree() + 1) * 3)
+    }
+
     /// Also measure the range rate `ρ̇ = p · v / ρ` (needs the velocity as states 3-5).
     ///
     /// ```
