@@ -22,7 +22,7 @@ use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::error::Param;
-use seqsmooth::kalman::noise::ProcessNoise;
+use seqsmooth::kalman::noise::{check_covariance, ProcessNoise};
 use seqsmooth::kalman::{smoother, KalmanFilter};
 use seqsmooth::model::dynamics::{Dynamics, Propagation};
 use seqsmooth::model::measurement::Measurement;
@@ -289,12 +289,14 @@ pub(crate) enum UserNoise {
     Callable(Callable, usize),
 }
 
-/// Why `q` is not a driving-noise covariance (symmetric to 1e-12 of its largest entry, with
-/// non-negative variances, the Kalman filter's rule for its prior), or `None`.
+/// Why `q` is not a driving-noise covariance by the library's rule
+/// ([`check_covariance`]: symmetric, positive semidefinite), or `None`.
 fn not_covariance(q: &DMatrix<f64>) -> Option<String> {
-    let asymmetric = (q - q.transpose()).amax() > 1e-12 * q.amax();
-    let negative = q.diagonal().iter().any(|&v| v < 0.0);
-    (asymmetric || negative).then(|| "is not symmetric with non-negative variances".into())
+    match check_covariance(q, q.nrows(), Param::ProcessNoiseQ) {
+        Ok(()) => None,
+        Err(Error::InvalidParameter { value, reason, .. }) => Some(format!("{value}: {reason}")),
+        Err(e) => Some(e.to_string()),
+    }
 }
 
 impl ProcessNoise for UserNoise {
@@ -313,7 +315,7 @@ impl ProcessNoise for UserNoise {
                 let q =
                     DMatrix::from_row_slice(*n, *n, &c.call(None, &[t_a, t_b], *n, Some(*n), at)?);
                 match not_covariance(&q) {
-                    Some(reason) => Err(c.refuse(at(), format!("returned a matrix that {reason}"))),
+                    Some(reason) => Err(c.refuse(at(), format!("returned a matrix {reason}"))),
                     None => Ok(q),
                 }
             }
@@ -385,16 +387,7 @@ pub(crate) fn user_model(
         )),
         Some(q) => {
             let q = crate::kalman::square_from(q, n, "Q")?;
-            if let Some(&v) = q.iter().find(|v| !v.is_finite()) {
-                return Err(raise(
-                    Kind::Parameter,
-                    format!("Q has {v}: every entry must be finite"),
-                    None,
-                ));
-            }
-            if let Some(reason) = not_covariance(&q) {
-                return Err(raise(Kind::Parameter, format!("Q {reason}"), None));
-            }
+            check_covariance(&q, n, Param::ProcessNoiseQ).py()?;
             Some(UserNoise::Constant(q))
         }
     };

@@ -321,10 +321,16 @@ pub fn check_matrix(m: &DMatrix<f64>, shape: (usize, usize), name: Param) -> Res
 pub fn check_covariance(m: &DMatrix<f64>, n: usize, name: Param) -> Result<(), Error> {
     check_matrix(m, (n, n), name)?;
     let largest = m.amax();
-    if (m - m.transpose()).amax() > 1e-12 * largest {
+    let skew = m - m.transpose();
+    if skew.amax() > 1e-12 * largest {
+        let (i, j) = skew.iamax_full();
         return Err(Error::InvalidParameter {
             name,
-            value: format!("{m:?}"),
+            value: format!(
+                "with [{i}, {j}] = {} and [{j}, {i}] = {}",
+                m[(i, j)],
+                m[(j, i)]
+            ),
             reason: "must be symmetric".into(),
         });
     }
@@ -334,8 +340,8 @@ pub fn check_covariance(m: &DMatrix<f64>, n: usize, name: Param) -> Result<(), E
     if least < -1e-12 * scale {
         return Err(Error::InvalidParameter {
             name,
-            value: format!("{m:?}"),
-            reason: format!("must be positive semidefinite (an eigenvalue is {least:e})"),
+            value: format!("with an eigenvalue {least:e}"),
+            reason: "must be positive semidefinite".into(),
         });
     }
     Ok(())
