@@ -508,3 +508,17 @@ fn the_circle_finder_finds_a_circle_of_three_and_not_a_chain() {
     fs::remove_dir_all(&dir).unwrap();
     assert_eq!(circles, vec![vec!["m::a", "m::b", "m::c"]]);
 }
+
+/// Every library source file small enough to hold in mind: at most 800 lines.
+#[test]
+fn no_library_file_is_over_800_lines() {
+    let mut files = Vec::new();
+    rust_files(&root().join("crates/seqsmooth/src"), &mut files);
+    assert!(files.len() > 100, "found only {} files", files.len());
+    let long: Vec<(usize, PathBuf)> = files
+        .into_iter()
+        .map(|f| (fs::read_to_string(&f).unwrap().lines().count(), f))
+        .filter(|(n, _)| *n > 800)
+        .collect();
+    assert!(long.is_empty(), "library files over 800 lines: {long:?}");
+}
