@@ -478,16 +478,8 @@ impl PyExtendedKalmanFilter {
         iterations: usize,
         tolerance: f64,
     ) -> PyResult<Self> {
-        if iterations == 0 || !(tolerance.is_finite() && tolerance > 0.0) {
-            return Err(raise(
-                Kind::Parameter,
-                format!(
-                    "iterations {iterations}, tolerance {tolerance}: at least 1 iteration and a \
-                     positive finite tolerance"
-                ),
-                None,
-            ));
-        }
+        // The library's range of the iterated update's limits.
+        seqsmooth::kalman::filter::check_iteration_limits(tolerance, iterations).py()?;
         let x = DVector::from_column_slice(crate::arrays::series(x0, "x0")?.as_slice());
         let p0 = crate::kalman::square_from(P0, x.len(), "P0")?;
         let model = user_model(&x, t0, f, h, F_jacobian, H_jacobian, Q, angles)?;

@@ -408,3 +408,9 @@ def test_ten_thousand_seeded_bad_calls_never_panic():
         accepted += 1
         assert np.all(np.isfinite(flt.state)) and np.all(np.isfinite(flt.covariance))
     assert refused > 2_000 and accepted > 2_000, (refused, accepted)
+
+
+@pytest.mark.parametrize("kw", [{"iterations": 0}, {"iterations": 3, "tolerance": 0.0}])
+def test_iteration_limits_are_the_librarys(kw):
+    with pytest.raises(ss.ParameterError, match="the tolerance must be positive and finite"):
+        ss.ExtendedKalmanFilter(X0, P0, f_linear, h, **kw)

@@ -40,14 +40,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<Option<Innovation>, Error> {
-        if !(tolerance.is_finite() && tolerance > 0.0) || max_iterations == 0 {
-            return Err(Error::InvalidParameter {
-                name: Param::IterationLimits,
-                value: format!("tolerance {tolerance}, {max_iterations} iterations"),
-                reason: "the tolerance must be positive and finite, the iterations at least 1"
-                    .into(),
-            });
-        }
+        check_iteration_limits(tolerance, max_iterations)?;
         let Some(t) = self.measure_and_predict(measurement)? else {
             return Ok(None);
         };
@@ -76,4 +69,23 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             chi_squared: f64::NAN,
         })
     }
+}
+
+/// The range of the iterated update's limits ([`KalmanFilter::update_iterated`]): a positive
+/// finite `tolerance` (in the correction's own σ) and at least one iteration.
+///
+/// ```
+/// use seqsmooth::kalman::filter::check_iteration_limits;
+/// assert!(check_iteration_limits(1e-9, 1).is_ok());
+/// assert!(check_iteration_limits(0.0, 5).is_err() && check_iteration_limits(1e-9, 0).is_err());
+/// ```
+pub fn check_iteration_limits(tolerance: f64, max_iterations: usize) -> Result<(), Error> {
+    if !(tolerance.is_finite() && tolerance > 0.0) || max_iterations == 0 {
+        return Err(Error::InvalidParameter {
+            name: Param::IterationLimits,
+            value: format!("tolerance {tolerance}, {max_iterations} iterations"),
+            reason: "the tolerance must be positive and finite, the iterations at least 1".into(),
+        });
+    }
+    Ok(())
 }

@@ -69,6 +69,7 @@ use std::sync::Arc;
 mod innovation;
 mod iterated;
 pub use innovation::{Innovation, InnovationStats};
+pub use iterated::check_iteration_limits;
 
 /// A Kalman filter on `D` and `O`, with optional driving noise.
 ///
