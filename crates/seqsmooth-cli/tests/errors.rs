@@ -296,6 +296,32 @@ fn error_vrf_n_below_degree() {
     );
 }
 
+/// A fixed-memory VRF at a lead so far out that its variances overflow a double is refused,
+/// naming the entry, where it printed NaN and inf with exit 0; `--exact` still gives it.
+#[test]
+fn error_vrf_lead_beyond_the_double_range() {
+    fails(
+        &[
+            "vrf", "--kind", "fixed", "--degree", "2", "--window", "10", "--lead", "1e200",
+        ],
+        "",
+        1,
+        &[
+            "error: the estimate's covariance of d0, d0 at the lead 1e200 is beyond the double \
+           range (about 1.8e308) in these units",
+        ],
+    );
+    let exact = run(
+        &[
+            "vrf", "--kind", "fixed", "--degree", "2", "--window", "10", "--lead", "1e200",
+            "--exact",
+        ],
+        "",
+    );
+    assert_eq!(exact.code, 0, "{}", exact.stderr);
+    assert!(!exact.stdout.contains("inf") && !exact.stdout.contains("NaN"));
+}
+
 /// Arguments of the other kind are rejected rather than silently ignored.
 #[test]
 fn error_argument_of_other_kind() {

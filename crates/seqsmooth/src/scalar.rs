@@ -30,6 +30,10 @@ pub trait Scalar:
     fn from_rational(r: &Rational) -> Self;
     /// Absolute value.
     fn abs_val(&self) -> Self;
+    /// Whether the number is one (every exact rational is; an `f64` not NaN or ±∞).
+    fn is_number(&self) -> bool {
+        true
+    }
     /// `self^k` for a non-negative integer power (`0^0 = 1`).
     fn powi_u(&self, k: usize) -> Self {
         let mut acc = Self::one();
@@ -41,6 +45,9 @@ pub trait Scalar:
 }
 
 impl Scalar for f64 {
+    fn is_number(&self) -> bool {
+        self.is_finite()
+    }
     fn from_i64(v: i64) -> Self {
         v as f64
     }

@@ -53,10 +53,14 @@ pub fn check_lead_steps(h: f64) -> Result<(), Error> {
 /// let s = covariance(1, 4, Rational::from_integer(0.into())).unwrap();
 /// assert_eq!(s[(0, 0)], Rational::new(3.into(), 5.into()));
 /// assert_eq!(s[(1, 1)], Rational::new(1.into(), 10.into()));
+/// // In f64 a lead so far out that the variance overflows is refused, exactly it is not.
+/// assert!(covariance(2, 9, 1e200_f64).is_err());
+/// assert!(covariance(2, 9, Rational::from_integer(10.into()).pow(200)).is_ok());
 /// ```
 pub fn covariance<T: Scalar>(m: usize, span: u64, h: T) -> Result<DMatrix<T>, Error> {
     check_span(m, span)?;
     check_finite("lead h", &h)?;
+    let lead = h.to_f64();
     let l = span_scalar::<T>(span);
     let basis = DiscreteLegendre::new(l.clone());
     let t = taylor_at(m, &basis, &(l + h));
@@ -68,7 +72,16 @@ pub fn covariance<T: Scalar>(m: usize, span: u64, h: T) -> Result<DMatrix<T>, Er
             T::zero()
         }
     });
-    Ok(congruence(&t, &c))
+    let s = congruence(&t, &c);
+    // A lead far beyond the window (|H| of 1e200 samples) overflows `f64`: refused, never
+    // written as ∞ or NaN (the exact field has no such limit).
+    if let Some(k) = s.iter().position(|v| !v.is_number()) {
+        let (i, j) = (k % (m + 1), k / (m + 1));
+        return Err(Error::EstimateOutOfRange {
+            what: format!("covariance of d{i}, d{j} at the lead {lead:e}"),
+        });
+    }
+    Ok(s)
 }
 
 /// Covariance of the unscaled derivatives per unit input variance,
