@@ -23,7 +23,7 @@ pub struct Innovation {
 }
 
 /// What one update saw, in numbers only: an [`Innovation`] without its vectors and matrices,
-/// what [`KalmanFilter::update_stats`] returns.
+/// what [`super::KalmanFilter::update_stats`] returns.
 ///
 /// ```
 /// use seqsmooth::kalman::filter::InnovationStats;
