@@ -351,7 +351,10 @@ def test_bad_callable_is_named_and_leaves_the_filter(which, how, kind):
 
 
 def test_a_bad_constant_q_is_refused():
-    with pytest.raises(ss.ParameterError, match=r"Q with \[0, 1\] = 1 and \[1, 0\] = 0 is invalid: must be symmetric"):
+    with pytest.raises(
+        ss.ParameterError,
+        match=r"Q with \[0, 1\] = 1 and \[1, 0\] = 0 is invalid: must be symmetric",
+    ):
         ss.ExtendedKalmanFilter(X0, P0, f_linear, h, Q=np.triu(np.ones((4, 4))))
     with pytest.raises(ss.ParameterError, match="finite"):
         ss.ExtendedKalmanFilter(X0, P0, f_linear, h, Q=np.full((4, 4), np.nan))

@@ -212,17 +212,23 @@ def test_defaults_and_repr():
     "call,kind,word",
     [
         (
-            lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, sigma_points=(0.0, 2.0, 0.0)),
+            lambda: ss.UnscentedKalmanFilter(
+                degree=1, x0=[0.0, 0.0], P0=1.0, sigma_points=(0.0, 2.0, 0.0)
+            ),
             ss.ParameterError,
             "alpha",
         ),
         (
-            lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, sigma_points=(1.0, math.inf, 0.0)),
+            lambda: ss.UnscentedKalmanFilter(
+                degree=1, x0=[0.0, 0.0], P0=1.0, sigma_points=(1.0, math.inf, 0.0)
+            ),
             ss.ParameterError,
             "beta",
         ),
         (
-            lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0, 0.0], P0=1.0, sigma_points=(1.0, 2.0, -2.0)),
+            lambda: ss.UnscentedKalmanFilter(
+                degree=1, x0=[0.0, 0.0], P0=1.0, sigma_points=(1.0, 2.0, -2.0)
+            ),
             ss.ParameterError,
             "kappa",
         ),
