@@ -216,7 +216,7 @@ def test_ukf_equals_filterpy(alpha, beta, kappa):
         prev = t
         zs.append(h(x) + rng.normal(0.0, np.sqrt(np.diag(R))))
     zs = np.array(zs)
-    points = MerweScaledSigmaPoints(4, sigma_points=(alpha, beta, kappa))
+    points = MerweScaledSigmaPoints(4, alpha=alpha, beta=beta, kappa=kappa)
 
     def both():
         fp = FilterpyUKF(dim_x=4, dim_z=2, dt=1.0, hx=h, fx=fx_drag, points=points)
@@ -353,7 +353,7 @@ def test_bad_callable_is_named_and_leaves_the_filter(which, how, kind):
 def test_a_bad_constant_q_is_refused():
     with pytest.raises(
         ss.ParameterError,
-        match=r"Q with \[0, 1\] = 1 and \[1, 0\] = 0 is invalid: must be symmetric",
+        match=r"Q with \[1, 0\] = 0 and \[0, 1\] = 1 is invalid: must be symmetric",
     ):
         ss.ExtendedKalmanFilter(X0, P0, f_linear, h, Q=np.triu(np.ones((4, 4))))
     with pytest.raises(ss.ParameterError, match="finite"):

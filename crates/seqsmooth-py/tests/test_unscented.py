@@ -138,7 +138,7 @@ def test_linear_model_equals_filterpy():
     f = ss.UnscentedKalmanFilter(
         degree=1, axes=2, q=0.2, t0=2.0, x0=x0, P0=p0, sigma_points=(0.5, 2.0, 1.0)
     )
-    points = MerweScaledSigmaPoints(4, sigma_points=(0.5, 2.0, 1.0))
+    points = MerweScaledSigmaPoints(4, alpha=0.5, beta=2.0, kappa=1.0)
     want = filterpy_run(1, 2, 0.2, 2.0, x0, p0, R, lambda x: x[:2], [], points, t, z)
     sx, sp = f.smooth(t, z, R)
     x, p, nis = f.update_many(t, z, R)
