@@ -3,13 +3,11 @@
 //! information (or a prior), with optional fading memory (ch. 14) and its true covariance.
 //! The model and observation are `KalmanFilter`'s (`kalman.rs`'s parsers).
 
-use crate::arrays::{matrix, series};
+use crate::arrays::matrix;
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{
     before, discount_from, measurement, measurements, observation_from, out_of_order, square,
-    square_from,
 };
-use nalgebra::DVector;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -80,21 +78,8 @@ impl PyBayesFilter {
         }
         match (x0, P0) {
             (Some(x0), Some(p0)) => {
-                let x = series(x0, "x0")?;
-                if x.as_slice().len() != n {
-                    return Err(raise(
-                        Kind::InvalidInput,
-                        format!(
-                            "x0 has {} values: degree {degree} on {axes} axes has {n} states",
-                            x.as_slice().len()
-                        ),
-                        None,
-                    ));
-                }
-                let p = square_from(p0, n, "P0")?;
-                filter = filter
-                    .with_prior(&DVector::from_column_slice(x.as_slice()), &p)
-                    .py()?;
+                let (x, p) = crate::kalman::polynomial_prior(x0, p0, degree, axes, n)?;
+                filter = filter.with_prior(&x, &p).py()?;
             }
             (None, None) => {}
             _ => {

@@ -321,28 +321,11 @@ impl PyKalmanFilter {
     ) -> PyResult<Self> {
         // The library's polynomial model: its degree, axes and states.
         let n = seqsmooth::polynomial::check_model(degree, axes).py()?;
-        let x = series(x0, "x0")?;
-        if x.as_slice().len() != n {
-            return Err(raise(
-                Kind::InvalidInput,
-                format!(
-                    "x0 has {} values: degree {degree} on {axes} axes has {n} states",
-                    x.as_slice().len()
-                ),
-                None,
-            ));
-        }
-        let p0 = square_from(P0, n, "P0")?;
+        let (x, p0) = polynomial_prior(x0, P0, degree, axes, n)?;
         let observe = observation_from(observation, axes, n)?;
         let components = observe.components();
-        let mut filter = KalmanFilter::new(
-            PolynomialDynamics::new(degree, axes),
-            observe,
-            DVector::from_column_slice(x.as_slice()),
-            p0,
-            t0,
-        )
-        .py()?;
+        let mut filter =
+            KalmanFilter::new(PolynomialDynamics::new(degree, axes), observe, x, p0, t0).py()?;
         if q != 0.0 {
             filter = filter
                 .with_process_noise(WhiteNoiseDerivative::new(degree, axes, q).py()?)
@@ -503,4 +486,33 @@ impl PyKalmanFilter {
     fn filter_components(&self) -> usize {
         self.components
     }
+}
+
+/// The prior `x0`, `P0` of the polynomial model of degree `degree` on `axes` axes (`n` states,
+/// from the library's `check_model`): `x0` of `n` values and `P0` an `n × n` covariance (a
+/// number or a diagonal as `square_from` reads it); the Kalman, Bayes and unscented classes'
+/// one reading of it.
+#[allow(non_snake_case)]
+pub(crate) fn polynomial_prior(
+    x0: &Bound<'_, PyAny>,
+    P0: &Bound<'_, PyAny>,
+    degree: usize,
+    axes: usize,
+    n: usize,
+) -> PyResult<(DVector<f64>, DMatrix<f64>)> {
+    let x = series(x0, "x0")?;
+    if x.as_slice().len() != n {
+        return Err(raise(
+            Kind::InvalidInput,
+            format!(
+                "x0 has {} values: degree {degree} on {axes} axes has {n} states",
+                x.as_slice().len()
+            ),
+            None,
+        ));
+    }
+    Ok((
+        DVector::from_column_slice(x.as_slice()),
+        square_from(P0, n, "P0")?,
+    ))
 }

@@ -190,19 +190,7 @@ impl PyUnscentedKalmanFilter {
         };
         // The library's polynomial model: its degree, axes and states.
         let n = seqsmooth::polynomial::check_model(degree, axes).py()?;
-        let x = series(x0, "x0")?;
-        if x.as_slice().len() != n {
-            return Err(raise(
-                Kind::InvalidInput,
-                format!(
-                    "x0 has {} values: degree {degree} on {axes} axes has {n} states",
-                    x.as_slice().len()
-                ),
-                None,
-            ));
-        }
-        let x = DVector::from_column_slice(x.as_slice());
-        let p0 = square_from(P0, n, "P0")?;
+        let (x, p0) = crate::kalman::polynomial_prior(x0, P0, degree, axes, n)?;
         let dynamics = PolynomialDynamics::new(degree, axes);
         let radar = match observation {
             Some(o) => o.extract::<String>().ok(),
