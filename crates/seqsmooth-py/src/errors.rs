@@ -116,6 +116,12 @@ pub fn keyword(p: Param) -> Option<&'static str> {
         Param::ObservationJacobian => Some("H_jacobian"),
         Param::ProcessNoiseFunction => Some("Q"),
         Param::AngleComponents => Some("angles"),
+        Param::DerivativeFunction => Some("dxdt"),
+        Param::DerivativeJacobian => Some("dxdt_jacobian"),
+        Param::DynamicsMatrixA => Some("A"),
+        Param::SpectralDensity => Some("Qc"),
+        Param::ManoeuvreAlpha => Some("manoeuvre_alpha"),
+        Param::ManoeuvreVariance => Some("manoeuvre_variance"),
         _ => None,
     }
 }

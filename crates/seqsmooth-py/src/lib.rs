@@ -8,6 +8,7 @@ mod automatic;
 mod bank;
 mod bayes;
 mod callables;
+mod continuous;
 mod errors;
 mod fit;
 mod frame;
@@ -40,6 +41,8 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<bayes::PyBayesFilter>()?;
     m.add_class::<unscented::PyUnscentedKalmanFilter>()?;
     m.add_class::<callables::PyExtendedKalmanFilter>()?;
+    m.add_class::<continuous::PyContinuousModel>()?;
+    m.add_class::<continuous::PyContinuousKalmanFilter>()?;
     m.add_class::<track::PyRadarTracker>()?;
     m.add_class::<fit::PySlidingFit>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;

@@ -20,6 +20,10 @@ LinearKalmanFilter
     ``KalmanFilter``), constant or one per step: ``update_many`` (``batch_filter``), the RTS
     smoother over that pass with its gains, and the fixed-lag smoother (streamed:
     ``LinearFixedLagSmoother``).
+ContinuousModel, ContinuousKalmanFilter
+    A continuous linear model ``dX/dt = A X + w`` (your ``A`` and spectral density ``Qc``, or
+    nearly constant velocity/acceleration, Singer, the polynomial model) discretised exactly
+    over each actual step, and the Kalman filter on it with each measurement at its own time.
 BayesFilter
     The Bayes filter (Morrison ch. 10) in square-root information form over the same model:
     starts from no information, fading memory with the true covariance.
@@ -58,6 +62,8 @@ from ._seqsmooth import (
     MAX_DEGREE,
     AutomaticFilter,
     BayesFilter,
+    ContinuousKalmanFilter,
+    ContinuousModel,
     CurveFit,
     ExpandingBank,
     ExpandingMemory,
@@ -111,6 +117,8 @@ __all__ = [
     "UnscentedKalmanFilter",
     "LinearKalmanFilter",
     "LinearFixedLagSmoother",
+    "ContinuousModel",
+    "ContinuousKalmanFilter",
     "ExtendedKalmanFilter",
     "RadarTracker",
     "SlidingFit",

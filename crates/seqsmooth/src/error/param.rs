@@ -306,6 +306,10 @@ pub enum Param {
     ProcessNoiseFunction,
     /// The observation components that are angles (their residuals wrapped to `(−π, π]`).
     AngleComponents,
+    /// A user's state derivative `dxdt(x, t)` of `dX/dt = F(X, t)`, integrated by the library.
+    DerivativeFunction,
+    /// The Jacobian `∂F/∂X` of a user's state derivative.
+    DerivativeJacobian,
 }
 
 impl Param {
@@ -453,6 +457,8 @@ impl Param {
         Param::ObservationJacobian,
         Param::ProcessNoiseFunction,
         Param::AngleComponents,
+        Param::DerivativeFunction,
+        Param::DerivativeJacobian,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -600,6 +606,8 @@ impl Param {
             Param::ObservationJacobian => "observation Jacobian",
             Param::ProcessNoiseFunction => "process noise function",
             Param::AngleComponents => "angle components",
+            Param::DerivativeFunction => "state derivative function",
+            Param::DerivativeJacobian => "state derivative Jacobian",
         }
     }
 

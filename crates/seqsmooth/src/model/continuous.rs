@@ -93,7 +93,8 @@ impl ContinuousModel {
         Ok(Self { dynamics, qc, norm })
     }
 
-    /// The polynomial model of degree `m` on `psd.len()` axes: `x_a^(m+1) = w_a`, white noise
+    /// The polynomial model of degree `m` (at most [`crate::polynomial::MAX_DEGREE`], by
+    /// [`crate::polynomial::check_model`]) on `psd.len()` axes: `x_a^(m+1) = w_a`, white noise
     /// of spectral density `psd[a]` (finite, at least 0; (value unit)² / (time unit)^(2m+1)) on
     /// each axis' highest derivative, the axes independent. Its `Q(ζ)` is Morrison (15.2.23)'s
     /// closed form, [`crate::kalman::noise::WhiteNoiseDerivative`] (equal to 1e-12:
@@ -114,6 +115,8 @@ impl ContinuousModel {
                 reason: "must be at least 1 (one spectral density per axis)".into(),
             });
         }
+        // The polynomial model's own limits on the degree and the axes.
+        crate::polynomial::check_model(degree, d)?;
         if let Some(&q) = psd.iter().find(|q| !(q.is_finite() && **q >= 0.0)) {
             return Err(Error::InvalidParameter {
                 name: Param::DrivingNoiseQ,
@@ -201,6 +204,7 @@ impl ContinuousModel {
                 reason: "must be finite and at least 0".into(),
             });
         }
+        crate::polynomial::check_model(2, axes)?;
         let d = axes;
         let mut a = DMatrix::zeros(3 * d, 3 * d);
         let mut qc = DMatrix::zeros(3 * d, 3 * d);
