@@ -26,7 +26,7 @@ use seqsmooth::kalman::noise::{check_covariance, ProcessNoise};
 use seqsmooth::kalman::{smoother, KalmanFilter};
 use seqsmooth::model::dynamics::{Dynamics, Propagation};
 use seqsmooth::model::measurement::Measurement;
-use seqsmooth::model::nonlinear::differenced_jacobian;
+use seqsmooth::model::nonlinear::{differenced_jacobian, NonlinearDynamics};
 use seqsmooth::model::observation::{Angles, Observation, Predicted};
 use seqsmooth::Error;
 use std::sync::{Arc, Mutex};
@@ -184,12 +184,67 @@ fn kind(obj: &Bound<'_, PyAny>) -> String {
         .map_or_else(|_| "an object".into(), |n| n.to_string())
 }
 
-/// `X(t1) = f(X(t0), t0, t1)`, `Φ` the caller's `F_jacobian` or the library's differences.
+/// `X(t1) = f(X(t0), t0, t1)`, `Φ` the caller's `F_jacobian` or the library's differences;
+/// or, with `ode`, `f` is `dxdt(x, t)` and the library integrates `dX/dt` and its variational
+/// equations for `Φ` ([`NonlinearDynamics`], Morrison §8.6).
 #[derive(Clone, Debug)]
 pub(crate) struct UserDynamics {
     n: usize,
     f: Callable,
     jacobian: Option<Callable>,
+    ode: Option<Ode>,
+}
+
+/// `dX/dt = dxdt(X, t)` integrated by the library, and the refusal of the user's callable
+/// that stopped the last integration (the integrator only sees a NaN).
+#[derive(Clone, Debug)]
+pub(crate) struct Ode {
+    dynamics: NonlinearDynamics,
+    refused: Arc<Mutex<Option<Error>>>,
+}
+
+impl Ode {
+    /// `dxdt(x, t)` (`n` values) and its optional Jacobian `dxdt_jacobian(x, t)` (`n × n`; by
+    /// default the library's central differences of `dxdt`).
+    fn new(n: usize, dxdt: &Callable, jacobian: Option<&Callable>) -> Self {
+        let refused: Arc<Mutex<Option<Error>>> = Arc::default();
+        let keep = |slot: &Arc<Mutex<Option<Error>>>, e: Error| {
+            slot.lock().unwrap_or_else(|p| p.into_inner()).get_or_insert(e);
+        };
+        let (f, slot) = (dxdt.clone(), Arc::clone(&refused));
+        let mut dynamics = NonlinearDynamics::new(n, move |t, x: &DVector<f64>| {
+            match f.call(Some(x), &[t], n, None, || format!("at t = {t}")) {
+                Ok(v) => DVector::from_vec(v),
+                Err(e) => {
+                    keep(&slot, e);
+                    DVector::from_element(n, f64::NAN)
+                }
+            }
+        });
+        if let Some(j) = jacobian {
+            let (j, slot) = (j.clone(), Arc::clone(&refused));
+            dynamics = dynamics.with_jacobian(move |t, x: &DVector<f64>| {
+                match j.call(Some(x), &[t], n, Some(n), || format!("at t = {t}")) {
+                    Ok(v) => DMatrix::from_row_slice(n, n, &v),
+                    Err(e) => {
+                        keep(&slot, e);
+                        DMatrix::from_element(n, n, f64::NAN)
+                    }
+                }
+            });
+        }
+        Self { dynamics, refused }
+    }
+
+    /// The integration from `t_a` to `t_b`; its failure the user's callable's refusal where
+    /// one stopped it.
+    fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
+        let slot = || self.refused.lock().unwrap_or_else(|p| p.into_inner()).take();
+        slot();
+        self.dynamics
+            .propagate(state, t_a, t_b)
+            .map_err(|e| slot().unwrap_or(e))
+    }
 }
 
 impl UserDynamics {
@@ -211,6 +266,9 @@ impl Dynamics for UserDynamics {
     }
 
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
+        if let Some(ode) = &self.ode {
+            return ode.propagate(state, t_a, t_b);
+        }
         let n = self.n;
         let new_state = self.transition_state(state, t_a, t_b)?;
         let transition = match &self.jacobian {
@@ -232,7 +290,10 @@ impl Dynamics for UserDynamics {
         t_a: f64,
         t_b: f64,
     ) -> Result<DVector<f64>, Error> {
-        self.transition_state(state, t_a, t_b)
+        match &self.ode {
+            Some(ode) => ode.propagate(state, t_a, t_b).map(|p| p.state),
+            None => self.transition_state(state, t_a, t_b),
+        }
     }
 }
 
@@ -323,15 +384,24 @@ impl ProcessNoise for UserNoise {
     }
 }
 
+/// The user's dynamics as given: `f(x, t0, t1)` with its optional `F_jacobian`, or
+/// `dxdt(x, t)` with its optional `dxdt_jacobian(x, t)`.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct Transition<'a, 'py> {
+    pub(crate) f: Option<&'a Bound<'py, PyAny>>,
+    pub(crate) f_jacobian: Option<&'a Bound<'py, PyAny>>,
+    pub(crate) dxdt: Option<&'a Bound<'py, PyAny>>,
+    pub(crate) dxdt_jacobian: Option<&'a Bound<'py, PyAny>>,
+}
+
 /// The user's model from the keywords of `ExtendedKalmanFilter` and `UnscentedKalmanFilter`:
 /// `n` states, the observation's components counted by one call of `h(x0, t0)`.
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub(crate) fn user_model(
     x0: &DVector<f64>,
     t0: f64,
-    f: &Bound<'_, PyAny>,
+    transition: Transition<'_, '_>,
     h: &Bound<'_, PyAny>,
-    F_jacobian: Option<&Bound<'_, PyAny>>,
     H_jacobian: Option<&Bound<'_, PyAny>>,
     Q: Option<&Bound<'_, PyAny>>,
     angles: Option<Vec<usize>>,
@@ -343,10 +413,50 @@ pub(crate) fn user_model(
             .map(|o| Callable::new(o, param, keyword, &raised))
             .transpose()
     };
-    let dynamics = UserDynamics {
-        n,
-        f: Callable::new(f, Param::TransitionFunction, "f", &raised)?,
-        jacobian: optional(F_jacobian, Param::TransitionJacobian, "F_jacobian")?,
+    let given = |o: Option<&Bound<'_, PyAny>>| o.is_some_and(|o| !o.is_none());
+    let dynamics = match (given(transition.f), given(transition.dxdt)) {
+        (true, false) => UserDynamics {
+            n,
+            f: Callable::new(
+                transition.f.expect("given"),
+                Param::TransitionFunction,
+                "f",
+                &raised,
+            )?,
+            jacobian: optional(
+                transition.f_jacobian,
+                Param::TransitionJacobian,
+                "F_jacobian",
+            )?,
+            ode: None,
+        },
+        (false, true) if !given(transition.f_jacobian) => {
+            let f = Callable::new(
+                transition.dxdt.expect("given"),
+                Param::DerivativeFunction,
+                "dxdt",
+                &raised,
+            )?;
+            let jacobian = optional(
+                transition.dxdt_jacobian,
+                Param::DerivativeJacobian,
+                "dxdt_jacobian",
+            )?;
+            let ode = Ode::new(n, &f, jacobian.as_ref());
+            UserDynamics {
+                n,
+                f,
+                jacobian,
+                ode: Some(ode),
+            }
+        }
+        _ => {
+            return Err(raise(
+                Kind::Parameter,
+                "the dynamics are f (with F_jacobian) or dxdt (with dxdt_jacobian): give one",
+                None,
+            ))
+        }
     };
     let h = Callable::new(h, Param::ObservationFunction, "h", &raised)?;
     // The components: what h gives at the prior (any length at least 1).
@@ -421,7 +531,7 @@ type Extended = KalmanFilter<UserDynamics, UserObservation>;
 ///     state; a vector: the diagonal; or ``n × n``) at time ``t0``.
 /// f : callable
 ///     ``f(x, t0, t1) -> x1``: the state at ``t1`` from the state ``x`` at ``t0`` (a step
-///     forwards or backwards).
+///     forwards or backwards). Or ``dxdt`` instead.
 /// h : callable
 ///     ``h(x, t) -> z``: the observation of the state ``x`` at ``t``, ``p`` values (counted by
 ///     one call ``h(x0, t0)``).
@@ -438,6 +548,15 @@ type Extended = KalmanFilter<UserDynamics, UserObservation>;
 /// angles : sequence of int, optional
 ///     The components of ``z`` that are angles in radians: their residuals are wrapped to
 ///     (−π, π].
+/// dxdt : callable, optional (keyword only)
+///     Instead of ``f``: ``dxdt(x, t) -> dx/dt`` (``n`` values) of ``dX/dt = F(X, t)``; the
+///     library integrates it with its variational equations ``dΦ/dt = (∂F/∂X) Φ`` (Morrison
+///     §8.6) over each step, forwards or backwards, by the Dormand–Prince 8(5,3) pair
+///     (DOP853) with step-size control on ``X`` and ``Φ`` to 1e-10 relative, 1e-12 absolute
+///     per component.
+/// dxdt_jacobian : callable, optional (keyword only)
+///     ``dxdt_jacobian(x, t) -> ∂F/∂X`` (``n × n``); default central differences of ``dxdt``
+///     (step ``ε^(1/3) max(|x_j|, 1)``).
 /// iterations : int
 ///     1 (default): the extended filter; more: the iterated update, relinearised about each
 ///     new estimate until the change is at most ``tolerance`` of its σ, at most
@@ -446,7 +565,8 @@ type Extended = KalmanFilter<UserDynamics, UserObservation>;
 ///     The iterated update's convergence test (default 1e-9).
 ///
 /// A callable that raises, returns the wrong shape, a NaN or an infinity is refused with a
-/// ``ParameterError`` naming it (``f``, ``h``, ``F_jacobian``, ``H_jacobian``, ``Q``), the
+/// ``ParameterError`` naming it (``f``, ``dxdt``, ``h``, ``F_jacobian``, ``dxdt_jacobian``,
+/// ``H_jacobian``, ``Q``), the
 /// time and, in ``update_many``, the measurement's index (``.index``), a raised exception as
 /// its ``__cause__``; the filter is left as it was.
 #[pyclass(name = "ExtendedKalmanFilter", module = "seqsmooth")]
@@ -464,12 +584,12 @@ pub struct PyExtendedKalmanFilter {
 impl PyExtendedKalmanFilter {
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
-    #[pyo3(signature = (x0, P0, f, h, Q = None, t0 = 0.0, F_jacobian = None, H_jacobian = None, angles = None, iterations = 1, tolerance = 1e-9))]
+    #[pyo3(signature = (x0, P0, f = None, h = None, Q = None, t0 = 0.0, F_jacobian = None, H_jacobian = None, angles = None, iterations = 1, tolerance = 1e-9, *, dxdt = None, dxdt_jacobian = None))]
     fn new(
         x0: &Bound<'_, PyAny>,
         P0: &Bound<'_, PyAny>,
-        f: &Bound<'_, PyAny>,
-        h: &Bound<'_, PyAny>,
+        f: Option<&Bound<'_, PyAny>>,
+        h: Option<&Bound<'_, PyAny>>,
         Q: Option<&Bound<'_, PyAny>>,
         t0: f64,
         F_jacobian: Option<&Bound<'_, PyAny>>,
@@ -477,12 +597,23 @@ impl PyExtendedKalmanFilter {
         angles: Option<Vec<usize>>,
         iterations: usize,
         tolerance: f64,
+        dxdt: Option<&Bound<'_, PyAny>>,
+        dxdt_jacobian: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         // The library's range of the iterated update's limits.
         seqsmooth::kalman::filter::check_iteration_limits(tolerance, iterations).py()?;
+        let Some(h) = h.filter(|h| !h.is_none()) else {
+            return Err(raise(Kind::Parameter, "h is required", None));
+        };
         let x = DVector::from_column_slice(crate::arrays::series(x0, "x0")?.as_slice());
         let p0 = crate::kalman::square_from(P0, x.len(), "P0")?;
-        let model = user_model(&x, t0, f, h, F_jacobian, H_jacobian, Q, angles)?;
+        let transition = Transition {
+            f,
+            f_jacobian: F_jacobian,
+            dxdt,
+            dxdt_jacobian,
+        };
+        let model = user_model(&x, t0, transition, h, H_jacobian, Q, angles)?;
         let components = model.observation.components();
         let mut filter = KalmanFilter::new(model.dynamics, model.observation, x, p0, t0).py()?;
         if let Some(q) = model.noise {

@@ -8,7 +8,9 @@
 //! Python callables of [`crate::callables`].
 
 use crate::arrays::series;
-use crate::callables::{stacked, user_model, Raised, Run, UserDynamics, UserObservation};
+use crate::callables::{
+    stacked, user_model, Raised, Run, Transition, UserDynamics, UserObservation,
+};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{
     before, measurement, measurements, observation_from, out_of_order, square, square_from,
@@ -110,6 +112,10 @@ fn build<O: Observation>(
 ///     ``q``, ``observation`` or ``site``): ``f(x, t0, t1) -> x1`` carries each sigma point
 ///     over the step, ``h(x, t) -> z`` observes it (``p`` values, counted by one call
 ///     ``h(x0, t0)``), as for :class:`ExtendedKalmanFilter` (no Jacobians are needed).
+/// dxdt : callable, optional
+///     Instead of ``f``: ``dxdt(x, t) -> dx/dt`` (``n`` values), integrated by the library
+///     over each step for each sigma point (DOP853, tolerances 1e-10 relative, 1e-12
+///     absolute), as for :class:`ExtendedKalmanFilter`.
 /// Q : array_like or callable, optional
 ///     With ``f``: the driving-noise covariance over each step, one ``n × n`` matrix (or a
 ///     number or diagonal) or ``Q(t0, t1)``. Default none.
@@ -135,7 +141,7 @@ pub struct PyUnscentedKalmanFilter {
 impl PyUnscentedKalmanFilter {
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
-    #[pyo3(signature = (degree = None, x0 = None, P0 = None, t0 = 0.0, axes = 1, q = 0.0, observation = None, site = None, sigma_points = (1.0, 2.0, 0.0), *, f = None, h = None, Q = None, angles = None))]
+    #[pyo3(signature = (degree = None, x0 = None, P0 = None, t0 = 0.0, axes = 1, q = 0.0, observation = None, site = None, sigma_points = (1.0, 2.0, 0.0), *, f = None, h = None, Q = None, angles = None, dxdt = None))]
     fn new(
         degree: Option<usize>,
         x0: Option<&Bound<'_, PyAny>>,
@@ -150,6 +156,7 @@ impl PyUnscentedKalmanFilter {
         h: Option<&Bound<'_, PyAny>>,
         Q: Option<&Bound<'_, PyAny>>,
         angles: Option<Vec<usize>>,
+        dxdt: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let (Some(x0), Some(P0)) = (x0, P0) else {
             return Err(raise(Kind::Parameter, "x0 and P0 are required", None));
@@ -158,11 +165,17 @@ impl PyUnscentedKalmanFilter {
         let points = SigmaPoints::new(alpha, beta, kappa).py()?;
         let polynomial =
             degree.is_some() || axes != 1 || q != 0.0 || observation.is_some() || site.is_some();
-        let degree = match (degree, f, h) {
-            (None, Some(f), Some(h)) if !polynomial => {
+        let dynamics = f.or(dxdt);
+        let degree = match (degree, dynamics, h) {
+            (None, Some(_), Some(h)) if !polynomial => {
                 let x = DVector::from_column_slice(series(x0, "x0")?.as_slice());
                 let p0 = square_from(P0, x.len(), "P0")?;
-                let user = user_model(&x, t0, f, h, None, None, Q, angles)?;
+                let transition = Transition {
+                    f,
+                    dxdt,
+                    ..Transition::default()
+                };
+                let user = user_model(&x, t0, transition, h, None, Q, angles)?;
                 let components = user.observation.components();
                 let mut filter =
                     UnscentedKalmanFilter::new(user.dynamics, user.observation, x, p0, t0)

@@ -175,6 +175,7 @@ class KalmanFilter:
 Transition = Callable[[Vector, float, float], ArrayLike]
 Observe = Callable[[Vector, float], ArrayLike]
 StepNoise = ArrayLike | float | Callable[[float, float], ArrayLike]
+Derivative = Callable[[Vector, float], ArrayLike]
 
 class UnscentedKalmanFilter:
     def __init__(
@@ -193,6 +194,7 @@ class UnscentedKalmanFilter:
         h: Observe | None = None,
         Q: StepNoise | None = None,
         angles: list[int] | None = None,
+        dxdt: Derivative | None = None,
     ) -> None: ...
     @property
     def state(self) -> Vector: ...
@@ -336,8 +338,8 @@ class ExtendedKalmanFilter:
         self,
         x0: ArrayLike,
         P0: ArrayLike | float,
-        f: Transition,
-        h: Observe,
+        f: Transition | None = None,
+        h: Observe | None = None,
         Q: StepNoise | None = None,
         t0: float = 0.0,
         F_jacobian: Transition | None = None,
@@ -345,6 +347,9 @@ class ExtendedKalmanFilter:
         angles: list[int] | None = None,
         iterations: int = 1,
         tolerance: float = 1e-9,
+        *,
+        dxdt: Derivative | None = None,
+        dxdt_jacobian: Derivative | None = None,
     ) -> None: ...
     @property
     def state(self) -> Vector: ...
@@ -361,6 +366,65 @@ class ExtendedKalmanFilter:
     ) -> tuple[Matrix, npt.NDArray[np.float64], Vector]: ...
     def smooth(
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
+    ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
+
+class ContinuousModel:
+    def __init__(self, A: ArrayLike, Qc: ArrayLike) -> None: ...
+    @staticmethod
+    def polynomial(
+        degree: int, q: ArrayLike | float, axes: int | None = None
+    ) -> ContinuousModel: ...
+    @staticmethod
+    def nearly_constant_velocity(
+        q: ArrayLike | float, axes: int | None = None
+    ) -> ContinuousModel: ...
+    @staticmethod
+    def nearly_constant_acceleration(
+        q: ArrayLike | float, axes: int | None = None
+    ) -> ContinuousModel: ...
+    @staticmethod
+    def singer(
+        manoeuvre_alpha: float, manoeuvre_variance: float, axes: int = 1
+    ) -> ContinuousModel: ...
+    def discretise(self, dt: float) -> tuple[Matrix, Matrix]: ...
+    @property
+    def A(self) -> Matrix: ...
+    @property
+    def Qc(self) -> Matrix: ...
+    @property
+    def dimension(self) -> int: ...
+
+class ContinuousKalmanFilter:
+    def __init__(
+        self,
+        model: ContinuousModel,
+        H: ArrayLike,
+        R: ArrayLike | float,
+        x0: ArrayLike,
+        P0: ArrayLike | float,
+        t0: float = 0.0,
+    ) -> None: ...
+    @property
+    def state(self) -> Vector: ...
+    @property
+    def covariance(self) -> Matrix: ...
+    @property
+    def std_devs(self) -> Vector: ...
+    @property
+    def time(self) -> float: ...
+    @property
+    def H(self) -> Matrix: ...
+    @property
+    def R(self) -> Matrix: ...
+    def predict(self, t: float) -> None: ...
+    def update(
+        self, t: float, z: ArrayLike | float, R: ArrayLike | float | None = None
+    ) -> Innovation | None: ...
+    def update_many(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float | None = None
+    ) -> tuple[Matrix, npt.NDArray[np.float64], Vector]: ...
+    def smooth(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float | None = None
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
 
 class BayesFilter:
