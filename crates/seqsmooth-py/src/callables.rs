@@ -26,7 +26,9 @@ use seqsmooth::kalman::noise::{check_covariance, ProcessNoise};
 use seqsmooth::kalman::{smoother, KalmanFilter};
 use seqsmooth::model::dynamics::{Dynamics, Propagation};
 use seqsmooth::model::measurement::Measurement;
-use seqsmooth::model::nonlinear::{differenced_jacobian, NonlinearDynamics};
+use seqsmooth::model::nonlinear::{
+    differenced_jacobian, differenced_jacobian_with, NonlinearDynamics,
+};
 use seqsmooth::model::observation::{Angles, Observation, Predicted};
 use seqsmooth::Error;
 use std::sync::{Arc, Mutex};
@@ -209,7 +211,9 @@ impl Ode {
     fn new(n: usize, dxdt: &Callable, jacobian: Option<&Callable>) -> Self {
         let refused: Arc<Mutex<Option<Error>>> = Arc::default();
         let keep = |slot: &Arc<Mutex<Option<Error>>>, e: Error| {
-            slot.lock().unwrap_or_else(|p| p.into_inner()).get_or_insert(e);
+            slot.lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .get_or_insert(e);
         };
         let (f, slot) = (dxdt.clone(), Arc::clone(&refused));
         let mut dynamics = NonlinearDynamics::new(n, move |t, x: &DVector<f64>| {
@@ -239,7 +243,12 @@ impl Ode {
     /// The integration from `t_a` to `t_b`; its failure the user's callable's refusal where
     /// one stopped it.
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
-        let slot = || self.refused.lock().unwrap_or_else(|p| p.into_inner()).take();
+        let slot = || {
+            self.refused
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .take()
+        };
         slot();
         self.dynamics
             .propagate(state, t_a, t_b)
@@ -325,7 +334,13 @@ impl Observation for UserObservation {
                 let m = j.call(Some(state), &[t], self.p, Some(self.n), at)?;
                 DMatrix::from_row_slice(self.p, self.n, &m)
             }
-            None => differenced_jacobian(self.p, state, |x| self.value(x, t))?,
+            // An angle's differences wrapped: a probe across ±π changes it little.
+            None => differenced_jacobian_with(
+                self.p,
+                state,
+                |x| self.value(x, t),
+                |c, up, down| self.angles.residual(c, up, down),
+            )?,
         };
         Ok(Predicted { value, jacobian })
     }
@@ -716,7 +731,8 @@ impl PyExtendedKalmanFilter {
 
     /// The Rauch–Tung–Striebel smoother over the measurements, from this filter's current
     /// state (the filter itself is not changed): the extended filter forwards (one
-    /// linearisation per measurement), then the backward pass with each step's ``Φ`` along the
+    /// linearisation per measurement; with ``iterations > 1`` the iterated update, as
+    /// ``update``), then the backward pass with each step's ``Φ`` along the
     /// forward trajectory. Returns ``(states, covariances)``, ``(n, dim)`` and
     /// ``(n, dim, dim)``.
     #[allow(non_snake_case)]
@@ -732,9 +748,13 @@ impl PyExtendedKalmanFilter {
         if let Some((k, t, previous)) = out_of_order(self.filter.time(), &rows) {
             return Err(before(t, previous, Some(k)));
         }
-        let smoothed = self
-            .raised
-            .py(smoother::smooth(self.filter.clone(), &rows))?;
+        // The forward pass iterated as the filter's own updates are (§12.5).
+        let forward = smoother::Smoother::new(self.filter.clone());
+        let forward = match self.iterations {
+            1 => Ok(forward),
+            most => forward.with_iterated_update(self.tolerance, most),
+        };
+        let smoothed = self.raised.py(forward.and_then(|s| s.smooth(&rows)))?;
         stacked(py, smoothed.iter().map(|s| (&s.state, &s.covariance)))
     }
 

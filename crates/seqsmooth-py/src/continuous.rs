@@ -335,16 +335,13 @@ impl PyContinuousKalmanFilter {
         let filter = &mut self.filter;
         py.detach(|| {
             rows.iter().enumerate().try_for_each(|(i, m)| {
-                let stats = filter.update_stats(m).map_err(|e| seqsmooth::Error::InBatch {
-                    index: i,
-                    source: Box::new(e),
-                })?;
-                run.record(
-                    i,
-                    filter.state(),
-                    filter.covariance(),
-                    stats.map(|s| s.nis),
-                );
+                let stats = filter
+                    .update_stats(m)
+                    .map_err(|e| seqsmooth::Error::InBatch {
+                        index: i,
+                        source: Box::new(e),
+                    })?;
+                run.record(i, filter.state(), filter.covariance(), stats.map(|s| s.nis));
                 Ok::<(), seqsmooth::Error>(())
             })
         })

@@ -59,7 +59,7 @@ pub(crate) fn count(
 }
 
 /// `epoch` as given: ``"end"``, ``"centre"`` (``"center"``) or a finite time.
-fn epoch_of(epoch: &Bound<'_, PyAny>) -> PyResult<Epoch> {
+pub(crate) fn epoch_of(epoch: &Bound<'_, PyAny>) -> PyResult<Epoch> {
     let bad = |shown: String| {
         raise(
             Kind::Parameter,

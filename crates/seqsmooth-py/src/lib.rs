@@ -14,6 +14,7 @@ mod fit;
 mod frame;
 mod kalman;
 mod linear;
+mod model_fit;
 mod paml;
 mod polynomial;
 mod smooth;
@@ -46,6 +47,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<track::PyRadarTracker>()?;
     m.add_class::<fit::PySlidingFit>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
+    m.add_function(wrap_pyfunction!(model_fit::fit_model, m)?)?;
     m.add_function(wrap_pyfunction!(frame::filter_series, m)?)?;
     m.add_function(wrap_pyfunction!(errors::error_kinds, m)?)?;
     m.add_function(wrap_pyfunction!(errors::parameter_kinds, m)?)?;

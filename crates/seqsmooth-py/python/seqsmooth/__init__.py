@@ -40,6 +40,9 @@ Functions
 ---------
 smooth
     ``scipy.signal.savgol_filter``'s names and meaning, on irregular times too.
+fit_model
+    The Gauss–Newton fit (Morrison §8.5-8.7) of your own model's state at one epoch (``f`` or
+    ``dxdt``, ``h``) to a window of measurements: the state, its covariance, chi-squared.
 filter_frame
     Many series of a pandas or Polars DataFrame or a pyarrow Table, one filter each: the rows
     of ``seqsmooth filter --id-col``, as a frame of the same kind.
@@ -84,6 +87,7 @@ from ._seqsmooth import (
     __version__,
     cramer_rao_bound,
     fit_curve,
+    fit_model,
     gains,
     gauss_rule,
     luenberger_gains,
@@ -134,6 +138,7 @@ __all__ = [
     "polynomial_samples",
     "OnlineSmoother",
     "fit_curve",
+    "fit_model",
     "cramer_rao_bound",
     "CurveFit",
     "luenberger_gains",

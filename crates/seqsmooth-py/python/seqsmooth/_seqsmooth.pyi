@@ -368,6 +368,23 @@ class ExtendedKalmanFilter:
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
 
+def fit_model(
+    x0: ArrayLike,
+    t: ArrayLike,
+    z: ArrayLike,
+    R: ArrayLike | float,
+    *,
+    h: Observe,
+    f: Transition | None = None,
+    dxdt: Derivative | None = None,
+    F_jacobian: Transition | None = None,
+    H_jacobian: Observe | None = None,
+    dxdt_jacobian: Derivative | None = None,
+    angles: list[int] | None = None,
+    epoch: str | float | None = None,
+    max_iterations: int = 20,
+) -> dict[str, object]: ...
+
 class ContinuousModel:
     def __init__(self, A: ArrayLike, Qc: ArrayLike) -> None: ...
     @staticmethod

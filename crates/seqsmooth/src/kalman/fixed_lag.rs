@@ -254,6 +254,9 @@ pub struct FixedLagSmoother<D: Dynamics, O: Observation> {
     pushed: usize,
     /// The last measurement's time and NIS.
     last: Option<(f64, Option<f64>)>,
+    /// The iterated update's tolerance and most iterations (§12.5), where the forward pass
+    /// iterates.
+    iterated: Option<(f64, usize)>,
 }
 
 impl<D: Dynamics + Clone, O: Observation + Clone> FixedLagSmoother<D, O> {
@@ -266,7 +269,35 @@ impl<D: Dynamics + Clone, O: Observation + Clone> FixedLagSmoother<D, O> {
             window: Window::default(),
             pushed: 0,
             last: None,
+            iterated: None,
         }
+    }
+
+    /// With the forward pass's update the iterated one
+    /// ([`KalmanFilter::update_iterated`], Morrison §12.5: relinearised about each new estimate
+    /// until the change is at most `tolerance` of its σ, at most `max_iterations` times); the
+    /// backward pass is the same, on that forward pass's own predictions. Its limits checked
+    /// ([`super::filter::check_iteration_limits`]).
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::fixed_lag::FixedLagSmoother;
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::zeros(1), DMatrix::identity(1, 1), 0.0).unwrap();
+    /// assert!(FixedLagSmoother::new(f.clone(), 2).with_iterated_update(1e-9, 5).is_ok());
+    /// assert!(FixedLagSmoother::new(f, 2).with_iterated_update(1e-9, 0).is_err());
+    /// ```
+    pub fn with_iterated_update(
+        mut self,
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<Self, Error> {
+        super::filter::check_iteration_limits(tolerance, max_iterations)?;
+        self.iterated = Some((tolerance, max_iterations));
+        Ok(self)
     }
 
     /// The lag, in measurements.
@@ -328,10 +359,15 @@ impl<D: Dynamics + Clone, O: Observation + Clone> FixedLagSmoother<D, O> {
             }
         }
         let before = self.filter.clone();
+        let iterated = self.iterated;
         let step_forward = |filter: &mut KalmanFilter<D, O>| {
             let phi = filter.predict_with_transition(m.time)?;
             let predicted = (phi, filter.state().clone(), filter.covariance().clone());
-            Ok::<_, Error>((predicted, filter.update(m)?.map(|i| i.nis)))
+            let innovation = match iterated {
+                Some((tolerance, most)) => filter.update_iterated(m, tolerance, most)?,
+                None => filter.update(m)?,
+            };
+            Ok::<_, Error>((predicted, innovation.map(|i| i.nis)))
         };
         let undo = |this: &mut Self, e: Error| {
             this.filter = before.clone();

@@ -61,14 +61,7 @@ pub fn smooth<D: Dynamics + Clone, O: Observation + Clone>(
     filter: KalmanFilter<D, O>,
     measurements: &[Measurement],
 ) -> Result<Vec<Smoothed>, Error> {
-    let mut smoother = Smoother::new(filter);
-    for (index, m) in measurements.iter().enumerate() {
-        smoother.push(m).map_err(|source| Error::InBatch {
-            index,
-            source: Box::new(source),
-        })?;
-    }
-    smoother.finish()
+    Smoother::new(filter).smooth(measurements)
 }
 
 /// The smoother a measurement at a time: the forward pass as the measurements come
@@ -102,6 +95,30 @@ impl<D: Dynamics + Clone, O: Observation + Clone> Smoother<D, O> {
         Self(FixedLagSmoother::new(filter, usize::MAX))
     }
 
+    /// With the forward pass's update the iterated one (Morrison §12.5,
+    /// [`FixedLagSmoother::with_iterated_update`]): the iterated extended Kalman filter's
+    /// smoother.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::smoother::Smoother;
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::zeros(1), DMatrix::identity(1, 1), 0.0).unwrap();
+    /// assert!(Smoother::new(f).with_iterated_update(0.0, 3).is_err()); // no tolerance
+    /// ```
+    pub fn with_iterated_update(
+        self,
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<Self, Error> {
+        Ok(Self(
+            self.0.with_iterated_update(tolerance, max_iterations)?,
+        ))
+    }
+
     /// The forward filter so far.
     pub fn filter(&self) -> &KalmanFilter<D, O> {
         self.0.filter()
@@ -123,6 +140,34 @@ impl<D: Dynamics + Clone, O: Observation + Clone> Smoother<D, O> {
             "an unbounded lag gives nothing before finish"
         );
         Ok(self.0.nis())
+    }
+
+    /// [`Self::push`] for each of `measurements` (in time order), then [`Self::finish`]: one
+    /// [`Smoothed`] per measurement; an error names its measurement ([`Error::InBatch`]).
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
+    /// use seqsmooth::kalman::smoother::Smoother;
+    /// use seqsmooth::kalman::KalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::zeros(1), DMatrix::from_element(1, 1, 1e12), 0.0).unwrap();
+    /// let rows: Vec<Measurement> = [2.0, 4.0].iter().enumerate()
+    ///     .map(|(k, &y)| Measurement { time: k as f64, values: vec![Some(y)], noise: NoiseCovariance::Identity })
+    ///     .collect();
+    /// let s = Smoother::new(f).with_iterated_update(1e-9, 3).unwrap().smooth(&rows).unwrap();
+    /// assert!((s[0].state[0] - 3.0).abs() < 1e-9); // linear: the iterated update is the plain one
+    /// ```
+    pub fn smooth(mut self, measurements: &[Measurement]) -> Result<Vec<Smoothed>, Error> {
+        for (index, m) in measurements.iter().enumerate() {
+            self.push(m).map_err(|source| Error::InBatch {
+                index,
+                source: Box::new(source),
+            })?;
+        }
+        self.finish()
     }
 
     /// The backward pass: every measurement's smoothed estimate, in order. An error names its

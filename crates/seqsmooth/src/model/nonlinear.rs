@@ -225,7 +225,32 @@ pub(crate) fn central_differences(
 pub fn differenced_jacobian<E>(
     rows: usize,
     x: &DVector<f64>,
+    f: impl FnMut(&DVector<f64>) -> Result<DVector<f64>, E>,
+) -> Result<DMatrix<f64>, E> {
+    differenced_jacobian_with(rows, x, f, |_, up, down| up - down)
+}
+
+/// [`differenced_jacobian`] with the difference of row `r`'s two values given by
+/// `difference(r, up, down)`: for an angle, the wrapped one
+/// ([`super::observation::Angles::residual`]), so that a probe across the branch cut at ±π
+/// gives the angle's small change, not `±2π` over the step.
+///
+/// ```
+/// use nalgebra::DVector;
+/// use seqsmooth::model::nonlinear::differenced_jacobian_with;
+/// use seqsmooth::model::observation::Angles;
+/// // The bearing atan2(y, x) at (−1, 0), on the cut: ∂/∂y = x / (x² + y²) = −1.
+/// let bearing = |p: &DVector<f64>| Ok::<_, ()>(DVector::from_vec(vec![p[1].atan2(p[0])]));
+/// let angles = Angles::new(1, &[0]).unwrap();
+/// let x = DVector::from_vec(vec![-1.0, 0.0]);
+/// let j = differenced_jacobian_with(1, &x, bearing, |c, a, b| angles.residual(c, a, b)).unwrap();
+/// assert!((j[(0, 1)] + 1.0).abs() < 1e-9);
+/// ```
+pub fn differenced_jacobian_with<E>(
+    rows: usize,
+    x: &DVector<f64>,
     mut f: impl FnMut(&DVector<f64>) -> Result<DVector<f64>, E>,
+    difference: impl Fn(usize, f64, f64) -> f64,
 ) -> Result<DMatrix<f64>, E> {
     let step = f64::EPSILON.cbrt();
     let mut out = DMatrix::zeros(rows, x.len());
@@ -239,7 +264,9 @@ pub fn differenced_jacobian<E>(
         let down = f(&probe)?;
         probe[c] = xc;
         if up.len() == rows && down.len() == rows {
-            out.set_column(c, &((up - down) / (2.0 * h)));
+            for r in 0..rows {
+                out[(r, c)] = difference(r, up[r], down[r]) / (2.0 * h);
+            }
         } else {
             out.column_mut(c).fill(f64::NAN);
         }
