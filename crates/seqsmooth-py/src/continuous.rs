@@ -103,6 +103,8 @@ impl PyContinuousModel {
     #[pyo3(signature = (degree, q, axes = None))]
     fn polynomial(degree: usize, q: &Bound<'_, PyAny>, axes: Option<usize>) -> PyResult<Self> {
         let q = per_axis(q, axes)?;
+        // The polynomial model's limits (its degree, as every polynomial class's).
+        seqsmooth::polynomial::check_model(degree, q.len().max(1)).py()?;
         Ok(Self {
             inner: ContinuousModel::polynomial(degree, &q).py()?,
         })

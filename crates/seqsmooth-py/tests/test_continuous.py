@@ -49,9 +49,7 @@ def ncv_by_hand(q, dt):
     Q_continuous_white_noise, in the derivative-then-axis order."""
     d = len(q)
     F = np.block([[np.eye(d), dt * np.eye(d)], [np.zeros((d, d)), np.eye(d)]])
-    Q = axis_order(
-        [Q_continuous_white_noise(dim=2, dt=dt, spectral_density=qa) for qa in q], d, 2
-    )
+    Q = axis_order([Q_continuous_white_noise(dim=2, dt=dt, spectral_density=qa) for qa in q], d, 2)
     return F, Q
 
 
@@ -87,9 +85,7 @@ def test_nearly_constant_velocity_equals_filterpy_q_continuous_white_noise():
     H = np.hstack([np.eye(2), np.zeros((2, 2))])
     R = np.diag([0.25, 0.36])
     x0, P0 = np.zeros(4), np.eye(4) * 100.0
-    ckf, got, lkf, want, Fs, Qs = run_both(
-        model, lambda dt: ncv_by_hand(q, dt), H, R, x0, P0, t, z
-    )
+    ckf, got, lkf, want, Fs, Qs = run_both(model, lambda dt: ncv_by_hand(q, dt), H, R, x0, P0, t, z)
     assert rel(got[0], want[0]) <= TOL and rel(got[1], want[1]) <= TOL
     assert ckf.time == t[-1] and rel(ckf.state, lkf.x) <= TOL
     # The smoother against the linear filter's RTS over its own pass (next step's F, Q).
@@ -118,9 +114,7 @@ def test_singer_equals_scipy_van_loan_on_irregular_steps():
     z += rng.normal(0, 1.0, size=z.shape)
     H = np.hstack([np.eye(2), np.zeros((2, 4))])
     x0, P0 = np.zeros(6), np.eye(6) * 50.0
-    ckf, got, _, want, _, _ = run_both(
-        model, lambda dt: van_loan(A, Qc, dt), H, 1.0, x0, P0, t, z
-    )
+    ckf, got, _, want, _, _ = run_both(model, lambda dt: van_loan(A, Qc, dt), H, 1.0, x0, P0, t, z)
     assert rel(got[0], want[0]) <= TOL and rel(got[1], want[1]) <= TOL
 
 
@@ -164,7 +158,10 @@ def test_update_one_at_a_time_equals_the_batch():
     model = ss.ContinuousModel.nearly_constant_acceleration([0.5])
     t = irregular_times(rng, 20)
     z = t**2 + rng.normal(0, 1, size=20)
-    make = lambda: ss.ContinuousKalmanFilter(model, [1.0, 0.0, 0.0], 1.0, [0, 0, 0], 100.0)
+
+    def make():
+        return ss.ContinuousKalmanFilter(model, [1.0, 0.0, 0.0], 1.0, [0, 0, 0], 100.0)
+
     batch = make().update_many(t, z)
     one = make()
     for k, (tk, zk) in enumerate(zip(t, z)):
@@ -210,7 +207,10 @@ def test_bad_models_are_refused_by_name():
 def test_bad_filter_input_is_refused_and_the_filter_unchanged():
     model = ss.ContinuousModel.nearly_constant_velocity([1.0, 1.0])
     H = np.hstack([np.eye(2), np.zeros((2, 2))])
-    make = lambda: ss.ContinuousKalmanFilter(model, H, 1.0, np.zeros(4), np.eye(4))
+
+    def make():
+        return ss.ContinuousKalmanFilter(model, H, 1.0, np.zeros(4), np.eye(4))
+
     bad(lambda: ss.ContinuousKalmanFilter(model, np.eye(2, 3), 1.0, np.zeros(4), 1.0), "H")
     bad(lambda: ss.ContinuousKalmanFilter(model, H, [[1, 2], [2, 1]], np.zeros(4), 1.0), "R")
     bad(lambda: ss.ContinuousKalmanFilter(model, H, 1.0, np.zeros(3), 1.0))

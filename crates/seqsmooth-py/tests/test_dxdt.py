@@ -154,8 +154,9 @@ BAD = {
 @pytest.mark.parametrize("kind", ["ekf", "ukf"])
 def test_bad_dxdt_is_named_and_leaves_the_filter(which, how, kind):
     """A dxdt (or its Jacobian) that raises or returns a wrong shape, NaN or infinity past a
-    time (between two measurements): a ParameterError naming it and the time, the filter as it was; in update_many the
-    sample's index (the samples before it taken); a raised exception as the cause."""
+    time (between two measurements): a ParameterError naming it and the time, the filter as
+    it was; in update_many the sample's index (the samples before it taken); a raised
+    exception as the cause."""
     if kind == "ukf" and which == "dxdt_jacobian":
         pytest.skip("the unscented filter takes no Jacobian")
     spoil, words = BAD[how]
@@ -197,3 +198,67 @@ def test_bad_dxdt_is_named_and_leaves_the_filter(which, how, kind):
         flt.update_many(t, z, 0.01)
     assert e.value.index == 3 and str(e.value).startswith(f"sample 3 of the batch: {which} ")
     assert flt.time == t[2]
+
+
+def test_ten_thousand_seeded_bad_calls_never_panic():
+    """10⁴ seeded calls of the new entry points with misbehaving callables (dxdt, its
+    Jacobian, h: each bad way) and junk arguments (fit_model's arrays, epochs, iterations):
+    every refusal a SeqsmoothError, a refused update leaving the filter as it was, every
+    accepted one finite."""
+    rng = np.random.default_rng(20261207)
+    ways = list(BAD) + ["ok"] * 3
+    plan = {"which": None, "how": "ok"}
+    specials = [np.nan, np.inf, -np.inf, 0.0, -1.0, 1e308]
+
+    def chaos(name, fn):
+        def call(x, t):
+            good = np.asarray(fn(x, t), float)
+            if plan["which"] == name and plan["how"] != "ok" and rng.random() < 0.3:
+                return BAD[plan["how"]][0](good)
+            return good
+
+        return call
+
+    A2 = np.array([[0.0, 1.0], [-1.0, -0.1]])
+    kw = {
+        "dxdt": chaos("dxdt", lambda x, t: A2 @ x),
+        "dxdt_jacobian": chaos("dxdt_jacobian", lambda x, t: A2),
+        "h": chaos("h", lambda x, t: x[:1]),
+    }
+    ekf = ss.ExtendedKalmanFilter([1.0, 0.0], 1.0, Q=1e-3, **kw)
+    refused = accepted = 0
+    for k in range(10_000):
+        plan["which"] = ["dxdt", "dxdt_jacobian", "h"][rng.integers(3)]
+        plan["how"] = ways[rng.integers(len(ways))]
+        if k % 2:
+            n = int(rng.integers(0, 6))
+            t = np.sort(rng.uniform(0, 3, size=n))
+            z = rng.normal(size=n)
+            if n and rng.random() < 0.3:
+                z[rng.integers(n)] = specials[rng.integers(len(specials))]
+            epoch = ["end", "centre", "middle", float(rng.normal()), np.nan][rng.integers(5)]
+            try:
+                fit = ss.fit_model(
+                    rng.normal(size=int(rng.integers(1, 4))),
+                    t,
+                    z,
+                    [1.0, -1.0, np.inf, 0.5][rng.integers(4)],
+                    epoch=epoch,
+                    max_iterations=int(rng.integers(0, 4)),
+                    **kw,
+                )
+                assert np.all(np.isfinite(fit["state"]))
+            except ss.SeqsmoothError:
+                refused += 1
+            continue
+        before = (ekf.state.copy(), ekf.covariance.copy(), ekf.time)
+        try:
+            ekf.update(ekf.time + rng.uniform(0.05, 0.5), rng.normal(), 0.01)
+        except ss.SeqsmoothError:
+            refused += 1
+            assert np.array_equal(ekf.state, before[0]) and ekf.time == before[2]
+            assert np.array_equal(ekf.covariance, before[1])
+            continue
+        accepted += 1
+        assert np.all(np.isfinite(ekf.state)) and np.all(np.isfinite(ekf.covariance))
+    assert refused > 2_000 and accepted > 500, (refused, accepted)

@@ -93,9 +93,7 @@ def test_range_and_bearing_through_dxdt_against_least_squares():
 
     x0 = [-480.0, 0.0, 0.0, 0.0]
     ref = least_squares(residuals, x0, jac=jac, xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    fit = ss.fit_model(
-        x0, t, z, sig**2, dxdt=cv, h=range_bearing, angles=[1], epoch="centre"
-    )
+    fit = ss.fit_model(x0, t, z, sig**2, dxdt=cv, h=range_bearing, angles=[1], epoch="centre")
     assert fit["epoch"] == pytest.approx(te, rel=1e-15)
     assert rel(fit["state"], ref.x) < 1e-8, rel(fit["state"], ref.x)
     J = jac(ref.x)

@@ -93,8 +93,7 @@ impl ContinuousModel {
         Ok(Self { dynamics, qc, norm })
     }
 
-    /// The polynomial model of degree `m` (at most [`crate::polynomial::MAX_DEGREE`], by
-    /// [`crate::polynomial::check_model`]) on `psd.len()` axes: `x_a^(m+1) = w_a`, white noise
+    /// The polynomial model of degree `m` on `psd.len()` axes: `x_a^(m+1) = w_a`, white noise
     /// of spectral density `psd[a]` (finite, at least 0; (value unit)² / (time unit)^(2m+1)) on
     /// each axis' highest derivative, the axes independent. Its `Q(ζ)` is Morrison (15.2.23)'s
     /// closed form, [`crate::kalman::noise::WhiteNoiseDerivative`] (equal to 1e-12:
@@ -115,8 +114,6 @@ impl ContinuousModel {
                 reason: "must be at least 1 (one spectral density per axis)".into(),
             });
         }
-        // The polynomial model's own limits on the degree and the axes.
-        crate::polynomial::check_model(degree, d)?;
         if let Some(&q) = psd.iter().find(|q| !(q.is_finite() && **q >= 0.0)) {
             return Err(Error::InvalidParameter {
                 name: Param::DrivingNoiseQ,
@@ -124,7 +121,7 @@ impl ContinuousModel {
                 reason: "must be finite and at least 0".into(),
             });
         }
-        let n = (degree + 1) * d;
+        let n = states(degree.saturating_add(1), d)?;
         let mut a = DMatrix::zeros(n, n);
         let mut qc = DMatrix::zeros(n, n);
         for (axis, &q) in psd.iter().enumerate() {
@@ -179,6 +176,7 @@ impl ContinuousModel {
     /// let q = m.noise_covariance(2.0).unwrap();
     /// assert!((q[(2, 2)] - 4.0 * (1.0 - (-2.0_f64).exp())).abs() < 1e-14);
     /// assert!(ContinuousModel::singer(1, 0.0, 4.0).is_err());
+    /// assert!(ContinuousModel::singer(usize::MAX / 2, 0.5, 4.0).is_err()); // beyond memory
     /// ```
     pub fn singer(axes: usize, alpha: f64, variance: f64) -> Result<Self, Error> {
         if axes == 0 {
@@ -204,10 +202,10 @@ impl ContinuousModel {
                 reason: "must be finite and at least 0".into(),
             });
         }
-        crate::polynomial::check_model(2, axes)?;
         let d = axes;
-        let mut a = DMatrix::zeros(3 * d, 3 * d);
-        let mut qc = DMatrix::zeros(3 * d, 3 * d);
+        let n = states(3, d)?;
+        let mut a = DMatrix::zeros(n, n);
+        let mut qc = DMatrix::zeros(n, n);
         for axis in 0..d {
             a[(axis, d + axis)] = 1.0;
             a[(d + axis, 2 * d + axis)] = 1.0;
@@ -342,6 +340,20 @@ impl ContinuousModel {
         }
         (phi, q)
     }
+}
+
+/// The states of a built-in model, `per_axis · axes`, refused ([`Param::Axes`]) where an
+/// `n × n` matrix's bytes would pass the largest allocation (`isize::MAX`).
+fn states(per_axis: usize, axes: usize) -> Result<usize, Error> {
+    let bytes = |n: usize| n.checked_mul(n)?.checked_mul(std::mem::size_of::<f64>());
+    per_axis
+        .checked_mul(axes)
+        .filter(|&n| bytes(n).is_some_and(|b| b <= isize::MAX as usize))
+        .ok_or_else(|| Error::InvalidParameter {
+            name: Param::Axes,
+            value: axes.to_string(),
+            reason: "too many: the model's matrices must fit in memory".into(),
+        })
 }
 
 /// `sum += term`; whether any entry of `sum` changed.
