@@ -240,9 +240,12 @@ impl Ode {
         Self { dynamics, refused }
     }
 
-    /// The integration from `t_a` to `t_b`; its failure the user's callable's refusal where
+    /// `integrate` on the library's dynamics; its failure the user's callable's refusal where
     /// one stopped it.
-    fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
+    fn run<T>(
+        &self,
+        integrate: impl FnOnce(&NonlinearDynamics) -> Result<T, Error>,
+    ) -> Result<T, Error> {
         let slot = || {
             self.refused
                 .lock()
@@ -250,9 +253,7 @@ impl Ode {
                 .take()
         };
         slot();
-        self.dynamics
-            .propagate(state, t_a, t_b)
-            .map_err(|e| slot().unwrap_or(e))
+        integrate(&self.dynamics).map_err(|e| slot().unwrap_or(e))
     }
 }
 
@@ -276,7 +277,7 @@ impl Dynamics for UserDynamics {
 
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
         if let Some(ode) = &self.ode {
-            return ode.propagate(state, t_a, t_b);
+            return ode.run(|d| d.propagate(state, t_a, t_b));
         }
         let n = self.n;
         let new_state = self.transition_state(state, t_a, t_b)?;
@@ -300,7 +301,8 @@ impl Dynamics for UserDynamics {
         t_b: f64,
     ) -> Result<DVector<f64>, Error> {
         match &self.ode {
-            Some(ode) => ode.propagate(state, t_a, t_b).map(|p| p.state),
+            // The trajectory alone: no variational equations for a state the caller carries.
+            Some(ode) => ode.run(|d| d.propagate_state(state, t_a, t_b)),
             None => self.transition_state(state, t_a, t_b),
         }
     }

@@ -279,27 +279,39 @@ pub fn differenced_jacobian_with<E>(
 /// stage time: ode_solvers 0.6.2's DOP853 evaluates its twelfth stage at `c₁₂ = 0` instead of 1
 /// (its `a` coefficients are right), which corrupts every `F` that depends on `t`; the carried
 /// `ζ` (`dζ/dζ = 1`, integrated exactly) has each stage's true time.
+/// Without `transition`, the state and `ζ` only (`n + 1` numbers): the trajectory alone, for a
+/// caller that needs no `Φ` ([`Dynamics::propagate_state`]: the unscented filter's sigma
+/// points), without the `n` (or `2n` differenced) extra evaluations of `F` per stage.
 struct Variational<'a> {
     model: &'a NonlinearDynamics,
     t_a: f64,
+    transition: bool,
     failed: Rc<Cell<Option<f64>>>,
 }
 
 impl System<f64, DVector<f64>> for Variational<'_> {
     fn system(&self, _zeta: f64, y: &DVector<f64>, dy: &mut DVector<f64>) {
         let n = self.model.n;
-        let t = self.t_a + y[n + n * n];
+        let m = if self.transition { n * n } else { 0 };
+        let t = self.t_a + y[n + m];
         let x = y.rows(0, n).into_owned();
-        let (Some(f), Some(a)) = (self.model.field_at(t, &x), self.model.jacobian_at(t, &x)) else {
+        let fail = |dy: &mut DVector<f64>| {
             self.failed.set(Some(t));
             dy.fill(0.0);
-            return;
+        };
+        let Some(f) = self.model.field_at(t, &x) else {
+            return fail(dy);
         };
         dy.rows_mut(0, n).copy_from(&f);
-        let phi = DMatrix::from_column_slice(n, n, &y.as_slice()[n..n + n * n]);
-        let dphi = a * phi;
-        dy.rows_mut(n, n * n).copy_from_slice(dphi.as_slice());
-        dy[n + n * n] = 1.0;
+        if self.transition {
+            let Some(a) = self.model.jacobian_at(t, &x) else {
+                return fail(dy);
+            };
+            let phi = DMatrix::from_column_slice(n, n, &y.as_slice()[n..n + m]);
+            let dphi = a * phi;
+            dy.rows_mut(n, m).copy_from_slice(dphi.as_slice());
+        }
+        dy[n + m] = 1.0;
     }
 
     fn solout(&mut self, _x: f64, _y: &DVector<f64>, _dy: &DVector<f64>) -> bool {
@@ -317,27 +329,56 @@ impl Dynamics for NonlinearDynamics {
     }
 
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
+        let (state, transition) = self.integrate(state, t_a, t_b, true)?;
+        Ok(Propagation {
+            state,
+            transition: transition.expect("integrated with the transition"),
+        })
+    }
+
+    /// The trajectory alone (no variational equations): `X(t_b)` within the same tolerances.
+    fn propagate_state(
+        &self,
+        state: &DVector<f64>,
+        t_a: f64,
+        t_b: f64,
+    ) -> Result<DVector<f64>, Error> {
+        Ok(self.integrate(state, t_a, t_b, false)?.0)
+    }
+}
+
+impl NonlinearDynamics {
+    /// `X(t_b)` from `X(t_a)` and, with `transition`, `Φ(t_b, t_a)` from the variational
+    /// equations integrated alongside (the error control covering both).
+    fn integrate(
+        &self,
+        state: &DVector<f64>,
+        t_a: f64,
+        t_b: f64,
+        transition: bool,
+    ) -> Result<(DVector<f64>, Option<DMatrix<f64>>), Error> {
         let n = self.n;
         check_propagation(n, state, t_a, t_b)?;
+        let m = if transition { n * n } else { 0 };
         let span = t_b - t_a;
         if span == 0.0 {
             if self.field_at(t_a, state).is_none() {
                 return Err(non_finite_field(t_a));
             }
-            return Ok(Propagation {
-                state: state.clone(),
-                transition: DMatrix::identity(n, n),
-            });
+            return Ok((state.clone(), transition.then(|| DMatrix::identity(n, n))));
         }
-        let mut y0 = DVector::zeros(n + n * n + 1);
+        let mut y0 = DVector::zeros(n + m + 1);
         y0.rows_mut(0, n).copy_from(state);
-        for k in 0..n {
-            y0[n + k * n + k] = 1.0;
+        if transition {
+            for k in 0..n {
+                y0[n + k * n + k] = 1.0;
+            }
         }
         let failed = Rc::new(Cell::new(None));
         let system = Variational {
             model: self,
             t_a,
+            transition,
             failed: Rc::clone(&failed),
         };
         let mut solver = Dop853::from_param(
@@ -380,10 +421,10 @@ impl Dynamics for NonlinearDynamics {
             }
             _ => return Err(non_finite_field(t_a + reached)),
         };
-        Ok(Propagation {
-            state: y.rows(0, n).into_owned(),
-            transition: DMatrix::from_column_slice(n, n, &y.as_slice()[n..n + n * n]),
-        })
+        Ok((
+            y.rows(0, n).into_owned(),
+            transition.then(|| DMatrix::from_column_slice(n, n, &y.as_slice()[n..n + m])),
+        ))
     }
 }
 
