@@ -294,22 +294,12 @@ impl LinearKalmanFilter {
         self.model.b.as_ref()
     }
 
-    /// Replaces the estimate `x`, `P` (checked as the prior).
+    /// Replaces the estimate `x`, `P` ([`KalmanFilter::set_estimate`]'s checks: `x` finite,
+    /// `P` a finite symmetric positive semidefinite covariance). On an error the filter is
+    /// unchanged.
     pub fn set_estimate(&mut self, x: DVector<f64>, p: DMatrix<f64>) -> Result<(), Error> {
-        let n = self.dimension();
-        if x.len() != n || x.iter().any(|v| !v.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: Param::State,
-                value: format!("{:?}", x.as_slice()),
-                reason: format!("must be {n} finite numbers"),
-            });
-        }
-        check_covariance(&p, n, Param::StateCovarianceP)?;
         let time = self.filter.time();
-        let mut filter = self.filter.clone();
-        filter.set_estimate(x, p, time)?;
-        self.filter = filter;
-        Ok(())
+        self.filter.set_estimate(x, p, time)
     }
 
     /// Replaces the constant `F`, `H`, `Q`, `R` or `B` (each `None` kept), all checked first.

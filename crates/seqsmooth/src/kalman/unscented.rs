@@ -275,6 +275,50 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
         self.time
     }
 
+    /// Replaces the estimate: `state` and `covariance` at `time`, checked by
+    /// [`check_estimate`](super::noise::check_estimate) and positive definite (the sigma
+    /// points are drawn from its Cholesky factor), the time finite. On an error the filter is
+    /// unchanged.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::UnscentedKalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = UnscentedKalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::zeros(1), DMatrix::identity(1, 1), 0.0).unwrap();
+    /// f.set_estimate(DVector::from_vec(vec![2.0]), DMatrix::from_element(1, 1, 4.0), 1.0).unwrap();
+    /// assert_eq!((f.state()[0], f.std_devs()[0], f.time()), (2.0, 2.0, 1.0));
+    /// // Singular: no sigma points; refused, the filter unchanged.
+    /// assert!(f.set_estimate(DVector::zeros(1), DMatrix::zeros(1, 1), 1.0).is_err());
+    /// assert_eq!(f.state()[0], 2.0);
+    /// ```
+    pub fn set_estimate(
+        &mut self,
+        state: DVector<f64>,
+        covariance: DMatrix<f64>,
+        time: f64,
+    ) -> Result<(), Error> {
+        super::noise::check_estimate(&state, &covariance, self.state.len())?;
+        if !time.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: time,
+            });
+        }
+        if Cholesky::new(covariance.clone()).is_none() {
+            return Err(Error::InvalidParameter {
+                name: Param::StateCovarianceP,
+                value: format!("{covariance:?}"),
+                reason: "must be positive definite (the unscented filter draws its sigma points \
+                         from its Cholesky factor)"
+                    .into(),
+            });
+        }
+        (self.state, self.covariance, self.time) = (state, covariance, time);
+        Ok(())
+    }
+
     /// Carries the estimate to `t` (forwards or backwards) through the sigma points
     /// (Wan and van der Merwe (18)-(20)). On an error the filter is unchanged.
     ///
