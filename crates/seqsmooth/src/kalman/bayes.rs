@@ -254,13 +254,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
         noise: P,
     ) -> Result<Self, Error> {
         let n = self.dynamics.dimension();
-        if noise.dimension() != n {
-            return Err(Error::InvalidParameter {
-                name: Param::ProcessNoise,
-                value: format!("for {} states", noise.dimension()),
-                reason: format!("the dynamics have {n} states"),
-            });
-        }
+        super::noise::check_noise_dimension(&noise, n)?;
         if self.fading.is_some() {
             return Err(noise_with_fading());
         }

@@ -377,3 +377,33 @@ pub fn check_estimate(
     }
     check_covariance(covariance, n, Param::StateCovarianceP)
 }
+
+/// [`check_estimate`] and a finite `time`: what a filter's `set_estimate(state, covariance,
+/// time)` checks.
+pub(crate) fn check_estimate_at(
+    state: &DVector<f64>,
+    covariance: &DMatrix<f64>,
+    n: usize,
+    time: f64,
+) -> Result<(), Error> {
+    check_estimate(state, covariance, n)?;
+    if !time.is_finite() {
+        return Err(Error::NonFinite {
+            what: "time",
+            value: time,
+        });
+    }
+    Ok(())
+}
+
+/// Refuses a driving noise of other than the dynamics' `n` states, naming it.
+pub(crate) fn check_noise_dimension(noise: &dyn ProcessNoise, n: usize) -> Result<(), Error> {
+    if noise.dimension() != n {
+        return Err(Error::InvalidParameter {
+            name: Param::ProcessNoise,
+            value: format!("for {} states", noise.dimension()),
+            reason: format!("the dynamics have {n} states"),
+        });
+    }
+    Ok(())
+}

@@ -127,15 +127,7 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
             covariance.clone(),
             time,
         )?;
-        if Cholesky::new(covariance.clone()).is_none() {
-            return Err(Error::InvalidParameter {
-                name: Param::PriorCovariance,
-                value: format!("{covariance:?}"),
-                reason: "must be positive definite (the unscented filter draws its sigma points \
-                         from its Cholesky factor)"
-                    .into(),
-            });
-        }
+        check_positive_definite(&covariance, Param::PriorCovariance)?;
         let n = state.len();
         let points = SigmaPoints::default();
         let weights = points.weights(n)?;
@@ -189,13 +181,7 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
         noise: P,
     ) -> Result<Self, Error> {
         let n = self.state.len();
-        if noise.dimension() != n {
-            return Err(Error::InvalidParameter {
-                name: Param::ProcessNoise,
-                value: format!("for {} states", noise.dimension()),
-                reason: format!("the dynamics have {n} states"),
-            });
-        }
+        super::noise::check_noise_dimension(&noise, n)?;
         self.noise = Some(Arc::new(noise));
         Ok(self)
     }
@@ -299,22 +285,8 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
         covariance: DMatrix<f64>,
         time: f64,
     ) -> Result<(), Error> {
-        super::noise::check_estimate(&state, &covariance, self.state.len())?;
-        if !time.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: time,
-            });
-        }
-        if Cholesky::new(covariance.clone()).is_none() {
-            return Err(Error::InvalidParameter {
-                name: Param::StateCovarianceP,
-                value: format!("{covariance:?}"),
-                reason: "must be positive definite (the unscented filter draws its sigma points \
-                         from its Cholesky factor)"
-                    .into(),
-            });
-        }
+        super::noise::check_estimate_at(&state, &covariance, self.state.len(), time)?;
+        check_positive_definite(&covariance, Param::StateCovarianceP)?;
         (self.state, self.covariance, self.time) = (state, covariance, time);
         Ok(())
     }
@@ -590,4 +562,19 @@ fn finite(values: &[f64], what: &'static str) -> Result<(), Error> {
         Some(&value) => Err(Error::NonFinite { what, value }),
         None => Ok(()),
     }
+}
+
+/// Refuses a covariance without a Cholesky factor (not positive definite), naming it: the
+/// unscented filter draws its sigma points from that factor.
+fn check_positive_definite(covariance: &DMatrix<f64>, name: Param) -> Result<(), Error> {
+    if Cholesky::new(covariance.clone()).is_none() {
+        return Err(Error::InvalidParameter {
+            name,
+            value: format!("{covariance:?}"),
+            reason: "must be positive definite (the unscented filter draws its sigma points \
+                     from its Cholesky factor)"
+                .into(),
+        });
+    }
+    Ok(())
 }

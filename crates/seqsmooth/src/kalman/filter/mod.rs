@@ -288,13 +288,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         covariance: DMatrix<f64>,
         time: f64,
     ) -> Result<(), Error> {
-        super::noise::check_estimate(&state, &covariance, self.state.len())?;
-        if !time.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: time,
-            });
-        }
+        super::noise::check_estimate_at(&state, &covariance, self.state.len(), time)?;
         if let Some(f) = &mut self.fading {
             f.weight.copy_from(&covariance);
             f.last_update = time;
@@ -495,13 +489,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// ```
     pub fn set_process_noise<P: ProcessNoise + 'static>(&mut self, noise: P) -> Result<(), Error> {
         let n = self.dynamics.dimension();
-        if noise.dimension() != n {
-            return Err(Error::InvalidParameter {
-                name: Param::ProcessNoise,
-                value: format!("for {} states", noise.dimension()),
-                reason: format!("the dynamics have {n} states"),
-            });
-        }
+        super::noise::check_noise_dimension(&noise, n)?;
         self.noise = Some(Arc::new(noise));
         Ok(())
     }

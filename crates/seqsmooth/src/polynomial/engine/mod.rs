@@ -82,7 +82,7 @@ impl EngineState {
     }
 
     /// Whether the samples so far (with a prior, none) may determine a fit of degree `m`.
-    fn enough_samples(&self, m: usize) -> bool {
+    pub(crate) fn enough_samples(&self, m: usize) -> bool {
         self.samples() > m as u64 || self.prior_time().is_some()
     }
 
@@ -482,6 +482,9 @@ macro_rules! impl_polynomial_filter {
             }
             fn last_time(&self) -> Option<f64> {
                 (self.core.samples() > 0).then(|| self.core.last_time())
+            }
+            fn is_determined(&self) -> bool {
+                self.core.enough_samples(self.m)
             }
         }
     };
