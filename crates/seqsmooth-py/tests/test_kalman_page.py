@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import re
 
-from conftest import ROOT
 from test_guide import blocks, run_page
+
+from conftest import ROOT
 
 PAGE = ROOT / "docs" / "kalman.md"
 PICTURE = re.compile(r"!\[[^\]]*\]\(images/(kalman-[\w-]+\.(?:svg|png))\)")

@@ -241,3 +241,37 @@ def test_a_prior_is_refused_where_it_cannot_be_held():
     assert f.estimate_at(5.0).derivatives.tolist() == [0.0, 0.0]
     with pytest.raises(InvalidInputError, match="previous time 5"):
         f.update(4.0, 1.0)
+
+
+def test_ten_thousand_random_bad_estimates_are_refused_or_taken_never_a_panic():
+    """10⁴ seeded random states and covariances (NaN, infinities, wrong shapes, asymmetric,
+    indefinite, singular, huge, tiny) set on every class: each is taken (and then reads back
+    as set) or refused with a ``SeqsmoothError`` leaving the filter as it was."""
+    rng = np.random.default_rng(2026)
+    specials = [np.nan, np.inf, -np.inf, 0.0, -1.0, 1e300, 1e-300]
+    made = filters()
+    taken = refused = 0
+    for k in range(10_000):
+        name = list(made)[k % len(made)]
+        f = made[name]
+        before = (f.state.copy(), f.covariance.copy())
+        shape = rng.choice([1, 2, 2, 2, 3])
+        value = rng.standard_normal((shape, shape) if rng.random() < 0.7 else (shape,))
+        if rng.random() < 0.5:
+            value.flat[rng.integers(value.size)] = rng.choice(specials)
+        if value.ndim == 2 and rng.random() < 0.5:
+            with np.errstate(over="ignore", invalid="ignore"):
+                value = value @ value.T  # symmetric, often positive definite
+        attribute = "covariance" if value.ndim == 2 or rng.random() < 0.3 else "state"
+        try:
+            setattr(f, attribute, value)
+        except ss.SeqsmoothError:
+            refused += 1
+            np.testing.assert_array_equal(f.state, before[0])
+            np.testing.assert_array_equal(f.covariance, before[1])
+        else:
+            taken += 1
+            got = getattr(f, attribute)
+            assert np.isfinite(got).all()
+    print(f"{taken} taken, {refused} refused")
+    assert taken > 500 and refused > 5000, (taken, refused)
