@@ -72,13 +72,19 @@ def test_blocks_run(tmp_path, monkeypatch):
     run_page(PAGE, tmp_path, monkeypatch)
 
 
-def test_pictures_have_their_commands():
-    text = PAGE.read_text()
-    shown = PICTURE.findall(text)
-    assert len(shown) >= 2, "the guide shows fewer than two pictures"
+def check_pictures_shown(page, picture):
+    """Every picture `page` shows (the names `picture` matches, two at least) is made by one
+    of its shell blocks and stored, under the size bound."""
+    text = page.read_text()
+    shown = picture.findall(text)
+    assert len(shown) >= 2, f"{page.name} shows fewer than two pictures"
     commands = "\n".join(code for lang, _, code in blocks(text) if lang == "sh")
     for name in shown:
-        assert f"docs/images/{name}" in commands, f"no command in the guide makes {name}"
+        assert f"docs/images/{name}" in commands, f"no command in {page.name} makes {name}"
         stored = ROOT / "docs" / "images" / name
         assert stored.exists(), f"docs/images/{name} is missing"
         assert stored.stat().st_size < MAX_PICTURE_BYTES, f"{name} is too large"
+
+
+def test_pictures_have_their_commands():
+    check_pictures_shown(PAGE, PICTURE)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import re
 
-from test_guide import blocks, run_page
+from test_guide import check_pictures_shown, run_page
 
 from conftest import ROOT
 
@@ -21,13 +21,7 @@ def test_blocks_run(tmp_path, monkeypatch):
 
 
 def test_pictures_have_their_commands():
-    text = PAGE.read_text()
-    shown = PICTURE.findall(text)
-    assert len(shown) >= 2, "the page shows fewer than two pictures"
-    commands = "\n".join(code for lang, _, code in blocks(text) if lang == "sh")
-    for name in shown:
-        assert f"docs/images/{name}" in commands, f"no command on the page makes {name}"
-        assert (ROOT / "docs" / "images" / name).exists(), f"docs/images/{name} is missing"
+    check_pictures_shown(PAGE, PICTURE)
 
 
 def test_the_table_names_what_exists():

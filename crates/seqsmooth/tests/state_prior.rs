@@ -468,7 +468,7 @@ fn driving_noise_and_fading_memory_are_refused_together() {
         .clone()
         .with_fading(fading)
         .unwrap()
-        .with_process_noise(noise.clone());
+        .with_process_noise(noise);
     assert!(matches!(
         e,
         Err(Error::InvalidParameter {

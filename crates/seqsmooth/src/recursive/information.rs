@@ -262,11 +262,11 @@ impl InformationFilter {
         // `TriangularFactor::from_r` cannot hold).
         let mut info = TriangularFactor::new(n);
         let mut row = vec![0.0; n];
-        for i in 0..n {
+        for (i, &d) in d_new.iter().enumerate() {
             row.iter_mut()
                 .zip(r_new.row(i).iter())
                 .for_each(|(a, b)| *a = *b);
-            info.add_row(&row, d_new[i], 1.0);
+            info.add_row(&row, d, 1.0);
         }
         self.info = info;
     }
