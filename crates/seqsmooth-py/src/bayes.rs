@@ -136,7 +136,7 @@ impl PyBayesFilter {
     }
 
     /// Sets the estimate (state only; the covariance kept): the information becomes that
-    /// of the estimate as a prior (10.3.1). Once determined; before, ``set_estimate``.
+    /// of the estimate as a prior (10.3.8). Once determined; before, ``set_estimate``.
     #[setter]
     fn set_state(&mut self, x: &Bound<'_, PyAny>) -> PyResult<()> {
         let p = self.filter.covariance().ok_or_else(undetermined)?;
@@ -152,7 +152,7 @@ impl PyBayesFilter {
     }
 
     /// Replaces the information by that of the estimate ``x`` with covariance ``P`` at the
-    /// filter's time, as a prior ((10.3.1); the information before forgotten): ``x`` finite,
+    /// filter's time, as a prior ((10.3.8); the information before forgotten): ``x`` finite,
     /// ``P`` finite, symmetric and positive definite (the filter holds its inverse), checked by
     /// the library — a ``ParameterError`` naming the state or ``P`` otherwise, the filter
     /// unchanged. With fading memory the discount counts from now.

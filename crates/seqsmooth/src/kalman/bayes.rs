@@ -172,7 +172,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     }
 
     /// Replaces the information by that of the estimate `state` with `covariance` at the
-    /// current time, as a prior ((10.3.1): `(S_{n,n})⁻¹` from it, the information before
+    /// current time, as a prior ((10.3.8): `(S_{n,n})⁻¹` from it, the information before
     /// forgotten), checked by [`check_estimate`] and positive definite (the information form
     /// needs `S⁻¹`); with fading memory the discount counts from now (§14.5). On an error the
     /// filter is unchanged.

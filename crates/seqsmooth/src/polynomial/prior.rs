@@ -2,13 +2,14 @@
 //! `x = (x, x', …, x^(m))` at a time `t₀` with their covariance `P`, so that the filter starts
 //! from that information instead of from none.
 //!
-//! With a prior the expanding-memory filter is the Bayes filter of Morrison ch. 9/10: its
-//! estimate minimises `(X − x)ᵀ P⁻¹ (X − x) + Σ_k (y_k − p(t_k))²/σ²` ((9.1.1) with the prior of
-//! (10.2.40)-(10.2.44), `(S_{1,0})⁻¹ = P⁻¹` in (10.3.1)), the prior entering as `m + 1`
-//! whitened pseudo-observations `L⁻¹ X ≈ L⁻¹ x` (`P = L Lᵀ`). The fading-memory filter
-//! discounts the prior like a sample taken at `t₀` (the criterion (13.1.4) with the prior's
-//! term weighted `θ^((t_n − t₀)/τ)`, the fading-memory Bayes filter (14.4.26)-(14.4.32)); its
-//! reported covariance stays the true one (14.3.11), the prior counted as one more whitened
+//! With a prior the expanding-memory filter is the Bayes filter of Morrison ch. 10: its
+//! estimate minimises `(X − x)ᵀ P⁻¹ (X − x) + Σ_k (y_k − p(t_k))²/σ²`, (10.3.8)
+//! `X* = [S⁻¹ + TᵀR⁻¹T]⁻¹ [TᵀR⁻¹Y + S⁻¹x]` with `S = P`, carried on by (10.2.40)-(10.2.44);
+//! the prior enters as `m + 1` whitened pseudo-observations `L⁻¹ X ≈ L⁻¹ x` (`P = L Lᵀ`). The
+//! fading-memory filter discounts the prior like a sample taken at `t₀` (the criterion
+//! (13.2.1), or (14.2.10)-(14.2.11) per time, with the prior's term weighted
+//! `θ^((t_n − t₀)/τ)`: the fading-memory Bayes filter (14.4.26)-(14.4.32)); its reported
+//! covariance stays the true one (14.3.11), the prior counted as one more whitened
 //! observation. The samples carry the noise `σ`, so the prior's weight against them needs it
 //! (`σ²P⁻¹` in the engine's units): a prior needs the filter's noise σ. The gain engine's
 //! fixed gains (Tables 9.1, 13.1) assume no prior and refuse one.

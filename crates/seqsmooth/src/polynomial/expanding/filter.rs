@@ -84,7 +84,7 @@ impl ExpandingMemory {
     }
 
     /// Starts from `prior` ([`Prior`]: the derivatives at `t₀` and their covariance) instead
-    /// of from no information: the Bayes filter (Morrison ch. 10, (10.3.1) with
+    /// of from no information: the Bayes filter (Morrison ch. 10, (10.3.8) with
     /// `(S_{1,0})⁻¹ = P⁻¹`), whose estimate is the least-squares fit with the prior as `m + 1`
     /// more observations; the first sample may be at `t₀`. Needs the exact engine and the
     /// noise σ ([`Self::with_noise_sigma`], first: it weighs the prior against the samples),
