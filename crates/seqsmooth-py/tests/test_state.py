@@ -178,7 +178,7 @@ def wls(t, y, sigma, t0, x0, p0, w0=1.0, w=None):
 
 
 @pytest.mark.parametrize("degree", [0, 1, 2, 3])
-@pytest.mark.parametrize("fading", [False, True])
+@pytest.mark.parametrize("fading", [None, "per time", "per update"])
 def test_a_prior_is_the_weighted_least_squares_fit(rng, degree, fading):
     sigma, theta, tau = 0.6, 0.85, 2.0
     n = degree + 1
@@ -189,15 +189,23 @@ def test_a_prior_is_the_weighted_least_squares_fit(rng, degree, fading):
     t = t0 + np.cumsum(rng.uniform(0.1, 1.2, 25))
     t[0] = t0  # the first sample may be at the prior's time
     y = x0[0] + rng.standard_normal(25)
-    if fading:
-        f = ss.FadingMemory(degree, theta=theta, tau=tau, sigma=sigma, x0=x0, P0=p0, t0=t0)
+    prior = {"sigma": sigma, "x0": x0, "P0": p0, "t0": t0}
+    if fading == "per time":
+        f = ss.FadingMemory(degree, theta=theta, tau=tau, **prior)
+    elif fading == "per update":
+        f = ss.FadingMemory(degree, theta_per_update=theta, **prior)
     else:
-        f = ss.ExpandingMemory(degree, sigma=sigma, x0=x0, P0=p0, t0=t0)
+        f = ss.ExpandingMemory(degree, **prior)
     d, s = f.update_many(t, y, return_sigma=True)
     for k in range(len(t)):
         tk = t[: k + 1]
-        weights = theta ** ((tk[-1] - tk) / tau) if fading else None
-        w0 = theta ** ((tk[-1] - t0) / tau) if fading else 1.0
+        if fading == "per time":
+            weights, w0 = theta ** ((tk[-1] - tk) / tau), theta ** ((tk[-1] - t0) / tau)
+        elif fading == "per update":
+            # The prior, then each sample: discounted once per sample after it.
+            weights, w0 = theta ** np.arange(k, -1, -1.0), theta ** (k + 1)
+        else:
+            weights, w0 = None, 1.0
         x, cov = wls(tk, y[: k + 1], sigma, t0, x0, p0, w0, weights)
         sd = np.sqrt(np.diag(cov))
         assert np.max(np.abs(d[k] - x) / sd) < 1e-10
