@@ -529,8 +529,8 @@ impl LinearKalmanFilter {
             let s = step(k);
             self.check(&s, true).map_err(in_batch(k))?;
             let (x0, p0) = &filtered[k - 1];
-            check_covariance(p0, n, Param::StateCovarianceP).map_err(in_batch(k - 1))?;
             let mut filter = self.filter.clone();
+            // Checked there (check_estimate: P named, the step its index).
             filter
                 .set_estimate(x0.clone(), p0.clone(), 0.0)
                 .map_err(in_batch(k - 1))?;
