@@ -6,11 +6,13 @@
 use crate::arrays::matrix;
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{
-    before, discount_from, measurement, measurements, observation_from, out_of_order, square,
+    before, covariance_from, discount_from, measurement, measurements, observation_from,
+    out_of_order, square, state_from,
 };
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
+use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::BayesFilter;
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::{LinearObservation, Observation};
@@ -41,6 +43,15 @@ type Filter = BayesFilter<PolynomialDynamics, LinearObservation>;
 /// theta_per_update : float, optional
 ///     Fading memory with the discount in (0, 1) per update (what ``theta`` alone meant
 ///     before; ``beta`` per unit of time is now ``theta``, ``tau=1.0``).
+/// q : float
+///     The spectral density of the white noise driving the highest derivative of each axis
+///     (value²/time^(2m+1), as ``KalmanFilter``'s ``q``); 0 for none. Each prediction adds
+///     ``Q`` over the step (ch. 15) in information form: the filter is then the Kalman filter
+///     with the same ``q`` (which it equals to rounding), and may still start from no
+///     information. Not with fading memory.
+///
+/// ``state`` and ``covariance`` are settable once determined; ``set_estimate(x, P)`` sets
+/// both at any time (``P`` positive definite: the filter holds its inverse).
 #[pyclass(name = "BayesFilter", module = "seqsmooth")]
 pub struct PyBayesFilter {
     filter: Filter,
@@ -54,7 +65,7 @@ pub struct PyBayesFilter {
 impl PyBayesFilter {
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
-    #[pyo3(signature = (degree, t0 = 0.0, axes = 1, observation = None, x0 = None, P0 = None, theta = None, tau = None, theta_per_update = None, beta = None))]
+    #[pyo3(signature = (degree, t0 = 0.0, axes = 1, observation = None, x0 = None, P0 = None, theta = None, tau = None, theta_per_update = None, beta = None, q = 0.0))]
     fn new(
         degree: usize,
         t0: f64,
@@ -66,6 +77,7 @@ impl PyBayesFilter {
         tau: Option<f64>,
         theta_per_update: Option<f64>,
         beta: Option<f64>,
+        q: f64,
     ) -> PyResult<Self> {
         // The library's polynomial model: its degree, axes and states.
         let n = seqsmooth::polynomial::check_model(degree, axes).py()?;
@@ -89,6 +101,11 @@ impl PyBayesFilter {
                     None,
                 ))
             }
+        }
+        if q != 0.0 {
+            filter = filter
+                .with_process_noise(WhiteNoiseDerivative::new(degree, axes, q).py()?)
+                .py()?;
         }
         Ok(Self {
             filter,
@@ -116,6 +133,33 @@ impl PyBayesFilter {
     #[getter]
     fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.filter.covariance().map(|c| square(py, &c)).transpose()
+    }
+
+    /// Sets the estimate (state only; the covariance kept): the information becomes that
+    /// of the estimate as a prior (10.3.8). Once determined; before, ``set_estimate``.
+    #[setter]
+    fn set_state(&mut self, x: &Bound<'_, PyAny>) -> PyResult<()> {
+        let p = self.filter.covariance().ok_or_else(undetermined)?;
+        self.filter.set_estimate(&state_from(x)?, &p).py()
+    }
+
+    /// Sets the covariance (the state kept), positive definite; once determined.
+    #[setter]
+    fn set_covariance(&mut self, p: &Bound<'_, PyAny>) -> PyResult<()> {
+        let x = self.filter.estimate().ok_or_else(undetermined)?;
+        let p = covariance_from(p, self.states)?;
+        self.filter.set_estimate(&x, &p).py()
+    }
+
+    /// Replaces the information by that of the estimate ``x`` with covariance ``P`` at the
+    /// filter's time, as a prior ((10.3.8); the information before forgotten): ``x`` finite,
+    /// ``P`` finite, symmetric and positive definite (the filter holds its inverse), checked by
+    /// the library — a ``ParameterError`` naming the state or ``P`` otherwise, the filter
+    /// unchanged. With fading memory the discount counts from now.
+    #[allow(non_snake_case)]
+    fn set_estimate(&mut self, x: &Bound<'_, PyAny>, P: &Bound<'_, PyAny>) -> PyResult<()> {
+        let p = covariance_from(P, self.states)?;
+        self.filter.set_estimate(&state_from(x)?, &p).py()
     }
 
     /// The 1σ of each state component, the square roots of ``covariance``'s diagonal;
@@ -214,4 +258,14 @@ impl PyBayesFilter {
             self.is_determined()
         )
     }
+}
+
+/// The refusal of a partial estimate (state or covariance alone) before the filter is
+/// determined.
+fn undetermined() -> PyErr {
+    raise(
+        Kind::NotDetermined,
+        "the filter is not determined yet: set both with set_estimate(x, P)",
+        None,
+    )
 }

@@ -645,16 +645,34 @@ impl PyExtendedKalmanFilter {
         })
     }
 
-    /// The current estimate ``X``.
+    /// The current estimate ``X``; settable (``n`` finite numbers, checked by the library;
+    /// on an error the filter is unchanged).
     #[getter]
     fn state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_slice(py, self.filter.state().as_slice())
     }
 
-    /// The covariance of ``X``'s errors.
+    #[setter]
+    fn set_state(&mut self, x: &Bound<'_, PyAny>) -> PyResult<()> {
+        let (p, t) = (self.filter.covariance().clone(), self.filter.time());
+        self.filter
+            .set_estimate(crate::kalman::state_from(x)?, p, t)
+            .py()
+    }
+
+    /// The covariance of ``X``'s errors; settable (finite, symmetric, positive
+    /// semidefinite, checked by the library: a ``ParameterError`` naming ``P`` otherwise,
+    /// the filter unchanged).
     #[getter]
     fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         square(py, self.filter.covariance())
+    }
+
+    #[setter]
+    fn set_covariance(&mut self, p: &Bound<'_, PyAny>) -> PyResult<()> {
+        let (x, t) = (self.filter.state().clone(), self.filter.time());
+        let p = crate::kalman::covariance_from(p, x.len())?;
+        self.filter.set_estimate(x, p, t).py()
     }
 
     /// The 1σ of each state component, the square roots of ``covariance``'s diagonal.

@@ -100,6 +100,27 @@ pub(crate) fn square_from(obj: &Bound<'_, PyAny>, n: usize, name: &str) -> PyRes
     }
 }
 
+/// A state a setter hands in (`n` values: the library checks the length and that they are
+/// finite).
+pub(crate) fn state_from(obj: &Bound<'_, PyAny>) -> PyResult<DVector<f64>> {
+    Ok(DVector::from_column_slice(series(obj, "state")?.as_slice()))
+}
+
+/// A covariance a setter hands in: a number (times the identity), `n` variances (the
+/// diagonal) or a matrix of any shape, which the library checks (`n × n`, finite, symmetric,
+/// positive semidefinite; a refusal naming `P`).
+pub(crate) fn covariance_from(obj: &Bound<'_, PyAny>, n: usize) -> PyResult<DMatrix<f64>> {
+    if let Ok(v) = obj.extract::<f64>() {
+        return Ok(DMatrix::from_diagonal_element(n, n, v));
+    }
+    let (values, rows, cols) = table(obj, "covariance")?;
+    let v = values.as_slice();
+    Ok(match (rows, cols) {
+        (r, 1) if r == n && n > 1 => DMatrix::from_diagonal(&DVector::from_column_slice(v)),
+        (r, c) => DMatrix::from_row_slice(r, c, v),
+    })
+}
+
 /// The measurement noise of `p` components from `R`: a variance for every component, `p`
 /// variances, or `p × p`.
 pub(crate) fn noise(obj: &Bound<'_, PyAny>, p: usize) -> PyResult<NoiseCovariance> {
@@ -337,16 +358,33 @@ impl PyKalmanFilter {
         Ok(Self { filter, components })
     }
 
-    /// The current estimate ``X``.
+    /// The current estimate ``X``; settable (``n`` finite numbers, checked by the library;
+    /// on an error the filter is unchanged).
     #[getter]
     fn state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_slice(py, self.filter.state().as_slice())
     }
 
-    /// The covariance of ``X``'s errors (with fading memory, the true covariance).
+    #[setter]
+    fn set_state(&mut self, x: &Bound<'_, PyAny>) -> PyResult<()> {
+        let (p, t) = (self.filter.covariance().clone(), self.filter.time());
+        self.filter.set_estimate(state_from(x)?, p, t).py()
+    }
+
+    /// The covariance of ``X``'s errors (with fading memory, the true covariance); settable
+    /// (finite, symmetric, positive semidefinite, checked by the library: a ``ParameterError``
+    /// naming ``P`` otherwise, the filter unchanged; with fading memory the recursion's own
+    /// matrix restarts at it, §14.5).
     #[getter]
     fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         square(py, self.filter.covariance())
+    }
+
+    #[setter]
+    fn set_covariance(&mut self, p: &Bound<'_, PyAny>) -> PyResult<()> {
+        let (x, t) = (self.filter.state().clone(), self.filter.time());
+        let p = covariance_from(p, x.len())?;
+        self.filter.set_estimate(x, p, t).py()
     }
 
     /// The 1σ of each state component, the square roots of ``covariance``'s diagonal.

@@ -388,16 +388,26 @@ impl PyLinearKalmanFilter {
         self.inner.set_estimate(x, p).py()
     }
 
-    /// ``x`` (the name of the other filters).
+    /// ``x`` (the name of the other filters); settable as ``x``.
     #[getter]
     fn state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.x(py)
     }
 
-    /// ``P`` (the name of the other filters).
+    #[setter]
+    fn set_state(&mut self, x: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.set_x(x)
+    }
+
+    /// ``P`` (the name of the other filters); settable as ``P``.
     #[getter]
     fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.p(py)
+    }
+
+    #[setter]
+    fn set_covariance(&mut self, p: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.set_p(p)
     }
 
     /// The 1σ of each state component, ``sqrt(diag(P))``.

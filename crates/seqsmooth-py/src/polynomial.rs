@@ -12,6 +12,7 @@ use pyo3::prelude::*;
 use pyo3::types::PySlice;
 use seqsmooth::discount::Discount;
 use seqsmooth::polynomial::fixed::FixedEngine;
+use seqsmooth::polynomial::prior::Prior;
 use seqsmooth::polynomial::rows::RowLayout;
 use seqsmooth::polynomial::spec::{AnyFilter, FilterKind, FilterSpec};
 use seqsmooth::{Engine, PolynomialFilter, PolynomialState};
@@ -269,6 +270,32 @@ pub(crate) fn fixed_engine(name: &str) -> PyResult<FixedEngine> {
     }
 }
 
+/// The prior of an expanding or fading memory from ``x0`` (the ``degree + 1`` derivatives
+/// at ``t0``) and ``P0`` (their covariance: a number, the diagonal or the matrix), both or
+/// neither; checked by the library (``polynomial::prior::Prior``).
+#[allow(non_snake_case)]
+fn prior_from(
+    x0: Option<&Bound<'_, PyAny>>,
+    P0: Option<&Bound<'_, PyAny>>,
+    t0: f64,
+    degree: usize,
+) -> PyResult<Option<Prior>> {
+    match (x0, P0) {
+        (None, None) => Ok(None),
+        (Some(x0), Some(p0)) => {
+            let n = degree + 1;
+            let x = crate::arrays::series(x0, "x0")?.as_slice().to_vec();
+            let p = crate::kalman::square_from(p0, n, "P0")?;
+            Prior::new(t0, x, p).py().map(Some)
+        }
+        _ => Err(raise(
+            Kind::Parameter,
+            "x0 and P0 go together: give both for a prior, or neither",
+            None,
+        )),
+    }
+}
+
 /// The expanding-memory polynomial filter of degree ``degree`` (Morrison ch. 9; Reyneke et
 /// al. 2012 eqs. 20-27 on irregular times): the least-squares polynomial through every
 /// sample so far, updated recursively.
@@ -282,17 +309,35 @@ pub(crate) fn fixed_engine(name: &str) -> PyResult<FixedEngine> {
 ///     fixed-gain recursion (9.3.x), exact on evenly spaced times only.
 /// sigma : float, optional
 ///     The white noise's standard deviation: the estimates then carry their covariance.
+/// x0, P0 : array_like, optional
+///     A prior (keywords): the ``degree + 1`` derivatives ``x, x', …`` at ``t0`` and their
+///     covariance (a number, the diagonal or the matrix; positive definite), both or neither.
+///     The filter starts from it instead of from no information: the Bayes filter (ch. 10),
+///     whose estimate is the least-squares fit with the prior as ``degree + 1`` more
+///     observations. Needs ``sigma`` (the prior is weighed against the samples by it) and
+///     the exact engine; the first sample may be at ``t0``.
+/// t0 : float
+///     The prior's time (default 0).
 #[pyclass(name = "ExpandingMemory", module = "seqsmooth", extends = PyPolynomialFilter)]
 pub struct PyExpandingMemory;
 
 #[pymethods]
 impl PyExpandingMemory {
     #[new]
-    #[pyo3(signature = (degree, engine = "exact", sigma = None))]
-    fn new(degree: usize, engine: &str, sigma: Option<f64>) -> PyResult<PyClassInitializer<Self>> {
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (degree, engine = "exact", sigma = None, *, x0 = None, P0 = None, t0 = 0.0))]
+    fn new(
+        degree: usize,
+        engine: &str,
+        sigma: Option<f64>,
+        x0: Option<&Bound<'_, PyAny>>,
+        P0: Option<&Bound<'_, PyAny>>,
+        t0: f64,
+    ) -> PyResult<PyClassInitializer<Self>> {
         let spec = FilterSpec {
             engine: self::engine(engine)?,
             sigma,
+            prior: prior_from(x0, P0, t0, degree)?,
             ..FilterSpec::new(FilterKind::Expanding, degree)
         };
         Ok(PyPolynomialFilter::new(spec)?.add_subclass(Self))
@@ -319,14 +364,25 @@ impl PyExpandingMemory {
 /// theta_per_update : float, optional
 ///     The discount per sample whatever the spacing, ``0 < theta_per_update < 1``, instead of
 ///     ``theta``: weight ``theta_per_update**(n − k)`` (the same names as ``KalmanFilter``'s).
+/// x0, P0 : array_like, optional
+///     A prior (keywords): the ``degree + 1`` derivatives ``x, x', …`` at ``t0`` and their
+///     covariance (a number, the diagonal or the matrix; positive definite), both or neither.
+///     The filter starts from it instead of from no information: the Bayes filter (ch. 10),
+///     whose estimate is the least-squares fit with the prior as ``degree + 1`` more
+///     observations, discounted like a sample at ``t0`` ((14.4.26)-(14.4.32)). Needs
+///     ``sigma`` (the prior is weighed against the samples by it) and the exact engine; the
+///     first sample may be at ``t0``.
+/// t0 : float
+///     The prior's time (default 0).
 #[pyclass(name = "FadingMemory", module = "seqsmooth", extends = PyPolynomialFilter)]
 pub struct PyFadingMemory;
 
 #[pymethods]
 impl PyFadingMemory {
     #[new]
+    #[allow(non_snake_case, clippy::too_many_arguments)]
     #[pyo3(signature = (degree, theta = None, tau = None, engine = "exact", sigma = None,
-        theta_per_update = None))]
+        theta_per_update = None, *, x0 = None, P0 = None, t0 = 0.0))]
     fn new(
         degree: usize,
         theta: Option<f64>,
@@ -334,6 +390,9 @@ impl PyFadingMemory {
         engine: &str,
         sigma: Option<f64>,
         theta_per_update: Option<f64>,
+        x0: Option<&Bound<'_, PyAny>>,
+        P0: Option<&Bound<'_, PyAny>>,
+        t0: f64,
     ) -> PyResult<PyClassInitializer<Self>> {
         // `tau` defaults to 1 with `theta` (as it always did).
         let tau = tau.or(theta.map(|_| 1.0));
@@ -353,6 +412,7 @@ impl PyFadingMemory {
             theta_per_update,
             engine: self::engine(engine)?,
             sigma,
+            prior: prior_from(x0, P0, t0, degree)?,
             ..FilterSpec::new(FilterKind::Fading, degree)
         };
         Ok(PyPolynomialFilter::new(spec)?.add_subclass(Self))

@@ -249,16 +249,38 @@ impl PyUnscentedKalmanFilter {
         })
     }
 
-    /// The current estimate ``X``.
+    /// The current estimate ``X``; settable (``n`` finite numbers, checked by the library;
+    /// on an error the filter is unchanged).
     #[getter]
     fn state<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         each!(&self.model, f => PyArray1::from_slice(py, f.state().as_slice()))
     }
 
-    /// The covariance of ``X``'s errors.
+    #[setter]
+    fn set_state(&mut self, x: &Bound<'_, PyAny>) -> PyResult<()> {
+        let x = crate::kalman::state_from(x)?;
+        each!(&mut self.model, f => {
+            let (p, t) = (f.covariance().clone(), f.time());
+            f.set_estimate(x, p, t).py()
+        })
+    }
+
+    /// The covariance of ``X``'s errors; settable (finite, symmetric, positive definite:
+    /// the sigma points come from its Cholesky factor; checked by the library: a
+    /// ``ParameterError`` naming ``P`` otherwise, the filter unchanged).
     #[getter]
     fn covariance<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         each!(&self.model, f => square(py, f.covariance()))
+    }
+
+    #[setter]
+    fn set_covariance(&mut self, p: &Bound<'_, PyAny>) -> PyResult<()> {
+        let n = self.state_len();
+        let p = crate::kalman::covariance_from(p, n)?;
+        each!(&mut self.model, f => {
+            let (x, t) = (f.state().clone(), f.time());
+            f.set_estimate(x, p, t).py()
+        })
     }
 
     /// The 1σ of each state component, the square roots of ``covariance``'s diagonal.

@@ -25,11 +25,13 @@ def blocks(text: str):
         yield m.group(1), text.count("\n", 0, m.start()) + 2, m.group(2)
 
 
-def test_blocks_run(tmp_path, monkeypatch):
-    text = PAGE.read_text()
+def run_page(page, tmp_path, monkeypatch):
+    """Runs `page`'s blocks in order in a scratch directory (the Python blocks in one
+    namespace: a block may use an earlier one's names) and returns the pictures they made."""
+    text = page.read_text()
     found = list(blocks(text))
-    assert any(lang == "sh" for lang, _, _ in found), "the guide has no shell example"
-    assert any(lang != "sh" for lang, _, _ in found), "the guide has no Python example"
+    assert any(lang == "sh" for lang, _, _ in found), f"{page.name} has no shell example"
+    assert any(lang != "sh" for lang, _, _ in found), f"{page.name} has no Python example"
     bin_dir = tmp_path / "bin"
     bin_dir.mkdir()
     (bin_dir / "seqsmooth").symlink_to(cli_path())
@@ -37,6 +39,8 @@ def test_blocks_run(tmp_path, monkeypatch):
     (work / "docs" / "images").mkdir(parents=True)
     env = dict(os.environ, PATH=f"{bin_dir}{os.pathsep}{os.environ['PATH']}")
     monkeypatch.chdir(work)
+    scope = {"__name__": page.stem}
+    where = f"docs/{page.name}"
     for lang, line, code in found:
         if lang == "sh":
             run = subprocess.run(
@@ -46,11 +50,11 @@ def test_blocks_run(tmp_path, monkeypatch):
                 capture_output=True,
                 text=True,
             )
-            assert run.returncode == 0, f"docs/guide.md line {line}: {run.stderr}"
+            assert run.returncode == 0, f"{where} line {line}: {run.stderr}"
         else:
-            exec(compile(code, f"docs/guide.md:{line}", "exec"), {"__name__": "guide"})
+            exec(compile(code, f"{where}:{line}", "exec"), scope)
     made = sorted((work / "docs" / "images").iterdir())
-    assert made, "no shell block of the guide makes a picture"
+    assert made, f"no shell block of {where} makes a picture"
     for picture in made:
         size = picture.stat().st_size
         assert 0 < size < MAX_PICTURE_BYTES, f"{picture.name}: {size} bytes"
@@ -58,18 +62,29 @@ def test_blocks_run(tmp_path, monkeypatch):
         if os.environ.get("SEQSMOOTH_GUIDE_PICTURES") == "write":
             shutil.copyfile(picture, stored)
         assert stored.exists() and stored.read_bytes() == picture.read_bytes(), (
-            f"docs/images/{picture.name} is not what its command in docs/guide.md makes: "
+            f"docs/images/{picture.name} is not what its command in {where} makes: "
             "re-make it with SEQSMOOTH_GUIDE_PICTURES=write"
         )
+    return made
 
 
-def test_pictures_have_their_commands():
-    text = PAGE.read_text()
-    shown = PICTURE.findall(text)
-    assert len(shown) >= 2, "the guide shows fewer than two pictures"
+def test_blocks_run(tmp_path, monkeypatch):
+    run_page(PAGE, tmp_path, monkeypatch)
+
+
+def check_pictures_shown(page, picture):
+    """Every picture `page` shows (the names `picture` matches, two at least) is made by one
+    of its shell blocks and stored, under the size bound."""
+    text = page.read_text()
+    shown = picture.findall(text)
+    assert len(shown) >= 2, f"{page.name} shows fewer than two pictures"
     commands = "\n".join(code for lang, _, code in blocks(text) if lang == "sh")
     for name in shown:
-        assert f"docs/images/{name}" in commands, f"no command in the guide makes {name}"
+        assert f"docs/images/{name}" in commands, f"no command in {page.name} makes {name}"
         stored = ROOT / "docs" / "images" / name
         assert stored.exists(), f"docs/images/{name} is missing"
         assert stored.stat().st_size < MAX_PICTURE_BYTES, f"{name} is too large"
+
+
+def test_pictures_have_their_commands():
+    check_pictures_shown(PAGE, PICTURE)

@@ -20,15 +20,24 @@
 //! observation is linearised about the current estimate (it must exist). A perfect observation
 //! (zero variance) cannot be weighed in this form and is refused (§12.4 item 4: the Bayes
 //! filter fails visibly).
+//!
+//! With driving noise ([`BayesFilter::with_process_noise`], ch. 15) each prediction adds
+//! `Q(t_n, t_{n−1})` to the covariance the information stands for ((15.4.11), in the
+//! square-root information form of [`InformationFilter::diffuse`]): the estimator is then the
+//! Kalman filter's with the same `Q` (the Bayes and Kalman forms of one estimator, §12.2),
+//! and unlike it may start from no information. Driving noise and fading memory are not
+//! combined here (the true covariance (14.3.11) assumes none).
 
 use crate::discount::Discount;
 use crate::error::{Error, Param};
+use crate::kalman::noise::{check_estimate, ProcessNoise};
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::Measurement;
 use crate::model::measurement::NoiseCovariance;
 use crate::model::observation::Observation;
 use crate::recursive::InformationFilter;
 use nalgebra::{Cholesky, DMatrix, DVector};
+use std::sync::Arc;
 
 /// The largest variance inflation at which [`BayesFilter`] reports an estimate. Rounding costs
 /// the estimate and covariance about `0.1-1 ε` times the inflation of their σ (measured: 0.12
@@ -63,6 +72,8 @@ pub struct BayesFilter<D: Dynamics, O: Observation> {
     fading: Option<(Discount, f64)>,
     /// Whether there is information to discount (a prior or an update).
     informed: bool,
+    /// The driving noise added at each prediction (ch. 15), if any.
+    noise: Option<Arc<dyn ProcessNoise>>,
 }
 
 impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
@@ -107,6 +118,7 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
             time,
             fading: None,
             informed: false,
+            noise: None,
         })
     }
 
@@ -152,15 +164,54 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
                 value,
             });
         }
-        let refuse = || Error::InvalidParameter {
-            name: Param::PriorCovariance,
-            value: format!("{covariance:?}"),
-            reason: "must be symmetric positive definite".into(),
-        };
         if (covariance - covariance.transpose()).abs().max() > 1e-12 * covariance.abs().max() {
-            return Err(refuse());
+            return Err(not_positive_definite(Param::PriorCovariance, covariance));
         }
-        // The information S⁻¹ = L⁻ᵀ L⁻¹ (S = L Lᵀ); its factor R = L_Jᵀ with J = L_J L_Jᵀ.
+        self.inform(state, covariance, Param::PriorCovariance)?;
+        Ok(self)
+    }
+
+    /// Replaces the information by that of the estimate `state` with `covariance` at the
+    /// current time, as a prior ((10.3.8): `(S_{n,n})⁻¹` from it, the information before
+    /// forgotten), checked by [`check_estimate`] and positive definite (the information form
+    /// needs `S⁻¹`); with fading memory the discount counts from now (§14.5). On an error the
+    /// filter is unchanged.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::BayesFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = BayesFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1), 0.0).unwrap();
+    /// f.set_estimate(&DVector::from_vec(vec![3.0]), &DMatrix::from_element(1, 1, 4.0)).unwrap();
+    /// assert!((f.std_devs().unwrap()[0] - 2.0).abs() < 1e-15);
+    /// // Singular: no information form; refused, the filter unchanged.
+    /// assert!(f.set_estimate(&DVector::zeros(1), &DMatrix::zeros(1, 1)).is_err());
+    /// assert!((f.estimate().unwrap()[0] - 3.0).abs() < 1e-15);
+    /// ```
+    pub fn set_estimate(
+        &mut self,
+        state: &DVector<f64>,
+        covariance: &DMatrix<f64>,
+    ) -> Result<(), Error> {
+        check_estimate(state, covariance, self.dynamics.dimension())?;
+        self.inform(state, covariance, Param::StateCovarianceP)?;
+        if let Some((_, last)) = &mut self.fading {
+            *last = self.time;
+        }
+        Ok(())
+    }
+
+    /// The information of `state` with `covariance` (finite, symmetric) as the filter's:
+    /// `S⁻¹ = L⁻ᵀ L⁻¹` (`S = L Lᵀ`), its factor `R = L_Jᵀ` with `J = L_J L_Jᵀ`; a covariance
+    /// that is not positive definite is refused naming `name`, the filter unchanged.
+    fn inform(
+        &mut self,
+        state: &DVector<f64>,
+        covariance: &DMatrix<f64>,
+        name: Param,
+    ) -> Result<(), Error> {
+        let refuse = || not_positive_definite(name, covariance);
         let l = Cholesky::new(covariance.clone()).ok_or_else(refuse)?;
         let information = l.inverse();
         let information = (&information + information.transpose()) * 0.5;
@@ -168,11 +219,46 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
             .ok_or_else(refuse)?
             .l()
             .transpose();
-        self.info = InformationFilter::with_prior(state, &r);
+        let info = InformationFilter::with_prior(state, &r);
+        self.info = match self.fading {
+            Some(_) => info.with_true_covariance(),
+            None => info,
+        };
         self.informed = true;
+        Ok(())
+    }
+
+    /// With driving noise (ch. 15): `Q(t_n, t_{n−1})` ([`ProcessNoise`]) added at each
+    /// prediction, (15.4.11) in information form ([`InformationFilter::diffuse`]). Refused
+    /// with fading memory, and for other than the dynamics' states.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+    /// use seqsmooth::kalman::BayesFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = BayesFilter::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2), 0.0)
+    ///     .unwrap()
+    ///     .with_prior(&DVector::zeros(2), &DMatrix::identity(2, 2))
+    ///     .unwrap()
+    ///     .with_process_noise(WhiteNoiseDerivative::new(1, 1, 3.0).unwrap())
+    ///     .unwrap();
+    /// f.predict(1.0).unwrap();
+    /// // Φ S Φᵀ + Q: [[2, 1], [1, 1]] + 3 [[1/3, 1/2], [1/2, 1]].
+    /// let want = DMatrix::from_row_slice(2, 2, &[3.0, 2.5, 2.5, 4.0]);
+    /// assert!((f.covariance().unwrap() - want).amax() < 1e-14);
+    /// ```
+    pub fn with_process_noise<P: ProcessNoise + 'static>(
+        mut self,
+        noise: P,
+    ) -> Result<Self, Error> {
+        let n = self.dynamics.dimension();
+        super::noise::check_noise_dimension(&noise, n)?;
         if self.fading.is_some() {
-            self.info = self.info.with_true_covariance();
+            return Err(noise_with_fading());
         }
+        self.noise = Some(Arc::new(noise));
         Ok(self)
     }
 
@@ -201,6 +287,9 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
     /// assert!((f.information_covariance().unwrap()[(0, 0)] - 0.5).abs() < 1e-12); // 1 − θ
     /// ```
     pub fn with_fading(mut self, discount: Discount) -> Result<Self, Error> {
+        if self.noise.is_some() {
+            return Err(noise_with_fading());
+        }
         self.fading = Some((discount.checked()?, self.time));
         self.info = self.info.with_true_covariance();
         Ok(self)
@@ -332,7 +421,15 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
         // Φ(t_old, t) does not depend on the state (linear dynamics).
         self.dynamics
             .propagate_into(&DVector::zeros(n), t, self.time, &mut x, &mut back)?;
+        // The noise's square root `G` (`Q = G Gᵀ`), before anything changes.
+        let root = match &self.noise {
+            Some(noise) => Some(noise_root(&noise.covariance(self.time, t)?)?),
+            None => None,
+        };
         self.info.change_variables(&back);
+        if let Some(g) = root {
+            self.info.diffuse(&g);
+        }
         self.time = t;
         Ok(())
     }
@@ -455,6 +552,44 @@ impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
         }
         Ok(())
     }
+}
+
+/// The refusal of a covariance the information form cannot hold.
+fn not_positive_definite(name: Param, covariance: &DMatrix<f64>) -> Error {
+    Error::InvalidParameter {
+        name,
+        value: format!("{covariance:?}"),
+        reason: "must be symmetric positive definite (the Bayes filter holds its inverse)".into(),
+    }
+}
+
+/// The refusal of driving noise with fading memory in the Bayes filter.
+fn noise_with_fading() -> Error {
+    Error::InvalidParameter {
+        name: Param::ProcessNoise,
+        value: "with fading memory".into(),
+        reason: "the Bayes filter's true covariance under fading memory (14.3.11) assumes no \
+                 driving noise: use one or the other (the Kalman filter takes both)"
+            .into(),
+    }
+}
+
+/// A square root `G` of the driving noise's `Q` (`Q = G Gᵀ`): its Cholesky factor, or for a
+/// singular `Q` the symmetric eigendecomposition's `V √Λ` (negative rounding clipped to 0);
+/// refused unless finite.
+fn noise_root(q: &DMatrix<f64>) -> Result<DMatrix<f64>, Error> {
+    if let Some(&value) = q.iter().find(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            what: "driving-noise covariance Q",
+            value,
+        });
+    }
+    if let Some(c) = Cholesky::new(q.clone()) {
+        return Ok(c.l());
+    }
+    let e = nalgebra::SymmetricEigen::new((q + q.transpose()) * 0.5);
+    let roots = e.eigenvalues.map(|v| v.max(0.0).sqrt());
+    Ok(e.eigenvectors * DMatrix::from_diagonal(&roots))
 }
 
 /// `L⁻¹` for the present components' `R = L Lᵀ` (positive definite: the information form

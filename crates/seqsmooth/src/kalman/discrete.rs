@@ -294,22 +294,12 @@ impl LinearKalmanFilter {
         self.model.b.as_ref()
     }
 
-    /// Replaces the estimate `x`, `P` (checked as the prior).
+    /// Replaces the estimate `x`, `P` ([`KalmanFilter::set_estimate`]'s checks: `x` finite,
+    /// `P` a finite symmetric positive semidefinite covariance). On an error the filter is
+    /// unchanged.
     pub fn set_estimate(&mut self, x: DVector<f64>, p: DMatrix<f64>) -> Result<(), Error> {
-        let n = self.dimension();
-        if x.len() != n || x.iter().any(|v| !v.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: Param::State,
-                value: format!("{:?}", x.as_slice()),
-                reason: format!("must be {n} finite numbers"),
-            });
-        }
-        check_covariance(&p, n, Param::StateCovarianceP)?;
         let time = self.filter.time();
-        let mut filter = self.filter.clone();
-        filter.set_estimate(x, p, time)?;
-        self.filter = filter;
-        Ok(())
+        self.filter.set_estimate(x, p, time)
     }
 
     /// Replaces the constant `F`, `H`, `Q`, `R` or `B` (each `None` kept), all checked first.
@@ -539,8 +529,8 @@ impl LinearKalmanFilter {
             let s = step(k);
             self.check(&s, true).map_err(in_batch(k))?;
             let (x0, p0) = &filtered[k - 1];
-            check_covariance(p0, n, Param::StateCovarianceP).map_err(in_batch(k - 1))?;
             let mut filter = self.filter.clone();
+            // Checked there (check_estimate: P named, the step its index).
             filter
                 .set_estimate(x0.clone(), p0.clone(), 0.0)
                 .map_err(in_batch(k - 1))?;

@@ -19,7 +19,7 @@ use crate::error::{Error, Param};
 use crate::model::continuous::ContinuousModel;
 use crate::numeric::power::powi;
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size, UNROLLED_MAX_SIZE};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 /// A driving-noise model: `Q` over a step.
 pub trait ProcessNoise: std::fmt::Debug + Send + Sync {
@@ -342,6 +342,67 @@ pub fn check_covariance(m: &DMatrix<f64>, n: usize, name: Param) -> Result<(), E
             name,
             value: format!("with an eigenvalue {least:e}"),
             reason: "must be positive semidefinite".into(),
+        });
+    }
+    Ok(())
+}
+
+/// Refuses an estimate to set in a filter of `n` states: `state` not `n` finite numbers
+/// ([`Param::State`]), or `covariance` not a covariance as [`check_covariance`] has it
+/// ([`Param::StateCovarianceP`]). The one check of every Kalman-family filter's
+/// `set_estimate`.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::error::{Error, Param};
+/// use seqsmooth::kalman::noise::check_estimate;
+/// let x = DVector::from_vec(vec![1.0, 2.0]);
+/// assert!(check_estimate(&x, &DMatrix::identity(2, 2), 2).is_ok());
+/// let e = check_estimate(&x, &DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]), 2);
+/// assert!(matches!(e, Err(Error::InvalidParameter { name: Param::StateCovarianceP, .. })));
+/// let e = check_estimate(&DVector::from_vec(vec![f64::NAN, 0.0]), &DMatrix::identity(2, 2), 2);
+/// assert!(matches!(e, Err(Error::InvalidParameter { name: Param::State, .. })));
+/// ```
+pub fn check_estimate(
+    state: &DVector<f64>,
+    covariance: &DMatrix<f64>,
+    n: usize,
+) -> Result<(), Error> {
+    if state.len() != n || state.iter().any(|v| !v.is_finite()) {
+        return Err(Error::InvalidParameter {
+            name: Param::State,
+            value: format!("{:?}", state.as_slice()),
+            reason: format!("must be {n} finite numbers"),
+        });
+    }
+    check_covariance(covariance, n, Param::StateCovarianceP)
+}
+
+/// [`check_estimate`] and a finite `time`: what a filter's `set_estimate(state, covariance,
+/// time)` checks.
+pub(crate) fn check_estimate_at(
+    state: &DVector<f64>,
+    covariance: &DMatrix<f64>,
+    n: usize,
+    time: f64,
+) -> Result<(), Error> {
+    check_estimate(state, covariance, n)?;
+    if !time.is_finite() {
+        return Err(Error::NonFinite {
+            what: "time",
+            value: time,
+        });
+    }
+    Ok(())
+}
+
+/// Refuses a driving noise of other than the dynamics' `n` states, naming it.
+pub(crate) fn check_noise_dimension(noise: &dyn ProcessNoise, n: usize) -> Result<(), Error> {
+    if noise.dimension() != n {
+        return Err(Error::InvalidParameter {
+            name: Param::ProcessNoise,
+            value: format!("for {} states", noise.dimension()),
+            reason: format!("the dynamics have {n} states"),
         });
     }
     Ok(())

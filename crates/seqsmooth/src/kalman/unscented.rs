@@ -127,15 +127,7 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
             covariance.clone(),
             time,
         )?;
-        if Cholesky::new(covariance.clone()).is_none() {
-            return Err(Error::InvalidParameter {
-                name: Param::PriorCovariance,
-                value: format!("{covariance:?}"),
-                reason: "must be positive definite (the unscented filter draws its sigma points \
-                         from its Cholesky factor)"
-                    .into(),
-            });
-        }
+        check_positive_definite(&covariance, Param::PriorCovariance)?;
         let n = state.len();
         let points = SigmaPoints::default();
         let weights = points.weights(n)?;
@@ -189,13 +181,7 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
         noise: P,
     ) -> Result<Self, Error> {
         let n = self.state.len();
-        if noise.dimension() != n {
-            return Err(Error::InvalidParameter {
-                name: Param::ProcessNoise,
-                value: format!("for {} states", noise.dimension()),
-                reason: format!("the dynamics have {n} states"),
-            });
-        }
+        super::noise::check_noise_dimension(&noise, n)?;
         self.noise = Some(Arc::new(noise));
         Ok(self)
     }
@@ -273,6 +259,36 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
     /// ```
     pub fn time(&self) -> f64 {
         self.time
+    }
+
+    /// Replaces the estimate: `state` and `covariance` at `time`, checked by
+    /// [`check_estimate`](super::noise::check_estimate) and positive definite (the sigma
+    /// points are drawn from its Cholesky factor), the time finite. On an error the filter is
+    /// unchanged.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::UnscentedKalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// let mut f = UnscentedKalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::zeros(1), DMatrix::identity(1, 1), 0.0).unwrap();
+    /// f.set_estimate(DVector::from_vec(vec![2.0]), DMatrix::from_element(1, 1, 4.0), 1.0).unwrap();
+    /// assert_eq!((f.state()[0], f.std_devs()[0], f.time()), (2.0, 2.0, 1.0));
+    /// // Singular: no sigma points; refused, the filter unchanged.
+    /// assert!(f.set_estimate(DVector::zeros(1), DMatrix::zeros(1, 1), 1.0).is_err());
+    /// assert_eq!(f.state()[0], 2.0);
+    /// ```
+    pub fn set_estimate(
+        &mut self,
+        state: DVector<f64>,
+        covariance: DMatrix<f64>,
+        time: f64,
+    ) -> Result<(), Error> {
+        super::noise::check_estimate_at(&state, &covariance, self.state.len(), time)?;
+        check_positive_definite(&covariance, Param::StateCovarianceP)?;
+        (self.state, self.covariance, self.time) = (state, covariance, time);
+        Ok(())
     }
 
     /// Carries the estimate to `t` (forwards or backwards) through the sigma points
@@ -546,4 +562,19 @@ fn finite(values: &[f64], what: &'static str) -> Result<(), Error> {
         Some(&value) => Err(Error::NonFinite { what, value }),
         None => Ok(()),
     }
+}
+
+/// Refuses a covariance without a Cholesky factor (not positive definite), naming it: the
+/// unscented filter draws its sigma points from that factor.
+fn check_positive_definite(covariance: &DMatrix<f64>, name: Param) -> Result<(), Error> {
+    if Cholesky::new(covariance.clone()).is_none() {
+        return Err(Error::InvalidParameter {
+            name,
+            value: format!("{covariance:?}"),
+            reason: "must be positive definite (the unscented filter draws its sigma points \
+                     from its Cholesky factor)"
+                .into(),
+        });
+    }
+    Ok(())
 }

@@ -95,6 +95,7 @@ mod filter;
 pub mod fixed;
 pub mod form;
 mod options;
+pub mod prior;
 pub mod rows;
 pub mod spec;
 pub mod stream;

@@ -20,6 +20,7 @@ use crate::polynomial::fading::FadingMemory;
 use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::fixed::{FixedEngine, FixedMemory};
 use crate::polynomial::options::Engine;
+use crate::polynomial::prior::Prior;
 use crate::polynomial::tau::default_tau;
 
 /// Which memory a polynomial filter has.
@@ -93,6 +94,9 @@ pub struct FilterSpec {
     /// The automatic filter's review window (accepted samples before an outlier decision is
     /// final); `None`: its default.
     pub review_window: Option<usize>,
+    /// A prior for expanding and fading memory ([`Prior`]: the exact engine, with `sigma`);
+    /// the other kinds refuse one.
+    pub prior: Option<Prior>,
 }
 
 impl FilterSpec {
@@ -110,6 +114,7 @@ impl FilterSpec {
             fixed_engine: FixedEngine::Adaptive,
             sigma: None,
             review_window: None,
+            prior: None,
         }
     }
 
@@ -141,14 +146,22 @@ impl FilterSpec {
     pub fn build(&self) -> Result<AnyFilter, Error> {
         let m = self.degree;
         let need = |value: Option<f64>, name| value.ok_or_else(|| needs(name, self.kind));
+        if self.prior.is_some() && !matches!(self.kind, FilterKind::Expanding | FilterKind::Fading)
+        {
+            return Err(Error::InvalidParameter {
+                name: Param::Prior,
+                value: format!("for kind {}", self.kind.name()),
+                reason: "a prior is for expanding and fading memory".into(),
+            });
+        }
         let inner = match self.kind {
             FilterKind::Expanding => {
                 let f = ExpandingMemory::new(m, self.engine)?;
-                Inner::Expanding(Box::new(noise(
-                    f,
-                    self.sigma,
-                    ExpandingMemory::with_noise_sigma,
-                )?))
+                let f = noise(f, self.sigma, ExpandingMemory::with_noise_sigma)?;
+                Inner::Expanding(Box::new(match &self.prior {
+                    Some(p) => f.with_prior(p)?,
+                    None => f,
+                }))
             }
             FilterKind::Fading => {
                 let f = match self.theta_per_update {
@@ -166,11 +179,11 @@ impl FilterSpec {
                         FadingMemory::new(m, theta, tau, self.engine)?
                     }
                 };
-                Inner::Fading(Box::new(noise(
-                    f,
-                    self.sigma,
-                    FadingMemory::with_noise_sigma,
-                )?))
+                let f = noise(f, self.sigma, FadingMemory::with_noise_sigma)?;
+                Inner::Fading(Box::new(match &self.prior {
+                    Some(p) => f.with_prior(p)?,
+                    None => f,
+                }))
             }
             FilterKind::Fixed => {
                 let window = self.window.ok_or_else(|| needs(Param::Window, self.kind))?;

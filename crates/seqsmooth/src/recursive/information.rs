@@ -222,6 +222,55 @@ impl InformationFilter {
         }
     }
 
+    /// Driving noise over a transition (after [`change_variables`](Self::change_variables) to
+    /// the new time): the state becomes `x + G v` with `v ~ N(0, I)`, so the information
+    /// `R x ≈ d` on the state without the noise becomes `R (x − G v) ≈ d`, and `v` brings its
+    /// own `I v ≈ 0`. An orthogonal triangularisation of the stacked rows
+    /// `[[I, 0 | 0], [−R G, R | d]]` leaves the information on the new state in its lower
+    /// right block: the square-root information filter's time update with process noise
+    /// (Bierman's SRIF; Morrison (15.4.11) `S ← Φ S Φᵀ + Q` in information form, `Q = G Gᵀ`),
+    /// which needs no inverse of `Q` or of the covariance and holds from zero information
+    /// (none stays none). Not with the true covariance of fading memory
+    /// ([`with_true_covariance`](Self::with_true_covariance)): the caller refuses that pair.
+    ///
+    /// ```
+    /// use nalgebra::DMatrix;
+    /// use seqsmooth::recursive::InformationFilter;
+    /// let mut f = InformationFilter::new(1);
+    /// f.observe(&[1.0], 2.0, 4.0); // variance 1/4
+    /// f.diffuse(&DMatrix::from_element(1, 1, 0.5)); // plus 1/4
+    /// assert!((f.covariance().unwrap()[(0, 0)] - 0.5).abs() < 1e-15);
+    /// assert!((f.solve().unwrap()[0] - 2.0).abs() < 1e-15);
+    /// ```
+    pub fn diffuse(&mut self, g: &DMatrix<f64>) {
+        debug_assert!(
+            self.spread.is_none(),
+            "driving noise with the true covariance"
+        );
+        let n = self.dim();
+        let (r, d) = (self.info.r(), self.info.rhs());
+        // The stored R is `scale` times the true one: so are the noise rows.
+        let mut a = DMatrix::zeros(2 * n, 2 * n + 1);
+        a.view_mut((0, 0), (n, n)).fill_diagonal(self.scale);
+        a.view_mut((n, 0), (n, n)).copy_from(&(-(&r * g)));
+        a.view_mut((n, n), (n, n)).copy_from(&r);
+        a.view_mut((n, 2 * n), (n, 1)).copy_from(&d);
+        let t = a.qr().r();
+        let r_new = t.view((n, n), (n, n)).into_owned();
+        let d_new: Vec<f64> = t.view((n, 2 * n), (n, 1)).iter().copied().collect();
+        // Row by row (a row with a zero pivot may still carry information to its right, which
+        // `TriangularFactor::from_r` cannot hold).
+        let mut info = TriangularFactor::new(n);
+        let mut row = vec![0.0; n];
+        for (i, &d) in d_new.iter().enumerate() {
+            row.iter_mut()
+                .zip(r_new.row(i).iter())
+                .for_each(|(a, b)| *a = *b);
+            info.add_row(&row, d, 1.0);
+        }
+        self.info = info;
+    }
+
     /// [`change_variables`](Self::change_variables) for an upper-triangular `A`.
     ///
     /// ```

@@ -262,9 +262,11 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         crate::linalg::std_devs(&self.covariance)
     }
 
-    /// Replaces the estimate: `state` and `covariance` at `time`, checked as
-    /// [`Self::new`] checks the prior (a fading filter's own matrix `P` restarts at the
-    /// covariance, §14.5). On an error the filter is unchanged.
+    /// Replaces the estimate: `state` and `covariance` at `time`, checked by
+    /// [`check_estimate`](super::noise::check_estimate) (`n` finite numbers; a finite,
+    /// symmetric, positive semidefinite `n × n` covariance), the time finite (a fading
+    /// filter's own matrix `P` restarts at the covariance, §14.5). On an error the filter is
+    /// unchanged.
     ///
     /// ```
     /// use nalgebra::{DMatrix, DVector};
@@ -276,6 +278,9 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// f.set_estimate(DVector::from_vec(vec![2.0]), DMatrix::identity(1, 1) * 4.0, 1.0).unwrap();
     /// assert_eq!((f.state()[0], f.std_devs()[0], f.time()), (2.0, 2.0, 1.0));
     /// assert!(f.set_estimate(DVector::zeros(2), DMatrix::identity(2, 2), 1.0).is_err());
+    /// // Not positive semidefinite: refused, the filter unchanged.
+    /// assert!(f.set_estimate(DVector::zeros(1), DMatrix::from_element(1, 1, -1.0), 1.0).is_err());
+    /// assert_eq!(f.std_devs()[0], 2.0);
     /// ```
     pub fn set_estimate(
         &mut self,
@@ -283,7 +288,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         covariance: DMatrix<f64>,
         time: f64,
     ) -> Result<(), Error> {
-        check_prior(self.state.len(), &state, &covariance, time)?;
+        super::noise::check_estimate_at(&state, &covariance, self.state.len(), time)?;
         if let Some(f) = &mut self.fading {
             f.weight.copy_from(&covariance);
             f.last_update = time;
@@ -484,13 +489,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// ```
     pub fn set_process_noise<P: ProcessNoise + 'static>(&mut self, noise: P) -> Result<(), Error> {
         let n = self.dynamics.dimension();
-        if noise.dimension() != n {
-            return Err(Error::InvalidParameter {
-                name: Param::ProcessNoise,
-                value: format!("for {} states", noise.dimension()),
-                reason: format!("the dynamics have {n} states"),
-            });
-        }
+        super::noise::check_noise_dimension(&noise, n)?;
         self.noise = Some(Arc::new(noise));
         Ok(())
     }

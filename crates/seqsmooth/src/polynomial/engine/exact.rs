@@ -29,7 +29,7 @@ use crate::polynomial::options::MAX_DEGREE;
 use crate::recursive::InformationFilter;
 #[cfg(doc)]
 use crate::recursive::TriangularFactor;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 /// The largest state size, `MAX_DEGREE + 1` (stack tables).
 const MAX_SIZE: usize = MAX_DEGREE + 1;
@@ -81,6 +81,8 @@ pub(crate) struct ExactEngine {
     /// Whether every `unscale` entry is a normal double; else the derivatives are unscaled one
     /// factor at a time ([`crate::model::taylor`]'s `unscale_stepwise`).
     unscale_in_range: bool,
+    /// The prior's time, when the filter started from one ([`Self::set_prior`]).
+    prior: Option<f64>,
 }
 
 impl ExactEngine {
@@ -103,7 +105,37 @@ impl ExactEngine {
             span_per_time: discount.map_or(0.0, |d| 3.0 * d.tau().unwrap_or(1.0) / -d.theta().ln()),
             unscale: [0.0; MAX_DEGREE + 1],
             unscale_in_range: true,
+            prior: None,
         }
+    }
+
+    /// Starts from a prior at `time` given as whitened pseudo-observations of the coefficients
+    /// of `Σ a_k (t − time)^k` (`rows`, `values`: [`crate::polynomial::prior::Prior`]'s), the
+    /// basis centred there with unit 1; before any sample (the caller checks).
+    pub fn set_prior(&mut self, time: f64, rows: &DMatrix<f64>, values: &DVector<f64>) {
+        self.centre = time;
+        self.unit = 1.0;
+        self.set_unscale();
+        (self.t_first, self.t_last) = (time, time);
+        let mut row = vec![0.0; self.m + 1];
+        for (i, &y) in values.iter().enumerate() {
+            row.iter_mut()
+                .zip(rows.row(i).iter())
+                .for_each(|(a, b)| *a = *b);
+            self.info.observe(&row, y, 1.0);
+        }
+        self.prior = Some(time);
+    }
+
+    /// The prior's time, if the filter started from one.
+    pub fn prior_time(&self) -> Option<f64> {
+        self.prior
+    }
+
+    /// Whether the rows so far may determine the fit: `m + 1` samples, or a prior.
+    #[inline(always)]
+    fn enough_rows(&self, size: u64) -> bool {
+        self.n >= size || self.prior.is_some()
     }
 
     pub fn track_covariance(&mut self, sigma: f64) {
@@ -112,6 +144,11 @@ impl ExactEngine {
             self.info =
                 std::mem::replace(&mut self.info, InformationFilter::new(0)).with_true_covariance();
         }
+    }
+
+    /// The noise σ, if tracked.
+    pub fn sigma(&self) -> Option<f64> {
+        self.sigma
     }
 
     /// Whether the covariance is tracked (a noise σ was given).
@@ -129,7 +166,7 @@ impl ExactEngine {
 
     /// Processes one sample; `t` must exceed the previous time (checked by the caller).
     pub fn update(&mut self, t: f64, y: f64) {
-        if self.n == 0 {
+        if self.n == 0 && self.prior.is_none() {
             self.t_first = t;
             self.centre = t;
             self.unit = 1.0;
@@ -145,7 +182,7 @@ impl ExactEngine {
                 }
                 self.info.fade(self.inv_root);
             }
-            if self.n == 1 {
+            if self.n == 1 && self.prior.is_none() {
                 // One row so far, (1, 0, …, 0) at the centre t_first, whatever the unit: the
                 // unit is chosen from the first step at no cost, so that the change of
                 // variables never has to bridge a factor like 2^±1000 (its powers α^j would
@@ -243,7 +280,7 @@ impl ExactEngine {
     }
 
     pub fn is_determined(&self) -> bool {
-        self.n > self.m as u64 && self.info.is_determined()
+        self.enough_rows(self.m as u64 + 1) && self.info.is_determined()
     }
 
     /// Writes the unscaled derivatives of the fit at `t` into `out` (`m+1` values) without
@@ -257,7 +294,7 @@ impl ExactEngine {
 
     #[inline(always)]
     fn derivatives_n<const N: usize>(&self, h: f64, out: &mut [f64]) -> bool {
-        if self.n < N as u64 {
+        if !self.enough_rows(N as u64) {
             return false;
         }
         let Some(mut a) = self.info.factor().solve_array::<N>() else {
@@ -344,7 +381,7 @@ impl ExactEngine {
     /// [`Self::std_devs_into`] for the size `p ≤ N` (its tables on the stack).
     #[inline(always)]
     fn std_devs_with<const N: usize>(&self, p: usize, t: f64, out: &mut [f64]) -> bool {
-        let Some(sigma) = self.sigma.filter(|_| self.n > self.m as u64) else {
+        let Some(sigma) = self.sigma.filter(|_| self.enough_rows(self.m as u64 + 1)) else {
             return false;
         };
         let v = (t - self.centre) * self.inv_unit;

@@ -64,9 +64,77 @@ impl EngineState {
 
     /// The sample's own check, and for the gain engine its value range
     /// ([`GAIN_MAX_VALUE`]).
+    /// The prior's time, when the filter started from one (the exact engine only).
+    pub(crate) fn prior_time(&self) -> Option<f64> {
+        match self {
+            EngineState::Exact(e) => e.prior_time(),
+            EngineState::Gain(_) => None,
+        }
+    }
+
+    /// The time a sample must come after: the previous sample's, or before the first, just
+    /// before a prior's time (a first sample may share it).
+    fn previous(&self) -> Option<f64> {
+        match self.samples() {
+            0 => self.prior_time().map(f64::next_down),
+            _ => Some(self.last_time()),
+        }
+    }
+
+    /// Whether the samples so far (with a prior, none) may determine a fit of degree `m`.
+    pub(crate) fn enough_samples(&self, m: usize) -> bool {
+        self.samples() > m as u64 || self.prior_time().is_some()
+    }
+
+    /// Starts from `prior` (degree `m`): the exact engine with a noise σ, before any sample;
+    /// the gain engine's fixed gains refuse it.
+    pub(crate) fn set_prior(
+        &mut self,
+        m: usize,
+        prior: &crate::polynomial::prior::Prior,
+    ) -> Result<(), Error> {
+        use crate::error::Param;
+        prior.check_degree(m)?;
+        let refuse = |value: &str, reason: &str| Error::InvalidParameter {
+            name: Param::Prior,
+            value: value.into(),
+            reason: reason.into(),
+        };
+        if self.samples() > 0 {
+            return Err(refuse(
+                "after the first sample",
+                "a prior is where the filter starts: give it before any sample",
+            ));
+        }
+        match self {
+            EngineState::Gain(_) => Err(refuse(
+                "on the gain engine",
+                "the fixed gains (Morrison Tables 9.1, 13.1) assume no prior information: use \
+                 the exact engine",
+            )),
+            EngineState::Exact(e) => match e.sigma() {
+                None => Err(refuse(
+                    "without the noise sigma",
+                    "the prior is weighed against the samples by their noise: give sigma",
+                )),
+                Some(sigma) => {
+                    let (rows, values) = prior.rows(sigma);
+                    e.set_prior(prior.time, &rows, &values);
+                    Ok(())
+                }
+            },
+        }
+    }
+
     fn check(&self, t: f64, y: f64) -> Result<(), Error> {
-        let previous = (self.samples() > 0).then(|| self.last_time());
-        crate::error::check_sample(t, y, previous)?;
+        let previous = self.previous();
+        crate::error::check_sample(t, y, previous).map_err(|e| match (e, self.prior_time()) {
+            // Before the first sample the bound is the prior's time itself.
+            (Error::TimeNotIncreasing { time, .. }, Some(p)) if self.samples() == 0 => {
+                Error::TimeNotIncreasing { time, previous: p }
+            }
+            (e, _) => e,
+        })?;
         if matches!(self, EngineState::Gain(_)) && y.abs() > GAIN_MAX_VALUE {
             return Err(Error::GainValueOutOfRange {
                 value: y,
@@ -143,8 +211,7 @@ impl EngineState {
         values: &[f64],
         out: Option<&mut [f64]>,
     ) -> usize {
-        let previous = (self.samples() > 0).then(|| self.last_time());
-        let mut valid = first_invalid(times, values, previous);
+        let mut valid = first_invalid(times, values, self.previous());
         if matches!(self, EngineState::Gain(_)) {
             let ys = &values[..valid];
             // Branch-free first (so that it vectorises), searched only when it fails.
@@ -183,7 +250,7 @@ impl EngineState {
     /// (not determined, no tracked `σ`, or beyond the double range): the exact engine without
     /// allocating, the gain engine from its estimate.
     pub(crate) fn position_at(&self, m: usize, t: f64) -> Option<(f64, f64)> {
-        if self.samples() <= m as u64 || !t.is_finite() {
+        if !self.enough_samples(m) || !t.is_finite() {
             return None;
         }
         let (x, v) = match self {
@@ -279,8 +346,7 @@ impl EngineState {
         values: &[f64],
         rows: &mut [f64],
     ) -> usize {
-        let previous = (self.samples() > 0).then(|| self.last_time());
-        let mut valid = first_invalid(times, values, previous);
+        let mut valid = first_invalid(times, values, self.previous());
         if matches!(self, EngineState::Gain(_)) {
             valid = values[..valid]
                 .iter()
@@ -316,7 +382,7 @@ impl EngineState {
     pub(crate) fn try_estimate_at(&self, m: usize, t: f64) -> Result<PolynomialState, Error> {
         crate::error::check_finite("time", &[t])?;
         let samples = self.samples();
-        if samples <= m as u64 {
+        if !self.enough_samples(m) {
             return Err(Error::TooFewSamples {
                 needed: m + 1,
                 got: samples as usize,
@@ -416,6 +482,9 @@ macro_rules! impl_polynomial_filter {
             }
             fn last_time(&self) -> Option<f64> {
                 (self.core.samples() > 0).then(|| self.core.last_time())
+            }
+            fn is_determined(&self) -> bool {
+                self.core.enough_samples(self.m)
             }
         }
     };

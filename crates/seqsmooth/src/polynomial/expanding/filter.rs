@@ -5,6 +5,7 @@ use crate::model::PolynomialState;
 use crate::polynomial::engine::{impl_polynomial_filter, EngineState, ExactEngine, GainEngine};
 use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::options::{check_engine_degree, Engine};
+use crate::polynomial::prior::{check_no_prior, Prior};
 
 /// Expanding-memory polynomial filter of degree `m` (Morrison ch. 9; Reyneke §6.3-6.4): the
 /// least-squares polynomial through all samples so far, with its derivatives, predictions and
@@ -25,6 +26,7 @@ use crate::polynomial::options::{check_engine_degree, Engine};
 #[derive(Clone, Debug)]
 pub struct ExpandingMemory {
     m: usize,
+    prior: bool,
     core: EngineState,
 }
 
@@ -58,7 +60,11 @@ impl ExpandingMemory {
             // The gain engine's output does not depend on τ for expanding memory; τ = 1.
             Engine::Gain => EngineState::Gain(GainEngine::new(m, 1.0, None)),
         };
-        Ok(Self { m, core })
+        Ok(Self {
+            m,
+            prior: false,
+            core,
+        })
     }
 
     /// Tracks the covariance of the estimate for white measurement noise of standard deviation
@@ -72,7 +78,35 @@ impl ExpandingMemory {
     /// assert!((var - 1.0).abs() < 1e-12); // σ²/4
     /// ```
     pub fn with_noise_sigma(mut self, sigma: f64) -> Result<Self, Error> {
+        check_no_prior(self.prior.then_some(&()))?;
         self.core.track_covariance(sigma)?;
+        Ok(self)
+    }
+
+    /// Starts from `prior` ([`Prior`]: the derivatives at `t₀` and their covariance) instead
+    /// of from no information: the Bayes filter (Morrison ch. 10, (10.3.8) with
+    /// `(S_{1,0})⁻¹ = P⁻¹`), whose estimate is the least-squares fit with the prior as `m + 1`
+    /// more observations; the first sample may be at `t₀`. Needs the exact engine and the
+    /// noise σ ([`Self::with_noise_sigma`], first: it weighs the prior against the samples),
+    /// before any sample.
+    ///
+    /// ```
+    /// use nalgebra::DMatrix;
+    /// use seqsmooth::polynomial::prior::Prior;
+    /// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
+    /// // A constant known to variance 1, one sample of variance 1: their mean.
+    /// let prior = Prior::new(0.0, vec![2.0], DMatrix::identity(1, 1)).unwrap();
+    /// let mut f = ExpandingMemory::new(0, Engine::Exact).unwrap()
+    ///     .with_noise_sigma(1.0).unwrap()
+    ///     .with_prior(&prior).unwrap();
+    /// f.update(0.0, 4.0).unwrap();
+    /// let s = f.estimate().unwrap();
+    /// assert!((s.derivatives[0] - 3.0).abs() < 1e-14);
+    /// assert!((s.covariance.unwrap()[(0, 0)] - 0.5).abs() < 1e-14);
+    /// ```
+    pub fn with_prior(mut self, prior: &Prior) -> Result<Self, Error> {
+        self.core.set_prior(self.m, prior)?;
+        self.prior = true;
         Ok(self)
     }
 }

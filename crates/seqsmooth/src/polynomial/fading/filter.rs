@@ -10,6 +10,7 @@ use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::options::{
     check_engine_degree, check_not_started, check_tau, check_theta, Discount, DiscountMode, Engine,
 };
+use crate::polynomial::prior::{check_no_prior, Prior};
 
 /// Fading-memory polynomial filter of degree `m` and discount `θ` per `τ` (Morrison ch. 13;
 /// Reyneke §6.5-6.6): the polynomial minimising `Σ_k θ^((t_n-t_k)/τ) (y_k - p(t_k))²`.
@@ -31,6 +32,7 @@ pub struct FadingMemory {
     mode: DiscountMode,
     rule: SwitchRule,
     sigma: Option<f64>,
+    prior: Option<Prior>,
     core: EngineState,
 }
 
@@ -82,6 +84,7 @@ impl FadingMemory {
             mode,
             rule,
             sigma: None,
+            prior: None,
             core,
         })
     }
@@ -137,6 +140,9 @@ impl FadingMemory {
         if let Some(sigma) = self.sigma {
             self.core.track_covariance(sigma)?;
         }
+        if let Some(prior) = &self.prior {
+            self.core.set_prior(self.m, prior)?;
+        }
         Ok(())
     }
 
@@ -186,8 +192,36 @@ impl FadingMemory {
     /// assert!((var - 1.0 / 3.0).abs() < 1e-12); // (1−θ)/(1+θ)
     /// ```
     pub fn with_noise_sigma(mut self, sigma: f64) -> Result<Self, Error> {
+        check_no_prior(self.prior.as_ref())?;
         self.core.track_covariance(sigma)?;
         self.sigma = Some(sigma);
+        Ok(self)
+    }
+
+    /// Starts from `prior` ([`Prior`]: the derivatives at `t₀` and their covariance) instead
+    /// of from no information: the fading-memory Bayes filter ((14.4.26)-(14.4.32)), the
+    /// prior discounted like a sample at `t₀`; the first sample may be at `t₀`. Needs the
+    /// exact engine and the noise σ ([`Self::with_noise_sigma`], first: it weighs the prior
+    /// against the samples), before any sample.
+    ///
+    /// ```
+    /// use nalgebra::DMatrix;
+    /// use seqsmooth::polynomial::prior::Prior;
+    /// use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
+    /// let prior = Prior::new(0.0, vec![1.0, 0.5], DMatrix::identity(2, 2)).unwrap();
+    /// let mut f = FadingMemory::new(1, 0.9, 1.0, Engine::Exact).unwrap()
+    ///     .with_noise_sigma(1.0).unwrap()
+    ///     .with_prior(&prior).unwrap();
+    /// let s = f.estimate_at(0.0).unwrap(); // determined before any sample: the prior
+    /// assert!((s.derivatives[0] - 1.0).abs() < 1e-14 && (s.derivatives[1] - 0.5).abs() < 1e-14);
+    /// f.update(1.0, 1.5).unwrap(); // one sample, on the prior's line: still on it
+    /// assert!((f.estimate().unwrap().derivatives[0] - 1.5).abs() < 1e-14);
+    /// assert!(FadingMemory::new(1, 0.9, 1.0, Engine::Gain).unwrap()
+    ///     .with_noise_sigma(1.0).unwrap().with_prior(&prior).is_err()); // fixed gains: no prior
+    /// ```
+    pub fn with_prior(mut self, prior: &Prior) -> Result<Self, Error> {
+        self.core.set_prior(self.m, prior)?;
+        self.prior = Some(prior.clone());
         Ok(self)
     }
 
