@@ -8,10 +8,10 @@ use crate::arrays::matrix;
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{square, PyInnovation};
 use nalgebra::{DMatrix, DVector};
-use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{IntoPyDict, PyTuple};
-use seqsmooth::kalman::discrete::{LinearFixedLag, LinearKalmanFilter, Pass, StepMatrices};
+use seqsmooth::kalman::discrete::{LinearFixedLag, LinearKalmanFilter, PassInto, StepMatrices};
 use seqsmooth::kalman::Smoothed;
 
 /// `obj` as a C-contiguous float64 array: its values (row-major) and shape, named `name`.
@@ -295,6 +295,11 @@ fn states_and_covariances<'py>(
     ))
 }
 
+/// A new `(rows, n, n)` array of zeros allocated by numpy, for the library to write into.
+fn cube(py: Python<'_>, rows: usize, n: usize) -> Bound<'_, PyArray3<f64>> {
+    PyArray3::zeros(py, [rows, n, n], false)
+}
+
 /// The Kalman filter on a discrete-time linear model given by its matrices (filterpy's
 /// ``KalmanFilter``): ``x_k = F x_{k-1} + B u_k + w``, ``w ~ N(0, Q)``; ``z_k = H x_k + v``,
 /// ``v ~ N(0, R)``. One ``predict`` then one ``update`` per step; every matrix may also be
@@ -529,15 +534,30 @@ impl PyLinearKalmanFilter {
     ) -> PyResult<Bound<'py, PyTuple>> {
         let (z, rows) = measurements(zs, self.inner.components())?;
         let steps = Steps::new(&self.inner, rows, Fs, Qs, Hs, Rs, Bs, us)?;
-        let mut pass = Pass::default();
-        let inner = &mut self.inner;
-        py.detach(|| inner.update_many(&z, |k| steps.at(k), &mut pass))
-            .py()?;
         let n = self.inner.dimension();
-        let (x, p) = states_and_covariances(py, pass.states, pass.covariances, n)?;
-        let (xp, pp) =
-            states_and_covariances(py, pass.predicted_states, pass.predicted_covariances, n)?;
-        PyTuple::new(py, [x, p, xp, pp])
+        // The four outputs allocated by numpy and filled in place (no batch-long buffer and
+        // copy; numpy maps a large array in huge pages where the system allows it).
+        let (x, p) = (PyArray2::zeros(py, [rows, n], false), cube(py, rows, n));
+        let (xp, pp) = (PyArray2::zeros(py, [rows, n], false), cube(py, rows, n));
+        {
+            let (mut xw, mut pw) = (x.readwrite(), p.readwrite());
+            let (mut xpw, mut ppw) = (xp.readwrite(), pp.readwrite());
+            let contiguous = "a new array is contiguous";
+            let out = PassInto {
+                states: xw.as_slice_mut().expect(contiguous),
+                covariances: pw.as_slice_mut().expect(contiguous),
+                predicted_states: xpw.as_slice_mut().expect(contiguous),
+                predicted_covariances: ppw.as_slice_mut().expect(contiguous),
+                nis: None,
+            };
+            let inner = &mut self.inner;
+            py.detach(|| inner.update_many_into(&z, |k| steps.at(k), out))
+                .py()?;
+        }
+        PyTuple::new(
+            py,
+            [x.into_any(), p.into_any(), xp.into_any(), pp.into_any()],
+        )
     }
 
     /// The Rauch–Tung–Striebel smoother over a forward pass's ``Xs`` ``(N, n)`` and ``Ps``

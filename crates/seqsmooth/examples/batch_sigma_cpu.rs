@@ -4,8 +4,10 @@
 //! `update_many_into` (derivatives, `m + 1`), each on a fresh filter with a noise σ (fading
 //! θ = 0.9 per τ = 1, and expanding) into a new zeroed buffer, best of 3, for each degree.
 //!
-//! Run: `cargo run --release -p seqsmooth --example batch_sigma_cpu -- [SAMPLES] [DEGREES]`
-//! (defaults 10⁷ and `1,2,8`; e.g. `-- 10000000 0,1,2,4,8,9,12`). The CPU time is read from
+//! Run: `cargo run --release -p seqsmooth --example batch_sigma_cpu -- [SAMPLES] [DEGREES]
+//! [touched]` (defaults 10⁷ and `1,2,8`; e.g. `-- 10000000 0,1,2,4,8,9,12`); with `touched`
+//! every buffer is written once before its call is timed, so that the system's mapping and
+//! clearing of its pages is left out and the ratio is that of the arithmetic and the stores. The CPU time is read from
 //! `/proc/thread-self/schedstat` (Linux); elsewhere the wall time is measured instead.
 
 use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
@@ -62,16 +64,29 @@ fn main() {
         .iter()
         .map(|&t| 10.0 * (t * 1e-3).sin() + 0.01 * ((t * 7.0) % 13.0))
         .collect();
+    let touched = args.next().is_some_and(|s| s == "touched");
     let unit = if cpu_ns().is_some() { "CPU" } else { "wall" };
-    println!("{n} samples, best of 3, {unit} time");
+    let pages = if touched {
+        "buffers written before timing"
+    } else {
+        "new zeroed buffers"
+    };
+    println!("{n} samples, best of 3, {unit} time, {pages}");
+    let buffer = |len: usize| {
+        let mut out = vec![0.0; len];
+        if touched {
+            out.fill(1.0);
+        }
+        out
+    };
     for &m in &degrees {
         for fading in [true, false] {
             let w = m + 1;
             let (mut plain, mut sigma) = (f64::INFINITY, f64::INFINITY);
             for _ in 0..3 {
-                let (mut f, mut out) = (filter(fading, m), vec![0.0; n * w]);
+                let (mut f, mut out) = (filter(fading, m), buffer(n * w));
                 plain = plain.min(seconds(|| f.update_many_into(&t, &y, &mut out).unwrap()));
-                let (mut f, mut out) = (filter(fading, m), vec![0.0; n * 2 * w]);
+                let (mut f, mut out) = (filter(fading, m), buffer(n * 2 * w));
                 sigma = sigma.min(seconds(|| {
                     f.update_many_sigma_into(&t, &y, &mut out).unwrap()
                 }));

@@ -5,7 +5,7 @@
 //! the data up to each lag, and refusals that leave the filter as it was.
 
 use nalgebra::{DMatrix, DVector};
-use seqsmooth::kalman::discrete::{LinearKalmanFilter, Pass, StepMatrices};
+use seqsmooth::kalman::discrete::{LinearKalmanFilter, Pass, PassInto, StepMatrices};
 use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};
 use seqsmooth::kalman::{smoother, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
@@ -131,6 +131,73 @@ fn matrices_give_the_polynomial_filter() {
         );
     }
     assert_eq!(linear.steps(), 60);
+}
+
+/// The batch into the caller's memory (`update_many_into`) gives `update_many`'s numbers and
+/// the single-step `predict` + `update` numbers bit for bit, missing components included;
+/// slices of the wrong length are refused before any step.
+#[test]
+fn batch_into_memory_is_the_step_by_step_filter() {
+    let Problem { mut linear, zs, .. } = problem(80);
+    let (n, rows) = (6, 80);
+    let (mut stepwise, mut into) = (linear.clone(), linear.clone());
+    let mut pass = Pass::default();
+    linear
+        .update_many(&zs, |_| StepMatrices::default(), &mut pass)
+        .unwrap();
+    let (mut x, mut p) = (vec![0.0; rows * n], vec![0.0; rows * n * n]);
+    let (mut xp, mut pp, mut nis) = (
+        vec![0.0; rows * n],
+        vec![0.0; rows * n * n],
+        vec![0.0; rows],
+    );
+    let out = PassInto {
+        states: &mut x,
+        covariances: &mut p,
+        predicted_states: &mut xp,
+        predicted_covariances: &mut pp,
+        nis: Some(&mut nis),
+    };
+    into.update_many_into(&zs, |_| StepMatrices::default(), out)
+        .unwrap();
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&x), bits(&pass.states));
+    assert_eq!(bits(&p), bits(&pass.covariances));
+    assert_eq!(bits(&xp), bits(&pass.predicted_states));
+    assert_eq!(bits(&pp), bits(&pass.predicted_covariances));
+    assert_eq!(bits(&nis), bits(&pass.nis));
+    for (k, z) in zs.chunks_exact(2).enumerate() {
+        stepwise.predict(&StepMatrices::default()).unwrap();
+        assert_eq!(
+            bits(stepwise.state().as_slice()),
+            bits(&xp[k * n..(k + 1) * n])
+        );
+        let c = stepwise.covariance().as_slice();
+        assert_eq!(bits(c), bits(&pp[k * n * n..(k + 1) * n * n]));
+        stepwise.update(z, &StepMatrices::default()).unwrap();
+        assert_eq!(
+            bits(stepwise.state().as_slice()),
+            bits(&x[k * n..(k + 1) * n])
+        );
+        let c = stepwise.covariance().as_slice();
+        assert_eq!(bits(c), bits(&p[k * n * n..(k + 1) * n * n]));
+    }
+    let mut short = vec![0.0; rows * n - 1];
+    let (mut p, mut xp, mut pp) = (vec![0.0; rows * n * n], vec![0.0; rows * n], p.clone());
+    let out = PassInto {
+        states: &mut short,
+        covariances: &mut p,
+        predicted_states: &mut xp,
+        predicted_covariances: &mut pp,
+        nis: None,
+    };
+    let before = into.steps();
+    let refused = into.update_many_into(&zs, |_| StepMatrices::default(), out);
+    assert!(
+        matches!(refused, Err(Error::InvalidParameter { .. })),
+        "{refused:?}"
+    );
+    assert_eq!(into.steps(), before);
 }
 
 /// The RTS smoother over the batch's own pass (no measurement read again) gives the

@@ -159,6 +159,31 @@ pub struct Pass {
     pub nis: Vec<f64>,
 }
 
+/// [`Pass`] in the caller's memory ([`LinearKalmanFilter::update_many_into`]): one row per
+/// step, row-major as there; `nis` optional.
+#[derive(Debug)]
+pub struct PassInto<'a> {
+    /// `x_{k|k}`, `steps × n`.
+    pub states: &'a mut [f64],
+    /// `P_{k|k}`, `steps × n × n`.
+    pub covariances: &'a mut [f64],
+    /// `x_{k|k−1}`, `steps × n`.
+    pub predicted_states: &'a mut [f64],
+    /// `P_{k|k−1}`, `steps × n × n`.
+    pub predicted_covariances: &'a mut [f64],
+    /// `νᵀ V⁻¹ ν`, `steps` (NaN where every component was missing), when wanted.
+    pub nis: Option<&'a mut [f64]>,
+}
+
+/// One step's results as the batch loop hands them on (the filter's own memory).
+struct BatchStep<'a> {
+    predicted_state: &'a [f64],
+    predicted_covariance: &'a [f64],
+    state: &'a [f64],
+    covariance: &'a [f64],
+    nis: f64,
+}
+
 type Inner = KalmanFilter<DiscreteDynamics, LinearObservation>;
 
 /// The Kalman filter on a discrete-time linear model with explicit matrices (the module's
@@ -451,6 +476,101 @@ impl LinearKalmanFilter {
             v.reserve(rows * n * n);
         }
         pass.nis.reserve(rows);
+        self.run_batch(zs, step, |_, step| {
+            pass.predicted_states
+                .extend_from_slice(step.predicted_state);
+            pass.predicted_covariances
+                .extend_from_slice(step.predicted_covariance);
+            pass.states.extend_from_slice(step.state);
+            pass.covariances.extend_from_slice(step.covariance);
+            pass.nis.push(step.nis);
+        })
+    }
+
+    /// [`Self::update_many`] into the caller's memory, for `N` rows of `zs`: row `k` of
+    /// `out.states` (`N × n`), `out.covariances` (`N × n × n`), `out.predicted_states`,
+    /// `out.predicted_covariances` and `out.nis` (`N`, where given) is step `k`'s, written in
+    /// place (no buffer of the whole batch is allocated: a front end hands in its own arrays,
+    /// e.g. numpy's, whose pages the system may map in large blocks). The same numbers as
+    /// [`Self::update_many`], bit for bit. On an error ([`Error::InBatch`] naming the step)
+    /// the steps before it are taken and written; slices of the wrong length are refused
+    /// before any step.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::discrete::{LinearKalmanFilter, PassInto, StepMatrices};
+    /// let f = DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 0.0, 1.0]);
+    /// let h = DMatrix::from_row_slice(1, 2, &[1.0, 0.0]);
+    /// let mut kf = LinearKalmanFilter::new(DVector::zeros(2), DMatrix::identity(2, 2) * 100.0,
+    ///     f, h, DMatrix::zeros(2, 2), DMatrix::identity(1, 1)).unwrap();
+    /// let zs = [1.0, 2.0, 3.0, 4.0];
+    /// let (mut x, mut p, mut xp, mut pp) = ([0.0; 8], [0.0; 16], [0.0; 8], [0.0; 16]);
+    /// let out = PassInto { states: &mut x, covariances: &mut p, predicted_states: &mut xp,
+    ///     predicted_covariances: &mut pp, nis: None };
+    /// kf.update_many_into(&zs, |_| StepMatrices::default(), out).unwrap();
+    /// assert!((x[7] - 1.0).abs() < 0.05); // the velocity after the fourth step
+    /// ```
+    pub fn update_many_into<'a>(
+        &mut self,
+        zs: &[f64],
+        step: impl Fn(usize) -> StepMatrices<'a>,
+        out: PassInto<'_>,
+    ) -> Result<(), Error> {
+        let (n, p) = (self.dimension(), self.components());
+        let rows = zs.len() / p;
+        let PassInto {
+            states,
+            covariances,
+            predicted_states,
+            predicted_covariances,
+            mut nis,
+        } = out;
+        let fits = [states.len(), predicted_states.len()] == [rows * n; 2]
+            && [covariances.len(), predicted_covariances.len()] == [rows * n * n; 2]
+            && nis.as_ref().is_none_or(|v| v.len() == rows);
+        if !fits {
+            return Err(Error::InvalidParameter {
+                name: Param::MatrixLength,
+                value: format!(
+                    "{} and {} state, {} and {} covariance entries for {rows} steps",
+                    states.len(),
+                    predicted_states.len(),
+                    covariances.len(),
+                    predicted_covariances.len()
+                ),
+                reason: format!("need {rows} x {n} states and {rows} x {n} x {n} covariances"),
+            });
+        }
+        let (mut x, mut c) = (
+            states.chunks_exact_mut(n),
+            covariances.chunks_exact_mut(n * n),
+        );
+        let mut xp = predicted_states.chunks_exact_mut(n);
+        let mut cp = predicted_covariances.chunks_exact_mut(n * n);
+        self.run_batch(zs, step, |k, step| {
+            let rows = (x.next(), c.next(), xp.next(), cp.next());
+            let (Some(x), Some(c), Some(xp), Some(cp)) = rows else {
+                unreachable!("the lengths were checked against the rows")
+            };
+            xp.copy_from_slice(step.predicted_state);
+            cp.copy_from_slice(step.predicted_covariance);
+            x.copy_from_slice(step.state);
+            c.copy_from_slice(step.covariance);
+            if let Some(nis) = nis.as_deref_mut() {
+                nis[k] = step.nis;
+            }
+        })
+    }
+
+    /// The one loop of [`Self::update_many`] and [`Self::update_many_into`]: each row's
+    /// prediction and update, its results handed to `emit` with the row's index.
+    fn run_batch<'a>(
+        &mut self,
+        zs: &[f64],
+        step: impl Fn(usize) -> StepMatrices<'a>,
+        mut emit: impl FnMut(usize, BatchStep<'_>),
+    ) -> Result<(), Error> {
+        let p = self.components();
         let mut m = Measurement {
             time: 0.0,
             values: Vec::with_capacity(p),
@@ -475,12 +595,16 @@ impl LinearKalmanFilter {
                 Some(_) => self.filter.last_prediction(),
                 None => (self.filter.state(), self.filter.covariance()),
             };
-            pass.predicted_states.extend_from_slice(xp.as_slice());
-            pass.predicted_covariances.extend_from_slice(pp.as_slice());
-            pass.states.extend_from_slice(self.state().as_slice());
-            pass.covariances
-                .extend_from_slice(self.covariance().as_slice());
-            pass.nis.push(nis.unwrap_or(f64::NAN));
+            emit(
+                k,
+                BatchStep {
+                    predicted_state: xp.as_slice(),
+                    predicted_covariance: pp.as_slice(),
+                    state: self.filter.state().as_slice(),
+                    covariance: self.filter.covariance().as_slice(),
+                    nis: nis.unwrap_or(f64::NAN),
+                },
+            );
         }
         Ok(())
     }
