@@ -47,6 +47,10 @@ pub(super) const MAX_UNDECIDED: usize = 63;
 /// waiting.
 const SNAPSHOT_EVERY: usize = 8;
 
+/// Kept states no longer needed that the review holds for their buffers (the next kept state
+/// is copied into one: no allocation).
+const SPARE_STATES: usize = 2;
+
 /// What the review goes back to and replays: the state one update changes (the filter without
 /// its review, [`super::state::State`]).
 pub(super) trait Replay: Clone {
@@ -82,6 +86,8 @@ struct Entry<S> {
 #[derive(Clone, Debug)]
 pub(super) struct Review<S> {
     entries: VecDeque<Entry<S>>,
+    /// Kept states no longer needed, whose buffers the next one reuses ([`Review::snapshot`]).
+    spare: Vec<Box<S>>,
     accepted: VecDeque<(f64, f64)>,
     scratch: Scratch,
     window: usize,
@@ -133,6 +139,7 @@ impl<S: Replay> Review<S> {
     pub(super) fn new(cfg: &AutoConfig) -> Self {
         Self {
             entries: VecDeque::new(),
+            spare: Vec::new(),
             accepted: VecDeque::new(),
             scratch: Scratch::default(),
             window: cfg.review_window,
@@ -166,6 +173,21 @@ impl<S: Replay> Review<S> {
             .all(|e| e.before.is_none())
     }
 
+    /// The state before the next sample when it keeps it ([`keeps_next`](Self::keeps_next)):
+    /// a copy of `state`, into the buffers of a kept state no longer needed when there is one.
+    pub(super) fn snapshot(&mut self, state: &S) -> Option<Box<S>> {
+        if !self.keeps_next() {
+            return None;
+        }
+        Some(match self.spare.pop() {
+            Some(mut kept) => {
+                kept.as_mut().clone_from(state);
+                kept
+            }
+            None => Box::new(state.clone()),
+        })
+    }
+
     /// The newest `n` rejected samples waiting (a run just applied) are not rejected.
     fn reinstate(&mut self, n: usize) {
         reinstate(self.entries.iter_mut(), n);
@@ -179,12 +201,20 @@ impl<S: Replay> Review<S> {
     /// Drops the decided samples before the last kept state at or before the first sample
     /// waiting (all of them when none waits): the first entry always keeps the state before it.
     fn trim(&mut self) {
-        let Some(f) = self.first_undecided() else {
-            self.entries.clear();
-            return;
+        let end = match self.first_undecided() {
+            Some(f) => (0..=f)
+                .rev()
+                .find(|&j| self.entries[j].before.is_some())
+                .unwrap_or(0),
+            None => self.entries.len(),
         };
-        let kept = (0..=f).rev().find(|&j| self.entries[j].before.is_some());
-        self.entries.drain(..kept.unwrap_or(0));
+        for e in self.entries.drain(..end) {
+            if let Some(kept) = e.before {
+                if self.spare.len() < SPARE_STATES {
+                    self.spare.push(kept);
+                }
+            }
+        }
     }
 }
 
@@ -332,14 +362,15 @@ pub(super) fn interpolation_verdict(
         fit,
         up,
         calibration,
+        ts,
+        ys,
+        ..
     } = scratch;
-    let mut ts = [0.0; WINDOW];
-    let mut ys = [0.0; WINDOW];
     let mut n = around.len().min(WINDOW);
-    for (i, &(t, y)) in around[..n].iter().enumerate() {
-        ts[i] = t;
-        ys[i] = y;
-    }
+    ts.clear();
+    ys.clear();
+    ts.extend(around[..n].iter().map(|s| s.0));
+    ys.extend(around[..n].iter().map(|s| s.1));
     if !fit.fit(&ts[..n], &ys[..n], degree) {
         return None;
     }
@@ -419,13 +450,19 @@ pub(super) fn interpolation_verdict(
 /// The most samples of a review window: `L` on each side.
 const WINDOW: usize = 2 * MAX_REVIEW_WINDOW;
 
-/// What the review's fits keep between samples: the calibration, and the two fits refitted in
-/// place (no allocation per sample).
+/// What the review's fits keep between samples: the calibration, the two fits refitted in
+/// place, and the window's samples (no allocation, nothing to clear, per sample).
 #[derive(Clone, Debug, Default)]
 pub(super) struct Scratch {
     fit: WindowFit,
     up: WindowFit,
     calibration: Calibration,
+    /// The window's times and values, the fit's (neighbours dropped in place).
+    ts: Vec<f64>,
+    ys: Vec<f64>,
+    /// The accepted samples after the sample decided, and the window around it.
+    after: Vec<(f64, f64)>,
+    around: Vec<(f64, f64)>,
 }
 
 impl<S: Replay> Review<S> {
@@ -495,15 +532,11 @@ impl<S: Replay> Review<S> {
         let mut newest = None;
         while let Some(f) = self.first_undecided() {
             let front = &self.entries[f];
-            // The accepted samples after it (at most 2L), on the stack.
-            let mut after_buf = [(0.0, 0.0); WINDOW];
-            let mut n_after = 0;
+            // The accepted samples after it (at most 2L), in the scratch's buffer.
+            let mut after = std::mem::take(&mut self.scratch.after);
+            after.clear();
             let later = self.entries.iter().skip(f + 1).filter(|u| !u.rejected);
-            for u in later.take(2 * l.max(1)) {
-                after_buf[n_after] = (u.t, u.y);
-                n_after += 1;
-            }
-            let after = &after_buf[..n_after];
+            after.extend(later.take(2 * l.max(1)).map(|u| (u.t, u.y)));
             let overflow = self.entries.len() - f > MAX_UNDECIDED;
             let (before_wanted, ready) = if l == 0 {
                 (0, !front.rejected || !after.is_empty() || finishing)
@@ -517,26 +550,23 @@ impl<S: Replay> Review<S> {
                 (before, enough && !state.noise_is_early())
             };
             if !ready && !overflow {
+                self.scratch.after = after;
                 break;
             }
             let (gate, gate_rms, sample) = (front.rejected, front.gate_rms, (front.t, front.y));
             let verdict = match (l, state.noise_sigma(), overflow) {
                 (1.., Some(sigma), false) if k > 0.0 && sigma > 0.0 => {
                     let before = self.accepted.len().min(before_wanted);
-                    let mut around_buf = [(0.0, 0.0); WINDOW];
+                    let mut around = std::mem::take(&mut self.scratch.around);
+                    around.clear();
                     let accepted = &self.accepted;
                     let earlier = accepted.iter().skip(accepted.len() - before);
-                    let mut n = 0;
-                    for &s in earlier.chain(after.iter().take(2 * l - before)) {
-                        around_buf[n] = s;
-                        n += 1;
-                    }
-                    let around = &around_buf[..n];
-                    (around.len() >= degree + 2)
+                    around.extend(earlier.chain(after.iter().take(2 * l - before)));
+                    let verdict = (around.len() >= degree + 2)
                         .then(|| {
                             let c = &mut self.scratch;
                             interpolation_verdict(
-                                around,
+                                &around,
                                 sample,
                                 degree,
                                 sigma,
@@ -546,10 +576,13 @@ impl<S: Replay> Review<S> {
                             )
                         })
                         .flatten()
-                        .unwrap_or(gate)
+                        .unwrap_or(gate);
+                    self.scratch.around = around;
+                    verdict
                 }
                 _ => gate,
             };
+            self.scratch.after = after;
             if verdict != gate {
                 if let Ok(out) = self.take_again(state, f, verdict) {
                     newest = Some(out);
