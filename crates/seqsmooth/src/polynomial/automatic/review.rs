@@ -32,6 +32,7 @@
 use super::config::{AutoConfig, MAX_REVIEW_WINDOW};
 use super::output::AutoOutput;
 use crate::error::Error;
+use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
 use crate::polynomial::options::MAX_DEGREE;
 use crate::recursive::TriangularFactor;
 use std::collections::VecDeque;
@@ -330,6 +331,62 @@ impl WindowFit {
         Some(q)
     }
 
+    /// The largest squared studentised residual `e_j²/(σ²(1 − h_j))` (`s2 = σ²`, `h_j` the
+    /// fit's VRF at `t_j`, as [`value_and_vrf_at`](Self::value_and_vrf_at) gives it) over the
+    /// samples `(ts, ys)`, and its index (the first of equals); `None` while not determined or
+    /// when one is not a number. The fit's size compiled in ([`unrolled_sizes!`]).
+    fn worst_residual(&self, ts: &[f64], ys: &[f64], s2: f64) -> Option<(f64, usize)> {
+        let p = self.degree + 1;
+        unrolled_sizes!(p, N => self.worst_residual_with(Fixed::<N>, ts, ys, s2), p => self.worst_residual_with(Any(p), ts, ys, s2))
+    }
+
+    #[inline(always)]
+    fn worst_residual_with(
+        &self,
+        size: impl Size,
+        ts: &[f64],
+        ys: &[f64],
+        s2: f64,
+    ) -> Option<(f64, usize)> {
+        if !self.determined {
+            return None;
+        }
+        let p = size.get();
+        let u = self.factor.unit_triangle(p);
+        let (a, inv_d) = (&self.coefficients[..p], &self.inv_d[..p]);
+        let mut worst = (f64::NEG_INFINITY, 0);
+        for (j, (&t, &y)) in ts.iter().zip(ys).enumerate() {
+            let v = (t - self.centre) * self.inv_half;
+            let mut h = [0.0; MAX_FIT];
+            let mut power = 1.0;
+            for hk in &mut h[..p] {
+                *hk = power;
+                power *= v;
+            }
+            let value: f64 = a.iter().zip(&h[..p]).map(|(a, h)| a * h).sum();
+            // h_j = Σ_i g_i²/d_i with Uᵀ g = h ([`vrf_of`](Self::vrf_of)).
+            let mut g = [0.0; MAX_FIT];
+            let mut q = 0.0;
+            for i in 0..p {
+                let mut gi = h[i];
+                for k in 0..i {
+                    gi -= u[k * p + i] * g[k];
+                }
+                g[i] = gi;
+                q += gi * gi * inv_d[i];
+            }
+            let e = y - value;
+            let r2 = e * e / (s2 * (1.0 - q).max(f64::EPSILON));
+            if r2.is_nan() {
+                return None;
+            }
+            if r2 > worst.0 {
+                worst = (r2, j);
+            }
+        }
+        Some(worst)
+    }
+
     fn residual_sq(&self) -> f64 {
         self.factor.residual_sq()
     }
@@ -390,19 +447,7 @@ pub(super) fn interpolation_verdict(
         if n < degree + 4 {
             break;
         }
-        let mut worst = (f64::NEG_INFINITY, 0);
-        for j in 0..n {
-            let (p, h) = fit.value_and_vrf_at(ts[j])?;
-            // The squared studentised residual.
-            let e = ys[j] - p;
-            let r2 = e * e / (sigma * sigma * (1.0 - h).max(f64::EPSILON));
-            if r2.is_nan() {
-                return None;
-            }
-            if r2 > worst.0 {
-                worst = (r2, j);
-            }
-        }
+        let worst = fit.worst_residual(&ts[..n], &ys[..n], sigma * sigma)?;
         if worst.0 <= k * k {
             break;
         }
