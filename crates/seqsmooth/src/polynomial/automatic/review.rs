@@ -297,16 +297,22 @@ impl WindowFit {
     /// `p(t)` and its variance for unit noise `h(t)ᵀ(AᵀA)⁻¹h(t)`.
     fn value_and_vrf_at(&self, t: f64) -> Option<(f64, f64)> {
         let p = self.degree + 1;
-        let u = (t - self.centre) * self.inv_half;
-        let a = &self.coefficients;
         let mut h = [0.0; MAX_FIT];
+        let value = self.value_and_row(t, &mut h[..p]);
+        Some((value, self.vrf_of(&h[..p])?))
+    }
+
+    /// `p(t)`, with the row `h(t) = (1, u, …, u^d)` into `h` (`p` values).
+    #[inline(always)]
+    fn value_and_row(&self, t: f64, h: &mut [f64]) -> f64 {
+        let u = (t - self.centre) * self.inv_half;
         let mut power = 1.0;
-        for hk in &mut h[..p] {
+        for hk in h.iter_mut() {
             *hk = power;
             power *= u;
         }
-        let value = a[..p].iter().zip(&h[..p]).map(|(a, h)| a * h).sum();
-        Some((value, self.vrf_of(&h[..p])?))
+        let a = &self.coefficients[..h.len()];
+        a.iter().zip(h.iter()).map(|(a, h)| a * h).sum()
     }
 
     /// `hᵀ(AᵀA)⁻¹h = Σ_i g_i²/d_i` with `Uᵀ g = h` (`AᵀA = Uᵀ D U`, the factor's
@@ -317,18 +323,11 @@ impl WindowFit {
             return None;
         }
         let p = h.len();
-        let u = self.factor.unit_triangle(p);
-        let mut g = [0.0; MAX_FIT];
-        let mut q = 0.0;
-        for i in 0..p {
-            let mut gi = h[i];
-            for k in 0..i {
-                gi -= u[k * p + i] * g[k];
-            }
-            g[i] = gi;
-            q += gi * gi * self.inv_d[i];
-        }
-        Some(q)
+        Some(quadratic_form(
+            self.factor.unit_triangle(p),
+            &self.inv_d[..p],
+            h,
+        ))
     }
 
     /// The largest squared studentised residual `e_j²/(σ²(1 − h_j))` (`s2 = σ²`, `h_j` the
@@ -352,29 +351,12 @@ impl WindowFit {
             return None;
         }
         let p = size.get();
-        let u = self.factor.unit_triangle(p);
-        let (a, inv_d) = (&self.coefficients[..p], &self.inv_d[..p]);
+        let (u, inv_d) = (self.factor.unit_triangle(p), &self.inv_d[..p]);
         let mut worst = (f64::NEG_INFINITY, 0);
         for (j, (&t, &y)) in ts.iter().zip(ys).enumerate() {
-            let v = (t - self.centre) * self.inv_half;
             let mut h = [0.0; MAX_FIT];
-            let mut power = 1.0;
-            for hk in &mut h[..p] {
-                *hk = power;
-                power *= v;
-            }
-            let value: f64 = a.iter().zip(&h[..p]).map(|(a, h)| a * h).sum();
-            // h_j = Σ_i g_i²/d_i with Uᵀ g = h ([`vrf_of`](Self::vrf_of)).
-            let mut g = [0.0; MAX_FIT];
-            let mut q = 0.0;
-            for i in 0..p {
-                let mut gi = h[i];
-                for k in 0..i {
-                    gi -= u[k * p + i] * g[k];
-                }
-                g[i] = gi;
-                q += gi * gi * inv_d[i];
-            }
+            let value = self.value_and_row(t, &mut h[..p]);
+            let q = quadratic_form(u, inv_d, &h[..p]);
             let e = y - value;
             let r2 = e * e / (s2 * (1.0 - q).max(f64::EPSILON));
             if r2.is_nan() {
@@ -390,6 +372,24 @@ impl WindowFit {
     fn residual_sq(&self) -> f64 {
         self.factor.residual_sq()
     }
+}
+
+/// `hᵀ(AᵀA)⁻¹h = Σ_i g_i²/d_i` with `Uᵀ g = h`, for the unit triangle `u` (row-major, `p × p`,
+/// `p = h.len()`) and the pivots' reciprocals `inv_d` of `AᵀA = Uᵀ D U`.
+#[inline(always)]
+fn quadratic_form(u: &[f64], inv_d: &[f64], h: &[f64]) -> f64 {
+    let p = h.len();
+    let mut g = [0.0; MAX_FIT];
+    let mut q = 0.0;
+    for i in 0..p {
+        let mut gi = h[i];
+        for k in 0..i {
+            gi -= u[k * p + i] * g[k];
+        }
+        g[i] = gi;
+        q += gi * gi * inv_d[i];
+    }
+    q
 }
 
 /// The most coefficients of a [`WindowFit`]: degree `MAX_DEGREE + 2`.
