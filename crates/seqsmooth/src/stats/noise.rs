@@ -256,8 +256,15 @@ fn divided_difference_with_factors(times: &[f64], values: &[f64], factors: &[f64
     let mut num = 0.0;
     let mut norm = 0.0;
     // Weights relative to the span; the common factor span^(-k+1) cancels in the ratio. Scale
-    // them by the largest to keep the sums in range.
-    let mut w = vec![0.0; k];
+    // them by the largest to keep the sums in range. On the stack up to the largest order.
+    let mut stack = [0.0; MAX_DIFFERENCE_ORDER + 1];
+    let mut heap = Vec::new();
+    let w: &mut [f64] = if k <= stack.len() {
+        &mut stack[..k]
+    } else {
+        heap.resize(k, 0.0);
+        &mut heap
+    };
     for j in 0..k {
         let mut p = 1.0;
         for i in 0..k {
@@ -516,15 +523,21 @@ impl DifferenceNoise {
         if self.times.len() < self.order + 1 {
             return Ok(None);
         }
-        // The windows as slices, in place (no copy per sample).
-        self.times.make_contiguous();
-        self.values.make_contiguous();
-        self.factors.make_contiguous();
-        let (d, expected) = divided_difference_with_factors(
-            self.times.as_slices().0,
-            self.values.as_slices().0,
-            self.factors.as_slices().0,
-        );
+        // The windows copied to the stack (`order + 1 ≤ MAX_DIFFERENCE_ORDER + 1` values each):
+        // cheaper than rotating the rings in place at every sample.
+        let k = self.order + 1;
+        let mut window = [[0.0; MAX_DIFFERENCE_ORDER + 1]; 3];
+        for (w, ring) in window
+            .iter_mut()
+            .zip([&self.times, &self.values, &self.factors])
+        {
+            for (a, &b) in w.iter_mut().zip(ring) {
+                *a = b;
+            }
+        }
+        let [times, values, factors] = &window;
+        let (d, expected) =
+            divided_difference_with_factors(&times[..k], &values[..k], &factors[..k]);
         let d2 = d * d / expected;
         if !self.screened_out(d2) {
             self.squares.push(d2);

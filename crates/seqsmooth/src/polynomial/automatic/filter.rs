@@ -320,10 +320,7 @@ impl AutomaticFilter {
         // step still fail, go back to the state before the sample so that an error never
         // leaves a half update ([`Review::recover`]). The state before one sample in eight is
         // kept: what its review may go back to.
-        let before = self
-            .review
-            .keeps_next()
-            .then(|| Box::new(self.state.clone()));
+        let before = self.review.snapshot(&self.state);
         match self.state.step(t, y, None) {
             Ok(out) => {
                 let out = self.review.review(&mut self.state, (t, y), out, before);

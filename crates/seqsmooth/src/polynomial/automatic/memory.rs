@@ -172,7 +172,7 @@ impl Fresh {
 /// The final degree's memories (see the module docs): memory 0 (expanding until the switch,
 /// then fading) and the shorter ones, each with its degree `m + 1` companion; which one is in
 /// use, and each one's calibration.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub(super) struct Memories {
     /// The final-degree expanding-memory filter of the current memory, until the switch.
     expanding: Option<ExpandingMemory>,
@@ -206,6 +206,26 @@ pub(super) struct Memories {
     /// The filters before their first sample (shared by every copy of the state).
     fresh: Arc<Fresh>,
 }
+
+// Field by field, `clone_from` too (the review's kept copies reuse their buffers).
+field_clone!(Memories {
+    expanding,
+    fading,
+    upper_expanding,
+    upper_fading,
+    shorter,
+    memory,
+    longer_runs,
+    compared,
+    predictions,
+    calibration,
+    switched_at,
+    switched,
+    t_first,
+    switch_constant,
+    memory_constant,
+    fresh
+});
 
 impl Memories {
     /// The memories of `cfg`'s final degree, before the first sample.

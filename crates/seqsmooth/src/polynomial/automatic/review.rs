@@ -32,6 +32,7 @@
 use super::config::{AutoConfig, MAX_REVIEW_WINDOW};
 use super::output::AutoOutput;
 use crate::error::Error;
+use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
 use crate::polynomial::options::MAX_DEGREE;
 use crate::recursive::TriangularFactor;
 use std::collections::VecDeque;
@@ -46,6 +47,10 @@ pub(super) const MAX_UNDECIDED: usize = 63;
 /// before it), so the review holds one or two copies of the state rather than one per sample
 /// waiting.
 const SNAPSHOT_EVERY: usize = 8;
+
+/// Kept states no longer needed that the review holds for their buffers (the next kept state
+/// is copied into one: no allocation).
+const SPARE_STATES: usize = 2;
 
 /// What the review goes back to and replays: the state one update changes (the filter without
 /// its review, [`super::state::State`]).
@@ -82,6 +87,8 @@ struct Entry<S> {
 #[derive(Clone, Debug)]
 pub(super) struct Review<S> {
     entries: VecDeque<Entry<S>>,
+    /// Kept states no longer needed, whose buffers the next one reuses ([`Review::snapshot`]).
+    spare: Vec<Box<S>>,
     accepted: VecDeque<(f64, f64)>,
     scratch: Scratch,
     window: usize,
@@ -133,6 +140,7 @@ impl<S: Replay> Review<S> {
     pub(super) fn new(cfg: &AutoConfig) -> Self {
         Self {
             entries: VecDeque::new(),
+            spare: Vec::new(),
             accepted: VecDeque::new(),
             scratch: Scratch::default(),
             window: cfg.review_window,
@@ -166,6 +174,21 @@ impl<S: Replay> Review<S> {
             .all(|e| e.before.is_none())
     }
 
+    /// The state before the next sample when it keeps it ([`keeps_next`](Self::keeps_next)):
+    /// a copy of `state`, into the buffers of a kept state no longer needed when there is one.
+    pub(super) fn snapshot(&mut self, state: &S) -> Option<Box<S>> {
+        if !self.keeps_next() {
+            return None;
+        }
+        Some(match self.spare.pop() {
+            Some(mut kept) => {
+                kept.as_mut().clone_from(state);
+                kept
+            }
+            None => Box::new(state.clone()),
+        })
+    }
+
     /// The newest `n` rejected samples waiting (a run just applied) are not rejected.
     fn reinstate(&mut self, n: usize) {
         reinstate(self.entries.iter_mut(), n);
@@ -179,12 +202,20 @@ impl<S: Replay> Review<S> {
     /// Drops the decided samples before the last kept state at or before the first sample
     /// waiting (all of them when none waits): the first entry always keeps the state before it.
     fn trim(&mut self) {
-        let Some(f) = self.first_undecided() else {
-            self.entries.clear();
-            return;
+        let end = match self.first_undecided() {
+            Some(f) => (0..=f)
+                .rev()
+                .find(|&j| self.entries[j].before.is_some())
+                .unwrap_or(0),
+            None => self.entries.len(),
         };
-        let kept = (0..=f).rev().find(|&j| self.entries[j].before.is_some());
-        self.entries.drain(..kept.unwrap_or(0));
+        for e in self.entries.drain(..end) {
+            if let Some(kept) = e.before {
+                if self.spare.len() < SPARE_STATES {
+                    self.spare.push(kept);
+                }
+            }
+        }
     }
 }
 
@@ -266,16 +297,22 @@ impl WindowFit {
     /// `p(t)` and its variance for unit noise `h(t)ᵀ(AᵀA)⁻¹h(t)`.
     fn value_and_vrf_at(&self, t: f64) -> Option<(f64, f64)> {
         let p = self.degree + 1;
-        let u = (t - self.centre) * self.inv_half;
-        let a = &self.coefficients;
         let mut h = [0.0; MAX_FIT];
+        let value = self.value_and_row(t, &mut h[..p]);
+        Some((value, self.vrf_of(&h[..p])?))
+    }
+
+    /// `p(t)`, with the row `h(t) = (1, u, …, u^d)` into `h` (`p` values).
+    #[inline(always)]
+    fn value_and_row(&self, t: f64, h: &mut [f64]) -> f64 {
+        let u = (t - self.centre) * self.inv_half;
         let mut power = 1.0;
-        for hk in &mut h[..p] {
+        for hk in h.iter_mut() {
             *hk = power;
             power *= u;
         }
-        let value = a[..p].iter().zip(&h[..p]).map(|(a, h)| a * h).sum();
-        Some((value, self.vrf_of(&h[..p])?))
+        let a = &self.coefficients[..h.len()];
+        a.iter().zip(h.iter()).map(|(a, h)| a * h).sum()
     }
 
     /// `hᵀ(AᵀA)⁻¹h = Σ_i g_i²/d_i` with `Uᵀ g = h` (`AᵀA = Uᵀ D U`, the factor's
@@ -286,23 +323,73 @@ impl WindowFit {
             return None;
         }
         let p = h.len();
-        let u = self.factor.unit_triangle(p);
-        let mut g = [0.0; MAX_FIT];
-        let mut q = 0.0;
-        for i in 0..p {
-            let mut gi = h[i];
-            for k in 0..i {
-                gi -= u[k * p + i] * g[k];
-            }
-            g[i] = gi;
-            q += gi * gi * self.inv_d[i];
+        Some(quadratic_form(
+            self.factor.unit_triangle(p),
+            &self.inv_d[..p],
+            h,
+        ))
+    }
+
+    /// The largest squared studentised residual `e_j²/(σ²(1 − h_j))` (`s2 = σ²`, `h_j` the
+    /// fit's VRF at `t_j`, as [`value_and_vrf_at`](Self::value_and_vrf_at) gives it) over the
+    /// samples `(ts, ys)`, and its index (the first of equals); `None` while not determined or
+    /// when one is not a number. The fit's size compiled in ([`unrolled_sizes!`]).
+    fn worst_residual(&self, ts: &[f64], ys: &[f64], s2: f64) -> Option<(f64, usize)> {
+        let p = self.degree + 1;
+        unrolled_sizes!(p, N => self.worst_residual_with(Fixed::<N>, ts, ys, s2), p => self.worst_residual_with(Any(p), ts, ys, s2))
+    }
+
+    #[inline(always)]
+    fn worst_residual_with(
+        &self,
+        size: impl Size,
+        ts: &[f64],
+        ys: &[f64],
+        s2: f64,
+    ) -> Option<(f64, usize)> {
+        if !self.determined {
+            return None;
         }
-        Some(q)
+        let p = size.get();
+        let (u, inv_d) = (self.factor.unit_triangle(p), &self.inv_d[..p]);
+        let mut worst = (f64::NEG_INFINITY, 0);
+        for (j, (&t, &y)) in ts.iter().zip(ys).enumerate() {
+            let mut h = [0.0; MAX_FIT];
+            let value = self.value_and_row(t, &mut h[..p]);
+            let q = quadratic_form(u, inv_d, &h[..p]);
+            let e = y - value;
+            let r2 = e * e / (s2 * (1.0 - q).max(f64::EPSILON));
+            if r2.is_nan() {
+                return None;
+            }
+            if r2 > worst.0 {
+                worst = (r2, j);
+            }
+        }
+        Some(worst)
     }
 
     fn residual_sq(&self) -> f64 {
         self.factor.residual_sq()
     }
+}
+
+/// `hᵀ(AᵀA)⁻¹h = Σ_i g_i²/d_i` with `Uᵀ g = h`, for the unit triangle `u` (row-major, `p × p`,
+/// `p = h.len()`) and the pivots' reciprocals `inv_d` of `AᵀA = Uᵀ D U`.
+#[inline(always)]
+fn quadratic_form(u: &[f64], inv_d: &[f64], h: &[f64]) -> f64 {
+    let p = h.len();
+    let mut g = [0.0; MAX_FIT];
+    let mut q = 0.0;
+    for i in 0..p {
+        let mut gi = h[i];
+        for k in 0..i {
+            gi -= u[k * p + i] * g[k];
+        }
+        g[i] = gi;
+        q += gi * gi * inv_d[i];
+    }
+    q
 }
 
 /// The most coefficients of a [`WindowFit`]: degree `MAX_DEGREE + 2`.
@@ -332,14 +419,15 @@ pub(super) fn interpolation_verdict(
         fit,
         up,
         calibration,
+        ts,
+        ys,
+        ..
     } = scratch;
-    let mut ts = [0.0; WINDOW];
-    let mut ys = [0.0; WINDOW];
     let mut n = around.len().min(WINDOW);
-    for (i, &(t, y)) in around[..n].iter().enumerate() {
-        ts[i] = t;
-        ys[i] = y;
-    }
+    ts.clear();
+    ys.clear();
+    ts.extend(around[..n].iter().map(|s| s.0));
+    ys.extend(around[..n].iter().map(|s| s.1));
     if !fit.fit(&ts[..n], &ys[..n], degree) {
         return None;
     }
@@ -359,19 +447,7 @@ pub(super) fn interpolation_verdict(
         if n < degree + 4 {
             break;
         }
-        let mut worst = (f64::NEG_INFINITY, 0);
-        for j in 0..n {
-            let (p, h) = fit.value_and_vrf_at(ts[j])?;
-            // The squared studentised residual.
-            let e = ys[j] - p;
-            let r2 = e * e / (sigma * sigma * (1.0 - h).max(f64::EPSILON));
-            if r2.is_nan() {
-                return None;
-            }
-            if r2 > worst.0 {
-                worst = (r2, j);
-            }
-        }
+        let worst = fit.worst_residual(&ts[..n], &ys[..n], sigma * sigma)?;
         if worst.0 <= k * k {
             break;
         }
@@ -419,13 +495,19 @@ pub(super) fn interpolation_verdict(
 /// The most samples of a review window: `L` on each side.
 const WINDOW: usize = 2 * MAX_REVIEW_WINDOW;
 
-/// What the review's fits keep between samples: the calibration, and the two fits refitted in
-/// place (no allocation per sample).
+/// What the review's fits keep between samples: the calibration, the two fits refitted in
+/// place, and the window's samples (no allocation, nothing to clear, per sample).
 #[derive(Clone, Debug, Default)]
 pub(super) struct Scratch {
     fit: WindowFit,
     up: WindowFit,
     calibration: Calibration,
+    /// The window's times and values, the fit's (neighbours dropped in place).
+    ts: Vec<f64>,
+    ys: Vec<f64>,
+    /// The accepted samples after the sample decided, and the window around it.
+    after: Vec<(f64, f64)>,
+    around: Vec<(f64, f64)>,
 }
 
 impl<S: Replay> Review<S> {
@@ -495,15 +577,11 @@ impl<S: Replay> Review<S> {
         let mut newest = None;
         while let Some(f) = self.first_undecided() {
             let front = &self.entries[f];
-            // The accepted samples after it (at most 2L), on the stack.
-            let mut after_buf = [(0.0, 0.0); WINDOW];
-            let mut n_after = 0;
+            // The accepted samples after it (at most 2L), in the scratch's buffer.
+            let mut after = std::mem::take(&mut self.scratch.after);
+            after.clear();
             let later = self.entries.iter().skip(f + 1).filter(|u| !u.rejected);
-            for u in later.take(2 * l.max(1)) {
-                after_buf[n_after] = (u.t, u.y);
-                n_after += 1;
-            }
-            let after = &after_buf[..n_after];
+            after.extend(later.take(2 * l.max(1)).map(|u| (u.t, u.y)));
             let overflow = self.entries.len() - f > MAX_UNDECIDED;
             let (before_wanted, ready) = if l == 0 {
                 (0, !front.rejected || !after.is_empty() || finishing)
@@ -517,26 +595,23 @@ impl<S: Replay> Review<S> {
                 (before, enough && !state.noise_is_early())
             };
             if !ready && !overflow {
+                self.scratch.after = after;
                 break;
             }
             let (gate, gate_rms, sample) = (front.rejected, front.gate_rms, (front.t, front.y));
             let verdict = match (l, state.noise_sigma(), overflow) {
                 (1.., Some(sigma), false) if k > 0.0 && sigma > 0.0 => {
                     let before = self.accepted.len().min(before_wanted);
-                    let mut around_buf = [(0.0, 0.0); WINDOW];
+                    let mut around = std::mem::take(&mut self.scratch.around);
+                    around.clear();
                     let accepted = &self.accepted;
                     let earlier = accepted.iter().skip(accepted.len() - before);
-                    let mut n = 0;
-                    for &s in earlier.chain(after.iter().take(2 * l - before)) {
-                        around_buf[n] = s;
-                        n += 1;
-                    }
-                    let around = &around_buf[..n];
-                    (around.len() >= degree + 2)
+                    around.extend(earlier.chain(after.iter().take(2 * l - before)));
+                    let verdict = (around.len() >= degree + 2)
                         .then(|| {
                             let c = &mut self.scratch;
                             interpolation_verdict(
-                                around,
+                                &around,
                                 sample,
                                 degree,
                                 sigma,
@@ -546,10 +621,13 @@ impl<S: Replay> Review<S> {
                             )
                         })
                         .flatten()
-                        .unwrap_or(gate)
+                        .unwrap_or(gate);
+                    self.scratch.around = around;
+                    verdict
                 }
                 _ => gate,
             };
+            self.scratch.after = after;
             if verdict != gate {
                 if let Ok(out) = self.take_again(state, f, verdict) {
                     newest = Some(out);

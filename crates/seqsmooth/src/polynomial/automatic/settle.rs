@@ -110,6 +110,11 @@ impl Ladder {
             }
             self.filters[self.active] = None;
             self.active = c;
+            if self.settled() {
+                // Every filter below the final degree is passed: none is kept (nor copied with
+                // the state).
+                self.filters = Vec::new();
+            }
             misfit.reset();
             self.stable_runs = 0;
             self.prev_top = None;

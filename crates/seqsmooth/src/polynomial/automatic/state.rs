@@ -22,7 +22,7 @@ use crate::polynomial::options::MAX_DEGREE;
 use crate::stats::ChiSquaredOutcome;
 
 /// The automatic filter's state without its review (what a review's decision goes back to).
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub(super) struct State {
     cfg: AutoConfig,
     ladder: Ladder,
@@ -36,6 +36,20 @@ pub(super) struct State {
     /// window, `max(0, mean(k²) − 1)·σ²(1 + v)` (value units²), at the newest sample.
     excess: f64,
 }
+
+// Field by field, `clone_from` too: a kept copy of the state (the review's) is taken again
+// into the buffers it has.
+field_clone!(State {
+    cfg,
+    ladder,
+    memories,
+    noise,
+    misfit,
+    run,
+    accepted,
+    last_time,
+    excess
+});
 
 impl State {
     /// The state of a checked configuration before the first sample.
