@@ -306,6 +306,12 @@ pub enum Param {
     ProcessNoiseFunction,
     /// The observation components that are angles (their residuals wrapped to `(−π, π]`).
     AngleComponents,
+    /// The coordinated turn's known turn rate `ω`.
+    TurnRate,
+    /// The coordinated turn's random-walk density `q_ω` of an estimated turn rate.
+    TurnRateNoise,
+    /// A built-in motion model's name (`seqsmooth track --model`).
+    MotionModel,
 }
 
 impl Param {
@@ -453,6 +459,9 @@ impl Param {
         Param::ObservationJacobian,
         Param::ProcessNoiseFunction,
         Param::AngleComponents,
+        Param::TurnRate,
+        Param::TurnRateNoise,
+        Param::MotionModel,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -600,6 +609,9 @@ impl Param {
             Param::ObservationJacobian => "observation Jacobian",
             Param::ProcessNoiseFunction => "process noise function",
             Param::AngleComponents => "angle components",
+            Param::TurnRate => "turn rate",
+            Param::TurnRateNoise => "turn rate noise",
+            Param::MotionModel => "motion model",
         }
     }
 
