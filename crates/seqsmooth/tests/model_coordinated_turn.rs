@@ -38,7 +38,11 @@ fn the_estimated_rate_transition_is_its_derivative() {
             let phi = turn.propagate(&x, 10.0, 10.0 + zeta).unwrap().transition;
             let at = |x: &DVector<f64>| turn.propagate(x, 10.0, 10.0 + zeta).unwrap().state;
             for col in 0..7 {
-                let h = if col == 6 { 1e-4 } else { 1e-2 * x[col].abs().max(1.0) };
+                let h = if col == 6 {
+                    1e-4
+                } else {
+                    1e-2 * x[col].abs().max(1.0)
+                };
                 let diff = |h: f64| {
                     let (mut up, mut down) = (x.clone(), x.clone());
                     up[col] += h;
@@ -94,7 +98,10 @@ fn the_known_rate_model_is_its_exponential_and_van_loan() {
             worst = (worst.0.max(e_phi), worst.1.max(e_q));
         }
     }
-    println!("largest relative difference: Φ {:.1e}, Q {:.1e}", worst.0, worst.1);
+    println!(
+        "largest relative difference: Φ {:.1e}, Q {:.1e}",
+        worst.0, worst.1
+    );
 }
 
 /// At `ω = 0` the turn is constant velocity exactly, and `Q` constant velocity's; near 0 the
@@ -113,9 +120,20 @@ fn a_vanishing_rate_is_constant_velocity() {
         assert_eq!(p.state[6], 0.0);
         // The ω column at 0: ∂x/∂ω = −ẏ ζ²/2, ∂y/∂ω = ẋ ζ²/2, ∂ẋ/∂ω = −ζ ẏ, ∂ẏ/∂ω = ζ ẋ.
         let z2 = zeta * zeta;
-        let want = [-x[4] * z2 / 2.0, x[3] * z2 / 2.0, 0.0, -zeta * x[4], zeta * x[3], 0.0, 1.0];
+        let want = [
+            -x[4] * z2 / 2.0,
+            x[3] * z2 / 2.0,
+            0.0,
+            -zeta * x[4],
+            zeta * x[3],
+            0.0,
+            1.0,
+        ];
         for (row, w) in want.iter().enumerate() {
-            assert!((p.transition[(row, 6)] - w).abs() <= 1e-15 * w.abs(), "ζ {zeta} row {row}");
+            assert!(
+                (p.transition[(row, 6)] - w).abs() <= 1e-15 * w.abs(),
+                "ζ {zeta} row {row}"
+            );
         }
         let q_cv = WhiteNoiseDerivative::new(1, 3, 0.4)
             .unwrap()
@@ -154,8 +172,12 @@ fn a_vanishing_rate_is_constant_velocity() {
 fn the_series_meets_the_closed_form() {
     let turn = CoordinatedTurn::estimated(1.0, 0.0).unwrap();
     let zeta = 2.0;
-    let below = turn.propagate(&state(0.5 * (1.0 - 1e-15)), 0.0, zeta).unwrap();
-    let above = turn.propagate(&state(0.5 * (1.0 + 1e-15)), 0.0, zeta).unwrap();
+    let below = turn
+        .propagate(&state(0.5 * (1.0 - 1e-15)), 0.0, zeta)
+        .unwrap();
+    let above = turn
+        .propagate(&state(0.5 * (1.0 + 1e-15)), 0.0, zeta)
+        .unwrap();
     let e = relative(&below.transition, &above.transition);
     assert!(e < 1e-13, "{e:e}");
     let qb = CoordinatedTurn::known(0.5 * (1.0 - 1e-15), 1.0).unwrap();
