@@ -6,16 +6,16 @@
 use crate::arrays::{matrix, series, times, Series};
 use crate::errors::{raise, to_py, IntoPy, Kind};
 use crate::kalman::discount_from;
+use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::estimate::gauss_newton::{check_max_iterations, GaussNewton, Measurement};
 use seqsmooth::kalman::smoother::Smoothed;
 use seqsmooth::model::radar::{AzimuthConvention, Radar};
-use nalgebra::{DMatrix, DVector};
 use seqsmooth::track::{
-    radar_row, MotionModel, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked,
-    DEFAULT_LAG, DEFAULT_WINDOW, REPORTED,
+    radar_row, MotionModel, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, DEFAULT_LAG,
+    DEFAULT_WINDOW, REPORTED,
 };
 use seqsmooth::{Error, Param};
 

@@ -4,6 +4,7 @@
 //! chooses: `q₀ 4^ℓ` or `θ = 1 − (1 − θ₀) 2^ℓ`; and the gated update of each row through it.
 
 use super::adaptive::{Monitor, TrackFlag};
+use super::model::{MotionModel, TrackDynamics};
 use crate::discount::Discount;
 use crate::error::Error;
 use crate::kalman::filter::KalmanFilter;
@@ -12,7 +13,6 @@ use crate::kalman::smoother::Smoothed;
 use crate::model::measurement::Measurement;
 use crate::model::measurement::NoiseCovariance;
 use crate::model::radar::Radar;
-use super::model::{MotionModel, TrackDynamics};
 
 /// The filter of the Kalman methods.
 pub(super) type Filter = KalmanFilter<TrackDynamics, Radar>;

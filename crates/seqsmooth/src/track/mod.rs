@@ -363,58 +363,7 @@ impl RadarTracker {
         solver: GaussNewton,
     ) -> Result<Self, Error> {
         model.check()?;
-        let refuse = |name: Param, value: String, reason: &str| Error::InvalidParameter {
-            name,
-            value,
-            reason: reason.into(),
-        };
-        match (method, model) {
-            (TrackMethod::Window { .. }, MotionModel::ConstantVelocity) => {}
-            (TrackMethod::Window { .. }, _) => {
-                return Err(refuse(
-                    Param::MotionModel,
-                    model.name().into(),
-                    "the window method fits the constant-velocity model only (use the \
-                     kalman, smooth or fading method)",
-                ))
-            }
-            (
-                TrackMethod::Kalman { q: Some(q) } | TrackMethod::Smooth { q: Some(q), .. },
-                MotionModel::Singer { .. },
-            ) => {
-                return Err(refuse(
-                    Param::Q,
-                    q.to_string(),
-                    "does not apply to the singer model: its driving noise is the manoeuvre \
-                     variance",
-                ))
-            }
-            (
-                TrackMethod::Fading(_),
-                MotionModel::Singer {
-                    variance: Some(v), ..
-                },
-            ) => {
-                return Err(refuse(
-                    Param::ManoeuvreVariance,
-                    v.to_string(),
-                    "does not apply to the fading method, which has no driving noise",
-                ))
-            }
-            (
-                TrackMethod::Fading(_),
-                MotionModel::CoordinatedTurn {
-                    turn_rate_noise: Some(v),
-                },
-            ) => {
-                return Err(refuse(
-                    Param::TurnRateNoise,
-                    v.to_string(),
-                    "does not apply to the fading method, which has no driving noise",
-                ))
-            }
-            _ => {}
-        }
+        model.check_method(method)?;
         let dynamics = model.dynamics()?;
         check_max_iterations(solver.max_iterations)?;
         let fit_radar = match model.start_degree() {
@@ -500,8 +449,7 @@ impl RadarTracker {
         // The row taken: `None` held, else `Some((nis, flag))`; the estimate is borrowed below.
         let taken = match &mut self.stage {
             Stage::Starting(fit) => {
-                let Some(mut c) = fit.push(m.clone()).map_err(|e| window(START_WINDOW, e))?
-                else {
+                let Some(mut c) = fit.push(m.clone()).map_err(|e| window(START_WINDOW, e))? else {
                     self.rows += 1;
                     self.last_time = m.time;
                     return Ok(Tracked::Undetermined);
@@ -703,11 +651,7 @@ pub fn window_flag(c: &Correction) -> TrackFlag {
 }
 
 /// A Kalman filter (no driving noise, no fading) from a fit.
-fn filter_from(
-    dynamics: TrackDynamics,
-    radar: Radar,
-    c: &Correction,
-) -> Result<Filter, Error> {
+fn filter_from(dynamics: TrackDynamics, radar: Radar, c: &Correction) -> Result<Filter, Error> {
     KalmanFilter::new(
         dynamics,
         radar,

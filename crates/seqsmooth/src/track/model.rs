@@ -16,6 +16,7 @@
 //! polynomial model of the start's degree; the turn rate starts at 0 (a straight leg).
 
 use super::memory::Filter;
+use super::TrackMethod;
 use crate::error::{Error, Param};
 use crate::estimate::gauss_newton::Correction;
 use crate::kalman::noise::WhiteNoiseDerivative;
@@ -206,6 +207,73 @@ impl MotionModel {
         self.dynamics().map(|_| ())
     }
 
+    /// Refuses the model where `method` cannot use it: the window method fits constant
+    /// velocity only; a `q` does not apply to Singer (its driving noise is its variance); the
+    /// fading method has no driving noise, so neither a Singer variance nor a turn rate noise.
+    ///
+    /// ```
+    /// use seqsmooth::track::{MotionModel, TrackMethod};
+    /// let singer = MotionModel::named("singer").unwrap();
+    /// assert!(singer.check_method(TrackMethod::Kalman { q: None }).is_ok());
+    /// assert!(singer.check_method(TrackMethod::Kalman { q: Some(1.0) }).is_err());
+    /// assert!(singer.check_method(TrackMethod::Window { window: 8 }).is_err());
+    /// ```
+    pub fn check_method(self, method: TrackMethod) -> Result<(), Error> {
+        let refuse = |name: Param, value: String, reason: &str| Error::InvalidParameter {
+            name,
+            value,
+            reason: reason.into(),
+        };
+        match (method, self) {
+            (TrackMethod::Window { .. }, MotionModel::ConstantVelocity) => {}
+            (TrackMethod::Window { .. }, _) => {
+                return Err(refuse(
+                    Param::MotionModel,
+                    self.name().into(),
+                    "the window method fits the constant-velocity model only (use the \
+                     kalman, smooth or fading method)",
+                ))
+            }
+            (
+                TrackMethod::Kalman { q: Some(q) } | TrackMethod::Smooth { q: Some(q), .. },
+                MotionModel::Singer { .. },
+            ) => {
+                return Err(refuse(
+                    Param::Q,
+                    q.to_string(),
+                    "does not apply to the singer model: its driving noise is the manoeuvre \
+                     variance",
+                ))
+            }
+            (
+                TrackMethod::Fading(_),
+                MotionModel::Singer {
+                    variance: Some(v), ..
+                },
+            ) => {
+                return Err(refuse(
+                    Param::ManoeuvreVariance,
+                    v.to_string(),
+                    "does not apply to the fading method, which has no driving noise",
+                ))
+            }
+            (
+                TrackMethod::Fading(_),
+                MotionModel::CoordinatedTurn {
+                    turn_rate_noise: Some(v),
+                },
+            ) => {
+                return Err(refuse(
+                    Param::TurnRateNoise,
+                    v.to_string(),
+                    "does not apply to the fading method, which has no driving noise",
+                ))
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
     /// The degree of the polynomial model of the start's fit: 2 where the state holds the
     /// acceleration, else 1.
     pub(crate) fn start_degree(self) -> usize {
@@ -236,7 +304,9 @@ impl MotionModel {
     /// The dynamics (checked).
     pub(crate) fn dynamics(self) -> Result<TrackDynamics, Error> {
         Ok(match self {
-            MotionModel::ConstantVelocity => TrackDynamics::Polynomial(PolynomialDynamics::new(1, 3)),
+            MotionModel::ConstantVelocity => {
+                TrackDynamics::Polynomial(PolynomialDynamics::new(1, 3))
+            }
             MotionModel::ConstantAcceleration => {
                 TrackDynamics::Polynomial(PolynomialDynamics::new(2, 3))
             }
