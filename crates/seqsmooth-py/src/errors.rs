@@ -116,6 +116,10 @@ pub fn keyword(p: Param) -> Option<&'static str> {
         Param::ObservationJacobian => Some("H_jacobian"),
         Param::ProcessNoiseFunction => Some("Q"),
         Param::AngleComponents => Some("angles"),
+        Param::MotionModel => Some("model"),
+        Param::ManoeuvreAlpha => Some("manoeuvre_alpha"),
+        Param::ManoeuvreVariance => Some("manoeuvre_variance"),
+        Param::TurnRateNoise => Some("turn_rate_noise"),
         _ => None,
     }
 }

@@ -13,6 +13,7 @@ mod fit;
 mod frame;
 mod kalman;
 mod linear;
+mod models;
 mod paml;
 mod polynomial;
 mod smooth;
@@ -41,6 +42,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<unscented::PyUnscentedKalmanFilter>()?;
     m.add_class::<callables::PyExtendedKalmanFilter>()?;
     m.add_class::<track::PyRadarTracker>()?;
+    m.add_class::<models::PyCoordinatedTurn>()?;
     m.add_class::<fit::PySlidingFit>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
     m.add_function(wrap_pyfunction!(frame::filter_series, m)?)?;

@@ -128,19 +128,26 @@ fn simulate(r: &mut StdRng) -> (Vec<Measurement>, Vec<DVector<f64>>) {
     (rows, truths)
 }
 
-/// The NEES of `(state, covariance)` at steps 30 and 59 of a forward pass.
-fn forward_nees(
-    k: usize,
-    x: &DVector<f64>,
-    s: &DMatrix<f64>,
+/// A filter's forward pass over `rows` (`update` gives each update's NIS and degrees of
+/// freedom, and the state and covariance after it): its NEES at steps 30 and 59, and every
+/// update's NIS.
+#[allow(clippy::type_complexity)]
+fn forward(
+    rows: &[Measurement],
     truths: &[DVector<f64>],
-    out: &mut [f64; 2],
-) {
-    for (slot, at) in [30, STEPS - 1].into_iter().enumerate() {
-        if k == at {
-            out[slot] = nees(x, s, &truths[k]).unwrap();
+    mut update: impl FnMut(&Measurement) -> (Option<(f64, usize)>, DVector<f64>, DMatrix<f64>),
+) -> ([f64; 2], Vec<(f64, usize)>) {
+    let (mut nis, mut filter_nees) = (Vec::new(), [0.0; 2]);
+    for (k, m) in rows.iter().enumerate() {
+        let (i, x, s) = update(m);
+        nis.extend(i);
+        for (slot, at) in [30, STEPS - 1].into_iter().enumerate() {
+            if k == at {
+                filter_nees[slot] = nees(&x, &s, &truths[k]).unwrap();
+            }
         }
     }
+    (filter_nees, nis)
 }
 
 fn run(seed: u64) -> Run {
@@ -155,13 +162,10 @@ fn run(seed: u64) -> Run {
             .unwrap()
     };
     let mut f = unscented_filter();
-    let (mut nis, mut filter_nees) = (Vec::new(), [0.0; 2]);
-    for (k, m) in rows.iter().enumerate() {
-        if let Some(i) = f.update(m).unwrap() {
-            nis.push((i.nis, i.components.len()));
-        }
-        forward_nees(k, f.state(), f.covariance(), &truths, &mut filter_nees);
-    }
+    let (filter_nees, nis) = forward(&rows, &truths, |m| {
+        let i = f.update(m).unwrap().map(|i| (i.nis, i.components.len()));
+        (i, f.state().clone(), f.covariance().clone())
+    });
     let smoothed = smooth_unscented(unscented_filter(), &rows).unwrap();
     let at = |k: usize| {
         (
@@ -179,13 +183,10 @@ fn run(seed: u64) -> Run {
             .unwrap()
     };
     let mut f = extended_filter();
-    let (mut nis, mut filter_nees) = (Vec::new(), [0.0; 2]);
-    for (k, m) in rows.iter().enumerate() {
-        if let Some(i) = f.update(m).unwrap() {
-            nis.push((i.nis, i.components.len()));
-        }
-        forward_nees(k, f.state(), f.covariance(), &truths, &mut filter_nees);
-    }
+    let (filter_nees, nis) = forward(&rows, &truths, |m| {
+        let i = f.update(m).unwrap().map(|i| (i.nis, i.components.len()));
+        (i, f.state().clone(), f.covariance().clone())
+    });
     let smoothed = smoother::smooth(extended_filter(), &rows).unwrap();
     let at = |k: usize| {
         (

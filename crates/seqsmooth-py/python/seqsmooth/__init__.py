@@ -24,9 +24,14 @@ BayesFilter
     The Bayes filter (Morrison ch. 10) in square-root information form over the same model:
     starts from no information, fading memory with the true covariance.
 RadarTracker
-    A radar's range, azimuth and elevation to a constant-velocity track: the sliding
-    Gauss–Newton fit, the extended Kalman filter (driving noise or fading memory) or its
-    smoother; the numbers of ``seqsmooth track``.
+    A radar's range, azimuth and elevation to a track of a built-in motion model (constant
+    velocity, constant acceleration, Singer, coordinated turn): the sliding Gauss–Newton fit,
+    the extended Kalman filter (driving noise or fading memory) or its smoother; the numbers
+    of ``seqsmooth track``.
+CoordinatedTurn
+    The library's coordinated-turn model (known or estimated turn rate) as the ``f``,
+    ``F_jacobian`` and ``Q`` callables of ``ExtendedKalmanFilter`` and
+    ``UnscentedKalmanFilter``.
 SlidingFit
     Gauss–Newton differential correction of each row's window of the last W rows (Morrison
     §8.5-8.7), radar or scalar polynomial model: ``update_many`` gives the states,
@@ -58,6 +63,7 @@ from ._seqsmooth import (
     MAX_DEGREE,
     AutomaticFilter,
     BayesFilter,
+    CoordinatedTurn,
     CurveFit,
     ExpandingBank,
     ExpandingMemory,
@@ -113,6 +119,7 @@ __all__ = [
     "LinearFixedLagSmoother",
     "ExtendedKalmanFilter",
     "RadarTracker",
+    "CoordinatedTurn",
     "SlidingFit",
     "Innovation",
     "PolynomialFilter",

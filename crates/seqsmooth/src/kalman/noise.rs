@@ -223,15 +223,18 @@ impl ProcessNoise for ContinuousModel {
     }
 
     fn covariance(&self, t_a: f64, t_b: f64) -> Result<DMatrix<f64>, Error> {
-        for t in [t_a, t_b] {
-            if !t.is_finite() {
-                return Err(Error::NonFinite {
-                    what: "time",
-                    value: t,
-                });
-            }
-        }
-        self.noise_covariance((t_b - t_a).abs())
+        self.noise_covariance(step_between(t_a, t_b)?)
+    }
+}
+
+/// The step `|t_b − t_a|` a driving noise accumulates over, both times finite.
+fn step_between(t_a: f64, t_b: f64) -> Result<f64, Error> {
+    match [t_a, t_b].into_iter().find(|t| !t.is_finite()) {
+        Some(value) => Err(Error::NonFinite {
+            what: "time",
+            value,
+        }),
+        None => Ok((t_b - t_a).abs()),
     }
 }
 /// The coordinated turn's driving noise ([`crate::model::coordinated_turn`]): white
@@ -252,15 +255,7 @@ impl ProcessNoise for CoordinatedTurn {
     }
 
     fn covariance(&self, t_a: f64, t_b: f64) -> Result<DMatrix<f64>, Error> {
-        for t in [t_a, t_b] {
-            if !t.is_finite() {
-                return Err(Error::NonFinite {
-                    what: "time",
-                    value: t,
-                });
-            }
-        }
-        self.noise_covariance(t_b - t_a)
+        self.noise_covariance(step_between(t_a, t_b)?)
     }
 }
 
