@@ -65,8 +65,10 @@ def test_bad_settings_and_states_are_refused():
         ss.CoordinatedTurn(1.0, turn_rate=0.1, turn_rate_noise=1e-4)
     with pytest.raises(ParameterError):
         ss.CoordinatedTurn(-1.0)
-    with pytest.raises(InvalidInputError):
+    with pytest.raises(ParameterError, match="state of length 6 is invalid"):
         ss.CoordinatedTurn(1.0).f(X, 0.0, 1.0)  # six values for seven states
+    with pytest.raises(InvalidInputError):
+        ss.CoordinatedTurn(1.0).f(np.ones((2, 7)), 0.0, 1.0)
 
 
 def h(x, t=0.0):

@@ -465,12 +465,6 @@ class SlidingFit:
         sigma: float | None = None,
         azimuth: Literal["from-x", "bearing"] = "from-x",
         max_iterations: int = 20,
-        model: Literal[
-            "constant-velocity", "constant-acceleration", "singer", "coordinated-turn"
-        ] = "constant-velocity",
-        manoeuvre_alpha: float | None = None,
-        manoeuvre_variance: float | None = None,
-        turn_rate_noise: float | None = None,
     ) -> None: ...
     @property
     def rows_taken(self) -> int: ...
