@@ -245,9 +245,9 @@ fn step_between(t_a: f64, t_b: f64) -> Result<f64, Error> {
 /// ```
 /// use seqsmooth::kalman::noise::ProcessNoise;
 /// use seqsmooth::model::coordinated_turn::CoordinatedTurn;
-/// let turn = CoordinatedTurn::estimated(2.0, 1e-4).unwrap();
+/// let turn = CoordinatedTurn::estimated(2.0, 0.25).unwrap();
 /// let q = turn.covariance(10.0, 13.0).unwrap();
-/// assert_eq!((q[(3, 3)], q[(6, 6)]), (6.0, 3e-4)); // q ζ, q_ω ζ
+/// assert_eq!((q[(3, 3)], q[(6, 6)]), (6.0, 0.75)); // q ζ, q_ω ζ
 /// ```
 impl ProcessNoise for CoordinatedTurn {
     fn dimension(&self) -> usize {
