@@ -95,6 +95,7 @@ pub mod linalg;
 pub mod model;
 pub mod numeric;
 pub mod paml;
+pub mod persist;
 pub mod polynomial;
 pub mod recursive;
 pub mod scalar;

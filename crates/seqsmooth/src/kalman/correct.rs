@@ -49,7 +49,7 @@ pub(super) fn noise_entries(
 /// the hot path allocates nothing, and writes its results here before they become the
 /// filter's (an update that fails leaves the filter as it was). Matrices are column-major;
 /// `n` states, `p` observation components, `k ≤ p` present in the update.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Work {
     /// The prediction: `X_{n,n−1}`, `Φ(t_n, t_{n−1})`, `Q`, `S_{n,n−1}` and the fading `P`.
     pub(super) x: DVector<f64>,

@@ -20,14 +20,14 @@ pub(super) type Filter = KalmanFilter<PolynomialDynamics, Radar>;
 
 /// The memory of a Kalman method: a driving noise or a discount, fixed or adaptive, with the
 /// innovation monitor that flags its rows.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Memory {
     kind: MemoryKind,
     monitor: Monitor,
 }
 
 /// What a level sets.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) enum MemoryKind {
     /// The driving noise `q` at level 0 (`q₀` when adaptive).
     Noise(f64),

@@ -95,10 +95,11 @@ pub use iterated::check_iteration_limits;
 /// assert!((f.covariance() - want).amax() < 1e-15);
 /// assert!((i.nis - 0.5).abs() < 1e-15); // ν² / V = 1 / 2
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct KalmanFilter<D: Dynamics, O: Observation> {
     dynamics: D,
     observation: O,
+    #[serde(with = "crate::kalman::saved_noise::field")]
     noise: Option<Arc<dyn ProcessNoise>>,
     fading: Option<Fading>,
     state: DVector<f64>,
@@ -109,7 +110,7 @@ pub struct KalmanFilter<D: Dynamics, O: Observation> {
 
 /// The fading filter's own matrix `P` (14.3.13), not the covariance when the discount is
 /// below 1, and the time of the last update (from which a discount per time counts).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct Fading {
     discount: Discount,
     weight: DMatrix<f64>,
@@ -780,4 +781,38 @@ fn check_prior(
         ));
     }
     Ok(())
+}
+
+impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
+    /// The dynamic and observation models (a restored filter's checks).
+    pub(crate) fn models(&self) -> (&D, &O) {
+        (&self.dynamics, &self.observation)
+    }
+
+    /// A restored filter's invariants ([`crate::persist`]): the state of the model's
+    /// dimension, finite; the covariance (and the fading weight) symmetric, positive
+    /// semi-definite; the time finite; the noise model of the same dimension. The work
+    /// buffers are made anew.
+    pub(crate) fn check_saved(&mut self) -> Result<(), String> {
+        use crate::persist::{covariance, vector};
+        let n = self.dynamics.dimension();
+        vector(&self.state, n, "state")?;
+        covariance(&self.covariance, n, "covariance")?;
+        if !self.time.is_finite() {
+            return Err(format!("time {} is not finite", self.time));
+        }
+        if let Some(noise) = &self.noise {
+            if noise.dimension() != n {
+                return Err(format!(
+                    "noise model is {}-dimensional, {n} expected",
+                    noise.dimension()
+                ));
+            }
+        }
+        if let Some(f) = &self.fading {
+            covariance(&f.weight, n, "fading weight")?;
+        }
+        self.work = Work::new(n, self.observation.components());
+        Ok(())
+    }
 }

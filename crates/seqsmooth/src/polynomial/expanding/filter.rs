@@ -22,7 +22,7 @@ use crate::polynomial::options::{check_engine_degree, Engine};
 /// // the 1-step prediction Z*_{5,4} = (27/5, 4/5)
 /// assert!((f.estimate_at(5.0).unwrap().derivatives[0] - 5.4).abs() < 1e-12);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct ExpandingMemory {
     m: usize,
     core: EngineState,
@@ -78,3 +78,10 @@ impl ExpandingMemory {
 }
 
 impl_polynomial_filter!(ExpandingMemory);
+
+impl ExpandingMemory {
+    /// The invariants of a restored filter ([`crate::persist`]).
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        self.core.check_saved(self.m)
+    }
+}
