@@ -8,6 +8,7 @@ use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{
     before, discount_from, measurement, measurements, observation_from, out_of_order, square,
 };
+use crate::persist;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -52,6 +53,31 @@ pub struct PyBayesFilter {
 
 #[pymethods]
 impl PyBayesFilter {
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
+    /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
+    /// copy of the state, and the copy and the original then run apart.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let state = persist::save(slf.py(), &slf.borrow().filter)?;
+        persist::reduce(slf.as_any(), state)
+    }
+
+    /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let filter: Filter = persist::load(state)?;
+        let (dynamics, observation) = filter.models();
+        let (states, components) = (
+            seqsmooth::model::dynamics::Dynamics::dimension(dynamics),
+            observation.components(),
+        );
+        Ok(Self {
+            filter,
+            components,
+            states,
+        })
+    }
+
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
     #[pyo3(signature = (degree, t0 = 0.0, axes = 1, observation = None, x0 = None, P0 = None, theta = None, tau = None, theta_per_update = None, beta = None))]

@@ -14,6 +14,7 @@ mod frame;
 mod kalman;
 mod linear;
 mod paml;
+mod persist;
 mod polynomial;
 mod smooth;
 mod tables;

@@ -3,6 +3,8 @@ PanicException, and a filter keeps the samples before the bad one."""
 
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -29,6 +31,7 @@ def test_every_error_kind_has_its_class():
         "TooFewSamples",
         "NotDetermined",
         "Numerical",
+        "DamagedState",
     ]
     for kind, cls in kinds:
         assert cls == kind + "Error" and issubclass(getattr(errors, cls), errors.SeqsmoothError)
@@ -39,6 +42,8 @@ def test_every_error_kind_has_its_class():
         ss.FadingMemory(degree=1, theta=0.9).update_many(np.arange(3.0), [1.0, np.nan, 1.0])
     with pytest.raises(ss.TooFewSamplesError):
         ss.smooth(np.ones(5), 7, 2)
+    with pytest.raises(ss.DamagedStateError):
+        pickle.loads(pickle.dumps(ss.FadingMemory(degree=1, theta=0.9))[:-3])
 
 
 def test_every_parameter_takes_its_kind_and_the_callers_words():

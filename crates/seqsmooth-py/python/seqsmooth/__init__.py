@@ -87,6 +87,7 @@ from ._seqsmooth import (
     vrf,
 )
 from .errors import (
+    DamagedStateError,
     InvalidInputError,
     InvalidTypeError,
     NotDeterminedError,
@@ -137,4 +138,5 @@ __all__ = [
     "TooFewSamplesError",
     "NotDeterminedError",
     "NumericalError",
+    "DamagedStateError",
 ]

@@ -497,8 +497,17 @@ fn whitener(p: usize, noise: &NoiseCovariance, present: &[usize]) -> Result<DMat
 }
 
 impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
-    /// The dynamic and observation models (a restored filter's checks).
-    pub(crate) fn models(&self) -> (&D, &O) {
+    /// The dynamic and observation models.
+    ///
+    /// ```
+    /// use seqsmooth::kalman::bayes::BayesFilter;
+    /// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+    /// use seqsmooth::model::observation::{LinearObservation, Observation};
+    /// let m = LinearObservation::new(nalgebra::DMatrix::from_row_slice(1, 2, &[1.0, 0.0])).unwrap();
+    /// let f = BayesFilter::new(PolynomialDynamics::new(1, 1), m, 0.0).unwrap();
+    /// assert_eq!((f.models().0.dimension(), f.models().1.components()), (2, 1));
+    /// ```
+    pub fn models(&self) -> (&D, &O) {
         (&self.dynamics, &self.observation)
     }
 

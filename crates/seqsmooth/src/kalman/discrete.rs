@@ -755,6 +755,21 @@ impl LinearKalmanFilter {
 }
 
 impl LinearFixedLag {
+    /// The state's dimension `n`.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::discrete::{LinearFixedLag, LinearKalmanFilter};
+    /// let i = DMatrix::identity(2, 2);
+    /// let h = DMatrix::from_row_slice(1, 2, &[1.0, 0.0]);
+    /// let r = DMatrix::identity(1, 1);
+    /// let f = LinearKalmanFilter::new(DVector::zeros(2), i.clone(), i.clone(), h, i, r).unwrap();
+    /// assert_eq!(LinearFixedLag::new(&f, 3).dimension(), 2);
+    /// ```
+    pub fn dimension(&self) -> usize {
+        self.model.dimension()
+    }
+
     /// A restored smoother's invariants ([`crate::persist`]): its model's and its own.
     pub(crate) fn check_saved(&mut self) -> Result<(), String> {
         self.model.check_saved()?;

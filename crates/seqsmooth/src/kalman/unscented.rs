@@ -550,8 +550,19 @@ fn finite(values: &[f64], what: &'static str) -> Result<(), Error> {
 }
 
 impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
-    /// The dynamic and observation models (a restored filter's checks).
-    pub(crate) fn models(&self) -> (&D, &O) {
+    /// The dynamic and observation models.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::UnscentedKalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::{LinearObservation, Observation};
+    /// let m = LinearObservation::new(DMatrix::from_row_slice(1, 2, &[1.0, 0.0])).unwrap();
+    /// let (x, p) = (DVector::zeros(2), DMatrix::identity(2, 2));
+    /// let f = UnscentedKalmanFilter::new(PolynomialDynamics::new(1, 1), m, x, p, 0.0).unwrap();
+    /// assert_eq!(f.models().1.components(), 1);
+    /// ```
+    pub fn models(&self) -> (&D, &O) {
         (&self.dynamics, &self.observation)
     }
 
