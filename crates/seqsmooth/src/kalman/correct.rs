@@ -49,7 +49,7 @@ pub(super) fn noise_entries(
 /// the hot path allocates nothing, and writes its results here before they become the
 /// filter's (an update that fails leaves the filter as it was). Matrices are column-major;
 /// `n` states, `p` observation components, `k ≤ p` present in the update.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug)]
 pub(super) struct Work {
     /// The prediction: `X_{n,n−1}`, `Φ(t_n, t_{n−1})`, `Q`, `S_{n,n−1}` and the fading `P`.
     pub(super) x: DVector<f64>,
@@ -90,6 +90,13 @@ pub(super) struct Work {
     pub(super) x_out: DVector<f64>,
     pub(super) s_out: DMatrix<f64>,
     pub(super) p_out: DMatrix<f64>,
+}
+
+/// Empty buffers, to be made anew for the filter's dimensions (a restored filter's scratch).
+impl Default for Work {
+    fn default() -> Self {
+        Self::new(0, 0)
+    }
 }
 
 impl Work {

@@ -736,7 +736,7 @@ impl LinearKalmanFilter {
     /// A restored filter's invariants ([`crate::persist`]): `F`, `H`, `Q`, `R`, `B` of the
     /// state's and the observation's dimensions, finite, `Q` and `R` covariances; the filter's.
     pub(crate) fn check_saved(&mut self) -> Result<(), String> {
-        use crate::persist::{covariance, matrix};
+        use crate::linalg::invariant::{covariance, matrix};
         let n = self.filter.state().len();
         let c = &self.model;
         let p = c.h.nrows();

@@ -446,8 +446,8 @@ impl<D: Dynamics, O: Observation> FixedLagSmoother<D, O> {
         self.filter.check_saved()?;
         let n = self.filter.state().len();
         for r in &self.rows {
-            crate::persist::vector(&r.state, n, "held state")?;
-            crate::persist::covariance(&r.covariance, n, "held covariance")?;
+            crate::linalg::invariant::vector(&r.state, n, "held state")?;
+            crate::linalg::invariant::covariance(&r.covariance, n, "held covariance")?;
         }
         let map = |m: &Map| {
             m.a.len() == n

@@ -570,8 +570,8 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
     /// model's dimension, the sigma points' weights for it, the time finite.
     pub(crate) fn check_saved(&self) -> Result<(), String> {
         let n = self.dynamics.dimension();
-        crate::persist::vector(&self.state, n, "state")?;
-        crate::persist::covariance(&self.covariance, n, "covariance")?;
+        crate::linalg::invariant::vector(&self.state, n, "state")?;
+        crate::linalg::invariant::covariance(&self.covariance, n, "covariance")?;
         let w = &self.weights;
         if w.n != n || w.mean.len() != 2 * n + 1 || w.covariance.len() != 2 * n + 1 {
             return Err(format!("sigma-point weights are not for {n} states"));

@@ -287,8 +287,8 @@ impl SmootherGains {
         if self.weights.len() % k != 0 || self.at_nodes.len() != k * k {
             return Err("gains are not of their order".into());
         }
-        crate::persist::finite(&self.weights, "gains")?;
-        crate::persist::finite(&self.at_nodes, "gains at the nodes")
+        crate::linalg::invariant::finite(&self.weights, "gains")?;
+        crate::linalg::invariant::finite(&self.at_nodes, "gains at the nodes")
     }
 }
 
@@ -300,6 +300,6 @@ impl<G: Deref<Target = SmootherGains>> OnlineSmoother<G> {
         if self.taken > self.gains.len() || self.coefficients.len() != self.gains.n + 1 {
             return Err("samples taken or sums do not fit the layout".into());
         }
-        crate::persist::finite(&self.coefficients, "sums")
+        crate::linalg::invariant::finite(&self.coefficients, "sums")
     }
 }

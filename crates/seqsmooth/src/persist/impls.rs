@@ -51,7 +51,7 @@ impl SavedModel for LinearObservation {
 
     fn check_model(&self) -> Result<(), String> {
         let m = self.matrix();
-        super::matrix(m, m.nrows(), m.ncols(), "observation matrix")
+        crate::linalg::invariant::matrix(m, m.nrows(), m.ncols(), "observation matrix")
     }
 }
 
@@ -60,7 +60,7 @@ impl SavedModel for DiscreteDynamics {
 
     fn check_model(&self) -> Result<(), String> {
         let f = self.transition();
-        super::matrix(f, f.nrows(), f.nrows(), "transition matrix")
+        crate::linalg::invariant::matrix(f, f.nrows(), f.nrows(), "transition matrix")
     }
 }
 

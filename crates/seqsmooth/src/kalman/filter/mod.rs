@@ -105,6 +105,8 @@ pub struct KalmanFilter<D: Dynamics, O: Observation> {
     state: DVector<f64>,
     covariance: DMatrix<f64>,
     time: f64,
+    /// Scratch: not saved; made anew on restoring ([`crate::persist`]).
+    #[serde(skip)]
     work: Work,
 }
 
@@ -794,7 +796,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// semi-definite; the time finite; the noise model of the same dimension. The work
     /// buffers are made anew.
     pub(crate) fn check_saved(&mut self) -> Result<(), String> {
-        use crate::persist::{covariance, vector};
+        use crate::linalg::invariant::{covariance, vector};
         let n = self.dynamics.dimension();
         vector(&self.state, n, "state")?;
         covariance(&self.covariance, n, "covariance")?;

@@ -688,9 +688,9 @@ impl TriangularFactor {
             return Err(format!("factor's parts disagree on its dimension {p}"));
         }
         let d: Vec<f64> = self.d.iter().map(|x| x.0).collect();
-        crate::persist::finite(&d, "factor D")?;
-        crate::persist::finite(&self.u, "factor U")?;
-        crate::persist::finite(&self.ubar, "factor ū")?;
+        crate::linalg::invariant::finite(&d, "factor D")?;
+        crate::linalg::invariant::finite(&self.u, "factor U")?;
+        crate::linalg::invariant::finite(&self.ubar, "factor ū")?;
         if d.iter().any(|&x| x < 0.0) || !self.residual_sq.is_finite() {
             return Err("factor has a negative pivot or residual".into());
         }

@@ -64,7 +64,7 @@ impl GainEngine {
             return Err("engine's start or gain schedule is not of its degree".into());
         }
         if let Some((_, c)) = &self.cov {
-            crate::persist::matrix(c, m + 1, m + 1, "engine's covariance")?;
+            crate::linalg::invariant::matrix(c, m + 1, m + 1, "engine's covariance")?;
         }
         Ok(())
     }
