@@ -57,8 +57,7 @@ impl PyBayesFilter {
     /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
     /// copy of the state, and the copy and the original then run apart.
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
-        let state = persist::save(slf.py(), &slf.borrow().filter)?;
-        persist::reduce(slf.as_any(), state)
+        persist::reduce_saved(slf.as_any(), &slf.borrow().filter)
     }
 
     /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or

@@ -334,8 +334,7 @@ impl PyLinearKalmanFilter {
     /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
     /// copy of the state, and the copy and the original then run apart.
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
-        let state = persist::save(slf.py(), &slf.borrow().inner)?;
-        persist::reduce(slf.as_any(), state)
+        persist::reduce_saved(slf.as_any(), &slf.borrow().inner)
     }
 
     /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
@@ -703,8 +702,7 @@ impl PyLinearFixedLagSmoother {
     /// copy of the state, and the copy and the original then run apart.
     /// A smoother after ``finish`` cannot be saved (it holds nothing more).
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
-        let state = persist::save(slf.py(), slf.borrow().smoother()?)?;
-        persist::reduce(slf.as_any(), state)
+        persist::reduce_saved(slf.as_any(), slf.borrow().smoother()?)
     }
 
     /// The smoother ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or

@@ -198,8 +198,7 @@ impl PyOnlineSmoother {
     /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
     /// copy of the state, and the copy and the original then run apart.
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
-        let state = persist::save(slf.py(), &slf.borrow().inner)?;
-        persist::reduce(slf.as_any(), state)
+        persist::reduce_saved(slf.as_any(), &slf.borrow().inner)
     }
 
     /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or

@@ -42,6 +42,14 @@ pub(crate) fn reduce<'py>(
     PyTuple::new(py, [restore, args.into_any()])
 }
 
+/// What `__reduce__` returns for a class whose state is the saved form of `value` alone.
+pub(crate) fn reduce_saved<'py, T: Persist>(
+    obj: &Bound<'py, PyAny>,
+    value: &T,
+) -> PyResult<Bound<'py, PyTuple>> {
+    reduce(obj, save(obj.py(), value)?)
+}
+
 /// `obj` if it is exactly of class `cls`, else the `DamagedStateError` of another class's
 /// state.
 pub(crate) fn of_class<'py>(

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import seqsmooth as ss
 
-SEEDS = 12
+SEEDS = 40
 
 
 def times(rng, n):
@@ -208,11 +208,22 @@ CASES = [
         auto_run,
     ),
     ("FadingBank", lambda rng: ss.FadingBank(int(rng.integers(0, 3)), 0.8, 3), bank_data, bank_run),
-    ("ExpandingBank", lambda rng: ss.ExpandingBank(int(rng.integers(0, 3)), 3), bank_data, bank_run),
+    (
+        "ExpandingBank",
+        lambda rng: ss.ExpandingBank(int(rng.integers(0, 3)), 3),
+        bank_data,
+        bank_run,
+    ),
     (
         "KalmanFilter",
         lambda rng: ss.KalmanFilter(
-            1, x0=np.zeros(4), P0=100.0, axes=2, q=0.05, theta=float(rng.uniform(0.8, 0.99)), tau=1.0
+            1,
+            x0=np.zeros(4),
+            P0=100.0,
+            axes=2,
+            q=0.05,
+            theta=float(rng.uniform(0.8, 0.99)),
+            tau=1.0,
         ),
         kalman_data,
         kalman_run,
