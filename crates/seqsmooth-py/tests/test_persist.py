@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import copy
 import pickle
+import zlib
 
 import numpy as np
 import pytest
+
 import seqsmooth as ss
 
 SEEDS = 40
@@ -360,8 +362,6 @@ def test_crafted_body_is_refused():
     assert i > 0
     body = bytearray(state)
     body[i + 1] = 0xBC
-    import zlib
-
     header = 8 + 2 + 1 + body[10] + 8
     crc = zlib.crc32(bytes(body[:header]) + bytes(body[header + 4 :]))
     body[header : header + 4] = crc.to_bytes(4, "little")
