@@ -114,7 +114,7 @@ proptest! {
     ) {
         let rows = data(seed, n);
         let cut = cut.min(n - 1);
-        let missing = |k: usize| (seed as usize + k * 7) % 5 == 0;
+        let missing = |k: usize| (seed as usize + k * 7).is_multiple_of(5);
         let x0 = DVector::zeros(2);
         let p0 = DMatrix::identity(2, 2) * 100.0;
         let mut kf = KalmanFilter::new(PolynomialDynamics::new(1, 1), position(), x0.clone(), p0.clone(), 0.0)
@@ -259,6 +259,9 @@ fn envelope(name: &str, body: &[u8]) -> Vec<u8> {
     out
 }
 
+/// A CBOR map's entries.
+type Entries = Vec<(ciborium::Value, ciborium::Value)>;
+
 #[test]
 fn a_crafted_body_breaking_the_invariants_is_refused() {
     type Kf = KalmanFilter<PolynomialDynamics, LinearObservation>;
@@ -280,14 +283,14 @@ fn a_crafted_body_breaking_the_invariants_is_refused() {
     );
     // Decode the body as CBOR, break one invariant, encode it again with a valid checksum.
     let value: ciborium::Value = ciborium::from_reader(body).unwrap();
-    let edit = |f: &dyn Fn(&mut Vec<(ciborium::Value, ciborium::Value)>)| {
+    let edit = |f: &dyn Fn(&mut Entries)| {
         let mut v = value.clone();
         f(v.as_map_mut().unwrap());
         let mut b = Vec::new();
         ciborium::into_writer(&v, &mut b).unwrap();
         from_bytes::<Kf>(&envelope(&name, &b)).unwrap_err()
     };
-    let field = |m: &mut Vec<(ciborium::Value, ciborium::Value)>, key: &str| -> usize {
+    let field = |m: &mut Entries, key: &str| -> usize {
         m.iter()
             .position(|(k, _)| k.as_text() == Some(key))
             .unwrap()

@@ -112,9 +112,7 @@ impl WhiteNoiseDerivative {
 
 impl ProcessNoise for WhiteNoiseDerivative {
     fn saved(&self) -> Option<super::saved_noise::SavedNoise> {
-        Some(super::saved_noise::SavedNoise::WhiteNoiseDerivative(
-            self.clone(),
-        ))
+        Some(super::saved_noise::SavedNoise::WhiteNoiseDerivative(*self))
     }
 
     fn dimension(&self) -> usize {

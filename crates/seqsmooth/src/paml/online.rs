@@ -284,7 +284,7 @@ impl SmootherGains {
     /// table `(n+1)²`, finite.
     pub(crate) fn check_saved(&self) -> Result<(), String> {
         let k = self.n + 1;
-        if self.weights.len() % k != 0 || self.at_nodes.len() != k * k {
+        if !self.weights.len().is_multiple_of(k) || self.at_nodes.len() != k * k {
             return Err("gains are not of their order".into());
         }
         crate::linalg::invariant::finite(&self.weights, "gains")?;

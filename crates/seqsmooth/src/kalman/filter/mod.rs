@@ -785,4 +785,3 @@ fn check_prior(
     }
     Ok(())
 }
-
