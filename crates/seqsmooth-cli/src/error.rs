@@ -77,7 +77,8 @@ impl From<seqsmooth::Error> for CliError {
             ErrorKind::InvalidInput
             | ErrorKind::TooFewSamples
             | ErrorKind::NotDetermined
-            | ErrorKind::Numerical => CliError::Data(message),
+            | ErrorKind::Numerical
+            | ErrorKind::DamagedState => CliError::Data(message),
         }
     }
 }

@@ -6,10 +6,12 @@
 
 use crate::arrays::{matrix, pair};
 use crate::errors::IntoPy;
+use crate::persist;
 use crate::polynomial::{engine as engine_named, state_of, State};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use pyo3::types::{PyBytes, PyTuple};
 use seqsmooth::polynomial::automatic::AutomaticFilter;
 use seqsmooth::polynomial::rows::{decisions, degree_in_use, RowLayout};
 use seqsmooth::polynomial::spec::{AnyFilter, FilterKind, FilterSpec};
@@ -46,6 +48,49 @@ pub struct PyAutomaticFilter {
 
 #[pymethods]
 impl PyAutomaticFilter {
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
+    /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
+    /// copy of the state, and the copy and the original then run apart.
+    /// The state is the library's saved form and the final decisions reported so far.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let me = slf.borrow();
+        let decided: Vec<u8> = me.decided.iter().map(|&d| u8::from(d)).collect();
+        let state = PyTuple::new(
+            py,
+            [
+                persist::save(py, &me.filter)?,
+                PyBytes::new(py, &decided).into_any(),
+            ],
+        )?;
+        persist::reduce(slf.as_any(), state.into_any())
+    }
+
+    /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let items = persist::items(state, 2)?;
+        let filter: AnyFilter = persist::load(&items.get_item(0)?)?;
+        if filter.kind() != FilterKind::Automatic {
+            return Err(persist::damaged(
+                "the state of another filter than an AutomaticFilter",
+            ));
+        }
+        let decided = items.get_item(1)?;
+        let decided = decided
+            .cast::<PyBytes>()
+            .map_err(|_| persist::damaged("the decisions are not bytes"))?
+            .as_bytes();
+        if decided.iter().any(|&d| d > 1) || decided.len() as u64 > filter.samples() {
+            return Err(persist::damaged("the decisions do not fit the filter"));
+        }
+        Ok(Self {
+            filter,
+            decided: decided.iter().map(|&d| d == 1).collect(),
+        })
+    }
+
     #[new]
     #[pyo3(signature = (degree, theta, tau = 1.0, engine = "exact", sigma = None, review_window = None))]
     fn new(

@@ -5,7 +5,9 @@
 
 use crate::arrays::{matrix, table};
 use crate::errors::{raise, IntoPy, Kind};
+use crate::persist;
 use pyo3::prelude::*;
+use pyo3::types::{PyTuple, PyType};
 use seqsmooth::polynomial::bank::{ExpandingBank, FadingBank};
 use seqsmooth::Error;
 
@@ -16,6 +18,7 @@ trait Bank: Send {
     fn samples(&self) -> u64;
     fn rows(&mut self, matrix: &[f64]) -> Result<(), Error>;
     fn derivative_into(&self, k: usize, out: &mut [f64]) -> Result<(), Error>;
+    fn save<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>>;
 }
 
 macro_rules! bank {
@@ -35,6 +38,9 @@ macro_rules! bank {
             }
             fn derivative_into(&self, k: usize, out: &mut [f64]) -> Result<(), Error> {
                 <$ty>::derivative_into(self, k, out)
+            }
+            fn save<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+                persist::save(py, self)
             }
         }
     };
@@ -93,6 +99,14 @@ pub struct PyBank {
 
 #[pymethods]
 impl PyBank {
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the bank's state in
+    /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
+    /// copy of the state, and the copy and the original then run apart.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let state = slf.borrow().bank.save(slf.py())?;
+        persist::reduce(slf.as_any(), state)
+    }
+
     /// The time steps taken.
     #[getter]
     fn samples(&self) -> u64 {
@@ -119,6 +133,21 @@ pub struct PyFadingBank;
 
 #[pymethods]
 impl PyFadingBank {
+    /// The bank ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[classmethod]
+    fn _from_state<'py>(
+        cls: &Bound<'py, PyType>,
+        state: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let bank: Box<FadingBank> = Box::new(persist::load(state)?);
+        let obj = Bound::new(
+            cls.py(),
+            PyClassInitializer::from(PyBank { bank }).add_subclass(Self),
+        )?;
+        persist::of_class(obj.into_any(), cls)
+    }
+
     #[new]
     #[pyo3(signature = (degree, theta, channels, tau = 1.0))]
     fn new(
@@ -139,6 +168,21 @@ pub struct PyExpandingBank;
 
 #[pymethods]
 impl PyExpandingBank {
+    /// The bank ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[classmethod]
+    fn _from_state<'py>(
+        cls: &Bound<'py, PyType>,
+        state: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let bank: Box<ExpandingBank> = Box::new(persist::load(state)?);
+        let obj = Bound::new(
+            cls.py(),
+            PyClassInitializer::from(PyBank { bank }).add_subclass(Self),
+        )?;
+        persist::of_class(obj.into_any(), cls)
+    }
+
     #[new]
     #[pyo3(signature = (degree, channels, tau = 1.0))]
     fn new(degree: usize, channels: usize, tau: f64) -> PyResult<PyClassInitializer<Self>> {

@@ -9,6 +9,7 @@ use crate::kalman::{
     before, covariance_from, discount_from, measurement, measurements, observation_from,
     out_of_order, square, state_from,
 };
+use crate::persist;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -63,6 +64,30 @@ pub struct PyBayesFilter {
 
 #[pymethods]
 impl PyBayesFilter {
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
+    /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
+    /// copy of the state, and the copy and the original then run apart.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        persist::reduce_saved(slf.as_any(), &slf.borrow().filter)
+    }
+
+    /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let filter: Filter = persist::load(state)?;
+        let (dynamics, observation) = filter.models();
+        let (states, components) = (
+            seqsmooth::model::dynamics::Dynamics::dimension(dynamics),
+            observation.components(),
+        );
+        Ok(Self {
+            filter,
+            components,
+            states,
+        })
+    }
+
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
     #[pyo3(signature = (degree, t0 = 0.0, axes = 1, observation = None, x0 = None, P0 = None, theta = None, tau = None, theta_per_update = None, beta = None, q = 0.0))]

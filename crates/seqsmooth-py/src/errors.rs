@@ -18,6 +18,7 @@ pub enum Kind {
     TooFewSamples,
     NotDetermined,
     Numerical,
+    DamagedState,
 }
 
 impl Kind {
@@ -29,6 +30,7 @@ impl Kind {
             Kind::TooFewSamples => "TooFewSamplesError",
             Kind::NotDetermined => "NotDeterminedError",
             Kind::Numerical => "NumericalError",
+            Kind::DamagedState => "DamagedStateError",
         }
     }
 
@@ -46,6 +48,7 @@ impl Kind {
             ErrorKind::TooFewSamples => Kind::TooFewSamples,
             ErrorKind::NotDetermined => Kind::NotDetermined,
             ErrorKind::Numerical => Kind::Numerical,
+            ErrorKind::DamagedState => Kind::DamagedState,
         }
     }
 }

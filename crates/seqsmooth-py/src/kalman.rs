@@ -7,6 +7,7 @@
 
 use crate::arrays::{matrix, series, table, times};
 use crate::errors::{raise, IntoPy, Kind};
+use crate::persist;
 use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -324,6 +325,22 @@ pub struct PyKalmanFilter {
 
 #[pymethods]
 impl PyKalmanFilter {
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
+    /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
+    /// copy of the state, and the copy and the original then run apart.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        persist::reduce_saved(slf.as_any(), &slf.borrow().filter)
+    }
+
+    /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let filter: Linear = persist::load(state)?;
+        let components = filter.observation().components();
+        Ok(Self { filter, components })
+    }
+
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
     #[pyo3(signature = (degree, x0, P0, t0 = 0.0, axes = 1, q = 0.0, observation = None, theta = None, tau = None, theta_per_update = None, beta = None))]

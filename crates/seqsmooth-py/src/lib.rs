@@ -17,6 +17,7 @@ mod linear;
 mod model_fit;
 mod models;
 mod paml;
+mod persist;
 mod polynomial;
 mod smooth;
 mod tables;

@@ -7,6 +7,7 @@
 use crate::arrays::matrix;
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::{square, PyInnovation};
+use crate::persist;
 use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -334,6 +335,22 @@ pub struct PyLinearKalmanFilter {
 
 #[pymethods]
 impl PyLinearKalmanFilter {
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
+    /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
+    /// copy of the state, and the copy and the original then run apart.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        persist::reduce_saved(slf.as_any(), &slf.borrow().inner)
+    }
+
+    /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        Ok(Self {
+            inner: persist::load(state)?,
+        })
+    }
+
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
     #[pyo3(signature = (x0, P0, F, H, Q, R, B = None))]
@@ -710,6 +727,26 @@ fn smoothed_tuple<'py>(
 
 #[pymethods]
 impl PyLinearFixedLagSmoother {
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the smoother's state in
+    /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
+    /// copy of the state, and the copy and the original then run apart.
+    /// A smoother after ``finish`` cannot be saved (it holds nothing more).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        persist::reduce_saved(slf.as_any(), slf.borrow().smoother()?)
+    }
+
+    /// The smoother ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let inner: LinearFixedLag = persist::load(state)?;
+        let n = inner.dimension();
+        Ok(Self {
+            inner: Some(inner),
+            n,
+        })
+    }
+
     #[new]
     fn new(filter: PyRef<'_, PyLinearKalmanFilter>, lag: usize) -> Self {
         Self {

@@ -6,10 +6,11 @@
 use crate::arrays::{series, table, times};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::kalman::square;
+use crate::persist;
 use nalgebra::DMatrix;
 use numpy::PyArray1;
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyList, PyTuple};
 use seqsmooth::basis::{GaussRule, Jacobi};
 use seqsmooth::error::Param;
 use seqsmooth::estimate::curve::{self, CurveFit, CurveModel};
@@ -193,6 +194,22 @@ pub struct PyOnlineSmoother {
 
 #[pymethods]
 impl PyOnlineSmoother {
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
+    /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
+    /// copy of the state, and the copy and the original then run apart.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        persist::reduce_saved(slf.as_any(), &slf.borrow().inner)
+    }
+
+    /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        Ok(Self {
+            inner: persist::load(state)?,
+        })
+    }
+
     #[new]
     #[pyo3(signature = (t, sigma, degree = None, *, n = None))]
     fn new(

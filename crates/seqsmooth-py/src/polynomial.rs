@@ -7,9 +7,10 @@
 
 use crate::arrays::{matrix, pair, zeros};
 use crate::errors::{raise, IntoPy, Kind};
+use crate::persist;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PySlice;
+use pyo3::types::{PySlice, PyTuple, PyType};
 use seqsmooth::discount::Discount;
 use seqsmooth::polynomial::fixed::FixedEngine;
 use seqsmooth::polynomial::prior::Prior;
@@ -137,6 +138,37 @@ impl PyPolynomialFilter {
     #[getter]
     fn is_determined(&self) -> bool {
         self.filter.is_determined()
+    }
+
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
+    /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
+    /// copy of the state, and the copy and the original then run apart.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        persist::reduce_saved(slf.as_any(), &slf.borrow().filter)
+    }
+
+    /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[classmethod]
+    fn _from_state<'py>(
+        cls: &Bound<'py, PyType>,
+        state: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let py = cls.py();
+        let filter: AnyFilter = persist::load(state)?;
+        let kind = filter.kind();
+        let base = PyClassInitializer::from(Self { filter });
+        let obj = match kind {
+            FilterKind::Expanding => {
+                Bound::new(py, base.add_subclass(PyExpandingMemory))?.into_any()
+            }
+            FilterKind::Fading => Bound::new(py, base.add_subclass(PyFadingMemory))?.into_any(),
+            FilterKind::Fixed => Bound::new(py, base.add_subclass(PyFixedMemory))?.into_any(),
+            FilterKind::Automatic => {
+                return Err(persist::damaged("the state of an AutomaticFilter"))
+            }
+        };
+        persist::of_class(obj, cls)
     }
 
     /// Takes one sample ``y`` at time ``t`` (after the previous sample's time).

@@ -7,6 +7,7 @@ use crate::arrays::{matrix, series, times, Series};
 use crate::errors::{raise, to_py, IntoPy, Kind};
 use crate::kalman::discount_from;
 use nalgebra::{DMatrix, DVector};
+use crate::persist;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -263,6 +264,69 @@ fn sigma_series<'py>(
 
 #[pymethods]
 impl PyRadarTracker {
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the tracker's state in
+    /// the library's saved form, with the σ given, the azimuth convention and the smoother's
+    /// rows not yet taken, restored bit for bit. A copy is a deep copy of the state.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let me = slf.borrow();
+        let g = &me.given;
+        let state = (
+            persist::save(py, &me.inner)?,
+            me.sigmas,
+            me.bearing,
+            (&g.rows, &g.states, &g.covariances, &g.nis, &g.flags),
+        )
+            .into_pyobject(py)?;
+        persist::reduce(slf.as_any(), state.into_any())
+    }
+
+    /// The tracker ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        type Rows = (Vec<i64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<String>);
+        let items = persist::items(state, 4)?;
+        let inner: RadarTracker = persist::load(&items.get_item(0)?)?;
+        let bad = |_| persist::damaged("the tracker's settings or held rows are not readable");
+        let sigmas: [Option<f64>; 2] = items.get_item(1)?.extract().map_err(bad)?;
+        let bearing: bool = items.get_item(2)?.extract().map_err(bad)?;
+        let (rows, states, covariances, nis, names): Rows =
+            items.get_item(3)?.extract().map_err(bad)?;
+        let count = rows.len();
+        let flags = [TrackFlag::None, TrackFlag::Outlier, TrackFlag::Misfit].map(TrackFlag::name);
+        let flags: Option<Vec<&'static str>> = names
+            .iter()
+            .map(|n| flags.iter().find(|f| *f == n).copied())
+            .collect();
+        let sigmas_ok = sigmas.iter().flatten().all(|s| s.is_finite() && *s > 0.0);
+        match flags {
+            Some(flags)
+                if sigmas_ok
+                    && states.len() == 6 * count
+                    && covariances.len() == 36 * count
+                    && nis.len() == count
+                    && flags.len() == count =>
+            {
+                Ok(Self {
+                    inner,
+                    sigmas,
+                    bearing,
+                    given: Given {
+                        rows,
+                        states,
+                        covariances,
+                        nis,
+                        flags,
+                    },
+                })
+            }
+            _ => Err(persist::damaged(
+                "the tracker's settings or held rows do not fit",
+            )),
+        }
+    }
+
     #[new]
     #[pyo3(signature = (method = "kalman", *, sigma_range = None, sigma_angle = None,
         site = (0.0, 0.0, 0.0), q = None, theta = None, tau = None, theta_per_update = None,

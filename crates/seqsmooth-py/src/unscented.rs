@@ -16,6 +16,7 @@ use crate::kalman::{
     before, measurement, measurements, observation_from, out_of_order, square, square_from,
     PyInnovation,
 };
+use crate::persist;
 use nalgebra::DVector;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -139,6 +140,51 @@ pub struct PyUnscentedKalmanFilter {
 
 #[pymethods]
 impl PyUnscentedKalmanFilter {
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too) for the built-in models:
+    /// the filter's state in the library's saved form, restored bit for bit. Filters are
+    /// mutable: a copy is a deep copy of the state. The form over the caller's callables
+    /// cannot be pickled yet (``TypeError``).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let state = match &slf.borrow().model {
+            Model::Linear(f) => ("linear", persist::save(py, f)?),
+            Model::Radar(f) => ("radar", persist::save(py, f)?),
+            Model::User(_) => {
+                return Err(pyo3::exceptions::PyTypeError::new_err(
+                    "an UnscentedKalmanFilter over the caller's callables cannot be pickled",
+                ))
+            }
+        };
+        persist::reduce(slf.as_any(), state.into_pyobject(py)?.into_any())
+    }
+
+    /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let items = persist::items(state, 2)?;
+        let body = items.get_item(1)?;
+        let (model, components) = match items.get_item(0)?.extract::<String>().as_deref() {
+            Ok("linear") => {
+                let f: UnscentedKalmanFilter<PolynomialDynamics, LinearObservation> =
+                    persist::load(&body)?;
+                let p = f.models().1.components();
+                (Model::Linear(f), p)
+            }
+            Ok("radar") => {
+                let f: UnscentedKalmanFilter<PolynomialDynamics, Radar> = persist::load(&body)?;
+                let p = f.models().1.components();
+                (Model::Radar(f), p)
+            }
+            _ => return Err(persist::damaged("not an UnscentedKalmanFilter's model")),
+        };
+        Ok(Self {
+            model,
+            components,
+            raised: Raised::default(),
+        })
+    }
+
     #[new]
     #[allow(non_snake_case, clippy::too_many_arguments)]
     #[pyo3(signature = (degree = None, x0 = None, P0 = None, t0 = 0.0, axes = 1, q = 0.0, observation = None, site = None, sigma_points = (1.0, 2.0, 0.0), *, f = None, h = None, Q = None, angles = None, dxdt = None))]

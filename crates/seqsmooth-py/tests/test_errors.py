@@ -29,6 +29,7 @@ def test_every_error_kind_has_its_class():
         "TooFewSamples",
         "NotDetermined",
         "Numerical",
+        "DamagedState",
     ]
     for kind, cls in kinds:
         assert cls == kind + "Error" and issubclass(getattr(errors, cls), errors.SeqsmoothError)
@@ -39,6 +40,9 @@ def test_every_error_kind_has_its_class():
         ss.FadingMemory(degree=1, theta=0.9).update_many(np.arange(3.0), [1.0, np.nan, 1.0])
     with pytest.raises(ss.TooFewSamplesError):
         ss.smooth(np.ones(5), 7, 2)
+    _, (cls, state) = ss.FadingMemory(degree=1, theta=0.9).__reduce__()
+    with pytest.raises(ss.DamagedStateError):
+        cls._from_state(state[:-3])
 
 
 def test_every_parameter_takes_its_kind_and_the_callers_words():

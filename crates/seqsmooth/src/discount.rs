@@ -31,7 +31,7 @@ use crate::error::{Error, Param};
 /// assert_eq!(Discount::per_update(1.0), Err(Error::ThetaOutOfRange { theta: 1.0 }));
 /// assert_eq!(Discount::per_time(0.9, 0.0), Err(Error::TauOutOfRange { tau: 0.0 }));
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Discount {
     /// `θ` per span `τ` of time: an observation `Δt` old weighs `θ^(Δt/τ)`.
     PerTime {
@@ -56,7 +56,7 @@ pub enum Discount {
 /// assert_eq!(Discount::per_update(0.5).unwrap().mode(), DiscountMode::PerUpdate);
 /// assert_eq!(DiscountMode::PerTime.with(0.9, 2.0).unwrap(), Discount::PerTime { theta: 0.9, tau: 2.0 });
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum DiscountMode {
     /// [`Discount::PerTime`]: `θ` per `τ` of elapsed time, weight `θ^((t_n - t_k)/τ)`.
     #[default]

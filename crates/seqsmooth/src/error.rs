@@ -229,6 +229,14 @@ pub enum Error {
         /// The iterations allowed.
         iterations: usize,
     },
+    /// A saved state ([`crate::persist::from_bytes`]) that cannot be restored: truncated, a
+    /// byte changed, another type's, a newer format, or a body whose numbers break the type's
+    /// invariants.
+    #[error("damaged saved state: {reason}")]
+    DamagedState {
+        /// What is wrong, in words.
+        reason: String,
+    },
     /// Some other parameter is out of range.
     #[error("{}", self.named(name.name()))]
     InvalidParameter {
@@ -264,20 +272,23 @@ pub enum ErrorKind {
     /// A numerical failure on valid input: a number beyond the double range, a fit that did
     /// not converge, an unobservable state.
     Numerical,
+    /// A saved state that cannot be restored (damaged, another type's, a newer format).
+    DamagedState,
 }
 
 impl ErrorKind {
     /// Every kind, in the order of their declaration.
-    pub const ALL: [ErrorKind; 5] = [
+    pub const ALL: [ErrorKind; 6] = [
         ErrorKind::InvalidInput,
         ErrorKind::Parameter,
         ErrorKind::TooFewSamples,
         ErrorKind::NotDetermined,
         ErrorKind::Numerical,
+        ErrorKind::DamagedState,
     ];
 
     /// The kind's name, the same in every front end (`InvalidInput`, `Parameter`,
-    /// `TooFewSamples`, `NotDetermined`, `Numerical`).
+    /// `TooFewSamples`, `NotDetermined`, `Numerical`, `DamagedState`).
     pub fn name(self) -> &'static str {
         match self {
             ErrorKind::InvalidInput => "InvalidInput",
@@ -285,6 +296,7 @@ impl ErrorKind {
             ErrorKind::TooFewSamples => "TooFewSamples",
             ErrorKind::NotDetermined => "NotDetermined",
             ErrorKind::Numerical => "Numerical",
+            ErrorKind::DamagedState => "DamagedState",
         }
     }
 }
@@ -316,6 +328,7 @@ impl Error {
             | Error::FitNotConverged { .. }
             | Error::SvdNotConverged { .. }
             | Error::EigenNotConverged { .. } => ErrorKind::Numerical,
+            Error::DamagedState { .. } => ErrorKind::DamagedState,
         }
     }
 }

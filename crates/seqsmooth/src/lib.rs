@@ -66,6 +66,7 @@
 //! - [`linalg`]: the small dense linear algebra the formulas share.
 //! - [`error`]: the one error type, [`Error`], of every fallible call.
 //! - [`discount`]: the discount of every fading memory, [`discount::Discount`].
+//! - [`persist`]: the one saved form of every filter (copy, save and resume bit for bit).
 //! - `numeric`: the numerical building blocks of the engines (double-word arithmetic, the
 //!   step tolerance).
 //!
@@ -95,6 +96,7 @@ pub mod linalg;
 pub mod model;
 pub mod numeric;
 pub mod paml;
+pub mod persist;
 pub mod polynomial;
 pub mod recursive;
 pub mod scalar;

@@ -3,6 +3,7 @@
 //! `L D Lᵀ` factorisation of the Kalman filter's covariance arithmetic.
 
 pub(crate) mod dense;
+pub(crate) mod invariant;
 
 use crate::error::Error;
 use crate::scalar::Scalar;

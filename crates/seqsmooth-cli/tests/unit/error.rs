@@ -28,6 +28,9 @@ fn example(kind: ErrorKind) -> Error {
             tolerance: 1e-9,
             chi_squared: 1e5,
         },
+        ErrorKind::DamagedState => Error::DamagedState {
+            reason: "checksum mismatch: a byte has changed".into(),
+        },
     }
 }
 

@@ -103,6 +103,7 @@ from ._seqsmooth import (
     vrf,
 )
 from .errors import (
+    DamagedStateError,
     InvalidInputError,
     InvalidTypeError,
     NotDeterminedError,
@@ -157,4 +158,5 @@ __all__ = [
     "TooFewSamplesError",
     "NotDeterminedError",
     "NumericalError",
+    "DamagedStateError",
 ]

@@ -49,6 +49,12 @@ class NumericalError(SeqsmoothError):
     double range, a singular fit, an iteration that diverged or did not converge."""
 
 
+class DamagedStateError(SeqsmoothError):
+    """A saved filter (a pickle, or the bytes of the library's saved form) that cannot be
+    restored: truncated, a byte changed, another class's, a newer format, or numbers that
+    break the filter's invariants."""
+
+
 __all__ = [
     "SeqsmoothError",
     "InvalidInputError",
@@ -57,4 +63,5 @@ __all__ = [
     "TooFewSamplesError",
     "NotDeterminedError",
     "NumericalError",
+    "DamagedStateError",
 ]

@@ -15,7 +15,7 @@ use nalgebra::DMatrix;
 /// assert_eq!(b.norm_sq(0), 5.0);              // c0² = L + 1
 /// assert_eq!(b.value(3, 4.0), -1.0);          // p_j(L) = (-1)^j
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct DiscreteLegendre<T> {
     span: T,
 }

@@ -18,7 +18,7 @@ const EIGEN_ITERATIONS: usize = 10_000;
 /// A Gauss rule: nodes (ascending) and their weights (`Σ λ_k = μ₀`). The nodes are kept as
 /// offsets from the interval's centre, which carry their full precision where the times
 /// themselves are large (Unix-epoch seconds round to 2.4e-7 s).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GaussRule {
     /// The centre `c` of the measure's interval (time units).
     pub centre: f64,

@@ -28,7 +28,7 @@ use crate::numeric::unrolled::unrolled_sizes;
 use nalgebra::{Cholesky, DMatrix, DMatrixViewMut, DVector, DVectorViewMut, Dyn};
 
 /// The instant the estimate refers to.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Epoch {
     /// The last observation time (the leading edge, §8.3).
     End,
@@ -104,7 +104,7 @@ pub struct Prior {
 }
 
 /// One iteration of the correction.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Iteration {
     /// The estimate after the step, `X̄ + step · δX`.
     pub state: DVector<f64>,
@@ -117,7 +117,7 @@ pub struct Iteration {
 }
 
 /// A converged differential correction.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Correction {
     /// The epoch `t_c` of the state.
     pub epoch: f64,
@@ -166,7 +166,7 @@ pub fn check_max_iterations(n: usize) -> Result<(), Error> {
 /// let g = GaussNewton::default();
 /// assert_eq!((g.max_iterations, g.tolerance, g.max_halvings), (20, 1e-6, 30));
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GaussNewton {
     /// Linearisations allowed before [`Error::NotConverged`].
     pub max_iterations: usize,

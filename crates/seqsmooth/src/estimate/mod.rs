@@ -34,7 +34,7 @@ use nalgebra::{DMatrix, DVector};
 /// let d = fit.derivatives_at(4.0);
 /// assert!((d[0] - 7.0).abs() < 1e-12 && (d[1] - 3.0).abs() < 1e-12 && (d[2] - 1.0).abs() < 1e-12);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct PolynomialFit {
     degree: usize,
     centre: f64,

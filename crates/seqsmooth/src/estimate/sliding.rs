@@ -47,7 +47,7 @@ pub fn check_window_length(window: usize) -> Result<(), Error> {
 }
 
 /// Where a window's iteration starts when there is no previous estimate to carry forward.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Start {
     /// The nominal state of §8.5 from polynomial fits of this degree (at most one less than
     /// the window's complete measurements) to the radar's range, azimuth and elevation.
@@ -87,7 +87,7 @@ pub enum Start {
 /// let c = last.unwrap(); // the line through (1, 3), (2, 5), (3, 7.5)
 /// assert!((c.state[1] - 2.25).abs() < 1e-12);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct SlidingFit<D: Dynamics, O: Observation> {
     dynamics: D,
     observation: O,

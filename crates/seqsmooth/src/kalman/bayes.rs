@@ -62,7 +62,7 @@ pub const MAX_VARIANCE_INFLATION: f64 = 1e11;
 /// let x = f.estimate().unwrap();
 /// assert!((x[0] - 5.0).abs() < 1e-14 && (x[1] - 2.0).abs() < 1e-14);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct BayesFilter<D: Dynamics, O: Observation> {
     dynamics: D,
     observation: O,
@@ -73,6 +73,7 @@ pub struct BayesFilter<D: Dynamics, O: Observation> {
     /// Whether there is information to discount (a prior or an update).
     informed: bool,
     /// The driving noise added at each prediction (ch. 15), if any.
+    #[serde(with = "crate::kalman::saved_noise::field")]
     noise: Option<Arc<dyn ProcessNoise>>,
 }
 
@@ -629,4 +630,32 @@ fn whitener(p: usize, noise: &NoiseCovariance, present: &[usize]) -> Result<DMat
     let l = Cholesky::new(r.clone()).ok_or_else(refuse)?.l();
     l.solve_lower_triangular(&DMatrix::identity(k, k))
         .ok_or_else(refuse)
+}
+
+impl<D: Dynamics, O: Observation> BayesFilter<D, O> {
+    /// The dynamic and observation models.
+    ///
+    /// ```
+    /// use seqsmooth::kalman::bayes::BayesFilter;
+    /// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+    /// use seqsmooth::model::observation::{LinearObservation, Observation};
+    /// let m = LinearObservation::new(nalgebra::DMatrix::from_row_slice(1, 2, &[1.0, 0.0])).unwrap();
+    /// let f = BayesFilter::new(PolynomialDynamics::new(1, 1), m, 0.0).unwrap();
+    /// assert_eq!((f.models().0.dimension(), f.models().1.components()), (2, 1));
+    /// ```
+    pub fn models(&self) -> (&D, &O) {
+        (&self.dynamics, &self.observation)
+    }
+
+    /// A restored filter's invariants ([`crate::persist`]): the information of the model's
+    /// dimension, the time finite.
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        self.info.check_saved()?;
+        if self.info.dim() != self.dynamics.dimension() || !self.time.is_finite() {
+            return Err(
+                "information is not of the model's dimension, or the time not finite".into(),
+            );
+        }
+        Ok(())
+    }
 }

@@ -92,6 +92,13 @@ pub(super) struct Work {
     pub(super) p_out: DMatrix<f64>,
 }
 
+/// Empty buffers, to be made anew for the filter's dimensions (a restored filter's scratch).
+impl Default for Work {
+    fn default() -> Self {
+        Self::new(0, 0)
+    }
+}
+
 impl Work {
     pub(super) fn new(n: usize, p: usize) -> Self {
         let vector = |len: usize| vec![0.0; len];

@@ -39,7 +39,7 @@ use nalgebra::{DMatrix, DVector};
 /// assert_eq!(p.state.as_slice(), &[2.0, 2.0]);
 /// assert!(d.propagate(&DVector::zeros(2), 3.0, 5.0).is_err());
 /// ```
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct DiscreteDynamics {
     transition: DMatrix<f64>,
     offset: Option<DVector<f64>>,
@@ -203,14 +203,14 @@ type Inner = KalmanFilter<DiscreteDynamics, LinearObservation>;
 /// }
 /// assert!((kf.state()[1] - 1.0).abs() < 0.05);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct LinearKalmanFilter {
     filter: Inner,
     model: Constants,
 }
 
 /// The constant matrices of a [`LinearKalmanFilter`].
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct Constants {
     f: DMatrix<f64>,
     h: DMatrix<f64>,
@@ -718,7 +718,7 @@ impl LinearKalmanFilter {
 /// assert!((first.state[0] - 2.0).abs() < 1e-9); // a constant: the mean of both
 /// assert_eq!(s.finish().unwrap().len(), 1);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct LinearFixedLag {
     smoother: FixedLagSmoother<DiscreteDynamics, LinearObservation>,
     model: LinearKalmanFilter,
@@ -844,4 +844,52 @@ fn update_on<T>(
     let out = apply_update(filter, model, step).and_then(|()| run(filter));
     restore(filter, model, step);
     out
+}
+
+impl LinearKalmanFilter {
+    /// A restored filter's invariants ([`crate::persist`]): `F`, `H`, `Q`, `R`, `B` of the
+    /// state's and the observation's dimensions, finite, `Q` and `R` covariances; the filter's.
+    pub(crate) fn check_saved(&mut self) -> Result<(), String> {
+        use crate::linalg::invariant::{covariance, matrix};
+        let n = self.filter.state().len();
+        let c = &self.model;
+        let p = c.h.nrows();
+        matrix(&c.f, n, n, "F")?;
+        matrix(&c.h, p, n, "H")?;
+        covariance(&c.q, n, "Q")?;
+        covariance(&c.r, p, "R")?;
+        if let Some(b) = &c.b {
+            matrix(b, n, b.ncols(), "B")?;
+        }
+        matrix(self.filter.dynamics_mut().transition(), n, n, "F")?;
+        let o = self.filter.observation().matrix();
+        matrix(o, p, n, "H")?;
+        self.filter.check_saved()
+    }
+}
+
+impl LinearFixedLag {
+    /// The state's dimension `n`.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::discrete::{LinearFixedLag, LinearKalmanFilter};
+    /// let i = DMatrix::identity(2, 2);
+    /// let h = DMatrix::from_row_slice(1, 2, &[1.0, 0.0]);
+    /// let r = DMatrix::identity(1, 1);
+    /// let f = LinearKalmanFilter::new(DVector::zeros(2), i.clone(), i.clone(), h, i, r).unwrap();
+    /// assert_eq!(LinearFixedLag::new(&f, 3).dimension(), 2);
+    /// ```
+    pub fn dimension(&self) -> usize {
+        self.model.dimension()
+    }
+
+    /// A restored smoother's invariants ([`crate::persist`]): its model's and its own.
+    pub(crate) fn check_saved(&mut self) -> Result<(), String> {
+        self.model.check_saved()?;
+        if self.smoother.filter().state().len() != self.model.dimension() {
+            return Err("smoother's and model's dimensions differ".into());
+        }
+        self.smoother.check_saved()
+    }
 }

@@ -35,7 +35,7 @@ use nalgebra::{Cholesky, DMatrix, DVector};
 use std::collections::VecDeque;
 
 /// One measurement's filtered estimate, until it is given.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Row {
     pub(super) time: f64,
     /// `X_{k|k}`, `S_{k|k}`.
@@ -47,7 +47,7 @@ pub(super) struct Row {
 
 /// `(X, S) ↦ (a + C X, D + C S Cᵀ)`: a backward step, a composition of them, or (`c` `None`)
 /// the constant `(a, D)`, an estimate.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Map {
     pub(super) a: DVector<f64>,
     pub(super) d: DMatrix<f64>,
@@ -172,7 +172,7 @@ pub(super) fn step(
 /// The maps of the window, oldest first, in two stacks (sliding-window aggregation): `front`
 /// with the oldest last, each with the composition of it and every newer map of `front`;
 /// `back` in order, with the composition of all of them (kept only for a bounded lag).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 struct Window {
     front: Vec<(Map, Map)>,
     back: Vec<Map>,
@@ -242,7 +242,7 @@ impl Window {
 /// out.extend(s.finish().unwrap()); // the last: the filter's
 /// assert!((out[2].state[0] - 4.0).abs() < 1e-9);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct FixedLagSmoother<D: Dynamics, O: Observation> {
     filter: KalmanFilter<D, O>,
     lag: usize,
@@ -467,5 +467,36 @@ fn smoothed(row: Row, s: Map) -> Smoothed {
         filtered_state: row.state,
         filtered_covariance: row.covariance,
         nis: row.nis,
+    }
+}
+
+impl<D: Dynamics, O: Observation> FixedLagSmoother<D, O> {
+    /// The dynamic and observation models (a restored smoother's checks).
+    pub(crate) fn models(&self) -> (&D, &O) {
+        self.filter.models()
+    }
+
+    /// A restored smoother's invariants ([`crate::persist`]): its filter's, and the rows it
+    /// holds of the filter's dimension.
+    pub(crate) fn check_saved(&mut self) -> Result<(), String> {
+        self.filter.check_saved()?;
+        let n = self.filter.state().len();
+        for r in &self.rows {
+            crate::linalg::invariant::vector(&r.state, n, "held state")?;
+            crate::linalg::invariant::covariance(&r.covariance, n, "held covariance")?;
+        }
+        let map = |m: &Map| {
+            m.a.len() == n
+                && m.d.shape() == (n, n)
+                && m.c.as_ref().is_none_or(|c| c.shape() == (n, n))
+        };
+        let w = &self.window;
+        if !(w.front.iter().all(|(a, b)| map(a) && map(b))
+            && w.back.iter().all(map)
+            && w.back_all.as_ref().is_none_or(map))
+        {
+            return Err(format!("smoother's maps are not {n}-dimensional"));
+        }
+        Ok(())
     }
 }

@@ -33,6 +33,7 @@ pub mod discrete;
 pub mod filter;
 pub mod fixed_lag;
 pub mod noise;
+pub mod saved_noise;
 pub mod sigma_points;
 pub mod smoother;
 pub mod steady;

@@ -46,6 +46,12 @@ pub trait ProcessNoise: std::fmt::Debug + Send + Sync {
         *out = self.covariance(t_a, t_b)?;
         Ok(())
     }
+
+    /// The model's saved form ([`crate::persist`]), or `None` for a model of the caller's own
+    /// type (a filter holding one cannot be saved).
+    fn saved(&self) -> Option<super::saved_noise::SavedNoise> {
+        None
+    }
 }
 
 /// The range of a driving noise's power spectral density `q` (ch. 15): finite and at least 0
@@ -77,7 +83,7 @@ pub fn check_psd(q: f64) -> Result<(), Error> {
 /// let q = WhiteNoiseDerivative::new(1, 1, 0.5).unwrap().covariance(10.0, 12.0).unwrap();
 /// assert_eq!((q[(0, 0)], q[(0, 1)], q[(1, 1)]), (0.5 * 8.0 / 3.0, 0.5 * 2.0, 0.5 * 2.0));
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WhiteNoiseDerivative {
     degree: usize,
     axes: usize,
@@ -106,6 +112,10 @@ impl WhiteNoiseDerivative {
 }
 
 impl ProcessNoise for WhiteNoiseDerivative {
+    fn saved(&self) -> Option<super::saved_noise::SavedNoise> {
+        Some(super::saved_noise::SavedNoise::WhiteNoiseDerivative(*self))
+    }
+
     fn dimension(&self) -> usize {
         (self.degree + 1) * self.axes
     }
@@ -218,6 +228,10 @@ fn fill<S: Size>(size: S, d: usize, psd: f64, zeta: f64, out: &mut [f64]) -> boo
 /// assert!((f.covariance() - q).amax() < 1e-15);
 /// ```
 impl ProcessNoise for ContinuousModel {
+    fn saved(&self) -> Option<super::saved_noise::SavedNoise> {
+        Some(super::saved_noise::SavedNoise::Continuous(self.clone()))
+    }
+
     fn dimension(&self) -> usize {
         crate::model::dynamics::Dynamics::dimension(self)
     }
@@ -250,6 +264,10 @@ fn step_between(t_a: f64, t_b: f64) -> Result<f64, Error> {
 /// assert_eq!((q[(3, 3)], q[(6, 6)]), (6.0, 0.75)); // q ζ, q_ω ζ
 /// ```
 impl ProcessNoise for CoordinatedTurn {
+    fn saved(&self) -> Option<super::saved_noise::SavedNoise> {
+        Some(super::saved_noise::SavedNoise::CoordinatedTurn(*self))
+    }
+
     fn dimension(&self) -> usize {
         crate::model::dynamics::Dynamics::dimension(self)
     }
@@ -269,7 +287,7 @@ impl ProcessNoise for CoordinatedTurn {
 /// assert_eq!(MatrixNoise::new(q.clone()).unwrap().covariance(0.0, 1.0).unwrap(), q);
 /// assert!(MatrixNoise::new(DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, -1.0])).is_err());
 /// ```
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MatrixNoise {
     q: DMatrix<f64>,
 }
@@ -288,6 +306,10 @@ impl MatrixNoise {
 }
 
 impl ProcessNoise for MatrixNoise {
+    fn saved(&self) -> Option<super::saved_noise::SavedNoise> {
+        Some(super::saved_noise::SavedNoise::Matrix(self.clone()))
+    }
+
     fn dimension(&self) -> usize {
         self.q.nrows()
     }

@@ -35,7 +35,7 @@ use nalgebra::{Cholesky, DMatrix, DVector};
 /// let w = SigmaPoints::default().weights(2).unwrap();
 /// assert_eq!((w.lambda, w.mean[0], w.covariance[0], w.mean[1]), (0.0, 0.0, 2.0, 0.25));
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SigmaPoints {
     alpha: f64,
     beta: f64,
@@ -171,7 +171,7 @@ impl SigmaPoints {
 }
 
 /// The weights of the `2n + 1` points for `n` states, and the points themselves.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Weights {
     /// The state dimension `n`.
     pub n: usize,

@@ -21,7 +21,7 @@ use crate::model::observation::Observation;
 use nalgebra::{DMatrix, DVector};
 
 /// The smoothed estimate at one measurement's time.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Smoothed {
     /// The measurement's time.
     pub time: f64,

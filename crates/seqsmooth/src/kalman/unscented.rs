@@ -85,10 +85,11 @@ pub struct Prediction {
 /// assert!((f.covariance() - want).amax() < 1e-15);
 /// assert!((i.nis - 0.5).abs() < 1e-15);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct UnscentedKalmanFilter<D: Dynamics, O: Observation> {
     dynamics: D,
     observation: O,
+    #[serde(with = "crate::kalman::saved_noise::field")]
     noise: Option<Arc<dyn ProcessNoise>>,
     points: SigmaPoints,
     weights: Weights,
@@ -577,4 +578,41 @@ fn check_positive_definite(covariance: &DMatrix<f64>, name: Param) -> Result<(),
         });
     }
     Ok(())
+}
+
+impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
+    /// The dynamic and observation models.
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::UnscentedKalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::{LinearObservation, Observation};
+    /// let m = LinearObservation::new(DMatrix::from_row_slice(1, 2, &[1.0, 0.0])).unwrap();
+    /// let (x, p) = (DVector::zeros(2), DMatrix::identity(2, 2));
+    /// let f = UnscentedKalmanFilter::new(PolynomialDynamics::new(1, 1), m, x, p, 0.0).unwrap();
+    /// assert_eq!(f.models().1.components(), 1);
+    /// ```
+    pub fn models(&self) -> (&D, &O) {
+        (&self.dynamics, &self.observation)
+    }
+
+    /// A restored filter's invariants ([`crate::persist`]): state and covariance of the
+    /// model's dimension, the sigma points' weights for it, the time finite.
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        let n = self.dynamics.dimension();
+        crate::linalg::invariant::vector(&self.state, n, "state")?;
+        crate::linalg::invariant::covariance(&self.covariance, n, "covariance")?;
+        let w = &self.weights;
+        if w.n != n || w.mean.len() != 2 * n + 1 || w.covariance.len() != 2 * n + 1 {
+            return Err(format!("sigma-point weights are not for {n} states"));
+        }
+        if !self.time.is_finite() {
+            return Err(format!("time {} is not finite", self.time));
+        }
+        if self.noise.as_ref().is_some_and(|q| q.dimension() != n) {
+            return Err(format!("noise model is not {n}-dimensional"));
+        }
+        Ok(())
+    }
 }

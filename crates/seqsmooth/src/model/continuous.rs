@@ -53,7 +53,7 @@ const MAX_TERMS: usize = 80;
 /// assert_eq!(phi, DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 0.0, 1.0]));
 /// assert!((q[(0, 0)] - 0.5 * 8.0 / 3.0).abs() < 1e-15 && (q[(1, 1)] - 1.0).abs() < 1e-15);
 /// ```
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContinuousModel {
     dynamics: LinearDynamics,
     qc: DMatrix<f64>,

@@ -56,7 +56,7 @@ const MAX_TERMS: usize = 20;
 /// assert!((p.state[0] - 1000.0).abs() < 1e-9 && (p.state[1] - 1000.0).abs() < 1e-9);
 /// assert!(p.state[3].abs() < 1e-12 && (p.state[4] - 100.0).abs() < 1e-12);
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CoordinatedTurn {
     /// `Some(ω)`: known; `None`: the seventh state.
     rate: Option<f64>,

@@ -194,7 +194,7 @@ pub(crate) fn finite_matrix(m: &DMatrix<f64>, what: &'static str) -> Result<(), 
 /// let phi = cv.transition(2.0);
 /// assert_eq!((phi[(0, 3)], phi[(2, 5)], phi[(0, 4)]), (2.0, 2.0, 0.0));
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct PolynomialDynamics {
     degree: usize,
     axes: usize,

@@ -23,7 +23,7 @@ use nalgebra::DMatrix;
 /// let p = d.transition(0.5).unwrap();
 /// assert!((p[(0, 1)] - 0.5_f64.sin()).abs() < 1e-15 && (p[(1, 1)] - 0.5_f64.cos()).abs() < 1e-15);
 /// ```
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LinearDynamics {
     a: DMatrix<f64>,
     /// `A^ν/ν!` for `ν = 0..k` when `A^k = 0` (nilpotent), else empty.

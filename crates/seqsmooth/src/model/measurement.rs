@@ -22,7 +22,7 @@ pub fn is_usable_sigma(sigma: f64) -> bool {
 }
 
 /// The covariance `R` of the stacked observation errors.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum NoiseCovariance {
     /// `R = I`.
     Identity,
@@ -35,7 +35,7 @@ pub enum NoiseCovariance {
 /// One observation: its time, its components (`None` for a missing one: its row is dropped),
 /// and the covariance of its errors (of all components; the missing ones' rows and columns are
 /// dropped).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Measurement {
     /// The time `t_k`.
     pub time: f64,

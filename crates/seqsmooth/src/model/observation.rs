@@ -209,7 +209,7 @@ impl Angles {
 }
 
 /// `Y = M X + N` with a constant `M` (8.2.2).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LinearObservation {
     m: DMatrix<f64>,
 }

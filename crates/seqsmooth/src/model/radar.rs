@@ -34,7 +34,7 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 /// assert!((p.value[1] - std::f64::consts::FRAC_PI_2).abs() < 1e-15); // +y: azimuth π/2
 /// assert!((p.value[2] - (4.0_f64 / 3.0).atan()).abs() < 1e-15);
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Radar {
     site: [f64; 3],
     states: usize,

@@ -14,7 +14,7 @@ use nalgebra::{DMatrix, DVector};
 /// let p = s.at(1.0);
 /// assert_eq!(p.derivatives, vec![4.0, 4.0, 2.0]);
 /// ```
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PolynomialState {
     /// The instant the state is valid at.
     pub time: f64,

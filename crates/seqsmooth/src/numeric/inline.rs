@@ -39,6 +39,24 @@ impl<T: Copy, const N: usize> InlineVec<T, N> {
     }
 }
 
+/// Saved as its values (a sequence), whichever the storage ([`crate::persist`]).
+impl<T: Copy + serde::Serialize, const N: usize> serde::Serialize for InlineVec<T, N> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(self.iter())
+    }
+}
+
+impl<'de, T: Copy + Default + serde::Deserialize<'de>, const N: usize> serde::Deserialize<'de>
+    for InlineVec<T, N>
+{
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let values = Vec::<T>::deserialize(d)?;
+        let mut v = Self::filled(T::default(), values.len());
+        v.copy_from_slice(&values);
+        Ok(v)
+    }
+}
+
 impl<T: Copy, const N: usize> Deref for InlineVec<T, N> {
     type Target = [T];
 

@@ -25,7 +25,7 @@ use std::ops::Deref;
 /// The offline part of [`OnlineSmoother`] for one layout of sample times and noise: each
 /// sample's `b_i(t_k)/σ_k²`, the segment's Gauss rule and `b_i` at its nodes. Shared by every
 /// segment with that layout.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct SmootherGains {
     n: usize,
     /// `b_i(t_k)/σ_k²`, `(n+1)` a sample.
@@ -144,7 +144,7 @@ impl SmootherGains {
 /// assert_eq!(s.taken(), 3);
 /// # Ok::<(), seqsmooth::Error>(())
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct OnlineSmoother<G: Deref<Target = SmootherGains>> {
     gains: G,
     taken: usize,
@@ -276,5 +276,30 @@ fn accumulate(c: &mut [f64], w: &[f64], y: &[f64]) {
                 }
             }
         }
+    }
+}
+
+impl SmootherGains {
+    /// Restored gains' invariants ([`crate::persist`]): `n + 1` weights a sample, the nodes'
+    /// table `(n+1)²`, finite.
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        let k = self.n + 1;
+        if !self.weights.len().is_multiple_of(k) || self.at_nodes.len() != k * k {
+            return Err("gains are not of their order".into());
+        }
+        crate::linalg::invariant::finite(&self.weights, "gains")?;
+        crate::linalg::invariant::finite(&self.at_nodes, "gains at the nodes")
+    }
+}
+
+impl<G: Deref<Target = SmootherGains>> OnlineSmoother<G> {
+    /// A restored smoother's invariants ([`crate::persist`]): its gains', the samples taken
+    /// at most the layout's, the sums of the order.
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        self.gains.check_saved()?;
+        if self.taken > self.gains.len() || self.coefficients.len() != self.gains.n + 1 {
+            return Err("samples taken or sums do not fit the layout".into());
+        }
+        crate::linalg::invariant::finite(&self.coefficients, "sums")
     }
 }

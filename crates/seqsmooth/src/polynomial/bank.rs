@@ -56,7 +56,7 @@ pub const PAR_CHUNK: usize = 64 * BLOCK;
 
 /// The channels' states of a bank, structure-of-arrays, and the shared sample count and gain
 /// schedule.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct BankState {
     m: usize,
     tau: f64,
@@ -334,7 +334,7 @@ macro_rules! bank_accessors {
 /// bank.derivative_into(1, &mut slopes).unwrap();
 /// assert!((slopes[2] + 1.0).abs() < 1e-9);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct FadingBank {
     core: BankState,
     theta: f64,
@@ -417,7 +417,7 @@ bank_accessors!(FadingBank, "FadingBank::new(1, 0.5, 1.0, 2)");
 /// let x = bank.estimate(0).unwrap(); // Morrison T9-02: (23/5, 4/5)
 /// assert!((x[0] - 4.6).abs() < 1e-12 && (x[1] - 0.8).abs() < 1e-12);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct ExpandingBank {
     core: BankState,
 }
@@ -463,6 +463,41 @@ impl ExpandingBank {
 bank_accessors!(ExpandingBank, "ExpandingBank::new(1, 1.0, 2)");
 
 pub use super::stream::StreamBank;
+
+impl BankState {
+    /// A restored bank's invariants ([`crate::persist`]): degree in range, `m + 1` rows of
+    /// `channels` values, the gains `m + 1`.
+    fn check_saved(&self) -> Result<(), String> {
+        check_engine_degree(self.m, Engine::Gain).map_err(|e| e.to_string())?;
+        let rows_ok = self.z.len() == self.m + 1 && self.z.iter().all(|r| r.len() == self.channels);
+        if !rows_ok || self.gains.len() != self.m + 1 || self.schedule.degree() != self.m {
+            return Err(format!(
+                "state is not {} rows of {} channels",
+                self.m + 1,
+                self.channels
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl FadingBank {
+    /// A restored bank's invariants ([`crate::persist`]).
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        self.core.check_saved()?;
+        if self.fading.len() != self.core.m + 1 || !(self.theta > 0.0 && self.theta < 1.0) {
+            return Err("fading gains or θ out of range".into());
+        }
+        Ok(())
+    }
+}
+
+impl ExpandingBank {
+    /// A restored bank's invariants ([`crate::persist`]).
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        self.core.check_saved()
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -30,7 +30,7 @@ const _: () = assert!(crate::stats::MAX_DIFFERENCE_ORDER == MAX_DEGREE + 1);
 ///     assert!((f.estimate().unwrap().derivatives[1] - 2.0).abs() < 1e-12);
 /// }
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum Engine {
     /// Recursive least squares, exact on any timestamps.
     #[default]

@@ -30,7 +30,7 @@ use nalgebra::{Cholesky, DMatrix, DVector};
 /// assert_eq!(p.degree(), 1);
 /// assert!(Prior::new(0.0, vec![1.0, 2.0], DMatrix::zeros(2, 2)).is_err()); // no information form
 /// ```
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Prior {
     /// The time `t₀` the prior refers to.
     pub time: f64,

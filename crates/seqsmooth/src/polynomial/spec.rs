@@ -24,7 +24,7 @@ use crate::polynomial::prior::Prior;
 use crate::polynomial::tau::default_tau;
 
 /// Which memory a polynomial filter has.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum FilterKind {
     /// Expanding memory (Morrison ch. 9): every sample so far, weighted alike.
     Expanding,
@@ -229,7 +229,7 @@ fn needs(name: Param, kind: FilterKind) -> Error {
 /// A polynomial filter of any kind, as [`FilterSpec::build`] makes it, with the rows it has run
 /// (the automatic filter's rejected samples included). Cloning a new one is how each series of
 /// many gets its filter.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct AnyFilter {
     pub(crate) inner: Inner,
     /// The samples offered so far (accepted or not).
@@ -238,7 +238,7 @@ pub struct AnyFilter {
 }
 
 /// The filter itself.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) enum Inner {
     Expanding(Box<ExpandingMemory>),
     Fading(Box<FadingMemory>),

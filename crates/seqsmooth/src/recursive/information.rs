@@ -43,7 +43,7 @@ const RENORMALISE: f64 = 1e30;
 /// let x = f.solve().unwrap();
 /// assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] - 2.0).abs() < 1e-12);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct InformationFilter {
     info: TriangularFactor,
     /// `Q` with `QᵀQ = Σ c_k w_k² h_k h_kᵀ`, when the true covariance is kept.
@@ -634,4 +634,25 @@ fn column_dot<const N: usize>(
         at += p;
     }
     s
+}
+
+impl InformationFilter {
+    /// The invariants of a restored filter ([`crate::persist`]): its factors valid and of one
+    /// dimension, the discount's scale finite and positive.
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        self.info.check_saved()?;
+        if let Some(s) = &self.spread {
+            s.check_saved()?;
+            if s.dim() != self.info.dim() {
+                return Err("information filter's factors differ in dimension".into());
+            }
+        }
+        if !(self.scale.is_finite() && self.scale > 0.0) {
+            return Err(format!(
+                "information filter's scale {} is not positive",
+                self.scale
+            ));
+        }
+        Ok(())
+    }
 }

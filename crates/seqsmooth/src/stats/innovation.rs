@@ -28,7 +28,7 @@ use crate::error::{Error, Param};
 /// assert_eq!((o.normalised, o.statistic, o.dof), (1.0, 1.0, 1));
 /// assert!(!o.misfit && o.threshold > 3.8);
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ChiSquaredOutcome {
     /// The normalised squared innovation `k² = ν²/σ_ε²` just added.
     pub normalised: f64,
@@ -58,7 +58,7 @@ pub struct ChiSquaredOutcome {
 /// }
 /// assert_eq!(fired, Some(4));
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct InnovationChiSquared {
     window: usize,
     alpha: f64,

@@ -301,7 +301,7 @@ fn divided_difference_with_factors(times: &[f64], values: &[f64], factors: &[f64
 /// let s = est.sigma().unwrap();
 /// assert!(s > 0.1 && s < 0.2); // the ramp is gone; the rest is the ±0.1 pattern
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct DifferenceNoise {
     order: usize,
     times: VecDeque<f64>,

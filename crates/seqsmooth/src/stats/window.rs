@@ -6,7 +6,7 @@ use std::collections::VecDeque;
 /// A sum over the last `window` values pushed, or over all of them with `None`. The windowed
 /// sum is updated as `(s − x_old) + x_new` and re-added from scratch every `4·window` pushes, so
 /// that its rounding cannot drift, and kept `≥ 0` (the values summed are squares).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) struct SlidingSum {
     window: Option<usize>,
     values: VecDeque<f64>,

@@ -38,7 +38,7 @@ pub const GATE_ALPHA: f64 = 1e-3;
 /// assert_eq!(TrackFlag::Misfit.name(), "misfit");
 /// assert_eq!(TrackFlag::None.name(), "");
 /// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum TrackFlag {
     /// The model holds as far as the tests see: the σ covers the error.
     #[default]
@@ -69,7 +69,7 @@ impl TrackFlag {
 }
 
 /// The monitor: the gate, the window test and the adaptive level.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Monitor {
     test: InnovationChiSquared,
     /// `gates[p − 1]`: the gate for `p` components.

@@ -19,7 +19,7 @@ pub(super) type Filter = KalmanFilter<TrackDynamics, Radar>;
 
 /// The memory of a Kalman method: a driving noise or a discount, fixed or adaptive, with the
 /// innovation monitor that flags its rows.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Memory {
     model: MotionModel,
     kind: MemoryKind,
@@ -27,7 +27,7 @@ pub(super) struct Memory {
 }
 
 /// What a level sets.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) enum MemoryKind {
     /// The driving noise `q` (Singer's `σ_m²`) at level 0 (`q₀` when adaptive).
     Noise(f64),

@@ -79,7 +79,7 @@ const FADING_LEVELS: (i32, i32) = (-4, 3);
 pub const DEFAULT_LAG: usize = 200;
 
 /// How rows become estimates.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum TrackMethod {
     /// The fit of the last `window` rows at each row.
     Window {
@@ -236,7 +236,7 @@ fn memory_of<'a, I: Iterator<Item = &'a Measurement>>(
 /// The smooth method's forward pass: the fixed-lag smoother, the memory that gates and adapts
 /// its filter (as the kalman method's), and the NIS and flag of each row the smoother holds,
 /// oldest first (its ring's rows: at most `lag + 1`).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct Lagged {
     smoother: FixedLagSmoother<TrackDynamics, Radar>,
     memory: Memory,
@@ -244,7 +244,7 @@ struct Lagged {
 }
 
 /// What the method keeps between rows.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 enum Stage {
     /// The Kalman methods before the state is determined: the start's fit.
     Starting(Box<SlidingFit<PolynomialDynamics, Radar>>),
@@ -297,7 +297,7 @@ enum Stage {
 /// let (vx, flag) = last.unwrap();
 /// assert!((vx - 10.0).abs() < 1e-6 && flag == TrackFlag::None);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct RadarTracker {
     method: TrackMethod,
     model: MotionModel,
@@ -759,4 +759,15 @@ pub fn radar_row(
             variances[1],
         ]),
     })
+}
+
+impl RadarTracker {
+    /// A restored tracker's invariants ([`crate::persist`]): the filter or smoother it runs.
+    pub(crate) fn check_saved(&mut self) -> Result<(), String> {
+        match &mut self.stage {
+            Stage::Filtering(f, _) => f.0.check_saved(),
+            Stage::Smoothing(l, ..) => l.smoother.check_saved(),
+            _ => Ok(()),
+        }
+    }
 }

@@ -46,7 +46,7 @@ pub const TURN_RATE_PRIOR_SIGMA: f64 = 0.1;
 /// assert_eq!(MotionModel::default(), MotionModel::ConstantVelocity);
 /// assert!(MotionModel::from_name("cv").is_none());
 /// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum MotionModel {
     /// Nearly constant velocity, white acceleration of density `q` on each axis.
     #[default]
@@ -358,7 +358,7 @@ impl MotionModel {
 }
 
 /// The tracker's dynamics: one of the built-in models' (a [`Dynamics`] by dispatch).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) enum TrackDynamics {
     Polynomial(PolynomialDynamics),
     Continuous(ContinuousModel),

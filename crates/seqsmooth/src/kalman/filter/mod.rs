@@ -68,6 +68,7 @@ use std::sync::Arc;
 
 mod innovation;
 mod iterated;
+mod saved;
 pub use innovation::{Innovation, InnovationStats};
 pub use iterated::check_iteration_limits;
 
@@ -95,21 +96,24 @@ pub use iterated::check_iteration_limits;
 /// assert!((f.covariance() - want).amax() < 1e-15);
 /// assert!((i.nis - 0.5).abs() < 1e-15); // ν² / V = 1 / 2
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct KalmanFilter<D: Dynamics, O: Observation> {
     dynamics: D,
     observation: O,
+    #[serde(with = "crate::kalman::saved_noise::field")]
     noise: Option<Arc<dyn ProcessNoise>>,
     fading: Option<Fading>,
     state: DVector<f64>,
     covariance: DMatrix<f64>,
     time: f64,
+    /// Scratch: not saved; made anew on restoring ([`crate::persist`]).
+    #[serde(skip)]
     work: Work,
 }
 
 /// The fading filter's own matrix `P` (14.3.13), not the covariance when the discount is
 /// below 1, and the time of the last update (from which a discount per time counts).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct Fading {
     discount: Discount,
     weight: DMatrix<f64>,

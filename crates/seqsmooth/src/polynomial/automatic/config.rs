@@ -62,7 +62,7 @@ pub const MAX_REVIEW_WINDOW: usize = 31;
 /// let c = f.config();
 /// assert_eq!((c.noise_sigma, c.outliers, c.misfit_window), (Some(5.0), OutlierRule::reyneke(), 10));
 /// ```
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AutoConfig {
     /// Final degree `m ≤ MAX_DEGREE`.
     pub degree: usize,

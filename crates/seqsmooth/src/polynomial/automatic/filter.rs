@@ -35,7 +35,7 @@ use crate::polynomial::filter::PolynomialFilter;
 /// assert_eq!(p.derivatives.len(), 3);
 /// assert!(!f.is_misfit() && f.restarts() == 0 && f.last_restart().is_none());
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct AutomaticFilter {
     /// Everything an update changes (what the review goes back to).
     pub(super) state: State,
@@ -402,5 +402,14 @@ impl PolynomialFilter for AutomaticFilter {
     /// The active filter is determined and `σ` is known (no estimate without its σ).
     fn is_determined(&self) -> bool {
         self.state.active_filter().is_determined() && self.noise_sigma().is_some()
+    }
+}
+
+impl AutomaticFilter {
+    /// A restored filter's invariants ([`crate::persist`]): its state and every state the
+    /// review may go back to.
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        self.state.check_saved()?;
+        self.review.check_saved(|s| s.check_saved())
     }
 }

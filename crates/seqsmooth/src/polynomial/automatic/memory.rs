@@ -119,7 +119,7 @@ fn upper_pair(cfg: &AutoConfig) -> Result<UpperPair, Error> {
 
 /// A shorter memory of the final degree: the degree-`m` fading-memory filter of discount
 /// `θ^(2^j)` per `τ` and its degree `m + 1` companion.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct Shorter {
     fading: FadingMemory,
     upper: FadingMemory,
@@ -150,7 +150,7 @@ fn shorter_memories(cfg: &AutoConfig) -> Result<Vec<Shorter>, Error> {
 
 /// The final degree's filters before their first sample, built once (a restart starts from
 /// copies of them: no settings checked again, no allocation to build them).
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 struct Fresh {
     expanding: ExpandingMemory,
     fading: FadingMemory,
@@ -172,7 +172,7 @@ impl Fresh {
 /// The final degree's memories (see the module docs): memory 0 (expanding until the switch,
 /// then fading) and the shorter ones, each with its degree `m + 1` companion; which one is in
 /// use, and each one's calibration.
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Memories {
     /// The final-degree expanding-memory filter of the current memory, until the switch.
     expanding: Option<ExpandingMemory>,
@@ -574,6 +574,47 @@ impl Memories {
             self.switched_at = Some(accepted);
             self.expanding = None;
             self.upper_expanding = None;
+        }
+        Ok(())
+    }
+}
+
+impl Memories {
+    /// Restored memories' invariants ([`crate::persist`]): every filter valid and of the
+    /// final degree `m` (the companions `m + 1`), the memory in use one of them.
+    pub(super) fn check_saved(&self, m: usize) -> Result<(), String> {
+        let degree = |f: &dyn PolynomialFilter, want: usize| {
+            if f.degree() == want {
+                Ok(())
+            } else {
+                Err(format!("memory of degree {}, {want} expected", f.degree()))
+            }
+        };
+        if let Some(e) = &self.expanding {
+            e.check_saved()?;
+            degree(e, m)?;
+        }
+        self.fading.check_saved()?;
+        degree(&self.fading, m)?;
+        if let Some(e) = &self.upper_expanding {
+            e.check_saved()?;
+            degree(e, m + 1)?;
+        }
+        if let Some(f) = &self.upper_fading {
+            f.check_saved()?;
+            degree(f, m + 1)?;
+        }
+        for s in &self.shorter {
+            s.fading.check_saved()?;
+            s.upper.check_saved()?;
+            degree(&s.fading, m)?;
+        }
+        if self.memory > self.shorter.len() {
+            return Err(format!(
+                "memory in use {} of {}",
+                self.memory,
+                self.shorter.len()
+            ));
         }
         Ok(())
     }

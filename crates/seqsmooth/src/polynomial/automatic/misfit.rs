@@ -12,7 +12,7 @@ use std::collections::VecDeque;
 /// use seqsmooth::polynomial::automatic::MisfitResponse;
 /// assert_eq!(MisfitResponse::default(), MisfitResponse::Restart { alpha: 1e-4 });
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum MisfitResponse {
     /// Raise [`AutoOutput::misfit`](super::AutoOutput::misfit) only: the memory keeps the
     /// unmodelled manoeuvre until it fades (about two memory lengths `c_0m/(1-θ)` for the bias
@@ -88,7 +88,7 @@ impl MisfitResponse {
 
 /// A sample kept for a restart or a run of rejections, with `ν²/σ_ε²` against the active
 /// filter's prediction when it arrived.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Kept {
     pub(super) t: f64,
     pub(super) y: f64,
@@ -119,7 +119,7 @@ fn misfit_onset(recent: &[Kept], window: usize, m: usize) -> usize {
 /// The misfit tests and what a restart needs (Morrison §14.8): the innovation chi-squared
 /// window of the flag, the stricter one of the restart ([`MisfitResponse::Restart`]), the
 /// newest accepted samples, and the restarts so far.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Misfit {
     chi: InnovationChiSquared,
     restart_test: Option<InnovationChiSquared>,

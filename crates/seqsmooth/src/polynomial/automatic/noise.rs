@@ -34,7 +34,7 @@ pub const MIN_NOISE_TERMS: usize = 5;
 /// }
 /// assert!(f.noise_sigma().unwrap() > 0.4); // the ±0.5 pattern, the parabola is modelled
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum NoiseSource {
     /// Normalised `(m+1)`-th divided differences of the accepted samples
     /// ([`crate::stats::DifferenceNoise`]), over the last `window` differences or all of them.
@@ -69,7 +69,7 @@ impl NoiseSource {
 
 /// A running mean over the last `window` values (or all of them), re-summed every `4·window`
 /// pushes so that the rounding of the sliding sum does not accumulate.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct WindowedMean {
     window: Option<usize>,
     values: VecDeque<f64>,
@@ -116,7 +116,7 @@ impl WindowedMean {
 }
 
 /// The noise estimate an [`AutomaticFilter`](super::AutomaticFilter) keeps.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) enum NoiseState {
     Known(f64),
     Differences(DifferenceNoise, Box<Early>),
@@ -140,7 +140,7 @@ const CHI2_1_TRIMMED_MEAN: f64 = 0.437_724_6;
 /// terms are an outlier's), the kept ones divided by the truncated variance. Once the review
 /// rejects the outlier, the filter takes the samples again without it, and the running estimate
 /// is clean too.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Early {
     /// The screen `c` ([`AutoConfig::noise_screen`](super::AutoConfig::noise_screen)).
     screen: f64,

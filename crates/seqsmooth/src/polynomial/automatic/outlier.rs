@@ -40,7 +40,7 @@ pub const REYNEKE_DEFAULT_K: f64 = 3.0;
 /// assert_eq!(OutlierRule::default(), OutlierRule::morrison());
 /// assert_eq!(OutlierRule::Off.threshold(1.0, 0.1, 10.0), None);
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum OutlierRule {
     /// No gating: every sample updates the filter.
     Off,
@@ -180,7 +180,7 @@ const MARGINAL: f64 = 1.25;
 
 /// The current run of rejected samples (the gate's, not yet applied as a manoeuvre), and the
 /// count of rejections.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub(super) struct Run {
     pending: Vec<Kept>,
     rejected: u64,

@@ -25,7 +25,7 @@ use crate::stats::ChiSquaredOutcome;
 /// assert!(!out.outlier && !out.misfit);
 /// assert_eq!(f.last_output(), Some(&out));
 /// ```
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AutoOutput {
     /// The sample's time.
     pub time: f64,
@@ -122,7 +122,7 @@ impl AutoOutput {
 /// assert!(outs[..7].iter().all(|o| o.estimate.is_none() && o.withheld == Some(Withheld::NoiseUnknown)));
 /// assert!(outs[7..].iter().all(|o| o.withheld.is_none() && o.std_devs().is_some()));
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Withheld {
     /// The noise `σ` is not given and not estimated yet: the `(m+1)`-th differences need
     /// [`MIN_NOISE_TERMS`](super::MIN_NOISE_TERMS) terms, `m + 1 +` that many samples

@@ -11,7 +11,7 @@
 /// assert_eq!(phases[29], Phase::Fading);             // switched at ⌊3.2/0.2⌋ = 16
 /// assert_eq!(f.switched_at(), Some(16));
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Phase {
     /// A lower degree of the quick-settling ladder (expanding memory).
     Settling,

@@ -69,7 +69,7 @@ pub(super) trait Replay: Clone {
 
 /// A sample of the review: the gate's verdict so far (or the final decision), and for one in
 /// [`SNAPSHOT_EVERY`] the state `S` before the sample.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct Entry<S> {
     t: f64,
     y: f64,
@@ -84,7 +84,7 @@ struct Entry<S> {
 /// The samples waiting for their decision, oldest first, after the decided ones still needed
 /// for the state the first of them keeps; and the newest accepted samples decided. `L`, `k` and
 /// the fit's degree `m + 1` are the configuration's.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Review<S> {
     entries: VecDeque<Entry<S>>,
     /// Kept states no longer needed, whose buffers the next one reuses ([`Review::snapshot`]).
@@ -103,7 +103,7 @@ pub(super) struct Review<S> {
 /// not follow, coloured noise): the deleted residual is then judged against `σ²` times that
 /// factor, not called an outlier (Morrison §14.8: the innovations' mean square against its
 /// predicted value).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub(super) struct Calibration {
     windows: VecDeque<(f64, usize)>,
 }
@@ -242,7 +242,7 @@ fn gate_rms(out: &AutoOutput) -> Option<f64> {
 /// QR factor of the rows `(1, u, …, u^d)`, `u = (t − c)/h` centred and scaled on the window
 /// (so `|u| ≤ 1`). Refitted in place ([`WindowFit::fit`]): the review keeps two and allocates
 /// nothing per sample.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct WindowFit {
     factor: TriangularFactor,
     /// The coefficients of `u^k`.
@@ -497,7 +497,7 @@ const WINDOW: usize = 2 * MAX_REVIEW_WINDOW;
 
 /// What the review's fits keep between samples: the calibration, the two fits refitted in
 /// place, and the window's samples (no allocation, nothing to clear, per sample).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub(super) struct Scratch {
     fit: WindowFit,
     up: WindowFit,
@@ -698,5 +698,18 @@ impl<S: Replay> Review<S> {
                 Err(e)
             }
         }
+    }
+}
+
+impl<S> Review<S> {
+    /// A restored review's invariants ([`crate::persist`]): every kept state by `check`.
+    pub(super) fn check_saved(
+        &self,
+        check: impl Fn(&S) -> Result<(), String>,
+    ) -> Result<(), String> {
+        self.entries
+            .iter()
+            .filter_map(|e| e.before.as_deref())
+            .try_for_each(check)
     }
 }

@@ -12,7 +12,7 @@ use crate::polynomial::expanding::ExpandingMemory;
 use crate::polynomial::filter::PolynomialFilter;
 
 /// The ladder's filters below the final degree and the active degree.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Ladder {
     /// Expanding-memory filters indexed by degree `< m` (`None` once passed or below `d₀`).
     filters: Vec<Option<ExpandingMemory>>,
@@ -119,5 +119,27 @@ impl Ladder {
             self.stable_runs = 0;
             self.prev_top = None;
         }
+    }
+}
+
+impl Ladder {
+    /// A restored ladder's invariants ([`crate::persist`]): each filter of its degree, the
+    /// active degree at most the final one.
+    pub(super) fn check_saved(&self, m: usize) -> Result<(), String> {
+        if self.degree != m || self.active > m || self.filters.len() != m {
+            return Err("degree ladder is not of the filter's degree".into());
+        }
+        for (d, f) in self.filters.iter().enumerate() {
+            if let Some(f) = f {
+                if f.degree() != d {
+                    return Err(format!(
+                        "degree ladder's filter {d} is of degree {}",
+                        f.degree()
+                    ));
+                }
+                f.check_saved()?;
+            }
+        }
+        Ok(())
     }
 }

@@ -22,7 +22,7 @@ use crate::polynomial::options::MAX_DEGREE;
 use crate::stats::ChiSquaredOutcome;
 
 /// The automatic filter's state without its review (what a review's decision goes back to).
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct State {
     cfg: AutoConfig,
     ladder: Ladder,
@@ -540,5 +540,18 @@ impl Replay for State {
     }
     fn end_run(&mut self) {
         self.run.clear();
+    }
+}
+
+impl State {
+    /// A restored state's invariants ([`crate::persist`]): degree in range, the ladder and
+    /// the memories valid and of that degree.
+    pub(super) fn check_saved(&self) -> Result<(), String> {
+        let m = self.cfg.degree;
+        if m > MAX_DEGREE {
+            return Err(format!("degree {m} is out of range"));
+        }
+        self.ladder.check_saved(m)?;
+        self.memories.check_saved(m)
     }
 }

@@ -53,7 +53,7 @@ const fn pascal() -> [[f64; MAX_SIZE]; MAX_SIZE] {
     c
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) struct ExactEngine {
     m: usize,
     discount: Option<Discount>,
@@ -474,5 +474,27 @@ fn phi_rows(v: f64, p: usize, rows: &mut [f64]) {
         for i in 0..=k {
             rows[i * p + k] = binomial[i] * powers[k - i];
         }
+    }
+}
+
+impl ExactEngine {
+    /// The invariants of a restored engine ([`crate::persist`]): degree in range, the
+    /// information filter `m + 1` wide.
+    pub(crate) fn check_saved(&self, m: usize) -> Result<(), String> {
+        if self.m != m || m > MAX_DEGREE {
+            return Err(format!(
+                "engine's degree {} is not the filter's {m}",
+                self.m
+            ));
+        }
+        self.info.check_saved()?;
+        if self.info.dim() != m + 1 {
+            return Err(format!(
+                "engine holds {} states, {} expected",
+                self.info.dim(),
+                m + 1
+            ));
+        }
+        Ok(())
     }
 }

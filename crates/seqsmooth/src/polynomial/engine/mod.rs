@@ -41,7 +41,7 @@ const FUSED_CHUNK: usize = 1024;
 // filter allocates nothing (the automatic filter copies its filters' state where a decision may
 // go back); boxing it would put one allocation back per copy.
 #[allow(clippy::large_enum_variant)]
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) enum EngineState {
     Exact(ExactEngine),
     Gain(GainEngine),
@@ -492,6 +492,16 @@ macro_rules! impl_polynomial_filter {
 pub(crate) use impl_polynomial_filter;
 
 /// Helpers of the engines' unit tests.
+impl EngineState {
+    /// The invariants of a restored engine of degree `m` ([`crate::persist`]).
+    pub(crate) fn check_saved(&self, m: usize) -> Result<(), String> {
+        match self {
+            EngineState::Exact(e) => e.check_saved(m),
+            EngineState::Gain(g) => g.check_saved(m),
+        }
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod testing {
     /// Errors of `z` against `want`, per degree, in units of the span `S`:

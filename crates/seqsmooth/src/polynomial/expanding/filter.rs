@@ -23,7 +23,7 @@ use crate::polynomial::prior::{check_no_prior, Prior};
 /// // the 1-step prediction Z*_{5,4} = (27/5, 4/5)
 /// assert!((f.estimate_at(5.0).unwrap().derivatives[0] - 5.4).abs() < 1e-12);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct ExpandingMemory {
     m: usize,
     prior: bool,
@@ -112,3 +112,10 @@ impl ExpandingMemory {
 }
 
 impl_polynomial_filter!(ExpandingMemory);
+
+impl ExpandingMemory {
+    /// The invariants of a restored filter ([`crate::persist`]).
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        self.core.check_saved(self.m)
+    }
+}

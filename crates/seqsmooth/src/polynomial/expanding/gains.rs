@@ -125,7 +125,7 @@ pub fn expanding_gains<T: Scalar>(m: usize, n: u64, form: GainForm) -> Vec<T> {
 /// s.gains(3, &mut h);
 /// assert_eq!(h, [0.7, 0.3]); // Morrison T9-01: (7/10, 3/10)
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct ExpandingGainSchedule {
     m: usize,
     /// The numerators' coefficients in `f64`, shared by every schedule of degree `m`.

@@ -24,7 +24,7 @@ use crate::polynomial::prior::{check_no_prior, Prior};
 /// let s = f.estimate().unwrap();
 /// assert!((s.derivatives[0] - 251.5).abs() < 1e-9 && (s.derivatives[1] - 0.5).abs() < 1e-12);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct FadingMemory {
     m: usize,
     theta: f64,
@@ -263,3 +263,17 @@ impl FadingMemory {
 }
 
 impl_polynomial_filter!(FadingMemory);
+
+impl FadingMemory {
+    /// The invariants of a restored filter ([`crate::persist`]): θ and τ in range, the engine
+    /// of the filter's degree.
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        if !(self.theta > 0.0 && self.theta < 1.0 && self.tau.is_finite() && self.tau > 0.0) {
+            return Err(format!(
+                "θ {} or τ {} is out of range",
+                self.theta, self.tau
+            ));
+        }
+        self.core.check_saved(self.m)
+    }
+}

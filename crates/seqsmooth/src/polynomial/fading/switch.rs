@@ -85,7 +85,7 @@ pub fn switch_constant(m: usize) -> Rational {
 /// [`crate::DiscountMode::PerUpdate`], and `θ^(ζ̄)` with [`crate::DiscountMode::PerTime`], where
 /// `ζ̄` is the mean step so far in units of `τ` (the filter re-evaluates the rule at every sample
 /// until it switches; [`SwitchRule::switch_index`] gives the index for a known per-sample `θ`).
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub enum SwitchRule {
     /// At `n = ⌊c_0m/(1-θ)⌋`, the position row of Table 13.4 (Reyneke Table 1; Morrison's text
     /// example (13.8.8): `m = 1, θ = 0.9 → n = 32`). The default.

@@ -18,7 +18,7 @@ use std::borrow::Cow;
 /// derivatives `x^(i) = (i!/τ^i) Σ_j [T(r) C]_ij μ_j` and their covariance
 /// `σ² D(τ) T(r) C T(r)ᵀ D(τ)` (7.5.26)-(7.5.28) for samples `τ` apart; `T(r)` (upper
 /// triangular) and `T(r) C` are kept for one `r`, computed for the others.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct MomentFit {
     m: usize,
     basis: DiscreteLegendre<f64>,
@@ -153,14 +153,14 @@ fn apply_upper_sized(p: usize, a: &[f64], mu: &[f64], out: &mut [f64]) {
 
 /// How the moments are kept: recomputed from the stored window (`O(L·m)` per sample, with the
 /// table of `p_j(x)`, row `x`) or slid.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 enum Moments {
     Direct { table: Vec<f64>, mu: Vec<f64> },
     Sliding(SlidingMoments),
 }
 
 /// The newest `L+1` evenly spaced samples and their moments.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct EvenWindow {
     m: usize,
     ring: Ring<f64>,
@@ -253,5 +253,12 @@ impl EvenWindow {
         sigma: Option<f64>,
     ) -> Option<(Vec<f64>, Option<DMatrix<f64>>)> {
         Some(self.fit.estimate(self.moments()?, r, step, sigma))
+    }
+}
+
+impl EvenWindow {
+    /// A restored window's invariants ([`crate::persist`]): its degree and ring.
+    pub(super) fn check_saved(&self, m: usize, window: usize) -> bool {
+        self.m == m && self.ring.check_saved(window)
     }
 }

@@ -27,7 +27,7 @@ use crate::polynomial::filter::PolynomialFilter;
 /// assert!((out[0][1] - out[1][1]).abs() < 1e-13 && (out[0][1] - out[2][1]).abs() < 1e-12);
 /// assert_eq!(out[1], out[3]); // evenly spaced: Adaptive runs the sliding engine
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum FixedEngine {
     /// Evenly spaced samples; each update recomputes the window's discrete Legendre
     /// coefficients `β = C B Y_(n)` from the stored window (the factor `C B` of
@@ -53,7 +53,7 @@ pub enum FixedEngine {
 
 /// The window fit a [`FixedMemory`] runs: on evenly spaced samples (direct or sliding moments)
 /// or on any timestamps (QR).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 enum WindowFit {
     Even(Box<EvenWindow>),
     Irregular(Box<IrregularWindow>),
@@ -87,7 +87,7 @@ enum WindowFit {
 /// let centre = f.estimate_at(2.0).unwrap(); // h = -L/2: (3, 9/10)
 /// assert!((centre.derivatives[0] - 3.0).abs() < 1e-14);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct FixedMemory {
     m: usize,
     window: usize,
@@ -378,5 +378,33 @@ impl PolynomialFilter for FixedMemory {
 
     fn is_determined(&self) -> bool {
         self.n >= self.window as u64
+    }
+}
+
+impl FixedMemory {
+    /// The invariants of a restored filter ([`crate::persist`]): degree and window in range,
+    /// the window's rings of its length.
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        if self.m > crate::polynomial::options::MAX_DEGREE || self.window < self.m + 1 {
+            return Err(format!(
+                "degree {} or window {} is out of range",
+                self.m, self.window
+            ));
+        }
+        let ring_ok = match &self.fit {
+            WindowFit::Even(e) => e.check_saved(self.m, self.window),
+            WindowFit::Irregular(i) => i.check_saved(self.m, self.window),
+        };
+        let times_ok = self
+            .times
+            .as_ref()
+            .is_none_or(|r| r.check_saved(self.window));
+        if !(ring_ok && times_ok) {
+            return Err(format!(
+                "window's samples are not of its length {}",
+                self.window
+            ));
+        }
+        Ok(())
     }
 }

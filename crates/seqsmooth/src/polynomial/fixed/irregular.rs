@@ -7,7 +7,7 @@ use crate::error::Error;
 use crate::estimate::PolynomialFit;
 
 /// The newest `window` samples `(t, y)` and, once full, their least-squares fit of degree `m`.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct IrregularWindow {
     m: usize,
     ring: Ring<(f64, f64)>,
@@ -64,5 +64,12 @@ impl IrregularWindow {
     /// The fit of the newest full window (`None` until the window is full).
     pub(super) fn fit(&self) -> Option<&PolynomialFit> {
         self.fit.as_ref()
+    }
+}
+
+impl IrregularWindow {
+    /// A restored window's invariants ([`crate::persist`]): its degree and ring.
+    pub(super) fn check_saved(&self, m: usize, window: usize) -> bool {
+        self.m == m && self.ring.check_saved(window)
     }
 }

@@ -1,7 +1,7 @@
 //! The window's samples: a ring buffer of the newest `capacity` values, oldest first.
 
 /// The newest `capacity` values pushed, in arrival order.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Ring<T> {
     buf: Vec<T>,
     head: usize,
@@ -51,5 +51,15 @@ impl<T: Copy> Ring<T> {
         } else {
             k
         }]
+    }
+}
+
+impl<T> Ring<T> {
+    /// A restored ring's invariants ([`crate::persist`]): `capacity` as given, at most that
+    /// many values, the head inside them.
+    pub(super) fn check_saved(&self, capacity: usize) -> bool {
+        self.capacity == capacity
+            && self.buf.len() <= capacity
+            && (self.head == 0 || self.head < self.buf.len())
     }
 }

@@ -107,7 +107,7 @@ fn exact_shift_matrix(m: usize, span: u64) -> Vec<Rational> {
 /// `p_0(x) … p_m(x)` on `x = 0..L` by the three-term recursion (A1.1) with precomputed
 /// coefficients: `p_j = (A_j x + B_j) p_{j-1} - C_j p_{j-2}`, `A_j = -2(2j-1)/(j(L-j+1))`,
 /// `B_j = L(2j-1)/(j(L-j+1))`, `C_j = (j-1)(L+j)/(j(L-j+1))`.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct LegendreRecursion {
     span: f64,
     coeffs: Vec<(f64, f64, f64)>,
@@ -149,7 +149,7 @@ impl LegendreRecursion {
 
 /// The moments `μ_j = Σ_{x=0..L} y(x) p_j(x)` of the newest `L+1` evenly spaced samples, by the
 /// sliding recursion with `q` staggered exact refreshes.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct SlidingMoments {
     window: usize,
     recursion: LegendreRecursion,

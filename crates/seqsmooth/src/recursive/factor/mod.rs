@@ -53,7 +53,7 @@ const INLINE_P: usize = 5;
 /// let r = f.r(); // upper triangular with RᵀR = the Gram matrix
 /// assert!((r[(0, 0)] - 5f64.sqrt()).abs() < 1e-12 && r[(1, 0)] == 0.0);
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct TriangularFactor {
     /// `D`, the squares of `R`'s diagonal, each in its own 16-byte slot ([`Pivot`]).
     d: InlineVec<Pivot, INLINE_P>,
@@ -73,7 +73,7 @@ pub struct TriangularFactor {
 /// which depends on `1/d_i`: stored as one pair, `d_i` would wait for `d_(i+1)` and every row
 /// for two divisions of the previous one (measured: see BENCHMARKS.md). And a
 /// 16-byte load spanning two 8-byte stores cannot be forwarded from the store buffer.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 #[repr(align(16))]
 struct Pivot(f64);
 
@@ -677,6 +677,28 @@ fn powers<const N: usize>(v: f64) -> [f64; N] {
 #[inline(always)]
 fn load_unmerged(x: &f64) -> f64 {
     *std::hint::black_box(x)
+}
+
+impl TriangularFactor {
+    /// The invariants of a restored factor ([`crate::persist`]): `D`, `U`, `ū` of one
+    /// dimension, finite, `D ≥ 0`.
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        let p = self.d.len();
+        if self.u.len() != p * p || self.ubar.len() != p {
+            return Err(format!("factor's parts disagree on its dimension {p}"));
+        }
+        let d: Vec<f64> = self.d.iter().map(|x| x.0).collect();
+        crate::linalg::invariant::finite(&d, "factor D")?;
+        crate::linalg::invariant::finite(&self.u, "factor U")?;
+        crate::linalg::invariant::finite(&self.ubar, "factor ū")?;
+        if d.iter().any(|&x| x < 0.0) || !self.residual_sq.is_finite() {
+            return Err("factor has a negative pivot or residual".into());
+        }
+        if self.positive && !d.iter().all(|x| x.is_normal()) {
+            return Err("factor's pivots are not all positive".into());
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]

@@ -32,6 +32,44 @@ mod batch;
 mod expanding_run;
 mod plain;
 mod steady_block;
+impl GainEngine {
+    /// The invariants of a restored engine ([`crate::persist`]): degree in range, the state,
+    /// its low words, the gains and the covariance `m + 1` wide.
+    pub(crate) fn check_saved(&self, m: usize) -> Result<(), String> {
+        if self.m != m || m > MAX_DEGREE {
+            return Err(format!(
+                "engine's degree {} is not the filter's {m}",
+                self.m
+            ));
+        }
+        for (v, what) in [(&self.z, "state"), (&self.z_lo, "state's low words")] {
+            if v.len() != m + 1 {
+                return Err(format!(
+                    "engine's {what} has {} numbers, {} expected",
+                    v.len(),
+                    m + 1
+                ));
+            }
+        }
+        for (v, what) in [(&self.k, "gains"), (&self.k_lo, "gains' low words")] {
+            if !v.is_empty() && v.len() != m + 1 {
+                return Err(format!(
+                    "engine's {what} has {} numbers, {} expected",
+                    v.len(),
+                    m + 1
+                ));
+            }
+        }
+        if self.start.len() > m + 1 || self.schedule.degree() != m {
+            return Err("engine's start or gain schedule is not of its degree".into());
+        }
+        if let Some((_, c)) = &self.cov {
+            crate::linalg::invariant::matrix(c, m + 1, m + 1, "engine's covariance")?;
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests;
 
@@ -39,7 +77,7 @@ pub(crate) use batch::out_of_range_as_nan;
 use batch::scale_gains_for_step;
 use steady_block::SteadyBlock;
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) struct FadingGains {
     pub theta: f64,
     pub mode: DiscountMode,
@@ -98,7 +136,7 @@ impl FadingGains {
 }
 
 /// State: Morrison's scaled `Z` (unit `τ`) valid at `t_last`, as the double-word `z + z_lo`.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) struct GainEngine {
     m: usize,
     /// The discount's interval `τ`.

@@ -10,7 +10,7 @@ use super::*;
 /// `Z_B = Āᴮ Z_0 + Σ_j Ā^(B−1−j) G y_j` (the recursion unrolled; Morrison's fading-memory
 /// filter is time-invariant once its gains are fixed, (13.5.35)). Computed once per gains and
 /// step.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct SteadyBlock {
     step: f64,
     gains: Vec<f64>,

@@ -1,0 +1,182 @@
+//! The [`Persist`] impls of the library's filters: each type's name and the invariants of a
+//! decoded value (each checked by the type's own `check_saved`, next to its fields).
+
+use super::Persist;
+use crate::kalman::bayes::BayesFilter;
+use crate::kalman::discrete::{DiscreteDynamics, LinearFixedLag, LinearKalmanFilter};
+use crate::kalman::filter::KalmanFilter;
+use crate::kalman::fixed_lag::FixedLagSmoother;
+use crate::kalman::unscented::UnscentedKalmanFilter;
+use crate::model::dynamics::{Dynamics, PolynomialDynamics};
+use crate::model::observation::{LinearObservation, Observation};
+use crate::model::radar::Radar;
+use crate::paml::{OnlineSmoother, SmootherGains};
+use crate::polynomial::automatic::AutomaticFilter;
+use crate::polynomial::bank::{ExpandingBank, FadingBank};
+use crate::polynomial::spec::{AnyFilter, FilterKind, Inner};
+use crate::polynomial::PolynomialFilter;
+use crate::track::RadarTracker;
+use crate::{ExpandingMemory, FadingMemory, FixedMemory};
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use std::ops::Deref;
+
+/// A dynamic or observation model a saved Kalman filter holds: its name in the envelope and
+/// the invariants of its data. A front end's own model (Python callables) implements it with
+/// no data of its own and is supplied again on restoring.
+pub trait SavedModel {
+    /// The model's name.
+    const MODEL: &'static str;
+
+    /// Why the model's data cannot be used, or nothing.
+    fn check_model(&self) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+impl SavedModel for PolynomialDynamics {
+    const MODEL: &'static str = "PolynomialDynamics";
+
+    fn check_model(&self) -> Result<(), String> {
+        let n = self.dimension();
+        if n == 0 || n > 1 << 12 {
+            return Err(format!("motion model of {n} states"));
+        }
+        Ok(())
+    }
+}
+
+impl SavedModel for LinearObservation {
+    const MODEL: &'static str = "LinearObservation";
+
+    fn check_model(&self) -> Result<(), String> {
+        let m = self.matrix();
+        crate::linalg::invariant::matrix(m, m.nrows(), m.ncols(), "observation matrix")
+    }
+}
+
+impl SavedModel for DiscreteDynamics {
+    const MODEL: &'static str = "DiscreteDynamics";
+
+    fn check_model(&self) -> Result<(), String> {
+        let f = self.transition();
+        crate::linalg::invariant::matrix(f, f.nrows(), f.nrows(), "transition matrix")
+    }
+}
+
+impl SavedModel for Radar {
+    const MODEL: &'static str = "Radar";
+}
+
+/// The models' own checks.
+fn models<D: SavedModel, O: SavedModel + Observation>((d, o): (&D, &O)) -> Result<(), String> {
+    d.check_model()?;
+    o.check_model()?;
+    if o.components() == 0 {
+        return Err("observation of no components".into());
+    }
+    Ok(())
+}
+
+/// [`Persist`] for a filter generic over its models: the name with the models', the checks
+/// after the models'.
+macro_rules! persist_over_models {
+    ($ty:ident, $name:literal, |$f:ident| $check:expr) => {
+        impl<D, O> Persist for $ty<D, O>
+        where
+            D: Dynamics + SavedModel + Serialize + DeserializeOwned,
+            O: Observation + SavedModel + Serialize + DeserializeOwned,
+        {
+            fn name() -> String {
+                format!(concat!($name, "<{}, {}>"), D::MODEL, O::MODEL)
+            }
+
+            fn check(&mut self) -> Result<(), String> {
+                let $f = self;
+                $check
+            }
+        }
+    };
+}
+
+persist_over_models!(KalmanFilter, "KalmanFilter", |f| {
+    models(f.models())?;
+    f.check_saved()
+});
+persist_over_models!(BayesFilter, "BayesFilter", |f| {
+    models(f.models())?;
+    f.check_saved()
+});
+persist_over_models!(UnscentedKalmanFilter, "UnscentedKalmanFilter", |f| {
+    models(f.models())?;
+    f.check_saved()
+});
+persist_over_models!(FixedLagSmoother, "FixedLagSmoother", |f| {
+    models(f.models())?;
+    f.check_saved()
+});
+
+/// [`Persist`] for a type of its own name whose checks are its `check_saved`.
+macro_rules! persist_plain {
+    ($($ty:ty => $name:literal),* $(,)?) => {$(
+        impl Persist for $ty {
+            fn name() -> String {
+                $name.into()
+            }
+
+            fn check(&mut self) -> Result<(), String> {
+                self.check_saved()
+            }
+        }
+    )*};
+}
+
+persist_plain!(
+    ExpandingMemory => "ExpandingMemory",
+    FadingMemory => "FadingMemory",
+    FixedMemory => "FixedMemory",
+    AutomaticFilter => "AutomaticFilter",
+    FadingBank => "FadingBank",
+    ExpandingBank => "ExpandingBank",
+    LinearKalmanFilter => "LinearKalmanFilter",
+    LinearFixedLag => "LinearFixedLag",
+    RadarTracker => "RadarTracker",
+);
+
+impl<G> Persist for OnlineSmoother<G>
+where
+    G: Deref<Target = SmootherGains> + Serialize + DeserializeOwned,
+{
+    fn name() -> String {
+        "OnlineSmoother".into()
+    }
+
+    fn check(&mut self) -> Result<(), String> {
+        self.check_saved()
+    }
+}
+
+impl Persist for AnyFilter {
+    fn name() -> String {
+        "AnyFilter".into()
+    }
+
+    fn check(&mut self) -> Result<(), String> {
+        let kind = match &self.inner {
+            Inner::Expanding(f) => f.check_saved().map(|_| FilterKind::Expanding),
+            Inner::Fading(f) => f.check_saved().map(|_| FilterKind::Fading),
+            Inner::Fixed(f, w) => f.check_saved().and_then(|_| {
+                if f.window() == *w {
+                    Ok(FilterKind::Fixed)
+                } else {
+                    Err(format!("window {w} is not the filter's {}", f.window()))
+                }
+            }),
+            Inner::Automatic(f) => f.check_saved().map(|_| FilterKind::Automatic),
+        }?;
+        if kind != self.kind() || self.rows < self.samples() {
+            return Err("kind or row count does not match the filter".into());
+        }
+        Ok(())
+    }
+}

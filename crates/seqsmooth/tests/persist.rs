@@ -1,0 +1,318 @@
+//! `seqsmooth::persist`: every filter cut at a random sample, saved, restored and continued,
+//! equals the unbroken filter continued bit for bit (every output's Debug form, which prints
+//! each double's shortest round-trip digits, and the whole saved state afterwards, byte for
+//! byte); the envelope refuses a truncated input, a changed byte, another type's state, a newer
+//! version, and a body whose numbers break the type's invariants.
+
+use nalgebra::{DMatrix, DVector};
+use proptest::prelude::*;
+use seqsmooth::discount::Discount;
+use seqsmooth::error::{Error, ErrorKind};
+use seqsmooth::kalman::bayes::BayesFilter;
+use seqsmooth::kalman::discrete::{LinearFixedLag, LinearKalmanFilter, StepMatrices};
+use seqsmooth::kalman::filter::KalmanFilter;
+use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+use seqsmooth::kalman::UnscentedKalmanFilter;
+use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
+use seqsmooth::model::observation::LinearObservation;
+use seqsmooth::model::radar::Radar;
+use seqsmooth::paml::{OnlineSmoother, SmootherGains};
+use seqsmooth::persist::{from_bytes, to_bytes, Persist};
+use seqsmooth::polynomial::bank::FadingBank;
+use seqsmooth::polynomial::spec::{AnyFilter, FilterKind, FilterSpec};
+use seqsmooth::track::{RadarTracker, TrackMethod};
+use seqsmooth::{Engine, PolynomialFilter};
+use std::sync::Arc;
+
+/// Irregular times and values from `seed` (a small LCG: the test's data are its own).
+fn data(seed: u64, n: usize) -> Vec<(f64, f64)> {
+    let mut s = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut next = move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut t = 0.0;
+    (0..n)
+        .map(|_| {
+            t += 0.3 + 1.4 * next();
+            (t, (0.3 * t).sin() + 0.1 * (next() - 0.5))
+        })
+        .collect()
+}
+
+/// Runs `step` over `rows[..cut]`, saves and restores the filter, runs both over the rest:
+/// their outputs and their final states are the same bits.
+fn cut_and_continue<T: Persist>(
+    mut f: T,
+    rows: &[(f64, f64)],
+    cut: usize,
+    step: impl Fn(&mut T, usize, (f64, f64)) -> String,
+) {
+    for (k, &r) in rows[..cut].iter().enumerate() {
+        step(&mut f, k, r);
+    }
+    let bytes = to_bytes(&f).unwrap();
+    let mut g: T = from_bytes(&bytes).unwrap();
+    for (k, &r) in rows.iter().enumerate().skip(cut) {
+        assert_eq!(step(&mut f, k, r), step(&mut g, k, r), "row {k}");
+    }
+    assert_eq!(to_bytes(&f).unwrap(), to_bytes(&g).unwrap());
+}
+
+fn measurement(t: f64, y: f64, missing: bool) -> Measurement {
+    Measurement {
+        time: t,
+        values: vec![(!missing).then_some(y)],
+        noise: NoiseCovariance::Variances(vec![0.01]),
+    }
+}
+
+fn position() -> LinearObservation {
+    LinearObservation::new(DMatrix::from_row_slice(1, 2, &[1.0, 0.0])).unwrap()
+}
+
+fn polynomial(kind: FilterKind, degree: usize, engine: Engine) -> AnyFilter {
+    FilterSpec {
+        theta: (kind != FilterKind::Expanding && kind != FilterKind::Fixed).then_some(0.9),
+        tau: (kind != FilterKind::Expanding && kind != FilterKind::Fixed).then_some(1.0),
+        window: (kind == FilterKind::Fixed).then_some(degree + 5),
+        engine,
+        sigma: Some(0.1),
+        ..FilterSpec::new(kind, degree)
+    }
+    .build()
+    .unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn polynomial_filters_resume_bit_for_bit(
+        seed in 0u64..1_000_000, n in 10usize..120, cut in 1usize..120, degree in 0usize..4,
+        kind in 0usize..4, gain in any::<bool>(),
+    ) {
+        let kind = [FilterKind::Expanding, FilterKind::Fading, FilterKind::Fixed,
+            FilterKind::Automatic][kind];
+        let engine = if gain && kind != FilterKind::Fixed { Engine::Gain } else { Engine::Exact };
+        let degree = if kind == FilterKind::Automatic { degree.max(1) } else { degree };
+        let rows = data(seed, n);
+        cut_and_continue(polynomial(kind, degree, engine), &rows, cut.min(n - 1), |f, _, (t, y)| {
+            let _ = f.update(t, y);
+            format!("{:?}", f.try_estimate())
+        });
+    }
+
+    #[test]
+    fn kalman_filters_resume_bit_for_bit(
+        seed in 0u64..1_000_000, n in 5usize..80, cut in 1usize..80, fading in any::<bool>(),
+    ) {
+        let rows = data(seed, n);
+        let cut = cut.min(n - 1);
+        let missing = |k: usize| (seed as usize + k * 7).is_multiple_of(5);
+        let x0 = DVector::zeros(2);
+        let p0 = DMatrix::identity(2, 2) * 100.0;
+        let mut kf = KalmanFilter::new(PolynomialDynamics::new(1, 1), position(), x0.clone(), p0.clone(), 0.0)
+            .unwrap()
+            .with_process_noise(WhiteNoiseDerivative::new(1, 1, 0.05).unwrap())
+            .unwrap();
+        if fading {
+            kf = kf.with_fading(Discount::PerTime { theta: 0.9, tau: 1.0 }).unwrap();
+        }
+        cut_and_continue(kf, &rows, cut, |f, k, (t, y)| {
+            format!("{:?} {:?} {:?}", f.update(&measurement(t, y, missing(k))), f.state(), f.covariance())
+        });
+        let mut bayes = BayesFilter::new(PolynomialDynamics::new(1, 1), position(), 0.0).unwrap();
+        if fading {
+            bayes = bayes.with_fading(Discount::PerUpdate { theta: 0.9 }).unwrap();
+        }
+        cut_and_continue(bayes, &rows, cut, |f, k, (t, y)| {
+            format!("{:?} {:?} {:?}", f.update(&measurement(t, y, missing(k))), f.estimate(), f.covariance())
+        });
+        let ukf = UnscentedKalmanFilter::new(PolynomialDynamics::new(1, 1), position(), x0, p0, 0.0)
+            .unwrap()
+            .with_process_noise(WhiteNoiseDerivative::new(1, 1, 0.05).unwrap())
+            .unwrap();
+        cut_and_continue(ukf, &rows, cut, |f, k, (t, y)| {
+            format!("{:?} {:?} {:?}", f.update(&measurement(t, y, missing(k))), f.state(), f.covariance())
+        });
+        let dt = 0.5 + rows[0].0;
+        let linear = LinearKalmanFilter::new(
+            DVector::zeros(2),
+            DMatrix::identity(2, 2) * 10.0,
+            DMatrix::from_row_slice(2, 2, &[1.0, dt, 0.0, 1.0]),
+            DMatrix::from_row_slice(1, 2, &[1.0, 0.0]),
+            DMatrix::identity(2, 2) * 0.01,
+            DMatrix::identity(1, 1) * 0.25,
+        )
+        .unwrap();
+        let z = |k: usize, y: f64| if missing(k) { f64::NAN } else { y };
+        cut_and_continue(linear.clone(), &rows, cut, |f, k, (_, y)| {
+            let none = StepMatrices::default();
+            format!("{:?} {:?} {:?}", f.predict(&none), f.update(&[z(k, y)], &none), f.covariance())
+        });
+        cut_and_continue(LinearFixedLag::new(&linear, 1 + (seed as usize) % 4), &rows, cut, |f, k, (_, y)| {
+            format!("{:?}", f.push(&[z(k, y)], &StepMatrices::default()))
+        });
+    }
+
+    #[test]
+    fn banks_tracker_and_online_smoother_resume_bit_for_bit(
+        seed in 0u64..1_000_000, n in 12usize..60, cut in 1usize..60, method in 0usize..4,
+    ) {
+        let rows = data(seed, n);
+        let cut = cut.min(n - 1);
+        cut_and_continue(FadingBank::new(1, 0.8, 1.0, 3).unwrap(), &rows, cut, |f, _, (t, y)| {
+            format!("{:?} {:?}", f.update(&[y, t, y * t]), f.estimate(2))
+        });
+        let method = [
+            TrackMethod::Kalman { q: Some(0.5) },
+            TrackMethod::Kalman { q: None },
+            TrackMethod::Window { window: 8 },
+            TrackMethod::Fading(Some(Discount::PerTime { theta: 0.8, tau: 1.0 })),
+        ][method];
+        let tracker = RadarTracker::new(Radar::new([0.0; 3], 6).unwrap(), method).unwrap();
+        cut_and_continue(tracker, &rows, cut, |f, k, (t, y)| {
+            let s = t + 100.0 * y;
+            let (x, v, z) = (20_000.0 + 150.0 * s, -8_000.0 + 60.0 * s, 3_000.0 + y);
+            let r = (x * x + v * v + z * z).sqrt();
+            let m = Measurement {
+                time: t,
+                values: vec![Some(r), (k % 7 != 3).then_some(v.atan2(x)), Some((z / r).asin())],
+                noise: NoiseCovariance::Variances(vec![100.0, 1e-6, 1e-6]),
+            };
+            format!("{:?}", f.push(&m))
+        });
+        let times: Vec<f64> = rows.iter().map(|r| r.0).collect();
+        let gains = SmootherGains::new(&times, &vec![0.1; n], 2).unwrap();
+        cut_and_continue(OnlineSmoother::new(Arc::new(gains)), &rows, cut, |f, _, (_, y)| {
+            format!("{:?} {:?}", f.push(y), f.polynomial_samples())
+        });
+    }
+}
+
+fn damaged(e: Error) -> String {
+    assert_eq!(e.kind(), ErrorKind::DamagedState, "{e}");
+    e.to_string()
+}
+
+fn a_filter() -> AnyFilter {
+    let mut f = polynomial(FilterKind::Fading, 2, Engine::Exact);
+    for (t, y) in data(3, 40) {
+        f.update(t, y).unwrap();
+    }
+    f
+}
+
+#[test]
+fn every_truncation_and_every_changed_byte_is_refused() {
+    let bytes = to_bytes(&a_filter()).unwrap();
+    for n in 0..bytes.len() {
+        damaged(from_bytes::<AnyFilter>(&bytes[..n]).unwrap_err());
+    }
+    for i in 0..bytes.len() {
+        for bit in 0..8 {
+            let mut b = bytes.clone();
+            b[i] ^= 1 << bit;
+            damaged(from_bytes::<AnyFilter>(&b).unwrap_err());
+        }
+    }
+    let mut longer = bytes.clone();
+    longer.push(0);
+    assert!(damaged(from_bytes::<AnyFilter>(&longer).unwrap_err()).contains("trailing"));
+}
+
+#[test]
+fn another_type_and_a_newer_version_are_refused_by_name() {
+    let bytes = to_bytes(&a_filter()).unwrap();
+    let why = damaged(from_bytes::<FadingBank>(&bytes).unwrap_err());
+    assert!(
+        why.contains("the state of a AnyFilter, not of a FadingBank"),
+        "{why}"
+    );
+    let mut newer = bytes.clone();
+    newer[8] = 2;
+    let why = damaged(from_bytes::<AnyFilter>(&newer).unwrap_err());
+    assert!(why.contains("format version 2"), "{why}");
+    let why = damaged(from_bytes::<AnyFilter>(b"not a saved state at all").unwrap_err());
+    assert!(why.contains("tag"), "{why}");
+}
+
+/// The envelope around `body` for type `name` with a valid checksum: what a crafted input
+/// looks like.
+fn envelope(name: &str, body: &[u8]) -> Vec<u8> {
+    let mut out = b"SEQSMST\0".to_vec();
+    out.extend_from_slice(&1u16.to_le_bytes());
+    out.push(name.len() as u8);
+    out.extend_from_slice(name.as_bytes());
+    out.extend_from_slice(&(body.len() as u64).to_le_bytes());
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(&out);
+    crc.update(body);
+    out.extend_from_slice(&crc.finalize().to_le_bytes());
+    out.extend_from_slice(body);
+    out
+}
+
+/// A CBOR map's entries.
+type Entries = Vec<(ciborium::Value, ciborium::Value)>;
+
+#[test]
+fn a_crafted_body_breaking_the_invariants_is_refused() {
+    type Kf = KalmanFilter<PolynomialDynamics, LinearObservation>;
+    let kf = Kf::new(
+        PolynomialDynamics::new(1, 1),
+        position(),
+        DVector::zeros(2),
+        DMatrix::identity(2, 2),
+        0.0,
+    )
+    .unwrap();
+    let name = <Kf as Persist>::name();
+    let good = to_bytes(&kf).unwrap();
+    let body = &good[good.len() - (good.len() - (8 + 2 + 1 + name.len() + 8 + 4))..];
+    assert_eq!(
+        envelope(&name, body),
+        good,
+        "the test's envelope is the library's"
+    );
+    // Decode the body as CBOR, break one invariant, encode it again with a valid checksum.
+    let value: ciborium::Value = ciborium::from_reader(body).unwrap();
+    let edit = |f: &dyn Fn(&mut Entries)| {
+        let mut v = value.clone();
+        f(v.as_map_mut().unwrap());
+        let mut b = Vec::new();
+        ciborium::into_writer(&v, &mut b).unwrap();
+        from_bytes::<Kf>(&envelope(&name, &b)).unwrap_err()
+    };
+    let field = |m: &mut Entries, key: &str| -> usize {
+        m.iter()
+            .position(|(k, _)| k.as_text() == Some(key))
+            .unwrap()
+    };
+    // the covariance not positive semi-definite: its first entry −1
+    let why = damaged(edit(&|m| {
+        let i = field(m, "covariance");
+        let data = m[i].1.as_array_mut().unwrap()[0].as_array_mut().unwrap();
+        data[0] = ciborium::Value::Float(-1.0);
+    }));
+    assert!(why.contains("covariance"), "{why}");
+    // the state of the wrong length
+    let why = damaged(edit(&|m| {
+        let i = field(m, "state");
+        let data = m[i].1.as_array_mut().unwrap()[0].as_array_mut().unwrap();
+        data.push(ciborium::Value::Float(0.0));
+    }));
+    assert!(why.contains("decode") || why.contains("state"), "{why}");
+    // a NaN time
+    let why = damaged(edit(&|m| {
+        let i = field(m, "time");
+        m[i].1 = ciborium::Value::Float(f64::NAN);
+    }));
+    assert!(why.contains("time"), "{why}");
+}
