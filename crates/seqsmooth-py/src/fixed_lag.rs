@@ -15,28 +15,31 @@ use seqsmooth::model::measurement::Measurement;
 use seqsmooth::model::observation::Observation;
 use seqsmooth::Error;
 
+/// A smoothed estimate: the state and its covariance.
+type Estimate = (DVector<f64>, DMatrix<f64>);
+
 /// A fixed-lag smoother as the batch runs it: the estimate given by a push, and those given at
 /// the end.
 pub(crate) trait Lagging {
-    fn push(&mut self, m: &Measurement) -> Result<Option<(DVector<f64>, DMatrix<f64>)>, Error>;
-    fn finish(self) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>, Error>;
+    fn push(&mut self, m: &Measurement) -> Result<Option<Estimate>, Error>;
+    fn finish(self) -> Result<Vec<Estimate>, Error>;
 }
 
 impl<D: Dynamics + Clone, O: Observation + Clone> Lagging for FixedLagSmoother<D, O> {
-    fn push(&mut self, m: &Measurement) -> Result<Option<(DVector<f64>, DMatrix<f64>)>, Error> {
+    fn push(&mut self, m: &Measurement) -> Result<Option<Estimate>, Error> {
         Ok(FixedLagSmoother::push(self, m)?.map(|s| (s.state, s.covariance)))
     }
-    fn finish(self) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>, Error> {
+    fn finish(self) -> Result<Vec<Estimate>, Error> {
         let given = FixedLagSmoother::finish(self)?;
         Ok(given.into_iter().map(|s| (s.state, s.covariance)).collect())
     }
 }
 
 impl<D: Dynamics + Clone, O: Observation + Clone> Lagging for UnscentedFixedLagSmoother<D, O> {
-    fn push(&mut self, m: &Measurement) -> Result<Option<(DVector<f64>, DMatrix<f64>)>, Error> {
+    fn push(&mut self, m: &Measurement) -> Result<Option<Estimate>, Error> {
         Ok(UnscentedFixedLagSmoother::push(self, m)?.map(|s| (s.state, s.covariance)))
     }
-    fn finish(self) -> Result<Vec<(DVector<f64>, DMatrix<f64>)>, Error> {
+    fn finish(self) -> Result<Vec<Estimate>, Error> {
         let given = UnscentedFixedLagSmoother::finish(self)?;
         Ok(given.into_iter().map(|s| (s.state, s.covariance)).collect())
     }
@@ -51,7 +54,7 @@ pub(crate) struct Lagged {
 }
 
 impl Lagged {
-    fn record(&mut self, (x, s): (DVector<f64>, DMatrix<f64>)) {
+    fn record(&mut self, (x, s): Estimate) {
         self.states.extend_from_slice(x.as_slice());
         // Symmetric: column-major is row-major.
         self.covariances.extend_from_slice(s.as_slice());

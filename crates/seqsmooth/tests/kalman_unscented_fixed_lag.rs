@@ -174,7 +174,7 @@ fn on_a_linear_model_it_is_the_kalman_fixed_lag_smoother() {
             let values = (0..2)
                 .map(|i| {
                     let y = (t * (0.3 + i as f64)).sin() * 10.0 + rng.gen_range(-1.0..1.0);
-                    (k % 9 != 4 && !(k % 7 == i)).then_some(y)
+                    (k % 9 != 4 && k % 7 != i).then_some(y)
                 })
                 .collect();
             Measurement {
