@@ -211,3 +211,29 @@ def test_unscented_kalman_filter_on_a_linear_model_is_the_kalman_filters():
     got = ss.UnscentedKalmanFilter(1, x0, 100.0, axes=2, q=0.3).fixed_lag_smoother(t, z, 0.25, 5)
     want = ss.KalmanFilter(1, x0, 100.0, axes=2, q=0.3).fixed_lag_smoother(t, z, 0.25, 5)
     assert worst(got[0], got[1], want[0], want[1]) <= 1e-9
+
+
+@pytest.mark.parametrize("kind", ["ekf", "ukf"])
+def test_a_raising_callable_is_named_with_its_index(kind):
+    """The user's h raises from measurement 5 on: ParameterError with .index 5, the callable's
+    exception its cause, the filter not moved."""
+    t, z = ekf_problem(8, 20)
+    R = np.diag([4.0, 1e-4])
+
+    def h(x, s):
+        if s >= t[5]:
+            raise RuntimeError("boom")
+        return np.array([math.hypot(x[0], x[2]), math.atan2(x[2], x[0])])
+
+    x0, P0 = [250.0, 0.0, 80.0, 0.0], np.diag([400.0, 25.0, 400.0, 25.0])
+    if kind == "ekf":
+        f = ss.ExtendedKalmanFilter(x0, P0, f=lambda x, a, b: cv(b - a) @ x, h=h, Q=cv_q(1.0))
+    else:
+        f = ss.UnscentedKalmanFilter(
+            x0=x0, P0=P0, f=lambda x, a, b: cv(b - a) @ x, h=h, Q=cv_q(1.0)
+        )
+    with pytest.raises(ss.ParameterError) as e:
+        f.fixed_lag_smoother(t, z, R, 3)
+    assert e.value.index == 5, str(e.value)
+    assert isinstance(e.value.__cause__, RuntimeError)
+    assert f.time == 0.0
