@@ -57,6 +57,10 @@ pub fn flag(p: Param) -> Option<&'static str> {
         Param::AzimuthConvention => "--azimuth",
         Param::NewestIndex => "--n",
         Param::Epoch => "--epoch",
+        Param::MotionModel => "--model",
+        Param::ManoeuvreAlpha => "--manoeuvre-alpha",
+        Param::ManoeuvreVariance => "--manoeuvre-variance",
+        Param::TurnRateNoise => "--turn-rate-noise",
         _ => return None,
     })
 }

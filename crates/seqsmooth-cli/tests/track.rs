@@ -1125,3 +1125,112 @@ fn fit_radar_defaults_run_on_landing_with_a_flag_column() {
     );
     assert!(flagged > 0 && flagged < rows.len() / 2);
 }
+
+/// `--model`: constant velocity is the default, byte for byte; every built-in model runs on the
+/// landing trajectory with the kalman and smooth methods at their defaults, each row reporting
+/// position and velocity, the NIS per degree of freedom near 1 (printed: docs/tracking.md).
+#[test]
+fn every_model_runs_on_landing() {
+    let (input, truth) = landing();
+    let default = ok(&LANDING_ARGS, &input);
+    let cv = ok(
+        &[&LANDING_ARGS[..], &["--model", "constant-velocity"]].concat(),
+        &input,
+    );
+    assert_eq!(default, cv);
+    for model in [
+        "constant-velocity",
+        "constant-acceleration",
+        "singer",
+        "coordinated-turn",
+    ] {
+        for method in ["kalman", "smooth"] {
+            let rows = track(&input, &[method, "--model", model]);
+            assert_eq!(rows.len(), truth.len());
+            let (mut nis, mut count, mut squared) = (0.0, 0usize, 0.0);
+            for (row, want) in rows.iter().zip(&truth) {
+                if row[1].is_empty() {
+                    continue;
+                }
+                squared += (0..3)
+                    .map(|k| (num(&row[1 + k]) - want[k]).powi(2))
+                    .sum::<f64>();
+                count += 1;
+                if !row[13].is_empty() {
+                    nis += num(&row[13]);
+                }
+            }
+            // Every row has its three components: the NIS per degree of freedom.
+            let per_dof = nis / (3 * count) as f64;
+            let rms = (squared / count as f64).sqrt();
+            println!("landing {method} --model {model}: NIS/dof {per_dof:.2}, RMS {rms:.1} m");
+            assert!(count >= truth.len() - 2, "{model}: {count} rows");
+            assert!((0.5..2.0).contains(&per_dof), "{model}: {per_dof}");
+        }
+    }
+}
+
+/// A model or model parameter a method cannot use is refused, naming the flag.
+#[test]
+fn models_a_method_cannot_use_are_refused() {
+    let base = ["track", "--sigma-range", "10", "--sigma-angle", "1e-3"];
+    let with = |extra: &[&'static str]| -> Vec<&'static str> {
+        base.iter().chain(extra).copied().collect()
+    };
+    let good = "t,range,azimuth,elevation\n0,10000,0.1,0.2\n1,10010,0.11,0.2\n2,10020,0.12,0.2\n";
+    fails(
+        &with(&["--model", "spiral"]),
+        good,
+        2,
+        &["--model 'spiral' is invalid: must be one of constant-velocity, constant-acceleration, singer, coordinated-turn"],
+    );
+    fails(
+        &with(&["--method", "window", "--model", "coordinated-turn"]),
+        good,
+        2,
+        &["--model coordinated-turn is invalid: the window method fits the constant-velocity model only"],
+    );
+    fails(
+        &with(&["--model", "singer", "--q", "1"]),
+        good,
+        2,
+        &["--q 1 is invalid: does not apply to the singer model"],
+    );
+    fails(
+        &with(&[
+            "--method",
+            "fading",
+            "--model",
+            "singer",
+            "--manoeuvre-variance",
+            "4",
+        ]),
+        good,
+        2,
+        &["--manoeuvre-variance 4 is invalid: does not apply to the fading method"],
+    );
+    fails(
+        &with(&["--turn-rate-noise", "1e-4"]),
+        good,
+        2,
+        &["--turn-rate-noise 0.0001 is invalid: is not a parameter of the constant-velocity model"],
+    );
+    fails(
+        &with(&["--model", "coordinated-turn", "--manoeuvre-alpha", "0.1"]),
+        good,
+        2,
+        &["--manoeuvre-alpha 0.1 is invalid: is not a parameter of the coordinated-turn model"],
+    );
+    fails(
+        &with(&["--model", "singer", "--manoeuvre-alpha", "0"]),
+        good,
+        2,
+        &["--manoeuvre-alpha 0 is invalid"],
+    );
+    fails(
+        &with(&["--model", "coordinated-turn", "--turn-rate-noise", "-1"]),
+        good,
+        2,
+        &["--turn-rate-noise -1 is invalid"],
+    );
+}

@@ -122,6 +122,8 @@ pub fn keyword(p: Param) -> Option<&'static str> {
         Param::SpectralDensity => Some("Qc"),
         Param::ManoeuvreAlpha => Some("manoeuvre_alpha"),
         Param::ManoeuvreVariance => Some("manoeuvre_variance"),
+        Param::MotionModel => Some("model"),
+        Param::TurnRateNoise => Some("turn_rate_noise"),
         _ => None,
     }
 }

@@ -16,6 +16,7 @@ mod frame;
 mod kalman;
 mod linear;
 mod model_fit;
+mod models;
 mod paml;
 mod polynomial;
 mod smooth;
@@ -46,6 +47,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<continuous::PyContinuousModel>()?;
     m.add_class::<continuous::PyContinuousKalmanFilter>()?;
     m.add_class::<track::PyRadarTracker>()?;
+    m.add_class::<models::PyCoordinatedTurn>()?;
     m.add_class::<fit::PySlidingFit>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
     m.add_function(wrap_pyfunction!(model_fit::fit_model, m)?)?;

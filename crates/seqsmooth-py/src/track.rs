@@ -6,6 +6,7 @@
 use crate::arrays::{matrix, series, times, Series};
 use crate::errors::{raise, to_py, IntoPy, Kind};
 use crate::kalman::discount_from;
+use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -13,8 +14,8 @@ use seqsmooth::estimate::gauss_newton::{check_max_iterations, GaussNewton, Measu
 use seqsmooth::kalman::smoother::Smoothed;
 use seqsmooth::model::radar::{AzimuthConvention, Radar};
 use seqsmooth::track::{
-    radar_row, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, DEFAULT_LAG,
-    DEFAULT_WINDOW,
+    radar_row, MotionModel, RadarTracker, TrackError, TrackFlag, TrackMethod, Tracked, DEFAULT_LAG,
+    DEFAULT_WINDOW, REPORTED,
 };
 use seqsmooth::{Error, Param};
 
@@ -75,11 +76,18 @@ fn write_row(
     flag: &mut &'static str,
 ) {
     if let Tracked::Estimate(e) = estimate {
-        states.copy_from_slice(e.state.as_slice());
-        // Symmetric: column-major is row-major.
-        covariances.copy_from_slice(e.covariance.as_slice());
+        reported(e.state, e.covariance, states, covariances);
         *nis = e.nis.unwrap_or(f64::NAN);
         *flag = e.flag.name();
+    }
+}
+
+/// The reported part of a model's state (position and velocity, [`REPORTED`]) and its
+/// covariance block (row-major: symmetric, so column-major is row-major).
+fn reported(x: &DVector<f64>, s: &DMatrix<f64>, states: &mut [f64], covariances: &mut [f64]) {
+    states.copy_from_slice(&x.as_slice()[..REPORTED]);
+    for (k, c) in covariances.chunks_mut(REPORTED).enumerate() {
+        c.copy_from_slice(&s.column(k).as_slice()[..REPORTED]);
     }
 }
 
@@ -136,6 +144,16 @@ pub(crate) fn flag_array<'py>(py: Python<'py>, flags: &[&str]) -> PyResult<Bound
 /// gate and was left out (the estimate is the prediction); ``"misfit"``, the model does not
 /// follow the target here (the innovation test, or the window's χ²), so the σ may not cover
 /// the error. The smoother's rows carry the flag its forward filter gave them.
+/// model : {"constant-velocity", "constant-acceleration", "singer", "coordinated-turn"}
+///     The motion model of the Kalman methods (``seqsmooth track --model``); the window method
+///     fits constant velocity only. ``q`` is the white acceleration's density (the jerk's for
+///     constant acceleration; not Singer's, whose driving noise is ``manoeuvre_variance``).
+///     Every model reports position and velocity: the states' first six components.
+/// manoeuvre_alpha, manoeuvre_variance : float, optional
+///     singer: the manoeuvre rate ``α > 0`` (default 0.1 per time unit) and variance
+///     ``σ_m²`` (default adaptive).
+/// turn_rate_noise : float, optional
+///     coordinated-turn: the turn rate's random-walk density (default 1e-4 rad² per time³).
 /// azimuth : {"from-x", "bearing"}
 ///     ``"from-x"``: from +x towards +y; ``"bearing"``: clockwise from +y (x east, y north).
 #[pyclass(name = "RadarTracker", module = "seqsmooth")]
@@ -161,8 +179,10 @@ struct Given {
 impl Given {
     fn push(&mut self, row: usize, s: &Smoothed, flag: TrackFlag) {
         self.rows.push(row as i64);
-        self.states.extend_from_slice(s.state.as_slice());
-        self.covariances.extend_from_slice(s.covariance.as_slice());
+        let (mut x, mut c) = ([0.0; REPORTED], [0.0; REPORTED * REPORTED]);
+        reported(&s.state, &s.covariance, &mut x, &mut c);
+        self.states.extend_from_slice(&x);
+        self.covariances.extend_from_slice(&c);
         self.nis.push(s.nis.unwrap_or(f64::NAN));
         self.flags.push(flag.name());
     }
@@ -247,7 +267,8 @@ impl PyRadarTracker {
     #[pyo3(signature = (method = "kalman", *, sigma_range = None, sigma_angle = None,
         site = (0.0, 0.0, 0.0), q = None, theta = None, tau = None, theta_per_update = None,
         beta = None, window = None,
-        lag = None, azimuth = "from-x", max_iterations = 20))]
+        lag = None, azimuth = "from-x", max_iterations = 20, model = "constant-velocity",
+        manoeuvre_alpha = None, manoeuvre_variance = None, turn_rate_noise = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         method: &str,
@@ -263,7 +284,14 @@ impl PyRadarTracker {
         lag: Option<usize>,
         azimuth: &str,
         max_iterations: i64,
+        model: &str,
+        manoeuvre_alpha: Option<f64>,
+        manoeuvre_variance: Option<f64>,
+        turn_rate_noise: Option<f64>,
     ) -> PyResult<Self> {
+        let model = MotionModel::named(model)
+            .and_then(|m| m.with_parameters(manoeuvre_alpha, manoeuvre_variance, turn_rate_noise))
+            .py()?;
         let usage = |m: &str| Err(raise(Kind::Parameter, m, None));
         let discount = discount_from(theta, tau, theta_per_update, beta)?;
         let fading = discount.is_some();
@@ -309,7 +337,7 @@ impl PyRadarTracker {
         let solver = GaussNewton::with_max_iterations(max_iterations).py()?;
         let radar = Radar::new([site.0, site.1, site.2], 6).py()?;
         Ok(Self {
-            inner: RadarTracker::with_solver(radar, method, solver).py()?,
+            inner: RadarTracker::with_model(radar, method, model, solver).py()?,
             sigmas: [sigma_range, sigma_angle],
             bearing,
             given: Given::default(),

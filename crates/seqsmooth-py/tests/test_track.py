@@ -95,6 +95,28 @@ METHODS = [
     ({"method": "smooth", "q": 0.2, "lag": 7}, ["--method", "smooth", "--q", "0.2", "--lag", "7"]),
     ({"method": "smooth", "q": 0.2, "lag": 0}, ["--method", "smooth", "--q", "0.2", "--lag", "0"]),
     ({"method": "window", "window": 12}, ["--method", "window", "--window", "12"]),
+    (
+        {"method": "kalman", "model": "coordinated-turn"},
+        ["--method", "kalman", "--model", "coordinated-turn"],
+    ),
+    (
+        {"method": "kalman", "model": "coordinated-turn", "q": 0.5, "turn_rate_noise": 1e-3},
+        ["--method", "kalman", "--model", "coordinated-turn", "--q", "0.5"]
+        + ["--turn-rate-noise", "1e-3"],
+    ),
+    (
+        {"method": "smooth", "model": "constant-acceleration", "q": 0.1, "lag": 5},
+        ["--method", "smooth", "--model", "constant-acceleration", "--q", "0.1", "--lag", "5"],
+    ),
+    (
+        {"method": "kalman", "model": "singer", "manoeuvre_alpha": 0.05, "manoeuvre_variance": 4.0},
+        ["--method", "kalman", "--model", "singer", "--manoeuvre-alpha", "0.05"]
+        + ["--manoeuvre-variance", "4"],
+    ),
+    (
+        {"method": "fading", "model": "coordinated-turn", "theta_per_update": 0.8},
+        ["--method", "fading", "--model", "coordinated-turn", "--theta-per-update", "0.8"],
+    ),
 ]
 
 
@@ -319,3 +341,28 @@ def test_smoothed_streams_with_the_lag():
         assert np.array_equal(held, np.arange(start + 1, len(t)))
         assert same(xs, kx[held]) and same(ps, kp[held]) and same(ns, kn[held]), q
         assert same(fs, kf[held]), q
+
+
+def test_models_a_method_cannot_use_are_refused_in_pythons_words():
+    """The library's refusals of a model (``seqsmooth track --model``'s), named by keyword."""
+    cases = [
+        ({"model": "spiral"}, "model 'spiral' is invalid: must be one of constant-velocity"),
+        (
+            {"method": "window", "model": "singer"},
+            "model singer is invalid: the window method fits the constant-velocity model only",
+        ),
+        ({"model": "singer", "q": 1.0}, "q 1 is invalid: does not apply to the singer model"),
+        (
+            {"model": "constant-velocity", "turn_rate_noise": 1e-4},
+            "turn_rate_noise 0.0001 is invalid: is not a parameter of the constant-velocity",
+        ),
+        ({"model": "singer", "manoeuvre_alpha": -1.0}, "manoeuvre_alpha -1 is invalid"),
+        (
+            {"method": "fading", "model": "singer", "manoeuvre_variance": 1.0},
+            "manoeuvre_variance 1 is invalid: does not apply to the fading method",
+        ),
+    ]
+    for kw, message in cases:
+        with pytest.raises(ParameterError) as e:
+            ss.RadarTracker(**kw, sigma_range=SR, sigma_angle=SA)
+        assert str(e.value).startswith(message), (kw, str(e.value))

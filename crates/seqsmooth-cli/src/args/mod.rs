@@ -129,8 +129,9 @@ const TRACK_AFTER_HELP: &str = concat!(
     "\
 Output: CSV, one row per input row in input order, with the header
   t,x,y,z,vx,vy,vz,sx,sy,sz,svx,svy,svz,nis,flag
-t echoes the input cell; x..vz is the constant-velocity state at t (in the units of the range \
-and of t; with --azimuth bearing x is east, y north, z up), s.. their 1-sigma errors, and nis \
+t echoes the input cell; x..vz is the position and velocity of --model's state at t (in the \
+units of the range and of t; with --azimuth bearing x is east, y north, z up), s.. their \
+1-sigma errors, and nis \
 the normalised innovation squared of the row's update (chi-squared with as many degrees of \
 freedom as components present when the model holds; Morrison 14.8). Rows before the state is \
 determinable leave their cells empty.

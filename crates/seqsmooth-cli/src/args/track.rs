@@ -1,9 +1,10 @@
 //! The arguments of `seqsmooth track`.
 
-use super::{parse_checked, parse_f64, parse_max_iterations, parse_window, RadarArgs};
+use super::{parse_checked, parse_f64, parse_max_iterations, parse_window, refused, RadarArgs};
 use clap::Args;
 use seqsmooth::estimate::gauss_newton::GaussNewton;
 use seqsmooth::kalman::noise::check_psd;
+use seqsmooth::track::MotionModel;
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -14,8 +15,25 @@ pub struct TrackArgs {
     /// The tracking method
     #[arg(long, value_enum, default_value_t = TrackMethod::Kalman)]
     pub method: TrackMethod,
-    /// kalman, smooth: spectral density of the white-noise acceleration on each axis
-    /// [default: adaptive, from the innovations]
+    /// The motion model of the kalman, smooth and fading methods: constant-velocity,
+    /// constant-acceleration, singer or coordinated-turn (the window method fits
+    /// constant-velocity only)
+    #[arg(long, value_name = "NAME", default_value = "constant-velocity", value_parser = parse_model)]
+    pub model: MotionModel,
+    /// --model singer: the manoeuvre rate alpha > 0, the reciprocal of the manoeuvre time
+    /// constant, per time unit [default: 0.1]
+    #[arg(long, value_name = "ALPHA", value_parser = parse_number, allow_hyphen_values = true)]
+    pub manoeuvre_alpha: Option<f64>,
+    /// --model singer: the manoeuvre variance (acceleration squared), the Singer model's
+    /// driving noise [default: adaptive, from the innovations]
+    #[arg(long, value_name = "VAR", value_parser = parse_number, allow_hyphen_values = true)]
+    pub manoeuvre_variance: Option<f64>,
+    /// --model coordinated-turn: the spectral density of the turn rate's random walk
+    /// (rad^2 per time unit^3) [default: 1e-4]
+    #[arg(long, value_name = "Q_OMEGA", value_parser = parse_number, allow_hyphen_values = true)]
+    pub turn_rate_noise: Option<f64>,
+    /// kalman, smooth: spectral density of the white-noise acceleration on each axis (of the
+    /// jerk with --model constant-acceleration) [default: adaptive, from the innovations]
     #[arg(long = "q", value_name = "ACCEL_PSD", value_parser = parse_psd, allow_hyphen_values = true)]
     pub q: Option<f64>,
     /// fading: the discount per span --tau of time, 0 < T < 1 (with --tau) [default: an
@@ -66,6 +84,11 @@ pub enum TrackMethod {
     Fading,
     /// The Rauch-Tung-Striebel smoother over the Kalman filter.
     Smooth,
+}
+
+/// Parses `--model`: a name of the library's ([`MotionModel::named`]).
+pub fn parse_model(s: &str) -> Result<MotionModel, String> {
+    MotionModel::named(s.trim()).map_err(refused)
 }
 
 /// Parses `--q`: a number in the library's range of a spectral density ([`check_psd`]).

@@ -261,7 +261,12 @@ impl Tracker {
             ),
         };
         let solver = GaussNewton::with_max_iterations(a.max_iterations).map_err(CliError::from)?;
-        let inner = RadarTracker::with_solver(radar, method, solver).map_err(CliError::from)?;
+        let model = a
+            .model
+            .with_parameters(a.manoeuvre_alpha, a.manoeuvre_variance, a.turn_rate_noise)
+            .map_err(CliError::from)?;
+        let inner =
+            RadarTracker::with_model(radar, method, model, solver).map_err(CliError::from)?;
         let keep = match method {
             Method::Window { window } => window,
             _ => START_WINDOW,

@@ -28,9 +28,14 @@ BayesFilter
     The Bayes filter (Morrison ch. 10) in square-root information form over the same model:
     starts from no information, fading memory with the true covariance.
 RadarTracker
-    A radar's range, azimuth and elevation to a constant-velocity track: the sliding
-    Gauss–Newton fit, the extended Kalman filter (driving noise or fading memory) or its
-    smoother; the numbers of ``seqsmooth track``.
+    A radar's range, azimuth and elevation to a track of a built-in motion model (constant
+    velocity, constant acceleration, Singer, coordinated turn): the sliding Gauss–Newton fit,
+    the extended Kalman filter (driving noise or fading memory) or its smoother; the numbers
+    of ``seqsmooth track``.
+CoordinatedTurn
+    The library's coordinated-turn model (known or estimated turn rate) as the ``f``,
+    ``F_jacobian`` and ``Q`` callables of ``ExtendedKalmanFilter`` and
+    ``UnscentedKalmanFilter``.
 SlidingFit
     Gauss–Newton differential correction of each row's window of the last W rows (Morrison
     §8.5-8.7), radar or scalar polynomial model: ``update_many`` gives the states,
@@ -67,6 +72,7 @@ from ._seqsmooth import (
     BayesFilter,
     ContinuousKalmanFilter,
     ContinuousModel,
+    CoordinatedTurn,
     CurveFit,
     ExpandingBank,
     ExpandingMemory,
@@ -125,6 +131,7 @@ __all__ = [
     "ContinuousKalmanFilter",
     "ExtendedKalmanFilter",
     "RadarTracker",
+    "CoordinatedTurn",
     "SlidingFit",
     "Innovation",
     "PolynomialFilter",

@@ -610,6 +610,12 @@ class RadarTracker:
         lag: int | None = None,
         azimuth: Literal["from-x", "bearing"] = "from-x",
         max_iterations: int = 20,
+        model: Literal[
+            "constant-velocity", "constant-acceleration", "singer", "coordinated-turn"
+        ] = "constant-velocity",
+        manoeuvre_alpha: float | None = None,
+        manoeuvre_variance: float | None = None,
+        turn_rate_noise: float | None = None,
     ) -> None: ...
     @property
     def rows_taken(self) -> int: ...
@@ -632,6 +638,18 @@ class RadarTracker:
     ) -> tuple[
         npt.NDArray[np.int64], Matrix, npt.NDArray[np.float64], Vector, npt.NDArray[np.str_]
     ]: ...
+
+class CoordinatedTurn:
+    def __init__(
+        self, q: float, *, turn_rate: float | None = None, turn_rate_noise: float = 0.0
+    ) -> None: ...
+    @property
+    def dim(self) -> int: ...
+    @property
+    def turn_rate(self) -> float | None: ...
+    def f(self, x: ArrayLike, t0: float, t1: float) -> Vector: ...
+    def F_jacobian(self, x: ArrayLike, t0: float, t1: float) -> Matrix: ...
+    def Q(self, t0: float, t1: float) -> Matrix: ...
 
 class SlidingFit:
     def __init__(

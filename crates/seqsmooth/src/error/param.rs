@@ -310,6 +310,12 @@ pub enum Param {
     DerivativeFunction,
     /// The Jacobian `∂F/∂X` of a user's state derivative.
     DerivativeJacobian,
+    /// The coordinated turn's known turn rate `ω`.
+    TurnRate,
+    /// The coordinated turn's random-walk density `q_ω` of an estimated turn rate.
+    TurnRateNoise,
+    /// A built-in motion model's name (`seqsmooth track --model`).
+    MotionModel,
 }
 
 impl Param {
@@ -459,6 +465,9 @@ impl Param {
         Param::AngleComponents,
         Param::DerivativeFunction,
         Param::DerivativeJacobian,
+        Param::TurnRate,
+        Param::TurnRateNoise,
+        Param::MotionModel,
     ];
 
     /// The library's word for the parameter (the one its messages use).
@@ -608,6 +617,9 @@ impl Param {
             Param::AngleComponents => "angle components",
             Param::DerivativeFunction => "state derivative function",
             Param::DerivativeJacobian => "state derivative Jacobian",
+            Param::TurnRate => "turn rate",
+            Param::TurnRateNoise => "turn rate noise",
+            Param::MotionModel => "motion model",
         }
     }
 

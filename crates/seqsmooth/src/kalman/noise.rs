@@ -17,6 +17,7 @@
 use crate::calculus::factorial;
 use crate::error::{Error, Param};
 use crate::model::continuous::ContinuousModel;
+use crate::model::coordinated_turn::CoordinatedTurn;
 use crate::numeric::power::powi;
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size, UNROLLED_MAX_SIZE};
 use nalgebra::{DMatrix, DVector};
@@ -222,17 +223,42 @@ impl ProcessNoise for ContinuousModel {
     }
 
     fn covariance(&self, t_a: f64, t_b: f64) -> Result<DMatrix<f64>, Error> {
-        for t in [t_a, t_b] {
-            if !t.is_finite() {
-                return Err(Error::NonFinite {
-                    what: "time",
-                    value: t,
-                });
-            }
-        }
-        self.noise_covariance((t_b - t_a).abs())
+        self.noise_covariance(step_between(t_a, t_b)?)
     }
 }
+
+/// The step `|t_b − t_a|` a driving noise accumulates over, both times finite.
+fn step_between(t_a: f64, t_b: f64) -> Result<f64, Error> {
+    match [t_a, t_b].into_iter().find(|t| !t.is_finite()) {
+        Some(value) => Err(Error::NonFinite {
+            what: "time",
+            value,
+        }),
+        None => Ok((t_b - t_a).abs()),
+    }
+}
+/// The coordinated turn's driving noise ([`crate::model::coordinated_turn`]): white
+/// acceleration on each axis (turned with the velocity for a known rate) and a random walk of
+/// an estimated rate, `Q` over `|t_b − t_a|` in closed form. The model is also the filter's
+/// [`Dynamics`](crate::model::dynamics::Dynamics).
+///
+/// ```
+/// use seqsmooth::kalman::noise::ProcessNoise;
+/// use seqsmooth::model::coordinated_turn::CoordinatedTurn;
+/// let turn = CoordinatedTurn::estimated(2.0, 0.25).unwrap();
+/// let q = turn.covariance(10.0, 13.0).unwrap();
+/// assert_eq!((q[(3, 3)], q[(6, 6)]), (6.0, 0.75)); // q ζ, q_ω ζ
+/// ```
+impl ProcessNoise for CoordinatedTurn {
+    fn dimension(&self) -> usize {
+        crate::model::dynamics::Dynamics::dimension(self)
+    }
+
+    fn covariance(&self, t_a: f64, t_b: f64) -> Result<DMatrix<f64>, Error> {
+        self.noise_covariance(step_between(t_a, t_b)?)
+    }
+}
+
 /// A given `Q` over each step, the same whatever the step's length: the process noise of a
 /// discrete-time model ([`super::discrete`]), symmetric positive semidefinite and finite.
 ///

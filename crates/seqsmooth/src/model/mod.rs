@@ -21,6 +21,8 @@
 //! - [`continuous`]: `dX/dt = A X + w` with white noise of spectral density `Q_c`, discretised
 //!   exactly on each step (`e^{Aζ}` and Van Loan's `Q(ζ)`, (15.2.23)); the polynomial, nearly
 //!   constant velocity and acceleration, and Singer models.
+//! - [`coordinated_turn`]: the coordinated turn in the horizontal plane, known or estimated
+//!   turn rate, in closed form with its analytic `Φ` and driving noise `Q(ζ)`.
 //! - [`nonlinear`]: `dX/dt = F(X, t)` and `dX/dt = A(t) X` with `Φ` from the variational
 //!   equations (§4.7, §8.6), integrated by an embedded Runge–Kutta 8(5,3) pair.
 //! - [`observation`]: the [`observation::Observation`] trait `Y = G(X, t) + N`, `M = ∂G/∂X`,
@@ -29,6 +31,7 @@
 //!   with covariance; the nominal state of §8.5.
 
 pub mod continuous;
+pub mod coordinated_turn;
 pub mod dynamics;
 pub mod linear;
 pub mod measurement;

@@ -4,24 +4,24 @@
 //! chooses: `q₀ 4^ℓ` or `θ = 1 − (1 − θ₀) 2^ℓ`; and the gated update of each row through it.
 
 use super::adaptive::{Monitor, TrackFlag};
+use super::model::{MotionModel, TrackDynamics};
 use crate::discount::Discount;
 use crate::error::Error;
 use crate::kalman::filter::KalmanFilter;
 use crate::kalman::fixed_lag::FixedLagSmoother;
-use crate::kalman::noise::WhiteNoiseDerivative;
 use crate::kalman::smoother::Smoothed;
-use crate::model::dynamics::PolynomialDynamics;
 use crate::model::measurement::Measurement;
 use crate::model::measurement::NoiseCovariance;
 use crate::model::radar::Radar;
 
 /// The filter of the Kalman methods.
-pub(super) type Filter = KalmanFilter<PolynomialDynamics, Radar>;
+pub(super) type Filter = KalmanFilter<TrackDynamics, Radar>;
 
 /// The memory of a Kalman method: a driving noise or a discount, fixed or adaptive, with the
 /// innovation monitor that flags its rows.
 #[derive(Clone, Debug)]
 pub(super) struct Memory {
+    model: MotionModel,
     kind: MemoryKind,
     monitor: Monitor,
 }
@@ -29,20 +29,23 @@ pub(super) struct Memory {
 /// What a level sets.
 #[derive(Clone, Copy, Debug)]
 pub(super) enum MemoryKind {
-    /// The driving noise `q` at level 0 (`q₀` when adaptive).
+    /// The driving noise `q` (Singer's `σ_m²`) at level 0 (`q₀` when adaptive).
     Noise(f64),
     /// The discount at level 0.
     Fading(Discount),
 }
 
 impl Memory {
-    /// The memory `kind` at level 0, adaptive between the levels `lowest..=highest` or fixed.
+    /// The memory `kind` of `model` at level 0, adaptive between the levels
+    /// `lowest..=highest` or fixed.
     pub(super) fn new(
+        model: MotionModel,
         kind: MemoryKind,
         adaptive: bool,
         (lowest, highest): (i32, i32),
     ) -> Result<Self, Error> {
         Ok(Self {
+            model,
             kind,
             monitor: Monitor::new(3, adaptive, lowest, highest)?,
         })
@@ -52,10 +55,7 @@ impl Memory {
     pub(super) fn apply(&self, f: &mut Filter) -> Result<(), Error> {
         let level = self.monitor.level();
         match self.kind {
-            MemoryKind::Noise(q) => {
-                let q = q * 4f64.powi(level);
-                f.set_process_noise(WhiteNoiseDerivative::new(1, 3, q)?)
-            }
+            MemoryKind::Noise(q) => self.model.set_noise(f, q, 4f64.powi(level)),
             MemoryKind::Fading(d) if level == 0 => f.set_fading(d),
             MemoryKind::Fading(d) => {
                 f.set_fading(d.with_theta(1.0 - (1.0 - d.theta()) * 2f64.powi(level))?)
@@ -89,7 +89,7 @@ impl Memory {
     /// before the push).
     pub(super) fn step_smoother(
         &mut self,
-        s: &mut FixedLagSmoother<PolynomialDynamics, Radar>,
+        s: &mut FixedLagSmoother<TrackDynamics, Radar>,
         m: &Measurement,
     ) -> Result<(Option<Smoothed>, Option<f64>, TrackFlag), Error> {
         let mut probe = s.filter().clone();
@@ -118,10 +118,11 @@ impl Memory {
     }
 }
 
-/// The adaptive driving noise's level 0, `q₀ = σ_r² / T³`: the range's noise variance (of the
-/// last row) over the cube of the rows' mean step, the density whose tracking index
-/// `√(q T³) / σ_r` is 1.
-pub(super) fn base_noise<'a>(rows: impl Iterator<Item = &'a Measurement>) -> f64 {
+/// The adaptive driving noise's level 0, `q₀ = σ_r² / T^(2m+1)` for white noise on the
+/// `m`-th derivative: the range's noise variance (of the last row) over the rows' mean step
+/// to that power (`T³` for constant velocity), the density whose tracking index
+/// `√(q T^(2m+1)) / σ_r` is 1.
+pub(super) fn base_noise<'a>(rows: impl Iterator<Item = &'a Measurement>, m: i32) -> f64 {
     let (mut first, mut last, mut count, mut variance) = (f64::NAN, f64::NAN, 0usize, 1.0);
     for m in rows {
         if count == 0 {
@@ -138,7 +139,7 @@ pub(super) fn base_noise<'a>(rows: impl Iterator<Item = &'a Measurement>) -> f64
         }
     }
     let step = (last - first) / count.saturating_sub(1).max(1) as f64;
-    let q = variance / (step * step * step);
+    let q = variance / (0..2 * m + 1).fold(1.0, |p, _| p * step);
     if q.is_finite() && q > 0.0 {
         q
     } else {

@@ -1,5 +1,6 @@
-//! A radar track: range, azimuth and elevation ([`Radar`]) to a constant-velocity Cartesian
-//! state `(x, y, z, ẋ, ẏ, ż)`, by one of four methods over the same models:
+//! A radar track: range, azimuth and elevation ([`Radar`]) to a Cartesian state
+//! `(x, y, z, ẋ, ẏ, ż, …)` of one of the built-in motion models ([`model`]: constant velocity by
+//! default, constant acceleration, Singer, the coordinated turn), by one of four methods:
 //!
 //! | method | each row's estimate | source |
 //! |---|---|---|
@@ -29,6 +30,7 @@
 
 pub mod adaptive;
 mod memory;
+pub mod model;
 
 use crate::discount::Discount;
 use crate::error::{Error, Param};
@@ -45,9 +47,18 @@ use crate::model::radar::{check_component, from_bearing, Radar};
 pub use adaptive::TrackFlag;
 use adaptive::{Monitor, MISFIT_ALPHA};
 use memory::{base_noise, Filter, Memory, MemoryKind};
+use model::TrackDynamics;
+pub use model::{
+    MotionModel, DEFAULT_MANOEUVRE_ALPHA, DEFAULT_TURN_RATE_NOISE, TURN_RATE_PRIOR_SIGMA,
+};
 use nalgebra::{DMatrix, DVector};
 use std::collections::VecDeque;
 use std::ops::Range;
+
+/// The state components every row reports, whatever the model: position and velocity
+/// `(x, y, z, ẋ, ẏ, ż)`, the first six of every model's state ([`model`]), with their
+/// covariance block.
+pub const REPORTED: usize = 6;
 
 /// The window of the Kalman methods' start: the first fit of at most this many last rows that
 /// determines the state.
@@ -153,7 +164,7 @@ pub enum TrackError {
 /// A row's estimate, borrowed from the tracker until its next row.
 #[derive(Clone, Copy, Debug)]
 pub struct TrackEstimate<'a> {
-    /// `X = (x, y, z, ẋ, ẏ, ż)` at the row's time.
+    /// The model's state at the row's time, `(x, y, z, ẋ, ẏ, ż)` first ([`REPORTED`]).
     pub state: &'a DVector<f64>,
     /// Its covariance.
     pub covariance: &'a DMatrix<f64>,
@@ -187,18 +198,27 @@ pub enum Tracked<'a> {
     },
 }
 
-/// The memory of `method` for a filter started from the fit over `rows` (the adaptive `q₀`
-/// from their steps and range noise, [`base_noise`]).
-fn memory_of<'a>(
+/// The memory of `method` and `model` for a filter started from the fit over `rows` (the
+/// adaptive `q₀` from their steps and range noise, [`base_noise`]; Singer's variance where
+/// given, else adaptive).
+fn memory_of<'a, I: Iterator<Item = &'a Measurement>>(
     method: TrackMethod,
-    rows: impl Iterator<Item = &'a Measurement>,
+    model: MotionModel,
+    rows: impl Fn() -> I,
 ) -> Result<Memory, Error> {
+    let fixed = match (method, model) {
+        (_, MotionModel::Singer { variance, .. }) => variance,
+        (TrackMethod::Kalman { q } | TrackMethod::Smooth { q, .. }, _) => q,
+        _ => None,
+    };
     let (kind, adaptive, levels) = match method {
-        TrackMethod::Kalman { q: Some(q) } | TrackMethod::Smooth { q: Some(q), .. } => {
-            (MemoryKind::Noise(q), false, (0, 0))
+        TrackMethod::Kalman { .. } | TrackMethod::Smooth { .. } if fixed.is_some() => {
+            (MemoryKind::Noise(fixed.unwrap_or(0.0)), false, (0, 0))
         }
-        TrackMethod::Kalman { q: None } | TrackMethod::Smooth { q: None, .. } => {
-            (MemoryKind::Noise(base_noise(rows)), true, NOISE_LEVELS)
+        TrackMethod::Kalman { .. } | TrackMethod::Smooth { .. } => {
+            let q0 = base_noise(rows(), model.noise_degree());
+            let q0 = model.adaptive_base(q0, base_noise(rows(), 1));
+            (MemoryKind::Noise(q0), true, NOISE_LEVELS)
         }
         TrackMethod::Fading(Some(d)) => (MemoryKind::Fading(d), false, (0, 0)),
         TrackMethod::Fading(None) => (
@@ -210,7 +230,7 @@ fn memory_of<'a>(
         ),
         TrackMethod::Window { .. } => (MemoryKind::Noise(0.0), false, (0, 0)),
     };
-    Memory::new(kind, adaptive, levels)
+    Memory::new(model, kind, adaptive, levels)
 }
 
 /// The smooth method's forward pass: the fixed-lag smoother, the memory that gates and adapts
@@ -218,7 +238,7 @@ fn memory_of<'a>(
 /// oldest first (its ring's rows: at most `lag + 1`).
 #[derive(Clone, Debug)]
 struct Lagged {
-    smoother: FixedLagSmoother<PolynomialDynamics, Radar>,
+    smoother: FixedLagSmoother<TrackDynamics, Radar>,
     memory: Memory,
     held: VecDeque<(Option<f64>, TrackFlag)>,
 }
@@ -280,8 +300,10 @@ enum Stage {
 #[derive(Clone, Debug)]
 pub struct RadarTracker {
     method: TrackMethod,
+    model: MotionModel,
+    /// The radar of the model's state (the filters').
     radar: Radar,
-    dynamics: PolynomialDynamics,
+    dynamics: TrackDynamics,
     stage: Stage,
     /// The rows taken so far.
     rows: usize,
@@ -314,8 +336,41 @@ impl RadarTracker {
         method: TrackMethod,
         solver: GaussNewton,
     ) -> Result<Self, Error> {
-        let dynamics = PolynomialDynamics::new(1, 3);
+        Self::with_model(radar, method, MotionModel::ConstantVelocity, solver)
+    }
+
+    /// [`Self::with_solver`] with the motion `model` ([`model`]) of the Kalman methods: the
+    /// window method fits constant velocity only, and refuses any other model; Singer's
+    /// driving noise is its manoeuvre variance (a `q` is refused with it, and with the
+    /// fading method, which has no driving noise, a variance or a turn rate noise). `radar` is the six-state radar
+    /// of constant velocity; the filters' has the model's states.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::GaussNewton;
+    /// use seqsmooth::track::{MotionModel, RadarTracker, TrackMethod};
+    /// use seqsmooth::model::radar::Radar;
+    /// let radar = Radar::new([0.0; 3], 6).unwrap();
+    /// let turn = MotionModel::named("coordinated-turn").unwrap();
+    /// let kalman = TrackMethod::Kalman { q: None };
+    /// assert!(RadarTracker::with_model(radar, kalman, turn, GaussNewton::default()).is_ok());
+    /// let window = TrackMethod::Window { window: 8 };
+    /// assert!(RadarTracker::with_model(radar, window, turn, GaussNewton::default()).is_err());
+    /// ```
+    pub fn with_model(
+        radar: Radar,
+        method: TrackMethod,
+        model: MotionModel,
+        solver: GaussNewton,
+    ) -> Result<Self, Error> {
+        model.check()?;
+        model.check_method(method)?;
+        let dynamics = model.dynamics()?;
         check_max_iterations(solver.max_iterations)?;
+        let fit_radar = match model.start_degree() {
+            1 => radar,
+            degree => Radar::new(radar.site(), 3 * (degree + 1))?,
+        };
+        let start = |solver| sliding(fit_radar, model.start_degree(), START_WINDOW, solver);
         let stage = match method {
             TrackMethod::Window { window } => {
                 if window < 2 {
@@ -328,7 +383,7 @@ impl RadarTracker {
                     });
                 }
                 Stage::Window(
-                    Box::new(sliding(dynamics, radar, window, solver)?),
+                    Box::new(sliding(radar, 1, window, solver)?),
                     None,
                     Box::new(Monitor::new(3, false, 0, 0)?),
                 )
@@ -337,17 +392,19 @@ impl RadarTracker {
                 if let Some(q) = q {
                     check_psd(q)?;
                 }
-                Stage::Starting(Box::new(sliding(dynamics, radar, START_WINDOW, solver)?))
+                Stage::Starting(Box::new(start(solver)?))
             }
             TrackMethod::Fading(d) => {
                 if let Some(d) = d {
                     d.checked()?;
                 }
-                Stage::Starting(Box::new(sliding(dynamics, radar, START_WINDOW, solver)?))
+                Stage::Starting(Box::new(start(solver)?))
             }
         };
+        let radar = Radar::new(radar.site(), model.dimension())?;
         Ok(Self {
             method,
+            model,
             radar,
             dynamics,
             stage,
@@ -359,6 +416,11 @@ impl RadarTracker {
     /// The method.
     pub fn method(&self) -> TrackMethod {
         self.method
+    }
+
+    /// The motion model.
+    pub fn model(&self) -> MotionModel {
+        self.model
     }
 
     /// The rows taken so far.
@@ -387,14 +449,15 @@ impl RadarTracker {
         // The row taken: `None` held, else `Some((nis, flag))`; the estimate is borrowed below.
         let taken = match &mut self.stage {
             Stage::Starting(fit) => {
-                let Some(c) = fit.push(m.clone()).map_err(|e| window(START_WINDOW, e))? else {
+                let Some(mut c) = fit.push(m.clone()).map_err(|e| window(START_WINDOW, e))? else {
                     self.rows += 1;
                     self.last_time = m.time;
                     return Ok(Tracked::Undetermined);
                 };
-                let memory = memory_of(self.method, fit.measurements());
+                self.model.extend(&mut c);
+                let memory = memory_of(self.method, self.model, || fit.measurements());
                 let started = memory.and_then(|memory| {
-                    let mut f = filter_from(self.dynamics, self.radar, &c)?;
+                    let mut f = filter_from(self.dynamics.clone(), self.radar, &c)?;
                     memory.apply(&mut f)?;
                     Ok((f, memory))
                 });
@@ -413,7 +476,7 @@ impl RadarTracker {
             }
             Stage::Window(fit, previous, gate) => {
                 let stats = match previous {
-                    Some(p) => filter_from(self.dynamics, self.radar, p)
+                    Some(p) => filter_from(self.dynamics.clone(), self.radar, p)
                         .map_err(TrackError::Start)?
                         .update_stats(m)
                         .ok()
@@ -540,7 +603,8 @@ impl RadarTracker {
         match self.method {
             TrackMethod::Smooth { lag, .. } => {
                 let rows = lag.saturating_add(1);
-                let each = FixedLagSmoother::<PolynomialDynamics, Radar>::bytes_per_measurement(6)
+                let n = self.model.dimension();
+                let each = FixedLagSmoother::<TrackDynamics, Radar>::bytes_per_measurement(n)
                     + std::mem::size_of::<(Option<f64>, TrackFlag)>();
                 (rows, rows.saturating_mul(each))
             }
@@ -587,11 +651,7 @@ pub fn window_flag(c: &Correction) -> TrackFlag {
 }
 
 /// A Kalman filter (no driving noise, no fading) from a fit.
-fn filter_from(
-    dynamics: PolynomialDynamics,
-    radar: Radar,
-    c: &Correction,
-) -> Result<Filter, Error> {
+fn filter_from(dynamics: TrackDynamics, radar: Radar, c: &Correction) -> Result<Filter, Error> {
     KalmanFilter::new(
         dynamics,
         radar,
@@ -601,16 +661,17 @@ fn filter_from(
     )
 }
 
-/// The sliding fit over `window` rows, started at the radar's nominal (§8.5), with `solver`'s
-/// limits and the misfit carried in its covariance ([`misfit_scale`](crate::estimate::sliding::misfit_scale)).
+/// The sliding fit of the polynomial model of `degree` on three axes over `window` rows
+/// (`radar` of its states), started at the radar's nominal (§8.5), with `solver`'s limits and
+/// the misfit carried in its covariance ([`misfit_scale`](crate::estimate::sliding::misfit_scale)).
 fn sliding(
-    dynamics: PolynomialDynamics,
     radar: Radar,
+    degree: usize,
     window: usize,
     solver: GaussNewton,
 ) -> Result<SlidingFit<PolynomialDynamics, Radar>, Error> {
     Ok(SlidingFit::new(
-        dynamics,
+        PolynomialDynamics::new(degree, 3),
         radar,
         window,
         Epoch::End,
