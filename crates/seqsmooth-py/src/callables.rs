@@ -16,6 +16,7 @@
 
 use crate::arrays::matrix;
 use crate::errors::{raise, IntoPy, Kind};
+use crate::fixed_lag::lagged;
 use crate::kalman::{before, measurement, measurements, out_of_order, square, PyInnovation};
 use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
@@ -23,7 +24,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::error::Param;
 use seqsmooth::kalman::noise::{check_covariance, ProcessNoise};
-use seqsmooth::kalman::{smoother, KalmanFilter};
+use seqsmooth::kalman::{smoother, FixedLagSmoother, KalmanFilter};
 use seqsmooth::model::dynamics::{Dynamics, Propagation};
 use seqsmooth::model::measurement::Measurement;
 use seqsmooth::model::nonlinear::{
@@ -776,6 +777,37 @@ impl PyExtendedKalmanFilter {
         };
         let smoothed = self.raised.py(forward.and_then(|s| s.smooth(&rows)))?;
         stacked(py, smoothed.iter().map(|s| (&s.state, &s.covariance)))
+    }
+
+    /// The fixed-lag smoother over the measurements (as ``smooth`` takes them), from this
+    /// filter's current state (the filter itself is not changed), its forward pass iterated as
+    /// ``smooth``'s: each measurement's estimate from the ``lag`` measurements after it (the
+    /// last ``lag`` from all of them; a ``lag`` of at least their number gives ``smooth``'s),
+    /// by the library's ``FixedLagSmoother``, which holds ``lag + 1`` measurements however
+    /// many there are. Returns ``(states, covariances)``, ``(N, dim)``
+    /// and ``(N, dim, dim)``; an error's ``.index`` names the measurement.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R, lag))]
+    fn fixed_lag_smoother<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        R: &Bound<'py, PyAny>,
+        lag: usize,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let rows = measurements(t, z, R, self.filter_components())?;
+        if let Some((k, t, previous)) = out_of_order(self.filter.time(), &rows) {
+            return Err(before(t, previous, Some(k)));
+        }
+        let forward = FixedLagSmoother::new(self.filter.clone(), lag);
+        let forward = match self.iterations {
+            1 => Ok(forward),
+            most => forward.with_iterated_update(self.tolerance, most),
+        };
+        let n = self.filter.state().len();
+        let out = forward.and_then(|s| lagged(s, &rows, n));
+        self.raised.py(out)?.into_tuple(py)
     }
 
     fn __repr__(&self) -> String {

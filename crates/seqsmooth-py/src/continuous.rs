@@ -11,6 +11,7 @@
 use crate::arrays::{matrix, table};
 use crate::callables::{stacked, Run};
 use crate::errors::{raise, IntoPy, Kind};
+use crate::fixed_lag::lagged;
 use crate::kalman::{before, measurement, measurements, noise, out_of_order, square, PyInnovation};
 use nalgebra::{DMatrix, DVector};
 use numpy::PyArray1;
@@ -18,7 +19,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::error::Param;
 use seqsmooth::kalman::noise::check_covariance;
-use seqsmooth::kalman::{smoother, KalmanFilter};
+use seqsmooth::kalman::{smoother, FixedLagSmoother, KalmanFilter};
 use seqsmooth::model::continuous::ContinuousModel;
 use seqsmooth::model::dynamics::Dynamics;
 use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
@@ -374,6 +375,34 @@ impl PyContinuousKalmanFilter {
         let filter = self.filter.clone();
         let smoothed = py.detach(|| smoother::smooth(filter, &rows)).py()?;
         stacked(py, smoothed.iter().map(|s| (&s.state, &s.covariance)))
+    }
+
+    /// The fixed-lag smoother over the measurements (as ``smooth`` takes them; ``R`` ``None``
+    /// for the filter's own), from this filter's current state (the filter itself is not
+    /// changed): each measurement's estimate from the ``lag`` measurements after it (the last
+    /// ``lag`` from all of them; a ``lag`` of at least their number gives ``smooth``'s), by
+    /// the library's ``FixedLagSmoother``, which holds ``lag + 1`` measurements however many
+    /// there are. Returns ``(states, covariances)``, ``(N, dim)``
+    /// and ``(N, dim, dim)``; an error's ``.index`` names the measurement.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R, lag))]
+    fn fixed_lag_smoother<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        R: Option<&Bound<'py, PyAny>>,
+        lag: usize,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let rows = self.rows(t, z, R)?;
+        if let Some((k, t, previous)) = out_of_order(self.filter.time(), &rows) {
+            return Err(before(t, previous, Some(k)));
+        }
+        let smoother = FixedLagSmoother::new(self.filter.clone(), lag);
+        let n = self.filter.state().len();
+        py.detach(|| lagged(smoother, &rows, n))
+            .py()?
+            .into_tuple(py)
     }
 
     fn __repr__(&self) -> String {

@@ -8,6 +8,7 @@
 use crate::arrays::{matrix, series, table, times};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::persist;
+use crate::fixed_lag::lagged;
 use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -17,7 +18,7 @@ use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::filter::Innovation;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
-use seqsmooth::kalman::{smoother, KalmanFilter};
+use seqsmooth::kalman::{smoother, FixedLagSmoother, KalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::{LinearObservation, Observation};
 
@@ -526,6 +527,31 @@ impl PyKalmanFilter {
             .reshape([count, n, n])?
             .into_any();
         PyTuple::new(py, [states, covariances])
+    }
+
+    /// The fixed-lag smoother over the measurements (as ``smooth`` takes them), from this
+    /// filter's current state (the filter itself is not changed): each measurement's estimate
+    /// from the ``lag`` measurements after it (the last ``lag`` from all of them; a ``lag`` of
+    /// at least their number gives ``smooth``'s), by the library's ``FixedLagSmoother``,
+    /// which holds ``lag + 1`` measurements however many there are. Returns
+    /// ``(states, covariances)``, ``(N, dim)``
+    /// and ``(N, dim, dim)``; an error's ``.index`` names the measurement.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R, lag))]
+    fn fixed_lag_smoother<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        R: &Bound<'py, PyAny>,
+        lag: usize,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let rows = measurements(t, z, R, self.filter_components())?;
+        let smoother = FixedLagSmoother::new(self.filter.clone(), lag);
+        let n = self.filter.state().len();
+        py.detach(|| lagged(smoother, &rows, n))
+            .py()?
+            .into_tuple(py)
     }
 
     fn __repr__(&self) -> String {

@@ -11,6 +11,7 @@ mod callables;
 mod continuous;
 mod errors;
 mod fit;
+mod fixed_lag;
 mod frame;
 mod kalman;
 mod linear;

@@ -12,6 +12,7 @@ use crate::callables::{
     stacked, user_model, Raised, Run, Transition, UserDynamics, UserObservation,
 };
 use crate::errors::{raise, IntoPy, Kind};
+use crate::fixed_lag::lagged;
 use crate::kalman::{
     before, measurement, measurements, observation_from, out_of_order, square, square_from,
     PyInnovation,
@@ -23,7 +24,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::sigma_points::SigmaPoints;
-use seqsmooth::kalman::{smooth_unscented, UnscentedKalmanFilter};
+use seqsmooth::kalman::{smooth_unscented, UnscentedFixedLagSmoother, UnscentedKalmanFilter};
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::measurement::Measurement;
 use seqsmooth::model::observation::{LinearObservation, Observation};
@@ -436,6 +437,34 @@ impl PyUnscentedKalmanFilter {
         let smoothed = py.detach(|| each!(model, f => smooth_unscented(f, &rows)));
         let smoothed = self.raised.py(smoothed)?;
         stacked(py, smoothed.iter().map(|s| (&s.state, &s.covariance)))
+    }
+
+    /// The fixed-lag smoother over the measurements (as ``smooth`` takes them), from this
+    /// filter's current state (the filter itself is not changed): each measurement's estimate
+    /// from the ``lag`` measurements after it (the last ``lag`` from all of them; a ``lag`` of
+    /// at least their number gives ``smooth``'s): the unscented RTS recursion of ``smooth``
+    /// (Särkkä 2008) over the last ``lag + 1`` at each measurement, by the library's
+    /// ``UnscentedFixedLagSmoother``, which holds ``lag + 1`` measurements however many there
+    /// are. Returns ``(states, covariances)``, ``(N, dim)``
+    /// and ``(N, dim, dim)``; an error's ``.index`` names the measurement.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (t, z, R, lag))]
+    fn fixed_lag_smoother<'py>(
+        &self,
+        py: Python<'py>,
+        t: &Bound<'py, PyAny>,
+        z: &Bound<'py, PyAny>,
+        R: &Bound<'py, PyAny>,
+        lag: usize,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let rows: Vec<Measurement> = measurements(t, z, R, self.components)?;
+        if let Some((k, t, previous)) = out_of_order(self.time(), &rows) {
+            return Err(before(t, previous, Some(k)));
+        }
+        let (model, n) = (self.model.clone(), self.state_len());
+        let out = py
+            .detach(|| each!(model, f => lagged(UnscentedFixedLagSmoother::new(f, lag), &rows, n)));
+        self.raised.py(out)?.into_tuple(py)
     }
 
     fn __repr__(&self) -> String {

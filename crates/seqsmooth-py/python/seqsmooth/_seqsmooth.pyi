@@ -183,6 +183,28 @@ class KalmanFilter:
     def smooth(
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
+    def fixed_lag_smoother(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float, lag: int
+    ) -> tuple[Matrix, npt.NDArray[np.float64]]:
+        """The fixed-lag smoother from this filter's estimate (the filter is not changed).
+
+        Parameters
+        ----------
+        t, z, R
+            The measurements, as ``smooth`` takes them (NaN: a missing component).
+        lag : int
+            The lag, in measurements: each estimate is from the ``lag`` measurements after
+            it (the last ``lag`` from all of them); ``lag`` at least ``len(t)`` gives
+            ``smooth``'s, 0 the filter's.
+
+        Returns
+        -------
+        states, covariances : ndarray
+            ``(N, dim)`` and ``(N, dim, dim)``: measurement ``k``'s estimate, the
+            whole-interval smoother's over measurements ``0..k+lag`` read at ``k``, computed
+            holding ``lag + 1`` measurements however many there are. An error's ``.index``
+            names the measurement.
+        """
 
 Transition = Callable[[Vector, float, float], ArrayLike]
 Observe = Callable[[Vector, float], ArrayLike]
@@ -230,6 +252,28 @@ class UnscentedKalmanFilter:
     def smooth(
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
+    def fixed_lag_smoother(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float, lag: int
+    ) -> tuple[Matrix, npt.NDArray[np.float64]]:
+        """The fixed-lag smoother from this filter's estimate (the filter is not changed).
+
+        Parameters
+        ----------
+        t, z, R
+            The measurements, as ``smooth`` takes them (NaN: a missing component).
+        lag : int
+            The lag, in measurements: each estimate is from the ``lag`` measurements after
+            it (the last ``lag`` from all of them); ``lag`` at least ``len(t)`` gives
+            ``smooth``'s, 0 the filter's.
+
+        Returns
+        -------
+        states, covariances : ndarray
+            ``(N, dim)`` and ``(N, dim, dim)``: measurement ``k``'s estimate, the
+            whole-interval smoother's over measurements ``0..k+lag`` read at ``k``, computed
+            holding ``lag + 1`` measurements however many there are. An error's ``.index``
+            names the measurement.
+        """
 
 class LinearKalmanFilter:
     """The Kalman filter on a discrete-time linear model given by its matrices (filterpy's
@@ -391,6 +435,28 @@ class ExtendedKalmanFilter:
     def smooth(
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
+    def fixed_lag_smoother(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float, lag: int
+    ) -> tuple[Matrix, npt.NDArray[np.float64]]:
+        """The fixed-lag smoother from this filter's estimate (the filter is not changed).
+
+        Parameters
+        ----------
+        t, z, R
+            The measurements, as ``smooth`` takes them (NaN: a missing component).
+        lag : int
+            The lag, in measurements: each estimate is from the ``lag`` measurements after
+            it (the last ``lag`` from all of them); ``lag`` at least ``len(t)`` gives
+            ``smooth``'s, 0 the filter's.
+
+        Returns
+        -------
+        states, covariances : ndarray
+            ``(N, dim)`` and ``(N, dim, dim)``: measurement ``k``'s estimate, the
+            whole-interval smoother's over measurements ``0..k+lag`` read at ``k``, computed
+            holding ``lag + 1`` measurements however many there are. An error's ``.index``
+            names the measurement.
+        """
 
 def fit_model(
     x0: ArrayLike,
@@ -467,6 +533,29 @@ class ContinuousKalmanFilter:
     def smooth(
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float | None = None
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
+    def fixed_lag_smoother(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float | None, lag: int
+    ) -> tuple[Matrix, npt.NDArray[np.float64]]:
+        """The fixed-lag smoother from this filter's estimate (the filter is not changed).
+
+        Parameters
+        ----------
+        t, z, R
+            The measurements, as ``smooth`` takes them (NaN: a missing component);
+            ``R`` ``None`` for the filter's own.
+        lag : int
+            The lag, in measurements: each estimate is from the ``lag`` measurements after
+            it (the last ``lag`` from all of them); ``lag`` at least ``len(t)`` gives
+            ``smooth``'s, 0 the filter's.
+
+        Returns
+        -------
+        states, covariances : ndarray
+            ``(N, dim)`` and ``(N, dim, dim)``: measurement ``k``'s estimate, the
+            whole-interval smoother's over measurements ``0..k+lag`` read at ``k``, computed
+            holding ``lag + 1`` measurements however many there are. An error's ``.index``
+            names the measurement.
+        """
 
 class BayesFilter:
     def __init__(

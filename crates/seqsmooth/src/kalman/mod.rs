@@ -21,7 +21,7 @@
 //!   [`Dynamics`](crate::model::dynamics::Dynamics) and
 //!   [`Observation`](crate::model::observation::Observation), its predictions kept with their
 //!   cross-covariances; [`unscented_smoother`], the unscented RTS smoother (Särkkä 2008) over
-//!   them.
+//!   them; [`unscented_fixed_lag`], the same with a fixed lag, in memory bounded by it.
 //! - [`noise`]: the driving-noise covariance `Q` over a step (15.2.23), in closed form for the
 //!   polynomial model ([`noise::WhiteNoiseDerivative`]), or given per step ([`noise::MatrixNoise`]).
 //!
@@ -38,6 +38,7 @@ pub mod sigma_points;
 pub mod smoother;
 pub mod steady;
 pub mod unscented;
+pub mod unscented_fixed_lag;
 pub mod unscented_smoother;
 
 pub use crate::discount::Discount;
@@ -47,4 +48,5 @@ pub use filter::{Innovation, KalmanFilter};
 pub use fixed_lag::FixedLagSmoother;
 pub use smoother::{rts, smooth, RtsStep, Smoothed, Smoother};
 pub use unscented::UnscentedKalmanFilter;
+pub use unscented_fixed_lag::UnscentedFixedLagSmoother;
 pub use unscented_smoother::{smooth_unscented, UnscentedSmoother};

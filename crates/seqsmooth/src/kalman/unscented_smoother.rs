@@ -83,11 +83,39 @@ pub fn smooth_unscented<D: Dynamics, O: Observation>(
 
 /// One forward step kept for the backward pass.
 #[derive(Clone, Debug)]
-struct Forward {
-    prediction: Prediction,
-    state: DVector<f64>,
-    covariance: DMatrix<f64>,
-    nis: Option<f64>,
+pub(super) struct Forward {
+    pub(super) prediction: Prediction,
+    pub(super) state: DVector<f64>,
+    pub(super) covariance: DMatrix<f64>,
+    pub(super) nis: Option<f64>,
+}
+
+/// The forward pass of `filter` over `m`, not before `previous` (the last step's time): the
+/// prediction and the update, kept for the backward pass. On an error the filter is unchanged.
+pub(super) fn forward<D: Dynamics, O: Observation>(
+    filter: &mut UnscentedKalmanFilter<D, O>,
+    m: &Measurement,
+    previous: Option<&Forward>,
+) -> Result<Forward, Error> {
+    if let Some(last) = previous {
+        if m.time < last.prediction.time {
+            return Err(Error::InvalidParameter {
+                name: Param::SampleTime,
+                value: m.time.to_string(),
+                reason: format!(
+                    "is before the previous measurement's time {}",
+                    last.prediction.time
+                ),
+            });
+        }
+    }
+    let (prediction, innovation) = filter.step(m)?;
+    Ok(Forward {
+        prediction,
+        state: filter.state().clone(),
+        covariance: filter.covariance().clone(),
+        nis: innovation.map(|i| i.nis),
+    })
 }
 
 /// The unscented RTS smoother a measurement at a time: the forward pass as the measurements
@@ -133,26 +161,9 @@ impl<D: Dynamics, O: Observation> UnscentedSmoother<D, O> {
     /// the update; the update's NIS (`None` where every component is missing). On an error
     /// the smoother is unchanged.
     pub fn push(&mut self, m: &Measurement) -> Result<Option<f64>, Error> {
-        if let Some(last) = self.steps.last() {
-            if m.time < last.prediction.time {
-                return Err(Error::InvalidParameter {
-                    name: Param::SampleTime,
-                    value: m.time.to_string(),
-                    reason: format!(
-                        "is before the previous measurement's time {}",
-                        last.prediction.time
-                    ),
-                });
-            }
-        }
-        let (prediction, innovation) = self.filter.step(m)?;
-        let nis = innovation.map(|i| i.nis);
-        self.steps.push(Forward {
-            prediction,
-            state: self.filter.state().clone(),
-            covariance: self.filter.covariance().clone(),
-            nis,
-        });
+        let step = forward(&mut self.filter, m, self.steps.last())?;
+        let nis = step.nis;
+        self.steps.push(step);
         Ok(nis)
     }
 
@@ -160,46 +171,60 @@ impl<D: Dynamics, O: Observation> UnscentedSmoother<D, O> {
     /// measurement ([`Error::InBatch`], counted from the first pushed): a predicted covariance
     /// that is not positive definite, or a smoothed number that is not finite.
     pub fn finish(self) -> Result<Vec<UnscentedSmoothed>, Error> {
-        let mut out: Vec<UnscentedSmoothed> = Vec::with_capacity(self.steps.len());
-        let mut next: Option<(&Forward, DVector<f64>, DMatrix<f64>)> = None;
-        for (index, step) in self.steps.iter().enumerate().rev() {
-            let at = |source: Error| Error::InBatch {
+        backward(&self.steps, 0, |_| true)
+    }
+}
+
+/// The backward pass over `steps` (consecutive forward steps, the first measurement `first`
+/// counted from the first pushed), from the last one's filtered estimate: the smoothed
+/// estimates of the steps at the positions `keep` accepts, in order. An error names its
+/// measurement ([`Error::InBatch`]): a predicted covariance that is not positive definite, or
+/// a smoothed number that is not finite.
+pub(super) fn backward(
+    steps: &[Forward],
+    first: usize,
+    keep: impl Fn(usize) -> bool,
+) -> Result<Vec<UnscentedSmoothed>, Error> {
+    let mut out: Vec<UnscentedSmoothed> = Vec::new();
+    let mut next: Option<(&Forward, DVector<f64>, DMatrix<f64>)> = None;
+    for (k, step) in steps.iter().enumerate().rev() {
+        let index = first + k;
+        let (state, covariance, gain) = match &next {
+            None => (step.state.clone(), step.covariance.clone(), None),
+            Some((after, smoothed_x, smoothed_s)) => {
+                let p = &after.prediction;
+                let Some(factor) = Cholesky::new(p.covariance.clone()) else {
+                    return Err(Error::InBatch {
+                        index: index + 1,
+                        source: Box::new(Error::InvalidParameter {
+                            name: Param::PredictedCovariance,
+                            value: format!("at t = {}", p.time),
+                            reason: "is not positive definite: no smoother gain".into(),
+                        }),
+                    });
+                };
+                // G = D S̄⁻¹ = (S̄⁻¹ Dᵀ)ᵀ.
+                let gain = factor.solve(&p.cross.transpose()).transpose();
+                let x = &step.state + &gain * (smoothed_x - &p.state);
+                let s = &step.covariance + &gain * (smoothed_s - &p.covariance) * gain.transpose();
+                let s = (&s + s.transpose()) * 0.5;
+                (x, s, Some(gain))
+            }
+        };
+        if let Some(&value) = state
+            .iter()
+            .chain(covariance.iter())
+            .find(|v| !v.is_finite())
+        {
+            return Err(Error::InBatch {
                 index,
-                source: Box::new(source),
-            };
-            let (state, covariance, gain) = match &next {
-                None => (step.state.clone(), step.covariance.clone(), None),
-                Some((after, smoothed_x, smoothed_s)) => {
-                    let p = &after.prediction;
-                    let Some(factor) = Cholesky::new(p.covariance.clone()) else {
-                        return Err(Error::InBatch {
-                            index: index + 1,
-                            source: Box::new(Error::InvalidParameter {
-                                name: Param::PredictedCovariance,
-                                value: format!("at t = {}", p.time),
-                                reason: "is not positive definite: no smoother gain".into(),
-                            }),
-                        });
-                    };
-                    // G = D S̄⁻¹ = (S̄⁻¹ Dᵀ)ᵀ.
-                    let gain = factor.solve(&p.cross.transpose()).transpose();
-                    let x = &step.state + &gain * (smoothed_x - &p.state);
-                    let s =
-                        &step.covariance + &gain * (smoothed_s - &p.covariance) * gain.transpose();
-                    let s = (&s + s.transpose()) * 0.5;
-                    (x, s, Some(gain))
-                }
-            };
-            if let Some(&value) = state
-                .iter()
-                .chain(covariance.iter())
-                .find(|v| !v.is_finite())
-            {
-                return Err(at(Error::NonFinite {
+                source: Box::new(Error::NonFinite {
                     what: "smoothed state or covariance entry",
                     value,
-                }));
-            }
+                }),
+            });
+        }
+        if keep(k) {
             out.push(UnscentedSmoothed {
                 time: step.prediction.time,
                 state: state.clone(),
@@ -211,9 +236,9 @@ impl<D: Dynamics, O: Observation> UnscentedSmoother<D, O> {
                 gain,
                 nis: step.nis,
             });
-            next = Some((step, state, covariance));
         }
-        out.reverse();
-        Ok(out)
+        next = Some((step, state, covariance));
     }
+    out.reverse();
+    Ok(out)
 }
