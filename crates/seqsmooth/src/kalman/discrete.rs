@@ -15,6 +15,7 @@
 //! ([`LinearKalmanFilter::rts_smoother`], [`super::smoother::rts`]) takes without running the
 //! measurements again.
 
+use super::discrete_fixed;
 use super::filter::{Innovation, KalmanFilter};
 use super::fixed_lag::FixedLagSmoother;
 use super::noise::MatrixNoise;
@@ -176,12 +177,12 @@ pub struct PassInto<'a> {
 }
 
 /// One step's results as the batch loop hands them on (the filter's own memory).
-struct BatchStep<'a> {
-    predicted_state: &'a [f64],
-    predicted_covariance: &'a [f64],
-    state: &'a [f64],
-    covariance: &'a [f64],
-    nis: f64,
+pub(super) struct BatchStep<'a> {
+    pub(super) predicted_state: &'a [f64],
+    pub(super) predicted_covariance: &'a [f64],
+    pub(super) state: &'a [f64],
+    pub(super) covariance: &'a [f64],
+    pub(super) nis: f64,
 }
 
 type Inner = KalmanFilter<DiscreteDynamics, LinearObservation>;
@@ -563,7 +564,9 @@ impl LinearKalmanFilter {
     }
 
     /// The one loop of [`Self::update_many`] and [`Self::update_many_into`]: each row's
-    /// prediction and update, its results handed to `emit` with the row's index.
+    /// prediction and update, its results handed to `emit` with the row's index. While the
+    /// steps take the constant matrices, `n ≤ 9` and `p ≤ 3`, the fixed-size kernel
+    /// (`discrete_fixed`, the same numbers bit for bit) takes them; the generic filter the rest.
     fn run_batch<'a>(
         &mut self,
         zs: &[f64],
@@ -571,12 +574,18 @@ impl LinearKalmanFilter {
         mut emit: impl FnMut(usize, BatchStep<'_>),
     ) -> Result<(), Error> {
         let p = self.components();
+        let c = &self.model;
+        let model = discrete_fixed::ConstantModel::new(&c.f, &c.q, &c.h, &c.r);
+        let (x, cov, time) = self.filter.estimate_mut();
+        let constant = |k| step(k).is_constant();
+        let taken = discrete_fixed::run_constant(&model, x, cov, zs, constant, &mut emit);
+        *time += taken as f64;
         let mut m = Measurement {
             time: 0.0,
             values: Vec::with_capacity(p),
             noise: NoiseCovariance::Identity,
         };
-        for (k, z) in zs.chunks_exact(p).enumerate() {
+        for (k, z) in zs.chunks_exact(p).enumerate().skip(taken) {
             let s = step(k);
             let in_batch = |e: Error| Error::InBatch {
                 index: k,
