@@ -103,6 +103,24 @@ fn assert_same(a: &Pass, b: &Pass, what: &str) {
     same(&a.nis, &b.nis, "NIS");
 }
 
+/// The batch over `zs` from `filter` with constant matrices (the fixed-size path) and forced
+/// onto the generic path (every step handed its `F`): each filter after, its pass, its result.
+fn both_paths(
+    filter: &LinearKalmanFilter,
+    f: &DMatrix<f64>,
+    zs: &[f64],
+) -> [(LinearKalmanFilter, Pass, Result<(), Error>); 2] {
+    let (mut fixed, mut generic) = (filter.clone(), filter.clone());
+    let (mut pass, mut general) = (Pass::default(), Pass::default());
+    let a = fixed.update_many(zs, |_| StepMatrices::default(), &mut pass);
+    let forced = |_| StepMatrices {
+        f: Some(f),
+        ..StepMatrices::default()
+    };
+    let b = generic.update_many(zs, forced, &mut general);
+    [(fixed, pass, a), (generic, general, b)]
+}
+
 /// Every size in the fixed range (n = 1..=9, p = 1..=3) and past it (n = 10, 11; p = 4),
 /// three seeded models each, 300 steps with 15 % of the components missing: the batch with
 /// constant matrices equals the generic filter step by step and the batch forced onto the
@@ -115,17 +133,9 @@ fn fixed_batch_is_the_generic_filter_bit_for_bit() {
             for _ in 0..3 {
                 let Model { filter, f, zs } = model(&mut rng, n, p, 300, 0.15);
                 let what = format!("n = {n}, p = {p}");
-                let (mut fixed, mut generic) = (filter.clone(), filter.clone());
-                let mut pass = Pass::default();
-                fixed
-                    .update_many(&zs, |_| StepMatrices::default(), &mut pass)
-                    .unwrap();
-                let forced = |_| StepMatrices {
-                    f: Some(&f),
-                    ..StepMatrices::default()
-                };
-                let mut general = Pass::default();
-                generic.update_many(&zs, forced, &mut general).unwrap();
+                let [(fixed, pass, a), (generic, general, b)] = both_paths(&filter, &f, &zs);
+                a.unwrap();
+                b.unwrap();
                 assert_same(&pass, &general, &what);
                 let by_step = stepwise(filter, &zs, |_| StepMatrices::default());
                 assert_same(&pass, &by_step, &what);
@@ -151,20 +161,9 @@ fn fixed_batch_is_the_generic_filter_bit_for_bit() {
 fn long_batch_and_batches_in_a_row() {
     let mut rng = StdRng::seed_from_u64(42);
     let Model { filter, f, zs } = model(&mut rng, 4, 2, 10_000, 0.1);
-    let mut whole = filter.clone();
-    let mut pass = Pass::default();
-    whole
-        .update_many(&zs, |_| StepMatrices::default(), &mut pass)
-        .unwrap();
-    let forced = |_| StepMatrices {
-        f: Some(&f),
-        ..StepMatrices::default()
-    };
-    let mut general = Pass::default();
-    filter
-        .clone()
-        .update_many(&zs, forced, &mut general)
-        .unwrap();
+    let [(_, pass, a), (_, general, b)] = both_paths(&filter, &f, &zs);
+    a.unwrap();
+    b.unwrap();
     assert_same(&pass, &general, "10^4 steps");
     let mut halves = filter;
     let (mut first, mut second) = (Pass::default(), Pass::default());
@@ -205,16 +204,8 @@ fn a_refused_step_is_the_generic_paths_error() {
     let mut rng = StdRng::seed_from_u64(11);
     let Model { filter, f, mut zs } = model(&mut rng, 3, 1, 300, 0.1);
     zs[150] = f64::INFINITY;
-    let (mut fixed, mut generic) = (filter.clone(), filter);
-    let (mut pass, mut general) = (Pass::default(), Pass::default());
-    let err = fixed
-        .update_many(&zs, |_| StepMatrices::default(), &mut pass)
-        .unwrap_err();
-    let forced = |_| StepMatrices {
-        f: Some(&f),
-        ..StepMatrices::default()
-    };
-    let want = generic.update_many(&zs, forced, &mut general).unwrap_err();
+    let [(fixed, pass, a), (generic, general, b)] = both_paths(&filter, &f, &zs);
+    let (err, want) = (a.unwrap_err(), b.unwrap_err());
     assert!(matches!(err, Error::InBatch { index: 150, .. }), "{err:?}");
     assert_eq!(format!("{err}"), format!("{want}"));
     assert_same(&pass, &general, "before the refused step");
