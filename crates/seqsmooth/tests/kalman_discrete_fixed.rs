@@ -179,17 +179,20 @@ fn long_batch_and_batches_in_a_row() {
     assert_eq!(bits(&joined), bits(&pass.states));
 }
 
-/// A step with its own `Q` (step 120) and `H` (step 200) in a constant batch: the fixed path
-/// hands the rest to the generic filter, and the batch equals the generic filter step by step.
+/// Steps with their own `R` (step 0), `Q` (step 120) and `H` (steps 200, 201) in a constant
+/// batch: the generic filter takes those, the fixed path the runs between them, and the batch
+/// equals the generic filter step by step.
 #[test]
 fn step_matrices_hand_over_to_the_generic_path() {
     let mut rng = StdRng::seed_from_u64(7);
     let Model { filter, zs, .. } = model(&mut rng, 5, 3, 300, 0.1);
     let q = DMatrix::identity(5, 5) * 0.5;
     let h = DMatrix::from_fn(3, 5, |i, j| f64::from(i == j));
+    let r = DMatrix::identity(3, 3) * 2.0;
     let step = |k: usize| StepMatrices {
+        r: (k == 0).then_some(&r),
         q: (k == 120).then_some(&q),
-        h: (k == 200).then_some(&h),
+        h: (k == 200 || k == 201).then_some(&h),
         ..StepMatrices::default()
     };
     let mut pass = Pass::default();

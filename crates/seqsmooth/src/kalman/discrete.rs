@@ -185,7 +185,7 @@ pub(super) struct BatchStep<'a> {
     pub(super) nis: f64,
 }
 
-type Inner = KalmanFilter<DiscreteDynamics, LinearObservation>;
+pub(super) type Inner = KalmanFilter<DiscreteDynamics, LinearObservation>;
 
 /// The Kalman filter on a discrete-time linear model with explicit matrices (the module's
 /// model): `predict` then `update`, one step each, as filterpy's `KalmanFilter`.
@@ -460,7 +460,9 @@ impl LinearKalmanFilter {
     /// `predict` and `update` for each row of `zs` (`steps × p`, row-major; NaN missing) with
     /// `step(k)`'s matrices, into `pass` (cleared first): the predicted and updated estimates of
     /// every step. On an error ([`Error::InBatch`] naming the step) the steps before it are
-    /// taken and given in `pass`.
+    /// taken and given in `pass`. Steps with the constant matrices at `n ≤ 9` states and
+    /// `p ≤ 3` components run a fixed-size kernel, without being asked: the same numbers as the
+    /// generic filter, bit for bit.
     pub fn update_many<'a>(
         &mut self,
         zs: &[f64],
@@ -564,9 +566,9 @@ impl LinearKalmanFilter {
     }
 
     /// The one loop of [`Self::update_many`] and [`Self::update_many_into`]: each row's
-    /// prediction and update, its results handed to `emit` with the row's index. While the
-    /// steps take the constant matrices, `n ≤ 9` and `p ≤ 3`, the fixed-size kernel
-    /// (`discrete_fixed`, the same numbers bit for bit) takes them; the generic filter the rest.
+    /// prediction and update, its results handed to `emit` with the row's index. Runs of steps
+    /// with the constant matrices at `n ≤ 9`, `p ≤ 3` go to the fixed-size kernel
+    /// (`discrete_fixed`, the same numbers bit for bit); the generic filter takes the others.
     fn run_batch<'a>(
         &mut self,
         zs: &[f64],
@@ -574,18 +576,19 @@ impl LinearKalmanFilter {
         mut emit: impl FnMut(usize, BatchStep<'_>),
     ) -> Result<(), Error> {
         let p = self.components();
-        let c = &self.model;
-        let model = discrete_fixed::ConstantModel::new(&c.f, &c.q, &c.h, &c.r);
-        let (x, cov, time) = self.filter.estimate_mut();
-        let constant = |k| step(k).is_constant();
-        let taken = discrete_fixed::run_constant(&model, x, cov, zs, constant, &mut emit);
-        *time += taken as f64;
         let mut m = Measurement {
             time: 0.0,
             values: Vec::with_capacity(p),
             noise: NoiseCovariance::Identity,
         };
-        for (k, z) in zs.chunks_exact(p).enumerate().skip(taken) {
+        let (rows, mut k) = (zs.len() / p, 0);
+        while k < rows {
+            let c = &self.model;
+            let model = discrete_fixed::ConstantModel::new(&c.f, &c.q, &c.h, &c.r);
+            k += discrete_fixed::run_from(&model, &mut self.filter, zs, k, &step, &mut emit);
+            let Some(z) = zs.get(k * p..(k + 1) * p) else {
+                break;
+            };
             let s = step(k);
             let in_batch = |e: Error| Error::InBatch {
                 index: k,
@@ -614,6 +617,7 @@ impl LinearKalmanFilter {
                     nis: nis.unwrap_or(f64::NAN),
                 },
             );
+            k += 1;
         }
         Ok(())
     }

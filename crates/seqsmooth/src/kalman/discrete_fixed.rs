@@ -24,7 +24,7 @@
 //! (giving its own error, or going on), so errors are the generic path's too.
 
 use super::correct::{carry, correct_kernel, Work};
-use super::discrete::{BatchStep, StepMatrices};
+use super::discrete::{BatchStep, Inner, StepMatrices};
 use crate::linalg::dense::all_finite;
 use crate::numeric::unrolled::{unrolled_sizes, Fixed};
 use nalgebra::{DMatrix, DVector};
@@ -74,6 +74,29 @@ pub(super) fn fits(model: &ConstantModel<'_>) -> bool {
     (1..=MAX_STATES).contains(&n)
         && (1..=MAX_COMPONENTS).contains(&p)
         && model.r.diagonal().iter().all(|&v| v >= 0.0)
+}
+
+/// [`run_constant`] on `filter`'s estimate (its time advanced by the steps taken) over the
+/// rows of `zs` from row `from` on, `step(k)` and `emit` with each row's index in `zs`; the
+/// steps taken. Nothing is set up when row `from` has matrices of its own.
+pub(super) fn run_from<'a>(
+    model: &ConstantModel<'_>,
+    filter: &mut Inner,
+    zs: &[f64],
+    from: usize,
+    step: &impl Fn(usize) -> StepMatrices<'a>,
+    emit: &mut impl FnMut(usize, BatchStep<'_>),
+) -> usize {
+    let p = model.h.nrows();
+    if p == 0 || zs.len() < (from + 1) * p || !step(from).is_constant() {
+        return 0;
+    }
+    let (x, cov, time) = filter.estimate_mut();
+    let constant = |k| step(from + k).is_constant();
+    let mut shifted = |k, s: BatchStep<'_>| emit(from + k, s);
+    let taken = run_constant(model, x, cov, &zs[from * p..], constant, &mut shifted);
+    *time += taken as f64;
+    taken
 }
 
 /// Runs the rows of `zs` (`p` values each, NaN missing) from the estimate `state`, `covariance`
