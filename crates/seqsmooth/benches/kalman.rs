@@ -7,7 +7,15 @@
 //! - `ekf6/…`: the extended filter on 6 states (`PolynomialDynamics::new(1, 3)`, constant
 //!   velocity on three axes) with `Radar` (range, azimuth, elevation) and white-noise
 //!   acceleration, over [`TRACKS`] simulated passes of 59 updates each (`common/kalman.rs`, the
-//!   tracks `scripts/peers.py` gives filterpy's `ExtendedKalmanFilter`).
+//!   tracks `scripts/peers.py` gives filterpy's `ExtendedKalmanFilter`);
+//! - `linear4/…`: `LinearKalmanFilter::update_many_into` on the Python benchmark's model
+//!   (`crates/seqsmooth-py/bench/linear_kalman.py`: constant velocity on two axes, 4 states,
+//!   both positions observed with a full `R`, unit steps) over [`LINEAR_STEPS`] steps, every
+//!   step's predicted and updated state and covariance and NIS written: `fixed` (constant
+//!   matrices: the fixed-size path), `general` (each step handed its `F`: the generic path,
+//!   the same numbers), and `floor`, a hand-written loop of the same filter on `nalgebra`'s
+//!   fixed-size matrices (`(I − K H) P (I − K H)ᵀ + K R Kᵀ` formed, `V⁻¹` by inverse: not the
+//!   library's arithmetic, its cost only).
 //!
 //! Each function runs every measurement through a fresh copy of the filter (the copy made
 //! outside the timing); the throughput is in measurements, so criterion's time per element is
@@ -19,9 +27,11 @@ use criterion::{
     black_box, criterion_group, criterion_main, BatchSize, BenchmarkGroup, Criterion, Throughput,
 };
 use nalgebra::{DMatrix, DVector};
+use nalgebra::{Matrix2, Matrix4, Matrix4x2, SMatrix, Vector2, Vector4};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::StandardNormal;
+use seqsmooth::kalman::discrete::{LinearKalmanFilter, PassInto, StepMatrices};
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
@@ -45,6 +55,9 @@ const Q3: f64 = 1.0;
 const SIGMA: f64 = 0.5;
 /// Radar tracks of the extended filter (59 updates each).
 const TRACKS: usize = 64;
+
+/// Steps of the `linear4` batch.
+const LINEAR_STEPS: usize = 2_000;
 
 /// The 3-state filter at its prior and its measurements.
 fn polynomial_case() -> (
@@ -146,5 +159,149 @@ fn ekf6(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, kalman3, ekf6);
+/// The Python benchmark's model: `F`, `H`, `Q` (`Q_discrete_white_noise(2, 1, 0.01)` per
+/// axis), `R`, and its measurements (a line on each axis plus unit noise).
+struct Linear4 {
+    f: Matrix4<f64>,
+    h: SMatrix<f64, 2, 4>,
+    q: Matrix4<f64>,
+    r: Matrix2<f64>,
+    zs: Vec<f64>,
+}
+
+fn linear4_case() -> Linear4 {
+    let f = Matrix4::new(
+        1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0,
+    );
+    let axis = Matrix2::new(0.25, 0.5, 0.5, 1.0) * 0.01;
+    let mut q = Matrix4::zeros();
+    q.fixed_view_mut::<2, 2>(0, 0).copy_from(&axis);
+    q.fixed_view_mut::<2, 2>(2, 2).copy_from(&axis);
+    let h = SMatrix::<f64, 2, 4>::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0);
+    let r = Matrix2::new(1.0, 0.2, 0.2, 0.5);
+    let mut rng = StdRng::seed_from_u64(1);
+    let zs = (0..LINEAR_STEPS)
+        .flat_map(|k| {
+            let t = k as f64;
+            let (a, b): (f64, f64) = (rng.sample(StandardNormal), rng.sample(StandardNormal));
+            [0.5 * t + a, 3.0 - 0.2 * t + b]
+        })
+        .collect();
+    Linear4 { f, h, q, r, zs }
+}
+
+/// Every step's outputs, as the Python batch returns them.
+struct Outputs {
+    x: Vec<f64>,
+    p: Vec<f64>,
+    xp: Vec<f64>,
+    pp: Vec<f64>,
+    nis: Vec<f64>,
+}
+
+impl Outputs {
+    fn new(steps: usize, n: usize) -> Self {
+        let v = |len| vec![0.0; len];
+        Self {
+            x: v(steps * n),
+            p: v(steps * n * n),
+            xp: v(steps * n),
+            pp: v(steps * n * n),
+            nis: v(steps),
+        }
+    }
+
+    fn pass(&mut self) -> PassInto<'_> {
+        PassInto {
+            states: &mut self.x,
+            covariances: &mut self.p,
+            predicted_states: &mut self.xp,
+            predicted_covariances: &mut self.pp,
+            nis: Some(&mut self.nis),
+        }
+    }
+}
+
+/// The hand-written fixed-size loop: predict, update in Joseph's form, every output written.
+fn floor_loop(case: &Linear4, x0: Vector4<f64>, p0: Matrix4<f64>, out: &mut Outputs) -> f64 {
+    let (f, h, q, r) = (&case.f, &case.h, &case.q, &case.r);
+    let (mut x, mut p) = (x0, p0);
+    let mut acc = 0.0;
+    for (k, z) in case.zs.chunks_exact(2).enumerate() {
+        let xp = f * x;
+        let pp = f * p * f.transpose() + q;
+        let pht: Matrix4x2<f64> = pp * h.transpose();
+        let v = h * pht + r;
+        let vi = v.try_inverse().expect("V positive definite");
+        let gain = pht * vi;
+        let nu = Vector2::new(z[0], z[1]) - h * xp;
+        x = xp + gain * nu;
+        let ikh = Matrix4::identity() - gain * h;
+        p = ikh * pp * ikh.transpose() + gain * r * gain.transpose();
+        let nis = nu.dot(&(vi * nu));
+        out.xp[4 * k..4 * k + 4].copy_from_slice(xp.as_slice());
+        out.pp[16 * k..16 * k + 16].copy_from_slice(pp.as_slice());
+        out.x[4 * k..4 * k + 4].copy_from_slice(x.as_slice());
+        out.p[16 * k..16 * k + 16].copy_from_slice(p.as_slice());
+        out.nis[k] = nis;
+        acc += nis;
+    }
+    acc
+}
+
+fn linear4(c: &mut Criterion) {
+    let case = linear4_case();
+    let dm = |m: &[f64], r: usize, c: usize| DMatrix::from_column_slice(r, c, m);
+    let (f, h) = (dm(case.f.as_slice(), 4, 4), dm(case.h.as_slice(), 2, 4));
+    let (q, r) = (dm(case.q.as_slice(), 4, 4), dm(case.r.as_slice(), 2, 2));
+    let (x0, p0) = (Vector4::zeros(), Matrix4::identity() * 100.0);
+    let filter = LinearKalmanFilter::new(
+        DVector::from_column_slice(x0.as_slice()),
+        dm(p0.as_slice(), 4, 4),
+        f.clone(),
+        h,
+        q,
+        r,
+    )
+    .unwrap();
+    let mut out = Outputs::new(LINEAR_STEPS, 4);
+    let mut group = c.benchmark_group("linear4");
+    group
+        .sample_size(30)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(3))
+        .throughput(Throughput::Elements(LINEAR_STEPS as u64));
+    group.bench_function("fixed", |b| {
+        b.iter_batched(
+            || filter.clone(),
+            |mut kf| {
+                kf.update_many_into(black_box(&case.zs), |_| StepMatrices::default(), out.pass())
+                    .unwrap();
+                kf
+            },
+            BatchSize::SmallInput,
+        )
+    });
+    let each_f = StepMatrices {
+        f: Some(&f),
+        ..StepMatrices::default()
+    };
+    group.bench_function("general", |b| {
+        b.iter_batched(
+            || filter.clone(),
+            |mut kf| {
+                kf.update_many_into(black_box(&case.zs), |_| each_f, out.pass())
+                    .unwrap();
+                kf
+            },
+            BatchSize::SmallInput,
+        )
+    });
+    group.bench_function("floor", |b| {
+        b.iter(|| floor_loop(black_box(&case), x0, p0, &mut out))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, kalman3, ekf6, linear4);
 criterion_main!(benches);

@@ -15,6 +15,7 @@
 //! ([`LinearKalmanFilter::rts_smoother`], [`super::smoother::rts`]) takes without running the
 //! measurements again.
 
+use super::discrete_fixed;
 use super::filter::{Innovation, KalmanFilter};
 use super::fixed_lag::FixedLagSmoother;
 use super::noise::MatrixNoise;
@@ -176,15 +177,15 @@ pub struct PassInto<'a> {
 }
 
 /// One step's results as the batch loop hands them on (the filter's own memory).
-struct BatchStep<'a> {
-    predicted_state: &'a [f64],
-    predicted_covariance: &'a [f64],
-    state: &'a [f64],
-    covariance: &'a [f64],
-    nis: f64,
+pub(super) struct BatchStep<'a> {
+    pub(super) predicted_state: &'a [f64],
+    pub(super) predicted_covariance: &'a [f64],
+    pub(super) state: &'a [f64],
+    pub(super) covariance: &'a [f64],
+    pub(super) nis: f64,
 }
 
-type Inner = KalmanFilter<DiscreteDynamics, LinearObservation>;
+pub(super) type Inner = KalmanFilter<DiscreteDynamics, LinearObservation>;
 
 /// The Kalman filter on a discrete-time linear model with explicit matrices (the module's
 /// model): `predict` then `update`, one step each, as filterpy's `KalmanFilter`.
@@ -459,7 +460,9 @@ impl LinearKalmanFilter {
     /// `predict` and `update` for each row of `zs` (`steps × p`, row-major; NaN missing) with
     /// `step(k)`'s matrices, into `pass` (cleared first): the predicted and updated estimates of
     /// every step. On an error ([`Error::InBatch`] naming the step) the steps before it are
-    /// taken and given in `pass`.
+    /// taken and given in `pass`. Steps with the constant matrices at `n ≤ 9` states and
+    /// `p ≤ 3` components run a fixed-size kernel, without being asked: the same numbers as the
+    /// generic filter, bit for bit.
     pub fn update_many<'a>(
         &mut self,
         zs: &[f64],
@@ -563,7 +566,9 @@ impl LinearKalmanFilter {
     }
 
     /// The one loop of [`Self::update_many`] and [`Self::update_many_into`]: each row's
-    /// prediction and update, its results handed to `emit` with the row's index.
+    /// prediction and update, its results handed to `emit` with the row's index. Runs of steps
+    /// with the constant matrices at `n ≤ 9`, `p ≤ 3` go to the fixed-size kernel
+    /// (`discrete_fixed`, the same numbers bit for bit); the generic filter takes the others.
     fn run_batch<'a>(
         &mut self,
         zs: &[f64],
@@ -576,7 +581,14 @@ impl LinearKalmanFilter {
             values: Vec::with_capacity(p),
             noise: NoiseCovariance::Identity,
         };
-        for (k, z) in zs.chunks_exact(p).enumerate() {
+        let (rows, mut k) = (zs.len() / p, 0);
+        while k < rows {
+            let c = &self.model;
+            let model = discrete_fixed::ConstantModel::new(&c.f, &c.q, &c.h, &c.r);
+            k += discrete_fixed::run_from(&model, &mut self.filter, zs, k, &step, &mut emit);
+            let Some(z) = zs.get(k * p..(k + 1) * p) else {
+                break;
+            };
             let s = step(k);
             let in_batch = |e: Error| Error::InBatch {
                 index: k,
@@ -605,6 +617,7 @@ impl LinearKalmanFilter {
                     nis: nis.unwrap_or(f64::NAN),
                 },
             );
+            k += 1;
         }
         Ok(())
     }

@@ -9,7 +9,8 @@
 //!   generalized fading memory of ch. 14 ([`Discount`]), innovation statistics; its arithmetic
 //!   on preallocated buffers (the covariance's prediction, one correction) in `correct`.
 //! - [`discrete`]: [`LinearKalmanFilter`], the filter on a discrete-time linear model given by
-//!   its matrices `F`, `H`, `Q`, `R`, `B u` (constant or one per step), its batch and smoothers.
+//!   its matrices `F`, `H`, `Q`, `R`, `B u` (constant or one per step), its batch and smoothers;
+//!   its batch with constant matrices at small sizes in `discrete_fixed` (the same numbers).
 //! - [`smoother`]: the Rauch–Tung–Striebel fixed-interval smoother over a forward run, or
 //!   over a forward pass already made ([`rts`]: gains and predicted covariances too).
 //! - [`fixed_lag`]: the same smoother with a fixed lag: each measurement's estimate from the
@@ -30,6 +31,7 @@
 pub mod bayes;
 mod correct;
 pub mod discrete;
+mod discrete_fixed;
 pub mod filter;
 pub mod fixed_lag;
 pub mod noise;

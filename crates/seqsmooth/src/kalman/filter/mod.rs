@@ -331,6 +331,12 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         (&self.work.x, &self.work.s)
     }
 
+    /// The estimate and its time, for a batch kernel of the same arithmetic to advance in
+    /// place (`kalman::discrete_fixed`): it keeps the filter's invariants.
+    pub(crate) fn estimate_mut(&mut self) -> (&mut DVector<f64>, &mut DMatrix<f64>, &mut f64) {
+        (&mut self.state, &mut self.covariance, &mut self.time)
+    }
+
     /// The dynamics, to change a step's matrices in place (the caller keeps its dimension).
     pub(crate) fn dynamics_mut(&mut self) -> &mut D {
         &mut self.dynamics
