@@ -7,8 +7,8 @@
 
 use crate::arrays::{matrix, series, table, times};
 use crate::errors::{raise, IntoPy, Kind};
-use crate::persist;
 use crate::fixed_lag::lagged;
+use crate::persist;
 use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;

@@ -6,8 +6,8 @@
 use crate::arrays::{matrix, series, times, Series};
 use crate::errors::{raise, to_py, IntoPy, Kind};
 use crate::kalman::discount_from;
-use nalgebra::{DMatrix, DVector};
 use crate::persist;
+use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
