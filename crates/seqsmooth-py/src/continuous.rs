@@ -13,6 +13,7 @@ use crate::callables::{stacked, Run};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::fixed_lag::lagged;
 use crate::kalman::{before, measurement, measurements, noise, out_of_order, square, PyInnovation};
+use crate::persist;
 use nalgebra::{DMatrix, DVector};
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -213,6 +214,35 @@ pub struct PyContinuousKalmanFilter {
 
 #[pymethods]
 impl PyContinuousKalmanFilter {
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state and
+    /// the constructor's ``R`` in the library's saved form, restored bit for bit. A copy is a
+    /// deep copy of the state.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let me = slf.borrow();
+        persist::reduce_saved(slf.as_any(), &(me.filter.clone(), me.r.clone()))
+    }
+
+    /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (filter, r): (Continuous, NoiseCovariance) = persist::load(state)?;
+        let components = filter.observation().components();
+        let fits = match &r {
+            NoiseCovariance::Identity => true,
+            NoiseCovariance::Variances(v) => v.len() == components,
+            NoiseCovariance::Full(m) => m.nrows() == components,
+        };
+        if !fits {
+            return Err(persist::damaged("the measurement noise R does not fit H"));
+        }
+        Ok(Self {
+            filter,
+            r,
+            components,
+        })
+    }
+
     #[new]
     #[allow(non_snake_case)]
     #[pyo3(signature = (model, H, R, x0, P0, t0 = 0.0))]

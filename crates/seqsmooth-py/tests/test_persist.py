@@ -132,6 +132,24 @@ def lag_run(f, rows):
     return out + [np.asarray(f.pushed)]
 
 
+def continuous_make(rng):
+    """A continuous-model filter (nearly constant velocity or Singer, two axes) with R a
+    number, one variance per component or a full matrix."""
+    if rng.random() < 0.5:
+        model = ss.ContinuousModel.nearly_constant_velocity([0.05, 0.1])
+    else:
+        model = ss.ContinuousModel.singer(float(rng.uniform(0.1, 1.0)), 0.2, axes=2)
+    n = model.dimension
+    R = [0.01, [0.01, 0.02], [[0.02, 0.005], [0.005, 0.03]]][int(rng.integers(0, 3))]
+    return ss.ContinuousKalmanFilter(model, np.eye(2, n), R, np.zeros(n), 100.0)
+
+
+def continuous_run(f, rows):
+    out = outputs(f.smooth(rows[:, 0], rows[:, 1:]))
+    out += outputs(f.update_many(rows[:, 0], rows[:, 1:]))
+    return out + [np.asarray(f.state), np.asarray(f.covariance), np.asarray(f.R)]
+
+
 def radar_data(rng, missing=0.05):
     n = int(rng.integers(15, 60))
     t = 1.7e9 + np.cumsum(rng.uniform(0.5, 1.5, n))
@@ -249,6 +267,7 @@ CASES = [
     ("RadarTracker-smooth", tracker("smooth"), radar_data, tracker_run),
     ("RadarTracker-window", tracker("window"), radar_data, tracker_run),
     ("OnlineSmoother", online_make, lambda rng: rng.standard_normal(40), online_run),
+    ("ContinuousKalmanFilter", continuous_make, kalman_data, continuous_run),
 ]
 
 
@@ -367,3 +386,18 @@ def test_crafted_body_is_refused():
     body[header : header + 4] = crc.to_bytes(4, "little")
     with pytest.raises(ss.DamagedStateError, match="covariance|state"):
         ss.KalmanFilter._from_state(bytes(body))
+
+
+def test_continuous_filter_noise_is_in_the_checked_bytes():
+    """ContinuousKalmanFilter's R is inside the library's bytes: a damaged R is refused, and
+    another class's bytes are."""
+    f = continuous_make(np.random.default_rng(3))
+    cls, state = saved(f)
+    assert isinstance(state, bytes)
+    assert b"NoiseCovariance" in state
+    for n in range(0, len(state), 7):
+        with pytest.raises(ss.DamagedStateError):
+            cls._from_state(state[:n])
+    _, kalman = saved(ss.KalmanFilter(1, x0=[0.0, 0.0], P0=1.0))
+    with pytest.raises(ss.DamagedStateError, match="KalmanFilter"):
+        cls._from_state(kalman)

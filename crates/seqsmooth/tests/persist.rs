@@ -13,6 +13,7 @@ use seqsmooth::kalman::discrete::{LinearFixedLag, LinearKalmanFilter, StepMatric
 use seqsmooth::kalman::filter::KalmanFilter;
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::UnscentedKalmanFilter;
+use seqsmooth::model::continuous::ContinuousModel;
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
 use seqsmooth::model::observation::LinearObservation;
@@ -133,6 +134,14 @@ proptest! {
         }
         cut_and_continue(bayes, &rows, cut, |f, k, (t, y)| {
             format!("{:?} {:?} {:?}", f.update(&measurement(t, y, missing(k))), f.estimate(), f.covariance())
+        });
+        let continuous = ContinuousModel::nearly_constant_velocity(&[0.05]).unwrap();
+        let ckf = KalmanFilter::new(continuous.clone(), position(), x0.clone(), p0.clone(), 0.0)
+            .unwrap()
+            .with_process_noise(continuous)
+            .unwrap();
+        cut_and_continue(ckf, &rows, cut, |f, k, (t, y)| {
+            format!("{:?} {:?} {:?}", f.update(&measurement(t, y, missing(k))), f.state(), f.covariance())
         });
         let ukf = UnscentedKalmanFilter::new(PolynomialDynamics::new(1, 1), position(), x0, p0, 0.0)
             .unwrap()
@@ -315,4 +324,57 @@ fn a_crafted_body_breaking_the_invariants_is_refused() {
         m[i].1 = ciborium::Value::Float(f64::NAN);
     }));
     assert!(why.contains("time"), "{why}");
+}
+
+#[test]
+fn a_continuous_model_not_matching_its_matrices_is_refused() {
+    type Kf = KalmanFilter<ContinuousModel, LinearObservation>;
+    let model = ContinuousModel::nearly_constant_velocity(&[0.05]).unwrap();
+    let kf = Kf::new(
+        model,
+        position(),
+        DVector::zeros(2),
+        DMatrix::identity(2, 2),
+        0.0,
+    )
+    .unwrap();
+    let name = <Kf as Persist>::name();
+    assert_eq!(name, "KalmanFilter<ContinuousModel, LinearObservation>");
+    let good = to_bytes(&kf).unwrap();
+    let body = &good[8 + 2 + 1 + name.len() + 8 + 4..];
+    let value: ciborium::Value = ciborium::from_reader(body).unwrap();
+    let edit = |f: &dyn Fn(&mut ciborium::Value)| {
+        let mut v = value.clone();
+        let m = v.as_map_mut().unwrap();
+        let i = m
+            .iter()
+            .position(|(k, _)| k.as_text() == Some("dynamics"))
+            .unwrap();
+        f(&mut m[i].1);
+        let mut b = Vec::new();
+        ciborium::into_writer(&v, &mut b).unwrap();
+        from_bytes::<Kf>(&envelope(&name, &b)).unwrap_err()
+    };
+    let entry = |d: &mut ciborium::Value, key: &str| -> usize {
+        d.as_map()
+            .unwrap()
+            .iter()
+            .position(|(k, _)| k.as_text() == Some(key))
+            .unwrap()
+    };
+    // ‖A‖₁ not A's (it scales each step's series)
+    let why = damaged(edit(&|d| {
+        let i = entry(d, "norm");
+        d.as_map_mut().unwrap()[i].1 = ciborium::Value::Float(1e300);
+    }));
+    assert!(why.contains("continuous model"), "{why}");
+    // Q_c not positive semi-definite: its first entry −1
+    let why = damaged(edit(&|d| {
+        let i = entry(d, "qc");
+        let data = d.as_map_mut().unwrap()[i].1.as_array_mut().unwrap()[0]
+            .as_array_mut()
+            .unwrap();
+        data[0] = ciborium::Value::Float(-1.0);
+    }));
+    assert!(why.contains("continuous model"), "{why}");
 }

@@ -7,7 +7,9 @@ use crate::kalman::discrete::{DiscreteDynamics, LinearFixedLag, LinearKalmanFilt
 use crate::kalman::filter::KalmanFilter;
 use crate::kalman::fixed_lag::FixedLagSmoother;
 use crate::kalman::unscented::UnscentedKalmanFilter;
+use crate::model::continuous::ContinuousModel;
 use crate::model::dynamics::{Dynamics, PolynomialDynamics};
+use crate::model::measurement::NoiseCovariance;
 use crate::model::observation::{LinearObservation, Observation};
 use crate::model::radar::Radar;
 use crate::paml::{OnlineSmoother, SmootherGains};
@@ -61,6 +63,24 @@ impl SavedModel for DiscreteDynamics {
     fn check_model(&self) -> Result<(), String> {
         let f = self.transition();
         crate::linalg::invariant::matrix(f, f.nrows(), f.nrows(), "transition matrix")
+    }
+}
+
+impl SavedModel for ContinuousModel {
+    const MODEL: &'static str = "ContinuousModel";
+
+    /// The model built again from its `A` and `Q_c` by [`ContinuousModel::new`] (all its
+    /// checks) must be the saved one, its `‖A‖₁` included.
+    fn check_model(&self) -> Result<(), String> {
+        let again = ContinuousModel::new(
+            self.dynamics().matrix().clone(),
+            self.spectral_density().clone(),
+        )
+        .map_err(|e| format!("continuous model: {e}"))?;
+        if again != *self {
+            return Err("continuous model does not match its A and Qc".into());
+        }
+        Ok(())
     }
 }
 
@@ -178,5 +198,34 @@ impl Persist for AnyFilter {
             return Err("kind or row count does not match the filter".into());
         }
         Ok(())
+    }
+}
+
+/// A filter with the constant measurement noise `R` a front end holds beside it (inside the
+/// checksum, so a damaged `R` is refused like the filter): the filter's checks, then `R`'s
+/// (finite, symmetric positive semidefinite: the constructors' rule,
+/// [`check_covariance`](crate::kalman::noise::check_covariance)).
+impl<T: Persist> Persist for (T, NoiseCovariance) {
+    fn name() -> String {
+        format!("({}, NoiseCovariance)", T::name())
+    }
+
+    fn check(&mut self) -> Result<(), String> {
+        self.0.check()?;
+        let invalid = |e: crate::Error| format!("measurement noise R: {e}");
+        match &self.1 {
+            NoiseCovariance::Identity => Ok(()),
+            NoiseCovariance::Variances(v) => {
+                let m = nalgebra::DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(v));
+                crate::kalman::noise::check_covariance(&m, v.len(), crate::Param::MeasurementNoiseR)
+                    .map_err(invalid)
+            }
+            NoiseCovariance::Full(m) => crate::kalman::noise::check_covariance(
+                m,
+                m.nrows(),
+                crate::Param::MeasurementNoiseR,
+            )
+            .map_err(invalid),
+        }
     }
 }

@@ -126,7 +126,9 @@ impl Ladder {
     /// A restored ladder's invariants ([`crate::persist`]): each filter of its degree, the
     /// active degree at most the final one.
     pub(super) fn check_saved(&self, m: usize) -> Result<(), String> {
-        if self.degree != m || self.active > m || self.filters.len() != m {
+        // Settled, the passed filters are dropped (none kept).
+        let settled_empty = self.active == m && self.filters.is_empty();
+        if self.degree != m || self.active > m || (self.filters.len() != m && !settled_empty) {
             return Err("degree ladder is not of the filter's degree".into());
         }
         for (d, f) in self.filters.iter().enumerate() {
