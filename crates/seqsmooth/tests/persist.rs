@@ -77,6 +77,18 @@ fn position() -> LinearObservation {
     LinearObservation::new(DMatrix::from_row_slice(1, 2, &[1.0, 0.0])).unwrap()
 }
 
+/// A Kalman filter of two states observing the first, at its prior `(0, I)` at time 0.
+fn at_rest<D: seqsmooth::model::dynamics::Dynamics>(d: D) -> KalmanFilter<D, LinearObservation> {
+    KalmanFilter::new(
+        d,
+        position(),
+        DVector::zeros(2),
+        DMatrix::identity(2, 2),
+        0.0,
+    )
+    .unwrap()
+}
+
 fn polynomial(kind: FilterKind, degree: usize, engine: Engine) -> AnyFilter {
     FilterSpec {
         theta: (kind != FilterKind::Expanding && kind != FilterKind::Fixed).then_some(0.9),
@@ -274,14 +286,7 @@ type Entries = Vec<(ciborium::Value, ciborium::Value)>;
 #[test]
 fn a_crafted_body_breaking_the_invariants_is_refused() {
     type Kf = KalmanFilter<PolynomialDynamics, LinearObservation>;
-    let kf = Kf::new(
-        PolynomialDynamics::new(1, 1),
-        position(),
-        DVector::zeros(2),
-        DMatrix::identity(2, 2),
-        0.0,
-    )
-    .unwrap();
+    let kf: Kf = at_rest(PolynomialDynamics::new(1, 1));
     let name = <Kf as Persist>::name();
     let good = to_bytes(&kf).unwrap();
     let body = &good[good.len() - (good.len() - (8 + 2 + 1 + name.len() + 8 + 4))..];
@@ -329,15 +334,7 @@ fn a_crafted_body_breaking_the_invariants_is_refused() {
 #[test]
 fn a_continuous_model_not_matching_its_matrices_is_refused() {
     type Kf = KalmanFilter<ContinuousModel, LinearObservation>;
-    let model = ContinuousModel::nearly_constant_velocity(&[0.05]).unwrap();
-    let kf = Kf::new(
-        model,
-        position(),
-        DVector::zeros(2),
-        DMatrix::identity(2, 2),
-        0.0,
-    )
-    .unwrap();
+    let kf: Kf = at_rest(ContinuousModel::nearly_constant_velocity(&[0.05]).unwrap());
     let name = <Kf as Persist>::name();
     assert_eq!(name, "KalmanFilter<ContinuousModel, LinearObservation>");
     let good = to_bytes(&kf).unwrap();
