@@ -56,3 +56,23 @@ def irregular_series(rng: np.random.Generator, n: int, start: float = 0.0):
     x = t - t[0]
     y = 2.0 + 0.3 * x - 0.01 * x**2 + 1e-4 * x**3 + 0.3 * rng.standard_normal(n)
     return t, y
+
+
+BAD_SPECIALS = [np.nan, np.inf, -np.inf, -1.0, 0.0, 1e308, 1e-308]
+
+
+def bad_value(rng: np.random.Generator, specials=BAD_SPECIALS):
+    """A seeded random bad argument for the 10⁴-bad-calls tests: an array of 0-3 dimensions of
+    0-3 entries, one entry often a special (NaN, inf, a sign, the double range's ends), a
+    special alone, or a symmetric, often indefinite 2 x 2 matrix."""
+    kind = rng.integers(6)
+    shape = tuple(int(s) for s in rng.integers(0, 4, size=rng.integers(0, 4)))
+    a = rng.normal(size=shape)
+    if a.size and kind < 3:
+        a.flat[rng.integers(a.size)] = specials[rng.integers(len(specials))]
+    if kind == 3:
+        return float(rng.choice(specials))
+    if kind == 4:
+        m = rng.normal(size=(2, 2))
+        return m + m.T  # symmetric, often indefinite
+    return a

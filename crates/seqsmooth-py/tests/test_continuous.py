@@ -11,6 +11,7 @@ from filterpy.common import Q_continuous_white_noise
 from scipy.linalg import block_diag, expm
 
 import seqsmooth as ss
+from conftest import bad_value
 
 TOL = 1e-12
 
@@ -243,17 +244,7 @@ def test_ten_thousand_random_bad_calls_never_panic():
     specials = [np.nan, np.inf, -np.inf, -1.0, 0.0, 1e308, 1e-308]
 
     def junk():
-        kind = rng.integers(6)
-        shape = tuple(int(s) for s in rng.integers(0, 4, size=rng.integers(0, 4)))
-        a = rng.normal(size=shape)
-        if a.size and kind < 3:
-            a.flat[rng.integers(a.size)] = specials[rng.integers(len(specials))]
-        if kind == 3:
-            return float(rng.choice(specials))
-        if kind == 4:
-            m = rng.normal(size=(2, 2))
-            return m + m.T
-        return a
+        return bad_value(rng, specials)
 
     def number():
         return float(rng.choice(specials)) if rng.random() < 0.5 else float(rng.normal())

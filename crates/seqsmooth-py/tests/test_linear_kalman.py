@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import seqsmooth as ss
+from conftest import bad_value
 
 FIXTURES = os.path.join(os.path.dirname(__file__), "fixtures", "filterpy_linear.json")
 with open(FIXTURES) as f:
@@ -219,17 +220,7 @@ def test_ten_thousand_random_bad_calls_never_panic():
     specials = [np.nan, np.inf, -np.inf, -1.0, 0.0, 1e308, 1e-308]
 
     def junk():
-        kind = rng.integers(6)
-        shape = tuple(int(s) for s in rng.integers(0, 4, size=rng.integers(0, 4)))
-        a = rng.normal(size=shape)
-        if a.size and kind < 3:
-            a.flat[rng.integers(a.size)] = specials[rng.integers(len(specials))]
-        if kind == 3:
-            return float(rng.choice(specials))
-        if kind == 4:
-            m = rng.normal(size=(2, 2))
-            return m + m.T  # symmetric, often indefinite
-        return a
+        return bad_value(rng, specials)
 
     kf = cv()
     lagged = ss.LinearFixedLagSmoother(kf, 3)
