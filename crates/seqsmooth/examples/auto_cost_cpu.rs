@@ -1,0 +1,143 @@
+//! The automatic filter's cost per sample against the fading-memory filter's with σ, in the
+//! calling thread's CPU time (which a busy machine disturbs less than wall time), without the
+//! command's reading and writing: what each of its parts costs. On the manoeuvring series of
+//! `benches/automatic.rs` (steps 1 s ± 40 %, σ = 10, acceleration steps every 40-160 s, 2 %
+//! outliers of 5-10σ), degree 2, θ = 0.95 per τ = 1 s, exact engine; best of 3:
+//!
+//! - `fading σ`: the fading-memory filter's batch σ path (`update_many_sigma_into`, the rows
+//!   `d0..d2, s0..s2` of `seqsmooth filter --sigma`);
+//! - `auto`: the automatic filter at its defaults, one `update` a sample (the command's path);
+//! - `auto, memory_levels 0`: without the shorter memories (Morrison §7.13's adaptive memory);
+//! - `auto, review_window 0`: without the review (the gate's decisions);
+//! - `auto, both 0`: neither.
+//!
+//! The last three are not the filter the command runs (they fail its Monte Carlo must-shows);
+//! they say what each part costs.
+//!
+//! Run: `cargo run --release -p seqsmooth --example auto_cost_cpu -- [SAMPLES]` (default 10⁶).
+//! The CPU time is read from `/proc/thread-self/schedstat` (Linux); elsewhere the wall time.
+
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+use rand_distr::{Distribution, Normal};
+use seqsmooth::polynomial::automatic::AutomaticFilter;
+use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
+use std::time::Instant;
+
+/// Nanoseconds this thread has run (user and system), or `None` without the Linux file.
+fn cpu_ns() -> Option<u64> {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+/// Seconds `f` takes: CPU time where it can be read, else wall time.
+fn seconds(f: impl FnOnce()) -> f64 {
+    let (wall, cpu) = (Instant::now(), cpu_ns());
+    f();
+    match (cpu, cpu_ns()) {
+        (Some(a), Some(b)) => (b - a) as f64 * 1e-9,
+        _ => wall.elapsed().as_secs_f64(),
+    }
+}
+
+/// The series of `benches/automatic.rs`, `n` samples.
+fn series(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut r = StdRng::seed_from_u64(20_261_206);
+    let noise = Normal::new(0.0, 10.0).unwrap();
+    let (mut x, mut v, mut a, mut t) = (0.0, 50.0, 0.0, 0.0);
+    let mut next = r.gen_range(40.0..160.0);
+    let (mut ts, mut ys) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    while ts.len() < n {
+        let dt = 1.0 + 0.4 * (2.0 * r.gen::<f64>() - 1.0);
+        x += v * dt + 0.5 * a * dt * dt;
+        v += a * dt;
+        t += dt;
+        if t > next {
+            a = r.gen_range(-3.0..3.0);
+            next += r.gen_range(40.0..160.0);
+        }
+        if !(-400.0..=400.0).contains(&v) {
+            a = -a;
+        }
+        let outlier = if r.gen::<f64>() < 0.02 {
+            r.gen_range(50.0..100.0) * if r.gen::<bool>() { 1.0 } else { -1.0 }
+        } else {
+            0.0
+        };
+        ts.push(t);
+        ys.push(x + noise.sample(&mut r) + outlier);
+    }
+    (ts, ys)
+}
+
+fn main() {
+    let n: usize = std::env::args()
+        .nth(1)
+        .map_or(1_000_000, |s| s.parse().expect("SAMPLES"));
+    let (ts, ys) = series(n);
+    let unit = if cpu_ns().is_some() { "CPU" } else { "wall" };
+    println!("{n} samples, best of 3, {unit} time");
+    let best = |f: &dyn Fn() -> f64| (0..3).map(|_| f()).fold(f64::INFINITY, f64::min);
+    let fading = best(&|| {
+        let mut f = FadingMemory::new(2, 0.95, 1.0, Engine::Exact)
+            .unwrap()
+            .with_noise_sigma(10.0)
+            .unwrap();
+        let mut rows = vec![0.0; 6 * 65_536];
+        seconds(|| {
+            for (tc, yc) in ts.chunks(65_536).zip(ys.chunks(65_536)) {
+                f.update_many_sigma_into(tc, yc, &mut rows[..6 * tc.len()])
+                    .unwrap();
+            }
+            std::hint::black_box(&rows);
+        })
+    });
+    println!(
+        "{:24} {:7.3} s  {:6.0} ns/sample",
+        "fading σ",
+        fading,
+        fading / n as f64 * 1e9
+    );
+    let auto = AutomaticFilter::new(2, 0.95, 1.0).unwrap();
+    let variants = [
+        ("auto", auto.clone()),
+        (
+            "auto, memory_levels 0",
+            auto.clone().with_memory_levels(0).unwrap(),
+        ),
+        (
+            "auto, review_window 0",
+            auto.clone().with_review_window(0).unwrap(),
+        ),
+        (
+            "auto, both 0",
+            auto.with_memory_levels(0)
+                .unwrap()
+                .with_review_window(0)
+                .unwrap(),
+        ),
+    ];
+    for (name, filter) in variants {
+        let secs = best(&|| {
+            let mut f = filter.clone();
+            seconds(|| {
+                let mut acc = 0.0;
+                for (&t, &y) in ts.iter().zip(&ys) {
+                    PolynomialFilter::update(&mut f, t, y).unwrap();
+                    let o = f.last_output().unwrap();
+                    acc += o.estimate.as_ref().map_or(0.0, |s| s.derivatives[0]);
+                }
+                std::hint::black_box(acc);
+            })
+        });
+        println!(
+            "{name:24} {secs:7.3} s  {:6.0} ns/sample  {:5.2}× fading σ",
+            secs / n as f64 * 1e9,
+            secs / fading
+        );
+    }
+}
