@@ -11,10 +11,14 @@
 //! - `auto, review_window 0`: without the review (the gate's decisions);
 //! - `auto, both 0`: neither.
 //!
-//! The last three are not the filter the command runs (they fail its Monte Carlo must-shows);
-//! they say what each part costs.
+//! The last three are not the filter the command runs (its Monte Carlo figures in ACCURACY.md
+//! are for the defaults); they bound what a part costs. With `review_window 0` the review keeps
+//! the state before every sample (none waits for a decision, and the first one waiting keeps
+//! it), so that variant costs more, not less: it is no measure of the review's own cost.
 //!
-//! Run: `cargo run --release -p seqsmooth --example auto_cost_cpu -- [SAMPLES]` (default 10⁶).
+//! Run: `cargo run --release -p seqsmooth --example auto_cost_cpu -- [SAMPLES] [VARIANT]`
+//! (default 10⁶ samples, every variant; `VARIANT`, e.g. `auto`, runs that one after the fading
+//! filter, for a profiler).
 //! The CPU time is read from `/proc/thread-self/schedstat` (Linux); elsewhere the wall time.
 
 use rand::rngs::StdRng;
@@ -78,6 +82,8 @@ fn main() {
     let n: usize = std::env::args()
         .nth(1)
         .map_or(1_000_000, |s| s.parse().expect("SAMPLES"));
+    // A second argument runs only the variant of that name (for a profiler).
+    let only = std::env::args().nth(2);
     let (ts, ys) = series(n);
     let unit = if cpu_ns().is_some() { "CPU" } else { "wall" };
     println!("{n} samples, best of 3, {unit} time");
@@ -122,6 +128,9 @@ fn main() {
         ),
     ];
     for (name, filter) in variants {
+        if only.as_deref().is_some_and(|o| o != name) {
+            continue;
+        }
         let secs = best(&|| {
             let mut f = filter.clone();
             seconds(|| {
