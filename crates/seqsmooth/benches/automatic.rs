@@ -17,9 +17,9 @@
 //! `cargo bench -p seqsmooth --bench automatic` (results in BENCHMARKS.md).
 
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use rand::rngs::StdRng;
-use rand::{Rng, SeedableRng};
-use rand_distr::{Distribution, Normal};
+#[path = "common/manoeuvring.rs"]
+mod manoeuvring;
+
 use seqsmooth::polynomial::automatic::AutomaticFilter;
 use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
 use std::time::Duration;
@@ -29,29 +29,7 @@ const SAMPLES: usize = 100_000;
 
 /// The manoeuvring series (see the file docs).
 fn series() -> (Vec<f64>, Vec<f64>) {
-    let mut r = StdRng::seed_from_u64(20_261_206);
-    let noise = Normal::new(0.0, 10.0).unwrap();
-    let (mut x, mut v, mut a, mut t) = (0.0, 50.0, 0.0, 0.0);
-    let mut next = r.gen_range(40.0..160.0);
-    let (mut ts, mut ys) = (Vec::with_capacity(SAMPLES), Vec::with_capacity(SAMPLES));
-    while ts.len() < SAMPLES {
-        let dt = 1.0 + 0.4 * (2.0 * r.gen::<f64>() - 1.0);
-        x += v * dt + 0.5 * a * dt * dt;
-        v += a * dt;
-        t += dt;
-        if t > next {
-            a = r.gen_range(-3.0..3.0);
-            next += r.gen_range(40.0..160.0);
-        }
-        let outlier = if r.gen::<f64>() < 0.02 {
-            r.gen_range(50.0..100.0) * if r.gen::<bool>() { 1.0 } else { -1.0 }
-        } else {
-            0.0
-        };
-        ts.push(t);
-        ys.push(x + noise.sample(&mut r) + outlier);
-    }
-    (ts, ys)
+    manoeuvring::series(SAMPLES, None)
 }
 
 fn per_sample(c: &mut Criterion) {

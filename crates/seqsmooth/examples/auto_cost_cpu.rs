@@ -1,8 +1,9 @@
 //! The automatic filter's cost per sample against the fading-memory filter's with σ, in the
 //! calling thread's CPU time (which a busy machine disturbs less than wall time), without the
 //! command's reading and writing: what each of its parts costs. On the manoeuvring series of
-//! `benches/automatic.rs` (steps 1 s ± 40 %, σ = 10, acceleration steps every 40-160 s, 2 %
-//! outliers of 5-10σ), degree 2, θ = 0.95 per τ = 1 s, exact engine; best of 3:
+//! `benches/automatic.rs` with the speed bound of `scripts/auto_speed.sh` (steps 1 s ± 40 %,
+//! σ = 10, acceleration steps every 40-160 s, 2 % outliers of 5-10σ), degree 2, θ = 0.95 per
+//! τ = 1 s, exact engine; best of 3:
 //!
 //! - `fading σ`: the fading-memory filter's batch σ path (`update_many_sigma_into`, the rows
 //!   `d0..d2, s0..s2` of `seqsmooth filter --sigma`);
@@ -21,62 +22,14 @@
 //! filter, for a profiler).
 //! The CPU time is read from `/proc/thread-self/schedstat` (Linux); elsewhere the wall time.
 
-use rand::rngs::StdRng;
-use rand::{Rng, SeedableRng};
-use rand_distr::{Distribution, Normal};
+#[path = "common/cpu.rs"]
+mod cpu;
+#[path = "../benches/common/manoeuvring.rs"]
+mod manoeuvring;
+
+use cpu::{cpu_ns, seconds};
 use seqsmooth::polynomial::automatic::AutomaticFilter;
 use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
-use std::time::Instant;
-
-/// Nanoseconds this thread has run (user and system), or `None` without the Linux file.
-fn cpu_ns() -> Option<u64> {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
-}
-
-/// Seconds `f` takes: CPU time where it can be read, else wall time.
-fn seconds(f: impl FnOnce()) -> f64 {
-    let (wall, cpu) = (Instant::now(), cpu_ns());
-    f();
-    match (cpu, cpu_ns()) {
-        (Some(a), Some(b)) => (b - a) as f64 * 1e-9,
-        _ => wall.elapsed().as_secs_f64(),
-    }
-}
-
-/// The series of `benches/automatic.rs`, `n` samples.
-fn series(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut r = StdRng::seed_from_u64(20_261_206);
-    let noise = Normal::new(0.0, 10.0).unwrap();
-    let (mut x, mut v, mut a, mut t) = (0.0, 50.0, 0.0, 0.0);
-    let mut next = r.gen_range(40.0..160.0);
-    let (mut ts, mut ys) = (Vec::with_capacity(n), Vec::with_capacity(n));
-    while ts.len() < n {
-        let dt = 1.0 + 0.4 * (2.0 * r.gen::<f64>() - 1.0);
-        x += v * dt + 0.5 * a * dt * dt;
-        v += a * dt;
-        t += dt;
-        if t > next {
-            a = r.gen_range(-3.0..3.0);
-            next += r.gen_range(40.0..160.0);
-        }
-        if !(-400.0..=400.0).contains(&v) {
-            a = -a;
-        }
-        let outlier = if r.gen::<f64>() < 0.02 {
-            r.gen_range(50.0..100.0) * if r.gen::<bool>() { 1.0 } else { -1.0 }
-        } else {
-            0.0
-        };
-        ts.push(t);
-        ys.push(x + noise.sample(&mut r) + outlier);
-    }
-    (ts, ys)
-}
 
 fn main() {
     let n: usize = std::env::args()
@@ -84,7 +37,7 @@ fn main() {
         .map_or(1_000_000, |s| s.parse().expect("SAMPLES"));
     // A second argument runs only the variant of that name (for a profiler).
     let only = std::env::args().nth(2);
-    let (ts, ys) = series(n);
+    let (ts, ys) = manoeuvring::series(n, Some(400.0));
     let unit = if cpu_ns().is_some() { "CPU" } else { "wall" };
     println!("{n} samples, best of 3, {unit} time");
     let best = |f: &dyn Fn() -> f64| (0..3).map(|_| f()).fold(f64::INFINITY, f64::min);

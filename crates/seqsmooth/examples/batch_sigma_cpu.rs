@@ -10,28 +10,11 @@
 //! clearing of its pages is left out and the ratio is that of the arithmetic and the stores. The CPU time is read from
 //! `/proc/thread-self/schedstat` (Linux); elsewhere the wall time is measured instead.
 
+#[path = "common/cpu.rs"]
+mod cpu;
+
+use cpu::{cpu_ns, seconds};
 use seqsmooth::{Engine, ExpandingMemory, FadingMemory, PolynomialFilter};
-use std::time::Instant;
-
-/// Nanoseconds this thread has run (user and system), or `None` without the Linux file.
-fn cpu_ns() -> Option<u64> {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
-}
-
-/// Seconds `f` takes: CPU time where it can be read, else wall time.
-fn seconds(f: impl FnOnce()) -> f64 {
-    let (wall, cpu) = (Instant::now(), cpu_ns());
-    f();
-    match (cpu, cpu_ns()) {
-        (Some(a), Some(b)) => (b - a) as f64 * 1e-9,
-        _ => wall.elapsed().as_secs_f64(),
-    }
-}
 
 fn filter(fading: bool, m: usize) -> Box<dyn PolynomialFilter> {
     if fading {
