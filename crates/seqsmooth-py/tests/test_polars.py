@@ -129,3 +129,21 @@ def test_bad_rows_raise_with_their_index(frame):
     bad = frame.with_columns(y=pl.when(pl.int_range(pl.len()) == 7).then(np.nan).otherwise("y"))
     with pytest.raises(ss.InvalidInputError):
         bad.with_columns(f=ssp.filter("y", by="t", **KINDS["expanding"]).over("id"))
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_one_series_streams_from_parquet_in_one_call(tmp_path, kind):
+    """Without .over, a Parquet file of many row groups through the streaming engine (scan
+    to sink) is one series: the filter sees the whole column at once, not batch by batch."""
+    rng = np.random.default_rng(7)
+    t = 1.7e9 + np.cumsum(rng.uniform(0.5, 1.5, 200_000))
+    y = np.sin(t / 50.0) + 0.3 * rng.standard_normal(t.size)
+    source, sink = tmp_path / "in.parquet", tmp_path / "out.parquet"
+    pl.DataFrame({"t": t, "y": y}).write_parquet(source, row_group_size=10_000)
+    settings = KINDS[kind]
+    expected = ss.filter_frame(pl.read_parquet(source), **settings)
+    query = pl.scan_parquet(source).with_columns(f=ssp.filter("y", by="t", **settings))
+    query.unnest("f").sink_parquet(sink)
+    out = pl.read_parquet(sink)
+    for name in expected.columns[2:]:
+        assert_bits(out[name].to_numpy(), expected[name].to_numpy(), name)
