@@ -3,7 +3,9 @@
 # API docs (every warning an error: a broken or ambiguous intra-doc link fails), then the
 # Python package, built and installed into its own virtual environment (target/py-venv,
 # made from crates/seqsmooth-py/requirements-test.txt on first use), linted and tested with
-# pytest against the `seqsmooth` binary built here.
+# pytest against the `seqsmooth` binary built here. The suite runs on the release wheel
+# (scripts/wheel.sh: manylinux2014, abi3), which scripts/wheel_test.sh first installs into a
+# clean environment with no Rust toolchain on PATH to run the README's Python quick start.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -25,6 +27,10 @@ fi
 # environment), then the import it promises.
 "$venv/bin/python" -m pip install --quiet --force-reinstall --no-deps ./crates/seqsmooth-py
 "$venv/bin/python" -c "import seqsmooth"
+# The wheel (its platform tag printed), then the suite on it.
+wheel=$(bash scripts/wheel.sh)
+bash scripts/wheel_test.sh "$wheel"
+"$venv/bin/python" -m pip install --quiet --force-reinstall --no-deps "$wheel"
 (
     cd crates/seqsmooth-py
     "../../$venv/bin/ruff" check .

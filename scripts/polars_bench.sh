@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# seqsmooth.polars' expression in a lazy streaming query against filter_frame, on one Parquet
+# file of ROWS rows of SERIES interleaved series with string ids (BENCHMARKS.md, "Polars
+# expressions"): each case in its own process under /usr/bin/time (wall time, peak resident set).
+#
+# Usage: [IDS=int] scripts/polars_bench.sh [ROWS] [SERIES]     (defaults 10000000 and 100)
+#   IDS=int: integer ids (Int64) instead of strings ("sensor-0042")
+#   filter_frame   pl.read_parquet → seqsmooth.filter_frame(by="id") → write_parquet
+#   expr-stream    pl.scan_parquet → with_columns(ssp.filter(...).over("id")) → unnest →
+#                  sink_parquet (the streaming engine)
+#   expr-lazy      the same query, collect() in memory → write_parquet
+# Settings: fading memory, degree 2, θ = 0.9, τ = 1 s, σ = 0.3. Uses target/py-venv (made by
+# scripts/test.sh) with the package installed there.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+rows=${1:-10000000}
+series=${2:-100}
+py=target/py-venv/bin/python
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+"$py" - "$tmp/in.parquet" "$rows" "$series" "${IDS:-str}" <<'PY'
+import sys
+
+import numpy as np
+import polars as pl
+
+path, rows, series, kind = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+rng = np.random.default_rng(1)
+ids = rng.integers(0, series, rows)
+t = 1.7e9 + np.cumsum(rng.uniform(0.5, 1.5, rows) / series)  # a log sorted by time
+y = np.sin(t / 50.0) * 10 + ids + 0.3 * rng.standard_normal(rows)
+names = ids if kind == "int" else np.array([f"sensor-{k:04d}" for k in range(series)])[ids]
+pl.DataFrame({"id": names, "t": t, "y": y}).write_parquet(path)
+PY
+echo "input: $rows rows, $series series (${IDS:-str} ids), $(du -m "$tmp/in.parquet" | cut -f1) MB of Parquet"
+
+cat >"$tmp/case.py" <<'PY'
+import sys
+
+import polars as pl
+
+import seqsmooth
+import seqsmooth.polars as ssp
+
+case, source, out = sys.argv[1:4]
+settings = dict(kind="fading", degree=2, theta=0.9, tau=1.0, sigma=0.3)
+if case == "filter_frame":
+    seqsmooth.filter_frame(pl.read_parquet(source), by="id", **settings).write_parquet(out)
+else:
+    query = (
+        pl.scan_parquet(source)
+        .with_columns(f=ssp.filter("y", by="t", **settings).over("id"))
+        .unnest("f")
+    )
+    if case == "expr-stream":
+        query.sink_parquet(out)
+    else:
+        query.collect().write_parquet(out)
+print(pl.scan_parquet(out).select(pl.len()).collect().item(), end=" ")
+PY
+for case in filter_frame expr-stream expr-lazy; do
+    /usr/bin/time -f "%e %M" -o "$tmp/time" "$py" "$tmp/case.py" "$case" "$tmp/in.parquet" \
+        "$tmp/out-$case.parquet" >"$tmp/rows"
+    read -r seconds kb <"$tmp/time"
+    awk -v c="$case" -v s="$seconds" -v kb="$kb" -v n="$(cat "$tmp/rows")" 'BEGIN {
+        printf "%-13s %d rows  %6.1f s  %5.2e rows/s  peak RSS %5d MB\n", c, n, s, n / s, kb / 1024 }'
+done
+"$py" - "$tmp" <<'PY'
+import sys
+
+import polars as pl
+
+a = pl.read_parquet(f"{sys.argv[1]}/out-filter_frame.parquet")
+for case in ("expr-stream", "expr-lazy"):
+    b = pl.read_parquet(f"{sys.argv[1]}/out-{case}.parquet")
+    assert a.equals(b), case
+print("the expression's rows equal filter_frame's (both cases)")
+PY
