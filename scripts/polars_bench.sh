@@ -50,7 +50,7 @@ if case == "filter_frame":
 else:
     query = (
         pl.scan_parquet(source)
-        .with_columns(f=ssp.filter("y", by="t", **settings).over("id"))
+        .with_columns(f=ssp.filter("y", time="t", **settings).over("id"))
         .unnest("f")
     )
     if case == "expr-stream":

@@ -48,7 +48,7 @@ def assert_bits(a: np.ndarray, b: np.ndarray, name: str):
 def test_filter_equals_filter_frame(frame, kind, mode):
     settings = KINDS[kind]
     expected = ss.filter_frame(frame, by="id", **settings)
-    out = run(frame, ssp.filter("y", by="t", **settings).over("id"), mode)
+    out = run(frame, ssp.filter("y", time="t", **settings).over("id"), mode)
     columns = expected.columns[3:]
     assert out.columns[3:] == columns
     assert out["id"].to_list() == frame["id"].to_list()  # rows in input order
@@ -56,7 +56,7 @@ def test_filter_equals_filter_frame(frame, kind, mode):
         assert_bits(out[name].to_numpy(), expected[name].to_numpy(), name)
     # Without .over the frame is one series, whose interleaved times go back: refused.
     with pytest.raises(ss.InvalidInputError, match="strictly increasing"):
-        run(frame, ssp.filter("y", by="t", **settings), mode)
+        run(frame, ssp.filter("y", time="t", **settings), mode)
 
 
 def per_series(frame: pl.DataFrame, compute) -> dict[str, np.ndarray]:
@@ -80,7 +80,7 @@ def test_smooth_equals_smooth_per_series(frame, mode):
         }
 
     expected = per_series(frame, compute)
-    out = run(frame, ssp.smooth("y", by="t", window_length=11, polyorder=2).over("id"), mode)
+    out = run(frame, ssp.smooth("y", time="t", window_length=11, polyorder=2).over("id"), mode)
     for name, column in expected.items():
         assert_bits(out[name].to_numpy(), column, name)
 
@@ -97,7 +97,7 @@ def test_kalman_equals_kalman_filter_per_series(frame, mode):
         }
 
     expected = per_series(frame, compute)
-    expr = ssp.kalman("y", by="t", degree=1, x0=x0, P0=P0, R=R, q=q).over("id")
+    expr = ssp.kalman("y", time="t", degree=1, x0=x0, P0=P0, R=R, q=q).over("id")
     out = run(frame, expr, mode)
     assert out.columns[3:] == ["x0", "x1", "s0", "s1", "nis"]
     for name, column in expected.items():
@@ -110,25 +110,25 @@ def test_dates_are_seconds(frame):
     settings = KINDS["fading"]
     dated = frame.with_columns(when=(pl.col("t") * 1e6).round().cast(pl.Int64).cast(pl.Datetime))
     dated = dated.with_columns(t=pl.Series(ss.seconds(dated["when"])))
-    a = dated.with_columns(f=ssp.filter("y", by="when", **settings).over("id")).unnest("f")
-    b = dated.with_columns(f=ssp.filter("y", by="t", **settings).over("id")).unnest("f")
+    a = dated.with_columns(f=ssp.filter("y", time="when", **settings).over("id")).unnest("f")
+    b = dated.with_columns(f=ssp.filter("y", time="t", **settings).over("id")).unnest("f")
     for name in ["d0", "d1", "d2", "s0"]:
         assert_bits(a[name].to_numpy(), b[name].to_numpy(), name)
 
 
 def test_settings_refused_at_once():
     with pytest.raises(ss.ParameterError, match="tau"):
-        ssp.filter("y", by="t", kind="fading", degree=1, theta=0.9)
+        ssp.filter("y", time="t", kind="fading", degree=1, theta=0.9)
     with pytest.raises(ss.ParameterError):
-        ssp.filter("y", by="t", kind="fading", degree=1, theta=1.5, tau=1.0)
+        ssp.filter("y", time="t", kind="fading", degree=1, theta=1.5, tau=1.0)
     with pytest.raises(ss.SeqsmoothError):
-        ssp.kalman("y", by="t", degree=1, x0=[0.0], P0=1.0, R=1.0)
+        ssp.kalman("y", time="t", degree=1, x0=[0.0], P0=1.0, R=1.0)
 
 
 def test_bad_rows_raise_with_their_index(frame):
     bad = frame.with_columns(y=pl.when(pl.int_range(pl.len()) == 7).then(np.nan).otherwise("y"))
     with pytest.raises(ss.InvalidInputError):
-        bad.with_columns(f=ssp.filter("y", by="t", **KINDS["expanding"]).over("id"))
+        bad.with_columns(f=ssp.filter("y", time="t", **KINDS["expanding"]).over("id"))
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -142,7 +142,7 @@ def test_one_series_streams_from_parquet_in_one_call(tmp_path, kind):
     pl.DataFrame({"t": t, "y": y}).write_parquet(source, row_group_size=10_000)
     settings = KINDS[kind]
     expected = ss.filter_frame(pl.read_parquet(source), **settings)
-    query = pl.scan_parquet(source).with_columns(f=ssp.filter("y", by="t", **settings))
+    query = pl.scan_parquet(source).with_columns(f=ssp.filter("y", time="t", **settings))
     query.unnest("f").sink_parquet(sink)
     out = pl.read_parquet(sink)
     for name in expected.columns[2:]:

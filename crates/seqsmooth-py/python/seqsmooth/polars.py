@@ -1,5 +1,5 @@
 """Polars expressions: the polynomial filters, ``smooth`` and the polynomial Kalman filter over
-a value column with a time column (``by=``), each returning a struct of the estimates, their
+a value column with a time column (``time=``), each returning a struct of the estimates, their
 1σ and the kind's flags, for ``select``/``with_columns``, ``.over(id)``, lazy queries and the
 streaming engine::
 
@@ -9,7 +9,7 @@ streaming engine::
     df = pl.DataFrame({"id": ["a", "b"] * 50, "t": [float(i) for i in range(100)],
                        "y": [0.1 * i for i in range(100)]})
     out = df.with_columns(
-        f=ssp.filter("y", by="t", kind="fading", degree=1, theta=0.9, tau=2.0, sigma=0.5)
+        f=ssp.filter("y", time="t", kind="fading", degree=1, theta=0.9, tau=2.0, sigma=0.5)
         .over("id")
     ).unnest("f")
     assert out.columns[-4:] == ["d0", "d1", "s0", "s1"]
@@ -42,7 +42,7 @@ def _expr(column: str | pl.Expr) -> pl.Expr:
     return pl.col(column) if isinstance(column, str) else column
 
 
-def _map(value: Any, by: Any, names: list[str], run: Any) -> pl.Expr:
+def _map(value: Any, time: Any, names: list[str], run: Any) -> pl.Expr:
     """``run(t, y) -> list of float64 columns`` over the struct of the time and value
     columns, as a Polars struct of ``names`` (all Float64)."""
     dtype = pl.Struct({name: pl.Float64 for name in names})
@@ -54,7 +54,7 @@ def _map(value: Any, by: Any, names: list[str], run: Any) -> pl.Expr:
         columns = run(t, s.struct.field("y").to_numpy())
         return pl.DataFrame(dict(zip(names, columns)), schema=dtype.to_schema()).to_struct(s.name)
 
-    return pl.struct(_expr(by).alias("t"), _expr(value).cast(pl.Float64).alias("y")).map_batches(
+    return pl.struct(_expr(time).alias("t"), _expr(value).cast(pl.Float64).alias("y")).map_batches(
         batch, return_dtype=dtype
     )
 
@@ -62,7 +62,7 @@ def _map(value: Any, by: Any, names: list[str], run: Any) -> pl.Expr:
 def filter(
     value: str | pl.Expr,
     *,
-    by: str | pl.Expr,
+    time: str | pl.Expr = "t",
     kind: Literal["expanding", "fading", "fixed", "auto"] = "fading",
     degree: int = 1,
     theta: float | None = None,
@@ -72,7 +72,7 @@ def filter(
     sigma: float | None = None,
     review_window: int | None = None,
 ) -> pl.Expr:
-    """The polynomial filter of ``kind`` over ``value`` at the times ``by`` (numbers, or
+    """The polynomial filter of ``kind`` over ``value`` at the times ``time`` (numbers, or
     Polars ``Datetime``/``Date`` read as seconds since the Unix epoch): a struct of
     :func:`seqsmooth.filter_frame`'s columns ``d0..dM``, ``s0..sM`` (with ``sigma``; always
     for ``auto``), then ``window`` (``fixed``) or ``noise``, ``outlier``, ``misfit``, ``bias``
@@ -105,19 +105,19 @@ def filter(
         values, _ = filter_series(np.zeros(len(t), np.int64), t, y, kind, degree, **settings)
         return list(values)
 
-    return _map(value, by, list(names), run)
+    return _map(value, time, list(names), run)
 
 
 def smooth(
     value: str | pl.Expr,
     *,
-    by: str | pl.Expr,
+    time: str | pl.Expr = "t",
     window_length: int,
     polyorder: int,
     sigma: float | None = None,
 ) -> pl.Expr:
     """:func:`seqsmooth.smooth` (the centred least-squares window, ``savgol_filter``'s
-    names) over ``value`` at the times ``by``: a struct of ``d0..dM`` (``M = polyorder``) and
+    names) over ``value`` at the times ``time``: a struct of ``d0..dM`` (``M = polyorder``) and
     their 1σ ``s0..sM``, each the numbers of ``smooth(y, window_length, polyorder, deriv=k,
     t=t, sigma=sigma, return_sigma=True)``."""
     names = [f"d{k}" for k in range(polyorder + 1)] + [f"s{k}" for k in range(polyorder + 1)]
@@ -129,13 +129,13 @@ def smooth(
         ]
         return [v for v, _ in fits] + [s for _, s in fits]
 
-    return _map(value, by, names, run)
+    return _map(value, time, names, run)
 
 
 def kalman(
     value: str | pl.Expr,
     *,
-    by: str | pl.Expr,
+    time: str | pl.Expr = "t",
     degree: int,
     x0: Any,
     P0: Any,
@@ -148,7 +148,7 @@ def kalman(
     """The polynomial Kalman filter (:class:`seqsmooth.KalmanFilter` of ``degree``, one axis,
     from ``x0``, ``P0`` at ``t0`` — default each series' first time — with white-noise
     intensity ``q`` and fading ``theta`` per ``tau``) updated with every ``value`` of noise
-    variance ``R`` at the times ``by``: a struct of the state ``x0..xM``, its 1σ ``s0..sM``
+    variance ``R`` at the times ``time``: a struct of the state ``x0..xM``, its 1σ ``s0..sM``
     and ``nis`` (the normalised innovation squared, the misfit flag's statistic), the
     numbers of ``KalmanFilter.update_many``."""
     width = degree + 1
@@ -164,4 +164,4 @@ def kalman(
         sd = np.sqrt(np.diagonal(covariances, axis1=1, axis2=2))
         return [states[:, k] for k in range(width)] + [sd[:, k] for k in range(width)] + [nis]
 
-    return _map(value, by, names, run)
+    return _map(value, time, names, run)
