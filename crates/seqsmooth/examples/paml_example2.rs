@@ -7,10 +7,10 @@
 //! The paper ran 20,000 runs (`--runs 20000`). It prints the block docs/paml.md holds (the
 //! test `paml_examples` regenerates it at a small `--runs`).
 
-#[path = "../tests/common/paml_ex1.rs"]
-mod paml_ex1;
 #[path = "../tests/common/doppler.rs"]
 mod doppler;
+#[path = "../tests/common/paml_ex1.rs"]
+mod paml_ex1;
 #[path = "../tests/common/paml_ex2.rs"]
 mod paml_ex2;
 

@@ -33,7 +33,11 @@ fn blocks(example: &str) -> Vec<(usize, u64, String)> {
             words[i + 1].parse::<u64>().expect("a number")
         };
         let (runs, seed) = (value("--runs") as usize, value("--seed"));
-        assert_eq!(lines.next(), Some("```text"), "a text block follows the marker");
+        assert_eq!(
+            lines.next(),
+            Some("```text"),
+            "a text block follows the marker"
+        );
         let mut text = String::new();
         for l in lines.by_ref() {
             if l == "```" {

@@ -285,9 +285,11 @@ pub fn report(runs: usize, seed: u64) -> Report {
         SPEED.0, SPEED.1, MISS.0, MISS.1, samples.0, samples.1, samples.2
     ));
     w(String::new());
-    w("σ by how far the target is from the radar when the observation ends (RMS over the runs; \
+    w(
+        "σ by how far the target is from the radar when the observation ends (RMS over the runs; \
        CRLB: root mean bound)"
-        .into());
+            .into(),
+    );
     w(String::new());
     w("| to the radar (m) | mean span (ms) | failed | CRLB x0 | ML x0 | PAML-5 x0 | EKF x0 | CRLB y0 | ML y0 | PAML-5 y0 | EKF y0 | CRLB v0 | ML v0 | PAML-5 v0 |".into());
     w("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|".into());

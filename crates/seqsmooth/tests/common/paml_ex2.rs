@@ -42,7 +42,9 @@ pub const RANGES: [(f64, f64); 7] = [
 pub const PRIOR_SIGMA: [f64; 7] = [0.2, 0.2, 0.5, 20.0, 0.01, 0.01, 2e-4];
 /// The observation ends at these times (ms) and at the crossing.
 pub const ENDS: [f64; 8] = [2.0, 3.0, 5.0, 7.5, 10.0, 15.0, 20.0, 25.0];
-pub const NAMES: [&str; 7] = ["y_f (m)", "z_f (m)", "d_v (m)", "v0 (m/s)", "φ (rad)", "θ (rad)", "γ (1/m)"];
+pub const NAMES: [&str; 7] = [
+    "y_f (m)", "z_f (m)", "d_v (m)", "v0 (m/s)", "φ (rad)", "θ (rad)", "γ (1/m)",
+];
 
 /// Eq. 41: the bullet's position at `t`.
 pub fn track(th: &[f64], t: f64) -> [f64; 3] {
@@ -111,7 +113,9 @@ fn run(seed: u64, index: usize) -> Run {
     let y: Vec<[f64; 3]> = times
         .iter()
         .zip(&sigmas)
-        .map(|(&t, s)| [0, 1, 2].map(|i| range(&truth, t, i) + s * rng.sample::<f64, _>(StandardNormal)))
+        .map(|(&t, s)| {
+            [0, 1, 2].map(|i| range(&truth, t, i) + s * rng.sample::<f64, _>(StandardNormal))
+        })
         .collect();
     let mut start = truth;
     for (v, s) in start.iter_mut().zip(PRIOR_SIGMA) {
@@ -130,7 +134,9 @@ fn run(seed: u64, index: usize) -> Run {
             .flat_map(|r| times[..c].iter().map(move |&t| (t, r)))
             .collect();
         let index: Vec<f64> = (0..rows.len()).map(|i| i as f64).collect();
-        let values: Vec<f64> = (0..3).flat_map(|r| y[..c].iter().map(move |v| v[r])).collect();
+        let values: Vec<f64> = (0..3)
+            .flat_map(|r| y[..c].iter().map(move |v| v[r]))
+            .collect();
         let noise: Vec<f64> = (0..3).flat_map(|_| sigmas[..c].iter().copied()).collect();
         let model = Ranges { rows };
         crlb.push(

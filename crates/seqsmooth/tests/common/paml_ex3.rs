@@ -57,7 +57,8 @@ fn axis_step() -> (Matrix2<f64>, Matrix2<f64>) {
     let mut m = Matrix4::zeros();
     m.fixed_view_mut::<2, 2>(0, 0).copy_from(&(-a * STEP));
     m[(1, 3)] = Q * STEP;
-    m.fixed_view_mut::<2, 2>(2, 2).copy_from(&(a.transpose() * STEP));
+    m.fixed_view_mut::<2, 2>(2, 2)
+        .copy_from(&(a.transpose() * STEP));
     let e = m.exp();
     let phi = e.fixed_view::<2, 2>(2, 2).transpose();
     let q = phi * e.fixed_view::<2, 2>(0, 2);
@@ -66,10 +67,7 @@ fn axis_step() -> (Matrix2<f64>, Matrix2<f64>) {
 
 /// The stationary covariance of one axis: `diag(q/(4ζω³), q/(4ζω))`.
 fn axis_stationary() -> [f64; 2] {
-    [
-        Q / (4.0 * ZETA * OMEGA.powi(3)),
-        Q / (4.0 * ZETA * OMEGA),
-    ]
+    [Q / (4.0 * ZETA * OMEGA.powi(3)), Q / (4.0 * ZETA * OMEGA)]
 }
 
 /// `h_1j` for `j = 2, 3, 4` at position `p`, and its gradient in `p`.
@@ -182,9 +180,7 @@ fn run(seed: u64, index: usize, sigma: f64, duration: f64) -> Run {
         }
         h
     });
-    let p0 = DMatrix::from_diagonal(&DVector::from_vec(vec![
-        stat[0], stat[0], stat[1], stat[1],
-    ]));
+    let p0 = DMatrix::from_diagonal(&DVector::from_vec(vec![stat[0], stat[0], stat[1], stat[1]]));
     let mut filter = KalmanFilter::new(
         LinearDynamics::new(a4).expect("A"),
         observation,
