@@ -13,24 +13,14 @@ mod doppler;
 mod paml_ex1;
 #[path = "../tests/common/paml_plot.rs"]
 mod paml_plot;
+#[path = "../tests/common/paml_report.rs"]
+mod paml_report;
 
 fn main() {
-    let mut runs = 300;
-    let mut seed = 1;
-    let mut plot = None;
-    let v: Vec<String> = std::env::args().skip(1).collect();
-    for pair in v.chunks(2) {
-        let value = pair.get(1).expect("every option takes a value");
-        match pair[0].as_str() {
-            "--runs" => runs = value.parse().expect("--runs N"),
-            "--seed" => seed = value.parse().expect("--seed N"),
-            "--plot" => plot = Some(value.clone()),
-            other => panic!("unknown option {other}"),
-        }
-    }
-    let r = paml_ex1::report(runs, seed);
+    let o = paml_report::options(300);
+    let r = paml_ex1::report(o.runs, o.seed);
     print!("{}", r.text);
-    if let Some(path) = plot {
+    if let Some(path) = o.plot {
         let x: Vec<f64> = paml_ex1::ENDS.iter().map(|e| paml_ex1::START - e).collect();
         let panels = [0usize, 1].map(|i| {
             let series = ["CRLB", "ML", "PAML order 5", "EKF"]

@@ -7,24 +7,12 @@
 //! The paper ran 20,000 runs (`--runs 20000`). It prints the block docs/paml.md holds (the
 //! test `paml_examples` regenerates it at a small `--runs`).
 
-#[path = "../tests/common/doppler.rs"]
-mod doppler;
-#[path = "../tests/common/paml_ex1.rs"]
-mod paml_ex1;
 #[path = "../tests/common/paml_ex2.rs"]
 mod paml_ex2;
+#[path = "../tests/common/paml_report.rs"]
+mod paml_report;
 
 fn main() {
-    let mut runs = 1000;
-    let mut seed = 1;
-    let v: Vec<String> = std::env::args().skip(1).collect();
-    for pair in v.chunks(2) {
-        let value = pair.get(1).expect("every option takes a value");
-        match pair[0].as_str() {
-            "--runs" => runs = value.parse().expect("--runs N"),
-            "--seed" => seed = value.parse().expect("--seed N"),
-            other => panic!("unknown option {other}"),
-        }
-    }
-    print!("{}", paml_ex2::report(runs, seed).text);
+    let o = paml_report::options(1000);
+    print!("{}", paml_ex2::report(o.runs, o.seed).text);
 }

@@ -9,18 +9,10 @@
 
 #[path = "../tests/common/paml_ex3.rs"]
 mod paml_ex3;
+#[path = "../tests/common/paml_report.rs"]
+mod paml_report;
 
 fn main() {
-    let mut runs = 300;
-    let mut seed = 1;
-    let v: Vec<String> = std::env::args().skip(1).collect();
-    for pair in v.chunks(2) {
-        let value = pair.get(1).expect("every option takes a value");
-        match pair[0].as_str() {
-            "--runs" => runs = value.parse().expect("--runs N"),
-            "--seed" => seed = value.parse().expect("--seed N"),
-            other => panic!("unknown option {other}"),
-        }
-    }
-    print!("{}", paml_ex3::report(runs, seed).text);
+    let o = paml_report::options(300);
+    print!("{}", paml_ex3::report(o.runs, o.seed).text);
 }

@@ -11,6 +11,8 @@ mod paml_ex1;
 mod paml_ex2;
 #[path = "common/paml_ex3.rs"]
 mod paml_ex3;
+#[path = "common/paml_report.rs"]
+mod paml_report;
 
 const PAGE: &str = include_str!("../../../docs/paml.md");
 

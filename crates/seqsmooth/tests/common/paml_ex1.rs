@@ -10,6 +10,7 @@
 #![allow(dead_code)]
 
 use crate::doppler::{doppler, Doppler, Scenario, K_DOPPLER, K_JITTER, PRIOR_SIGMA, SIGMA_FLOOR};
+use crate::paml_report::sig;
 use nalgebra::{DMatrix, DVector};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -217,15 +218,6 @@ pub struct Report {
 fn rms(v: &[Errors]) -> [f64; 3] {
     let n = v.len().max(1) as f64;
     [0, 1, 2].map(|i| (v.iter().map(|e| e[i] * e[i]).sum::<f64>() / n).sqrt())
-}
-
-/// `v` to `digits` significant figures.
-pub fn sig(v: f64, digits: i32) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let d = (digits - 1 - v.abs().log10().floor() as i32).max(0);
-    format!("{:.*}", d as usize, v)
 }
 
 /// Runs `runs` Monte Carlo runs from `seed` (each run's generator seeded from the seed and

@@ -195,7 +195,7 @@ fn rms(v: &[Errors]) -> Errors {
 
 pub fn report(runs: usize, seed: u64) -> Report {
     let all: Vec<Run> = (0..runs).into_par_iter().map(|i| run(seed, i)).collect();
-    let sig = |v: f64| crate::paml_ex1::sig(v, 3);
+    let sig = |v: f64| crate::paml_report::sig(v, 3);
     let mut text = format!(
         "Example 2: {runs} runs, seed {seed}; radars at {RADARS:?} m; {SAMPLES} samples a radar \
          to the plane x = 0; PAML order {ORDER}\n\n"
