@@ -5,7 +5,7 @@ fit (estimate::curve) is checked against (crates/seqsmooth/tests/fixtures/curve/
 Run:  python3 scripts/make_curve_fixtures.py
 It creates (once) a private virtual environment in target/savgol-venv with numpy and scipy
 (scripts/fixture_venv.py, shared with make_savgol_fixtures.py), re-runs itself there, and writes:
-  demo.csv    - t,y,sigma: Villien & Ostertag's demonstration model h = a exp(b t) + c t,
+  demo.csv    - t,y,sigma: a test model h = a exp(b t) + c t (not in Villien & Ostertag),
                 truth (1, 0.8, -0.5), 2000 samples on [0, 2], noise sigma 0.05 (1 + t)
   fit.csv     - name,value: scipy's Levenberg-Marquardt (MINPACK lmder) estimate from
                 (0.5, 0, 0) with the analytic Jacobian and tolerances 1e-15, and the covariance

@@ -11,7 +11,8 @@ use seqsmooth::error::Param;
 use seqsmooth::estimate::curve::{cramer_rao_bound, fit_curve, Curve, CurveModel};
 use seqsmooth::Error;
 
-/// Villien & Ostertag's demonstration model `h = a e^{b t} + c t`.
+/// A test model `h = a e^{b t} + c t` (not in Villien & Ostertag: their examples are eqs. 38,
+/// 41 and 43-44).
 fn demo(analytic: bool) -> Curve {
     let h = Curve::new(3, |th: &[f64], t| th[0] * (th[1] * t).exp() + th[2] * t);
     if analytic {
