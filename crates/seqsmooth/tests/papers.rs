@@ -4,6 +4,9 @@
 //! block, so the pages' numbers are the programs' and not typed. The programs are the
 //! examples themselves, compiled in here.
 
+// Each example is compiled here as it is, with its own `mod papers` of the shared options.
+#![allow(clippy::duplicate_mod)]
+
 #[allow(dead_code)]
 #[path = "../examples/morrison_figures.rs"]
 mod morrison_figures;

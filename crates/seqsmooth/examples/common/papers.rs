@@ -87,7 +87,7 @@ pub fn range(values: impl IntoIterator<Item = f64>) -> std::ops::Range<f64> {
         lo = lo.min(v);
         hi = hi.max(v);
     }
-    if !(lo < hi) {
+    if lo >= hi {
         return (lo - 0.5)..(lo + 0.5);
     }
     let pad = 0.05 * (hi - lo);
