@@ -308,11 +308,7 @@ fn plot_startup(path: &str, seed: u64) -> Result<(), Box<dyn std::error::Error>>
             ))?
             .label("steady-state σ")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RGBColor(120, 120, 120)));
-            c.configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .background_style(WHITE)
-                .border_style(BLACK)
-                .draw()?;
+            papers::legend(&mut c, SeriesLabelPosition::UpperRight)?;
         }
     }
     root.present()?;
@@ -343,11 +339,7 @@ fn plot_fading(path: &str) -> Result<(), Box<dyn std::error::Error>> {
         .label(format!("β = {beta}"))
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour));
     }
-    c.configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE)
-        .border_style(BLACK)
-        .draw()?;
+    papers::legend(&mut c, SeriesLabelPosition::UpperRight)?;
     for (k, (fig, name)) in [("14.2", "p00"), ("14.3", "p11")].into_iter().enumerate() {
         let mut c = ChartBuilder::on(&panels[k + 1])
             .caption(
@@ -371,11 +363,7 @@ fn plot_fading(path: &str) -> Result<(), Box<dyn std::error::Error>> {
             .label(format!("β = {beta}"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour));
         }
-        c.configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE)
-            .border_style(BLACK)
-            .draw()?;
+        papers::legend(&mut c, SeriesLabelPosition::LowerLeft)?;
     }
     root.present()?;
     Ok(())

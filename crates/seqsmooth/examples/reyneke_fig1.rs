@@ -194,11 +194,7 @@ fn plot(path: &str, rows: &[Row]) -> Result<(), Box<dyn std::error::Error>> {
     ))?
     .label("filter (gain engine)")
     .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RED));
-    c.configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE)
-        .border_style(BLACK)
-        .draw()?;
+    papers::legend(&mut c, SeriesLabelPosition::UpperLeft)?;
 
     let err = |r: &Row, f: fn(&Row) -> &(Vec<f64>, Vec<f64>)| f(r).0[0] - truth(r.t)[0];
     let bound = rows
@@ -237,11 +233,7 @@ fn plot(path: &str, rows: &[Row]) -> Result<(), Box<dyn std::error::Error>> {
     ))?
     .label("gain")
     .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RED));
-    c.configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE)
-        .border_style(BLACK)
-        .draw()?;
+    papers::legend(&mut c, SeriesLabelPosition::UpperRight)?;
 
     let names = [
         "x (m)",
