@@ -19,7 +19,7 @@ mod papers;
 use plotters::prelude::*;
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
-use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
+use seqsmooth::{DiscountMode, Engine, FadingMemory, PolynomialFilter};
 use std::fmt::Write;
 
 /// The paper's parameters (§8.1).
@@ -47,8 +47,9 @@ fn truth(t: f64) -> [f64; 5] {
     })
 }
 
-fn filter(engine: Engine) -> FadingMemory {
+fn filter(engine: Engine, mode: DiscountMode) -> FadingMemory {
     FadingMemory::new(DEGREE, THETA, TAU, engine)
+        .and_then(|f| f.with_discount_mode(mode))
         .and_then(|f| f.with_noise_sigma(SIGMA))
         .expect("the paper's parameters are in range")
 }
@@ -62,9 +63,9 @@ struct Row {
 }
 
 /// One run: the detections and both filters' estimates after each.
-fn run(rng: &mut impl Rng) -> Vec<Row> {
+fn run(rng: &mut impl Rng, mode: DiscountMode) -> Vec<Row> {
     let noise = Normal::new(0.0, SIGMA).expect("σ > 0");
-    let (mut gain, mut exact) = (filter(Engine::Gain), filter(Engine::Exact));
+    let (mut gain, mut exact) = (filter(Engine::Gain, mode), filter(Engine::Exact, mode));
     let mut rows = Vec::new();
     for k in 0..=SLOTS {
         let t = k as f64 * TAU;
@@ -101,7 +102,7 @@ fn at(rows: &[Row], t: f64) -> Option<&Row> {
 
 /// The printed table at `runs` runs from `seed` (the block docs/reyneke.md holds).
 pub fn report(runs: usize, seed: u64) -> String {
-    let all = papers::monte_carlo(runs, seed, |_, rng| run(rng));
+    let all = papers::monte_carlo(runs, seed, |_, rng| run(rng, DiscountMode::PerTime));
     let mut out = String::new();
     writeln!(
         out,
@@ -144,6 +145,28 @@ pub fn report(runs: usize, seed: u64) -> String {
             .unwrap();
         }
     }
+    // The paper's other reading of θ (§6.1: "or by simply updating with θ₀"): θ per update, on
+    // the same data (the same seed draws the same detections and noise).
+    let per_update = papers::monte_carlo(runs, seed, |_, rng| run(rng, DiscountMode::PerUpdate));
+    writeln!(out, "theta per update instead: position (k = 0)").unwrap();
+    for &t in &REPORT_AT {
+        let rows: Vec<&Row> = per_update.iter().filter_map(|r| at(r, t)).collect();
+        let err = |f: fn(&Row) -> &(Vec<f64>, Vec<f64>)| {
+            papers::rms(rows.iter().map(|r| f(r).0[0] - truth(r.t)[0]))
+        };
+        let sd = |f: fn(&Row) -> &(Vec<f64>, Vec<f64>)| {
+            rows.iter().map(|r| f(r).1[0]).sum::<f64>() / rows.len() as f64
+        };
+        writeln!(
+            out,
+            "{t:7.0}  0 | {:12.4e} {:16.4e} | {:13.4e} {:17.4e} |",
+            err(|r| &r.gain),
+            sd(|r| &r.gain),
+            err(|r| &r.exact),
+            sd(|r| &r.exact)
+        )
+        .unwrap();
+    }
     out
 }
 
@@ -151,7 +174,7 @@ fn main() {
     let a = papers::args(400, 1);
     print!("{}", report(a.runs, a.seed));
     if let Some(path) = &a.plot {
-        let rows = run(&mut papers::rng(a.seed, 0));
+        let rows = run(&mut papers::rng(a.seed, 0), DiscountMode::PerTime);
         plot(path, &rows).expect("plot");
         println!("plot: {path} (run 0 of seed {})", a.seed);
     }
