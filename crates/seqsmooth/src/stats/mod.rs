@@ -13,6 +13,9 @@
 //!   (App. A.5), both biased by a trend; the bias-free `k`-th difference estimator
 //!   ([`difference_variance`], and [`DifferenceNoise`] on irregular timestamps, running or
 //!   windowed); residual-based [`residual_variance`] (Morrison (6.10.24)).
+//! - Reyneke et al.'s §7.1 goodness of fit ([`goodness_of_fit`], [`reyneke_gof_limit`]) and its
+//!   reading as Morrison's χ² test of a window's residuals ([`gof_mean`], [`gof_threshold`],
+//!   [`gof_false_alarm_rate`]).
 //! - [`Welford`]: running mean and variance.
 //! - [`consistency`]: NEES against a known truth and the chi-squared interval of the mean NEES
 //!   or NIS over many runs (a filter's run-time consistency check).
@@ -29,6 +32,7 @@
 
 pub mod chi_squared;
 pub mod consistency;
+pub mod goodness_of_fit;
 pub mod innovation;
 pub mod noise;
 pub mod welford;
@@ -37,6 +41,9 @@ mod window;
 pub use chi_squared::{
     chi_squared_cdf, chi_squared_quantile, chi_squared_sf, normal_quantile, two_sided_tail,
     two_sided_threshold, ChiSquaredTest,
+};
+pub use goodness_of_fit::{
+    gof_false_alarm_rate, gof_mean, gof_threshold, goodness_of_fit, reyneke_gof_limit,
 };
 pub use innovation::{ChiSquaredOutcome, InnovationChiSquared};
 pub use noise::{
