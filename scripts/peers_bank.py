@@ -21,11 +21,11 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import peers_venv  # noqa: E402
+import peers_venv
 
 peers_venv.enter(__file__)
 
-import numpy as np  # noqa: E402
+import numpy as np
 
 ROOT = peers_venv.ROOT
 Q, R, P0 = 0.01, 1.0, 100.0

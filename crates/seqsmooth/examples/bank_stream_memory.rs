@@ -38,7 +38,9 @@ fn main() {
     let mut x = 12345_u64;
     for k in 0..steps {
         for (s, (t, v)) in times.iter_mut().zip(values.iter_mut()).enumerate() {
-            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             let u = (x >> 11) as f64 / (1u64 << 53) as f64;
             *t = k as f64;
             *v = if u < 0.1 {

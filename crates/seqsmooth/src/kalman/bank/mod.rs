@@ -37,6 +37,7 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::sync::Arc;
 
+mod backward;
 mod series;
 mod smooth;
 mod stream;

@@ -22,6 +22,11 @@ pub(crate) struct SeriesFilter<'a, D: Dynamics> {
     pub(super) x: DVector<f64>,
     pub(super) s: DMatrix<f64>,
     pub(super) time: f64,
+    /// For a time-invariant model, the last step's length and its `Φ` and `Q` (NaN: none).
+    invariant: bool,
+    step: f64,
+    phi: DMatrix<f64>,
+    q: DMatrix<f64>,
 }
 
 impl<'a, D: Dynamics> SeriesFilter<'a, D> {
@@ -35,6 +40,11 @@ impl<'a, D: Dynamics> SeriesFilter<'a, D> {
             x: bank.state.clone(),
             s: bank.covariance.clone(),
             time: f64::NAN,
+            invariant: bank.dynamics.is_time_invariant()
+                && bank.noise.as_ref().is_none_or(|q| q.is_time_invariant()),
+            step: f64::NAN,
+            phi: DMatrix::zeros(n, n),
+            q: DMatrix::zeros(n, n),
         }
     }
 
@@ -116,15 +126,40 @@ impl<'a, D: Dynamics> SeriesFilter<'a, D> {
             return Ok(());
         }
         let bank = self.bank;
-        bank.dynamics
-            .propagate_into(&self.x, self.time, t, &mut w.x, &mut w.phi)?;
-        let q = match &bank.noise {
-            Some(noise) => {
-                noise.covariance_into(self.time, t, &mut w.q)?;
-                Some(w.q.as_slice())
+        let dt = t - self.time;
+        if self.invariant && dt == self.step {
+            // Φ and Q of the same step length again: X_{k|k−1} = Φ X (each entry's sum over
+            // the columns in order).
+            w.phi.copy_from(&self.phi);
+            w.q.copy_from(&self.q);
+            let (f, x, xp) = (self.phi.as_slice(), self.x.as_slice(), w.x.as_mut_slice());
+            for i in 0..n {
+                xp[i] = f[i] * x[0];
             }
-            None => None,
-        };
+            for j in 1..n {
+                for i in 0..n {
+                    xp[i] += f[i + j * n] * x[j];
+                }
+            }
+            if let Some(&value) = xp.iter().find(|v| !v.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: "propagated state entry",
+                    value,
+                });
+            }
+        } else {
+            bank.dynamics
+                .propagate_into(&self.x, self.time, t, &mut w.x, &mut w.phi)?;
+            if let Some(noise) = &bank.noise {
+                noise.covariance_into(self.time, t, &mut w.q)?;
+            }
+            if self.invariant {
+                self.phi.copy_from(&w.phi);
+                self.q.copy_from(&w.q);
+                self.step = dt;
+            }
+        }
+        let q = bank.noise.as_ref().map(|_| w.q.as_slice());
         let (phi, from, to) = (w.phi.as_slice(), self.s.as_slice(), w.s.as_mut_slice());
         let finite_out = unrolled_sizes!(n, N => carry(Fixed::<N>, phi, from, q, &mut w.square, to),
             n => carry(Any(n), phi, from, q, &mut w.square, to));

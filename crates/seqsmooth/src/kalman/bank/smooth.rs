@@ -4,15 +4,16 @@
 //! `C_k = S_{k|k} Φᵀ S_{k+1|k}⁻¹`, `X_{k|N} = X_{k|k} + C_k (X_{k+1|N} − X_{k+1|k})`,
 //! `S_{k|N} = S_{k|k} + C_k (S_{k+1|N} − S_{k+1|k}) C_kᵀ`,
 //!
-//! the library's own (`step`, `Map::then`), applied from the last row back over the whole
-//! series (fixed interval), or over the last `L` rows (fixed lag).
+//! over the whole series from its last row (fixed interval: [`Backward`], in place on flat
+//! arrays, the size a compile-time constant), or over the last `L` rows (fixed lag: the
+//! library's own `step` and `Map::then`).
 
 use super::super::fixed_lag::{step, Map, Row};
+use super::backward::Backward;
 use super::series::SeriesFilter;
 use super::{Panel, RowsMut};
 use crate::error::Error;
 use crate::model::dynamics::Dynamics;
-use nalgebra::{DMatrix, DVector};
 use std::collections::VecDeque;
 
 /// The filtered estimate of the row just updated.
@@ -31,31 +32,55 @@ fn emit(out: &mut RowsMut<'_>, r: usize, point: &Map, nis: Option<f64>) {
 }
 
 /// The fixed-interval smoother over series `s`: the forward pass kept (each row's filtered
-/// estimate and the prediction into it), then the backward recursion from the last row.
+/// estimate and the prediction into it, flat), then the backward recursion from the last row
+/// ([`Backward`], in place).
 pub(super) fn rts_series<D: Dynamics>(
     f: &mut SeriesFilter<'_, D>,
     panel: &Panel<'_>,
     s: usize,
     mut out: RowsMut<'_>,
 ) -> Result<(), Error> {
-    let mut rows: Vec<Row> = Vec::new();
-    let mut predictions: Vec<(DMatrix<f64>, DVector<f64>, DMatrix<f64>)> = Vec::new();
-    f.each_row(panel, s, |f, _, nis| {
+    let n = f.x.len();
+    let nn = n * n;
+    let rows = panel.offsets[s + 1] - panel.offsets[s];
+    let (mut xs, mut ss) = (Vec::with_capacity(rows * n), Vec::with_capacity(rows * nn));
+    let (mut phis, mut xps, mut sps) = (
+        Vec::with_capacity(rows * nn),
+        Vec::with_capacity(rows * n),
+        Vec::with_capacity(rows * nn),
+    );
+    let mut nis = Vec::with_capacity(rows);
+    f.each_row(panel, s, |f, _, v| {
         let (phi, x, s) = f.prediction();
-        predictions.push((phi.clone(), x.clone(), s.clone()));
-        rows.push(filtered(f, nis));
+        phis.extend_from_slice(phi.as_slice());
+        xps.extend_from_slice(x.as_slice());
+        sps.extend_from_slice(s.as_slice());
+        xs.extend_from_slice(f.x.as_slice());
+        ss.extend_from_slice(f.s.as_slice());
+        nis.push(v);
         Ok(())
     })?;
-    let Some(last) = rows.last() else {
+    if rows == 0 {
         return Ok(());
-    };
-    let mut point = Map::point(&last.state, &last.covariance);
-    emit(&mut out, rows.len() - 1, &point, last.nis);
-    for k in (0..rows.len() - 1).rev() {
-        let (phi, x, s) = &predictions[k + 1];
-        let map = step(&rows[k], (phi, x, s), k + 1)?;
-        point = map.then(&point).finite(k)?;
-        emit(&mut out, k, &point, rows[k].nis);
+    }
+    let last = rows - 1;
+    out.set(last, &xs[last * n..], &ss[last * nn..], nis[last]);
+    let mut back = Backward::new(n);
+    for k in (0..last).rev() {
+        let (x, x_next) = xs.split_at_mut((k + 1) * n);
+        let (sk, s_next) = ss.split_at_mut((k + 1) * nn);
+        let next = k + 1;
+        back.step(
+            (&mut x[k * n..], &mut sk[k * nn..]),
+            (
+                &phis[next * nn..(next + 1) * nn],
+                &xps[next * n..(next + 1) * n],
+                &sps[next * nn..(next + 1) * nn],
+            ),
+            (&x_next[..n], &s_next[..nn]),
+            next,
+        )?;
+        out.set(k, &x[k * n..], &sk[k * nn..], nis[k]);
     }
     Ok(())
 }
