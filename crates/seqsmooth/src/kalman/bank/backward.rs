@@ -35,7 +35,6 @@ impl Backward {
     /// The smoothed `(x, s)` at step `k` in place of the filtered `(x, s)` there, from the
     /// prediction into step `k + 1` (`phi`, `x_pred`, `s_pred`) and its smoothed estimate
     /// (`x_next`, `s_next`); an error names `index` (step `k + 1`).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn step(
         &mut self,
         (x, s): (&mut [f64], &mut [f64]),
@@ -105,7 +104,7 @@ fn back<Z: Size>(
         for k in 0..j {
             d -= l[j + k * n] * l[j + k * n];
         }
-        if !(d > 0.0) {
+        if d.is_nan() || d <= 0.0 {
             return false;
         }
         let d = d.sqrt();
