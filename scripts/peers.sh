@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Peer comparison (filterpy, scipy; scipy.optimize.least_squares for the radar Gauss–Newton fit)
+# Peer comparison (filterpy, scipy; scipy.optimize.least_squares for the radar Gauss–Newton fit;
+# simdkalman and pykalman for the Kalman bank, scripts/peers_bank.py)
 # in one command: builds the Rust side (release), then runs
 # scripts/peers.py, which creates its own virtual environment (target/peers-venv, pinned
 # filterpy/numpy/scipy from PyPI), generates the data, runs and times both sides, checks that
@@ -13,11 +14,16 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}"
-cargo build --release --quiet -p seqsmooth --example peers
+cargo build --release --quiet -p seqsmooth --example peers --example bank_peers
 cargo build --release --quiet -p seqsmooth-cli
 if [ "$CARGO_TARGET_DIR" != "$PWD/target" ]; then
     mkdir -p target/release/examples
     ln -sf "$CARGO_TARGET_DIR/release/examples/peers" target/release/examples/peers
+    ln -sf "$CARGO_TARGET_DIR/release/examples/bank_peers" target/release/examples/bank_peers
     ln -sf "$CARGO_TARGET_DIR/release/seqsmooth" target/release/seqsmooth
 fi
-exec python3 scripts/peers.py "$@"
+python3 scripts/peers.py "$@"
+if [ "${1:-}" = "--quick" ]; then
+    exec python3 scripts/peers_bank.py --series 1000 --steps 200 --reps 1
+fi
+exec python3 scripts/peers_bank.py

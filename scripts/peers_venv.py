@@ -1,4 +1,5 @@
-"""The peer scripts' pinned virtual environment (target/peers-venv): filterpy, numpy and scipy
+"""The peer scripts' pinned virtual environment (target/peers-venv): filterpy, numpy, scipy,
+simdkalman and pykalman
 at the versions below, created once from PyPI. `enter(__file__)` re-runs the calling script in
 that environment (with the same arguments) unless it already runs there; scripts/peers.py and
 scripts/make_kalman_fixtures.py share it, so the peer timings and the stored fixtures come from
@@ -9,7 +10,7 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 VENV = os.path.join(ROOT, "target", "peers-venv")
-PINS = ["filterpy==2.0.0", "numpy==2.4.6", "scipy==1.17.1"]
+PINS = ["filterpy==2.0.0", "numpy==2.4.6", "scipy==1.17.1", "simdkalman==1.0.4", "pykalman==0.11.2"]
 STAMP = os.path.join(VENV, "peers-pins.txt")
 
 

@@ -14,6 +14,7 @@ mod fit;
 mod fixed_lag;
 mod frame;
 mod kalman;
+mod kalman_bank;
 mod linear;
 mod model_fit;
 mod models;
@@ -40,6 +41,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<bank::PyExpandingBank>()?;
     m.add_class::<kalman::PyKalmanFilter>()?;
     m.add_class::<kalman::PyInnovation>()?;
+    m.add_class::<kalman_bank::PyKalmanBank>()?;
     m.add_class::<linear::PyLinearKalmanFilter>()?;
     m.add_class::<linear::PyLinearFixedLagSmoother>()?;
     m.add_class::<bayes::PyBayesFilter>()?;

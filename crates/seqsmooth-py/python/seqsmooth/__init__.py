@@ -15,6 +15,10 @@ FadingBank, ExpandingBank
 KalmanFilter
     The Kalman filter over the polynomial model (Morrison chs. 12, 14, 15): driving noise,
     fading memory, missing components, ``update_many`` and the RTS ``smooth``.
+KalmanBank
+    One Kalman filter's model (the polynomial model, driving noise, missing components) over
+    many series, each with its own times: the filter, the RTS and fixed-lag smoothers, the
+    series on the rayon pool.
 LinearKalmanFilter
     The Kalman filter on your own matrices ``F``, ``H``, ``Q``, ``R``, ``B u`` (filterpy's
     ``KalmanFilter``), constant or one per step: ``update_many`` (``batch_filter``), the RTS
@@ -51,6 +55,9 @@ fit_model
 filter_frame
     Many series of a pandas or Polars DataFrame or a pyarrow Table, one filter each: the rows
     of ``seqsmooth filter --id-col``, as a frame of the same kind.
+kalman_frame
+    Many series of a frame through a ``KalmanBank``: the estimates, their σ and the NIS, as a
+    frame of the same kind.
 gains, vrf
     The gains and variance-reduction matrices of Morrison's tables, in floats or exactly as
     ``fractions.Fraction``.
@@ -81,6 +88,7 @@ from ._seqsmooth import (
     FadingMemory,
     FixedMemory,
     Innovation,
+    KalmanBank,
     KalmanFilter,
     LinearFixedLagSmoother,
     LinearKalmanFilter,
@@ -112,7 +120,7 @@ from .errors import (
     SeqsmoothError,
     TooFewSamplesError,
 )
-from .frame import filter_frame
+from .frame import filter_frame, kalman_frame
 
 __all__ = [
     "__version__",
@@ -125,6 +133,7 @@ __all__ = [
     "FadingMemory",
     "FixedMemory",
     "KalmanFilter",
+    "KalmanBank",
     "UnscentedKalmanFilter",
     "LinearKalmanFilter",
     "LinearFixedLagSmoother",
@@ -140,6 +149,7 @@ __all__ = [
     "smooth",
     "seconds",
     "filter_frame",
+    "kalman_frame",
     "gains",
     "vrf",
     "gauss_rule",

@@ -149,6 +149,58 @@ class Innovation:
     @property
     def log_likelihood(self) -> float: ...
 
+class KalmanBank:
+    """One Kalman filter's model over many series (the library's ``kalman::bank``).
+
+    Parameters
+    ----------
+    degree : int
+        The polynomial model's degree.
+    x0 : array_like
+        The prior state every series starts from at its first time, ``n = (degree + 1) * axes``.
+    P0 : float or array_like
+        The prior covariance (a number times the identity, the variances, or ``n x n``).
+    R : float or array_like
+        The measurement noise (a variance for every component, the variances, or ``p x p``).
+    axes : int
+        The axes of the model.
+    q : float
+        The white-noise driving's spectral density (0: none).
+    observation : array_like, optional
+        ``M``, ``p x n`` (default: the positions of the axes).
+
+    Notes
+    -----
+    ``filter``, ``smooth`` and ``fixed_lag_smoother`` take ``series`` (int64 codes from 0,
+    any order, series may interleave), ``t`` and ``z`` (``rows x p``, NaN missing), each
+    series' times not decreasing, and return ``(state, sigma, nis)`` by input row (``nis``
+    NaN where every component was missing). An error's ``.index`` is the input row.
+    """
+
+    def __init__(
+        self,
+        degree: int,
+        x0: ArrayLike,
+        P0: ArrayLike | float,
+        R: ArrayLike | float,
+        axes: int = 1,
+        q: float = 0.0,
+        observation: ArrayLike | None = None,
+    ) -> None: ...
+    @property
+    def states(self) -> int: ...
+    @property
+    def components(self) -> int: ...
+    def filter(
+        self, series: npt.NDArray[np.int64], t: ArrayLike, z: ArrayLike
+    ) -> tuple[Matrix, Matrix, Vector]: ...
+    def smooth(
+        self, series: npt.NDArray[np.int64], t: ArrayLike, z: ArrayLike
+    ) -> tuple[Matrix, Matrix, Vector]: ...
+    def fixed_lag_smoother(
+        self, series: npt.NDArray[np.int64], t: ArrayLike, z: ArrayLike, lag: int
+    ) -> tuple[Matrix, Matrix, Vector]: ...
+
 class KalmanFilter:
     def __init__(
         self,

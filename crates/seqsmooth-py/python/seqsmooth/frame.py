@@ -11,12 +11,12 @@ estimates back in the input's row order.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any, Literal
 
 import numpy as np
 
-from ._seqsmooth import filter_series, seconds
+from ._seqsmooth import KalmanBank, filter_series, seconds
 from .errors import InvalidInputError, SeqsmoothError
 
 
@@ -81,6 +81,17 @@ def _like(frame: Any, columns: dict[str, np.ndarray]) -> Any:
 
         return pyarrow.table(columns)
     return columns
+
+
+def _in_row(e: SeqsmoothError, by: str | None, names: Any, codes: np.ndarray) -> SeqsmoothError:
+    """``e`` naming the frame's row (``.index``) and its series, or ``e`` itself without a row."""
+    if e.index is None:
+        return e
+    message = str(e)
+    if message.startswith("sample ") and ": " in message:
+        message = message.split(": ", 1)[1]  # the row is named below
+    series = "" if by is None else f" (series {names[codes[e.index]]!r} of column {by!r})"
+    return type(e)(f"row {e.index}{series}: {message}", e.index)
 
 
 def filter_frame(
@@ -163,13 +174,7 @@ def filter_frame(
             review_window=review_window,
         )
     except SeqsmoothError as e:
-        if e.index is None:
-            raise
-        message = str(e)
-        if message.startswith("sample ") and ": " in message:
-            message = message.split(": ", 1)[1]  # the row is named below
-        series = "" if by is None else f" (series {names[codes[e.index]]!r} of column {by!r})"
-        raise type(e)(f"row {e.index}{series}: {message}", e.index) from e
+        raise _in_row(e, by, names, codes) from e
     values, names_out = result
     columns: dict[str, np.ndarray] = {}
     if keys is not None:
@@ -178,4 +183,117 @@ def filter_frame(
     columns[value] = y
     for name, column in zip(names_out, values):
         columns[name] = column
+    return _like(df, columns)
+
+
+def kalman_frame(
+    df: Any,
+    time: str = "t",
+    value: str | Sequence[str] = "y",
+    by: str | None = None,
+    *,
+    degree: int = 1,
+    P0: Any,
+    R: Any = 1.0,
+    q: float = 0.0,
+    x0: Any = None,
+    smoother: Literal["filter", "rts", "fixed_lag"] = "filter",
+    lag: int | None = None,
+) -> Any:
+    """Runs one Kalman filter's model over every series of a frame (:class:`KalmanBank`).
+
+    The polynomial model of ``degree`` on as many axes as ``value`` names columns (each
+    column the position on its axis), white-noise driving of spectral density ``q``; every
+    series starts from ``x0``, ``P0`` at its own first time.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame, polars.DataFrame, pyarrow.Table or dict of arrays
+        The rows; series may interleave, each series' times not decreasing.
+    time : str
+        The time column (numbers or dates, read as :func:`seconds` reads them).
+    value : str or sequence of str
+        The observed column(s), one per axis; NaN (or null) marks a missing component.
+    by : str, optional
+        The column naming each row's series (any type); without it the frame is one series.
+    degree : int
+        The polynomial model's degree (1: constant velocity).
+    P0 : float, sequence or array
+        The prior covariance every series starts from (a number times the identity, the
+        variances, or ``n x n``), ``n = (degree + 1) * axes``.
+    R : float, sequence or array
+        The measurement noise: a variance for every component, the variances, or ``p x p``.
+    q : float
+        The driving noise's spectral density (0: none).
+    x0 : array, optional
+        The prior state (default zeros), ``[x_axes..., x'_axes..., ...]``.
+    smoother : {"filter", "rts", "fixed_lag"}
+        The filter's estimates, the Rauch–Tung–Striebel smoother's (from the whole series), or
+        the fixed-lag smoother's (from the ``lag`` rows after each row).
+    lag : int, optional
+        The fixed-lag smoother's lag, in rows (``smoother="fixed_lag"`` only).
+
+    Returns
+    -------
+    The kind of ``df`` with the columns ``[by,] time, value..., x0..x{n-1}`` (the estimate),
+    ``s0..s{n-1}`` (their 1σ) and ``nis`` (the update's normalised innovation squared, NaN
+    where every component was missing), one row per input row, in input order.
+
+    Raises
+    ------
+    SeqsmoothError
+        A bad setting, or a bad row: ``.index`` is the row of the frame, and the message
+        names its series.
+
+    Examples
+    --------
+    >>> import numpy as np, seqsmooth
+    >>> rows = {"id": np.array([0, 1, 0, 1]), "t": np.array([0.0, 0.0, 1.0, 2.0]),
+    ...         "y": np.array([1.0, 5.0, 2.0, np.nan])}
+    >>> out = seqsmooth.kalman_frame(rows, by="id", P0=100.0, R=1.0)
+    >>> sorted(out)
+    ['id', 'nis', 's0', 's1', 't', 'x0', 'x1', 'y']
+    """
+    values = [value] if isinstance(value, str) else list(value)
+    if not values:
+        raise InvalidInputError("value names no column")
+    t = seconds(_raw_column(df, time), time)
+    rows = len(t)
+    if rows == 0:
+        raise InvalidInputError("the frame has no rows")
+    columns_in = [np.asarray(_column(df, v), dtype=np.float64) for v in values]
+    z = np.ascontiguousarray(np.column_stack(columns_in))
+    axes = len(values)
+    n = (degree + 1) * axes
+    bank = KalmanBank(degree, np.zeros(n) if x0 is None else x0, P0, R, axes=axes, q=q)
+    keys = None if by is None else _column(df, by)
+    codes, names = (np.zeros(rows, dtype=np.int64), [None]) if keys is None else _codes(keys, by)
+    if smoother != "fixed_lag" and lag is not None:
+        raise InvalidInputError(f"lag is for smoother='fixed_lag', not {smoother!r}")
+    try:
+        if smoother == "filter":
+            state, sigma, nis = bank.filter(codes, t, z)
+        elif smoother == "rts":
+            state, sigma, nis = bank.smooth(codes, t, z)
+        elif smoother == "fixed_lag":
+            if lag is None:
+                raise InvalidInputError("smoother='fixed_lag' needs lag")
+            state, sigma, nis = bank.fixed_lag_smoother(codes, t, z, lag)
+        else:
+            raise InvalidInputError(
+                f"smoother {smoother!r} is not one of 'filter', 'rts', 'fixed_lag'"
+            )
+    except SeqsmoothError as e:
+        raise _in_row(e, by, names, codes) from e
+    columns: dict[str, np.ndarray] = {}
+    if keys is not None:
+        columns[by] = keys
+    columns[time] = t
+    for name, column in zip(values, columns_in):
+        columns[name] = column
+    for k in range(n):
+        columns[f"x{k}"] = state[:, k]
+    for k in range(n):
+        columns[f"s{k}"] = sigma[:, k]
+    columns["nis"] = nis
     return _like(df, columns)

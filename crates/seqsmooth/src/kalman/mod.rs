@@ -2,6 +2,9 @@
 //! the Bayes filter in information form, and the Kalman filter, extended and iterated for
 //! nonlinear models, with driving noise or fading memory, and its smoother.
 //!
+//! - [`bank`]: [`KalmanBank`](bank::KalmanBank), one linear model over many series, each
+//!   with its own times and missing components, in structure of arrays on the rayon pool:
+//!   the filter, the RTS and fixed-lag smoothers, and a streaming form.
 //! - [`bayes`]: [`BayesFilter`], the Bayes filter (ch. 10) in square-root information form, the
 //!   recursion of the exact polynomial engine over any linear model; it starts from nothing;
 //!   with fading memory (ch. 14, [`Discount`]) it reports its true covariance.
@@ -28,6 +31,7 @@
 //!
 //! The radar tracking application over these filters is [`crate::track`].
 
+pub mod bank;
 pub mod bayes;
 mod correct;
 pub mod discrete;

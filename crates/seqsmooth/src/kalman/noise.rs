@@ -52,6 +52,13 @@ pub trait ProcessNoise: std::fmt::Debug + Send + Sync {
     fn saved(&self) -> Option<super::saved_noise::SavedNoise> {
         None
     }
+
+    /// Whether `Q(t_b, t_a)` depends only on the step `t_b − t_a` (the white-noise driving of
+    /// the polynomial model, a continuous model's Van Loan `Q`): a bank computes it once for
+    /// each step length in a row. `false` unless the model says so.
+    fn is_time_invariant(&self) -> bool {
+        false
+    }
 }
 
 /// The range of a driving noise's power spectral density `q` (ch. 15): finite and at least 0
@@ -114,6 +121,10 @@ impl WhiteNoiseDerivative {
 impl ProcessNoise for WhiteNoiseDerivative {
     fn saved(&self) -> Option<super::saved_noise::SavedNoise> {
         Some(super::saved_noise::SavedNoise::WhiteNoiseDerivative(*self))
+    }
+
+    fn is_time_invariant(&self) -> bool {
+        true
     }
 
     fn dimension(&self) -> usize {
@@ -230,6 +241,10 @@ fn fill<S: Size>(size: S, d: usize, psd: f64, zeta: f64, out: &mut [f64]) -> boo
 impl ProcessNoise for ContinuousModel {
     fn saved(&self) -> Option<super::saved_noise::SavedNoise> {
         Some(super::saved_noise::SavedNoise::Continuous(self.clone()))
+    }
+
+    fn is_time_invariant(&self) -> bool {
+        true
     }
 
     fn dimension(&self) -> usize {

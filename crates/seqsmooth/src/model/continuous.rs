@@ -424,6 +424,10 @@ impl Dynamics for ContinuousModel {
         true
     }
 
+    fn is_time_invariant(&self) -> bool {
+        true
+    }
+
     /// [`LinearDynamics`]'s propagation by `e^{Aζ}` ([`ContinuousModel::transition`]).
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
         self.dynamics.propagate(state, t_a, t_b)

@@ -57,6 +57,18 @@ pub trait Dynamics {
         false
     }
 
+    /// Whether `Φ(t_b, t_a)` depends only on the step `t_b − t_a` (a time-invariant linear
+    /// model: the polynomial model, `dX/dt = A X` with a constant `A`): a bank computes it once
+    /// for each step length in a row. `false` unless the model says so.
+    ///
+    /// ```
+    /// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+    /// assert!(PolynomialDynamics::new(1, 3).is_time_invariant());
+    /// ```
+    fn is_time_invariant(&self) -> bool {
+        false
+    }
+
     /// [`Dynamics::propagate`] into the caller's buffers (`state_out` of length `n`,
     /// `transition_out` `n × n`, replaced if they are not), allocating nothing where the model
     /// allows ([`PolynomialDynamics`] does): what the estimators call at every observation time.
@@ -293,6 +305,10 @@ impl Dynamics for PolynomialDynamics {
         true
     }
 
+    fn is_time_invariant(&self) -> bool {
+        true
+    }
+
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
         let n = self.dimension();
         let mut p = Propagation {
@@ -360,6 +376,10 @@ impl Dynamics for LinearDynamics {
         true
     }
 
+    fn is_time_invariant(&self) -> bool {
+        true
+    }
+
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
         check_propagation(LinearDynamics::dimension(self), state, t_a, t_b)?;
         let transition = self.transition(t_b - t_a)?;
@@ -381,6 +401,10 @@ impl<D: Dynamics + ?Sized> Dynamics for &D {
 
     fn is_linear(&self) -> bool {
         (**self).is_linear()
+    }
+
+    fn is_time_invariant(&self) -> bool {
+        (**self).is_time_invariant()
     }
 
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {

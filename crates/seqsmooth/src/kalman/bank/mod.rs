@@ -1,0 +1,342 @@
+//! A Kalman bank: one linear model, many series, each with its own times (any spacing) and
+//! its own missing components — the Kalman filter of Morrison ch. 12 (prediction
+//! (12.2.15)-(12.2.16) with driving noise (15.4.10)-(15.4.11), update (12.2.17)-(12.2.19) with
+//! Joseph's covariance (12.3.7)) run on every series independently, and the
+//! Rauch–Tung–Striebel fixed-interval and fixed-lag smoothers over it.
+//!
+//! - [`KalmanBank`]: the model (any linear [`Dynamics`] — the polynomial model of any degree
+//!   and axes, a continuous model `dX/dt = A X` discretised for each step's own length,
+//!   [`ContinuousModel`](crate::model::continuous::ContinuousModel) — with optional driving
+//!   noise [`ProcessNoise`], a constant observation matrix `M` and noise `R`) and the prior
+//!   every series starts from, at its own first time.
+//! - [`Panel`]: the series in structure-of-arrays form, one array per quantity: the times of
+//!   every row, the `p` values of every row (NaN where a component is missing), and the
+//!   offsets of each series' rows (in time order within a series).
+//! - [`KalmanBank::filter`], [`KalmanBank::smooth`] (RTS), [`KalmanBank::smooth_fixed_lag`]:
+//!   per row the estimate, its σ (`√diag S`) and the update's NIS (`νᵀ V⁻¹ ν`, χ² with as
+//!   many degrees of freedom as components present when the model holds, §14.8), in
+//!   [`BankRows`]; the series run in parallel (rayon), each by the same code whatever the
+//!   split, so any batching of the series gives the same numbers bit for bit.
+//! - [`BankStream`]: the streaming filter, a step of every series at a time; its memory is
+//!   the series' states and covariances (`n + n²` numbers and a time each), not the steps.
+//!
+//! Every series runs the library's own Kalman arithmetic (the kernels of
+//! [`KalmanFilter`](super::KalmanFilter): `Φ S Φᵀ + Q` and the correction, compiled with the
+//! state size and the components present as constants for `n ≤ 9`, `k ≤ 4`, a general-size
+//! fallback beyond) and the library's own backward step ([`super::smoother`]), so it equals one
+//! `KalmanFilter` (and one `Smoother`) per series: tested to `10⁻¹²` relative in
+//! `tests/kalman_bank.rs` (bit for bit in practice).
+
+use super::correct::noise_entries;
+use super::noise::{check_covariance, check_estimate, check_noise_dimension, ProcessNoise};
+use crate::error::{Error, Param};
+use crate::model::dynamics::Dynamics;
+use crate::model::measurement::NoiseCovariance;
+use crate::model::observation::{LinearObservation, Observation};
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+use std::sync::Arc;
+
+mod backward;
+mod series;
+mod smooth;
+mod stream;
+
+pub use stream::BankStream;
+
+use series::SeriesFilter;
+
+/// Series per rayon task (each series is independent; the split changes no number).
+pub const SERIES_PER_TASK: usize = 64;
+
+/// The series of a bank, structure of arrays: series `s` is rows `offsets[s]..offsets[s + 1]`
+/// of `times` and of `values` (`p` values a row, row-major, NaN for a missing component),
+/// its times not decreasing.
+#[derive(Clone, Copy, Debug)]
+pub struct Panel<'a> {
+    /// `S + 1` offsets, from 0 to the rows, not decreasing.
+    pub offsets: &'a [usize],
+    /// One time a row.
+    pub times: &'a [f64],
+    /// `p` values a row.
+    pub values: &'a [f64],
+}
+
+impl Panel<'_> {
+    /// The number of series.
+    pub fn series(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// The number of rows.
+    pub fn rows(&self) -> usize {
+        self.times.len()
+    }
+
+    /// Refuses offsets that do not cut `times` into series, or values not `p` a row.
+    fn check(&self, p: usize) -> Result<(), Error> {
+        let rows = self.times.len();
+        let bad = |name, value: String, reason: String| Error::InvalidParameter {
+            name,
+            value,
+            reason,
+        };
+        if self.offsets.first() != Some(&0)
+            || self.offsets.last() != Some(&rows)
+            || self.offsets.windows(2).any(|w| w[0] > w[1])
+        {
+            return Err(bad(
+                Param::Channels,
+                format!("offsets of {} series over {rows} rows", self.series()),
+                "must run from 0 to the number of rows, not decreasing".into(),
+            ));
+        }
+        if self.values.len() != rows * p {
+            return Err(bad(
+                Param::RowsLength,
+                format!("{} values for {rows} rows", self.values.len()),
+                format!("must be {p} a row"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Per row of a [`Panel`], in its order: the estimate, its σ and the update's NIS.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BankRows {
+    /// The state dimension `n`.
+    pub states: usize,
+    /// `n` a row: `X` (filtered `X_{k|k}`, or smoothed).
+    pub state: Vec<f64>,
+    /// `n` a row: `√diag S` of the same estimate.
+    pub sigma: Vec<f64>,
+    /// The forward update's NIS, `None` where every component was missing.
+    pub nis: Vec<Option<f64>>,
+}
+
+impl BankRows {
+    fn zeros(rows: usize, n: usize) -> Self {
+        Self {
+            states: n,
+            state: vec![0.0; rows * n],
+            sigma: vec![0.0; rows * n],
+            nis: vec![None; rows],
+        }
+    }
+
+    /// Row `r`'s `(state, σ, NIS)`.
+    pub fn row(&self, r: usize) -> (&[f64], &[f64], Option<f64>) {
+        let n = self.states;
+        (
+            &self.state[r * n..(r + 1) * n],
+            &self.sigma[r * n..(r + 1) * n],
+            self.nis[r],
+        )
+    }
+}
+
+/// The rows of one series in [`BankRows`], as mutable slices.
+pub(super) struct RowsMut<'a> {
+    pub(super) state: &'a mut [f64],
+    pub(super) sigma: &'a mut [f64],
+    pub(super) nis: &'a mut [Option<f64>],
+}
+
+impl RowsMut<'_> {
+    /// Row `r` from the estimate `(x, s)` and its NIS.
+    pub(super) fn set(&mut self, r: usize, x: &[f64], s: &[f64], nis: Option<f64>) {
+        let n = x.len();
+        self.state[r * n..(r + 1) * n].copy_from_slice(x);
+        for (i, o) in self.sigma[r * n..(r + 1) * n].iter_mut().enumerate() {
+            *o = s[i + i * n].max(0.0).sqrt();
+        }
+        self.nis[r] = nis;
+    }
+}
+
+/// A Kalman bank: one linear model and prior for many series.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::kalman::bank::{KalmanBank, Panel};
+/// use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+/// use seqsmooth::model::dynamics::PolynomialDynamics;
+/// use seqsmooth::model::observation::LinearObservation;
+/// // Constant velocity, position observed (σ = 1), two series with their own times.
+/// let bank = KalmanBank::new(PolynomialDynamics::new(1, 1), LinearObservation::value_of(2),
+///     DMatrix::identity(1, 1), DVector::zeros(2), DMatrix::identity(2, 2) * 100.0).unwrap()
+///     .with_process_noise(WhiteNoiseDerivative::new(1, 1, 0.01).unwrap()).unwrap();
+/// let times = [0.0, 1.0, 2.5, 0.0, 3.0];
+/// let values = [0.0, 1.1, f64::NAN, 5.0, 4.0];
+/// let rows = bank.filter(&Panel { offsets: &[0, 3, 5], times: &times, values: &values }).unwrap();
+/// assert_eq!(rows.nis[2], None); // missing: the prediction
+/// assert!((rows.state[2 * 2] - (rows.state[2] + 1.5 * rows.state[3])).abs() < 1e-12);
+/// ```
+#[derive(Clone, Debug)]
+pub struct KalmanBank<D: Dynamics> {
+    dynamics: D,
+    observation: LinearObservation,
+    r: DMatrix<f64>,
+    noise: Option<Arc<dyn ProcessNoise>>,
+    state: DVector<f64>,
+    covariance: DMatrix<f64>,
+}
+
+impl<D: Dynamics + Sync> KalmanBank<D> {
+    /// The bank of `dynamics` (linear, [`Dynamics::is_linear`]) observed by `observation`
+    /// with noise covariance `r` (`p × p`, symmetric, positive semidefinite), every series
+    /// starting from `state`, `covariance` at its first time (the first row is then an update
+    /// without a prediction, as a [`KalmanFilter`](super::KalmanFilter) made at that time).
+    pub fn new(
+        dynamics: D,
+        observation: LinearObservation,
+        r: DMatrix<f64>,
+        state: DVector<f64>,
+        covariance: DMatrix<f64>,
+    ) -> Result<Self, Error> {
+        let n = dynamics.dimension();
+        if !dynamics.is_linear() {
+            return Err(Error::InvalidParameter {
+                name: Param::Dynamics,
+                value: "nonlinear".into(),
+                reason: "a Kalman bank takes a linear model".into(),
+            });
+        }
+        if observation.state_dimension() != n {
+            return Err(Error::InvalidParameter {
+                name: Param::ObservationModel,
+                value: format!("for {} states", observation.state_dimension()),
+                reason: format!("the dynamics have {n} states"),
+            });
+        }
+        check_covariance(&r, observation.components(), Param::MeasurementNoise)?;
+        check_estimate(&state, &covariance, n)?;
+        Ok(Self {
+            dynamics,
+            observation,
+            r,
+            noise: None,
+            state,
+            covariance,
+        })
+    }
+
+    /// With driving noise `Q` (ch. 15) of the model's dimension.
+    pub fn with_process_noise<P: ProcessNoise + 'static>(
+        mut self,
+        noise: P,
+    ) -> Result<Self, Error> {
+        check_noise_dimension(&noise, self.dynamics.dimension())?;
+        self.noise = Some(Arc::new(noise));
+        Ok(self)
+    }
+
+    /// The state dimension `n`.
+    pub fn states(&self) -> usize {
+        self.dynamics.dimension()
+    }
+
+    /// The observed components `p`.
+    pub fn components(&self) -> usize {
+        self.observation.components()
+    }
+
+    /// The measurement noise as the filter takes it.
+    fn noise_covariance(&self) -> NoiseCovariance {
+        NoiseCovariance::Full(self.r.clone())
+    }
+
+    /// `R`'s entries, checked.
+    fn r_entries(&self) -> Vec<f64> {
+        let p = self.components();
+        let noise = self.noise_covariance();
+        let entry = noise_entries(p, &noise).expect("R is p × p");
+        (0..p * p).map(|i| entry(i % p, i / p)).collect()
+    }
+
+    /// The filter over every series of `panel`: per row `X_{k|k}`, its σ and the NIS. An error
+    /// names the first failing series ([`Error::InChannel`]) and its row within the series
+    /// ([`Error::InBatch`]).
+    pub fn filter(&self, panel: &Panel<'_>) -> Result<BankRows, Error> {
+        self.run(panel, |f, panel, s, out| f.filter_series(panel, s, out))
+    }
+
+    /// The Rauch–Tung–Striebel smoother over every series (see [`super::smoother`]): per row
+    /// `X_{k|N}`, its σ and the forward update's NIS; memory per series is its rows'.
+    pub fn smooth(&self, panel: &Panel<'_>) -> Result<BankRows, Error> {
+        self.run(panel, |f, panel, s, out| {
+            smooth::rts_series(f, panel, s, out)
+        })
+    }
+
+    /// The fixed-lag smoother (see [`super::fixed_lag`]) over every series: per row
+    /// `X_{k|k+L}` (the last `L` rows of a series from all of its rows), its σ and the NIS;
+    /// memory per series is `L + 1` rows' estimates and backward steps, not its length.
+    pub fn smooth_fixed_lag(&self, panel: &Panel<'_>, lag: usize) -> Result<BankRows, Error> {
+        self.run(panel, |f, panel, s, out| {
+            smooth::fixed_lag_series(f, panel, s, lag, out)
+        })
+    }
+
+    /// Runs `series` on every series of `panel` in parallel, each into its own rows.
+    fn run(
+        &self,
+        panel: &Panel<'_>,
+        series: impl Fn(&mut SeriesFilter<'_, D>, &Panel<'_>, usize, RowsMut<'_>) -> Result<(), Error>
+            + Sync,
+    ) -> Result<BankRows, Error> {
+        let (n, p) = (self.states(), self.components());
+        panel.check(p)?;
+        let mut out = BankRows::zeros(panel.rows(), n);
+        let r = self.r_entries();
+        // The output cut into each task's contiguous rows.
+        let count = panel.series();
+        let mut tasks = Vec::with_capacity(count.div_ceil(SERIES_PER_TASK));
+        let (mut state, mut sigma, mut nis) =
+            (&mut out.state[..], &mut out.sigma[..], &mut out.nis[..]);
+        for first in (0..count).step_by(SERIES_PER_TASK) {
+            let last = (first + SERIES_PER_TASK).min(count);
+            let rows = panel.offsets[last] - panel.offsets[first];
+            let (a, rest_a) = std::mem::take(&mut state).split_at_mut(rows * n);
+            let (b, rest_b) = std::mem::take(&mut sigma).split_at_mut(rows * n);
+            let (c, rest_c) = std::mem::take(&mut nis).split_at_mut(rows);
+            (state, sigma, nis) = (rest_a, rest_b, rest_c);
+            tasks.push((
+                first..last,
+                RowsMut {
+                    state: a,
+                    sigma: b,
+                    nis: c,
+                },
+            ));
+        }
+        let failures: Vec<(usize, Error)> = tasks
+            .into_par_iter()
+            .filter_map(|(range, rows)| {
+                let mut f = SeriesFilter::new(self, &r);
+                let base = panel.offsets[range.start];
+                for s in range {
+                    let (a, b) = (panel.offsets[s] - base, panel.offsets[s + 1] - base);
+                    let out = RowsMut {
+                        state: &mut rows.state[a * n..b * n],
+                        sigma: &mut rows.sigma[a * n..b * n],
+                        nis: &mut rows.nis[a..b],
+                    };
+                    if let Err(e) = series(&mut f, panel, s, out) {
+                        return Some((s, e));
+                    }
+                }
+                None
+            })
+            .collect();
+        match failures.into_iter().min_by_key(|(s, _)| *s) {
+            Some((channel, source)) => Err(Error::InChannel {
+                channel,
+                source: Box::new(source),
+                also_failed: Vec::new(),
+            }),
+            None => Ok(out),
+        }
+    }
+}
