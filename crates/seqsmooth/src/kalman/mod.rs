@@ -28,6 +28,7 @@
 //!
 //! The radar tracking application over these filters is [`crate::track`].
 
+mod backward;
 pub mod bayes;
 mod correct;
 pub mod discrete;

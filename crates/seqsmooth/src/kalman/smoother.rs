@@ -12,8 +12,11 @@
 //! minimum-variance estimate from the prior and all the measurements (tested against
 //! [`crate::estimate::gauss_newton`]).
 
+use super::backward::{apply_into, map_into};
 use super::filter::KalmanFilter;
-use super::fixed_lag::{step, FixedLagSmoother, Map, Row};
+use super::fixed_lag::{
+    not_finite, not_positive_definite, step, time_before, FixedLagSmoother, Map, Row,
+};
 use crate::error::Error;
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::Measurement;
@@ -61,7 +64,164 @@ pub fn smooth<D: Dynamics + Clone, O: Observation + Clone>(
     filter: KalmanFilter<D, O>,
     measurements: &[Measurement],
 ) -> Result<Vec<Smoothed>, Error> {
-    Smoother::new(filter).smooth(measurements)
+    let run = smooth_flat(filter, measurements)?;
+    let (n, nn) = (run.dimension, run.dimension * run.dimension);
+    Ok((0..run.times.len())
+        .map(|k| Smoothed {
+            time: run.times[k],
+            state: DVector::from_column_slice(&run.states[k * n..(k + 1) * n]),
+            covariance: DMatrix::from_column_slice(n, n, &run.covariances[k * nn..(k + 1) * nn]),
+            filtered_state: DVector::from_column_slice(&run.filtered_states[k * n..(k + 1) * n]),
+            filtered_covariance: DMatrix::from_column_slice(
+                n,
+                n,
+                &run.filtered_covariances[k * nn..(k + 1) * nn],
+            ),
+            nis: run.nis[k],
+        })
+        .collect())
+}
+
+/// Every measurement's smoothed and filtered estimates ([`smooth_flat`]) in flat buffers:
+/// measurement `k`'s state is `states[k n..(k + 1) n]` and its covariance
+/// `covariances[k n²..(k + 1) n²]` (column-major; symmetric, so row-major too), `n` the
+/// [`Self::dimension`]; likewise the filtered ones.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SmoothedRun {
+    /// The state dimension `n`.
+    pub dimension: usize,
+    /// The measurements' times.
+    pub times: Vec<f64>,
+    /// `X_{k|N}`, `n` a measurement.
+    pub states: Vec<f64>,
+    /// `S_{k|N}`, `n²` a measurement.
+    pub covariances: Vec<f64>,
+    /// The forward filter's `X_{k|k}`.
+    pub filtered_states: Vec<f64>,
+    /// The forward filter's `S_{k|k}`.
+    pub filtered_covariances: Vec<f64>,
+    /// The forward update's NIS (`None` where every component was missing).
+    pub nis: Vec<Option<f64>>,
+}
+
+/// [`smooth`]'s numbers (bit for bit) in flat buffers, with nothing allocated per
+/// measurement: the forward pass keeps each step's backward map
+/// ([`backward::map_into`](super::backward), made from the filter's own prediction `Φ`,
+/// `X_{k+1|k}`, `S_{k+1|k}` by the Cholesky factor of `S_{k+1|k}`), and the backward pass
+/// applies them from the last estimate. Errors as [`Smoother::smooth`]'s.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
+/// use seqsmooth::kalman::{smoother, KalmanFilter};
+/// use seqsmooth::model::dynamics::PolynomialDynamics;
+/// use seqsmooth::model::observation::LinearObservation;
+/// let f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+///     DVector::zeros(1), DMatrix::from_element(1, 1, 1e12), 0.0).unwrap();
+/// let rows: Vec<Measurement> = [1.0, 2.0, 6.0].iter().enumerate()
+///     .map(|(k, &y)| Measurement { time: k as f64, values: vec![Some(y)], noise: NoiseCovariance::Identity })
+///     .collect();
+/// let run = smoother::smooth_flat(f, &rows).unwrap();
+/// assert!(run.states.iter().all(|x| (x - 3.0).abs() < 1e-9)); // the mean, everywhere
+/// ```
+pub fn smooth_flat<D: Dynamics + Clone, O: Observation + Clone>(
+    mut filter: KalmanFilter<D, O>,
+    measurements: &[Measurement],
+) -> Result<SmoothedRun, Error> {
+    let (n, count) = (filter.state().len(), measurements.len());
+    let nn = n * n;
+    let mut run = SmoothedRun {
+        dimension: n,
+        times: Vec::with_capacity(count),
+        states: vec![0.0; count * n],
+        covariances: vec![0.0; count * nn],
+        filtered_states: Vec::with_capacity(count * n),
+        filtered_covariances: Vec::with_capacity(count * nn),
+        nis: Vec::with_capacity(count),
+    };
+    // The backward maps (a, D, C) from measurement k + 1 to k, at k.
+    let steps = count.saturating_sub(1);
+    let (mut a, mut d, mut c) = (
+        vec![0.0; steps * n],
+        vec![0.0; steps * nn],
+        vec![0.0; steps * nn],
+    );
+    let (mut phi, mut x_pred, mut s_pred) = (vec![0.0; nn], vec![0.0; n], vec![0.0; nn]);
+    let in_batch = |index: usize, e: Error| Error::InBatch {
+        index,
+        source: Box::new(e),
+    };
+    for (index, m) in measurements.iter().enumerate() {
+        if let Some(&previous) = run.times.last() {
+            if m.time.is_finite() && m.time < previous {
+                return Err(in_batch(index, time_before(m.time, previous)));
+            }
+        }
+        match filter
+            .predict_transition(m.time)
+            .map_err(|e| in_batch(index, e))?
+        {
+            Some(transition) => phi.copy_from_slice(transition.as_slice()),
+            None => {
+                phi.fill(0.0);
+                phi.iter_mut().step_by(n + 1).for_each(|v| *v = 1.0);
+            }
+        }
+        x_pred.copy_from_slice(filter.state().as_slice());
+        s_pred.copy_from_slice(filter.covariance().as_slice());
+        let nis = filter
+            .update_stats(m)
+            .map_err(|e| in_batch(index, e))?
+            .map(|s| s.nis);
+        if index > 0 {
+            let k = index - 1;
+            let (x, s) = (
+                &run.filtered_states[k * n..index * n],
+                &run.filtered_covariances[k * nn..index * nn],
+            );
+            let (ak, dk) = (&mut a[k * n..index * n], &mut d[k * nn..index * nn]);
+            if !map_into(
+                n,
+                (x, s),
+                (&phi, &x_pred, &s_pred),
+                ak,
+                dk,
+                &mut c[k * nn..index * nn],
+            ) {
+                return Err(in_batch(index, not_positive_definite(&s_pred, n, index)));
+            }
+            if let Some(&value) = ak.iter().chain(dk.iter()).find(|v| !v.is_finite()) {
+                return Err(in_batch(index, in_batch(index, not_finite(value))));
+            }
+        }
+        run.times.push(m.time);
+        run.filtered_states
+            .extend_from_slice(filter.state().as_slice());
+        run.filtered_covariances
+            .extend_from_slice(filter.covariance().as_slice());
+        run.nis.push(nis);
+    }
+    if count == 0 {
+        return Ok(run);
+    }
+    let last = count - 1;
+    run.states[last * n..].copy_from_slice(&run.filtered_states[last * n..]);
+    run.covariances[last * nn..].copy_from_slice(&run.filtered_covariances[last * nn..]);
+    for k in (0..last).rev() {
+        let (states, later) = run.states.split_at_mut((k + 1) * n);
+        let (covariances, later_s) = run.covariances.split_at_mut((k + 1) * nn);
+        let (x, s) = (&mut states[k * n..], &mut covariances[k * nn..]);
+        let map = (
+            &a[k * n..(k + 1) * n],
+            &d[k * nn..(k + 1) * nn],
+            &c[k * nn..(k + 1) * nn],
+        );
+        apply_into(n, map, (&later[..n], &later_s[..nn]), x, s);
+        if let Some(&value) = x.iter().chain(s.iter()).find(|v| !v.is_finite()) {
+            return Err(in_batch(k, not_finite(value)));
+        }
+    }
+    Ok(run)
 }
 
 /// The smoother a measurement at a time: the forward pass as the measurements come
