@@ -414,9 +414,12 @@ fn linear4(c: &mut Criterion) {
 const SMOOTH_SAMPLES: usize = 10_000;
 
 /// The Rauch–Tung–Striebel smoother against its own filter, per measurement: `filter` (the
-/// forward filter alone, `update_stats`), `forward` (the smoother's forward pass,
-/// [`Smoother::push`], keeping what the backward pass needs), `backward` (its backward pass,
-/// [`Smoother::finish`], the forward pass made outside the timing) and `smooth` (both).
+/// forward filter alone, `update_stats`); the measurement-at-a-time [`Smoother`]'s `forward`
+/// pass ([`Smoother::push`], which also makes each step's backward map) and `backward` pass
+/// ([`Smoother::finish`], the forward pass made outside the timing); `smooth_flat` (the
+/// whole-interval smoother on flat buffers: the filter keeping its predictions, then every
+/// backward map made and applied) and `smooth` (the same, each estimate in its own
+/// `Smoothed`).
 fn bench_smoother<D: Dynamics + Clone, O: Observation + Clone>(
     c: &mut Criterion,
     name: &str,
@@ -457,6 +460,15 @@ fn bench_smoother<D: Dynamics + Clone, O: Observation + Clone>(
             },
             BatchSize::LargeInput,
         )
+    });
+    group.bench_function("smooth_flat", |b| {
+        b.iter(|| {
+            filters
+                .iter()
+                .zip(runs)
+                .map(|(f, run)| smoother::smooth_flat(f.clone(), run).unwrap().times.len())
+                .sum::<usize>()
+        })
     });
     group.bench_function("smooth", |b| {
         b.iter(|| {

@@ -1,6 +1,7 @@
 //! `kalman::smoother::smooth_flat` (the whole-interval Rauch–Tung–Striebel smoother on flat
-//! buffers, what `smooth` and Python's `KalmanFilter.smooth` run): bit for bit the
-//! measurement-at-a-time [`Smoother`] (`push`, then `finish`) on every state size 1-12 (the
+//! buffers in the textbook form, what `smooth` and Python's `KalmanFilter.smooth` run): the
+//! measurement-at-a-time [`Smoother`]'s numbers (`push`, then `finish`: the backward maps) to
+//! 1e-10 of σ (measured: 4.2e-12), the filtered ones bit for bit, on every state size 1-12 (the
 //! backward kernel's fixed sizes and its general one), with driving noise, one to three
 //! components, missing ones and irregular times, and on the radar extended filter; the same
 //! errors; and each step against the textbook form with an explicit inverse,
@@ -64,48 +65,65 @@ fn case(
     (filter, rows)
 }
 
-/// Asserts that `smooth` and `smooth_flat` give the `Smoother`'s numbers bit for bit.
-fn assert_bit_identical<D: Dynamics + Clone, O: Observation + Clone>(
+/// Asserts that `smooth` and `smooth_flat` give the `Smoother`'s numbers (its backward maps
+/// applied in turn) to rounding: within 1e-10 of each σ (of `σ_i σ_j` for a covariance
+/// entry), the filtered estimates and NIS bit for bit.
+fn assert_same<D: Dynamics + Clone, O: Observation + Clone>(
     filter: &KalmanFilter<D, O>,
     rows: &[Measurement],
-) {
+) -> f64 {
     let mut s = Smoother::new(filter.clone());
     for m in rows {
         s.push(m).unwrap();
     }
     let want = s.finish().unwrap();
     let got = smooth(filter.clone(), rows).unwrap();
-    assert_eq!(got, want);
     let flat = smooth_flat(filter.clone(), rows).unwrap();
     let n = flat.dimension;
-    for (k, w) in want.iter().enumerate() {
-        assert_eq!(&flat.states[k * n..(k + 1) * n], w.state.as_slice());
+    let mut worst: f64 = 0.0;
+    for (k, (w, g)) in want.iter().zip(&got).enumerate() {
+        assert_eq!(
+            (&g.filtered_state, &g.filtered_covariance, g.nis, g.time),
+            (&w.filtered_state, &w.filtered_covariance, w.nis, w.time)
+        );
+        assert_eq!(&flat.states[k * n..(k + 1) * n], g.state.as_slice());
         assert_eq!(
             &flat.covariances[k * n * n..(k + 1) * n * n],
-            w.covariance.as_slice()
+            g.covariance.as_slice()
         );
         assert_eq!(flat.nis[k], w.nis);
+        let sigma = w.covariance.diagonal().map(f64::sqrt);
+        for i in 0..n {
+            worst = worst.max((g.state[i] - w.state[i]).abs() / sigma[i]);
+            for j in 0..n {
+                let e = (g.covariance[(i, j)] - w.covariance[(i, j)]).abs();
+                worst = worst.max(e / (sigma[i] * sigma[j]));
+            }
+        }
     }
+    assert!(worst < 1e-10, "worst {worst:e} of σ");
+    worst
 }
 
 #[test]
-fn flat_smoother_is_the_smoother_bit_for_bit_on_every_size() {
+fn flat_smoother_is_the_smoother_on_every_size() {
     let mut rng = StdRng::seed_from_u64(33);
-    let mut sizes = 0;
+    let (mut sizes, mut worst): (usize, f64) = (0, 0.0);
     for degree in 0..=3 {
         for axes in 1..=3 {
             for p in 1..=3 {
                 let (filter, rows) = case(&mut rng, degree, axes, p, 60);
-                assert_bit_identical(&filter, &rows);
+                worst = worst.max(assert_same(&filter, &rows));
                 sizes += 1;
             }
         }
     }
     assert_eq!(sizes, 36);
+    println!("worst against the maps: {worst:e} of σ");
 }
 
 #[test]
-fn flat_smoother_is_the_smoother_bit_for_bit_on_the_radar() {
+fn flat_smoother_is_the_smoother_on_the_radar() {
     let mut rng = StdRng::seed_from_u64(34);
     let radar = Radar::new([0.0; 3], 6).unwrap();
     let mut x: DVector<f64> = DVector::from_vec(vec![20e3, -5e3, 3e3, -150.0, 80.0, 5.0]);
@@ -135,7 +153,10 @@ fn flat_smoother_is_the_smoother_bit_for_bit_on_the_radar() {
         .unwrap()
         .with_process_noise(WhiteNoiseDerivative::new(1, 3, 1.0).unwrap())
         .unwrap();
-    assert_bit_identical(&filter, &rows);
+    println!(
+        "worst against the maps: {:e} of σ",
+        assert_same(&filter, &rows)
+    );
 }
 
 /// Every smoothed estimate against the textbook backward recursion with `S_{k+1|k}⁻¹` by an
@@ -207,10 +228,15 @@ fn flat_smoother_refuses_as_the_smoother() {
         0.0,
     )
     .unwrap();
-    let cases: [(&KalmanFilter<_, _>, Vec<Measurement>); 3] = [
+    // The last: the map into measurement 1 fails before the bad value of measurement 2.
+    let cases: [(&KalmanFilter<_, _>, Vec<Measurement>); 4] = [
         (&vague, vec![row(1.0, 1.0), row(2.0, 1.0), row(1.5, 1.0)]),
         (&vague, vec![row(1.0, 1.0), row(2.0, f64::INFINITY)]),
         (&known, vec![row(1.0, 1.0), row(2.0, 1.0), row(3.0, 1.0)]),
+        (
+            &known,
+            vec![row(1.0, 1.0), row(2.0, 1.0), row(3.0, f64::INFINITY)],
+        ),
     ];
     for (filter, rows) in cases {
         let mut s = Smoother::new(filter.clone());

@@ -24,12 +24,18 @@ pub(crate) fn map_into(
     c: &mut [f64],
 ) -> bool {
     if n <= MAX {
-        let mut scratch = [0.0; 2 * MAX * MAX + MAX];
-        unrolled_sizes!(n, N => map_kernel(Fixed::<N>, (x, s), (phi, x_pred, s_pred), &mut scratch, a, d, c),
+        unrolled_sizes!(n, N => {
+                let mut scratch = [0.0; 2 * N * N + 2 * N];
+                let mut entries = [(0, 0, 0.0); N * N];
+                let scratch = (&mut scratch[..], &mut entries[..]);
+                map_kernel(Fixed::<N>, (x, s), (phi, x_pred, s_pred), scratch, a, d, c)
+            },
             _ => false)
     } else {
-        let mut scratch = vec![0.0; 2 * n * n + n];
-        map_kernel(Any(n), (x, s), (phi, x_pred, s_pred), &mut scratch, a, d, c)
+        let mut scratch = vec![0.0; 2 * n * n + 2 * n];
+        let mut entries = vec![(0, 0, 0.0); n * n];
+        let scratch = (&mut scratch[..], &mut entries[..]);
+        map_kernel(Any(n), (x, s), (phi, x_pred, s_pred), scratch, a, d, c)
     }
 }
 
@@ -43,8 +49,10 @@ pub(crate) fn apply_into(
     s_out: &mut [f64],
 ) {
     if n <= MAX {
-        let mut scratch = [0.0; MAX * MAX];
-        unrolled_sizes!(n, N => apply_kernel(Fixed::<N>, (a, d, c), (x, s), &mut scratch, x_out, s_out),
+        unrolled_sizes!(n, N => {
+                let mut scratch = [0.0; N * N];
+                apply_kernel(Fixed::<N>, (a, d, c), (x, s), &mut scratch, x_out, s_out)
+            },
             _ => ())
     } else {
         let mut scratch = vec![0.0; n * n];
@@ -52,36 +60,148 @@ pub(crate) fn apply_into(
     }
 }
 
+/// One whole-interval backward step in the textbook form: from `(x, s)` (`X_{k|k}`,
+/// `S_{k|k}`), the prediction out of it `(Φ, X_{k+1|k}, S_{k+1|k})` and the later smoothed
+/// estimate `(x_next, s_next)` (`X_{k+1|N}`, `S_{k+1|N}`), `X_{k|N} = x + C (x_next − X_{k+1|k})`
+/// and `S_{k|N} = s + C (s_next − S_{k+1|k}) Cᵀ` (symmetrized) into `x_out`, `s_out`, with `C`
+/// by [`gain_kernel`] into `c`: the map's numbers ([`map_into`] then [`apply_into`]) to rounding,
+/// at about three quarters of its arithmetic. `false` when `S_{k+1|k}` is not positive definite.
+pub(crate) fn smooth_into(
+    n: usize,
+    (x, s): (&[f64], &[f64]),
+    (phi, x_pred, s_pred): (&[f64], &[f64], &[f64]),
+    (x_next, s_next): (&[f64], &[f64]),
+    (x_out, s_out, c): (&mut [f64], &mut [f64], &mut [f64]),
+) -> bool {
+    let estimates = ((x, s), (x_next, s_next));
+    if n <= MAX {
+        unrolled_sizes!(n, N => {
+                let mut scratch = [0.0; 2 * N * N + 2 * N];
+                let mut entries = [(0, 0, 0.0); N * N];
+                let scratch = (&mut scratch[..], &mut entries[..]);
+                smooth_kernel(Fixed::<N>, estimates, (phi, x_pred, s_pred), scratch, (x_out, s_out, c))
+            },
+            _ => false)
+    } else {
+        let mut scratch = vec![0.0; 2 * n * n + 2 * n];
+        let mut entries = vec![(0, 0, 0.0); n * n];
+        let scratch = (&mut scratch[..], &mut entries[..]);
+        smooth_kernel(
+            Any(n),
+            estimates,
+            (phi, x_pred, s_pred),
+            scratch,
+            (x_out, s_out, c),
+        )
+    }
+}
+
+/// [`smooth_into`] for `n` states.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn smooth_kernel<S: Size>(
+    n: S,
+    ((x, s), (x_next, s_next)): ((&[f64], &[f64]), (&[f64], &[f64])),
+    (phi, x_pred, s_pred): (&[f64], &[f64], &[f64]),
+    scratch: (&mut [f64], &mut [(usize, usize, f64)]),
+    (x_out, s_out, c): (&mut [f64], &mut [f64], &mut [f64]),
+) -> bool {
+    if !gain_kernel(n, s, (phi, s_pred), (&mut *scratch.0, scratch.1), c) {
+        return false;
+    }
+    let n = n.get();
+    let nn = n * n;
+    let (e, rest) = scratch.0.split_at_mut(nn);
+    let (w, rest) = rest.split_at_mut(nn);
+    let dx = &mut rest[..n];
+    let (c, x, s, x_pred, s_pred) = (&c[..nn], &x[..n], &s[..nn], &x_pred[..n], &s_pred[..nn]);
+    let (x_next, s_next) = (&x_next[..n], &s_next[..nn]);
+    let (x_out, s_out) = (&mut x_out[..n], &mut s_out[..nn]);
+    for i in 0..n {
+        dx[i] = x_next[i] - x_pred[i];
+    }
+    x_out.copy_from_slice(x);
+    for m in 0..n {
+        let (v, cm) = (dx[m], &c[m * n..(m + 1) * n]);
+        for i in 0..n {
+            x_out[i] += cm[i] * v;
+        }
+    }
+    for i in 0..nn {
+        e[i] = s_next[i] - s_pred[i];
+    }
+    // W = C E, then s + W Cᵀ.
+    w.fill(0.0);
+    for j in 0..n {
+        for m in 0..n {
+            let (v, cm) = (e[m + j * n], &c[m * n..(m + 1) * n]);
+            for i in 0..n {
+                w[i + j * n] += cm[i] * v;
+            }
+        }
+    }
+    s_out.copy_from_slice(s);
+    for m in 0..n {
+        let wm = &w[m * n..(m + 1) * n];
+        for j in 0..n {
+            let v = c[j + m * n];
+            for i in 0..n {
+                s_out[i + j * n] += wm[i] * v;
+            }
+        }
+    }
+    symmetrize(n, s_out);
+    true
+}
+
 /// The largest dimension with its kernels unrolled and its scratch on the stack.
 const MAX: usize = crate::numeric::unrolled::UNROLLED_MAX_SIZE;
 
-/// [`map_into`] for `n` states; `scratch` holds `Φ S`, `L` and a column (`2n² + n`).
+/// The smoother gain `C = S Φᵀ S_{k+1|k}⁻¹` into `c` and `P = Φ S` into `scratch`'s first
+/// `n²` (the rest: `L`, a column, the reciprocals of `L`'s diagonal: `2n² + 2n` in all;
+/// `entries` holds the entries of `Φ` that are not zero, `n²`); `false` when `S_{k+1|k}` is
+/// not positive definite.
 #[inline(always)]
-fn map_kernel<S: Size>(
+fn gain_kernel<S: Size>(
     n: S,
-    (x, s): (&[f64], &[f64]),
-    (phi, x_pred, s_pred): (&[f64], &[f64], &[f64]),
-    scratch: &mut [f64],
-    a: &mut [f64],
-    d: &mut [f64],
+    s: &[f64],
+    (phi, s_pred): (&[f64], &[f64]),
+    (scratch, entries): (&mut [f64], &mut [(usize, usize, f64)]),
     c: &mut [f64],
 ) -> bool {
     let n = n.get();
     let (nn, s, phi, s_pred) = (n * n, &s[..n * n], &phi[..n * n], &s_pred[..n * n]);
     let (p, rest) = scratch.split_at_mut(nn);
     let (l, rest) = rest.split_at_mut(nn);
-    let column = &mut rest[..n];
-    let (a, d, c) = (&mut a[..n], &mut d[..nn], &mut c[..nn]);
-    // P = Φ S, a column at a time (Φ's zeros skipped: adding 0·s changes nothing finite).
+    let (column, inverse) = rest.split_at_mut(n);
+    let (inverse, c) = (&mut inverse[..n], &mut c[..nn]);
+    // P = Φ S, a column at a time over the entries of Φ that are not zero (listed once, by
+    // columns: each entry of P sums its terms in the order of Φ's columns; adding 0 · s
+    // would change nothing for a finite s).
+    let mut count = 0;
+    for m in 0..n {
+        for i in 0..n {
+            let v = phi[i + m * n];
+            if v != 0.0 {
+                entries[count] = (i, m, v);
+                count += 1;
+            }
+        }
+    }
+    // Dense when at most a quarter of the entries are zero.
+    let sparse = 4 * count < 3 * n * n;
     for j in 0..n {
-        let pj = &mut p[j * n..(j + 1) * n];
+        let (pj, sj) = (&mut p[j * n..(j + 1) * n], &s[j * n..(j + 1) * n]);
         pj.fill(0.0);
-        for m in 0..n {
-            let v = s[m + j * n];
-            let fm = &phi[m * n..(m + 1) * n];
-            for i in 0..n {
-                if fm[i] != 0.0 {
-                    pj[i] += fm[i] * v;
+        if sparse {
+            for &(i, m, v) in &entries[..count] {
+                pj[i] += v * sj[m];
+            }
+        } else {
+            for m in 0..n {
+                let fm = &phi[m * n..(m + 1) * n];
+                for i in 0..n {
+                    pj[i] += fm[i] * sj[m];
                 }
             }
         }
@@ -97,51 +217,77 @@ fn map_kernel<S: Size>(
         }
         let pivot = diagonal.sqrt();
         l[j + j * n] = pivot;
+        inverse[j] = 1.0 / pivot;
         for i in j + 1..n {
             let mut v = s_pred[i + j * n];
             for m in 0..j {
                 v -= l[i + m * n] * l[j + m * n];
             }
-            l[i + j * n] = v / pivot;
+            l[i + j * n] = v * inverse[j];
         }
     }
-    // Cᵀ = S_{k+1|k}⁻¹ P, a column at a time: L y = P_j, then Lᵀ z = y; row j of C is z.
+    // Cᵀ = S_{k+1|k}⁻¹ P, a column at a time: L y = P_j (by columns of L), then Lᵀ z = y
+    // (by its rows, L's columns); row j of C is z.
     for j in 0..n {
-        for i in 0..n {
-            let mut v = p[i + j * n];
-            for m in 0..i {
-                v -= l[i + m * n] * column[m];
+        column.copy_from_slice(&p[j * n..(j + 1) * n]);
+        for m in 0..n {
+            column[m] *= inverse[m];
+            let (ym, lm) = (column[m], &l[m * n..(m + 1) * n]);
+            for i in m + 1..n {
+                column[i] -= lm[i] * ym;
             }
-            column[i] = v / l[i + i * n];
         }
         for i in (0..n).rev() {
+            let li = &l[i * n..(i + 1) * n];
             let mut v = column[i];
             for m in i + 1..n {
-                v -= l[m + i * n] * column[m];
+                v -= li[m] * column[m];
             }
-            column[i] = v / l[i + i * n];
+            column[i] = v * inverse[i];
         }
         for i in 0..n {
             c[j + i * n] = column[i];
         }
     }
-    // D = S − C P (symmetrized), a = x − C X_{k+1|k}.
+    true
+}
+
+/// [`map_into`] for `n` states: [`gain_kernel`], then `D = S − C P` (symmetrized) and
+/// `a = x − C X_{k+1|k}`, by columns of `C`.
+#[inline(always)]
+fn map_kernel<S: Size>(
+    n: S,
+    (x, s): (&[f64], &[f64]),
+    (phi, x_pred, s_pred): (&[f64], &[f64], &[f64]),
+    scratch: (&mut [f64], &mut [(usize, usize, f64)]),
+    a: &mut [f64],
+    d: &mut [f64],
+    c: &mut [f64],
+) -> bool {
+    if !gain_kernel(n, s, (phi, s_pred), (&mut *scratch.0, scratch.1), c) {
+        return false;
+    }
+    let n = n.get();
+    let nn = n * n;
+    let (p, s, c) = (&scratch.0[..nn], &s[..nn], &c[..nn]);
+    let (a, d) = (&mut a[..n], &mut d[..nn]);
+    d.copy_from_slice(s);
     for j in 0..n {
-        for i in 0..n {
-            let mut v = 0.0;
-            for m in 0..n {
-                v += c[i + m * n] * p[m + j * n];
+        let dj = &mut d[j * n..(j + 1) * n];
+        for m in 0..n {
+            let (v, cm) = (p[m + j * n], &c[m * n..(m + 1) * n]);
+            for i in 0..n {
+                dj[i] -= cm[i] * v;
             }
-            d[i + j * n] = s[i + j * n] - v;
         }
     }
     symmetrize(n, d);
-    for i in 0..n {
-        let mut v = 0.0;
-        for m in 0..n {
-            v += c[i + m * n] * x_pred[m];
+    a.copy_from_slice(&x[..n]);
+    for m in 0..n {
+        let (v, cm) = (x_pred[m], &c[m * n..(m + 1) * n]);
+        for i in 0..n {
+            a[i] -= cm[i] * v;
         }
-        a[i] = x[i] - v;
     }
     true
 }
