@@ -5,9 +5,10 @@
 //!
 //! `C = S_{k|k} Φᵀ S_{k+1|k}⁻¹`, `a = X_{k|k} − C X_{k+1|k}`, `D = S_{k|k} − C Φ S_{k|k}`,
 //!
-//! with `S_{k+1|k}⁻¹` applied by its Cholesky factor `L Lᵀ` (never inverted), and the map
-//! applied to a later estimate ([`apply_into`]): `X = a + C X'`, `S = D + C S' Cᵀ`. The
-//! smoothers of [`super::smoother`] and [`super::fixed_lag`] make every backward step here.
+//! with `S_{k+1|k}⁻¹` applied by its square-root-free Cholesky factors `L D Lᵀ` (never inverted), and the map
+//! applied to a later estimate ([`apply_into`]): `X = a + C X'`, `S = D + C S' Cᵀ`; or the
+//! whole-interval step at once in the textbook form ([`smooth_into`]). The smoothers of
+//! [`super::smoother`] and [`super::fixed_lag`] make every backward step here.
 
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
 
@@ -158,7 +159,7 @@ fn smooth_kernel<S: Size>(
 const MAX: usize = crate::numeric::unrolled::UNROLLED_MAX_SIZE;
 
 /// The smoother gain `C = S Φᵀ S_{k+1|k}⁻¹` into `c` and `P = Φ S` into `scratch`'s first
-/// `n²` (the rest: `L`, a column, the reciprocals of `L`'s diagonal: `2n² + 2n` in all;
+/// `n²` (the rest: `L` below its diagonal and `L D` above, a column, `1/D`: `2n² + 2n` in all;
 /// `entries` holds the entries of `Φ` that are not zero, `n²`); `false` when `S_{k+1|k}` is
 /// not positive definite.
 #[inline(always)]
@@ -206,36 +207,39 @@ fn gain_kernel<S: Size>(
             }
         }
     }
-    // S_{k+1|k} = L Lᵀ (lower, column-major).
+    // S_{k+1|k} = L D Lᵀ (L unit lower, column-major, below its diagonal; `inverse` holds
+    // 1/D: the square-root-free Cholesky factorisation, no square root in the chain). Below the
+    // diagonal, the entries l_{im} D_m are kept in the upper triangle as they are formed.
     for j in 0..n {
-        let mut diagonal = s_pred[j + j * n];
+        let mut pivot = s_pred[j + j * n];
         for m in 0..j {
-            diagonal -= l[j + m * n] * l[j + m * n];
+            pivot -= l[j + m * n] * l[m + j * n];
         }
-        if diagonal.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        if pivot.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return false;
         }
-        let pivot = diagonal.sqrt();
-        l[j + j * n] = pivot;
         inverse[j] = 1.0 / pivot;
         for i in j + 1..n {
             let mut v = s_pred[i + j * n];
             for m in 0..j {
-                v -= l[i + m * n] * l[j + m * n];
+                v -= l[i + m * n] * l[m + j * n];
             }
+            l[j + i * n] = v;
             l[i + j * n] = v * inverse[j];
         }
     }
-    // Cᵀ = S_{k+1|k}⁻¹ P, a column at a time: L y = P_j (by columns of L), then Lᵀ z = y
-    // (by its rows, L's columns); row j of C is z.
+    // Cᵀ = S_{k+1|k}⁻¹ P, a column at a time: L y = P_j (by columns of L), y / D, then
+    // Lᵀ z = y (by its rows, L's columns); row j of C is z.
     for j in 0..n {
         column.copy_from_slice(&p[j * n..(j + 1) * n]);
         for m in 0..n {
-            column[m] *= inverse[m];
             let (ym, lm) = (column[m], &l[m * n..(m + 1) * n]);
             for i in m + 1..n {
                 column[i] -= lm[i] * ym;
             }
+        }
+        for m in 0..n {
+            column[m] *= inverse[m];
         }
         for i in (0..n).rev() {
             let li = &l[i * n..(i + 1) * n];
@@ -243,7 +247,7 @@ fn gain_kernel<S: Size>(
             for m in i + 1..n {
                 v -= li[m] * column[m];
             }
-            column[i] = v * inverse[i];
+            column[i] = v;
         }
         for i in 0..n {
             c[j + i * n] = column[i];

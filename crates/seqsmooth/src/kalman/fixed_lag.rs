@@ -120,7 +120,7 @@ fn mul_into(n: usize, a: &[f64], b: &[f64], out: &mut [f64]) {
 }
 
 /// The backward step `T_k` from measurement `k + 1` to `k` ([`backward::map_into`]):
-/// `C = S_{k|k} Φᵀ S_{k+1|k}⁻¹` by the Cholesky factor of `S_{k+1|k}`,
+/// `C = S_{k|k} Φᵀ S_{k+1|k}⁻¹` by the `L D Lᵀ` factors of `S_{k+1|k}`,
 /// `a = X_{k|k} − C X_{k+1|k}`, `D = S_{k|k} − C Φ S_{k|k}` (that is,
 /// `S_{k|k} − C S_{k+1|k} Cᵀ`); an error names measurement `index` (`k + 1`).
 pub(super) fn step(

@@ -7,8 +7,8 @@
 //! `S_{k|N} = S_{k|k} + C_k (S_{k+1|N} − S_{k+1|k}) C_kᵀ`,
 //!
 //! on any times (`Φ` and `Q` of the actual step; for the extended filter `Φ` is the
-//! linearisation along the forward trajectory). `S_{k+1|k}⁻¹` is applied by its Cholesky
-//! factor. For linear models without driving noise the result at every time is the batch
+//! linearisation along the forward trajectory). `S_{k+1|k}⁻¹` is applied by its square-root-free
+//! Cholesky factors `L D Lᵀ`. For linear models without driving noise the result at every time is the batch
 //! minimum-variance estimate from the prior and all the measurements (tested against
 //! [`crate::estimate::gauss_newton`]).
 
@@ -142,7 +142,7 @@ impl Default for SmoothedRun {
 /// [`smooth`]'s numbers in flat buffers, with nothing allocated per measurement: the forward
 /// pass runs the filter and keeps each step's prediction `Φ`, `X_{k+1|k}`, `S_{k+1|k}`; the
 /// backward pass is the textbook recursion of the module's doc from the last estimate
-/// ([`backward::smooth_into`](super::backward), `S_{k+1|k}⁻¹` by its Cholesky factor), the
+/// ([`backward::smooth_into`](super::backward), `S_{k+1|k}⁻¹` by its `L D Lᵀ` factors), the
 /// measurement-at-a-time [`Smoother`]'s numbers (its maps) to rounding, at about three quarters
 /// of its arithmetic. Errors as [`Smoother::smooth`]'s (the first in the order that smoother
 /// meets them).
