@@ -8,6 +8,9 @@
 //! the log-likelihoods, which the bench compares with the library's before timing (a floor
 //! that did less would not agree).
 
+// The loops index by row and column on purpose: the recursion's formulas, entry by entry.
+#![allow(clippy::needless_range_loop)]
+
 use std::f64::consts::{PI, TAU};
 
 /// The 3-state polynomial filter (constant acceleration on one axis, `Φ = Ψ(ζ)`, white jerk of
