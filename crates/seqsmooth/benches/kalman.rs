@@ -32,12 +32,10 @@ use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::StandardNormal;
 use seqsmooth::kalman::discrete::{LinearKalmanFilter, PassInto, StepMatrices};
-use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::smoother::{self, Smoother};
 use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
 use seqsmooth::model::measurement::Measurement;
-use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::{LinearObservation, Observation};
 use std::time::Duration;
 
@@ -53,46 +51,18 @@ mod floor;
 
 /// Measurements of the 3-state filter.
 const SAMPLES: usize = 100_000;
-/// The 3-state filter's driving-noise spectral density (jerk), value²/time⁵.
-const Q3: f64 = 1.0;
-/// σ of the 3-state filter's measurements.
-const SIGMA: f64 = 0.5;
 /// Radar tracks of the extended filter (59 updates each).
 const TRACKS: usize = 64;
 
 /// Steps of the `linear4` batch.
 const LINEAR_STEPS: usize = 2_000;
 
-/// The 3-state filter at its prior and its measurements.
+/// The 3-state filter at its prior and its measurements ([`floor::polynomial_case`]).
 fn polynomial_case() -> (
     KalmanFilter<PolynomialDynamics, LinearObservation>,
     Vec<Measurement>,
 ) {
-    let mut rng = StdRng::seed_from_u64(20_260_417);
-    let mut t = 0.0;
-    let rows = (0..SAMPLES)
-        .map(|_| {
-            t += 1e-3 * rng.gen_range(0.5..1.5);
-            let e: f64 = rng.sample(StandardNormal);
-            let y = 10.0 * (t * std::f64::consts::TAU / 25.0).sin() + 0.5 * t + SIGMA * e;
-            Measurement {
-                time: t,
-                values: vec![Some(y)],
-                noise: NoiseCovariance::Variances(vec![SIGMA * SIGMA]),
-            }
-        })
-        .collect();
-    let filter = KalmanFilter::new(
-        PolynomialDynamics::new(2, 1),
-        LinearObservation::value_of(3),
-        DVector::zeros(3),
-        DMatrix::from_diagonal(&DVector::from_vec(vec![1e4, 1e4, 1e4])),
-        0.0,
-    )
-    .unwrap()
-    .with_process_noise(WhiteNoiseDerivative::new(2, 1, Q3).unwrap())
-    .unwrap();
-    (filter, rows)
+    floor::polynomial_case(SAMPLES)
 }
 
 /// Benchmark `name`: every filter of `filters` (a fresh copy each iteration, made outside the
@@ -178,7 +148,9 @@ fn kalman3(c: &mut Criterion) {
     let ys: Vec<f64> = rows.iter().map(|m| m.values[0].unwrap()).collect();
     let x0 = [0.0; 3];
     let s0 = [[1e4, 0.0, 0.0], [0.0, 1e4, 0.0], [0.0, 0.0, 1e4]];
-    let floor_run = |ts: &[f64], ys: &[f64]| floor::kalman3(x0, s0, 0.0, Q3, SIGMA * SIGMA, ts, ys);
+    let floor_run = |ts: &[f64], ys: &[f64]| {
+        floor::kalman3(x0, s0, 0.0, floor::Q3, floor::SIGMA3.powi(2), ts, ys)
+    };
     let (x, s, total) = floor_run(&ts, &ys);
     let s_flat: Vec<f64> = (0..9).map(|k| s[k % 3][k / 3]).collect();
     assert_agrees(

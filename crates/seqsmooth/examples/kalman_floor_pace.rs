@@ -28,51 +28,12 @@ mod kalman_tracks;
 #[path = "../benches/common/floor.rs"]
 mod floor;
 
-use nalgebra::{DMatrix, DVector};
-use rand::rngs::StdRng;
-use rand::{Rng, SeedableRng};
-use rand_distr::StandardNormal;
-use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::kalman::smoother::{smooth_flat, smooth_flat_into, SmoothedRun};
 use seqsmooth::kalman::KalmanFilter;
-use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
-use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
-use seqsmooth::model::observation::{LinearObservation, Observation};
+use seqsmooth::model::dynamics::Dynamics;
+use seqsmooth::model::measurement::Measurement;
+use seqsmooth::model::observation::Observation;
 use std::hint::black_box;
-
-/// The bench's 3-state case: the filter at its prior and `count` measurements.
-fn polynomial_case(
-    count: usize,
-) -> (
-    KalmanFilter<PolynomialDynamics, LinearObservation>,
-    Vec<Measurement>,
-) {
-    let mut rng = StdRng::seed_from_u64(20_260_417);
-    let mut t = 0.0;
-    let rows = (0..count)
-        .map(|_| {
-            t += 1e-3 * rng.gen_range(0.5..1.5);
-            let e: f64 = rng.sample(StandardNormal);
-            let y = 10.0 * (t * std::f64::consts::TAU / 25.0).sin() + 0.5 * t + 0.5 * e;
-            Measurement {
-                time: t,
-                values: vec![Some(y)],
-                noise: NoiseCovariance::Variances(vec![0.25]),
-            }
-        })
-        .collect();
-    let filter = KalmanFilter::new(
-        PolynomialDynamics::new(2, 1),
-        LinearObservation::value_of(3),
-        DVector::zeros(3),
-        DMatrix::from_diagonal(&DVector::from_vec(vec![1e4, 1e4, 1e4])),
-        0.0,
-    )
-    .unwrap()
-    .with_process_noise(WhiteNoiseDerivative::new(2, 1, 1.0).unwrap())
-    .unwrap();
-    (filter, rows)
-}
 
 /// The calling thread's CPU time, seconds (`CLOCK_THREAD_CPUTIME_ID`).
 fn cpu_seconds() -> f64 {
@@ -151,11 +112,22 @@ fn main() {
     let reps: usize = std::env::args()
         .nth(1)
         .map_or(15, |a| a.parse().expect("REPS a count"));
-    let (filter, rows) = polynomial_case(100_000);
+    let (filter, rows) = floor::polynomial_case(100_000);
     let ts: Vec<f64> = rows.iter().map(|m| m.time).collect();
     let ys: Vec<f64> = rows.iter().map(|m| m.values[0].unwrap()).collect();
     let s0 = [[1e4, 0.0, 0.0], [0.0, 1e4, 0.0], [0.0, 0.0, 1e4]];
-    let floor3 = || floor::kalman3([0.0; 3], s0, 0.0, 1.0, 0.25, &ts, &ys).2;
+    let floor3 = || {
+        floor::kalman3(
+            [0.0; 3],
+            s0,
+            0.0,
+            floor::Q3,
+            floor::SIGMA3.powi(2),
+            &ts,
+            &ys,
+        )
+        .2
+    };
     let lib3 = || filter_runs(std::slice::from_ref(&filter), &[&rows]);
     let (want, got) = (lib3(), floor3());
     assert!(

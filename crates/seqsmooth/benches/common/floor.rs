@@ -11,7 +11,60 @@
 // The loops index by row and column on purpose: the recursion's formulas, entry by entry.
 #![allow(clippy::needless_range_loop)]
 
-use std::f64::consts::{PI, TAU};
+use nalgebra::{DMatrix, DVector};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+use rand_distr::StandardNormal;
+use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+use seqsmooth::kalman::KalmanFilter;
+use seqsmooth::model::dynamics::PolynomialDynamics;
+use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
+use seqsmooth::model::observation::LinearObservation;
+use seqsmooth::model::radar::wrap;
+use std::f64::consts::TAU;
+
+/// The 3-state filter's driving-noise spectral density (jerk), value²/time⁵.
+pub const Q3: f64 = 1.0;
+/// σ of the 3-state filter's measurements.
+pub const SIGMA3: f64 = 0.5;
+
+/// The 3-state case the floor is timed on (`benches/kalman.rs`, `examples/kalman_floor_pace.rs`):
+/// `KalmanFilter` on `PolynomialDynamics::new(2, 1)` observed by `LinearObservation::value_of(3)`
+/// with driving noise `WhiteNoiseDerivative::new(2, 1, Q3)`, from a vague prior (state 0,
+/// variances 10⁴) at 0, and `count` measurements at irregular steps `0.001·U(0.5, 1.5)` of a
+/// slow sine plus N(0, SIGMA3²).
+pub fn polynomial_case(
+    count: usize,
+) -> (
+    KalmanFilter<PolynomialDynamics, LinearObservation>,
+    Vec<Measurement>,
+) {
+    let mut rng = StdRng::seed_from_u64(20_260_417);
+    let mut t = 0.0;
+    let rows = (0..count)
+        .map(|_| {
+            t += 1e-3 * rng.gen_range(0.5..1.5);
+            let e: f64 = rng.sample(StandardNormal);
+            let y = 10.0 * (t * TAU / 25.0).sin() + 0.5 * t + SIGMA3 * e;
+            Measurement {
+                time: t,
+                values: vec![Some(y)],
+                noise: NoiseCovariance::Variances(vec![SIGMA3 * SIGMA3]),
+            }
+        })
+        .collect();
+    let filter = KalmanFilter::new(
+        PolynomialDynamics::new(2, 1),
+        LinearObservation::value_of(3),
+        DVector::zeros(3),
+        DMatrix::from_diagonal(&DVector::from_vec(vec![1e4, 1e4, 1e4])),
+        0.0,
+    )
+    .unwrap()
+    .with_process_noise(WhiteNoiseDerivative::new(2, 1, Q3).unwrap())
+    .unwrap();
+    (filter, rows)
+}
 
 /// The 3-state polynomial filter (constant acceleration on one axis, `Φ = Ψ(ζ)`, white jerk of
 /// spectral density `q`, `Q(ζ)` of (15.2.23) in closed form), the position observed with
@@ -87,18 +140,6 @@ pub fn kalman3(
         }
     }
     (x, s, total)
-}
-
-/// The azimuth residual wrapped to `(−π, π]`.
-fn wrap(a: f64) -> f64 {
-    let w = a - TAU * (a / TAU).round();
-    if w <= -PI {
-        w + TAU
-    } else if w > PI {
-        w - TAU
-    } else {
-        w
-    }
 }
 
 /// The 6-state radar extended filter (constant velocity on three axes, state
