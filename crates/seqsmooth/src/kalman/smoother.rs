@@ -64,22 +64,7 @@ pub fn smooth<D: Dynamics + Clone, O: Observation + Clone>(
     filter: KalmanFilter<D, O>,
     measurements: &[Measurement],
 ) -> Result<Vec<Smoothed>, Error> {
-    let run = smooth_flat(filter, measurements)?;
-    let (n, nn) = (run.dimension, run.dimension * run.dimension);
-    Ok((0..run.times.len())
-        .map(|k| Smoothed {
-            time: run.times[k],
-            state: DVector::from_column_slice(&run.states[k * n..(k + 1) * n]),
-            covariance: DMatrix::from_column_slice(n, n, &run.covariances[k * nn..(k + 1) * nn]),
-            filtered_state: DVector::from_column_slice(&run.filtered_states[k * n..(k + 1) * n]),
-            filtered_covariance: DMatrix::from_column_slice(
-                n,
-                n,
-                &run.filtered_covariances[k * nn..(k + 1) * nn],
-            ),
-            nis: run.nis[k],
-        })
-        .collect())
+    Smoother::new(filter).smooth(measurements)
 }
 
 /// Every measurement's smoothed and filtered estimates ([`smooth_flat`]) in flat buffers:
