@@ -511,19 +511,11 @@ impl PyKalmanFilter {
     ) -> PyResult<Bound<'py, PyTuple>> {
         let rows = measurements(t, z, R, self.filter_components())?;
         let filter = self.filter.clone();
-        let smoothed = py.detach(|| smoother::smooth(filter, &rows)).py()?;
-        let n = self.filter.state().len();
-        let states: Vec<f64> = smoothed
-            .iter()
-            .flat_map(|s| s.state.iter().copied())
-            .collect();
-        let covariances: Vec<f64> = smoothed
-            .iter()
-            .flat_map(|s| s.covariance.iter().copied())
-            .collect();
-        let count = smoothed.len();
-        let states = matrix(py, states, count, n)?;
-        let covariances = PyArray1::from_vec(py, covariances)
+        let run = py.detach(|| smoother::smooth_flat(filter, &rows)).py()?;
+        let (n, count) = (run.dimension, run.times.len());
+        let states = matrix(py, run.states, count, n)?;
+        // Symmetric: column-major is row-major.
+        let covariances = PyArray1::from_vec(py, run.covariances)
             .reshape([count, n, n])?
             .into_any();
         PyTuple::new(py, [states, covariances])

@@ -32,11 +32,10 @@ use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::StandardNormal;
 use seqsmooth::kalman::discrete::{LinearKalmanFilter, PassInto, StepMatrices};
-use seqsmooth::kalman::noise::WhiteNoiseDerivative;
+use seqsmooth::kalman::smoother::{self, Smoother};
 use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
 use seqsmooth::model::measurement::Measurement;
-use seqsmooth::model::measurement::NoiseCovariance;
 use seqsmooth::model::observation::{LinearObservation, Observation};
 use std::time::Duration;
 
@@ -47,48 +46,23 @@ mod radar;
 #[path = "common/kalman.rs"]
 mod kalman_tracks;
 
+#[path = "common/floor.rs"]
+mod floor;
+
 /// Measurements of the 3-state filter.
 const SAMPLES: usize = 100_000;
-/// The 3-state filter's driving-noise spectral density (jerk), value²/time⁵.
-const Q3: f64 = 1.0;
-/// σ of the 3-state filter's measurements.
-const SIGMA: f64 = 0.5;
 /// Radar tracks of the extended filter (59 updates each).
 const TRACKS: usize = 64;
 
 /// Steps of the `linear4` batch.
 const LINEAR_STEPS: usize = 2_000;
 
-/// The 3-state filter at its prior and its measurements.
+/// The 3-state filter at its prior and its measurements ([`floor::polynomial_case`]).
 fn polynomial_case() -> (
     KalmanFilter<PolynomialDynamics, LinearObservation>,
     Vec<Measurement>,
 ) {
-    let mut rng = StdRng::seed_from_u64(20_260_417);
-    let mut t = 0.0;
-    let rows = (0..SAMPLES)
-        .map(|_| {
-            t += 1e-3 * rng.gen_range(0.5..1.5);
-            let e: f64 = rng.sample(StandardNormal);
-            let y = 10.0 * (t * std::f64::consts::TAU / 25.0).sin() + 0.5 * t + SIGMA * e;
-            Measurement {
-                time: t,
-                values: vec![Some(y)],
-                noise: NoiseCovariance::Variances(vec![SIGMA * SIGMA]),
-            }
-        })
-        .collect();
-    let filter = KalmanFilter::new(
-        PolynomialDynamics::new(2, 1),
-        LinearObservation::value_of(3),
-        DVector::zeros(3),
-        DMatrix::from_diagonal(&DVector::from_vec(vec![1e4, 1e4, 1e4])),
-        0.0,
-    )
-    .unwrap()
-    .with_process_noise(WhiteNoiseDerivative::new(2, 1, Q3).unwrap())
-    .unwrap();
-    (filter, rows)
+    floor::polynomial_case(SAMPLES)
 }
 
 /// Benchmark `name`: every filter of `filters` (a fresh copy each iteration, made outside the
@@ -132,16 +106,104 @@ fn bench_both<D: Dynamics + Clone, O: Observation + Clone>(
     });
 }
 
+/// The library's filter over `run` by `update_stats`: its state, covariance and summed
+/// log-likelihood, to check a floor against.
+fn library_run<D: Dynamics + Clone, O: Observation + Clone>(
+    filter: &KalmanFilter<D, O>,
+    run: &[Measurement],
+) -> (Vec<f64>, Vec<f64>, f64) {
+    let mut f = filter.clone();
+    let total = run
+        .iter()
+        .map(|m| f.update_stats(m).unwrap().map_or(0.0, |s| s.log_likelihood))
+        .sum();
+    (
+        f.state().as_slice().to_vec(),
+        f.covariance().as_slice().to_vec(),
+        total,
+    )
+}
+
+/// Panics unless `got` (a floor's state, covariance and log-likelihood) equals `want` (the
+/// library's) within `tol` relative to each one's largest entry.
+fn assert_agrees(
+    what: &str,
+    got: (&[f64], &[f64], f64),
+    want: &(Vec<f64>, Vec<f64>, f64),
+    tol: f64,
+) {
+    let close = |a: &[f64], b: &[f64]| {
+        let scale = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tol * scale)
+    };
+    assert!(
+        close(got.0, &want.0) && close(got.1, &want.1) && close(&[got.2], &[want.2]),
+        "{what}: the floor does not run the library's recursion"
+    );
+}
+
 fn kalman3(c: &mut Criterion) {
     let (filter, rows) = polynomial_case();
+    let ts: Vec<f64> = rows.iter().map(|m| m.time).collect();
+    let ys: Vec<f64> = rows.iter().map(|m| m.values[0].unwrap()).collect();
+    let x0 = [0.0; 3];
+    let s0 = [[1e4, 0.0, 0.0], [0.0, 1e4, 0.0], [0.0, 0.0, 1e4]];
+    let floor_run = |ts: &[f64], ys: &[f64]| {
+        floor::kalman3(x0, s0, 0.0, floor::Q3, floor::SIGMA3.powi(2), ts, ys)
+    };
+    let (x, s, total) = floor_run(&ts, &ys);
+    let s_flat: Vec<f64> = (0..9).map(|k| s[k % 3][k / 3]).collect();
+    assert_agrees(
+        "kalman3",
+        (&x, &s_flat, total),
+        &library_run(&filter, &rows),
+        1e-9,
+    );
     let mut group = c.benchmark_group("kalman3");
     group
         .sample_size(20)
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(4))
         .throughput(Throughput::Elements(rows.len() as u64));
-    bench_both(&mut group, &[filter], &[&rows]);
+    bench_both(&mut group, std::slice::from_ref(&filter), &[&rows]);
+    group.bench_function("floor", |b| {
+        b.iter(|| floor_run(black_box(&ts), black_box(&ys)).2)
+    });
     group.finish();
+}
+
+/// A radar track as the floor takes it: prior, times, measured triples.
+type FloorTrack = ([f64; 6], [[f64; 6]; 6], f64, Vec<f64>, Vec<[f64; 3]>);
+
+fn floor_tracks(tracks: &[kalman_tracks::Track]) -> Vec<FloorTrack> {
+    tracks
+        .iter()
+        .map(|t| {
+            let x: [f64; 6] = std::array::from_fn(|i| t.state[i]);
+            let s: [[f64; 6]; 6] =
+                std::array::from_fn(|i| std::array::from_fn(|j| t.covariance[(i, j)]));
+            let ts = t.measurements.iter().map(|m| m.time).collect();
+            let zs = t
+                .measurements
+                .iter()
+                .map(|m| std::array::from_fn(|c| m.values[c].unwrap()))
+                .collect();
+            (x, s, t.time, ts, zs)
+        })
+        .collect()
+}
+
+/// The radar floor over every track: its summed log-likelihood.
+fn floor_ekf6(tracks: &[FloorTrack]) -> f64 {
+    let r = [
+        radar::SIGMA_RANGE.powi(2),
+        radar::SIGMA_ANGLE.powi(2),
+        radar::SIGMA_ANGLE.powi(2),
+    ];
+    tracks
+        .iter()
+        .map(|(x, s, t0, ts, zs)| floor::ekf6(*x, *s, *t0, kalman_tracks::Q, r, ts, zs).2)
+        .sum()
 }
 
 fn ekf6(c: &mut Criterion) {
@@ -149,6 +211,22 @@ fn ekf6(c: &mut Criterion) {
     let filters: Vec<_> = tracks.iter().map(|t| t.filter()).collect();
     let runs: Vec<&[Measurement]> = tracks.iter().map(|t| t.measurements.as_slice()).collect();
     let updates: usize = runs.iter().map(|r| r.len()).sum();
+    let hand = floor_tracks(&tracks);
+    let r = [
+        radar::SIGMA_RANGE.powi(2),
+        radar::SIGMA_ANGLE.powi(2),
+        radar::SIGMA_ANGLE.powi(2),
+    ];
+    for (f, (t, h)) in filters.iter().zip(tracks.iter().zip(&hand)) {
+        let (x, s, total) = floor::ekf6(h.0, h.1, h.2, kalman_tracks::Q, r, &h.3, &h.4);
+        let s_flat: Vec<f64> = (0..36).map(|k| s[k % 6][k / 6]).collect();
+        assert_agrees(
+            "ekf6",
+            (&x, &s_flat, total),
+            &library_run(f, &t.measurements),
+            1e-7,
+        );
+    }
     let mut group = c.benchmark_group("ekf6");
     group
         .sample_size(30)
@@ -156,6 +234,7 @@ fn ekf6(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(4))
         .throughput(Throughput::Elements(updates as u64));
     bench_both(&mut group, &filters, &runs);
+    group.bench_function("floor", |b| b.iter(|| floor_ekf6(black_box(&hand))));
     group.finish();
 }
 
@@ -303,5 +382,89 @@ fn linear4(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, kalman3, ekf6, linear4);
+/// Samples of the 3-state smoother's run.
+const SMOOTH_SAMPLES: usize = 10_000;
+
+/// The Rauch–Tung–Striebel smoother against its own filter, per measurement: `filter` (the
+/// forward filter alone, `update_stats`); the measurement-at-a-time [`Smoother`]'s `forward`
+/// pass ([`Smoother::push`], which also makes each step's backward map) and `backward` pass
+/// ([`Smoother::finish`], the forward pass made outside the timing); `smooth_flat` (the
+/// whole-interval smoother on flat buffers: the filter keeping its predictions, then every
+/// backward map made and applied) and `smooth` (the same, each estimate in its own
+/// `Smoothed`).
+fn bench_smoother<D: Dynamics + Clone, O: Observation + Clone>(
+    c: &mut Criterion,
+    name: &str,
+    filters: &[KalmanFilter<D, O>],
+    runs: &[&[Measurement]],
+) {
+    let updates: usize = runs.iter().map(|r| r.len()).sum();
+    let mut group = c.benchmark_group(name);
+    group
+        .sample_size(20)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(3))
+        .throughput(Throughput::Elements(updates as u64));
+    bench_updates(&mut group, "filter", filters, runs, |f, m| {
+        f.update_stats(m).unwrap().map_or(0.0, |i| i.nis)
+    });
+    let pushed = || -> Vec<Smoother<D, O>> {
+        filters
+            .iter()
+            .zip(runs)
+            .map(|(f, run)| {
+                let mut s = Smoother::new(f.clone());
+                for m in *run {
+                    s.push(m).unwrap();
+                }
+                s
+            })
+            .collect()
+    };
+    group.bench_function("forward", |b| b.iter(|| pushed().len()));
+    group.bench_function("backward", |b| {
+        b.iter_batched(
+            pushed,
+            |ss| {
+                ss.into_iter()
+                    .map(|s| s.finish().unwrap().len())
+                    .sum::<usize>()
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    group.bench_function("smooth_flat", |b| {
+        b.iter(|| {
+            filters
+                .iter()
+                .zip(runs)
+                .map(|(f, run)| smoother::smooth_flat(f.clone(), run).unwrap().times.len())
+                .sum::<usize>()
+        })
+    });
+    group.bench_function("smooth", |b| {
+        b.iter(|| {
+            filters
+                .iter()
+                .zip(runs)
+                .map(|(f, run)| smoother::smooth(f.clone(), run).unwrap().len())
+                .sum::<usize>()
+        })
+    });
+    group.finish();
+}
+
+fn rts3(c: &mut Criterion) {
+    let (filter, rows) = polynomial_case();
+    bench_smoother(c, "rts3", &[filter], &[&rows[..SMOOTH_SAMPLES]]);
+}
+
+fn rts6(c: &mut Criterion) {
+    let tracks = kalman_tracks::tracks(radar::SEED, TRACKS);
+    let filters: Vec<_> = tracks.iter().map(|t| t.filter()).collect();
+    let runs: Vec<&[Measurement]> = tracks.iter().map(|t| t.measurements.as_slice()).collect();
+    bench_smoother(c, "rts6", &filters, &runs);
+}
+
+criterion_group!(benches, kalman3, ekf6, linear4, rts3, rts6);
 criterion_main!(benches);

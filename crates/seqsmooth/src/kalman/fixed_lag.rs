@@ -25,13 +25,14 @@
 //! time): memory is `L + 1` measurements' filtered estimates and maps, whatever the input's
 //! length.
 
+use super::backward;
 use super::filter::KalmanFilter;
 use super::smoother::Smoothed;
 use crate::error::{Error, Param};
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::Measurement;
 use crate::model::observation::Observation;
-use nalgebra::{Cholesky, DMatrix, DVector};
+use nalgebra::{DMatrix, DVector};
 use std::collections::VecDeque;
 
 /// One measurement's filtered estimate, until it is given.
@@ -71,21 +72,15 @@ impl Map {
             return self.clone();
         };
         let n = self.a.len();
-        let (cs, mut w) = (c.as_slice(), vec![0.0; n * n]);
-        let mut a = self.a.clone();
-        for (r, &ar) in inner.a.iter().enumerate() {
-            axpy(ar, &cs[r * n..(r + 1) * n], a.as_mut_slice());
-        }
-        // D + (C D') Cᵀ.
-        mul_into(n, cs, inner.d.as_slice(), &mut w);
-        let mut d = self.d.clone();
-        for r in 0..n {
-            let wr = &w[r * n..(r + 1) * n];
-            for (j, dj) in d.as_mut_slice().chunks_exact_mut(n).enumerate() {
-                axpy(cs[j + r * n], wr, dj);
-            }
-        }
-        symmetrise(&mut d);
+        let cs = c.as_slice();
+        let (mut a, mut d) = (DVector::zeros(n), DMatrix::zeros(n, n));
+        backward::apply_into(
+            n,
+            (self.a.as_slice(), self.d.as_slice(), cs),
+            (inner.a.as_slice(), inner.d.as_slice()),
+            a.as_mut_slice(),
+            d.as_mut_slice(),
+        );
         let c = inner.c.as_ref().map(|ci| {
             let mut out = DMatrix::zeros(n, n);
             mul_into(n, cs, ci.as_slice(), out.as_mut_slice());
@@ -99,10 +94,7 @@ impl Map {
         match self.a.iter().chain(self.d.iter()).find(|v| !v.is_finite()) {
             Some(&value) => Err(Error::InBatch {
                 index,
-                source: Box::new(Error::NonFinite {
-                    what: "smoothed state or covariance entry",
-                    value,
-                }),
+                source: Box::new(not_finite(value)),
             }),
             None => Ok(self),
         }
@@ -127,46 +119,65 @@ fn mul_into(n: usize, a: &[f64], b: &[f64], out: &mut [f64]) {
     }
 }
 
-/// `(M + Mᵀ)/2` in place.
-fn symmetrise(m: &mut DMatrix<f64>) {
-    for j in 0..m.ncols() {
-        for i in 0..j {
-            let v = 0.5 * (m[(i, j)] + m[(j, i)]);
-            m[(i, j)] = v;
-            m[(j, i)] = v;
-        }
-    }
-}
-
-/// The backward step `T_k` from measurement `k + 1` to `k`: `C = S_{k|k} Φᵀ S_{k+1|k}⁻¹` by the
-/// Cholesky factor of `S_{k+1|k}`, `a = X_{k|k} − C X_{k+1|k}`, `D = S_{k|k} − C Φ S_{k|k}` (that
-/// is, `S_{k|k} − C S_{k+1|k} Cᵀ`); an error names measurement `index` (`k + 1`).
+/// The backward step `T_k` from measurement `k + 1` to `k` ([`backward::map_into`]):
+/// `C = S_{k|k} Φᵀ S_{k+1|k}⁻¹` by the `L D Lᵀ` factors of `S_{k+1|k}`,
+/// `a = X_{k|k} − C X_{k+1|k}`, `D = S_{k|k} − C Φ S_{k|k}` (that is,
+/// `S_{k|k} − C S_{k+1|k} Cᵀ`); an error names measurement `index` (`k + 1`).
 pub(super) fn step(
     row: &Row,
     (phi, x_pred, s_pred): (&DMatrix<f64>, &DVector<f64>, &DMatrix<f64>),
     index: usize,
 ) -> Result<Map, Error> {
-    let chol = Cholesky::new(s_pred.clone()).ok_or_else(|| Error::InBatch {
+    let n = row.state.len();
+    let (mut a, mut d, mut c) = (
+        DVector::zeros(n),
+        DMatrix::zeros(n, n),
+        DMatrix::zeros(n, n),
+    );
+    let made = backward::map_into(
+        n,
+        (row.state.as_slice(), row.covariance.as_slice()),
+        (phi.as_slice(), x_pred.as_slice(), s_pred.as_slice()),
+        a.as_mut_slice(),
+        d.as_mut_slice(),
+        c.as_mut_slice(),
+    );
+    if !made {
+        return Err(not_positive_definite(s_pred.as_slice(), n, index));
+    }
+    Map { a, d, c: Some(c) }.finite(index)
+}
+
+/// The error of a smoothed estimate's entry `value` that is not finite.
+pub(super) fn not_finite(value: f64) -> Error {
+    Error::NonFinite {
+        what: "smoothed state or covariance entry",
+        value,
+    }
+}
+
+/// The error of a measurement at `time`, before the previous one's `previous`.
+pub(super) fn time_before(time: f64, previous: f64) -> Error {
+    Error::InvalidParameter {
+        name: Param::Time,
+        value: time.to_string(),
+        reason: format!("is before the previous measurement's {previous}"),
+    }
+}
+
+/// The error of a backward step whose `S_{k+1|k}` (`n × n`) is not positive definite, naming
+/// measurement `index`.
+pub(super) fn not_positive_definite(s_pred: &[f64], n: usize, index: usize) -> Error {
+    Error::InBatch {
         index,
         source: Box::new(Error::InvalidParameter {
             name: Param::PredictedCovariance,
-            value: format!("{s_pred:?}"),
+            value: format!("{:?}", DMatrix::from_column_slice(n, n, s_pred)),
             reason: "is not positive definite, so the smoother cannot weigh the later \
                      measurements (add driving noise, or avoid perfect observations)"
                 .into(),
         }),
-    })?;
-    let p = phi * &row.covariance;
-    // S_pred Cᵀ = Φ S_{k|k}.
-    let c = chol.solve(&p).transpose();
-    let mut d = &row.covariance - &c * p;
-    symmetrise(&mut d);
-    Map {
-        a: &row.state - &c * x_pred,
-        d,
-        c: Some(c),
     }
-    .finite(index)
 }
 
 /// The maps of the window, oldest first, in two stacks (sliding-window aggregation): `front`
@@ -351,26 +362,24 @@ impl<D: Dynamics + Clone, O: Observation + Clone> FixedLagSmoother<D, O> {
     pub fn push(&mut self, m: &Measurement) -> Result<Option<Smoothed>, Error> {
         if let Some((previous, _)) = self.last {
             if m.time.is_finite() && m.time < previous {
-                return Err(Error::InvalidParameter {
-                    name: Param::Time,
-                    value: m.time.to_string(),
-                    reason: format!("is before the previous measurement's {previous}"),
-                });
+                return Err(time_before(m.time, previous));
             }
         }
-        let before = self.filter.clone();
+        let before = self.filter.estimate_copy();
         let iterated = self.iterated;
         let step_forward = |filter: &mut KalmanFilter<D, O>| {
             let phi = filter.predict_with_transition(m.time)?;
             let predicted = (phi, filter.state().clone(), filter.covariance().clone());
-            let innovation = match iterated {
-                Some((tolerance, most)) => filter.update_iterated(m, tolerance, most)?,
-                None => filter.update(m)?,
+            let nis = match iterated {
+                Some((tolerance, most)) => {
+                    filter.update_iterated(m, tolerance, most)?.map(|i| i.nis)
+                }
+                None => filter.update_stats(m)?.map(|i| i.nis),
             };
-            Ok::<_, Error>((predicted, innovation.map(|i| i.nis)))
+            Ok::<_, Error>((predicted, nis))
         };
         let undo = |this: &mut Self, e: Error| {
-            this.filter = before.clone();
+            this.filter.restore_estimate(before.clone());
             Err(e)
         };
         let ((phi, x_pred, s_pred), nis) = match step_forward(&mut self.filter) {

@@ -32,6 +32,7 @@
 //! The radar tracking application over these filters is [`crate::track`].
 
 pub mod bank;
+mod backward;
 pub mod bayes;
 mod correct;
 pub mod discrete;

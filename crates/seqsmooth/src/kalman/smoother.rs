@@ -7,13 +7,16 @@
 //! `S_{k|N} = S_{k|k} + C_k (S_{k+1|N} − S_{k+1|k}) C_kᵀ`,
 //!
 //! on any times (`Φ` and `Q` of the actual step; for the extended filter `Φ` is the
-//! linearisation along the forward trajectory). `S_{k+1|k}⁻¹` is applied by its Cholesky
-//! factor. For linear models without driving noise the result at every time is the batch
+//! linearisation along the forward trajectory). `S_{k+1|k}⁻¹` is applied by its square-root-free
+//! Cholesky factors `L D Lᵀ`. For linear models without driving noise the result at every time is the batch
 //! minimum-variance estimate from the prior and all the measurements (tested against
 //! [`crate::estimate::gauss_newton`]).
 
+use super::backward::{map_into, smooth_into};
 use super::filter::KalmanFilter;
-use super::fixed_lag::{step, FixedLagSmoother, Map, Row};
+use super::fixed_lag::{
+    not_finite, not_positive_definite, step, time_before, FixedLagSmoother, Map, Row,
+};
 use crate::error::Error;
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::Measurement;
@@ -62,6 +65,275 @@ pub fn smooth<D: Dynamics + Clone, O: Observation + Clone>(
     measurements: &[Measurement],
 ) -> Result<Vec<Smoothed>, Error> {
     Smoother::new(filter).smooth(measurements)
+}
+
+/// Every measurement's smoothed and filtered estimates ([`smooth_flat`]) in flat buffers:
+/// measurement `k`'s state is `states[k n..(k + 1) n]` and its covariance
+/// `covariances[k n²..(k + 1) n²]` (column-major; symmetric, so row-major too), `n` the
+/// [`Self::dimension`]; likewise the filtered ones.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SmoothedRun {
+    /// The state dimension `n`.
+    pub dimension: usize,
+    /// The measurements' times.
+    pub times: Vec<f64>,
+    /// `X_{k|N}`, `n` a measurement.
+    pub states: Vec<f64>,
+    /// `S_{k|N}`, `n²` a measurement.
+    pub covariances: Vec<f64>,
+    /// The forward filter's `X_{k|k}`.
+    pub filtered_states: Vec<f64>,
+    /// The forward filter's `S_{k|k}`.
+    pub filtered_covariances: Vec<f64>,
+    /// The forward update's NIS (`None` where every component was missing).
+    pub nis: Vec<Option<f64>>,
+    /// The forward pass's predictions, kept for the backward pass (and their buffers for the
+    /// next run, [`smooth_flat_into`]): `Φ` at each measurement, `X_{k+1|k}` and `S_{k+1|k}`
+    /// at `k`.
+    phi: Vec<f64>,
+    x_pred: Vec<f64>,
+    s_pred: Vec<f64>,
+}
+
+impl SmoothedRun {
+    /// Empty buffers, for [`smooth_flat_into`] to fill.
+    ///
+    /// ```
+    /// use seqsmooth::kalman::smoother::SmoothedRun;
+    /// assert!(SmoothedRun::new().times.is_empty());
+    /// ```
+    pub fn new() -> Self {
+        Self {
+            dimension: 0,
+            times: Vec::new(),
+            states: Vec::new(),
+            covariances: Vec::new(),
+            filtered_states: Vec::new(),
+            filtered_covariances: Vec::new(),
+            nis: Vec::new(),
+            phi: Vec::new(),
+            x_pred: Vec::new(),
+            s_pred: Vec::new(),
+        }
+    }
+}
+
+impl Default for SmoothedRun {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// [`smooth`]'s numbers in flat buffers, with nothing allocated per measurement: the forward
+/// pass runs the filter and keeps each step's prediction `Φ`, `X_{k+1|k}`, `S_{k+1|k}`; the
+/// backward pass is the textbook recursion of the module's doc from the last estimate
+/// ([`backward::smooth_into`](super::backward), `S_{k+1|k}⁻¹` by its `L D Lᵀ` factors), the
+/// measurement-at-a-time [`Smoother`]'s numbers (its maps) to rounding, at about three quarters
+/// of its arithmetic. Errors as [`Smoother::smooth`]'s (the first in the order that smoother
+/// meets them).
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
+/// use seqsmooth::kalman::{smoother, KalmanFilter};
+/// use seqsmooth::model::dynamics::PolynomialDynamics;
+/// use seqsmooth::model::observation::LinearObservation;
+/// let f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+///     DVector::zeros(1), DMatrix::from_element(1, 1, 1e12), 0.0).unwrap();
+/// let rows: Vec<Measurement> = [1.0, 2.0, 6.0].iter().enumerate()
+///     .map(|(k, &y)| Measurement { time: k as f64, values: vec![Some(y)], noise: NoiseCovariance::Identity })
+///     .collect();
+/// let run = smoother::smooth_flat(f, &rows).unwrap();
+/// assert!(run.states.iter().all(|x| (x - 3.0).abs() < 1e-9)); // the mean, everywhere
+/// ```
+pub fn smooth_flat<D: Dynamics + Clone, O: Observation + Clone>(
+    filter: KalmanFilter<D, O>,
+    measurements: &[Measurement],
+) -> Result<SmoothedRun, Error> {
+    let mut run = SmoothedRun::new();
+    smooth_flat_into(filter, measurements, &mut run)?;
+    Ok(run)
+}
+
+/// [`smooth_flat`] into `run`, its buffers reused (cleared first; their capacity kept, so a
+/// run no longer than the last allocates nothing): the smoother of many series in turn.
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
+/// use seqsmooth::kalman::smoother::{smooth_flat, smooth_flat_into, SmoothedRun};
+/// use seqsmooth::kalman::KalmanFilter;
+/// use seqsmooth::model::dynamics::PolynomialDynamics;
+/// use seqsmooth::model::observation::LinearObservation;
+/// let f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+///     DVector::zeros(1), DMatrix::from_element(1, 1, 1e12), 0.0).unwrap();
+/// let rows: Vec<Measurement> = [1.0, 2.0, 6.0].iter().enumerate()
+///     .map(|(k, &y)| Measurement { time: k as f64, values: vec![Some(y)], noise: NoiseCovariance::Identity })
+///     .collect();
+/// let mut run = SmoothedRun::new();
+/// for _ in 0..2 {
+///     smooth_flat_into(f.clone(), &rows, &mut run).unwrap();
+/// }
+/// assert_eq!(run, smooth_flat(f, &rows).unwrap());
+/// ```
+pub fn smooth_flat_into<D: Dynamics + Clone, O: Observation + Clone>(
+    mut filter: KalmanFilter<D, O>,
+    measurements: &[Measurement],
+    run: &mut SmoothedRun,
+) -> Result<(), Error> {
+    let (n, count) = (filter.state().len(), measurements.len());
+    let nn = n * n;
+    run.dimension = n;
+    for v in [
+        &mut run.times,
+        &mut run.states,
+        &mut run.covariances,
+        &mut run.filtered_states,
+        &mut run.filtered_covariances,
+        &mut run.phi,
+        &mut run.x_pred,
+        &mut run.s_pred,
+    ] {
+        v.clear();
+    }
+    run.nis.clear();
+    // The prediction into measurement k + 1, at k: Φ, X_{k+1|k}, S_{k+1|k}.
+    let steps = count.saturating_sub(1);
+    let (mut phi, mut x_pred, mut s_pred) = (
+        std::mem::take(&mut run.phi),
+        std::mem::take(&mut run.x_pred),
+        std::mem::take(&mut run.s_pred),
+    );
+    phi.reserve(count * nn);
+    x_pred.reserve(steps * n);
+    s_pred.reserve(steps * nn);
+    run.filtered_states.reserve(count * n);
+    run.filtered_covariances.reserve(count * nn);
+    let result = passes(
+        &mut filter,
+        measurements,
+        run,
+        (&mut phi, &mut x_pred, &mut s_pred),
+    );
+    (run.phi, run.x_pred, run.s_pred) = (phi, x_pred, s_pred);
+    result
+}
+
+/// [`smooth_flat_into`]'s forward and backward passes into `run`, the predictions kept in
+/// `phi`, `x_pred`, `s_pred`.
+fn passes<D: Dynamics + Clone, O: Observation + Clone>(
+    filter: &mut KalmanFilter<D, O>,
+    measurements: &[Measurement],
+    run: &mut SmoothedRun,
+    (phi, x_pred, s_pred): (&mut Vec<f64>, &mut Vec<f64>, &mut Vec<f64>),
+) -> Result<(), Error> {
+    let (n, count) = (filter.state().len(), measurements.len());
+    let nn = n * n;
+    for (index, m) in measurements.iter().enumerate() {
+        let mut forward = |filter: &mut KalmanFilter<D, O>| {
+            if let Some(&previous) = run.times.last() {
+                if m.time.is_finite() && m.time < previous {
+                    return Err(time_before(m.time, previous));
+                }
+            }
+            match filter.predict_transition(m.time)? {
+                Some(transition) => phi.extend_from_slice(transition.as_slice()),
+                None => phi.extend((0..nn).map(|e| f64::from(u8::from(e % (n + 1) == 0)))),
+            }
+            if index > 0 {
+                x_pred.extend_from_slice(filter.state().as_slice());
+                s_pred.extend_from_slice(filter.covariance().as_slice());
+            }
+            Ok(filter.update_stats(m)?.map(|s| s.nis))
+        };
+        let nis = match forward(filter) {
+            Ok(nis) => nis,
+            Err(e) => {
+                let run = (&*run, &phi[..], &x_pred[..], &s_pred[..]);
+                return Err(first_map_error(run, index).unwrap_or(in_batch(index, e)));
+            }
+        };
+        run.times.push(m.time);
+        run.filtered_states
+            .extend_from_slice(filter.state().as_slice());
+        run.filtered_covariances
+            .extend_from_slice(filter.covariance().as_slice());
+        run.nis.push(nis);
+    }
+    if count == 0 {
+        return Ok(());
+    }
+    let last = count - 1;
+    run.states.resize(count * n, 0.0);
+    run.covariances.resize(count * nn, 0.0);
+    run.states[last * n..].copy_from_slice(&run.filtered_states[last * n..]);
+    run.covariances[last * nn..].copy_from_slice(&run.filtered_covariances[last * nn..]);
+    let mut c = vec![0.0; nn];
+    for k in (0..last).rev() {
+        let prediction = (
+            &phi[(k + 1) * nn..(k + 2) * nn],
+            &x_pred[k * n..(k + 1) * n],
+            &s_pred[k * nn..(k + 1) * nn],
+        );
+        let filtered = (
+            &run.filtered_states[k * n..(k + 1) * n],
+            &run.filtered_covariances[k * nn..(k + 1) * nn],
+        );
+        let (states, later) = run.states.split_at_mut((k + 1) * n);
+        let (covariances, later_s) = run.covariances.split_at_mut((k + 1) * nn);
+        let (x, s) = (&mut states[k * n..], &mut covariances[k * nn..]);
+        let next = (&later[..n], &later_s[..nn]);
+        let made = smooth_into(n, filtered, prediction, next, (&mut *x, &mut *s, &mut c));
+        let bad = x.iter().chain(s.iter()).find(|v| !v.is_finite()).copied();
+        if !made || bad.is_some() {
+            // The first error in the measurement-at-a-time smoother's order: a map that
+            // cannot be made, from the first; else this estimate's entry.
+            let found = first_map_error((&*run, &phi[..], &x_pred[..], &s_pred[..]), k + 2);
+            return Err(found.unwrap_or_else(|| in_batch(k, not_finite(bad.unwrap_or(f64::NAN)))));
+        }
+    }
+    Ok(())
+}
+
+/// `e` naming measurement `index`.
+fn in_batch(index: usize, e: Error) -> Error {
+    Error::InBatch {
+        index,
+        source: Box::new(e),
+    }
+}
+
+/// The first backward map among the steps into measurements `1..before` that cannot be made
+/// (`S_{k+1|k}` not positive definite, or a number that is not finite), as the
+/// measurement-at-a-time smoother reports it when that measurement is pushed.
+fn first_map_error(
+    (run, phi, x_pred, s_pred): (&SmoothedRun, &[f64], &[f64], &[f64]),
+    before: usize,
+) -> Option<Error> {
+    let n = run.dimension;
+    let nn = n * n;
+    let (mut a, mut d, mut c) = (vec![0.0; n], vec![0.0; nn], vec![0.0; nn]);
+    let made = x_pred.len() / n.max(1);
+    (1..before.min(made + 1)).find_map(|index| {
+        let k = index - 1;
+        let filtered = (
+            &run.filtered_states[k * n..index * n],
+            &run.filtered_covariances[k * nn..index * nn],
+        );
+        let prediction = (
+            &phi[index * nn..(index + 1) * nn],
+            &x_pred[k * n..index * n],
+            &s_pred[k * nn..index * nn],
+        );
+        if !map_into(n, filtered, prediction, &mut a, &mut d, &mut c) {
+            return Some(in_batch(
+                index,
+                not_positive_definite(&s_pred[k * nn..index * nn], n, index),
+            ));
+        }
+        let value = a.iter().chain(&d).find(|v| !v.is_finite())?;
+        Some(in_batch(index, in_batch(index, not_finite(*value))))
+    })
 }
 
 /// The smoother a measurement at a time: the forward pass as the measurements come

@@ -69,6 +69,7 @@ use std::sync::Arc;
 mod innovation;
 mod iterated;
 mod saved;
+mod undo;
 pub use innovation::{Innovation, InnovationStats};
 pub use iterated::check_iteration_limits;
 
