@@ -122,11 +122,19 @@ impl StreamState {
         };
         if s.kind != given.kind {
             let (a, b) = (given.kind.name(), s.kind.name());
-            return differs(Param::Configuration, format!("kind {a}"), format!("kind {b}"));
+            return differs(
+                Param::Configuration,
+                format!("kind {a}"),
+                format!("kind {b}"),
+            );
         }
         if s.engine != given.engine {
             let (a, b) = (format!("{:?}", given.engine), format!("{:?}", s.engine));
-            return differs(Param::Configuration, format!("engine {a}"), format!("engine {b}"));
+            return differs(
+                Param::Configuration,
+                format!("engine {a}"),
+                format!("engine {b}"),
+            );
         }
         if s.series != given.series {
             let what = |many: bool| if many { "an id column" } else { "no id column" };
@@ -137,10 +145,18 @@ impl StreamState {
             );
         }
         let pairs = [
-            (Param::Degree, Some(given.degree as f64), Some(s.degree as f64)),
+            (
+                Param::Degree,
+                Some(given.degree as f64),
+                Some(s.degree as f64),
+            ),
             (Param::Theta, given.theta, s.theta),
             (Param::Tau, given.tau, s.tau),
-            (Param::Window, given.window.map(|w| w as f64), s.window.map(|w| w as f64)),
+            (
+                Param::Window,
+                given.window.map(|w| w as f64),
+                s.window.map(|w| w as f64),
+            ),
             (Param::Sigma, given.sigma, s.sigma),
             (
                 Param::ReviewWindow,
