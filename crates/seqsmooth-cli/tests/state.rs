@@ -131,13 +131,28 @@ fn pieces_match(args: &[&str], series: usize, n: usize, seed: u64) {
 fn ten_pieces_give_the_unbroken_rows_for_every_kind() {
     let kinds: &[&[&str]] = &[
         &["--kind", "expanding", "--degree", "2"],
-        &["--kind", "expanding", "--degree", "1", "--sigma", "0.3", "--engine", "gain"],
+        &[
+            "--kind",
+            "expanding",
+            "--degree",
+            "1",
+            "--sigma",
+            "0.3",
+            "--engine",
+            "gain",
+        ],
         &["--kind", "fading", "--degree", "2", "--theta", "0.9"],
-        &["--kind", "fading", "--degree", "1", "--theta", "0.8", "--sigma", "0.5", "--lead", "2"],
+        &[
+            "--kind", "fading", "--degree", "1", "--theta", "0.8", "--sigma", "0.5", "--lead", "2",
+        ],
         &["--kind", "fixed", "--degree", "2", "--window", "15"],
-        &["--kind", "fixed", "--degree", "1", "--window", "6", "--sigma", "0.5"],
+        &[
+            "--kind", "fixed", "--degree", "1", "--window", "6", "--sigma", "0.5",
+        ],
         &["--kind", "auto", "--degree", "2", "--theta", "0.9"],
-        &["--kind", "auto", "--degree", "1", "--theta", "0.95", "--sigma", "0.3"],
+        &[
+            "--kind", "auto", "--degree", "1", "--theta", "0.95", "--sigma", "0.3",
+        ],
     ];
     for (k, args) in kinds.iter().enumerate() {
         for (series, n) in [(1, 600), (7, 3000)] {
@@ -170,12 +185,33 @@ fn other_options_and_damaged_states_are_refused() {
     let before = std::fs::read(&path).unwrap();
     let f = "filter";
     let other = [
-        (vec![f, "--kind", "fading", "--degree", "2", "--theta", "0.8"], "--theta"),
-        (vec![f, "--kind", "fading", "--degree", "1", "--theta", "0.9"], "--degree"),
-        (vec![f, "--kind", "fading", "--degree", "2", "--theta", "0.9", "--tau", "2"], "--tau"),
+        (
+            vec![f, "--kind", "fading", "--degree", "2", "--theta", "0.8"],
+            "--theta",
+        ),
+        (
+            vec![f, "--kind", "fading", "--degree", "1", "--theta", "0.9"],
+            "--degree",
+        ),
+        (
+            vec![
+                f, "--kind", "fading", "--degree", "2", "--theta", "0.9", "--tau", "2",
+            ],
+            "--tau",
+        ),
         (vec![f, "--kind", "expanding", "--degree", "2"], "kind"),
-        (vec![f, "--kind", "fading", "--degree", "2", "--theta", "0.9", "--lead", "1"], "--lead"),
-        (vec![f, "--kind", "fading", "--degree", "2", "--theta", "0.9", "--sigma", "1"], "--sigma"),
+        (
+            vec![
+                f, "--kind", "fading", "--degree", "2", "--theta", "0.9", "--lead", "1",
+            ],
+            "--lead",
+        ),
+        (
+            vec![
+                f, "--kind", "fading", "--degree", "2", "--theta", "0.9", "--sigma", "1",
+            ],
+            "--sigma",
+        ),
     ];
     for (mut a, word) in other {
         a.extend_from_slice(&["--state", p]);
@@ -187,7 +223,11 @@ fn other_options_and_damaged_states_are_refused() {
     a.extend_from_slice(&args);
     let o = run(&a, &back);
     assert_eq!(o.code, 1, "{}", o.stderr);
-    assert_eq!(std::fs::read(&path).unwrap(), before, "a failed run changed the state");
+    assert_eq!(
+        std::fs::read(&path).unwrap(),
+        before,
+        "a failed run changed the state"
+    );
     // One byte changed, the file cut short, another file: refused naming the file.
     for damage in [0usize, 1, 2] {
         let mut bytes = before.clone();
@@ -198,7 +238,11 @@ fn other_options_and_damaged_states_are_refused() {
         }
         std::fs::write(&path, &bytes).unwrap();
         fails(&a, &rest, 1, &["state file", p]);
-        assert_eq!(std::fs::read(&path).unwrap(), bytes, "a refused state was overwritten");
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            bytes,
+            "a refused state was overwritten"
+        );
     }
     std::fs::remove_file(&path).unwrap();
 }

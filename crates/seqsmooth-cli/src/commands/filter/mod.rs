@@ -177,7 +177,10 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     let shown = ((a.degree + 1) << usize::from(sigma)) + extra.len();
     let stride = prototype.stride(layout);
     let (mut held, bank) = match saved {
-        Some(s) => (held::Held::restore(s.pending), StreamBank::resume(prototype, s.filters)),
+        Some(s) => (
+            held::Held::restore(s.pending),
+            StreamBank::resume(prototype, s.filters),
+        ),
         None => (held::Held::default(), StreamBank::growing(prototype)),
     };
     let mut bank = bank.map_err(CliError::from)?;
@@ -278,7 +281,11 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
                     let Some(path) = &a.state else { return Ok(()) };
                     let saved = StreamState {
                         options,
-                        ids: if a.id_col.is_some() { raw_ids } else { Vec::new() },
+                        ids: if a.id_col.is_some() {
+                            raw_ids
+                        } else {
+                            Vec::new()
+                        },
                         filters: bank.into_channels(),
                         pending: held.save(),
                     };
