@@ -9,26 +9,8 @@
 //! possibly empty or a single row.
 
 mod common;
-use common::{fails, run, tmp};
+use common::{fails, run, tmp, Rng};
 use std::path::Path;
-
-/// xorshift64*: deterministic test data.
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        let mut x = self.0;
-        x ^= x >> 12;
-        x ^= x << 25;
-        x ^= x >> 27;
-        self.0 = x;
-        (x.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.uniform() * n as f64) as usize % n
-    }
-}
 
 /// `n` rows of `series` interleaved series (ids `s0`, `s1`, … when more than one): a cubic with
 /// noise, steps of 1 mostly (so that the default τ of any first piece is 1), some of 0.5 and
