@@ -38,6 +38,7 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 mod impls;
+pub mod stream;
 
 pub use impls::SavedModel;
 

@@ -68,6 +68,19 @@ pub struct FilterArgs {
     /// and the input is larger than one chunk of rows)
     #[arg(long)]
     pub no_progress: bool,
+    /// Resume from FILE and save to it: the filters' state (each series' filter, the options,
+    /// the automatic filter's rows still waiting for their outlier decision) is read from FILE
+    /// if it exists and written to it at the end (atomically: a new file renamed over the old),
+    /// so that a stream cut into files, each run with the same --state FILE, gives the rows of
+    /// the unbroken run. A state made with other options is refused, naming the option; a
+    /// damaged one is refused; a run that fails leaves FILE as it was
+    #[arg(long, value_name = "FILE")]
+    pub state: Option<PathBuf>,
+    /// With --state: this input ends the stream, so the automatic filter decides its rows still
+    /// waiting for their outlier decision and writes them (without it they wait in FILE for the
+    /// next input, as in an unbroken run)
+    #[arg(long = "final", requires = "state")]
+    pub end: bool,
     /// Rows read, filtered and written at a time (testing aid)
     #[arg(long, value_name = "N", hide = true, default_value_t = CHUNK_ROWS,
           value_parser = clap::value_parser!(u32).range(1..))]

@@ -37,6 +37,8 @@ pub struct Chunk {
     /// The ids of the series first seen in this chunk, in order of their index, as CSV output
     /// cells (quoted where needed).
     pub new_ids: Vec<Vec<u8>>,
+    /// The same ids as read (for a saved state, `--state`).
+    pub new_raw_ids: Vec<Vec<u8>>,
     /// Why reading stopped before the chunk was full, other than the end of the input: the
     /// error of the row after the last one.
     pub error: Option<CliError>,
@@ -141,6 +143,7 @@ impl Chunk {
         self.cells.clear();
         self.text.clear();
         self.new_ids.clear();
+        self.new_raw_ids.clear();
         self.error = None;
         self.done = false;
     }
@@ -277,6 +280,17 @@ impl<S: Records> RowReader<S> {
         chunk.rows_read = self.rows_read;
     }
 
+    /// The series `ids` (as read) known already, in order of their index, as a resumed run
+    /// knows them from its saved state; returns them as CSV output cells.
+    pub fn resume_ids(&mut self, ids: &[Vec<u8>]) -> Vec<Vec<u8>> {
+        for id in ids {
+            self.index.insert(id.clone(), self.ids.len());
+            self.ids.push(String::from_utf8_lossy(id).into_owned());
+            self.newest.push(None);
+        }
+        ids.iter().map(|id| csv_field(id)).collect()
+    }
+
     /// How the id column's values are typed (text for CSV).
     pub fn id_type(&self) -> IdType {
         self.csv.id_type()
@@ -303,6 +317,7 @@ impl<S: Records> RowReader<S> {
         self.ids.push(String::from_utf8_lossy(id).into_owned());
         self.newest.push(None);
         chunk.new_ids.push(csv_field(id));
+        chunk.new_raw_ids.push(id.to_vec());
         Ok(s)
     }
 

@@ -104,3 +104,23 @@ pub const T9_02: &str = "t,y\n0,1\n1,3\n2,2\n3,5\n4,4\n";
 /// Morrison test vector T7-08: Y = (y_n, …, y_{n-4}) = (5, 3, 4, 2, 1), newest first, so
 /// the CSV (oldest first) is y = 1, 2, 4, 3, 5 at t = 0..4.
 pub const T7_08: &str = "t,y\n0,1\n1,2\n2,4\n3,3\n4,5\n";
+
+/// xorshift64*: deterministic test data.
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// Uniform on `[0, 1)`.
+    pub fn uniform(&mut self) -> f64 {
+        let mut x = self.0;
+        x ^= x >> 12;
+        x ^= x << 25;
+        x ^= x >> 27;
+        self.0 = x;
+        (x.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform on `0..n`.
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.uniform() * n as f64) as usize % n
+    }
+}

@@ -167,6 +167,32 @@ impl PolynomialFit {
         self.samples
     }
 
+    /// A fit from its parts: the basis' `(centre, half width)`, the Legendre coefficients,
+    /// the QR factor `R` they solve, the residual sum of squares and the sample count.
+    pub(crate) fn from_parts(
+        degree: usize,
+        (centre, half_width): (f64, f64),
+        coeffs: DVector<f64>,
+        r: DMatrix<f64>,
+        residual_sq: f64,
+        samples: usize,
+    ) -> Self {
+        Self {
+            degree,
+            centre,
+            half_width,
+            coeffs,
+            r,
+            residual_sq,
+            samples,
+        }
+    }
+
+    /// The map from the coefficients to the derivatives at `t`.
+    pub(crate) fn jacobian_at(&self, t: f64) -> DMatrix<f64> {
+        self.jacobian(t)
+    }
+
     fn jacobian(&self, t: f64) -> DMatrix<f64> {
         // Row k maps the Legendre coefficients to the k-th derivative at t.
         let u = (t - self.centre) / self.half_width;

@@ -15,6 +15,7 @@ use crate::model::radar::Radar;
 use crate::paml::{OnlineSmoother, SmootherGains};
 use crate::polynomial::automatic::AutomaticFilter;
 use crate::polynomial::bank::{ExpandingBank, FadingBank};
+use crate::polynomial::merge::Information;
 use crate::polynomial::spec::{AnyFilter, FilterKind, Inner};
 use crate::polynomial::PolynomialFilter;
 use crate::track::RadarTracker;
@@ -161,6 +162,7 @@ persist_plain!(
     LinearKalmanFilter => "LinearKalmanFilter",
     LinearFixedLag => "LinearFixedLag",
     RadarTracker => "RadarTracker",
+    Information => "Information",
 );
 
 impl<G> Persist for OnlineSmoother<G>

@@ -94,6 +94,7 @@ pub mod fading;
 mod filter;
 pub mod fixed;
 pub mod form;
+pub mod merge;
 mod options;
 pub mod prior;
 pub mod rows;

@@ -309,6 +309,33 @@ impl<F: PolynomialFilter + Clone> StreamBank<F> {
         Err(failure(failed))
     }
 
+    /// A growing bank ([`growing`](Self::growing)) resumed with the channels' filters
+    /// `channels` (e.g. read back from a saved state), new channels starting from `prototype`.
+    ///
+    /// ```
+    /// use seqsmooth::polynomial::stream::StreamBank;
+    /// use seqsmooth::{Engine, ExpandingMemory, PolynomialFilter};
+    /// let proto = ExpandingMemory::new(0, Engine::Exact)?;
+    /// let mut a = StreamBank::growing(proto.clone())?;
+    /// a.update_channel(0, &[0.0, 1.0], &[2.0, 4.0]).ok(); // a growing bank has no channel yet
+    /// let mut one = proto.clone();
+    /// one.update_many(&[0.0, 1.0], &[2.0, 4.0])?;
+    /// let mut b = StreamBank::resume(proto, vec![one])?;
+    /// b.update_channel(0, &[2.0], &[6.0])?;
+    /// assert_eq!(b.into_channels()[0].estimate().unwrap().derivatives[0], 4.0);
+    /// # Ok::<(), seqsmooth::Error>(())
+    /// ```
+    pub fn resume(prototype: F, channels: Vec<F>) -> Result<Self, Error> {
+        let mut bank = Self::growing(prototype)?;
+        bank.filters = channels;
+        Ok(bank)
+    }
+
+    /// The channels' filters, in channel order (to save them).
+    pub fn into_channels(self) -> Vec<F> {
+        self.filters
+    }
+
     /// Number of channels.
     pub fn channels(&self) -> usize {
         self.filters.len()

@@ -10,11 +10,14 @@
 
 use crate::error::CliError;
 use crate::io::Output;
+use seqsmooth::persist::stream::PendingRow;
 use seqsmooth::polynomial::rows::Undecided;
 use std::collections::VecDeque;
 
 /// One formatted row and where its `outlier` cell is.
 struct Row {
+    /// The row's series.
+    series: usize,
     bytes: Vec<u8>,
     /// Byte offset of the `outlier` cell while its decision is to come.
     open: Option<usize>,
@@ -51,6 +54,7 @@ impl Held {
         let open = outlier_offset(&bytes, trailing);
         let index = self.first + self.rows.len();
         self.rows.push_back(Row {
+            series,
             bytes,
             open,
             waiting: true,
@@ -63,6 +67,35 @@ impl Held {
     pub fn decide(&mut self, series: usize, verdicts: &[bool]) {
         let (rows, first) = (&mut self.rows, self.first);
         (self.open).decide(series, verdicts, |i, r| rows[i - first].decide(r));
+    }
+
+    /// The rows held, to save with the filters (`--state`).
+    pub fn save(&self) -> Vec<PendingRow> {
+        let row = |r: &Row| PendingRow {
+            series: r.series,
+            bytes: r.bytes.clone(),
+            cell: r.open,
+            waiting: r.waiting,
+        };
+        self.rows.iter().map(row).collect()
+    }
+
+    /// The rows a saved state held, in order, held again.
+    pub fn restore(rows: Vec<PendingRow>) -> Self {
+        let mut held = Self::default();
+        for r in rows {
+            let index = held.rows.len();
+            if r.waiting {
+                held.open.push(r.series, index, &[], |_, _| {});
+            }
+            held.rows.push_back(Row {
+                series: r.series,
+                bytes: r.bytes,
+                open: r.cell,
+                waiting: r.waiting,
+            });
+        }
+        held
     }
 
     /// Writes the rows up to the first undecided one.

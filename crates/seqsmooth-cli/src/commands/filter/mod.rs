@@ -14,6 +14,7 @@
 //! decision is final, a few samples of their series later (`held`).
 
 mod held;
+mod state;
 
 use crate::args::{check_window, name, only, EngineArg, FilterArgs, Kind, CHUNK_ROWS};
 use crate::commands::shared::{filter_kind, LOOKAHEAD};
@@ -24,6 +25,7 @@ use crate::io::rows::{Chunk, RowReader};
 use crate::io::{check_distinct, input_size, named, open_input, CsvIn, Need, Output};
 use crate::io::{IdType, Records};
 use rayon::prelude::*;
+use seqsmooth::persist::stream::{StreamOptions, StreamState};
 use seqsmooth::polynomial::rows::{decisions, RowLayout};
 use seqsmooth::polynomial::spec::{AnyFilter, FilterSpec};
 use seqsmooth::polynomial::stream::{self, StreamBank};
@@ -113,6 +115,10 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         &need,
     )?;
     let id_type = a.id_col.as_ref().map(|_| reader.id_type());
+    // A saved state (--state): its series keep their indices, its filters their samples.
+    let saved = a.state.as_deref().map(state::read).transpose()?.flatten();
+    let mut raw_ids = saved.as_ref().map_or_else(Vec::new, |s| s.ids.clone());
+    let mut ids = reader.resume_ids(&raw_ids);
     // A fixed-memory window longer than LOOKAHEAD is read in full before the first output row:
     // its rows have no estimate, and an input shorter than the window is an error.
     let hold = LOOKAHEAD.max(need.rows);
@@ -132,8 +138,11 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     if let Some(e) = chunk.error.take_if(|_| early) {
         return Err(e);
     }
-    need.check(chunk.len())?;
-    let tau = match a.tau {
+    if saved.is_none() {
+        need.check(chunk.len())?;
+    }
+    // A resumed stream keeps the τ its first run decided.
+    let tau = match a.tau.or(saved.as_ref().and_then(|s| s.options.tau)) {
         Some(tau) => tau,
         None if tau_needed => default_tau(&chunk, chunk.len().min(hold.max(scan)))?,
         None => 1.0,
@@ -148,6 +157,11 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
         ..FilterSpec::new(filter_kind(a.kind), a.degree)
     };
     let prototype = spec.build().map_err(CliError::from)?;
+    let options = StreamOptions::of(&spec, a.lead, a.id_col.is_some());
+    if let (Some(s), Some(path)) = (&saved, &a.state) {
+        let refuse = |e| CliError::from(e).reworded(|m| state::in_file(path, &m));
+        s.check_options(&options).map_err(refuse)?;
+    }
     // The automatic filter always writes s0..sM (from the given or the estimated noise).
     let sigma = spec.writes_sigma();
     let lead = a.lead;
@@ -162,9 +176,18 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     let auto = a.kind == Kind::Auto;
     let shown = ((a.degree + 1) << usize::from(sigma)) + extra.len();
     let stride = prototype.stride(layout);
-    let mut held = held::Held::default();
-    let mut bank = StreamBank::growing(prototype).map_err(CliError::from)?;
-    let (mut ids, mut values, mut out) = (Vec::new(), Vec::new(), None);
+    let (mut held, bank) = match saved {
+        Some(s) => (
+            held::Held::restore(s.pending),
+            StreamBank::resume(prototype, s.filters),
+        ),
+        None => (held::Held::default(), StreamBank::growing(prototype)),
+    };
+    let mut bank = bank.map_err(CliError::from)?;
+    // With --state and without --final the stream goes on in the next input: the automatic
+    // filter's undecided rows wait in the state, as they would wait for the next rows.
+    let goes_on = a.state.is_some() && !a.end;
+    let (mut values, mut out) = (Vec::new(), None);
     let mut progress = Progress::hidden();
     // The rest of the input is read on a thread of its own, a chunk ahead.
     let mut pipeline = (!chunk.done && chunk.error.is_none()).then(|| {
@@ -178,6 +201,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
     columns.extend(lead_cells.iter().map(|_| "lead"));
     for first in std::iter::once(true).chain(std::iter::repeat(false)) {
         ids.append(&mut chunk.new_ids);
+        raw_ids.append(&mut chunk.new_raw_ids);
         values.resize(chunk.len() * stride, 0.0);
         // The library's rows, each refused row (no estimate once determined, a number beyond
         // the double range) the error of its row: right or refused.
@@ -217,7 +241,7 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
                 let decided = decisions(&row[shown..]);
                 held.push(chunk.series[i], buf, 2 + lead_cells.len(), &decided);
             }
-            if failed.is_none() && chunk.error.is_none() && chunk.done {
+            if failed.is_none() && chunk.error.is_none() && chunk.done && !goes_on {
                 // The input is complete: every series decides its samples still waiting.
                 for series in 0..bank.channels() {
                     if let Some(f) = bank.channel_mut(series).and_then(AnyFilter::automatic_mut) {
@@ -243,13 +267,30 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             }
         }
         if failed.is_some() || chunk.error.is_some() || chunk.done {
-            // Stopped early: the rows still undecided keep the gate's verdict.
-            held.flush_all(sink)?;
+            let ok = failed.is_none() && chunk.error.is_none();
+            if !(ok && goes_on) {
+                // Stopped early: the rows still undecided keep the gate's verdict.
+                held.flush_all(sink)?;
+            }
             return match (failed, chunk.error.take()) {
                 // Dropped unfinished: standard output keeps the rows before the error, a
-                // file is not written.
+                // file is not written, nor the state.
                 (Some((_, e)), _) | (None, Some(e)) => Err(e),
-                (None, None) => out.take().map_or(Ok(()), Output::finish),
+                (None, None) => {
+                    out.take().map_or(Ok(()), Output::finish)?;
+                    let Some(path) = &a.state else { return Ok(()) };
+                    let saved = StreamState {
+                        options,
+                        ids: if a.id_col.is_some() {
+                            raw_ids
+                        } else {
+                            Vec::new()
+                        },
+                        filters: bank.into_channels(),
+                        pending: held.save(),
+                    };
+                    state::write(path, &saved)
+                }
             };
         }
         if first && progress::wanted(a.no_progress) {

@@ -261,6 +261,12 @@ impl TriangularFactor {
         self.residual_sq
     }
 
+    /// Adds `r` to the residual sum of squares: another factor's, when its rows are folded
+    /// into this one (the residuals of disjoint samples add).
+    pub fn add_residual_sq(&mut self, r: f64) {
+        self.residual_sq += r;
+    }
+
     /// `RᵀR = UᵀDU`.
     pub fn gram(&self) -> DMatrix<f64> {
         let r = self.r();
