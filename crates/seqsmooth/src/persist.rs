@@ -38,8 +38,10 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 mod impls;
+mod left_out;
 
-pub use impls::SavedModel;
+pub use impls::{Beside, SavedModel};
+pub use left_out::{DynamicsLeftOut, ObservationLeftOut};
 
 /// The envelope's magic tag.
 pub const MAGIC: [u8; 8] = *b"SEQSMST\0";

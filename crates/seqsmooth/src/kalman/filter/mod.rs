@@ -70,7 +70,8 @@ mod innovation;
 mod iterated;
 mod saved;
 pub use innovation::{Innovation, InnovationStats};
-pub use iterated::check_iteration_limits;
+pub use iterated::{check_iteration_limits, IterationLimits};
+pub(crate) use saved::same_shape;
 
 /// A Kalman filter on `D` and `O`, with optional driving noise.
 ///
