@@ -246,6 +246,18 @@ def online_run(f, rows):
     return (outputs(f.polynomial_samples()) if done else []) + [np.asarray(f.taken)]
 
 
+def sliding_polynomial(rng):
+    degree = int(rng.integers(0, 3))
+    epoch = str(rng.choice(["end", "centre"]))
+    window = int(rng.integers(degree + 2, 12))
+    return ss.SlidingFit("polynomial", degree=degree, window=window, sigma=0.1, epoch=epoch)
+
+
+def sliding_run(f, rows):
+    out = outputs(f.update_many(rows[:, 0], *rows[:, 1:].T))
+    return out + [np.asarray(f.rows_taken), np.asarray(repr(f))]
+
+
 def tracker(method):
     extra = {"smooth": {"lag": 3}, "window": {"window": 8}}.get(method, {})
     return lambda rng: ss.RadarTracker(method, sigma_range=10.0, sigma_angle=1e-3, **extra)
@@ -332,6 +344,19 @@ CASES = [
     ("ContinuousKalmanFilter", continuous_make, kalman_data, continuous_run),
     ("ExtendedKalmanFilter", extended_make, kalman_data, kalman_run),
     ("UnscentedKalmanFilter-callables", unscented_user_make, kalman_data, kalman_run),
+    ("SlidingFit-polynomial", sliding_polynomial, poly_data, sliding_run),
+    (
+        "SlidingFit-radar",
+        lambda rng: ss.SlidingFit(
+            "radar",
+            sigma_range=10.0,
+            sigma_angle=1e-3,
+            window=int(rng.integers(4, 10)),
+            azimuth=str(rng.choice(["from-x", "bearing"])),
+        ),
+        radar_data,
+        sliding_run,
+    ),
 ]
 
 

@@ -4,6 +4,7 @@
 use super::Persist;
 use crate::kalman::bayes::BayesFilter;
 use crate::kalman::discrete::{DiscreteDynamics, LinearFixedLag, LinearKalmanFilter};
+use crate::estimate::sliding::{Fitter, RowNoise};
 use crate::kalman::filter::{IterationLimits, KalmanFilter};
 use crate::kalman::fixed_lag::FixedLagSmoother;
 use crate::kalman::unscented::UnscentedKalmanFilter;
@@ -170,6 +171,7 @@ persist_plain!(
     LinearKalmanFilter => "LinearKalmanFilter",
     LinearFixedLag => "LinearFixedLag",
     RadarTracker => "RadarTracker",
+    Fitter => "SlidingFit",
 );
 
 impl<G> Persist for OnlineSmoother<G>
@@ -268,5 +270,16 @@ impl Beside for IterationLimits {
 
     fn check_beside(&self) -> Result<(), String> {
         self.check().map_err(|e| format!("iteration limits: {e}"))
+    }
+}
+
+/// A sliding fit's row noise, its σ usable ([`RowNoise::check`]).
+impl Beside for RowNoise {
+    fn name() -> String {
+        "RowNoise".into()
+    }
+
+    fn check_beside(&self) -> Result<(), String> {
+        self.check()
     }
 }
