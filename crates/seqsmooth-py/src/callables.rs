@@ -17,16 +17,16 @@
 use crate::arrays::matrix;
 use crate::errors::{raise, IntoPy, Kind};
 use crate::fixed_lag::lagged;
-use crate::persist;
 use crate::kalman::{before, measurement, measurements, out_of_order, square, PyInnovation};
+use crate::persist;
 use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::error::Param;
+use seqsmooth::kalman::filter::IterationLimits;
 use seqsmooth::kalman::noise::{check_covariance, MatrixNoise, ProcessNoise};
 use seqsmooth::kalman::saved_noise::SavedNoise;
-use seqsmooth::kalman::filter::IterationLimits;
 use seqsmooth::kalman::{smoother, FixedLagSmoother, KalmanFilter};
 use seqsmooth::model::dynamics::{Dynamics, Propagation};
 use seqsmooth::model::measurement::Measurement;
@@ -581,8 +581,14 @@ pub(crate) fn callables_of<'py>(
         None => (obj(f), obj(jacobian), obj(None), obj(None)),
         Some(_) => (obj(None), obj(None), obj(f), obj(jacobian)),
     };
-    let (h, h_jacobian) = (obj(Some(&observation.h)), obj(observation.jacobian.as_ref()));
-    PyTuple::new(py, [f, f_jacobian, dxdt, dxdt_jacobian, h, h_jacobian, obj(q)])
+    let (h, h_jacobian) = (
+        obj(Some(&observation.h)),
+        obj(observation.jacobian.as_ref()),
+    );
+    PyTuple::new(
+        py,
+        [f, f_jacobian, dxdt, dxdt_jacobian, h, h_jacobian, obj(q)],
+    )
 }
 
 /// The library's stand-ins a filter over the caller's model is saved over: its states, its
@@ -617,7 +623,9 @@ pub(crate) fn model_again(
         return Err(persist::damaged("the observation h is missing"));
     };
     if q.as_ref().is_some_and(|q| !q.is_callable()) {
-        return Err(persist::damaged("the driving noise Q beside the bytes is not callable"));
+        return Err(persist::damaged(
+            "the driving noise Q beside the bytes is not callable",
+        ));
     }
     let transition = Transition {
         f: f.as_ref(),
@@ -798,13 +806,17 @@ impl PyExtendedKalmanFilter {
     #[staticmethod]
     fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
         let items = persist::items(state, 2)?;
-        let (mut bare, limits): (KalmanFilter<DynamicsLeftOut, ObservationLeftOut>, IterationLimits) =
-            persist::load(&items.get_item(0)?)?;
+        let (mut bare, limits): (
+            KalmanFilter<DynamicsLeftOut, ObservationLeftOut>,
+            IterationLimits,
+        ) = persist::load(&items.get_item(0)?)?;
         let (d, o) = bare.models();
         let model = model_again(&items.get_item(1)?, d, o)?;
         let (components, q) = (model.observation.components(), model.q_callable());
         if q.is_some() && bare.take_process_noise().is_some() {
-            return Err(persist::damaged("the driving noise is both in the bytes and beside them"));
+            return Err(persist::damaged(
+                "the driving noise is both in the bytes and beside them",
+            ));
         }
         let mut filter = bare.with_models(model.dynamics, model.observation).py()?;
         if let Some(noise) = model.noise {

@@ -500,7 +500,13 @@ impl PySlidingFit {
             }
             Fitter::Polynomial(f) => {
                 let d = f.models().0;
-                ("polynomial", d.degree(), f.window(), f.epoch(), d.dimension())
+                (
+                    "polynomial",
+                    d.degree(),
+                    f.window(),
+                    f.epoch(),
+                    d.dimension(),
+                )
             }
         };
         let taken = usize::try_from(rows.rows)

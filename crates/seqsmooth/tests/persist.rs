@@ -389,11 +389,20 @@ fn filters_saved_with_their_models_left_out_resume_bit_for_bit() {
     let run = |f: &mut KalmanFilter<PolynomialDynamics, LinearObservation>, from: usize| {
         let mut out = Vec::new();
         for (k, &(t, y)) in rows.iter().enumerate().skip(from) {
-            out.push(format!("{:?} {:?}", f.update(&measurement(t, y, missing(k))), f.covariance()));
+            out.push(format!(
+                "{:?} {:?}",
+                f.update(&measurement(t, y, missing(k))),
+                f.covariance()
+            ));
         }
         out
     };
-    let stand_ins = || (DynamicsLeftOut::new(2), ObservationLeftOut::new(2, Angles::new(1, &[]).unwrap()));
+    let stand_ins = || {
+        (
+            DynamicsLeftOut::new(2),
+            ObservationLeftOut::new(2, Angles::new(1, &[]).unwrap()),
+        )
+    };
     for cut in [1, 17, 39] {
         let mut f = at_rest(PolynomialDynamics::new(1, 1))
             .with_process_noise(WhiteNoiseDerivative::new(1, 1, 0.05).unwrap())
@@ -409,9 +418,15 @@ fn filters_saved_with_their_models_left_out_resume_bit_for_bit() {
         let mut back: KalmanFilter<DynamicsLeftOut, ObservationLeftOut> =
             from_bytes(&to_bytes(&bare).unwrap()).unwrap();
         assert!(back.predict(1e9).is_err(), "a stand-in runs");
-        assert!(back.clone().with_models(PolynomialDynamics::new(2, 1), position()).is_err());
-        let mut g = back.with_models(PolynomialDynamics::new(1, 1), position()).unwrap();
-        g.set_process_noise(WhiteNoiseDerivative::new(1, 1, 0.05).unwrap()).unwrap();
+        assert!(back
+            .clone()
+            .with_models(PolynomialDynamics::new(2, 1), position())
+            .is_err());
+        let mut g = back
+            .with_models(PolynomialDynamics::new(1, 1), position())
+            .unwrap();
+        g.set_process_noise(WhiteNoiseDerivative::new(1, 1, 0.05).unwrap())
+            .unwrap();
         assert_eq!(run(&mut f, cut), run(&mut g, cut));
     }
     let mut u = UnscentedKalmanFilter::new(
@@ -429,7 +444,9 @@ fn filters_saved_with_their_models_left_out_resume_bit_for_bit() {
     let bare = u.clone().with_models(d, o).unwrap();
     let back: UnscentedKalmanFilter<DynamicsLeftOut, ObservationLeftOut> =
         from_bytes(&to_bytes(&bare).unwrap()).unwrap();
-    let mut v = back.with_models(PolynomialDynamics::new(1, 1), position()).unwrap();
+    let mut v = back
+        .with_models(PolynomialDynamics::new(1, 1), position())
+        .unwrap();
     for (k, &(t, y)) in rows.iter().enumerate().skip(20) {
         let m = measurement(t, y, missing(k));
         assert_eq!(format!("{:?}", u.update(&m)), format!("{:?}", v.update(&m)));

@@ -293,10 +293,16 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
         } = self.solver;
         super::gauss_newton::check_max_iterations(max_iterations).map_err(text)?;
         if !(tolerance.is_finite() && tolerance > 0.0) || max_halvings > 64 {
-            return Err(format!("limits: tolerance {tolerance}, {max_halvings} halvings"));
+            return Err(format!(
+                "limits: tolerance {tolerance}, {max_halvings} halvings"
+            ));
         }
         if self.observation.state_dimension() != n || self.rows.len() > self.window {
-            return Err(format!("window of {} rows over {}", self.rows.len(), self.window));
+            return Err(format!(
+                "window of {} rows over {}",
+                self.rows.len(),
+                self.window
+            ));
         }
         let mut previous = f64::NEG_INFINITY;
         for m in &self.rows {
@@ -304,7 +310,10 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
                 return Err(format!("measurement at {} out of order or shape", m.time));
             }
             previous = m.time;
-            finite(&m.values.iter().flatten().copied().collect::<Vec<_>>(), "value")?;
+            finite(
+                &m.values.iter().flatten().copied().collect::<Vec<_>>(),
+                "value",
+            )?;
             match &m.noise {
                 NoiseCovariance::Identity => {}
                 NoiseCovariance::Variances(v) if v.len() == p => {

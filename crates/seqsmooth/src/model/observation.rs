@@ -205,7 +205,9 @@ impl Angles {
     /// assert_eq!(Angles::new(3, &[2, 0]).unwrap().indices(), vec![0, 2]);
     /// ```
     pub fn indices(&self) -> Vec<usize> {
-        (0..self.is_angle.len()).filter(|&c| self.is_angle[c]).collect()
+        (0..self.is_angle.len())
+            .filter(|&c| self.is_angle[c])
+            .collect()
     }
 
     /// Whether component `c` is an angle.

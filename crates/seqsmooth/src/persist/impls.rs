@@ -2,9 +2,9 @@
 //! decoded value (each checked by the type's own `check_saved`, next to its fields).
 
 use super::Persist;
+use crate::estimate::sliding::{Fitter, RowNoise};
 use crate::kalman::bayes::BayesFilter;
 use crate::kalman::discrete::{DiscreteDynamics, LinearFixedLag, LinearKalmanFilter};
-use crate::estimate::sliding::{Fitter, RowNoise};
 use crate::kalman::filter::{IterationLimits, KalmanFilter};
 use crate::kalman::fixed_lag::FixedLagSmoother;
 use crate::kalman::unscented::UnscentedKalmanFilter;

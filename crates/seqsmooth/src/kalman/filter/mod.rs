@@ -745,7 +745,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
 }
 
 /// Refuses a prior of other than `n` states, with a number that is not finite, or with a
-/// covariance that is not symmetric with a non-negative diagonal.
+/// covariance that is not symmetric positive semidefinite ([`check_covariance`](super::noise::check_covariance)).
 fn check_prior(
     n: usize,
     state: &DVector<f64>,
@@ -780,14 +780,7 @@ fn check_prior(
             value,
         });
     }
-    if (covariance - covariance.transpose()).abs().max() > 1e-12 * covariance.abs().max()
-        || covariance.diagonal().iter().any(|&v| v < 0.0)
-    {
-        return Err(bad(
-            Param::PriorCovariance,
-            format!("{covariance:?}"),
-            "must be symmetric with a non-negative diagonal".into(),
-        ));
-    }
-    Ok(())
+    // Symmetric positive semidefinite: the library's one rule of a covariance, as
+    // `set_estimate`'s.
+    super::noise::check_covariance(covariance, n, Param::PriorCovariance)
 }
