@@ -18,12 +18,15 @@ use crate::arrays::matrix;
 use crate::errors::{raise, IntoPy, Kind};
 use crate::fixed_lag::lagged;
 use crate::kalman::{before, measurement, measurements, out_of_order, square, PyInnovation};
+use crate::persist;
 use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use seqsmooth::error::Param;
-use seqsmooth::kalman::noise::{check_covariance, ProcessNoise};
+use seqsmooth::kalman::filter::IterationLimits;
+use seqsmooth::kalman::noise::{check_covariance, MatrixNoise, ProcessNoise};
+use seqsmooth::kalman::saved_noise::SavedNoise;
 use seqsmooth::kalman::{smoother, FixedLagSmoother, KalmanFilter};
 use seqsmooth::model::dynamics::{Dynamics, Propagation};
 use seqsmooth::model::measurement::Measurement;
@@ -31,6 +34,7 @@ use seqsmooth::model::nonlinear::{
     differenced_jacobian, differenced_jacobian_with, NonlinearDynamics,
 };
 use seqsmooth::model::observation::{Angles, Observation, Predicted};
+use seqsmooth::persist::{DynamicsLeftOut, ObservationLeftOut};
 use seqsmooth::Error;
 use std::sync::{Arc, Mutex};
 
@@ -364,7 +368,8 @@ impl Observation for UserObservation {
 /// call (`n × n`, finite, symmetric, non-negative variances).
 #[derive(Clone, Debug)]
 pub(crate) enum UserNoise {
-    Constant(DMatrix<f64>),
+    /// The library's constant `Q`, which has a saved form.
+    Constant(MatrixNoise),
     Callable(Callable, usize),
 }
 
@@ -381,14 +386,23 @@ fn not_covariance(q: &DMatrix<f64>) -> Option<String> {
 impl ProcessNoise for UserNoise {
     fn dimension(&self) -> usize {
         match self {
-            UserNoise::Constant(q) => q.nrows(),
+            UserNoise::Constant(q) => q.dimension(),
             UserNoise::Callable(_, n) => *n,
+        }
+    }
+
+    /// A constant `Q`'s saved form (the library's); a callable has none (it is pickled
+    /// beside the filter's bytes).
+    fn saved(&self) -> Option<SavedNoise> {
+        match self {
+            UserNoise::Constant(q) => q.saved(),
+            UserNoise::Callable(..) => None,
         }
     }
 
     fn covariance(&self, t_a: f64, t_b: f64) -> Result<DMatrix<f64>, Error> {
         match self {
-            UserNoise::Constant(q) => Ok(q.clone()),
+            UserNoise::Constant(q) => q.covariance(t_a, t_b),
             UserNoise::Callable(c, n) => {
                 let at = || format!("over t = {t_a} to {t_b}");
                 let q =
@@ -424,7 +438,51 @@ pub(crate) fn user_model(
     Q: Option<&Bound<'_, PyAny>>,
     angles: Option<Vec<usize>>,
 ) -> PyResult<UserModel> {
-    let n = x0.len();
+    let angles = |h: &Callable| {
+        let p = components_at(h, x0, t0)?;
+        Angles::new(p, &angles.unwrap_or_default()).py()
+    };
+    model_of(x0.len(), transition, h, H_jacobian, Q, angles)
+}
+
+/// The components `h` gives at the prior (at least 1).
+fn components_at(h: &Callable, x0: &DVector<f64>, t0: f64) -> PyResult<usize> {
+    let first = Python::attach(|py| {
+        h.func
+            .call1(py, (PyArray1::from_slice(py, x0.as_slice()), t0))
+            .and_then(|v| {
+                let np = py.import("numpy")?;
+                np.call_method1("size", (v,))?.extract::<usize>()
+            })
+    })
+    .map_err(|e| {
+        raise(
+            Kind::Parameter,
+            format!("h at the prior (t0 = {t0}) gave no array of numbers: {e}"),
+            None,
+        )
+    })?;
+    if first == 0 {
+        return Err(raise(
+            Kind::Parameter,
+            "h at the prior gave no values: the observation needs at least one component",
+            None,
+        ));
+    }
+    Ok(first)
+}
+
+/// The user's model of `n` states, its observation's components and angles given by
+/// `angles` (called once `h` is taken).
+#[allow(non_snake_case)]
+fn model_of(
+    n: usize,
+    transition: Transition<'_, '_>,
+    h: &Bound<'_, PyAny>,
+    H_jacobian: Option<&Bound<'_, PyAny>>,
+    Q: Option<&Bound<'_, PyAny>>,
+    angles: impl FnOnce(&Callable) -> PyResult<Angles>,
+) -> PyResult<UserModel> {
     let raised = Raised::default();
     let optional = |obj: Option<&Bound<'_, PyAny>>, param, keyword| {
         obj.filter(|o| !o.is_none())
@@ -477,35 +535,13 @@ pub(crate) fn user_model(
         }
     };
     let h = Callable::new(h, Param::ObservationFunction, "h", &raised)?;
-    // The components: what h gives at the prior (any length at least 1).
-    let first = Python::attach(|py| {
-        h.func
-            .call1(py, (PyArray1::from_slice(py, x0.as_slice()), t0))
-            .and_then(|v| {
-                let np = py.import("numpy")?;
-                np.call_method1("size", (v,))?.extract::<usize>()
-            })
-    })
-    .map_err(|e| {
-        raise(
-            Kind::Parameter,
-            format!("h at the prior (t0 = {t0}) gave no array of numbers: {e}"),
-            None,
-        )
-    })?;
-    if first == 0 {
-        return Err(raise(
-            Kind::Parameter,
-            "h at the prior gave no values: the observation needs at least one component",
-            None,
-        ));
-    }
+    let angles = angles(&h)?;
     let observation = UserObservation {
         n,
-        p: first,
+        p: angles.components(),
         h,
         jacobian: optional(H_jacobian, Param::ObservationJacobian, "H_jacobian")?,
-        angles: Angles::new(first, &angles.unwrap_or_default()).py()?,
+        angles,
     };
     let noise = match Q.filter(|q| !q.is_none()) {
         None => None,
@@ -516,7 +552,7 @@ pub(crate) fn user_model(
         Some(q) => {
             let q = crate::kalman::square_from(q, n, "Q")?;
             check_covariance(&q, n, Param::ProcessNoiseQ).py()?;
-            Some(UserNoise::Constant(q))
+            Some(UserNoise::Constant(MatrixNoise::new(q).py()?))
         }
     };
     Ok(UserModel {
@@ -527,6 +563,88 @@ pub(crate) fn user_model(
     })
 }
 
+/// The caller's callables of a model, pickled beside the library's bytes:
+/// `(f, F_jacobian, dxdt, dxdt_jacobian, h, H_jacobian, Q)`, `None` where not given (`Q`
+/// only a callable: a constant `Q` is in the library's bytes).
+pub(crate) fn callables_of<'py>(
+    py: Python<'py>,
+    dynamics: &UserDynamics,
+    observation: &UserObservation,
+    q: Option<&Callable>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let obj = |c: Option<&Callable>| match c {
+        Some(c) => c.func.clone_ref(py).into_bound(py),
+        None => py.None().into_bound(py),
+    };
+    let (f, jacobian) = (Some(&dynamics.f), dynamics.jacobian.as_ref());
+    let (f, f_jacobian, dxdt, dxdt_jacobian) = match dynamics.ode {
+        None => (obj(f), obj(jacobian), obj(None), obj(None)),
+        Some(_) => (obj(None), obj(None), obj(f), obj(jacobian)),
+    };
+    let (h, h_jacobian) = (
+        obj(Some(&observation.h)),
+        obj(observation.jacobian.as_ref()),
+    );
+    PyTuple::new(
+        py,
+        [f, f_jacobian, dxdt, dxdt_jacobian, h, h_jacobian, obj(q)],
+    )
+}
+
+/// The library's stand-ins a filter over the caller's model is saved over: its states, its
+/// observation's components and angles.
+pub(crate) fn stand_ins(
+    dynamics: &UserDynamics,
+    observation: &UserObservation,
+) -> (DynamicsLeftOut, ObservationLeftOut) {
+    let n = dynamics.n;
+    (
+        DynamicsLeftOut::new(n),
+        ObservationLeftOut::new(n, observation.angles.clone()),
+    )
+}
+
+/// The caller's model again from the callables pickled beside the library's bytes
+/// ([`callables_of`]) and the stand-ins restored from them (states, components, angles);
+/// anything amiss a `DamagedStateError`.
+pub(crate) fn model_again(
+    callables: &Bound<'_, PyAny>,
+    dynamics: &DynamicsLeftOut,
+    observation: &ObservationLeftOut,
+) -> PyResult<UserModel> {
+    let items = persist::items(callables, 7)?;
+    let given = (0..7)
+        .map(|i| Ok(items.get_item(i)?).map(|v| (!v.is_none()).then_some(v)))
+        .collect::<PyResult<Vec<_>>>()?;
+    let [f, f_jacobian, dxdt, dxdt_jacobian, h, h_jacobian, q] = &given[..] else {
+        unreachable!("seven items")
+    };
+    let Some(h) = h else {
+        return Err(persist::damaged("the observation h is missing"));
+    };
+    if q.as_ref().is_some_and(|q| !q.is_callable()) {
+        return Err(persist::damaged(
+            "the driving noise Q beside the bytes is not callable",
+        ));
+    }
+    let transition = Transition {
+        f: f.as_ref(),
+        f_jacobian: f_jacobian.as_ref(),
+        dxdt: dxdt.as_ref(),
+        dxdt_jacobian: dxdt_jacobian.as_ref(),
+    };
+    let angles = |_: &Callable| Ok(observation.angles().clone());
+    model_of(
+        dynamics.dimension(),
+        transition,
+        h,
+        h_jacobian.as_ref(),
+        q.as_ref(),
+        angles,
+    )
+    .map_err(|e| persist::damaged(format!("the model's callables: {e}")))
+}
+
 /// The user's model: its dynamics, observation, driving noise and the slot its callables
 /// keep their first exception in.
 pub(crate) struct UserModel {
@@ -534,6 +652,17 @@ pub(crate) struct UserModel {
     pub(crate) observation: UserObservation,
     pub(crate) noise: Option<UserNoise>,
     pub(crate) raised: Raised,
+}
+
+impl UserModel {
+    /// The driving noise `Q` if it is the caller's callable (pickled beside the filter's
+    /// bytes; a constant `Q` is in them).
+    pub(crate) fn q_callable(&self) -> Option<Callable> {
+        match &self.noise {
+            Some(UserNoise::Callable(c, _)) => Some(c.clone()),
+            _ => None,
+        }
+    }
 }
 
 type Extended = KalmanFilter<UserDynamics, UserObservation>;
@@ -592,6 +721,8 @@ type Extended = KalmanFilter<UserDynamics, UserObservation>;
 pub struct PyExtendedKalmanFilter {
     filter: Extended,
     raised: Raised,
+    /// The driving noise `Q` if it is the caller's callable.
+    q: Option<Callable>,
     /// The observation's components `p`.
     components: usize,
     iterations: usize,
@@ -619,7 +750,7 @@ impl PyExtendedKalmanFilter {
         dxdt_jacobian: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         // The library's range of the iterated update's limits.
-        seqsmooth::kalman::filter::check_iteration_limits(tolerance, iterations).py()?;
+        IterationLimits::new(tolerance, iterations).py()?;
         let Some(h) = h.filter(|h| !h.is_none()) else {
             return Err(raise(Kind::Parameter, "h is required", None));
         };
@@ -632,7 +763,7 @@ impl PyExtendedKalmanFilter {
             dxdt_jacobian,
         };
         let model = user_model(&x, t0, transition, h, H_jacobian, Q, angles)?;
-        let components = model.observation.components();
+        let (components, q) = (model.observation.components(), model.q_callable());
         let mut filter = KalmanFilter::new(model.dynamics, model.observation, x, p0, t0).py()?;
         if let Some(q) = model.noise {
             filter = filter.with_process_noise(q).py()?;
@@ -640,9 +771,64 @@ impl PyExtendedKalmanFilter {
         Ok(Self {
             filter,
             raised: model.raised,
+            q,
             components,
             iterations,
             tolerance,
+        })
+    }
+
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
+    /// the library's saved form over its stand-in models (``iterations`` and ``tolerance``
+    /// inside the checksum), the callables ``f``/``dxdt``, ``h``, the Jacobians and a
+    /// callable ``Q`` beside it, pickled by Python (a module-level function pickles; a lambda
+    /// or a local function raises pickle's own error). Restored bit for bit; a copy is a deep
+    /// copy of the state that shares the callables.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let me = slf.borrow();
+        let (d, o) = me.filter.models();
+        let callables = callables_of(py, d, o, me.q.as_ref())?;
+        let (dynamics, observation) = stand_ins(d, o);
+        let mut filter = me.filter.clone();
+        if me.q.is_some() {
+            filter.take_process_noise();
+        }
+        let filter = filter.with_models(dynamics, observation).py()?;
+        let limits = IterationLimits::new(me.tolerance, me.iterations).py()?;
+        let bytes = persist::save(py, &(filter, limits))?;
+        let state = PyTuple::new(py, [bytes, callables.into_any()])?;
+        persist::reduce(slf.as_any(), state.into_any())
+    }
+
+    /// The filter ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let items = persist::items(state, 2)?;
+        let (mut bare, limits): (
+            KalmanFilter<DynamicsLeftOut, ObservationLeftOut>,
+            IterationLimits,
+        ) = persist::load(&items.get_item(0)?)?;
+        let (d, o) = bare.models();
+        let model = model_again(&items.get_item(1)?, d, o)?;
+        let (components, q) = (model.observation.components(), model.q_callable());
+        if q.is_some() && bare.take_process_noise().is_some() {
+            return Err(persist::damaged(
+                "the driving noise is both in the bytes and beside them",
+            ));
+        }
+        let mut filter = bare.with_models(model.dynamics, model.observation).py()?;
+        if let Some(noise) = model.noise {
+            filter.set_process_noise(noise).py()?;
+        }
+        Ok(Self {
+            filter,
+            raised: model.raised,
+            q,
+            components,
+            iterations: limits.iterations(),
+            tolerance: limits.tolerance(),
         })
     }
 

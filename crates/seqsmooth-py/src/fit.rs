@@ -14,8 +14,9 @@ use pyo3::types::{PyDict, PyString, PyTuple};
 use seqsmooth::estimate::batch::NoiseCovariance;
 use seqsmooth::estimate::gauss_newton::{check_max_iterations, Epoch, GaussNewton, Measurement};
 use seqsmooth::estimate::sliding::{
-    check_window_length, Fitter, SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW,
+    check_window_length, Fitter, RowNoise, SlidingFit, POLYNOMIAL_WINDOW, RADAR_WINDOW,
 };
+use seqsmooth::model::dynamics::Dynamics;
 use seqsmooth::model::radar::AzimuthConvention;
 use seqsmooth::polynomial::check_degree;
 use seqsmooth::track::radar_row;
@@ -472,6 +473,55 @@ impl PySlidingFit {
             info.set_item("flag", crate::track::flag_array(py, &flags)?)?;
         }
         PyTuple::new(py, [states, covariances, info.into_any()])
+    }
+
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the fit (its window of
+    /// rows, last estimate, settings) and the rows' noise in the library's saved form,
+    /// restored bit for bit. A copy is a deep copy.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let me = slf.borrow();
+        let rows = RowNoise {
+            sigmas: me.sigmas,
+            bearing: me.bearing,
+            rows: me.rows as u64,
+        };
+        crate::persist::reduce_saved(slf.as_any(), &(me.inner.clone(), rows))
+    }
+
+    /// The fit ``__reduce__`` saved (a ``DamagedStateError`` if ``state`` is damaged or
+    /// another class's).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (inner, rows): (Fitter, RowNoise) = crate::persist::load(state)?;
+        let (model, degree, window, epoch, states) = match &inner {
+            Fitter::Radar(f) => {
+                let d = f.models().0;
+                ("radar", d.degree(), f.window(), f.epoch(), d.dimension())
+            }
+            Fitter::Polynomial(f) => {
+                let d = f.models().0;
+                (
+                    "polynomial",
+                    d.degree(),
+                    f.window(),
+                    f.epoch(),
+                    d.dimension(),
+                )
+            }
+        };
+        let taken = usize::try_from(rows.rows)
+            .map_err(|_| crate::persist::damaged("the rows taken overflow"))?;
+        Ok(Self {
+            inner,
+            sigmas: rows.sigmas,
+            bearing: rows.bearing,
+            states,
+            rows: taken,
+            model,
+            degree,
+            window,
+            epoch,
+        })
     }
 
     fn __repr__(&self) -> String {

@@ -9,7 +9,8 @@
 
 use crate::arrays::series;
 use crate::callables::{
-    stacked, user_model, Raised, Run, Transition, UserDynamics, UserObservation,
+    callables_of, model_again, stacked, stand_ins, user_model, Callable, Raised, Run, Transition,
+    UserDynamics, UserObservation,
 };
 use crate::errors::{raise, IntoPy, Kind};
 use crate::fixed_lag::lagged;
@@ -29,6 +30,7 @@ use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::measurement::Measurement;
 use seqsmooth::model::observation::{LinearObservation, Observation};
 use seqsmooth::model::radar::Radar;
+use seqsmooth::persist::{DynamicsLeftOut, ObservationLeftOut};
 use seqsmooth::Error;
 
 /// The filter on one of the built-in observations.
@@ -137,23 +139,35 @@ pub struct PyUnscentedKalmanFilter {
     components: usize,
     /// The exception a callable of the user's model raised (empty for the built-in models).
     raised: Raised,
+    /// The driving noise `Q` if it is the caller's callable.
+    q: Option<Callable>,
 }
 
 #[pymethods]
 impl PyUnscentedKalmanFilter {
-    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too) for the built-in models:
-    /// the filter's state in the library's saved form, restored bit for bit. Filters are
-    /// mutable: a copy is a deep copy of the state. The form over the caller's callables
-    /// cannot be pickled yet (``TypeError``).
+    /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
+    /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
+    /// copy of the state. Over the caller's model, the state is saved over the library's
+    /// stand-in models and the callables ``f``/``dxdt``, ``h`` and a callable ``Q`` are
+    /// pickled beside it by Python (a module-level function pickles; a lambda or a local
+    /// function raises pickle's own error).
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
         let py = slf.py();
-        let state = match &slf.borrow().model {
+        let me = slf.borrow();
+        let state = match &me.model {
             Model::Linear(f) => ("linear", persist::save(py, f)?),
             Model::Radar(f) => ("radar", persist::save(py, f)?),
-            Model::User(_) => {
-                return Err(pyo3::exceptions::PyTypeError::new_err(
-                    "an UnscentedKalmanFilter over the caller's callables cannot be pickled",
-                ))
+            Model::User(f) => {
+                let (d, o) = f.models();
+                let callables = callables_of(py, d, o, me.q.as_ref())?;
+                let (dynamics, observation) = stand_ins(d, o);
+                let mut f = f.clone();
+                if me.q.is_some() {
+                    f.take_process_noise();
+                }
+                let bare = f.with_models(dynamics, observation).py()?;
+                let body = [persist::save(py, &bare)?, callables.into_any()];
+                ("user", PyTuple::new(py, body)?.into_any())
             }
         };
         persist::reduce(slf.as_any(), state.into_pyobject(py)?.into_any())
@@ -177,12 +191,36 @@ impl PyUnscentedKalmanFilter {
                 let p = f.models().1.components();
                 (Model::Radar(f), p)
             }
+            Ok("user") => {
+                let body = persist::items(&body, 2)?;
+                let mut bare: UnscentedKalmanFilter<DynamicsLeftOut, ObservationLeftOut> =
+                    persist::load(&body.get_item(0)?)?;
+                let (d, o) = bare.models();
+                let user = model_again(&body.get_item(1)?, d, o)?;
+                let (p, q) = (user.observation.components(), user.q_callable());
+                if q.is_some() && bare.take_process_noise().is_some() {
+                    return Err(persist::damaged(
+                        "the driving noise is both in the bytes and beside them",
+                    ));
+                }
+                let mut f = bare.with_models(user.dynamics, user.observation).py()?;
+                if let Some(noise) = user.noise {
+                    f = f.with_process_noise(noise).py()?;
+                }
+                return Ok(Self {
+                    model: Model::User(f),
+                    components: p,
+                    raised: user.raised,
+                    q,
+                });
+            }
             _ => return Err(persist::damaged("not an UnscentedKalmanFilter's model")),
         };
         Ok(Self {
             model,
             components,
             raised: Raised::default(),
+            q: None,
         })
     }
 
@@ -223,7 +261,7 @@ impl PyUnscentedKalmanFilter {
                     ..Transition::default()
                 };
                 let user = user_model(&x, t0, transition, h, None, Q, angles)?;
-                let components = user.observation.components();
+                let (components, q) = (user.observation.components(), user.q_callable());
                 let mut filter =
                     UnscentedKalmanFilter::new(user.dynamics, user.observation, x, p0, t0)
                         .py()?
@@ -236,6 +274,7 @@ impl PyUnscentedKalmanFilter {
                     model: Model::User(filter),
                     components,
                     raised: user.raised,
+                    q,
                 });
             }
             (Some(degree), None, None) if Q.is_none() && angles.is_none() => degree,
@@ -293,6 +332,7 @@ impl PyUnscentedKalmanFilter {
             model,
             components,
             raised: Raised::default(),
+            q: None,
         })
     }
 

@@ -293,3 +293,19 @@ def test_fading_kalman_equals_fading_memory_given_one_discount(degree, discount)
     x, _, _ = kf.update_many(t[m + 1 :], y[m + 1 :], sigma**2)
     rel = np.abs(x - d[m + 1 :]) / (np.abs(d[m + 1 :]) + s[m + 1 :])
     assert rel.max() <= 1e-10, rel.max()
+
+
+def test_an_indefinite_P0_is_refused_at_construction():
+    """P0 symmetric with a positive diagonal but indefinite, or not finite, is refused by the
+    library's rule at construction (as the covariance setter refuses it), for every class
+    taking a P0."""
+    indefinite = [[1.0, 2.0], [2.0, 1.0]]
+    with pytest.raises(ss.ParameterError):
+        ss.KalmanFilter(1, x0=[0.0, 0.0], P0=indefinite)
+    with pytest.raises(ss.ParameterError):
+        ss.UnscentedKalmanFilter(1, x0=[0.0, 0.0], P0=indefinite)
+    with pytest.raises(ss.ParameterError):
+        ss.ExtendedKalmanFilter([0.0, 0.0], indefinite, f=lambda x, t0, t1: x, h=lambda x, t: x[:1])
+    with pytest.raises(ss.SeqsmoothError):
+        ss.KalmanFilter(1, x0=[0.0, 0.0], P0=[[1.0, np.inf], [np.inf, 1.0]])
+    ss.KalmanFilter(1, x0=[0.0, 0.0], P0=[[1.0, 1.0], [1.0, 1.0]])  # singular: a covariance

@@ -150,6 +150,68 @@ def continuous_run(f, rows):
     return out + [np.asarray(f.state), np.asarray(f.covariance), np.asarray(f.R)]
 
 
+# The caller's own model, module-level so that pickle finds it: nearly constant velocity on
+# two axes, observed in position.
+
+
+def cv_f(x, t0, t1):
+    dt = t1 - t0
+    return np.array([x[0] + dt * x[2], x[1] + dt * x[3], x[2], x[3]])
+
+
+def cv_F(x, t0, t1):
+    F = np.eye(4)
+    F[0, 2] = F[1, 3] = t1 - t0
+    return F
+
+
+def cv_dxdt(x, t):
+    return np.array([x[2], x[3], 0.0, 0.0])
+
+
+def cv_h(x, t):
+    return np.array([x[0], x[1]])
+
+
+def cv_H(x, t):
+    return np.eye(2, 4)
+
+
+def cv_Q(t0, t1):
+    dt = t1 - t0
+    q = np.array([[dt**3 / 3, dt**2 / 2], [dt**2 / 2, dt]]) * 0.05
+    return np.kron(q, np.eye(2))
+
+
+def user_keywords(rng, jacobians):
+    """The callables of the caller's model, drawn: f or dxdt, with or without Jacobians, Q a
+    callable, a constant or none, an angle component or none."""
+    kw = {"h": cv_h, "angles": [1] if rng.random() < 0.5 else None}
+    ode = rng.random() < 0.25
+    if ode:
+        kw["dxdt"] = cv_dxdt
+    else:
+        kw["f"] = cv_f
+    if jacobians and rng.random() < 0.5:
+        kw["H_jacobian"] = cv_H
+        if not ode:
+            kw["F_jacobian"] = cv_F
+    kw["Q"] = [cv_Q, 0.01 * np.eye(4), None][int(rng.integers(0, 3))]
+    return kw
+
+
+def extended_make(rng):
+    kw = user_keywords(rng, jacobians=True)
+    return ss.ExtendedKalmanFilter(
+        np.zeros(4), 100.0, iterations=int(rng.integers(1, 3)), tolerance=1e-8, **kw
+    )
+
+
+def unscented_user_make(rng):
+    kw = user_keywords(rng, jacobians=False)
+    return ss.UnscentedKalmanFilter(x0=np.zeros(4), P0=100.0, **kw)
+
+
 def radar_data(rng, missing=0.05):
     n = int(rng.integers(15, 60))
     t = 1.7e9 + np.cumsum(rng.uniform(0.5, 1.5, n))
@@ -182,6 +244,18 @@ def online_run(f, rows):
     f.push_all(rows)
     done = f.taken == f.size
     return (outputs(f.polynomial_samples()) if done else []) + [np.asarray(f.taken)]
+
+
+def sliding_polynomial(rng):
+    degree = int(rng.integers(0, 3))
+    epoch = str(rng.choice(["end", "centre"]))
+    window = int(rng.integers(degree + 2, 12))
+    return ss.SlidingFit("polynomial", degree=degree, window=window, sigma=0.1, epoch=epoch)
+
+
+def sliding_run(f, rows):
+    out = outputs(f.update_many(rows[:, 0], *rows[:, 1:].T))
+    return out + [np.asarray(f.rows_taken), np.asarray(repr(f))]
 
 
 def tracker(method):
@@ -268,6 +342,21 @@ CASES = [
     ("RadarTracker-window", tracker("window"), radar_data, tracker_run),
     ("OnlineSmoother", online_make, lambda rng: rng.standard_normal(40), online_run),
     ("ContinuousKalmanFilter", continuous_make, kalman_data, continuous_run),
+    ("ExtendedKalmanFilter", extended_make, kalman_data, kalman_run),
+    ("UnscentedKalmanFilter-callables", unscented_user_make, kalman_data, kalman_run),
+    ("SlidingFit-polynomial", sliding_polynomial, poly_data, sliding_run),
+    (
+        "SlidingFit-radar",
+        lambda rng: ss.SlidingFit(
+            "radar",
+            sigma_range=10.0,
+            sigma_angle=1e-3,
+            window=int(rng.integers(4, 10)),
+            azimuth=str(rng.choice(["from-x", "bearing"])),
+        ),
+        radar_data,
+        sliding_run,
+    ),
 ]
 
 
@@ -401,3 +490,53 @@ def test_continuous_filter_noise_is_in_the_checked_bytes():
     _, kalman = saved(ss.KalmanFilter(1, x0=[0.0, 0.0], P0=1.0))
     with pytest.raises(ss.DamagedStateError, match="KalmanFilter"):
         cls._from_state(kalman)
+
+
+@pytest.mark.parametrize("make", [extended_make, unscented_user_make])
+def test_callables_model_damaged_state_is_refused(make):
+    """A filter over the caller's callables: its library bytes (the filter over the stand-in
+    models) truncated or flipped, its callables tuple of the wrong length, an item not
+    callable, or another class's bytes: DamagedStateError."""
+    rng = np.random.default_rng(5)
+    f = make(rng)
+    rows = kalman_data(rng)
+    kalman_run(f, rows[:5])
+    cls, state = saved(f)
+    user = isinstance(state[0], str)
+    bytes_, callables = state[1] if user else state
+
+    def again(b, c):
+        return cls._from_state(("user", (b, c)) if user else (b, c))
+
+    for n in range(0, len(bytes_), 5):
+        with pytest.raises(ss.DamagedStateError):
+            again(bytes_[:n], callables)
+    for i in range(0, len(bytes_), 3):
+        b = bytearray(bytes_)
+        b[i] ^= 1 << (i % 8)
+        with pytest.raises(ss.DamagedStateError):
+            again(bytes(b), callables)
+    with pytest.raises(ss.DamagedStateError):
+        again(bytes_, callables[:-1])
+    with pytest.raises(ss.DamagedStateError, match="h"):
+        again(bytes_, callables[:4] + (None,) + callables[5:])
+    with pytest.raises(ss.DamagedStateError, match="Q"):
+        again(bytes_, callables[:6] + (np.eye(4),))
+    with pytest.raises(ss.DamagedStateError):
+        again(bytes_, callables[:4] + (3.0,) + callables[5:])
+    _, kalman = saved(ss.KalmanFilter(1, x0=[0.0, 0.0], P0=1.0))
+    with pytest.raises(ss.DamagedStateError, match="KalmanFilter"):
+        again(kalman, callables)
+    # the model is restored as given: the same callables, not copies
+    g = copy.deepcopy(f)
+    same(kalman_run(g, rows[5:]), kalman_run(f, rows[5:]))
+
+
+def test_a_lambda_gives_pickles_own_error():
+    """A callable pickle cannot find (a lambda) is pickle's own error when pickling; copy and
+    deepcopy, which do not pickle the callables, still work."""
+    f = ss.ExtendedKalmanFilter(np.zeros(4), 100.0, f=lambda x, t0, t1: cv_f(x, t0, t1), h=cv_h)
+    with pytest.raises((pickle.PicklingError, AttributeError, TypeError)):
+        pickle.dumps(f)
+    g = copy.deepcopy(f)
+    assert np.array_equal(g.state, f.state)

@@ -235,7 +235,7 @@ def test_defaults_and_repr():
         (
             lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0, 0.0], P0=[[1.0, 2.0], [2.0, 1.0]]),
             ss.ParameterError,
-            "positive definite",
+            "positive (semi)?definite",
         ),
         (lambda: ss.UnscentedKalmanFilter(degree=1, x0=[0.0], P0=1.0), ss.InvalidInputError, "x0"),
         (

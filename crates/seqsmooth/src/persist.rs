@@ -39,8 +39,10 @@ use serde::Serialize;
 
 mod impls;
 pub mod stream;
+mod left_out;
 
-pub use impls::SavedModel;
+pub use impls::{Beside, SavedModel};
+pub use left_out::{DynamicsLeftOut, ObservationLeftOut};
 
 /// The envelope's magic tag.
 pub const MAGIC: [u8; 8] = *b"SEQSMST\0";

@@ -610,3 +610,44 @@ fn iterated_update_is_chapter_11() {
     assert_close(a.covariance(), b.covariance(), 1e-15, "linear S");
     assert!((a.state() - b.state()).amax() < 1e-15);
 }
+
+/// A prior covariance that is symmetric with a positive diagonal but indefinite, or not
+/// finite, is refused at construction by the rule `set_estimate` applies (the filter's and the
+/// unscented filter's constructors alike), naming the prior covariance.
+#[test]
+fn an_indefinite_prior_covariance_is_refused_at_construction() {
+    use seqsmooth::error::Param;
+    use seqsmooth::kalman::UnscentedKalmanFilter;
+    let indefinite = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+    let kf = |p: DMatrix<f64>| {
+        KalmanFilter::new(
+            PolynomialDynamics::new(1, 1),
+            LinearObservation::value_of(2),
+            DVector::zeros(2),
+            p,
+            0.0,
+        )
+    };
+    assert!(matches!(
+        kf(indefinite.clone()),
+        Err(Error::InvalidParameter {
+            name: Param::PriorCovariance,
+            ..
+        })
+    ));
+    assert!(kf(DMatrix::from_row_slice(
+        2,
+        2,
+        &[1.0, f64::INFINITY, f64::INFINITY, 1.0]
+    ))
+    .is_err());
+    assert!(kf(DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 1.0, 1.0])).is_ok()); // singular is a covariance
+    let ukf = UnscentedKalmanFilter::new(
+        PolynomialDynamics::new(1, 1),
+        LinearObservation::value_of(2),
+        DVector::zeros(2),
+        indefinite,
+        0.0,
+    );
+    assert!(ukf.is_err());
+}

@@ -375,3 +375,96 @@ fn a_continuous_model_not_matching_its_matrices_is_refused() {
     }));
     assert!(why.contains("continuous model"), "{why}");
 }
+
+/// A Kalman filter and an unscented filter saved over the stand-ins of their models
+/// (`with_models` to `DynamicsLeftOut`/`ObservationLeftOut`, a front end's own driving noise
+/// taken out) and restored over their models again continue bit for bit; a stand-in cannot be
+/// run, and a model of another shape is refused.
+#[test]
+fn filters_saved_with_their_models_left_out_resume_bit_for_bit() {
+    use seqsmooth::model::observation::Angles;
+    use seqsmooth::persist::{DynamicsLeftOut, ObservationLeftOut};
+    let rows = data(11, 40);
+    let missing = |k: usize| k % 6 == 2;
+    let run = |f: &mut KalmanFilter<PolynomialDynamics, LinearObservation>, from: usize| {
+        let mut out = Vec::new();
+        for (k, &(t, y)) in rows.iter().enumerate().skip(from) {
+            out.push(format!(
+                "{:?} {:?}",
+                f.update(&measurement(t, y, missing(k))),
+                f.covariance()
+            ));
+        }
+        out
+    };
+    let stand_ins = || {
+        (
+            DynamicsLeftOut::new(2),
+            ObservationLeftOut::new(2, Angles::new(1, &[]).unwrap()),
+        )
+    };
+    for cut in [1, 17, 39] {
+        let mut f = at_rest(PolynomialDynamics::new(1, 1))
+            .with_process_noise(WhiteNoiseDerivative::new(1, 1, 0.05).unwrap())
+            .unwrap();
+        for (k, &(t, y)) in rows.iter().enumerate().take(cut) {
+            f.update(&measurement(t, y, missing(k))).unwrap();
+        }
+        let mut bare = f.clone();
+        let noise = bare.take_process_noise();
+        assert!(noise.is_some());
+        let (d, o) = stand_ins();
+        let bare = bare.with_models(d, o).unwrap();
+        let mut back: KalmanFilter<DynamicsLeftOut, ObservationLeftOut> =
+            from_bytes(&to_bytes(&bare).unwrap()).unwrap();
+        assert!(back.predict(1e9).is_err(), "a stand-in runs");
+        assert!(back
+            .clone()
+            .with_models(PolynomialDynamics::new(2, 1), position())
+            .is_err());
+        let mut g = back
+            .with_models(PolynomialDynamics::new(1, 1), position())
+            .unwrap();
+        g.set_process_noise(WhiteNoiseDerivative::new(1, 1, 0.05).unwrap())
+            .unwrap();
+        assert_eq!(run(&mut f, cut), run(&mut g, cut));
+    }
+    let mut u = UnscentedKalmanFilter::new(
+        PolynomialDynamics::new(1, 1),
+        position(),
+        DVector::zeros(2),
+        DMatrix::identity(2, 2) * 100.0,
+        0.0,
+    )
+    .unwrap();
+    for (k, &(t, y)) in rows.iter().enumerate().take(20) {
+        u.update(&measurement(t, y, missing(k))).unwrap();
+    }
+    let (d, o) = stand_ins();
+    let bare = u.clone().with_models(d, o).unwrap();
+    let back: UnscentedKalmanFilter<DynamicsLeftOut, ObservationLeftOut> =
+        from_bytes(&to_bytes(&bare).unwrap()).unwrap();
+    let mut v = back
+        .with_models(PolynomialDynamics::new(1, 1), position())
+        .unwrap();
+    for (k, &(t, y)) in rows.iter().enumerate().skip(20) {
+        let m = measurement(t, y, missing(k));
+        assert_eq!(format!("{:?}", u.update(&m)), format!("{:?}", v.update(&m)));
+        assert_eq!(u.covariance(), v.covariance());
+    }
+}
+
+/// A sliding Gauss–Newton fit cut anywhere, saved and restored, gives the unbroken fit's
+/// corrections bit for bit.
+#[test]
+fn a_sliding_fit_resumes_bit_for_bit() {
+    use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton};
+    use seqsmooth::estimate::sliding::{Fitter, SlidingFit};
+    let rows = data(5, 30);
+    for (cut, epoch) in [(2, Epoch::End), (9, Epoch::Centre), (25, Epoch::End)] {
+        let fit = SlidingFit::polynomial(2, 6, epoch, GaussNewton::default()).unwrap();
+        cut_and_continue(Fitter::Polynomial(fit), &rows, cut, |f, k, (t, y)| {
+            format!("{:?}", f.push_finite(measurement(t, y, k % 7 == 3)))
+        });
+    }
+}

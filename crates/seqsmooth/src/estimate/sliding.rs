@@ -12,6 +12,7 @@ use super::bootstrap;
 use super::gauss_newton::{Correction, Epoch, GaussNewton, Measurement};
 use crate::error::{Error, Param};
 use crate::model::dynamics::{Dynamics, PolynomialDynamics};
+use crate::model::measurement::NoiseCovariance;
 use crate::model::observation::{LinearObservation, Observation};
 use crate::model::radar::Radar;
 use nalgebra::DVector;
@@ -59,6 +60,28 @@ pub enum Start {
     },
     /// This state at the epoch.
     State(DVector<f64>),
+}
+
+/// The start rule's range for a model of `n` states: a state of `n` finite entries, or the
+/// radar's nominal of degree 1 or more for `n` states.
+fn check_start(start: &Start, n: usize) -> Result<(), Error> {
+    match start {
+        Start::State(x) if x.len() != n || x.iter().any(|v| !v.is_finite()) => {
+            Err(Error::InvalidParameter {
+                name: Param::StartState,
+                value: format!("{:?}", x.as_slice()),
+                reason: format!("must have {n} finite entries"),
+            })
+        }
+        Start::Radar { radar, degree } if radar.state_dimension() != n || *degree == 0 => {
+            Err(Error::InvalidParameter {
+                name: Param::RadarStart,
+                value: format!("degree {degree} for {} states", radar.state_dimension()),
+                reason: format!("needs degree 1 or more and the model's {n} states"),
+            })
+        }
+        _ => Ok(()),
+    }
 }
 
 /// A Gauss–Newton fit of the last `W` measurements, renewed at each one.
@@ -158,23 +181,7 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
                 reason: format!("the dynamics have {n} states"),
             });
         }
-        match &start {
-            Start::State(x) if x.len() != n || x.iter().any(|v| !v.is_finite()) => {
-                return Err(Error::InvalidParameter {
-                    name: Param::StartState,
-                    value: format!("{:?}", x.as_slice()),
-                    reason: format!("must have {n} finite entries"),
-                })
-            }
-            Start::Radar { radar, degree } if radar.state_dimension() != n || *degree == 0 => {
-                return Err(Error::InvalidParameter {
-                    name: Param::RadarStart,
-                    value: format!("degree {degree} for {} states", radar.state_dimension()),
-                    reason: format!("needs degree 1 or more and the model's {n} states"),
-                })
-            }
-            _ => {}
-        }
+        check_start(&start, n)?;
         epoch.check()?;
         Ok(Self {
             dynamics,
@@ -240,6 +247,91 @@ impl<D: Dynamics, O: Observation> SlidingFit<D, O> {
     /// ```
     pub fn window(&self) -> usize {
         self.window
+    }
+
+    /// The epoch each fit's state refers to.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton};
+    /// use seqsmooth::estimate::sliding::SlidingFit;
+    /// let fit = SlidingFit::polynomial(1, 3, Epoch::End, GaussNewton::default()).unwrap();
+    /// assert_eq!(fit.epoch(), Epoch::End);
+    /// ```
+    pub fn epoch(&self) -> Epoch {
+        self.epoch
+    }
+
+    /// The dynamic and observation models.
+    ///
+    /// ```
+    /// use seqsmooth::estimate::gauss_newton::{Epoch, GaussNewton};
+    /// use seqsmooth::estimate::sliding::SlidingFit;
+    /// use seqsmooth::model::dynamics::Dynamics;
+    /// let fit = SlidingFit::polynomial(2, 5, Epoch::End, GaussNewton::default()).unwrap();
+    /// assert_eq!(fit.models().0.dimension(), 3);
+    /// ```
+    pub fn models(&self) -> (&D, &O) {
+        (&self.dynamics, &self.observation)
+    }
+
+    /// A restored fit's invariants ([`crate::persist`]): the window, epoch, start and limits
+    /// in the constructors' ranges; at most `W` measurements in the window, at finite
+    /// increasing times, each of the observation's components (finite where present) and its
+    /// noise of them (variances positive and finite, a full `R` symmetric positive
+    /// semi-definite); the last fit's state and covariance of the model's dimension.
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        use crate::linalg::invariant::{covariance, finite, vector};
+        let text = |e: Error| e.to_string();
+        let (n, p) = (self.dynamics.dimension(), self.observation.components());
+        check_window_length(self.window).map_err(text)?;
+        self.epoch.check().map_err(text)?;
+        check_start(&self.start, n).map_err(text)?;
+        let GaussNewton {
+            max_iterations,
+            tolerance,
+            max_halvings,
+        } = self.solver;
+        super::gauss_newton::check_max_iterations(max_iterations).map_err(text)?;
+        if !(tolerance.is_finite() && tolerance > 0.0) || max_halvings > 64 {
+            return Err(format!(
+                "limits: tolerance {tolerance}, {max_halvings} halvings"
+            ));
+        }
+        if self.observation.state_dimension() != n || self.rows.len() > self.window {
+            return Err(format!(
+                "window of {} rows over {}",
+                self.rows.len(),
+                self.window
+            ));
+        }
+        let mut previous = f64::NEG_INFINITY;
+        for m in &self.rows {
+            if !(m.time.is_finite() && m.time > previous) || m.values.len() != p {
+                return Err(format!("measurement at {} out of order or shape", m.time));
+            }
+            previous = m.time;
+            finite(
+                &m.values.iter().flatten().copied().collect::<Vec<_>>(),
+                "value",
+            )?;
+            match &m.noise {
+                NoiseCovariance::Identity => {}
+                NoiseCovariance::Variances(v) if v.len() == p => {
+                    if v.iter().any(|&v| !(v.is_finite() && v > 0.0)) {
+                        return Err(format!("noise variances {v:?}"));
+                    }
+                }
+                NoiseCovariance::Full(r) => covariance(r, p, "measurement noise")?,
+                NoiseCovariance::Variances(v) => {
+                    return Err(format!("{} noise variances for {p} components", v.len()))
+                }
+            }
+        }
+        if let Some(c) = &self.last {
+            vector(&c.state, n, "last fit's state")?;
+            covariance(&c.covariance, n, "last fit's covariance")?;
+        }
+        Ok(())
     }
 
     /// The measurements in the window, oldest first.
@@ -555,7 +647,7 @@ impl SlidingFit<PolynomialDynamics, LinearObservation> {
 /// assert!((c.state[1] - 2.0).abs() < 1e-9);
 /// # Ok::<(), seqsmooth::Error>(())
 /// ```
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum Fitter {
     /// Range, azimuth and elevation of a target of constant velocity or acceleration.
     Radar(SlidingFit<PolynomialDynamics, Radar>),
@@ -563,7 +655,47 @@ pub enum Fitter {
     Polynomial(SlidingFit<PolynomialDynamics, LinearObservation>),
 }
 
+/// How a front end makes each row of a [`Fitter`] a measurement, saved beside the fit
+/// ([`crate::persist::Beside`]): the noise σ (radar: the range's and the angles'; polynomial:
+/// the value's, and 0), whether a radar's azimuth is a bearing, and the rows taken so far.
+///
+/// ```
+/// use seqsmooth::estimate::sliding::RowNoise;
+/// assert!(RowNoise { sigmas: [10.0, 1e-3], bearing: false, rows: 4 }.check().is_ok());
+/// assert!(RowNoise { sigmas: [0.0, 1e-3], bearing: false, rows: 4 }.check().is_err());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RowNoise {
+    /// The σ of each row's components (see above).
+    pub sigmas: [f64; 2],
+    /// Whether a radar's azimuth is clockwise from +y.
+    pub bearing: bool,
+    /// The rows taken so far.
+    pub rows: u64,
+}
+
+impl RowNoise {
+    /// Why the σ cannot be used ([`is_usable_sigma`](crate::model::measurement::is_usable_sigma);
+    /// the second may be 0), or nothing.
+    pub fn check(&self) -> Result<(), String> {
+        use crate::model::measurement::is_usable_sigma;
+        let [a, b] = self.sigmas;
+        if !is_usable_sigma(a) || !(b == 0.0 || is_usable_sigma(b)) {
+            return Err(format!("row noise σ {a}, {b}"));
+        }
+        Ok(())
+    }
+}
+
 impl Fitter {
+    /// A restored fit's invariants ([`crate::persist`]), as [`SlidingFit`]'s.
+    pub(crate) fn check_saved(&self) -> Result<(), String> {
+        match self {
+            Fitter::Radar(f) => f.check_saved(),
+            Fitter::Polynomial(f) => f.check_saved(),
+        }
+    }
+
     /// [`SlidingFit::push_finite`] of the model's fit: the row taken and the window fitted,
     /// or the row refused and the fit as before it.
     pub fn push_finite(&mut self, m: Measurement) -> Result<Option<Correction>, Error> {

@@ -597,6 +597,47 @@ impl<D: Dynamics, O: Observation> UnscentedKalmanFilter<D, O> {
         (&self.dynamics, &self.observation)
     }
 
+    /// The filter over the models `dynamics` and `observation` in place of its own (the same
+    /// states and components, else refused), its estimate, time, sigma points and driving
+    /// noise kept, as [`KalmanFilter::with_models`]: how a filter over a front end's own
+    /// models is saved and restored ([`crate::persist`]).
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::kalman::UnscentedKalmanFilter;
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::{Angles, LinearObservation};
+    /// use seqsmooth::persist::{DynamicsLeftOut, ObservationLeftOut};
+    /// let (d, o) = (PolynomialDynamics::new(1, 1), LinearObservation::value_of(2));
+    /// let f = UnscentedKalmanFilter::new(d, o.clone(), DVector::zeros(2), DMatrix::identity(2, 2), 0.0)?;
+    /// let bare = f.with_models(DynamicsLeftOut::new(2), ObservationLeftOut::new(2, Angles::new(1, &[])?))?;
+    /// assert_eq!(bare.with_models(d, o)?.state().len(), 2);
+    /// # Ok::<(), seqsmooth::Error>(())
+    /// ```
+    pub fn with_models<D2: Dynamics, O2: Observation>(
+        self,
+        dynamics: D2,
+        observation: O2,
+    ) -> Result<UnscentedKalmanFilter<D2, O2>, Error> {
+        super::filter::same_shape(self.models(), &dynamics, &observation)?;
+        Ok(UnscentedKalmanFilter {
+            dynamics,
+            observation,
+            noise: self.noise,
+            points: self.points,
+            weights: self.weights,
+            state: self.state,
+            covariance: self.covariance,
+            time: self.time,
+        })
+    }
+
+    /// The driving-noise model taken out (the filter has none after), as
+    /// [`KalmanFilter::take_process_noise`].
+    pub fn take_process_noise(&mut self) -> Option<Arc<dyn ProcessNoise>> {
+        self.noise.take()
+    }
+
     /// A restored filter's invariants ([`crate::persist`]): state and covariance of the
     /// model's dimension, the sigma points' weights for it, the time finite.
     pub(crate) fn check_saved(&self) -> Result<(), String> {

@@ -163,7 +163,7 @@ pub(crate) fn check_state(n: usize, state: &DVector<f64>) -> Result<(), Error> {
 /// assert!((a.residual(1, 3.1, -3.1) - (6.2 - std::f64::consts::TAU)).abs() < 1e-15);
 /// assert!(Angles::new(2, &[2]).is_err()); // no component 2
 /// ```
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Angles {
     is_angle: Vec<bool>,
 }
@@ -186,6 +186,28 @@ impl Angles {
             is_angle[i] = true;
         }
         Ok(Self { is_angle })
+    }
+
+    /// The observation's components (angles or not).
+    ///
+    /// ```
+    /// use seqsmooth::model::observation::Angles;
+    /// assert_eq!(Angles::new(3, &[1]).unwrap().components(), 3);
+    /// ```
+    pub fn components(&self) -> usize {
+        self.is_angle.len()
+    }
+
+    /// The components that are angles, in order.
+    ///
+    /// ```
+    /// use seqsmooth::model::observation::Angles;
+    /// assert_eq!(Angles::new(3, &[2, 0]).unwrap().indices(), vec![0, 2]);
+    /// ```
+    pub fn indices(&self) -> Vec<usize> {
+        (0..self.is_angle.len())
+            .filter(|&c| self.is_angle[c])
+            .collect()
     }
 
     /// Whether component `c` is an angle.

@@ -2,9 +2,10 @@
 //! decoded value (each checked by the type's own `check_saved`, next to its fields).
 
 use super::Persist;
+use crate::estimate::sliding::{Fitter, RowNoise};
 use crate::kalman::bayes::BayesFilter;
 use crate::kalman::discrete::{DiscreteDynamics, LinearFixedLag, LinearKalmanFilter};
-use crate::kalman::filter::KalmanFilter;
+use crate::kalman::filter::{IterationLimits, KalmanFilter};
 use crate::kalman::fixed_lag::FixedLagSmoother;
 use crate::kalman::unscented::UnscentedKalmanFilter;
 use crate::model::continuous::ContinuousModel;
@@ -89,12 +90,21 @@ impl SavedModel for Radar {
     const MODEL: &'static str = "Radar";
 }
 
-/// The models' own checks.
-fn models<D: SavedModel, O: SavedModel + Observation>((d, o): (&D, &O)) -> Result<(), String> {
+/// The models' own checks, and that the observation is of the dynamics' states.
+fn models<D: SavedModel + Dynamics, O: SavedModel + Observation>(
+    (d, o): (&D, &O),
+) -> Result<(), String> {
     d.check_model()?;
     o.check_model()?;
     if o.components() == 0 {
         return Err("observation of no components".into());
+    }
+    if o.state_dimension() != d.dimension() {
+        return Err(format!(
+            "observation of {} states, dynamics of {}",
+            o.state_dimension(),
+            d.dimension()
+        ));
     }
     Ok(())
 }
@@ -163,6 +173,7 @@ persist_plain!(
     LinearFixedLag => "LinearFixedLag",
     RadarTracker => "RadarTracker",
     Information => "Information",
+    Fitter => "SlidingFit",
 );
 
 impl<G> Persist for OnlineSmoother<G>
@@ -203,19 +214,40 @@ impl Persist for AnyFilter {
     }
 }
 
-/// A filter with the constant measurement noise `R` a front end holds beside it (inside the
-/// checksum, so a damaged `R` is refused like the filter): the filter's checks, then `R`'s
-/// (finite, symmetric positive semidefinite: the constructors' rule,
-/// [`check_covariance`](crate::kalman::noise::check_covariance)).
-impl<T: Persist> Persist for (T, NoiseCovariance) {
+/// What a front end holds beside a saved filter (its constant measurement noise, an update's
+/// limits), saved inside the filter's checksum so that a damaged one is refused like the
+/// filter: its name in the envelope and the checks of a decoded value.
+pub trait Beside: Serialize + DeserializeOwned {
+    /// The name written after the filter's.
+    fn name() -> String;
+
+    /// Why the decoded value cannot be used, or nothing.
+    fn check_beside(&self) -> Result<(), String>;
+}
+
+/// A filter with what a front end holds beside it: the filter's checks, then its
+/// companion's.
+impl<T: Persist, B: Beside> Persist for (T, B) {
     fn name() -> String {
-        format!("({}, NoiseCovariance)", T::name())
+        format!("({}, {})", T::name(), B::name())
     }
 
     fn check(&mut self) -> Result<(), String> {
         self.0.check()?;
+        self.1.check_beside()
+    }
+}
+
+/// The constant measurement noise `R`: finite, symmetric positive semidefinite (the
+/// constructors' rule, [`check_covariance`](crate::kalman::noise::check_covariance)).
+impl Beside for NoiseCovariance {
+    fn name() -> String {
+        "NoiseCovariance".into()
+    }
+
+    fn check_beside(&self) -> Result<(), String> {
         let invalid = |e: crate::Error| format!("measurement noise R: {e}");
-        match &self.1 {
+        match self {
             NoiseCovariance::Identity => Ok(()),
             NoiseCovariance::Variances(v) => {
                 let m = nalgebra::DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(v));
@@ -229,5 +261,27 @@ impl<T: Persist> Persist for (T, NoiseCovariance) {
             )
             .map_err(invalid),
         }
+    }
+}
+
+/// The iterated update's limits, in [`check_iteration_limits`](crate::kalman::filter::check_iteration_limits)'s range.
+impl Beside for IterationLimits {
+    fn name() -> String {
+        "IterationLimits".into()
+    }
+
+    fn check_beside(&self) -> Result<(), String> {
+        self.check().map_err(|e| format!("iteration limits: {e}"))
+    }
+}
+
+/// A sliding fit's row noise, its σ usable ([`RowNoise::check`]).
+impl Beside for RowNoise {
+    fn name() -> String {
+        "RowNoise".into()
+    }
+
+    fn check_beside(&self) -> Result<(), String> {
+        self.check()
     }
 }

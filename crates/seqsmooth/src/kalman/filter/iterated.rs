@@ -89,3 +89,47 @@ pub fn check_iteration_limits(tolerance: f64, max_iterations: usize) -> Result<(
     }
     Ok(())
 }
+
+/// The iterated update's limits a front end holds beside its filter (Morrison §12.5): at most
+/// `iterations` relinearisations, until the correction is at most `tolerance` of its σ; saved
+/// inside the filter's checksum ([`crate::persist::Beside`]) and checked on restoring by
+/// [`check_iteration_limits`].
+///
+/// ```
+/// use seqsmooth::kalman::filter::IterationLimits;
+/// let limits = IterationLimits::new(1e-9, 5)?;
+/// assert_eq!((limits.tolerance(), limits.iterations()), (1e-9, 5));
+/// assert!(IterationLimits::new(f64::NAN, 5).is_err());
+/// # Ok::<(), seqsmooth::Error>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct IterationLimits {
+    tolerance: f64,
+    iterations: usize,
+}
+
+impl IterationLimits {
+    /// The limits, in [`check_iteration_limits`]'s range.
+    pub fn new(tolerance: f64, iterations: usize) -> Result<Self, Error> {
+        check_iteration_limits(tolerance, iterations)?;
+        Ok(Self {
+            tolerance,
+            iterations,
+        })
+    }
+
+    /// The convergence test, in the correction's own σ.
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+
+    /// The most iterations (1: the extended filter's single update).
+    pub fn iterations(&self) -> usize {
+        self.iterations
+    }
+
+    /// Why the limits are out of range, or nothing (a restored value's check).
+    pub fn check(&self) -> Result<(), Error> {
+        check_iteration_limits(self.tolerance, self.iterations)
+    }
+}

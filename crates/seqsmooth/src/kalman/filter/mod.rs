@@ -71,7 +71,8 @@ mod iterated;
 mod saved;
 mod undo;
 pub use innovation::{Innovation, InnovationStats};
-pub use iterated::check_iteration_limits;
+pub use iterated::{check_iteration_limits, IterationLimits};
+pub(crate) use saved::same_shape;
 
 /// A Kalman filter on `D` and `O`, with optional driving noise.
 ///
@@ -745,7 +746,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
 }
 
 /// Refuses a prior of other than `n` states, with a number that is not finite, or with a
-/// covariance that is not symmetric with a non-negative diagonal.
+/// covariance that is not symmetric positive semidefinite ([`check_covariance`](super::noise::check_covariance)).
 fn check_prior(
     n: usize,
     state: &DVector<f64>,
@@ -780,14 +781,7 @@ fn check_prior(
             value,
         });
     }
-    if (covariance - covariance.transpose()).abs().max() > 1e-12 * covariance.abs().max()
-        || covariance.diagonal().iter().any(|&v| v < 0.0)
-    {
-        return Err(bad(
-            Param::PriorCovariance,
-            format!("{covariance:?}"),
-            "must be symmetric with a non-negative diagonal".into(),
-        ));
-    }
-    Ok(())
+    // Symmetric positive semidefinite: the library's one rule of a covariance, as
+    // `set_estimate`'s.
+    super::noise::check_covariance(covariance, n, Param::PriorCovariance)
 }
