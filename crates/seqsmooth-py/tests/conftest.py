@@ -76,3 +76,42 @@ def bad_value(rng: np.random.Generator, specials=BAD_SPECIALS):
         m = rng.normal(size=(2, 2))
         return m + m.T  # symmetric, often indefinite
     return a
+
+
+# The scale-out recipes' clusters, one of each for the whole run (a Spark session or a Dask
+# cluster takes seconds to start): the tests of test_scaleout*.py share them.
+@pytest.fixture(scope="session")
+def client():
+    distributed = pytest.importorskip("distributed")
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as c,
+    ):
+        yield c
+
+
+@pytest.fixture(scope="session")
+def spark():
+    import os
+    import sys
+
+    pyspark = pytest.importorskip("pyspark")
+    os.environ["PYSPARK_PYTHON"] = sys.executable
+    # The workers import the recipe functions from the test modules, as they would from the
+    # user's own module (shipped with --py-files or on PYTHONPATH).
+    here = os.path.dirname(os.path.abspath(__file__))
+    os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [here, os.environ.get("PYTHONPATH")]))
+    os.environ["PYSPARK_DRIVER_PYTHON"] = sys.executable
+    session = (
+        pyspark.sql.SparkSession.builder.master("local[2]")
+        .appName("seqsmooth-test")
+        .config("spark.driver.memory", "4g")
+        .config("spark.sql.execution.arrow.pyspark.enabled", "true")
+        .config("spark.sql.shuffle.partitions", "8")
+        .config("spark.ui.enabled", "false")
+        .getOrCreate()
+    )
+    yield session
+    session.stop()

@@ -61,18 +61,6 @@ def same_bits(got: pd.DataFrame, want: pd.DataFrame) -> None:
             assert np.array_equal(a, b), c
 
 
-@pytest.fixture(scope="module")
-def client():
-    distributed = pytest.importorskip("distributed")
-    with (
-        distributed.LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-        ) as cluster,
-        distributed.Client(cluster) as c,
-    ):
-        yield c
-
-
 def test_dask_map_partitions_equals_one_process(rows, single, client):
     import dask.dataframe as dd
 
@@ -99,31 +87,6 @@ def filter_pandas_group(group: pd.DataFrame) -> pd.DataFrame:
 def filter_arrow_group(table):
     table = table.sort_by("t")
     return seqsmooth.filter_frame(table, by="id", **SETTINGS)
-
-
-@pytest.fixture(scope="module")
-def spark():
-    import os
-    import sys
-
-    pyspark = pytest.importorskip("pyspark")
-    os.environ["PYSPARK_PYTHON"] = sys.executable
-    # The workers import the recipe functions from this module, as they would from the
-    # user's own module (shipped with --py-files or on PYTHONPATH).
-    here = os.path.dirname(os.path.abspath(__file__))
-    os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [here, os.environ.get("PYTHONPATH")]))
-    os.environ["PYSPARK_DRIVER_PYTHON"] = sys.executable
-    session = (
-        pyspark.sql.SparkSession.builder.master("local[2]")
-        .appName("seqsmooth-test")
-        .config("spark.driver.memory", "4g")
-        .config("spark.sql.execution.arrow.pyspark.enabled", "true")
-        .config("spark.sql.shuffle.partitions", "8")
-        .config("spark.ui.enabled", "false")
-        .getOrCreate()
-    )
-    yield session
-    session.stop()
 
 
 def spark_schema(single: pd.DataFrame) -> str:
