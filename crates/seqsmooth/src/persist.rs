@@ -38,8 +38,8 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 mod impls;
-pub mod stream;
 mod left_out;
+pub mod stream;
 
 pub use impls::{Beside, SavedModel};
 pub use left_out::{DynamicsLeftOut, ObservationLeftOut};

@@ -31,8 +31,8 @@
 //!
 //! The radar tracking application over these filters is [`crate::track`].
 
-pub mod bank;
 mod backward;
+pub mod bank;
 pub mod bayes;
 mod correct;
 pub mod discrete;

@@ -32,8 +32,8 @@
 use crate::error::{check_sample, Error, Param};
 use crate::estimate::PolynomialFit;
 use crate::model::state::PolynomialState;
-use crate::polynomial::prior::Prior;
 use crate::polynomial::options::MAX_DEGREE;
+use crate::polynomial::prior::Prior;
 use crate::recursive::TriangularFactor;
 use nalgebra::{DMatrix, DVector};
 
