@@ -45,7 +45,7 @@ for name, smoother, rust_name in [
         out = seqsmooth.kalman_frame(rows, smoother=smoother, **settings)
         best = min(best, time.perf_counter() - start)
     if smoother == "filter":
-        assert np.array_equal(out[["x0", "x1"]].to_numpy(), filtered)
+        assert np.array_equal(out[["d0", "d1"]].to_numpy(), filtered)
     print(
         f"{name}: kalman_frame {best:.3f} s, Rust KalmanBank {rust[rust_name]:.3f} s, "
         f"ratio {best / rust[rust_name]:.2f}x ({series * steps / best:.3e} updates/s)"

@@ -94,9 +94,11 @@ def test_kalman_frame_is_the_bank_in_every_frame_kind(kind, smoother):
     def col(c):
         return np.asarray(out[c].to_numpy() if kind == "pyarrow" else out[c], dtype=float)
 
-    for k in range(4):
-        assert np.array_equal(col(f"x{k}"), state[:, k])
-        assert np.array_equal(col(f"s{k}"), sigma[:, k])
+    # Component k·2 + a of the state is axis a's k-th derivative.
+    for k in range(2):
+        for a, axis in enumerate(["x", "y"]):
+            assert np.array_equal(col(f"{axis}_d{k}"), state[:, 2 * k + a])
+            assert np.array_equal(col(f"{axis}_s{k}"), sigma[:, 2 * k + a])
     assert np.array_equal(col("nis"), nis, equal_nan=True)
 
 

@@ -92,14 +92,14 @@ def test_kalman_equals_kalman_filter_per_series(frame, mode):
     def compute(t, y):
         states, covariances, nis = ss.KalmanFilter(1, x0, P0, t[0], q=q).update_many(t, y, R)
         sd = np.sqrt(np.diagonal(covariances, axis1=1, axis2=2))
-        return {"x0": states[:, 0], "x1": states[:, 1], "s0": sd[:, 0], "s1": sd[:, 1]} | {
+        return {"d0": states[:, 0], "d1": states[:, 1], "s0": sd[:, 0], "s1": sd[:, 1]} | {
             "nis": nis
         }
 
     expected = per_series(frame, compute)
     expr = ssp.kalman("y", time="t", degree=1, x0=x0, P0=P0, R=R, q=q).over("id")
     out = run(frame, expr, mode)
-    assert out.columns[3:] == ["x0", "x1", "s0", "s1", "nis"]
+    assert out.columns[3:] == ["d0", "d1", "s0", "s1", "nis"]
     for name, column in expected.items():
         assert_bits(out[name].to_numpy(), column, name)
 

@@ -235,9 +235,11 @@ def kalman_frame(
 
     Returns
     -------
-    The kind of ``df`` with the columns ``[by,] time, value..., x0..x{n-1}`` (the estimate),
-    ``s0..s{n-1}`` (their 1σ) and ``nis`` (the update's normalised innovation squared, NaN
-    where every component was missing), one row per input row, in input order.
+    The kind of ``df`` with the columns ``[by,] time, value...``, the estimate's derivatives
+    ``d0..dM`` and their 1σ ``s0..sM`` (``M = degree``; named as :func:`filter_frame` names
+    them; with several value columns ``<value>_d0..``, ``<value>_s0..`` for each), and
+    ``nis`` (the update's normalised innovation squared, NaN where every component was
+    missing), one row per input row, in input order.
 
     Raises
     ------
@@ -252,7 +254,7 @@ def kalman_frame(
     ...         "y": np.array([1.0, 5.0, 2.0, np.nan])}
     >>> out = seqsmooth.kalman_frame(rows, by="id", P0=100.0, R=1.0)
     >>> sorted(out)
-    ['id', 'nis', 's0', 's1', 't', 'x0', 'x1', 'y']
+    ['d0', 'd1', 'id', 'nis', 's0', 's1', 't', 'y']
     """
     values = [value] if isinstance(value, str) else list(value)
     if not values:
@@ -291,9 +293,13 @@ def kalman_frame(
     columns[time] = t
     for name, column in zip(values, columns_in):
         columns[name] = column
-    for k in range(n):
-        columns[f"x{k}"] = state[:, k]
-    for k in range(n):
-        columns[f"s{k}"] = sigma[:, k]
+    # The state is [positions of the axes, their first derivatives, ...]: component k·axes + a
+    # is axis a's k-th derivative, named as filter_frame names derivatives (``d``/``s`` and k),
+    # after the axis' value column when there are several.
+    prefixes = [""] if axes == 1 else [f"{v}_" for v in values]
+    for letter, numbers in (("d", state), ("s", sigma)):
+        for a, prefix in enumerate(prefixes):
+            for k in range(degree + 1):
+                columns[f"{prefix}{letter}{k}"] = numbers[:, k * axes + a]
     columns["nis"] = nis
     return _like(df, columns)

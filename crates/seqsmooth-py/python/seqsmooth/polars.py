@@ -148,11 +148,11 @@ def kalman(
     """The polynomial Kalman filter (:class:`seqsmooth.KalmanFilter` of ``degree``, one axis,
     from ``x0``, ``P0`` at ``t0`` — default each series' first time — with white-noise
     intensity ``q`` and fading ``theta`` per ``tau``) updated with every ``value`` of noise
-    variance ``R`` at the times ``time``: a struct of the state ``x0..xM``, its 1σ ``s0..sM``
-    and ``nis`` (the normalised innovation squared, the misfit flag's statistic), the
-    numbers of ``KalmanFilter.update_many``."""
+    variance ``R`` at the times ``time``: a struct of the state ``d0..dM`` (the derivatives,
+    named as ``filter``'s), its 1σ ``s0..sM`` and ``nis`` (the normalised innovation squared,
+    the misfit flag's statistic), the numbers of ``KalmanFilter.update_many``."""
     width = degree + 1
-    names = [f"x{k}" for k in range(width)] + [f"s{k}" for k in range(width)] + ["nis"]
+    names = [f"d{k}" for k in range(width)] + [f"s{k}" for k in range(width)] + ["nis"]
     settings = dict(q=q, theta=theta, tau=tau)
     KalmanFilter(degree, x0, P0, 0.0 if t0 is None else t0, **settings)  # settings checked now
 

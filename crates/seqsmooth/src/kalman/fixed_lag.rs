@@ -167,7 +167,7 @@ pub(super) fn time_before(time: f64, previous: f64) -> Error {
 
 /// The error of a backward step whose `S_{k+1|k}` (`n × n`) is not positive definite, naming
 /// measurement `index`.
-pub(super) fn not_positive_definite(s_pred: &[f64], n: usize, index: usize) -> Error {
+pub(crate) fn not_positive_definite(s_pred: &[f64], n: usize, index: usize) -> Error {
     Error::InBatch {
         index,
         source: Box::new(Error::InvalidParameter {

@@ -57,6 +57,7 @@ fn check_window(n: usize, m: usize) -> Result<usize, Error> {
 /// assert!(goodness_of_fit(&[], 1.0).is_err());
 /// assert!(goodness_of_fit(&[1.0], 0.0).is_err());
 /// assert!(goodness_of_fit(&[f64::NAN], 1.0).is_err());
+/// assert!(goodness_of_fit(&[1e200], 1.0).is_err()); // overflows: refused, not infinity
 /// ```
 pub fn goodness_of_fit(residuals: &[f64], variance: f64) -> Result<f64, Error> {
     if residuals.is_empty() {
@@ -79,8 +80,15 @@ pub fn goodness_of_fit(residuals: &[f64], variance: f64) -> Result<f64, Error> {
             value: r,
         });
     }
-    let e2: f64 = residuals.iter().map(|r| r * r).sum::<f64>() / variance;
-    Ok(e2 / residuals.len() as f64)
+    let g = residuals.iter().map(|r| r * r).sum::<f64>() / variance / residuals.len() as f64;
+    if !g.is_finite() {
+        // Residuals near 1e155, or a variance near the smallest normal: the measure overflows.
+        return Err(Error::NonFinite {
+            what: "goodness-of-fit measure (the residuals' squares over the variance overflow)",
+            value: g,
+        });
+    }
+    Ok(g)
 }
 
 /// `1 − 1/√N`, the value Reyneke et al. §7.1 say the measure "empirically converges to" on a

@@ -23,9 +23,11 @@
 //! Every series runs the library's own Kalman arithmetic (the kernels of
 //! [`KalmanFilter`](super::KalmanFilter): `Φ S Φᵀ + Q` and the correction, compiled with the
 //! state size and the components present as constants for `n ≤ 9`, `k ≤ 4`, a general-size
-//! fallback beyond) and the library's own backward step ([`super::smoother`]), so it equals one
-//! `KalmanFilter` (and one `Smoother`) per series: tested to `10⁻¹²` relative in
-//! `tests/kalman_bank.rs` (bit for bit in practice).
+//! fallback beyond) and the library's own backward steps (the whole-interval step of
+//! [`super::smoother`]'s `smooth_flat` for the RTS smoother, [`super::fixed_lag`]'s for the
+//! fixed-lag one), so it equals one `KalmanFilter` (and one `Smoother`, one
+//! `FixedLagSmoother`) per series to rounding: tested to `10⁻¹²` relative in
+//! `tests/kalman_bank.rs`.
 
 use super::correct::noise_entries;
 use super::noise::{check_covariance, check_estimate, check_noise_dimension, ProcessNoise};
