@@ -9,10 +9,12 @@
 //! symmetric, positive semidefinite) is the library's.
 
 use crate::arrays::{matrix, table};
-use crate::callables::{stacked, Run};
+use crate::callables::Run;
 use crate::errors::{raise, IntoPy, Kind};
 use crate::fixed_lag::lagged;
-use crate::kalman::{before, measurement, measurements, noise, out_of_order, square, PyInnovation};
+use crate::kalman::{
+    before, measurement, measurements, noise, out_of_order, smoothed_run, square, PyInnovation,
+};
 use crate::persist;
 use nalgebra::{DMatrix, DVector};
 use numpy::PyArray1;
@@ -388,23 +390,27 @@ impl PyContinuousKalmanFilter {
     /// The Rauch–Tung–Striebel smoother over the measurements (as ``update_many`` takes them),
     /// from this filter's current state (the filter itself is not changed): at each
     /// measurement's time the estimate from all of them. Returns ``(states, covariances)``,
-    /// ``(N, n)`` and ``(N, n, n)``.
+    /// ``(N, n)`` and ``(N, n, n)``; with ``return_gains``, also the smoother gains ``C[k] =
+    /// P[k] Φᵀ Pp[k]⁻¹`` and the predicted covariances ``Pp[k]`` out of each measurement (the
+    /// last gain 0, the last ``Pp`` its own covariance: filterpy's ``rts_smoother``'s ``K``
+    /// and ``Pp``), from the same pass.
     #[allow(non_snake_case)]
-    #[pyo3(signature = (t, z, R = None))]
+    #[pyo3(signature = (t, z, R = None, return_gains = false))]
     fn smooth<'py>(
         &self,
         py: Python<'py>,
         t: &Bound<'py, PyAny>,
         z: &Bound<'py, PyAny>,
         R: Option<&Bound<'py, PyAny>>,
+        return_gains: bool,
     ) -> PyResult<Bound<'py, PyTuple>> {
         let rows = self.rows(t, z, R)?;
         if let Some((k, t, previous)) = out_of_order(self.filter.time(), &rows) {
             return Err(before(t, previous, Some(k)));
         }
         let filter = self.filter.clone();
-        let smoothed = py.detach(|| smoother::smooth(filter, &rows)).py()?;
-        stacked(py, smoothed.iter().map(|s| (&s.state, &s.covariance)))
+        let run = py.detach(|| smoother::smooth_flat(filter, &rows)).py()?;
+        smoothed_run(py, run, return_gains)
     }
 
     /// The fixed-lag smoother over the measurements (as ``smooth`` takes them; ``R`` ``None``

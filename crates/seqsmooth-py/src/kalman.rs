@@ -324,6 +324,43 @@ pub struct PyKalmanFilter {
     components: usize,
 }
 
+/// A smoothed run as ``(states, covariances)``, with ``(gains, predicted_covariances)`` after
+/// them when `return_gains` (the last ``Pp`` the last covariance).
+pub(crate) fn smoothed_run<'py>(
+    py: Python<'py>,
+    mut run: smoother::SmoothedRun,
+    return_gains: bool,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let (n, count) = (run.dimension, run.times.len());
+    let nn = n * n;
+    let cube = |v: Vec<f64>| -> PyResult<Bound<'py, PyAny>> {
+        Ok(PyArray1::from_vec(py, v).reshape([count, n, n])?.into_any())
+    };
+    let mut out = vec![matrix(py, std::mem::take(&mut run.states), count, n)?];
+    if return_gains {
+        // A gain is not symmetric: column-major to row-major. A covariance is.
+        let mut gains = vec![0.0; count * nn];
+        for k in 0..count {
+            for i in 0..n {
+                for j in 0..n {
+                    gains[k * nn + i * n + j] = run.gains[k * nn + i + j * n];
+                }
+            }
+        }
+        let mut predicted = Vec::with_capacity(count * nn);
+        for k in 0..count {
+            predicted.extend_from_slice(
+                run.predicted_covariance(k)
+                    .unwrap_or(&run.covariances[k * nn..(k + 1) * nn]),
+            );
+        }
+        out.extend([cube(run.covariances)?, cube(gains)?, cube(predicted)?]);
+    } else {
+        out.push(cube(run.covariances)?);
+    }
+    PyTuple::new(py, out)
+}
+
 #[pymethods]
 impl PyKalmanFilter {
     /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
@@ -499,26 +536,25 @@ impl PyKalmanFilter {
 
     /// The Rauch–Tung–Striebel smoother over the measurements, from this filter's current
     /// state (the filter itself is not changed): at each measurement's time the estimate from
-    /// all of them. Returns ``(states, covariances)``, ``(n, dim)`` and ``(n, dim, dim)``.
+    /// all of them. Returns ``(states, covariances)``, ``(n, dim)`` and ``(n, dim, dim)``;
+    /// with ``return_gains``, also the smoother gains ``C[k] = P[k] Φᵀ Pp[k]⁻¹`` and the
+    /// predicted covariances ``Pp[k]`` out of each measurement, ``(n, dim, dim)`` each (the
+    /// last gain 0, the last ``Pp`` its own covariance: filterpy's ``rts_smoother``'s ``K``
+    /// and ``Pp``), from the same pass.
     #[allow(non_snake_case)]
-    #[pyo3(signature = (t, z, R))]
+    #[pyo3(signature = (t, z, R, return_gains = false))]
     fn smooth<'py>(
         &self,
         py: Python<'py>,
         t: &Bound<'py, PyAny>,
         z: &Bound<'py, PyAny>,
         R: &Bound<'py, PyAny>,
+        return_gains: bool,
     ) -> PyResult<Bound<'py, PyTuple>> {
         let rows = measurements(t, z, R, self.filter_components())?;
         let filter = self.filter.clone();
         let run = py.detach(|| smoother::smooth_flat(filter, &rows)).py()?;
-        let (n, count) = (run.dimension, run.times.len());
-        let states = matrix(py, run.states, count, n)?;
-        // Symmetric: column-major is row-major.
-        let covariances = PyArray1::from_vec(py, run.covariances)
-            .reshape([count, n, n])?
-            .into_any();
-        PyTuple::new(py, [states, covariances])
+        smoothed_run(py, run, return_gains)
     }
 
     /// The fixed-lag smoother over the measurements (as ``smooth`` takes them), from this

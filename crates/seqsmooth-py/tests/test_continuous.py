@@ -93,6 +93,11 @@ def test_nearly_constant_velocity_equals_filterpy_q_continuous_white_noise():
     xs, Ps = ckf.__class__(model, H, R, x0, P0).smooth(t, z)
     rts = lkf.rts_smoother(want[0], want[1], Fs=Fs, Qs=Qs)
     assert rel(xs, rts[0]) <= 1e-11 and rel(Ps, rts[1]) <= 1e-11
+    # The smoother gains and predicted covariances from the same pass: filterpy's K and Pp.
+    xg, Pg, K, Pp = ckf.__class__(model, H, R, x0, P0).smooth(t, z, return_gains=True)
+    assert np.array_equal(xg, xs) and np.array_equal(Pg, Ps)
+    assert K.shape == Pp.shape == (len(t), 4, 4) and not K[-1].any()
+    assert rel(K, rts[2]) <= 1e-11 and rel(Pp, rts[3]) <= 1e-11
 
 
 def test_singer_equals_scipy_van_loan_on_irregular_steps():

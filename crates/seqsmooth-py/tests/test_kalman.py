@@ -309,3 +309,28 @@ def test_an_indefinite_P0_is_refused_at_construction():
     with pytest.raises(ss.SeqsmoothError):
         ss.KalmanFilter(1, x0=[0.0, 0.0], P0=[[1.0, np.inf], [np.inf, 1.0]])
     ss.KalmanFilter(1, x0=[0.0, 0.0], P0=[[1.0, 1.0], [1.0, 1.0]])  # singular: a covariance
+
+
+def test_smooth_returns_its_gains_and_predicted_covariances():
+    """``smooth(..., return_gains=True)`` gives the backward pass's own gains and predicted
+    covariances: ``K[k] Pp[k] = P[k] Φᵀ`` and ``Ps[k] = P[k] + K[k] (Ps[k+1] − Pp[k]) K[k]ᵀ``
+    with the filter's own ``P[k]`` (``update_many``) and the model's ``Φ`` over each step; the
+    last gain 0, the last ``Pp`` its own covariance; the first two outputs as without."""
+    rng = np.random.default_rng(12)
+    t = np.cumsum(rng.uniform(0.5, 1.5, 30))
+    z = 2.0 + 0.3 * t + rng.normal(0, 0.5, 30)
+    z[7] = np.nan
+
+    def fresh():
+        return ss.KalmanFilter(1, np.zeros(2), 100.0 * np.eye(2), t0=t[0], q=0.01)
+
+    _, P, _ = fresh().update_many(t, z, 0.25)
+    xs, Ps, K, Pp = fresh().smooth(t, z, 0.25, return_gains=True)
+    plain = fresh().smooth(t, z, 0.25)
+    assert np.array_equal(plain[0], xs) and np.array_equal(plain[1], Ps)
+    for k in range(len(t) - 1):
+        phi = np.array([[1.0, t[k + 1] - t[k]], [0.0, 1.0]])
+        assert np.allclose(K[k] @ Pp[k], P[k] @ phi.T, rtol=1e-9, atol=1e-12), k
+        again = P[k] + K[k] @ (Ps[k + 1] - Pp[k]) @ K[k].T
+        assert np.allclose(Ps[k], again, rtol=1e-9, atol=1e-12), k
+    assert not K[-1].any() and np.array_equal(Pp[-1], Ps[-1])

@@ -186,6 +186,21 @@ fn flat_smoother_against_the_textbook_recursion() {
             xs = x + &c * (&xs - xp);
             ss = s + &c * (&ss - sp) * c.transpose();
             let scale = ss.diagonal().map(f64::sqrt);
+            // The run's gain C_k and S_{k+1|k}: the backward step's own, and the prediction's.
+            let gain = &got.gains[k * n * n..(k + 1) * n * n];
+            let largest = c.amax();
+            for (e, want) in gain.iter().zip(c.iter()) {
+                worst = worst.max((e - want).abs() / largest);
+            }
+            let sd = sp.diagonal().map(f64::sqrt);
+            for (e, (i, j)) in got
+                .predicted_covariance(k)
+                .unwrap()
+                .iter()
+                .zip((0..n).flat_map(|j| (0..n).map(move |i| (i, j))))
+            {
+                worst = worst.max((e - sp[(i, j)]).abs() / (sd[i] * sd[j]));
+            }
             for i in 0..n {
                 worst = worst.max((got.states[k * n + i] - xs[i]).abs() / scale[i]);
                 for j in 0..n {
@@ -194,6 +209,9 @@ fn flat_smoother_against_the_textbook_recursion() {
                 }
             }
         }
+        let last = rows.len() - 1;
+        assert!(got.gains[last * n * n..].iter().all(|&g| g == 0.0));
+        assert!(got.predicted_covariance(last).is_none());
     }
     assert!(worst < 1e-8, "worst {worst:e} of σ");
 }

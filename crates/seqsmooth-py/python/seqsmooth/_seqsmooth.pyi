@@ -10,6 +10,7 @@ import numpy.typing as npt
 ArrayLike = npt.ArrayLike
 Matrix = npt.NDArray[np.float64]
 Vector = npt.NDArray[np.float64]
+Cube = npt.NDArray[np.float64]
 
 MAX_DEGREE: int
 __version__: str
@@ -232,9 +233,14 @@ class KalmanFilter:
     def update_many(
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
     ) -> tuple[Matrix, npt.NDArray[np.float64], Vector]: ...
+    @overload
     def smooth(
-        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float, return_gains: Literal[False] = ...
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
+    @overload
+    def smooth(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float, return_gains: Literal[True]
+    ) -> tuple[Matrix, Cube, Cube, Cube]: ...
     def fixed_lag_smoother(
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float, lag: int
     ) -> tuple[Matrix, npt.NDArray[np.float64]]:
@@ -582,9 +588,18 @@ class ContinuousKalmanFilter:
     def update_many(
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float | None = None
     ) -> tuple[Matrix, npt.NDArray[np.float64], Vector]: ...
+    @overload
     def smooth(
-        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float | None = None
+        self,
+        t: ArrayLike,
+        z: ArrayLike,
+        R: ArrayLike | float | None = None,
+        return_gains: Literal[False] = ...,
     ) -> tuple[Matrix, npt.NDArray[np.float64]]: ...
+    @overload
+    def smooth(
+        self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float | None, return_gains: Literal[True]
+    ) -> tuple[Matrix, Cube, Cube, Cube]: ...
     def fixed_lag_smoother(
         self, t: ArrayLike, z: ArrayLike, R: ArrayLike | float | None, lag: int
     ) -> tuple[Matrix, npt.NDArray[np.float64]]:

@@ -87,6 +87,9 @@ pub struct SmoothedRun {
     pub filtered_covariances: Vec<f64>,
     /// The forward update's NIS (`None` where every component was missing).
     pub nis: Vec<Option<f64>>,
+    /// The smoother gains `C_k = S_{k|k} Φᵀ S_{k+1|k}⁻¹`, `n²` a measurement (column-major;
+    /// the last measurement's zero): the backward step's own.
+    pub gains: Vec<f64>,
     /// The forward pass's predictions, kept for the backward pass (and their buffers for the
     /// next run, [`smooth_flat_into`]): `Φ` at each measurement, `X_{k+1|k}` and `S_{k+1|k}`
     /// at `k`.
@@ -111,10 +114,40 @@ impl SmoothedRun {
             filtered_states: Vec::new(),
             filtered_covariances: Vec::new(),
             nis: Vec::new(),
+            gains: Vec::new(),
             phi: Vec::new(),
             x_pred: Vec::new(),
             s_pred: Vec::new(),
         }
+    }
+}
+
+impl SmoothedRun {
+    /// The predicted covariance `S_{k+1|k}` out of measurement `k` (column-major, `n²`), the
+    /// one the gain `C_k` weighs; `None` for the last measurement (nothing follows it).
+    ///
+    /// ```
+    /// use nalgebra::{DMatrix, DVector};
+    /// use seqsmooth::model::measurement::{Measurement, NoiseCovariance};
+    /// use seqsmooth::kalman::{smoother, KalmanFilter};
+    /// use seqsmooth::model::dynamics::PolynomialDynamics;
+    /// use seqsmooth::model::observation::LinearObservation;
+    /// // A constant (Φ = 1, no driving noise) seen twice with unit variance from a vague prior.
+    /// let f = KalmanFilter::new(PolynomialDynamics::new(0, 1), LinearObservation::value_of(1),
+    ///     DVector::zeros(1), DMatrix::from_element(1, 1, 1e12), 0.0).unwrap();
+    /// let rows: Vec<Measurement> = [1.0, 2.0].iter().enumerate()
+    ///     .map(|(k, &y)| Measurement { time: k as f64, values: vec![Some(y)], noise: NoiseCovariance::Identity })
+    ///     .collect();
+    /// let run = smoother::smooth_flat(f, &rows).unwrap();
+    /// let p = run.predicted_covariance(0).unwrap()[0];
+    /// assert!((p - 1.0).abs() < 1e-9); // S_{1|0} = S_{0|0} = 1 (no driving noise)
+    /// assert!((run.gains[0] - 1.0).abs() < 1e-9); // C_0 = S_{0|0} S_{1|0}⁻¹ = 1
+    /// assert_eq!(run.gains[1], 0.0); // the last
+    /// assert!(run.predicted_covariance(1).is_none());
+    /// ```
+    pub fn predicted_covariance(&self, k: usize) -> Option<&[f64]> {
+        let nn = self.dimension * self.dimension;
+        self.s_pred.get(k * nn..(k + 1) * nn)
     }
 }
 
@@ -190,6 +223,7 @@ pub fn smooth_flat_into<D: Dynamics + Clone, O: Observation + Clone>(
         &mut run.covariances,
         &mut run.filtered_states,
         &mut run.filtered_covariances,
+        &mut run.gains,
         &mut run.phi,
         &mut run.x_pred,
         &mut run.s_pred,
@@ -266,6 +300,7 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone>(
     let last = count - 1;
     run.states.resize(count * n, 0.0);
     run.covariances.resize(count * nn, 0.0);
+    run.gains.resize(count * nn, 0.0);
     run.states[last * n..].copy_from_slice(&run.filtered_states[last * n..]);
     run.covariances[last * nn..].copy_from_slice(&run.filtered_covariances[last * nn..]);
     let mut c = vec![0.0; nn];
@@ -291,6 +326,7 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone>(
             let found = first_map_error((&*run, &phi[..], &x_pred[..], &s_pred[..]), k + 2);
             return Err(found.unwrap_or_else(|| in_batch(k, not_finite(bad.unwrap_or(f64::NAN)))));
         }
+        run.gains[k * nn..(k + 1) * nn].copy_from_slice(&c);
     }
     Ok(())
 }
