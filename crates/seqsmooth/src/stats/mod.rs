@@ -13,7 +13,7 @@
 //!   (App. A.5), both biased by a trend; the bias-free `k`-th difference estimator
 //!   ([`difference_variance`], and [`DifferenceNoise`] on irregular timestamps, running or
 //!   windowed); residual-based [`residual_variance`] (Morrison (6.10.24)).
-//! - Reyneke et al.'s §7.1 goodness of fit ([`goodness_of_fit`], [`reyneke_gof_limit`]) and its
+//! - Reyneke et al.'s §7.1 goodness of fit ([`goodness_of_fit()`], [`reyneke_gof_limit`]) and its
 //!   reading as Morrison's χ² test of a window's residuals ([`gof_mean`], [`gof_threshold`],
 //!   [`gof_false_alarm_rate`]).
 //! - [`Welford`]: running mean and variance.
