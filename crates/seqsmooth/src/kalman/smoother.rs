@@ -160,7 +160,7 @@ impl Default for SmoothedRun {
 /// [`smooth`]'s numbers in flat buffers, with nothing allocated per measurement: the forward
 /// pass runs the filter and keeps each step's prediction `Φ`, `X_{k+1|k}`, `S_{k+1|k}`; the
 /// backward pass is the textbook recursion of the module's doc from the last estimate
-/// ([`backward::smooth_into`](super::backward), `S_{k+1|k}⁻¹` by its `L D Lᵀ` factors), the
+/// (`backward::smooth_into`, `S_{k+1|k}⁻¹` by its `L D Lᵀ` factors), the
 /// measurement-at-a-time [`Smoother`]'s numbers (its maps) to rounding, at about three quarters
 /// of its arithmetic. Errors as [`Smoother::smooth`]'s (the first in the order that smoother
 /// meets them).
