@@ -16,7 +16,9 @@
 //! Times are the thread's CPU time (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`), so that other processes on
 //! a shared machine count less. Each side's run is checked against the other's before timing (the floors against the
 //! library within 1e-9 and 1e-7 relative, as the bench does).
-//! Run: `cargo run --release -p seqsmooth --example kalman_floor_pace -- [REPS]` (default 15).
+//! Run: `cargo run --release -p seqsmooth --example kalman_floor_pace -- [REPS] [PAIR]` (default
+//! 15 repetitions, every pair; `PAIR` times only the pairs whose name starts with it, e.g.
+//! `kalman3` under `valgrind --tool=callgrind` for instructions per update).
 
 #[path = "../benches/common/radar.rs"]
 #[allow(dead_code)]
@@ -175,6 +177,8 @@ fn main() {
     let f3 = std::slice::from_ref(&filter);
     let per = |s: f64, count: usize| s / count as f64 * 1e9;
     println!("pair,steps,reps,a_best_ns,b_best_ns,ratio_min,ratio_median,ratio_max");
+    let only = std::env::args().nth(2);
+    let want = |name: &str| only.as_deref().is_none_or(|o| name.starts_with(o));
     let show = |name: &str, steps: usize, p: [f64; 5]| {
         println!(
             "{name},{steps},{reps},{:.1},{:.1},{:.3},{:.3},{:.3}",
@@ -185,38 +189,48 @@ fn main() {
             p[4]
         );
     };
-    show(
-        "kalman3 floor/library",
-        rows.len(),
-        pair(reps, floor3, lib3),
-    );
-    show("ekf6 floor/library", updates, pair(reps, floor6, lib6));
+    if want("kalman3 floor/library") {
+        show(
+            "kalman3 floor/library",
+            rows.len(),
+            pair(reps, floor3, lib3),
+        );
+    }
+    if want("ekf6 floor/library") {
+        show("ekf6 floor/library", updates, pair(reps, floor6, lib6));
+    }
     let mut out = SmoothedRun::new();
-    show(
-        "rts3 filter/smooth_flat_into",
-        short.len(),
-        pair(
-            reps,
-            || filter_runs(f3, &[short]),
-            || smooth_runs(f3, &[short], &mut out),
-        ),
-    );
-    show(
-        "rts3 filter/smooth_flat",
-        short.len(),
-        pair(
-            reps,
-            || filter_runs(f3, &[short]),
-            || smooth_flat(filter.clone(), short).unwrap().states[0],
-        ),
-    );
-    show(
-        "rts6 filter/smooth_flat_into",
-        updates,
-        pair(
-            reps,
-            || filter_runs(&filters, &runs),
-            || smooth_runs(&filters, &runs, &mut out),
-        ),
-    );
+    if want("rts3 filter/smooth_flat_into") {
+        show(
+            "rts3 filter/smooth_flat_into",
+            short.len(),
+            pair(
+                reps,
+                || filter_runs(f3, &[short]),
+                || smooth_runs(f3, &[short], &mut out),
+            ),
+        );
+    }
+    if want("rts3 filter/smooth_flat") {
+        show(
+            "rts3 filter/smooth_flat",
+            short.len(),
+            pair(
+                reps,
+                || filter_runs(f3, &[short]),
+                || smooth_flat(filter.clone(), short).unwrap().states[0],
+            ),
+        );
+    }
+    if want("rts6 filter/smooth_flat_into") {
+        show(
+            "rts6 filter/smooth_flat_into",
+            updates,
+            pair(
+                reps,
+                || filter_runs(&filters, &runs),
+                || smooth_runs(&filters, &runs, &mut out),
+            ),
+        );
+    }
 }

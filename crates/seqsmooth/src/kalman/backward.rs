@@ -27,15 +27,13 @@ pub(crate) fn map_into(
     if n <= MAX {
         unrolled_sizes!(n, N => {
                 let mut scratch = [0.0; 2 * N * N + 2 * N];
-                let mut entries = [(0, 0, 0.0); N * N];
-                let scratch = (&mut scratch[..], &mut entries[..]);
+                let scratch = &mut scratch[..];
                 map_kernel(Fixed::<N>, (x, s), (phi, x_pred, s_pred), scratch, a, d, c)
             },
             _ => false)
     } else {
         let mut scratch = vec![0.0; 2 * n * n + 2 * n];
-        let mut entries = vec![(0, 0, 0.0); n * n];
-        let scratch = (&mut scratch[..], &mut entries[..]);
+        let scratch = &mut scratch[..];
         map_kernel(Any(n), (x, s), (phi, x_pred, s_pred), scratch, a, d, c)
     }
 }
@@ -78,15 +76,13 @@ pub(crate) fn smooth_into(
     if n <= MAX {
         unrolled_sizes!(n, N => {
                 let mut scratch = [0.0; 2 * N * N + 2 * N];
-                let mut entries = [(0, 0, 0.0); N * N];
-                let scratch = (&mut scratch[..], &mut entries[..]);
+                let scratch = &mut scratch[..];
                 smooth_kernel(Fixed::<N>, estimates, (phi, x_pred, s_pred), scratch, (x_out, s_out, c))
             },
             _ => false)
     } else {
         let mut scratch = vec![0.0; 2 * n * n + 2 * n];
-        let mut entries = vec![(0, 0, 0.0); n * n];
-        let scratch = (&mut scratch[..], &mut entries[..]);
+        let scratch = &mut scratch[..];
         smooth_kernel(
             Any(n),
             estimates,
@@ -104,15 +100,15 @@ fn smooth_kernel<S: Size>(
     n: S,
     ((x, s), (x_next, s_next)): ((&[f64], &[f64]), (&[f64], &[f64])),
     (phi, x_pred, s_pred): (&[f64], &[f64], &[f64]),
-    scratch: (&mut [f64], &mut [(usize, usize, f64)]),
+    scratch: &mut [f64],
     (x_out, s_out, c): (&mut [f64], &mut [f64], &mut [f64]),
 ) -> bool {
-    if !gain_kernel(n, s, (phi, s_pred), (&mut *scratch.0, scratch.1), c) {
+    if !gain_kernel(n, s, (phi, s_pred), &mut *scratch, c) {
         return false;
     }
     let n = n.get();
     let nn = n * n;
-    let (e, rest) = scratch.0.split_at_mut(nn);
+    let (e, rest) = scratch.split_at_mut(nn);
     let (w, rest) = rest.split_at_mut(nn);
     let dx = &mut rest[..n];
     let (c, x, s, x_pred, s_pred) = (&c[..nn], &x[..n], &s[..nn], &x_pred[..n], &s_pred[..nn]);
@@ -159,15 +155,14 @@ fn smooth_kernel<S: Size>(
 const MAX: usize = crate::numeric::unrolled::UNROLLED_MAX_SIZE;
 
 /// The smoother gain `C = S Φᵀ S_{k+1|k}⁻¹` into `c` and `P = Φ S` into `scratch`'s first
-/// `n²` (the rest: `L` below its diagonal and `L D` above, a column, `1/D`: `2n² + 2n` in all;
-/// `entries` holds the entries of `Φ` that are not zero, `n²`); `false` when `S_{k+1|k}` is
-/// not positive definite.
+/// `n²` (the rest: `L` below its diagonal and `L D` above, a column, `1/D`: `2n² + 2n` in all);
+/// `false` when `S_{k+1|k}` is not positive definite.
 #[inline(always)]
 fn gain_kernel<S: Size>(
     n: S,
     s: &[f64],
     (phi, s_pred): (&[f64], &[f64]),
-    (scratch, entries): (&mut [f64], &mut [(usize, usize, f64)]),
+    scratch: &mut [f64],
     c: &mut [f64],
 ) -> bool {
     let n = n.get();
@@ -176,33 +171,16 @@ fn gain_kernel<S: Size>(
     let (l, rest) = rest.split_at_mut(nn);
     let (column, inverse) = rest.split_at_mut(n);
     let (inverse, c) = (&mut inverse[..n], &mut c[..nn]);
-    // P = Φ S, a column at a time over the entries of Φ that are not zero (listed once, by
-    // columns: each entry of P sums its terms in the order of Φ's columns; adding 0 · s
-    // would change nothing for a finite s).
-    let mut count = 0;
+    // P = Φ S, each entry's terms in the order of Φ's columns, those of Φ's zeros skipped
+    // (adding 0 · s would change nothing for a finite s; the polynomial model's Φ is mostly
+    // zeros): one test per entry of Φ, its row of S then an axpy into P's row.
+    p.fill(0.0);
     for m in 0..n {
         for i in 0..n {
             let v = phi[i + m * n];
             if v != 0.0 {
-                entries[count] = (i, m, v);
-                count += 1;
-            }
-        }
-    }
-    // Dense when at most a quarter of the entries are zero.
-    let sparse = 4 * count < 3 * n * n;
-    for j in 0..n {
-        let (pj, sj) = (&mut p[j * n..(j + 1) * n], &s[j * n..(j + 1) * n]);
-        pj.fill(0.0);
-        if sparse {
-            for &(i, m, v) in &entries[..count] {
-                pj[i] += v * sj[m];
-            }
-        } else {
-            for m in 0..n {
-                let fm = &phi[m * n..(m + 1) * n];
-                for i in 0..n {
-                    pj[i] += fm[i] * sj[m];
+                for j in 0..n {
+                    p[i + j * n] += v * s[m + j * n];
                 }
             }
         }
@@ -263,17 +241,17 @@ fn map_kernel<S: Size>(
     n: S,
     (x, s): (&[f64], &[f64]),
     (phi, x_pred, s_pred): (&[f64], &[f64], &[f64]),
-    scratch: (&mut [f64], &mut [(usize, usize, f64)]),
+    scratch: &mut [f64],
     a: &mut [f64],
     d: &mut [f64],
     c: &mut [f64],
 ) -> bool {
-    if !gain_kernel(n, s, (phi, s_pred), (&mut *scratch.0, scratch.1), c) {
+    if !gain_kernel(n, s, (phi, s_pred), &mut *scratch, c) {
         return false;
     }
     let n = n.get();
     let nn = n * n;
-    let (p, s, c) = (&scratch.0[..nn], &s[..nn], &c[..nn]);
+    let (p, s, c) = (&scratch[..nn], &s[..nn], &c[..nn]);
     let (a, d) = (&mut a[..n], &mut d[..nn]);
     d.copy_from_slice(s);
     for j in 0..n {

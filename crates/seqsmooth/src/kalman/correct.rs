@@ -160,11 +160,28 @@ pub(super) fn carry<S: Size>(
     a: &mut [f64],
     out: &mut [f64],
 ) -> bool {
+    let nn = n.get() * n.get();
+    let phi = &phi[..nn];
+    carry_with(n, |i, l| phi[i + l * n.get()], s, q, a, out)
+}
+
+/// [`carry`] with `Φ`'s entry `(i, l)` from `phi(i, l)`: where the entries are known zeros
+/// (the polynomial model's `Ψ(ζ) ⊗ I_d`, (4.2.5)) and the sizes constants, their terms are
+/// dropped at compile time rather than skipped at run time; the same numbers.
+#[inline(always)]
+pub(super) fn carry_with<S: Size>(
+    n: S,
+    phi: impl Fn(usize, usize) -> f64 + Copy,
+    s: &[f64],
+    q: Option<&[f64]>,
+    a: &mut [f64],
+    out: &mut [f64],
+) -> bool {
     let n = n.get();
-    let (phi, out) = (&phi[..n * n], &mut out[..n * n]);
-    times_transpose(n, s, n, |i, l| phi[i + l * n], a);
+    let out = &mut out[..n * n];
+    times_transpose(n, s, n, phi, a);
     transpose(n, a);
-    times_transpose(n, a, n, |j, l| phi[j + l * n], out);
+    times_transpose(n, a, n, phi, out);
     match q {
         // (out + Q) symmetrized, in one pass.
         Some(q) => {

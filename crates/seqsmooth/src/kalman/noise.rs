@@ -59,6 +59,19 @@ pub trait ProcessNoise: std::fmt::Debug + Send + Sync {
     fn is_time_invariant(&self) -> bool {
         false
     }
+
+    /// The white noise on the polynomial model's highest derivative this is, when it is one
+    /// ([`WhiteNoiseDerivative`], `Q` in closed form): the Kalman filter then fills `Q` with
+    /// the sizes fixed at compile time (the same numbers). `None` unless the model says so.
+    ///
+    /// ```
+    /// use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};
+    /// let q = WhiteNoiseDerivative::new(1, 1, 0.5).unwrap();
+    /// assert_eq!(q.white_noise_derivative(), Some(q));
+    /// ```
+    fn white_noise_derivative(&self) -> Option<WhiteNoiseDerivative> {
+        None
+    }
 }
 
 /// The range of a driving noise's power spectral density `q` (ch. 15): finite and at least 0
@@ -116,6 +129,11 @@ impl WhiteNoiseDerivative {
         }
         Ok(Self { degree, axes, psd })
     }
+
+    /// The degree `m`, the axes `d` and the spectral density `q`.
+    pub(crate) fn parts(&self) -> (usize, usize, f64) {
+        (self.degree, self.axes, self.psd)
+    }
 }
 
 impl ProcessNoise for WhiteNoiseDerivative {
@@ -125,6 +143,10 @@ impl ProcessNoise for WhiteNoiseDerivative {
 
     fn is_time_invariant(&self) -> bool {
         true
+    }
+
+    fn white_noise_derivative(&self) -> Option<WhiteNoiseDerivative> {
+        Some(*self)
     }
 
     fn dimension(&self) -> usize {
@@ -181,7 +203,7 @@ impl ProcessNoise for WhiteNoiseDerivative {
 /// finite. Derivatives `i ≤ j` are counted from the highest, `u = m − i ≥ v = m − j`, so
 /// `p = 2m + 1 − i − j = u + v + 1`; each entry is written at `(i, j)` and `(j, i)` of each axis.
 #[inline(always)]
-fn fill<S: Size>(size: S, d: usize, psd: f64, zeta: f64, out: &mut [f64]) -> bool {
+pub(crate) fn fill<S: Size>(size: S, d: usize, psd: f64, zeta: f64, out: &mut [f64]) -> bool {
     let (size, mut finite) = (size.get(), true);
     let n = size * d;
     // k! for k < size as a running product (the operations of `factorial`, in its order), in a

@@ -270,15 +270,24 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone>(
                     return Err(time_before(m.time, previous));
                 }
             }
-            match filter.predict_transition(m.time)? {
-                Some(transition) => phi.extend_from_slice(transition.as_slice()),
-                None => phi.extend((0..nn).map(|e| f64::from(u8::from(e % (n + 1) == 0)))),
+            // One update (its prediction and correction), the prediction then read from
+            // the filter's work buffers: the same numbers as predicting and updating apart.
+            let stepped = m.time != filter.time();
+            let stats = filter.update_stats(m)?;
+            if stepped {
+                phi.extend_from_slice(filter.last_transition().as_slice());
+            } else {
+                phi.extend((0..nn).map(|e| f64::from(u8::from(e % (n + 1) == 0))));
             }
             if index > 0 {
-                x_pred.extend_from_slice(filter.state().as_slice());
-                s_pred.extend_from_slice(filter.covariance().as_slice());
+                let (x, s) = match stats {
+                    Some(_) => filter.last_prediction(),
+                    None => (filter.state(), filter.covariance()),
+                };
+                x_pred.extend_from_slice(x.as_slice());
+                s_pred.extend_from_slice(s.as_slice());
             }
-            Ok(filter.update_stats(m)?.map(|s| s.nis))
+            Ok(stats.map(|s| s.nis))
         };
         let nis = match forward(filter) {
             Ok(nis) => nis,

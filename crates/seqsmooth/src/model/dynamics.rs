@@ -69,6 +69,19 @@ pub trait Dynamics {
         false
     }
 
+    /// The polynomial model this is, when it is one ([`PolynomialDynamics`]: `Φ = Ψ(ζ) ⊗ I_d`,
+    /// (4.2.5)): the Kalman filter then predicts with `Φ`'s structure and the sizes fixed at
+    /// compile time (the same numbers). `None` unless the model says so.
+    ///
+    /// ```
+    /// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+    /// let cv = PolynomialDynamics::new(1, 3);
+    /// assert_eq!(cv.polynomial(), Some(cv));
+    /// ```
+    fn polynomial(&self) -> Option<PolynomialDynamics> {
+        None
+    }
+
     /// [`Dynamics::propagate`] into the caller's buffers (`state_out` of length `n`,
     /// `transition_out` `n × n`, replaced if they are not), allocating nothing where the model
     /// allows ([`PolynomialDynamics`] does): what the estimators call at every observation time.
@@ -309,6 +322,10 @@ impl Dynamics for PolynomialDynamics {
         true
     }
 
+    fn polynomial(&self) -> Option<PolynomialDynamics> {
+        Some(*self)
+    }
+
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
         let n = self.dimension();
         let mut p = Propagation {
@@ -405,6 +422,10 @@ impl<D: Dynamics + ?Sized> Dynamics for &D {
 
     fn is_time_invariant(&self) -> bool {
         (**self).is_time_invariant()
+    }
+
+    fn polynomial(&self) -> Option<PolynomialDynamics> {
+        (**self).polynomial()
     }
 
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {

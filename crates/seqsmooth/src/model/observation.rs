@@ -101,6 +101,19 @@ pub trait Observation {
         let _ = component;
         measured - predicted
     }
+
+    /// The constant `M` of `G(X) = M X` when this is a [`LinearObservation`] (residuals
+    /// `measured − predicted`): the Kalman filter then reads `M` in place rather than through
+    /// [`Observation::predict_into`] (the same numbers). `None` unless the model says so.
+    ///
+    /// ```
+    /// use seqsmooth::model::observation::{LinearObservation, Observation};
+    /// let m = LinearObservation::value_of(2);
+    /// assert_eq!(m.linear_matrix(), Some(m.matrix()));
+    /// ```
+    fn linear_matrix(&self) -> Option<&DMatrix<f64>> {
+        None
+    }
 }
 
 impl<O: Observation + ?Sized> Observation for &O {
@@ -130,6 +143,9 @@ impl<O: Observation + ?Sized> Observation for &O {
     }
     fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {
         (**self).residual(component, measured, predicted)
+    }
+    fn linear_matrix(&self) -> Option<&DMatrix<f64>> {
+        (**self).linear_matrix()
     }
 }
 
@@ -284,7 +300,21 @@ impl LinearObservation {
     }
 }
 
+/// `M X` into `value` (`p`), each row's sum over the columns in order: [`LinearObservation`]'s
+/// prediction, and the Kalman filter's where it reads `M` in place.
+#[inline]
+pub(crate) fn linear_value(m: &DMatrix<f64>, x: &[f64], value: &mut [f64]) {
+    let (p, n) = m.shape();
+    let m = m.as_slice();
+    for (r, v) in value[..p].iter_mut().enumerate() {
+        *v = (0..n).map(|c| m[r + c * p] * x[c]).sum();
+    }
+}
+
 impl Observation for LinearObservation {
+    fn linear_matrix(&self) -> Option<&DMatrix<f64>> {
+        Some(&self.m)
+    }
     fn is_linear(&self) -> bool {
         true
     }
@@ -323,11 +353,7 @@ impl Observation for LinearObservation {
         if value.len() != p {
             *value = DVector::zeros(p);
         }
-        // M X, each row's sum over the columns in order.
-        let (m, x, value) = (self.m.as_slice(), state.as_slice(), value.as_mut_slice());
-        for (r, v) in value.iter_mut().enumerate() {
-            *v = (0..n).map(|c| m[r + c * p] * x[c]).sum();
-        }
+        linear_value(&self.m, state.as_slice(), value.as_mut_slice());
         if let Some(&v) = value.iter().find(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 what: "predicted observation",

@@ -64,6 +64,18 @@ impl Size for Any {
     }
 }
 
+/// The size `N / D`, a constant (the degree's size `m + 1` of a polynomial state of `N`
+/// entries on `D` axes), where `N / D` cannot be written as a constant parameter.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Quotient<const N: usize, const D: usize>;
+
+impl<const N: usize, const D: usize> Size for Quotient<N, D> {
+    #[inline(always)]
+    fn get(self) -> usize {
+        N / D
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -73,6 +85,7 @@ mod tests {
     fn sizes_report_themselves() {
         let got = unrolled_sizes!(4usize, N => Fixed::<N>.get(), n => Any(n).get());
         assert_eq!((got, Any(11).get()), (4, 11));
+        assert_eq!(Quotient::<6, 2>.get(), 3);
     }
 
     /// Every size in range gets its own constant; the rest the general arm.

@@ -47,27 +47,35 @@
 //! - `V = L D Lᵀ` (the square-root-free Cholesky factorisation) gives the gain
 //!   `H = (S Mᵀ) L⁻ᵀ D⁻¹ L⁻¹`, `NIS = Σ (L⁻¹ ν)_c² / D_c` and `ln det V = Σ ln D_c`, with no square
 //!   root and fewer roundings than `L Lᵀ`.
+//! - The polynomial model (`Dynamics::polynomial`: `n ≤ 9` states on `d ≤ 3` axes, with
+//!   [`WhiteNoiseDerivative`](super::noise::WhiteNoiseDerivative) or no driving noise) is
+//!   predicted at compile-time sizes, `Φ`'s zeros known to the compiler (`kalman::filter::fixed`),
+//!   a constant `M` ([`Observation::linear_matrix`]) is read in place, and `R`'s identity and
+//!   variances are checked at once: chosen without the caller asking, the same numbers bit for
+//!   bit.
 //! - The state dimension `n` and the present components `k` go through the crate's one size
 //!   dispatch (`unrolled_sizes!`, [`crate::numeric`]): for `n ≤ 9` and `k ≤ 4` each kernel is
 //!   compiled with them constants (its loops unrolled), other sizes take the same source with
 //!   them variables. Measured in BENCHMARKS.md ("Kalman and extended Kalman filters against
 //!   filterpy").
 
-use super::correct::{carry, correct_kernel, finite, noise_entries, Work};
+use super::correct::{carry, correct_kernel, finite, Work};
 use super::noise::ProcessNoise;
 use crate::discount::Discount;
 use crate::error::{Error, Param};
+use crate::linalg::dense::all_finite;
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::Measurement;
-use crate::model::measurement::NoiseCovariance;
-use crate::model::observation::Observation;
+use crate::model::observation::{linear_value, Observation};
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
+mod fixed;
 mod innovation;
 mod iterated;
+mod measure;
 mod saved;
 mod undo;
 pub use innovation::{Innovation, InnovationStats};
@@ -578,6 +586,10 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             }
             return Ok(());
         }
+        if self.predict_fixed(t) {
+            return Ok(());
+        }
+        let w = &mut self.work;
         self.dynamics
             .propagate_into(&self.state, self.time, t, &mut w.x, &mut w.phi)?;
         let q = match &self.noise {
@@ -627,62 +639,6 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         self.time = t;
     }
 
-    /// The measurement's present components and values, and `R` on them, into the work
-    /// buffers; their number. The checks are [`Measurement::present`]'s (called for its
-    /// refusal when this measurement fails them) and, on the whole `R`: finite, symmetric,
-    /// non-negative variances (a perfect observation is allowed).
-    fn measure(&mut self, m: &Measurement) -> Result<usize, Error> {
-        let p = self.observation.components();
-        let w = &mut self.work;
-        w.present.clear();
-        w.values.clear();
-        let accepted = m.time.is_finite()
-            && m.values.len() == p
-            && m.values.iter().all(|v| v.is_none_or(f64::is_finite));
-        if accepted {
-            for (c, v) in m.values.iter().enumerate() {
-                if let Some(v) = *v {
-                    w.present.push(c);
-                    w.values.push(v);
-                }
-            }
-        } else {
-            (w.present, w.values) = m.present(p)?;
-        }
-        let entry = noise_entries(p, &m.noise)?;
-        // Column by column; off the diagonal only a full R has entries other than 0.
-        let full = matches!(m.noise, NoiseCovariance::Full(_));
-        let (mut largest, mut asymmetry, mut negative) = (0.0_f64, 0.0_f64, false);
-        for j in 0..p {
-            for i in if full { 0..p } else { j..j + 1 } {
-                let v = entry(i, j);
-                if !v.is_finite() {
-                    return Err(Error::NonFinite {
-                        what: "measurement noise entry",
-                        value: v,
-                    });
-                }
-                largest = largest.max(v.abs());
-                asymmetry = asymmetry.max((v - entry(j, i)).abs());
-                negative |= i == j && v < 0.0;
-            }
-        }
-        if asymmetry > 1e-12 * largest || negative {
-            return Err(Error::InvalidParameter {
-                name: Param::MeasurementNoise,
-                value: format!("{:?}", DMatrix::from_fn(p, p, entry)),
-                reason: "must be symmetric with non-negative variances".into(),
-            });
-        }
-        let k = w.present.len();
-        for (j, &b) in w.present.iter().enumerate() {
-            for (i, &a) in w.present.iter().enumerate() {
-                w.r[i + j * k] = entry(a, b);
-            }
-        }
-        Ok(k)
-    }
-
     /// The update of the predicted state in the work buffers with the measured components
     /// (after [`Self::measure`] and [`Self::predict_work`]), into the work buffers' outputs,
     /// the filter unchanged: the observation linearised about the prediction, or with
@@ -692,11 +648,25 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         let (n, p) = (self.state.len(), self.observation.components());
         let w = &mut self.work;
         let about = if iterated { &w.about } else { &w.x };
-        self.observation
-            .predict_into(about, t, &mut w.g, &mut w.m_all)?;
+        // A constant M is read in place (G = M X from the finite prediction, as the model's
+        // `predict_into` makes it); anything else, or a G that is not finite, through the model.
+        let linear = match self.observation.linear_matrix() {
+            Some(m) if !iterated && m.shape() == (p, n) => {
+                linear_value(m, about.as_slice(), w.g.as_mut_slice());
+                all_finite(&w.g.as_slice()[..p]).then_some(m)
+            }
+            _ => None,
+        };
+        let m_all = match linear {
+            Some(m) => m.as_slice(),
+            None => {
+                self.observation
+                    .predict_into(about, t, &mut w.g, &mut w.m_all)?;
+                w.m_all.as_slice()
+            }
+        };
         let k = w.present.len();
         for (c, (&a, &y)) in w.present.iter().zip(&w.values).enumerate() {
-            let m_all = w.m_all.as_slice();
             for (l, mt) in w.mt[c * n..(c + 1) * n].iter_mut().enumerate() {
                 *mt = m_all[a + l * p];
             }

@@ -1,9 +1,8 @@
 //! Keeping a filter's estimate aside and putting it back: what a smoother's forward pass needs
 //! to undo an update (Morrison ch. 12's estimate `X_{n,n}`, `S_{n,n}`, and ch. 14's fading `P`),
-//! and the prediction's transition `Φ` read in place.
+//! and the last prediction's transition `Φ` read in place.
 
 use super::KalmanFilter;
-use crate::error::Error;
 use crate::model::dynamics::Dynamics;
 use crate::model::observation::Observation;
 use nalgebra::{DMatrix, DVector};
@@ -40,13 +39,9 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         }
     }
 
-    /// [`Self::predict`] to `t`, and `Φ(t, t_before)` of that step read in place (`None` for
-    /// no step: the identity): what the smoother's forward pass keeps.
-    pub(crate) fn predict_transition(&mut self, t: f64) -> Result<Option<&DMatrix<f64>>, Error> {
-        if t == self.time {
-            return Ok(None);
-        }
-        self.predict(t)?;
-        Ok(Some(&self.work.phi))
+    /// `Φ` of the last prediction that made a step (the work buffers'): right after an update
+    /// to a later time, the `Φ(t_n, t_{n−1})` of its prediction.
+    pub(crate) fn last_transition(&self) -> &DMatrix<f64> {
+        &self.work.phi
     }
 }
