@@ -59,6 +59,18 @@ pub trait ProcessNoise: std::fmt::Debug + Send + Sync {
     fn is_time_invariant(&self) -> bool {
         false
     }
+
+    /// The model as a [`WhiteNoiseDerivative`], if it is one: the Kalman filter then takes a
+    /// fixed-size path where it has one (the same numbers), without being asked. `None` unless
+    /// the model says so.
+    ///
+    /// ```
+    /// use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};
+    /// assert!(WhiteNoiseDerivative::new(1, 3, 1.0).unwrap().as_white_noise_derivative().is_some());
+    /// ```
+    fn as_white_noise_derivative(&self) -> Option<&WhiteNoiseDerivative> {
+        None
+    }
 }
 
 /// The range of a driving noise's power spectral density `q` (ch. 15): finite and at least 0
@@ -118,7 +130,18 @@ impl WhiteNoiseDerivative {
     }
 }
 
+impl WhiteNoiseDerivative {
+    /// The degree `m`, the axes `d` and the spectral density `q`.
+    pub(crate) fn parts(&self) -> (usize, usize, f64) {
+        (self.degree, self.axes, self.psd)
+    }
+}
+
 impl ProcessNoise for WhiteNoiseDerivative {
+    fn as_white_noise_derivative(&self) -> Option<&WhiteNoiseDerivative> {
+        Some(self)
+    }
+
     fn saved(&self) -> Option<super::saved_noise::SavedNoise> {
         Some(super::saved_noise::SavedNoise::WhiteNoiseDerivative(*self))
     }
@@ -181,7 +204,7 @@ impl ProcessNoise for WhiteNoiseDerivative {
 /// finite. Derivatives `i ≤ j` are counted from the highest, `u = m − i ≥ v = m − j`, so
 /// `p = 2m + 1 − i − j = u + v + 1`; each entry is written at `(i, j)` and `(j, i)` of each axis.
 #[inline(always)]
-fn fill<S: Size>(size: S, d: usize, psd: f64, zeta: f64, out: &mut [f64]) -> bool {
+pub(super) fn fill<S: Size>(size: S, d: usize, psd: f64, zeta: f64, out: &mut [f64]) -> bool {
     let (size, mut finite) = (size.get(), true);
     let n = size * d;
     // k! for k < size as a running product (the operations of `factorial`, in its order), in a

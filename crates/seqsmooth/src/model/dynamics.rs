@@ -69,6 +69,18 @@ pub trait Dynamics {
         false
     }
 
+    /// The model as a [`PolynomialDynamics`], if it is one (`Φ = Ψ(ζ) ⊗ I`, (4.2.5)): the
+    /// Kalman filter then takes a fixed-size path where it has one for the degree and axes (the
+    /// same numbers), without being asked. `None` unless the model says so.
+    ///
+    /// ```
+    /// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};
+    /// assert_eq!(PolynomialDynamics::new(1, 3).as_polynomial().map(|p| p.axes()), Some(3));
+    /// ```
+    fn as_polynomial(&self) -> Option<&PolynomialDynamics> {
+        None
+    }
+
     /// [`Dynamics::propagate`] into the caller's buffers (`state_out` of length `n`,
     /// `transition_out` `n × n`, replaced if they are not), allocating nothing where the model
     /// allows ([`PolynomialDynamics`] does): what the estimators call at every observation time.
@@ -307,6 +319,10 @@ impl Dynamics for PolynomialDynamics {
 
     fn is_time_invariant(&self) -> bool {
         true
+    }
+
+    fn as_polynomial(&self) -> Option<&PolynomialDynamics> {
+        Some(self)
     }
 
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
