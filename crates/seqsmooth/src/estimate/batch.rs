@@ -187,12 +187,12 @@ pub(crate) struct Factored {
 }
 
 impl Factored {
-    pub(crate) fn new(t: DMatrix<f64>, mut y: DVector<f64>) -> Self {
+    pub(crate) fn new(mut t: DMatrix<f64>, mut y: DVector<f64>) -> Self {
         let (rows, states) = t.shape();
-        let qr = t.qr();
-        qr.q_tr_mul(&mut y);
+        let mut r = DMatrix::zeros(rows.min(states), states);
+        factor_in_place(&mut t, &mut y, &mut r);
         Self {
-            r: qr.r(),
+            r,
             rotated: y,
             rows,
             states,
@@ -259,13 +259,81 @@ fn full_rank(r: &DMatrix<f64>, rows: usize, states: usize, floor: f64) -> Result
 impl Solved {
     /// `(Rᵀ R)⁻¹ = R⁻¹ R⁻ᵀ`, the inverse of the Gram matrix `tᵀ t`: the covariance of `x`.
     pub(crate) fn covariance(&self) -> DMatrix<f64> {
-        let n = self.r.ncols();
-        let r_inv = self
-            .r
-            .solve_upper_triangular(&DMatrix::identity(n, n))
-            .expect("R is non-singular at full rank");
-        symmetric(&r_inv * r_inv.transpose())
+        covariance_of(&self.r)
     }
+}
+
+/// `(Rᵀ R)⁻¹ = R⁻¹ R⁻ᵀ` for the `R` of a full-rank system ([`Solved::covariance`]).
+pub(crate) fn covariance_of(r: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = r.ncols();
+    let r_inv = r
+        .solve_upper_triangular(&DMatrix::identity(n, n))
+        .expect("R is non-singular at full rank");
+    symmetric(&r_inv * r_inv.transpose())
+}
+
+/// The Householder QR of `t` (`rows × states`) in place, nalgebra's `QR::new` reflection by
+/// reflection (its `householder::clear_column_unchecked`), each reflection applied to `y` as
+/// soon as it is made (its `q_tr_mul`: the same operations on `y` in the same order, so
+/// `y ← Qᵀ y`), and `R` into `r` (`min(rows, states) × states`: `QR::r`, the upper triangle
+/// with the moduli of the reflections' signed norms on the diagonal). The numbers of
+/// `t.qr()`, `q_tr_mul` and `r()`, with nothing allocated: what an iteration reuses its
+/// buffers for ([`super::gauss_newton`]).
+pub(crate) fn factor_in_place(t: &mut DMatrix<f64>, y: &mut DVector<f64>, r: &mut DMatrix<f64>) {
+    use nalgebra::{Reflection, Unit};
+    let (rows, states) = t.shape();
+    let dim = rows.min(states);
+    debug_assert_eq!((r.shape(), y.len()), ((dim, states), rows));
+    r.fill(0.0);
+    for i in 0..dim {
+        let signed_norm = nalgebra::linalg::householder::clear_column_unchecked(t, i, 0, None);
+        let axis = t.view_range(i.., i);
+        let reflection = Reflection::new(Unit::new_unchecked(axis), 0.0);
+        reflection.reflect_with_sign(&mut y.rows_range_mut(i..), signed_norm.signum());
+        r[(i, i)] = signed_norm.abs();
+    }
+    for j in 0..states {
+        for i in 0..dim.min(j) {
+            r[(i, j)] = t[(i, j)];
+        }
+    }
+}
+
+/// [`Factored::solve`] on the factors of [`factor_in_place`] (`r`, and `rotated = Qᵀ y`),
+/// `x` into the caller's buffer: the rank check, `x = R⁻¹ (Qᵀ y)_head`, `|R x|`, `χ²`.
+pub(crate) fn solve_factored(
+    r: &DMatrix<f64>,
+    rotated: &DVector<f64>,
+    floor: f64,
+    x: &mut DVector<f64>,
+) -> Result<SolvedStep, Error> {
+    let (rows, states) = (rotated.len(), r.ncols());
+    let condition_number = full_rank(r, rows, states, floor)?;
+    let head = rotated.rows(0, states);
+    x.copy_from(&head);
+    if !r.solve_upper_triangular_mut(x) {
+        return Err(Error::EstimateOutOfRange {
+            what: "correction (a zero pivot at full rank)".into(),
+        });
+    }
+    Ok(SolvedStep {
+        explained: head.norm(),
+        chi_squared: rotated.rows(states, rows - states).norm_squared(),
+        degrees_of_freedom: rows - states,
+        condition_number,
+    })
+}
+
+/// [`Solved`] without `x` and `R` (the caller's buffers hold them): [`solve_factored`].
+pub(crate) struct SolvedStep {
+    /// `|t x| = |R x|`.
+    pub(crate) explained: f64,
+    /// `|y − t x|²`.
+    pub(crate) chi_squared: f64,
+    /// Rows less states.
+    pub(crate) degrees_of_freedom: usize,
+    /// `σ_max/σ_min` of `t`.
+    pub(crate) condition_number: f64,
 }
 
 /// The QR of a system, with `Q` formed (least squares needs `W = R⁻¹ Qᵀ`), and its solution.

@@ -114,6 +114,20 @@ pub trait Observation {
     fn linear_matrix(&self) -> Option<&DMatrix<f64>> {
         None
     }
+
+    /// The model as a [`Radar`](super::radar::Radar), if it is one: the Kalman filter then
+    /// takes its fixed-size radar update (the same numbers), without being asked. `None`
+    /// unless the model says so.
+    ///
+    /// ```
+    /// use seqsmooth::model::observation::{LinearObservation, Observation};
+    /// use seqsmooth::model::radar::Radar;
+    /// assert!(Radar::new([0.0; 3], 6).unwrap().as_radar().is_some());
+    /// assert!(LinearObservation::value_of(2).as_radar().is_none());
+    /// ```
+    fn as_radar(&self) -> Option<&super::radar::Radar> {
+        None
+    }
 }
 
 impl<O: Observation + ?Sized> Observation for &O {
@@ -146,6 +160,9 @@ impl<O: Observation + ?Sized> Observation for &O {
     }
     fn linear_matrix(&self) -> Option<&DMatrix<f64>> {
         (**self).linear_matrix()
+    }
+    fn as_radar(&self) -> Option<&super::radar::Radar> {
+        (**self).as_radar()
     }
 }
 

@@ -196,6 +196,62 @@ impl Radar {
     }
 }
 
+/// The range, azimuth and elevation of a position and their Jacobian `J = ∂(ρ, ψ, θ)/∂(x, y, z)`
+/// ((8.5.3)-(8.5.5)), the arithmetic of [`Radar::predict_into`] (and of the Kalman filter's
+/// fixed-size radar update, which must give its numbers).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Look {
+    /// `(ρ, ψ, θ)`.
+    pub(crate) value: [f64; 3],
+    /// `J`, by rows (`J[1][2] = 0`).
+    pub(crate) jacobian: [[f64; 3]; 3],
+    /// `p = position − site`.
+    pub(crate) offset: [f64; 3],
+    /// `ρ²`.
+    pub(crate) range_squared: f64,
+}
+
+impl Radar {
+    /// Whether the radar measures the range rate too (4 components, not 3).
+    pub(crate) fn has_range_rate(&self) -> bool {
+        self.range_rate
+    }
+
+    /// [`Look`] at `position` (absolute), or `None` at the site or directly above or below it
+    /// (`√(p_x² + p_y²)` not positive, or a length that is not finite), where the azimuth is
+    /// undefined. The values and the Jacobian may still hold a number that is not finite; the
+    /// caller checks.
+    #[inline(always)]
+    pub(crate) fn look(&self, position: [f64; 3]) -> Option<Look> {
+        let p = [
+            position[0] - self.site[0],
+            position[1] - self.site[1],
+            position[2] - self.site[2],
+        ];
+        let h2 = p[0] * p[0] + p[1] * p[1];
+        let rho2 = h2 + p[2] * p[2];
+        let (h, rho) = (h2.sqrt(), rho2.sqrt());
+        if !(h > 0.0 && h.is_finite() && rho.is_finite()) {
+            return None;
+        }
+        Some(Look {
+            // + 0.0: atan2(−0, x < 0) is −π, outside (−π, π].
+            value: [rho, (p[1] + 0.0).atan2(p[0]), p[2].atan2(h)],
+            jacobian: [
+                [p[0] / rho, p[1] / rho, p[2] / rho],
+                [-p[1] / h2, p[0] / h2, 0.0],
+                [
+                    -p[0] * p[2] / (rho2 * h),
+                    -p[1] * p[2] / (rho2 * h),
+                    h / rho2,
+                ],
+            ],
+            offset: p,
+            range_squared: rho2,
+        })
+    }
+}
+
 /// A radar measurement in Cartesian position, with its first-order covariance.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Converted {
@@ -376,15 +432,8 @@ impl Observation for Radar {
         jacobian: &mut DMatrix<f64>,
     ) -> Result<(), Error> {
         check_state(self.states, state)?;
-        let p = [
-            state[0] - self.site[0],
-            state[1] - self.site[1],
-            state[2] - self.site[2],
-        ];
-        let h2 = p[0] * p[0] + p[1] * p[1];
-        let rho2 = h2 + p[2] * p[2];
-        let (h, rho) = (h2.sqrt(), rho2.sqrt());
-        if !(h > 0.0 && h.is_finite() && rho.is_finite()) {
+        let position = [state[0], state[1], state[2]];
+        let Some(look) = self.look(position) else {
             return Err(Error::InvalidParameter {
                 name: Param::RadarGeometry,
                 value: format!(
@@ -394,7 +443,7 @@ impl Observation for Radar {
                 reason: "at the site or directly above or below it: the azimuth is undefined"
                     .into(),
             });
-        }
+        };
         let rows = self.components();
         if value.len() != rows {
             *value = DVector::zeros(rows);
@@ -404,17 +453,13 @@ impl Observation for Radar {
         } else {
             jacobian.as_mut_slice().fill(0.0);
         }
-        value[0] = rho;
-        value[1] = (p[1] + 0.0).atan2(p[0]); // + 0.0: atan2(−0, x < 0) is −π, outside (−π, π]
-        value[2] = p[2].atan2(h);
-        for k in 0..3 {
-            jacobian[(0, k)] = p[k] / rho;
+        for c in 0..3 {
+            value[c] = look.value[c];
+            for k in 0..3 {
+                jacobian[(c, k)] = look.jacobian[c][k];
+            }
         }
-        jacobian[(1, 0)] = -p[1] / h2;
-        jacobian[(1, 1)] = p[0] / h2;
-        jacobian[(2, 0)] = -p[0] * p[2] / (rho2 * h);
-        jacobian[(2, 1)] = -p[1] * p[2] / (rho2 * h);
-        jacobian[(2, 2)] = h / rho2;
+        let (p, rho, rho2) = (look.offset, look.value[0], look.range_squared);
         if self.range_rate {
             let v = [state[3], state[4], state[5]];
             let pv = p[0] * v[0] + p[1] * v[1] + p[2] * v[2];
@@ -436,6 +481,10 @@ impl Observation for Radar {
             });
         }
         Ok(())
+    }
+
+    fn as_radar(&self) -> Option<&Radar> {
+        Some(self)
     }
 
     fn residual(&self, component: usize, measured: f64, predicted: f64) -> f64 {

@@ -382,6 +382,13 @@ impl Dynamics for TrackDynamics {
         }
     }
 
+    fn polynomial(&self) -> Option<PolynomialDynamics> {
+        match self {
+            TrackDynamics::Polynomial(d) => Some(*d),
+            _ => None,
+        }
+    }
+
     fn propagate(&self, state: &DVector<f64>, t_a: f64, t_b: f64) -> Result<Propagation, Error> {
         match self {
             TrackDynamics::Polynomial(d) => d.propagate(state, t_a, t_b),

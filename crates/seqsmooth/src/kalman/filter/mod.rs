@@ -76,6 +76,7 @@ mod fixed;
 mod innovation;
 mod iterated;
 mod measure;
+mod radar;
 mod saved;
 mod undo;
 pub use innovation::{Innovation, InnovationStats};
@@ -479,10 +480,9 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         measurement: &Measurement,
         accept: impl FnOnce(&InnovationStats) -> bool,
     ) -> Result<Option<(InnovationStats, bool)>, Error> {
-        let Some(t) = self.measure_and_predict(measurement)? else {
+        let Some((t, stats)) = self.predict_and_correct(measurement)? else {
             return Ok(None);
         };
-        let stats = self.correct(t, false)?;
         let used = accept(&stats);
         if used {
             self.commit_correction(t);
@@ -544,13 +544,29 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         measurement: &Measurement,
         report: impl FnOnce(&Work, InnovationStats) -> T,
     ) -> Result<Option<T>, Error> {
-        let Some(t) = self.measure_and_predict(measurement)? else {
+        let Some((t, stats)) = self.predict_and_correct(measurement)? else {
             return Ok(None);
         };
-        let stats = self.correct(t, false)?;
         let out = report(&self.work, stats);
         self.commit_correction(t);
         Ok(Some(out))
+    }
+
+    /// The prediction to the measurement's time and the correction into the work buffers, the
+    /// filter unchanged: the time and the statistics, or `None` with no component present (the
+    /// prediction then made the filter's). The radar model's fixed-size update where it applies
+    /// (module `radar`, the same numbers), else [`Self::measure_and_predict`] and [`Self::correct`].
+    fn predict_and_correct(
+        &mut self,
+        measurement: &Measurement,
+    ) -> Result<Option<(f64, InnovationStats)>, Error> {
+        if let Some(stats) = self.correct_radar_fixed(measurement) {
+            return Ok(Some((measurement.time, stats)));
+        }
+        let Some(t) = self.measure_and_predict(measurement)? else {
+            return Ok(None);
+        };
+        Ok(Some((t, self.correct(t, false)?)))
     }
 
     /// The start of every update: the measurement read ([`Self::measure`]) and the prediction

@@ -1,0 +1,473 @@
+//! The extended Kalman filter's update written out for the radar model: constant velocity on
+//! three axes (`PolynomialDynamics::new(1, 3)`, `Φ = Ψ(ζ) ⊗ I₃`, (4.2.5)), white-acceleration
+//! driving noise (`WhiteNoiseDerivative` of degree 1 on 3 axes, or none), range, azimuth and
+//! elevation from one radar ((8.5.3)-(8.5.5)) with all three measured and `R` diagonal, no
+//! fading memory; over a step or none. The filter takes it without being asked
+//! (`KalmanFilter::update`, `update_stats`, `update_gated`); any other case, and any case this
+//! path would refuse (a number that is not finite, `V` not positive definite, the target at
+//! the site), goes to the general recursion, which gives the error.
+//!
+//! It is the general recursion's arithmetic (`kalman::correct`: `Φ S Φᵀ + Q` by `carry`, the
+//! update by `correct_kernel`, `V = L D Lᵀ`, Joseph's form (12.3.7)), operation for operation
+//! in the same order, with the sizes (6 states, 3 components) and the zeros of `Φ`, of
+//! `M = [J 0]` and of the diagonal `R` fixed at compile time instead of tested or multiplied
+//! at run time, on fixed-size arrays, and the model interfaces (`propagate_into`,
+//! `covariance_into`, `predict_into`) and the measurement's general checks replaced by their
+//! arithmetic (`psi_term`, the noise's `fill`, `Radar::look`). Its sums start at `−0` where the
+//! general path's start at `0` (`−0 + a = a` exactly, which the compiler can drop; `0 + a`
+//! differs from `a` only for `a = −0`), and it leaves out the products with a zero of `M` or
+//! `R` that the general path adds or skips at run time: so its numbers are the general path's,
+//! equal as numbers (`==`), a zero's sign aside. Tested update by update against the general
+//! path (this module's tests on the work buffers, `tests/kalman_radar_fixed.rs` on the
+//! filter's results).
+
+use super::{InnovationStats, KalmanFilter};
+use crate::kalman::noise::fill;
+use crate::linalg::dense::{all_finite, ldl, log_det, symmetrize};
+use crate::model::dynamics::Dynamics;
+use crate::model::measurement::{Measurement, NoiseCovariance};
+use crate::model::observation::Observation;
+use crate::model::radar::wrap;
+use crate::model::transition::psi_term;
+use crate::numeric::unrolled::Fixed;
+use std::f64::consts::TAU;
+
+/// States.
+const N: usize = 6;
+/// Components.
+const K: usize = 3;
+
+impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
+    /// The prediction to the measurement's time and the update, when the model is the radar
+    /// case of this module, into the work buffers (the prediction `x`, `s`; the present
+    /// components and values, `ν`, `V` and the gain that an `Innovation` reads; the updated
+    /// state and covariance), the filter unchanged: the statistics, or `None` for the general
+    /// path (another model, or anything the general path would refuse or treat otherwise).
+    pub(super) fn correct_radar_fixed(&mut self, m: &Measurement) -> Option<InnovationStats> {
+        if self.fading.is_some() {
+            return None;
+        }
+        let dynamics = self.dynamics.polynomial()?;
+        let radar = self.observation.as_radar()?;
+        if dynamics.degree() != 1 || dynamics.axes() != 3 || radar.has_range_rate() {
+            return None;
+        }
+        let psd = match &self.noise {
+            None => None,
+            Some(noise) => match noise.white_noise_derivative()?.parts() {
+                (1, 3, psd) => Some(psd),
+                _ => return None,
+            },
+        };
+        let t = m.time;
+        let [Some(y0), Some(y1), Some(y2)] = *m.values.as_slice() else {
+            return None;
+        };
+        let r = match &m.noise {
+            NoiseCovariance::Identity => [1.0; K],
+            NoiseCovariance::Variances(v) if v.len() == K => [v[0], v[1], v[2]],
+            _ => return None,
+        };
+        let ok = |v: f64| v.is_finite() && v >= 0.0;
+        if !(t.is_finite()
+            && y0.is_finite()
+            && y1.is_finite()
+            && y2.is_finite()
+            && ok(r[0])
+            && ok(r[1])
+            && ok(r[2]))
+        {
+            return None;
+        }
+        let x: &[f64; N] = self.state.as_slice().try_into().ok()?;
+        let s: &[f64; N * N] = self.covariance.as_slice().try_into().ok()?;
+        let w = &mut self.work;
+        let xp: &mut [f64; N] = w.x.as_mut_slice().try_into().ok()?;
+        let sp: &mut [f64; N * N] = w.s.as_mut_slice().try_into().ok()?;
+        let x_out: &mut [f64; N] = w.x_out.as_mut_slice().try_into().ok()?;
+        let s_out: &mut [f64; N * N] = w.s_out.as_mut_slice().try_into().ok()?;
+
+        // The prediction, into the work buffers (none at the filter's own time: the estimate
+        // as it is, as `predict_work`).
+        if t == self.time {
+            *xp = *x;
+            *sp = *s;
+        } else {
+            predict(x, s, t - self.time, psd, xp, sp)?;
+        }
+
+        // The radar's prediction and its Jacobian J (M = [J 0]; J₁₂ = 0).
+        let look = radar.look([xp[0], xp[1], xp[2]])?;
+        let (g, jm) = (look.value, look.jacobian);
+        if !(all_finite(&g) && jm.iter().all(|row| all_finite(row))) {
+            return None;
+        }
+        let y = [y0, y1, y2];
+        let nu = [y[0] - g[0], wrap(y[1] - g[1]), y[2] - g[2]];
+
+        // `correct_kernel` without fading (P = S, f = 1): U = S Mᵀ, V = M U + R = L D Lᵀ.
+        let mut u = [0.0; N * K];
+        times_mt(sp, &jm, &mut u);
+        let mut v = [0.0; K * K];
+        for b in 0..K {
+            for a in 0..K {
+                let mut msm = -0.0;
+                for l in 0..3 {
+                    if a != 1 || l != 2 {
+                        msm += jm[a][l] * u[l + b * N];
+                    }
+                }
+                v[a + b * K] = if a == b { msm + r[a] } else { msm + 0.0 };
+            }
+        }
+        symmetrize(K, &mut v);
+        let mut lv = [0.0; K * K];
+        if !ldl(K, &v, &mut lv) {
+            return None;
+        }
+        // H = U L⁻ᵀ D⁻¹ L⁻¹: forwards, the pivots, backwards.
+        let mut h = u;
+        for c in 0..K {
+            for d in 0..c {
+                let l = lv[c + d * K];
+                for i in 0..N {
+                    h[i + c * N] -= l * h[i + d * N];
+                }
+            }
+        }
+        for c in 0..K {
+            let pivot = lv[c + c * K];
+            for i in 0..N {
+                h[i + c * N] /= pivot;
+            }
+        }
+        for c in (0..K).rev() {
+            for d in c + 1..K {
+                let l = lv[d + c * K];
+                for i in 0..N {
+                    h[i + c * N] -= l * h[i + d * N];
+                }
+            }
+        }
+        // NIS = Σ z_c² / D_c, z = L⁻¹ ν.
+        let (mut nis, mut z) = (0.0, [0.0; K]);
+        for c in 0..K {
+            let mut acc = nu[c];
+            for d in 0..c {
+                acc -= lv[c + d * K] * z[d];
+            }
+            z[c] = acc;
+            nis += acc * acc / lv[c + c * K];
+        }
+        for i in 0..N {
+            let mut acc = -0.0;
+            for c in 0..K {
+                acc += h[i + c * N] * nu[c];
+            }
+            x_out[i] = acc + xp[i];
+        }
+        // Joseph's form: X = S − H (M S), Y = X Mᵀ, out = (X − Y Hᵀ) + (H R) Hᵀ, with
+        // H R = H diag(R).
+        let mut xm = [0.0; N * N];
+        for j in 0..N {
+            for i in 0..N {
+                let mut acc = -0.0;
+                for c in 0..K {
+                    acc += h[i + c * N] * u[j + c * N];
+                }
+                xm[i + j * N] = sp[i + j * N] - acc;
+            }
+        }
+        let mut ym = [0.0; N * K];
+        times_mt(&xm, &jm, &mut ym);
+        let mut hr = [0.0; N * K];
+        for d in 0..K {
+            for i in 0..N {
+                hr[i + d * N] = h[i + d * N] * r[d];
+            }
+        }
+        for j in 0..N {
+            for i in 0..N {
+                let (mut yh, mut rh) = (-0.0, -0.0);
+                for c in 0..K {
+                    yh += ym[i + c * N] * h[j + c * N];
+                }
+                for d in 0..K {
+                    rh += hr[i + d * N] * h[j + d * N];
+                }
+                s_out[i + j * N] = (xm[i + j * N] - yh) + rh;
+            }
+        }
+        symmetrize(N, s_out);
+        let log_likelihood = -0.5 * (nis + log_det(K, &lv) + K as f64 * TAU.ln());
+        if !(all_finite(x_out)
+            && all_finite(s_out)
+            && nis.is_finite()
+            && log_likelihood.is_finite())
+        {
+            return None;
+        }
+
+        // What an `Innovation` reads, as the general path leaves it.
+        w.present.clear();
+        w.present.extend_from_slice(&[0, 1, 2]);
+        w.values.clear();
+        w.values.extend_from_slice(&y);
+        w.nu[..K].copy_from_slice(&nu);
+        w.v[..K * K].copy_from_slice(&v);
+        w.h[..N * K].copy_from_slice(&h);
+        Some(InnovationStats {
+            components: K,
+            nis,
+            log_likelihood,
+        })
+    }
+}
+
+/// The prediction over a step `zeta ≠ 0` of the filter's state `x` and covariance `s` into
+/// `xp`, `sp`: `X(t)` as `PolynomialDynamics::propagate_into` (`Φ`'s terms `(1, ζ)` by
+/// `psi_term`, each row's diagonal term first), `Q` as `WhiteNoiseDerivative::covariance_into`,
+/// `Φ S Φᵀ + Q` as `carry` (`A = S Φᵀ`, `Aᵀ`, `Aᵀ Φᵀ`; `(out + Q)` symmetrized); `None` where
+/// a number is not finite (the general path then gives the error).
+#[inline(always)]
+fn predict(
+    x: &[f64; N],
+    s: &[f64; N * N],
+    zeta: f64,
+    psd: Option<f64>,
+    xp: &mut [f64; N],
+    sp: &mut [f64; N * N],
+) -> Option<()> {
+    let (t0, t1) = (psi_term(0, &zeta), psi_term(1, &zeta));
+    for r in 0..N {
+        xp[r] = t0 * x[r];
+    }
+    for a in 0..3 {
+        xp[a] += t1 * x[a + 3];
+    }
+    if !(t0.is_finite() && t1.is_finite() && all_finite(xp)) {
+        return None;
+    }
+    let mut q = [0.0; N * N];
+    if let Some(psd) = psd {
+        if !fill(Fixed::<2>, 3, psd, zeta.abs(), &mut q) {
+            return None;
+        }
+    }
+    // Aᵀ directly: (Aᵀ)_{ir} = A_{ri}.
+    let mut at = [0.0; N * N];
+    for i in 0..N {
+        for r in 0..N {
+            let mut acc = -0.0;
+            acc += s[r + i * N] * t0;
+            if i < 3 {
+                acc += s[r + (i + 3) * N] * t1;
+            }
+            at[i + r * N] = acc;
+        }
+    }
+    for i in 0..N {
+        for r in 0..N {
+            let mut acc = -0.0;
+            acc += at[r + i * N] * t0;
+            if i < 3 {
+                acc += at[r + (i + 3) * N] * t1;
+            }
+            sp[r + i * N] = acc;
+        }
+    }
+    match psd {
+        Some(_) => {
+            for j in 0..N {
+                sp[j + j * N] += q[j + j * N];
+                for i in j + 1..N {
+                    let (lower, upper) = (i + j * N, j + i * N);
+                    let v = ((sp[lower] + q[lower]) + (sp[upper] + q[upper])) * 0.5;
+                    sp[lower] = v;
+                    sp[upper] = v;
+                }
+            }
+        }
+        None => symmetrize(N, sp),
+    }
+    all_finite(sp).then_some(())
+}
+
+/// `out = A Mᵀ` (`N × K`) for `M = [J 0]` (`J` by rows, `J₁₂ = 0`): column `c` is
+/// `Σ_l A_{·l} J_{cl}` over the `J_{cl}` not structurally zero, `l` ascending, as
+/// `times_transpose`.
+#[inline(always)]
+fn times_mt(a: &[f64; N * N], jm: &[[f64; 3]; 3], out: &mut [f64; N * K]) {
+    for c in 0..K {
+        for r in 0..N {
+            let mut acc = -0.0;
+            for l in 0..3 {
+                if c != 1 || l != 2 {
+                    acc += a[r + l * N] * jm[c][l];
+                }
+            }
+            out[r + c * N] = acc;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kalman::noise::WhiteNoiseDerivative;
+    use crate::model::dynamics::PolynomialDynamics;
+    use crate::model::radar::Radar;
+    use nalgebra::{DMatrix, DVector};
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    /// A random radar filter: a site, a target 5-80 km away moving at up to 300 m/s, a
+    /// positive definite prior, white acceleration `q` or none.
+    fn filter(rng: &mut StdRng) -> KalmanFilter<PolynomialDynamics, Radar> {
+        let site = [0.0; 3].map(|_| rng.gen_range(-1e3..1e3));
+        let mut state = DVector::zeros(6);
+        for a in 0..3 {
+            state[a] = site[a] + rng.gen_range(5e3..8e4) * if rng.gen() { 1.0 } else { -1.0 };
+            state[a + 3] = rng.gen_range(-300.0..300.0);
+        }
+        let g = DMatrix::from_fn(6, 6, |_, _| rng.gen_range(-1.0..1.0));
+        let scale = DMatrix::from_diagonal(&DVector::from_vec(vec![
+            100.0, 100.0, 100.0, 10.0, 10.0, 10.0,
+        ]));
+        let covariance = &scale * (&g * g.transpose() + DMatrix::identity(6, 6)) * &scale;
+        let covariance = (&covariance + covariance.transpose()) * 0.5;
+        let dynamics = PolynomialDynamics::new(1, 3);
+        let radar = Radar::of_polynomial(site, &dynamics).unwrap();
+        let f = KalmanFilter::new(dynamics, radar, state, covariance, 0.0).unwrap();
+        if rng.gen_bool(0.8) {
+            let q = rng.gen_range(0.0..5.0);
+            f.with_process_noise(WhiteNoiseDerivative::new(1, 3, q).unwrap())
+                .unwrap()
+        } else {
+            f
+        }
+    }
+
+    /// The fast path taken, and its work buffers and statistics equal (`==`) to the general
+    /// path's (`measure_and_predict`, `correct`) on 200 random filters of 40 updates each,
+    /// at irregular steps forwards and backwards, with `R` by variances or the identity.
+    #[test]
+    fn the_general_paths_numbers() {
+        let mut rng = StdRng::seed_from_u64(20_261_207);
+        let mut taken = 0;
+        for _ in 0..200 {
+            let mut f = filter(&mut rng);
+            let mut t = 0.0;
+            for _ in 0..40 {
+                t += rng.gen_range(0.05..3.0) * if rng.gen_bool(0.1) { -1.0 } else { 1.0 };
+                let truth = f.state().clone();
+                let look = f
+                    .observation()
+                    .look([truth[0], truth[1], truth[2]])
+                    .unwrap();
+                let noise = if rng.gen_bool(0.2) {
+                    NoiseCovariance::Identity
+                } else {
+                    NoiseCovariance::Variances(vec![
+                        rng.gen_range(1.0..400.0),
+                        rng.gen_range(1e-7..1e-5),
+                        rng.gen_range(1e-7..1e-5),
+                    ])
+                };
+                let m = Measurement {
+                    time: t,
+                    values: vec![
+                        Some(look.value[0] + rng.gen_range(-30.0..30.0)),
+                        Some(wrap(look.value[1] + rng.gen_range(-0.01..0.01))),
+                        Some(look.value[2] + rng.gen_range(-0.01..0.01)),
+                    ],
+                    noise,
+                };
+                let (mut fast, mut general) = (f.clone(), f.clone());
+                let a = fast.correct_radar_fixed(&m).expect("the fixed-size path");
+                let t_general = general.measure_and_predict(&m).unwrap().unwrap();
+                let b = general.correct(t_general, false).unwrap();
+                assert_eq!(
+                    (a.components, a.nis, a.log_likelihood),
+                    (b.components, b.nis, b.log_likelihood)
+                );
+                let (wa, wb) = (&fast.work, &general.work);
+                assert_eq!(wa.x, wb.x);
+                assert_eq!(wa.s, wb.s);
+                assert_eq!(wa.x_out, wb.x_out);
+                assert_eq!(wa.s_out, wb.s_out);
+                assert_eq!(wa.present, wb.present);
+                assert_eq!(wa.values, wb.values);
+                assert_eq!(wa.nu[..3], wb.nu[..3]);
+                assert_eq!(wa.v[..9], wb.v[..9]);
+                assert_eq!(wa.h[..18], wb.h[..18]);
+                taken += 1;
+                f.update_stats(&m).unwrap();
+                assert_eq!(f.state(), &wa.x_out);
+            }
+        }
+        assert_eq!(taken, 200 * 40);
+    }
+
+    /// Not taken where the general path must decide: a missing component, a full `R`, fading
+    /// memory, a target at the site.
+    #[test]
+    fn the_general_path_otherwise() {
+        let mut rng = StdRng::seed_from_u64(7);
+        let f = filter(&mut rng);
+        let m = |values: Vec<Option<f64>>, noise| Measurement {
+            time: 1.0,
+            values,
+            noise,
+        };
+        let all = vec![Some(1e4), Some(0.5), Some(0.1)];
+        let variances = NoiseCovariance::Variances(vec![100.0, 1e-6, 1e-6]);
+        assert!(f
+            .clone()
+            .correct_radar_fixed(&m(all.clone(), variances.clone()))
+            .is_some());
+        let missing = vec![Some(1e4), None, Some(0.1)];
+        assert!(f
+            .clone()
+            .correct_radar_fixed(&m(missing, variances.clone()))
+            .is_none());
+        let full = NoiseCovariance::Full(DMatrix::identity(3, 3));
+        assert!(f
+            .clone()
+            .correct_radar_fixed(&m(all.clone(), full))
+            .is_none());
+        let fading = f
+            .clone()
+            .with_fading(crate::discount::Discount::PerUpdate { theta: 0.9 })
+            .unwrap();
+        assert!(fading
+            .clone()
+            .correct_radar_fixed(&m(all.clone(), variances.clone()))
+            .is_none());
+        // At the filter's own time it is taken too (no prediction), with the general numbers.
+        let mut now = m(all.clone(), variances.clone());
+        now.time = 0.0;
+        let (mut fast, mut general) = (f.clone(), f.clone());
+        let a = fast.correct_radar_fixed(&now).expect("taken with no step");
+        let t = general.measure_and_predict(&now).unwrap().unwrap();
+        assert_eq!(a, general.correct(t, false).unwrap());
+        assert_eq!(fast.work.s_out, general.work.s_out);
+        let site = f.observation().site();
+        let mut at_site = f.clone();
+        at_site
+            .set_estimate(
+                DVector::from_vec(vec![site[0], site[1], site[2], 0.0, 0.0, 0.0]),
+                f.covariance().clone(),
+                0.0,
+            )
+            .unwrap();
+        assert!(at_site
+            .correct_radar_fixed(&m(all, variances.clone()))
+            .is_none());
+        // The general path gives the error.
+        let mut at_site_general = at_site.clone();
+        assert!(at_site_general
+            .update_stats(&m(vec![Some(1e4), Some(0.5), Some(0.1)], variances))
+            .is_err());
+    }
+}
