@@ -4,6 +4,7 @@
 
 use super::factor::TriangularFactor;
 use crate::linalg::{solve_upper_in_place, solve_upper_transpose_in_place};
+use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
 use nalgebra::{DMatrix, DVector};
 
 /// When the lazy discount's row scale exceeds this, it is folded into the factors.
@@ -362,13 +363,26 @@ impl InformationFilter {
         inv: &mut [f64],
         out: &mut [f64],
     ) -> bool {
+        // The sizes compiled in with their loops unrolled (the same operations in the same
+        // order as the general path).
+        unrolled_sizes!(self.dim(), N => self.variances_of_rows_with(Fixed::<N>, rows, inv, out), p => self.variances_of_rows_with(Any(p), rows, inv, out))
+    }
+
+    #[inline(always)]
+    fn variances_of_rows_with(
+        &self,
+        size: impl Size,
+        rows: &mut [f64],
+        inv: &mut [f64],
+        out: &mut [f64],
+    ) -> bool {
         let mut out = out.iter_mut();
-        self.for_each_solved_row(rows, inv, |j, spread| {
+        self.for_each_solved_row(size, rows, inv, |j, spread| {
             let Some(o) = out.next() else { return };
             *o = match spread {
                 None => j.iter().map(|v| v * v).sum::<f64>() * (self.scale * self.scale),
                 // The variance ‖Q k‖² (the lazy scale cancels).
-                Some(q) => q.norm_sq_of(j),
+                Some(q) => q.norm_sq_of(size, j),
             };
         })
     }
@@ -384,11 +398,23 @@ impl InformationFilter {
         inv: &mut [f64],
         out: &mut [f64],
     ) -> bool {
-        let p = self.dim();
-        let solved = self.for_each_solved_row(rows, inv, |j, spread| match spread {
+        // As in `variances_of_rows`: the sizes compiled in, the same operations in order.
+        unrolled_sizes!(self.dim(), N => self.covariance_of_rows_with(Fixed::<N>, rows, inv, out), p => self.covariance_of_rows_with(Any(p), rows, inv, out))
+    }
+
+    #[inline(always)]
+    fn covariance_of_rows_with(
+        &self,
+        size: impl Size,
+        rows: &mut [f64],
+        inv: &mut [f64],
+        out: &mut [f64],
+    ) -> bool {
+        let p = size.get();
+        let solved = self.for_each_solved_row(size, rows, inv, |j, spread| match spread {
             None => j.iter_mut().for_each(|v| *v *= self.scale),
             // U_Q k (the lazy scale cancels).
-            Some(q) => q.unit_upper_times(j),
+            Some(q) => q.unit_upper_times(size, j),
         });
         if !solved {
             return false;
@@ -409,21 +435,23 @@ impl InformationFilter {
     /// Each row `j` of `rows` (`p` values) replaced by `(J R⁻¹)ᵀ` from the stored factor (`R`
     /// times the lazy scale), or with the true covariance kept by `kᵀ = R⁻¹ (J R⁻¹)ᵀ`, and
     /// handed to `f` with `Q` when it is kept; `false` (and no row touched) while not
-    /// determined. `inv` is scratch of `p` values.
+    /// determined. `inv` is scratch of `p` values; `size` is `p`.
+    #[inline(always)]
     fn for_each_solved_row(
         &self,
+        size: impl Size,
         rows: &mut [f64],
         inv: &mut [f64],
         mut f: impl FnMut(&mut [f64], Option<&TriangularFactor>),
     ) -> bool {
-        let p = self.dim();
-        if !self.info.inverse_sqrt_pivots(&mut inv[..p]) {
+        let p = size.get();
+        if !self.info.inverse_sqrt_pivots(size, &mut inv[..p]) {
             return false;
         }
         for j in rows.chunks_exact_mut(p) {
-            self.info.right_divide_row(j, inv);
+            self.info.right_divide_row(size, j, inv);
             if self.spread.is_some() {
-                self.info.left_solve(j, inv);
+                self.info.left_solve(size, j, inv);
             }
             f(j, self.spread.as_ref());
         }

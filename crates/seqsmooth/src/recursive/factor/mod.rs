@@ -1,5 +1,5 @@
 use crate::numeric::inline::InlineVec;
-use crate::numeric::unrolled::unrolled_sizes;
+use crate::numeric::unrolled::{unrolled_sizes, Size};
 use nalgebra::{DMatrix, DVector};
 
 /// The largest dimension whose factor is stored inline ([`InlineVec`]): a copy of it allocates
@@ -135,9 +135,11 @@ impl TriangularFactor {
 
     /// `1/√d_i` for every pivot into `out`, or `false` when a pivot is not positive (the factor
     /// does not determine the state): the one set of square roots and divisions that
-    /// [`Self::right_divide_row`] and [`Self::left_solve`] share across rows.
-    pub(crate) fn inverse_sqrt_pivots(&self, out: &mut [f64]) -> bool {
-        for (o, d) in out.iter_mut().zip(&self.d) {
+    /// [`Self::right_divide_row`] and [`Self::left_solve`] share across rows. `size` is the
+    /// dimension (a [`Fixed`](crate::numeric::unrolled::Fixed) one unrolls the loop).
+    #[inline(always)]
+    pub(crate) fn inverse_sqrt_pivots(&self, size: impl Size, out: &mut [f64]) -> bool {
+        for (o, d) in out[..size.get()].iter_mut().zip(&self.d[..size.get()]) {
             // NaN fails too.
             if d.0.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 return false;
@@ -177,54 +179,68 @@ impl TriangularFactor {
 
     /// `x ← D^-½ U⁻ᵀ x`, i.e. `(x R⁻¹)ᵀ` for a row `x` (forward substitution with the unit
     /// triangular `Uᵀ`, then the pivots' `inv` from [`Self::inverse_sqrt_pivots`]), without
-    /// allocating.
-    pub(crate) fn right_divide_row(&self, x: &mut [f64], inv: &[f64]) {
-        let p = self.dim();
+    /// allocating. `size` is the dimension (as for [`Self::inverse_sqrt_pivots`]; the same
+    /// operations in the same order for either kind of size).
+    #[inline(always)]
+    pub(crate) fn right_divide_row(&self, size: impl Size, x: &mut [f64], inv: &[f64]) {
+        let p = size.get();
+        let x = &mut x[..p];
+        let u = &self.u[..p * p];
         for i in 0..p {
             let (done, rest) = x.split_at_mut(i);
             let v = done
                 .iter()
                 .enumerate()
-                .fold(rest[0], |v, (k, xk)| v - self.u[k * p + i] * xk);
+                .fold(rest[0], |v, (k, xk)| v - u[k * p + i] * xk);
             rest[0] = v;
         }
-        for (v, r) in x.iter_mut().zip(inv) {
+        for (v, r) in x.iter_mut().zip(&inv[..p]) {
             *v *= r;
         }
     }
 
     /// `x ← U⁻¹ D^-½ x`, i.e. `R⁻¹ x` (the pivots' `inv`, then back substitution with the unit
-    /// triangular `U`), without allocating.
-    pub(crate) fn left_solve(&self, x: &mut [f64], inv: &[f64]) {
-        let p = self.dim();
-        for (v, r) in x.iter_mut().zip(inv) {
+    /// triangular `U`), without allocating; `size` as for [`Self::right_divide_row`].
+    #[inline(always)]
+    pub(crate) fn left_solve(&self, size: impl Size, x: &mut [f64], inv: &[f64]) {
+        let p = size.get();
+        let x = &mut x[..p];
+        let uu = &self.u[..p * p];
+        for (v, r) in x.iter_mut().zip(&inv[..p]) {
             *v *= r;
         }
         for i in (0..p).rev() {
             let (head, later) = x.split_at_mut(i + 1);
-            let u = &self.u[i * p + i + 1..(i + 1) * p];
+            let u = &uu[i * p + i + 1..(i + 1) * p];
             head[i] = later.iter().zip(u).fold(head[i], |v, (xk, uk)| v - uk * xk);
         }
     }
 
-    /// `‖R x‖² = Σ_i d_i (U x)_i²`, without allocating.
-    pub(crate) fn norm_sq_of(&self, x: &[f64]) -> f64 {
-        let p = self.dim();
+    /// `‖R x‖² = Σ_i d_i (U x)_i²`, without allocating; `size` as for
+    /// [`Self::right_divide_row`].
+    #[inline(always)]
+    pub(crate) fn norm_sq_of(&self, size: impl Size, x: &[f64]) -> f64 {
+        let p = size.get();
+        let (x, u, d) = (&x[..p], &self.u[..p * p], &self.d[..p]);
         (0..p)
             .map(|i| {
-                let ux = x[i] + (i + 1..p).map(|k| self.u[i * p + k] * x[k]).sum::<f64>();
-                self.d[i].0 * ux * ux
+                let ux = x[i] + (i + 1..p).map(|k| u[i * p + k] * x[k]).sum::<f64>();
+                d[i].0 * ux * ux
             })
             .sum()
     }
 
     /// `x ← U x` (the unit upper triangular part of `R = D^½ U`), without allocating: with
-    /// [`Self::pivot`], `(R x)ᵀ(R y) = Σ_i d_i (U x)_i (U y)_i` needs no square root.
-    pub(crate) fn unit_upper_times(&self, x: &mut [f64]) {
-        let p = self.dim();
+    /// [`Self::pivot`], `(R x)ᵀ(R y) = Σ_i d_i (U x)_i (U y)_i` needs no square root; `size` as
+    /// for [`Self::right_divide_row`].
+    #[inline(always)]
+    pub(crate) fn unit_upper_times(&self, size: impl Size, x: &mut [f64]) {
+        let p = size.get();
+        let x = &mut x[..p];
+        let uu = &self.u[..p * p];
         for i in 0..p {
             let (head, later) = x.split_at_mut(i + 1);
-            let u = &self.u[i * p + i + 1..(i + 1) * p];
+            let u = &uu[i * p + i + 1..(i + 1) * p];
             head[i] = later.iter().zip(u).fold(head[i], |v, (xk, uk)| v + uk * xk);
         }
     }
