@@ -552,23 +552,6 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         Ok(Some(out))
     }
 
-    /// The prediction to the measurement's time and the correction into the work buffers, the
-    /// filter unchanged: the time and the statistics, or `None` with no component present (the
-    /// prediction then made the filter's). The radar model's fixed-size update where it applies
-    /// (module `radar`, the same numbers), else [`Self::measure_and_predict`] and [`Self::correct`].
-    fn predict_and_correct(
-        &mut self,
-        measurement: &Measurement,
-    ) -> Result<Option<(f64, InnovationStats)>, Error> {
-        if let Some(stats) = self.correct_radar_fixed(measurement) {
-            return Ok(Some((measurement.time, stats)));
-        }
-        let Some(t) = self.measure_and_predict(measurement)? else {
-            return Ok(None);
-        };
-        Ok(Some((t, self.correct(t, false)?)))
-    }
-
     /// The start of every update: the measurement read ([`Self::measure`]) and the prediction
     /// to its time ([`Self::predict_work`]); with no component present the prediction is made
     /// the filter's and `None` returned, else the time to correct at.

@@ -22,6 +22,7 @@
 //! filter's results).
 
 use super::{InnovationStats, KalmanFilter};
+use crate::error::Error;
 use crate::kalman::noise::fill;
 use crate::linalg::dense::{all_finite, ldl, log_det, symmetrize};
 use crate::model::dynamics::Dynamics;
@@ -38,6 +39,23 @@ const N: usize = 6;
 const K: usize = 3;
 
 impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
+    /// The prediction to the measurement's time and the correction into the work buffers, the
+    /// filter unchanged: the time and the statistics, or `None` with no component present (the
+    /// prediction then made the filter's). The radar model's fixed-size update where it applies
+    /// ([`Self::correct_radar_fixed`], the same numbers), else `measure_and_predict` and `correct`.
+    pub(super) fn predict_and_correct(
+        &mut self,
+        measurement: &Measurement,
+    ) -> Result<Option<(f64, InnovationStats)>, Error> {
+        if let Some(stats) = self.correct_radar_fixed(measurement) {
+            return Ok(Some((measurement.time, stats)));
+        }
+        let Some(t) = self.measure_and_predict(measurement)? else {
+            return Ok(None);
+        };
+        Ok(Some((t, self.correct(t, false)?)))
+    }
+
     /// The prediction to the measurement's time and the update, when the model is the radar
     /// case of this module, into the work buffers (the prediction `x`, `s`; the present
     /// components and values, `ν`, `V` and the gain that an `Innovation` reads; the updated
