@@ -112,6 +112,21 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             *sp = *s;
         } else {
             predict(x, s, t - self.time, psd, xp, sp)?;
+            // `Φ` into the work buffer as the general path leaves it (the smoothers read it:
+            // `last_transition`): `[[I, ζ I], [0, I]]` by `psi_term`, (4.2.5).
+            let (t0, t1) = (psi_term(0, &(t - self.time)), psi_term(1, &(t - self.time)));
+            let phi = w.phi.as_mut_slice();
+            for c in 0..N {
+                for r in 0..N {
+                    phi[r + c * N] = if r == c {
+                        t0
+                    } else if c == r + 3 {
+                        t1
+                    } else {
+                        0.0
+                    };
+                }
+            }
         }
 
         // The radar's prediction and its Jacobian J (M = [J 0]; J₁₂ = 0).
