@@ -5,8 +5,10 @@
 //! rows of the pieces (each piece's header dropped) must be the same bytes, for every filter
 //! kind (with and without `--sigma`, a lead, one series or many interleaved series with ids,
 //! the automatic filter with outliers whose decisions cross the cuts). The cuts are at random
-//! rows, ten pieces (the first holding the 101 rows that decide the default τ), a piece
-//! possibly empty or a single row.
+//! rows, ten pieces, a piece possibly empty or a single row; where the run decides the default
+//! τ (fading memory and the automatic filter without `--tau`) the first piece holds the 101
+//! rows that decide it, elsewhere one cut falls within them (the first piece holding the rows
+//! the command needs to start without a state: the window, or degree + 1).
 
 mod common;
 use common::{fails, run, tmp, Rng};
@@ -72,13 +74,28 @@ fn pieces_match(args: &[&str], series: usize, n: usize, seed: u64) {
     }
     let whole = format!("{header}\n{}\n", rows.join("\n"));
     let unbroken = filter(&base, &whole);
-    // The first piece decides the default τ from its first rows (101, as the unbroken run):
-    // it holds them; the other cuts fall anywhere, an empty piece included.
+    // Where the run decides the default τ, the first piece decides it from its first rows
+    // (101, as the unbroken run): it holds them. Otherwise (`--tau`, or a kind without τ) a cut
+    // falls within them, after the rows the command needs to start without a state (the
+    // window, or degree + 1: it refuses fewer). The other cuts fall anywhere, an empty piece
+    // included.
+    let decides_tau =
+        ["fading", "auto"].iter().any(|k| args.contains(k)) && !args.contains(&"--tau");
+    let value = |flag: &str| {
+        let i = args.iter().position(|a| *a == flag)?;
+        args[i + 1].parse::<usize>().ok()
+    };
+    let start = value("--window").unwrap_or_else(|| value("--degree").unwrap_or(1) + 1);
+    let first = if decides_tau { FIRST } else { start };
     let mut cuts: Vec<usize> = (0..8).map(|_| rng.below(n)).collect();
-    cuts.push(FIRST + rng.below(n - FIRST));
+    cuts.push(if decides_tau {
+        FIRST + rng.below(n - FIRST)
+    } else {
+        start + rng.below(FIRST - start)
+    });
     cuts.extend([0, n]);
     cuts.sort_unstable();
-    cuts.iter_mut().skip(1).for_each(|c| *c = (*c).max(FIRST));
+    cuts.iter_mut().skip(1).for_each(|c| *c = (*c).max(first));
     let name = format!("state-{seed}-{}.bin", args.join("_").replace('/', ""));
     let state = tmp(&name);
     let _ = std::fs::remove_file(&state);
@@ -108,7 +125,7 @@ fn pieces_match(args: &[&str], series: usize, n: usize, seed: u64) {
     std::fs::remove_file(&state).unwrap();
 }
 
-/// Every kind, one series and many, with and without σ and a lead.
+/// Every kind, one series and many, with and without σ, a lead and `--tau`.
 #[test]
 fn ten_pieces_give_the_unbroken_rows_for_every_kind() {
     let kinds: &[&[&str]] = &[
@@ -131,7 +148,13 @@ fn ten_pieces_give_the_unbroken_rows_for_every_kind() {
         &[
             "--kind", "fixed", "--degree", "1", "--window", "6", "--sigma", "0.5",
         ],
+        &[
+            "--kind", "fading", "--degree", "2", "--theta", "0.9", "--tau", "1.5",
+        ],
         &["--kind", "auto", "--degree", "2", "--theta", "0.9"],
+        &[
+            "--kind", "auto", "--degree", "2", "--theta", "0.9", "--tau", "1",
+        ],
         &[
             "--kind", "auto", "--degree", "1", "--theta", "0.95", "--sigma", "0.3",
         ],
