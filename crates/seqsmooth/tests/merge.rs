@@ -187,11 +187,12 @@ fn exact_coefficients(
         .map(|i| (0..=p).map(|j| sums[i * (p + 1) + j].value()).collect())
         .collect();
     for k in 0..p {
-        for i in k + 1..p {
-            let f = &a[i][k] / &a[k][k];
-            for j in k..=p {
-                let d = &f * &a[k][j];
-                a[i][j] -= d;
+        let (top, bottom) = a.split_at_mut(k + 1);
+        let pivot = &top[k];
+        for row in bottom.iter_mut() {
+            let f = &row[k] / &pivot[k];
+            for (x, y) in row[k..].iter_mut().zip(&pivot[k..]) {
+                *x -= &f * y;
             }
         }
     }

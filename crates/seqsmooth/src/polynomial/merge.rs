@@ -143,10 +143,10 @@ fn cholesky(a: &[DoubleWord], n: usize, determined: usize) -> Option<Vec<DoubleW
             d = double_word::sub(d, double_word::mul(l[j * n + k], l[j * n + k]));
         }
         if j < determined {
-            if !(d.0 > PIVOT_FLOOR * a[packed(n, j, j)].0) {
+            if d.0.is_nan() || d.0 <= PIVOT_FLOOR * a[packed(n, j, j)].0 {
                 return None;
             }
-        } else if !(d.0 > 0.0) {
+        } else if d.0.is_nan() || d.0 <= 0.0 {
             l[j * n + j] = zero;
             continue;
         }
