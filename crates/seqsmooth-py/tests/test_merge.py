@@ -91,6 +91,7 @@ def check_against_single_passes(infos, rows, span, single):
     t, y = rows.t.to_numpy(), rows.y.to_numpy()
     h = 0.5 * (span[1] - span[0])
     end = span[1]
+    centre = 0.5 * (span[0] + span[1])
     for m, info in zip(DEGREES, infos):
         assert info.samples == N
         got = info.estimate(end)
@@ -107,18 +108,18 @@ def check_against_single_passes(infos, rows, span, single):
         # rounding (ACCURACY.md, measured up to 4e-11 at degree 8).
         assert r < (1e-12 if m <= 5 else 1e-10), (m, r)
         c = curve_relative(
-            lambda s: info.estimate(s).derivatives[0],
-            lambda s: f.estimate_at(s).derivatives[0],
+            lambda s, info=info: info.estimate(s).derivatives[0],
+            lambda s, f=f: f.estimate_at(s).derivatives[0],
             span,
         )
         assert c < 1e-12, (m, c)
         np.testing.assert_allclose(got.std_devs, want.std_devs, rtol=1e-9)
         # numpy's least squares (LAPACK's SVD solver) on the Legendre basis of the span.
-        u = (t - 0.5 * (span[0] + span[1])) / h
+        u = (t - centre) / h
         coef = np.linalg.lstsq(np.polynomial.legendre.legvander(u, m), y, rcond=None)[0]
         c = curve_relative(
-            lambda s: info.estimate(s).derivatives[0],
-            lambda s: np.polynomial.legendre.legval((s - 0.5 * (span[0] + span[1])) / h, coef),
+            lambda s, info=info: info.estimate(s).derivatives[0],
+            lambda s, coef=coef: np.polynomial.legendre.legval((s - centre) / h, coef),
             span,
         )
         assert c < 1e-12, (m, c)
