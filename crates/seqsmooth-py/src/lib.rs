@@ -16,6 +16,7 @@ mod frame;
 mod kalman;
 mod kalman_bank;
 mod linear;
+mod merge;
 mod model_fit;
 mod models;
 mod paml;
@@ -52,6 +53,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<track::PyRadarTracker>()?;
     m.add_class::<models::PyCoordinatedTurn>()?;
     m.add_class::<fit::PySlidingFit>()?;
+    m.add_class::<merge::PyInformation>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
     m.add_function(wrap_pyfunction!(model_fit::fit_model, m)?)?;
     m.add_function(wrap_pyfunction!(frame::filter_series, m)?)?;

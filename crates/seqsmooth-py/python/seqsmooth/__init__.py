@@ -44,6 +44,10 @@ SlidingFit
     Gauss–Newton differential correction of each row's window of the last W rows (Morrison
     §8.5-8.7), radar or scalar polynomial model: ``update_many`` gives the states,
     covariances, iterations, chi-squared and epochs of ``seqsmooth fit``.
+Information
+    One long series cut into partitions (on Dask, Spark, or anywhere): each partition's
+    least-squares information, merged exactly, gives the single pass's expanding-memory,
+    least-squares or Bayes fit (``reduce``, ``merge`` or ``+``, ``add_prior``, ``estimate``).
 
 Functions
 ---------
@@ -87,6 +91,7 @@ from ._seqsmooth import (
     FadingBank,
     FadingMemory,
     FixedMemory,
+    Information,
     Innovation,
     KalmanBank,
     KalmanFilter,
@@ -143,6 +148,7 @@ __all__ = [
     "RadarTracker",
     "CoordinatedTurn",
     "SlidingFit",
+    "Information",
     "Innovation",
     "PolynomialFilter",
     "State",
