@@ -14,15 +14,37 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArray
 use pyo3::prelude::*;
 use pyo3::types::IntoPyDict;
 
-/// A contiguous one-dimensional `f64` array from Python: the caller's own, or the
+/// A contiguous, aligned one-dimensional `f64` array from Python: the caller's own, or the
 /// conversion of what the caller passed.
 pub struct Series<'py>(PyReadonlyArray1<'py, f64>);
 
-impl Series<'_> {
+impl<'py> Series<'py> {
+    /// `a` when it can be read as a slice (contiguous and aligned), else an error (never a
+    /// panic: a contiguous array unpickled from a buffer may be unaligned).
+    fn new(a: PyReadonlyArray1<'py, f64>, name: &str) -> PyResult<Self> {
+        if a.as_slice().is_err() {
+            return Err(raise(
+                Kind::InvalidInput,
+                format!("{name} could not be read as a contiguous, aligned float64 array"),
+                None,
+            ));
+        }
+        Ok(Series(a))
+    }
+
     /// The values.
     pub fn as_slice(&self) -> &[f64] {
-        self.0.as_slice().expect("contiguous by construction")
+        self.0.as_slice().unwrap_or(&[])
     }
+}
+
+/// `numpy.require(array, dtype, ["C", "A"])`: contiguous and aligned (a copy only when needed).
+fn contiguous_aligned<'py, T: IntoPyObject<'py>>(
+    array: &Bound<'py, PyAny>,
+    dtype: T,
+) -> PyResult<Bound<'py, PyAny>> {
+    let np = array.py().import("numpy")?;
+    np.call_method1("require", (array, dtype, vec!["C", "A"]))
 }
 
 /// `numpy.asarray(obj)`, its failure an [`Kind::InvalidType`] error naming `name`.
@@ -55,7 +77,7 @@ fn one_dimensional(array: &Bound<'_, PyAny>, name: &str) -> PyResult<()> {
 pub fn series<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Series<'py>> {
     if let Ok(a) = obj.cast::<PyArray1<f64>>() {
         let a = a.readonly();
-        if a.is_contiguous() {
+        if a.as_slice().is_ok() {
             return Ok(Series(a));
         }
     }
@@ -70,9 +92,8 @@ pub fn series<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Series<'py>>
         ));
     }
     one_dimensional(&array, name)?;
-    let np = obj.py().import("numpy")?;
-    let converted = np.call_method1("ascontiguousarray", (array, "float64"))?;
-    Ok(Series(converted.cast::<PyArray1<f64>>()?.readonly()))
+    let converted = contiguous_aligned(&array, "float64")?;
+    Series::new(converted.cast::<PyArray1<f64>>()?.readonly(), name)
 }
 
 /// `obj` as one-dimensional times, named `name` in errors: reals as [`series`] takes them, or
@@ -112,11 +133,16 @@ pub fn times<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Series<'py>> 
     let (unit, count): (String, i64) = np
         .call_method1("datetime_data", (array.getattr("dtype")?,))?
         .extract()?;
-    let ticks = np
-        .call_method1("ascontiguousarray", (&array,))?
+    let ticks = contiguous_aligned(&array, array.getattr("dtype")?)?
         .call_method1("view", ("int64",))?;
     let ticks = ticks.cast::<PyArray1<i64>>()?.readonly();
-    let ticks = ticks.as_slice().expect("contiguous by construction");
+    let Ok(ticks) = ticks.as_slice() else {
+        return Err(raise(
+            Kind::InvalidInput,
+            format!("{name} could not be read as a contiguous, aligned array of dates"),
+            None,
+        ));
+    };
     let dtype = array.getattr("dtype")?.str()?.to_string();
     let seconds = tick_seconds(ticks, &unit, count, kind == "M").map_err(|(i, why)| {
         raise(
@@ -126,7 +152,7 @@ pub fn times<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Series<'py>> 
         )
     })?;
     let out = PyArray1::from_vec(py, seconds);
-    Ok(Series(out.readonly()))
+    Series::new(out.readonly(), name)
 }
 
 /// numpy's `datetime64` / `timedelta64` ticks of `count` × `unit` as seconds (since the Unix
