@@ -20,14 +20,16 @@
 //! - [`BankStream`]: the streaming filter, a step of every series at a time; its memory is
 //!   the series' states and covariances (`n + n²` numbers and a time each), not the steps.
 //!
-//! Every series runs the library's own Kalman arithmetic (the kernels of
-//! [`KalmanFilter`](super::KalmanFilter): `Φ S Φᵀ + Q` and the correction, compiled with the
-//! state size and the components present as constants for `n ≤ 9`, `k ≤ 4`, a general-size
-//! fallback beyond) and the library's own backward steps (the whole-interval step of
-//! [`super::smoother`]'s `smooth_flat` for the RTS smoother, [`super::fixed_lag`]'s for the
-//! fixed-lag one), so it equals one `KalmanFilter` (and one `Smoother`, one
-//! `FixedLagSmoother`) per series to rounding: tested to `10⁻¹²` relative in
-//! `tests/kalman_bank.rs`.
+//! Every series runs the library's own Kalman arithmetic: for `n ≤ 9` states and `p ≤ 3`
+//! components a fixed-size path (the series' estimate, prediction and scratch in arrays on
+//! the stack, the sizes compile-time constants, the arithmetic of the filter's `carry` and
+//! `correct_kernel` operation for operation), beyond it the kernels of
+//! [`KalmanFilter`](super::KalmanFilter) on their work buffers; `Φ` and `Q` computed once per
+//! step length for a time-invariant model; and the library's own backward steps (the
+//! whole-interval step of [`super::smoother`]'s `smooth_flat` for the RTS smoother,
+//! [`super::fixed_lag`]'s for the fixed-lag one), so it equals one `KalmanFilter` (and one
+//! `Smoother`, one `FixedLagSmoother`) per series to rounding: tested to `10⁻¹²` relative in
+//! `tests/kalman_bank.rs`, on both sides of the fixed sizes.
 
 use super::correct::noise_entries;
 use super::noise::{check_covariance, check_estimate, check_noise_dimension, ProcessNoise};
@@ -342,7 +344,9 @@ impl<D: Dynamics + Sync> KalmanBank<D> {
             out.sigma = vec![0.0; rows * n];
         }
         if out.nis.len() != rows {
-            out.nis = vec![None; rows];
+            // Written by the threads (their pages faulted in in parallel, not here serially).
+            out.nis = Vec::with_capacity(rows);
+            out.nis.par_extend(rayon::iter::repeat_n(None, rows));
         }
         let r = self.r_entries();
         // The output cut into each task's contiguous rows.
