@@ -14,6 +14,10 @@
 //! What differs is the layout: no work buffers on the heap, no matrix `M` per step, and
 //! `ln det V` (for the log-likelihood's finiteness) only when the pivots cannot vouch for it.
 
+// The loops index by position on purpose: each sum in the general kernels' order, over
+// arrays whose sizes are constants (the loops unroll).
+#![allow(clippy::needless_range_loop)]
+
 use super::super::correct::finite;
 use super::series::Forward;
 use super::{KalmanBank, RowsMut};
