@@ -1,9 +1,9 @@
 //! `KalmanBank`: the library's `kalman::bank::KalmanBank` over the polynomial model (degree,
 //! axes, driving noise `q`, the observation `M`, `R`, the prior every series starts from at its
 //! first time), many series in one set of arrays, each row tagged with its series (`series`,
-//! 0-based codes, any order: the rows are grouped by a stable counting sort, each series' rows
-//! kept in input order), the results put back in input order. The engine of
-//! `seqsmooth.kalman_frame`.
+//! int64 labels, any values, rows in any order: rows already grouped by label are taken as
+//! they are; otherwise grouped by a stable counting sort, each series' rows kept in input
+//! order), the results in input order. The engine of `seqsmooth.kalman_frame`.
 
 use crate::arrays::{matrix, series, table};
 use crate::errors::{raise, IntoPy, Kind};
@@ -138,7 +138,7 @@ impl PyKalmanBank {
         let codes = codes.cast::<PyArray1<i64>>().map_err(|_| {
             raise(
                 Kind::InvalidType,
-                "series must be a one-dimensional int64 numpy array",
+                "series must be a one-dimensional int64 numpy array (each row's series label)",
                 None,
             )
         })?;
@@ -167,33 +167,62 @@ impl PyKalmanBank {
     }
 }
 
-/// The rows by series (a stable counting sort of `codes`), `pass` over the panel, the rows
-/// put back in input order; an error's row the input's ([`Error::InBatch`]).
+/// The rows by series, `pass` over the panel, the results by input row; an error's row the
+/// input's ([`Error::InBatch`]). Rows already grouped (each label's rows one run, as a frame
+/// sorted by its id) are the panel as they are, nothing copied; otherwise the rows are
+/// grouped by a stable counting sort (each series' rows kept in input order) and the results
+/// put back in input order.
 fn run_grouped(
     bank: &KalmanBank<PolynomialDynamics>,
-    codes: &[i64],
+    labels: &[i64],
     t: &[f64],
     z: &[f64],
     pass: Pass,
 ) -> Result<BankRows, Error> {
     let (n, p, count) = (bank.states(), bank.components(), t.len());
-    let mut series = Vec::with_capacity(count);
-    for (i, &c) in codes.iter().enumerate() {
-        match usize::try_from(c) {
-            Ok(c) if c < count => series.push(c),
-            _ => {
-                return Err(Error::InBatch {
-                    index: i,
-                    source: Box::new(Error::InvalidParameter {
-                        name: seqsmooth::Param::Channel,
-                        value: c.to_string(),
-                        reason: format!("must be a series number from 0 to {}", count - 1),
-                    }),
-                })
-            }
+    let run = |panel: &Panel<'_>| match pass {
+        Pass::Filter => bank.filter(panel),
+        Pass::Rts => bank.smooth(panel),
+        Pass::Lag(lag) => bank.smooth_fixed_lag(panel, lag),
+    };
+    // An error of series `channel`'s row `index` named by its input row.
+    let input_row = |e: Error, row: &dyn Fn(usize, usize) -> usize| match e {
+        Error::InChannel {
+            channel, source, ..
+        } => match *source {
+            Error::InBatch { index, source } => Error::InBatch {
+                index: row(channel, index),
+                source,
+            },
+            other => other,
+        },
+        other => other,
+    };
+    // The runs of equal labels; grouped when no label starts two runs.
+    let mut starts: Vec<usize> = Vec::with_capacity(1024);
+    for i in 0..count {
+        if i == 0 || labels[i] != labels[i - 1] {
+            starts.push(i);
         }
     }
-    let groups = series.iter().max().map_or(0, |m| m + 1);
+    let mut firsts: Vec<i64> = starts.iter().map(|&i| labels[i]).collect();
+    firsts.sort_unstable();
+    if firsts.windows(2).all(|w| w[0] != w[1]) {
+        starts.push(count);
+        let panel = Panel {
+            offsets: &starts,
+            times: t,
+            values: z,
+        };
+        return run(&panel).map_err(|e| input_row(e, &|s, k| starts[s] + k));
+    }
+    let mut group = std::collections::HashMap::with_capacity(firsts.len());
+    let mut series = Vec::with_capacity(count);
+    for &label in labels {
+        let next = group.len();
+        series.push(*group.entry(label).or_insert(next));
+    }
+    let groups = group.len();
     let mut offsets = vec![0usize; groups + 1];
     for &s in &series {
         offsets[s + 1] += 1;
@@ -217,23 +246,7 @@ fn run_grouped(
         times: &times,
         values: &values,
     };
-    let grouped = match pass {
-        Pass::Filter => bank.filter(&panel),
-        Pass::Rts => bank.smooth(&panel),
-        Pass::Lag(lag) => bank.smooth_fixed_lag(&panel, lag),
-    }
-    .map_err(|e| match e {
-        Error::InChannel {
-            channel, source, ..
-        } => match *source {
-            Error::InBatch { index, source } => Error::InBatch {
-                index: order[offsets[channel] + index],
-                source,
-            },
-            other => other,
-        },
-        other => other,
-    })?;
+    let grouped = run(&panel).map_err(|e| input_row(e, &|s, k| order[offsets[s] + k]))?;
     let mut out = BankRows {
         states: n,
         state: vec![0.0; count * n],

@@ -115,8 +115,42 @@ def test_a_bad_row_is_named_with_its_series():
             P0=P0,
             R=R,
         )
-    assert e.value.index == bad and "(series" in str(e.value) and "7)" in str(e.value)
+    assert e.value.index == bad and "(series 7 of column 'id')" in str(e.value)
     with pytest.raises(seqsmooth.SeqsmoothError):
         seqsmooth.kalman_frame({"t": t, "y": z[:, 0]}, P0=1.0, smoother="rts", lag=2)
     with pytest.raises(seqsmooth.SeqsmoothError):
         seqsmooth.KalmanBank(1, np.zeros(2), -np.eye(2), 1.0)
+
+
+def test_integer_labels_grouped_or_interleaved_are_the_same_series():
+    # Any int64 labels (not codes from 0): interleaved rows grouped by the bank, rows already
+    # grouped by label taken as they are; the same numbers either way, in input order.
+    ids, t, z = rows(40, seed=4)
+    bank = seqsmooth.KalmanBank(1, np.zeros(4), P0, R, axes=2, q=Q)
+    labels = ids * 1000 - 7
+    order = np.argsort(ids, kind="stable")
+    for run in (bank.filter, bank.smooth):
+        by_code = run(ids, t, z)
+        by_label = run(labels, t, z)
+        grouped = run(labels[order], t[order], z[order])
+        for a, b, c in zip(by_code, by_label, grouped):
+            assert np.array_equal(a, b, equal_nan=True)
+            assert np.array_equal(a[order], c, equal_nan=True)
+
+
+def test_kalman_frame_integer_ids_are_the_string_ids_and_name_a_bad_row():
+    ids, t, z = rows(30, seed=6)
+    order = np.argsort(ids, kind="stable")
+    ids, t, z = ids[order], t[order], z[order]  # grouped by id, as a frame sorted by id
+    settings = dict(value=["x", "y"], by="id", P0=P0, R=R, q=Q, smoother="rts")
+    by_int = seqsmooth.kalman_frame({"id": ids, "t": t, "x": z[:, 0], "y": z[:, 1]}, **settings)
+    names = np.array([f"s{i}" for i in ids])
+    by_str = seqsmooth.kalman_frame({"id": names, "t": t, "x": z[:, 0], "y": z[:, 1]}, **settings)
+    for c in ["x_d0", "y_d1", "x_s0", "y_s1", "nis"]:
+        assert np.array_equal(by_int[c], by_str[c], equal_nan=True)
+    bad = np.flatnonzero(ids == 11)[3]
+    t = t.copy()
+    t[bad] = t[bad - 1] - 1.0
+    with pytest.raises(seqsmooth.SeqsmoothError) as e:
+        seqsmooth.kalman_frame({"id": ids, "t": t, "x": z[:, 0], "y": z[:, 1]}, **settings)
+    assert e.value.index == bad and "(series 11 of column 'id')" in str(e.value)

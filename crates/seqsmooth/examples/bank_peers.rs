@@ -8,10 +8,14 @@
 //! `DIR/bank.txt` holding `series steps q r p0` and `DIR/bank.t.f64`, `DIR/bank.z.f64` the
 //! times and values (`series × steps` raw little-endian doubles, series by series, NaN missing).
 //! Writes `DIR/bank.filtered.f64`, `DIR/bank.smoothed.f64` (`series × steps × 2`: the state) and
-//! prints `filter,SECONDS` and `filter+rts,SECONDS`, the best of `REPS` runs (I/O excluded).
+//! prints `filter,SECONDS` and `filter+rts,SECONDS`, the best of `REPS` runs (I/O excluded),
+//! each run into new output buffers, and `filter-reused,SECONDS`, `filter+rts-reused,SECONDS`
+//! into the same buffers every run ([`KalmanBank::filter_into`]: no page faults); then
+//! `cpu:NAME,SECONDS`, the process' CPU time (all threads, user + system) of the best run of
+//! each.
 
 use nalgebra::{DMatrix, DVector};
-use seqsmooth::kalman::bank::{KalmanBank, Panel};
+use seqsmooth::kalman::bank::{BankRows, KalmanBank, Panel};
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::observation::LinearObservation;
@@ -57,20 +61,61 @@ fn main() {
     .expect("the model")
     .with_process_noise(WhiteNoiseDerivative::new(1, 1, q).expect("q"))
     .expect("the noise");
+    // The best wall time of `reps` runs, and the process' CPU time (user + system, every
+    // thread) of that run: on a shared machine the CPU time is the steadier figure.
+    let cpu = std::cell::Cell::new(Vec::new());
     let best = |run: &dyn Fn() -> Vec<f64>| {
-        let mut best = f64::INFINITY;
+        let (mut best, mut best_cpu) = (f64::INFINITY, f64::INFINITY);
         let mut out = Vec::new();
         for _ in 0..reps {
-            let start = Instant::now();
+            let (start, start_cpu) = (Instant::now(), cpu_seconds());
             out = run();
             best = best.min(start.elapsed().as_secs_f64());
+            best_cpu = best_cpu.min(cpu_seconds() - start_cpu);
         }
+        let mut all = cpu.take();
+        all.push(best_cpu);
+        cpu.set(all);
         (best, out)
     };
+    // New output buffers every run (their pages faulted in, as a caller's first run or
+    // simdkalman's new arrays), then the same buffers reused (`filter_into`: no page faults).
     let (filter, filtered) = best(&|| bank.filter(&panel).expect("filter").state);
     let (rts, smoothed) = best(&|| bank.smooth(&panel).expect("smooth").state);
+    let reused = std::cell::RefCell::new(BankRows::default());
+    let (filter_reused, _) = best(&|| {
+        let mut out = reused.borrow_mut();
+        bank.filter_into(&panel, &mut out).expect("filter");
+        Vec::new()
+    });
+    let (rts_reused, _) = best(&|| {
+        let mut out = reused.borrow_mut();
+        bank.smooth_into(&panel, &mut out).expect("smooth");
+        Vec::new()
+    });
     write(&format!("{dir}/bank.filtered.f64"), &filtered);
     write(&format!("{dir}/bank.smoothed.f64"), &smoothed);
     println!("filter,{filter}");
     println!("filter+rts,{rts}");
+    println!("filter-reused,{filter_reused}");
+    println!("filter+rts-reused,{rts_reused}");
+    let cpu = cpu.take();
+    for (name, seconds) in ["filter", "filter+rts", "filter-reused", "filter+rts-reused"]
+        .iter()
+        .zip(cpu)
+    {
+        println!("cpu:{name},{seconds}");
+    }
+}
+
+/// The process' CPU time so far (user + system, all threads), seconds.
+fn cpu_seconds() -> f64 {
+    // SAFETY: getrusage writes the struct it is given.
+    let usage = unsafe {
+        let mut usage: libc::rusage = std::mem::zeroed();
+        libc::getrusage(libc::RUSAGE_SELF, &mut usage);
+        usage
+    };
+    let seconds = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    seconds(usage.ru_utime) + seconds(usage.ru_stime)
 }

@@ -172,7 +172,7 @@ class KalmanBank:
 
     Notes
     -----
-    ``filter``, ``smooth`` and ``fixed_lag_smoother`` take ``series`` (int64 codes from 0,
+    ``filter``, ``smooth`` and ``fixed_lag_smoother`` take ``series`` (int64 labels, any values,
     any order, series may interleave), ``t`` and ``z`` (``rows x p``, NaN missing), each
     series' times not decreasing, and return ``(state, sigma, nis)`` by input row (``nis``
     NaN where every component was missing). An error's ``.index`` is the input row.

@@ -264,12 +264,22 @@ def kalman_frame(
     if rows == 0:
         raise InvalidInputError("the frame has no rows")
     columns_in = [np.asarray(_column(df, v), dtype=np.float64) for v in values]
-    z = np.ascontiguousarray(np.column_stack(columns_in))
+    # One value column is z as it is (one component a row); several are stacked by row.
+    z = columns_in[0] if len(values) == 1 else np.column_stack(columns_in)
+    z = np.ascontiguousarray(z)
     axes = len(values)
     n = (degree + 1) * axes
     bank = KalmanBank(degree, np.zeros(n) if x0 is None else x0, P0, R, axes=axes, q=q)
     keys = None if by is None else _column(df, by)
-    codes, names = (np.zeros(rows, dtype=np.int64), [None]) if keys is None else _codes(keys, by)
+    names_by_row = False
+    if keys is None:
+        codes, names = np.zeros(rows, dtype=np.int64), [None]
+    elif keys.ndim == 1 and keys.dtype.kind in "iu" and np.can_cast(keys.dtype, np.int64):
+        # Integer ids are the bank's series labels as they are (grouped there, no hashing
+        # here); a row's series is its own id.
+        codes, names, names_by_row = np.ascontiguousarray(keys, dtype=np.int64), keys, True
+    else:
+        codes, names = _codes(keys, by)
     if smoother != "fixed_lag" and lag is not None:
         raise InvalidInputError(f"lag is for smoother='fixed_lag', not {smoother!r}")
     try:
@@ -286,6 +296,9 @@ def kalman_frame(
                 f"smoother {smoother!r} is not one of 'filter', 'rts', 'fixed_lag'"
             )
     except SeqsmoothError as e:
+        if names_by_row and e.index is not None:
+            # The row's series is its own id, named as a Python number.
+            names, codes = {e.index: keys[e.index].item()}, range(rows)
         raise _in_row(e, by, names, codes) from e
     columns: dict[str, np.ndarray] = {}
     if keys is not None:

@@ -20,14 +20,16 @@
 //! - [`BankStream`]: the streaming filter, a step of every series at a time; its memory is
 //!   the series' states and covariances (`n + n²` numbers and a time each), not the steps.
 //!
-//! Every series runs the library's own Kalman arithmetic (the kernels of
-//! [`KalmanFilter`](super::KalmanFilter): `Φ S Φᵀ + Q` and the correction, compiled with the
-//! state size and the components present as constants for `n ≤ 9`, `k ≤ 4`, a general-size
-//! fallback beyond) and the library's own backward steps (the whole-interval step of
-//! [`super::smoother`]'s `smooth_flat` for the RTS smoother, [`super::fixed_lag`]'s for the
-//! fixed-lag one), so it equals one `KalmanFilter` (and one `Smoother`, one
-//! `FixedLagSmoother`) per series to rounding: tested to `10⁻¹²` relative in
-//! `tests/kalman_bank.rs`.
+//! Every series runs the library's own Kalman arithmetic: for `n ≤ 9` states and `p ≤ 3`
+//! components a fixed-size path (the series' estimate, prediction and scratch in arrays on
+//! the stack, the sizes compile-time constants, the arithmetic of the filter's `carry` and
+//! `correct_kernel` operation for operation), beyond it the kernels of
+//! [`KalmanFilter`](super::KalmanFilter) on their work buffers; `Φ` and `Q` computed once per
+//! step length for a time-invariant model; and the library's own backward steps (the
+//! whole-interval step of [`super::smoother`]'s `smooth_flat` for the RTS smoother,
+//! [`super::fixed_lag`]'s for the fixed-lag one), so it equals one `KalmanFilter` (and one
+//! `Smoother`, one `FixedLagSmoother`) per series to rounding: tested to `10⁻¹²` relative in
+//! `tests/kalman_bank.rs`, on both sides of the fixed sizes.
 
 use super::correct::noise_entries;
 use super::noise::{check_covariance, check_estimate, check_noise_dimension, ProcessNoise};
@@ -40,13 +42,43 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 mod backward;
+mod fixed;
 mod series;
 mod smooth;
 mod stream;
 
 pub use stream::BankStream;
 
-use series::SeriesFilter;
+use crate::numeric::unrolled::unrolled_sizes;
+use fixed::{FixedSeries, MAX_COMPONENTS};
+use series::{Forward, SeriesFilter};
+use smooth::Kept;
+
+/// A pass over a series: the filter, the RTS smoother, the fixed-lag smoother of a lag.
+#[derive(Clone, Copy, Debug)]
+enum Pass {
+    Filter,
+    Rts,
+    Lag(usize),
+}
+
+impl Pass {
+    /// The pass over series `s` of `panel` into `out` with the filter `f`.
+    fn series<F: Forward>(
+        self,
+        f: &mut F,
+        kept: &mut Kept,
+        panel: &Panel<'_>,
+        s: usize,
+        out: RowsMut<'_>,
+    ) -> Result<(), Error> {
+        match self {
+            Pass::Filter => f.filter_series(panel, s, out),
+            Pass::Rts => smooth::rts_series(f, kept, panel, s, out),
+            Pass::Lag(lag) => smooth::fixed_lag_series(f, panel, s, lag, out),
+        }
+    }
+}
 
 /// Series per rayon task (each series is independent; the split changes no number).
 pub const SERIES_PER_TASK: usize = 64;
@@ -147,6 +179,7 @@ pub(super) struct RowsMut<'a> {
 
 impl RowsMut<'_> {
     /// Row `r` from the estimate `(x, s)` and its NIS.
+    #[inline]
     pub(super) fn set(&mut self, r: usize, x: &[f64], s: &[f64], nis: Option<f64>) {
         let n = x.len();
         self.state[r * n..(r + 1) * n].copy_from_slice(x);
@@ -261,36 +294,60 @@ impl<D: Dynamics + Sync> KalmanBank<D> {
     /// names the first failing series ([`Error::InChannel`]) and its row within the series
     /// ([`Error::InBatch`]).
     pub fn filter(&self, panel: &Panel<'_>) -> Result<BankRows, Error> {
-        self.run(panel, |f, panel, s, out| f.filter_series(panel, s, out))
+        self.run(panel, Pass::Filter)
     }
 
     /// The Rauch–Tung–Striebel smoother over every series (see [`super::smoother`]): per row
     /// `X_{k|N}`, its σ and the forward update's NIS; memory per series is its rows'.
     pub fn smooth(&self, panel: &Panel<'_>) -> Result<BankRows, Error> {
-        self.run(panel, |f, panel, s, out| {
-            smooth::rts_series(f, panel, s, out)
-        })
+        self.run(panel, Pass::Rts)
     }
 
     /// The fixed-lag smoother (see [`super::fixed_lag`]) over every series: per row
     /// `X_{k|k+L}` (the last `L` rows of a series from all of its rows), its σ and the NIS;
     /// memory per series is `L + 1` rows' estimates and backward steps, not its length.
     pub fn smooth_fixed_lag(&self, panel: &Panel<'_>, lag: usize) -> Result<BankRows, Error> {
-        self.run(panel, |f, panel, s, out| {
-            smooth::fixed_lag_series(f, panel, s, lag, out)
-        })
+        self.run(panel, Pass::Lag(lag))
     }
 
-    /// Runs `series` on every series of `panel` in parallel, each into its own rows.
-    fn run(
-        &self,
-        panel: &Panel<'_>,
-        series: impl Fn(&mut SeriesFilter<'_, D>, &Panel<'_>, usize, RowsMut<'_>) -> Result<(), Error>
-            + Sync,
-    ) -> Result<BankRows, Error> {
+    /// [`KalmanBank::filter`] into `out`, its buffers reused (grown or shrunk to the panel's
+    /// rows): no page of a large output faulted in again. On an error `out` holds no rows.
+    pub fn filter_into(&self, panel: &Panel<'_>, out: &mut BankRows) -> Result<(), Error> {
+        self.run_into(panel, Pass::Filter, out)
+    }
+
+    /// [`KalmanBank::smooth`] into `out`, its buffers reused as [`KalmanBank::filter_into`]'s.
+    pub fn smooth_into(&self, panel: &Panel<'_>, out: &mut BankRows) -> Result<(), Error> {
+        self.run_into(panel, Pass::Rts, out)
+    }
+
+    /// Runs `pass` on every series of `panel` in parallel, each into its own rows.
+    fn run(&self, panel: &Panel<'_>, pass: Pass) -> Result<BankRows, Error> {
+        let mut out = BankRows::default();
+        self.run_into(panel, pass, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Self::run`] into `out`'s buffers.
+    fn run_into(&self, panel: &Panel<'_>, pass: Pass, out: &mut BankRows) -> Result<(), Error> {
         let (n, p) = (self.states(), self.components());
-        panel.check(p)?;
-        let mut out = BankRows::zeros(panel.rows(), n);
+        if let Err(e) = panel.check(p) {
+            *out = BankRows::default();
+            return Err(e);
+        }
+        // Buffers of the right length kept as they are (every entry is written); others made
+        // anew (zeroed pages, faulted in by the tasks that write them).
+        let rows = panel.rows();
+        out.states = n;
+        if out.state.len() != rows * n || out.sigma.len() != rows * n {
+            out.state = vec![0.0; rows * n];
+            out.sigma = vec![0.0; rows * n];
+        }
+        if out.nis.len() != rows {
+            // Written by the threads (their pages faulted in in parallel, not here serially).
+            out.nis = Vec::with_capacity(rows);
+            out.nis.par_extend(rayon::iter::repeat_n(None, rows));
+        }
         let r = self.r_entries();
         // The output cut into each task's contiguous rows.
         let count = panel.series();
@@ -316,29 +373,51 @@ impl<D: Dynamics + Sync> KalmanBank<D> {
         let failures: Vec<(usize, Error)> = tasks
             .into_par_iter()
             .filter_map(|(range, rows)| {
-                let mut f = SeriesFilter::new(self, &r);
-                let base = panel.offsets[range.start];
-                for s in range {
-                    let (a, b) = (panel.offsets[s] - base, panel.offsets[s + 1] - base);
-                    let out = RowsMut {
-                        state: &mut rows.state[a * n..b * n],
-                        sigma: &mut rows.sigma[a * n..b * n],
-                        nis: &mut rows.nis[a..b],
-                    };
-                    if let Err(e) = series(&mut f, panel, s, out) {
-                        return Some((s, e));
-                    }
+                if p <= MAX_COMPONENTS {
+                    unrolled_sizes!(n, N => self.task(&mut FixedSeries::<D, N>::new(self, &r), pass, panel, range, rows),
+                        _ => self.task(&mut SeriesFilter::new(self, &r), pass, panel, range, rows))
+                } else {
+                    self.task(&mut SeriesFilter::new(self, &r), pass, panel, range, rows)
                 }
-                None
             })
             .collect();
         match failures.into_iter().min_by_key(|(s, _)| *s) {
-            Some((channel, source)) => Err(Error::InChannel {
-                channel,
-                source: Box::new(source),
-                also_failed: Vec::new(),
-            }),
-            None => Ok(out),
+            Some((channel, source)) => {
+                *out = BankRows::default();
+                Err(Error::InChannel {
+                    channel,
+                    source: Box::new(source),
+                    also_failed: Vec::new(),
+                })
+            }
+            None => Ok(()),
         }
+    }
+
+    /// `pass` over the series `range` of `panel` with the filter `f`, into their `rows`: the
+    /// first failing series and its error.
+    fn task<F: Forward>(
+        &self,
+        f: &mut F,
+        pass: Pass,
+        panel: &Panel<'_>,
+        range: std::ops::Range<usize>,
+        rows: RowsMut<'_>,
+    ) -> Option<(usize, Error)> {
+        let n = self.states();
+        let mut kept = Kept::default();
+        let base = panel.offsets[range.start];
+        for s in range {
+            let (a, b) = (panel.offsets[s] - base, panel.offsets[s + 1] - base);
+            let out = RowsMut {
+                state: &mut rows.state[a * n..b * n],
+                sigma: &mut rows.sigma[a * n..b * n],
+                nis: &mut rows.nis[a..b],
+            };
+            if let Err(e) = pass.series(f, &mut kept, panel, s, out) {
+                return Some((s, e));
+            }
+        }
+        None
     }
 }

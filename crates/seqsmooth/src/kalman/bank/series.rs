@@ -18,10 +18,10 @@ pub(crate) struct SeriesFilter<'a, D: Dynamics> {
     bank: &'a KalmanBank<D>,
     /// `R`, `p × p` column-major.
     r: &'a [f64],
-    pub(super) w: Work,
-    pub(super) x: DVector<f64>,
-    pub(super) s: DMatrix<f64>,
-    pub(super) time: f64,
+    w: Work,
+    x: DVector<f64>,
+    s: DMatrix<f64>,
+    time: f64,
     /// For a time-invariant model, the last step's length and its `Φ` and `Q` (NaN: none).
     invariant: bool,
     step: f64,
@@ -48,30 +48,8 @@ impl<'a, D: Dynamics> SeriesFilter<'a, D> {
         }
     }
 
-    /// Starts a series at `time` from the bank's prior.
-    pub(super) fn start(&mut self, time: f64) {
-        self.x.copy_from(&self.bank.state);
-        self.s.copy_from(&self.bank.covariance);
-        self.time = time;
-    }
-
-    /// Starts a series at `time` from the estimate `(x, s)`.
-    pub(super) fn resume(&mut self, x: &[f64], s: &[f64], time: f64) {
-        self.x.as_mut_slice().copy_from_slice(x);
-        self.s.as_mut_slice().copy_from_slice(s);
-        self.time = time;
-    }
-
-    /// The prediction of the last step: `Φ(t_k, t_{k−1})` (the identity for no step),
-    /// `X_{k|k−1}`, `S_{k|k−1}`.
-    pub(super) fn prediction(&self) -> (&DMatrix<f64>, &DVector<f64>, &DMatrix<f64>) {
-        (&self.w.phi, &self.w.x, &self.w.s)
-    }
-
-    /// The prediction to `t` and the update with `z` (`p` values, NaN missing): the update's
-    /// NIS, `None` when every component is missing (the prediction alone). `t` not before the
-    /// estimate's time. On an error the estimate is unchanged.
-    pub(super) fn step(&mut self, t: f64, z: &[f64]) -> Result<Option<f64>, Error> {
+    /// The prediction to `t` and the update with `z` ([`Forward::step`]).
+    fn step_general(&mut self, t: f64, z: &[f64]) -> Result<Option<f64>, Error> {
         if !t.is_finite() {
             return Err(Error::NonFinite {
                 what: "time",
@@ -212,16 +190,54 @@ impl<'a, D: Dynamics> SeriesFilter<'a, D> {
         }
         Ok(nis)
     }
+}
+
+/// A series' filter, fixed-size ([`super::fixed::FixedSeries`]) or general ([`SeriesFilter`]):
+/// what the bank's passes need of it.
+pub(super) trait Forward {
+    /// The observed components `p`.
+    fn components(&self) -> usize;
+
+    /// Starts a series at `time` from the bank's prior.
+    fn start(&mut self, time: f64);
+
+    /// Starts a series at `time` from the estimate `(x, s)` (`s` column-major).
+    fn resume(&mut self, x: &[f64], s: &[f64], time: f64);
+
+    /// The estimate's time.
+    fn time(&self) -> f64;
+
+    /// The estimate `(X, S)`, `S` column-major.
+    fn estimate(&self) -> (&[f64], &[f64]);
+
+    /// The prediction of the last step: `Φ(t_k, t_{k−1})` (the identity for no step),
+    /// `X_{k|k−1}`, `S_{k|k−1}`, column-major.
+    fn prediction(&self) -> (&[f64], &[f64], &[f64]);
+
+    /// The prediction to `t` and the update with `z` (`p` values, NaN missing): the update's
+    /// NIS, `None` when every component is missing (the prediction alone). `t` not before the
+    /// estimate's time. On an error the estimate is unchanged.
+    fn step(&mut self, t: f64, z: &[f64]) -> Result<Option<f64>, Error>;
+
+    /// Row `r` of `out` from the estimate and `nis`.
+    #[inline(always)]
+    fn write(&self, out: &mut RowsMut<'_>, r: usize, nis: Option<f64>) {
+        let (x, s) = self.estimate();
+        out.set(r, x, s, nis);
+    }
 
     /// The filter over series `s` of `panel` into `out`.
-    pub(super) fn filter_series(
+    fn filter_series(
         &mut self,
         panel: &Panel<'_>,
         s: usize,
         mut out: RowsMut<'_>,
-    ) -> Result<(), Error> {
+    ) -> Result<(), Error>
+    where
+        Self: Sized,
+    {
         self.each_row(panel, s, |f, r, nis| {
-            out.set(r, f.x.as_slice(), f.s.as_slice(), nis);
+            f.write(&mut out, r, nis);
             Ok(())
         })
     }
@@ -229,14 +245,17 @@ impl<'a, D: Dynamics> SeriesFilter<'a, D> {
     /// Each row of series `s` of `panel` through [`Self::step`] from the prior at the series'
     /// first time, then `after(self, row within the series, NIS)`; an error names the row
     /// ([`Error::InBatch`]).
-    pub(super) fn each_row(
+    fn each_row(
         &mut self,
         panel: &Panel<'_>,
         s: usize,
         mut after: impl FnMut(&mut Self, usize, Option<f64>) -> Result<(), Error>,
-    ) -> Result<(), Error> {
+    ) -> Result<(), Error>
+    where
+        Self: Sized,
+    {
         let (a, b) = (panel.offsets[s], panel.offsets[s + 1]);
-        let p = self.bank.observation.components();
+        let p = self.components();
         if a == b {
             return Ok(());
         }
@@ -255,5 +274,43 @@ impl<'a, D: Dynamics> SeriesFilter<'a, D> {
             })?;
         }
         Ok(())
+    }
+}
+
+impl<D: Dynamics> Forward for SeriesFilter<'_, D> {
+    fn components(&self) -> usize {
+        self.bank.observation.components()
+    }
+
+    fn start(&mut self, time: f64) {
+        self.x.copy_from(&self.bank.state);
+        self.s.copy_from(&self.bank.covariance);
+        self.time = time;
+    }
+
+    fn resume(&mut self, x: &[f64], s: &[f64], time: f64) {
+        self.x.as_mut_slice().copy_from_slice(x);
+        self.s.as_mut_slice().copy_from_slice(s);
+        self.time = time;
+    }
+
+    fn time(&self) -> f64 {
+        self.time
+    }
+
+    fn estimate(&self) -> (&[f64], &[f64]) {
+        (self.x.as_slice(), self.s.as_slice())
+    }
+
+    fn prediction(&self) -> (&[f64], &[f64], &[f64]) {
+        (
+            self.w.phi.as_slice(),
+            self.w.x.as_slice(),
+            self.w.s.as_slice(),
+        )
+    }
+
+    fn step(&mut self, t: f64, z: &[f64]) -> Result<Option<f64>, Error> {
+        self.step_general(t, z)
     }
 }

@@ -10,18 +10,20 @@
 
 use super::super::fixed_lag::{step, Map, Row};
 use super::backward::Backward;
-use super::series::SeriesFilter;
+use super::series::Forward;
 use super::{Panel, RowsMut};
 use crate::error::Error;
-use crate::model::dynamics::Dynamics;
+use nalgebra::{DMatrix, DVector};
 use std::collections::VecDeque;
 
 /// The filtered estimate of the row just updated.
-fn filtered<D: Dynamics>(f: &SeriesFilter<'_, D>, nis: Option<f64>) -> Row {
+fn filtered<F: Forward>(f: &F, nis: Option<f64>) -> Row {
+    let (x, s) = f.estimate();
+    let n = x.len();
     Row {
-        time: f.time,
-        state: f.x.clone(),
-        covariance: f.s.clone(),
+        time: f.time(),
+        state: DVector::from_column_slice(x),
+        covariance: DMatrix::from_column_slice(n, n, s),
         nis,
     }
 }
@@ -31,38 +33,57 @@ fn emit(out: &mut RowsMut<'_>, r: usize, point: &Map, nis: Option<f64>) {
     out.set(r, point.a.as_slice(), point.d.as_slice(), nis);
 }
 
+/// A series' forward pass kept for its backward pass, flat: each row's filtered estimate and
+/// the prediction into it. Reused from series to series (its memory that of the longest).
+#[derive(Default)]
+pub(super) struct Kept {
+    xs: Vec<f64>,
+    ss: Vec<f64>,
+    phis: Vec<f64>,
+    xps: Vec<f64>,
+    sps: Vec<f64>,
+    nis: Vec<Option<f64>>,
+}
+
 /// The fixed-interval smoother over series `s`: the forward pass kept (each row's filtered
-/// estimate and the prediction into it, flat), then the backward recursion from the last row
-/// ([`Backward`], in place).
-pub(super) fn rts_series<D: Dynamics>(
-    f: &mut SeriesFilter<'_, D>,
+/// estimate and the prediction into it, flat, in `kept`), then the backward recursion from
+/// the last row ([`Backward`], in place).
+pub(super) fn rts_series<F: Forward>(
+    f: &mut F,
+    kept: &mut Kept,
     panel: &Panel<'_>,
     s: usize,
     mut out: RowsMut<'_>,
 ) -> Result<(), Error> {
-    let n = f.x.len();
-    let nn = n * n;
-    let rows = panel.offsets[s + 1] - panel.offsets[s];
-    let (mut xs, mut ss) = (Vec::with_capacity(rows * n), Vec::with_capacity(rows * nn));
-    let (mut phis, mut xps, mut sps) = (
-        Vec::with_capacity(rows * nn),
-        Vec::with_capacity(rows * n),
-        Vec::with_capacity(rows * nn),
-    );
-    let mut nis = Vec::with_capacity(rows);
+    let Kept {
+        xs,
+        ss,
+        phis,
+        xps,
+        sps,
+        nis,
+    } = kept;
+    for v in [&mut *xs, &mut *ss, &mut *phis, &mut *xps, &mut *sps] {
+        v.clear();
+    }
+    nis.clear();
     f.each_row(panel, s, |f, _, v| {
         let (phi, x, s) = f.prediction();
-        phis.extend_from_slice(phi.as_slice());
-        xps.extend_from_slice(x.as_slice());
-        sps.extend_from_slice(s.as_slice());
-        xs.extend_from_slice(f.x.as_slice());
-        ss.extend_from_slice(f.s.as_slice());
+        phis.extend_from_slice(phi);
+        xps.extend_from_slice(x);
+        sps.extend_from_slice(s);
+        let (x, s) = f.estimate();
+        xs.extend_from_slice(x);
+        ss.extend_from_slice(s);
         nis.push(v);
         Ok(())
     })?;
+    let rows = nis.len();
     if rows == 0 {
         return Ok(());
     }
+    let n = xs.len() / rows;
+    let nn = n * n;
     let last = rows - 1;
     out.set(last, &xs[last * n..], &ss[last * nn..], nis[last]);
     let mut back = Backward::new(n);
@@ -89,8 +110,8 @@ pub(super) fn rts_series<D: Dynamics>(
 /// (the backward recursion over them, from the newest), given as soon as they are in, from
 /// the last `lag + 1` rows and the `lag` backward steps between them; the last `lag` rows of
 /// the series from all of its rows.
-pub(super) fn fixed_lag_series<D: Dynamics>(
-    f: &mut SeriesFilter<'_, D>,
+pub(super) fn fixed_lag_series<F: Forward>(
+    f: &mut F,
     panel: &Panel<'_>,
     s: usize,
     lag: usize,
@@ -102,7 +123,14 @@ pub(super) fn fixed_lag_series<D: Dynamics>(
     f.each_row(panel, s, |f, r, nis| {
         let row = filtered(f, nis);
         if let Some((_, previous)) = rows.back() {
-            maps.push_back(step(previous, f.prediction(), r)?);
+            let (phi, x, s) = f.prediction();
+            let n = x.len();
+            let prediction = (
+                &DMatrix::from_column_slice(n, n, phi),
+                &DVector::from_column_slice(x),
+                &DMatrix::from_column_slice(n, n, s),
+            );
+            maps.push_back(step(previous, prediction, r)?);
         }
         rows.push_back((r, row));
         if rows.len() > lag {

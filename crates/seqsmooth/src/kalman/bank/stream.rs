@@ -2,10 +2,12 @@
 //! (all states, all covariances, all times), a step of every series at a time. Its memory is
 //! `n + n² + 1` numbers a series whatever the number of steps.
 
-use super::series::SeriesFilter;
+use super::fixed::{FixedSeries, MAX_COMPONENTS};
+use super::series::{Forward, SeriesFilter};
 use super::{BankRows, KalmanBank, RowsMut};
 use crate::error::{Error, Param};
 use crate::model::dynamics::Dynamics;
+use crate::numeric::unrolled::unrolled_sizes;
 use rayon::prelude::*;
 
 /// Series per rayon task of a streaming step.
@@ -105,39 +107,19 @@ impl<D: Dynamics + Sync> BankStream<D> {
             .zip(out.nis.par_chunks_mut(task))
             .enumerate()
             .flat_map_iter(|(c, (((((x, cov), time), state), sigma), nis))| {
-                let mut f = SeriesFilter::new(bank, r);
-                let mut out = RowsMut { state, sigma, nis };
-                let mut failed = Vec::new();
-                for (i, t) in time.iter_mut().enumerate() {
-                    let s = c * task + i;
-                    let (xs, ss) = (
-                        &mut x[i * n..(i + 1) * n],
-                        &mut cov[i * n * n..(i + 1) * n * n],
-                    );
-                    let at = times[s];
-                    if at.is_nan() {
-                        out.set(i, xs, ss, None);
-                        continue;
-                    }
-                    if t.is_nan() {
-                        f.start(at);
-                    } else {
-                        f.resume(xs, ss, *t);
-                    }
-                    match f.step(at, &values[s * p..(s + 1) * p]) {
-                        Ok(nis) => {
-                            xs.copy_from_slice(f.x.as_slice());
-                            ss.copy_from_slice(f.s.as_slice());
-                            *t = at;
-                            out.set(i, xs, ss, nis);
-                        }
-                        Err(e) => {
-                            out.set(i, xs, ss, None);
-                            failed.push((s, e));
-                        }
-                    }
+                let chunk = Chunk {
+                    first: c * task,
+                    x,
+                    cov,
+                    time,
+                    out: RowsMut { state, sigma, nis },
+                };
+                if p <= MAX_COMPONENTS {
+                    unrolled_sizes!(n, N => chunk.update(&mut FixedSeries::<D, N>::new(bank, r), times, values),
+                        _ => chunk.update(&mut SeriesFilter::new(bank, r), times, values))
+                } else {
+                    chunk.update(&mut SeriesFilter::new(bank, r), times, values)
                 }
-                failed
             })
             .collect();
         if failures.is_empty() {
@@ -163,5 +145,60 @@ impl<D: Dynamics + Sync> BankStream<D> {
             &self.covariance[s * n * n..(s + 1) * n * n],
             (!t.is_nan()).then_some(t),
         ))
+    }
+}
+
+/// A streaming step's share of the series: from series `first`, their states, covariances,
+/// times and output rows.
+struct Chunk<'a> {
+    first: usize,
+    x: &'a mut [f64],
+    cov: &'a mut [f64],
+    time: &'a mut [f64],
+    out: RowsMut<'a>,
+}
+
+impl Chunk<'_> {
+    /// Each series' row of `times`, `values` through `f`: the failures.
+    fn update<F: Forward>(
+        mut self,
+        f: &mut F,
+        times: &[f64],
+        values: &[f64],
+    ) -> Vec<(usize, Error)> {
+        let p = f.components();
+        let n = self.x.len() / self.time.len().max(1);
+        let mut failed = Vec::new();
+        for (i, t) in self.time.iter_mut().enumerate() {
+            let s = self.first + i;
+            let (xs, ss) = (
+                &mut self.x[i * n..(i + 1) * n],
+                &mut self.cov[i * n * n..(i + 1) * n * n],
+            );
+            let at = times[s];
+            if at.is_nan() {
+                self.out.set(i, xs, ss, None);
+                continue;
+            }
+            if t.is_nan() {
+                f.start(at);
+            } else {
+                f.resume(xs, ss, *t);
+            }
+            match f.step(at, &values[s * p..(s + 1) * p]) {
+                Ok(nis) => {
+                    let (x, s) = f.estimate();
+                    xs.copy_from_slice(x);
+                    ss.copy_from_slice(s);
+                    *t = at;
+                    self.out.set(i, xs, ss, nis);
+                }
+                Err(e) => {
+                    self.out.set(i, xs, ss, None);
+                    failed.push((s, e));
+                }
+            }
+        }
+        failed
     }
 }

@@ -1,0 +1,522 @@
+//! One series of a [`KalmanBank`] with the state size `N ≤ 9` and at most
+//! [`MAX_COMPONENTS`] observed components: the Kalman filter's prediction and update (Morrison
+//! (12.2.15)-(12.2.19), driving noise (15.4.10)-(15.4.11), Joseph's covariance (12.3.7)) with
+//! the series' state, covariance, prediction and every scratch in arrays on the stack, the
+//! sizes compile-time constants (`N`, and `K` the components present), plain loops that
+//! unroll, nothing allocated per step.
+//!
+//! The arithmetic is the general path's ([`SeriesFilter`](super::series::SeriesFilter), the
+//! filter's `carry` and `correct_kernel`) operation for operation, each sum in the same order:
+//! `Φ S Φᵀ + Q` as `(S Φᵀ)ᵀ Φᵀ`; `U = S Mᵀ`, `V = M U + R = L D Lᵀ`, `H = U V⁻¹`,
+//! `NIS = Σ z_c² / D_c` with `z = L⁻¹ ν`, `X = X_{k|k−1} + H ν`, Joseph's `S` with `I − H M`
+//! applied from each side; the general kernels skip the zero entries of `Φ` and `M`, which
+//! adds nothing to a finite sum, so the numbers are the general path's (a zero's sign aside).
+//! What differs is the layout: no work buffers on the heap, no matrix `M` per step, and
+//! `ln det V` (for the log-likelihood's finiteness) only when the pivots cannot vouch for it.
+
+// The loops index by position on purpose: each sum in the general kernels' order, over
+// arrays whose sizes are constants (the loops unroll).
+#![allow(clippy::needless_range_loop)]
+
+use super::super::correct::finite;
+use super::series::Forward;
+use super::{KalmanBank, RowsMut};
+use crate::error::{Error, Param};
+use crate::linalg::dense::{all_finite, log_det};
+use crate::model::dynamics::Dynamics;
+use crate::model::observation::Observation;
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::TAU;
+
+/// The most observed components the fixed-size path takes (more: the general path).
+pub(super) const MAX_COMPONENTS: usize = 3;
+
+/// A series' filter with `N` states on the stack: its estimate `(x, s)` at `time` and, after
+/// a step, the step's prediction (`phi`, `xp`, `sp`).
+pub(super) struct FixedSeries<'a, D: Dynamics, const N: usize> {
+    bank: &'a KalmanBank<D>,
+    p: usize,
+    /// `M` by rows: `m[c][l] = M(c, l)`.
+    m: [[f64; N]; MAX_COMPONENTS],
+    /// `R`, `p × p`, column-major.
+    r: &'a [f64],
+    x0: [f64; N],
+    s0: [[f64; N]; N],
+    x: [f64; N],
+    /// Column-major: `s[j][i] = S(i, j)`.
+    s: [[f64; N]; N],
+    time: f64,
+    phi: [[f64; N]; N],
+    xp: [f64; N],
+    sp: [[f64; N]; N],
+    /// For a time-invariant model, the last step's length and its `Φ` and `Q` (NaN: none).
+    invariant: bool,
+    step: f64,
+    phi_step: [[f64; N]; N],
+    q_step: [[f64; N]; N],
+    /// The model's buffers for a new step length.
+    dx: DVector<f64>,
+    dxo: DVector<f64>,
+    dphi: DMatrix<f64>,
+    dq: DMatrix<f64>,
+}
+
+/// `n × n` column-major from a slice.
+fn square<const N: usize>(from: &[f64]) -> [[f64; N]; N] {
+    let mut out = [[0.0; N]; N];
+    out.as_flattened_mut().copy_from_slice(&from[..N * N]);
+    out
+}
+
+fn identity<const N: usize>() -> [[f64; N]; N] {
+    let mut out = [[0.0; N]; N];
+    for (i, column) in out.iter_mut().enumerate() {
+        column[i] = 1.0;
+    }
+    out
+}
+
+impl<'a, D: Dynamics, const N: usize> FixedSeries<'a, D, N> {
+    /// A filter of `bank` (not started); `N` is the bank's state size and it has at most
+    /// [`MAX_COMPONENTS`] components.
+    pub(super) fn new(bank: &'a KalmanBank<D>, r: &'a [f64]) -> Self {
+        let p = bank.observation.components();
+        debug_assert!(bank.dynamics.dimension() == N && p <= MAX_COMPONENTS);
+        let mut m = [[0.0; N]; MAX_COMPONENTS];
+        let h = bank.observation.matrix();
+        for (c, row) in m.iter_mut().enumerate().take(p) {
+            for (l, v) in row.iter_mut().enumerate() {
+                *v = h[(c, l)];
+            }
+        }
+        let mut x0 = [0.0; N];
+        x0.copy_from_slice(bank.state.as_slice());
+        let s0 = square(bank.covariance.as_slice());
+        Self {
+            bank,
+            p,
+            m,
+            r,
+            x0,
+            s0,
+            x: x0,
+            s: s0,
+            time: f64::NAN,
+            phi: identity(),
+            xp: x0,
+            sp: s0,
+            invariant: bank.dynamics.is_time_invariant()
+                && bank.noise.as_ref().is_none_or(|q| q.is_time_invariant()),
+            step: f64::NAN,
+            phi_step: identity(),
+            q_step: [[0.0; N]; N],
+            dx: DVector::zeros(N),
+            dxo: DVector::zeros(N),
+            dphi: DMatrix::zeros(N, N),
+            dq: DMatrix::zeros(N, N),
+        }
+    }
+
+    /// `X_{k|k−1}`, `S_{k|k−1}` and `Φ` (the general path's `predict`).
+    #[inline(always)]
+    fn predict(&mut self, t: f64) -> Result<(), Error> {
+        if t == self.time {
+            self.xp = self.x;
+            self.sp = self.s;
+            self.phi = identity();
+            return Ok(());
+        }
+        let bank = self.bank;
+        let dt = t - self.time;
+        let noise = bank.noise.is_some();
+        if self.invariant && dt == self.step {
+            self.phi = self.phi_step;
+            let (f, x) = (self.phi_step.as_flattened(), &self.x);
+            let xp = &mut self.xp;
+            for i in 0..N {
+                xp[i] = f[i] * x[0];
+            }
+            for j in 1..N {
+                for i in 0..N {
+                    xp[i] += f[i + j * N] * x[j];
+                }
+            }
+            if let Some(&value) = xp.iter().find(|v| !v.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: "propagated state entry",
+                    value,
+                });
+            }
+        } else {
+            self.dx.as_mut_slice().copy_from_slice(&self.x);
+            bank.dynamics
+                .propagate_into(&self.dx, self.time, t, &mut self.dxo, &mut self.dphi)?;
+            self.xp.copy_from_slice(self.dxo.as_slice());
+            self.phi = square(self.dphi.as_slice());
+            if let Some(q) = &bank.noise {
+                q.covariance_into(self.time, t, &mut self.dq)?;
+            }
+            if self.invariant {
+                self.phi_step = self.phi;
+                if noise {
+                    self.q_step = square(self.dq.as_slice());
+                }
+                self.step = dt;
+            }
+        }
+        let q = if !noise {
+            None
+        } else if self.invariant {
+            Some(self.q_step)
+        } else {
+            Some(square(self.dq.as_slice()))
+        };
+        self.sp = carry(&self.phi, &self.s, q.as_ref());
+        if all_finite(self.sp.as_flattened()) {
+            Ok(())
+        } else {
+            finite(self.sp.as_flattened(), "predicted covariance")
+        }
+    }
+
+    /// The correction of the prediction with the present components of `z`: the NIS.
+    #[inline(always)]
+    fn correct(&mut self, z: &[f64]) -> Result<f64, Error> {
+        let p = self.p;
+        let mut g = [0.0; MAX_COMPONENTS];
+        for (v, m) in g.iter_mut().zip(&self.m).take(p) {
+            *v = (0..N).map(|c| m[c] * self.xp[c]).sum();
+        }
+        if let Some(&v) = g[..p].iter().find(|v| !v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "predicted observation",
+                value: v,
+            });
+        }
+        let mut present = [0; MAX_COMPONENTS];
+        let mut nu = [0.0; MAX_COMPONENTS];
+        let mut k = 0;
+        for (a, &y) in z.iter().enumerate() {
+            if !y.is_nan() {
+                present[k] = a;
+                nu[k] = self.bank.observation.residual(a, y, g[a]);
+                k += 1;
+            }
+        }
+        match k {
+            1 => self.correct_k::<1>(&present, &nu),
+            2 => self.correct_k::<2>(&present, &nu),
+            _ => self.correct_k::<3>(&present, &nu),
+        }
+    }
+
+    /// The correction with `K` components present (`present`, their residuals `nu`): the
+    /// filter's `correct_kernel` (no fading) on arrays, each sum in its order.
+    #[inline(always)]
+    fn correct_k<const K: usize>(
+        &mut self,
+        present: &[usize; MAX_COMPONENTS],
+        nu: &[f64; MAX_COMPONENTS],
+    ) -> Result<f64, Error> {
+        let p = self.p;
+        // Mᵀ of the present rows (`mt[c]` row `present[c]` of M) and R on them (`r[b][a]`).
+        let mut mt = [[0.0; N]; K];
+        let mut r = [[0.0; K]; K];
+        for c in 0..K {
+            mt[c] = self.m[present[c]];
+            for (i, v) in r[c].iter_mut().enumerate() {
+                *v = self.r[present[i] + present[c] * p];
+            }
+        }
+        let s = &self.sp;
+        // U = S Mᵀ (`u[c]` its column c).
+        let mut u = [[0.0; N]; K];
+        for c in 0..K {
+            for l in 0..N {
+                let scale = mt[c][l];
+                for row in 0..N {
+                    u[c][row] += s[l][row] * scale;
+                }
+            }
+        }
+        // V = M U + R, symmetrized, and its L D Lᵀ (`lv[j][i]`: row i, column j).
+        let mut v = [[0.0; K]; K];
+        for b in 0..K {
+            for a in 0..K {
+                let mut msm = 0.0;
+                for l in 0..N {
+                    msm += mt[a][l] * u[b][l];
+                }
+                v[b][a] = msm + r[b][a] * 1.0;
+            }
+        }
+        for j in 0..K {
+            for i in j + 1..K {
+                let value = (v[j][i] + v[i][j]) * 0.5;
+                v[j][i] = value;
+                v[i][j] = value;
+            }
+        }
+        let mut lv = v;
+        let mut positive = true;
+        for j in 0..K {
+            for c in 0..j {
+                let scale = lv[c][j] * lv[c][c];
+                for i in j..K {
+                    lv[j][i] -= lv[c][i] * scale;
+                }
+            }
+            let d = lv[j][j];
+            positive &= d > 0.0;
+            for i in j + 1..K {
+                lv[j][i] /= d;
+            }
+        }
+        if !positive {
+            return Err(Error::InvalidParameter {
+                name: Param::InnovationCovariance,
+                value: format!("{:?}", DMatrix::from_column_slice(K, K, v.as_flattened())),
+                reason: "is not positive definite: the observation adds nothing the filter \
+                         can weigh (a perfect observation of a component already known exactly)"
+                    .into(),
+            });
+        }
+        // H = U V⁻¹: G Lᵀ = U (forwards), over the pivots, then H L = G (backwards).
+        let mut h = u;
+        for c in 0..K {
+            for d in 0..c {
+                let l = lv[d][c];
+                for i in 0..N {
+                    h[c][i] -= l * h[d][i];
+                }
+            }
+        }
+        for c in 0..K {
+            let pivot = lv[c][c];
+            for o in &mut h[c] {
+                *o /= pivot;
+            }
+        }
+        for c in (0..K).rev() {
+            for d in c + 1..K {
+                let l = lv[c][d];
+                for i in 0..N {
+                    h[c][i] -= l * h[d][i];
+                }
+            }
+        }
+        // NIS = Σ z_c² / D_c, z = L⁻¹ ν.
+        let mut z = [0.0; K];
+        let mut nis = 0.0;
+        for c in 0..K {
+            let mut acc = nu[c];
+            for d in 0..c {
+                acc -= lv[d][c] * z[d];
+            }
+            z[c] = acc;
+            nis += acc * acc / lv[c][c];
+        }
+        let mut x_out = [0.0; N];
+        for i in 0..N {
+            let mut acc = 0.0;
+            for c in 0..K {
+                acc += h[c][i] * nu[c];
+            }
+            x_out[i] = acc + self.xp[i];
+        }
+        // Joseph's form (12.3.7), I − H M applied from each side (the filter's `joseph`):
+        // X = S − H (S Mᵀ)ᵀ, Y = X Mᵀ, out = (X − Y Hᵀ) + (H R) Hᵀ, symmetrized.
+        let mut x = [[0.0; N]; N];
+        for j in 0..N {
+            for i in 0..N {
+                let mut acc = 0.0;
+                for c in 0..K {
+                    acc += h[c][i] * u[c][j];
+                }
+                x[j][i] = s[j][i] - acc;
+            }
+        }
+        let mut y = [[0.0; N]; K];
+        for c in 0..K {
+            for l in 0..N {
+                let scale = mt[c][l];
+                for row in 0..N {
+                    y[c][row] += x[l][row] * scale;
+                }
+            }
+        }
+        let mut hr = [[0.0; N]; K];
+        for d in 0..K {
+            for i in 0..N {
+                let mut acc = 0.0;
+                for c in 0..K {
+                    acc += h[c][i] * r[d][c];
+                }
+                hr[d][i] = acc;
+            }
+        }
+        let mut s_out = [[0.0; N]; N];
+        for j in 0..N {
+            for i in 0..N {
+                let (mut yh, mut rh) = (0.0, 0.0);
+                for c in 0..K {
+                    yh += y[c][i] * h[c][j];
+                }
+                for d in 0..K {
+                    rh += hr[d][i] * h[d][j];
+                }
+                s_out[j][i] = (x[j][i] - yh) + rh;
+            }
+        }
+        for j in 0..N {
+            for i in j + 1..N {
+                let value = (s_out[j][i] + s_out[i][j]) * 0.5;
+                s_out[j][i] = value;
+                s_out[i][j] = value;
+            }
+        }
+        if !(all_finite(&x_out) & all_finite(s_out.as_flattened())) {
+            finite(s_out.as_flattened(), "updated covariance")?;
+            finite(&x_out, "updated state entry")?;
+        }
+        // The log-likelihood −(NIS + ln det V + k ln 2π)/2 is finite when the NIS is and the
+        // pivots are finite (each |ln D_c| < 746); otherwise computed as the filter does.
+        let pivots_finite = (0..K).all(|c| lv[c][c].is_finite());
+        if !(nis.is_finite() && pivots_finite && nis < 1e300) {
+            let log_likelihood = -0.5 * (nis + log_det(K, lv.as_flattened()) + K as f64 * TAU.ln());
+            if !(nis.is_finite() && log_likelihood.is_finite()) {
+                return Err(Error::EstimateOutOfRange {
+                    what: "normalised innovation squared".into(),
+                });
+            }
+        }
+        self.x = x_out;
+        self.s = s_out;
+        Ok(nis)
+    }
+}
+
+/// `Φ S Φᵀ + Q`, symmetrized (the filter's `carry`, (12.2.16), (15.4.11)): `A = S Φᵀ`, then
+/// `Aᵀ Φᵀ`, each entry summed over the columns of `Φ` in order, then `(out + Q)` symmetrized
+/// in one pass. Arrays column-major (`m[j][i]` row `i`, column `j`).
+#[inline(always)]
+fn carry<const N: usize>(
+    phi: &[[f64; N]; N],
+    s: &[[f64; N]; N],
+    q: Option<&[[f64; N]; N]>,
+) -> [[f64; N]; N] {
+    let mut a = [[0.0; N]; N];
+    for i in 0..N {
+        for l in 0..N {
+            let scale = phi[l][i];
+            for row in 0..N {
+                a[i][row] += s[l][row] * scale;
+            }
+        }
+    }
+    // (S Φᵀ)ᵀ column l, row r is a[r][l].
+    let mut out = [[0.0; N]; N];
+    for j in 0..N {
+        for l in 0..N {
+            let scale = phi[l][j];
+            for row in 0..N {
+                out[j][row] += a[row][l] * scale;
+            }
+        }
+    }
+    match q {
+        Some(q) => {
+            for j in 0..N {
+                out[j][j] += q[j][j];
+                for i in j + 1..N {
+                    let v = ((out[j][i] + q[j][i]) + (out[i][j] + q[i][j])) * 0.5;
+                    out[j][i] = v;
+                    out[i][j] = v;
+                }
+            }
+        }
+        None => {
+            for j in 0..N {
+                for i in j + 1..N {
+                    let v = (out[j][i] + out[i][j]) * 0.5;
+                    out[j][i] = v;
+                    out[i][j] = v;
+                }
+            }
+        }
+    }
+    out
+}
+
+impl<D: Dynamics, const N: usize> Forward for FixedSeries<'_, D, N> {
+    fn components(&self) -> usize {
+        self.p
+    }
+
+    fn start(&mut self, time: f64) {
+        self.x = self.x0;
+        self.s = self.s0;
+        self.time = time;
+    }
+
+    fn resume(&mut self, x: &[f64], s: &[f64], time: f64) {
+        self.x.copy_from_slice(x);
+        self.s = square(s);
+        self.time = time;
+    }
+
+    fn time(&self) -> f64 {
+        self.time
+    }
+
+    fn estimate(&self) -> (&[f64], &[f64]) {
+        (&self.x, self.s.as_flattened())
+    }
+
+    fn prediction(&self) -> (&[f64], &[f64], &[f64]) {
+        (self.phi.as_flattened(), &self.xp, self.sp.as_flattened())
+    }
+
+    #[inline(always)]
+    fn write(&self, out: &mut RowsMut<'_>, r: usize, nis: Option<f64>) {
+        out.state[r * N..(r + 1) * N].copy_from_slice(&self.x);
+        let sigma = &mut out.sigma[r * N..(r + 1) * N];
+        for i in 0..N {
+            sigma[i] = self.s[i][i].max(0.0).sqrt();
+        }
+        out.nis[r] = nis;
+    }
+
+    #[inline(always)]
+    fn step(&mut self, t: f64, z: &[f64]) -> Result<Option<f64>, Error> {
+        if !t.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time",
+                value: t,
+            });
+        }
+        if t < self.time {
+            return Err(Error::InvalidParameter {
+                name: Param::Time,
+                value: t.to_string(),
+                reason: format!("is before the previous row's {}", self.time),
+            });
+        }
+        if let Some(&value) = z.iter().find(|v| v.is_infinite()) {
+            return Err(Error::NonFinite {
+                what: "measurement value",
+                value,
+            });
+        }
+        self.predict(t)?;
+        if z.iter().all(|v| v.is_nan()) {
+            self.x = self.xp;
+            self.s = self.sp;
+            self.time = t;
+            return Ok(None);
+        }
+        let nis = self.correct(z)?;
+        self.time = t;
+        Ok(Some(nis))
+    }
+}
