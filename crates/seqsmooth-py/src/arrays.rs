@@ -133,8 +133,8 @@ pub fn times<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Series<'py>> 
     let (unit, count): (String, i64) = np
         .call_method1("datetime_data", (array.getattr("dtype")?,))?
         .extract()?;
-    let ticks = contiguous_aligned(&array, array.getattr("dtype")?)?
-        .call_method1("view", ("int64",))?;
+    let ticks =
+        contiguous_aligned(&array, array.getattr("dtype")?)?.call_method1("view", ("int64",))?;
     let ticks = ticks.cast::<PyArray1<i64>>()?.readonly();
     let Ok(ticks) = ticks.as_slice() else {
         return Err(raise(

@@ -104,13 +104,22 @@ impl PyInformation {
     ///     mismatched lengths, values so large their squares overflow.
     /// InvalidTypeError
     ///     arrays that do not hold real numbers.
-    fn reduce(&mut self, py: Python<'_>, t: &Bound<'_, PyAny>, y: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn reduce(
+        &mut self,
+        py: Python<'_>,
+        t: &Bound<'_, PyAny>,
+        y: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
         let (ts, ys) = (times(t, "t")?, series(y, "y")?);
         let (t, y) = (ts.as_slice(), ys.as_slice());
         if t.len() != y.len() {
             return Err(raise(
                 Kind::InvalidInput,
-                format!("t has {} values and y {}: one time per value", t.len(), y.len()),
+                format!(
+                    "t has {} values and y {}: one time per value",
+                    t.len(),
+                    y.len()
+                ),
                 None,
             ));
         }
@@ -208,7 +217,11 @@ impl PyInformation {
             self.inner.degree(),
             self.inner.sigma(),
             self.inner.samples(),
-            if self.inner.has_prior() { "True" } else { "False" }
+            if self.inner.has_prior() {
+                "True"
+            } else {
+                "False"
+            }
         )
     }
 }

@@ -161,3 +161,25 @@ def test_smooth_sigma():
         ss.smooth(y, 3, 2, return_sigma=True)
     with pytest.raises(ss.ParameterError, match="sigma"):
         ss.smooth(y, 5, 2, sigma=-1.0, return_sigma=True)
+
+
+def _unaligned(values: np.ndarray) -> np.ndarray:
+    """``values`` in a contiguous array one byte off an 8-byte boundary (as an array
+    unpickled from a buffer can be)."""
+    raw = np.zeros(values.nbytes + 1, dtype=np.uint8)
+    out = raw[1:].view(values.dtype)
+    out[:] = values
+    assert out.flags.c_contiguous and not out.flags.aligned
+    return out
+
+
+def test_unaligned_arrays_are_read_not_refused():
+    t, y = _seconds() - EPOCH, _values()
+    expected = ss.FadingMemory(degree=1, theta=0.9, tau=0.25).update_many(t, y)
+    got = ss.FadingMemory(degree=1, theta=0.9, tau=0.25).update_many(_unaligned(t), _unaligned(y))
+    np.testing.assert_array_equal(got, expected)
+    stamps = (_seconds() * 1e9).astype("int64").view("datetime64[ns]")
+    got = ss.FadingMemory(degree=1, theta=0.9, tau=0.25).update_many(_unaligned(stamps), y)
+    np.testing.assert_array_equal(
+        got, ss.FadingMemory(degree=1, theta=0.9, tau=0.25).update_many(_seconds(), y)
+    )
