@@ -154,3 +154,28 @@ def test_kalman_frame_integer_ids_are_the_string_ids_and_name_a_bad_row():
     with pytest.raises(seqsmooth.SeqsmoothError) as e:
         seqsmooth.kalman_frame({"id": ids, "t": t, "x": z[:, 0], "y": z[:, 1]}, **settings)
     assert e.value.index == bad and "(series 11 of column 'id')" in str(e.value)
+
+
+def _unaligned(values: np.ndarray) -> np.ndarray:
+    """``values`` in a contiguous array one byte off its alignment (as an array unpickled
+    from a buffer can be)."""
+    raw = np.zeros(values.nbytes + 1, dtype=np.uint8)
+    out = raw[1:].view(values.dtype).reshape(values.shape)
+    out[...] = values
+    assert not out.flags.aligned
+    return out
+
+
+def test_kalman_frame_reads_unaligned_columns():
+    ids, t, z = rows(30, seed=7)
+    settings = dict(value=["x", "y"], by="id", P0=P0, R=R, q=Q, smoother="rts")
+    want = seqsmooth.kalman_frame({"id": ids, "t": t, "x": z[:, 0], "y": z[:, 1]}, **settings)
+    frame = {
+        "id": _unaligned(ids.astype(np.int64)),
+        "t": _unaligned(t),
+        "x": _unaligned(np.ascontiguousarray(z[:, 0])),
+        "y": _unaligned(np.ascontiguousarray(z[:, 1])),
+    }
+    got = seqsmooth.kalman_frame(frame, **settings)
+    for c in ["x_d0", "y_d1", "x_s0", "y_s1", "nis"]:
+        assert np.array_equal(got[c], want[c], equal_nan=True)

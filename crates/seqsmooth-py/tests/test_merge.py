@@ -58,8 +58,6 @@ def reduce_partition(part: pd.DataFrame, span) -> list[seqsmooth.Information]:
     infos = []
     for m in DEGREES:
         info = seqsmooth.Information(m, *span, sigma=SIGMA)
-        # Fresh arrays: a partition Dask unpickled may hold unaligned buffers, which the
-        # binding does not yet copy (it panics on them).
         info.reduce(np.array(part["t"], dtype=float), np.array(part["y"], dtype=float))
         infos.append(info)
     return infos

@@ -266,7 +266,8 @@ def kalman_frame(
     columns_in = [np.asarray(_column(df, v), dtype=np.float64) for v in values]
     # One value column is z as it is (one component a row); several are stacked by row.
     z = columns_in[0] if len(values) == 1 else np.column_stack(columns_in)
-    z = np.ascontiguousarray(z)
+    # Contiguous and aligned (a partition unpickled from a buffer may be neither).
+    z = np.require(z, np.float64, ["C", "A"])
     axes = len(values)
     n = (degree + 1) * axes
     bank = KalmanBank(degree, np.zeros(n) if x0 is None else x0, P0, R, axes=axes, q=q)
@@ -277,7 +278,7 @@ def kalman_frame(
     elif keys.ndim == 1 and keys.dtype.kind in "iu" and np.can_cast(keys.dtype, np.int64):
         # Integer ids are the bank's series labels as they are (grouped there, no hashing
         # here); a row's series is its own id.
-        codes, names, names_by_row = np.ascontiguousarray(keys, dtype=np.int64), keys, True
+        codes, names, names_by_row = np.require(keys, np.int64, ["C", "A"]), keys, True
     else:
         codes, names = _codes(keys, by)
     if smoother != "fixed_lag" and lag is not None:
