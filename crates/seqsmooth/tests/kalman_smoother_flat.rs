@@ -217,8 +217,8 @@ fn flat_smoother_against_the_textbook_recursion() {
 }
 
 /// The errors of the measurement-at-a-time smoother, with the same indices: a time before
-/// the previous, a bad value, and a prediction that is not positive definite (no prior
-/// uncertainty, no driving noise).
+/// the previous, a bad value, a prediction that is not positive definite (no prior
+/// uncertainty, no driving noise), and a row with two faults.
 #[test]
 fn flat_smoother_refuses_as_the_smoother() {
     let row = |t: f64, y: f64| Measurement {
@@ -243,7 +243,10 @@ fn flat_smoother_refuses_as_the_smoother() {
     )
     .unwrap();
     // The last: the map into measurement 1 fails before the bad value of measurement 2.
-    let cases: [(&KalmanFilter<_, _>, Vec<Measurement>); 4] = [
+    let cases: [(&KalmanFilter<_, _>, Vec<Measurement>); 5] = [
+        // A step too long to predict over and a bad value in one row: the prediction's
+        // error, which the smoother meets first.
+        (&vague, vec![row(1.0, 1.0), row(1e300, f64::INFINITY)]),
         (&vague, vec![row(1.0, 1.0), row(2.0, 1.0), row(1.5, 1.0)]),
         (&vague, vec![row(1.0, 1.0), row(2.0, f64::INFINITY)]),
         (&known, vec![row(1.0, 1.0), row(2.0, 1.0), row(3.0, 1.0)]),

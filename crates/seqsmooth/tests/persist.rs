@@ -468,3 +468,58 @@ fn a_sliding_fit_resumes_bit_for_bit() {
         });
     }
 }
+
+/// A saved `Information` whose numbers break its invariants (a valid checksum): a prior
+/// without σ, moments without samples, and moments that are no Gram matrix's are refused.
+#[test]
+fn a_crafted_information_is_refused() {
+    use seqsmooth::polynomial::merge::Information;
+    let mut info = Information::new(2, 0.0, 10.0, None).unwrap();
+    let t: Vec<f64> = (0..40).map(|k| 0.25 * f64::from(k)).collect();
+    let y: Vec<f64> = t.iter().map(|t| 1.0 + t * (0.5 - 0.01 * t)).collect();
+    info.reduce(&t, &y).unwrap();
+    let name = <Information as Persist>::name();
+    let good = to_bytes(&info).unwrap();
+    let body = &good[8 + 2 + 1 + name.len() + 8 + 4..];
+    assert_eq!(envelope(&name, body), good);
+    let value: ciborium::Value = ciborium::from_reader(body).unwrap();
+    let edit = |f: &dyn Fn(&mut Entries)| {
+        let mut v = value.clone();
+        f(v.as_map_mut().unwrap());
+        let mut b = Vec::new();
+        ciborium::into_writer(&v, &mut b).unwrap();
+        from_bytes::<Information>(&envelope(&name, &b))
+    };
+    let field = |m: &mut Entries, key: &str| -> usize {
+        m.iter()
+            .position(|(k, _)| k.as_text() == Some(key))
+            .unwrap()
+    };
+    // Unchanged, the body decodes (the edits below are what is refused).
+    assert!(edit(&|_| {}).is_ok());
+    let why = damaged(
+        edit(&|m| {
+            let i = field(m, "prior");
+            m[i].1 = ciborium::Value::Bool(true);
+        })
+        .unwrap_err(),
+    );
+    assert!(why.contains("prior"), "{why}");
+    let why = damaged(
+        edit(&|m| {
+            let i = field(m, "samples");
+            m[i].1 = ciborium::Value::Integer(0.into());
+        })
+        .unwrap_err(),
+    );
+    assert!(why.contains("without samples"), "{why}");
+    let why = damaged(
+        edit(&|m| {
+            let i = field(m, "moments");
+            let first_off_diagonal = m[i].1.as_array_mut().unwrap()[1].as_array_mut().unwrap();
+            first_off_diagonal[0] = ciborium::Value::Float(1e200);
+        })
+        .unwrap_err(),
+    );
+    assert!(why.contains("Gram"), "{why}");
+}

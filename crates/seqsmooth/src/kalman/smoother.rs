@@ -273,7 +273,18 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone>(
             // One update (its prediction and correction), the prediction then read from
             // the filter's work buffers: the same numbers as predicting and updating apart.
             let stepped = m.time != filter.time();
-            let stats = filter.update_stats(m)?;
+            let stats = match filter.update_stats(m) {
+                Ok(stats) => stats,
+                // [`Smoother`] predicts before it reads the measurement: a row whose
+                // prediction fails too gives that error, as there (the filter is unchanged).
+                Err(e) => {
+                    return Err(filter
+                        .clone()
+                        .predict_with_transition(m.time)
+                        .err()
+                        .unwrap_or(e))
+                }
+            };
             if stepped {
                 phi.extend_from_slice(filter.last_transition().as_slice());
             } else {

@@ -468,6 +468,26 @@ impl Information {
         if (0..n).any(|i| self.moments[packed(n, i, i)].0 < 0.0) {
             return Err("negative moments on the diagonal".into());
         }
+        if self.prior && self.sigma.is_none() {
+            return Err("a prior without the noise sigma it is weighed by".into());
+        }
+        if self.samples == 0 && !self.prior && self.moments.iter().any(|w| w.0 != 0.0) {
+            return Err("moments without samples".into());
+        }
+        // Cauchy–Schwarz for a Gram matrix, `m_ij² ≤ m_ii m_jj` (a necessary condition of
+        // positive semi-definiteness), with room for the rounding of the sums.
+        let entry = |i: usize, j: usize| {
+            let w = self.moments[packed(n, i.min(j), i.max(j))];
+            w.0 + w.1
+        };
+        for i in 0..n {
+            for j in i + 1..n {
+                let (mij, mii, mjj) = (entry(i, j), entry(i, i), entry(j, j));
+                if mij.abs() > (mii.sqrt() * mjj.sqrt()) * (1.0 + 1e-9) {
+                    return Err("moments that are not a Gram matrix's".into());
+                }
+            }
+        }
         Ok(())
     }
 }

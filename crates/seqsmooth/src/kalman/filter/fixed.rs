@@ -149,3 +149,45 @@ fn predict<const N: usize, const A: usize>(
         None => true,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::discount::Discount;
+    use crate::kalman::noise::WhiteNoiseDerivative;
+    use crate::model::dynamics::PolynomialDynamics;
+    use crate::model::observation::LinearObservation;
+
+    /// The path is taken (not silently left to the generic one) for every polynomial model
+    /// in range, with and without driving noise and fading, and not outside the range or
+    /// with a noise of another model: the equality tests of `tests/kalman_fixed_path.rs`
+    /// could not tell.
+    #[test]
+    fn taken_in_range_and_only_there() {
+        for axes in 1..=4 {
+            for degree in 0..=8 {
+                let n = (degree + 1) * axes;
+                let mut f = KalmanFilter::new(
+                    PolynomialDynamics::new(degree, axes),
+                    LinearObservation::value_of(n),
+                    DVector::from_element(n, 0.5),
+                    DMatrix::identity(n, n),
+                    0.0,
+                )
+                .unwrap();
+                let in_range = n <= UNROLLED_MAX_SIZE && axes <= MAX_AXES;
+                assert_eq!(f.predict_fixed(0.7), in_range, "m = {degree}, d = {axes}");
+                let q = WhiteNoiseDerivative::new(degree, axes, 0.3).unwrap();
+                f.set_process_noise(q).unwrap();
+                f.set_fading(Discount::PerUpdate { theta: 0.9 }).unwrap();
+                assert_eq!(f.predict_fixed(-1.3), in_range, "m = {degree}, d = {axes}");
+                // The same state count from another degree and axes: not this model's `Q`.
+                if axes == 1 && degree % 2 == 1 {
+                    let other = WhiteNoiseDerivative::new((degree - 1) / 2, 2, 0.3).unwrap();
+                    f.set_process_noise(other).unwrap();
+                    assert!(!f.predict_fixed(0.7), "m = {degree}: a noise on 2 axes");
+                }
+            }
+        }
+    }
+}
