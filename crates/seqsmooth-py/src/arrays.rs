@@ -10,7 +10,7 @@
 //! Parquet timestamps and ISO-8601 cells); a `timedelta64` as its seconds. A naive date is UTC.
 
 use crate::errors::{raise, Kind};
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::IntoPyDict;
 
