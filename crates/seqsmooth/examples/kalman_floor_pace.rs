@@ -20,6 +20,9 @@
 //! 15 repetitions, every pair; `PAIR` times only the pairs whose name starts with it, e.g.
 //! `kalman3` under `valgrind --tool=callgrind` for instructions per update).
 
+#[path = "common/pace.rs"]
+mod pace;
+
 #[path = "../benches/common/radar.rs"]
 #[allow(dead_code)]
 mod radar;
@@ -30,51 +33,12 @@ mod kalman_tracks;
 #[path = "../benches/common/floor.rs"]
 mod floor;
 
+use pace::pair;
 use seqsmooth::kalman::smoother::{smooth_flat, smooth_flat_into, SmoothedRun};
 use seqsmooth::kalman::KalmanFilter;
 use seqsmooth::model::dynamics::Dynamics;
 use seqsmooth::model::measurement::Measurement;
 use seqsmooth::model::observation::Observation;
-use std::hint::black_box;
-
-/// The calling thread's CPU time, seconds (`CLOCK_THREAD_CPUTIME_ID`).
-fn cpu_seconds() -> f64 {
-    let mut t = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `t` is a valid timespec for clock_gettime to write.
-    let ok = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) };
-    assert_eq!(ok, 0, "clock_gettime");
-    t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
-}
-
-/// CPU seconds of one call of `f` (the thread's: other processes on a loaded machine excluded).
-fn seconds(f: &mut impl FnMut() -> f64) -> f64 {
-    let start = cpu_seconds();
-    black_box(f());
-    cpu_seconds() - start
-}
-
-/// `a` and `b` timed back to back `reps` times: each side's best, and the ratios `b / a` of
-/// the pairs (min, median, max).
-fn pair(reps: usize, mut a: impl FnMut() -> f64, mut b: impl FnMut() -> f64) -> [f64; 5] {
-    let (mut best_a, mut best_b, mut ratios) = (f64::INFINITY, f64::INFINITY, Vec::new());
-    for _ in 0..reps {
-        let (ta, tb) = (seconds(&mut a), seconds(&mut b));
-        best_a = best_a.min(ta);
-        best_b = best_b.min(tb);
-        ratios.push(tb / ta);
-    }
-    ratios.sort_by(f64::total_cmp);
-    [
-        best_a,
-        best_b,
-        ratios[0],
-        ratios[reps / 2],
-        ratios[reps - 1],
-    ]
-}
 
 /// The library's filter over every run by `update_stats`: the summed log-likelihood.
 fn filter_runs<D: Dynamics + Clone, O: Observation + Clone>(
