@@ -178,8 +178,8 @@ def test_unaligned_arrays_are_read_not_refused():
     expected = ss.FadingMemory(degree=1, theta=0.9, tau=0.25).update_many(t, y)
     got = ss.FadingMemory(degree=1, theta=0.9, tau=0.25).update_many(_unaligned(t), _unaligned(y))
     np.testing.assert_array_equal(got, expected)
-    stamps = (_seconds() * 1e9).astype("int64").view("datetime64[ns]")
+    stamps = _dates("ns")
     got = ss.FadingMemory(degree=1, theta=0.9, tau=0.25).update_many(_unaligned(stamps), y)
     np.testing.assert_array_equal(
-        got, ss.FadingMemory(degree=1, theta=0.9, tau=0.25).update_many(_seconds(), y)
+        got, ss.FadingMemory(degree=1, theta=0.9, tau=0.25).update_many(stamps, y)
     )
