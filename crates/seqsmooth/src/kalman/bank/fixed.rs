@@ -23,7 +23,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::super::correct::finite;
-use super::series::Forward;
+use super::series::{check_row, Forward};
 use super::{KalmanBank, RowsMut};
 use crate::error::{Error, Param};
 use crate::linalg::dense::{all_finite, log_det};
@@ -493,25 +493,7 @@ impl<D: Dynamics, const N: usize> Forward for FixedSeries<'_, D, N> {
 
     #[inline(always)]
     fn step(&mut self, t: f64, z: &[f64]) -> Result<Option<f64>, Error> {
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
-        if t < self.time {
-            return Err(Error::InvalidParameter {
-                name: Param::Time,
-                value: t.to_string(),
-                reason: format!("is before the previous row's {}", self.time),
-            });
-        }
-        if let Some(&value) = z.iter().find(|v| v.is_infinite()) {
-            return Err(Error::NonFinite {
-                what: "measurement value",
-                value,
-            });
-        }
+        check_row(self.time, t, z)?;
         self.predict(t)?;
         if z.iter().all(|v| v.is_nan()) {
             self.x = self.xp;

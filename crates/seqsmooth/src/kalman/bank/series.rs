@@ -50,25 +50,7 @@ impl<'a, D: Dynamics> SeriesFilter<'a, D> {
 
     /// The prediction to `t` and the update with `z` ([`Forward::step`]).
     fn step_general(&mut self, t: f64, z: &[f64]) -> Result<Option<f64>, Error> {
-        if !t.is_finite() {
-            return Err(Error::NonFinite {
-                what: "time",
-                value: t,
-            });
-        }
-        if t < self.time {
-            return Err(Error::InvalidParameter {
-                name: Param::Time,
-                value: t.to_string(),
-                reason: format!("is before the previous row's {}", self.time),
-            });
-        }
-        if let Some(&value) = z.iter().find(|v| v.is_infinite()) {
-            return Err(Error::NonFinite {
-                what: "measurement value",
-                value,
-            });
-        }
+        check_row(self.time, t, z)?;
         self.predict(t)?;
         let w = &mut self.w;
         w.present.clear();
@@ -313,4 +295,30 @@ impl<D: Dynamics> Forward for SeriesFilter<'_, D> {
     fn step(&mut self, t: f64, z: &[f64]) -> Result<Option<f64>, Error> {
         self.step_general(t, z)
     }
+}
+
+/// A series' row at `t` with values `z` after one at `previous` (NaN: none): a finite time,
+/// not before the previous row's, and no infinite value (NaN is a missing component).
+#[inline(always)]
+pub(super) fn check_row(previous: f64, t: f64, z: &[f64]) -> Result<(), Error> {
+    if !t.is_finite() {
+        return Err(Error::NonFinite {
+            what: "time",
+            value: t,
+        });
+    }
+    if t < previous {
+        return Err(Error::InvalidParameter {
+            name: Param::Time,
+            value: t.to_string(),
+            reason: format!("is before the previous row's {previous}"),
+        });
+    }
+    if let Some(&value) = z.iter().find(|v| v.is_infinite()) {
+        return Err(Error::NonFinite {
+            what: "measurement value",
+            value,
+        });
+    }
+    Ok(())
 }
