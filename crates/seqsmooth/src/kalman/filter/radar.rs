@@ -287,28 +287,10 @@ fn predict(
             return None;
         }
     }
-    // Aᵀ directly: (Aᵀ)_{ir} = A_{ri}.
+    // A = S Φᵀ written transposed ((Aᵀ)_{ir} = A_{ri}), then Aᵀ Φᵀ.
     let mut at = [0.0; N * N];
-    for i in 0..N {
-        for r in 0..N {
-            let mut acc = -0.0;
-            acc += s[r + i * N] * t0;
-            if i < 3 {
-                acc += s[r + (i + 3) * N] * t1;
-            }
-            at[i + r * N] = acc;
-        }
-    }
-    for i in 0..N {
-        for r in 0..N {
-            let mut acc = -0.0;
-            acc += at[r + i * N] * t0;
-            if i < 3 {
-                acc += at[r + (i + 3) * N] * t1;
-            }
-            sp[r + i * N] = acc;
-        }
-    }
+    times_phi_t(s, t0, t1, |r, i| i + r * N, &mut at);
+    times_phi_t(&at, t0, t1, |r, i| r + i * N, sp);
     match psd {
         Some(_) => {
             for j in 0..N {
@@ -324,6 +306,28 @@ fn predict(
         None => symmetrize(N, sp),
     }
     all_finite(sp).then_some(())
+}
+
+/// `(B Φᵀ)_{ri} = B_{ri} ζ⁰ + B_{r,i+3} ζ` (`Φ = [[I, ζ I], [0, I]]`, terms `t0`, `t1`) into
+/// `out` at `at(r, i)`, each sum from `−0` in the general kernel's order.
+#[inline(always)]
+fn times_phi_t(
+    b: &[f64; N * N],
+    t0: f64,
+    t1: f64,
+    at: impl Fn(usize, usize) -> usize,
+    out: &mut [f64; N * N],
+) {
+    for i in 0..N {
+        for r in 0..N {
+            let mut acc = -0.0;
+            acc += b[r + i * N] * t0;
+            if i < 3 {
+                acc += b[r + (i + 3) * N] * t1;
+            }
+            out[at(r, i)] = acc;
+        }
+    }
 }
 
 /// `out = A Mᵀ` (`N × K`) for `M = [J 0]` (`J` by rows, `J₁₂ = 0`): column `c` is
