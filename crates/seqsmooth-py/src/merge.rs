@@ -172,8 +172,9 @@ impl PyInformation {
     /// Raises
     /// ------
     /// TooFewSamplesError
-    ///     the samples do not determine the polynomial (fewer distinct times than ``m + 1``
-    ///     without a prior).
+    ///     fewer samples than ``m + 1`` (without a prior).
+    /// NotDeterminedError
+    ///     enough samples, but at too few distinct times to determine the polynomial.
     /// InvalidInputError, NumericalError
     ///     ``t`` not finite, or an estimate beyond the double range.
     fn estimate(&self, t: f64) -> PyResult<State> {
@@ -185,7 +186,7 @@ impl PyInformation {
     ///
     /// Raises
     /// ------
-    /// TooFewSamplesError
+    /// TooFewSamplesError, NotDeterminedError
     ///     as :meth:`estimate`.
     fn residual_sq(&self) -> PyResult<f64> {
         Ok(self.inner.fit().py()?.residual_sq())

@@ -192,6 +192,13 @@ def test_pickle_merge_rules_and_errors(span):
         seqsmooth.Information(2, 0.0, 1.0).add_prior([0.0, 0.0, 0.0], 1.0)
     with pytest.raises(seqsmooth.TooFewSamplesError):
         seqsmooth.Information(2, 0.0, 1.0).estimate(0.5)
+    two_times = seqsmooth.Information(2, 0.0, 1.0)
+    two_times.reduce([0.2, 0.7] * 50, [1.0] * 100)
+    with pytest.raises(seqsmooth.NotDeterminedError):
+        two_times.estimate(0.5)
+    with pytest.raises(seqsmooth.InvalidInputError) as big:
+        a.reduce([4.0, 5.0], [1.0, 1e200])  # its square leaves the double range
+    assert big.value.index == 1 and a.samples == 4
     with pytest.raises(seqsmooth.InvalidInputError) as bad:
         a.reduce([4.0, 5.0], [1.0, np.nan])
     assert bad.value.index == 1 and a.samples == 4

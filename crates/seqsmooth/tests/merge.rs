@@ -472,8 +472,13 @@ fn informations_of_other_shapes_do_not_merge_and_round_trip_bit_for_bit() {
     a.reduce(&[0.0, 1.0, 2.0, 3.0], &[1.0, 2.0, 5.0, 10.0])
         .unwrap();
     assert!(a.reduce(&[4.0], &[f64::NAN]).is_err());
-    assert!(a.reduce(&[4.0], &[1e200]).is_err()); // its square leaves the double range
-                                                  // Many samples at two distinct times do not determine a parabola.
+    // Its square leaves the double range: refused naming the sample, nothing added.
+    assert!(matches!(
+        a.reduce(&[4.0, 5.0], &[1.0, 1e200]),
+        Err(seqsmooth::Error::InBatch { index: 1, .. })
+    ));
+    assert_eq!(a.samples(), 4);
+    // Many samples at two distinct times do not determine a parabola.
     let mut two = Information::new(2, 0.0, 10.0, None).unwrap();
     let t: Vec<f64> = (0..1000)
         .map(|k| if k % 2 == 0 { 1.0 } else { 7.0 })
@@ -481,7 +486,13 @@ fn informations_of_other_shapes_do_not_merge_and_round_trip_bit_for_bit() {
     two.reduce(&t, &vec![3.0; 1000]).unwrap();
     assert!(matches!(
         two.estimate(5.0),
-        Err(seqsmooth::Error::TooFewSamples { .. })
+        Err(seqsmooth::Error::NotDetermined { samples: 1000, .. })
+    ));
+    let mut one = Information::new(2, 0.0, 10.0, None).unwrap();
+    one.reduce(&[1.0, 2.0], &[3.0, 3.0]).unwrap();
+    assert!(matches!(
+        one.estimate(5.0),
+        Err(seqsmooth::Error::TooFewSamples { needed: 3, got: 2 })
     ));
     two.reduce(&[4.0], &[3.0]).unwrap();
     let d = two.estimate(5.0).unwrap().derivatives;

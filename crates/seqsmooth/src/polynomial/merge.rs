@@ -274,13 +274,22 @@ impl Information {
         let mut total = vec![(0.0, 0.0); self.moments.len()];
         let mut row = vec![0.0; n];
         let mut parts = vec![(0.0, 0.0); n];
-        for (t, z) in t.chunks(BLOCK).zip(z.chunks(BLOCK)) {
+        for (block, (t, z)) in t.chunks(BLOCK).zip(z.chunks(BLOCK)).enumerate() {
             let mut sums = Sums::new(total.len());
-            for (&t, &y) in t.iter().zip(z) {
+            for (k, (&t, &y)) in t.iter().zip(z).enumerate() {
                 // The batch fit's rows, bit for bit.
                 let v = crate::basis::legendre::values(self.degree, (t - centre) / half);
                 row[..n - 1].copy_from_slice(&v);
                 row[n - 1] = y;
+                if let Some(&v) = row.iter().find(|v| !(*v * *v).is_finite()) {
+                    return Err(Error::InBatch {
+                        index: block * BLOCK + k,
+                        source: Box::new(Error::NonFinite {
+                            what: "square of a sample's basis value or value",
+                            value: v * v,
+                        }),
+                    });
+                }
                 sums.add_row(&row, &mut parts);
             }
             for (w, s) in total.iter_mut().zip(sums.words()) {
@@ -396,16 +405,31 @@ impl Information {
 
     /// The least-squares fit of every sample in (with the prior): the double-word Cholesky
     /// factor of the augmented moments gives `R`, `d` and `ρ²` (see the module doc) and the
-    /// coefficients `R⁻¹ d`, rounded once to doubles; refused ([`Error::TooFewSamples`])
-    /// while they do not determine the polynomial.
+    /// coefficients `R⁻¹ d`, rounded once to doubles; refused while they do not determine the
+    /// polynomial: [`Error::TooFewSamples`] with fewer samples than coefficients,
+    /// [`Error::NotDetermined`] with enough samples at too few distinct times.
     pub fn fit(&self) -> Result<PolynomialFit, Error> {
         let p = self.degree + 1;
         let n = p + 1;
-        let too_few = || Error::TooFewSamples {
-            needed: p,
-            got: self.samples as usize,
+        let not_determined = || {
+            if self.samples < p as u64 {
+                Error::TooFewSamples {
+                    needed: p,
+                    got: self.samples as usize,
+                }
+            } else {
+                Error::NotDetermined {
+                    samples: self.samples,
+                    why: format!(
+                        "the samples' times do not determine a polynomial of degree {} (fewer \
+                         than {p} distinct times, or times too close together for the span): \
+                         lower the degree or add samples at other times",
+                        self.degree
+                    ),
+                }
+            }
         };
-        let l = cholesky(&self.moments, n, p).ok_or_else(too_few)?;
+        let l = cholesky(&self.moments, n, p).ok_or_else(not_determined)?;
         // Rᵀ = L's leading block, d = L's last row: back substitution R c = d.
         let mut c = vec![(0.0, 0.0); p];
         for i in (0..p).rev() {
