@@ -2,7 +2,10 @@
 //! on expanding memory, the switch to fading memory, outlier rejection, noise estimation,
 //! misfit restarts and the degree settling, with each sample's flags; `update_many` gives the
 //! numbers `seqsmooth filter --kind auto` writes (the estimate of each update, its 1σ, the
-//! noise in use, the flags), and `finish` the final outlier decisions.
+//! noise in use, the flags) and the final outlier decisions made at each call, and `finish`
+//! those of the samples still under review: as the library's `AutoOutput::decided` and
+//! `AutomaticFilter::finish`, so the object holds no row of its past (its memory and its
+//! pickle do not grow with the samples).
 
 use crate::arrays::{matrix, pair};
 use crate::errors::IntoPy;
@@ -11,7 +14,7 @@ use crate::polynomial::{engine as engine_named, state_of, State};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use pyo3::types::{PyBytes, PyTuple};
+use pyo3::types::{PyBytes, PyInt, PyTuple};
 use seqsmooth::polynomial::automatic::AutomaticFilter;
 use seqsmooth::polynomial::rows::{decisions, degree_in_use, RowLayout};
 use seqsmooth::polynomial::spec::{AnyFilter, FilterKind, FilterSpec};
@@ -42,8 +45,9 @@ use seqsmooth::{Error, PolynomialFilter};
 pub struct PyAutomaticFilter {
     /// The library's automatic filter, run by its row runner.
     filter: AnyFilter,
-    /// The final outlier decisions reported so far, in sample order.
-    decided: Vec<bool>,
+    /// The samples whose final outlier decision has been reported (`update_many`'s
+    /// `decided`, then `finish`).
+    decided: u64,
 }
 
 #[pymethods]
@@ -51,16 +55,15 @@ impl PyAutomaticFilter {
     /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
     /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
     /// copy of the state, and the copy and the original then run apart.
-    /// The state is the library's saved form and the final decisions reported so far.
+    /// The state is the library's saved form and the count of final decisions reported.
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
         let py = slf.py();
         let me = slf.borrow();
-        let decided: Vec<u8> = me.decided.iter().map(|&d| u8::from(d)).collect();
         let state = PyTuple::new(
             py,
             [
                 persist::save(py, &me.filter)?,
-                PyBytes::new(py, &decided).into_any(),
+                me.decided.into_pyobject(py)?.into_any(),
             ],
         )?;
         persist::reduce(slf.as_any(), state.into_any())
@@ -77,18 +80,25 @@ impl PyAutomaticFilter {
                 "the state of another filter than an AutomaticFilter",
             ));
         }
-        let decided = items.get_item(1)?;
-        let decided = decided
-            .cast::<PyBytes>()
-            .map_err(|_| persist::damaged("the decisions are not bytes"))?
-            .as_bytes();
-        if decided.iter().any(|&d| d > 1) || decided.len() as u64 > filter.samples() {
-            return Err(persist::damaged("the decisions do not fit the filter"));
-        }
-        Ok(Self {
-            filter,
-            decided: decided.iter().map(|&d| d == 1).collect(),
-        })
+        // The count of decisions reported; a pickle of an earlier version kept the decisions
+        // themselves (bytes of 0 and 1), whose count it is.
+        let item = items.get_item(1)?;
+        let decided = if let Ok(bytes) = item.cast::<PyBytes>() {
+            let bytes = bytes.as_bytes();
+            if bytes.iter().any(|&d| d > 1) {
+                return Err(persist::damaged("the decisions are not 0 or 1"));
+            }
+            bytes.len() as u64
+        } else if let Ok(count) = item.cast::<PyInt>() {
+            count
+                .extract::<u64>()
+                .map_err(|_| persist::damaged("the count of decisions is not a count"))?
+        } else {
+            return Err(persist::damaged(
+                "the decisions are neither a count nor bytes",
+            ));
+        };
+        Ok(Self { filter, decided })
     }
 
     #[new]
@@ -112,7 +122,7 @@ impl PyAutomaticFilter {
         };
         Ok(Self {
             filter: spec.build().py()?,
-            decided: Vec::new(),
+            decided: 0,
         })
     }
 
@@ -128,13 +138,24 @@ impl PyAutomaticFilter {
         self.filter.samples()
     }
 
+    /// The number of samples, from the first, whose final outlier decision has been
+    /// reported (by ``update_many``'s ``decided`` and by :meth:`finish`).
+    #[getter]
+    fn decided(&self) -> u64 {
+        self.decided
+    }
+
     /// Takes the samples ``(t[i], y[i])`` and returns, per sample, what ``seqsmooth filter
     /// --kind auto`` writes: a dict of numpy arrays ``d`` and ``s`` (``(n, m+1)``: the
     /// estimate at ``t[i]`` of the active degree and its 1σ, NaN above that degree, before
     /// the filter is determined, and while ``noise`` is NaN: no estimate is given without its
     /// σ), ``noise`` (the σ in use, NaN until estimated), ``bias`` (the estimated bias of
-    /// ``d0``), ``degree`` (the active degree), and the flags ``outlier`` (the decision at the
-    /// update: see :meth:`finish` for the final ones) and ``misfit``.
+    /// ``d0``), ``degree`` (the active degree), the flags ``outlier`` (the decision at the
+    /// update) and ``misfit``, and ``decided``: the final outlier decisions this call made, in
+    /// sample order, of the samples from number :attr:`decided` (before the call) on — a
+    /// sample's decision is final once the review has seen ``review_window`` accepted samples
+    /// after it (Morrison §14.8); :meth:`finish` gives those of the samples still under review.
+    /// The filter keeps no decision once reported, so its memory is bounded.
     fn update_many<'py>(
         &mut self,
         py: Python<'py>,
@@ -164,9 +185,8 @@ impl PyAutomaticFilter {
             _ => n,
         };
         let cells = |i: usize| &rows[i * stride + 2 * w + 4..(i + 1) * stride];
-        for i in 0..taken {
-            self.decided.extend(decisions(cells(i)));
-        }
+        let decided: Vec<bool> = (0..taken).flat_map(|i| decisions(cells(i))).collect();
+        self.decided += decided.len() as u64;
         run.py()?;
         let column = |k: usize| (0..n).map(|i| rows[i * stride + k]).collect::<Vec<f64>>();
         let flag = |k: usize| {
@@ -187,16 +207,19 @@ impl PyAutomaticFilter {
         out.set_item("degree", PyArray1::from_vec(py, degree))?;
         out.set_item("outlier", PyArray1::from_vec(py, flag(2 * w + 1)))?;
         out.set_item("misfit", PyArray1::from_vec(py, flag(2 * w + 2)))?;
+        out.set_item("decided", PyArray1::from_vec(py, decided))?;
         Ok(out)
     }
 
-    /// Decides every sample still waiting for its review and returns the final outlier
-    /// decision of every sample taken so far (``True``: rejected), in order.
+    /// Decides every sample still waiting for its review and returns those final outlier
+    /// decisions (``True``: rejected), in sample order, of the samples from number
+    /// :attr:`decided` on: after the ``decided`` arrays of every ``update_many``, they make
+    /// the final decision of every sample taken (the library's ``AutomaticFilter::finish``).
     fn finish<'py>(&mut self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
         let tail = self.filter.automatic_mut().map(AutomaticFilter::finish);
         let tail = tail.unwrap_or_default();
-        self.decided.extend_from_slice(&tail);
-        PyArray1::from_slice(py, &self.decided)
+        self.decided += tail.len() as u64;
+        PyArray1::from_vec(py, tail)
     }
 
     /// The estimate at the newest sample (the active filter's; after a rejected sample, the

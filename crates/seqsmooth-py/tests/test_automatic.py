@@ -4,6 +4,8 @@ and a manoeuvre; its errors."""
 
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -27,7 +29,9 @@ def test_equals_the_command(tmp_path, rng, sigma):
     m = 2
     f = ss.AutomaticFilter(degree=m, theta=0.95, tau=1.0, sigma=sigma)
     got = f.update_many(t, y)
-    final = f.finish()
+    assert f.decided == len(got["decided"]) and len(t) - f.decided <= 2 + 4  # the review's
+    final = np.concatenate([got["decided"], f.finish()])
+    assert f.decided == len(t)
     flags = ["--kind", "auto", "--degree", "2", "--theta", "0.95", "--tau", "1"]
     want = run_filter(tmp_path, t, y, *flags, *(["--sigma", "0.3"] if sigma else []))
     for k in range(m + 1):
@@ -51,7 +55,23 @@ def test_equals_the_command(tmp_path, rng, sigma):
     parts = [g.update_many(t[k], y[k]) for k in (slice(0, 251), slice(251, None))]
     for key in got:
         same_bits(np.concatenate([p[key] for p in parts]), got[key], key)
-    assert np.array_equal(g.finish(), final)
+    assert np.array_equal(np.concatenate([p["decided"] for p in parts] + [g.finish()]), final)
+    # Pickled between the pieces: the same decisions, and a state that does not grow with
+    # the samples (no decision is kept once reported).
+    h = ss.AutomaticFilter(degree=m, theta=0.95, tau=1.0, sigma=sigma)
+    first = h.update_many(t[:251], y[:251])["decided"]
+    small = len(pickle.dumps(h))
+    h = pickle.loads(pickle.dumps(h))
+    assert h.decided == len(first)
+    rest = h.update_many(t[251:], y[251:])["decided"]
+    assert abs(len(pickle.dumps(h)) - small) < 200
+    assert np.array_equal(np.concatenate([first, rest, h.finish()]), final)
+    # A pickle of an earlier version kept the decisions themselves: their count is taken.
+    fn, (cls, (body, _)) = g.__reduce__()
+    old = fn(cls, (body, bytes(len(final) - 3) + b"\x01\x00\x01"))
+    assert old.decided == len(final)
+    with pytest.raises(ss.DamagedStateError):
+        fn(cls, (body, b"\x02"))
 
 
 def test_errors():
