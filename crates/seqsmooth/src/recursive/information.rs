@@ -7,6 +7,27 @@ use crate::linalg::{solve_upper_in_place, solve_upper_transpose_in_place};
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
 use nalgebra::{DMatrix, DVector};
 
+/// `each_index!(p, k => { … })`: the block for `k = 0, 1, …, p − 1` in turn, `k` a constant
+/// in each copy for `k < 9` (the sizes with unrolled kernels,
+/// [`crate::numeric::unrolled`]) and a loop variable beyond: loops bounded by `k` inside then
+/// have constant trip counts and unroll, which the compiler does not do for a triangle of
+/// loops past a few hundred operations.
+macro_rules! each_index {
+    ($p:expr, $k:ident => $body:block) => {
+        each_index!(@each $p, $k, $body, 0 1 2 3 4 5 6 7 8);
+        for $k in 9..$p $body
+    };
+    (@each $p:expr, $k:ident, $body:block, $($v:literal)*) => {
+        $(
+            if $v < $p {
+                #[allow(non_upper_case_globals)]
+                const $k: usize = $v;
+                $body
+            }
+        )*
+    };
+}
+
 /// When the lazy discount's row scale exceeds this, it is folded into the factors.
 const RENORMALISE: f64 = 1e30;
 
@@ -465,13 +486,21 @@ impl InformationFilter {
     /// not determined.
     ///
     /// With `R = D^½ U`, `(RᵀR)⁻¹ Jᵀ = U⁻¹ D⁻¹ Y` for `Y = U⁻ᵀ Jᵀ`, which is lower triangular
-    /// (both factors are), so each of its columns is a forward substitution that starts at its
-    /// diagonal (`p³/6` in all). The plain covariance's diagonal is then `Σ_k Y_ki²/d_k`; the
-    /// true (sandwich) covariance's, `‖Q (RᵀR)⁻¹ Jᵀ‖²` column by column with `Q = D_Q^½ U_Q`,
-    /// is `Σ_r (D_Q)_r (T D⁻¹ Y)_ri²` with the unit upper triangle `T = U_Q U⁻¹` formed once
-    /// (`p³/6`; the product with the triangle `D⁻¹ Y`, `p³/3`): no square root, and `p`
-    /// divisions independent of each other. The lazy scale cancels as in
-    /// [`Self::covariance_of`].
+    /// (both factors are): `Uᵀ Y = Jᵀ` by forward substitution (`p³/6` in all). The plain
+    /// covariance's diagonal is then `Σ_k Y_ki²/d_k`; the true (sandwich) covariance's,
+    /// `‖Q (RᵀR)⁻¹ Jᵀ‖²` column by column with `Q = D_Q^½ U_Q`, is `Σ_r (D_Q)_r (T D⁻¹ Y)_ri²`
+    /// with the unit upper triangle `T = U_Q U⁻¹` (`T U = U_Q`, `p³/6`; the product with the
+    /// triangle `D⁻¹ Y`, `p³/3`): no square root, and `p` divisions independent of each other.
+    /// The lazy scale cancels as in [`Self::covariance_of`].
+    ///
+    /// Every triangle is computed a row of `Y` (a column of `T`, a row of `T D⁻¹ Y`) at a
+    /// time, each step one multiple of an earlier row subtracted from all of a row's entries
+    /// at once: the entries of a row do not wait for each other (the processor overlaps them,
+    /// the compiler packs neighbours into one vector operation), where one entry's
+    /// substitution is a chain of dependent steps. Each entry still sees its own terms in the
+    /// same order, from the diagonal outwards, so the result is the entry-by-entry
+    /// substitution's to the bit. The row index is a constant in each step (`each_index!`),
+    /// so that the steps' short loops unroll at every size compiled in, not only the smallest.
     #[inline(always)]
     pub(crate) fn variances_of_upper_rows<const N: usize>(
         &self,
@@ -486,50 +515,78 @@ impl InformationFilter {
             return false;
         }
         let u = self.info.unit_triangle(p);
-        let mut y = [0.0; N];
+        // y[k][i] = Y_ki (i ≤ k): row k of Y is row k of Jᵀ less the earlier rows j < k times
+        // U_jk (Uᵀ Y = Jᵀ).
+        let mut y = [[0.0; N]; N];
+        each_index!(p, k => {
+            let (done, rest) = y.split_at_mut(k);
+            let row = &mut rest[0][..k + 1];
+            for (i, v) in row.iter_mut().enumerate() {
+                *v = entry(i, k);
+            }
+            for (j, earlier) in done.iter().enumerate() {
+                let c = u[j * p + k];
+                for (v, e) in row[..j + 1].iter_mut().zip(&earlier[..j + 1]) {
+                    *v -= c * e;
+                }
+            }
+        });
+        let mut sum = [0.0; N];
         match &self.spread {
             None => {
+                each_index!(p, k => {
+                    for (s, v) in sum[..k + 1].iter_mut().zip(&y[k][..k + 1]) {
+                        *s += v * v * inv_d[k];
+                    }
+                });
                 let s2 = self.scale * self.scale;
-                for (i, o) in out.iter_mut().enumerate() {
-                    lower_column(u, p, entry, i, &mut y);
-                    let sum = y[i..p]
-                        .iter()
-                        .zip(&inv_d[i..p])
-                        .fold(0.0, |acc, (yk, ek)| acc + yk * yk * ek);
-                    *o = sum * s2;
+                for (o, s) in out.iter_mut().zip(&sum) {
+                    *o = s * s2;
                 }
             }
             Some(q) => {
                 let mut dq = [0.0; N];
                 q.pivots_into(&mut dq[..p]);
-                // T = U_Q U⁻¹, row by row: `T_r U = (U_Q)_r`, a forward substitution from the
-                // diagonal (`T_rr = 1`, implied).
+                // tc[k][r] = T_rk (r ≤ k, T_kk = 1): column k of T is column k of U_Q less the
+                // earlier columns j < k times U_jk (T U = U_Q).
                 let uq = q.unit_triangle(p);
-                let mut t = [[0.0; N]; N];
-                for (r, t_row) in t[..p].iter_mut().enumerate() {
-                    t_row[r] = 1.0;
-                    for k in r + 1..p {
-                        t_row[k] = column_dot(u, p, k, r, t_row, uq[r * p + k]);
+                let mut tc = [[0.0; N]; N];
+                each_index!(p, k => {
+                    let (done, rest) = tc.split_at_mut(k);
+                    let col = &mut rest[0][..k + 1];
+                    for (r, v) in col[..k].iter_mut().enumerate() {
+                        *v = uq[r * p + k];
                     }
-                }
-                let mut w = [0.0; N];
-                for (i, o) in out.iter_mut().enumerate() {
-                    lower_column(u, p, entry, i, &mut y);
-                    for k in i..p {
-                        w[k] = y[k] * inv_d[k];
+                    col[k] = 1.0;
+                    for (j, earlier) in done.iter().enumerate() {
+                        let c = u[j * p + k];
+                        for (v, e) in col[..j + 1].iter_mut().zip(&earlier[..j + 1]) {
+                            *v -= c * e;
+                        }
                     }
-                    // z_r = Σ_(k ≥ max(r, i)) T_rk w_k, the variance Σ_r (D_Q)_r z_r².
-                    let mut sum = 0.0;
-                    for (r, t_row) in t[..p].iter().enumerate() {
-                        let from = r.max(i);
-                        let z = t_row[from..p]
-                            .iter()
-                            .zip(&w[from..p])
-                            .fold(0.0, |z, (trk, wk)| z + trk * wk);
-                        sum += dq[r] * z * z;
+                });
+                // W = D⁻¹ Y, row by row.
+                each_index!(p, k => {
+                    let e = inv_d[k];
+                    for v in &mut y[k][..k + 1] {
+                        *v *= e;
                     }
-                    *o = sum;
-                }
+                });
+                // Row r of Z = T W (entries z_ri = Σ_(k ≥ max(r, i)) T_rk W_ki), then the
+                // variances Σ_r (D_Q)_r z_ri².
+                each_index!(p, r => {
+                    let mut z = [0.0; N];
+                    for k in r..p {
+                        let c = tc[k][r];
+                        for (v, w) in z[..k + 1].iter_mut().zip(&y[k][..k + 1]) {
+                            *v += c * w;
+                        }
+                    }
+                    for (s, v) in sum[..p].iter_mut().zip(&z) {
+                        *s += dq[r] * v * v;
+                    }
+                });
+                out.copy_from_slice(&sum[..p]);
             }
         }
         true
@@ -625,43 +682,6 @@ impl InformationFilter {
             }
         }
     }
-}
-
-/// Column `i` of `Y = U⁻ᵀ Jᵀ` (entries `k ≥ i`; lower triangular) into `y`:
-/// `Uᵀ y = (row i of J)ᵀ` by forward substitution from the diagonal, for the unit triangle
-/// `u` (`p × p`, row-major) and the upper-triangular `J` (`entry(i, k) = J_ik`).
-#[inline(always)]
-fn lower_column<const N: usize>(
-    u: &[f64],
-    p: usize,
-    entry: impl Fn(usize, usize) -> f64,
-    i: usize,
-    y: &mut [f64; N],
-) {
-    for k in i..p {
-        y[k] = column_dot(u, p, k, i, y, entry(i, k));
-    }
-}
-
-/// `init − Σ_(j in from..k) U_jk x_j` for the unit triangle `u` of dimension `p` (row-major):
-/// column `k` of `U` from row `from` down to above the diagonal, against `x`, in the order of
-/// `j` (one accumulator in a register).
-#[inline(always)]
-fn column_dot<const N: usize>(
-    u: &[f64],
-    p: usize,
-    k: usize,
-    from: usize,
-    x: &[f64; N],
-    init: f64,
-) -> f64 {
-    let mut s = init;
-    let mut at = from * p + k;
-    for xj in &x[from..k] {
-        s -= u[at] * xj;
-        at += p;
-    }
-    s
 }
 
 impl InformationFilter {

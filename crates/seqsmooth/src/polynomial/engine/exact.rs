@@ -395,13 +395,15 @@ impl ExactEngine {
         if !self.info.variances_of_upper_rows::<N>(p, phi, out) {
             return false;
         }
-        for (i, o) in out.iter_mut().enumerate() {
-            let sd = sigma * o.max(0.0).sqrt();
-            *o = if self.unscale_in_range {
-                sd * self.unscale[i]
-            } else {
-                unscale_stepwise(sd, i, self.unit)
-            };
+        // The test outside the loop, so that its square roots go in vector operations.
+        if self.unscale_in_range {
+            for (o, c) in out.iter_mut().zip(&self.unscale[..p]) {
+                *o = sigma * o.max(0.0).sqrt() * c;
+            }
+        } else {
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = unscale_stepwise(sigma * o.max(0.0).sqrt(), i, self.unit);
+            }
         }
         true
     }
