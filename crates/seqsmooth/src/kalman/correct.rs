@@ -265,15 +265,42 @@ fn joseph(
     symmetrize(n, out);
 }
 
-/// The numbers of one correction ((12.2.17)-(12.2.19), (12.3.7); fading (14.4.34)-(14.4.40)),
-/// from the work buffers' prediction, `Mᵀ`, `ν` and `R` into its outputs; `NIS`, `ln det V`
-/// and whether the outputs are all finite.
-/// With `f` the discount over the step (1 without fading, when `P = S`):
-///
-/// `U = P Mᵀ`, `V_P = M U + f R = L_P D_P L_Pᵀ` ([`ldl`]), `H = U V_P⁻¹` (two unit
-/// triangular solves and the pivots), `V = M S Mᵀ + R = L D Lᵀ` (`V_P` without fading),
-/// `NIS = Σ z_c² / D_c` with `z = L⁻¹ ν`, `ln det V = Σ ln D_c`, `X = X_{n,n−1} + H ν`,
-/// `S` by [`joseph`] with `R`, and the fading `P` by [`joseph`] with `f R`, divided by `f`.
+/// The buffers of one correction ([`correct_in`]) as column-major slices: its inputs (the
+/// prediction `X_{n,n−1}`, `S_{n,n−1}`, the fading `P` (`S` without fading), `Mᵀ` of the
+/// present rows, `R` on them, `ν`), its scratch and its outputs. The filter's are its
+/// [`Work`]'s ([`correct_kernel`]); a fixed-size caller passes arrays of its own, which the
+/// compiler can keep in registers (slices of distinct arrays cannot overlap, where the
+/// buffers behind a `Work` could for all it knows).
+pub(super) struct Buffers<'a> {
+    pub(super) x: &'a [f64],
+    pub(super) s: &'a [f64],
+    pub(super) p: &'a [f64],
+    pub(super) mt: &'a [f64],
+    pub(super) r: &'a [f64],
+    pub(super) nu: &'a [f64],
+    /// `n × k`: `P Mᵀ`, the gain `H`, `S Mᵀ` (fading only), `(I − H M) S Mᵀ`, `H R`.
+    pub(super) u: &'a mut [f64],
+    pub(super) h: &'a mut [f64],
+    pub(super) sm: &'a mut [f64],
+    pub(super) y: &'a mut [f64],
+    pub(super) hr: &'a mut [f64],
+    /// `k × k`: `V_P` and its factors (fading only), `V` and its factors, `f R`.
+    pub(super) vp: &'a mut [f64],
+    pub(super) lp: &'a mut [f64],
+    pub(super) v: &'a mut [f64],
+    pub(super) lv: &'a mut [f64],
+    pub(super) rf: &'a mut [f64],
+    /// `L⁻¹ ν` (`k`), a column (`n`) and an `n × n` square.
+    pub(super) z: &'a mut [f64],
+    pub(super) column: &'a mut [f64],
+    pub(super) square: &'a mut [f64],
+    /// `X_{n,n}`, `S_{n,n}` and the fading `P`'s update.
+    pub(super) x_out: &'a mut [f64],
+    pub(super) s_out: &'a mut [f64],
+    pub(super) p_out: &'a mut [f64],
+}
+
+/// [`correct_in`] on the filter's work buffers.
 pub(super) fn correct_kernel<S: Size, C: Size>(
     n: S,
     k: C,
@@ -281,12 +308,65 @@ pub(super) fn correct_kernel<S: Size, C: Size>(
     fading: bool,
     w: &mut Work,
 ) -> Result<(f64, f64, bool), Error> {
+    let s = w.s.as_slice();
+    correct_in(
+        n,
+        k,
+        f,
+        fading,
+        Buffers {
+            x: w.x.as_slice(),
+            s,
+            p: if fading { w.p.as_slice() } else { s },
+            mt: &w.mt,
+            r: &w.r,
+            nu: &w.nu,
+            u: &mut w.u,
+            h: &mut w.h,
+            sm: &mut w.sm,
+            y: &mut w.y,
+            hr: &mut w.hr,
+            vp: &mut w.vp,
+            lp: &mut w.lp,
+            v: &mut w.v,
+            lv: &mut w.lv,
+            rf: &mut w.rf,
+            z: &mut w.z,
+            column: &mut w.column,
+            square: &mut w.square,
+            x_out: w.x_out.as_mut_slice(),
+            s_out: w.s_out.as_mut_slice(),
+            p_out: w.p_out.as_mut_slice(),
+        },
+    )
+}
+
+/// The numbers of one correction ((12.2.17)-(12.2.19), (12.3.7); fading (14.4.34)-(14.4.40)),
+/// from the prediction, `Mᵀ`, `ν` and `R` in `b` into its outputs; `NIS`, `ln det V`
+/// and whether the outputs are all finite.
+/// With `f` the discount over the step (1 without fading, when `P = S`):
+///
+/// `U = P Mᵀ`, `V_P = M U + f R = L_P D_P L_Pᵀ` ([`ldl`]), `H = U V_P⁻¹` (two unit
+/// triangular solves and the pivots), `V = M S Mᵀ + R = L D Lᵀ` (`V_P` without fading, and
+/// then `S Mᵀ = U`), `NIS = Σ z_c² / D_c` with `z = L⁻¹ ν`, `ln det V = Σ ln D_c`,
+/// `X = X_{n,n−1} + H ν`, `S` by [`joseph`] with `R`, and the fading `P` by [`joseph`] with
+/// `f R`, divided by `f`. Without fading `V` and its factors are made in `v`, `lv` (`vp`,
+/// `lp` and `sm` untouched).
+#[inline(always)]
+pub(super) fn correct_in<S: Size, C: Size>(
+    n: S,
+    k: C,
+    f: f64,
+    fading: bool,
+    b: Buffers<'_>,
+) -> Result<(f64, f64, bool), Error> {
     let (n, k) = (n.get(), k.get());
     let (nn, nk, kk) = (n * n, n * k, k * k);
-    let s = &w.s.as_slice()[..nn];
-    let p = if fading { &w.p.as_slice()[..nn] } else { s };
-    let (mt, u, h) = (&w.mt[..nk], &mut w.u[..nk], &mut w.h[..nk]);
-    let (r, vp, lp) = (&w.r[..kk], &mut w.vp[..kk], &mut w.lp[..kk]);
+    let s = &b.s[..nn];
+    let p = &b.p[..nn];
+    let (mt, u, h) = (&b.mt[..nk], &mut b.u[..nk], &mut b.h[..nk]);
+    let r = &b.r[..kk];
+    let (v, lv) = (&mut b.v[..kk], &mut b.lv[..kk]);
     times_transpose(n, p, k, |c, l| mt[l + c * n], u);
     let not_pd = |v: &[f64]| Error::InvalidParameter {
         name: Param::InnovationCovariance,
@@ -294,6 +374,12 @@ pub(super) fn correct_kernel<S: Size, C: Size>(
         reason: "is not positive definite: the observation adds nothing the filter can weigh \
                  (a perfect observation of a component already known exactly)"
             .into(),
+    };
+    // V_P = M U + f R and its factors: V's own without fading (P = S, f = 1).
+    let (vp, lp) = if fading {
+        (&mut b.vp[..kk], &mut b.lp[..kk])
+    } else {
+        (&mut *v, &mut *lv)
     };
     innovation_covariance((n, k), mt, u, r, f, vp);
     if !ldl(k, vp, lp) {
@@ -329,19 +415,18 @@ pub(super) fn correct_kernel<S: Size, C: Size>(
         }
     }
     // The innovation's true covariance M S Mᵀ + R (§14.8): V_P itself without fading.
-    let (v, lv, sm) = (&mut w.v[..kk], &mut w.lv[..kk], &mut w.sm[..nk]);
-    if fading {
+    let sm: &[f64] = if fading {
+        let sm = &mut b.sm[..nk];
         times_transpose(n, s, k, |c, l| mt[l + c * n], sm);
         innovation_covariance((n, k), mt, sm, r, 1.0, v);
         if !ldl(k, v, lv) {
             return Err(not_pd(v));
         }
+        sm
     } else {
-        v.copy_from_slice(vp);
-        lv.copy_from_slice(lp);
-        sm.copy_from_slice(u);
-    }
-    let (nu, z) = (&w.nu[..k], &mut w.z[..k]);
+        u
+    };
+    let (nu, z) = (&b.nu[..k], &mut b.z[..k]);
     // NIS = νᵀ V⁻¹ ν = Σ z_c² / D_c, z = L⁻¹ ν.
     let mut nis = 0.0;
     for c in 0..k {
@@ -352,32 +437,22 @@ pub(super) fn correct_kernel<S: Size, C: Size>(
         z[c] = acc;
         nis += acc * acc / lv[c + c * k];
     }
-    let (x, x_out) = (&w.x.as_slice()[..n], &mut w.x_out.as_mut_slice()[..n]);
+    let (x, x_out) = (&b.x[..n], &mut b.x_out[..n]);
     combine(n, k, h, |c| nu[c], x_out);
     for i in 0..n {
         x_out[i] += x[i];
     }
-    let scratch = (
-        &mut w.square[..],
-        &mut w.y[..],
-        &mut w.hr[..],
-        &mut w.column[..],
-    );
-    let s_out = &mut w.s_out.as_mut_slice()[..nn];
+    let s_out = &mut b.s_out[..nn];
+    let scratch = (&mut *b.square, &mut *b.y, &mut *b.hr, &mut *b.column);
     joseph((n, k), s, h, sm, mt, r, scratch, s_out);
     let mut finite_out = all_finite(x_out) & all_finite(s_out);
     if fading {
-        let rf = &mut w.rf[..kk];
+        let rf = &mut b.rf[..kk];
         for (rf, r) in rf.iter_mut().zip(r) {
             *rf = r * f;
         }
-        let scratch = (
-            &mut w.square[..],
-            &mut w.y[..],
-            &mut w.hr[..],
-            &mut w.column[..],
-        );
-        let out = &mut w.p_out.as_mut_slice()[..nn];
+        let scratch = (&mut *b.square, &mut *b.y, &mut *b.hr, &mut *b.column);
+        let out = &mut b.p_out[..nn];
         joseph((n, k), p, h, u, mt, rf, scratch, out);
         for v in out.iter_mut() {
             *v /= f;

@@ -52,7 +52,9 @@
 //!   predicted at compile-time sizes, `Φ`'s zeros known to the compiler (`kalman::filter::fixed`),
 //!   a constant `M` ([`Observation::linear_matrix`]) is read in place, and `R`'s identity and
 //!   variances are checked at once: chosen without the caller asking, the same numbers bit for
-//!   bit.
+//!   bit. With a constant `M` of at most 3 rows the whole update ([`KalmanFilter::update`],
+//!   [`KalmanFilter::update_stats`]) is one function compiled for each `n`, on arrays the compiler
+//!   keeps in registers, the correction the same kernel with `k` a constant.
 //! - The state dimension `n` and the present components `k` go through the crate's one size
 //!   dispatch (`unrolled_sizes!`, [`crate::numeric`]): for `n ≤ 9` and `k ≤ 4` each kernel is
 //!   compiled with them constants (its loops unrolled), other sizes take the same source with
@@ -422,7 +424,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// assert_eq!(i.innovation[0], 0.5);
     /// ```
     pub fn update(&mut self, measurement: &Measurement) -> Result<Option<Innovation>, Error> {
-        self.update_with(measurement, Work::innovation)
+        self.update_with(measurement, true, Work::innovation)
     }
 
     /// [`Self::update`] reporting only the innovation's statistics ([`InnovationStats`]): the
@@ -453,7 +455,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         &mut self,
         measurement: &Measurement,
     ) -> Result<Option<InnovationStats>, Error> {
-        self.update_with(measurement, |_, stats| stats)
+        self.update_with(measurement, false, |_, stats| stats)
     }
 
     /// [`Self::update_stats`] with a gate (Morrison §14.8): the update is made only where
@@ -538,12 +540,20 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     }
 
     /// The one update behind [`Self::update`] and [`Self::update_stats`]: `report` reads what
-    /// the caller wants from the work buffers once the update has succeeded.
+    /// the caller wants from the work buffers once the update has succeeded (with
+    /// `innovation`, what an [`Innovation`] reads). The whole update at fixed size where the
+    /// model allows ([`Self::update_fixed`], the same numbers), else prediction and correction.
     fn update_with<T>(
         &mut self,
         measurement: &Measurement,
+        innovation: bool,
         report: impl FnOnce(&Work, InnovationStats) -> T,
     ) -> Result<Option<T>, Error> {
+        if let Some(stats) = self.update_fixed(measurement, innovation) {
+            let out = report(&self.work, stats);
+            self.commit_correction(measurement.time);
+            return Ok(Some(out));
+        }
         let Some((t, stats)) = self.predict_and_correct(measurement)? else {
             return Ok(None);
         };
