@@ -138,6 +138,7 @@
 //! | the filters it runs, one update, acceptance: [`AutomaticFilter`] | `filter` | Morrison (14.8.1)-(14.8.4) |
 //! | what each sample did: [`AutoOutput`]; the final decisions, [`final_outliers`] | `output` | — |
 //! | the final outlier decision by interpolation, going back: [`MAX_REVIEW_WINDOW`] | `review` | Morrison ch. 7, (6.10.24), (7.13.5), §14.8 |
+//! | the review's window fit: the normal equations in the Legendre basis of the window | `window_fit` | Morrison ch. 7, §6.5 |
 //! | outlier gate: [`OutlierRule`], [`MORRISON_K`], [`REYNEKE_DEFAULT_K`]; each sample's prediction, innovation and verdict; truncated variance | `outlier` | Morrison §14.8, (14.8.1)-(14.8.4); Reyneke §7.4 |
 //! | noise `σ`: [`NoiseSource`], [`MIN_NOISE_TERMS`] | `noise` | Reyneke §7.1; Morrison (6.10.24), (14.8.4); [`crate::stats::DifferenceNoise`] |
 //! | misfit and restart: [`MisfitResponse`], CUSUM onset | `misfit` | Morrison §14.8, (14.8.5); [`crate::stats::InnovationChiSquared`] |
@@ -201,6 +202,7 @@ mod phase;
 mod review;
 mod settle;
 mod state;
+mod window_fit;
 
 pub use config::{AutoConfig, GATE_MAX_VRF, MAX_MEMORY_LEVELS, MAX_REVIEW_WINDOW};
 pub use filter::AutomaticFilter;

@@ -31,10 +31,8 @@
 
 use super::config::{AutoConfig, MAX_REVIEW_WINDOW};
 use super::output::AutoOutput;
+use super::window_fit::WindowFit;
 use crate::error::Error;
-use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
-use crate::polynomial::options::MAX_DEGREE;
-use crate::recursive::TriangularFactor;
 use std::collections::VecDeque;
 
 /// The most samples waiting for their decision after an update; beyond it the oldest keeps the
@@ -238,163 +236,6 @@ fn gate_rms(out: &AutoOutput) -> Option<f64> {
         .filter(|_| !out.manoeuvre)
 }
 
-/// A least-squares polynomial through the samples of a review window: the square-root-free
-/// QR factor of the rows `(1, u, …, u^d)`, `u = (t − c)/h` centred and scaled on the window
-/// (so `|u| ≤ 1`). Refitted in place ([`WindowFit::fit`]): the review keeps two and allocates
-/// nothing per sample.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub(super) struct WindowFit {
-    factor: TriangularFactor,
-    /// The coefficients of `u^k`.
-    coefficients: [f64; MAX_FIT],
-    centre: f64,
-    inv_half: f64,
-    degree: usize,
-    /// `1/d_i` of the factor's pivots (every VRF of the fit without a division), when they are
-    /// all positive (`determined`).
-    inv_d: [f64; MAX_FIT],
-    determined: bool,
-}
-
-impl Default for WindowFit {
-    fn default() -> Self {
-        Self {
-            factor: TriangularFactor::new(0),
-            coefficients: [0.0; MAX_FIT],
-            centre: 0.0,
-            inv_half: 1.0,
-            degree: 0,
-            inv_d: [0.0; MAX_FIT],
-            determined: false,
-        }
-    }
-}
-
-impl WindowFit {
-    /// Fits degree `d` through `(ts, ys)` (at least `d + 1` distinct times), replacing the fit
-    /// held; false when it is not determined.
-    fn fit(&mut self, ts: &[f64], ys: &[f64], degree: usize) -> bool {
-        let (lo, hi) = ts
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
-                (a.min(t), b.max(t))
-            });
-        let half = 0.5 * (hi - lo);
-        self.factor.reset(degree + 1);
-        self.coefficients = [0.0; MAX_FIT];
-        self.centre = 0.5 * (lo + hi);
-        self.inv_half = if half > 0.0 { 1.0 / half } else { 1.0 };
-        self.degree = degree;
-        for (&t, &y) in ts.iter().zip(ys) {
-            self.factor
-                .add_row_powers((t - self.centre) * self.inv_half, y, 1.0);
-        }
-        let p = degree + 1;
-        self.determined = self.factor.inverse_pivots(&mut self.inv_d[..p]);
-        self.factor.solve_into(&mut self.coefficients[..p])
-    }
-
-    /// `p(t)` and its variance for unit noise `h(t)ᵀ(AᵀA)⁻¹h(t)`.
-    fn value_and_vrf_at(&self, t: f64) -> Option<(f64, f64)> {
-        let p = self.degree + 1;
-        let mut h = [0.0; MAX_FIT];
-        let value = self.value_and_row(t, &mut h[..p]);
-        Some((value, self.vrf_of(&h[..p])?))
-    }
-
-    /// `p(t)`, with the row `h(t) = (1, u, …, u^d)` into `h` (`p` values).
-    #[inline(always)]
-    fn value_and_row(&self, t: f64, h: &mut [f64]) -> f64 {
-        let u = (t - self.centre) * self.inv_half;
-        let mut power = 1.0;
-        for hk in h.iter_mut() {
-            *hk = power;
-            power *= u;
-        }
-        let a = &self.coefficients[..h.len()];
-        a.iter().zip(h.iter()).map(|(a, h)| a * h).sum()
-    }
-
-    /// `hᵀ(AᵀA)⁻¹h = Σ_i g_i²/d_i` with `Uᵀ g = h` (`AᵀA = Uᵀ D U`, the factor's
-    /// square-root-free form): a forward substitution and the pivots' reciprocals kept by
-    /// [`fit`](Self::fit); `None` while not determined.
-    fn vrf_of(&self, h: &[f64]) -> Option<f64> {
-        if !self.determined {
-            return None;
-        }
-        let p = h.len();
-        Some(quadratic_form(
-            self.factor.unit_triangle(p),
-            &self.inv_d[..p],
-            h,
-        ))
-    }
-
-    /// The largest squared studentised residual `e_j²/(σ²(1 − h_j))` (`s2 = σ²`, `h_j` the
-    /// fit's VRF at `t_j`, as [`value_and_vrf_at`](Self::value_and_vrf_at) gives it) over the
-    /// samples `(ts, ys)`, and its index (the first of equals); `None` while not determined or
-    /// when one is not a number. The fit's size compiled in ([`unrolled_sizes!`]).
-    fn worst_residual(&self, ts: &[f64], ys: &[f64], s2: f64) -> Option<(f64, usize)> {
-        let p = self.degree + 1;
-        unrolled_sizes!(p, N => self.worst_residual_with(Fixed::<N>, ts, ys, s2), p => self.worst_residual_with(Any(p), ts, ys, s2))
-    }
-
-    #[inline(always)]
-    fn worst_residual_with(
-        &self,
-        size: impl Size,
-        ts: &[f64],
-        ys: &[f64],
-        s2: f64,
-    ) -> Option<(f64, usize)> {
-        if !self.determined {
-            return None;
-        }
-        let p = size.get();
-        let (u, inv_d) = (self.factor.unit_triangle(p), &self.inv_d[..p]);
-        let mut worst = (f64::NEG_INFINITY, 0);
-        for (j, (&t, &y)) in ts.iter().zip(ys).enumerate() {
-            let mut h = [0.0; MAX_FIT];
-            let value = self.value_and_row(t, &mut h[..p]);
-            let q = quadratic_form(u, inv_d, &h[..p]);
-            let e = y - value;
-            let r2 = e * e / (s2 * (1.0 - q).max(f64::EPSILON));
-            if r2.is_nan() {
-                return None;
-            }
-            if r2 > worst.0 {
-                worst = (r2, j);
-            }
-        }
-        Some(worst)
-    }
-
-    fn residual_sq(&self) -> f64 {
-        self.factor.residual_sq()
-    }
-}
-
-/// `hᵀ(AᵀA)⁻¹h = Σ_i g_i²/d_i` with `Uᵀ g = h`, for the unit triangle `u` (row-major, `p × p`,
-/// `p = h.len()`) and the pivots' reciprocals `inv_d` of `AᵀA = Uᵀ D U`.
-#[inline(always)]
-fn quadratic_form(u: &[f64], inv_d: &[f64], h: &[f64]) -> f64 {
-    let p = h.len();
-    let mut g = [0.0; MAX_FIT];
-    let mut q = 0.0;
-    for i in 0..p {
-        let mut gi = h[i];
-        for k in 0..i {
-            gi -= u[k * p + i] * g[k];
-        }
-        g[i] = gi;
-        q += gi * gi * inv_d[i];
-    }
-    q
-}
-
-/// The most coefficients of a [`WindowFit`]: degree `MAX_DEGREE + 2`.
-const MAX_FIT: usize = MAX_DEGREE + 3;
-
 /// The final verdict on `(t, y)` (`true`: an outlier) from the samples around it and the
 /// gate's: the interpolation's, judged against the root mean square of its deleted residual
 /// `√(c σ²(1 + v_p) + b²)`, where that is below the gate's `σ_ε` (`gate_rms`, `None` when the
@@ -499,7 +340,10 @@ const WINDOW: usize = 2 * MAX_REVIEW_WINDOW;
 /// place, and the window's samples (no allocation, nothing to clear, per sample).
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub(super) struct Scratch {
+    /// The fits, refitted at each use ([`WindowFit`]): not saved.
+    #[serde(skip)]
     fit: WindowFit,
+    #[serde(skip)]
     up: WindowFit,
     calibration: Calibration,
     /// The window's times and values, the fit's (neighbours dropped in place).

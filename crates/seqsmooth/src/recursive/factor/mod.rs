@@ -91,17 +91,6 @@ impl TriangularFactor {
         }
     }
 
-    /// Makes this the zero factor of dimension `p`, keeping its storage (no allocation once it
-    /// has held a factor of that size).
-    pub(crate) fn reset(&mut self, p: usize) {
-        self.d.refill(Pivot(0.0), p);
-        self.u.refill(0.0, p * p);
-        self.ubar.refill(0.0, p);
-        self.residual_sq = 0.0;
-        self.positive = p == 0;
-        self.scratch.clear();
-    }
-
     /// Recomputes [`positive`](Self::positive) after `d` changed other than by a row in the
     /// reciprocal form (which only increases `d`).
     fn refresh_positive(&mut self) {
