@@ -6,7 +6,9 @@
 //!   data: 10⁵ irregular samples) against the hand-written loop of the same recursion
 //!   (`benches/common/floor.rs`);
 //! - `ekf6`: the 6-state radar extended filter over 64 tracks of 59 updates
-//!   (`benches/common/kalman.rs`) against its hand-written loop;
+//!   (`benches/common/kalman.rs`) against its hand-written loop, which reads flat arrays of
+//!   times and values made beforehand (`ekf6 floor/library`) or the library's own input, the
+//!   `Measurement` rows (`ekf6 rows-floor/library`);
 //! - `rts3`, `rts6`: the forward filter alone against `smoother::smooth_flat_into` (the filter
 //!   keeping its predictions, then the backward pass; its buffers reused from call to call)
 //!   on the first 2·10⁴ samples and on the 64 tracks, and against `smooth_flat` (new buffers
@@ -136,6 +138,18 @@ fn main() {
         (want - got).abs() <= 1e-7 * want.abs(),
         "ekf6 floor {got} library {want}"
     );
+    // The same loop reading the library's input (the `Measurement` rows) instead of arrays.
+    let floor6_rows = || {
+        hand.iter()
+            .zip(&runs)
+            .map(|((x, s, t0, _, _), run)| floor::ekf6_rows(*x, *s, *t0, kalman_tracks::Q, run).2)
+            .sum::<f64>()
+    };
+    assert_eq!(
+        floor6_rows(),
+        got,
+        "the floor on rows is the floor on arrays"
+    );
 
     let short = &rows[..20_000];
     let f3 = std::slice::from_ref(&filter);
@@ -162,6 +176,13 @@ fn main() {
     }
     if want("ekf6 floor/library") {
         show("ekf6 floor/library", updates, pair(reps, floor6, lib6));
+    }
+    if want("ekf6 rows-floor/library") {
+        show(
+            "ekf6 rows-floor/library",
+            updates,
+            pair(reps, floor6_rows, lib6),
+        );
     }
     let mut out = SmoothedRun::new();
     if want("rts3 filter/smooth_flat_into") {

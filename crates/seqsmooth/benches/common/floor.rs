@@ -148,18 +148,54 @@ pub fn kalman3(
 /// measurements `(ts[i], zs[i])`. `Φ S Φᵀ` by the constant-velocity blocks, `M` on the
 /// position columns only (its Jacobian `J`, 3 × 3), `V = L D Lᵀ` (3 × 3).
 pub fn ekf6(
-    mut x: [f64; 6],
-    mut s: [[f64; 6]; 6],
+    x: [f64; 6],
+    s: [[f64; 6]; 6],
     t0: f64,
     q: f64,
     r: [f64; 3],
     ts: &[f64],
     zs: &[[f64; 3]],
 ) -> ([f64; 6], [[f64; 6]; 6], f64) {
+    ekf6_over(x, s, t0, q, ts.iter().zip(zs).map(|(&t, z)| (t, *z, r)))
+}
+
+/// [`ekf6`] reading what the library reads, the `Measurement` rows (each one's time, its
+/// three values and the variances of its `R`, from their own allocations), instead of flat
+/// arrays made beforehand: the same loop on the library's input (`examples/kalman_floor_pace.rs`;
+/// the criterion bench does not time it).
+#[allow(dead_code)]
+pub fn ekf6_rows(
+    x: [f64; 6],
+    s: [[f64; 6]; 6],
+    t0: f64,
+    q: f64,
+    rows: &[Measurement],
+) -> ([f64; 6], [[f64; 6]; 6], f64) {
+    let read = |m: &Measurement| {
+        let z = [0, 1, 2].map(|c| m.values[c].expect("every component present"));
+        let r = match &m.noise {
+            NoiseCovariance::Variances(v) => [v[0], v[1], v[2]],
+            NoiseCovariance::Identity => [1.0; 3],
+            NoiseCovariance::Full(_) => panic!("a diagonal R"),
+        };
+        (m.time, z, r)
+    };
+    ekf6_over(x, s, t0, q, rows.iter().map(read))
+}
+
+/// The loop of [`ekf6`] over `(time, values, variances)`.
+#[inline(always)]
+fn ekf6_over(
+    mut x: [f64; 6],
+    mut s: [[f64; 6]; 6],
+    t0: f64,
+    q: f64,
+    rows: impl Iterator<Item = (f64, [f64; 3], [f64; 3])>,
+) -> ([f64; 6], [[f64; 6]; 6], f64) {
     let mut t_prev = t0;
     let mut total = 0.0;
     let ln_tau = TAU.ln();
-    for (&t, zm) in ts.iter().zip(zs) {
+    for (t, zm, r) in rows {
         let z = t - t_prev;
         t_prev = t;
         let mut xp = x;

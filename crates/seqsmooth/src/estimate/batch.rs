@@ -239,7 +239,12 @@ impl Factored {
 /// The condition number `σ_max/σ_min` of `T = Q R` from `R`'s singular values (those of
 /// `T`), or [`Error::Unobservable`] when its numerical rank is below `states`, singular
 /// values at or below `floor` of the largest counting as zero too.
-fn full_rank(r: &DMatrix<f64>, rows: usize, states: usize, floor: f64) -> Result<f64, Error> {
+pub(crate) fn full_rank(
+    r: &DMatrix<f64>,
+    rows: usize,
+    states: usize,
+    floor: f64,
+) -> Result<f64, Error> {
     let sv = crate::linalg::singular_values(r)?;
     let largest = sv.max();
     let smallest = if rows < states { 0.0 } else { sv.min() };
@@ -309,6 +314,18 @@ pub(crate) fn solve_factored(
 ) -> Result<SolvedStep, Error> {
     let (rows, states) = (rotated.len(), r.ncols());
     let condition_number = full_rank(r, rows, states, floor)?;
+    solve_step(r, rotated, condition_number, x)
+}
+
+/// [`solve_factored`] after its rank check, `condition_number` the caller's (`NaN` where the
+/// caller has not computed it yet: [`certainly_full_rank`]).
+pub(crate) fn solve_step(
+    r: &DMatrix<f64>,
+    rotated: &DVector<f64>,
+    condition_number: f64,
+    x: &mut DVector<f64>,
+) -> Result<SolvedStep, Error> {
+    let (rows, states) = (rotated.len(), r.ncols());
     let head = rotated.rows(0, states);
     x.copy_from(&head);
     if !r.solve_upper_triangular_mut(x) {
@@ -323,6 +340,43 @@ pub(crate) fn solve_factored(
         condition_number,
     })
 }
+
+/// Whether `R` (`states × states`, upper triangular, from [`factor_in_place`] of a system of
+/// `rows` rows) certainly passes [`full_rank`]'s test with `floor`, found without its singular
+/// values: `σ_max ≤ ‖R‖_F` and `σ_min ≥ 1/‖R⁻¹‖_F` (`R⁻¹`'s columns by back substitution, on
+/// the stack), so `κ ≤ ‖R‖_F ‖R⁻¹‖_F`; `true` when that bound, times a margin of 2¹⁰ for the
+/// roundings of the bound and of the singular values, is below both thresholds of the test
+/// (`1/(max(rows, states) ε)` of [`numerical_rank`] and `1/floor`). `false` means only "not
+/// known": the caller then makes the test itself. More than [`BOUND_STATES`] states, fewer
+/// rows than states, or a number that is not finite: `false`.
+pub(crate) fn certainly_full_rank(r: &DMatrix<f64>, rows: usize, floor: f64) -> bool {
+    let states = r.ncols();
+    if states > BOUND_STATES || rows < states || r.nrows() != states {
+        return false;
+    }
+    let norm2: f64 = (0..states)
+        .map(|j| (0..=j).map(|i| r[(i, j)] * r[(i, j)]).sum::<f64>())
+        .sum();
+    let mut inverse2 = 0.0;
+    let mut column = [0.0; BOUND_STATES];
+    for c in 0..states {
+        // Column c of R⁻¹: R z = e_c, only its first c + 1 entries non-zero.
+        for i in (0..=c).rev() {
+            let mut acc = if i == c { 1.0 } else { 0.0 };
+            for l in i + 1..=c {
+                acc -= r[(i, l)] * column[l];
+            }
+            column[i] = acc / r[(i, i)];
+            inverse2 += column[i] * column[i];
+        }
+    }
+    let bound = (norm2 * inverse2).sqrt() * 1024.0;
+    let threshold = 1.0 / (rows.max(states) as f64 * f64::EPSILON);
+    bound.is_finite() && bound < threshold && bound * floor < 1.0
+}
+
+/// The most states [`certainly_full_rank`] bounds.
+const BOUND_STATES: usize = 16;
 
 /// [`Solved`] without `x` and `R` (the caller's buffers hold them): [`solve_factored`].
 pub(crate) struct SolvedStep {

@@ -62,9 +62,9 @@ pub(crate) fn apply_into(
 /// One whole-interval backward step in the textbook form: from `(x, s)` (`X_{k|k}`,
 /// `S_{k|k}`), the prediction out of it `(Φ, X_{k+1|k}, S_{k+1|k})` and the later smoothed
 /// estimate `(x_next, s_next)` (`X_{k+1|N}`, `S_{k+1|N}`), `X_{k|N} = x + C (x_next − X_{k+1|k})`
-/// and `S_{k|N} = s + C (s_next − S_{k+1|k}) Cᵀ` (symmetrized) into `x_out`, `s_out`, with `C`
-/// by [`gain_kernel`] into `c`: the map's numbers ([`map_into`] then [`apply_into`]) to rounding,
-/// at about three quarters of its arithmetic. `false` when `S_{k+1|k}` is not positive definite.
+/// and `S_{k|N} = s + C (s_next − S_{k+1|k}) Cᵀ` (its lower triangle, mirrored) into `x_out`,
+/// `s_out`, with `C` by [`gain_kernel`] into `c`: the map's numbers ([`map_into`] then
+/// [`apply_into`]) to rounding, at about three quarters of its arithmetic. `false` when `S_{k+1|k}` is not positive definite.
 pub(crate) fn smooth_into(
     n: usize,
     (x, s): (&[f64], &[f64]),
@@ -74,11 +74,7 @@ pub(crate) fn smooth_into(
 ) -> bool {
     let estimates = ((x, s), (x_next, s_next));
     if n <= MAX {
-        unrolled_sizes!(n, N => {
-                let mut scratch = [0.0; 2 * N * N + 2 * N];
-                let scratch = &mut scratch[..];
-                smooth_kernel(Fixed::<N>, estimates, (phi, x_pred, s_pred), scratch, (x_out, s_out, c))
-            },
+        unrolled_sizes!(n, N => smooth_fixed::<N>(estimates, (phi, x_pred, s_pred), (x_out, s_out, c)),
             _ => false)
     } else {
         let mut scratch = vec![0.0; 2 * n * n + 2 * n];
@@ -91,6 +87,123 @@ pub(crate) fn smooth_into(
             (x_out, s_out, c),
         )
     }
+}
+
+/// [`smooth_into`] for `N ≤ 9` states on the stack, a matrix as an array of its columns (or
+/// rows): [`smooth_kernel`]'s operations entry for entry in the same order (its numbers), laid
+/// out so that each step is a sum of whole columns kept in registers. `P = Φ S` by rows (the
+/// rows of `S` are its columns: it is symmetric) skipping `Φ`'s zeros; `Cᵀ = L⁻ᵀ D⁻¹ L⁻¹ P` on
+/// all of `P`'s columns at once, its rows (the columns of `C`) as they come; then `x + C dx`,
+/// `W = C E` and the lower triangle of `s + W Cᵀ`, mirrored.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn smooth_fixed<const N: usize>(
+    ((x, s), (x_next, s_next)): ((&[f64], &[f64]), (&[f64], &[f64])),
+    (phi, x_pred, s_pred): (&[f64], &[f64], &[f64]),
+    (x_out, s_out, c): (&mut [f64], &mut [f64], &mut [f64]),
+) -> bool {
+    let nn = N * N;
+    let (s, phi, s_pred, s_next) = (&s[..nn], &phi[..nn], &s_pred[..nn], &s_next[..nn]);
+    let column = |a: &[f64], j: usize| -> [f64; N] { std::array::from_fn(|i| a[i + j * N]) };
+    let s_rows: [[f64; N]; N] = std::array::from_fn(|m| std::array::from_fn(|j| s[m + j * N]));
+    // Rows of P = Φ S, each entry's terms in the order of Φ's columns, Φ's zeros skipped.
+    let mut y = [[0.0; N]; N];
+    for m in 0..N {
+        for (i, row) in y.iter_mut().enumerate() {
+            let v = phi[i + m * N];
+            if v != 0.0 {
+                for j in 0..N {
+                    row[j] += v * s_rows[m][j];
+                }
+            }
+        }
+    }
+    // S_{k+1|k} = L D Lᵀ as `gain_kernel` makes it: `l[m][i]` = L_{im} (i > m) and
+    // `l[i][m]` = L_{im} D_m; `inverse` = 1/D.
+    let mut l = [[0.0; N]; N];
+    let mut inverse = [0.0; N];
+    for j in 0..N {
+        let mut pivot = s_pred[j + j * N];
+        for (lm, ljm) in l.iter().zip(&l[j]).take(j) {
+            pivot -= lm[j] * ljm;
+        }
+        if pivot.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return false;
+        }
+        inverse[j] = 1.0 / pivot;
+        for i in j + 1..N {
+            let mut v = s_pred[i + j * N];
+            for (lm, ljm) in l.iter().zip(&l[j]).take(j) {
+                v -= lm[i] * ljm;
+            }
+            l[i][j] = v;
+            l[j][i] = v * inverse[j];
+        }
+    }
+    // Cᵀ = S_{k+1|k}⁻¹ P on every column of P at once: L Y = P, Y / D, Lᵀ Z = Y; row i of Z
+    // is column i of C.
+    for m in 0..N {
+        let ym = y[m];
+        for i in m + 1..N {
+            let lim = l[m][i];
+            for j in 0..N {
+                y[i][j] -= lim * ym[j];
+            }
+        }
+    }
+    for (row, &d) in y.iter_mut().zip(&inverse) {
+        for v in row.iter_mut() {
+            *v *= d;
+        }
+    }
+    for i in (0..N).rev() {
+        let mut v = y[i];
+        for m in i + 1..N {
+            let lmi = l[i][m];
+            for j in 0..N {
+                v[j] -= lmi * y[m][j];
+            }
+        }
+        y[i] = v;
+    }
+    let c_columns = y;
+    // X = x + C (x_next − X_{k+1|k}), by columns of C.
+    let mut xo: [f64; N] = std::array::from_fn(|i| x[i]);
+    for m in 0..N {
+        let v = x_next[m] - x_pred[m];
+        for i in 0..N {
+            xo[i] += c_columns[m][i] * v;
+        }
+    }
+    // W = C E (E = s_next − S_{k+1|k}), a column at a time.
+    let mut w = [[0.0; N]; N];
+    for (j, wj) in w.iter_mut().enumerate() {
+        for m in 0..N {
+            let e = s_next[m + j * N] - s_pred[m + j * N];
+            for i in 0..N {
+                wj[i] += c_columns[m][i] * e;
+            }
+        }
+    }
+    // S = s + W Cᵀ, column j from row j on, then mirrored.
+    for j in 0..N {
+        let mut out = column(s, j);
+        for m in 0..N {
+            let v = c_columns[m][j];
+            for i in 0..N {
+                out[i] += w[m][i] * v;
+            }
+        }
+        for i in j..N {
+            s_out[i + j * N] = out[i];
+            s_out[j + i * N] = out[i];
+        }
+    }
+    x_out[..N].copy_from_slice(&xo);
+    for (m, cm) in c_columns.iter().enumerate() {
+        c[m * N..(m + 1) * N].copy_from_slice(cm);
+    }
+    true
 }
 
 /// [`smooth_into`] for `n` states.
@@ -137,17 +250,23 @@ fn smooth_kernel<S: Size>(
             }
         }
     }
+    // s + W Cᵀ is symmetric: its lower triangle, each entry's terms in the order of `C`'s
+    // columns, mirrored (half the products of the full square and its symmetrization).
     s_out.copy_from_slice(s);
     for m in 0..n {
         let wm = &w[m * n..(m + 1) * n];
         for j in 0..n {
             let v = c[j + m * n];
-            for i in 0..n {
+            for i in j..n {
                 s_out[i + j * n] += wm[i] * v;
             }
         }
     }
-    symmetrize(n, s_out);
+    for j in 0..n {
+        for i in j + 1..n {
+            s_out[j + i * n] = s_out[i + j * n];
+        }
+    }
     true
 }
 
@@ -327,6 +446,78 @@ fn symmetrize(n: usize, m: &mut [f64]) {
             let v = 0.5 * (m[i + j * n] + m[j + i * n]);
             m[i + j * n] = v;
             m[j + i * n] = v;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    /// A random symmetric positive definite `n × n`, column-major.
+    fn spd(rng: &mut StdRng, n: usize) -> Vec<f64> {
+        let g: Vec<f64> = (0..n * n).map(|_| rng.gen_range(-1.0..1.0)).collect();
+        let mut out = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                let dot: f64 = (0..n).map(|k| g[i + k * n] * g[j + k * n]).sum();
+                out[i + j * n] = dot + if i == j { 0.5 } else { 0.0 };
+            }
+        }
+        out
+    }
+
+    fn case<const N: usize>(rng: &mut StdRng) {
+        let n = N;
+        let (s, s_pred, s_next) = (spd(rng, n), spd(rng, n), spd(rng, n));
+        // Φ upper triangular with zeros, as the polynomial model's.
+        let phi: Vec<f64> = (0..n * n)
+            .map(|e| {
+                let (i, j) = (e % n, e / n);
+                if i > j || rng.gen_bool(0.3) {
+                    0.0
+                } else {
+                    rng.gen_range(-2.0..2.0)
+                }
+            })
+            .collect();
+        let v =
+            |rng: &mut StdRng| -> Vec<f64> { (0..n).map(|_| rng.gen_range(-5.0..5.0)).collect() };
+        let (x, x_pred, x_next) = (v(rng), v(rng), v(rng));
+        let estimates = ((&x[..], &s[..]), (&x_next[..], &s_next[..]));
+        let prediction = (&phi[..], &x_pred[..], &s_pred[..]);
+        let (mut xa, mut sa, mut ca) = (vec![0.0; n], vec![0.0; n * n], vec![0.0; n * n]);
+        let (mut xb, mut sb, mut cb) = (vec![0.0; n], vec![0.0; n * n], vec![0.0; n * n]);
+        let a = smooth_fixed::<N>(estimates, prediction, (&mut xa, &mut sa, &mut ca));
+        let mut scratch = vec![0.0; 2 * n * n + 2 * n];
+        let b = smooth_kernel(
+            Any(n),
+            estimates,
+            prediction,
+            &mut scratch,
+            (&mut xb, &mut sb, &mut cb),
+        );
+        assert_eq!((a, &xa, &sa, &ca), (b, &xb, &sb, &cb), "n = {n}");
+        assert!(a);
+    }
+
+    /// The fixed-size step is the general kernel's arithmetic: equal bit for bit on random
+    /// steps of every unrolled size.
+    #[test]
+    fn the_fixed_step_is_the_kernels() {
+        let mut rng = StdRng::seed_from_u64(6);
+        for _ in 0..50 {
+            case::<1>(&mut rng);
+            case::<2>(&mut rng);
+            case::<3>(&mut rng);
+            case::<4>(&mut rng);
+            case::<5>(&mut rng);
+            case::<6>(&mut rng);
+            case::<7>(&mut rng);
+            case::<8>(&mut rng);
+            case::<9>(&mut rng);
         }
     }
 }

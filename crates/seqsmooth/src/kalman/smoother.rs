@@ -18,6 +18,7 @@ use super::fixed_lag::{
     not_finite, not_positive_definite, step, time_before, FixedLagSmoother, Map, Row,
 };
 use crate::error::Error;
+use crate::linalg::dense::all_finite;
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::Measurement;
 use crate::model::observation::Observation;
@@ -217,13 +218,12 @@ pub fn smooth_flat_into<D: Dynamics + Clone, O: Observation + Clone>(
     let (n, count) = (filter.state().len(), measurements.len());
     let nn = n * n;
     run.dimension = n;
+    // The smoothed states, covariances and gains are written whole by the backward pass (their
+    // lengths set there, without filling them first), so they are not cleared here.
     for v in [
         &mut run.times,
-        &mut run.states,
-        &mut run.covariances,
         &mut run.filtered_states,
         &mut run.filtered_covariances,
-        &mut run.gains,
         &mut run.phi,
         &mut run.x_pred,
         &mut run.s_pred,
@@ -250,6 +250,11 @@ pub fn smooth_flat_into<D: Dynamics + Clone, O: Observation + Clone>(
         (&mut phi, &mut x_pred, &mut s_pred),
     );
     (run.phi, run.x_pred, run.s_pred) = (phi, x_pred, s_pred);
+    if result.is_err() {
+        for v in [&mut run.states, &mut run.covariances, &mut run.gains] {
+            v.clear();
+        }
+    }
     result
 }
 
@@ -314,16 +319,18 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone>(
             .extend_from_slice(filter.covariance().as_slice());
         run.nis.push(nis);
     }
+    // Every entry below is written (the last estimate copied, the last gain zero, the others
+    // by the backward steps): the lengths are set without filling the buffers first.
+    run.states.resize(count * n, 0.0);
+    run.covariances.resize(count * nn, 0.0);
+    run.gains.resize(count * nn, 0.0);
     if count == 0 {
         return Ok(());
     }
     let last = count - 1;
-    run.states.resize(count * n, 0.0);
-    run.covariances.resize(count * nn, 0.0);
-    run.gains.resize(count * nn, 0.0);
+    run.gains[last * nn..].fill(0.0);
     run.states[last * n..].copy_from_slice(&run.filtered_states[last * n..]);
     run.covariances[last * nn..].copy_from_slice(&run.filtered_covariances[last * nn..]);
-    let mut c = vec![0.0; nn];
     for k in (0..last).rev() {
         let prediction = (
             &phi[(k + 1) * nn..(k + 2) * nn],
@@ -338,15 +345,15 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone>(
         let (covariances, later_s) = run.covariances.split_at_mut((k + 1) * nn);
         let (x, s) = (&mut states[k * n..], &mut covariances[k * nn..]);
         let next = (&later[..n], &later_s[..nn]);
-        let made = smooth_into(n, filtered, prediction, next, (&mut *x, &mut *s, &mut c));
-        let bad = x.iter().chain(s.iter()).find(|v| !v.is_finite()).copied();
-        if !made || bad.is_some() {
+        let c = &mut run.gains[k * nn..(k + 1) * nn];
+        let made = smooth_into(n, filtered, prediction, next, (&mut *x, &mut *s, c));
+        if !(made && all_finite(x) && all_finite(s)) {
+            let bad = x.iter().chain(s.iter()).find(|v| !v.is_finite()).copied();
             // The first error in the measurement-at-a-time smoother's order: a map that
             // cannot be made, from the first; else this estimate's entry.
             let found = first_map_error((&*run, &phi[..], &x_pred[..], &s_pred[..]), k + 2);
             return Err(found.unwrap_or_else(|| in_batch(k, not_finite(bad.unwrap_or(f64::NAN)))));
         }
-        run.gains[k * nn..(k + 1) * nn].copy_from_slice(&c);
     }
     Ok(())
 }

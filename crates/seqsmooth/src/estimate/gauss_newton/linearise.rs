@@ -11,43 +11,51 @@ use crate::model::observation::Observation;
 use crate::model::radar::Radar;
 use crate::model::transition::psi_term;
 use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
-use nalgebra::{Cholesky, DMatrix, DMatrixViewMut, DVector, DVectorViewMut, Dyn};
+use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
 
-/// How one measurement's present components are whitened: `R_k = L Lᵀ` on those rows.
+/// One measurement: its time, where its present components start in [`Prepared`]'s lists
+/// and how many there are, and how they are whitened (`R_k = L Lᵀ` on those rows).
 #[derive(Clone, Debug)]
 pub(super) struct Rows {
     pub(super) time: f64,
-    pub(super) present: Vec<usize>,
-    values: Vec<f64>,
+    start: usize,
+    pub(super) count: usize,
     whiten: Whiten,
 }
 
+/// A measurement's whitening: each row times its scale `1/σ` (the lists' `scale`), or by the
+/// Cholesky factor of its `R` (the lists' scale then 1, unused).
 #[derive(Clone, Debug)]
 enum Whiten {
-    Scale(Vec<f64>),
+    Scale,
     Factor(Cholesky<f64, Dyn>),
 }
 
-impl Whiten {
-    fn apply_vector(&self, v: &mut DVectorViewMut<f64>) {
-        match self {
-            Whiten::Scale(s) => v.iter_mut().zip(s).for_each(|(x, s)| *x *= s),
-            Whiten::Factor(c) => {
-                let _ = c.l_dirty().solve_lower_triangular_mut(v);
-            }
-        }
-    }
+/// Every measurement's [`Rows`], and their present components, values and scales one after
+/// another in three lists: four allocations for a fit, not three a measurement.
+pub(super) struct Prepared {
+    pub(super) rows: Vec<Rows>,
+    present: Vec<usize>,
+    values: Vec<f64>,
+    scale: Vec<f64>,
+}
 
-    fn apply_matrix(&self, m: &mut DMatrixViewMut<f64>) {
-        match self {
-            Whiten::Scale(s) => {
-                for (r, s) in s.iter().enumerate() {
-                    m.row_mut(r).scale_mut(*s);
-                }
-            }
-            Whiten::Factor(c) => {
-                let _ = c.l_dirty().solve_lower_triangular_mut(m);
-            }
+/// One measurement's present components, their measured values and their scales.
+#[derive(Clone, Copy)]
+struct Entries<'a> {
+    present: &'a [usize],
+    values: &'a [f64],
+    scale: &'a [f64],
+}
+
+impl Prepared {
+    #[inline]
+    fn entries(&self, row: &Rows) -> Entries<'_> {
+        let range = row.start..row.start + row.count;
+        Entries {
+            present: &self.present[range.clone()],
+            values: &self.values[range.clone()],
+            scale: &self.scale[range],
         }
     }
 }
@@ -103,7 +111,7 @@ impl Scratch {
 pub(super) struct Model<'a, D, O> {
     pub(super) dynamics: &'a D,
     pub(super) observation: &'a O,
-    pub(super) rows: &'a [Rows],
+    pub(super) rows: &'a Prepared,
     pub(super) layout: &'a Layout,
     pub(super) t_c: f64,
     pub(super) prior: Option<&'a PriorRows>,
@@ -113,29 +121,74 @@ pub(super) struct Model<'a, D, O> {
 pub(super) fn prepare<O: Observation>(
     observation: &O,
     measurements: &[Measurement],
-) -> Result<Vec<Rows>, Error> {
+) -> Result<Prepared, Error> {
     let p = observation.components();
-    measurements
-        .iter()
-        .enumerate()
-        .map(|(index, m)| {
-            prepare_one(p, m).map_err(|source| Error::InBatch {
-                index,
-                source: Box::new(source),
-            })
-        })
-        .collect()
+    let entries = measurements.len() * p;
+    let mut out = Prepared {
+        rows: Vec::with_capacity(measurements.len()),
+        present: Vec::with_capacity(entries),
+        values: Vec::with_capacity(entries),
+        scale: Vec::with_capacity(entries),
+    };
+    for (index, m) in measurements.iter().enumerate() {
+        let row = out.push(p, m).map_err(|source| Error::InBatch {
+            index,
+            source: Box::new(source),
+        })?;
+        out.rows.push(row);
+    }
+    Ok(out)
 }
 
-fn prepare_one(p: usize, m: &Measurement) -> Result<Rows, Error> {
-    let (present, values) = m.present(p)?;
+impl Prepared {
+    /// One measurement's present components and values onto the lists, as
+    /// [`Measurement::present`] finds them (its errors where it refuses the measurement), and
+    /// their whitening.
+    fn push(&mut self, p: usize, m: &Measurement) -> Result<Rows, Error> {
+        let start = self.present.len();
+        let usable = m.time.is_finite()
+            && m.values.len() == p
+            && m.values.iter().all(|v| v.is_none_or(f64::is_finite));
+        if usable {
+            for (k, v) in m.values.iter().enumerate() {
+                if let Some(v) = *v {
+                    self.present.push(k);
+                    self.values.push(v);
+                }
+            }
+        } else {
+            let (present, values) = m.present(p)?;
+            self.present.extend(present);
+            self.values.extend(values);
+        }
+        let whiten = whiten(p, m, &self.present[start..], &mut self.scale)?;
+        Ok(Rows {
+            time: m.time,
+            start,
+            count: self.present.len() - start,
+            whiten,
+        })
+    }
+}
+
+/// The whitening of a measurement's `present` components, their scales onto `scale` (1
+/// where `R` is full).
+fn whiten(
+    p: usize,
+    m: &Measurement,
+    present: &[usize],
+    scale: &mut Vec<f64>,
+) -> Result<Whiten, Error> {
     let bad = |value: String, reason: &str| Error::InvalidParameter {
         name: Param::MeasurementNoise,
         value,
         reason: reason.into(),
     };
-    let whiten = match &m.noise {
-        NoiseCovariance::Identity => Whiten::Scale(vec![1.0; present.len()]),
+    Ok(match &m.noise {
+        NoiseCovariance::Identity => {
+            scale.extend(present.iter().map(|_| 1.0));
+            Whiten::Scale
+        }
         NoiseCovariance::Variances(v) => {
             if v.len() != p {
                 return Err(bad(
@@ -143,8 +196,7 @@ fn prepare_one(p: usize, m: &Measurement) -> Result<Rows, Error> {
                     &format!("need {p}, one per component"),
                 ));
             }
-            let mut scale = Vec::with_capacity(present.len());
-            for &k in &present {
+            for &k in present {
                 if !(v[k].is_finite() && v[k] > 0.0) {
                     return Err(bad(
                         format!("variance {}", v[k]),
@@ -153,7 +205,7 @@ fn prepare_one(p: usize, m: &Measurement) -> Result<Rows, Error> {
                 }
                 scale.push(1.0 / v[k].sqrt());
             }
-            Whiten::Scale(scale)
+            Whiten::Scale
         }
         NoiseCovariance::Full(r) => {
             if r.shape() != (p, p) {
@@ -170,18 +222,13 @@ fn prepare_one(p: usize, m: &Measurement) -> Result<Rows, Error> {
             let sub = DMatrix::from_fn(present.len(), present.len(), |i, j| {
                 r[(present[i], present[j])]
             });
+            scale.extend(present.iter().map(|_| 1.0));
             match Cholesky::new(sub) {
                 Some(c) => Whiten::Factor(c),
-                None if present.is_empty() => Whiten::Scale(Vec::new()),
+                None if present.is_empty() => Whiten::Scale,
                 None => return Err(bad(format!("{r:?}"), "must be positive definite")),
             }
         }
-    };
-    Ok(Rows {
-        time: m.time,
-        present,
-        values,
-        whiten,
     })
 }
 
@@ -245,7 +292,9 @@ pub(super) struct Layout {
     before: Vec<usize>,
     pub(super) total: usize,
     /// `Φ(t_k, t_c)` of each row, once per fit, for dynamics whose `Φ` does not depend on the
-    /// state ([`Dynamics::is_linear`]), column-major `n × n` one after another.
+    /// state ([`Dynamics::is_linear`]), column-major `n × n` one after another; empty where
+    /// every row is the radar's, written without them ([`radar_rows`]), each then computed
+    /// only for a row that the radar's rows leave to the general path.
     transitions: Option<Vec<f64>>,
 }
 
@@ -255,7 +304,7 @@ impl Layout {
         let mut at = 0;
         for row in rows {
             offsets.push(at);
-            at += row.present.len();
+            at += row.count;
         }
         let mut order: Vec<usize> = (0..rows.len()).collect();
         order.sort_by(|&a, &b| rows[a].time.total_cmp(&rows[b].time));
@@ -271,14 +320,22 @@ impl Layout {
         }
     }
 
-    /// With each row's `Φ(t_k, t_c)`, carried from `t_c` directly (any state will do).
+    /// With each row's `Φ(t_k, t_c)`, carried from `t_c` directly (any state will do); none
+    /// stored for the radar's model with every row whitened by scales (`radar`), whose rows
+    /// [`radar_rows`] writes from `Φ`'s two terms (a row it leaves to the general path computes
+    /// its own then, the same numbers; the first linearisation is at `x`, where a `Φ x` that
+    /// is not finite gives the error it gives here).
     pub(super) fn with_transitions<D: Dynamics>(
         mut self,
         dynamics: &D,
         rows: &[Rows],
-        t_c: f64,
-        x: &DVector<f64>,
+        (t_c, x): (f64, &DVector<f64>),
+        radar: bool,
     ) -> Result<Self, Error> {
+        if radar && rows.iter().all(|r| matches!(r.whiten, Whiten::Scale)) {
+            self.transitions = Some(Vec::new());
+            return Ok(self);
+        }
         let n = x.len();
         let (mut state, mut phi) = (DVector::zeros(n), DMatrix::zeros(n, n));
         let mut all = Vec::with_capacity(rows.len() * n * n);
@@ -333,47 +390,61 @@ fn product_n<S: Size>(inner: S, rows: usize, a: &[f64], b: &[f64], out: &mut [f6
 /// Writes one observation's present rows, `M Φ` and the residuals, whitened, at `at`: each
 /// row times its scale `1/σ` as it is copied (the products of a copy scaled afterwards), or
 /// copied and then solved by the Cholesky factor of `R`.
+#[allow(clippy::too_many_arguments)]
 fn write_rows<O: Observation>(
     observation: &O,
     row: &Rows,
+    entries: Entries<'_>,
     at: usize,
     m: &DMatrix<f64>,
     value: &DVector<f64>,
     t: &mut DMatrix<f64>,
     r: &mut DVector<f64>,
 ) {
-    let (count, n) = (row.present.len(), m.ncols());
+    let (count, n) = (row.count, m.ncols());
+    let Entries {
+        present,
+        values,
+        scale,
+    } = entries;
     match &row.whiten {
-        Whiten::Scale(scale) => {
+        Whiten::Scale => {
             let (total, p) = (t.nrows(), m.nrows());
             let (t, m) = (t.as_mut_slice(), m.as_slice());
-            for (i, (&c, &s)) in row.present.iter().zip(scale).enumerate() {
+            for (i, (&c, &s)) in present.iter().zip(scale).enumerate() {
                 for j in 0..n {
                     t[at + i + j * total] = m[c + j * p] * s;
                 }
-                r[at + i] = observation.residual(c, row.values[i], value[c]) * s;
+                r[at + i] = observation.residual(c, values[i], value[c]) * s;
             }
         }
-        whiten => {
-            for (i, &c) in row.present.iter().enumerate() {
+        Whiten::Factor(factor) => {
+            for (i, &c) in present.iter().enumerate() {
                 t.row_mut(at + i).copy_from(&m.row(c));
-                r[at + i] = observation.residual(c, row.values[i], value[c]);
+                r[at + i] = observation.residual(c, values[i], value[c]);
             }
-            whiten.apply_matrix(&mut t.view_mut((at, 0), (count, n)));
-            whiten.apply_vector(&mut r.rows_mut(at, count));
+            let _ = factor
+                .l_dirty()
+                .solve_lower_triangular_mut(&mut t.view_mut((at, 0), (count, n)));
+            let _ = factor
+                .l_dirty()
+                .solve_lower_triangular_mut(&mut r.rows_mut(at, count));
         }
     }
 }
 
-impl<D: Dynamics, O: Observation> Model<'_, D, O> {
-    /// The radar, when the model is constant velocity on three axes seen by one radar
-    /// measuring range, azimuth and elevation: [`radar_rows`] writes its rows.
-    fn radar_cv(&self) -> Option<&Radar> {
-        let dynamics = self.dynamics.polynomial()?;
-        let radar = self.observation.as_radar()?;
-        (dynamics.degree() == 1 && dynamics.axes() == 3 && !radar.has_range_rate()).then_some(radar)
-    }
+/// The radar, when the model is constant velocity on three axes seen by one radar measuring
+/// range, azimuth and elevation: [`radar_rows`] writes its rows.
+pub(super) fn radar_cv<'a, D: Dynamics, O: Observation>(
+    dynamics: &D,
+    observation: &'a O,
+) -> Option<&'a Radar> {
+    let dynamics = dynamics.polynomial()?;
+    let radar = observation.as_radar()?;
+    (dynamics.degree() == 1 && dynamics.axes() == 3 && !radar.has_range_rate()).then_some(radar)
+}
 
+impl<D: Dynamics, O: Observation> Model<'_, D, O> {
     /// `T` and `δY` whitened, and `e(X̄)`, at the nominal `x` (state at `t_c`) into `out`:
     /// with each row's `Φ(t_k, t_c)` computed once ([`Layout::with_transitions`]), or carried
     /// outwards from `t_c` through the sorted times,
@@ -399,22 +470,31 @@ impl<D: Dynamics, O: Observation> Model<'_, D, O> {
         } = scratch;
         let (t, r) = (&mut out.t, &mut out.r);
         if let Some(transitions) = &layout.transitions {
-            let radar = self.radar_cv();
-            let phis = transitions.chunks_exact(n * n);
-            for (k, (row, phi)) in self.rows.iter().zip(phis).enumerate() {
-                if row.present.is_empty() {
+            let radar = radar_cv(self.dynamics, observation);
+            for (k, row) in self.rows.rows.iter().enumerate() {
+                if row.count == 0 {
                     continue;
                 }
-                if let (Some(radar), Whiten::Scale(scale)) = (radar, &row.whiten) {
+                let entries = self.rows.entries(row);
+                if let (Some(radar), Whiten::Scale) = (radar, &row.whiten) {
                     let at = layout.offsets[k];
-                    if radar_rows(radar, row, scale, self.t_c, x, at, t, r) {
+                    if radar_rows(radar, row.time, entries, self.t_c, x, at, t, r) {
                         continue;
                     }
                 }
+                let phi = match transitions.get(k * n * n..(k + 1) * n * n) {
+                    Some(stored) => stored,
+                    None => {
+                        self.dynamics
+                            .propagate_into(x, self.t_c, row.time, next, phi)?;
+                        phi.as_slice()
+                    }
+                };
                 product_slices(n, n, phi, x.as_slice(), next.as_mut_slice());
                 observation.predict_into(next, row.time, value, jacobian)?;
                 product_slices(m.nrows(), n, jacobian.as_slice(), phi, m.as_mut_slice());
-                write_rows(observation, row, layout.offsets[k], m, value, t, r);
+                let at = layout.offsets[k];
+                write_rows(observation, row, entries, at, m, value, t, r);
             }
         }
         let sides = match layout.transitions {
@@ -426,7 +506,7 @@ impl<D: Dynamics, O: Observation> Model<'_, D, O> {
             phi.fill_with_identity();
             let mut time = self.t_c;
             for &k in side {
-                let row = &self.rows[k];
+                let row = &self.rows.rows[k];
                 if row.time != time {
                     self.dynamics
                         .propagate_into(state, time, row.time, next, step)?;
@@ -435,12 +515,13 @@ impl<D: Dynamics, O: Observation> Model<'_, D, O> {
                     std::mem::swap(state, next);
                     time = row.time;
                 }
-                if row.present.is_empty() {
+                if row.count == 0 {
                     continue;
                 }
                 observation.predict_into(state, row.time, value, jacobian)?;
                 product_into(jacobian, phi, m);
-                write_rows(observation, row, layout.offsets[k], m, value, t, r);
+                let (entries, at) = (self.rows.entries(row), layout.offsets[k]);
+                write_rows(observation, row, entries, at, m, value, t, r);
             }
         }
         if let Some(p) = self.prior {
@@ -454,7 +535,7 @@ impl<D: Dynamics, O: Observation> Model<'_, D, O> {
         }
         let chi_squared = r.norm_squared();
         out.chi_squared = chi_squared;
-        if !chi_squared.is_finite() || t.iter().any(|v| !v.is_finite()) {
+        if !(chi_squared.is_finite() && all_finite(t.as_slice())) {
             return Err(Error::NonFinite {
                 what: "linearised observation system",
                 value: chi_squared,
@@ -476,16 +557,19 @@ impl<D: Dynamics, O: Observation> Model<'_, D, O> {
 #[inline(always)]
 fn radar_rows(
     radar: &Radar,
-    row: &Rows,
-    scale: &[f64],
+    time: f64,
+    entries: Entries<'_>,
     t_c: f64,
     x: &DVector<f64>,
     at: usize,
     t: &mut DMatrix<f64>,
     r: &mut DVector<f64>,
 ) -> bool {
-    let zeta = row.time - t_c;
+    let zeta = time - t_c;
     let (t0, t1) = (psi_term(0, &zeta), psi_term(1, &zeta));
+    let Ok(x) = <&[f64; 6]>::try_from(x.as_slice()) else {
+        return false;
+    };
     let next: [f64; 6] = std::array::from_fn(|i| {
         if i < 3 {
             t0 * x[i] + t1 * x[i + 3]
@@ -504,14 +588,25 @@ fn radar_rows(
         return false;
     }
     let total = t.nrows();
-    let t = t.as_mut_slice();
-    for (i, (&c, &s)) in row.present.iter().zip(scale).enumerate() {
-        let at = at + i;
+    let Entries {
+        present,
+        values,
+        scale,
+    } = entries;
+    let count = present.len().min(3);
+    // The rows into a block by columns of `T`, then each column's part copied at once.
+    let mut block = [[0.0; 3]; 6];
+    let mut residuals = [0.0; 3];
+    for (i, (&c, &s)) in present.iter().zip(scale).take(count).enumerate() {
         for l in 0..3 {
-            t[at + l * total] = j[c][l] * t0 * s;
-            t[at + (l + 3) * total] = j[c][l] * t1 * s;
+            block[l][i] = j[c][l] * t0 * s;
+            block[l + 3][i] = j[c][l] * t1 * s;
         }
-        r[at] = radar.residual(c, row.values[i], g[c]) * s;
+        residuals[i] = radar.residual(c, values[i], g[c]) * s;
     }
+    for (column, values) in t.as_mut_slice().chunks_exact_mut(total).zip(&block) {
+        column[at..at + count].copy_from_slice(&values[..count]);
+    }
+    r.as_mut_slice()[at..at + count].copy_from_slice(&residuals[..count]);
     true
 }
