@@ -3,9 +3,11 @@
 # file of ROWS rows of SERIES interleaved series with string ids (BENCHMARKS.md, "Polars
 # expressions"): each case in its own process under /usr/bin/time (wall time, peak resident set).
 #
-# Usage: [IDS=int] [CASES="..."] [PY=python] scripts/polars_bench.sh [ROWS] [SERIES]
+# Usage: [IDS=int] [CASES="..."] [PY=python] [TRACE=1] scripts/polars_bench.sh [ROWS] [SERIES]
 #        (defaults 10000000 and 100; all cases)
 #   IDS=int: integer ids (Int64) instead of strings ("sensor-0042")
+#   TRACE=1: each case also prints its resident set every 2 s (to stderr), to see whether
+#            it grows with the rows or stays on a plateau
 #   copy           pl.scan_parquet → sink_parquet: Polars' own streaming copy of the file, no
 #                  filter (the floor of any streaming query over it)
 #   filter_frame   pl.read_parquet → seqsmooth.filter_frame(by="id") → write_parquet
@@ -43,7 +45,10 @@ PY
 echo "input: $rows rows, $series series (${IDS:-str} ids), $(du -m "$tmp/in.parquet" | cut -f1) MB of Parquet"
 
 cat >"$tmp/case.py" <<'PY'
+import os
 import sys
+import threading
+import time
 
 import polars as pl
 
@@ -51,6 +56,17 @@ import seqsmooth
 import seqsmooth.polars as ssp
 
 case, source, out = sys.argv[1:4]
+if os.environ.get("TRACE"):
+
+    def watch():
+        start = time.time()
+        while True:
+            time.sleep(2.0)
+            with open("/proc/self/status") as f:
+                rss = next(int(line.split()[1]) for line in f if line.startswith("VmRSS"))
+            print(f"{case}: {time.time() - start:5.1f} s  RSS {rss // 1024} MB", file=sys.stderr)
+
+    threading.Thread(target=watch, daemon=True).start()
 settings = dict(kind="fading", degree=2, theta=0.9, tau=1.0, sigma=0.3)
 if case == "copy":
     pl.scan_parquet(source).sink_parquet(out)
