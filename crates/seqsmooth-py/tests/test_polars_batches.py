@@ -220,3 +220,19 @@ def test_kalman_batches_bad_row(frame):
         query.collect()
     assert got.value.index == 700
     assert str(got.value).startswith(f"row 700 (series {bad['id'][700]!r} of column 'id'): ")
+
+
+def test_empty_ids_refused_as_filter_frame_refuses_them(frame):
+    """A null id (a NaN one in a float column) names no series: refused with its row, as
+    filter_frame refuses it."""
+    settings = KINDS["fading"]
+    row = pl.int_range(pl.len()) == 300
+    null = frame.with_columns(id=pl.when(row).then(None).otherwise(pl.col("id")))
+    numbered = frame.with_columns(
+        id=pl.when(row).then(float("nan")).otherwise(pl.col("id").str.slice(7).cast(pl.Float64))
+    )
+    for bad in [null, numbered]:
+        with pytest.raises(ss.InvalidInputError, match="row 300: the 'id' cell is empty"):
+            ss.filter_frame(bad, by="id", **settings)
+        with pytest.raises(ss.InvalidInputError, match="row 300: the 'id' cell is empty"):
+            ssp.filter_batches(bad.lazy(), by="id", chunk_size=100, **settings).collect()

@@ -193,8 +193,11 @@ class _Series:
 
     def codes(self, keys: pl.Series, first: int) -> np.ndarray:
         """The series numbers of ``keys`` (rows ``first``.. of the stream)."""
-        if keys.null_count():
-            i = first + int(keys.is_null().arg_true()[0])
+        empty = keys.is_null()
+        if keys.dtype.is_float():
+            empty = empty | keys.is_nan()  # NaN names no series (filter_frame: empty)
+        if empty.any():
+            i = first + int(empty.arg_true()[0])
             raise InvalidInputError(f"row {i}: the {self.by!r} cell is empty (no series)", i)
         # The keys of the batch in order of first appearance, then each one's number in the
         # stream (a new key: the count of keys before it).
