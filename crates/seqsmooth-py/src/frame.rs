@@ -78,56 +78,22 @@ pub fn filter_series<'py>(
             }
         }
     }
-    let kind = match kind {
-        "expanding" => FilterKind::Expanding,
-        "fading" => FilterKind::Fading,
-        "fixed" => FilterKind::Fixed,
-        "auto" => FilterKind::Automatic,
-        other => {
-            return Err(raise(
-                Kind::Parameter,
-                format!("kind {other:?} is not one of 'expanding', 'fading', 'fixed', 'auto'"),
-                None,
-            ))
-        }
-    };
-    let spec = FilterSpec {
+    let spec = spec(
+        kind,
+        degree,
         theta,
         tau,
         window,
+        engine,
         sigma,
         review_window,
-        ..FilterSpec::new(kind, degree)
-    };
-    let spec = match kind {
-        FilterKind::Fixed => FilterSpec {
-            fixed_engine: fixed_engine(engine.unwrap_or("adaptive"))?,
-            ..spec
-        },
-        // Without tau, the library's default: the median time step within series, as
-        // `seqsmooth filter` takes it without --tau.
-        _ => FilterSpec {
-            engine: engine_named(engine.unwrap_or("exact"))?,
-            ..spec
-        }
-        .with_default_tau(t, &channels, true)
-        .py()?,
-    };
+    )?;
+    // Without tau, the library's default: the median time step within series, as
+    // `seqsmooth filter` takes it without --tau.
+    let spec = spec.with_default_tau(t, &channels, true).py()?;
     let prototype = spec.build().py()?;
-    // The kind's cells (fixed memory's `window`, the automatic filter's `noise`, `outlier`,
-    // `misfit`, `bias`); the automatic filter always has its 1σ.
+    let (layout, names) = rows_of(&spec, &prototype);
     let extra = prototype.trailing_columns();
-    let layout = RowLayout {
-        sigma: spec.writes_sigma(),
-        lead: 0.0,
-        trailing: !extra.is_empty(),
-    };
-    let width = degree + 1;
-    let mut names: Vec<String> = (0..width).map(|k| format!("d{k}")).collect();
-    if layout.sigma {
-        names.extend((0..width).map(|k| format!("s{k}")));
-    }
-    names.extend(extra.iter().map(|c| c.to_string()));
     let shown = names.len();
     let stride = prototype.stride(layout);
     let mut out = vec![0.0; n * stride];
@@ -157,6 +123,72 @@ pub fn filter_series<'py>(
     out.truncate(shown * n);
     let values = matrix(py, out, shown, n)?;
     Ok((values, names).into_pyobject(py)?.into_any())
+}
+
+/// The filter of `kind` (``"expanding"``, ``"fading"``, ``"fixed"``, ``"auto"``) with
+/// `filter_series`' settings, its `τ` as given (the default not resolved yet).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn spec(
+    kind: &str,
+    degree: usize,
+    theta: Option<f64>,
+    tau: Option<f64>,
+    window: Option<usize>,
+    engine: Option<&str>,
+    sigma: Option<f64>,
+    review_window: Option<usize>,
+) -> PyResult<FilterSpec> {
+    let kind = match kind {
+        "expanding" => FilterKind::Expanding,
+        "fading" => FilterKind::Fading,
+        "fixed" => FilterKind::Fixed,
+        "auto" => FilterKind::Automatic,
+        other => {
+            return Err(raise(
+                Kind::Parameter,
+                format!("kind {other:?} is not one of 'expanding', 'fading', 'fixed', 'auto'"),
+                None,
+            ))
+        }
+    };
+    let spec = FilterSpec {
+        theta,
+        tau,
+        window,
+        sigma,
+        review_window,
+        ..FilterSpec::new(kind, degree)
+    };
+    Ok(match kind {
+        FilterKind::Fixed => FilterSpec {
+            fixed_engine: fixed_engine(engine.unwrap_or("adaptive"))?,
+            ..spec
+        },
+        _ => FilterSpec {
+            engine: engine_named(engine.unwrap_or("exact"))?,
+            ..spec
+        },
+    })
+}
+
+/// The rows `prototype` (built from `spec`) writes for `filter_series`, and the names of the
+/// columns shown: ``d0..dM``, with σ ``s0..sM``, then the kind's cells (fixed memory's
+/// `window`, the automatic filter's `noise`, `outlier`, `misfit`, `bias`; the automatic filter
+/// always has its 1σ). The automatic filter's decision cells follow, not shown.
+pub(crate) fn rows_of(spec: &FilterSpec, prototype: &AnyFilter) -> (RowLayout, Vec<String>) {
+    let extra = prototype.trailing_columns();
+    let layout = RowLayout {
+        sigma: spec.writes_sigma(),
+        lead: 0.0,
+        trailing: !extra.is_empty(),
+    };
+    let width = spec.degree + 1;
+    let mut names: Vec<String> = (0..width).map(|k| format!("d{k}")).collect();
+    if layout.sigma {
+        names.extend((0..width).map(|k| format!("s{k}")));
+    }
+    names.extend(extra.iter().map(|c| c.to_string()));
+    (layout, names)
 }
 
 /// Sets each row's `outlier` cell in `flags` (by row; empty where the filter withheld the

@@ -23,6 +23,7 @@ mod paml;
 mod persist;
 mod polynomial;
 mod smooth;
+mod stream;
 mod tables;
 mod track;
 mod unscented;
@@ -54,6 +55,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<models::PyCoordinatedTurn>()?;
     m.add_class::<fit::PySlidingFit>()?;
     m.add_class::<merge::PyInformation>()?;
+    m.add_class::<stream::PyFilterStream>()?;
     m.add_function(wrap_pyfunction!(smooth::smooth, m)?)?;
     m.add_function(wrap_pyfunction!(model_fit::fit_model, m)?)?;
     m.add_function(wrap_pyfunction!(frame::filter_series, m)?)?;
@@ -70,6 +72,7 @@ fn _seqsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<paml::PyCurveFit>()?;
     m.add_function(wrap_pyfunction!(arrays::seconds, m)?)?;
     m.add("MAX_DEGREE", seqsmooth::polynomial::MAX_DEGREE)?;
+    m.add("TAU_SCAN_ROWS", seqsmooth::polynomial::tau::TAU_SCAN_ROWS)?;
     // The one version: the workspace's Cargo version, which maturin also gives the package.
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

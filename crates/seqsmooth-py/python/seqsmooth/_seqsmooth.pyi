@@ -129,6 +129,43 @@ def filter_series(
     ``outlier`` (final), ``misfit``, ``bias``)."""
     ...
 
+class FilterStream:
+    """``filter_series`` kept open: rows of many series that come in chunks, one filter per
+    series carried from chunk to chunk (the library's ``StreamBank``, as ``seqsmooth filter
+    --id-col``); the numbers of ``filter_series`` on all the rows at once, bit for bit."""
+
+    def __init__(
+        self,
+        kind: Literal["expanding", "fading", "fixed", "auto"],
+        degree: int,
+        theta: float | None = None,
+        tau: float | None = None,
+        window: int | None = None,
+        engine: str | None = None,
+        sigma: float | None = None,
+        review_window: int | None = None,
+    ) -> None: ...
+    @property
+    def names(self) -> list[str]:
+        """The columns ``update`` gives back (``filter_series``' names)."""
+    @property
+    def rows(self) -> int:
+        """Rows taken so far."""
+    @property
+    def waiting(self) -> int:
+        """Rows taken, not given back yet (``auto``: their outlier decision to come)."""
+    def update(
+        self, codes: npt.NDArray[np.int64], t: ArrayLike, y: ArrayLike, last: bool = False
+    ) -> tuple[Matrix, int]:
+        """A chunk of rows (``codes``: each series numbered from 0 in order of first
+        appearance in the stream); the columns ``(columns, rows)`` of the next ``rows`` rows of
+        the stream (``auto``: up to the first whose outlier decision is still to come; with
+        ``last``, all). Without ``tau`` the first chunk holds ``TAU_SCAN_ROWS`` rows or all."""
+        ...
+
+TAU_SCAN_ROWS: int
+"""Rows the default ``tau`` (the median time step within series) is taken from."""
+
 def seconds(t: ArrayLike, name: str = "t") -> Vector:
     """Times as every entry point reads them: numbers as they are; dates (numpy datetime64 of
     any unit, pandas datetime columns, tz-aware too, Polars Datetime/Date, Arrow timestamps and

@@ -22,20 +22,36 @@ the Polars crates (docs/python.md, "Polars expressions"). The filter is sequenti
 call receives a whole series (with ``.over(id)``, one series; without, the whole column), so
 Polars holds the series' columns in memory even in the streaming engine: memory is bounded by
 the longest series' columns, not by the filter's window (BENCHMARKS.md, "Polars expressions").
+
+Which to use: the expressions for frames that fit in memory (any query, any columns kept,
+``.over(id)``); :func:`filter_batches` for data larger than memory, such as a long Parquet
+log of many interleaved sensors: it takes a lazy query's ordered batches from the streaming
+engine through one filter per series, carried from batch to batch (the library's stream
+bank, as ``seqsmooth filter --id-col``), and is itself a lazy query, in memory bounded by the
+number of series and the batch size, not by the rows; :func:`sink_parquet` writes such a
+query to a Parquet file without ever leaving a half-written one::
+
+    lf = pl.scan_parquet("log.parquet")  # columns id, t, y; series interleaved
+    out = ssp.filter_batches(lf, by="id", kind="fading", degree=2, theta=0.9, tau=1.0)
+    ssp.sink_parquet(out, "estimates.parquet")
 """
 
 from __future__ import annotations
 
+import os
+import tempfile
+from collections.abc import Iterator
 from typing import Any, Literal
 
 import numpy as np
 import polars as pl
+from polars.io.plugins import register_io_source
 
-from ._seqsmooth import KalmanFilter, filter_series, seconds
+from ._seqsmooth import TAU_SCAN_ROWS, FilterStream, KalmanFilter, filter_series, seconds
 from ._seqsmooth import smooth as _smooth
-from .errors import ParameterError
+from .errors import InvalidInputError, ParameterError, SeqsmoothError
 
-__all__ = ["filter", "smooth", "kalman"]
+__all__ = ["filter", "smooth", "kalman", "filter_batches", "kalman_batches", "sink_parquet"]
 
 
 def _expr(column: str | pl.Expr) -> pl.Expr:
@@ -165,3 +181,297 @@ def kalman(
         return [states[:, k] for k in range(width)] + [sd[:, k] for k in range(width)] + [nis]
 
     return _map(value, time, names, run)
+
+
+class _Series:
+    """Each key's series number, from 0 in order of first appearance in the stream."""
+
+    def __init__(self, by: str) -> None:
+        self.by = by
+        self.numbers: dict[Any, int] = {}
+        self.names: list[Any] = []
+
+    def codes(self, keys: pl.Series, first: int) -> np.ndarray:
+        """The series numbers of ``keys`` (rows ``first``.. of the stream)."""
+        empty = keys.is_null()
+        if keys.dtype.is_float():
+            empty = empty | keys.is_nan()  # NaN names no series (filter_frame: empty)
+        if empty.any():
+            i = first + int(empty.arg_true()[0])
+            raise InvalidInputError(f"row {i}: the {self.by!r} cell is empty (no series)", i)
+        # The keys of the batch in order of first appearance, then each one's number in the
+        # stream (a new key: the count of keys before it).
+        firsts = keys.unique(maintain_order=True)
+        known = []
+        for k in firsts.to_list():
+            if k not in self.numbers:
+                self.numbers[k] = len(self.names)
+                self.names.append(k)
+            known.append(self.numbers[k])
+        table = pl.DataFrame({"k": firsts, "c": np.asarray(known, dtype=np.int64)})
+        joined = keys.to_frame("k").join(table, on="k", how="left", maintain_order="left")
+        return joined["c"].to_numpy().astype(np.int64, copy=False)
+
+
+def _ahead(batches: Iterator[pl.DataFrame]) -> Iterator[tuple[pl.DataFrame, bool]]:
+    """Each non-empty batch with whether it is the last."""
+    held = None
+    for batch in batches:
+        if batch.height == 0:
+            continue
+        if held is not None:
+            yield held, False
+        held = batch
+    if held is not None:
+        yield held, True
+
+
+def _batches(
+    lf: pl.LazyFrame,
+    time: str,
+    value: str,
+    by: str | None,
+    names: list[str],
+    start: Any,
+    hold: int,
+    chunk_size: int | None,
+    explain: str,
+) -> pl.LazyFrame:
+    """The LazyFrame of ``[by,] time, value`` and the columns ``names`` of a stream made by
+    ``start()`` (``.rows`` taken so far; ``.update(codes, t, y, last) -> (values, ready)``:
+    the columns of its next ``ready`` rows), fed ``lf``'s batches in order from the streaming
+    engine, the first ``hold`` rows at once."""
+    lf = lf.lazy()
+    source = lf.collect_schema()
+    for column in [c for c in (by, time, value) if c is not None]:
+        if column not in source:
+            raise InvalidInputError(
+                f"no column {column!r} in the frame (columns: {source.names()})"
+            )
+    schema: dict[str, Any] = {} if by is None else {by: source[by]}
+    schema |= {time: pl.Float64, value: pl.Float64} | {n: pl.Float64 for n in names}
+    inputs = lf.select([c for c in (by, time, value) if c is not None])
+
+    def rows() -> Iterator[pl.DataFrame]:
+        stream = start()
+        series = None if by is None else _Series(by)
+        pending: pl.DataFrame | None = None  # rows taken, not given back yet
+        batches = inputs.collect_batches(chunk_size=chunk_size, engine="streaming")
+        first: list[pl.DataFrame] = []
+        for batch, last in _ahead(iter(batches)):
+            if stream.rows == 0 and hold:
+                first.append(batch)
+                if not last and sum(b.height for b in first) < hold:
+                    continue
+                batch, first = pl.concat(first, rechunk=True), []
+            start_row = stream.rows
+            t = seconds(batch[time], time)
+            y = np.ascontiguousarray(np.asarray(batch[value]), dtype=np.float64)
+            codes = (
+                np.zeros(len(t), np.int64) if series is None else series.codes(batch[by], start_row)
+            )
+            try:
+                values, ready = stream.update(codes, t, y, last)
+            except SeqsmoothError as e:
+                if e.index is None or series is None:
+                    raise
+                # filter_frame's words: the row among all rows and its series.
+                name = series.names[codes[e.index - start_row]]
+                message = str(e)
+                if message.startswith("sample ") and ": " in message:
+                    message = message.split(": ", 1)[1]
+                raise type(e)(
+                    f"row {e.index} (series {name!r} of column {by!r}): {message}", e.index
+                ) from e
+            taken = ({} if by is None else {by: batch[by]}) | {time: t, value: y}
+            taken = pl.DataFrame(taken, schema={c: schema[c] for c in taken})
+            pending = taken if pending is None else pl.concat([pending, taken])
+            if ready:
+                out = pending.head(ready).hstack([pl.Series(n, v) for n, v in zip(names, values)])
+                # The rows still waiting in buffers of their own (a slice would keep the
+                # batches' buffers alive).
+                pending = pending.slice(ready).rechunk() if ready < pending.height else None
+                yield out
+
+    def io_source(
+        with_columns: list[str] | None,
+        predicate: pl.Expr | None,
+        n_rows: int | None,
+        batch_size: int | None,
+    ) -> Iterator[pl.DataFrame]:
+        left = n_rows
+        for out in rows():
+            if with_columns is not None:
+                out = out.select(with_columns)
+            if predicate is not None:
+                out = out.filter(predicate)
+            if left is not None:
+                out = out.head(left)
+                left -= out.height
+            yield out
+            if left is not None and left <= 0:
+                return
+
+    return register_io_source(io_source, schema=schema, explain_name=explain)
+
+
+def filter_batches(
+    lf: pl.LazyFrame | pl.DataFrame,
+    time: str = "t",
+    value: str = "y",
+    by: str | None = None,
+    kind: Literal["expanding", "fading", "fixed", "auto"] = "fading",
+    degree: int = 1,
+    theta: float | None = None,
+    tau: float | None = None,
+    window: int | None = None,
+    engine: str | None = None,
+    sigma: float | None = None,
+    review_window: int | None = None,
+    chunk_size: int | None = 1 << 15,
+) -> pl.LazyFrame:
+    """:func:`seqsmooth.filter_frame` over a lazy query, batch by batch: a LazyFrame of
+    ``filter_frame``'s rows (``[by,] time, value, d0..dM``, ``s0..sM``, the kind's cells; the
+    time in seconds, the rows in input order), bit for bit, for data larger than memory.
+
+    Collecting the result (``collect``, ``sink_parquet``, :func:`sink_parquet`,
+    ``collect_batches``) runs ``lf`` in Polars' streaming engine and takes its batches in
+    order (``collect_batches``, ``maintain_order``), each through one filter per series,
+    carried from batch to batch (``FilterStream``: the library's stream bank, ``seqsmooth
+    filter --id-col``'s engine): memory holds one filter per series, a few batches
+    (``chunk_size`` rows each; ``None``: Polars' default, about 10⁵ rows here) and, for
+    ``auto``, the rows whose outlier decision is still to come, not all the rows. Each
+    collection runs the whole stream again from its start.
+
+    Which to use: the expressions (:func:`filter`) for frames in memory and for queries that
+    keep other columns; this for a stream longer than memory, in one pass. The settings are
+    ``filter_frame``'s; without ``tau``, ``fading`` and ``auto`` take ``filter_frame``'s
+    default from the first ``TAU_SCAN_ROWS`` rows, which are held before the first estimate.
+
+    Raises
+    ------
+    SeqsmoothError
+        At once for settings the filter refuses; while collecting, for a bad row, with its
+        index among all rows and its series (the batches before it already given out: write
+        with :func:`sink_parquet`, which then leaves no file).
+    """
+    settings = dict(
+        theta=theta,
+        tau=tau,
+        window=window,
+        engine=engine,
+        sigma=sigma,
+        review_window=review_window,
+    )
+    names = FilterStream(kind, degree, **settings).names  # the settings checked now
+    hold = TAU_SCAN_ROWS if tau is None and kind in ("fading", "auto") else 0
+    return _batches(
+        lf,
+        time,
+        value,
+        by,
+        names,
+        lambda: FilterStream(kind, degree, **settings),
+        hold,
+        chunk_size,
+        "seqsmooth.filter_batches",
+    )
+
+
+class _KalmanStream:
+    """One :class:`seqsmooth.KalmanFilter` per series, each from ``x0``, ``P0`` at ``t0``
+    (default its first time), carried from batch to batch; each batch's rows of a series go
+    to its ``update_many`` at once."""
+
+    def __init__(self, degree: int, x0: Any, P0: Any, R: float, t0: Any, settings: Any):
+        self.degree, self.x0, self.P0, self.R, self.t0 = degree, x0, P0, R, t0
+        self.settings = settings
+        self.filters: list[KalmanFilter] = []
+        self.rows = 0
+
+    def update(
+        self, codes: np.ndarray, t: np.ndarray, y: np.ndarray, last: bool
+    ) -> tuple[np.ndarray, int]:
+        width = self.degree + 1
+        out = np.empty((2 * width + 1, len(t)))
+        order = np.argsort(codes, kind="stable")
+        for rows in np.split(order, np.flatnonzero(np.diff(codes[order])) + 1):
+            c = int(codes[rows[0]])
+            if c == len(self.filters):
+                start = t[rows[0]] if self.t0 is None else self.t0
+                self.filters.append(
+                    KalmanFilter(self.degree, self.x0, self.P0, start, **self.settings)
+                )
+            try:
+                states, covariances, nis = self.filters[c].update_many(t[rows], y[rows], self.R)
+            except SeqsmoothError as e:
+                if e.index is None:
+                    raise
+                i = self.rows + int(rows[e.index])
+                message = str(e)
+                if message.startswith("sample ") and ": " in message:
+                    message = message.split(": ", 1)[1]
+                raise type(e)(f"sample {i} of the batch: {message}", i) from e
+            sd = np.sqrt(np.diagonal(covariances, axis1=1, axis2=2))
+            out[:width, rows] = states.T
+            out[width : 2 * width, rows] = sd.T
+            out[2 * width, rows] = nis
+        self.rows += len(t)
+        return out, len(t)
+
+
+def kalman_batches(
+    lf: pl.LazyFrame | pl.DataFrame,
+    time: str = "t",
+    value: str = "y",
+    by: str | None = None,
+    *,
+    degree: int,
+    x0: Any,
+    P0: Any,
+    R: float,
+    q: float = 0.0,
+    t0: float | None = None,
+    theta: float | None = None,
+    tau: float | None = None,
+    chunk_size: int | None = 1 << 15,
+) -> pl.LazyFrame:
+    """The expression :func:`kalman` with ``.over(by)``, batch by batch, as
+    :func:`filter_batches` runs ``filter_frame``: a LazyFrame of ``[by,] time, value``
+    (the time in seconds) and ``d0..dM``, ``s0..sM``, ``nis``, the numbers of one
+    :class:`seqsmooth.KalmanFilter` per series (from ``x0``, ``P0`` at ``t0``, default the
+    series' first time) carried from batch to batch, bit for bit those of the expression;
+    memory holds one filter per series and a few batches."""
+    settings = dict(q=q, theta=theta, tau=tau)
+    KalmanFilter(degree, x0, P0, 0.0 if t0 is None else t0, **settings)  # settings checked now
+    width = degree + 1
+    names = [f"d{k}" for k in range(width)] + [f"s{k}" for k in range(width)] + ["nis"]
+    return _batches(
+        lf,
+        time,
+        value,
+        by,
+        names,
+        lambda: _KalmanStream(degree, x0, P0, R, t0, settings),
+        0,
+        chunk_size,
+        "seqsmooth.kalman_batches",
+    )
+
+
+def sink_parquet(query: pl.LazyFrame, path: str | os.PathLike[str], **kwargs: Any) -> None:
+    """``query.sink_parquet(path, **kwargs)`` (Polars' streaming engine) that never leaves a
+    half-written file: the rows go to a temporary file in ``path``'s directory, renamed to
+    ``path`` once complete (an existing file is replaced only then, atomically); on an error
+    the temporary file is removed and ``path`` is untouched."""
+    path = os.fspath(path)
+    directory, name = os.path.split(os.path.abspath(path))
+    fd, temporary = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=directory)
+    os.close(fd)
+    try:
+        query.sink_parquet(temporary, **kwargs)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+        raise
