@@ -48,6 +48,9 @@ pub struct PyAutomaticFilter {
     /// The samples whose final outlier decision has been reported (`update_many`'s
     /// `decided`, then `finish`).
     decided: u64,
+    /// Final decisions made but not reported yet (by a call that then refused a sample),
+    /// reported first by the next call: at most the review's window and a refused batch's.
+    waiting: Vec<bool>,
 }
 
 #[pymethods]
@@ -55,17 +58,20 @@ impl PyAutomaticFilter {
     /// ``pickle`` support (``copy.copy`` and ``copy.deepcopy`` too): the filter's state in
     /// the library's saved form, restored bit for bit. Filters are mutable: a copy is a deep
     /// copy of the state, and the copy and the original then run apart.
-    /// The state is the library's saved form and the count of final decisions reported.
+    /// The state is the library's saved form, the count of final decisions reported and the
+    /// decisions made but not reported yet.
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
         let py = slf.py();
         let me = slf.borrow();
-        let state = PyTuple::new(
+        let waiting: Vec<u8> = me.waiting.iter().map(|&d| u8::from(d)).collect();
+        let decisions = PyTuple::new(
             py,
             [
-                persist::save(py, &me.filter)?,
                 me.decided.into_pyobject(py)?.into_any(),
+                PyBytes::new(py, &waiting).into_any(),
             ],
         )?;
+        let state = PyTuple::new(py, [persist::save(py, &me.filter)?, decisions.into_any()])?;
         persist::reduce(slf.as_any(), state.into_any())
     }
 
@@ -80,25 +86,37 @@ impl PyAutomaticFilter {
                 "the state of another filter than an AutomaticFilter",
             ));
         }
-        // The count of decisions reported; a pickle of an earlier version kept the decisions
-        // themselves (bytes of 0 and 1), whose count it is.
+        // The count of decisions reported and those waiting; a pickle of an earlier version
+        // kept every decision made (bytes of 0 and 1), none of them reported yet.
         let item = items.get_item(1)?;
-        let decided = if let Ok(bytes) = item.cast::<PyBytes>() {
+        let flags = |bytes: &Bound<'_, PyBytes>| -> PyResult<Vec<bool>> {
             let bytes = bytes.as_bytes();
             if bytes.iter().any(|&d| d > 1) {
                 return Err(persist::damaged("the decisions are not 0 or 1"));
             }
-            bytes.len() as u64
-        } else if let Ok(count) = item.cast::<PyInt>() {
-            count
-                .extract::<u64>()
-                .map_err(|_| persist::damaged("the count of decisions is not a count"))?
-        } else {
-            return Err(persist::damaged(
-                "the decisions are neither a count nor bytes",
-            ));
+            Ok(bytes.iter().map(|&d| d == 1).collect())
         };
-        Ok(Self { filter, decided })
+        let (decided, waiting) = if let Ok(bytes) = item.cast::<PyBytes>() {
+            (0, flags(bytes)?)
+        } else {
+            let pair = persist::items(&item, 2)?;
+            let count = pair.get_item(0)?;
+            let count = count
+                .cast::<PyInt>()
+                .ok()
+                .and_then(|c| c.extract::<u64>().ok())
+                .ok_or_else(|| persist::damaged("the count of decisions is not a count"))?;
+            let waiting = pair.get_item(1)?;
+            let waiting = waiting
+                .cast::<PyBytes>()
+                .map_err(|_| persist::damaged("the waiting decisions are not bytes"))?;
+            (count, flags(waiting)?)
+        };
+        Ok(Self {
+            filter,
+            decided,
+            waiting,
+        })
     }
 
     #[new]
@@ -123,6 +141,7 @@ impl PyAutomaticFilter {
         Ok(Self {
             filter: spec.build().py()?,
             decided: 0,
+            waiting: Vec::new(),
         })
     }
 
@@ -185,9 +204,15 @@ impl PyAutomaticFilter {
             _ => n,
         };
         let cells = |i: usize| &rows[i * stride + 2 * w + 4..(i + 1) * stride];
-        let decided: Vec<bool> = (0..taken).flat_map(|i| decisions(cells(i))).collect();
+        // Those still waiting from a refused call first, then this call's; kept for the next
+        // call if this one refused a sample (its error is what this call returns).
+        let mut decided = std::mem::take(&mut self.waiting);
+        decided.extend((0..taken).flat_map(|i| decisions(cells(i))));
+        if let Err(e) = run {
+            self.waiting = decided;
+            return Err(e).py();
+        }
         self.decided += decided.len() as u64;
-        run.py()?;
         let column = |k: usize| (0..n).map(|i| rows[i * stride + k]).collect::<Vec<f64>>();
         let flag = |k: usize| {
             (0..n)
@@ -216,8 +241,10 @@ impl PyAutomaticFilter {
     /// :attr:`decided` on: after the ``decided`` arrays of every ``update_many``, they make
     /// the final decision of every sample taken (the library's ``AutomaticFilter::finish``).
     fn finish<'py>(&mut self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        let tail = self.filter.automatic_mut().map(AutomaticFilter::finish);
-        let tail = tail.unwrap_or_default();
+        let mut tail = std::mem::take(&mut self.waiting);
+        if let Some(f) = self.filter.automatic_mut() {
+            tail.extend(f.finish());
+        }
         self.decided += tail.len() as u64;
         PyArray1::from_vec(py, tail)
     }

@@ -66,12 +66,26 @@ def test_equals_the_command(tmp_path, rng, sigma):
     rest = h.update_many(t[251:], y[251:])["decided"]
     assert abs(len(pickle.dumps(h)) - small) < 200
     assert np.array_equal(np.concatenate([first, rest, h.finish()]), final)
-    # A pickle of an earlier version kept the decisions themselves: their count is taken.
+    # A refused sample: the decisions its call made before it are reported by the next call
+    # (and survive a pickle), none lost.
+    e = ss.AutomaticFilter(degree=m, theta=0.95, tau=1.0, sigma=sigma)
+    first = e.update_many(t[:200], y[:200])["decided"]
+    with pytest.raises(ss.InvalidInputError) as bad:
+        e.update_many(np.append(t[200:260], t[259]), np.append(y[200:260], 0.0))
+    assert bad.value.index == 60 and e.decided == len(first)
+    e = pickle.loads(pickle.dumps(e))
+    rest = e.update_many(t[260:], y[260:])["decided"]
+    assert np.array_equal(np.concatenate([first, rest, e.finish()]), final)
+    # A pickle of an earlier version kept every decision made, none reported: the next call
+    # reports them, from the first sample.
     fn, (cls, (body, _)) = g.__reduce__()
     old = fn(cls, (body, bytes(len(final) - 3) + b"\x01\x00\x01"))
-    assert old.decided == len(final)
+    assert old.decided == 0
+    assert np.array_equal(old.finish(), [False] * (len(final) - 3) + [True, False, True])
     with pytest.raises(ss.DamagedStateError):
         fn(cls, (body, b"\x02"))
+    with pytest.raises(ss.DamagedStateError):
+        fn(cls, (body, (-1, b"")))
 
 
 def test_errors():

@@ -236,3 +236,36 @@ def test_empty_ids_refused_as_filter_frame_refuses_them(frame):
             ss.filter_frame(bad, by="id", **settings)
         with pytest.raises(ss.InvalidInputError, match="row 300: the 'id' cell is empty"):
             ssp.filter_batches(bad.lazy(), by="id", chunk_size=100, **settings).collect()
+
+
+def test_a_null_time_named_by_its_row_among_all_rows(frame):
+    """A null date in a later batch: its row among all rows and its series (not its place in
+    the batch)."""
+    dated = frame.with_columns(t=(pl.col("t") * 1e6).cast(pl.Datetime("us")))
+    bad = dated.with_columns(t=pl.when(pl.int_range(pl.len()) == 700).then(None).otherwise("t"))
+    with pytest.raises(ss.InvalidInputError) as want:
+        ss.filter_frame(bad, by="id", **KINDS["fading"])
+    query = ssp.filter_batches(bad.lazy(), by="id", chunk_size=100, **KINDS["fading"])
+    with pytest.raises(ss.InvalidInputError) as got:
+        query.collect()
+    assert got.value.index == 700 == want.value.index
+    assert str(got.value).startswith(f"row 700 (series {bad['id'][700]!r}): ")
+
+
+def test_sink_parquet_keeps_modes_makes_directories_and_refuses_lazy(frame, tmp_path):
+    query = ssp.filter_batches(frame.lazy(), by="id", **KINDS["fading"])
+    target = tmp_path / "out.parquet"
+    target.write_bytes(b"old")
+    target.chmod(0o640)
+    ssp.sink_parquet(query, target)
+    assert (target.stat().st_mode & 0o777) == 0o640 and pl.read_parquet(target).height > 0
+    fresh = tmp_path / "new" / "deeper" / "out.parquet"
+    ssp.sink_parquet(query, fresh, mkdir=True)
+    assert pl.read_parquet(fresh).height == frame.height
+    assert (fresh.stat().st_mode & 0o077) == (0o666 & ~ssp._umask() & 0o077)
+    with pytest.raises(ss.ParameterError, match="lazy"):
+        ssp.sink_parquet(query, target, lazy=True)
+    with pytest.raises(ss.ParameterError, match="local file"):
+        ssp.sink_parquet(query, "s3://bucket/out.parquet")
+    assert pl.read_parquet(target).height == frame.height  # untouched by the refusals
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["new", "out.parquet"]

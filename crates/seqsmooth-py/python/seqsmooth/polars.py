@@ -265,11 +265,21 @@ def _batches(
                     continue
                 batch, first = pl.concat(first, rechunk=True), []
             start_row = stream.rows
-            t = seconds(batch[time], time)
-            y = np.ascontiguousarray(np.asarray(batch[value]), dtype=np.float64)
             codes = (
-                np.zeros(len(t), np.int64) if series is None else series.codes(batch[by], start_row)
+                np.zeros(batch.height, np.int64)
+                if series is None
+                else series.codes(batch[by], start_row)
             )
+            try:
+                t = seconds(batch[time], time)
+            except SeqsmoothError as e:
+                if e.index is None:
+                    raise
+                # A time that is no time (a null date): its row among all rows, as filter_frame.
+                row = start_row + e.index
+                named = "" if series is None else f" (series {series.names[codes[e.index]]!r})"
+                raise type(e)(f"row {row}{named}: {e}", row) from e
+            y = np.ascontiguousarray(np.asarray(batch[value]), dtype=np.float64)
             try:
                 values, ready = stream.update(codes, t, y, last)
             except SeqsmoothError as e:
@@ -340,7 +350,10 @@ def filter_batches(
     carried from batch to batch (``FilterStream``: the library's stream bank, ``seqsmooth
     filter --id-col``'s engine): memory holds one filter per series, a few batches
     (``chunk_size`` rows each; ``None``: Polars' default, about 10⁵ rows here) and, for
-    ``auto``, the rows whose outlier decision is still to come, not all the rows. Each
+    ``auto``, the rows from the oldest one whose outlier decision is still to come (rows go
+    out in input order, and a sample is decided ``review_window`` samples of its series
+    later: a series that falls silent holds every row after its last ones until it speaks
+    again or the stream ends, as ``seqsmooth filter --id-col --kind auto`` does). Each
     collection runs the whole stream again from its start.
 
     Which to use: the expressions (:func:`filter`) for frames in memory and for queries that
@@ -459,17 +472,52 @@ def kalman_batches(
     )
 
 
+def _umask() -> int:
+    """The process's umask (read from /proc where it can be, without changing it)."""
+    try:
+        with open("/proc/self/status") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except OSError:
+        pass
+    umask = os.umask(0o022)
+    os.umask(umask)
+    return umask
+
+
 def sink_parquet(query: pl.LazyFrame, path: str | os.PathLike[str], **kwargs: Any) -> None:
     """``query.sink_parquet(path, **kwargs)`` (Polars' streaming engine) that never leaves a
     half-written file: the rows go to a temporary file in ``path``'s directory, renamed to
-    ``path`` once complete (an existing file is replaced only then, atomically); on an error
-    the temporary file is removed and ``path`` is untouched."""
+    ``path`` once complete (an existing file is replaced only then, atomically, and keeps
+    its permissions; a new one gets the umask's); on an error the temporary file is removed
+    and ``path`` is untouched. ``path`` is a local file: ``lazy``, partitioned or cloud
+    targets are Polars' own ``sink_parquet``'s (refused here, with ``ParameterError``);
+    ``mkdir=True`` creates the directory first."""
+    if not isinstance(path, (str, os.PathLike)) or "://" in os.fspath(path):
+        raise ParameterError(
+            f"sink_parquet writes a local file path, not {path!r}: use the query's own "
+            "sink_parquet for partitioned, cloud or file-object targets"
+        )
+    if kwargs.get("lazy"):
+        raise ParameterError(
+            "sink_parquet(lazy=True) would write nothing: use the query's own "
+            "sink_parquet(..., lazy=True) and collect it"
+        )
+    kwargs.pop("lazy", None)
     path = os.fspath(path)
     directory, name = os.path.split(os.path.abspath(path))
+    if kwargs.pop("mkdir", False):
+        os.makedirs(directory, exist_ok=True)
     fd, temporary = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=directory)
     os.close(fd)
     try:
         query.sink_parquet(temporary, **kwargs)
+        try:
+            mode = os.stat(path).st_mode & 0o7777
+        except FileNotFoundError:
+            mode = 0o666 & ~_umask()
+        os.chmod(temporary, mode)
         os.replace(temporary, path)
     except BaseException:
         if os.path.exists(temporary):
