@@ -15,7 +15,6 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use pyo3::types::{PyBytes, PyInt, PyTuple};
-use seqsmooth::polynomial::automatic::AutomaticFilter;
 use seqsmooth::polynomial::rows::{decisions, degree_in_use, RowLayout};
 use seqsmooth::polynomial::spec::{AnyFilter, FilterKind, FilterSpec};
 use seqsmooth::{Error, PolynomialFilter};
