@@ -18,6 +18,10 @@
 //! The lanes are compiled for x86-64 with AVX2 (four lanes an instruction, no fused
 //! multiply-add: the same roundings) and taken where the processor has it.
 
+// The loops index by position on purpose: entry by entry, lane by lane (the innermost, over
+// the lanes, vectorises).
+#![allow(clippy::needless_range_loop)]
+
 use super::fixed::FixedSeries;
 use super::kernel::{self, lane_of, set_lane, Column, Square};
 use super::series::{check_row, Forward};
@@ -459,6 +463,10 @@ impl<'a, D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'a, 
     }
 }
 
+/// The one-series smoother of a series (by its index) into its rows.
+pub(super) type Alone<'f, D, const N: usize> =
+    dyn FnMut(&mut FixedSeries<'_, D, N>, usize, RowsMut<'_>) -> Result<(), Error> + 'f;
+
 /// A step of `L` lanes kept for the backward pass: the prediction into it (`Φ`, the identity
 /// for no step; `X_{k|k−1}`, `S_{k|k−1}`), the filtered estimate and the update's NIS.
 #[derive(Clone, Copy)]
@@ -503,7 +511,7 @@ impl<D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'_, D, N
         out: &mut RowsMut<'_>,
         base: usize,
         steps: &mut Vec<Step<N, L>>,
-        alone: &mut dyn FnMut(&mut FixedSeries<'_, D, N>, usize, RowsMut<'_>) -> Result<(), Error>,
+        alone: &mut Alone<'_, D, N>,
     ) -> Option<(usize, Error)> {
         assert!(available(), "the lanes need AVX2");
         // SAFETY: the processor has AVX2 (checked above), the one feature it enables.
@@ -519,7 +527,7 @@ impl<D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'_, D, N
         out: &mut RowsMut<'_>,
         base: usize,
         steps: &mut Vec<Step<N, L>>,
-        alone: &mut dyn FnMut(&mut FixedSeries<'_, D, N>, usize, RowsMut<'_>) -> Result<(), Error>,
+        alone: &mut Alone<'_, D, N>,
     ) -> Option<(usize, Error)> {
         self.smooth_lanes(panel, range, out, base, steps, alone)
     }
@@ -533,7 +541,7 @@ impl<D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'_, D, N
         out: &mut RowsMut<'_>,
         base: usize,
         steps: &mut Vec<Step<N, L>>,
-        alone: &mut dyn FnMut(&mut FixedSeries<'_, D, N>, usize, RowsMut<'_>) -> Result<(), Error>,
+        alone: &mut Alone<'_, D, N>,
     ) -> Option<(usize, Error)> {
         let mut failure: Option<(usize, Error)> = None;
         let mut fail = |s: usize, e: Error| {
