@@ -254,7 +254,7 @@ fn in_batches(
     cuts: &[usize],
     lag: usize,
 ) -> [BankRows; 3] {
-    let (p, n) = (2, 4);
+    let (p, n) = (bank.components(), bank.states());
     let mut all: [BankRows; 3] = Default::default();
     for o in all.iter_mut() {
         o.states = n;
@@ -298,6 +298,60 @@ proptest! {
         let split = in_batches(&bank, &d, &cuts, lag);
         prop_assert_eq!(whole, split);
     }
+
+    /// The lane path's own model (constant velocity, the position observed): batches of a
+    /// few series each (fewer than a task's lanes, so series move between the lanes and the
+    /// one-series path), the same numbers bit for bit.
+    #[test]
+    fn any_split_into_small_batches_gives_the_same_numbers_scalar(
+        sizes in proptest::collection::vec(1usize..=9, 1..30),
+    ) {
+        let d = data(120, 1, 12);
+        let bank = polynomial_of(1, 1).bank;
+        let mut cuts = Vec::new();
+        let mut at = 0;
+        for size in sizes {
+            at += size;
+            if at < 120 {
+                cuts.push(at);
+            }
+        }
+        let whole = in_batches(&bank, &d, &[], 2);
+        let split = in_batches(&bank, &d, &cuts, 2);
+        prop_assert_eq!(whole, split);
+    }
+}
+
+/// Every series in a bank of its own (the one-series path) against its rows in the whole
+/// bank (in lanes with its neighbours), bit for bit, the filter and the RTS smoother: the
+/// scalar observation (whole rows missing: the lanes' masks), two components (rows with one
+/// missing: steps taken alone), the largest fixed size (9 states, 3 components).
+#[test]
+fn each_series_alone_gives_its_numbers_in_lanes() {
+    for (model, p, seed) in [
+        (polynomial_of(1, 1), 1, 31),
+        (polynomial(), 2, 32),
+        (polynomial_of(2, 3), 3, 33),
+    ] {
+        let d = data(90, p, seed);
+        let bank = &model.bank;
+        let whole = [
+            bank.filter(&d.panel()).unwrap(),
+            bank.smooth(&d.panel()).unwrap(),
+        ];
+        let cuts: Vec<usize> = (1..90).collect();
+        let alone = in_batches(bank, &d, &cuts, 1);
+        for (a, b) in whole.iter().zip(&alone) {
+            assert_eq!(a, b, "p = {p}");
+        }
+    }
+}
+
+/// The lane path's model on 1,000 series (irregular times, 10 % missing) against one library
+/// filter and smoother per series.
+#[test]
+fn bank_equals_one_library_filter_per_series_scalar() {
+    equals_library(&polynomial_of(1, 1), &data(1000, 1, 9), 3);
 }
 
 #[test]

@@ -5,8 +5,10 @@
 //! sizes compile-time constants (`N`, and `K` the components present), plain loops that
 //! unroll, nothing allocated per step.
 //!
-//! The arithmetic is the general path's ([`SeriesFilter`](super::series::SeriesFilter), the
-//! filter's `carry` and `correct_kernel`) operation for operation, each sum in the same order:
+//! The arithmetic is [`super::kernel`]'s at one lane (the lane path, [`super::lanes`], runs
+//! the same code on `L` series at once), which is the general path's
+//! ([`SeriesFilter`](super::series::SeriesFilter), the filter's `carry` and `correct_kernel`)
+//! operation for operation, each sum in the same order:
 //! `Φ S Φᵀ + Q` as `(S Φᵀ)ᵀ Φᵀ`; `U = S Mᵀ`, `V = M U + R = L D Lᵀ`, `H = U V⁻¹`,
 //! `NIS = Σ z_c² / D_c` with `z = L⁻¹ ν`, `X = X_{k|k−1} + H ν`, Joseph's `S` with `I − H M`
 //! applied from each side; the general kernels skip the zero entries of `Φ` and `M`, which
@@ -14,7 +16,7 @@
 //! sign aside); what the tests hold them to is one [`KalmanFilter`](crate::kalman::KalmanFilter)
 //! per series within 1e-12 relative (`tests/kalman_bank.rs`, both sides of the size cut-off),
 //! not bit for bit. The same mathematics as `kalman::correct`'s kernels, written again on
-//! stack arrays: one kernel over slices for both is the open step.
+//! stack arrays in lanes: one kernel over slices for both is the open step.
 //! What differs is the layout: no work buffers on the heap, no matrix `M` per step, and
 //! `ln det V` (for the log-likelihood's finiteness) only when the pivots cannot vouch for it.
 
@@ -23,6 +25,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::super::correct::finite;
+use super::kernel::{self, one, only};
 use super::series::{check_row, Forward};
 use super::{KalmanBank, RowsMut};
 use crate::error::{Error, Param};
@@ -44,20 +47,20 @@ pub(super) struct FixedSeries<'a, D: Dynamics, const N: usize> {
     m: [[f64; N]; MAX_COMPONENTS],
     /// `R`, `p × p`, column-major.
     r: &'a [f64],
-    x0: [f64; N],
-    s0: [[f64; N]; N],
-    x: [f64; N],
+    pub(super) x0: [f64; N],
+    pub(super) s0: [[f64; N]; N],
+    pub(super) x: [f64; N],
     /// Column-major: `s[j][i] = S(i, j)`.
-    s: [[f64; N]; N],
-    time: f64,
+    pub(super) s: [[f64; N]; N],
+    pub(super) time: f64,
     phi: [[f64; N]; N],
     xp: [f64; N],
     sp: [[f64; N]; N],
     /// For a time-invariant model, the last step's length and its `Φ` and `Q` (NaN: none).
-    invariant: bool,
-    step: f64,
-    phi_step: [[f64; N]; N],
-    q_step: [[f64; N]; N],
+    pub(super) invariant: bool,
+    pub(super) step: f64,
+    pub(super) phi_step: [[f64; N]; N],
+    pub(super) q_step: [[f64; N]; N],
     /// The model's buffers for a new step length.
     dx: DVector<f64>,
     dxo: DVector<f64>,
@@ -135,17 +138,8 @@ impl<'a, D: Dynamics, const N: usize> FixedSeries<'a, D, N> {
         let noise = bank.noise.is_some();
         if self.invariant && dt == self.step {
             self.phi = self.phi_step;
-            let (f, x) = (self.phi_step.as_flattened(), &self.x);
-            let xp = &mut self.xp;
-            for i in 0..N {
-                xp[i] = f[i] * x[0];
-            }
-            for j in 1..N {
-                for i in 0..N {
-                    xp[i] += f[i + j * N] * x[j];
-                }
-            }
-            if let Some(&value) = xp.iter().find(|v| !v.is_finite()) {
+            self.xp = kernel::propagate(&one(&self.phi_step), &self.x.map(|v| [v])).map(|v| v[0]);
+            if let Some(&value) = self.xp.iter().find(|v| !v.is_finite()) {
                 return Err(Error::NonFinite {
                     what: "propagated state entry",
                     value,
@@ -175,7 +169,11 @@ impl<'a, D: Dynamics, const N: usize> FixedSeries<'a, D, N> {
         } else {
             Some(square(self.dq.as_slice()))
         };
-        self.sp = carry(&self.phi, &self.s, q.as_ref());
+        self.sp = only(&kernel::carry(
+            &one(&self.phi),
+            &one(&self.s),
+            q.as_ref().map(one).as_ref(),
+        ));
         if all_finite(self.sp.as_flattened()) {
             Ok(())
         } else {
@@ -187,10 +185,7 @@ impl<'a, D: Dynamics, const N: usize> FixedSeries<'a, D, N> {
     #[inline(always)]
     fn correct(&mut self, z: &[f64]) -> Result<f64, Error> {
         let p = self.p;
-        let mut g = [0.0; MAX_COMPONENTS];
-        for (v, m) in g.iter_mut().zip(&self.m).take(p) {
-            *v = (0..N).map(|c| m[c] * self.xp[c]).sum();
-        }
+        let g = kernel::observe(&self.m, &self.xp.map(|v| [v])).map(|v| v[0]);
         if let Some(&v) = g[..p].iter().find(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 what: "predicted observation",
@@ -232,51 +227,11 @@ impl<'a, D: Dynamics, const N: usize> FixedSeries<'a, D, N> {
                 *v = self.r[present[i] + present[c] * p];
             }
         }
-        let s = &self.sp;
-        // U = S Mᵀ (`u[c]` its column c).
-        let mut u = [[0.0; N]; K];
-        for c in 0..K {
-            for l in 0..N {
-                let scale = mt[c][l];
-                for row in 0..N {
-                    u[c][row] += s[l][row] * scale;
-                }
-            }
-        }
-        // V = M U + R, symmetrized, and its L D Lᵀ (`lv[j][i]`: row i, column j).
-        let mut v = [[0.0; K]; K];
-        for b in 0..K {
-            for a in 0..K {
-                let mut msm = 0.0;
-                for l in 0..N {
-                    msm += mt[a][l] * u[b][l];
-                }
-                v[b][a] = msm + r[b][a] * 1.0;
-            }
-        }
-        for j in 0..K {
-            for i in j + 1..K {
-                let value = (v[j][i] + v[i][j]) * 0.5;
-                v[j][i] = value;
-                v[i][j] = value;
-            }
-        }
-        let mut lv = v;
-        let mut positive = true;
-        for j in 0..K {
-            for c in 0..j {
-                let scale = lv[c][j] * lv[c][c];
-                for i in j..K {
-                    lv[j][i] -= lv[c][i] * scale;
-                }
-            }
-            let d = lv[j][j];
-            positive &= d > 0.0;
-            for i in j + 1..K {
-                lv[j][i] /= d;
-            }
-        }
-        if !positive {
+        let nu1 = std::array::from_fn(|c| [nu[c]]);
+        let out = kernel::correct::<N, K, 1>(&mt, &r, &self.xp.map(|v| [v]), &one(&self.sp), &nu1);
+        let lv = out.lv.map(|column| column.map(|v| v[0]));
+        if !out.positive[0] {
+            let v = out.v.map(|column| column.map(|v| v[0]));
             return Err(Error::InvalidParameter {
                 name: Param::InnovationCovariance,
                 value: format!("{:?}", DMatrix::from_column_slice(K, K, v.as_flattened())),
@@ -285,100 +240,7 @@ impl<'a, D: Dynamics, const N: usize> FixedSeries<'a, D, N> {
                     .into(),
             });
         }
-        // H = U V⁻¹: G Lᵀ = U (forwards), over the pivots, then H L = G (backwards).
-        let mut h = u;
-        for c in 0..K {
-            for d in 0..c {
-                let l = lv[d][c];
-                for i in 0..N {
-                    h[c][i] -= l * h[d][i];
-                }
-            }
-        }
-        for c in 0..K {
-            let pivot = lv[c][c];
-            for o in &mut h[c] {
-                *o /= pivot;
-            }
-        }
-        for c in (0..K).rev() {
-            for d in c + 1..K {
-                let l = lv[c][d];
-                for i in 0..N {
-                    h[c][i] -= l * h[d][i];
-                }
-            }
-        }
-        // NIS = Σ z_c² / D_c, z = L⁻¹ ν.
-        let mut z = [0.0; K];
-        let mut nis = 0.0;
-        for c in 0..K {
-            let mut acc = nu[c];
-            for d in 0..c {
-                acc -= lv[d][c] * z[d];
-            }
-            z[c] = acc;
-            nis += acc * acc / lv[c][c];
-        }
-        let mut x_out = [0.0; N];
-        for i in 0..N {
-            let mut acc = 0.0;
-            for c in 0..K {
-                acc += h[c][i] * nu[c];
-            }
-            x_out[i] = acc + self.xp[i];
-        }
-        // Joseph's form (12.3.7), I − H M applied from each side (the filter's `joseph`):
-        // X = S − H (S Mᵀ)ᵀ, Y = X Mᵀ, out = (X − Y Hᵀ) + (H R) Hᵀ, symmetrized.
-        let mut x = [[0.0; N]; N];
-        for j in 0..N {
-            for i in 0..N {
-                let mut acc = 0.0;
-                for c in 0..K {
-                    acc += h[c][i] * u[c][j];
-                }
-                x[j][i] = s[j][i] - acc;
-            }
-        }
-        let mut y = [[0.0; N]; K];
-        for c in 0..K {
-            for l in 0..N {
-                let scale = mt[c][l];
-                for row in 0..N {
-                    y[c][row] += x[l][row] * scale;
-                }
-            }
-        }
-        let mut hr = [[0.0; N]; K];
-        for d in 0..K {
-            for i in 0..N {
-                let mut acc = 0.0;
-                for c in 0..K {
-                    acc += h[c][i] * r[d][c];
-                }
-                hr[d][i] = acc;
-            }
-        }
-        let mut s_out = [[0.0; N]; N];
-        for j in 0..N {
-            for i in 0..N {
-                let (mut yh, mut rh) = (0.0, 0.0);
-                for c in 0..K {
-                    yh += y[c][i] * h[c][j];
-                }
-                for d in 0..K {
-                    rh += hr[d][i] * h[d][j];
-                }
-                s_out[j][i] = (x[j][i] - yh) + rh;
-            }
-        }
-        for j in 0..N {
-            for i in j + 1..N {
-                let value = (s_out[j][i] + s_out[i][j]) * 0.5;
-                s_out[j][i] = value;
-                s_out[i][j] = value;
-            }
-        }
+        let (x_out, s_out, nis) = (out.x.map(|v| v[0]), only(&out.s), out.nis[0]);
         if !(all_finite(&x_out) & all_finite(s_out.as_flattened())) {
             finite(s_out.as_flattened(), "updated covariance")?;
             finite(&x_out, "updated state entry")?;
@@ -400,58 +262,6 @@ impl<'a, D: Dynamics, const N: usize> FixedSeries<'a, D, N> {
     }
 }
 
-/// `Φ S Φᵀ + Q`, symmetrized (the filter's `carry`, (12.2.16), (15.4.11)): `A = S Φᵀ`, then
-/// `Aᵀ Φᵀ`, each entry summed over the columns of `Φ` in order, then `(out + Q)` symmetrized
-/// in one pass. Arrays column-major (`m[j][i]` row `i`, column `j`).
-#[inline(always)]
-fn carry<const N: usize>(
-    phi: &[[f64; N]; N],
-    s: &[[f64; N]; N],
-    q: Option<&[[f64; N]; N]>,
-) -> [[f64; N]; N] {
-    let mut a = [[0.0; N]; N];
-    for i in 0..N {
-        for l in 0..N {
-            let scale = phi[l][i];
-            for row in 0..N {
-                a[i][row] += s[l][row] * scale;
-            }
-        }
-    }
-    // (S Φᵀ)ᵀ column l, row r is a[r][l].
-    let mut out = [[0.0; N]; N];
-    for j in 0..N {
-        for l in 0..N {
-            let scale = phi[l][j];
-            for row in 0..N {
-                out[j][row] += a[row][l] * scale;
-            }
-        }
-    }
-    match q {
-        Some(q) => {
-            for j in 0..N {
-                out[j][j] += q[j][j];
-                for i in j + 1..N {
-                    let v = ((out[j][i] + q[j][i]) + (out[i][j] + q[i][j])) * 0.5;
-                    out[j][i] = v;
-                    out[i][j] = v;
-                }
-            }
-        }
-        None => {
-            for j in 0..N {
-                for i in j + 1..N {
-                    let v = (out[j][i] + out[i][j]) * 0.5;
-                    out[j][i] = v;
-                    out[i][j] = v;
-                }
-            }
-        }
-    }
-    out
-}
-
 impl<D: Dynamics, const N: usize> Forward for FixedSeries<'_, D, N> {
     fn components(&self) -> usize {
         self.p
@@ -461,6 +271,8 @@ impl<D: Dynamics, const N: usize> Forward for FixedSeries<'_, D, N> {
         self.x = self.x0;
         self.s = self.s0;
         self.time = time;
+        // Each series' numbers its own: no step length remembered from the one before.
+        self.step = f64::NAN;
     }
 
     fn resume(&mut self, x: &[f64], s: &[f64], time: f64) {

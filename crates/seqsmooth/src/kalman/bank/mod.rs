@@ -23,7 +23,10 @@
 //! Every series runs the library's own Kalman arithmetic: for `n ≤ 9` states and `p ≤ 3`
 //! components a fixed-size path (the series' estimate, prediction and scratch in arrays on
 //! the stack, the sizes compile-time constants, the arithmetic of the filter's `carry` and
-//! `correct_kernel` operation for operation), beyond it the kernels of
+//! `correct_kernel` operation for operation), which the filter and the RTS smoother run on
+//! four series at once (structure of arrays across the series, each its own step lengths and
+//! missing rows: `lanes`; the same operations, so a series' numbers do not depend on its
+//! neighbours), beyond it the kernels of
 //! [`KalmanFilter`](super::KalmanFilter) on their work buffers; `Φ` and `Q` computed once per
 //! step length for a time-invariant model; and the library's own backward steps (the
 //! whole-interval step of [`super::smoother`]'s `smooth_flat` for the RTS smoother,
@@ -43,6 +46,9 @@ use std::sync::Arc;
 
 mod backward;
 mod fixed;
+mod kernel;
+#[cfg(target_arch = "x86_64")]
+mod lanes;
 mod series;
 mod smooth;
 mod stream;
@@ -51,6 +57,8 @@ pub use stream::BankStream;
 
 use crate::numeric::unrolled::unrolled_sizes;
 use fixed::{FixedSeries, MAX_COMPONENTS};
+#[cfg(target_arch = "x86_64")]
+use lanes::{Lanes, LANES};
 use series::{Forward, SeriesFilter};
 use smooth::Kept;
 
@@ -373,6 +381,15 @@ impl<D: Dynamics + Sync> KalmanBank<D> {
         let failures: Vec<(usize, Error)> = tasks
             .into_par_iter()
             .filter_map(|(range, rows)| {
+                #[cfg(target_arch = "x86_64")]
+                if !matches!(pass, Pass::Lag(_))
+                    && (1..=MAX_COMPONENTS).contains(&p)
+                    && (1..=9).contains(&n)
+                    && lanes::available()
+                {
+                    return unrolled_sizes!(n, N => self.lanes::<N>(&r, pass, panel, range, rows),
+                        _ => unreachable!("n ≤ 9"));
+                }
                 if p <= MAX_COMPONENTS {
                     unrolled_sizes!(n, N => self.task(&mut FixedSeries::<D, N>::new(self, &r), pass, panel, range, rows),
                         _ => self.task(&mut SeriesFilter::new(self, &r), pass, panel, range, rows))
@@ -391,6 +408,49 @@ impl<D: Dynamics + Sync> KalmanBank<D> {
                 })
             }
             None => Ok(()),
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    /// The filter or the RTS smoother over the series `range` of `panel` into their `rows`,
+    /// [`LANES`] series at a time ([`Lanes`], `N ≤ 9` states, 1 to [`MAX_COMPONENTS`]
+    /// components): the first failing series and its error.
+    fn lanes<const N: usize>(
+        &self,
+        r: &[f64],
+        pass: Pass,
+        panel: &Panel<'_>,
+        range: std::ops::Range<usize>,
+        rows: RowsMut<'_>,
+    ) -> Option<(usize, Error)> {
+        match self.components() {
+            1 => self.lanes_of::<N, 1>(r, pass, panel, range, rows),
+            2 => self.lanes_of::<N, 2>(r, pass, panel, range, rows),
+            _ => self.lanes_of::<N, 3>(r, pass, panel, range, rows),
+        }
+    }
+
+    /// [`Self::lanes`] with `K` components.
+    #[cfg(target_arch = "x86_64")]
+    fn lanes_of<const N: usize, const K: usize>(
+        &self,
+        r: &[f64],
+        pass: Pass,
+        panel: &Panel<'_>,
+        range: std::ops::Range<usize>,
+        mut rows: RowsMut<'_>,
+    ) -> Option<(usize, Error)> {
+        let base = panel.offsets[range.start];
+        let mut lanes = Lanes::<D, N, K, LANES>::new(self, r);
+        match pass {
+            Pass::Filter => lanes.filter(panel, range, &mut rows, base),
+            _ => {
+                let mut kept = Kept::default();
+                let mut alone = |one: &mut FixedSeries<'_, D, N>, s, out: RowsMut<'_>| {
+                    smooth::rts_series(one, &mut kept, panel, s, out)
+                };
+                lanes.smooth(panel, range, &mut rows, base, &mut Vec::new(), &mut alone)
+            }
         }
     }
 

@@ -268,6 +268,8 @@ impl<D: Dynamics> Forward for SeriesFilter<'_, D> {
         self.x.copy_from(&self.bank.state);
         self.s.copy_from(&self.bank.covariance);
         self.time = time;
+        // Each series' numbers its own: no step length remembered from the one before.
+        self.step = f64::NAN;
     }
 
     fn resume(&mut self, x: &[f64], s: &[f64], time: f64) {
