@@ -4,7 +4,7 @@
 //! `smooth_flat` makes,
 //!
 //! `C = S_{k|k} Φᵀ S_{k+1|k}⁻¹`, `X_{k|N} = X_{k|k} + C (X_{k+1|N} − X_{k+1|k})`,
-//! `S_{k|N} = S_{k|k} + C (S_{k+1|N} − S_{k+1|k}) Cᵀ` (symmetrised),
+//! `S_{k|N} = S_{k|k} + C (S_{k+1|N} − S_{k+1|k}) Cᵀ` (its lower triangle, mirrored),
 //!
 //! with the errors named by the series' row.
 
