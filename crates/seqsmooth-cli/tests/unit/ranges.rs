@@ -12,9 +12,15 @@ use std::path::{Path, PathBuf};
 const ALLOWED: &[(&str, &str, &str)] = &[
     (
         "seqsmooth-py/src/automatic.rs",
-        "if decided.iter().any(|&d| d > 1) || decided.len() as u64 > filter.samples() {",
-        "a restored pickle's own extra (the final decisions the binding keeps beside the \
-         library's bytes): data read back, refused as damaged, no parameter",
+        "if bytes.iter().any(|&d| d > 1) {",
+        "a restored pickle's own extra (the final decisions made but not yet reported, kept \
+         beside the library's bytes): data read back, refused as damaged, no parameter",
+    ),
+    (
+        "seqsmooth-py/src/stream.rs",
+        "if self.spec.kind.uses_tau() && self.spec.tau.is_none() && !last && n < TAU_SCAN_ROWS {",
+        "how the caller cuts the rows into chunks (the library's default-τ rows, \
+         TAU_SCAN_ROWS, must come in the first one): a size of the caller's chunk, no parameter",
     ),
     (
         "seqsmooth-py/src/kalman.rs",
