@@ -272,13 +272,15 @@ pub(super) fn interpolation_verdict(
     if !fit.fit(&ts[..n], &ys[..n], degree) {
         return None;
     }
+    // The calibration's factor of the earlier windows (this window enters it only below).
+    let scale = calibration.factor();
     // The gate decides where its σ_ε is at most the interpolation's noise-only root mean square
     // (below). Dropping neighbours only raises the fit's VRF at `t` (less information), so
     // where the fit through every neighbour already says so, the neighbours are not studied:
     // the window's residuals enter the calibration as they are.
     if let Some(g) = gate_rms {
         let (_, v) = fit.value_and_vrf_at(t)?;
-        let rms_noise = (sigma * sigma * calibration.factor() * (1.0 + v.max(0.0))).sqrt();
+        let rms_noise = (sigma * sigma * scale * (1.0 + v.max(0.0))).sqrt();
         if g <= rms_noise {
             calibration.push(fit.residual_sq() / (sigma * sigma), n - (degree + 1));
             return None;
@@ -302,7 +304,6 @@ pub(super) fn interpolation_verdict(
     let (p, v) = fit.value_and_vrf_at(t)?;
     let v = v.max(0.0);
     let spare = n - (degree + 1);
-    let scale = calibration.factor();
     let var = sigma * sigma * scale;
     calibration.push(fit.residual_sq() / (sigma * sigma), spare);
     // The judge of the smaller mean square: the gate's prediction where the memory is long
@@ -420,13 +421,17 @@ impl<S: Replay> Review<S> {
         let mut decided = Vec::new();
         let mut newest = None;
         while let Some(f) = self.first_undecided() {
+            let overflow = self.entries.len() - f > MAX_UNDECIDED;
+            if l > 0 && !finishing && !overflow && self.entries.len() - f - 1 < l {
+                // Fewer than `L` samples after it, accepted or not: not ready (below).
+                break;
+            }
             let front = &self.entries[f];
             // The accepted samples after it (at most 2L), in the scratch's buffer.
             let mut after = std::mem::take(&mut self.scratch.after);
             after.clear();
             let later = self.entries.iter().skip(f + 1).filter(|u| !u.rejected);
             after.extend(later.take(2 * l.max(1)).map(|u| (u.t, u.y)));
-            let overflow = self.entries.len() - f > MAX_UNDECIDED;
             let (before_wanted, ready) = if l == 0 {
                 (0, !front.rejected || !after.is_empty() || finishing)
             } else if finishing {
