@@ -155,6 +155,9 @@ struct Score {
 impl Score {
     fn run(seed: u64, data: &[Sample]) -> Score {
         let mut f = AutomaticFilter::new(2, 0.95, median_step(data)).unwrap();
+        if let Some(levels) = memory_levels() {
+            f = f.with_memory_levels(levels).unwrap();
+        }
         let mut s = Score::default();
         let mut outs: Vec<AutoOutput> = Vec::with_capacity(data.len());
         for d in data {
@@ -265,6 +268,17 @@ impl Score {
         }
         m
     }
+}
+
+/// `SEQSMOOTH_AUTO_MEMORY_LEVELS=J` runs the scenarios with `J` shorter memories instead of the
+/// default (BENCHMARKS.md, "The automatic filter's speed against the fading filter": what fewer
+/// memories would save and what they cost in coverage); the thresholds are asserted either way.
+fn memory_levels() -> Option<usize> {
+    let v = std::env::var("SEQSMOOTH_AUTO_MEMORY_LEVELS").ok()?;
+    Some(
+        v.parse()
+            .expect("SEQSMOOTH_AUTO_MEMORY_LEVELS: a number of memory levels"),
+    )
 }
 
 fn scenario(what: &str, runs: impl Fn(u64) -> Vec<Vec<Sample>> + Sync) -> (String, Score) {
