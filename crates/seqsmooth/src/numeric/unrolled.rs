@@ -33,6 +33,28 @@ macro_rules! unrolled_sizes {
 }
 pub(crate) use unrolled_sizes;
 
+/// `each_index!(p, k => { … })`: the block for `k = 0, 1, …, p − 1` in turn, `k` a constant
+/// in each copy for `k < 9` (the sizes with unrolled kernels,
+/// [`crate::numeric::unrolled`]) and a loop variable beyond: loops bounded by `k` inside then
+/// have constant trip counts and unroll, which the compiler does not do for a triangle of
+/// loops past a few hundred operations.
+macro_rules! each_index {
+    ($p:expr, $k:ident => $body:block) => {
+        $crate::numeric::unrolled::each_index!(@each $p, $k, $body, 0 1 2 3 4 5 6 7 8);
+        for $k in 9..$p $body
+    };
+    (@each $p:expr, $k:ident, $body:block, $($v:literal)*) => {
+        $(
+            if $v < $p {
+                #[allow(non_upper_case_globals)]
+                const $k: usize = $v;
+                $body
+            }
+        )*
+    };
+}
+pub(crate) use each_index;
+
 /// A size known at compile time ([`Fixed`]) or only at run time ([`Any`]). A kernel generic
 /// over it is one source, compiled once for each fixed size (its loops then have constant
 /// trip counts and unroll, closures and all) and once for any size; the caller picks through

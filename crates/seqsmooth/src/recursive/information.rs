@@ -4,29 +4,8 @@
 
 use super::factor::TriangularFactor;
 use crate::linalg::{solve_upper_in_place, solve_upper_transpose_in_place};
-use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
+use crate::numeric::unrolled::{each_index, unrolled_sizes, Any, Fixed, Size};
 use nalgebra::{DMatrix, DVector};
-
-/// `each_index!(p, k => { … })`: the block for `k = 0, 1, …, p − 1` in turn, `k` a constant
-/// in each copy for `k < 9` (the sizes with unrolled kernels,
-/// [`crate::numeric::unrolled`]) and a loop variable beyond: loops bounded by `k` inside then
-/// have constant trip counts and unroll, which the compiler does not do for a triangle of
-/// loops past a few hundred operations.
-macro_rules! each_index {
-    ($p:expr, $k:ident => $body:block) => {
-        each_index!(@each $p, $k, $body, 0 1 2 3 4 5 6 7 8);
-        for $k in 9..$p $body
-    };
-    (@each $p:expr, $k:ident, $body:block, $($v:literal)*) => {
-        $(
-            if $v < $p {
-                #[allow(non_upper_case_globals)]
-                const $k: usize = $v;
-                $body
-            }
-        )*
-    };
-}
 
 /// When the lazy discount's row scale exceeds this, it is folded into the factors.
 const RENORMALISE: f64 = 1e30;
@@ -560,9 +539,11 @@ impl InformationFilter {
                     col[k] = 1.0;
                     for (j, earlier) in done.iter().enumerate() {
                         let c = u[j * p + k];
-                        for (v, e) in col[..j + 1].iter_mut().zip(&earlier[..j + 1]) {
+                        for (v, e) in col[..j].iter_mut().zip(&earlier[..j]) {
                             *v -= c * e;
                         }
+                        // `earlier[j] = T_jj = 1`: `c · 1` is `c`, bit for bit.
+                        col[j] -= c;
                     }
                 });
                 // W = D⁻¹ Y, row by row.
@@ -575,8 +556,10 @@ impl InformationFilter {
                 // Row r of Z = T W (entries z_ri = Σ_(k ≥ max(r, i)) T_rk W_ki), then the
                 // variances Σ_r (D_Q)_r z_ri².
                 each_index!(p, r => {
-                    let mut z = [0.0; N];
-                    for k in r..p {
+                    // The term k = r first: `T_rr = 1`, so it is row r of W itself (zero
+                    // beyond its diagonal), bit for bit what `0 + 1 · w` gives once squared.
+                    let mut z = y[r];
+                    for k in r + 1..p {
                         let c = tc[k][r];
                         for (v, w) in z[..k + 1].iter_mut().zip(&y[k][..k + 1]) {
                             *v += c * w;

@@ -1,5 +1,5 @@
 use crate::numeric::inline::InlineVec;
-use crate::numeric::unrolled::{unrolled_sizes, Size};
+use crate::numeric::unrolled::{each_index, unrolled_sizes, Size};
 use nalgebra::{DMatrix, DVector};
 
 /// The largest dimension whose factor is stored inline ([`InlineVec`]): a copy of it allocates
@@ -409,7 +409,10 @@ impl TriangularFactor {
         let mut after = [[0.0; N]; N];
         let mut y_after = [0.0; N];
         let mut y = b;
-        for i in 0..N {
+        // The pivot index a constant in each step (`each_index!`), so that the steps' loops
+        // unroll at every size compiled in (at 9 the compiler left them rolled: twice the
+        // instructions of size 8).
+        each_index!(N, i => {
             let xi = x[i];
             for j in i + 1..N {
                 x[j] -= xi * u[i * N + j];
@@ -417,7 +420,7 @@ impl TriangularFactor {
             after[i][i + 1..].copy_from_slice(&x[i + 1..]);
             y -= xi * ubar[i];
             y_after[i] = y;
-        }
+        });
         // `η_(i+1) = η_i + x_i²/d_i` from `η_0 = 1/c`, then `δ_(i+1) = 1/η_(i+1)`.
         let mut xe = [0.0; N];
         let mut delta = [0.0; N];
@@ -430,7 +433,7 @@ impl TriangularFactor {
         for di in delta.iter_mut() {
             *di = 1.0 / *di;
         }
-        for i in 0..N {
+        each_index!(N, i => {
             let delta_i = if i == 0 { weight } else { delta[i - 1] };
             let sbar = xe[i] * delta[i];
             d[i].0 += delta_i * (x[i] * x[i]);
@@ -438,7 +441,7 @@ impl TriangularFactor {
                 u[i * N + j] += sbar * after[i][j];
             }
             ubar[i] += sbar * y_after[i];
-        }
+        });
         self.residual_sq += delta[N - 1] * y * y;
     }
 
@@ -570,7 +573,23 @@ impl TriangularFactor {
 
     #[inline(always)]
     fn change_variables_polynomial_n<const N: usize>(&mut self, alpha: f64, beta: f64) {
-        self.change_variables_polynomial_any(N, alpha, beta);
+        let u: &mut [f64] = &mut self.u[..N * N];
+        let h = -beta;
+        if h != 0.0 {
+            // As in `change_variables_polynomial_any`, the same steps in the same order, the
+            // outer index a constant in each copy (`each_index!`) so that the triangle unrolls
+            // at every size compiled in.
+            each_index!(N.saturating_sub(1), ii => {
+                let i = N - 2 - ii;
+                for k in i..N - 1 {
+                    for r in 0..k {
+                        u[r * N + k + 1] += h * u[r * N + k];
+                    }
+                    u[k * N + k + 1] += h;
+                }
+            });
+        }
+        self.scale_polynomial(N, alpha);
     }
 
     #[inline(always)]
@@ -590,6 +609,13 @@ impl TriangularFactor {
                 }
             }
         }
+        self.scale_polynomial(p, alpha);
+    }
+
+    /// The scaling of [`Self::change_variables_polynomial`] by `α` (none when `α = 1`).
+    #[inline(always)]
+    fn scale_polynomial(&mut self, p: usize, alpha: f64) {
+        let u: &mut [f64] = &mut self.u[..p * p];
         if alpha != 1.0 {
             // `U_ij ← α^(i-j) U_ij`, `D_i ← α^(-2i) D_i`, `ū_i ← α^i ū_i`.
             let inv = 1.0 / alpha;
