@@ -20,7 +20,15 @@
 //! equal as numbers (`==`), a zero's sign aside. Tested update by update against the general
 //! path (this module's tests on the work buffers, `tests/kalman_radar_fixed.rs` on the
 //! filter's results).
+//!
+//! The filter's part (the models recognised, the measurement read once into a stack value)
+//! is inlined where the filter updates and folds away for any other observation model; the
+//! arithmetic ([`update`]) is one function kept out of line, so that the hot code is compact
+//! and apart from the general path's. `Q` is the noise's own `fill` on one axis (its 2 × 2,
+//! `Q₁ ⊗ I₃` read from it), and of `Φ` only the nine entries that are not structurally zero
+//! are written (every writer of the buffer writes this model's `Ψ(ζ) ⊗ I₃`).
 
+use super::super::correct::Work;
 use super::{InnovationStats, KalmanFilter};
 use crate::error::Error;
 use crate::kalman::noise::fill;
@@ -28,7 +36,7 @@ use crate::linalg::dense::{all_finite, ldl, log_det, symmetrize};
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::{Measurement, NoiseCovariance};
 use crate::model::observation::Observation;
-use crate::model::radar::wrap;
+use crate::model::radar::{wrap, Radar};
 use crate::model::transition::psi_term;
 use crate::numeric::unrolled::Fixed;
 use std::f64::consts::TAU;
@@ -57,16 +65,19 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     }
 
     /// The prediction to the measurement's time and the update, when the model is the radar
-    /// case of this module, into the work buffers (the prediction `x`, `s`; the present
+    /// case of this module, into the work buffers (the prediction `x`, `s`, `Φ`; the present
     /// components and values, `ν`, `V` and the gain that an `Innovation` reads; the updated
     /// state and covariance), the filter unchanged: the statistics, or `None` for the general
     /// path (another model, or anything the general path would refuse or treat otherwise).
+    /// The model's checks here (folded away for any other observation model), the arithmetic
+    /// in [`update`], compiled once, apart from the general path.
+    #[inline]
     pub(super) fn correct_radar_fixed(&mut self, m: &Measurement) -> Option<InnovationStats> {
+        let radar = self.observation.as_radar()?;
         if self.fading.is_some() {
             return None;
         }
         let dynamics = self.dynamics.polynomial()?;
-        let radar = self.observation.as_radar()?;
         if dynamics.degree() != 1 || dynamics.axes() != 3 || radar.has_range_rate() {
             return None;
         }
@@ -86,175 +97,196 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             NoiseCovariance::Variances(v) if v.len() == K => [v[0], v[1], v[2]],
             _ => return None,
         };
-        let ok = |v: f64| v.is_finite() && v >= 0.0;
-        if !(t.is_finite()
-            && y0.is_finite()
-            && y1.is_finite()
-            && y2.is_finite()
-            && ok(r[0])
-            && ok(r[1])
-            && ok(r[2]))
-        {
-            return None;
-        }
         let x: &[f64; N] = self.state.as_slice().try_into().ok()?;
         let s: &[f64; N * N] = self.covariance.as_slice().try_into().ok()?;
-        let w = &mut self.work;
-        let xp: &mut [f64; N] = w.x.as_mut_slice().try_into().ok()?;
-        let sp: &mut [f64; N * N] = w.s.as_mut_slice().try_into().ok()?;
-        let x_out: &mut [f64; N] = w.x_out.as_mut_slice().try_into().ok()?;
-        let s_out: &mut [f64; N * N] = w.s_out.as_mut_slice().try_into().ok()?;
+        let read = Read {
+            zeta: (t != self.time).then_some(t - self.time),
+            t,
+            psd,
+            y: [y0, y1, y2],
+            r,
+        };
+        update(radar, read, x, s, &mut self.work)
+    }
+}
 
-        // The prediction, into the work buffers (none at the filter's own time: the estimate
-        // as it is, as `predict_work`).
-        if t == self.time {
+/// What [`update`] reads besides the filter's estimate: the step (`None` at the filter's own
+/// time), the measurement's time, the driving noise's spectral density (`None`: none), the
+/// three measured values and `R`'s variances.
+#[derive(Clone, Copy)]
+struct Read {
+    zeta: Option<f64>,
+    t: f64,
+    psd: Option<f64>,
+    y: [f64; K],
+    r: [f64; K],
+}
+
+/// The radar case's update (the module's doc) from the estimate `x`, `s` into the work
+/// buffers: the statistics, or `None` for the general path. Kept out of line so that the
+/// filter's hot code is this function alone, compact, with the general path elsewhere.
+#[inline(never)]
+fn update(
+    radar: &Radar,
+    m: Read,
+    x: &[f64; N],
+    s: &[f64; N * N],
+    w: &mut Work,
+) -> Option<InnovationStats> {
+    let Read { zeta, t, psd, y, r } = m;
+    // Every check at once (no early exit: one branch).
+    let usable = |v: &f64| v.is_finite() & (*v >= 0.0);
+    if !(t.is_finite() & all_finite(&y) & r.iter().fold(true, |ok, v| ok & usable(v))) {
+        return None;
+    }
+    let xp: &mut [f64; N] = w.x.as_mut_slice().try_into().ok()?;
+    let sp: &mut [f64; N * N] = w.s.as_mut_slice().try_into().ok()?;
+    let x_out: &mut [f64; N] = w.x_out.as_mut_slice().try_into().ok()?;
+    let s_out: &mut [f64; N * N] = w.s_out.as_mut_slice().try_into().ok()?;
+    let phi: &mut [f64; N * N] = w.phi.as_mut_slice().try_into().ok()?;
+
+    // The prediction, into the work buffers (none at the filter's own time: the estimate
+    // as it is, as `predict_work`).
+    match zeta {
+        None => {
             *xp = *x;
             *sp = *s;
-        } else {
-            predict(x, s, t - self.time, psd, xp, sp)?;
+        }
+        Some(zeta) => {
+            predict(x, s, zeta, psd, xp, sp)?;
+            let (t0, t1) = (psi_term(0, &zeta), psi_term(1, &zeta));
             // `Φ` into the work buffer as the general path leaves it (the smoothers read it:
-            // `last_transition`): `[[I, ζ I], [0, I]]` by `psi_term`, (4.2.5).
-            let (t0, t1) = (psi_term(0, &(t - self.time)), psi_term(1, &(t - self.time)));
-            let phi = w.phi.as_mut_slice();
-            for c in 0..N {
-                for r in 0..N {
-                    phi[r + c * N] = if r == c {
-                        t0
-                    } else if c == r + 3 {
-                        t1
-                    } else {
-                        0.0
-                    };
-                }
+            // `last_transition`): `[[I, ζ I], [0, I]]` by `psi_term`, (4.2.5). Every writer of
+            // this buffer (this path, `predict_fixed`, `propagate_into`) writes this model's
+            // `Ψ(ζ) ⊗ I₃`, and the buffer starts at zero, so only the entries that are not
+            // structurally zero are written.
+            for a in 0..3 {
+                phi[a + a * N] = t0;
+                phi[(a + 3) + (a + 3) * N] = t0;
+                phi[a + (a + 3) * N] = t1;
             }
         }
+    }
+    // The radar's prediction and its Jacobian J (M = [J 0]; J₁₂ = 0).
+    let look = radar.look([xp[0], xp[1], xp[2]])?;
+    let (g, jm) = (look.value, look.jacobian);
+    if !(all_finite(&g) && jm.iter().all(|row| all_finite(row))) {
+        return None;
+    }
+    let nu = [y[0] - g[0], wrap(y[1] - g[1]), y[2] - g[2]];
 
-        // The radar's prediction and its Jacobian J (M = [J 0]; J₁₂ = 0).
-        let look = radar.look([xp[0], xp[1], xp[2]])?;
-        let (g, jm) = (look.value, look.jacobian);
-        if !(all_finite(&g) && jm.iter().all(|row| all_finite(row))) {
-            return None;
-        }
-        let y = [y0, y1, y2];
-        let nu = [y[0] - g[0], wrap(y[1] - g[1]), y[2] - g[2]];
-
-        // `correct_kernel` without fading (P = S, f = 1): U = S Mᵀ, V = M U + R = L D Lᵀ.
-        let mut u = [0.0; N * K];
-        times_mt(sp, &jm, &mut u);
-        let mut v = [0.0; K * K];
-        for b in 0..K {
-            for a in 0..K {
-                let mut msm = -0.0;
-                for l in 0..3 {
-                    if a != 1 || l != 2 {
-                        msm += jm[a][l] * u[l + b * N];
-                    }
-                }
-                v[a + b * K] = if a == b { msm + r[a] } else { msm + 0.0 };
-            }
-        }
-        symmetrize(K, &mut v);
-        let mut lv = [0.0; K * K];
-        if !ldl(K, &v, &mut lv) {
-            return None;
-        }
-        // H = U L⁻ᵀ D⁻¹ L⁻¹: forwards, the pivots, backwards.
-        let mut h = u;
-        for c in 0..K {
-            for d in 0..c {
-                let l = lv[c + d * K];
-                for i in 0..N {
-                    h[i + c * N] -= l * h[i + d * N];
+    // `correct_kernel` without fading (P = S, f = 1): U = S Mᵀ, V = M U + R = L D Lᵀ.
+    let mut u = [0.0; N * K];
+    times_mt(sp, &jm, &mut u);
+    let mut v = [0.0; K * K];
+    for b in 0..K {
+        for a in 0..K {
+            let mut msm = -0.0;
+            for l in 0..3 {
+                if a != 1 || l != 2 {
+                    msm += jm[a][l] * u[l + b * N];
                 }
             }
+            v[a + b * K] = if a == b { msm + r[a] } else { msm + 0.0 };
         }
-        for c in 0..K {
-            let pivot = lv[c + c * K];
+    }
+    symmetrize(K, &mut v);
+    let mut lv = [0.0; K * K];
+    if !ldl(K, &v, &mut lv) {
+        return None;
+    }
+    // H = U L⁻ᵀ D⁻¹ L⁻¹: forwards, the pivots, backwards.
+    let mut h = u;
+    for c in 0..K {
+        for d in 0..c {
+            let l = lv[c + d * K];
             for i in 0..N {
-                h[i + c * N] /= pivot;
+                h[i + c * N] -= l * h[i + d * N];
             }
         }
-        for c in (0..K).rev() {
-            for d in c + 1..K {
-                let l = lv[d + c * K];
-                for i in 0..N {
-                    h[i + c * N] -= l * h[i + d * N];
-                }
+    }
+    for c in 0..K {
+        let pivot = lv[c + c * K];
+        for i in 0..N {
+            h[i + c * N] /= pivot;
+        }
+    }
+    for c in (0..K).rev() {
+        for d in c + 1..K {
+            let l = lv[d + c * K];
+            for i in 0..N {
+                h[i + c * N] -= l * h[i + d * N];
             }
         }
-        // NIS = Σ z_c² / D_c, z = L⁻¹ ν.
-        let (mut nis, mut z) = (0.0, [0.0; K]);
+    }
+    // NIS = Σ z_c² / D_c, z = L⁻¹ ν.
+    let (mut nis, mut z) = (0.0, [0.0; K]);
+    for c in 0..K {
+        let mut acc = nu[c];
+        for d in 0..c {
+            acc -= lv[c + d * K] * z[d];
+        }
+        z[c] = acc;
+        nis += acc * acc / lv[c + c * K];
+    }
+    for i in 0..N {
+        let mut acc = -0.0;
         for c in 0..K {
-            let mut acc = nu[c];
-            for d in 0..c {
-                acc -= lv[c + d * K] * z[d];
-            }
-            z[c] = acc;
-            nis += acc * acc / lv[c + c * K];
+            acc += h[i + c * N] * nu[c];
         }
+        x_out[i] = acc + xp[i];
+    }
+    // Joseph's form: X = S − H (M S), Y = X Mᵀ, out = (X − Y Hᵀ) + (H R) Hᵀ, with
+    // H R = H diag(R).
+    let mut xm = [0.0; N * N];
+    for j in 0..N {
         for i in 0..N {
             let mut acc = -0.0;
             for c in 0..K {
-                acc += h[i + c * N] * nu[c];
+                acc += h[i + c * N] * u[j + c * N];
             }
-            x_out[i] = acc + xp[i];
+            xm[i + j * N] = sp[i + j * N] - acc;
         }
-        // Joseph's form: X = S − H (M S), Y = X Mᵀ, out = (X − Y Hᵀ) + (H R) Hᵀ, with
-        // H R = H diag(R).
-        let mut xm = [0.0; N * N];
-        for j in 0..N {
-            for i in 0..N {
-                let mut acc = -0.0;
-                for c in 0..K {
-                    acc += h[i + c * N] * u[j + c * N];
-                }
-                xm[i + j * N] = sp[i + j * N] - acc;
-            }
-        }
-        let mut ym = [0.0; N * K];
-        times_mt(&xm, &jm, &mut ym);
-        let mut hr = [0.0; N * K];
-        for d in 0..K {
-            for i in 0..N {
-                hr[i + d * N] = h[i + d * N] * r[d];
-            }
-        }
-        for j in 0..N {
-            for i in 0..N {
-                let (mut yh, mut rh) = (-0.0, -0.0);
-                for c in 0..K {
-                    yh += ym[i + c * N] * h[j + c * N];
-                }
-                for d in 0..K {
-                    rh += hr[i + d * N] * h[j + d * N];
-                }
-                s_out[i + j * N] = (xm[i + j * N] - yh) + rh;
-            }
-        }
-        symmetrize(N, s_out);
-        let log_likelihood = -0.5 * (nis + log_det(K, &lv) + K as f64 * TAU.ln());
-        if !(all_finite(x_out)
-            && all_finite(s_out)
-            && nis.is_finite()
-            && log_likelihood.is_finite())
-        {
-            return None;
-        }
-
-        // What an `Innovation` reads, as the general path leaves it.
-        w.present.clear();
-        w.present.extend_from_slice(&[0, 1, 2]);
-        w.values.clear();
-        w.values.extend_from_slice(&y);
-        w.nu[..K].copy_from_slice(&nu);
-        w.v[..K * K].copy_from_slice(&v);
-        w.h[..N * K].copy_from_slice(&h);
-        Some(InnovationStats {
-            components: K,
-            nis,
-            log_likelihood,
-        })
     }
+    let mut ym = [0.0; N * K];
+    times_mt(&xm, &jm, &mut ym);
+    let mut hr = [0.0; N * K];
+    for d in 0..K {
+        for i in 0..N {
+            hr[i + d * N] = h[i + d * N] * r[d];
+        }
+    }
+    for j in 0..N {
+        for i in 0..N {
+            let (mut yh, mut rh) = (-0.0, -0.0);
+            for c in 0..K {
+                yh += ym[i + c * N] * h[j + c * N];
+            }
+            for d in 0..K {
+                rh += hr[i + d * N] * h[j + d * N];
+            }
+            s_out[i + j * N] = (xm[i + j * N] - yh) + rh;
+        }
+    }
+    symmetrize(N, s_out);
+    let log_likelihood = -0.5 * (nis + log_det(K, &lv) + K as f64 * TAU.ln());
+    if !(all_finite(x_out) && all_finite(s_out) && nis.is_finite() && log_likelihood.is_finite()) {
+        return None;
+    }
+
+    // What an `Innovation` reads, as the general path leaves it.
+    w.present.clear();
+    w.present.extend_from_slice(&[0, 1, 2]);
+    w.values.clear();
+    w.values.extend_from_slice(&y);
+    w.nu[..K].copy_from_slice(&nu);
+    w.v[..K * K].copy_from_slice(&v);
+    w.h[..N * K].copy_from_slice(&h);
+    Some(InnovationStats {
+        components: K,
+        nis,
+        log_likelihood,
+    })
 }
 
 /// The prediction over a step `zeta ≠ 0` of the filter's state `x` and covariance `s` into
@@ -281,12 +313,22 @@ fn predict(
     if !(t0.is_finite() && t1.is_finite() && all_finite(xp)) {
         return None;
     }
-    let mut q = [0.0; N * N];
+    // Q = Q₁ ⊗ I₃ with Q₁ the noise's own 2 × 2 (`fill` on one axis: each entry's formula
+    // does not depend on the axes); its zeros are added as `+ 0` where the general path adds
+    // them, so that a zero's sign stays the general path's too.
+    let mut q1 = [0.0; 4];
     if let Some(psd) = psd {
-        if !fill(Fixed::<2>, 3, psd, zeta.abs(), &mut q) {
+        if !fill(Fixed::<2>, 1, psd, zeta.abs(), &mut q1) {
             return None;
         }
     }
+    let q = |i: usize, j: usize| {
+        if i % 3 == j % 3 {
+            q1[i / 3 + (j / 3) * 2]
+        } else {
+            0.0
+        }
+    };
     // A = S Φᵀ written transposed ((Aᵀ)_{ir} = A_{ri}), then Aᵀ Φᵀ.
     let mut at = [0.0; N * N];
     times_phi_t(s, t0, t1, |r, i| i + r * N, &mut at);
@@ -294,10 +336,10 @@ fn predict(
     match psd {
         Some(_) => {
             for j in 0..N {
-                sp[j + j * N] += q[j + j * N];
+                sp[j + j * N] += q(j, j);
                 for i in j + 1..N {
                     let (lower, upper) = (i + j * N, j + i * N);
-                    let v = ((sp[lower] + q[lower]) + (sp[upper] + q[upper])) * 0.5;
+                    let v = ((sp[lower] + q(i, j)) + (sp[upper] + q(j, i))) * 0.5;
                     sp[lower] = v;
                     sp[upper] = v;
                 }
@@ -431,6 +473,7 @@ mod tests {
                 let (wa, wb) = (&fast.work, &general.work);
                 assert_eq!(wa.x, wb.x);
                 assert_eq!(wa.s, wb.s);
+                assert_eq!(wa.phi, wb.phi);
                 assert_eq!(wa.x_out, wb.x_out);
                 assert_eq!(wa.s_out, wb.s_out);
                 assert_eq!(wa.present, wb.present);
