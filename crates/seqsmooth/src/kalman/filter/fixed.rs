@@ -251,6 +251,9 @@ const fn on<const A: usize>(r: usize, c: usize) -> bool {
 /// NaN; a finite sum that overflows only sends the step to the generic path): a non-finite
 /// `Φ`, `Q` or entry of the prediction reaches the same entry of the update
 /// (`X_{n,n−1} + …`, `S_{n,n−1} − …`), so the update's sum covers them.
+// The loops index by position on purpose: each sum in the kernel's order, over arrays whose
+// sizes are constants (the loops unroll).
+#[allow(clippy::needless_range_loop)]
 #[inline(never)]
 fn update<const N: usize, const K: usize>(
     axes: usize,
@@ -454,6 +457,7 @@ fn update<const N: usize, const K: usize>(
 /// whatever their value, and the sums from `−0`, each entry of `S_{n,n−1}` then made `+0`
 /// where it is `−0` ([`update`]'s doc: the same numbers). Whether `Φ`, `Q` and the
 /// prediction are finite is left to [`update`]'s check.
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 fn predict_exact<const N: usize, const A: usize>(
     zeta: f64,
