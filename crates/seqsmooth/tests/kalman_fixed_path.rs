@@ -110,6 +110,12 @@ fn case(rng: &mut StdRng, degree: usize, axes: usize, p: usize, steps: usize) ->
     let x0 = DVector::from_fn(n, |i, _| c[(i, 0)]);
     let b = normal(p, p) * 0.4;
     let full = &b * b.transpose() + DMatrix::identity(p, p) * 0.2;
+    // M of unit rows now and then (each row one state component, as
+    // `LinearObservation::value_of`).
+    if rng.gen_bool(0.3) {
+        let picks: Vec<usize> = (0..p).map(|_| rng.gen_range(0..n)).collect();
+        m = DMatrix::from_fn(p, n, |r, c| if c == picks[r] { 1.0 } else { 0.0 });
+    }
     let dynamics = PolynomialDynamics::new(degree, axes);
     let observation = LinearObservation::new(m).unwrap();
     let mut fast = KalmanFilter::new(

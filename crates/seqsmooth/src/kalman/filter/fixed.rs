@@ -15,33 +15,36 @@
 //!
 //! With a constant `M` ([`Observation::linear_matrix`]) of at most 3 rows, `R` the identity
 //! or variances, at least one component present and no fading memory, the whole update
-//! ((12.2.15)-(12.2.19), Joseph's form (12.3.7)) is one function compiled for each `n`
-//! ([`update`]; a fading filter takes the prediction above and the generic correction): the measurement
-//! read once, the prediction, `G = M X_{n,n−1}` and `ν`, and the generic path's correction
-//! ([`correct_in`]) with the present components `k` a constant, all on arrays of its own that
-//! the compiler keeps in registers, the results written to the filter's buffers once; no
-//! `DMatrix` is read or written inside the arithmetic, and the checks are those the generic
-//! path makes, once each.
+//! ((12.2.15)-(12.2.19), Joseph's form (12.3.7)) is one function compiled for each `n` and
+//! each count `k` of present components ([`update`]; a fading filter takes the prediction
+//! above and the generic correction): the measurement read once, the prediction, `G = M X_{n,n−1}`
+//! and `ν`, and the correction, all on arrays of its own (`[[f64; N]; N]`) that the compiler
+//! keeps in registers where it can, the estimate written to the filter once, without a swap;
+//! what the path needs of the models (the polynomial model's degree and axes, the driving
+//! noise's spectral density) is read once when they change ([`Plan`]), not through the model
+//! interfaces (a virtual call for the noise) at each step. Whether every number is finite is
+//! one sum of the results, not a test of each.
 //!
 //! Every number is the generic path's (`Dynamics::propagate_into`, `ProcessNoise::covariance_into`,
 //! [`carry`](super::super::correct::carry), `Observation::predict_into`,
 //! [`correct_kernel`](super::super::correct::correct_kernel)) **bit for bit**: each sum adds
 //! the same terms in the same order (a skipped term is `0 · a` for a finite `a`, which adds
-//! nothing to a sum that started at `+0`), tested on seeded random models of every size in
-//! range (`tests/kalman_fixed_path.rs`). Anything not finite, or `V` not positive definite,
-//! stops this path before the filter changes; the generic path then takes the step and gives
-//! its own error.
+//! nothing to a sum; a sum started at `−0` rather than `+0` differs at most in a zero's sign,
+//! and each result is made `+0` where it is `−0`: [`update`]'s doc), tested on seeded random
+//! models of every size in range, `M` random or of unit rows (`tests/kalman_fixed_path.rs`).
+//! Anything not finite, or `V` not positive definite, stops this path before the filter
+//! changes; the generic path then takes the step and gives its own error.
 
-use super::super::correct::{carry_with, correct_in, Buffers, Work};
+use super::super::correct::{carry_with, Work};
 use super::{InnovationStats, KalmanFilter};
 use crate::kalman::noise::fill;
-use crate::linalg::dense::all_finite;
+use crate::linalg::dense::{all_finite, ldl, log_det};
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::{Measurement, NoiseCovariance};
-use crate::model::observation::{linear_value, Observation};
+use crate::model::observation::Observation;
 use crate::model::transition::psi_term;
 use crate::numeric::unrolled::{unrolled_sizes, Fixed, Quotient, UNROLLED_MAX_SIZE};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use std::f64::consts::TAU;
 
 /// The most axes with the path compiled for them.
@@ -49,21 +52,64 @@ const MAX_AXES: usize = 3;
 /// The most components of a constant `M` the whole update takes at fixed size.
 const MAX_COMPONENTS: usize = 3;
 
+/// The fixed-size path's reading of the filter's models (what [`KalmanFilter::update_fixed`]
+/// and [`KalmanFilter::predict_fixed`] need of them each step): made when first needed after
+/// the dynamics or the driving noise change, so that a step makes no call through the model
+/// interfaces (the driving noise's is a virtual call). Not saved: a restored filter makes it
+/// again.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) enum Plan {
+    /// Not made since the models last changed.
+    #[default]
+    Unknown,
+    /// Not a model of the path: the generic recursion.
+    Generic,
+    /// The polynomial model of `degree` on `axes` axes, with `WhiteNoiseDerivative`'s spectral
+    /// density `psd` of the same degree and axes or no driving noise (`None`).
+    Polynomial {
+        degree: usize,
+        axes: usize,
+        psd: Option<f64>,
+    },
+}
+
 impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// The degree, axes and driving noise's spectral density (`None`: no driving noise) of a
-    /// polynomial model in the path's range, the filter's state of its size; `None` otherwise.
-    fn fixed_model(&self) -> Option<(usize, usize, Option<f64>)> {
-        let model = self.dynamics.polynomial()?;
+    /// polynomial model in the path's range, the filter's state of its size; `None` otherwise
+    /// (the [`Plan`], made if it is not).
+    fn fixed_model(&mut self) -> Option<(usize, usize, Option<f64>)> {
+        if matches!(self.plan, Plan::Unknown) {
+            self.plan = self.make_plan();
+        }
+        match self.plan {
+            Plan::Polynomial { degree, axes, psd } => Some((degree, axes, psd)),
+            _ => None,
+        }
+    }
+
+    /// The [`Plan`] of the filter's models.
+    fn make_plan(&self) -> Plan {
+        let Some(model) = self.dynamics.polynomial() else {
+            return Plan::Generic;
+        };
         let (m, d) = (model.degree(), model.axes());
         let psd = match &self.noise {
             None => None,
             Some(noise) => match noise.white_noise_derivative().map(|q| q.parts()) {
                 Some((degree, axes, psd)) if degree == m && axes == d => Some(psd),
-                _ => return None,
+                _ => return Plan::Generic,
             },
         };
         let n = (m + 1) * d;
-        (n <= UNROLLED_MAX_SIZE && d <= MAX_AXES && self.state.len() == n).then_some((m, d, psd))
+        if n <= UNROLLED_MAX_SIZE && d <= MAX_AXES && self.state.len() == n {
+            Plan::Polynomial {
+                degree: m,
+                axes: d,
+                psd,
+            }
+        } else {
+            Plan::Generic
+        }
     }
 
     /// The prediction to `t` (not the filter's time) into the work buffers on the fixed-size
@@ -88,12 +134,13 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     }
 
     /// The whole update on the fixed-size path, prediction and correction in one function
-    /// compiled for each state size (the module's doc), into the work buffers as the generic
-    /// path leaves them (the prediction `X_{n,n−1}`, `S_{n,n−1}`, `Φ`; with `innovation` what
-    /// an [`Innovation`](super::Innovation) reads; the updated estimate), the filter unchanged:
-    /// the statistics, or `None` for the generic path (a model out of range, a constant `M`
-    /// of more than [`MAX_COMPONENTS`] rows, no component present, `R` other than the
-    /// identity or variances, or anything the generic path would refuse).
+    /// compiled for each state size and count of present components (the module's doc): the
+    /// filter's new estimate and time, and in the work buffers what the generic path leaves
+    /// there (the prediction `X_{n,n−1}`, `S_{n,n−1}`, `Φ`; with `innovation` what an
+    /// [`Innovation`](super::Innovation) reads); the statistics. `None`, the filter unchanged,
+    /// for the generic path: a model out of range, a constant `M` of more than
+    /// [`MAX_COMPONENTS`] rows, no component present, `R` other than the identity or
+    /// variances, fading memory, or anything the generic path would refuse.
     pub(super) fn update_fixed(
         &mut self,
         m: &Measurement,
@@ -111,7 +158,12 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             return None;
         }
         // The measurement as `measure` reads it: the present components, their values and
-        // variances.
+        // variances (every variance checked, as `measure` checks the whole `R`).
+        let variances = match &m.noise {
+            NoiseCovariance::Identity => None,
+            NoiseCovariance::Variances(v) if v.len() == p => Some(v.as_slice()),
+            _ => return None,
+        };
         let mut seen = Seen {
             model,
             present: [0; MAX_COMPONENTS],
@@ -120,42 +172,34 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             k: 0,
         };
         for (c, v) in m.values.iter().enumerate() {
+            let variance = variances.map_or(1.0, |v| v[c]);
+            // Not negative and finite, as `measure` requires.
+            if !(0.0..f64::INFINITY).contains(&variance) {
+                return None;
+            }
             if let Some(v) = *v {
-                if !v.is_finite() {
+                if !v.is_finite() || seen.k >= MAX_COMPONENTS {
                     return None;
                 }
                 (seen.present[seen.k], seen.values[seen.k]) = (c, v);
+                seen.variances[seen.k] = variance;
                 seen.k += 1;
             }
         }
-        match &m.noise {
-            NoiseCovariance::Identity => {}
-            NoiseCovariance::Variances(v)
-                if v.len() == p && v.iter().all(|v| (0.0..f64::INFINITY).contains(v)) =>
-            {
-                for c in 0..seen.k {
-                    seen.variances[c] = v[seen.present[c]];
-                }
-            }
-            _ => return None,
-        }
-        if seen.k == 0 {
-            return None;
-        }
         let step = (t != self.time).then_some(t - self.time);
-        let from = (self.state.as_slice(), self.covariance.as_slice());
+        let estimate = (&mut self.state, &mut self.covariance);
         let observation = &self.observation;
         let residual = |a: usize, y: f64, g: f64| observation.residual(a, y, g);
         let w = &mut self.work;
-        let (nis, log_det) = unrolled_sizes!(n, N =>
-            update::<N>(axes, (step, psd), from, (&seen, residual), w, innovation),
+        let stats = unrolled_sizes!(n, N => match seen.k {
+                0 => None,
+                1 => update::<N, 1>(axes, (step, psd), estimate, (&seen, residual), w, innovation),
+                2 => update::<N, 2>(axes, (step, psd), estimate, (&seen, residual), w, innovation),
+                _ => update::<N, 3>(axes, (step, psd), estimate, (&seen, residual), w, innovation),
+            },
             _ => None)?;
-        let log_likelihood = -0.5 * (nis + log_det + seen.k as f64 * TAU.ln());
-        (nis.is_finite() && log_likelihood.is_finite()).then_some(InnovationStats {
-            components: seen.k,
-            nis,
-            log_likelihood,
-        })
+        self.time = t;
+        Some(stats)
     }
 }
 
@@ -169,120 +213,336 @@ struct Seen<'a> {
     k: usize,
 }
 
-/// The largest `n × n` the path holds.
-const SQUARE: usize = UNROLLED_MAX_SIZE * UNROLLED_MAX_SIZE;
-/// The largest `n × k` the path holds.
-const TALL: usize = UNROLLED_MAX_SIZE * MAX_COMPONENTS;
+/// `N × N`, column-major: `m[j][i]` is the entry `(i, j)`.
+type Square<const N: usize> = [[f64; N]; N];
 
-/// [`KalmanFilter::update_fixed`] for `N` states on `axes` axes: the prediction over `step`
-/// ([`predict_in`]; `None`: no step, the estimate as it is), `G = M X_{n,n−1}`
-/// ([`linear_value`], the generic path's), `ν` by the model's `residual`, `Mᵀ` and `R` of the
-/// present components, and [`correct_in`] with `k` a constant, all on arrays of this function
-/// (which the compiler keeps in registers), the results then written to `w` once: `NIS` and
-/// `ln det V`, or `None` where a number is not finite or `V` not positive definite.
+/// Whether `Φ`'s entry `(r, c)` on `A` axes is one of `Ψ ⊗ I`'s terms `ζ^k/k!` (4.2.5): `c ≥ r`
+/// on the same axis (every other entry is a structural zero).
+#[inline(always)]
+const fn on<const A: usize>(r: usize, c: usize) -> bool {
+    c >= r && (c - r).is_multiple_of(A)
+}
+
+/// [`KalmanFilter::update_fixed`] for `N` states on `axes` axes with `K` components present:
+/// the prediction over `step` ([`predict_exact`]; `None`: no step, the estimate as it is),
+/// `G = M X_{n,n−1}` (each row's sum over the columns in order, as
+/// [`linear_value`](crate::model::observation::linear_value)), `ν` by the model's `residual`,
+/// and the correction ((12.2.17)-(12.2.19), Joseph's form (12.3.7)), all on arrays of this
+/// function; only when every number is finite and `V` positive definite, the results are
+/// written once: the estimate into `estimate`, the prediction and what an `Innovation` reads
+/// into `w`. The statistics, or `None` (nothing written but `Φ`, which the generic path
+/// writes again).
+///
+/// The correction is [`correct_in`](super::super::correct::correct_in)'s with no fading,
+/// operation for operation: each sum over the same terms in the same order, with two
+/// differences that change no result. The generic path skips the products with a zero of `M`
+/// or `Φ` (and adds those with `R`'s zeros off the diagonal); for a finite `a`, `0 · a` is
+/// `±0`, which adds nothing to a sum. And its sums start at `+0` where these start at `−0`
+/// (which the compiler drops: `−0 + a = a`): an intermediate zero's sign can then differ,
+/// and a zero's sign changes only the sign of a zero it reaches through `+`, `−`, `·` and
+/// `/` by a pivot (`0 + a = a` for `a ≠ 0`), so each result is the generic path's or a zero
+/// of the other sign; the generic path's results are never `−0` (a sum from `+0` is not), and
+/// each result here is made `+0` where it is `−0` (`a + 0`) before it is written.
+///
+/// `U = S Mᵀ`, `V = M U + R` symmetrized, `V = L D Lᵀ` ([`ldl`]), `H = U L⁻ᵀ D⁻¹ L⁻¹`,
+/// `NIS = Σ z_c² / D_c` (`z = L⁻¹ ν`), `X = H ν + X_{n,n−1}`, and Joseph's
+/// `X' = S − H (M S)`, `Y = X' Mᵀ`, `S = (X' − Y Hᵀ) + (H R) Hᵀ` symmetrized. Whether every
+/// number is finite is one sum of the results (an infinity or NaN makes the sum infinite or
+/// NaN; a finite sum that overflows only sends the step to the generic path): a non-finite
+/// `Φ`, `Q` or entry of the prediction reaches the same entry of the update
+/// (`X_{n,n−1} + …`, `S_{n,n−1} − …`), so the update's sum covers them.
+// The loops index by position on purpose: each sum in the kernel's order, over arrays whose
+// sizes are constants (the loops unroll).
+#[allow(clippy::needless_range_loop)]
 #[inline(never)]
-fn update<const N: usize>(
+fn update<const N: usize, const K: usize>(
     axes: usize,
     (step, psd): (Option<f64>, Option<f64>),
-    (x, s): (&[f64], &[f64]),
+    (state, covariance): (&mut DVector<f64>, &mut DMatrix<f64>),
     (seen, residual): (&Seen<'_>, impl Fn(usize, f64, f64) -> f64),
     w: &mut Work,
     innovation: bool,
-) -> Option<(f64, f64)> {
-    let (mut xp, mut sp) = ([0.0; UNROLLED_MAX_SIZE], [0.0; SQUARE]);
-    let (xp, sp) = (&mut xp[..N], &mut sp[..N * N]);
-    let (mut q, mut square) = ([0.0; SQUARE], [0.0; SQUARE]);
-    match step {
-        Some(zeta) => {
-            let from = (x, s, None);
-            let (phi, q, square) = (&mut w.phi.as_mut_slice()[..N * N], &mut q, &mut square);
-            let into: (&mut [f64], &mut [f64], &mut [f64]) = (&mut *xp, &mut *sp, &mut []);
-            let predicted = match axes {
-                1 => predict_in::<N, 1>(zeta, psd, from, phi, q, square, into),
-                2 => {
-                    N.is_multiple_of(2) && predict_in::<N, 2>(zeta, psd, from, phi, q, square, into)
+) -> Option<InnovationStats> {
+    let (x, s) = (&state.as_slice()[..N], &covariance.as_slice()[..N * N]);
+    let mut xp: [f64; N] = std::array::from_fn(|i| x[i]);
+    let mut sp: Square<N> = std::array::from_fn(|j| std::array::from_fn(|i| s[i + j * N]));
+    if let Some(zeta) = step {
+        let phi = &mut w.phi.as_mut_slice()[..N * N];
+        match axes {
+            1 => predict_exact::<N, 1>(zeta, psd, &mut xp, &mut sp, phi),
+            2 if N.is_multiple_of(2) => predict_exact::<N, 2>(zeta, psd, &mut xp, &mut sp, phi),
+            3 if N.is_multiple_of(3) => predict_exact::<N, 3>(zeta, psd, &mut xp, &mut sp, phi),
+            _ => return None,
+        }
+    }
+    // G = M X_{n,n−1}, every row (the generic path checks them all), each from −0 as
+    // `Iterator::sum`.
+    let p = seen.model.nrows();
+    let model = &seen.model.as_slice()[..p * N];
+    let mut check = 0.0;
+    let mut g = [0.0; MAX_COMPONENTS];
+    for (a, g) in g.iter_mut().enumerate().take(p) {
+        let mut acc = -0.0;
+        for l in 0..N {
+            acc += model[a + l * p] * xp[l];
+        }
+        *g = acc;
+        check += acc;
+    }
+    // Mᵀ (`mt[c]` row `present[c]` of `M`), `ν` and `R`'s diagonal on the present components.
+    let mut mt = [[0.0; N]; K];
+    let (mut nu, mut rd) = ([0.0; K], [0.0; K]);
+    for c in 0..K {
+        let a = seen.present[c];
+        for l in 0..N {
+            mt[c][l] = model[a + l * p];
+        }
+        nu[c] = residual(a, seen.values[c], g[a]);
+        rd[c] = seen.variances[c];
+    }
+    // U = S Mᵀ.
+    let mut u = [[-0.0; N]; K];
+    for c in 0..K {
+        for l in 0..N {
+            for r in 0..N {
+                u[c][r] += sp[l][r] * mt[c][l];
+            }
+        }
+    }
+    // V = M U + R, symmetrized, and V = L D Lᵀ.
+    let mut v = [[0.0; K]; K];
+    for b in 0..K {
+        for a in 0..K {
+            let mut msm = -0.0;
+            for l in 0..N {
+                msm += mt[a][l] * u[b][l];
+            }
+            v[b][a] = if a == b { msm + rd[a] } else { msm };
+        }
+    }
+    for j in 0..K {
+        for i in j + 1..K {
+            let value = (v[j][i] + v[i][j]) * 0.5;
+            v[j][i] = value;
+            v[i][j] = value;
+        }
+    }
+    let mut lv = [[0.0; K]; K];
+    if !ldl(K, v.as_flattened(), lv.as_flattened_mut()) {
+        return None;
+    }
+    // H = U L⁻ᵀ D⁻¹ L⁻¹: forwards, each column by its pivot, backwards.
+    let mut h = u;
+    for c in 0..K {
+        for d in 0..c {
+            let l = lv[d][c];
+            for i in 0..N {
+                h[c][i] -= l * h[d][i];
+            }
+        }
+    }
+    for c in 0..K {
+        let pivot = lv[c][c];
+        for i in 0..N {
+            h[c][i] /= pivot;
+        }
+    }
+    for c in (0..K).rev() {
+        for d in c + 1..K {
+            let l = lv[c][d];
+            for i in 0..N {
+                h[c][i] -= l * h[d][i];
+            }
+        }
+    }
+    // NIS = Σ z_c² / D_c, z = L⁻¹ ν.
+    let (mut nis, mut z) = (0.0, [0.0; K]);
+    for c in 0..K {
+        let mut acc = nu[c];
+        for d in 0..c {
+            acc -= lv[d][c] * z[d];
+        }
+        z[c] = acc;
+        nis += acc * acc / lv[c][c];
+    }
+    let mut x_out = [0.0; N];
+    for i in 0..N {
+        let mut acc = -0.0;
+        for c in 0..K {
+            acc += h[c][i] * nu[c];
+        }
+        x_out[i] = (acc + xp[i]) + 0.0;
+        check += x_out[i];
+    }
+    // Joseph's form: X' = S − H (M S), Y = X' Mᵀ, H R, then (X' − Y Hᵀ) + (H R) Hᵀ.
+    let mut xs = sp;
+    for j in 0..N {
+        for i in 0..N {
+            let mut acc = -0.0;
+            for c in 0..K {
+                acc += h[c][i] * u[c][j];
+            }
+            xs[j][i] = sp[j][i] - acc;
+        }
+    }
+    let mut y = [[-0.0; N]; K];
+    for c in 0..K {
+        for l in 0..N {
+            for r in 0..N {
+                y[c][r] += xs[l][r] * mt[c][l];
+            }
+        }
+    }
+    let mut hr = [[0.0; N]; K];
+    for d in 0..K {
+        for i in 0..N {
+            hr[d][i] = h[d][i] * rd[d];
+        }
+    }
+    let mut s_out = [[0.0; N]; N];
+    for j in 0..N {
+        for i in 0..N {
+            let (mut yh, mut hrh) = (-0.0, -0.0);
+            for c in 0..K {
+                yh += y[c][i] * h[c][j];
+            }
+            for d in 0..K {
+                hrh += hr[d][i] * h[d][j];
+            }
+            s_out[j][i] = (xs[j][i] - yh) + hrh;
+        }
+    }
+    for j in 0..N {
+        s_out[j][j] += 0.0;
+        check += s_out[j][j];
+        for i in j + 1..N {
+            let value = (s_out[j][i] + s_out[i][j]) * 0.5 + 0.0;
+            s_out[j][i] = value;
+            s_out[i][j] = value;
+            check += value;
+        }
+    }
+    let log_likelihood = -0.5 * (nis + log_det(K, lv.as_flattened()) + K as f64 * TAU.ln());
+    if !(check.is_finite() && nis.is_finite() && log_likelihood.is_finite()) {
+        return None;
+    }
+    // The results, once: the estimate, the prediction (which the smoothers read), and what an
+    // `Innovation` reads.
+    state.as_mut_slice()[..N].copy_from_slice(&x_out);
+    covariance.as_mut_slice()[..N * N].copy_from_slice(s_out.as_flattened());
+    w.x.as_mut_slice()[..N].copy_from_slice(&xp);
+    w.s.as_mut_slice()[..N * N].copy_from_slice(sp.as_flattened());
+    if innovation {
+        w.present.clear();
+        w.present.extend_from_slice(&seen.present[..K]);
+        w.nu[..K].copy_from_slice(&nu);
+        for (to, v) in w.v[..K * K].iter_mut().zip(v.as_flattened()) {
+            *to = v + 0.0;
+        }
+        for (to, h) in w.h[..N * K].iter_mut().zip(h.as_flattened()) {
+            *to = h + 0.0;
+        }
+    }
+    Some(InnovationStats {
+        components: K,
+        nis,
+        log_likelihood,
+    })
+}
+
+/// The prediction of `N` states on `A` axes over the step `zeta` in place of `(xp, sp)`, `Φ`
+/// into `phi`: [`predict_in`]'s numbers (the generic path's
+/// [`carry`](super::super::correct::carry)), operation for operation on this function's
+/// arrays, `Φ`'s structural zeros left out at compile time, its other entries multiplied
+/// whatever their value, and the sums from `−0`, each entry of `S_{n,n−1}` then made `+0`
+/// where it is `−0` ([`update`]'s doc: the same numbers). Whether `Φ`, `Q` and the
+/// prediction are finite is left to [`update`]'s check.
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+fn predict_exact<const N: usize, const A: usize>(
+    zeta: f64,
+    psd: Option<f64>,
+    xp: &mut [f64; N],
+    sp: &mut Square<N>,
+    phi: &mut [f64],
+) {
+    let size = N / A;
+    let mut psi = [0.0; N];
+    for (k, psi) in psi[..size].iter_mut().enumerate() {
+        *psi = psi_term(k, &zeta);
+    }
+    let entry = |r: usize, c: usize| {
+        if on::<A>(r, c) {
+            psi[(c - r) / A]
+        } else {
+            0.0
+        }
+    };
+    for c in 0..N {
+        for r in 0..N {
+            phi[r + c * N] = entry(r, c);
+        }
+    }
+    let x = *xp;
+    for r in 0..N {
+        let mut acc = psi[0] * x[r];
+        for k in 1..size {
+            if r + k * A < N {
+                acc += psi[k] * x[r + k * A];
+            }
+        }
+        xp[r] = acc;
+    }
+    // T = S Φᵀ (`t[i]` its column i), then Φ S Φᵀ = Tᵀ Φᵀ: its column j is Σ_l Tᵀ[:, l] Φ(j, l).
+    let s = *sp;
+    let mut t = [[-0.0; N]; N];
+    for i in 0..N {
+        for l in 0..N {
+            if on::<A>(i, l) {
+                let scale = psi[(l - i) / A];
+                for r in 0..N {
+                    t[i][r] += s[l][r] * scale;
                 }
-                _ => {
-                    N.is_multiple_of(3) && predict_in::<N, 3>(zeta, psd, from, phi, q, square, into)
+            }
+        }
+    }
+    let mut out = [[-0.0; N]; N];
+    for j in 0..N {
+        for l in 0..N {
+            if on::<A>(j, l) {
+                let scale = psi[(l - j) / A];
+                for r in 0..N {
+                    out[j][r] += t[r][l] * scale;
                 }
-            };
-            if !predicted {
-                return None;
+            }
+        }
+    }
+    match psd {
+        // (out + Q) symmetrized, in one pass.
+        Some(psd) => {
+            let mut q = [[0.0; N]; N];
+            fill(Quotient::<N, A>, A, psd, zeta.abs(), q.as_flattened_mut());
+            for j in 0..N {
+                out[j][j] = (out[j][j] + q[j][j]) + 0.0;
+                for i in j + 1..N {
+                    let v = ((out[j][i] + q[j][i]) + (out[i][j] + q[i][j])) * 0.5 + 0.0;
+                    out[j][i] = v;
+                    out[i][j] = v;
+                }
             }
         }
         None => {
-            xp.copy_from_slice(&x[..N]);
-            sp.copy_from_slice(&s[..N * N]);
+            for j in 0..N {
+                out[j][j] += 0.0;
+                for i in j + 1..N {
+                    let v = (out[j][i] + out[i][j]) * 0.5 + 0.0;
+                    out[j][i] = v;
+                    out[i][j] = v;
+                }
+            }
         }
     }
-    let (p, k) = (seen.model.nrows(), seen.k);
-    let mut g = [0.0; MAX_COMPONENTS];
-    linear_value(seen.model, xp, &mut g);
-    if !all_finite(&g[..p]) {
-        return None;
-    }
-    let model = &seen.model.as_slice()[..p * N];
-    let (mut mt, mut nu, mut r) = ([0.0; TALL], [0.0; MAX_COMPONENTS], [0.0; 9]);
-    for c in 0..k {
-        let a = seen.present[c];
-        for l in 0..N {
-            mt[l + c * N] = model[a + l * p];
-        }
-        nu[c] = residual(a, seen.values[c], g[a]);
-        r[c + c * k] = seen.variances[c];
-    }
-    let (mut u, mut h, mut y, mut hr) = ([0.0; TALL], [0.0; TALL], [0.0; TALL], [0.0; TALL]);
-    let (mut v, mut lv) = ([0.0; 9], [0.0; 9]);
-    let (mut z, mut column) = ([0.0; MAX_COMPONENTS], [0.0; UNROLLED_MAX_SIZE]);
-    let (mut x_out, mut s_out) = ([0.0; UNROLLED_MAX_SIZE], [0.0; SQUARE]);
-    let (xp, sp): (&[f64], &[f64]) = (xp, sp);
-    let buffers = Buffers {
-        x: xp,
-        s: sp,
-        p: sp,
-        mt: &mt,
-        r: &r,
-        nu: &nu,
-        u: &mut u,
-        h: &mut h,
-        sm: &mut [],
-        y: &mut y,
-        hr: &mut hr,
-        vp: &mut [],
-        lp: &mut [],
-        v: &mut v,
-        lv: &mut lv,
-        rf: &mut [],
-        z: &mut z,
-        column: &mut column,
-        square: &mut square,
-        x_out: &mut x_out,
-        s_out: &mut s_out,
-        p_out: &mut [],
-    };
-    let corrected = match k {
-        1 => correct_in(Fixed::<N>, Fixed::<1>, 1.0, false, buffers),
-        2 => correct_in(Fixed::<N>, Fixed::<2>, 1.0, false, buffers),
-        _ => correct_in(Fixed::<N>, Fixed::<3>, 1.0, false, buffers),
-    };
-    let (nis, log_det, finite_out) = corrected.ok()?;
-    if !finite_out {
-        return None;
-    }
-    // The results, once: the prediction (which the smoothers read), the update, and what an
-    // `Innovation` reads.
-    w.x.as_mut_slice()[..N].copy_from_slice(xp);
-    w.s.as_mut_slice()[..N * N].copy_from_slice(sp);
-    w.x_out.as_mut_slice()[..N].copy_from_slice(&x_out[..N]);
-    w.s_out.as_mut_slice()[..N * N].copy_from_slice(&s_out[..N * N]);
-    if innovation {
-        w.present.clear();
-        w.present.extend_from_slice(&seen.present[..k]);
-        w.nu[..k].copy_from_slice(&nu[..k]);
-        w.v[..k * k].copy_from_slice(&v[..k * k]);
-        w.h[..N * k].copy_from_slice(&h[..N * k]);
-    }
-    Some((nis, log_det))
+    *sp = out;
 }
 
 /// [`KalmanFilter::predict_fixed`] for `N` states on `A` axes over the step `zeta`: from the
@@ -417,9 +677,9 @@ mod tests {
             }
         }
     }
-    /// The whole update at fixed size is taken for every polynomial model in range with a
-    /// constant `M` of 1-3 rows, with and without driving noise, over a step (forwards or
-    /// backwards) or none, and not with 4 rows, a full `R`, no component present, fading
+    /// The whole update at fixed size is taken (and made the filter's) for every polynomial
+    /// model in range with a constant `M` of 1-3 rows, with and without driving noise, over a
+    /// step (forwards or backwards) or none, and not with 4 rows, a full `R`, no component present, fading
     /// memory, or out of range (where
     /// `tests/kalman_fixed_path.rs`'s equalities could not tell a silent fallback).
     #[test]
@@ -460,8 +720,11 @@ mod tests {
                         taken,
                         "{what}"
                     );
+                    // The path commits its update: the filter is now at −1.3.
+                    assert_eq!(f.time(), if taken { -1.3 } else { 0.0 }, "{what}");
+                    let now = f.time();
                     assert_eq!(
-                        f.update_fixed(&row(0.0, NoiseCovariance::Identity), true)
+                        f.update_fixed(&row(now, NoiseCovariance::Identity), true)
                             .is_some(),
                         taken,
                         "{what}: no step"

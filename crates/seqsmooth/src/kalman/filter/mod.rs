@@ -53,8 +53,11 @@
 //!   a constant `M` ([`Observation::linear_matrix`]) is read in place, and `R`'s identity and
 //!   variances are checked at once: chosen without the caller asking, the same numbers bit for
 //!   bit. With a constant `M` of at most 3 rows the whole update ([`KalmanFilter::update`],
-//!   [`KalmanFilter::update_stats`]) is one function compiled for each `n`, on arrays the compiler
-//!   keeps in registers, the correction the same kernel with `k` a constant.
+//!   [`KalmanFilter::update_stats`]) is one function compiled for each `n` and `k`, on
+//!   fixed-size arrays the compiler keeps in registers: the correction kernel's operations
+//!   written out for them in its order (the one place the recursion is written twice, as the
+//!   radar's update is; tested bit for bit against the general path), the estimate written to
+//!   the filter once, what it needs of the models read when they change.
 //! - The state dimension `n` and the present components `k` go through the crate's one size
 //!   dispatch (`unrolled_sizes!`, [`crate::numeric`]): for `n ≤ 9` and `k ≤ 4` each kernel is
 //!   compiled with them constants (its loops unrolled), other sizes take the same source with
@@ -84,6 +87,8 @@ mod undo;
 pub use innovation::{Innovation, InnovationStats};
 pub use iterated::{check_iteration_limits, IterationLimits};
 pub(crate) use saved::same_shape;
+
+use fixed::Plan;
 
 /// A Kalman filter on `D` and `O`, with optional driving noise.
 ///
@@ -122,6 +127,10 @@ pub struct KalmanFilter<D: Dynamics, O: Observation> {
     /// Scratch: not saved; made anew on restoring ([`crate::persist`]).
     #[serde(skip)]
     work: Work,
+    /// What the fixed-size path needs of the models, made when first needed after they
+    /// change: not saved.
+    #[serde(skip)]
+    plan: Plan,
 }
 
 /// The fading filter's own matrix `P` (14.3.13), not the covariance when the discount is
@@ -184,6 +193,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             covariance,
             time,
             work,
+            plan: Plan::Unknown,
         })
     }
 
@@ -335,6 +345,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             });
         }
         self.observation = observation;
+        self.plan = Plan::Unknown;
         Ok(())
     }
 
@@ -352,6 +363,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
 
     /// The dynamics, to change a step's matrices in place (the caller keeps its dimension).
     pub(crate) fn dynamics_mut(&mut self) -> &mut D {
+        self.plan = Plan::Unknown;
         &mut self.dynamics
     }
 
@@ -513,6 +525,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         let n = self.dynamics.dimension();
         super::noise::check_noise_dimension(&noise, n)?;
         self.noise = Some(Arc::new(noise));
+        self.plan = Plan::Unknown;
         Ok(())
     }
 
@@ -549,10 +562,9 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         innovation: bool,
         report: impl FnOnce(&Work, InnovationStats) -> T,
     ) -> Result<Option<T>, Error> {
+        // The fixed-size path has made its update the filter's.
         if let Some(stats) = self.update_fixed(measurement, innovation) {
-            let out = report(&self.work, stats);
-            self.commit_correction(measurement.time);
-            return Ok(Some(out));
+            return Ok(Some(report(&self.work, stats)));
         }
         let Some((t, stats)) = self.predict_and_correct(measurement)? else {
             return Ok(None);

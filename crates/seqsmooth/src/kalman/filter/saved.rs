@@ -81,6 +81,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             covariance: self.covariance,
             time: self.time,
             work: self.work,
+            plan: super::Plan::Unknown,
         })
     }
 
@@ -88,6 +89,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// caller's own, which has no saved form, is taken out before saving and set again on
     /// restoring ([`Self::set_process_noise`]).
     pub fn take_process_noise(&mut self) -> Option<Arc<dyn ProcessNoise>> {
+        self.plan = super::Plan::Unknown;
         self.noise.take()
     }
 
