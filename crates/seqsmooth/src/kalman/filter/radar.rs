@@ -156,10 +156,10 @@ fn update(
             predict(x, s, zeta, psd, xp, sp)?;
             let (t0, t1) = (psi_term(0, &zeta), psi_term(1, &zeta));
             // `Φ` into the work buffer as the general path leaves it (the smoothers read it:
-            // `last_transition`): `[[I, ζ I], [0, I]]` by `psi_term`, (4.2.5). Every writer of
-            // this buffer (this path, `predict_fixed`, `propagate_into`) writes this model's
-            // `Ψ(ζ) ⊗ I₃`, and the buffer starts at zero, so only the entries that are not
-            // structurally zero are written.
+            // `last_transition`): `[[I, ζ I], [0, I]]` by `psi_term`, (4.2.5). Written whole:
+            // the buffer may hold another model's `Φ` of the same size (`with_models` keeps
+            // the work buffers).
+            phi.fill(0.0);
             for a in 0..3 {
                 phi[a + a * N] = t0;
                 phi[(a + 3) + (a + 3) * N] = t0;
@@ -487,6 +487,29 @@ mod tests {
             }
         }
         assert_eq!(taken, 200 * 40);
+    }
+
+    /// `Φ` written whole even where the work buffer held another model's transition of the
+    /// same size (`with_models` keeps the work buffers): equal to the general path's.
+    #[test]
+    fn the_whole_transition_over_a_stale_buffer() {
+        let mut rng = StdRng::seed_from_u64(11);
+        let mut f = filter(&mut rng);
+        f.work.phi.fill(0.25);
+        let look = f
+            .observation()
+            .look([f.state()[0], f.state()[1], f.state()[2]])
+            .unwrap();
+        let m = Measurement {
+            time: 1.5,
+            values: look.value.iter().map(|&v| Some(v)).collect(),
+            noise: NoiseCovariance::Identity,
+        };
+        let (mut fast, mut general) = (f.clone(), f);
+        fast.correct_radar_fixed(&m).expect("the fixed-size path");
+        let t_general = general.measure_and_predict(&m).unwrap().unwrap();
+        general.correct(t_general, false).unwrap();
+        assert_eq!(fast.work.phi, general.work.phi);
     }
 
     /// Not taken where the general path must decide: a missing component, a full `R`, fading
