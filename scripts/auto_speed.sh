@@ -8,6 +8,7 @@
 # ratio to the fading filter's with σ.
 #
 # Usage: scripts/auto_speed.sh [ROWS]     (default 10000000; builds the release binary first)
+# With AUTO_SPEED_INPUT=PATH the input is also copied to PATH (for callgrind on its first rows).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 rows=${1:-10000000}
@@ -26,6 +27,7 @@ awk -v n="$rows" 'BEGIN {
         printf "%.4f,%.4f\n", t, x + e
     }
 }' > "$work/in.csv"
+if [ -n "${AUTO_SPEED_INPUT:-}" ]; then cp "$work/in.csv" "$AUTO_SPEED_INPUT"; fi
 run() {
     local label=$1; shift
     /usr/bin/time -f "%e %U %S %M" -o "$work/time" "$bin" filter "$work/in.csv" "$@" > /dev/null

@@ -14,7 +14,7 @@
 //! - `auto, review_window 0`: without the review (the gate's decisions);
 //! - `auto, both 0`: neither.
 //!
-//! The last three are not the filter the command runs (its Monte Carlo figures in ACCURACY.md
+//! All but `auto` are not the filter the command runs (its Monte Carlo figures in ACCURACY.md
 //! are for the defaults); they bound what a part costs. With `review_window 0` the review keeps
 //! the state before every sample (none waits for a decision, and the first one waiting keeps
 //! it), so that variant costs more, not less: it is no measure of the review's own cost.
