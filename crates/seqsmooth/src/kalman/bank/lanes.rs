@@ -15,6 +15,12 @@
 //! starts with no step length remembered), so they do not depend on its neighbours, on the
 //! task, or on the split of the series into batches.
 //!
+//! The common step — every lane holding a series whose next row has every component present
+//! and finite, at a later time, with a step length whose `Φ` and `Q` the lane has, and no
+//! check stopping its numbers — takes a straight path (`Lanes::steady`: the same kernels on
+//! the same inputs, without the per-lane choices, the checks one sum per lane); any other step
+//! goes through `Lanes::advance`, from the same state.
+//!
 //! The lanes are compiled for x86-64 with AVX2 (four lanes an instruction, no fused
 //! multiply-add: the same roundings) and taken where the processor has it.
 
@@ -189,13 +195,149 @@ impl<'a, D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'a, 
                 }
                 return failure;
             }
-            for (e, err) in self.advance(panel, out, base, None).into_iter().enumerate() {
-                if let Some(err) = err {
-                    let held = self.held[e].take().expect("a failing lane holds a series");
-                    fail(held.series, err);
+            // Every lane holds a series: the steps before the first of them ends.
+            let run = self
+                .held
+                .iter()
+                .flatten()
+                .map(|h| h.end - h.row)
+                .min()
+                .unwrap_or(0);
+            for _ in 0..run {
+                if self.steady(panel, out, base, None) {
+                    continue;
+                }
+                let mut failed = false;
+                for (e, err) in self.advance(panel, out, base, None).into_iter().enumerate() {
+                    if let Some(err) = err {
+                        let held = self.held[e].take().expect("a failing lane holds a series");
+                        fail(held.series, err);
+                        failed = true;
+                    }
+                }
+                if failed {
+                    break;
                 }
             }
         }
+    }
+
+    /// The step of every lane when each is steady — it holds a series whose next row has
+    /// every component present and finite, a later finite time, and a step length whose `Φ`
+    /// and `Q` the lane has (a time-invariant model) — and no check would stop its numbers:
+    /// [`Self::advance`]'s arithmetic for such lanes, operation for operation, without its
+    /// per-lane choices (into `out` the rows, or into `keep` the step); `true` when taken.
+    /// Otherwise nothing changes and `false` ([`Self::advance`] takes the step).
+    // `v − v` on purpose: 0 for a finite `v`, NaN for an infinite or NaN one.
+    #[allow(clippy::eq_op)]
+    #[inline(always)]
+    fn steady(
+        &mut self,
+        panel: &Panel<'_>,
+        out: &mut RowsMut<'_>,
+        base: usize,
+        keep: Option<&mut Step<N, L>>,
+    ) -> bool {
+        if !self.one.invariant {
+            return false;
+        }
+        let mut rows = [0; L];
+        let mut t = [0.0; L];
+        let mut z = [[0.0; L]; K];
+        for e in 0..L {
+            let Some(held) = self.held[e] else {
+                return false;
+            };
+            rows[e] = held.row;
+            t[e] = panel.times[held.row];
+            for c in 0..K {
+                z[c][e] = panel.values[held.row * K + c];
+            }
+        }
+        // `v − v` is 0 for a finite `v`, NaN otherwise: one sum per lane, NaN when any
+        // entry is not finite.
+        let mut bad = [0.0; L];
+        for c in 0..K {
+            for e in 0..L {
+                bad[e] += z[c][e] - z[c][e];
+            }
+        }
+        let mut steady = true;
+        for e in 0..L {
+            steady &= (bad[e] == 0.0)
+                & (t[e] - t[e] == 0.0)
+                & (t[e] > self.time[e])
+                & (t[e] - self.time[e] == self.step[e]);
+        }
+        if !steady {
+            return false;
+        }
+        let noise = self.bank.noise.as_ref();
+        let xp = kernel::propagate(&self.phi, &self.x);
+        let sp = kernel::carry(&self.phi, &self.s, noise.map(|_| &self.q));
+        let g = kernel::observe(&self.mt, &xp);
+        let mut nu = [[0.0; L]; K];
+        for c in 0..K {
+            for e in 0..L {
+                nu[c][e] = z[c][e] - g[c][e];
+            }
+        }
+        let up = kernel::correct(&self.mt, &self.r, &xp, &sp, &nu);
+        // The checks of `advance`: every entry finite, `V` positive definite, the NIS
+        // below 1e300.
+        let mut bad = [0.0; L];
+        for i in 0..N {
+            for e in 0..L {
+                bad[e] += (xp[i][e] - xp[i][e]) + (up.x[i][e] - up.x[i][e]);
+            }
+            for j in 0..N {
+                for e in 0..L {
+                    bad[e] += (sp[j][i][e] - sp[j][i][e]) + (up.s[j][i][e] - up.s[j][i][e]);
+                }
+            }
+        }
+        for c in 0..K {
+            for e in 0..L {
+                bad[e] += (g[c][e] - g[c][e]) + (up.lv[c][c][e] - up.lv[c][c][e]);
+            }
+        }
+        let mut fine = true;
+        for e in 0..L {
+            fine &= (bad[e] == 0.0) & up.positive[e] & (up.nis[e] < 1e300);
+        }
+        if !fine {
+            return false;
+        }
+        (self.x, self.s, self.time) = (up.x, up.s, t);
+        match keep {
+            Some(keep) => {
+                (keep.phi, keep.xp, keep.sp, keep.x, keep.s) = (self.phi, xp, sp, up.x, up.s);
+                keep.nis = up.nis.map(Some);
+            }
+            None => {
+                let sigma: [[f64; L]; N] = std::array::from_fn(|i| {
+                    std::array::from_fn(|e| self.s[i][i][e].max(0.0).sqrt())
+                });
+                for e in 0..L {
+                    let r = rows[e] - base;
+                    let state = &mut out.state[r * N..(r + 1) * N];
+                    let to = &mut out.sigma[r * N..(r + 1) * N];
+                    for i in 0..N {
+                        state[i] = self.x[i][e];
+                        to[i] = sigma[i][e];
+                    }
+                    out.nis[r] = Some(up.nis[e]);
+                }
+            }
+        }
+        for held in self.held.iter_mut() {
+            let h = held.as_mut().expect("every lane holds");
+            h.row += 1;
+            if h.row == h.end {
+                *held = None;
+            }
+        }
+        true
     }
 
     /// Lane `e`'s estimate and remembered step into the one-series path.
@@ -581,6 +723,10 @@ impl<D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'_, D, N
                     s: [[[0.0; L]; N]; N],
                     nis: [None; L],
                 };
+                if self.steady(panel, out, base, Some(&mut step)) {
+                    steps.push(step);
+                    continue;
+                }
                 let errors = self.advance(panel, out, base, Some(&mut step));
                 for (e, err) in errors.into_iter().enumerate() {
                     if let Some(err) = err {
