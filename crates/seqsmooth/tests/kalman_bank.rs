@@ -63,6 +63,41 @@ fn data(series: usize, p: usize, seed: u64) -> Data {
     }
 }
 
+/// Series at a constant step (0.5) with now and then a longer one, a missing component in 2 %
+/// of the rows and a repeated time in 1 %, of unequal lengths: most steps are the lanes'
+/// straight path (every lane's row complete at its remembered step), the rest their general
+/// step, in runs of both.
+fn data_steady(series: usize, p: usize, seed: u64) -> Data {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let (mut offsets, mut times, mut values) = (vec![0], Vec::new(), Vec::new());
+    for _ in 0..series {
+        let rows = rng.gen_range(20..90);
+        let mut t: f64 = rng.gen_range(-5.0..5.0);
+        let velocity: Vec<f64> = (0..p).map(|_| rng.gen_range(-3.0..3.0)).collect();
+        for _ in 0..rows {
+            if !rng.gen_bool(0.01) {
+                t += if rng.gen_bool(0.05) { 1.5 } else { 0.5 };
+            }
+            times.push(t);
+            let missing = rng.gen_bool(0.02).then(|| rng.gen_range(0..p));
+            for (c, v) in velocity.iter().enumerate() {
+                let e: f64 = StandardNormal.sample(&mut rng);
+                values.push(if missing == Some(c) {
+                    f64::NAN
+                } else {
+                    v * t + e
+                });
+            }
+        }
+        offsets.push(times.len());
+    }
+    Data {
+        offsets,
+        times,
+        values,
+    }
+}
+
 /// The rows of series `s` as the library's measurements.
 fn measurements(d: &Data, s: usize, p: usize, r: &DMatrix<f64>) -> Vec<Measurement> {
     (d.offsets[s]..d.offsets[s + 1])
@@ -345,6 +380,31 @@ fn each_series_alone_gives_its_numbers_in_lanes() {
             assert_eq!(a, b, "p = {p}");
         }
     }
+}
+
+/// The lanes' straight path (constant steps, rows complete): each series alone (the
+/// one-series path) gives its rows in the bank bit for bit, filter and smoother, and the bank
+/// equals one library filter and smoother per series.
+#[test]
+fn the_lanes_straight_path_gives_each_series_its_numbers() {
+    for (model, p, seed) in [
+        (polynomial_of(1, 1), 1, 41),
+        (polynomial(), 2, 42),
+        (polynomial_of(2, 3), 3, 43),
+    ] {
+        let d = data_steady(90, p, seed);
+        let bank = &model.bank;
+        let whole = [
+            bank.filter(&d.panel()).unwrap(),
+            bank.smooth(&d.panel()).unwrap(),
+        ];
+        let cuts: Vec<usize> = (1..90).collect();
+        let alone = in_batches(bank, &d, &cuts, 1);
+        for (a, b) in whole.iter().zip(&alone) {
+            assert_eq!(a, b, "p = {p}");
+        }
+    }
+    equals_library(&polynomial_of(1, 1), &data_steady(200, 1, 44), 3);
 }
 
 /// The lane path's model on 1,000 series (irregular times, 10 % missing) against one library
