@@ -63,6 +63,8 @@ pub trait ProcessNoise: std::fmt::Debug + Send + Sync {
     /// The white noise on the polynomial model's highest derivative this is, when it is one
     /// ([`WhiteNoiseDerivative`], `Q` in closed form): the Kalman filter then fills `Q` with
     /// the sizes fixed at compile time (the same numbers). `None` unless the model says so.
+    /// The filter reads it once when the noise is set, so the answer must not change over
+    /// the model's life.
     ///
     /// ```
     /// use seqsmooth::kalman::noise::{ProcessNoise, WhiteNoiseDerivative};

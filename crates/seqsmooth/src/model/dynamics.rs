@@ -71,7 +71,8 @@ pub trait Dynamics {
 
     /// The polynomial model this is, when it is one ([`PolynomialDynamics`]: `Φ = Ψ(ζ) ⊗ I_d`,
     /// (4.2.5)): the Kalman filter then predicts with `Φ`'s structure and the sizes fixed at
-    /// compile time (the same numbers). `None` unless the model says so.
+    /// compile time (the same numbers). `None` unless the model says so. The filter reads
+    /// it once when the model is set, so the answer must not change over the model's life.
     ///
     /// ```
     /// use seqsmooth::model::dynamics::{Dynamics, PolynomialDynamics};

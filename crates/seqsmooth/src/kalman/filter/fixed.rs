@@ -30,7 +30,8 @@
 //! [`correct_kernel`](super::super::correct::correct_kernel)) **bit for bit**: each sum adds
 //! the same terms in the same order (a skipped term is `0 · a` for a finite `a`, which adds
 //! nothing to a sum; a sum started at `−0` rather than `+0` differs at most in a zero's sign,
-//! and each result is made `+0` where it is `−0`: [`update`]'s doc), tested on seeded random
+//! and each result is made `+0` where it is `−0`: [`update`]'s doc; a result that underflows
+//! to zero may be `−0` on the generic path and `+0` here, the only difference), tested on seeded random
 //! models of every size in range, `M` random or of unit rows (`tests/kalman_fixed_path.rs`).
 //! Anything not finite, or `V` not positive definite, stops this path before the filter
 //! changes; the generic path then takes the step and gives its own error.
@@ -154,7 +155,12 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         let model = self.observation.linear_matrix()?;
         let p = model.nrows();
         let t = m.time;
-        if model.ncols() != n || p > MAX_COMPONENTS || m.values.len() != p || !t.is_finite() {
+        if model.ncols() != n
+            || p > MAX_COMPONENTS
+            || p != self.observation.components()
+            || m.values.len() != p
+            || !t.is_finite()
+        {
             return None;
         }
         // The measurement as `measure` reads it: the present components, their values and
@@ -241,7 +247,8 @@ const fn on<const A: usize>(r: usize, c: usize) -> bool {
 /// (which the compiler drops: `−0 + a = a`): an intermediate zero's sign can then differ,
 /// and a zero's sign changes only the sign of a zero it reaches through `+`, `−`, `·` and
 /// `/` by a pivot (`0 + a = a` for `a ≠ 0`), so each result is the generic path's or a zero
-/// of the other sign; the generic path's results are never `−0` (a sum from `+0` is not), and
+/// of the other sign; the generic path's results are never `−0` (a sum from `+0` is not; barring
+/// a result that underflows to zero), and
 /// each result here is made `+0` where it is `−0` (`a + 0`) before it is written.
 ///
 /// `U = S Mᵀ`, `V = M U + R` symmetrized, `V = L D Lᵀ` ([`ldl`]), `H = U L⁻ᵀ D⁻¹ L⁻¹`,
