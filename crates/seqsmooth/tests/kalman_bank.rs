@@ -363,12 +363,18 @@ proptest! {
 /// missing: steps taken alone), the largest fixed size (9 states, 3 components).
 #[test]
 fn each_series_alone_gives_its_numbers_in_lanes() {
+    alone_as_in_lanes(data, 31);
+}
+
+/// [`each_series_alone_gives_its_numbers_in_lanes`] on the data `make` gives (90 series), for
+/// one, two and three components, with seeds from `seed`.
+fn alone_as_in_lanes(make: fn(usize, usize, u64) -> Data, seed: u64) {
     for (model, p, seed) in [
-        (polynomial_of(1, 1), 1, 31),
-        (polynomial(), 2, 32),
-        (polynomial_of(2, 3), 3, 33),
+        (polynomial_of(1, 1), 1, seed),
+        (polynomial(), 2, seed + 1),
+        (polynomial_of(2, 3), 3, seed + 2),
     ] {
-        let d = data(90, p, seed);
+        let d = make(90, p, seed);
         let bank = &model.bank;
         let whole = [
             bank.filter(&d.panel()).unwrap(),
@@ -387,23 +393,7 @@ fn each_series_alone_gives_its_numbers_in_lanes() {
 /// equals one library filter and smoother per series.
 #[test]
 fn the_lanes_straight_path_gives_each_series_its_numbers() {
-    for (model, p, seed) in [
-        (polynomial_of(1, 1), 1, 41),
-        (polynomial(), 2, 42),
-        (polynomial_of(2, 3), 3, 43),
-    ] {
-        let d = data_steady(90, p, seed);
-        let bank = &model.bank;
-        let whole = [
-            bank.filter(&d.panel()).unwrap(),
-            bank.smooth(&d.panel()).unwrap(),
-        ];
-        let cuts: Vec<usize> = (1..90).collect();
-        let alone = in_batches(bank, &d, &cuts, 1);
-        for (a, b) in whole.iter().zip(&alone) {
-            assert_eq!(a, b, "p = {p}");
-        }
-    }
+    alone_as_in_lanes(data_steady, 41);
     equals_library(&polynomial_of(1, 1), &data_steady(200, 1, 44), 3);
 }
 
