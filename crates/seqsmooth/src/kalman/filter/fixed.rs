@@ -308,14 +308,7 @@ fn update<const N: usize, const K: usize>(
         rd[c] = seen.variances[c];
     }
     // U = S Mᵀ.
-    let mut u = [[-0.0; N]; K];
-    for c in 0..K {
-        for l in 0..N {
-            for r in 0..N {
-                u[c][r] += sp[l][r] * mt[c][l];
-            }
-        }
-    }
+    let u = times_mt(&sp, &mt);
     // V = M U + R, symmetrized, and V = L D Lᵀ.
     let mut v = [[0.0; K]; K];
     for b in 0..K {
@@ -392,14 +385,7 @@ fn update<const N: usize, const K: usize>(
             xs[j][i] = sp[j][i] - acc;
         }
     }
-    let mut y = [[-0.0; N]; K];
-    for c in 0..K {
-        for l in 0..N {
-            for r in 0..N {
-                y[c][r] += xs[l][r] * mt[c][l];
-            }
-        }
-    }
+    let y = times_mt(&xs, &mt);
     let mut hr = [[0.0; N]; K];
     for d in 0..K {
         for i in 0..N {
@@ -641,6 +627,24 @@ fn predict_in<const N: usize, const A: usize>(
         Some(p) => carry_with(Fixed::<N>, entry, p, q, square, pp),
         None => true,
     }
+}
+
+/// `A Mᵀ` from `M`'s rows: `out[c][r] = Σ_l a[l][r] · mt[c][l]`, each sum from `−0` over `l`
+/// ascending (the order of the generic path's product, [`update`]'s doc on `−0`).
+#[inline(always)]
+fn times_mt<const N: usize, const K: usize>(
+    a: &[[f64; N]; N],
+    mt: &[[f64; N]; K],
+) -> [[f64; N]; K] {
+    let mut out = [[-0.0; N]; K];
+    for c in 0..K {
+        for l in 0..N {
+            for r in 0..N {
+                out[c][r] += a[l][r] * mt[c][l];
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]
