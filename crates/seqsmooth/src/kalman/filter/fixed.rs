@@ -464,28 +464,8 @@ fn predict_exact<const N: usize, const A: usize>(
     for (k, psi) in psi[..size].iter_mut().enumerate() {
         *psi = psi_term(k, &zeta);
     }
-    let entry = |r: usize, c: usize| {
-        if on::<A>(r, c) {
-            psi[(c - r) / A]
-        } else {
-            0.0
-        }
-    };
-    for c in 0..N {
-        for r in 0..N {
-            phi[r + c * N] = entry(r, c);
-        }
-    }
     let x = *xp;
-    for r in 0..N {
-        let mut acc = psi[0] * x[r];
-        for k in 1..size {
-            if r + k * A < N {
-                acc += psi[k] * x[r + k * A];
-            }
-        }
-        xp[r] = acc;
-    }
+    transition_into::<N, A>(&psi, &x, phi, xp);
     // T = S Φᵀ (`t[i]` its column i), then Φ S Φᵀ = Tᵀ Φᵀ: its column j is Σ_l Tᵀ[:, l] Φ(j, l).
     let s = *sp;
     let mut t = [[-0.0; N]; N];
@@ -578,32 +558,9 @@ fn predict_in<const N: usize, const A: usize>(
     if !all_finite(&psi[..size]) {
         return false;
     }
-    // [Φ]_{i A + a, (i + k) A + a} = ζ^k/k!: row r, column c, when c ≥ r on the same axis.
-    let entry = |r: usize, c: usize| {
-        if c >= r && (c - r).is_multiple_of(A) {
-            psi[(c - r) / A]
-        } else {
-            0.0
-        }
-    };
-    let phi = &mut phi[..N * N];
-    for c in 0..N {
-        for r in 0..N {
-            phi[r + c * N] = entry(r, c);
-        }
-    }
-    // X = Φ X, each row's sum from its diagonal term over the columns ascending (the
-    // model's order; its structural zeros add nothing).
-    let (x, xp) = (&x[..N], &mut xp[..N]);
-    for r in 0..N {
-        let mut acc = psi[0] * x[r];
-        for k in 1..size {
-            if r + k * A < N {
-                acc += psi[k] * x[r + k * A];
-            }
-        }
-        xp[r] = acc;
-    }
+    let xp = &mut xp[..N];
+    transition_into::<N, A>(&psi, &x[..N], phi, xp);
+    let entry = |r: usize, c: usize| phi_entry::<A>(&psi, r, c);
     if !all_finite(xp) {
         return false;
     }
@@ -645,6 +602,44 @@ fn times_mt<const N: usize, const K: usize>(
         }
     }
     out
+}
+
+/// `[Φ]_{r c}` from `psi[k] = ζ^k/k!` ([`transition_into`]).
+#[inline(always)]
+fn phi_entry<const A: usize>(psi: &[f64], r: usize, c: usize) -> f64 {
+    if on::<A>(r, c) {
+        psi[(c - r) / A]
+    } else {
+        0.0
+    }
+}
+
+/// `Φ` into `phi` (`[Φ]_{i A + a, (i + k) A + a} = ζ^k/k!`: row r, column c, when c ≥ r on the
+/// same axis, (4.2.5); `psi[k] = ζ^k/k!`) and `Φ x` into `xp`, each row's sum from its diagonal
+/// term over the columns ascending (the model's order; its structural zeros add nothing).
+#[inline(always)]
+fn transition_into<const N: usize, const A: usize>(
+    psi: &[f64],
+    x: &[f64],
+    phi: &mut [f64],
+    xp: &mut [f64],
+) {
+    let size = N / A;
+    let phi = &mut phi[..N * N];
+    for c in 0..N {
+        for r in 0..N {
+            phi[r + c * N] = phi_entry::<A>(psi, r, c);
+        }
+    }
+    for r in 0..N {
+        let mut acc = psi[0] * x[r];
+        for k in 1..size {
+            if r + k * A < N {
+                acc += psi[k] * x[r + k * A];
+            }
+        }
+        xp[r] = acc;
+    }
 }
 
 #[cfg(test)]
