@@ -5,6 +5,7 @@ over a Python dxdt"): constant velocity on two axes written as dxdt = A x, posit
 import time
 
 import numpy as np
+
 import seqsmooth as ss
 
 A = np.array([[0.0, 1.0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 1.0], [0, 0, 0, 0]])
@@ -49,6 +50,4 @@ for name, make in FILTERS.items():
         start = time.perf_counter()
         flt.update_many(t, z, 1.0)
         best = min(best, time.perf_counter() - start)
-    print(
-        f"{name}: {best / 200 * 1e6:.0f} us/step, {calls['n'] / 200:.0f} dxdt calls/step"
-    )
+    print(f"{name}: {best / 200 * 1e6:.0f} us/step, {calls['n'] / 200:.0f} dxdt calls/step")

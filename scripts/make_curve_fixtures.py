@@ -12,6 +12,7 @@ It creates (once) a private virtual environment in target/savgol-venv with numpy
                 (J^T J)^-1 of the whitened Jacobian at it (by numpy's SVD), row by row
   versions.txt - the numpy and scipy versions used
 """
+
 import os
 import sys
 

@@ -24,6 +24,7 @@ explicit inverse K = P H' inv(H P H' + R); it has no option for another form.
 Every number is written with repr (17 significant digits at most, round-trip exact), so the Rust
 side reads back the same doubles.
 """
+
 import math
 import os
 import sys
@@ -101,21 +102,35 @@ def problem(name, m, d, q, t0, x0, p0, r, rng, forced_missing):
         else:
             z = [float(v) for v in y]
             kf.update(np.array(z).reshape(k, 1))
-        rows.append([t[s + 1]] + z + [float(v) for v in kf.x.ravel()]
-                    + [float(v) for v in kf.P.ravel()])
-    header = (["t"] + [f"z{i}" for i in range(k)] + [f"x{i}" for i in range(n)]
-              + [f"P{i}_{j}" for i in range(n) for j in range(n)])
+        rows.append(
+            [t[s + 1]] + z + [float(v) for v in kf.x.ravel()] + [float(v) for v in kf.P.ravel()]
+        )
+    header = (
+        ["t"]
+        + [f"z{i}" for i in range(k)]
+        + [f"x{i}" for i in range(n)]
+        + [f"P{i}_{j}" for i in range(n) for j in range(n)]
+    )
 
     def num(v):
         return "NaN" if math.isnan(v) else repr(float(v))
 
     path = os.path.join(OUT, f"{name}.csv")
     with open(path, "w") as f:
-        f.write(f"# made by scripts/make_kalman_fixtures.py: filterpy {filterpy.__version__} "
-                f"KalmanFilter (Joseph-form update); numpy {np.__version__}; seed {SEED}; "
-                f"{STEPS} steps; {int(missing.sum())} measurements missing\n")
-        setup = [("degree", [m]), ("axes", [d]), ("q", [q]), ("t0", [t0]),
-                 ("x0", list(x0)), ("P0", list(np.ravel(p0))), ("R", list(np.ravel(r)))]
+        f.write(
+            f"# made by scripts/make_kalman_fixtures.py: filterpy {filterpy.__version__} "
+            f"KalmanFilter (Joseph-form update); numpy {np.__version__}; seed {SEED}; "
+            f"{STEPS} steps; {int(missing.sum())} measurements missing\n"
+        )
+        setup = [
+            ("degree", [m]),
+            ("axes", [d]),
+            ("q", [q]),
+            ("t0", [t0]),
+            ("x0", list(x0)),
+            ("P0", list(np.ravel(p0))),
+            ("R", list(np.ravel(r))),
+        ]
         for key, vals in setup:
             cells = (num(v) if isinstance(v, float) else str(v) for v in vals)
             f.write(f"# {key}," + ",".join(cells) + "\n")
@@ -129,13 +144,33 @@ def main():
     os.makedirs(OUT, exist_ok=True)
     rng = np.random.default_rng(SEED)
     # (a) constant velocity, one axis, position observed; the first step and a run of three missing.
-    problem("cv1", 1, 1, 0.05, 100.0, [2.0, 1.0],
-            np.array([[4.0, 0.5], [0.5, 1.0]]), np.array([[0.25]]), rng, [0, 60, 61, 62])
+    problem(
+        "cv1",
+        1,
+        1,
+        0.05,
+        100.0,
+        [2.0, 1.0],
+        np.array([[4.0, 0.5], [0.5, 1.0]]),
+        np.array([[0.25]]),
+        rng,
+        [0, 60, 61, 62],
+    )
     # (b) constant acceleration, two axes, both positions observed with correlated noise.
     per_axis = np.array([[25.0, 5.0, 0.5], [5.0, 4.0, 0.4], [0.5, 0.4, 1.0]])
     p0 = np.kron(per_axis, np.eye(2))  # derivative then axis
-    problem("ca2", 2, 2, 0.01, -3.5, [10.0, -5.0, 2.0, 1.0, 0.1, -0.2], p0,
-            np.array([[0.5, 0.15], [0.15, 0.3]]), rng, [0, 100, 101, 102, 199])
+    problem(
+        "ca2",
+        2,
+        2,
+        0.01,
+        -3.5,
+        [10.0, -5.0, 2.0, 1.0, 0.1, -0.2],
+        p0,
+        np.array([[0.5, 0.15], [0.15, 0.3]]),
+        rng,
+        [0, 100, 101, 102, 199],
+    )
 
 
 if __name__ == "__main__":

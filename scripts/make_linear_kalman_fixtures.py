@@ -26,6 +26,7 @@ augmented-state recursion as coded there (it starts each smoothed gain from the 
 
 Numbers are written by json (repr: round-trip exact doubles).
 """
+
 import json
 import os
 import sys
@@ -63,8 +64,13 @@ def run(x0, P0, F, H, Q, R, zs, B=None, Fs=None, Qs=None, Hs=None, Rs=None, Bs=N
     means, covs, means_p, covs_p = kf.batch_filter(zs, Fs=Fs, Qs=Qs, Hs=Hs, Rs=Rs, Bs=Bs, us=us)
     x, P, K, Pp = kf.rts_smoother(means, covs, Fs=Fs, Qs=Qs)
     return {
-        "means": lst(means), "covariances": lst(covs), "means_p": lst(means_p),
-        "covariances_p": lst(covs_p), "rts_x": lst(x), "rts_P": lst(P), "rts_K": lst(K),
+        "means": lst(means),
+        "covariances": lst(covs),
+        "means_p": lst(means_p),
+        "covariances_p": lst(covs_p),
+        "rts_x": lst(x),
+        "rts_P": lst(P),
+        "rts_K": lst(K),
         "rts_Pp": lst(Pp),
     }
 
@@ -73,8 +79,14 @@ def truth_cv(rng, steps, dt):
     x = np.array([0.0, 1.0, 5.0, -0.5])
     out = []
     for _ in range(steps):
-        x = np.array([x[0] + dt * x[1], x[1] + rng.normal(0, 0.1),
-                      x[2] + dt * x[3], x[3] + rng.normal(0, 0.1)])
+        x = np.array(
+            [
+                x[0] + dt * x[1],
+                x[1] + rng.normal(0, 0.1),
+                x[2] + dt * x[3],
+                x[3] + rng.normal(0, 0.1),
+            ]
+        )
         out.append(x.copy())
     return out
 
@@ -95,8 +107,15 @@ def main():
     for k, x in enumerate(truth_cv(rng, steps, dt)):
         z = H @ x + rng.multivariate_normal([0, 0], R)
         zs.append(None if k % 9 == 4 else z)
-    cv = {"x0": lst(x0), "P0": lst(P0), "F": lst(F), "H": lst(H), "Q": lst(Q), "R": lst(R),
-          "zs": [lst(z) for z in zs]}
+    cv = {
+        "x0": lst(x0),
+        "P0": lst(P0),
+        "F": lst(F),
+        "H": lst(H),
+        "Q": lst(Q),
+        "R": lst(R),
+        "zs": [lst(z) for z in zs],
+    }
     cv.update(run(x0, P0, F, H, Q, R, zs))
     problems["cv_qdwn"] = cv
 
@@ -110,8 +129,17 @@ def main():
     us = [np.array([np.sin(0.3 * k)]) for k in range(steps)]
     x0, P0 = np.array([1.0, 0.0, 0.0]), np.diag([1.0, 2.0, 3.0])
     zs3 = [np.array([np.cos(0.2 * k) + rng.normal(0, 0.6)]) for k in range(steps)]
-    c = {"x0": lst(x0), "P0": lst(P0), "F": lst(F3), "H": lst(H3), "Q": lst(Q3), "R": R3,
-         "B": lst(B3), "us": lst(us), "zs": lst(zs3)}
+    c = {
+        "x0": lst(x0),
+        "P0": lst(P0),
+        "F": lst(F3),
+        "H": lst(H3),
+        "Q": lst(Q3),
+        "R": R3,
+        "B": lst(B3),
+        "us": lst(us),
+        "zs": lst(zs3),
+    }
     c.update(run(x0, P0, F3, H3, Q3, np.array([[R3]]), zs3, B=B3, Bs=[B3] * steps, us=us))
     problems["control_diag"] = c
 
@@ -119,20 +147,34 @@ def main():
     steps = 50
     A = rng.normal(size=(3, 3))
     Qfull = A @ A.T * 0.05
-    Fs = [np.array([[1.0, 0.1 + 0.01 * k, 0.0], [0.0, 1.0, 0.05], [0.02 * np.sin(k), 0.0, 0.98]])
-          for k in range(steps)]
+    Fs = [
+        np.array([[1.0, 0.1 + 0.01 * k, 0.0], [0.0, 1.0, 0.05], [0.02 * np.sin(k), 0.0, 0.98]])
+        for k in range(steps)
+    ]
     Qs = [Qfull * (1.0 + 0.5 * np.sin(0.4 * k)) for k in range(steps)]
     Hs = [np.array([[1.0, 0.0, 0.1 * (k % 3)], [0.0, 1.0, 0.5]]) for k in range(steps)]
     Rs = []
-    for k in range(steps):
+    for _ in range(steps):
         a = rng.normal(size=(2, 2))
         Rs.append(a @ a.T * 0.1 + np.eye(2) * 0.2)
     x0, P0 = np.array([0.5, -0.5, 0.0]), np.eye(3) * 4.0
-    zs4 = [np.array([np.sin(0.1 * k), 0.3 * np.cos(0.2 * k)]) + rng.normal(0, 0.3, 2)
-           for k in range(steps)]
-    ps = {"x0": lst(x0), "P0": lst(P0), "F": lst(Fs[0]), "H": lst(Hs[0]), "Q": lst(Qfull),
-          "R": lst(Rs[0]), "Fs": lst(Fs), "Qs": lst(Qs), "Hs": lst(Hs), "Rs": lst(Rs),
-          "zs": lst(zs4)}
+    zs4 = [
+        np.array([np.sin(0.1 * k), 0.3 * np.cos(0.2 * k)]) + rng.normal(0, 0.3, 2)
+        for k in range(steps)
+    ]
+    ps = {
+        "x0": lst(x0),
+        "P0": lst(P0),
+        "F": lst(Fs[0]),
+        "H": lst(Hs[0]),
+        "Q": lst(Qfull),
+        "R": lst(Rs[0]),
+        "Fs": lst(Fs),
+        "Qs": lst(Qs),
+        "Hs": lst(Hs),
+        "Rs": lst(Rs),
+        "zs": lst(zs4),
+    }
     ps.update(run(x0, P0, Fs[0], Hs[0], Qfull, Rs[0], zs4, Fs=Fs, Qs=Qs, Hs=Hs, Rs=Rs))
     problems["per_step"] = ps
 
@@ -147,14 +189,26 @@ def main():
         r = run(np.zeros(4), np.eye(4) * 10.0, F, H, Q, R, zs5[:end])
         exact.append((r["rts_x"][k], r["rts_P"][k]))
     problems["fixed_lag"] = {
-        "x0": lst(np.zeros(4)), "P0": lst(np.eye(4) * 10.0), "F": lst(F), "H": lst(H),
-        "Q": lst(Q), "R": lst(R), "zs": lst(zs5), "lag": LAG,
-        "filterpy_fls_x": lst(smoothed), "filterpy_fls_filtered": lst(filtered),
-        "exact_x": [e[0] for e in exact], "exact_P": [e[1] for e in exact],
+        "x0": lst(np.zeros(4)),
+        "P0": lst(np.eye(4) * 10.0),
+        "F": lst(F),
+        "H": lst(H),
+        "Q": lst(Q),
+        "R": lst(R),
+        "zs": lst(zs5),
+        "lag": LAG,
+        "filterpy_fls_x": lst(smoothed),
+        "filterpy_fls_filtered": lst(filtered),
+        "exact_x": [e[0] for e in exact],
+        "exact_P": [e[1] for e in exact],
     }
 
-    meta = {"made_by": "scripts/make_linear_kalman_fixtures.py", "filterpy": filterpy.__version__,
-            "numpy": np.__version__, "seed": SEED}
+    meta = {
+        "made_by": "scripts/make_linear_kalman_fixtures.py",
+        "filterpy": filterpy.__version__,
+        "numpy": np.__version__,
+        "seed": SEED,
+    }
     with open(OUT, "w") as f:
         json.dump({"meta": meta, "problems": problems}, f, indent=None)
         f.write("\n")

@@ -10,6 +10,7 @@ re-runs itself there, and writes:
                delta=0.05, mode="interp") for degrees 0-5, windows 5..201, derivatives 0-2
   versions.txt - the numpy and scipy versions used
 """
+
 import os
 import sys
 

@@ -37,6 +37,7 @@ How filterpy is driven:
 
 Every number is written with repr (round-trip exact).
 """
+
 import math
 import os
 import sys
@@ -67,7 +68,8 @@ def transition(m, d, dt):
 
 def process_noise(m, d, q, dt):
     """Q over a step dt for white noise of spectral density q on the highest derivative of
-    each axis (Morrison (15.2.23) in closed form): q |dt|^(2m+1-i-j) / ((m-i)! (m-j)! (2m+1-i-j))."""
+    each axis (Morrison (15.2.23) in closed form):
+    q |dt|^(2m+1-i-j) / ((m-i)! (m-j)! (2m+1-i-j))."""
     z = abs(dt)
     out = np.zeros(((m + 1) * d, (m + 1) * d))
     for i in range(m + 1):
@@ -92,8 +94,9 @@ def wrap(a):
 def radar(x):
     dx, dy, dz = x[0] - SITE[0], x[1] - SITE[1], x[2] - SITE[2]
     horizontal = math.hypot(dx, dy)
-    return np.array([math.sqrt(dx * dx + dy * dy + dz * dz), math.atan2(dy, dx),
-                     math.atan2(dz, horizontal)])
+    return np.array(
+        [math.sqrt(dx * dx + dy * dy + dz * dz), math.atan2(dy, dx), math.atan2(dz, horizontal)]
+    )
 
 
 def problem(name, m, d, q, t0, x0, p0, r, h, angles, points, steps, rng):
@@ -120,9 +123,16 @@ def problem(name, m, d, q, t0, x0, p0, r, h, angles, points, steps, rng):
         # other components this is np.dot(wm, sigmas) up to rounding.
         return sigmas[0] + sum(w * residual_z(row, sigmas[0]) for w, row in zip(wm[1:], sigmas[1:]))
 
-    ukf = UnscentedKalmanFilter(dim_x=n, dim_z=k, dt=1.0, hx=h,
-                                fx=lambda x, dt: transition(m, d, dt) @ x,
-                                points=points, residual_z=residual_z, z_mean_fn=z_mean)
+    ukf = UnscentedKalmanFilter(
+        dim_x=n,
+        dim_z=k,
+        dt=1.0,
+        hx=h,
+        fx=lambda x, dt: transition(m, d, dt) @ x,
+        points=points,
+        residual_z=residual_z,
+        z_mean_fn=z_mean,
+    )
     ukf.x = np.array(x0, dtype=float)
     ukf.P = np.array(p0, dtype=float)
     rows, xs, ps = [], [], []
@@ -138,40 +148,61 @@ def problem(name, m, d, q, t0, x0, p0, r, h, angles, points, steps, rng):
         nis = float("nan")
         if present:
             idx = list(present)
-            ukf.update(np.array([z[c] for c in idx]), R=r[np.ix_(idx, idx)],
-                       hx=lambda x, idx=idx: h(x)[idx])
+            ukf.update(
+                np.array([z[c] for c in idx]),
+                R=r[np.ix_(idx, idx)],
+                hx=lambda x, idx=idx: h(x)[idx],
+            )
             nis = float(ukf.y @ np.linalg.inv(ukf.S) @ ukf.y)
         xs.append(ukf.x.copy())
         ps.append(ukf.P.copy())
-        rows.append([t[s + 1]] + z + [float(v) for v in ukf.x] + [float(v) for v in ukf.P.ravel()]
-                    + [nis])
+        rows.append(
+            [t[s + 1]] + z + [float(v) for v in ukf.x] + [float(v) for v in ukf.P.ravel()] + [nis]
+        )
     # The smoother, one backward step at a time (each with its own Q, see the docstring).
     sx, sp = [None] * steps, [None] * steps
     sx[-1], sp[-1] = xs[-1].copy(), ps[-1].copy()
     for s in reversed(range(steps - 1)):
         dt = t[s + 2] - t[s + 1]
         ukf.Q = process_noise(m, d, q, dt)
-        out_x, out_p, _ = ukf.rts_smoother(np.array([xs[s], sx[s + 1]]),
-                                           np.array([ps[s], sp[s + 1]]), dts=[dt, dt])
+        out_x, out_p, _ = ukf.rts_smoother(
+            np.array([xs[s], sx[s + 1]]), np.array([ps[s], sp[s + 1]]), dts=[dt, dt]
+        )
         sx[s], sp[s] = out_x[0], out_p[0]
     for s in range(steps):
         rows[s] += [float(v) for v in sx[s]] + [float(v) for v in sp[s].ravel()]
-    header = (["t"] + [f"z{i}" for i in range(k)] + [f"x{i}" for i in range(n)]
-              + [f"P{i}_{j}" for i in range(n) for j in range(n)] + ["nis"]
-              + [f"xs{i}" for i in range(n)] + [f"Ps{i}_{j}" for i in range(n) for j in range(n)])
+    header = (
+        ["t"]
+        + [f"z{i}" for i in range(k)]
+        + [f"x{i}" for i in range(n)]
+        + [f"P{i}_{j}" for i in range(n) for j in range(n)]
+        + ["nis"]
+        + [f"xs{i}" for i in range(n)]
+        + [f"Ps{i}_{j}" for i in range(n) for j in range(n)]
+    )
 
     def num(v):
         return "NaN" if math.isnan(v) else repr(float(v))
 
     path = os.path.join(OUT, f"{name}.csv")
     with open(path, "w") as out:
-        out.write(f"# made by scripts/make_unscented_fixtures.py: filterpy {filterpy.__version__} "
-                  f"UnscentedKalmanFilter, MerweScaledSigmaPoints, rts_smoother; numpy "
-                  f"{np.__version__}; seed {SEED}; {steps} steps; {int(whole.sum())} rows "
-                  f"missing\n")
-        setup = [("degree", [m]), ("axes", [d]), ("q", [q]), ("t0", [t0]), ("x0", list(x0)),
-                 ("P0", list(np.ravel(p0))), ("R", list(np.ravel(r))),
-                 ("sigma", [points.alpha, points.beta, points.kappa]), ("site", SITE)]
+        out.write(
+            f"# made by scripts/make_unscented_fixtures.py: filterpy {filterpy.__version__} "
+            f"UnscentedKalmanFilter, MerweScaledSigmaPoints, rts_smoother; numpy "
+            f"{np.__version__}; seed {SEED}; {steps} steps; {int(whole.sum())} rows "
+            f"missing\n"
+        )
+        setup = [
+            ("degree", [m]),
+            ("axes", [d]),
+            ("q", [q]),
+            ("t0", [t0]),
+            ("x0", list(x0)),
+            ("P0", list(np.ravel(p0))),
+            ("R", list(np.ravel(r))),
+            ("sigma", [points.alpha, points.beta, points.kappa]),
+            ("site", SITE),
+        ]
         for key, vals in setup:
             cells = (num(v) if isinstance(v, float) else str(v) for v in vals)
             out.write(f"# {key}," + ",".join(cells) + "\n")
@@ -186,15 +217,39 @@ def main():
     rng = np.random.default_rng(SEED)
     # (a) linear: constant velocity on two axes, both positions observed (full R).
     per_axis = np.array([[9.0, 1.0], [1.0, 4.0]])
-    problem("linear", 1, 2, 0.2, 5.0, [10.0, -4.0, 1.5, 0.5], np.kron(per_axis, np.eye(2)),
-            np.array([[0.5, 0.2], [0.2, 0.8]]), lambda x: np.array([x[0], x[1]]), [],
-            MerweScaledSigmaPoints(4, alpha=0.5, beta=2.0, kappa=1.0), 150, rng)
+    problem(
+        "linear",
+        1,
+        2,
+        0.2,
+        5.0,
+        [10.0, -4.0, 1.5, 0.5],
+        np.kron(per_axis, np.eye(2)),
+        np.array([[0.5, 0.2], [0.2, 0.8]]),
+        lambda x: np.array([x[0], x[1]]),
+        [],
+        MerweScaledSigmaPoints(4, alpha=0.5, beta=2.0, kappa=1.0),
+        150,
+        rng,
+    )
     # (b) radar: constant velocity on three axes, range, azimuth, elevation.
     per_axis = np.array([[400.0, 20.0], [20.0, 25.0]])
     # From azimuth 2.84 rad through pi (at about t = 160) to -2.9: the wrapped residuals.
-    problem("radar", 1, 3, 2.0, 100.0, [-7700.0, 2300.0, 2010.0, 30.0, -40.0, 2.0],
-            np.kron(per_axis, np.eye(3)), np.diag([25.0, 4e-6, 4e-6]), radar, [1],
-            MerweScaledSigmaPoints(6, alpha=1.0, beta=2.0, kappa=0.0), 150, rng)
+    problem(
+        "radar",
+        1,
+        3,
+        2.0,
+        100.0,
+        [-7700.0, 2300.0, 2010.0, 30.0, -40.0, 2.0],
+        np.kron(per_axis, np.eye(3)),
+        np.diag([25.0, 4e-6, 4e-6]),
+        radar,
+        [1],
+        MerweScaledSigmaPoints(6, alpha=1.0, beta=2.0, kappa=0.0),
+        150,
+        rng,
+    )
 
 
 if __name__ == "__main__":

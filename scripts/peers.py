@@ -37,11 +37,13 @@ PINS below, re-runs itself there, and then
    any pair disagrees beyond its tolerance.
 
 Agreement metric: for each derivative k, max over the compared samples of |peer - ours| divided
-by the largest |ours_k| over those samples (as tests/fixed_smooth_scipy.rs), the worst k reported; for the
-Savitzky-Golay pairs divided by max|y|·Σ|c_k| instead (see TOL); for the Gauss–Newton fits the
-largest |peer - ours| over the windows in units of each component's σ (our covariance), beside
-each side's distance from the stationary point (its next Gauss–Newton step, computed here).
+by the largest |ours_k| over those samples (as tests/fixed_smooth_scipy.rs), the worst k
+reported; for the Savitzky-Golay pairs divided by max|y|·Σ|c_k| instead (see TOL); for the
+Gauss–Newton fits the largest |peer - ours| over the windows in units of each component's σ (our
+covariance), beside each side's distance from the stationary point (its next Gauss–Newton step,
+computed here).
 """
+
 import argparse
 import json
 import os
@@ -57,16 +59,17 @@ import peers_venv  # noqa: E402
 VENV, PINS = peers_venv.VENV, peers_venv.PINS
 peers_venv.enter(__file__)
 
+from fractions import Fraction  # noqa: E402
+from math import factorial  # noqa: E402
+
+import filterpy  # noqa: E402
 import numpy as np  # noqa: E402
 import scipy  # noqa: E402
-import filterpy  # noqa: E402
+from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter  # noqa: E402
+from filterpy.leastsq import LeastSquaresFilter  # noqa: E402
+from filterpy.memory import FadingMemoryFilter  # noqa: E402
 from scipy.optimize import least_squares  # noqa: E402
 from scipy.signal import savgol_coeffs, savgol_filter  # noqa: E402
-from filterpy.memory import FadingMemoryFilter  # noqa: E402
-from filterpy.leastsq import LeastSquaresFilter  # noqa: E402
-from filterpy.kalman import ExtendedKalmanFilter, KalmanFilter  # noqa: E402
-from math import factorial  # noqa: E402
-from fractions import Fraction  # noqa: E402
 
 SEED = 20260415
 DT = 1e-3
@@ -161,8 +164,10 @@ def exact_savgol_coeffs(window, m):
     h = (window - 1) // 2
     xs = range(-h, h + 1)
     moments = [sum(Fraction(x) ** p for x in xs) for p in range(2 * m + 1)]
-    g = [[moments[i + j] for j in range(m + 1)] + [Fraction(int(i == j)) for j in range(m + 1)]
-         for i in range(m + 1)]
+    g = [
+        [moments[i + j] for j in range(m + 1)] + [Fraction(int(i == j)) for j in range(m + 1)]
+        for i in range(m + 1)
+    ]
     for c in range(m + 1):  # Gauss-Jordan in rationals
         p = g[c][c]
         g[c] = [v / p for v in g[c]]
@@ -170,9 +175,11 @@ def exact_savgol_coeffs(window, m):
             if r != c:
                 f = g[r][c]
                 g[r] = [a - f * b for a, b in zip(g[r], g[c])]
-    inv = [row[m + 1:] for row in g]
-    return [[float(factorial(k) * sum(inv[k][j] * Fraction(x) ** j for j in range(m + 1)))
-             for x in xs] for k in range(m + 1)]
+    inv = [row[m + 1 :] for row in g]
+    return [
+        [float(factorial(k) * sum(inv[k][j] * Fraction(x) ** j for j in range(m + 1))) for x in xs]
+        for k in range(m + 1)
+    ]
 
 
 def phi(m, h):
@@ -276,8 +283,8 @@ def run_kf_q(t, y, m, q, x0, P0):
     out = np.full((n, m + 1), np.nan)
     out[m] = x0
     kf, kf_built = make(), make()
-    secs = kf_pass(kf, y[m + 1:], [psi_q(m, h, q) for h in steps], out[m + 1:])
-    secs_build = kf_pass(kf_built, y[m + 1:], (psi_q(m, h, q) for h in steps), None)
+    secs = kf_pass(kf, y[m + 1 :], [psi_q(m, h, q) for h in steps], out[m + 1 :])
+    secs_build = kf_pass(kf_built, y[m + 1 :], (psi_q(m, h, q) for h in steps), None)
     if not np.array_equal(kf.x, kf_built.x):
         sys.exit("filterpy KalmanFilter: the two timed loops differ")
     return out, secs, secs_build, n - m - 1
@@ -389,20 +396,42 @@ def main():
     global DT
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=1_000_000, help="evenly spaced samples")
-    ap.add_argument("--n-kf", type=int, default=100_000,
-                    help="samples for the Kalman filter pairs (even and irregular)")
-    ap.add_argument("--dt", type=float, default=DT,
-                    help="sampling step of the even data (default 0.001: a decimal step, so "
-                         "t = k*dt carries the timestamps' own rounding)")
+    ap.add_argument(
+        "--n-kf",
+        type=int,
+        default=100_000,
+        help="samples for the Kalman filter pairs (even and irregular)",
+    )
+    ap.add_argument(
+        "--dt",
+        type=float,
+        default=DT,
+        help="sampling step of the even data (default 0.001: a decimal step, so "
+        "t = k*dt carries the timestamps' own rounding)",
+    )
     ap.add_argument("--reps", type=int, default=5, help="repetitions of each seqsmooth timing")
-    ap.add_argument("--gn-windows", type=int, default=400,
-                    help="radar passes fitted by Gauss–Newton (60 samples, 6 states each)")
-    ap.add_argument("--ekf-tracks", type=int, default=400,
-                    help="radar tracks of the extended Kalman filter pair (59 updates each)")
-    ap.add_argument("--quick", action="store_true",
-                    help="small smoke run (n 20000, n-kf 2000, gn-windows 50, ekf-tracks 50)")
-    ap.add_argument("--dir", default=os.path.join(ROOT, "target", "peers"),
-                    help="work directory for the data and estimates")
+    ap.add_argument(
+        "--gn-windows",
+        type=int,
+        default=400,
+        help="radar passes fitted by Gauss–Newton (60 samples, 6 states each)",
+    )
+    ap.add_argument(
+        "--ekf-tracks",
+        type=int,
+        default=400,
+        help="radar tracks of the extended Kalman filter pair (59 updates each)",
+    )
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="small smoke run (n 20000, n-kf 2000, gn-windows 50, ekf-tracks 50)",
+    )
+    ap.add_argument(
+        "--dir",
+        default=os.path.join(ROOT, "target", "peers"),
+        help="work directory for the data and estimates",
+    )
     a = ap.parse_args()
     DT = a.dt
     if a.quick:
@@ -440,18 +469,21 @@ def main():
     for m in KF_DEGREES:
         for d in ("kfeven", "irregular"):
             runs.append((f"kfx{m}_{d}", d, "expanding-exact", m, ""))
-            runs.append((f"kff{m}_{d}", d, "fading-exact", m,
-                         f"theta={THETA} tau={DT!r} mode=update"))
+            runs.append(
+                (f"kff{m}_{d}", d, "fading-exact", m, f"theta={THETA} tau={DT!r} mode=update")
+            )
     runs.append(("sg", "even", "smooth", SG_DEGREE, f"window={SG_WINDOW}"))
     runs.append(("sgs", "even", "fixed-sliding", SG_DEGREE, f"window={SG_WINDOW}"))
     runs.append(("gn", "radar", "gauss-newton", 1, f"windows={a.gn_windows}"))
-    runs.append((f"kq{KQ_DEGREE}", "irregular", "kalman-q", KQ_DEGREE,
-                 f"q={KQ_Q!r} r={SIGMA**2!r}"))
+    runs.append(
+        (f"kq{KQ_DEGREE}", "irregular", "kalman-q", KQ_DEGREE, f"q={KQ_Q!r} r={SIGMA**2!r}")
+    )
     runs.append(("ekf", "radar", "ekf", 1, f"tracks={a.ekf_tracks}"))
     # The Kalman filter's prior, shared: the exact fit of the first KQ_DEGREE + 1 samples.
     kq_x0, kq_P0 = kf_start(t_irr, y_irr, KQ_DEGREE, None)
     np.concatenate([kq_x0, kq_P0.ravel()]).astype("<f8").tofile(
-        os.path.join(a.dir, f"kq{KQ_DEGREE}.prior.f64"))
+        os.path.join(a.dir, f"kq{KQ_DEGREE}.prior.f64")
+    )
     with open(os.path.join(a.dir, "runs.txt"), "w") as f:
         for r in runs:
             f.write(" ".join(str(x) for x in r) + "\n")
@@ -462,8 +494,13 @@ def main():
     ours = {}
     for line in res.stdout.strip().splitlines()[1:]:
         name, n, s_upd, s_est, sw, *extra = line.split(",")
-        ours[name] = {"n": int(n), "upd": float(s_upd), "est": float(s_est),
-                      "switch": int(sw) if sw else None, "extra": [float(e) for e in extra]}
+        ours[name] = {
+            "n": int(n),
+            "upd": float(s_upd),
+            "est": float(s_est),
+            "switch": int(sw) if sw else None,
+            "extra": [float(e) for e in extra],
+        }
 
     def est(name, m):
         return np.fromfile(os.path.join(a.dir, f"{name}.est.f64"), dtype="<f8").reshape(-1, m + 1)
@@ -473,28 +510,58 @@ def main():
     def last(name):
         return np.fromfile(os.path.join(a.dir, f"{name}.last.f64"), dtype="<f8")
 
-    def check_last(pair, peer_name, peer_last, our_name, our_label, scale_rows, tol,
-                   call="update_many"):
+    def check_last(
+        pair, peer_name, peer_last, our_name, our_label, scale_rows, tol, call="update_many"
+    ):
         """The state after our update-only call (the timed one) against the peer's last."""
         mine = last(our_name)
         scale = np.max(np.abs(scale_rows), axis=0)
         err = float(np.max(np.abs(peer_last - mine) / np.where(scale > 0, scale, 1.0)))
-        agree.append({"pair": f"{pair}: {peer_name}, last state vs {our_label} after {call}",
-                      "err": err, "tol": tol, "rows": "last", "metric": "max abs(ours_k)"})
+        agree.append(
+            {
+                "pair": f"{pair}: {peer_name}, last state vs {our_label} after {call}",
+                "err": err,
+                "tol": tol,
+                "rows": "last",
+                "metric": "max abs(ours_k)",
+            }
+        )
         if not err <= tol:
             failures.append(f"{pair}, {our_label} {call}: difference {err:.2e} > {tol:.1e}")
 
-    def record(pair, peer_name, peer_updates, peer_secs, our_name, our_label, err, tol, rows_cmp,
-               metric="max abs(ours_k)"):
+    def record(
+        pair,
+        peer_name,
+        peer_updates,
+        peer_secs,
+        our_name,
+        our_label,
+        err,
+        tol,
+        rows_cmp,
+        metric="max abs(ours_k)",
+    ):
         o = ours[our_name]
         peer_rate = peer_updates / peer_secs
-        rows.append({
-            "pair": pair, "peer": peer_name, "ours": our_label,
-            "peer_rate": peer_rate,
-            "our_rate": o["n"] / o["upd"], "our_rate_est": o["n"] / o["est"],
-        })
-        agree.append({"pair": f"{pair}: {peer_name} vs {our_label}", "err": err, "tol": tol,
-                      "rows": rows_cmp, "metric": metric})
+        rows.append(
+            {
+                "pair": pair,
+                "peer": peer_name,
+                "ours": our_label,
+                "peer_rate": peer_rate,
+                "our_rate": o["n"] / o["upd"],
+                "our_rate_est": o["n"] / o["est"],
+            }
+        )
+        agree.append(
+            {
+                "pair": f"{pair}: {peer_name} vs {our_label}",
+                "err": err,
+                "tol": tol,
+                "rows": rows_cmp,
+                "metric": metric,
+            }
+        )
         if not err <= tol:
             failures.append(f"{pair}, {our_label}: difference {err:.2e} > tolerance {tol:.1e}")
 
@@ -519,10 +586,26 @@ def main():
             out[i] = f.x
         err = rel_diff(out, mine[s:])
         tol = TOL["fading"] + np.max(np.abs(np.diff(t) - DT)) / DT
-        record(f"fading memory, degree {m}", "filterpy FadingMemoryFilter", len(ys), secs, name,
-               "FadingMemory (gain engine)", err, tol, f"{s}..{len(y) - 1}")
-        check_last(f"fading memory, degree {m}", "filterpy FadingMemoryFilter", out[-1], name,
-                   "FadingMemory (gain engine)", mine[s:], tol)
+        record(
+            f"fading memory, degree {m}",
+            "filterpy FadingMemoryFilter",
+            len(ys),
+            secs,
+            name,
+            "FadingMemory (gain engine)",
+            err,
+            tol,
+            f"{s}..{len(y) - 1}",
+        )
+        check_last(
+            f"fading memory, degree {m}",
+            "filterpy FadingMemoryFilter",
+            out[-1],
+            name,
+            "FadingMemory (gain engine)",
+            mine[s:],
+            tol,
+        )
 
     # 3b. LeastSquaresFilter from its zero start; exact from sample m on.
     for m in range(3):
@@ -540,35 +623,72 @@ def main():
         for i, z in enumerate(y):
             out[i] = f.update(z)
         err = rel_diff(out[m:], mine[m:])
-        record(f"expanding memory, degree {m}", "filterpy LeastSquaresFilter", len(y), secs, name,
-               "ExpandingMemory (gain engine)", err, TOL["leastsq"], f"{m}..{len(y) - 1}")
-        check_last(f"expanding memory, degree {m}", "filterpy LeastSquaresFilter", out[-1], name,
-                   "ExpandingMemory (gain engine)", mine[m:], TOL["leastsq"])
+        record(
+            f"expanding memory, degree {m}",
+            "filterpy LeastSquaresFilter",
+            len(y),
+            secs,
+            name,
+            "ExpandingMemory (gain engine)",
+            err,
+            TOL["leastsq"],
+            f"{m}..{len(y) - 1}",
+        )
+        check_last(
+            f"expanding memory, degree {m}",
+            "filterpy LeastSquaresFilter",
+            out[-1],
+            name,
+            "ExpandingMemory (gain engine)",
+            mine[m:],
+            TOL["leastsq"],
+        )
 
     # 3c. KalmanFilter, Q = 0, polynomial model, started at sample m from the exact fit.
     for d, label in (("kfeven", "even"), ("irregular", "irregular")):
         tk, yk = data[d]
         for m in KF_DEGREES:
-            for theta, kind, our_label in ((None, "x", "ExpandingMemory (exact engine)"),
-                                           (THETA, "f", "FadingMemory (exact, per update)")):
+            for theta, kind, our_label in (
+                (None, "x", "ExpandingMemory (exact engine)"),
+                (THETA, "f", "FadingMemory (exact, per update)"),
+            ):
                 name = f"kf{kind}{m}_{d}"
                 mine = est(name, m)
                 out, secs, count = run_kf(tk, yk, m, theta)
                 err = rel_diff(out[m:], mine[m:])
                 memory = "expanding" if theta is None else f"fading θ={theta}"
-                record(f"Kalman {memory}, degree {m}, {label}",
-                       "filterpy KalmanFilter" + (" (alpha)" if theta else ""), count, secs,
-                       name, our_label, err, TOL["kalman"], f"{m}..{len(tk) - 1}")
-                check_last(f"Kalman {memory}, degree {m}, {label}",
-                           "filterpy KalmanFilter" + (" (alpha)" if theta else ""), out[-1],
-                           name, our_label, mine[m:], TOL["kalman"])
+                record(
+                    f"Kalman {memory}, degree {m}, {label}",
+                    "filterpy KalmanFilter" + (" (alpha)" if theta else ""),
+                    count,
+                    secs,
+                    name,
+                    our_label,
+                    err,
+                    TOL["kalman"],
+                    f"{m}..{len(tk) - 1}",
+                )
+                check_last(
+                    f"Kalman {memory}, degree {m}, {label}",
+                    "filterpy KalmanFilter" + (" (alpha)" if theta else ""),
+                    out[-1],
+                    name,
+                    our_label,
+                    mine[m:],
+                    TOL["kalman"],
+                )
 
     # 3d. savgol_filter (all three derivatives) against smooth and the streaming filter, and all
     # three against the convolution with exact (rational) coefficients.
     mine = est("sg", SG_DEGREE)
     start = time.perf_counter()
-    out = np.stack([savgol_filter(y, SG_WINDOW, SG_DEGREE, deriv=k, delta=DT, mode="interp")
-                    for k in range(SG_DEGREE + 1)], axis=1)
+    out = np.stack(
+        [
+            savgol_filter(y, SG_WINDOW, SG_DEGREE, deriv=k, delta=DT, mode="interp")
+            for k in range(SG_DEGREE + 1)
+        ],
+        axis=1,
+    )
     secs = time.perf_counter() - start
     half = (SG_WINDOW - 1) // 2
     inner = slice(half, len(y) - half)
@@ -586,44 +706,90 @@ def main():
     sg_tol = TOL["savgol"] + scipy_err
     pair = f"Savitzky-Golay, window {SG_WINDOW}, degree {SG_DEGREE}, d0-d2"
     for name, label, rows_sel, span in (
-            ("sg", "fixed::smooth_into", slice(None), f"0..{len(y) - 1}"),
-            ("sgs", "FixedMemory (sliding, centred)", inner, f"{half}..{len(y) - 1 - half}")):
+        ("sg", "fixed::smooth_into", slice(None), f"0..{len(y) - 1}"),
+        ("sgs", "FixedMemory (sliding, centred)", inner, f"{half}..{len(y) - 1 - half}"),
+    ):
         mine = est(name, SG_DEGREE)
         err = sized_diff(out[rows_sel], mine[rows_sel], size)
-        record(pair, "scipy savgol_filter (interp)", len(y), secs, name, label, err, sg_tol,
-               span, metric="max abs(y)·Σ abs(c_k)")
+        record(
+            pair,
+            "scipy savgol_filter (interp)",
+            len(y),
+            secs,
+            name,
+            label,
+            err,
+            sg_tol,
+            span,
+            metric="max abs(y)·Σ abs(c_k)",
+        )
         err = sized_diff(oracle, mine[inner], size)
-        agree.append({"pair": f"{label} vs exact-coefficient convolution", "err": err,
-                      "tol": TOL["savgol"], "rows": f"{half}..{len(y) - 1 - half}",
-                      "metric": "max abs(y)·Σ abs(c_k)"})
+        agree.append(
+            {
+                "pair": f"{label} vs exact-coefficient convolution",
+                "err": err,
+                "tol": TOL["savgol"],
+                "rows": f"{half}..{len(y) - 1 - half}",
+                "metric": "max abs(y)·Σ abs(c_k)",
+            }
+        )
         if not err <= TOL["savgol"]:
             failures.append(f"{label} vs exact coefficients: {err:.2e} > {TOL['savgol']:.0e}")
     err = sized_diff(out[inner], oracle, size)
-    agree.append({"pair": "scipy savgol_filter vs exact-coefficient convolution (its own error; "
-                  "not checked)", "err": err, "tol": float("nan"),
-                  "rows": f"{half}..{len(y) - 1 - half}", "metric": "max abs(y)·Σ abs(c_k)"})
+    agree.append(
+        {
+            "pair": "scipy savgol_filter vs exact-coefficient convolution (its own error; "
+            "not checked)",
+            "err": err,
+            "tol": float("nan"),
+            "rows": f"{half}..{len(y) - 1 - half}",
+            "metric": "max abs(y)·Σ abs(c_k)",
+        }
+    )
 
     # 4. The CLI end to end, against filterpy FadingMemoryFilter order 2.
     fm2_peer = next(r["peer_rate"] for r in rows if r["pair"] == "fading memory, degree 2")
     cli_rows = []
     for engine in ("gain", "exact"):
         out_path = os.path.join(a.dir, f"cli_{engine}.csv")
-        cmd = [cli, "filter", "--kind", "fading", "--degree", "2", "--theta", str(THETA),
-               "--tau", repr(DT), "--engine", engine, csv_path, "-o", out_path]
+        cmd = [
+            cli,
+            "filter",
+            "--kind",
+            "fading",
+            "--degree",
+            "2",
+            "--theta",
+            str(THETA),
+            "--tau",
+            repr(DT),
+            "--engine",
+            engine,
+            csv_path,
+            "-o",
+            out_path,
+        ]
         best = float("inf")
         for _ in range(3):
             start = time.perf_counter()
             subprocess.run(cmd, check=True)
             best = min(best, time.perf_counter() - start)
-        shown = ["seqsmooth"] + [os.path.relpath(c, ROOT) if c.startswith(a.dir) else c
-                                 for c in cmd[1:]]
+        shown = ["seqsmooth"] + [
+            os.path.relpath(c, ROOT) if c.startswith(a.dir) else c for c in cmd[1:]
+        ]
         cli_rows.append((engine, " ".join(shown), len(y) / best))
         if engine == "gain":
             got = np.loadtxt(out_path, delimiter=",", skiprows=3, usecols=(2, 3, 4))
             err = rel_diff(got, est("fm2", 2)[2:])
-            agree.append({"pair": "CLI filter --kind fading --engine gain vs library",
-                          "err": err, "tol": TOL["cli"], "rows": f"2..{len(y) - 1}",
-                          "metric": "max abs(ours_k)"})
+            agree.append(
+                {
+                    "pair": "CLI filter --kind fading --engine gain vs library",
+                    "err": err,
+                    "tol": TOL["cli"],
+                    "rows": f"2..{len(y) - 1}",
+                    "metric": "max abs(ours_k)",
+                }
+            )
             if not err <= TOL["cli"]:
                 failures.append(f"CLI vs library: difference {err:.2e} > {TOL['cli']}")
 
@@ -635,36 +801,48 @@ def main():
     gmine = est("gn", 5)
     gsigma = np.fromfile(os.path.join(a.dir, "gn.sigma.f64"), dtype="<f8").reshape(windows, 6)
     problems = [radar_problem(w[:, 0], w[:, 1:]) for w in gdat]
-    gn_rows = [("seqsmooth GaussNewton::fit from the nominal", windows / g["upd"], None, None),
-               ("seqsmooth bootstrap::radar + GaussNewton::fit", windows / g["est"], None, None),
-               ("seqsmooth bootstrap::radar alone", windows / g["extra"][0], None, None)]
+    gn_rows = [
+        ("seqsmooth GaussNewton::fit from the nominal", windows / g["upd"], None, None),
+        ("seqsmooth bootstrap::radar + GaussNewton::fit", windows / g["est"], None, None),
+        ("seqsmooth bootstrap::radar alone", windows / g["extra"][0], None, None),
+    ]
     our_fit_rate = windows / g["upd"]
-    ours_stat = max(float(np.max(np.abs(gauss_newton_step(p, x)) / s))
-                    for p, x, s in zip(problems, gmine, gsigma))
+    ours_stat = max(
+        float(np.max(np.abs(gauss_newton_step(p, x)) / s))
+        for p, x, s in zip(problems, gmine, gsigma)
+    )
     gn_agree = []
     for method, use_jac in (("lm", True), ("trf", True), ("lm", False)):
-        label = f"scipy least_squares '{method}', " + ("analytic Jacobian" if use_jac
-                                                        else "2-point Jacobian")
+        label = f"scipy least_squares '{method}', " + (
+            "analytic Jacobian" if use_jac else "2-point Jacobian"
+        )
         best, nfev = float("inf"), 0
         out = np.empty((windows, 6))
         for _ in range(3):
             nfev = 0
             start = time.perf_counter()
             for i, (fun, jac) in enumerate(problems):
-                r = least_squares(fun, nominal[i], jac=jac if use_jac else "2-point",
-                                  method=method)
+                r = least_squares(fun, nominal[i], jac=jac if use_jac else "2-point", method=method)
                 out[i] = r.x
                 nfev += r.nfev
             best = min(best, time.perf_counter() - start)
         err = float(np.max(np.abs(out - gmine) / gsigma))
-        stat = max(float(np.max(np.abs(gauss_newton_step(p, x)) / s))
-                   for p, x, s in zip(problems, out, gsigma))
+        stat = max(
+            float(np.max(np.abs(gauss_newton_step(p, x)) / s))
+            for p, x, s in zip(problems, out, gsigma)
+        )
         gn_rows.append((label, windows / best, nfev / windows, err))
         tol = TOL["gauss_newton" if use_jac else "gauss_newton_2point"]
         gn_agree.append((label, err, stat, tol))
-        agree.append({"pair": f"radar Gauss–Newton fit: {label} vs GaussNewton::fit",
-                      "err": err, "tol": tol, "rows": f"{windows} windows, 6 states",
-                      "metric": "σ_k (ours)"})
+        agree.append(
+            {
+                "pair": f"radar Gauss–Newton fit: {label} vs GaussNewton::fit",
+                "err": err,
+                "tol": tol,
+                "rows": f"{windows} windows, 6 states",
+                "metric": "σ_k (ours)",
+            }
+        )
         if not err <= tol:
             failures.append(f"radar Gauss–Newton, {label}: {err:.2e} σ > {tol:.0e} σ")
 
@@ -676,14 +854,42 @@ def main():
     out, secs, secs_build, count = run_kf_q(tk, yk, KQ_DEGREE, KQ_Q, kq_x0, kq_P0)
     err = rel_diff(out[KQ_DEGREE:], mine[KQ_DEGREE:])
     pair = f"Kalman, {KQ_DEGREE + 1} states, q = {KQ_Q}, irregular"
-    record(pair, "filterpy KalmanFilter (F, Q given)", count, secs, name,
-           "KalmanFilter::update_stats", err, TOL["kalman_q"], f"{KQ_DEGREE}..{len(tk) - 1}")
-    check_last(pair, "filterpy KalmanFilter", out[-1], name, "KalmanFilter", mine[KQ_DEGREE:],
-               TOL["kalman_q"], call="the update_stats loop")
+    record(
+        pair,
+        "filterpy KalmanFilter (F, Q given)",
+        count,
+        secs,
+        name,
+        "KalmanFilter::update_stats",
+        err,
+        TOL["kalman_q"],
+        f"{KQ_DEGREE}..{len(tk) - 1}",
+    )
+    check_last(
+        pair,
+        "filterpy KalmanFilter",
+        out[-1],
+        name,
+        "KalmanFilter",
+        mine[KQ_DEGREE:],
+        TOL["kalman_q"],
+        call="the update_stats loop",
+    )
     o = ours[name]
-    kq_rows.append((pair, "KalmanFilter.predict(F, Q) + update", secs / count,
-                    secs_build / count, o["upd"] / o["n"], o["extra"][0] / o["n"],
-                    o["est"] / o["n"], err, "relative", TOL["kalman_q"]))
+    kq_rows.append(
+        (
+            pair,
+            "KalmanFilter.predict(F, Q) + update",
+            secs / count,
+            secs_build / count,
+            o["upd"] / o["n"],
+            o["extra"][0] / o["n"],
+            o["est"] / o["n"],
+            err,
+            "relative",
+            TOL["kalman_q"],
+        )
+    )
     g = ours["ekf"]
     tracks = a.ekf_tracks
     edata = np.fromfile(os.path.join(a.dir, "ekf.data.f64"), dtype="<f8").reshape(tracks, -1, 4)
@@ -693,66 +899,119 @@ def main():
     out, secs, count = run_ekf(edata, eprior, 2)
     err = float(np.max(np.abs(out - emine) / esigma))
     pair = "extended Kalman, 6 states, radar"
-    record(pair, "filterpy ExtendedKalmanFilter", count, secs, "ekf",
-           "KalmanFilter::update_stats (extended)", err, TOL["ekf"],
-           f"{tracks} tracks × {edata.shape[1]} updates", metric="σ_k (ours)")
-    kq_rows.append((pair, "ExtendedKalmanFilter.predict + update", secs / count, None,
-                    g["upd"] / g["n"], g["extra"][0] / g["n"], g["est"] / g["n"], err, "σ (ours)",
-                    TOL["ekf"]))
+    record(
+        pair,
+        "filterpy ExtendedKalmanFilter",
+        count,
+        secs,
+        "ekf",
+        "KalmanFilter::update_stats (extended)",
+        err,
+        TOL["ekf"],
+        f"{tracks} tracks × {edata.shape[1]} updates",
+        metric="σ_k (ours)",
+    )
+    kq_rows.append(
+        (
+            pair,
+            "ExtendedKalmanFilter.predict + update",
+            secs / count,
+            None,
+            g["upd"] / g["n"],
+            g["extra"][0] / g["n"],
+            g["est"] / g["n"],
+            err,
+            "σ (ours)",
+            TOL["ekf"],
+        )
+    )
 
     # 7. Report.
-    print(f"\nPeer comparison: {a.n} even samples (dt {DT}), {a.n_kf} for the Kalman pairs; "
-          f"seqsmooth best of {a.reps}; filterpy memory/leastsq best of 2, Kalman and savgol one run")
-    print(f"python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}"
-          f", filterpy {filterpy.__version__}; {platform.machine()}, "
-          f"{os.cpu_count()} logical CPUs")
-    print("\n| pair | peer | peer updates/s | seqsmooth | ours updates/s (update only) | ratio |"
-          " ours updates/s (update + estimate) | ratio |")
+    print(
+        f"\nPeer comparison: {a.n} even samples (dt {DT}), {a.n_kf} for the Kalman pairs; "
+        f"seqsmooth best of {a.reps}; filterpy memory/leastsq best of 2, Kalman and savgol one run"
+    )
+    print(
+        f"python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}"
+        f", filterpy {filterpy.__version__}; {platform.machine()}, "
+        f"{os.cpu_count()} logical CPUs"
+    )
+    print(
+        "\n| pair | peer | peer updates/s | seqsmooth | ours updates/s (update only) | ratio |"
+        " ours updates/s (update + estimate) | ratio |"
+    )
     print("|---|---|---:|---|---:|---:|---:|---:|")
     for r in rows:
-        print(f"| {r['pair']} | {r['peer']} | {r['peer_rate']:.3g} | {r['ours']} | "
-              f"{r['our_rate']:.3g} | {r['our_rate'] / r['peer_rate']:.0f}× | "
-              f"{r['our_rate_est']:.3g} | {r['our_rate_est'] / r['peer_rate']:.0f}× |")
-    print("\n| CLI, end to end (CSV in, CSV out) | rows/s | ÷ filterpy FadingMemoryFilter(order 2)"
-          " updates/s |")
+        print(
+            f"| {r['pair']} | {r['peer']} | {r['peer_rate']:.3g} | {r['ours']} | "
+            f"{r['our_rate']:.3g} | {r['our_rate'] / r['peer_rate']:.0f}× | "
+            f"{r['our_rate_est']:.3g} | {r['our_rate_est'] / r['peer_rate']:.0f}× |"
+        )
+    print(
+        "\n| CLI, end to end (CSV in, CSV out) | rows/s | ÷ filterpy FadingMemoryFilter(order 2)"
+        " updates/s |"
+    )
     print("|---|---:|---:|")
-    for engine, cmd, rate in cli_rows:
+    for _engine, cmd, rate in cli_rows:
         print(f"| `{cmd}` | {rate:.3g} | {rate / fm2_peer:.1f}× |")
-    print(f"\nRadar Gauss–Newton fit, 60 samples, 6 states: {windows} windows (seqsmooth best of "
-          f"{a.reps}, scipy best of 3, each over all the windows; scipy at its default "
-          f"tolerances, from our bootstrap nominal)")
-    print("\n| fit | µs per fit | fits/s | scipy evaluations per fit | our fit from the nominal"
-          " faster by | our bootstrap + fit faster by | max abs(peer − ours)/σ |"
-          " peer's next Gauss–Newton step/σ |")
+    print(
+        f"\nRadar Gauss–Newton fit, 60 samples, 6 states: {windows} windows (seqsmooth best of "
+        f"{a.reps}, scipy best of 3, each over all the windows; scipy at its default "
+        f"tolerances, from our bootstrap nominal)"
+    )
+    print(
+        "\n| fit | µs per fit | fits/s | scipy evaluations per fit | our fit from the nominal"
+        " faster by | our bootstrap + fit faster by | max abs(peer − ours)/σ |"
+        " peer's next Gauss–Newton step/σ |"
+    )
     print("|---|---:|---:|---:|---:|---:|---:|---:|")
     stats = {lab: st for lab, _, st, _ in gn_agree}
     for label, rate, nfev, err in gn_rows:
         if nfev is None:
             print(f"| {label} | {1e6 / rate:.1f} | {rate:.3g} | | | | | |")
         else:
-            print(f"| {label} | {1e6 / rate:.1f} | {rate:.3g} | {nfev:.1f} | "
-                  f"{our_fit_rate / rate:.1f}× | {windows / g['est'] / rate:.1f}× | {err:.2e} | "
-                  f"{stats[label]:.1e} |")
-    print(f"\nour next Gauss–Newton step from our converged state, max over the windows and "
-          f"components: {ours_stat:.1e} σ")
-    print("\nKalman filters, per update (ours best of "
-          f"{a.reps}; filterpy one run of the linear filter, best of 2 over the radar tracks)")
-    print("\n| pair | filterpy | filterpy µs (F, Q given) | filterpy µs (F, Q built in the loop) |"
-          " ours ns, update_stats | ratio | ours ns, update (Innovation) | ratio |"
-          " ours ns, update_stats + state read | max difference |")
+            print(
+                f"| {label} | {1e6 / rate:.1f} | {rate:.3g} | {nfev:.1f} | "
+                f"{our_fit_rate / rate:.1f}× | {windows / g['est'] / rate:.1f}× | {err:.2e} | "
+                f"{stats[label]:.1e} |"
+            )
+    print(
+        f"\nour next Gauss–Newton step from our converged state, max over the windows and "
+        f"components: {ours_stat:.1e} σ"
+    )
+    print(
+        "\nKalman filters, per update (ours best of "
+        f"{a.reps}; filterpy one run of the linear filter, best of 2 over the radar tracks)"
+    )
+    print(
+        "\n| pair | filterpy | filterpy µs (F, Q given) | filterpy µs (F, Q built in the loop) |"
+        " ours ns, update_stats | ratio | ours ns, update (Innovation) | ratio |"
+        " ours ns, update_stats + state read | max difference |"
+    )
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for pair, peer, p_s, pb_s, q_s, f_s, r_s, err, unit, tol in kq_rows:
         built = f"{pb_s * 1e6:.1f}" if pb_s is not None else ""
-        print(f"| {pair} | {peer} | {p_s * 1e6:.1f} | {built} | {q_s * 1e9:.0f} | "
-              f"{p_s / q_s:.0f}× | {f_s * 1e9:.0f} | {p_s / f_s:.0f}× | {r_s * 1e9:.0f} | "
-              f"{err:.2e} {unit} (tolerance {tol:.0e}) |")
+        print(
+            f"| {pair} | {peer} | {p_s * 1e6:.1f} | {built} | {q_s * 1e9:.0f} | "
+            f"{p_s / q_s:.0f}× | {f_s * 1e9:.0f} | {p_s / f_s:.0f}× | {r_s * 1e9:.0f} | "
+            f"{err:.2e} {unit} (tolerance {tol:.0e}) |"
+        )
     print("\n| agreement | samples compared | max difference | relative to | tolerance |")
     print("|---|---|---:|---|---:|")
     for g in agree:
         print(f"| {g['pair']} | {g['rows']} | {g['err']:.2e} | {g['metric']} | {g['tol']:.1e} |")
     with open(os.path.join(a.dir, "results.json"), "w") as f:
-        json.dump({"rows": rows, "cli": cli_rows, "agree": agree, "gauss_newton": gn_rows,
-                   "kalman": kq_rows}, f, indent=1)
+        json.dump(
+            {
+                "rows": rows,
+                "cli": cli_rows,
+                "agree": agree,
+                "gauss_newton": gn_rows,
+                "kalman": kq_rows,
+            },
+            f,
+            indent=1,
+        )
     if failures:
         print("\nDISAGREEMENT:\n  " + "\n  ".join(failures), file=sys.stderr)
         sys.exit(1)

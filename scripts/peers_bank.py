@@ -25,7 +25,7 @@ import peers_venv
 
 peers_venv.enter(__file__)
 
-import numpy as np
+import numpy as np  # noqa: E402 (after the peers' environment is entered)
 
 ROOT = peers_venv.ROOT
 Q, R, P0 = 0.01, 1.0, 100.0

@@ -4,6 +4,7 @@ at the versions below, created once from PyPI. `enter(__file__)` re-runs the cal
 that environment (with the same arguments) unless it already runs there; scripts/peers.py and
 scripts/make_kalman_fixtures.py share it, so the peer timings and the stored fixtures come from
 the same versions."""
+
 import os
 import subprocess
 import sys

@@ -35,5 +35,8 @@ bash scripts/wheel_test.sh "$wheel"
     cd crates/seqsmooth-py
     "../../$venv/bin/ruff" check .
     "../../$venv/bin/ruff" format --check .
+    # The scripts that make fixtures and run the peers, under the package's rules.
+    "../../$venv/bin/ruff" check --config pyproject.toml ../../scripts
+    "../../$venv/bin/ruff" format --check --config pyproject.toml ../../scripts
     SEQSMOOTH_CLI="$PWD/../../target/release/seqsmooth" "../../$venv/bin/python" -m pytest -q
 )

@@ -34,7 +34,11 @@ def noise(dt):
 def radar(x):
     dx, dy, dz = x[0], x[1], x[2]
     return np.array(
-        [math.sqrt(dx * dx + dy * dy + dz * dz), math.atan2(dy, dx), math.atan2(dz, math.hypot(dx, dy))]
+        [
+            math.sqrt(dx * dx + dy * dy + dz * dz),
+            math.atan2(dy, dx),
+            math.atan2(dz, math.hypot(dx, dy)),
+        ]
     )
 
 
