@@ -273,7 +273,10 @@ def kalman_frame(
     ``d0..dM`` and their 1σ ``s0..sM`` (``M = degree``; named as :func:`filter_frame` names
     them; with several value columns ``<value>_d0..``, ``<value>_s0..`` for each), and
     ``nis`` (the update's normalised innovation squared, NaN where every component was
-    missing), one row per input row, in input order.
+    missing), one row per input row, in input order. The input's own columns are not copied:
+    for pandas they are the input's columns under copy-on-write (every column of the result
+    writable; writing either frame copies the column written, the other unchanged), for a
+    dict the caller's arrays themselves (a ``float64`` time column too).
 
     Raises
     ------

@@ -129,11 +129,11 @@ impl Grouping {
     }
 
     /// `grouped` (`width` values a row, grouped order) in input order.
-    pub fn scatter<T: Copy>(&self, grouped: &[T], width: usize) -> Vec<T> {
+    pub fn scatter<T: Copy + Default>(&self, grouped: &[T], width: usize) -> Vec<T> {
         match &self.order {
             None => grouped.to_vec(),
             Some(order) => {
-                let mut out = grouped.to_vec();
+                let mut out = vec![T::default(); grouped.len()];
                 for (k, &i) in order.iter().enumerate() {
                     out[i * width..(i + 1) * width]
                         .copy_from_slice(&grouped[k * width..(k + 1) * width]);
