@@ -133,6 +133,20 @@ def test_one_series_without_by(rng):
     np.testing.assert_array_equal(got[["d0", "d1"]].to_numpy(), want)
 
 
+def test_pandas_result_is_writable_and_leaves_the_input_alone(rng):
+    # The input's columns in the result share its memory under pandas' copy-on-write: every
+    # column of the result can be written, without changing the input.
+    names, t, y = interleaved(rng, series=4, rows=200)
+    df = pd.DataFrame({"id": names, "t": t, "y": y}, index=np.arange(200) * 2)
+    before = df.copy(deep=True)
+    out = ss.filter_frame(df, by="id", kind="fading", degree=1, theta=0.8, tau=1.0)
+    assert isinstance(out.index, pd.RangeIndex)
+    np.testing.assert_array_equal(out["y"].to_numpy(), y)
+    for c in out.columns:
+        out.loc[0, c] = "x" if c == "id" else 7.0
+    pd.testing.assert_frame_equal(df, before)
+
+
 def test_auto_outliers_are_the_final_decisions(rng):
     """The `outlier` column of kind "auto" is each series' final decision, as
     `AutomaticFilter.finish` gives it series by series (the review may overturn the gate)."""

@@ -179,3 +179,26 @@ def test_kalman_frame_reads_unaligned_columns():
     got = seqsmooth.kalman_frame(frame, **settings)
     for c in ["x_d0", "y_d1", "x_s0", "y_s1", "nis"]:
         assert np.array_equal(got[c], want[c], equal_nan=True)
+
+
+def test_kalman_frame_pandas_result_is_writable_and_leaves_the_input_alone():
+    # The result's input columns share the input's memory under pandas' copy-on-write: every
+    # column of the result can be written, and writing it changes neither the input nor
+    # another call's result.
+    pandas = pytest.importorskip("pandas")
+    ids, t, z = rows(30, seed=8)
+    df = pandas.DataFrame({"id": ids, "t": t, "x": z[:, 0], "y": z[:, 1]}, index=ids * 3 + 1)
+    before = df.copy(deep=True)
+    settings = dict(value=["x", "y"], by="id", P0=P0, R=R, q=Q)
+    out = seqsmooth.kalman_frame(df, **settings)
+    again = seqsmooth.kalman_frame(df, **settings)
+    assert isinstance(out.index, pandas.RangeIndex) and len(out) == len(df)
+    for c in ["id", "t", "x", "y"]:
+        assert np.array_equal(out[c].to_numpy(), df[c].to_numpy(), equal_nan=True)
+    for c in out.columns:
+        out.loc[0, c] = 7
+        out[c] = out[c] * 2
+        assert out[c].iloc[0] == 14
+    pandas.testing.assert_frame_equal(df, before)
+    assert not np.array_equal(again["x_d0"].to_numpy(), out["x_d0"].to_numpy())
+    assert again["t"].iloc[0] == t[0] and again["id"].iloc[0] == ids[0]

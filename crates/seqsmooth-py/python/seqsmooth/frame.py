@@ -65,13 +65,47 @@ def _codes(keys: np.ndarray, by: str) -> tuple[np.ndarray, Any]:
     return codes.astype(np.int64, copy=False), np.asarray(names)
 
 
-def _like(frame: Any, columns: dict[str, np.ndarray]) -> Any:
-    """``columns`` as a frame of the kind of ``frame``."""
+def _times(frame: Any, name: str) -> np.ndarray:
+    """Column ``name`` as seconds (:func:`seconds`); a ``float64`` column as it is (the
+    numbers :func:`seconds` would copy, not copied: contiguous and aligned, else converted)."""
+    raw = _raw_column(frame, name)
+    dtype = getattr(raw, "dtype", None)
+    if isinstance(dtype, np.dtype) and dtype == np.float64 and np.ndim(raw) == 1:
+        return np.require(np.asarray(raw), np.float64, ["C", "A"])
+    return seconds(raw, name)
+
+
+def _same_data(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether ``a`` and ``b`` are the same numbers in the same memory (shape, dtype, strides
+    and address), in constant time."""
+    return (
+        a.shape == b.shape
+        and a.dtype == b.dtype
+        and a.strides == b.strides
+        and a.__array_interface__["data"][0] == b.__array_interface__["data"][0]
+    )
+
+
+def _like(frame: Any, columns: dict[str, np.ndarray], kept: Sequence[str] = ()) -> Any:
+    """``columns`` as a frame of the kind of ``frame``, no column copied; ``kept`` names the
+    columns that may be ``frame``'s own columns as they are.
+
+    pandas: such a column is the input's own pandas column (on the result's ``RangeIndex``),
+    so the result shares its memory under pandas' copy-on-write (the first write to either
+    frame copies that column: the result's columns are all writable, and writing them never
+    changes the input); the new columns are the arrays as they are (no copy into a
+    consolidated block). Polars and Arrow: their constructors' own rules, as before.
+    """
     module = type(frame).__module__.split(".")[0]
     if module == "pandas":
         import pandas
 
-        return pandas.DataFrame(columns, copy=False)
+        data: dict[str, Any] = dict(columns)
+        for name in kept:
+            column = frame[name]
+            if isinstance(column, pandas.Series) and _same_data(np.asarray(column), columns[name]):
+                data[name] = column.reset_index(drop=True)
+        return pandas.DataFrame(data, copy=False)
     if module == "polars":
         import polars
 
@@ -183,7 +217,7 @@ def filter_frame(
     columns[value] = y
     for name, column in zip(names_out, values):
         columns[name] = column
-    return _like(df, columns)
+    return _like(df, columns, kept=[c for c in (by, value) if c is not None])
 
 
 def kalman_frame(
@@ -239,7 +273,10 @@ def kalman_frame(
     ``d0..dM`` and their 1σ ``s0..sM`` (``M = degree``; named as :func:`filter_frame` names
     them; with several value columns ``<value>_d0..``, ``<value>_s0..`` for each), and
     ``nis`` (the update's normalised innovation squared, NaN where every component was
-    missing), one row per input row, in input order.
+    missing), one row per input row, in input order. The input's own columns are not copied:
+    for pandas they are the input's columns under copy-on-write (every column of the result
+    writable; writing either frame copies the column written, the other unchanged), for a
+    dict the caller's arrays themselves (a ``float64`` time column too).
 
     Raises
     ------
@@ -259,7 +296,7 @@ def kalman_frame(
     values = [value] if isinstance(value, str) else list(value)
     if not values:
         raise InvalidInputError("value names no column")
-    t = seconds(_raw_column(df, time), time)
+    t = _times(df, time)
     rows = len(t)
     if rows == 0:
         raise InvalidInputError("the frame has no rows")
@@ -316,4 +353,4 @@ def kalman_frame(
             for k in range(degree + 1):
                 columns[f"{prefix}{letter}{k}"] = numbers[:, k * axes + a]
     columns["nis"] = nis
-    return _like(df, columns)
+    return _like(df, columns, kept=[c for c in (by, time, *values) if c is not None])

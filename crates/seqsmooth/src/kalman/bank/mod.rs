@@ -47,12 +47,14 @@ use std::sync::Arc;
 mod backward;
 mod fixed;
 mod kernel;
+mod labels;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
 mod series;
 mod smooth;
 mod stream;
 
+pub use labels::Grouping;
 pub use stream::BankStream;
 
 use crate::numeric::unrolled::unrolled_sizes;
