@@ -8,8 +8,8 @@
 //! - `fading σ`: the fading-memory filter's batch σ path (`update_many_sigma_into`, the rows
 //!   `d0..d2, s0..s2` of `seqsmooth filter --sigma`);
 //! - `auto`: the automatic filter at its defaults, one `update` a sample (the command's path);
-//! - `auto, memory_levels 2`, `1`: the shortest memory `θ⁸` left out, then `θ⁴` too
-//!   (`tests/automatic_manoeuvres.rs` scores them with `SEQSMOOTH_AUTO_MEMORY_LEVELS`);
+//! - `auto, memory_levels 2`: one more shorter memory (`θ⁴` and `θ¹⁶`; the default runs `θ⁴`
+//!   alone; `tests/automatic_manoeuvres.rs` scores it with `SEQSMOOTH_AUTO_MEMORY_LEVELS`);
 //! - `auto, memory_levels 0`: without the shorter memories (Morrison §7.13's adaptive memory);
 //! - `auto, review_window 0`: without the review (the gate's decisions);
 //! - `auto, both 0`: neither.
@@ -69,10 +69,6 @@ fn main() {
         (
             "auto, memory_levels 2",
             auto.clone().with_memory_levels(2).unwrap(),
-        ),
-        (
-            "auto, memory_levels 1",
-            auto.clone().with_memory_levels(1).unwrap(),
         ),
         (
             "auto, memory_levels 0",

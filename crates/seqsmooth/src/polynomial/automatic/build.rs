@@ -268,13 +268,13 @@ impl AutomaticFilter {
         with_misfit_response(response: MisfitResponse) => misfit_response = response;
 
         /// The number `J ≤` [`MAX_MEMORY_LEVELS`](super::MAX_MEMORY_LEVELS) of shorter memories
-        /// `θ², θ⁴, …, θ^(2^J)` the final degree may use (default 3; 0: the configured `θ` only);
+        /// `θ⁴, θ¹⁶, …, θ^(4^J)` the final degree may use (default 1; 0: the configured `θ` only);
         /// see [`memory`](Self::memory).
         ///
         /// ```
         /// use seqsmooth::polynomial::automatic::AutomaticFilter;
         /// let f = AutomaticFilter::new(2, 0.95, 1.0).unwrap();
-        /// assert_eq!(f.config().memory_levels, 3);
+        /// assert_eq!(f.config().memory_levels, 1);
         /// assert_eq!(f.with_memory_levels(0).unwrap().config().memory_levels, 0);
         /// ```
         with_memory_levels(levels: usize) => memory_levels = levels;

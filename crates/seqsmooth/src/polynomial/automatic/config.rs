@@ -22,7 +22,7 @@ use crate::polynomial::options::{DiscountMode, Engine};
 pub const GATE_MAX_VRF: f64 = 1.0;
 
 /// The most shorter memories [`AutoConfig::memory_levels`] may ask for (the shortest discounts
-/// by `θ^65536`).
+/// by `θ^65536 = θ^(4^8)`).
 ///
 /// ```
 /// use seqsmooth::polynomial::automatic::{AutomaticFilter, MAX_MEMORY_LEVELS};
@@ -30,7 +30,7 @@ pub const GATE_MAX_VRF: f64 = 1.0;
 /// assert!(f.clone().with_memory_levels(MAX_MEMORY_LEVELS).is_ok());
 /// assert!(f.with_memory_levels(MAX_MEMORY_LEVELS + 1).is_err());
 /// ```
-pub const MAX_MEMORY_LEVELS: usize = 16;
+pub const MAX_MEMORY_LEVELS: usize = 8;
 
 /// The largest [`AutoConfig::review_window`].
 ///
@@ -108,9 +108,10 @@ pub struct AutoConfig {
     pub misfit_alpha: f64,
     /// What the filter does when the model no longer fits (default: restart at α = 10⁻⁴).
     pub misfit_response: MisfitResponse,
-    /// Shorter memories `θ², θ⁴, …, θ^(2^J)` the final degree may use (`J`; default 3; 0: only
-    /// `θ`): for each prediction and estimate the memory of least estimated mean squared error
-    /// `σ² V + b̂²` (Morrison §7.13; see [`AutomaticFilter::memory`](super::AutomaticFilter::memory)).
+    /// Shorter memories `θ⁴, θ¹⁶, …, θ^(4^J)` the final degree may use (`J`; default 1: `θ⁴`, a
+    /// memory a quarter as long; 0: only `θ`): for each prediction and estimate the memory of
+    /// least estimated mean squared error `σ² V + b̂²` (Morrison §7.13, (13.9.28); see
+    /// [`AutomaticFilter::memory`](super::AutomaticFilter::memory)).
     pub memory_levels: usize,
     /// First degree of the quick-settling ladder, `≤ degree` (default 0; `degree` disables it).
     pub start_degree: usize,
@@ -142,7 +143,7 @@ impl AutoConfig {
             misfit_window: 10,
             misfit_alpha: 0.01,
             misfit_response: MisfitResponse::default(),
-            memory_levels: 3,
+            memory_levels: 1,
             start_degree: 0,
             settle_vrf: 0.5,
             settle_stable: 3,

@@ -334,7 +334,7 @@ impl AutomaticFilter {
         }
     }
 
-    /// The index `j` of the memory in use: the final degree's discount is `θ^(2^j)` per `τ`
+    /// The index `j` of the memory in use: the final degree's discount is `θ^(4^j)` per `τ`
     /// (0: the configured `θ`; see the [module docs](super) and
     /// [`AutoConfig::memory_levels`]).
     ///

@@ -1,8 +1,8 @@
 //! The adaptive memory of the final degree (Morrison §7.13, §13.9, §14.8): beside the
 //! configured discount `θ` it runs fading-memory filters of the shorter memories
-//! `θ_j = θ^(2^j)`, `j = 1 … J` ([`AutoConfig::memory_levels`]), each with its degree `m + 1`
-//! companion, on the same accepted samples, and uses the memory of least estimated mean squared
-//! error.
+//! `θ_j = θ^(4^j)`, `j = 1 … J` ([`AutoConfig::memory_levels`], default 1: `θ⁴`), each with its
+//! degree `m + 1` companion, on the same accepted samples, and uses the memory of least
+//! estimated mean squared error.
 //!
 //! The memory trades noise against bias: the position VRF of a fading-memory filter falls as its
 //! memory lengthens (about `∝ 1 − θ`, Morrison (13.4.4)), while the bias of an unmodelled
@@ -19,14 +19,27 @@
 //! shorter memories are not compared (they keep running); compared again, their calibrations
 //! start from memory 0's. Only with
 //! [`MisfitResponse::Restart`](super::MisfitResponse::Restart) (the flag-only response keeps
-//! the memory). Halving the memory (`θ → θ²`, so
-//! `1 − θ → ≈ 2(1 − θ)`) divides the bias by `≈ 2^(m+1)` and about doubles the VRF. Memory
-//! `j = 0` is the configured one (expanding until the switch, then fading); the shorter memories
-//! are fading from the first sample (exact discounted least squares, on the exact engine always); a
-//! restart rebuilds them all from the onset
+//! the memory). Memory `j = 0` is the configured one (expanding until the switch, then
+//! fading); the shorter memories are fading from the first sample (exact discounted least
+//! squares, on the exact engine always); a restart rebuilds them all from the onset
 //! ([`Memories::rebuild`]). The expanding → fading switch of memory 0 is here too (Morrison
 //! §13.8, (13.8.8); Reyneke et al. §7.2, Table 1): the rule's sample index for the discount per
 //! sample so far, re-evaluated at each sample until the switch.
+//!
+//! **The ladder's step** ([`MEMORY_RATIO`]): each shorter memory is a quarter of the one above
+//! (`θ → θ⁴`, so `1 − θ → ≈ 4(1 − θ)`): it divides the bias of the unmodelled `(m+1)`-th
+//! derivative by `≈ 4^(m+1)` (64 at `m = 2`; the bias grows as `(1 − θ)^−(m+1)`, Morrison
+//! (13.9.28)) and multiplies the VRF by about 4 (`∝ 1 − θ`, Morrison (13.4.4)), so one rung
+//! spans what halving took two more rungs to span (`θ², θ⁴, θ⁸`): a manoeuvre's bias is either
+//! small against the noise in the long memory, which is then chosen, or removed by the short
+//! one. §7.13's balance may fall between two rungs, where a coarser ladder raises the mean
+//! squared error of the memory chosen; the reported error `σ² V + b̂ b̂ᵀ` ([`super::bias`])
+//! carries that bias either way, so coverage does not rest on the balance being met exactly.
+//! Each rung costs two exact filters (the memory and its companion) at every sample and two
+//! positions at every comparison. Measured on the Monte Carlo of manoeuvring tracks and
+//! landing.csv (ACCURACY.md), the single rung `θ⁴` covers the truth better than the halving
+//! ladder `θ², θ⁴, θ⁸` did (fewer rungs, fewer noisy choices of a memory too short) with half
+//! the filters.
 
 use super::bias::position_bias;
 use super::config::{AutoConfig, MAX_MEMORY_LEVELS};
@@ -117,8 +130,12 @@ fn upper_pair(cfg: &AutoConfig) -> Result<UpperPair, Error> {
     ))
 }
 
+/// Each shorter memory discounts by this power of the one above: `θ_j = θ^(4^j)` per `τ` (the
+/// module docs: a memory a quarter as long per rung).
+const MEMORY_RATIO: i32 = 4;
+
 /// A shorter memory of the final degree: the degree-`m` fading-memory filter of discount
-/// `θ^(2^j)` per `τ` and its degree `m + 1` companion.
+/// `θ^(4^j)` per `τ` and its degree `m + 1` companion.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct Shorter {
     fading: FadingMemory,
@@ -136,7 +153,7 @@ fn shorter_memories(cfg: &AutoConfig) -> Result<Vec<Shorter>, Error> {
     let mut out = Vec::new();
     let mut theta = cfg.theta;
     for _ in 0..cfg.memory_levels {
-        theta *= theta;
+        theta = theta.powi(MEMORY_RATIO);
         if theta < MIN_THETA {
             break;
         }
@@ -182,7 +199,7 @@ pub(super) struct Memories {
     /// of the final degree; `None` at `m = MAX_DEGREE`, the expanding one after the switch).
     upper_expanding: Option<ExpandingMemory>,
     upper_fading: Option<FadingMemory>,
-    /// The shorter memories `θ^(2^j)`, `j = 1 … J`, of the final degree.
+    /// The shorter memories `θ^(4^j)`, `j = 1 … J`, of the final degree.
     shorter: Vec<Shorter>,
     /// The memory in use (0: the configured `θ`).
     memory: usize,
@@ -521,8 +538,13 @@ impl Memories {
     /// (switched, or a shorter memory); `None` before (the caller counts samples).
     pub(super) fn faded_length(&self, cfg: &AutoConfig, t: f64) -> Option<f64> {
         (self.switched || self.memory > 0).then(|| {
-            // The memory in use discounts by θ^(2^j) per sample.
-            let theta = self.theta_per_sample(cfg, t).powi(1 << self.memory);
+            // The memory in use discounts by θ^(4^j) per sample (the power its own filter's
+            // discount is of θ, so that a restored filter keeps its own).
+            let power = match self.memory {
+                0 => 1,
+                j => (self.shorter[j - 1].fading.theta().ln() / cfg.theta.ln()).round() as i32,
+            };
+            let theta = self.theta_per_sample(cfg, t).powi(power);
             self.memory_constant / (1.0 - theta)
         })
     }

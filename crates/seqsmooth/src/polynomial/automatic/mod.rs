@@ -50,9 +50,11 @@
 //!      accepted samples (weights `θ^((t_n−t_k)/τ)`), run in tandem from the first sample, so
 //!      there is no start-up transient; the expanding start is used because its variance is the
 //!      lower one until the crossover.
-//!    - **Adaptive memory** (Morrison §7.13, §14.8; [`AutoConfig::memory_levels`], default 3):
+//!    - **Adaptive memory** (Morrison §7.13, §14.8; [`AutoConfig::memory_levels`], default 1):
 //!      beside `θ` the final degree runs fading-memory filters of the shorter memories
-//!      `θ², θ⁴, θ⁸` with their degree-`(m+1)` companions. Before each prediction the memory of
+//!      `θ⁴, θ¹⁶, …` (by default `θ⁴` alone: a memory a quarter as long, whose bias of an
+//!      unmodelled `(m+1)`-th derivative is `4^−(m+1)` of `θ`'s, Morrison (13.9.28)) with their
+//!      degree-`(m+1)` companions. Before each prediction the memory of
 //!      least estimated mean squared error `σ² v_j + b̂_j²` is chosen (bias counted where `|Δ|`
 //!      exceeds 2.5 of its noise standard deviations): the VRF falls as the memory lengthens,
 //!      the bias of the unmodelled `(m+1)`-th derivative grows as `(1−θ)^−(m+1)` (Morrison

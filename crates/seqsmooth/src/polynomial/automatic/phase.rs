@@ -18,6 +18,6 @@ pub enum Phase {
     /// The final degree, expanding memory (before the switch).
     Expanding,
     /// The final degree, fading memory (the configured `θ` after the switch, or a shorter
-    /// memory `θ^(2^j)`, see [`AutomaticFilter::memory`](super::AutomaticFilter::memory)).
+    /// memory `θ^(4^j)`, see [`AutomaticFilter::memory`](super::AutomaticFilter::memory)).
     Fading,
 }
