@@ -103,7 +103,13 @@ def _like(frame: Any, columns: dict[str, np.ndarray], kept: Sequence[str] = ()) 
         data: dict[str, Any] = dict(columns)
         for name in kept:
             column = frame[name]
-            if isinstance(column, pandas.Series) and _same_data(np.asarray(column), columns[name]):
+            # Only a column held in a numpy array is compared (``np.asarray`` is then a view);
+            # any other (strings, categorical, nullable) was converted, so it is not the same.
+            if (
+                isinstance(column, pandas.Series)
+                and isinstance(column.dtype, np.dtype)
+                and _same_data(np.asarray(column), columns[name])
+            ):
                 data[name] = column.reset_index(drop=True)
         return pandas.DataFrame(data, copy=False)
     if module == "polars":
@@ -273,10 +279,13 @@ def kalman_frame(
     ``d0..dM`` and their 1σ ``s0..sM`` (``M = degree``; named as :func:`filter_frame` names
     them; with several value columns ``<value>_d0..``, ``<value>_s0..`` for each), and
     ``nis`` (the update's normalised innovation squared, NaN where every component was
-    missing), one row per input row, in input order. The input's own columns are not copied:
-    for pandas they are the input's columns under copy-on-write (every column of the result
-    writable; writing either frame copies the column written, the other unchanged), for a
-    dict the caller's arrays themselves (a ``float64`` time column too).
+    missing), one row per input row, in input order. The input's columns that need no
+    conversion (``float64`` times and values, numeric numpy ids) are not copied: for pandas
+    they are the input's columns under copy-on-write (every column of the result writable;
+    writing either frame copies the column written, the other unchanged; pandas before 3
+    without copy-on-write may copy them), for a dict the caller's arrays themselves (a
+    ``float64`` time column too); other columns (strings, categorical, nullable, integer or
+    date times) are converted copies.
 
     Raises
     ------

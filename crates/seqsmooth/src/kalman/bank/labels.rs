@@ -110,12 +110,23 @@ impl Grouping {
         self.order.as_ref().map_or(row, |order| order[row])
     }
 
+    /// The number of rows grouped.
+    pub fn rows(&self) -> usize {
+        self.offsets.last().copied().unwrap_or(0)
+    }
+
     /// `input` (`width` values a row, input order) in grouped order: borrowed when the input
     /// was grouped.
-    pub fn gather<'a, T: Copy>(&self, input: &'a [T], width: usize) -> std::borrow::Cow<'a, [T]>
-    where
-        [T]: ToOwned<Owned = Vec<T>>,
-    {
+    ///
+    /// # Panics
+    ///
+    /// If `input` is not `width` values for each of [`Self::rows`].
+    pub fn gather<'a, T: Copy>(&self, input: &'a [T], width: usize) -> std::borrow::Cow<'a, [T]> {
+        assert_eq!(
+            input.len(),
+            self.rows() * width,
+            "gather: {width} values a row"
+        );
         match &self.order {
             None => std::borrow::Cow::Borrowed(input),
             Some(order) => {
@@ -129,7 +140,16 @@ impl Grouping {
     }
 
     /// `grouped` (`width` values a row, grouped order) in input order.
+    ///
+    /// # Panics
+    ///
+    /// If `grouped` is not `width` values for each of [`Self::rows`].
     pub fn scatter<T: Copy + Default>(&self, grouped: &[T], width: usize) -> Vec<T> {
+        assert_eq!(
+            grouped.len(),
+            self.rows() * width,
+            "scatter: {width} values a row"
+        );
         match &self.order {
             None => grouped.to_vec(),
             Some(order) => {
