@@ -602,8 +602,11 @@ impl Memories {
 }
 
 impl Memories {
-    /// Restored memories' invariants ([`crate::persist`]): every filter valid and of the
-    /// final degree `m` (the companions `m + 1`), the memory in use one of them.
+    /// Restored memories' invariants ([`crate::persist`]): at most [`MAX_MEMORY_LEVELS`]
+    /// shorter memories, every filter valid and of the final degree `m` (the companions
+    /// `m + 1`), the memory in use one of them. The shorter memories' discounts are not
+    /// checked against the configured ladder: a state saved before 2026-12-07 holds the
+    /// ladder `θ², θ⁴, θ⁸` of then, and keeps it.
     pub(super) fn check_saved(&self, m: usize) -> Result<(), String> {
         let degree = |f: &dyn PolynomialFilter, want: usize| {
             if f.degree() == want {
@@ -626,10 +629,21 @@ impl Memories {
             f.check_saved()?;
             degree(f, m + 1)?;
         }
-        for s in &self.shorter {
-            s.fading.check_saved()?;
-            s.upper.check_saved()?;
-            degree(&s.fading, m)?;
+        // A restart starts again from the fresh memories.
+        for shorter in [&self.shorter, &self.fresh.shorter] {
+            if shorter.len() > MAX_MEMORY_LEVELS {
+                // `choose` holds the positions of at most `MAX_MEMORY_LEVELS + 1` memories.
+                return Err(format!(
+                    "{} shorter memories, at most {MAX_MEMORY_LEVELS}",
+                    shorter.len()
+                ));
+            }
+            for s in shorter {
+                s.fading.check_saved()?;
+                s.upper.check_saved()?;
+                degree(&s.fading, m)?;
+                degree(&s.upper, m + 1)?;
+            }
         }
         if self.memory > self.shorter.len() {
             return Err(format!(
