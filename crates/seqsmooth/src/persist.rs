@@ -19,6 +19,15 @@
 //! finite where the filter needs them so, covariances symmetric and positive semi-definite),
 //! so that a body crafted with a valid checksum cannot make a later call panic.
 //!
+//! A restored filter runs on with what it was saved with: its settings and its parts as they
+//! were. Where a later version changed how a new filter is built, a saved state keeps the old
+//! construction: an [`AutomaticFilter`](crate::polynomial::automatic::AutomaticFilter) restored
+//! from a state saved before 2026-12-07 keeps the memories it was saved with (the adaptive
+//! memory's ladder `θ², θ⁴, θ⁸` of then, not today's `θ⁴`; see
+//! [`AutoConfig::memory_levels`](crate::polynomial::automatic::AutoConfig::memory_levels)), while
+//! a new filter gets today's; a state saved with a setting since out of range (such as
+//! `memory_levels` 9 to 16) is refused as damaged, naming it.
+//!
 //! ```
 //! use seqsmooth::persist::{from_bytes, to_bytes};
 //! use seqsmooth::{Engine, FadingMemory, PolynomialFilter};

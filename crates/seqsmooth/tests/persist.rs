@@ -20,10 +20,11 @@ use seqsmooth::model::observation::LinearObservation;
 use seqsmooth::model::radar::Radar;
 use seqsmooth::paml::{OnlineSmoother, SmootherGains};
 use seqsmooth::persist::{from_bytes, to_bytes, Persist};
+use seqsmooth::polynomial::automatic::{AutomaticFilter, MAX_MEMORY_LEVELS};
 use seqsmooth::polynomial::bank::FadingBank;
 use seqsmooth::polynomial::spec::{AnyFilter, FilterKind, FilterSpec};
 use seqsmooth::track::{RadarTracker, TrackMethod};
-use seqsmooth::{Engine, PolynomialFilter};
+use seqsmooth::{Engine, FadingMemory, PolynomialFilter};
 use std::sync::Arc;
 
 /// Irregular times and values from `seed` (a small LCG: the test's data are its own).
@@ -522,4 +523,159 @@ fn a_crafted_information_is_refused() {
         .unwrap_err(),
     );
     assert!(why.contains("Gram"), "{why}");
+}
+
+/// The CBOR body of a saved `AutomaticFilter` and the filter back from an edited body (with a
+/// valid checksum: what a crafted or an old saved state looks like).
+fn automatic_body(f: &AutomaticFilter) -> ciborium::Value {
+    let name = <AutomaticFilter as Persist>::name();
+    let bytes = to_bytes(f).unwrap();
+    let body = &bytes[8 + 2 + 1 + name.len() + 8 + 4..];
+    assert_eq!(
+        envelope(&name, body),
+        bytes,
+        "the test's envelope is the library's"
+    );
+    ciborium::from_reader(body).unwrap()
+}
+
+fn automatic_from(body: &ciborium::Value) -> Result<AutomaticFilter, Error> {
+    let mut b = Vec::new();
+    ciborium::into_writer(body, &mut b).unwrap();
+    from_bytes::<AutomaticFilter>(&envelope(&<AutomaticFilter as Persist>::name(), &b))
+}
+
+/// Why the edited body is refused (it must be).
+fn automatic_refused(body: &ciborium::Value) -> String {
+    match automatic_from(body) {
+        Ok(_) => panic!("a damaged AutomaticFilter was accepted"),
+        Err(e) => damaged(e),
+    }
+}
+
+/// The entry `key` of the CBOR map `v`.
+fn entry<'a>(v: &'a mut ciborium::Value, key: &str) -> &'a mut ciborium::Value {
+    let m = v.as_map_mut().unwrap();
+    let i = m
+        .iter()
+        .position(|(k, _)| k.as_text() == Some(key))
+        .unwrap_or_else(|| panic!("no {key}"));
+    &mut m[i].1
+}
+
+/// The saved state's shorter memories (`fresh`: those a restart starts from).
+fn shorter(body: &mut ciborium::Value, fresh: bool) -> &mut Vec<ciborium::Value> {
+    let memories = entry(entry(body, "state"), "memories");
+    let memories = if fresh {
+        entry(memories, "fresh")
+    } else {
+        memories
+    };
+    entry(memories, "shorter").as_array_mut().unwrap()
+}
+
+/// A polynomial track with a little noise: every sample accepted, no restart.
+fn gentle(n: usize) -> Vec<(f64, f64)> {
+    data(5, n)
+        .into_iter()
+        .map(|(t, e)| {
+            (
+                t,
+                1.0 + 0.5 * t + 0.02 * t * t + 0.1 * (e - (0.3 * t).sin()),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn an_automatic_state_with_more_shorter_memories_than_the_most_is_refused() {
+    // A state saved when `memory_levels` went up to 16 (θ ≥ 0.9866 kept 9 to 16 of them):
+    // `choose` has room for MAX_MEMORY_LEVELS + 1 positions and would index past them.
+    let mut f = AutomaticFilter::new(2, 0.999, 1.0).unwrap();
+    for (t, y) in gentle(60) {
+        f.update(t, y).unwrap();
+    }
+    let good = automatic_body(&f);
+    automatic_from(&good).unwrap();
+    let n = MAX_MEMORY_LEVELS + 4;
+    for fresh in [false, true] {
+        let mut body = good.clone();
+        let s = shorter(&mut body, fresh);
+        let one = s[0].clone();
+        s.resize(n, one);
+        let why = automatic_refused(&body);
+        assert!(why.contains(&format!("{n} shorter memories")), "{why}");
+    }
+    // … and with the setting it was saved with: refused as out of range.
+    let mut body = good.clone();
+    *entry(entry(entry(&mut body, "state"), "cfg"), "memory_levels") = (n as u64).into();
+    let why = automatic_refused(&body);
+    assert!(
+        why.contains("memory levels") || why.contains("memory_levels"),
+        "{why}"
+    );
+    // A companion of the wrong degree: the final degree's filter in its place.
+    let mut body = good.clone();
+    let s = shorter(&mut body, false);
+    let fading = entry(&mut s[0], "fading").clone();
+    *entry(&mut s[0], "upper") = fading;
+    let why = automatic_refused(&body);
+    assert!(why.contains("degree 2, 3 expected"), "{why}");
+}
+
+#[test]
+fn an_automatic_state_saved_with_the_old_ladder_keeps_it() {
+    // A filter saved before the ladder became θ^(4^j) holds θ², θ⁴, θ⁸: restored, it keeps
+    // running them (each an exact fading memory on the accepted samples).
+    let (m, theta, tau) = (2, 0.95, 1.0);
+    let f = AutomaticFilter::new(m, theta, tau)
+        .unwrap()
+        .with_memory_levels(3)
+        .unwrap();
+    let unit = |degree: usize, th: f64| {
+        FadingMemory::new(degree, th, tau, Engine::Exact)
+            .unwrap()
+            .with_noise_sigma(1.0)
+            .unwrap()
+    };
+    let old: Vec<f64> = [2, 4, 8].iter().map(|&p| theta.powi(p)).collect();
+    let mut body = automatic_body(&f);
+    for fresh in [false, true] {
+        let s = shorter(&mut body, fresh);
+        assert_eq!(s.len(), 3);
+        for (entry_j, &th) in s.iter_mut().zip(&old) {
+            *entry(entry_j, "fading") = ciborium::Value::serialized(&unit(m, th)).unwrap();
+            *entry(entry_j, "upper") = ciborium::Value::serialized(&unit(m + 1, th)).unwrap();
+        }
+    }
+    let mut g = automatic_from(&body).unwrap();
+    let mut oracle: Vec<_> = old.iter().map(|&th| unit(m, th)).collect();
+    for (t, y) in gentle(200) {
+        g.update(t, y).unwrap();
+        for o in &mut oracle {
+            o.update(t, y).unwrap();
+        }
+    }
+    assert_eq!(
+        (g.rejected(), g.restarts()),
+        (0, 0),
+        "every sample accepted"
+    );
+    let mut after = automatic_body(&g);
+    for fresh in [false, true] {
+        let thetas: Vec<f64> = shorter(&mut after, fresh)
+            .iter_mut()
+            .map(|s| {
+                let th = entry(entry(s, "fading"), "theta");
+                th.as_float().unwrap()
+            })
+            .collect();
+        assert_eq!(thetas, old, "the old ladder kept (fresh: {fresh})");
+    }
+    // The running ones are the exact fading memories of θ², θ⁴, θ⁸ on the same samples.
+    let running = shorter(&mut after, false);
+    for (s, o) in running.iter_mut().zip(&oracle) {
+        let fading: FadingMemory = entry(s, "fading").deserialized().unwrap();
+        assert_eq!(fading.estimate(), o.estimate());
+    }
 }

@@ -73,7 +73,9 @@ pub struct FilterArgs {
     /// if it exists and written to it at the end (atomically: a new file renamed over the old),
     /// so that a stream cut into files, each run with the same --state FILE, gives the rows of
     /// the unbroken run. A state made with other options is refused, naming the option; a
-    /// damaged one is refused; a run that fails leaves FILE as it was
+    /// damaged one is refused; a run that fails leaves FILE as it was. Each saved filter keeps
+    /// what it was saved with: an automatic filter saved before 2026-12-07 keeps its memories
+    /// θ², θ⁴, θ⁸, while a series first seen after the resume gets today's θ⁴
     #[arg(long, value_name = "FILE")]
     pub state: Option<PathBuf>,
     /// With --state: this input ends the stream, so the automatic filter decides its rows still

@@ -269,7 +269,11 @@ impl AutomaticFilter {
 
         /// The number `J ≤` [`MAX_MEMORY_LEVELS`](super::MAX_MEMORY_LEVELS) of shorter memories
         /// `θ⁴, θ¹⁶, …, θ^(4^J)` the final degree may use (default 1; 0: the configured `θ` only);
-        /// see [`memory`](Self::memory).
+        /// see [`memory`](Self::memory). A rung with `θ^(4^j) < 10⁻³` is not built (at 1: none
+        /// for `θ < 0.178`; all 8 only for `θ ≥ 0.999895`). Before 2026-12-07 the ladder was
+        /// `θ^(2^j)` and the most 16: 9 to 16 are now refused. A filter restored from a state
+        /// saved before 2026-12-07 keeps the memories it was saved with
+        /// ([`AutoConfig::memory_levels`](super::AutoConfig::memory_levels)).
         ///
         /// ```
         /// use seqsmooth::polynomial::automatic::AutomaticFilter;

@@ -21,8 +21,10 @@ use crate::polynomial::options::{DiscountMode, Engine};
 /// ```
 pub const GATE_MAX_VRF: f64 = 1.0;
 
-/// The most shorter memories [`AutoConfig::memory_levels`] may ask for (the shortest discounts
-/// by `θ^65536 = θ^(4^8)`).
+/// The most shorter memories [`AutoConfig::memory_levels`] may ask for (the shortest would
+/// discount by `θ^(4^8) = θ^65536`; a rung below `10⁻³` is dropped, so all 8 are built only for
+/// `θ ≥ 0.999895`). It was 16 before 2026-12-07 (the ladder `θ^(2^j)` of then):
+/// `with_memory_levels(9..=16)` is now refused, as is a state saved with such a setting.
 ///
 /// ```
 /// use seqsmooth::polynomial::automatic::{AutomaticFilter, MAX_MEMORY_LEVELS};
@@ -109,9 +111,14 @@ pub struct AutoConfig {
     /// What the filter does when the model no longer fits (default: restart at α = 10⁻⁴).
     pub misfit_response: MisfitResponse,
     /// Shorter memories `θ⁴, θ¹⁶, …, θ^(4^J)` the final degree may use (`J`; default 1: `θ⁴`, a
-    /// memory a quarter as long; 0: only `θ`): for each prediction and estimate the memory of
-    /// least estimated mean squared error `σ² V + b̂²` (Morrison §7.13, (13.9.28); see
-    /// [`AutomaticFilter::memory`](super::AutomaticFilter::memory)).
+    /// memory about a quarter as long; 0: only `θ`): for each prediction and estimate the memory
+    /// of least estimated mean squared error `σ² V + b̂²` (Morrison §7.13, (13.9.28); see
+    /// [`AutomaticFilter::memory`](super::AutomaticFilter::memory)). A rung with
+    /// `θ^(4^j) < 10⁻³` (a memory of well under one sample) is not built, nor those below it:
+    /// at the default 1 there is no shorter memory for `θ < 0.178`, and all
+    /// [`MAX_MEMORY_LEVELS`] are built only for `θ ≥ 0.999895`. Before 2026-12-07 the ladder
+    /// was `θ², θ⁴, θ⁸` (`θ^(2^j)`, default 3, at most 16): a filter restored from a state saved
+    /// before 2026-12-07 keeps the memories it was saved with.
     pub memory_levels: usize,
     /// First degree of the quick-settling ladder, `≤ degree` (default 0; `degree` disables it).
     pub start_degree: usize,

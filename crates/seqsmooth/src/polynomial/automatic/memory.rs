@@ -26,15 +26,18 @@
 //! §13.8, (13.8.8); Reyneke et al. §7.2, Table 1): the rule's sample index for the discount per
 //! sample so far, re-evaluated at each sample until the switch.
 //!
-//! **The ladder's step** ([`MEMORY_RATIO`]): each shorter memory is a quarter of the one above
-//! (`θ → θ⁴`, so `1 − θ → ≈ 4(1 − θ)`): it divides the bias of the unmodelled `(m+1)`-th
-//! derivative by `≈ 4^(m+1)` (64 at `m = 2`; the bias grows as `(1 − θ)^−(m+1)`, Morrison
-//! (13.9.28)) and multiplies the VRF by about 4 (`∝ 1 − θ`, Morrison (13.4.4)), so one rung
-//! spans what halving took two more rungs to span (`θ², θ⁴, θ⁸`): a manoeuvre's bias is either
-//! small against the noise in the long memory, which is then chosen, or removed by the short
-//! one. §7.13's balance may fall between two rungs, where a coarser ladder raises the mean
-//! squared error of the memory chosen; the reported error `σ² V + b̂ b̂ᵀ` ([`super::bias`])
-//! carries that bias either way, so coverage does not rest on the balance being met exactly.
+//! **The ladder's step** ([`MEMORY_RATIO`]): each shorter memory is about a quarter of the one
+//! above (`θ → θ⁴`, so `1 − θ → (1 − θ)(1 + θ + θ² + θ³) ≈ 4(1 − θ)`): it divides the bias of
+//! the unmodelled `(m+1)`-th derivative by `(1 + θ + θ² + θ³)^(m+1)` (≈ 51 at `θ = 0.95`,
+//! `m = 2`; `→ 4^(m+1) = 64` as `θ → 1`; the bias grows as `(1 − θ)^−(m+1)`, Morrison
+//! (13.9.28)) and multiplies the VRF by about 4 (`∝ 1 − θ`, Morrison (13.4.4)). The default
+//! single rung `θ⁴` does not reach as deep as the halving ladder `θ², θ⁴, θ⁸` it replaced: its
+//! shortest memory went from `θ⁸` to `θ⁴`, and at `m = 2` the deepest bias reduction from
+//! ≈ 512× to ≈ 64× (as `θ → 1`; ≈ 305× to ≈ 51× at `θ = 0.95`). A manoeuvre's bias is either small against the noise in the long memory,
+//! which is then chosen, or reduced by the short one, and what is left of it is carried by the
+//! reported error `σ² V + b̂ b̂ᵀ` ([`super::bias`]): coverage does not rest on the bias being
+//! removed, nor on §7.13's balance being met exactly (it may fall between two rungs, where a
+//! coarser ladder raises the mean squared error of the memory chosen).
 //! Each rung costs two exact filters (the memory and its companion) at every sample and two
 //! positions at every comparison. Measured on the Monte Carlo of manoeuvring tracks and
 //! landing.csv (ACCURACY.md), the single rung `θ⁴` covers the truth better than the halving
@@ -62,7 +65,8 @@ use std::sync::Arc;
 pub(super) type Positions = (Option<(f64, f64)>, Option<(f64, f64)>);
 
 /// A shorter memory never discounts by less than this per `τ` (a memory of well under one
-/// sample says nothing more).
+/// sample says nothing more): a rung with `θ^(4^j) < 10⁻³` is dropped with those below it
+/// ([`AutoConfig::memory_levels`]).
 const MIN_THETA: f64 = 1e-3;
 
 /// For the choice a memory's bias counts only where `Δ` exceeds this many of its noise standard
@@ -602,8 +606,11 @@ impl Memories {
 }
 
 impl Memories {
-    /// Restored memories' invariants ([`crate::persist`]): every filter valid and of the
-    /// final degree `m` (the companions `m + 1`), the memory in use one of them.
+    /// Restored memories' invariants ([`crate::persist`]): at most [`MAX_MEMORY_LEVELS`]
+    /// shorter memories, every filter valid and of the final degree `m` (the companions
+    /// `m + 1`), the memory in use one of them. The shorter memories' discounts are not
+    /// checked against the configured ladder: a state saved before 2026-12-07 holds the
+    /// ladder `θ², θ⁴, θ⁸` of then, and keeps it.
     pub(super) fn check_saved(&self, m: usize) -> Result<(), String> {
         let degree = |f: &dyn PolynomialFilter, want: usize| {
             if f.degree() == want {
@@ -626,10 +633,21 @@ impl Memories {
             f.check_saved()?;
             degree(f, m + 1)?;
         }
-        for s in &self.shorter {
-            s.fading.check_saved()?;
-            s.upper.check_saved()?;
-            degree(&s.fading, m)?;
+        // A restart starts again from the fresh memories.
+        for shorter in [&self.shorter, &self.fresh.shorter] {
+            if shorter.len() > MAX_MEMORY_LEVELS {
+                // `choose` holds the positions of at most `MAX_MEMORY_LEVELS + 1` memories.
+                return Err(format!(
+                    "{} shorter memories, at most {MAX_MEMORY_LEVELS}",
+                    shorter.len()
+                ));
+            }
+            for s in shorter {
+                s.fading.check_saved()?;
+                s.upper.check_saved()?;
+                degree(&s.fading, m)?;
+                degree(&s.upper, m + 1)?;
+            }
         }
         if self.memory > self.shorter.len() {
             return Err(format!(
@@ -639,5 +657,47 @@ impl Memories {
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The discounts of the shorter memories built for `θ` and `levels`.
+    fn ladder(theta: f64, levels: usize) -> Vec<f64> {
+        let mut cfg = AutoConfig::new(2, theta, 1.0);
+        cfg.memory_levels = levels;
+        shorter_memories(&cfg)
+            .unwrap()
+            .iter()
+            .map(|s| {
+                assert_eq!(s.fading.theta(), s.upper.theta());
+                assert_eq!((s.fading.degree(), s.upper.degree()), (2, 3));
+                s.fading.theta()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_ladder_is_theta_to_the_powers_of_four_down_to_the_cutoff() {
+        // θ⁴ and θ¹⁶ at θ = 0.95: 0.81450625 and 0.95¹⁶ = 0.4401266686517657 (from exact rationals).
+        let th: f64 = 0.95;
+        let l = ladder(th, 2);
+        assert_eq!(l.len(), 2);
+        assert!((l[0] - 0.814_506_25).abs() < 1e-15, "{l:?}");
+        assert!((l[1] - 0.440_126_668_651_765_7).abs() < 1e-15, "{l:?}");
+        let t4 = l[0];
+        assert_eq!(ladder(th, 1), [t4]);
+        assert!(ladder(th, 0).is_empty());
+        // A rung below 10⁻³ is dropped: θ⁴ < 10⁻³ for θ < 10^(−3/4) ≈ 0.1778.
+        assert!(ladder(0.177, 1).is_empty());
+        assert_eq!(ladder(0.18, 1).len(), 1);
+        // All MAX_MEMORY_LEVELS rungs only where θ^(4^8) ≥ 10⁻³: θ ≥ 10^(−3/65536) ≈ 0.999895.
+        assert_eq!(ladder(0.99990, MAX_MEMORY_LEVELS).len(), MAX_MEMORY_LEVELS);
+        assert_eq!(
+            ladder(0.99989, MAX_MEMORY_LEVELS).len(),
+            MAX_MEMORY_LEVELS - 1
+        );
     }
 }

@@ -52,8 +52,9 @@
 //!      lower one until the crossover.
 //!    - **Adaptive memory** (Morrison §7.13, §14.8; [`AutoConfig::memory_levels`], default 1):
 //!      beside `θ` the final degree runs fading-memory filters of the shorter memories
-//!      `θ⁴, θ¹⁶, …` (by default `θ⁴` alone: a memory a quarter as long, whose bias of an
-//!      unmodelled `(m+1)`-th derivative is `4^−(m+1)` of `θ`'s, Morrison (13.9.28)) with their
+//!      `θ⁴, θ¹⁶, …` (by default `θ⁴` alone: a memory about a quarter as long, whose bias of an
+//!      unmodelled `(m+1)`-th derivative is `(1+θ+θ²+θ³)^−(m+1)` of `θ`'s, Morrison (13.9.28):
+//!      ≈ 1/51 at `θ = 0.95`, `m = 2`, tending to `4^−(m+1)` as `θ → 1`) with their
 //!      degree-`(m+1)` companions. Before each prediction the memory of
 //!      least estimated mean squared error `σ² v_j + b̂_j²` is chosen (bias counted where `|Δ|`
 //!      exceeds 2.5 of its noise standard deviations): the VRF falls as the memory lengthens,

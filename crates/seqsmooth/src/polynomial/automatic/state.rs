@@ -544,13 +544,16 @@ impl Replay for State {
 }
 
 impl State {
-    /// A restored state's invariants ([`crate::persist`]): degree in range, the ladder and
-    /// the memories valid and of that degree.
+    /// A restored state's invariants ([`crate::persist`]): every setting in range (the
+    /// builders' checks), the ladder and the memories valid and of the degree.
     pub(super) fn check_saved(&self) -> Result<(), String> {
         let m = self.cfg.degree;
         if m > MAX_DEGREE {
             return Err(format!("degree {m} is out of range"));
         }
+        self.cfg
+            .validate()
+            .map_err(|e| format!("a setting out of range: {e}"))?;
         self.ladder.check_saved(m)?;
         self.memories.check_saved(m)
     }
