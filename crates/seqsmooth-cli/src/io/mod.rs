@@ -24,6 +24,12 @@ use std::path::Path;
 /// (`tie_digit`). Non-finite values print as `NaN`, `inf`, `-inf` (never in valid output).
 #[inline]
 pub fn write_f64(out: &mut Vec<u8>, x: f64) {
+    // The flags' cells (the automatic filter's `outlier` and `misfit`, two a row): the same
+    // text as below, without the general formatting.
+    if x == 1.0 || (x == 0.0 && x.is_sign_positive()) {
+        out.push(if x == 1.0 { b'1' } else { b'0' });
+        return;
+    }
     let mut buf = ryu::Buffer::new();
     let text = buf.format(x).as_bytes();
     let text = text.strip_suffix(b".0").unwrap_or(text);

@@ -236,10 +236,11 @@ pub fn run(a: &FilterArgs) -> Result<(), CliError> {
             // end, before `misfit` and `bias` (and `lead`).
             for i in 0..limit {
                 let row = &values[i * stride..(i + 1) * stride];
-                let mut buf = Vec::with_capacity(stride * 20);
-                chunk.row_with(&mut buf, i, id(i), &row[..shown], lead_cells);
+                let write = |buf: &mut Vec<u8>| {
+                    chunk.row_with(buf, i, id(i), &row[..shown], lead_cells);
+                };
                 let decided = decisions(&row[shown..]);
-                held.push(chunk.series[i], buf, 2 + lead_cells.len(), &decided);
+                held.push(chunk.series[i], write, 2 + lead_cells.len(), &decided);
             }
             if failed.is_none() && chunk.error.is_none() && chunk.done && !goes_on {
                 // The input is complete: every series decides its samples still waiting.

@@ -113,14 +113,18 @@ pub(super) fn innovation_excess(chi: &InnovationChiSquared, var: f64) -> f64 {
 /// estimated bias `b` (none: the noise's only), in place.
 pub(super) fn honest(raw: &mut PolynomialState, sigma: f64, bias: Option<&[f64]>, factor: f64) {
     if let Some(c) = &mut raw.covariance {
-        *c *= sigma * sigma;
-        if let Some(b) = bias {
-            for i in 0..c.nrows() {
-                for j in 0..c.ncols() {
-                    c[(i, j)] += b[i] * b[j];
+        // Entry by entry `((c σ²) + b_i b_j)·factor`, column-major as the matrix is stored.
+        let (p, s2) = (c.nrows(), sigma * sigma);
+        match bias {
+            Some(b) => {
+                for (k, v) in c.as_mut_slice().iter_mut().enumerate() {
+                    *v = (*v * s2 + b[k % p] * b[k / p]) * factor;
                 }
             }
+            None => c
+                .as_mut_slice()
+                .iter_mut()
+                .for_each(|v| *v = *v * s2 * factor),
         }
-        *c *= factor;
     }
 }

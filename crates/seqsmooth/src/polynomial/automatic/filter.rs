@@ -323,7 +323,10 @@ impl AutomaticFilter {
         let before = self.review.snapshot(&self.state);
         match self.state.step(t, y, None) {
             Ok(out) => {
-                let out = self.review.review(&mut self.state, (t, y), out, before);
+                // The previous output's decisions vector, its allocation reused.
+                let buffer = (self.last_output.as_mut())
+                    .map_or_else(Vec::new, |o| std::mem::take(&mut o.decided));
+                let out = (self.review).review(&mut self.state, (t, y), out, before, buffer);
                 self.last_output = Some(out);
                 Ok(())
             }

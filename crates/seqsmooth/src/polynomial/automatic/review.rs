@@ -383,16 +383,17 @@ impl<S: Replay> Review<S> {
     /// Takes the newest sample into the review (its output `out` from `state`, and the state
     /// before it when [`keeps_next`](Self::keeps_next)) and makes every decision it can;
     /// returns the newest sample's output (taken again when a decision went back) with the
-    /// decisions.
+    /// decisions (in `buffer`'s allocation: the previous output's, reused).
     pub(super) fn review(
         &mut self,
         state: &mut S,
         (t, y): (f64, f64),
         mut out: AutoOutput,
         before: Option<Box<S>>,
+        buffer: Vec<bool>,
     ) -> AutoOutput {
         self.push(t, y, &out, before);
-        let (decided, newest) = self.decide(state, false);
+        let (decided, newest) = self.decide(state, false, buffer);
         if let Some(newest) = newest {
             out = newest;
         }
@@ -405,7 +406,7 @@ impl<S: Replay> Review<S> {
     /// newest output, becomes the newest sample's output taken again if a decision went back
     /// (keeping its decisions).
     pub(super) fn decide_all(&mut self, state: &mut S, last: Option<&mut AutoOutput>) -> Vec<bool> {
-        let (decided, newest) = self.decide(state, true);
+        let (decided, newest) = self.decide(state, true, Vec::new());
         if let (Some(newest), Some(last)) = (newest, last) {
             let keep = std::mem::take(&mut last.decided);
             *last = newest;
@@ -416,9 +417,14 @@ impl<S: Replay> Review<S> {
 
     /// The oldest waiting samples' decisions, in order, and the newest sample's output if a
     /// decision went back and took the samples again.
-    fn decide(&mut self, state: &mut S, finishing: bool) -> (Vec<bool>, Option<AutoOutput>) {
+    fn decide(
+        &mut self,
+        state: &mut S,
+        finishing: bool,
+        mut decided: Vec<bool>,
+    ) -> (Vec<bool>, Option<AutoOutput>) {
         let (l, k, degree) = (self.window, self.k, self.degree);
-        let mut decided = Vec::new();
+        decided.clear();
         let mut newest = None;
         while let Some(f) = self.first_undecided() {
             let overflow = self.entries.len() - f > MAX_UNDECIDED;
