@@ -115,6 +115,10 @@ fn case(rng: &mut StdRng, degree: usize, axes: usize, p: usize, steps: usize) ->
     if rng.gen_bool(0.3) {
         let picks: Vec<usize> = (0..p).map(|_| rng.gen_range(0..n)).collect();
         m = DMatrix::from_fn(p, n, |r, c| if c == picks[r] { 1.0 } else { 0.0 });
+    } else if p <= n && rng.gen_bool(0.3) {
+        // M = [I_p 0] (the first p state components, as `value_of` and a position on each
+        // axis), which the fixed-size update reads as a pattern, not as numbers.
+        m = DMatrix::from_fn(p, n, |r, c| if c == r { 1.0 } else { 0.0 });
     }
     let dynamics = PolynomialDynamics::new(degree, axes);
     let observation = LinearObservation::new(m).unwrap();

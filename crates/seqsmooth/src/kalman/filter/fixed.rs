@@ -23,7 +23,11 @@
 //! what the path needs of the models (the polynomial model's degree and axes, the driving
 //! noise's spectral density) is read once when they change ([`Plan`]), not through the model
 //! interfaces (a virtual call for the noise) at each step. Whether every number is finite is
-//! one sum of the results, not a test of each.
+//! one sum of the results, not a test of each. `M = [I_p 0]` (`LinearObservation::value_of`,
+//! or a position seen on each axis) with every component present is known when the models
+//! are ([`Observed`]), and the update is compiled for it too: `G`, `S Mᵀ`, `M S Mᵀ` and
+//! `X Mᵀ` are then entries and columns read in place, the products with `M`'s zeros and ones
+//! left out (the generic path skips the zeros; `a · 1 = a`).
 //!
 //! Every number is the generic path's (`Dynamics::propagate_into`, `ProcessNoise::covariance_into`,
 //! [`carry`](super::super::correct::carry), `Observation::predict_into`,
@@ -66,12 +70,25 @@ pub(super) enum Plan {
     /// Not a model of the path: the generic recursion.
     Generic,
     /// The polynomial model of `degree` on `axes` axes, with `WhiteNoiseDerivative`'s spectral
-    /// density `psd` of the same degree and axes or no driving noise (`None`).
+    /// density `psd` of the same degree and axes or no driving noise (`None`), observed as
+    /// `observed` says.
     Polynomial {
         degree: usize,
         axes: usize,
         psd: Option<f64>,
+        observed: Observed,
     },
+}
+
+/// What the whole update at fixed size needs of the observation model (part of the [`Plan`]):
+/// the rows `p` of its constant `M` ([`Observation::linear_matrix`]) when it has `n` columns,
+/// at most [`MAX_COMPONENTS`] rows and as many as the model's components (`0`: the update
+/// is not taken at fixed size), and whether `M = [I_p 0]` (each row `a` the state's
+/// component `a`: `LinearObservation::value_of`, a position seen on each axis).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Observed {
+    components: usize,
+    unit: bool,
 }
 
 impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
@@ -83,7 +100,9 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             self.plan = self.make_plan();
         }
         match self.plan {
-            Plan::Polynomial { degree, axes, psd } => Some((degree, axes, psd)),
+            Plan::Polynomial {
+                degree, axes, psd, ..
+            } => Some((degree, axes, psd)),
             _ => None,
         }
     }
@@ -102,11 +121,28 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             },
         };
         let n = (m + 1) * d;
+        let observed = match self.observation.linear_matrix() {
+            Some(model)
+                if model.ncols() == n
+                    && model.nrows() <= MAX_COMPONENTS
+                    && model.nrows() == self.observation.components() =>
+            {
+                let unit = |(l, a): (usize, usize)| model[(a, l)] == if a == l { 1.0 } else { 0.0 };
+                Observed {
+                    components: model.nrows(),
+                    unit: (0..n)
+                        .flat_map(|l| (0..model.nrows()).map(move |a| (l, a)))
+                        .all(unit),
+                }
+            }
+            _ => Observed::default(),
+        };
         if n <= UNROLLED_MAX_SIZE && d <= MAX_AXES && self.state.len() == n {
             Plan::Polynomial {
                 degree: m,
                 axes: d,
                 psd,
+                observed,
             }
         } else {
             Plan::Generic
@@ -150,58 +186,50 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         if self.fading.is_some() {
             return None;
         }
-        let (degree, axes, psd) = self.fixed_model()?;
+        if matches!(self.plan, Plan::Unknown) {
+            self.plan = self.make_plan();
+        }
+        let Plan::Polynomial {
+            degree,
+            axes,
+            psd,
+            observed: Observed {
+                components: p,
+                unit,
+            },
+        } = self.plan
+        else {
+            return None;
+        };
         let n = (degree + 1) * axes;
-        let model = self.observation.linear_matrix()?;
-        let p = model.nrows();
         let t = m.time;
-        if model.ncols() != n
-            || p > MAX_COMPONENTS
-            || p != self.observation.components()
-            || m.values.len() != p
-            || !t.is_finite()
-        {
+        if p == 0 || m.values.len() != p || !t.is_finite() {
             return None;
         }
-        // The measurement as `measure` reads it: the present components, their values and
-        // variances (every variance checked, as `measure` checks the whole `R`).
-        let variances = match &m.noise {
-            NoiseCovariance::Identity => None,
-            NoiseCovariance::Variances(v) if v.len() == p => Some(v.as_slice()),
-            _ => return None,
-        };
-        let mut seen = Seen {
-            model,
-            present: [0; MAX_COMPONENTS],
-            values: [0.0; MAX_COMPONENTS],
-            variances: [1.0; MAX_COMPONENTS],
-            k: 0,
-        };
-        for (c, v) in m.values.iter().enumerate() {
-            let variance = variances.map_or(1.0, |v| v[c]);
-            // Not negative and finite, as `measure` requires.
-            if !(0.0..f64::INFINITY).contains(&variance) {
-                return None;
-            }
-            if let Some(v) = *v {
-                if !v.is_finite() || seen.k >= MAX_COMPONENTS {
-                    return None;
-                }
-                (seen.present[seen.k], seen.values[seen.k]) = (c, v);
-                seen.variances[seen.k] = variance;
-                seen.k += 1;
-            }
-        }
+        // The plan has checked `M`'s shape against the model's components and `n`.
+        let model = self.observation.linear_matrix()?;
+        let mut seen = match p {
+            1 => read::<1>(m),
+            2 => read::<2>(m),
+            _ => read::<3>(m),
+        }?;
+        seen.model = Some(model);
+        // `M = [I_p 0]` with every component present: row `c` of `M` is component `c`.
+        let unit = unit && seen.k == p;
         let step = (t != self.time).then_some(t - self.time);
         let estimate = (&mut self.state, &mut self.covariance);
         let observation = &self.observation;
         let residual = |a: usize, y: f64, g: f64| observation.residual(a, y, g);
         let w = &mut self.work;
-        let stats = unrolled_sizes!(n, N => match seen.k {
-                0 => None,
-                1 => update::<N, 1>(axes, (step, psd), estimate, (&seen, residual), w, innovation),
-                2 => update::<N, 2>(axes, (step, psd), estimate, (&seen, residual), w, innovation),
-                _ => update::<N, 3>(axes, (step, psd), estimate, (&seen, residual), w, innovation),
+        let how = (step, psd);
+        let stats = unrolled_sizes!(n, N => match (seen.k, unit) {
+                (0, _) => None,
+                (1, false) => update::<N, 1, false>(axes, how, estimate, (&seen, residual), w, innovation),
+                (1, true) => update::<N, 1, true>(axes, how, estimate, (&seen, residual), w, innovation),
+                (2, false) => update::<N, 2, false>(axes, how, estimate, (&seen, residual), w, innovation),
+                (2, true) => update::<N, 2, true>(axes, how, estimate, (&seen, residual), w, innovation),
+                (_, false) => update::<N, 3, false>(axes, how, estimate, (&seen, residual), w, innovation),
+                (_, true) => update::<N, 3, true>(axes, how, estimate, (&seen, residual), w, innovation),
             },
             _ => None)?;
         self.time = t;
@@ -212,11 +240,45 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
 /// A measurement as the fixed-size update reads it: the constant `M` (`p × n`), the `k`
 /// present components, their values and their variances (`R`'s diagonal on them).
 struct Seen<'a> {
-    model: &'a DMatrix<f64>,
+    model: Option<&'a DMatrix<f64>>,
     present: [usize; MAX_COMPONENTS],
     values: [f64; MAX_COMPONENTS],
     variances: [f64; MAX_COMPONENTS],
     k: usize,
+}
+
+/// The measurement `m` of `P` components as `measure` reads it (the model's `M` left for the
+/// caller): the present components, their values and variances; `None` (for the generic
+/// path) unless it has `P` values, `R` is the identity or `P` variances, every variance is
+/// finite and not negative (as `measure` checks the whole `R`) and every present value
+/// finite. Every check at once, `P` a constant (the loops unrolled, no bounds tests).
+#[inline(always)]
+fn read<const P: usize>(m: &Measurement) -> Option<Seen<'static>> {
+    let values: &[Option<f64>; P] = m.values.as_slice().try_into().ok()?;
+    let variances: [f64; P] = match &m.noise {
+        NoiseCovariance::Identity => [1.0; P],
+        NoiseCovariance::Variances(v) => *<&[f64; P]>::try_from(v.as_slice()).ok()?,
+        NoiseCovariance::Full(_) => return None,
+    };
+    let mut seen = Seen {
+        model: None,
+        present: [0; MAX_COMPONENTS],
+        values: [0.0; MAX_COMPONENTS],
+        variances: [1.0; MAX_COMPONENTS],
+        k: 0,
+    };
+    let mut ok = true;
+    for c in 0..P.min(MAX_COMPONENTS) {
+        let variance = variances[c];
+        ok &= (0.0..f64::INFINITY).contains(&variance);
+        if let Some(v) = values[c] {
+            ok &= v.is_finite();
+            let k = seen.k.min(c);
+            (seen.present[k], seen.values[k], seen.variances[k]) = (c, v, variance);
+            seen.k = k + 1;
+        }
+    }
+    ok.then_some(seen)
 }
 
 /// `N × N`, column-major: `m[j][i]` is the entry `(i, j)`.
@@ -257,12 +319,15 @@ const fn on<const A: usize>(r: usize, c: usize) -> bool {
 /// number is finite is one sum of the results (an infinity or NaN makes the sum infinite or
 /// NaN; a finite sum that overflows only sends the step to the generic path): a non-finite
 /// `Φ`, `Q` or entry of the prediction reaches the same entry of the update
-/// (`X_{n,n−1} + …`, `S_{n,n−1} − …`), so the update's sum covers them.
+/// (`X_{n,n−1} + …`, `S_{n,n−1} − …`), so the update's sum covers them. The log-likelihood
+/// `−(NIS + ln det V + K ln 2π)/2` is finite when the NIS is below `10³⁰⁰` and each pivot
+/// finite (then `|ln D_c| ≤ 745`): tested before the results are written, the logarithm
+/// taken after them, so that no number is held across its call.
 // The loops index by position on purpose: each sum in the kernel's order, over arrays whose
 // sizes are constants (the loops unroll).
 #[allow(clippy::needless_range_loop)]
 #[inline(never)]
-fn update<const N: usize, const K: usize>(
+fn update<const N: usize, const K: usize, const UNIT: bool>(
     axes: usize,
     (step, psd): (Option<f64>, Option<f64>),
     (state, covariance): (&mut DVector<f64>, &mut DMatrix<f64>),
@@ -270,6 +335,10 @@ fn update<const N: usize, const K: usize>(
     w: &mut Work,
     innovation: bool,
 ) -> Option<InnovationStats> {
+    if UNIT && K > N {
+        // `M = [I_K 0]` has at least as many columns as rows (never called so).
+        return None;
+    }
     let (x, s) = (&state.as_slice()[..N], &covariance.as_slice()[..N * N]);
     let mut xp: [f64; N] = std::array::from_fn(|i| x[i]);
     let mut sp: Square<N> = std::array::from_fn(|j| std::array::from_fn(|i| s[i + j * N]));
@@ -284,38 +353,56 @@ fn update<const N: usize, const K: usize>(
     }
     // G = M X_{n,n−1}, every row (the generic path checks them all), each from −0 as
     // `Iterator::sum`.
-    let p = seen.model.nrows();
-    let model = &seen.model.as_slice()[..p * N];
+    let model = seen.model.map_or(&[][..], |m| m.as_slice());
+    let p = model.len() / N;
     let mut check = 0.0;
     let mut g = [0.0; MAX_COMPONENTS];
-    for (a, g) in g.iter_mut().enumerate().take(p) {
-        let mut acc = -0.0;
-        for l in 0..N {
-            acc += model[a + l * p] * xp[l];
+    if UNIT {
+        // M = [I_K 0] (K = p, every component present): G = the state's first K entries.
+        for a in 0..K {
+            g[a] = xp[a];
+            check += xp[a];
         }
-        *g = acc;
-        check += acc;
+    } else {
+        for (a, g) in g.iter_mut().enumerate().take(p) {
+            let mut acc = -0.0;
+            for l in 0..N {
+                acc += model[a + l * p] * xp[l];
+            }
+            *g = acc;
+            check += acc;
+        }
     }
     // Mᵀ (`mt[c]` row `present[c]` of `M`), `ν` and `R`'s diagonal on the present components.
     let mut mt = [[0.0; N]; K];
     let (mut nu, mut rd) = ([0.0; K], [0.0; K]);
     for c in 0..K {
-        let a = seen.present[c];
+        let a = if UNIT { c } else { seen.present[c] };
         for l in 0..N {
-            mt[c][l] = model[a + l * p];
+            mt[c][l] = if UNIT {
+                if l == c {
+                    1.0
+                } else {
+                    0.0
+                }
+            } else {
+                model[a + l * p]
+            };
         }
         nu[c] = residual(a, seen.values[c], g[a]);
         rd[c] = seen.variances[c];
     }
     // U = S Mᵀ.
-    let u = times_mt(&sp, &mt);
+    let u = times_mt::<N, K, UNIT>(&sp, &mt);
     // V = M U + R, symmetrized, and V = L D Lᵀ.
     let mut v = [[0.0; K]; K];
     for b in 0..K {
         for a in 0..K {
             let mut msm = -0.0;
             for l in 0..N {
-                msm += mt[a][l] * u[b][l];
+                if !UNIT || l == a {
+                    msm += mt[a][l] * u[b][l];
+                }
             }
             v[b][a] = if a == b { msm + rd[a] } else { msm };
         }
@@ -385,7 +472,7 @@ fn update<const N: usize, const K: usize>(
             xs[j][i] = sp[j][i] - acc;
         }
     }
-    let y = times_mt(&xs, &mt);
+    let y = times_mt::<N, K, UNIT>(&xs, &mt);
     let mut hr = [[0.0; N]; K];
     for d in 0..K {
         for i in 0..N {
@@ -415,8 +502,11 @@ fn update<const N: usize, const K: usize>(
             check += value;
         }
     }
-    let log_likelihood = -0.5 * (nis + log_det(K, lv.as_flattened()) + K as f64 * TAU.ln());
-    if !(check.is_finite() && nis.is_finite() && log_likelihood.is_finite()) {
+    // The log-likelihood is finite when the NIS is below 10³⁰⁰ and each pivot finite (each
+    // `ln D_c` of a positive finite pivot is within ±745): checked before the results are
+    // written, the logarithm taken after (no values held across its call).
+    let pivots_finite = (0..K).all(|c| lv[c][c] < f64::INFINITY);
+    if !(check.is_finite() && nis < 1e300 && pivots_finite) {
         return None;
     }
     // The results, once: the estimate, the prediction (which the smoothers read), and what an
@@ -436,6 +526,7 @@ fn update<const N: usize, const K: usize>(
             *to = h + 0.0;
         }
     }
+    let log_likelihood = -0.5 * (nis + log_det(K, lv.as_flattened()) + K as f64 * TAU.ln());
     Some(InnovationStats {
         components: K,
         nis,
@@ -587,12 +678,17 @@ fn predict_in<const N: usize, const A: usize>(
 }
 
 /// `A Mᵀ` from `M`'s rows: `out[c][r] = Σ_l a[l][r] · mt[c][l]`, each sum from `−0` over `l`
-/// ascending (the order of the generic path's product, [`update`]'s doc on `−0`).
+/// ascending (the order of the generic path's product, [`update`]'s doc on `−0`). With
+/// `UNIT` (`M = [I_K 0]`) only the term `l = c`, `a[c][r] · 1` (the generic path skips `M`'s
+/// zeros; `−0 + a · 1 = a`): column `c` of `A`.
 #[inline(always)]
-fn times_mt<const N: usize, const K: usize>(
+fn times_mt<const N: usize, const K: usize, const UNIT: bool>(
     a: &[[f64; N]; N],
     mt: &[[f64; N]; K],
 ) -> [[f64; N]; K] {
+    if UNIT {
+        return std::array::from_fn(|c| a[c]);
+    }
     let mut out = [[-0.0; N]; K];
     for c in 0..K {
         for l in 0..N {

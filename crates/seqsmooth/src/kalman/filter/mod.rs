@@ -494,7 +494,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         measurement: &Measurement,
         accept: impl FnOnce(&InnovationStats) -> bool,
     ) -> Result<Option<(InnovationStats, bool)>, Error> {
-        let Some((t, stats)) = self.predict_and_correct(measurement)? else {
+        let Some((t, stats)) = self.predict_and_correct(measurement, false)? else {
             return Ok(None);
         };
         let used = accept(&stats);
@@ -566,7 +566,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         if let Some(stats) = self.update_fixed(measurement, innovation) {
             return Ok(Some(report(&self.work, stats)));
         }
-        let Some((t, stats)) = self.predict_and_correct(measurement)? else {
+        let Some((t, stats)) = self.predict_and_correct(measurement, innovation)? else {
             return Ok(None);
         };
         let out = report(&self.work, stats);

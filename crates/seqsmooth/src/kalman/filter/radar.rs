@@ -32,7 +32,7 @@ use super::super::correct::Work;
 use super::{InnovationStats, KalmanFilter};
 use crate::error::Error;
 use crate::kalman::noise::fill;
-use crate::linalg::dense::{all_finite, ldl, log_det, symmetrize};
+use crate::linalg::dense::{ldl, log_det, symmetrize};
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::{Measurement, NoiseCovariance};
 use crate::model::observation::Observation;
@@ -54,8 +54,9 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     pub(super) fn predict_and_correct(
         &mut self,
         measurement: &Measurement,
+        innovation: bool,
     ) -> Result<Option<(f64, InnovationStats)>, Error> {
-        if let Some(stats) = self.correct_radar_fixed(measurement) {
+        if let Some(stats) = self.correct_radar_fixed(measurement, innovation) {
             return Ok(Some((measurement.time, stats)));
         }
         let Some(t) = self.measure_and_predict(measurement)? else {
@@ -72,7 +73,11 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// The model's checks here (folded away for any other observation model), the arithmetic
     /// in [`update`], compiled once, apart from the general path.
     #[inline]
-    pub(super) fn correct_radar_fixed(&mut self, m: &Measurement) -> Option<InnovationStats> {
+    pub(super) fn correct_radar_fixed(
+        &mut self,
+        m: &Measurement,
+        innovation: bool,
+    ) -> Option<InnovationStats> {
         let radar = self.observation.as_radar()?;
         if self.fading.is_some() {
             return None;
@@ -106,7 +111,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             y: [y0, y1, y2],
             r,
         };
-        update(radar, read, x, s, &mut self.work)
+        update(radar, read, (x, s), &mut self.work, innovation)
     }
 }
 
@@ -129,14 +134,16 @@ struct Read {
 fn update(
     radar: &Radar,
     m: Read,
-    x: &[f64; N],
-    s: &[f64; N * N],
+    (x, s): (&[f64; N], &[f64; N * N]),
     w: &mut Work,
+    innovation: bool,
 ) -> Option<InnovationStats> {
     let Read { zeta, t, psd, y, r } = m;
-    // Every check at once (no early exit: one branch).
-    let usable = |v: &f64| v.is_finite() & (*v >= 0.0);
-    if !(t.is_finite() & all_finite(&y) & r.iter().fold(true, |ok, v| ok & usable(v))) {
+    // Every check at once (no early exit: one branch): the inputs finite (their sum: an
+    // infinity or NaN makes it so; a finite sum that overflows only sends the step to the
+    // general path), the variances not negative.
+    let inputs = (t + y[0]) + (y[1] + y[2]) + ((r[0] + r[1]) + r[2]);
+    if !(inputs.is_finite() & (r[0] >= 0.0) & (r[1] >= 0.0) & (r[2] >= 0.0)) {
         return None;
     }
     let xp: &mut [f64; N] = w.x.as_mut_slice().try_into().ok()?;
@@ -170,9 +177,6 @@ fn update(
     // The radar's prediction and its Jacobian J (M = [J 0]; J₁₂ = 0).
     let look = radar.look([xp[0], xp[1], xp[2]])?;
     let (g, jm) = (look.value, look.jacobian);
-    if !(all_finite(&g) && jm.iter().all(|row| all_finite(row))) {
-        return None;
-    }
     let nu = [y[0] - g[0], wrap(y[1] - g[1]), y[2] - g[2]];
 
     // `correct_kernel` without fading (P = S, f = 1): U = S Mᵀ, V = M U + R = L D Lᵀ.
@@ -270,18 +274,37 @@ fn update(
     }
     symmetrize(N, s_out);
     let log_likelihood = -0.5 * (nis + log_det(K, &lv) + K as f64 * TAU.ln());
-    if !(all_finite(x_out) && all_finite(s_out) && nis.is_finite() && log_likelihood.is_finite()) {
+    // Whether every number is finite, by one sum (module's doc): the results, and `G` and
+    // `J`, from which they are made (the prediction's `Φ`, `Q`, `X` and `S` reach the
+    // results' entries by sums and differences, so a number not finite there is not finite
+    // here).
+    let [j0, j1, j2] = jm;
+    let sums = [
+        sums(x_out),
+        sums(s_out),
+        sums(&g),
+        sums(&j0),
+        sums(&j1),
+        sums(&j2),
+    ];
+    let total = sums
+        .iter()
+        .fold([0.0; 4], |a, b| std::array::from_fn(|i| a[i] + b[i]));
+    let finite = ((total[0] + total[1]) + (total[2] + total[3])).is_finite();
+    if !(finite && nis.is_finite() && log_likelihood.is_finite()) {
         return None;
     }
 
     // What an `Innovation` reads, as the general path leaves it.
-    w.present.clear();
-    w.present.extend_from_slice(&[0, 1, 2]);
-    w.values.clear();
-    w.values.extend_from_slice(&y);
-    w.nu[..K].copy_from_slice(&nu);
-    w.v[..K * K].copy_from_slice(&v);
-    w.h[..N * K].copy_from_slice(&h);
+    if innovation {
+        w.present.clear();
+        w.present.extend_from_slice(&[0, 1, 2]);
+        w.values.clear();
+        w.values.extend_from_slice(&y);
+        w.nu[..K].copy_from_slice(&nu);
+        w.v[..K * K].copy_from_slice(&v);
+        w.h[..N * K].copy_from_slice(&h);
+    }
     Some(InnovationStats {
         components: K,
         nis,
@@ -293,7 +316,7 @@ fn update(
 /// `xp`, `sp`: `X(t)` as `PolynomialDynamics::propagate_into` (`Φ`'s terms `(1, ζ)` by
 /// `psi_term`, each row's diagonal term first), `Q` as `WhiteNoiseDerivative::covariance_into`,
 /// `Φ S Φᵀ + Q` as `carry` (`A = S Φᵀ`, `Aᵀ`, `Aᵀ Φᵀ`; `(out + Q)` symmetrized); `None` where
-/// a number is not finite (the general path then gives the error).
+/// the noise's `Q` is not finite (other numbers are left to [`update`]'s test of the results).
 #[inline(always)]
 fn predict(
     x: &[f64; N],
@@ -309,9 +332,6 @@ fn predict(
     }
     for a in 0..3 {
         xp[a] += t1 * x[a + 3];
-    }
-    if !(t0.is_finite() && t1.is_finite() && all_finite(xp)) {
-        return None;
     }
     // Q = Q₁ ⊗ I₃ with Q₁ the noise's own 2 × 2 (`fill` on one axis: each entry's formula
     // does not depend on the axes); its zeros are added as `+ 0` where the general path adds
@@ -347,7 +367,21 @@ fn predict(
         }
         None => symmetrize(N, sp),
     }
-    all_finite(sp).then_some(())
+    // Whether `Φ`, `X` and `S` are finite is left to [`update`]'s one test of the results.
+    Some(())
+}
+
+/// The numbers of `a` summed in four running sums, to test whether every number is finite
+/// by one test of their total (an infinity or NaN makes it infinite or NaN; a finite total
+/// that overflows says "not finite", which only sends the step to the general path).
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+fn sums<const L: usize>(a: &[f64; L]) -> [f64; 4] {
+    let mut sums = [0.0; 4];
+    for i in 0..L {
+        sums[i % 4] += a[i];
+    }
+    sums
 }
 
 /// `(B Φᵀ)_{ri} = B_{ri} ζ⁰ + B_{r,i+3} ζ` (`Φ = [[I, ζ I], [0, I]]`, terms `t0`, `t1`) into
@@ -463,7 +497,9 @@ mod tests {
                     noise,
                 };
                 let (mut fast, mut general) = (f.clone(), f.clone());
-                let a = fast.correct_radar_fixed(&m).expect("the fixed-size path");
+                let a = fast
+                    .correct_radar_fixed(&m, true)
+                    .expect("the fixed-size path");
                 let t_general = general.measure_and_predict(&m).unwrap().unwrap();
                 let b = general.correct(t_general, false).unwrap();
                 assert_eq!(
@@ -506,7 +542,8 @@ mod tests {
             noise: NoiseCovariance::Identity,
         };
         let (mut fast, mut general) = (f.clone(), f);
-        fast.correct_radar_fixed(&m).expect("the fixed-size path");
+        fast.correct_radar_fixed(&m, true)
+            .expect("the fixed-size path");
         let t_general = general.measure_and_predict(&m).unwrap().unwrap();
         general.correct(t_general, false).unwrap();
         assert_eq!(fast.work.phi, general.work.phi);
@@ -527,17 +564,17 @@ mod tests {
         let variances = NoiseCovariance::Variances(vec![100.0, 1e-6, 1e-6]);
         assert!(f
             .clone()
-            .correct_radar_fixed(&m(all.clone(), variances.clone()))
+            .correct_radar_fixed(&m(all.clone(), variances.clone()), true)
             .is_some());
         let missing = vec![Some(1e4), None, Some(0.1)];
         assert!(f
             .clone()
-            .correct_radar_fixed(&m(missing, variances.clone()))
+            .correct_radar_fixed(&m(missing, variances.clone()), true)
             .is_none());
         let full = NoiseCovariance::Full(DMatrix::identity(3, 3));
         assert!(f
             .clone()
-            .correct_radar_fixed(&m(all.clone(), full))
+            .correct_radar_fixed(&m(all.clone(), full), true)
             .is_none());
         let fading = f
             .clone()
@@ -545,13 +582,15 @@ mod tests {
             .unwrap();
         assert!(fading
             .clone()
-            .correct_radar_fixed(&m(all.clone(), variances.clone()))
+            .correct_radar_fixed(&m(all.clone(), variances.clone()), true)
             .is_none());
         // At the filter's own time it is taken too (no prediction), with the general numbers.
         let mut now = m(all.clone(), variances.clone());
         now.time = 0.0;
         let (mut fast, mut general) = (f.clone(), f.clone());
-        let a = fast.correct_radar_fixed(&now).expect("taken with no step");
+        let a = fast
+            .correct_radar_fixed(&now, true)
+            .expect("taken with no step");
         let t = general.measure_and_predict(&now).unwrap().unwrap();
         assert_eq!(a, general.correct(t, false).unwrap());
         assert_eq!(fast.work.s_out, general.work.s_out);
@@ -565,7 +604,7 @@ mod tests {
             )
             .unwrap();
         assert!(at_site
-            .correct_radar_fixed(&m(all, variances.clone()))
+            .correct_radar_fixed(&m(all, variances.clone()), true)
             .is_none());
         // The general path gives the error.
         let mut at_site_general = at_site.clone();
