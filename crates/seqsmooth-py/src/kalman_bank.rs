@@ -167,6 +167,9 @@ impl PyKalmanBank {
     }
 }
 
+/// `(state, sigma, nis)` by row: `n`, `n` and one a row, the NIS NaN where none.
+type Columns = (Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// The rows by series (the library's [`Grouping`]), `pass` over the panel, the results by
 /// input row; an error's row the input's ([`Error::InBatch`]). Rows already grouped (each
 /// label's rows one run, as a frame sorted by its id) are the panel as they are, nothing
@@ -178,7 +181,7 @@ fn run_grouped(
     t: &[f64],
     z: &[f64],
     pass: Pass,
-) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>), Error> {
+) -> Result<Columns, Error> {
     let (n, p) = (bank.states(), bank.components());
     let grouping = Grouping::from_labels(labels);
     let (times, values) = (grouping.gather(t, 1), grouping.gather(z, p));
