@@ -11,9 +11,7 @@ use crate::kalman::{noise, observation_from, polynomial_prior};
 use nalgebra::DMatrix;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PySlice;
-use rayon::prelude::*;
-use seqsmooth::kalman::bank::{BankRows, Grouping, KalmanBank, Panel};
+use seqsmooth::kalman::bank::{Grouping, KalmanBank, Panel};
 use seqsmooth::kalman::noise::WhiteNoiseDerivative;
 use seqsmooth::model::dynamics::PolynomialDynamics;
 use seqsmooth::model::measurement::NoiseCovariance;
@@ -158,59 +156,19 @@ impl PyKalmanBank {
                 None,
             ));
         }
-        let (out, wide) = py
-            .detach(|| {
-                run_grouped(&self.bank, codes, t, z, pass).map(|out| {
-                    let wide = nis_in_place(out.nis);
-                    (
-                        BankRows {
-                            nis: Vec::new(),
-                            ..out
-                        },
-                        wide,
-                    )
-                })
-            })
+        let (state, sigma, nis) = py
+            .detach(|| run_grouped(&self.bank, codes, t, z, pass))
             .py()?;
-        let state = matrix(py, out.state, count, n)?;
-        let sigma = matrix(py, out.sigma, count, n)?;
-        // Every other entry of `wide`: the NIS by row (a view, nothing copied).
-        let nis = PyArray1::from_vec(py, wide)
-            .into_any()
-            .get_item(PySlice::new(py, 0, (2 * count) as isize, 2))?;
+        let state = matrix(py, state, count, n)?;
+        let sigma = matrix(py, sigma, count, n)?;
+        // The bank's own NIS column (NaN where every component was missing), nothing copied.
+        let nis = PyArray1::from_vec(py, nis).into_any();
         Ok((state, sigma, nis).into_pyobject(py)?.into_any())
     }
 }
 
-/// The NIS as numbers, NaN where every component was missing (`None`), written in place into
-/// `nis`' own allocation (no new memory to fault in: 10⁷ rows' NIS are 80 MB) by the rayon
-/// pool: row `r`'s number fills both `f64` halves of its own 16 bytes, so the result holds
-/// `2 · rows` numbers, the NIS its even entries.
-fn nis_in_place(nis: Vec<Option<f64>>) -> Vec<f64> {
-    const {
-        assert!(std::mem::size_of::<Option<f64>>() == 2 * std::mem::size_of::<f64>());
-        assert!(std::mem::align_of::<Option<f64>>() == std::mem::align_of::<f64>());
-    }
-    let mut nis = std::mem::ManuallyDrop::new(nis);
-    nis.par_chunks_mut(1 << 16).for_each(|chunk| {
-        let p = chunk.as_mut_ptr();
-        for r in 0..chunk.len() {
-            // SAFETY: `p + r` is element `r` of `chunk`, initialised; it is read whole before
-            // its own 16 bytes, two aligned `f64` slots, are written (nothing else is).
-            unsafe {
-                let v = p.add(r).read().unwrap_or(f64::NAN);
-                let slots = p.add(r).cast::<f64>();
-                slots.write(v);
-                slots.add(1).write(v);
-            }
-        }
-    });
-    let (p, len, capacity) = (nis.as_mut_ptr(), nis.len(), nis.capacity());
-    // SAFETY: the allocation of `capacity` `Option<f64>` is the allocation of `2 · capacity`
-    // `f64` (the same size and alignment, asserted above), its first `2 · len` now written as
-    // `f64`; ownership passes to the new vector (the old one is not dropped).
-    unsafe { Vec::from_raw_parts(p.cast::<f64>(), 2 * len, 2 * capacity) }
-}
+/// `(state, sigma, nis)` by row: `n`, `n` and one a row, the NIS NaN where none.
+type Columns = (Vec<f64>, Vec<f64>, Vec<f64>);
 
 /// The rows by series (the library's [`Grouping`]), `pass` over the panel, the results by
 /// input row; an error's row the input's ([`Error::InBatch`]). Rows already grouped (each
@@ -223,7 +181,7 @@ fn run_grouped(
     t: &[f64],
     z: &[f64],
     pass: Pass,
-) -> Result<BankRows, Error> {
+) -> Result<Columns, Error> {
     let (n, p) = (bank.states(), bank.components());
     let grouping = Grouping::from_labels(labels);
     let (times, values) = (grouping.gather(t, 1), grouping.gather(z, p));
@@ -251,12 +209,12 @@ fn run_grouped(
         other => other,
     })?;
     if grouping.order().is_none() {
-        return Ok(grouped);
+        return Ok(grouped.into_columns());
     }
-    Ok(BankRows {
-        states: n,
-        state: grouping.scatter(&grouped.state, n),
-        sigma: grouping.scatter(&grouped.sigma, n),
-        nis: grouping.scatter(&grouped.nis, 1),
-    })
+    let (state, sigma, nis) = grouped.into_columns();
+    Ok((
+        grouping.scatter(&state, n),
+        grouping.scatter(&sigma, n),
+        grouping.scatter(&nis, 1),
+    ))
 }

@@ -55,6 +55,8 @@ def test_bank_equals_one_kalman_filter_per_series():
     state, sigma, nis = bank.filter(ids, t, z)
     rts_state, rts_sigma, _ = bank.smooth(ids, t, z)
     lag_state, lag_sigma, _ = bank.fixed_lag_smoother(ids, t, z, 4)
+    # The NIS is one float64 a row, contiguous (the bank's own buffer).
+    assert nis.shape == (len(t),) and nis.dtype == np.float64 and nis.flags.c_contiguous
     for s in range(0, 200, 7):
         at, (x, cov, nis_s) = library(ids, t, z, s, "update_many")
         close(state[at], x)

@@ -12,7 +12,8 @@
 //! each run into new output buffers, and `filter-reused,SECONDS`, `filter+rts-reused,SECONDS`
 //! into the same buffers every run ([`KalmanBank::filter_into`]: no page faults); then
 //! `cpu:NAME,SECONDS`, the process' CPU time (all threads, user + system) of the best run of
-//! each.
+//! each. The previous run's output is freed before each run's clock starts. With `-v` after
+//! `REPS`, every run's wall time, CPU time and minor page faults go to stderr.
 
 use nalgebra::{DMatrix, DVector};
 use seqsmooth::kalman::bank::{BankRows, KalmanBank, Panel};
@@ -37,6 +38,8 @@ fn write(path: &str, v: &[f64]) {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let (dir, reps): (&str, usize) = (&args[1], args[2].parse().expect("REPS"));
+    // `-v` after REPS: every run's wall and CPU time and page faults on stderr.
+    let verbose = args.get(3).is_some_and(|a| a == "-v");
     let spec = std::fs::read_to_string(format!("{dir}/bank.txt")).expect("bank.txt");
     let w: Vec<f64> = spec
         .split_whitespace()
@@ -68,10 +71,21 @@ fn main() {
         let (mut best, mut best_cpu) = (f64::INFINITY, f64::INFINITY);
         let mut out = Vec::new();
         for _ in 0..reps {
-            let (start, start_cpu) = (Instant::now(), cpu_seconds());
+            // The previous run's output freed before the clock starts (the caller's, not the
+            // bank's work).
+            drop(std::mem::take(&mut out));
+            let (start, start_cpu, start_faults) = (Instant::now(), cpu_seconds(), faults());
             out = run();
-            best = best.min(start.elapsed().as_secs_f64());
-            best_cpu = best_cpu.min(cpu_seconds() - start_cpu);
+            let (wall, used) = (start.elapsed().as_secs_f64(), cpu_seconds() - start_cpu);
+            if verbose {
+                eprintln!(
+                    "run: {wall:.4} s wall, {used:.4} s CPU, {} page faults",
+                    faults() - start_faults
+                );
+            }
+            if wall < best {
+                (best, best_cpu) = (wall, used);
+            }
         }
         let mut all = cpu.take();
         all.push(best_cpu);
@@ -106,6 +120,17 @@ fn main() {
     {
         println!("cpu:{name},{seconds}");
     }
+}
+
+/// The process' minor page faults so far.
+fn faults() -> i64 {
+    // SAFETY: getrusage writes the struct it is given.
+    let usage = unsafe {
+        let mut usage: libc::rusage = std::mem::zeroed();
+        libc::getrusage(libc::RUSAGE_SELF, &mut usage);
+        usage
+    };
+    usage.ru_minflt
 }
 
 /// The process' CPU time so far (user + system, all threads), seconds.

@@ -311,9 +311,7 @@ fn in_batches(
             bank.smooth_fixed_lag(&panel, lag).unwrap(),
         ];
         for (o, part) in all.iter_mut().zip(parts) {
-            o.state.extend(part.state);
-            o.sigma.extend(part.sigma);
-            o.nis.extend(part.nis);
+            o.append(part);
         }
     }
     all

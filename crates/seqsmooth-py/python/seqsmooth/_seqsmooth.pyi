@@ -213,10 +213,8 @@ class KalmanBank:
     any order, series may interleave), ``t`` and ``z`` (``rows x p``, NaN missing), each
     series' times not decreasing, and return ``(state, sigma, nis)`` by input row (``nis``
     NaN where every component was missing). ``state`` and ``sigma`` are ``rows x n``
-    arrays; ``nis`` is a view of every other ``float64`` of the bank's own buffer of two a
-    row (no copy is made, so it is not C-contiguous and holds 16 bytes a row while it
-    lives): take ``np.ascontiguousarray(nis)`` where a contiguous array is needed. An
-    error's ``.index`` is the input row.
+    arrays and ``nis`` a contiguous array of ``rows``, each the bank's own buffer (no copy
+    is made). An error's ``.index`` is the input row.
     """
 
     def __init__(

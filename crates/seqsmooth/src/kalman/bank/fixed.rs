@@ -300,7 +300,7 @@ impl<D: Dynamics, const N: usize> Forward for FixedSeries<'_, D, N> {
         for i in 0..N {
             sigma[i] = self.s[i][i].max(0.0).sqrt();
         }
-        out.nis[r] = nis;
+        out.put_nis(r, nis);
     }
 
     #[inline(always)]

@@ -476,7 +476,7 @@ impl<'a, D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'a, 
                         out.state[r * N + i] = self.x[i][e];
                         out.sigma[r * N + i] = sigma[i][e];
                     }
-                    out.nis[r] = present[e].then_some(up.nis[e]);
+                    out.put_nis(r, present[e].then_some(up.nis[e]));
                 }
             }
             let h = self.held[e].as_mut().expect("every lane holds");
@@ -694,7 +694,7 @@ impl<D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'_, D, N
                             out.state[r * N + i] = x[i][e];
                             out.sigma[r * N + i] = sigma[i][e];
                         }
-                        out.nis[r] = now.nis[e];
+                        out.put_nis(r, now.nis[e]);
                     }
                 }
             }

@@ -147,7 +147,12 @@ impl Panel<'_> {
 }
 
 /// Per row of a [`Panel`], in its order: the estimate, its σ and the update's NIS.
-#[derive(Clone, Debug, Default, PartialEq)]
+///
+/// The NIS is held as one number a row (8 bytes: 10⁷ rows' NIS are 80 MB, not the 160 MB of
+/// an `Option<f64>` a row), read as an `Option` by [`BankRows::nis`] and [`BankRows::row`]
+/// (`None` where every component of the row was missing); [`BankRows::into_columns`] hands
+/// the columns over as they are, NaN for `None`, the form of an array front end.
+#[derive(Clone, Debug, Default)]
 pub struct BankRows {
     /// The state dimension `n`.
     pub states: usize,
@@ -155,8 +160,24 @@ pub struct BankRows {
     pub state: Vec<f64>,
     /// `n` a row: `√diag S` of the same estimate.
     pub sigma: Vec<f64>,
-    /// The forward update's NIS, `None` where every component was missing.
-    pub nis: Vec<Option<f64>>,
+    /// One a row: the forward update's NIS, NaN where none (every NIS the bank gives is finite).
+    nis: Vec<f64>,
+}
+
+impl PartialEq for BankRows {
+    /// The same rows: every number equal, the NIS present in the same rows (bit for bit where
+    /// absent).
+    fn eq(&self, other: &Self) -> bool {
+        self.states == other.states
+            && self.state == other.state
+            && self.sigma == other.sigma
+            && self.nis.len() == other.nis.len()
+            && self
+                .nis
+                .iter()
+                .zip(&other.nis)
+                .all(|(a, b)| a == b || a.is_nan() && b.is_nan())
+    }
 }
 
 impl BankRows {
@@ -165,8 +186,19 @@ impl BankRows {
             states: n,
             state: vec![0.0; rows * n],
             sigma: vec![0.0; rows * n],
-            nis: vec![None; rows],
+            nis: vec![f64::NAN; rows],
         }
+    }
+
+    /// The number of rows.
+    pub fn rows(&self) -> usize {
+        self.nis.len()
+    }
+
+    /// Row `r`'s NIS, `None` where every component was missing (the prediction).
+    pub fn nis(&self, r: usize) -> Option<f64> {
+        let v = self.nis[r];
+        (!v.is_nan()).then_some(v)
     }
 
     /// Row `r`'s `(state, σ, NIS)`.
@@ -175,8 +207,23 @@ impl BankRows {
         (
             &self.state[r * n..(r + 1) * n],
             &self.sigma[r * n..(r + 1) * n],
-            self.nis[r],
+            self.nis(r),
         )
+    }
+
+    /// The rows of `other` after these (the same state dimension): the rows of a panel run
+    /// in batches put back together.
+    pub fn append(&mut self, other: BankRows) {
+        assert_eq!(self.states, other.states, "the same state dimension");
+        self.state.extend(other.state);
+        self.sigma.extend(other.sigma);
+        self.nis.extend(other.nis);
+    }
+
+    /// The columns `(state, σ, NIS)`, `n`, `n` and one a row, the NIS NaN where
+    /// [`BankRows::nis`] is `None`: nothing copied.
+    pub fn into_columns(self) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        (self.state, self.sigma, self.nis)
     }
 }
 
@@ -184,7 +231,7 @@ impl BankRows {
 pub(super) struct RowsMut<'a> {
     pub(super) state: &'a mut [f64],
     pub(super) sigma: &'a mut [f64],
-    pub(super) nis: &'a mut [Option<f64>],
+    pub(super) nis: &'a mut [f64],
 }
 
 impl RowsMut<'_> {
@@ -196,7 +243,13 @@ impl RowsMut<'_> {
         for (i, o) in self.sigma[r * n..(r + 1) * n].iter_mut().enumerate() {
             *o = s[i + i * n].max(0.0).sqrt();
         }
-        self.nis[r] = nis;
+        self.put_nis(r, nis);
+    }
+
+    /// Row `r`'s NIS, NaN for `None` ([`BankRows`]' form).
+    #[inline]
+    pub(super) fn put_nis(&mut self, r: usize, nis: Option<f64>) {
+        self.nis[r] = nis.unwrap_or(f64::NAN);
     }
 }
 
@@ -248,7 +301,7 @@ fn huge_pages<T>(v: &mut Vec<T>) {
 /// let times = [0.0, 1.0, 2.5, 0.0, 3.0];
 /// let values = [0.0, 1.1, f64::NAN, 5.0, 4.0];
 /// let rows = bank.filter(&Panel { offsets: &[0, 3, 5], times: &times, values: &values }).unwrap();
-/// assert_eq!(rows.nis[2], None); // missing: the prediction
+/// assert_eq!(rows.nis(2), None); // missing: the prediction
 /// assert!((rows.state[2 * 2] - (rows.state[2] + 1.5 * rows.state[3])).abs() < 1e-12);
 /// ```
 #[derive(Clone, Debug)]
@@ -387,10 +440,7 @@ impl<D: Dynamics + Sync> KalmanBank<D> {
             out.sigma = zeroed(rows * n);
         }
         if out.nis.len() != rows {
-            // Written by the threads (their pages faulted in in parallel, not here serially).
-            out.nis = Vec::with_capacity(rows);
-            huge_pages(&mut out.nis);
-            out.nis.par_extend(rayon::iter::repeat_n(None, rows));
+            out.nis = zeroed(rows);
         }
         let r = self.r_entries();
         // The output cut into each task's contiguous rows.

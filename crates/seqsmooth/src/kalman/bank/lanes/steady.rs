@@ -118,7 +118,7 @@ impl<D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'_, D, N
                         state[i] = self.x[i][e];
                         to[i] = sigma[i][e];
                     }
-                    out.nis[r] = Some(up.nis[e]);
+                    out.nis[r] = up.nis[e];
                 }
             }
         }
