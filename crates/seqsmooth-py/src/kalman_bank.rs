@@ -161,7 +161,8 @@ impl PyKalmanBank {
             .py()?;
         let state = matrix(py, state, count, n)?;
         let sigma = matrix(py, sigma, count, n)?;
-        // The bank's own NIS column (NaN where every component was missing), nothing copied.
+        // The NIS column (NaN where every component was missing), handed to numpy as it is:
+        // the bank's own buffer, or `run_grouped`'s copy in input order for interleaved rows.
         let nis = PyArray1::from_vec(py, nis).into_any();
         Ok((state, sigma, nis).into_pyobject(py)?.into_any())
     }

@@ -67,9 +67,9 @@ fn main() {
     // The best wall time of `reps` runs, and the process' CPU time (user + system, every
     // thread) of that run: on a shared machine the CPU time is the steadier figure.
     let cpu = std::cell::Cell::new(Vec::new());
-    let best = |run: &dyn Fn() -> Vec<f64>| {
+    let best = |run: &dyn Fn() -> BankRows| {
         let (mut best, mut best_cpu) = (f64::INFINITY, f64::INFINITY);
-        let mut out = Vec::new();
+        let mut out = BankRows::default();
         for _ in 0..reps {
             // The previous run's output freed before the clock starts (the caller's, not the
             // bank's work).
@@ -90,22 +90,22 @@ fn main() {
         let mut all = cpu.take();
         all.push(best_cpu);
         cpu.set(all);
-        (best, out)
+        (best, out.state)
     };
     // New output buffers every run (their pages faulted in, as a caller's first run or
     // simdkalman's new arrays), then the same buffers reused (`filter_into`: no page faults).
-    let (filter, filtered) = best(&|| bank.filter(&panel).expect("filter").state);
-    let (rts, smoothed) = best(&|| bank.smooth(&panel).expect("smooth").state);
+    let (filter, filtered) = best(&|| bank.filter(&panel).expect("filter"));
+    let (rts, smoothed) = best(&|| bank.smooth(&panel).expect("smooth"));
     let reused = std::cell::RefCell::new(BankRows::default());
     let (filter_reused, _) = best(&|| {
         let mut out = reused.borrow_mut();
         bank.filter_into(&panel, &mut out).expect("filter");
-        Vec::new()
+        BankRows::default()
     });
     let (rts_reused, _) = best(&|| {
         let mut out = reused.borrow_mut();
         bank.smooth_into(&panel, &mut out).expect("smooth");
-        Vec::new()
+        BankRows::default()
     });
     write(&format!("{dir}/bank.filtered.f64"), &filtered);
     write(&format!("{dir}/bank.smoothed.f64"), &smoothed);
@@ -130,7 +130,7 @@ fn faults() -> i64 {
         libc::getrusage(libc::RUSAGE_SELF, &mut usage);
         usage
     };
-    usage.ru_minflt
+    usage.ru_minflt as i64
 }
 
 /// The process' CPU time so far (user + system, all threads), seconds.

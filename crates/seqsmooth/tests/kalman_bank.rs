@@ -289,11 +289,9 @@ fn in_batches(
     cuts: &[usize],
     lag: usize,
 ) -> [BankRows; 3] {
-    let (p, n) = (bank.components(), bank.states());
+    let p = bank.components();
+    // Empty rows to start with: the first batch appended gives them their state dimension.
     let mut all: [BankRows; 3] = Default::default();
-    for o in all.iter_mut() {
-        o.states = n;
-    }
     let mut bounds = vec![0];
     bounds.extend(cuts.iter().copied());
     bounds.push(d.offsets.len() - 1);

@@ -337,3 +337,57 @@ fn a_step_past_the_numbers_gives_the_generic_error() {
     assert_eq!(a.unwrap_err().to_string(), b.unwrap_err().to_string());
     assert_eq!(fast.time(), 0.0);
 }
+
+/// Signed zeros: `M = [I_p 0]` and `M` with a `−0` entry (not the pattern: its `−0·x` terms
+/// set signs), a state entry `−0` beside positive ones and a measured `−0`. The innovation's
+/// zeros have the generic path's signs (its `G` sums every column from `−0`).
+#[test]
+fn signed_zeros_are_the_generic_paths() {
+    let identity = DMatrix::identity(2, 2);
+    let matrices = [
+        DMatrix::from_row_slice(1, 2, &[1.0, 0.0]),
+        DMatrix::from_row_slice(1, 2, &[1.0, -0.0]),
+        DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, 1.0]),
+    ];
+    for m in matrices {
+        for x0 in [[-0.0, 1.0], [-0.0, -1.0], [0.0, -0.0], [-0.0, -0.0]] {
+            let p = m.nrows();
+            let observation = LinearObservation::new(m.clone()).unwrap();
+            let dynamics = PolynomialDynamics::new(1, 1);
+            let x0 = DVector::from_row_slice(&x0);
+            let mut fast = KalmanFilter::new(
+                dynamics,
+                observation.clone(),
+                x0.clone(),
+                identity.clone(),
+                0.0,
+            )
+            .unwrap();
+            let mut plain = KalmanFilter::new(
+                Plain(dynamics),
+                PlainObservation(observation),
+                x0,
+                identity.clone(),
+                0.0,
+            )
+            .unwrap();
+            let row = Measurement {
+                time: 0.0,
+                values: vec![Some(-0.0); p],
+                noise: NoiseCovariance::Identity,
+            };
+            let (a, b) = (fast.update(&row).unwrap(), plain.update(&row).unwrap());
+            let what = format!("M {m:?}, x0 {:?}", fast.state());
+            assert_eq!(
+                bits(a.innovation.as_slice()),
+                bits(b.innovation.as_slice()),
+                "{what}"
+            );
+            assert_eq!(
+                bits(fast.state().as_slice()),
+                bits(plain.state().as_slice()),
+                "{what}"
+            );
+        }
+    }
+}

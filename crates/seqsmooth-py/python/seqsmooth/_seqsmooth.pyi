@@ -213,8 +213,9 @@ class KalmanBank:
     any order, series may interleave), ``t`` and ``z`` (``rows x p``, NaN missing), each
     series' times not decreasing, and return ``(state, sigma, nis)`` by input row (``nis``
     NaN where every component was missing). ``state`` and ``sigma`` are ``rows x n``
-    arrays and ``nis`` a contiguous array of ``rows``, each the bank's own buffer (no copy
-    is made). An error's ``.index`` is the input row.
+    arrays and ``nis`` a contiguous array of ``rows``: the bank's own buffers when each
+    series' rows are already together (no copy), else one copy putting them back in input
+    order. An error's ``.index`` is the input row.
     """
 
     def __init__(

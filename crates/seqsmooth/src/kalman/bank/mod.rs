@@ -165,8 +165,8 @@ pub struct BankRows {
 }
 
 impl PartialEq for BankRows {
-    /// The same rows: every number equal, the NIS present in the same rows (bit for bit where
-    /// absent).
+    /// The same rows: every number equal, the NIS present in the same rows (any two absent
+    /// ones equal).
     fn eq(&self, other: &Self) -> bool {
         self.states == other.states
             && self.state == other.state
@@ -211,9 +211,12 @@ impl BankRows {
         )
     }
 
-    /// The rows of `other` after these (the same state dimension): the rows of a panel run
-    /// in batches put back together.
+    /// The rows of `other` after these (the same state dimension, or these empty: they take
+    /// `other`'s): the rows of a panel run in batches put back together.
     pub fn append(&mut self, other: BankRows) {
+        if self.nis.is_empty() {
+            self.states = other.states;
+        }
         assert_eq!(self.states, other.states, "the same state dimension");
         self.state.extend(other.state);
         self.sigma.extend(other.sigma);

@@ -127,12 +127,17 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
                     && model.nrows() <= MAX_COMPONENTS
                     && model.nrows() == self.observation.components() =>
             {
-                let unit = |(l, a): (usize, usize)| model[(a, l)] == if a == l { 1.0 } else { 0.0 };
+                // Exactly `1` and `+0` (by their bits: a `−0` entry gives `−0·x` terms whose
+                // sign the pattern's update would not reproduce).
+                let unit = |(l, a): (usize, usize)| {
+                    model[(a, l)].to_bits() == if a == l { 1.0f64 } else { 0.0 }.to_bits()
+                };
                 Observed {
                     components: model.nrows(),
-                    unit: (0..n)
-                        .flat_map(|l| (0..model.nrows()).map(move |a| (l, a)))
-                        .all(unit),
+                    unit: model.nrows() <= n
+                        && (0..n)
+                            .flat_map(|l| (0..model.nrows()).map(move |a| (l, a)))
+                            .all(unit),
                 }
             }
             _ => Observed::default(),
@@ -208,6 +213,11 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         }
         // The plan has checked `M`'s shape against the model's components and `n`.
         let model = self.observation.linear_matrix()?;
+        // A user's model whose `M` changed shape since the plan was made takes the general
+        // path, which checks it, rather than indexing past it.
+        if model.len() != p * n {
+            return None;
+        }
         let mut seen = match p {
             1 => read::<1>(m),
             2 => read::<2>(m),
@@ -358,10 +368,16 @@ fn update<const N: usize, const K: usize, const UNIT: bool>(
     let mut check = 0.0;
     let mut g = [0.0; MAX_COMPONENTS];
     if UNIT {
-        // M = [I_K 0] (K = p, every component present): G = the state's first K entries.
+        // M = [I_K 0] (K = p, every component present): G_a = x_a, summed as the general
+        // path does (from −0, with the `0·x_l` terms: they set the sign of a zero and carry a
+        // NaN), so the innovation is its bits too.
         for a in 0..K {
-            g[a] = xp[a];
-            check += xp[a];
+            let mut acc = -0.0;
+            for (l, x) in xp.iter().enumerate() {
+                acc += if l == a { *x } else { 0.0 * x };
+            }
+            g[a] = acc;
+            check += acc;
         }
     } else {
         for (a, g) in g.iter_mut().enumerate().take(p) {
