@@ -243,12 +243,17 @@ pub fn smooth_flat_into<D: Dynamics + Clone, O: Observation + Clone>(
     s_pred.reserve(steps * nn);
     run.filtered_states.reserve(count * n);
     run.filtered_covariances.reserve(count * nn);
-    let result = passes(
-        &mut filter,
-        measurements,
-        run,
-        (&mut phi, &mut x_pred, &mut s_pred),
-    );
+    let kept = (&mut phi, &mut x_pred, &mut s_pred);
+    // The common sizes at compile time (the copies then inline, the slicing checked once):
+    // the same operations in the same order, so the same numbers.
+    let result = match n {
+        1 => passes::<_, _, 1>(&mut filter, measurements, run, kept),
+        2 => passes::<_, _, 2>(&mut filter, measurements, run, kept),
+        3 => passes::<_, _, 3>(&mut filter, measurements, run, kept),
+        4 => passes::<_, _, 4>(&mut filter, measurements, run, kept),
+        6 => passes::<_, _, 6>(&mut filter, measurements, run, kept),
+        _ => passes::<_, _, 0>(&mut filter, measurements, run, kept),
+    };
     (run.phi, run.x_pred, run.s_pred) = (phi, x_pred, s_pred);
     if result.is_err() {
         for v in [&mut run.states, &mut run.covariances, &mut run.gains] {
@@ -259,14 +264,17 @@ pub fn smooth_flat_into<D: Dynamics + Clone, O: Observation + Clone>(
 }
 
 /// [`smooth_flat_into`]'s forward and backward passes into `run`, the predictions kept in
-/// `phi`, `x_pred`, `s_pred`.
-fn passes<D: Dynamics + Clone, O: Observation + Clone>(
+/// `phi`, `x_pred`, `s_pred`; `N` the state's dimension when it is known at compile time
+/// (it is then `filter`'s), else 0.
+fn passes<D: Dynamics + Clone, O: Observation + Clone, const N: usize>(
     filter: &mut KalmanFilter<D, O>,
     measurements: &[Measurement],
     run: &mut SmoothedRun,
     (phi, x_pred, s_pred): (&mut Vec<f64>, &mut Vec<f64>, &mut Vec<f64>),
 ) -> Result<(), Error> {
     let (n, count) = (filter.state().len(), measurements.len());
+    debug_assert!(N == 0 || N == n);
+    let n = if N == 0 { n } else { N };
     let nn = n * n;
     for (index, m) in measurements.iter().enumerate() {
         let mut forward = |filter: &mut KalmanFilter<D, O>| {
@@ -291,7 +299,7 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone>(
                 }
             };
             if stepped {
-                phi.extend_from_slice(filter.last_transition().as_slice());
+                phi.extend_from_slice(&filter.last_transition().as_slice()[..nn]);
             } else {
                 phi.extend((0..nn).map(|e| f64::from(u8::from(e % (n + 1) == 0))));
             }
@@ -300,8 +308,8 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone>(
                     Some(_) => filter.last_prediction(),
                     None => (filter.state(), filter.covariance()),
                 };
-                x_pred.extend_from_slice(x.as_slice());
-                s_pred.extend_from_slice(s.as_slice());
+                x_pred.extend_from_slice(&x.as_slice()[..n]);
+                s_pred.extend_from_slice(&s.as_slice()[..nn]);
             }
             Ok(stats.map(|s| s.nis))
         };
@@ -314,9 +322,9 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone>(
         };
         run.times.push(m.time);
         run.filtered_states
-            .extend_from_slice(filter.state().as_slice());
+            .extend_from_slice(&filter.state().as_slice()[..n]);
         run.filtered_covariances
-            .extend_from_slice(filter.covariance().as_slice());
+            .extend_from_slice(&filter.covariance().as_slice()[..nn]);
         run.nis.push(nis);
     }
     // Every entry below is written (the last estimate copied, the last gain zero, the others
