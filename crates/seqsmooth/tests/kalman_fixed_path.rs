@@ -376,7 +376,10 @@ fn signed_zeros_are_the_generic_paths() {
                 values: vec![Some(-0.0); p],
                 noise: NoiseCovariance::Identity,
             };
-            let (a, b) = (fast.update(&row).unwrap(), plain.update(&row).unwrap());
+            let (a, b) = (
+                fast.update(&row).unwrap().unwrap(),
+                plain.update(&row).unwrap().unwrap(),
+            );
             let what = format!("M {m:?}, x0 {:?}", fast.state());
             assert_eq!(
                 bits(a.innovation.as_slice()),

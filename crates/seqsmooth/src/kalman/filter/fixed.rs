@@ -7,9 +7,9 @@
 //! `X_{n,n−1} = Φ X_{n−1,n−1}` (12.2.15), `S_{n,n−1} = Φ S Φᵀ + Q` (12.2.16), (15.4.11)
 //!
 //! is one function compiled for each `(n, d)`: `Φ`'s entries `ζ^k/k!` are made once
-//! ([`psi_term`], the model's one formula) and `Φ`'s structural zeros are known to the
-//! compiler, so that `Φ S Φᵀ` ([`carry_with`], the generic path's kernel) has only the
-//! products that are not zero, and `Q` is the noise model's own [`fill`] with the degree a
+//! ([`psi_term`](crate::model::transition::psi_term), the model's one formula) and `Φ`'s structural zeros are known to the
+//! compiler, so that `Φ S Φᵀ` ([`carry_with`](crate::kalman::correct::carry_with), the generic path's kernel) has only the
+//! products that are not zero, and `Q` is the noise model's own [`fill`](crate::kalman::noise::fill) with the degree a
 //! constant. There are no calls through the model interfaces, no checks of what the filter
 //! already holds (a finite state of the model's size), and no general loops over the axes.
 //!
@@ -40,16 +40,17 @@
 //! Anything not finite, or `V` not positive definite, stops this path before the filter
 //! changes; the generic path then takes the step and gives its own error.
 
-use super::super::correct::{carry_with, Work};
+mod predict;
+
+use super::super::correct::Work;
 use super::{InnovationStats, KalmanFilter};
-use crate::kalman::noise::fill;
-use crate::linalg::dense::{all_finite, ldl, log_det};
+use crate::linalg::dense::{ldl, log_det};
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::{Measurement, NoiseCovariance};
 use crate::model::observation::Observation;
-use crate::model::transition::psi_term;
-use crate::numeric::unrolled::{unrolled_sizes, Fixed, Quotient, UNROLLED_MAX_SIZE};
+use crate::numeric::unrolled::{unrolled_sizes, UNROLLED_MAX_SIZE};
 use nalgebra::{DMatrix, DVector};
+use predict::{predict, predict_exact};
 use std::f64::consts::TAU;
 
 /// The most axes with the path compiled for them.
@@ -293,13 +294,6 @@ fn read<const P: usize>(m: &Measurement) -> Option<Seen<'static>> {
 
 /// `N × N`, column-major: `m[j][i]` is the entry `(i, j)`.
 type Square<const N: usize> = [[f64; N]; N];
-
-/// Whether `Φ`'s entry `(r, c)` on `A` axes is one of `Ψ ⊗ I`'s terms `ζ^k/k!` (4.2.5): `c ≥ r`
-/// on the same axis (every other entry is a structural zero).
-#[inline(always)]
-const fn on<const A: usize>(r: usize, c: usize) -> bool {
-    c >= r && (c - r).is_multiple_of(A)
-}
 
 /// [`KalmanFilter::update_fixed`] for `N` states on `axes` axes with `K` components present:
 /// the prediction over `step` ([`predict_exact`]; `None`: no step, the estimate as it is),
@@ -550,149 +544,6 @@ fn update<const N: usize, const K: usize, const UNIT: bool>(
     })
 }
 
-/// The prediction of `N` states on `A` axes over the step `zeta` in place of `(xp, sp)`, `Φ`
-/// into `phi`: [`predict_in`]'s numbers (the generic path's
-/// [`carry`](super::super::correct::carry)), operation for operation on this function's
-/// arrays, `Φ`'s structural zeros left out at compile time, its other entries multiplied
-/// whatever their value, and the sums from `−0`, each entry of `S_{n,n−1}` then made `+0`
-/// where it is `−0` ([`update`]'s doc: the same numbers). Whether `Φ`, `Q` and the
-/// prediction are finite is left to [`update`]'s check.
-#[allow(clippy::needless_range_loop)]
-#[inline(always)]
-fn predict_exact<const N: usize, const A: usize>(
-    zeta: f64,
-    psd: Option<f64>,
-    xp: &mut [f64; N],
-    sp: &mut Square<N>,
-    phi: &mut [f64],
-) {
-    let size = N / A;
-    let mut psi = [0.0; N];
-    for (k, psi) in psi[..size].iter_mut().enumerate() {
-        *psi = psi_term(k, &zeta);
-    }
-    let x = *xp;
-    transition_into::<N, A>(&psi, &x, phi, xp);
-    // T = S Φᵀ (`t[i]` its column i), then Φ S Φᵀ = Tᵀ Φᵀ: its column j is Σ_l Tᵀ[:, l] Φ(j, l).
-    let s = *sp;
-    let mut t = [[-0.0; N]; N];
-    for i in 0..N {
-        for l in 0..N {
-            if on::<A>(i, l) {
-                let scale = psi[(l - i) / A];
-                for r in 0..N {
-                    t[i][r] += s[l][r] * scale;
-                }
-            }
-        }
-    }
-    let mut out = [[-0.0; N]; N];
-    for j in 0..N {
-        for l in 0..N {
-            if on::<A>(j, l) {
-                let scale = psi[(l - j) / A];
-                for r in 0..N {
-                    out[j][r] += t[r][l] * scale;
-                }
-            }
-        }
-    }
-    match psd {
-        // (out + Q) symmetrized, in one pass.
-        Some(psd) => {
-            let mut q = [[0.0; N]; N];
-            fill(Quotient::<N, A>, A, psd, zeta.abs(), q.as_flattened_mut());
-            for j in 0..N {
-                out[j][j] = (out[j][j] + q[j][j]) + 0.0;
-                for i in j + 1..N {
-                    let v = ((out[j][i] + q[j][i]) + (out[i][j] + q[i][j])) * 0.5 + 0.0;
-                    out[j][i] = v;
-                    out[i][j] = v;
-                }
-            }
-        }
-        None => {
-            for j in 0..N {
-                out[j][j] += 0.0;
-                for i in j + 1..N {
-                    let v = (out[j][i] + out[i][j]) * 0.5 + 0.0;
-                    out[j][i] = v;
-                    out[i][j] = v;
-                }
-            }
-        }
-    }
-    *sp = out;
-}
-
-/// [`KalmanFilter::predict_fixed`] for `N` states on `A` axes over the step `zeta`: from the
-/// estimate `(x, s)` and the fading `P`, into `w`; whether every number is finite.
-#[inline(never)]
-fn predict<const N: usize, const A: usize>(
-    zeta: f64,
-    psd: Option<f64>,
-    from: (&[f64], &[f64], Option<&[f64]>),
-    w: &mut Work,
-) -> bool {
-    let into = (
-        &mut w.x.as_mut_slice()[..N],
-        &mut w.s.as_mut_slice()[..N * N],
-        &mut w.p.as_mut_slice()[..N * N],
-    );
-    let (phi, q) = (w.phi.as_mut_slice(), w.q.as_mut_slice());
-    predict_in::<N, A>(zeta, psd, from, phi, q, &mut w.square, into)
-}
-
-/// The prediction of `N` states on `A` axes over the step `zeta`, from the estimate `(x, s)`
-/// and the fading `P` into `Φ`, `Q` and `(X_{n,n−1}, S_{n,n−1}, P)`, `square` its scratch
-/// (`N × N`); whether every number is finite.
-#[inline(always)]
-fn predict_in<const N: usize, const A: usize>(
-    zeta: f64,
-    psd: Option<f64>,
-    (x, s, fading): (&[f64], &[f64], Option<&[f64]>),
-    phi: &mut [f64],
-    q: &mut [f64],
-    square: &mut [f64],
-    (xp, sp, pp): (&mut [f64], &mut [f64], &mut [f64]),
-) -> bool {
-    // ζ^k/k! for k ≤ m (the model's `for_each_entry`: `psi_term`, k a constant).
-    let size = N / A;
-    let mut psi = [0.0; UNROLLED_MAX_SIZE];
-    for (k, psi) in psi[..size].iter_mut().enumerate() {
-        *psi = psi_term(k, &zeta);
-    }
-    if !all_finite(&psi[..size]) {
-        return false;
-    }
-    let xp = &mut xp[..N];
-    transition_into::<N, A>(&psi, &x[..N], phi, xp);
-    let entry = |r: usize, c: usize| phi_entry::<A>(&psi, r, c);
-    if !all_finite(xp) {
-        return false;
-    }
-    let q = match psd {
-        Some(psd) => {
-            let q = &mut q[..N * N];
-            if A > 1 {
-                q.fill(0.0);
-            }
-            if !fill(Quotient::<N, A>, A, psd, zeta.abs(), q) {
-                return false;
-            }
-            Some(&*q)
-        }
-        None => None,
-    };
-    if !carry_with(Fixed::<N>, entry, s, q, square, sp) {
-        return false;
-    }
-    match fading {
-        Some(p) => carry_with(Fixed::<N>, entry, p, q, square, pp),
-        None => true,
-    }
-}
-
 /// `A Mᵀ` from `M`'s rows: `out[c][r] = Σ_l a[l][r] · mt[c][l]`, each sum from `−0` over `l`
 /// ascending (the order of the generic path's product, [`update`]'s doc on `−0`). With
 /// `UNIT` (`M = [I_K 0]`) only the term `l = c`, `a[c][r] · 1` (the generic path skips `M`'s
@@ -714,44 +565,6 @@ fn times_mt<const N: usize, const K: usize, const UNIT: bool>(
         }
     }
     out
-}
-
-/// `[Φ]_{r c}` from `psi[k] = ζ^k/k!` ([`transition_into`]).
-#[inline(always)]
-fn phi_entry<const A: usize>(psi: &[f64], r: usize, c: usize) -> f64 {
-    if on::<A>(r, c) {
-        psi[(c - r) / A]
-    } else {
-        0.0
-    }
-}
-
-/// `Φ` into `phi` (`[Φ]_{i A + a, (i + k) A + a} = ζ^k/k!`: row r, column c, when c ≥ r on the
-/// same axis, (4.2.5); `psi[k] = ζ^k/k!`) and `Φ x` into `xp`, each row's sum from its diagonal
-/// term over the columns ascending (the model's order; its structural zeros add nothing).
-#[inline(always)]
-fn transition_into<const N: usize, const A: usize>(
-    psi: &[f64],
-    x: &[f64],
-    phi: &mut [f64],
-    xp: &mut [f64],
-) {
-    let size = N / A;
-    let phi = &mut phi[..N * N];
-    for c in 0..N {
-        for r in 0..N {
-            phi[r + c * N] = phi_entry::<A>(psi, r, c);
-        }
-    }
-    for r in 0..N {
-        let mut acc = psi[0] * x[r];
-        for k in 1..size {
-            if r + k * A < N {
-                acc += psi[k] * x[r + k * A];
-            }
-        }
-        xp[r] = acc;
-    }
 }
 
 #[cfg(test)]
