@@ -94,6 +94,34 @@ struct Case {
     rows: Vec<Measurement>,
 }
 
+/// The filter on the models as they are (the fixed path) and on the same models wrapped (the
+/// generic path), from the same prior.
+fn both(
+    dynamics: PolynomialDynamics,
+    observation: LinearObservation,
+    x0: DVector<f64>,
+    prior: DMatrix<f64>,
+) -> (
+    KalmanFilter<PolynomialDynamics, LinearObservation>,
+    KalmanFilter<Plain, PlainObservation>,
+) {
+    let fast = KalmanFilter::new(
+        dynamics,
+        observation.clone(),
+        x0.clone(),
+        prior.clone(),
+        0.0,
+    );
+    let plain = KalmanFilter::new(
+        Plain(dynamics),
+        PlainObservation(observation),
+        x0,
+        prior,
+        0.0,
+    );
+    (fast.unwrap(), plain.unwrap())
+}
+
 fn case(rng: &mut StdRng, degree: usize, axes: usize, p: usize, steps: usize) -> Case {
     let n = (degree + 1) * axes;
     let mut normal =
@@ -122,22 +150,7 @@ fn case(rng: &mut StdRng, degree: usize, axes: usize, p: usize, steps: usize) ->
     }
     let dynamics = PolynomialDynamics::new(degree, axes);
     let observation = LinearObservation::new(m).unwrap();
-    let mut fast = KalmanFilter::new(
-        dynamics,
-        observation.clone(),
-        x0.clone(),
-        prior.clone(),
-        0.0,
-    )
-    .unwrap();
-    let mut plain = KalmanFilter::new(
-        Plain(dynamics),
-        PlainObservation(observation),
-        x0,
-        prior,
-        0.0,
-    )
-    .unwrap();
+    let (mut fast, mut plain) = both(dynamics, observation, x0, prior);
     if rng.gen_bool(0.7) {
         let psd = 10f64.powf(rng.gen_range(-3.0..1.0));
         let q = WhiteNoiseDerivative::new(degree, axes, psd).unwrap();
@@ -355,22 +368,7 @@ fn signed_zeros_are_the_generic_paths() {
             let observation = LinearObservation::new(m.clone()).unwrap();
             let dynamics = PolynomialDynamics::new(1, 1);
             let x0 = DVector::from_row_slice(&x0);
-            let mut fast = KalmanFilter::new(
-                dynamics,
-                observation.clone(),
-                x0.clone(),
-                identity.clone(),
-                0.0,
-            )
-            .unwrap();
-            let mut plain = KalmanFilter::new(
-                Plain(dynamics),
-                PlainObservation(observation),
-                x0,
-                identity.clone(),
-                0.0,
-            )
-            .unwrap();
+            let (mut fast, mut plain) = both(dynamics, observation, x0, identity.clone());
             let row = Measurement {
                 time: 0.0,
                 values: vec![Some(-0.0); p],
