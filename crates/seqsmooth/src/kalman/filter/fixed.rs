@@ -96,7 +96,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// The degree, axes and driving noise's spectral density (`None`: no driving noise) of a
     /// polynomial model in the path's range, the filter's state of its size; `None` otherwise
     /// (the [`Plan`], made if it is not).
-    fn fixed_model(&mut self) -> Option<(usize, usize, Option<f64>)> {
+    pub(super) fn fixed_model(&mut self) -> Option<(usize, usize, Option<f64>)> {
         if matches!(self.plan, Plan::Unknown) {
             self.plan = self.make_plan();
         }
@@ -278,18 +278,22 @@ fn read<const P: usize>(m: &Measurement) -> Option<Seen<'static>> {
         variances: [1.0; MAX_COMPONENTS],
         k: 0,
     };
-    let mut ok = true;
+    // Finite by one sum (an infinity or NaN makes it so; a finite sum that overflows only
+    // sends the step to the generic path, which reads the same numbers), not negative by a
+    // comparison each: float arithmetic, no tests of each number's class.
+    let (mut sum, mut negative) = (0.0, false);
     for c in 0..P.min(MAX_COMPONENTS) {
         let variance = variances[c];
-        ok &= (0.0..f64::INFINITY).contains(&variance);
+        sum += variance;
+        negative |= variance < 0.0;
         if let Some(v) = values[c] {
-            ok &= v.is_finite();
+            sum += v;
             let k = seen.k.min(c);
             (seen.present[k], seen.values[k], seen.variances[k]) = (c, v, variance);
             seen.k = k + 1;
         }
     }
-    ok.then_some(seen)
+    (sum.is_finite() && !negative).then_some(seen)
 }
 
 /// `N × N`, column-major: `m[j][i]` is the entry `(i, j)`.

@@ -78,21 +78,21 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         m: &Measurement,
         innovation: bool,
     ) -> Option<InnovationStats> {
-        let radar = self.observation.as_radar()?;
+        self.observation.as_radar()?;
         if self.fading.is_some() {
             return None;
         }
-        let dynamics = self.dynamics.polynomial()?;
-        if dynamics.degree() != 1 || dynamics.axes() != 3 || radar.has_range_rate() {
+        // The models read once when they change (the fixed-size path's plan: the polynomial
+        // model's degree and axes, the driving noise's spectral density when it is
+        // `WhiteNoiseDerivative` of the same degree and axes), not through the interfaces (a
+        // virtual call for the noise) at each update.
+        let (1, 3, psd) = self.fixed_model()? else {
+            return None;
+        };
+        let radar = self.observation.as_radar()?;
+        if radar.has_range_rate() {
             return None;
         }
-        let psd = match &self.noise {
-            None => None,
-            Some(noise) => match noise.white_noise_derivative()?.parts() {
-                (1, 3, psd) => Some(psd),
-                _ => return None,
-            },
-        };
         let t = m.time;
         let [Some(y0), Some(y1), Some(y2)] = *m.values.as_slice() else {
             return None;
@@ -163,14 +163,19 @@ fn update(
             predict(x, s, zeta, psd, xp, sp)?;
             let (t0, t1) = (psi_term(0, &zeta), psi_term(1, &zeta));
             // `Φ` into the work buffer as the general path leaves it (the smoothers read it:
-            // `last_transition`): `[[I, ζ I], [0, I]]` by `psi_term`, (4.2.5). Written whole:
-            // the buffer may hold another model's `Φ` of the same size (`with_models` keeps
-            // the work buffers).
-            phi.fill(0.0);
-            for a in 0..3 {
-                phi[a + a * N] = t0;
-                phi[(a + 3) + (a + 3) * N] = t0;
-                phi[a + (a + 3) * N] = t1;
+            // `last_transition`): `[[I, ζ I], [0, I]]` by `psi_term`, (4.2.5). Written whole,
+            // entry by entry (no separate fill): the buffer may hold another model's `Φ` of
+            // the same size (`with_models` keeps the work buffers).
+            for c in 0..N {
+                for r in 0..N {
+                    phi[r + c * N] = if r == c {
+                        t0
+                    } else if c == r + 3 {
+                        t1
+                    } else {
+                        0.0
+                    };
+                }
             }
         }
     }
@@ -287,9 +292,12 @@ fn update(
         sums(&j1),
         sums(&j2),
     ];
-    let total = sums
-        .iter()
-        .fold([0.0; 4], |a, b| std::array::from_fn(|i| a[i] + b[i]));
+    let mut total = [0.0; 4];
+    for part in &sums {
+        for (total, part) in total.iter_mut().zip(part) {
+            *total += part;
+        }
+    }
     let finite = ((total[0] + total[1]) + (total[2] + total[3])).is_finite();
     if !(finite && nis.is_finite() && log_likelihood.is_finite()) {
         return None;
