@@ -97,7 +97,7 @@ pub(crate) fn smooth_into(
 /// `W = C E` and the lower triangle of `s + W Cᵀ`, mirrored.
 #[inline(always)]
 #[allow(clippy::type_complexity)]
-fn smooth_fixed<const N: usize>(
+pub(crate) fn smooth_fixed<const N: usize>(
     ((x, s), (x_next, s_next)): ((&[f64], &[f64]), (&[f64], &[f64])),
     (phi, x_pred, s_pred): (&[f64], &[f64], &[f64]),
     (x_out, s_out, c): (&mut [f64], &mut [f64], &mut [f64]),

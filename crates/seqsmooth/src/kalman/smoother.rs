@@ -12,7 +12,7 @@
 //! minimum-variance estimate from the prior and all the measurements (tested against
 //! [`crate::estimate::gauss_newton`]).
 
-use super::backward::{map_into, smooth_into};
+use super::backward::{map_into, smooth_fixed, smooth_into};
 use super::filter::KalmanFilter;
 use super::fixed_lag::{
     not_finite, not_positive_definite, step, time_before, FixedLagSmoother, Map, Row,
@@ -316,7 +316,7 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone, const N: usize>(
         let nis = match forward(filter) {
             Ok(nis) => nis,
             Err(e) => {
-                let run = (&*run, &phi[..], &x_pred[..], &s_pred[..]);
+                let run = (run.filtered(), &phi[..], &x_pred[..], &s_pred[..]);
                 return Err(first_map_error(run, index).unwrap_or(in_batch(index, e)));
             }
         };
@@ -339,6 +339,10 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone, const N: usize>(
     run.gains[last * nn..].fill(0.0);
     run.states[last * n..].copy_from_slice(&run.filtered_states[last * n..]);
     run.covariances[last * nn..].copy_from_slice(&run.filtered_covariances[last * nn..]);
+    let kept = (&phi[..], &x_pred[..], &s_pred[..]);
+    if N != 0 {
+        return backward_fixed::<N>(run, kept);
+    }
     for k in (0..last).rev() {
         let prediction = (
             &phi[(k + 1) * nn..(k + 2) * nn],
@@ -356,14 +360,106 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone, const N: usize>(
         let c = &mut run.gains[k * nn..(k + 1) * nn];
         let made = smooth_into(n, filtered, prediction, next, (&mut *x, &mut *s, c));
         if !(made && all_finite(x) && all_finite(s)) {
-            let bad = x.iter().chain(s.iter()).find(|v| !v.is_finite()).copied();
-            // The first error in the measurement-at-a-time smoother's order: a map that
-            // cannot be made, from the first; else this estimate's entry.
-            let found = first_map_error((&*run, &phi[..], &x_pred[..], &s_pred[..]), k + 2);
-            return Err(found.unwrap_or_else(|| in_batch(k, not_finite(bad.unwrap_or(f64::NAN)))));
+            let filtered = Filtered {
+                dimension: n,
+                states: &run.filtered_states,
+                covariances: &run.filtered_covariances,
+            };
+            return Err(step_error(filtered, kept, k, (x, s)));
         }
     }
     Ok(())
+}
+
+/// [`passes`]'s backward steps with the state's dimension `N` known at compile time
+/// (`backward::smooth_fixed`, inlined: the same operations as [`smooth_into`], so the same
+/// numbers), walking the flat buffers by chunks from the last estimate (written) back to the
+/// first, each step reading the one after it as the previous step left it.
+#[inline(always)]
+fn backward_fixed<const N: usize>(
+    run: &mut SmoothedRun,
+    (phi, x_pred, s_pred): (&[f64], &[f64], &[f64]),
+) -> Result<(), Error> {
+    let nn = N * N;
+    let filtered = Filtered {
+        dimension: N,
+        states: &run.filtered_states,
+        covariances: &run.filtered_covariances,
+    };
+    let mut states = run.states.chunks_exact_mut(N).rev();
+    let mut covariances = run.covariances.chunks_exact_mut(nn).rev();
+    let (Some(x_last), Some(s_last)) = (states.next(), covariances.next()) else {
+        return Ok(());
+    };
+    let (mut x_next, mut s_next): (&[f64], &[f64]) = (x_last, s_last);
+    // One iterator a buffer, each walked from its end (a zip of them is not inlined), over
+    // the steps out of measurements 0..last: as many as the predictions kept.
+    let (steps, steps_nn) = (x_pred.len(), s_pred.len());
+    let mut gains = run.gains[..steps_nn].chunks_exact_mut(nn);
+    let mut xfs = filtered.states[..steps].chunks_exact(N);
+    let mut sfs = filtered.covariances[..steps_nn].chunks_exact(nn);
+    let mut phis = phi[nn..].chunks_exact(nn);
+    let (mut xps, mut sps) = (x_pred.chunks_exact(N), s_pred.chunks_exact(nn));
+    let mut k = steps / N;
+    while let (Some(x), Some(s), Some(c), Some(xf), Some(sf), Some(f), Some(xp), Some(sp)) = (
+        states.next(),
+        covariances.next(),
+        gains.next_back(),
+        xfs.next_back(),
+        sfs.next_back(),
+        phis.next_back(),
+        xps.next_back(),
+        sps.next_back(),
+    ) {
+        k -= 1;
+        let estimates = ((xf, sf), (x_next, s_next));
+        let made = smooth_fixed::<N>(estimates, (f, xp, sp), (&mut *x, &mut *s, c));
+        if !(made && finite(x, s)) {
+            return Err(step_error(filtered, (phi, x_pred, s_pred), k, (x, s)));
+        }
+        (x_next, s_next) = (x, s);
+    }
+    Ok(())
+}
+
+/// Whether every entry of `x` and `s` is finite: so when their sum is (an infinity or NaN
+/// among them makes the sum one); a sum that overflows is checked entry by entry.
+#[inline(always)]
+fn finite(x: &[f64], s: &[f64]) -> bool {
+    let sum = x.iter().chain(s).sum::<f64>();
+    sum.is_finite() || (all_finite(x) && all_finite(s))
+}
+
+/// The forward pass's estimates, as [`first_map_error`] reads them.
+#[derive(Clone, Copy)]
+struct Filtered<'a> {
+    dimension: usize,
+    states: &'a [f64],
+    covariances: &'a [f64],
+}
+
+impl SmoothedRun {
+    fn filtered(&self) -> Filtered<'_> {
+        Filtered {
+            dimension: self.dimension,
+            states: &self.filtered_states,
+            covariances: &self.filtered_covariances,
+        }
+    }
+}
+
+/// The error of the backward step into measurement `k` (its results `x`, `s`), when its map
+/// could not be made or an entry is not finite: the first in the measurement-at-a-time
+/// smoother's order, a map that cannot be made, from the first; else this estimate's entry.
+fn step_error(
+    filtered: Filtered<'_>,
+    (phi, x_pred, s_pred): (&[f64], &[f64], &[f64]),
+    k: usize,
+    (x, s): (&[f64], &[f64]),
+) -> Error {
+    let bad = x.iter().chain(s.iter()).find(|v| !v.is_finite()).copied();
+    let found = first_map_error((filtered, phi, x_pred, s_pred), k + 2);
+    found.unwrap_or_else(|| in_batch(k, not_finite(bad.unwrap_or(f64::NAN))))
 }
 
 /// `e` naming measurement `index`.
@@ -378,7 +474,7 @@ fn in_batch(index: usize, e: Error) -> Error {
 /// (`S_{k+1|k}` not positive definite, or a number that is not finite), as the
 /// measurement-at-a-time smoother reports it when that measurement is pushed.
 fn first_map_error(
-    (run, phi, x_pred, s_pred): (&SmoothedRun, &[f64], &[f64], &[f64]),
+    (run, phi, x_pred, s_pred): (Filtered<'_>, &[f64], &[f64], &[f64]),
     before: usize,
 ) -> Option<Error> {
     let n = run.dimension;
@@ -388,8 +484,8 @@ fn first_map_error(
     (1..before.min(made + 1)).find_map(|index| {
         let k = index - 1;
         let filtered = (
-            &run.filtered_states[k * n..index * n],
-            &run.filtered_covariances[k * nn..index * nn],
+            &run.states[k * n..index * n],
+            &run.covariances[k * nn..index * nn],
         );
         let prediction = (
             &phi[index * nn..(index + 1) * nn],
@@ -595,4 +691,22 @@ pub fn rts(
     }
     out.reverse();
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::finite;
+
+    /// The finite test by the sum: a sum that overflows is not an entry that is not finite;
+    /// an infinity or NaN anywhere is found, whatever the other entries.
+    #[test]
+    fn finite_by_the_sum_and_by_entry() {
+        assert!(finite(&[f64::MAX, f64::MAX], &[f64::MAX; 4]));
+        assert!(finite(&[1.0], &[-2.0]));
+        for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+            assert!(!finite(&[1.0, bad], &[1.0; 4]));
+            assert!(!finite(&[f64::MAX, 0.0], &[1.0, 2.0, 3.0, bad]));
+            assert!(!finite(&[f64::MAX, f64::MAX], &[bad, f64::MAX, 0.0, 0.0]));
+        }
+    }
 }
