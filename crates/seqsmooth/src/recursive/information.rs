@@ -668,6 +668,47 @@ impl InformationFilter {
 }
 
 impl InformationFilter {
+    /// The filter of the first `q` state components alone, into `out` (dimension `q`, smaller
+    /// than this one's): the leading blocks of `R` and of the true covariance's `Q`
+    /// ([`TriangularFactor::leading_into`]), and the lazy discount's scale. Where the rows
+    /// `h_k` of this filter extend those of a smaller model by further columns (a polynomial of
+    /// degree `m + 1` and one of degree `m` on the same samples and weights), `out` is that
+    /// model's filter: the same discounted least squares (14.3.11)-(14.3.13) restricted to
+    /// its columns. `false` (and `out` untouched) unless `out` is smaller and keeps the true
+    /// covariance exactly when this one does.
+    ///
+    /// ```
+    /// use seqsmooth::recursive::InformationFilter;
+    /// let mut line = InformationFilter::new(2).with_true_covariance();
+    /// let mut constant = InformationFilter::new(1).with_true_covariance();
+    /// for (u, y) in [(0.0, 1.0), (1.0, 3.0), (2.0, 2.0)] {
+    ///     for f in [&mut line, &mut constant] {
+    ///         f.fade(2.0);
+    ///     }
+    ///     line.observe_powers(u, y, 1.0);
+    ///     constant.observe_powers(u, y, 1.0);
+    /// }
+    /// let mut lead = InformationFilter::new(1).with_true_covariance();
+    /// assert!(line.leading_into(&mut lead));
+    /// let (a, b) = (lead.solve().unwrap()[0], constant.solve().unwrap()[0]);
+    /// assert!((a - b).abs() < 1e-14);
+    /// let (va, vb) = (lead.covariance().unwrap()[(0, 0)], constant.covariance().unwrap()[(0, 0)]);
+    /// assert!((va - vb).abs() < 1e-14);
+    /// ```
+    pub fn leading_into(&self, out: &mut InformationFilter) -> bool {
+        if out.dim() >= self.dim() || out.spread.is_some() != self.spread.is_some() {
+            return false;
+        }
+        if let (Some(q), Some(lead)) = (&self.spread, &mut out.spread) {
+            q.leading_into(lead);
+        }
+        self.info.leading_into(&mut out.info);
+        out.scale = self.scale;
+        true
+    }
+}
+
+impl InformationFilter {
     /// The invariants of a restored filter ([`crate::persist`]): its factors valid and of one
     /// dimension, the discount's scale finite and positive.
     pub(crate) fn check_saved(&self) -> Result<(), String> {

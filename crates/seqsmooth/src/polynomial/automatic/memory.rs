@@ -38,8 +38,21 @@
 //! reported error `σ² V + b̂ b̂ᵀ` ([`super::bias`]): coverage does not rest on the bias being
 //! removed, nor on §7.13's balance being met exactly (it may fall between two rungs, where a
 //! coarser ladder raises the mean squared error of the memory chosen).
-//! Each rung costs two exact filters (the memory and its companion) at every sample and two
-//! positions at every comparison. Measured on the Monte Carlo of manoeuvring tracks and
+//! Each rung costs one exact filter update at every sample (its companion's) and two
+//! positions at every comparison.
+//!
+//! **One factor per memory.** On the exact engine a memory's degree-`m` filter is not updated
+//! itself but taken from its degree `m + 1` companion's leading block
+//! ([`FadingMemory::follow_leading`], [`ExpandingMemory::follow_leading`]): in the engine's
+//! basis `(1, u, …, u^(m+1))` of re-centred time, whose centre and unit follow the samples'
+//! times alone, the degree-`m` design is the companion's first `m + 1` columns, so the same
+//! discounted least squares (Morrison (13.2.1), (14.3.11)-(14.3.13)) has the leading block of
+//! the companion's information factor, of its true covariance's middle factor and of `Qᵀz` for
+//! its own (Morrison (10.2.42)-(10.2.44): the rotations act column by column), and the
+//! companion's residual plus the square of its last `Qᵀz` entry for its residual. The two agree
+//! to rounding (`leading_tests.rs`: within 3·10⁻⁹ of their σ at degree 8 on long irregular
+//! runs). Memory 0's filters follow at every sample; a shorter memory's only when it is in use
+//! or compared ([`Memories::choose`]), its companion running at every sample. Measured on the Monte Carlo of manoeuvring tracks and
 //! landing.csv (ACCURACY.md), the single rung `θ⁴` covers the truth better than the halving
 //! ladder `θ², θ⁴, θ⁸` did (fewer rungs, fewer noisy choices of a memory too short) with half
 //! the filters.
@@ -134,6 +147,42 @@ fn upper_pair(cfg: &AutoConfig) -> Result<UpperPair, Error> {
     ))
 }
 
+/// Applies a sample to a degree-`m` fading-memory filter and its degree `m + 1` companion (if
+/// any): the companion updated, then the filter taken from the companion's leading block
+/// ([`FadingMemory::follow_leading`]: on the exact engine the degree-`m` discounted least
+/// squares is the first `m + 1` columns of the degree-`m + 1` one, so one factor serves both),
+/// or updated itself where that does not apply (the gain engine, no companion).
+fn fading_pair(
+    lower: &mut FadingMemory,
+    upper: Option<&mut FadingMemory>,
+    t: f64,
+    y: f64,
+) -> Result<(), Error> {
+    if let Some(upper) = upper {
+        upper.update(t, y)?;
+        if lower.follow_leading(upper) {
+            return Ok(());
+        }
+    }
+    lower.update(t, y)
+}
+
+/// [`fading_pair`] for the expanding-memory filters.
+fn expanding_pair(
+    lower: &mut ExpandingMemory,
+    upper: Option<&mut ExpandingMemory>,
+    t: f64,
+    y: f64,
+) -> Result<(), Error> {
+    if let Some(upper) = upper {
+        upper.update(t, y)?;
+        if lower.follow_leading(upper) {
+            return Ok(());
+        }
+    }
+    lower.update(t, y)
+}
+
 /// Each shorter memory discounts by this power of the one above: `θ_j = θ^(4^j)` per `τ` (the
 /// module docs: a memory a quarter as long per rung).
 const MEMORY_RATIO: i32 = 4;
@@ -144,6 +193,24 @@ const MEMORY_RATIO: i32 = 4;
 struct Shorter {
     fading: FadingMemory,
     upper: FadingMemory,
+    /// `fading` lags `upper` by samples not yet taken from its leading block
+    /// ([`Memories::sync`]: only the memories compared or in use need their own filter; a
+    /// state saved before this flag has none lagging).
+    #[serde(default)]
+    stale: bool,
+}
+
+impl Shorter {
+    /// Brings `fading` up to `upper`'s samples from `upper`'s leading block
+    /// ([`FadingMemory::follow_leading`]; both run the exact engine with one discount, as
+    /// [`shorter_memories`] builds them).
+    fn sync(&mut self) {
+        if self.stale {
+            let synced = self.fading.follow_leading(&self.upper);
+            debug_assert!(synced, "a shorter memory's filters do not match");
+            self.stale = !synced;
+        }
+    }
 }
 
 /// The shorter memories of `cfg` (none when `m + 1` is not a supported degree: without the
@@ -164,6 +231,7 @@ fn shorter_memories(cfg: &AutoConfig) -> Result<Vec<Shorter>, Error> {
         out.push(Shorter {
             fading: unit_fading_on(cfg, cfg.degree, Engine::Exact, theta)?,
             upper: unit_fading_on(cfg, u, Engine::Exact, theta)?,
+            stale: false,
         });
     }
     Ok(out)
@@ -284,17 +352,11 @@ impl Memories {
         let mut shorter = fresh.shorter.clone();
         for k in kept {
             for s in &mut shorter {
-                s.fading.update(k.t, k.y)?;
                 s.upper.update(k.t, k.y)?;
+                s.stale = true;
             }
-            expanding.update(k.t, k.y)?;
-            fading.update(k.t, k.y)?;
-            if let Some(f) = &mut upper_expanding {
-                f.update(k.t, k.y)?;
-            }
-            if let Some(f) = &mut upper_fading {
-                f.update(k.t, k.y)?;
-            }
+            expanding_pair(&mut expanding, upper_expanding.as_mut(), k.t, k.y)?;
+            fading_pair(&mut fading, upper_fading.as_mut(), k.t, k.y)?;
         }
         self.expanding = Some(expanding);
         self.fading = fading;
@@ -312,18 +374,18 @@ impl Memories {
     /// Applies an accepted sample to every memory and companion.
     pub(super) fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
         if let Some(f) = &mut self.expanding {
+            expanding_pair(f, self.upper_expanding.as_mut(), t, y)?;
+        } else if let Some(f) = &mut self.upper_expanding {
             f.update(t, y)?;
         }
-        self.fading.update(t, y)?;
-        if let Some(f) = &mut self.upper_expanding {
-            f.update(t, y)?;
-        }
-        if let Some(f) = &mut self.upper_fading {
-            f.update(t, y)?;
-        }
-        for s in &mut self.shorter {
-            s.fading.update(t, y)?;
+        fading_pair(&mut self.fading, self.upper_fading.as_mut(), t, y)?;
+        // A shorter memory's own filter only where it is in use; the others' when compared.
+        for (j, s) in self.shorter.iter_mut().enumerate() {
             s.upper.update(t, y)?;
+            s.stale = true;
+            if j + 1 == self.memory {
+                s.sync();
+            }
         }
         if self.t_first.is_none() {
             self.t_first = Some(t);
@@ -451,6 +513,9 @@ impl Memories {
         let mut positions = [(None, None); MAX_MEMORY_LEVELS + 1];
         let memories = self.shorter.len() + 1;
         for (j, slot) in positions.iter_mut().enumerate().take(memories) {
+            if j > 0 {
+                self.shorter[j - 1].sync();
+            }
             let Some(est) = self.position(j, t) else {
                 continue;
             };

@@ -207,6 +207,9 @@ mod settle;
 mod state;
 mod window_fit;
 
+#[cfg(test)]
+mod leading_tests;
+
 pub use config::{AutoConfig, GATE_MAX_VRF, MAX_MEMORY_LEVELS, MAX_REVIEW_WINDOW};
 pub use filter::AutomaticFilter;
 pub use misfit::MisfitResponse;

@@ -500,3 +500,51 @@ impl ExactEngine {
         Ok(())
     }
 }
+
+impl ExactEngine {
+    /// The degree-`m − 1` engine on the same samples, from this one's leading block, into
+    /// `out` (built for degree `m − 1` with the same discount, tracking the covariance exactly
+    /// when this one does): the state `a` holds the coefficients of `(1, u, …, u^m)` in the
+    /// shared re-centred basis `u = (t − c)/s`, whose centre and unit follow the samples' times
+    /// alone (the same for both degrees), so the degree-`m − 1` fit's design is this one's
+    /// first `m` columns, and its factors, estimate, true covariance and residual are the
+    /// leading block's ([`InformationFilter::leading_into`]). The result equals `out` updated
+    /// with the same samples up to rounding: the factor's rows go through the same rotations
+    /// except where one of the two uses Gentleman's sequential form and the other its
+    /// reciprocal form (the `m + 1`-th sample, whose pivots the smaller factor already has
+    /// positive). `false` (and `out` untouched) when they do not match.
+    pub(crate) fn leading_into(&self, out: &mut ExactEngine) -> bool {
+        if out.m + 1 != self.m
+            || out.discount != self.discount
+            || out.sigma.is_some() != self.sigma.is_some()
+            || !self.info.leading_into(&mut out.info)
+        {
+            return false;
+        }
+        if out.n == 0 || out.unit != self.unit {
+            out.unit = self.unit;
+            out.set_unscale();
+        }
+        out.centre = self.centre;
+        out.t_first = self.t_first;
+        out.t_last = self.t_last;
+        out.n = self.n;
+        out.step_cached = self.step_cached;
+        out.inv_root = self.inv_root;
+        out.prior = self.prior;
+        true
+    }
+}
+
+impl super::EngineState {
+    /// [`ExactEngine::leading_into`] where both are exact engines; `false` otherwise (a gain
+    /// engine's recursion keeps no factor to share).
+    pub(crate) fn leading_into(&self, out: &mut super::EngineState) -> bool {
+        match (self, out) {
+            (super::EngineState::Exact(upper), super::EngineState::Exact(lower)) => {
+                upper.leading_into(lower)
+            }
+            _ => false,
+        }
+    }
+}

@@ -31,6 +31,20 @@ pub struct ExpandingMemory {
 }
 
 impl ExpandingMemory {
+    /// Becomes the degree-`m` filter of `upper`'s samples (`upper` of degree `m + 1`, the same
+    /// settings) from `upper`'s leading block, instead of updating with them itself: the same
+    /// least squares up to rounding (the exact engine's `ExactEngine::leading_into`, crate
+    /// private). `false` (and `self` untouched: update it with the sample instead) unless
+    /// both run the exact engine with matching settings and no prior.
+    pub(crate) fn follow_leading(&mut self, upper: &ExpandingMemory) -> bool {
+        self.m + 1 == upper.m
+            && !self.prior
+            && !upper.prior
+            && upper.core.leading_into(&mut self.core)
+    }
+}
+
+impl ExpandingMemory {
     /// The position at `t` and its variance, without allocating (the automatic filter's
     /// per-sample choices); `None` when [`PolynomialFilter::estimate_at`] has no covariance
     /// or is `None`.

@@ -37,6 +37,24 @@ pub struct FadingMemory {
 }
 
 impl FadingMemory {
+    /// Becomes the degree-`m` filter of `upper`'s samples (`upper` of degree `m + 1`, the same
+    /// settings) from `upper`'s leading block, instead of updating with them itself: the same
+    /// least squares up to rounding (the exact engine's `ExactEngine::leading_into`, crate
+    /// private). `false` (and `self` untouched: update it with the sample instead) unless
+    /// both run the exact engine with matching settings and no prior.
+    pub(crate) fn follow_leading(&mut self, upper: &FadingMemory) -> bool {
+        self.m + 1 == upper.m
+            && self.theta == upper.theta
+            && self.tau == upper.tau
+            && self.mode == upper.mode
+            && self.sigma.is_some() == upper.sigma.is_some()
+            && self.prior.is_none()
+            && upper.prior.is_none()
+            && upper.core.leading_into(&mut self.core)
+    }
+}
+
+impl FadingMemory {
     /// The position at `t` and its variance, without allocating (the automatic filter's
     /// per-sample choices); `None` when [`PolynomialFilter::estimate_at`] has no covariance
     /// or is `None`.

@@ -717,6 +717,57 @@ fn load_unmerged(x: &f64) -> f64 {
 }
 
 impl TriangularFactor {
+    /// The leading `q × q` block of this factor into `out` (dimension `q < p`): the factor of
+    /// the same rows restricted to their first `q` entries. In a QR factorisation the first `q`
+    /// columns of `R` and the first `q` entries of `Qᵀb` depend only on the first `q` columns of
+    /// the design (Morrison (10.2.42)-(10.2.44): each rotation combines whole rows, column by
+    /// column), so the leading block of `[R ∣ d]` *is* the factor of the first `q` columns; the
+    /// residual sum of squares of that smaller fit is this one's plus what the dropped columns
+    /// explained, `Σ_(i ≥ q) d_i ū_i²` (the squares of the dropped entries of `d = D^½ ū`).
+    /// `false` (and `out` untouched) unless `out` is smaller.
+    ///
+    /// ```
+    /// use seqsmooth::recursive::TriangularFactor;
+    /// // a line (2 columns) and a constant (its first column) through 0, 1, 5
+    /// let (mut line, mut constant) = (TriangularFactor::new(2), TriangularFactor::new(1));
+    /// for (u, y) in [(0.0, 0.0), (1.0, 1.0), (2.0, 5.0)] {
+    ///     line.add_row(&[1.0, u], y, 1.0);
+    /// }
+    /// let mut lead = TriangularFactor::new(1);
+    /// assert!(line.leading_into(&mut lead));
+    /// let mut x = [0.0];
+    /// assert!(lead.solve_into(&mut x));
+    /// assert!((x[0] - 2.0).abs() < 1e-14); // the mean
+    /// assert!((lead.residual_sq() - 14.0).abs() < 1e-13); // 4 + 1 + 9
+    /// ```
+    pub fn leading_into(&self, out: &mut TriangularFactor) -> bool {
+        let q = out.dim();
+        if q >= self.dim() {
+            return false;
+        }
+        // The sizes compiled in copy in fixed-length moves (no call per row).
+        unrolled_sizes!(q, N => self.leading_with(N, out), q => self.leading_with(q, out));
+        true
+    }
+
+    /// [`Self::leading_into`] for `q = out.dim() < p`.
+    #[inline(always)]
+    fn leading_with(&self, q: usize, out: &mut TriangularFactor) {
+        let p = self.dim();
+        let (d, u, b) = (&self.d[..], &self.u[..], &self.ubar[..]);
+        let (od, ou, ob) = (&mut out.d[..q], &mut out.u[..q * q], &mut out.ubar[..q]);
+        od.copy_from_slice(&d[..q]);
+        ob.copy_from_slice(&b[..q]);
+        for (i, row) in ou.chunks_exact_mut(q).enumerate() {
+            row.copy_from_slice(&u[i * p..i * p + q]);
+        }
+        let dropped: f64 = d[q..].iter().zip(&b[q..]).map(|(d, u)| d.0 * u * u).sum();
+        out.residual_sq = self.residual_sq + dropped;
+        out.positive = od.iter().all(|v| v.0 >= f64::MIN_POSITIVE);
+    }
+}
+
+impl TriangularFactor {
     /// The invariants of a restored factor ([`crate::persist`]): `D`, `U`, `ū` of one
     /// dimension, finite, `D ≥ 0`.
     pub(crate) fn check_saved(&self) -> Result<(), String> {
