@@ -25,8 +25,8 @@
 //! is inlined where the filter updates and folds away for any other observation model; the
 //! arithmetic ([`update`]) is one function kept out of line, so that the hot code is compact
 //! and apart from the general path's. `Q` is the noise's own `fill` on one axis (its 2 × 2,
-//! `Q₁ ⊗ I₃` read from it), and of `Φ` only the nine entries that are not structurally zero
-//! are written (every writer of the buffer writes this model's `Ψ(ζ) ⊗ I₃`).
+//! `Q₁ ⊗ I₃` read from it), from the spectral density the filter's plan holds, and `Φ`'s 36
+//! entries are written one by one, the structural zeros as `0` (this model's `Ψ(ζ) ⊗ I₃`).
 
 use super::super::correct::Work;
 use super::{InnovationStats, KalmanFilter};
