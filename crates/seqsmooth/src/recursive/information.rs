@@ -480,8 +480,13 @@ impl InformationFilter {
     /// same order, from the diagonal outwards, so the result is the entry-by-entry
     /// substitution's to the bit. The row index is a constant in each step (`each_index!`),
     /// so that the steps' short loops unroll at every size compiled in, not only the smallest.
+    ///
+    /// With `FUSED` each multiply-add is one fused operation (`f64::mul_add`: one rounding
+    /// instead of two); the caller instantiates it only inside a function compiled for a
+    /// processor with fused multiply-add (elsewhere `mul_add` is a library call). The terms
+    /// and their order are the same, so the two differ by rounding alone.
     #[inline(always)]
-    pub(crate) fn variances_of_upper_rows<const N: usize>(
+    pub(crate) fn variances_of_upper_rows<const N: usize, const FUSED: bool>(
         &self,
         p: usize,
         entry: impl Fn(usize, usize) -> f64 + Copy,
@@ -506,7 +511,7 @@ impl InformationFilter {
             for (j, earlier) in done.iter().enumerate() {
                 let c = u[j * p + k];
                 for (v, e) in row[..j + 1].iter_mut().zip(&earlier[..j + 1]) {
-                    *v -= c * e;
+                    *v = sub_mul::<FUSED>(*v, c, *e);
                 }
             }
         });
@@ -515,7 +520,7 @@ impl InformationFilter {
             None => {
                 each_index!(p, k => {
                     for (s, v) in sum[..k + 1].iter_mut().zip(&y[k][..k + 1]) {
-                        *s += v * v * inv_d[k];
+                        *s = add_mul::<FUSED>(*s, v * v, inv_d[k]);
                     }
                 });
                 let s2 = self.scale * self.scale;
@@ -540,7 +545,7 @@ impl InformationFilter {
                     for (j, earlier) in done.iter().enumerate() {
                         let c = u[j * p + k];
                         for (v, e) in col[..j].iter_mut().zip(&earlier[..j]) {
-                            *v -= c * e;
+                            *v = sub_mul::<FUSED>(*v, c, *e);
                         }
                         // `earlier[j] = T_jj = 1`: `c · 1` is `c`, bit for bit.
                         col[j] -= c;
@@ -562,11 +567,11 @@ impl InformationFilter {
                     for k in r + 1..p {
                         let c = tc[k][r];
                         for (v, w) in z[..k + 1].iter_mut().zip(&y[k][..k + 1]) {
-                            *v += c * w;
+                            *v = add_mul::<FUSED>(*v, c, *w);
                         }
                     }
                     for (s, v) in sum[..p].iter_mut().zip(&z) {
-                        *s += dq[r] * v * v;
+                        *s = add_mul::<FUSED>(*s, dq[r] * v, *v);
                     }
                 });
                 out.copy_from_slice(&sum[..p]);
@@ -726,5 +731,26 @@ impl InformationFilter {
             ));
         }
         Ok(())
+    }
+}
+
+/// `v − c·e`: one fused multiply-add with `FUSED`, else the product rounded, then the
+/// difference ([`InformationFilter::variances_of_upper_rows`]).
+#[inline(always)]
+fn sub_mul<const FUSED: bool>(v: f64, c: f64, e: f64) -> f64 {
+    if FUSED {
+        (-c).mul_add(e, v)
+    } else {
+        v - c * e
+    }
+}
+
+/// `s + a·b`: one fused multiply-add with `FUSED`, else the product rounded, then the sum.
+#[inline(always)]
+fn add_mul<const FUSED: bool>(s: f64, a: f64, b: f64) -> f64 {
+    if FUSED {
+        a.mul_add(b, s)
+    } else {
+        s + a * b
     }
 }

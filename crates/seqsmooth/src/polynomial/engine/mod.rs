@@ -361,7 +361,7 @@ impl EngineState {
                 for ((&t, &y), row) in ts.iter().zip(ys).zip(rows.chunks_exact_mut(2 * w)) {
                     e.update(t, y);
                     let (d, s) = row.split_at_mut(w);
-                    if !(e.derivatives_into(t, d) && e.std_devs_into(t, s)) {
+                    if !(e.derivatives_into(t, d) && e.batch_std_devs_into(t, s)) {
                         row.fill(f64::NAN);
                     }
                 }
