@@ -57,8 +57,15 @@ pub use left_out::{DynamicsLeftOut, ObservationLeftOut};
 pub const MAGIC: [u8; 8] = *b"SEQSMST\0";
 
 /// The version of the saved form this library writes; a saved state of a later version is
-/// refused.
-pub const FORMAT_VERSION: u16 = 1;
+/// refused, every earlier one read.
+///
+/// - 1: the first.
+/// - 2 (2026-12-07): an automatic filter's shorter memory may hold its degree-`m` filter behind
+///   its companion's samples, brought up to them from the companion's leading block when the
+///   memory is compared or used; a reader of version 1 would take the lagging filter as
+///   current, so it refuses these states instead. Version 1's states read as before (their
+///   filters never lag).
+pub const FORMAT_VERSION: u16 = 2;
 
 /// A type with a saved form: its name in the envelope and the invariants a decoded value must
 /// hold before it is handed out.

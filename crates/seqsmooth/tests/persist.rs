@@ -258,9 +258,9 @@ fn another_type_and_a_newer_version_are_refused_by_name() {
         "{why}"
     );
     let mut newer = bytes.clone();
-    newer[8] = 2;
+    newer[8] = 3;
     let why = damaged(from_bytes::<AnyFilter>(&newer).unwrap_err());
-    assert!(why.contains("format version 2"), "{why}");
+    assert!(why.contains("format version 3"), "{why}");
     let why = damaged(from_bytes::<AnyFilter>(b"not a saved state at all").unwrap_err());
     assert!(why.contains("tag"), "{why}");
 }
@@ -269,7 +269,7 @@ fn another_type_and_a_newer_version_are_refused_by_name() {
 /// looks like.
 fn envelope(name: &str, body: &[u8]) -> Vec<u8> {
     let mut out = b"SEQSMST\0".to_vec();
-    out.extend_from_slice(&1u16.to_le_bytes());
+    out.extend_from_slice(&seqsmooth::persist::FORMAT_VERSION.to_le_bytes());
     out.push(name.len() as u8);
     out.extend_from_slice(name.as_bytes());
     out.extend_from_slice(&(body.len() as u64).to_le_bytes());
@@ -682,4 +682,59 @@ fn an_automatic_state_saved_with_the_old_ladder_keeps_it() {
         assert!(o.estimate().is_some());
         assert_eq!(upper.estimate(), o.estimate());
     }
+}
+
+#[test]
+fn an_automatic_state_of_version_1_reads_as_before() {
+    // Version 1 had no `stale` flag (every shorter memory's filter was current): such a body,
+    // the key taken out of a state saved mid-run, resumes exactly as the same body with the
+    // flag written `false`.
+    let mut f = AutomaticFilter::new(2, 0.95, 1.0).unwrap();
+    let samples = gentle(300);
+    for &(t, y) in &samples[..150] {
+        f.update(t, y).unwrap();
+    }
+    let mut written = automatic_body(&f);
+    let mut left_out = automatic_body(&f);
+    let mut flags = 0;
+    for fresh in [false, true] {
+        for s in shorter(&mut written, fresh).iter_mut() {
+            *entry(s, "stale") = ciborium::Value::Bool(false);
+            flags += 1;
+        }
+        for s in shorter(&mut left_out, fresh).iter_mut() {
+            let map = s.as_map_mut().unwrap();
+            map.retain(|(k, _)| k.as_text() != Some("stale"));
+            assert!(map.iter().all(|(k, _)| k.as_text() != Some("stale")));
+        }
+    }
+    assert!(flags > 0, "the state has shorter memories");
+    let mut a = automatic_from(&written).unwrap();
+    let mut b = automatic_from(&left_out).unwrap();
+    for &(t, y) in &samples[150..] {
+        assert_eq!(
+            format!("{:?}", a.update(t, y).unwrap()),
+            format!("{:?}", b.update(t, y).unwrap())
+        );
+    }
+    assert_eq!(to_bytes(&a).unwrap(), to_bytes(&b).unwrap());
+}
+
+#[test]
+fn an_automatic_state_whose_shorter_pair_differs_is_refused() {
+    // `Shorter::sync` takes a memory's filter from its companion's leading block; a crafted
+    // pair of different discounts would leave the filter behind for good.
+    let mut f = AutomaticFilter::new(2, 0.95, 1.0).unwrap();
+    for (t, y) in gentle(20) {
+        f.update(t, y).unwrap();
+    }
+    let mut body = automatic_body(&f);
+    let s = &mut shorter(&mut body, false)[0];
+    let other = FadingMemory::new(3, 0.5, 1.0, Engine::Exact)
+        .unwrap()
+        .with_noise_sigma(1.0)
+        .unwrap();
+    *entry(s, "upper") = ciborium::Value::serialized(&other).unwrap();
+    let why = automatic_refused(&body);
+    assert!(why.contains("differ in discount"), "{why}");
 }

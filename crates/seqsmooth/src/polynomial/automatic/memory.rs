@@ -207,6 +207,7 @@ impl Shorter {
     fn sync(&mut self) {
         if self.stale {
             let synced = self.fading.follow_leading(&self.upper);
+            // Every pair is built matching (`shorter_memories`) and checked on restore.
             debug_assert!(synced, "a shorter memory's filters do not match");
             self.stale = !synced;
         }
@@ -712,6 +713,15 @@ impl Memories {
                 s.upper.check_saved()?;
                 degree(&s.fading, m)?;
                 degree(&s.upper, m + 1)?;
+                // `Shorter::sync` takes the filter from its companion's leading block: a pair
+                // that does not match (discount, engine, σ, prior) would leave it behind.
+                if !s.fading.clone().follow_leading(&s.upper) {
+                    return Err(
+                        "a shorter memory's filter and its companion differ in discount, \
+                         engine or noise"
+                            .to_string(),
+                    );
+                }
             }
         }
         if self.memory > self.shorter.len() {
