@@ -1,4 +1,4 @@
-//! One factor per memory (`memory.rs`'s `fading_pair`): a degree-`m` filter taken from its
+//! One factor per memory (`memory.rs`'s `update_pair`): a degree-`m` filter taken from its
 //! degree `m + 1` companion's leading block against the same filter updated with the samples
 //! itself, on long irregular runs at degrees 0-8: estimates, their covariance (σ) and the
 //! residual sum of squares agree to rounding.

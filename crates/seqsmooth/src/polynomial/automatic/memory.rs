@@ -147,36 +147,38 @@ fn upper_pair(cfg: &AutoConfig) -> Result<UpperPair, Error> {
     ))
 }
 
-/// Applies a sample to a degree-`m` fading-memory filter and its degree `m + 1` companion (if
-/// any): the companion updated, then the filter taken from the companion's leading block
-/// ([`FadingMemory::follow_leading`]: on the exact engine the degree-`m` discounted least
-/// squares is the first `m + 1` columns of the degree-`m + 1` one, so one factor serves both),
-/// or updated itself where that does not apply (the gain engine, no companion).
-fn fading_pair(
-    lower: &mut FadingMemory,
-    upper: Option<&mut FadingMemory>,
-    t: f64,
-    y: f64,
-) -> Result<(), Error> {
-    if let Some(upper) = upper {
-        upper.update(t, y)?;
-        if lower.follow_leading(upper) {
-            return Ok(());
-        }
-    }
-    lower.update(t, y)
+/// A filter whose degree-`m` estimate can be taken from its degree `m + 1` companion's
+/// leading block ([`FadingMemory::follow_leading`], [`ExpandingMemory::follow_leading`]).
+trait FollowLeading: PolynomialFilter {
+    fn follow(&mut self, upper: &Self) -> bool;
 }
 
-/// [`fading_pair`] for the expanding-memory filters.
-fn expanding_pair(
-    lower: &mut ExpandingMemory,
-    upper: Option<&mut ExpandingMemory>,
+impl FollowLeading for FadingMemory {
+    fn follow(&mut self, upper: &Self) -> bool {
+        self.follow_leading(upper)
+    }
+}
+
+impl FollowLeading for ExpandingMemory {
+    fn follow(&mut self, upper: &Self) -> bool {
+        self.follow_leading(upper)
+    }
+}
+
+/// Applies a sample to a degree-`m` filter and its degree `m + 1` companion (if any): the
+/// companion updated, then the filter taken from the companion's leading block (on the exact
+/// engine the degree-`m` discounted least squares is the first `m + 1` columns of the
+/// degree-`m + 1` one, so one factor serves both), or updated itself where that does not
+/// apply (the gain engine, no companion).
+fn update_pair<F: FollowLeading>(
+    lower: &mut F,
+    upper: Option<&mut F>,
     t: f64,
     y: f64,
 ) -> Result<(), Error> {
     if let Some(upper) = upper {
         upper.update(t, y)?;
-        if lower.follow_leading(upper) {
+        if lower.follow(upper) {
             return Ok(());
         }
     }
@@ -356,8 +358,8 @@ impl Memories {
                 s.upper.update(k.t, k.y)?;
                 s.stale = true;
             }
-            expanding_pair(&mut expanding, upper_expanding.as_mut(), k.t, k.y)?;
-            fading_pair(&mut fading, upper_fading.as_mut(), k.t, k.y)?;
+            update_pair(&mut expanding, upper_expanding.as_mut(), k.t, k.y)?;
+            update_pair(&mut fading, upper_fading.as_mut(), k.t, k.y)?;
         }
         self.expanding = Some(expanding);
         self.fading = fading;
@@ -375,11 +377,11 @@ impl Memories {
     /// Applies an accepted sample to every memory and companion.
     pub(super) fn update(&mut self, t: f64, y: f64) -> Result<(), Error> {
         if let Some(f) = &mut self.expanding {
-            expanding_pair(f, self.upper_expanding.as_mut(), t, y)?;
+            update_pair(f, self.upper_expanding.as_mut(), t, y)?;
         } else if let Some(f) = &mut self.upper_expanding {
             f.update(t, y)?;
         }
-        fading_pair(&mut self.fading, self.upper_fading.as_mut(), t, y)?;
+        update_pair(&mut self.fading, self.upper_fading.as_mut(), t, y)?;
         // A shorter memory's own filter only where it is in use; the others' when compared.
         for (j, s) in self.shorter.iter_mut().enumerate() {
             s.upper.update(t, y)?;
