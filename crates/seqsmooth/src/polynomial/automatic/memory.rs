@@ -348,24 +348,27 @@ impl Memories {
     /// The memories rebuilt from the `kept` samples (a restart, [`MisfitResponse::Restart`]):
     /// memory 0 expanding again, the calibration cleared.
     pub(super) fn rebuild(&mut self, kept: &[Kept]) -> Result<(), Error> {
+        // Into the filters' own places (`clone_from`: the shorter memories' vector keeps its
+        // allocation); the samples cannot fail on filters built from checked settings, and the
+        // state is the caller's to restore should they (`Review::recover`).
         let fresh = &self.fresh;
-        let mut expanding = fresh.expanding.clone();
-        let mut fading = fresh.fading.clone();
-        let (mut upper_expanding, mut upper_fading) = fresh.upper.clone();
-        let mut shorter = fresh.shorter.clone();
+        match &mut self.expanding {
+            Some(e) => e.clone_from(&fresh.expanding),
+            None => self.expanding = Some(fresh.expanding.clone()),
+        }
+        self.fading.clone_from(&fresh.fading);
+        self.upper_expanding.clone_from(&fresh.upper.0);
+        self.upper_fading.clone_from(&fresh.upper.1);
+        self.shorter.clone_from(&fresh.shorter);
+        let expanding = self.expanding.as_mut().expect("set above");
         for k in kept {
-            for s in &mut shorter {
+            for s in &mut self.shorter {
                 s.upper.update(k.t, k.y)?;
                 s.stale = true;
             }
-            update_pair(&mut expanding, upper_expanding.as_mut(), k.t, k.y)?;
-            update_pair(&mut fading, upper_fading.as_mut(), k.t, k.y)?;
+            update_pair(expanding, self.upper_expanding.as_mut(), k.t, k.y)?;
+            update_pair(&mut self.fading, self.upper_fading.as_mut(), k.t, k.y)?;
         }
-        self.expanding = Some(expanding);
-        self.fading = fading;
-        self.upper_expanding = upper_expanding;
-        self.upper_fading = upper_fading;
-        self.shorter = shorter;
         self.memory = 0;
         self.longer_runs = 0;
         self.calibration.clear();
