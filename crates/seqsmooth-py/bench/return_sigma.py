@@ -3,10 +3,13 @@
 call then also keeps its covariance), degree 2 (or ``--degree M``), best of 2 calls on fresh
 filters (or ``--repeat K``), in seconds of wall time and of the calling thread's CPU time (the
 figure that a busy machine disturbs least), and their ratios; ``--exact`` runs the exact
-engine's filters only. Run in target/py-venv after installing the package:
+engine's filters only; ``--out`` gives each call an ``out=`` array made (and written) once
+before the timed calls, so that the new memory's page faults and clearing are left out of both
+figures. Run in target/py-venv after installing the package:
 
     target/py-venv/bin/python crates/seqsmooth-py/bench/return_sigma.py
     target/py-venv/bin/python crates/seqsmooth-py/bench/return_sigma.py --exact --degree 8
+    target/py-venv/bin/python crates/seqsmooth-py/bench/return_sigma.py --exact --degree 8 --out
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ def main() -> None:
     parser.add_argument("--degree", type=int, default=2)
     parser.add_argument("--repeat", type=int, default=2)
     parser.add_argument("--exact", action="store_true", help="the exact engine's filters only")
+    parser.add_argument("--out", action="store_true", help="reuse one written out= array per path")
     args = parser.parse_args()
     m = args.degree
     rng = np.random.default_rng(1)
@@ -40,7 +44,9 @@ def main() -> None:
     }
     if args.exact:
         makers = {name: make for name, make in makers.items() if name.endswith("exact")}
-    print(f"degree {m}, {N} samples, best of {args.repeat}", flush=True)
+    buffers = {s: np.ones((N, (m + 1) * (1 + s))) if args.out else None for s in (False, True)}
+    pages = ", out= arrays written before timing" if args.out else ""
+    print(f"degree {m}, {N} samples, best of {args.repeat}{pages}", flush=True)
     for name, make in makers.items():
         wall, cpu = {}, {}
         for sigma in (False, True):
@@ -48,7 +54,7 @@ def main() -> None:
             for _ in range(args.repeat):
                 f = make()
                 start, start_cpu = time.perf_counter(), time.thread_time()
-                f.update_many(t, y, return_sigma=sigma)
+                f.update_many(t, y, return_sigma=sigma, out=buffers[sigma])
                 wall[sigma] = min(wall[sigma], time.perf_counter() - start)
                 cpu[sigma] = min(cpu[sigma], time.thread_time() - start_cpu)
         print(

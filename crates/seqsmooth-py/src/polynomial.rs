@@ -8,7 +8,7 @@
 use crate::arrays::{matrix, pair, zeros};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::persist;
-use numpy::{PyArray1, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PySlice, PyTuple, PyType};
 use seqsmooth::discount::Discount;
@@ -193,6 +193,14 @@ impl PyPolynomialFilter {
     /// with its rule: a row the determined fit cannot give (a fading discount that
     /// underflowed, a number beyond the double range) is refused with its index.
     ///
+    /// ``out``, a C-contiguous, writeable float64 array of that ``(len(t), m+1)`` or
+    /// ``(len(t), 2(m+1))`` shape, is written instead of a new array and returned (with
+    /// ``return_sigma``, as its two views): a caller running many batches reuses one buffer
+    /// and pays for no new memory per call (on some systems the clearing of a new array's
+    /// pages costs as much as the σ themselves: BENCHMARKS.md, "The batch σ path"). On an
+    /// error its rows before the refused sample hold their estimates; the rest are
+    /// unspecified.
+    ///
     /// The work runs without the GIL; Ctrl-C stops it between blocks of 65,536 samples, the
     /// samples before the block taken.
     ///
@@ -200,18 +208,20 @@ impl PyPolynomialFilter {
     /// ------
     /// InvalidInputError
     ///     NaN or infinite values, times that do not increase (``.index`` is the sample's
-    ///     position; the samples before it are taken), mismatched or empty arrays.
+    ///     position; the samples before it are taken), mismatched or empty arrays; an ``out``
+    ///     of the wrong shape, not C-contiguous or not writeable (nothing is taken).
     /// InvalidTypeError
-    ///     arrays that do not hold real numbers.
+    ///     arrays that do not hold real numbers; an ``out`` that is not a float64 array.
     /// NotDeterminedError, NumericalError
     ///     a row refused (``.index`` its position).
-    #[pyo3(signature = (t, y, return_sigma = false))]
+    #[pyo3(signature = (t, y, return_sigma = false, *, out = None))]
     fn update_many<'py>(
         &mut self,
         py: Python<'py>,
         t: &Bound<'py, PyAny>,
         y: &Bound<'py, PyAny>,
         return_sigma: bool,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (ts, ys) = pair(t, y)?;
         let (t, y) = (ts.as_slice(), ys.as_slice());
@@ -221,10 +231,18 @@ impl PyPolynomialFilter {
             ..RowLayout::default()
         };
         let stride = self.filter.stride(layout);
-        let rows = zeros(py, n, stride);
+        let rows = match out {
+            Some(given) => output_buffer(given, n, stride)?,
+            None => zeros(py, n, stride),
+        };
         {
-            let mut buffer = rows.readwrite();
-            let out = buffer.as_slice_mut().expect("a new array is contiguous");
+            let mut buffer = rows.try_readwrite().map_err(|e| {
+                let why = format!("out is not writeable, or is in use by another array ({e})");
+                raise(Kind::InvalidInput, why, None)
+            })?;
+            let out = buffer
+                .as_slice_mut()
+                .map_err(|_| raise(Kind::InvalidInput, "out is not C-contiguous", None))?;
             for start in (0..n).step_by(CHUNK) {
                 let end = (start + CHUNK).min(n);
                 let (tc, yc) = (&t[start..end], &y[start..end]);
@@ -271,6 +289,37 @@ impl PyPolynomialFilter {
             this.filter.last_time()
         ))
     }
+}
+
+/// The caller's `out` for [`PyPolynomialFilter::update_many`]: a float64 array of `n × stride`
+/// cells, C-contiguous and writeable (each checked before any sample is taken).
+fn output_buffer<'py>(
+    out: &Bound<'py, PyAny>,
+    n: usize,
+    stride: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let array = out.cast::<PyArray2<f64>>().map_err(|_| {
+        raise(
+            Kind::InvalidType,
+            format!("out must be a 2-D float64 numpy array of shape ({n}, {stride})"),
+            None,
+        )
+    })?;
+    let shape = array.shape();
+    if shape != [n, stride] {
+        return Err(raise(
+            Kind::InvalidInput,
+            format!(
+                "out has shape ({}, {}); these {n} samples need ({n}, {stride})",
+                shape[0], shape[1]
+            ),
+            None,
+        ));
+    }
+    if !array.is_c_contiguous() {
+        return Err(raise(Kind::InvalidInput, "out is not C-contiguous", None));
+    }
+    Ok(array.clone())
 }
 
 /// The engine named `name`: `"exact"` or `"gain"`.

@@ -4,6 +4,8 @@ recursion), against a direct least-squares solve, and their errors."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -65,6 +67,72 @@ def test_update_many_equals_the_command_to_the_last_bit(
         same_bits(sd, np.column_stack([want[f"s{k}"] for k in range(m + 1)]))
     else:
         same_bits(got, d)
+
+
+@pytest.mark.parametrize("kind,kwargs,flags", CASES, ids=[c[0] for c in CASES])
+@pytest.mark.parametrize("with_sigma", [False, True])
+def test_update_many_into_out_is_the_new_arrays_bits(rng, kind, kwargs, flags, with_sigma):
+    # A reused out= buffer, dirty from the batch before, written in place: the same bits as
+    # new arrays, batch after batch, and the returned arrays are that buffer (or its views).
+    t, y = irregular_series(rng, 300)
+    m = kwargs["degree"]
+    sigma = 0.3 if with_sigma else None
+    fresh, reused = make(kind, kwargs, sigma), make(kind, kwargs, sigma)
+    out = np.full((100, (m + 1) * (2 if with_sigma else 1)), 1e300)
+    for start in range(0, 300, 100):
+        part = slice(start, start + 100)
+        want = fresh.update_many(t[part], y[part], return_sigma=with_sigma)
+        got = reused.update_many(t[part], y[part], return_sigma=with_sigma, out=out)
+        if with_sigma:
+            for a, b in zip(got, want):
+                same_bits(a, b)
+                assert np.shares_memory(a, out)
+            np.testing.assert_array_equal(np.hstack(got), out)
+        else:
+            assert got is out
+            same_bits(got, want)
+
+
+@pytest.mark.parametrize(
+    "bad,error,words",
+    [
+        (np.empty((50, 5)), ss.InvalidInputError, "shape (50, 5)"),
+        (np.empty((49, 6)), ss.InvalidInputError, "need (50, 6)"),
+        (np.empty((50, 6), dtype=np.float32), ss.InvalidTypeError, "float64"),
+        (np.empty(300), ss.InvalidTypeError, "2-D"),
+        (np.empty((50, 6), order="F"), ss.InvalidInputError, "C-contiguous"),
+        (np.empty((100, 6))[::2], ss.InvalidInputError, "C-contiguous"),
+        ([[0.0] * 6] * 50, ss.InvalidTypeError, "numpy array"),
+    ],
+)
+def test_update_many_refuses_an_unusable_out_before_taking_a_sample(bad, error, words):
+    f = ss.FadingMemory(2, 0.9, 1.0, sigma=0.3)
+    t = np.arange(50.0)
+    with pytest.raises(error, match=re.escape(words)):
+        f.update_many(t, np.sin(t), return_sigma=True, out=bad)
+    assert f.samples == 0
+
+
+def test_update_many_refuses_a_read_only_out():
+    out = np.empty((10, 2))
+    out.flags.writeable = False
+    f = ss.FadingMemory(1, 0.9, 1.0)
+    with pytest.raises(ss.InvalidInputError, match="not writeable"):
+        f.update_many(np.arange(10.0), np.ones(10), out=out)
+    assert f.samples == 0
+
+
+def test_update_many_out_keeps_the_rows_before_a_refused_sample():
+    t = np.arange(10.0)
+    y = np.ones(10)
+    y[6] = np.nan
+    out = np.full((10, 2), 5.0)
+    f = ss.FadingMemory(1, 0.9, 1.0)
+    with pytest.raises(ss.InvalidInputError) as e:
+        f.update_many(t, y, out=out)
+    assert e.value.index == 6 and f.samples == 6
+    want = ss.FadingMemory(1, 0.9, 1.0).update_many(t[:6], y[:6])
+    same_bits(out[:6], want)
 
 
 @pytest.mark.parametrize("kind,kwargs,flags", CASES, ids=[c[0] for c in CASES])

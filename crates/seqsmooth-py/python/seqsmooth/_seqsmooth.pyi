@@ -42,11 +42,21 @@ class PolynomialFilter:
     def update(self, t: float, y: float) -> None: ...
     @overload
     def update_many(
-        self, t: ArrayLike, y: ArrayLike, return_sigma: Literal[False] = ...
+        self,
+        t: ArrayLike,
+        y: ArrayLike,
+        return_sigma: Literal[False] = ...,
+        *,
+        out: Matrix | None = None,
     ) -> Matrix: ...
     @overload
     def update_many(
-        self, t: ArrayLike, y: ArrayLike, return_sigma: Literal[True]
+        self,
+        t: ArrayLike,
+        y: ArrayLike,
+        return_sigma: Literal[True],
+        *,
+        out: Matrix | None = None,
     ) -> tuple[Matrix, Matrix]: ...
     def estimate(self) -> State: ...
     def estimate_at(self, t: float) -> State: ...
