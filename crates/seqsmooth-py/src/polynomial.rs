@@ -8,7 +8,9 @@
 use crate::arrays::{matrix, pair, zeros};
 use crate::errors::{raise, IntoPy, Kind};
 use crate::persist;
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{
+    PyArray1, PyArray2, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PySlice, PyTuple, PyType};
 use seqsmooth::discount::Discount;
@@ -188,8 +190,9 @@ impl PyPolynomialFilter {
     /// needs its noise ``sigma``): the two are views of one ``(len(t), 2(m+1))`` buffer, the
     /// rows ``d0..dM, s0..sM`` of ``seqsmooth filter --sigma``, written by the library's batch
     /// σ path (no covariance matrix per sample; 1.1-1.6× the plain call's time for the gain
-    /// engines and fixed memory, the output being twice as large; more for the exact engine's
-    /// fading filter at degree 4 and up: BENCHMARKS.md). The rows are the library's row runner's,
+    /// engines and fixed memory, the output being twice as large; under 2× for the exact
+    /// engine at degrees to 8 into a reused ``out``, more into new arrays where clearing new
+    /// memory is slow: BENCHMARKS.md). The rows are the library's row runner's,
     /// with its rule: a row the determined fit cannot give (a fading discount that
     /// underflowed, a number beyond the double range) is refused with its index.
     ///
@@ -197,9 +200,10 @@ impl PyPolynomialFilter {
     /// ``(len(t), 2(m+1))`` shape, is written instead of a new array and returned (with
     /// ``return_sigma``, as its two views): a caller running many batches reuses one buffer
     /// and pays for no new memory per call (on some systems the clearing of a new array's
-    /// pages costs as much as the σ themselves: BENCHMARKS.md, "The batch σ path"). On an
-    /// error its rows before the refused sample hold their estimates; the rest are
-    /// unspecified.
+    /// pages costs as much as the σ themselves: BENCHMARKS.md, "The batch σ path"). It must
+    /// not share memory with ``t`` or ``y`` (refused), and, as with numpy's ``out=``, no other
+    /// thread may use it during the call (the work runs without the GIL). On an error its
+    /// rows before the refused sample hold their estimates; the rest are unspecified.
     ///
     /// The work runs without the GIL; Ctrl-C stops it between blocks of 65,536 samples, the
     /// samples before the block taken.
@@ -236,13 +240,8 @@ impl PyPolynomialFilter {
             None => zeros(py, n, stride),
         };
         {
-            let mut buffer = rows.try_readwrite().map_err(|e| {
-                let why = format!("out is not writeable, or is in use by another array ({e})");
-                raise(Kind::InvalidInput, why, None)
-            })?;
-            let out = buffer
-                .as_slice_mut()
-                .map_err(|_| raise(Kind::InvalidInput, "out is not C-contiguous", None))?;
+            let mut buffer = writable_rows(&rows, [t, y])?;
+            let out = buffer.as_slice_mut().expect("checked by writable_rows");
             for start in (0..n).step_by(CHUNK) {
                 let end = (start + CHUNK).min(n);
                 let (tc, yc) = (&t[start..end], &y[start..end]);
@@ -291,35 +290,67 @@ impl PyPolynomialFilter {
     }
 }
 
-/// The caller's `out` for [`PyPolynomialFilter::update_many`]: a float64 array of `n × stride`
-/// cells, C-contiguous and writeable (each checked before any sample is taken).
+/// The caller's `out` for [`PyPolynomialFilter::update_many`]: a float64 array (native byte
+/// order) of shape `n × stride`, C-contiguous, checked before any sample is taken — a wrong
+/// dtype or object is [`Kind::InvalidType`], a wrong shape or order [`Kind::InvalidInput`], as
+/// `arrays`' checks of inputs are; writeability, alignment and overlap with the inputs are
+/// checked as it is borrowed ([`writable_rows`]).
 fn output_buffer<'py>(
     out: &Bound<'py, PyAny>,
     n: usize,
     stride: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let array = out.cast::<PyArray2<f64>>().map_err(|_| {
-        raise(
-            Kind::InvalidType,
-            format!("out must be a 2-D float64 numpy array of shape ({n}, {stride})"),
-            None,
-        )
+    let need = format!("({n}, {stride})");
+    let untyped = out.cast::<PyUntypedArray>().map_err(|_| {
+        let kind = out.get_type().name().map_or("?".into(), |s| s.to_string());
+        let why = format!("out must be a float64 numpy array of shape {need}, not a {kind}");
+        raise(Kind::InvalidType, why, None)
     })?;
-    let shape = array.shape();
-    if shape != [n, stride] {
-        return Err(raise(
-            Kind::InvalidInput,
-            format!(
-                "out has shape ({}, {}); these {n} samples need ({n}, {stride})",
-                shape[0], shape[1]
-            ),
-            None,
-        ));
+    let dtype = untyped.dtype();
+    if !dtype.is_equiv_to(&numpy::dtype::<f64>(out.py())) {
+        let why = format!("out has dtype {dtype}; it must be float64 in native byte order");
+        return Err(raise(Kind::InvalidType, why, None));
     }
-    if !array.is_c_contiguous() {
+    let shape = untyped.shape();
+    if shape != [n, stride] {
+        let dims: Vec<String> = shape.iter().map(usize::to_string).collect();
+        let got = match dims.len() {
+            1 => format!("({},)", dims[0]),
+            _ => format!("({})", dims.join(", ")),
+        };
+        let why = format!("out has shape {got}; these {n} samples need {need}");
+        return Err(raise(Kind::InvalidInput, why, None));
+    }
+    if !untyped.is_c_contiguous() {
         return Err(raise(Kind::InvalidInput, "out is not C-contiguous", None));
     }
-    Ok(array.clone())
+    Ok(untyped.cast::<PyArray2<f64>>()?.clone())
+}
+
+/// `rows` borrowed for writing, refused when it cannot be written as a contiguous, aligned
+/// float64 slice or when its memory overlaps an input's (`t` or `y` over the same buffer,
+/// which numpy's own check of a shared base does not see for two `frombuffer` arrays).
+fn writable_rows<'py>(
+    rows: &Bound<'py, PyArray2<f64>>,
+    inputs: [&[f64]; 2],
+) -> PyResult<numpy::PyReadwriteArray2<'py, f64>> {
+    let mut buffer = rows.try_readwrite().map_err(|e| {
+        let why = format!("out is not writeable, or is in use by another array ({e})");
+        raise(Kind::InvalidInput, why, None)
+    })?;
+    let out = buffer.as_slice_mut().map_err(|_| {
+        let why = "out could not be written as a contiguous, aligned float64 array";
+        raise(Kind::InvalidInput, why, None)
+    })?;
+    let span = out.as_ptr_range();
+    for (name, input) in ["t", "y"].into_iter().zip(inputs) {
+        let other = input.as_ptr_range();
+        if span.start < other.end && other.start < span.end {
+            let why = format!("out shares memory with {name}: give it a buffer of its own");
+            return Err(raise(Kind::InvalidInput, why, None));
+        }
+    }
+    Ok(buffer)
 }
 
 /// The engine named `name`: `"exact"` or `"gain"`.

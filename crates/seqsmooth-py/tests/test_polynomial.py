@@ -98,11 +98,17 @@ def test_update_many_into_out_is_the_new_arrays_bits(rng, kind, kwargs, flags, w
     [
         (np.empty((50, 5)), ss.InvalidInputError, "shape (50, 5)"),
         (np.empty((49, 6)), ss.InvalidInputError, "need (50, 6)"),
-        (np.empty((50, 6), dtype=np.float32), ss.InvalidTypeError, "float64"),
-        (np.empty(300), ss.InvalidTypeError, "2-D"),
+        (np.empty((50, 6), dtype=np.float32), ss.InvalidTypeError, "dtype float32"),
+        (np.empty((50, 6), dtype=">f8"), ss.InvalidTypeError, "native byte order"),
+        (np.empty(300), ss.InvalidInputError, "shape (300,)"),
         (np.empty((50, 6), order="F"), ss.InvalidInputError, "C-contiguous"),
         (np.empty((100, 6))[::2], ss.InvalidInputError, "C-contiguous"),
-        ([[0.0] * 6] * 50, ss.InvalidTypeError, "numpy array"),
+        (
+            np.frombuffer(bytearray(50 * 6 * 8 + 1), offset=1).reshape(50, 6),
+            ss.InvalidInputError,
+            "aligned",
+        ),
+        ([[0.0] * 6] * 50, ss.InvalidTypeError, "not a list"),
     ],
 )
 def test_update_many_refuses_an_unusable_out_before_taking_a_sample(bad, error, words):
@@ -111,6 +117,23 @@ def test_update_many_refuses_an_unusable_out_before_taking_a_sample(bad, error, 
     with pytest.raises(error, match=re.escape(words)):
         f.update_many(t, np.sin(t), return_sigma=True, out=bad)
     assert f.samples == 0
+
+
+def test_update_many_refuses_an_out_over_its_inputs_memory():
+    # Two frombuffer arrays over one buffer have different bases, so numpy's borrow check
+    # does not see them overlap: the filter compares the memory itself.
+    memory = bytearray(8 * 30)
+    y = np.frombuffer(memory, count=10)
+    y[:] = np.arange(10.0)
+    out = np.frombuffer(memory, offset=8 * 3, count=10).reshape(10, 1)
+    f = ss.ExpandingMemory(0)
+    with pytest.raises(ss.InvalidInputError, match="shares memory with y"):
+        f.update_many(np.arange(10.0), y, out=out)
+    assert f.samples == 0
+    # Beside it, not over it: taken.
+    apart = np.frombuffer(memory, offset=8 * 10, count=10).reshape(10, 1)
+    got = ss.ExpandingMemory(0).update_many(np.arange(10.0), y, out=apart)
+    np.testing.assert_allclose(got[:, 0], np.cumsum(np.arange(10.0)) / np.arange(1, 11))
 
 
 def test_update_many_refuses_a_read_only_out():
