@@ -5,7 +5,9 @@ filters (or ``--repeat K``), in seconds of wall time and of the calling thread's
 figure that a busy machine disturbs least), and their ratios; ``--exact`` runs the exact
 engine's filters only; ``--out`` gives each call an ``out=`` array made (and written) once
 before the timed calls, so that the new memory's page faults and clearing are left out of both
-figures. Run in target/py-venv after installing the package:
+figures; ``--no-huge-pages`` turns transparent huge pages off for the process (Linux
+``prctl(PR_SET_THP_DISABLE)``), so that new arrays are cleared 4 KiB at a time. Run in
+target/py-venv after installing the package:
 
     target/py-venv/bin/python crates/seqsmooth-py/bench/return_sigma.py
     target/py-venv/bin/python crates/seqsmooth-py/bench/return_sigma.py --exact --degree 8
@@ -15,6 +17,7 @@ figures. Run in target/py-venv after installing the package:
 from __future__ import annotations
 
 import argparse
+import ctypes
 import time
 
 import numpy as np
@@ -30,7 +33,10 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=2)
     parser.add_argument("--exact", action="store_true", help="the exact engine's filters only")
     parser.add_argument("--out", action="store_true", help="reuse one written out= array per path")
+    parser.add_argument("--no-huge-pages", action="store_true", help="THP off (Linux prctl)")
     args = parser.parse_args()
+    if args.no_huge_pages and ctypes.CDLL(None).prctl(41, 1, 0, 0, 0) != 0:  # PR_SET_THP_DISABLE
+        raise SystemExit("prctl(PR_SET_THP_DISABLE) failed")
     m = args.degree
     rng = np.random.default_rng(1)
     t = np.arange(N, dtype=np.float64)
@@ -46,6 +52,7 @@ def main() -> None:
         makers = {name: make for name, make in makers.items() if name.endswith("exact")}
     buffers = {s: np.ones((N, (m + 1) * (1 + s))) if args.out else None for s in (False, True)}
     pages = ", out= arrays written before timing" if args.out else ""
+    pages += ", no huge pages" if args.no_huge_pages else ""
     print(f"degree {m}, {N} samples, best of {args.repeat}{pages}", flush=True)
     for name, make in makers.items():
         wall, cpu = {}, {}
