@@ -629,7 +629,7 @@ mod tests {
                 let n = (degree + 1) * axes;
                 let dynamics = PolynomialDynamics::new(degree, axes);
                 let mut f = KalmanFilter::new(
-                    dynamics.clone(),
+                    dynamics,
                     LinearObservation::value_of(n),
                     DVector::from_element(n, 0.5),
                     DMatrix::identity(n, n),
