@@ -57,11 +57,6 @@ pub(super) struct Work {
     pub(super) q: DMatrix<f64>,
     pub(super) s: DMatrix<f64>,
     pub(super) p: DMatrix<f64>,
-    /// `Φ` not yet written into `phi`: the polynomial model's `Φ(ζ) = Ψ(ζ) ⊗ I_d` (4.2.5) for
-    /// `(ζ, d)`, left by the fixed-size update for whoever reads it
-    /// ([`KalmanFilter::last_transition`](super::KalmanFilter)); `None` when `phi` holds the
-    /// last step's `Φ`. Every writer of `phi` sets it to `None`.
-    pub(super) phi_due: Option<(f64, usize)>,
     /// `n × n` scratch (`S Φᵀ`, then `(I − H M) S`).
     pub(super) square: Vec<f64>,
     /// The measurement: the present components, their values, `R` on them (`k × k`).
@@ -113,7 +108,6 @@ impl Work {
             q: DMatrix::zeros(n, n),
             s: DMatrix::zeros(n, n),
             p: DMatrix::zeros(n, n),
-            phi_due: None,
             square: vector(n * n),
             present: Vec::with_capacity(p),
             values: Vec::with_capacity(p),

@@ -305,10 +305,9 @@ type Square<const N: usize> = [[f64; N]; N];
 /// [`linear_value`](crate::model::observation::linear_value)), `ν` by the model's `residual`,
 /// and the correction ((12.2.17)-(12.2.19), Joseph's form (12.3.7)), all on arrays of this
 /// function; only when every number is finite and `V` positive definite, the results are
-/// written once: the estimate into `estimate` and what an `Innovation` reads into `w`. The
-/// prediction is written into `w` as soon as it is made, `Φ` left due ([`Work::phi_due`]).
-/// The statistics, or `None` (nothing written but the prediction and `Φ`'s due mark, which
-/// the generic path writes again).
+/// written once: the estimate into `estimate`, the prediction and what an `Innovation` reads
+/// into `w`. The statistics, or `None` (nothing written but `Φ`, which the generic path
+/// writes again).
 ///
 /// The correction is [`correct_in`](super::super::correct::correct_in)'s with no fading,
 /// operation for operation: each sum over the same terms in the same order, with two
@@ -352,21 +351,14 @@ fn update<const N: usize, const K: usize, const UNIT: bool>(
     let mut xp: [f64; N] = std::array::from_fn(|i| x[i]);
     let mut sp: Square<N> = std::array::from_fn(|j| std::array::from_fn(|i| s[i + j * N]));
     if let Some(zeta) = step {
+        let phi = &mut w.phi.as_mut_slice()[..N * N];
         match axes {
-            1 => predict_exact::<N, 1>(zeta, psd, &mut xp, &mut sp),
-            2 if N.is_multiple_of(2) => predict_exact::<N, 2>(zeta, psd, &mut xp, &mut sp),
-            3 if N.is_multiple_of(3) => predict_exact::<N, 3>(zeta, psd, &mut xp, &mut sp),
+            1 => predict_exact::<N, 1>(zeta, psd, &mut xp, &mut sp, phi),
+            2 if N.is_multiple_of(2) => predict_exact::<N, 2>(zeta, psd, &mut xp, &mut sp, phi),
+            3 if N.is_multiple_of(3) => predict_exact::<N, 3>(zeta, psd, &mut xp, &mut sp, phi),
             _ => return None,
         }
-        // `Φ` left due: made from `(ζ, axes)` when it is read (`last_transition`), not at
-        // each step (only the smoothers read it).
-        w.phi_due = Some((zeta, axes));
     }
-    // The prediction (which the smoothers read) written now: the generic path writes it
-    // again (and `Φ`) if this one gives the step up, and no register holds it across the
-    // correction.
-    w.x.as_mut_slice()[..N].copy_from_slice(&xp);
-    w.s.as_mut_slice()[..N * N].copy_from_slice(sp.as_flattened());
     // G = M X_{n,n−1}, every row (the generic path checks them all), each from −0 as
     // `Iterator::sum`.
     let model = seen.model.map_or(&[][..], |m| m.as_slice());
@@ -531,9 +523,12 @@ fn update<const N: usize, const K: usize, const UNIT: bool>(
     if !(check.is_finite() && nis < 1e300 && pivots_finite) {
         return None;
     }
-    // The results, once: the estimate and what an `Innovation` reads.
+    // The results, once: the estimate, the prediction (which the smoothers read), and what an
+    // `Innovation` reads.
     state.as_mut_slice()[..N].copy_from_slice(&x_out);
     covariance.as_mut_slice()[..N * N].copy_from_slice(s_out.as_flattened());
+    w.x.as_mut_slice()[..N].copy_from_slice(&xp);
+    w.s.as_mut_slice()[..N * N].copy_from_slice(sp.as_flattened());
     if innovation {
         w.present.clear();
         w.present.extend_from_slice(&seen.present[..K]);
@@ -614,52 +609,6 @@ mod tests {
                     f.set_process_noise(other).unwrap();
                     assert!(!f.predict_fixed(0.7), "m = {degree}: a noise on 2 axes");
                 }
-            }
-        }
-    }
-    /// `Φ` left due by the whole update at fixed size is, when read, the model's own
-    /// `Φ(ζ)` (`Dynamics::propagate_into`) bit for bit, on every size in range; an update
-    /// at the same time keeps the last step's; a step by another path (a fading filter's)
-    /// writes its own and drops the due one.
-    #[test]
-    fn due_transition_is_the_models() {
-        use crate::model::measurement::{Measurement, NoiseCovariance};
-        for axes in 1..=MAX_AXES {
-            for degree in 0..UNROLLED_MAX_SIZE / axes {
-                let n = (degree + 1) * axes;
-                let dynamics = PolynomialDynamics::new(degree, axes);
-                let mut f = KalmanFilter::new(
-                    dynamics,
-                    LinearObservation::value_of(n),
-                    DVector::from_element(n, 0.5),
-                    DMatrix::identity(n, n),
-                    0.0,
-                )
-                .unwrap();
-                let row = |time: f64| Measurement {
-                    time,
-                    values: vec![Some(0.3)],
-                    noise: NoiseCovariance::Identity,
-                };
-                let phi_of = |a: f64, b: f64| {
-                    let (mut x, mut phi) = (DVector::zeros(n), DMatrix::zeros(n, n));
-                    dynamics
-                        .propagate_into(&DVector::zeros(n), a, b, &mut x, &mut phi)
-                        .unwrap();
-                    phi
-                };
-                let what = format!("m = {degree}, d = {axes}");
-                assert!(f.update_fixed(&row(0.7), false).is_some(), "{what}");
-                assert!(f.work.phi_due.is_some(), "{what}: left due");
-                assert_eq!(f.last_transition(), &phi_of(0.0, 0.7), "{what}");
-                assert!(f.update_fixed(&row(-0.6), false).is_some(), "{what}");
-                assert!(f.update_fixed(&row(-0.6), false).is_some(), "{what}");
-                assert_eq!(f.last_transition(), &phi_of(0.7, -0.6), "{what}: no step");
-                assert!(f.update_fixed(&row(1.9), false).is_some(), "{what}");
-                f.set_fading(Discount::PerUpdate { theta: 0.9 }).unwrap();
-                f.update(&row(2.3)).unwrap();
-                assert!(f.work.phi_due.is_none(), "{what}: written");
-                assert_eq!(f.last_transition(), &phi_of(1.9, 2.3), "{what}: fading");
             }
         }
     }

@@ -566,19 +566,6 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         if let Some(stats) = self.update_fixed(measurement, innovation) {
             return Ok(Some(report(&self.work, stats)));
         }
-        self.update_generic(measurement, innovation, report)
-    }
-
-    /// [`Self::update_with`] by prediction and correction (any model, or a step the
-    /// fixed-size path gave up): apart, so that the fixed-size path's caller keeps a small
-    /// frame.
-    #[inline(never)]
-    fn update_generic<T>(
-        &mut self,
-        measurement: &Measurement,
-        innovation: bool,
-        report: impl FnOnce(&Work, InnovationStats) -> T,
-    ) -> Result<Option<T>, Error> {
         let Some((t, stats)) = self.predict_and_correct(measurement, innovation)? else {
             return Ok(None);
         };
@@ -624,7 +611,6 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
             return Ok(());
         }
         let w = &mut self.work;
-        w.phi_due = None;
         self.dynamics
             .propagate_into(&self.state, self.time, t, &mut w.x, &mut w.phi)?;
         let q = match &self.noise {

@@ -161,7 +161,6 @@ fn update(
         }
         Some(zeta) => {
             predict(x, s, zeta, psd, xp, sp)?;
-            w.phi_due = None;
             let (t0, t1) = (psi_term(0, &zeta), psi_term(1, &zeta));
             // `Φ` into the work buffer as the general path leaves it (the smoothers read it:
             // `last_transition`): `[[I, ζ I], [0, I]]` by `psi_term`, (4.2.5). Written whole,

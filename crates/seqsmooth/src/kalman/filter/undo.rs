@@ -5,7 +5,6 @@
 use super::KalmanFilter;
 use crate::model::dynamics::Dynamics;
 use crate::model::observation::Observation;
-use crate::model::transition::psi_term;
 use nalgebra::{DMatrix, DVector};
 
 /// A filter's estimate kept aside ([`KalmanFilter::estimate_copy`]).
@@ -41,24 +40,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     }
 
     /// `Φ` of the last prediction that made a step (the work buffers'): right after an update
-    /// to a later time, the `Φ(t_n, t_{n−1})` of its prediction. Made here when the
-    /// fixed-size update left it due ([`Work::phi_due`](super::super::correct::Work)):
-    /// `[Φ]_{i d + a, (i + k) d + a} = ζ^k/k!` (4.2.5) by [`psi_term`], the entries the
-    /// prediction would have written, bit for bit.
-    pub(crate) fn last_transition(&mut self) -> &DMatrix<f64> {
-        if let Some((zeta, axes)) = self.work.phi_due.take() {
-            let phi = &mut self.work.phi;
-            let n = phi.nrows();
-            for c in 0..n {
-                for r in 0..n {
-                    phi[(r, c)] = if c >= r && (c - r).is_multiple_of(axes) {
-                        psi_term((c - r) / axes, &zeta)
-                    } else {
-                        0.0
-                    };
-                }
-            }
-        }
+    /// to a later time, the `Φ(t_n, t_{n−1})` of its prediction.
+    pub(crate) fn last_transition(&self) -> &DMatrix<f64> {
         &self.work.phi
     }
 }

@@ -17,8 +17,8 @@ const fn on<const A: usize>(r: usize, c: usize) -> bool {
     c >= r && (c - r).is_multiple_of(A)
 }
 
-/// The prediction of `N` states on `A` axes over the step `zeta` in place of `(xp, sp)` (`Φ`
-/// itself not written: the caller leaves it due, [`Work::phi_due`]): [`predict_in`]'s numbers (the generic path's
+/// The prediction of `N` states on `A` axes over the step `zeta` in place of `(xp, sp)`, `Φ`
+/// into `phi`: [`predict_in`]'s numbers (the generic path's
 /// [`carry`](crate::kalman::correct::carry)), operation for operation on this function's
 /// arrays, `Φ`'s structural zeros left out at compile time, its other entries multiplied
 /// whatever their value, and the sums from `−0`, each entry of `S_{n,n−1}` then made `+0`
@@ -31,6 +31,7 @@ pub(super) fn predict_exact<const N: usize, const A: usize>(
     psd: Option<f64>,
     xp: &mut [f64; N],
     sp: &mut Square<N>,
+    phi: &mut [f64],
 ) {
     let size = N / A;
     let mut psi = [0.0; N];
@@ -38,7 +39,7 @@ pub(super) fn predict_exact<const N: usize, const A: usize>(
         *psi = psi_term(k, &zeta);
     }
     let x = *xp;
-    transition_into::<N, A>(&psi, &x, xp);
+    transition_into::<N, A>(&psi, &x, phi, xp);
     // T = S Φᵀ (`t[i]` its column i), then Φ S Φᵀ = Tᵀ Φᵀ: its column j is Σ_l Tᵀ[:, l] Φ(j, l).
     let s = *sp;
     let mut t = [[-0.0; N]; N];
@@ -105,7 +106,6 @@ pub(super) fn predict<const N: usize, const A: usize>(
         &mut w.s.as_mut_slice()[..N * N],
         &mut w.p.as_mut_slice()[..N * N],
     );
-    w.phi_due = None;
     let (phi, q) = (w.phi.as_mut_slice(), w.q.as_mut_slice());
     predict_in::<N, A>(zeta, psd, from, phi, q, &mut w.square, into)
 }
@@ -133,8 +133,7 @@ fn predict_in<const N: usize, const A: usize>(
         return false;
     }
     let xp = &mut xp[..N];
-    write_phi::<N, A>(&psi, phi);
-    transition_into::<N, A>(&psi, &x[..N], xp);
+    transition_into::<N, A>(&psi, &x[..N], phi, xp);
     let entry = |r: usize, c: usize| phi_entry::<A>(&psi, r, c);
     if !all_finite(xp) {
         return false;
@@ -172,23 +171,22 @@ fn phi_entry<const A: usize>(psi: &[f64], r: usize, c: usize) -> f64 {
 }
 
 /// `Φ` into `phi` (`[Φ]_{i A + a, (i + k) A + a} = ζ^k/k!`: row r, column c, when c ≥ r on the
-/// same axis, (4.2.5); `psi[k] = ζ^k/k!`), written whole.
+/// same axis, (4.2.5); `psi[k] = ζ^k/k!`) and `Φ x` into `xp`, each row's sum from its diagonal
+/// term over the columns ascending (the model's order; its structural zeros add nothing).
 #[inline(always)]
-fn write_phi<const N: usize, const A: usize>(psi: &[f64], phi: &mut [f64]) {
+fn transition_into<const N: usize, const A: usize>(
+    psi: &[f64],
+    x: &[f64],
+    phi: &mut [f64],
+    xp: &mut [f64],
+) {
+    let size = N / A;
     let phi = &mut phi[..N * N];
     for c in 0..N {
         for r in 0..N {
             phi[r + c * N] = phi_entry::<A>(psi, r, c);
         }
     }
-}
-
-/// `Φ x` into `xp` (`psi[k] = ζ^k/k!`, [`write_phi`]'s `Φ`), each row's sum from its
-/// diagonal term over the columns ascending (the model's order; its structural zeros add
-/// nothing).
-#[inline(always)]
-fn transition_into<const N: usize, const A: usize>(psi: &[f64], x: &[f64], xp: &mut [f64]) {
-    let size = N / A;
     for r in 0..N {
         let mut acc = psi[0] * x[r];
         for k in 1..size {
