@@ -6,6 +6,7 @@ pub(crate) mod dense;
 pub(crate) mod invariant;
 
 use crate::error::Error;
+use crate::numeric::sigma::std_dev;
 use crate::scalar::Scalar;
 use nalgebra::{DMatrix, DVector};
 
@@ -143,8 +144,9 @@ pub fn singular_values(m: &DMatrix<f64>) -> Result<DVector<f64>, Error> {
         })
 }
 
-/// The 1σ of each component of an estimate of covariance `S`: `√max(0, S_ii)` (a rounding
-/// below zero reads as 0). The one rule behind every `std_devs` of the library.
+/// The 1σ of each component of an estimate of covariance `S`: `√S_ii` by
+/// [`std_dev`](crate::numeric::sigma::std_dev) (a rounding below zero reads as +0, a NaN stays
+/// NaN). The one rule behind every `std_devs` of the library.
 ///
 /// ```
 /// use nalgebra::DMatrix;
@@ -152,5 +154,5 @@ pub fn singular_values(m: &DMatrix<f64>) -> Result<DVector<f64>, Error> {
 /// assert_eq!(std_devs(&DMatrix::from_row_slice(2, 2, &[4.0, 1.0, 1.0, -0.0])), vec![2.0, 0.0]);
 /// ```
 pub fn std_devs(s: &DMatrix<f64>) -> Vec<f64> {
-    s.diagonal().iter().map(|v| v.max(0.0).sqrt()).collect()
+    s.diagonal().iter().map(|&v| std_dev(v)).collect()
 }

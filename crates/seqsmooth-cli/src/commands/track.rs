@@ -29,6 +29,7 @@ use seqsmooth::estimate::gauss_newton::GaussNewton;
 use seqsmooth::estimate::gauss_newton::Measurement;
 use seqsmooth::kalman::Discount;
 use seqsmooth::model::radar::Radar;
+use seqsmooth::numeric::sigma::std_dev;
 use seqsmooth::track::{
     RadarTracker, TrackError, TrackFlag, TrackMethod as Method, Tracked, DEFAULT_LAG,
     DEFAULT_WINDOW, START_WINDOW,
@@ -354,7 +355,7 @@ fn cells(x: &DVector<f64>, s: &DMatrix<f64>, nis: Option<f64>, flag: TrackFlag) 
     let mut sigma = [0.0; 6];
     for k in 0..6 {
         state[k] = x[k];
-        sigma[k] = s[(k, k)].max(0.0).sqrt();
+        sigma[k] = std_dev(s[(k, k)]);
     }
     (state, sigma, nis, flag)
 }

@@ -3,7 +3,8 @@
 //! decides whether two sampling steps are the same step ([`steps`]), the memo of constants
 //! that cost exact arithmetic (`memo`), the dispatch from a
 //! run-time state size to code compiled for that size (the crate-internal `unrolled_sizes!`),
-//! integer powers inline ([`power`]), and timestamps as seconds since the Unix epoch
+//! integer powers inline ([`power`]), a variance read as a reported 1σ ([`sigma`]: NaN kept,
+//! a rounding below zero read as 0), and timestamps as seconds since the Unix epoch
 //! ([`epoch`]: ticks of any unit, ISO-8601 text; the one rule of every front end).
 
 pub mod double_word;
@@ -11,5 +12,6 @@ pub mod epoch;
 pub(crate) mod inline;
 pub(crate) mod memo;
 pub mod power;
+pub mod sigma;
 pub mod steps;
 pub(crate) mod unrolled;

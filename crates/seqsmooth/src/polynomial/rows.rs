@@ -21,6 +21,7 @@
 
 use crate::error::{Error, Param};
 use crate::model::PolynomialState;
+use crate::numeric::sigma::std_dev;
 use crate::polynomial::filter::{check_rows, no_noise_sigma, PolynomialFilter, RowRule};
 use crate::polynomial::spec::{AnyFilter, Inner};
 use std::collections::VecDeque;
@@ -399,7 +400,7 @@ fn store(estimate: Option<&PolynomialState>, sigma: bool, values: &mut [f64]) ->
             .iter_mut()
             .enumerate()
         {
-            *v = c[(i, i)].max(0.0).sqrt();
+            *v = std_dev(c[(i, i)]);
         }
     }
     Ok(())

@@ -32,6 +32,7 @@ use crate::error::{Error, Param};
 use crate::linalg::dense::{all_finite, log_det};
 use crate::model::dynamics::Dynamics;
 use crate::model::observation::Observation;
+use crate::numeric::sigma::std_dev;
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::TAU;
 
@@ -298,7 +299,7 @@ impl<D: Dynamics, const N: usize> Forward for FixedSeries<'_, D, N> {
         out.state[r * N..(r + 1) * N].copy_from_slice(&self.x);
         let sigma = &mut out.sigma[r * N..(r + 1) * N];
         for i in 0..N {
-            sigma[i] = self.s[i][i].max(0.0).sqrt();
+            sigma[i] = std_dev(self.s[i][i]);
         }
         out.put_nis(r, nis);
     }

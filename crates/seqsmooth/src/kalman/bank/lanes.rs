@@ -37,6 +37,7 @@ use super::{KalmanBank, Panel, RowsMut};
 use crate::error::Error;
 use crate::model::dynamics::Dynamics;
 use crate::model::observation::Observation;
+use crate::numeric::sigma::std_dev;
 use nalgebra::{DMatrix, DVector};
 use std::ops::Range;
 
@@ -443,7 +444,7 @@ impl<'a, D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'a, 
             }
         }
         let sigma: [[f64; L]; N] =
-            std::array::from_fn(|i| std::array::from_fn(|e| self.s[i][i][e].max(0.0).sqrt()));
+            std::array::from_fn(|i| std::array::from_fn(|e| std_dev(self.s[i][i][e])));
         let mut errors = [const { None }; L];
         for e in 0..L {
             let Some(held) = held[e] else {
@@ -686,7 +687,7 @@ impl<D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'_, D, N
                     }
                 }
                 let sigma: [[f64; L]; N] =
-                    std::array::from_fn(|i| std::array::from_fn(|e| s[i][i][e].max(0.0).sqrt()));
+                    std::array::from_fn(|i| std::array::from_fn(|e| std_dev(s[i][i][e])));
                 for e in 0..L {
                     if last[e] || back[e] {
                         let r = panel.offsets[first + e] + k - base;

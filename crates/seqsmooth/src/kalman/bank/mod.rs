@@ -40,6 +40,7 @@ use crate::error::{Error, Param};
 use crate::model::dynamics::Dynamics;
 use crate::model::measurement::NoiseCovariance;
 use crate::model::observation::{LinearObservation, Observation};
+use crate::numeric::sigma::std_dev;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -244,7 +245,7 @@ impl RowsMut<'_> {
         let n = x.len();
         self.state[r * n..(r + 1) * n].copy_from_slice(x);
         for (i, o) in self.sigma[r * n..(r + 1) * n].iter_mut().enumerate() {
-            *o = s[i + i * n].max(0.0).sqrt();
+            *o = std_dev(s[i + i * n]);
         }
         self.put_nis(r, nis);
     }

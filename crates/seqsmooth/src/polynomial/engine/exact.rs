@@ -24,6 +24,7 @@
 use crate::discount::{Discount, DiscountMode};
 use crate::model::taylor::{unscale_in_range, unscale_stepwise};
 use crate::model::{derivative_scale, shift_scaled, shift_scaled_array};
+use crate::numeric::sigma::std_dev;
 use crate::numeric::unrolled::unrolled_sizes;
 use crate::polynomial::options::MAX_DEGREE;
 use crate::recursive::InformationFilter;
@@ -429,11 +430,11 @@ impl ExactEngine {
         // The test outside the loop, so that its square roots go in vector operations.
         if self.unscale_in_range {
             for (o, c) in out.iter_mut().zip(&self.unscale[..p]) {
-                *o = sigma * o.max(0.0).sqrt() * c;
+                *o = sigma * std_dev(*o) * c;
             }
         } else {
             for (i, o) in out.iter_mut().enumerate() {
-                *o = unscale_stepwise(sigma * o.max(0.0).sqrt(), i, self.unit);
+                *o = unscale_stepwise(sigma * std_dev(*o), i, self.unit);
             }
         }
         true

@@ -11,6 +11,7 @@ use super::{check_window, steps_agree};
 use crate::basis::DiscreteLegendre;
 use crate::error::{Error, Param};
 use crate::estimate::PolynomialFit;
+use crate::numeric::sigma::std_dev;
 
 /// Where the 1σ of each smoothed row comes from (Morrison §7.5: the covariance of a window's
 /// fit is `σ²` times its variance-reduction factors, `D(τ) T(r) C T(r)ᵀ D(τ)` on evenly spaced
@@ -315,7 +316,7 @@ impl CentredSmoother {
                 if sigma {
                     let cov = fit.covariance_at(time);
                     for (i, v) in s.iter_mut().enumerate() {
-                        *v = self.window_sigma * cov[(i, i)].max(0.0).sqrt();
+                        *v = self.window_sigma * std_dev(cov[(i, i)]);
                     }
                 }
             }

@@ -12,6 +12,7 @@ use super::super::kernel;
 use super::super::{Panel, RowsMut};
 use super::{Lanes, Step};
 use crate::model::dynamics::Dynamics;
+use crate::numeric::sigma::std_dev;
 
 impl<D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'_, D, N, K, L> {
     /// The step of every lane when each is steady — it holds a series whose next row has
@@ -107,9 +108,8 @@ impl<D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'_, D, N
                 keep.nis = up.nis.map(Some);
             }
             None => {
-                let sigma: [[f64; L]; N] = std::array::from_fn(|i| {
-                    std::array::from_fn(|e| self.s[i][i][e].max(0.0).sqrt())
-                });
+                let sigma: [[f64; L]; N] =
+                    std::array::from_fn(|i| std::array::from_fn(|e| std_dev(self.s[i][i][e])));
                 for e in 0..L {
                     let r = rows[e] - base;
                     let state = &mut out.state[r * N..(r + 1) * N];

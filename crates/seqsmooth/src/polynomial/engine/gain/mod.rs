@@ -16,6 +16,7 @@ use crate::model::taylor::{unscale_in_range, unscale_stepwise};
 use crate::model::{derivative_scale, factorial_powers, shift_scaled, shift_scaled_compensated};
 use crate::numeric::double_word::{self as dw, two_prod, two_sum, DoubleWord};
 use crate::numeric::memo::Memo;
+use crate::numeric::sigma::std_dev;
 use crate::numeric::steps::{same_step, snaps_to, StepCheck};
 use crate::numeric::unrolled::{unrolled_sizes, UNROLLED_MAX_SIZE};
 use crate::polynomial::expanding::gains::ExpandingGainSchedule;
@@ -237,7 +238,7 @@ impl GainEngine {
             return;
         };
         for (k, (s, (f, tk))) in row.iter_mut().zip(factorial_powers(self.unit)).enumerate() {
-            let sd = p[(k, k)].max(0.0).sqrt();
+            let sd = std_dev(p[(k, k)]);
             *s = if tk.is_normal() {
                 sd * f / tk
             } else {
