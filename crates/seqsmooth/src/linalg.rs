@@ -145,7 +145,7 @@ pub fn singular_values(m: &DMatrix<f64>) -> Result<DVector<f64>, Error> {
 }
 
 /// The 1σ of each component of an estimate of covariance `S`: `√S_ii` by
-/// [`std_dev`](crate::numeric::sigma::std_dev) (a rounding below zero reads as +0, a NaN stays
+/// [`std_dev`] (a rounding below zero reads as +0, a NaN stays
 /// NaN). The one rule behind every `std_devs` of the library.
 ///
 /// ```
