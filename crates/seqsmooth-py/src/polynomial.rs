@@ -236,11 +236,11 @@ impl PyPolynomialFilter {
         };
         let stride = self.filter.stride(layout);
         let rows = match out {
-            Some(given) => output_buffer(given, n, stride)?,
+            Some(given) => output_buffer(given, n, stride, [t, y])?,
             None => zeros(py, n, stride),
         };
         {
-            let mut buffer = writable_rows(&rows, [t, y])?;
+            let mut buffer = writable_rows(&rows)?;
             let out = buffer.as_slice_mut().expect("checked by writable_rows");
             for start in (0..n).step_by(CHUNK) {
                 let end = (start + CHUNK).min(n);
@@ -291,14 +291,17 @@ impl PyPolynomialFilter {
 }
 
 /// The caller's `out` for [`PyPolynomialFilter::update_many`]: a float64 array (native byte
-/// order) of shape `n × stride`, C-contiguous, checked before any sample is taken — a wrong
-/// dtype or object is [`Kind::InvalidType`], a wrong shape or order [`Kind::InvalidInput`], as
-/// `arrays`' checks of inputs are; writeability, alignment and overlap with the inputs are
-/// checked as it is borrowed ([`writable_rows`]).
+/// order) of shape `n × stride`, C-contiguous, sharing no memory with the inputs, checked
+/// before any sample is taken — a wrong dtype or object is [`Kind::InvalidType`], a wrong
+/// shape, order or overlap [`Kind::InvalidInput`], as `arrays`' checks of inputs are. The
+/// overlap is found from the addresses before any slice of `out` is made (numpy's own check
+/// of a shared base does not see two `frombuffer` arrays over one buffer); writeability and
+/// alignment are checked as it is borrowed ([`writable_rows`]).
 fn output_buffer<'py>(
     out: &Bound<'py, PyAny>,
     n: usize,
     stride: usize,
+    inputs: [&[f64]; 2],
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let need = format!("({n}, {stride})");
     let untyped = out.cast::<PyUntypedArray>().map_err(|_| {
@@ -311,44 +314,39 @@ fn output_buffer<'py>(
         let why = format!("out has dtype {dtype}; it must be float64 in native byte order");
         return Err(raise(Kind::InvalidType, why, None));
     }
-    let shape = untyped.shape();
-    if shape != [n, stride] {
-        let dims: Vec<String> = shape.iter().map(usize::to_string).collect();
-        let got = match dims.len() {
-            1 => format!("({},)", dims[0]),
-            _ => format!("({})", dims.join(", ")),
-        };
+    if untyped.shape() != [n, stride] {
+        let got = out.getattr("shape")?.str()?.to_string();
         let why = format!("out has shape {got}; these {n} samples need {need}");
         return Err(raise(Kind::InvalidInput, why, None));
     }
     if !untyped.is_c_contiguous() {
         return Err(raise(Kind::InvalidInput, "out is not C-contiguous", None));
     }
-    Ok(untyped.cast::<PyArray2<f64>>()?.clone())
+    let array = untyped.cast::<PyArray2<f64>>()?;
+    let start = array.data() as usize;
+    let end = start + n * stride * std::mem::size_of::<f64>();
+    for (name, input) in ["t", "y"].into_iter().zip(inputs) {
+        let other = input.as_ptr_range();
+        if start < other.end as usize && (other.start as usize) < end {
+            let why = format!("out shares memory with {name}: give it a buffer of its own");
+            return Err(raise(Kind::InvalidInput, why, None));
+        }
+    }
+    Ok(array.clone())
 }
 
-/// `rows` borrowed for writing, refused when it cannot be written as a contiguous, aligned
-/// float64 slice or when its memory overlaps an input's (`t` or `y` over the same buffer,
-/// which numpy's own check of a shared base does not see for two `frombuffer` arrays).
+/// `rows` borrowed for writing, refused when it is read-only, borrowed elsewhere, or cannot
+/// be written as a contiguous, aligned float64 slice.
 fn writable_rows<'py>(
     rows: &Bound<'py, PyArray2<f64>>,
-    inputs: [&[f64]; 2],
 ) -> PyResult<numpy::PyReadwriteArray2<'py, f64>> {
     let mut buffer = rows.try_readwrite().map_err(|e| {
         let why = format!("out is not writeable, or is in use by another array ({e})");
         raise(Kind::InvalidInput, why, None)
     })?;
-    let out = buffer.as_slice_mut().map_err(|_| {
+    if buffer.as_slice_mut().is_err() {
         let why = "out could not be written as a contiguous, aligned float64 array";
-        raise(Kind::InvalidInput, why, None)
-    })?;
-    let span = out.as_ptr_range();
-    for (name, input) in ["t", "y"].into_iter().zip(inputs) {
-        let other = input.as_ptr_range();
-        if span.start < other.end && other.start < span.end {
-            let why = format!("out shares memory with {name}: give it a buffer of its own");
-            return Err(raise(Kind::InvalidInput, why, None));
-        }
+        return Err(raise(Kind::InvalidInput, why, None));
     }
     Ok(buffer)
 }
