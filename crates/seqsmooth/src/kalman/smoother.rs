@@ -286,7 +286,7 @@ fn passes<D: Dynamics + Clone, O: Observation + Clone, const N: usize>(
             // One update (its prediction and correction), the prediction then read from
             // the filter's work buffers: the same numbers as predicting and updating apart.
             let stepped = m.time != filter.time();
-            let stats = match filter.update_stats(m) {
+            let stats = match filter.update_stats_keeping_prediction(m) {
                 Ok(stats) => stats,
                 // [`Smoother`] predicts before it reads the measurement: a row whose
                 // prediction fails too gives that error, as there (the filter is unchanged).

@@ -602,7 +602,7 @@ impl LinearKalmanFilter {
             // The prediction and the update in one call: both or neither.
             apply_prediction(&mut self.filter, &self.model, &s);
             let stats = apply_update(&mut self.filter, &self.model, &s)
-                .and_then(|()| self.filter.update_stats(&m));
+                .and_then(|()| self.filter.update_stats_keeping_prediction(&m));
             restore(&mut self.filter, &self.model, &s);
             let nis = stats.map_err(in_batch)?.map(|s| s.nis);
             let (xp, pp) = match nis {

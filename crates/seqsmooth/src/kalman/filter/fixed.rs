@@ -178,9 +178,10 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
 
     /// The whole update on the fixed-size path, prediction and correction in one function
     /// compiled for each state size and count of present components (the module's doc): the
-    /// filter's new estimate and time, and in the work buffers what the generic path leaves
-    /// there (the prediction `X_{n,n−1}`, `S_{n,n−1}`, `Φ`; with `innovation` what an
-    /// [`Innovation`](super::Innovation) reads); the statistics. `None`, the filter unchanged,
+    /// filter's new estimate and time, and in the work buffers what the caller reads of what
+    /// the generic path leaves there (with `prediction` the prediction `X_{n,n−1}`,
+    /// `S_{n,n−1}` and `Φ`; with `innovation` what an [`Innovation`](super::Innovation)
+    /// reads); the statistics. `None`, the filter unchanged,
     /// for the generic path: a model out of range, a constant `M` of more than
     /// [`MAX_COMPONENTS`] rows, no component present, `R` other than the identity or
     /// variances, fading memory, or anything the generic path would refuse.
@@ -188,6 +189,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         &mut self,
         m: &Measurement,
         innovation: bool,
+        prediction: bool,
     ) -> Option<InnovationStats> {
         if self.fading.is_some() {
             return None;
@@ -219,12 +221,11 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         if model.len() != p * n {
             return None;
         }
-        let mut seen = match p {
-            1 => read::<1>(m),
-            2 => read::<2>(m),
-            _ => read::<3>(m),
+        let seen = match p {
+            1 => read::<1>(m, model),
+            2 => read::<2>(m, model),
+            _ => read::<3>(m, model),
         }?;
-        seen.model = Some(model);
         // `M = [I_p 0]` with every component present: row `c` of `M` is component `c`.
         let unit = unit && seen.k == p;
         let step = (t != self.time).then_some(t - self.time);
@@ -233,14 +234,15 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         let residual = |a: usize, y: f64, g: f64| observation.residual(a, y, g);
         let w = &mut self.work;
         let how = (step, psd);
+        let keep = (innovation, prediction);
         let stats = unrolled_sizes!(n, N => match (seen.k, unit) {
                 (0, _) => None,
-                (1, false) => update::<N, 1, false>(axes, how, estimate, (&seen, residual), w, innovation),
-                (1, true) => update::<N, 1, true>(axes, how, estimate, (&seen, residual), w, innovation),
-                (2, false) => update::<N, 2, false>(axes, how, estimate, (&seen, residual), w, innovation),
-                (2, true) => update::<N, 2, true>(axes, how, estimate, (&seen, residual), w, innovation),
-                (_, false) => update::<N, 3, false>(axes, how, estimate, (&seen, residual), w, innovation),
-                (_, true) => update::<N, 3, true>(axes, how, estimate, (&seen, residual), w, innovation),
+                (1, false) => update::<N, 1, false>(axes, how, estimate, (&seen, residual), w, keep),
+                (1, true) => update::<N, 1, true>(axes, how, estimate, (&seen, residual), w, keep),
+                (2, false) => update::<N, 2, false>(axes, how, estimate, (&seen, residual), w, keep),
+                (2, true) => update::<N, 2, true>(axes, how, estimate, (&seen, residual), w, keep),
+                (_, false) => update::<N, 3, false>(axes, how, estimate, (&seen, residual), w, keep),
+                (_, true) => update::<N, 3, true>(axes, how, estimate, (&seen, residual), w, keep),
             },
             _ => None)?;
         self.time = t;
@@ -258,13 +260,13 @@ struct Seen<'a> {
     k: usize,
 }
 
-/// The measurement `m` of `P` components as `measure` reads it (the model's `M` left for the
-/// caller): the present components, their values and variances; `None` (for the generic
+/// The measurement `m` of `P` components as `measure` reads it, with the model's `M` (`model`):
+/// the present components, their values and variances; `None` (for the generic
 /// path) unless it has `P` values, `R` is the identity or `P` variances, every variance is
 /// finite and not negative (as `measure` checks the whole `R`) and every present value
 /// finite. Every check at once, `P` a constant (the loops unrolled, no bounds tests).
 #[inline(always)]
-fn read<const P: usize>(m: &Measurement) -> Option<Seen<'static>> {
+fn read<'a, const P: usize>(m: &Measurement, model: &'a DMatrix<f64>) -> Option<Seen<'a>> {
     let values: &[Option<f64>; P] = m.values.as_slice().try_into().ok()?;
     let variances: [f64; P] = match &m.noise {
         NoiseCovariance::Identity => [1.0; P],
@@ -272,7 +274,7 @@ fn read<const P: usize>(m: &Measurement) -> Option<Seen<'static>> {
         NoiseCovariance::Full(_) => return None,
     };
     let mut seen = Seen {
-        model: None,
+        model: Some(model),
         present: [0; MAX_COMPONENTS],
         values: [0.0; MAX_COMPONENTS],
         variances: [1.0; MAX_COMPONENTS],
@@ -305,9 +307,9 @@ type Square<const N: usize> = [[f64; N]; N];
 /// [`linear_value`](crate::model::observation::linear_value)), `ν` by the model's `residual`,
 /// and the correction ((12.2.17)-(12.2.19), Joseph's form (12.3.7)), all on arrays of this
 /// function; only when every number is finite and `V` positive definite, the results are
-/// written once: the estimate into `estimate`, the prediction and what an `Innovation` reads
-/// into `w`. The statistics, or `None` (nothing written but `Φ`, which the generic path
-/// writes again).
+/// written once: the estimate into `estimate`, and into `w` what the caller reads (`keep`):
+/// what an `Innovation` reads, and the prediction with its `Φ` (`Φ` written as it is made).
+/// The statistics, or `None` (nothing written but `Φ`, which the generic path writes again).
 ///
 /// The correction is [`correct_in`](super::super::correct::correct_in)'s with no fading,
 /// operation for operation: each sum over the same terms in the same order, with two
@@ -341,7 +343,7 @@ fn update<const N: usize, const K: usize, const UNIT: bool>(
     (state, covariance): (&mut DVector<f64>, &mut DMatrix<f64>),
     (seen, residual): (&Seen<'_>, impl Fn(usize, f64, f64) -> f64),
     w: &mut Work,
-    innovation: bool,
+    (innovation, prediction): (bool, bool),
 ) -> Option<InnovationStats> {
     if UNIT && K > N {
         // `M = [I_K 0]` has at least as many columns as rows (never called so).
@@ -351,7 +353,7 @@ fn update<const N: usize, const K: usize, const UNIT: bool>(
     let mut xp: [f64; N] = std::array::from_fn(|i| x[i]);
     let mut sp: Square<N> = std::array::from_fn(|j| std::array::from_fn(|i| s[i + j * N]));
     if let Some(zeta) = step {
-        let phi = &mut w.phi.as_mut_slice()[..N * N];
+        let phi = prediction.then(|| &mut w.phi.as_mut_slice()[..N * N]);
         match axes {
             1 => predict_exact::<N, 1>(zeta, psd, &mut xp, &mut sp, phi),
             2 if N.is_multiple_of(2) => predict_exact::<N, 2>(zeta, psd, &mut xp, &mut sp, phi),
@@ -527,8 +529,16 @@ fn update<const N: usize, const K: usize, const UNIT: bool>(
     // `Innovation` reads.
     state.as_mut_slice()[..N].copy_from_slice(&x_out);
     covariance.as_mut_slice()[..N * N].copy_from_slice(s_out.as_flattened());
-    w.x.as_mut_slice()[..N].copy_from_slice(&xp);
-    w.s.as_mut_slice()[..N * N].copy_from_slice(sp.as_flattened());
+    if prediction {
+        w.x.as_mut_slice()[..N].copy_from_slice(&xp);
+        // `S_{n,n−1}` made `+0` where it is `−0` here, off the chain ([`predict_exact`]).
+        for (to, s) in w.s.as_mut_slice()[..N * N]
+            .iter_mut()
+            .zip(sp.as_flattened())
+        {
+            *to = s + 0.0;
+        }
+    }
     if innovation {
         w.present.clear();
         w.present.extend_from_slice(&seen.present[..K]);
@@ -643,14 +653,14 @@ mod tests {
                     let what = format!("m = {degree}, d = {axes}, p = {p}");
                     let variances = NoiseCovariance::Variances(vec![0.25; p]);
                     assert_eq!(
-                        f.update_fixed(&row(0.7, variances), false).is_some(),
+                        f.update_fixed(&row(0.7, variances), false, true).is_some(),
                         taken,
                         "{what}"
                     );
                     let q = WhiteNoiseDerivative::new(degree, axes, 0.3).unwrap();
                     f.set_process_noise(q).unwrap();
                     assert_eq!(
-                        f.update_fixed(&row(-1.3, NoiseCovariance::Identity), true)
+                        f.update_fixed(&row(-1.3, NoiseCovariance::Identity), true, true)
                             .is_some(),
                         taken,
                         "{what}"
@@ -659,14 +669,14 @@ mod tests {
                     assert_eq!(f.time(), if taken { -1.3 } else { 0.0 }, "{what}");
                     let now = f.time();
                     assert_eq!(
-                        f.update_fixed(&row(now, NoiseCovariance::Identity), true)
+                        f.update_fixed(&row(now, NoiseCovariance::Identity), true, true)
                             .is_some(),
                         taken,
                         "{what}: no step"
                     );
                     let full = NoiseCovariance::Full(DMatrix::identity(p, p));
                     assert!(
-                        f.update_fixed(&row(0.7, full), false).is_none(),
+                        f.update_fixed(&row(0.7, full), false, true).is_none(),
                         "{what}: full R"
                     );
                     let none = Measurement {
@@ -675,12 +685,12 @@ mod tests {
                         noise: NoiseCovariance::Identity,
                     };
                     assert!(
-                        f.update_fixed(&none, false).is_none(),
+                        f.update_fixed(&none, false, true).is_none(),
                         "{what}: nothing present"
                     );
                     f.set_fading(Discount::PerUpdate { theta: 0.9 }).unwrap();
                     assert!(
-                        f.update_fixed(&row(0.7, NoiseCovariance::Identity), false)
+                        f.update_fixed(&row(0.7, NoiseCovariance::Identity), false, true)
                             .is_none(),
                         "{what}: fading"
                     );

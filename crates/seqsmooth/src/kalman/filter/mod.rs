@@ -350,7 +350,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     }
 
     /// The prediction `X_{n,n−1}`, `S_{n,n−1}` that the last update corrected (valid right
-    /// after an update that made its correction).
+    /// after an update that made its correction by [`Self::update_stats_keeping_prediction`]).
     pub(crate) fn last_prediction(&self) -> (&DVector<f64>, &DMatrix<f64>) {
         (&self.work.x, &self.work.s)
     }
@@ -436,7 +436,7 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// assert_eq!(i.innovation[0], 0.5);
     /// ```
     pub fn update(&mut self, measurement: &Measurement) -> Result<Option<Innovation>, Error> {
-        self.update_with(measurement, true, Work::innovation)
+        self.update_with(measurement, true, false, Work::innovation)
     }
 
     /// [`Self::update`] reporting only the innovation's statistics ([`InnovationStats`]): the
@@ -467,7 +467,18 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
         &mut self,
         measurement: &Measurement,
     ) -> Result<Option<InnovationStats>, Error> {
-        self.update_with(measurement, false, |_, stats| stats)
+        self.update_with(measurement, false, false, |_, stats| stats)
+    }
+
+    /// [`Self::update_stats`] leaving in the work buffers the prediction it corrected and its
+    /// `Φ` ([`Self::last_prediction`], [`Self::last_transition`]), for the smoothers and
+    /// batch kernels that read them; [`Self::update_stats`] on the fixed-size path does not
+    /// write them (a filter alone never reads them).
+    pub(crate) fn update_stats_keeping_prediction(
+        &mut self,
+        measurement: &Measurement,
+    ) -> Result<Option<InnovationStats>, Error> {
+        self.update_with(measurement, false, true, |_, stats| stats)
     }
 
     /// [`Self::update_stats`] with a gate (Morrison §14.8): the update is made only where
@@ -555,15 +566,18 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     /// The one update behind [`Self::update`] and [`Self::update_stats`]: `report` reads what
     /// the caller wants from the work buffers once the update has succeeded (with
     /// `innovation`, what an [`Innovation`] reads). The whole update at fixed size where the
-    /// model allows ([`Self::update_fixed`], the same numbers), else prediction and correction.
+    /// model allows ([`Self::update_fixed`], the same numbers; the prediction and `Φ` left in
+    /// the work buffers only with `prediction`), else prediction and correction (which leave
+    /// them there).
     fn update_with<T>(
         &mut self,
         measurement: &Measurement,
         innovation: bool,
+        prediction: bool,
         report: impl FnOnce(&Work, InnovationStats) -> T,
     ) -> Result<Option<T>, Error> {
         // The fixed-size path has made its update the filter's.
-        if let Some(stats) = self.update_fixed(measurement, innovation) {
+        if let Some(stats) = self.update_fixed(measurement, innovation, prediction) {
             return Ok(Some(report(&self.work, stats)));
         }
         let Some((t, stats)) = self.predict_and_correct(measurement, innovation)? else {

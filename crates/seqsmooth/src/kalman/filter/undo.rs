@@ -40,7 +40,8 @@ impl<D: Dynamics, O: Observation> KalmanFilter<D, O> {
     }
 
     /// `Φ` of the last prediction that made a step (the work buffers'): right after an update
-    /// to a later time, the `Φ(t_n, t_{n−1})` of its prediction.
+    /// to a later time by [`Self::update_stats_keeping_prediction`], the `Φ(t_n, t_{n−1})` of
+    /// its prediction.
     pub(crate) fn last_transition(&self) -> &DMatrix<f64> {
         &self.work.phi
     }

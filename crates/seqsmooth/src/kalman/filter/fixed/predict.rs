@@ -18,12 +18,15 @@ const fn on<const A: usize>(r: usize, c: usize) -> bool {
 }
 
 /// The prediction of `N` states on `A` axes over the step `zeta` in place of `(xp, sp)`, `Φ`
-/// into `phi`: [`predict_in`]'s numbers (the generic path's
+/// into `phi` (when the caller reads it): [`predict_in`]'s numbers (the generic path's
 /// [`carry`](crate::kalman::correct::carry)), operation for operation on this function's
 /// arrays, `Φ`'s structural zeros left out at compile time, its other entries multiplied
-/// whatever their value, and the sums from `−0`, each entry of `S_{n,n−1}` then made `+0`
-/// where it is `−0` ([`update`](super::update)'s doc: the same numbers). Whether `Φ`, `Q` and the
-/// prediction are finite is left to [`update`](super::update)'s check.
+/// whatever their value, and the sums from `−0`: each entry of `S_{n,n−1}` the generic path's
+/// or a zero of the other sign, which [`update`](super::update) makes `+0` where it writes the
+/// prediction out (its doc: a zero's sign reaches only zeros, and every result is made `+0`
+/// where it is `−0`; not here, where the add would lengthen the chain from one covariance to
+/// the next). Whether `Φ`, `Q` and the prediction are finite is left to
+/// [`update`](super::update)'s check.
 #[allow(clippy::needless_range_loop)]
 #[inline(always)]
 pub(super) fn predict_exact<const N: usize, const A: usize>(
@@ -31,7 +34,7 @@ pub(super) fn predict_exact<const N: usize, const A: usize>(
     psd: Option<f64>,
     xp: &mut [f64; N],
     sp: &mut Square<N>,
-    phi: &mut [f64],
+    phi: Option<&mut [f64]>,
 ) {
     let size = N / A;
     let mut psi = [0.0; N];
@@ -39,7 +42,10 @@ pub(super) fn predict_exact<const N: usize, const A: usize>(
         *psi = psi_term(k, &zeta);
     }
     let x = *xp;
-    transition_into::<N, A>(&psi, &x, phi, xp);
+    if let Some(phi) = phi {
+        write_transition::<N, A>(&psi, phi);
+    }
+    transition_times::<N, A>(&psi, &x, xp);
     // T = S Φᵀ (`t[i]` its column i), then Φ S Φᵀ = Tᵀ Φᵀ: its column j is Σ_l Tᵀ[:, l] Φ(j, l).
     let s = *sp;
     let mut t = [[-0.0; N]; N];
@@ -70,9 +76,9 @@ pub(super) fn predict_exact<const N: usize, const A: usize>(
             let mut q = [[0.0; N]; N];
             fill(Quotient::<N, A>, A, psd, zeta.abs(), q.as_flattened_mut());
             for j in 0..N {
-                out[j][j] = (out[j][j] + q[j][j]) + 0.0;
+                out[j][j] += q[j][j];
                 for i in j + 1..N {
-                    let v = ((out[j][i] + q[j][i]) + (out[i][j] + q[i][j])) * 0.5 + 0.0;
+                    let v = ((out[j][i] + q[j][i]) + (out[i][j] + q[i][j])) * 0.5;
                     out[j][i] = v;
                     out[i][j] = v;
                 }
@@ -80,9 +86,8 @@ pub(super) fn predict_exact<const N: usize, const A: usize>(
         }
         None => {
             for j in 0..N {
-                out[j][j] += 0.0;
                 for i in j + 1..N {
-                    let v = (out[j][i] + out[i][j]) * 0.5 + 0.0;
+                    let v = (out[j][i] + out[i][j]) * 0.5;
                     out[j][i] = v;
                     out[i][j] = v;
                 }
@@ -133,7 +138,8 @@ fn predict_in<const N: usize, const A: usize>(
         return false;
     }
     let xp = &mut xp[..N];
-    transition_into::<N, A>(&psi, &x[..N], phi, xp);
+    write_transition::<N, A>(&psi, phi);
+    transition_times::<N, A>(&psi, &x[..N], xp);
     let entry = |r: usize, c: usize| phi_entry::<A>(&psi, r, c);
     if !all_finite(xp) {
         return false;
@@ -160,7 +166,7 @@ fn predict_in<const N: usize, const A: usize>(
     }
 }
 
-/// `[Φ]_{r c}` from `psi[k] = ζ^k/k!` ([`transition_into`]).
+/// `[Φ]_{r c}` from `psi[k] = ζ^k/k!` ([`write_transition`]).
 #[inline(always)]
 fn phi_entry<const A: usize>(psi: &[f64], r: usize, c: usize) -> f64 {
     if on::<A>(r, c) {
@@ -171,22 +177,23 @@ fn phi_entry<const A: usize>(psi: &[f64], r: usize, c: usize) -> f64 {
 }
 
 /// `Φ` into `phi` (`[Φ]_{i A + a, (i + k) A + a} = ζ^k/k!`: row r, column c, when c ≥ r on the
-/// same axis, (4.2.5); `psi[k] = ζ^k/k!`) and `Φ x` into `xp`, each row's sum from its diagonal
-/// term over the columns ascending (the model's order; its structural zeros add nothing).
+/// same axis, (4.2.5); `psi[k] = ζ^k/k!`).
 #[inline(always)]
-fn transition_into<const N: usize, const A: usize>(
-    psi: &[f64],
-    x: &[f64],
-    phi: &mut [f64],
-    xp: &mut [f64],
-) {
-    let size = N / A;
+fn write_transition<const N: usize, const A: usize>(psi: &[f64], phi: &mut [f64]) {
     let phi = &mut phi[..N * N];
     for c in 0..N {
         for r in 0..N {
             phi[r + c * N] = phi_entry::<A>(psi, r, c);
         }
     }
+}
+
+/// `Φ x` into `xp` (`psi[k] = ζ^k/k!`, [`write_transition`]'s `Φ`), each row's sum from its
+/// diagonal term over the columns ascending (the model's order; its structural zeros add
+/// nothing).
+#[inline(always)]
+fn transition_times<const N: usize, const A: usize>(psi: &[f64], x: &[f64], xp: &mut [f64]) {
+    let size = N / A;
     for r in 0..N {
         let mut acc = psi[0] * x[r];
         for k in 1..size {
