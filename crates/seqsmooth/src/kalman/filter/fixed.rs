@@ -34,8 +34,8 @@
 //! [`correct_kernel`](super::super::correct::correct_kernel)) **bit for bit**: each sum adds
 //! the same terms in the same order (a skipped term is `0 · a` for a finite `a`, which adds
 //! nothing to a sum; a sum started at `−0` rather than `+0` differs at most in a zero's sign,
-//! and each result is made `+0` where it is `−0`: [`update`]'s doc; a result that underflows
-//! to zero may be `−0` on the generic path and `+0` here, the only difference), tested on seeded random
+//! and each result is made `+0` where it is `−0`: [`update`]'s doc; a state entry that
+//! underflows to zero may be `−0` on the generic path and `+0` here, the only difference), tested on seeded random
 //! models of every size in range, `M` random or of unit rows (`tests/kalman_fixed_path.rs`).
 //! Anything not finite, or `V` not positive definite, stops this path before the filter
 //! changes; the generic path then takes the step and gives its own error.
@@ -321,7 +321,13 @@ type Square<const N: usize> = [[f64; N]; N];
 /// `/` by a pivot (`0 + a = a` for `a ≠ 0`), so each result is the generic path's or a zero
 /// of the other sign; the generic path's results are never `−0` (a sum from `+0` is not; barring
 /// a result that underflows to zero), and
-/// each result here is made `+0` where it is `−0` (`a + 0`) before it is written.
+/// each result here is made `+0` where it is `−0` (`a + 0`) before it is written. For the
+/// covariance that `a + 0` is on `(H R) Hᵀ`, off the chain from one covariance to the next
+/// (`S_{n,n−1}`'s is where the prediction is written out, [`predict_exact`]): then
+/// `(X' − Y Hᵀ) + (H R) Hᵀ` is never `−0` (an add is `−0` only when both terms are), nor is
+/// the sum of two such entries, and each entry is the generic path's (whose `(H R) Hᵀ`, from
+/// `+0`, is never `−0` either), its symmetrized `(a + b) / 2` too, an underflow to zero
+/// included.
 ///
 /// `U = S Mᵀ`, `V = M U + R` symmetrized, `V = L D Lᵀ` ([`ldl`]), `H = U L⁻ᵀ D⁻¹ L⁻¹`,
 /// `NIS = Σ z_c² / D_c` (`z = L⁻¹ ν`), `X = H ν + X_{n,n−1}`, and Joseph's
@@ -505,14 +511,14 @@ fn update<const N: usize, const K: usize, const UNIT: bool>(
             for d in 0..K {
                 hrh += hr[d][i] * h[d][j];
             }
-            s_out[j][i] = (xs[j][i] - yh) + hrh;
+            // `+ 0` here (never `−0` after it), not on the result: off the chain.
+            s_out[j][i] = (xs[j][i] - yh) + (hrh + 0.0);
         }
     }
     for j in 0..N {
-        s_out[j][j] += 0.0;
         check += s_out[j][j];
         for i in j + 1..N {
-            let value = (s_out[j][i] + s_out[i][j]) * 0.5 + 0.0;
+            let value = (s_out[j][i] + s_out[i][j]) * 0.5;
             s_out[j][i] = value;
             s_out[i][j] = value;
             check += value;
