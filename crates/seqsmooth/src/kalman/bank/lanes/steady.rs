@@ -188,14 +188,21 @@ unsafe fn put_rows<const N: usize, const L: usize>(
         };
         let state = rows(load(&x[0]), load(&x[1]));
         let sd = rows(sigma(0), sigma(1));
+        // One bounds check for the four rows: the last of them in each buffer.
+        let top = r.iter().fold(0, |top, &row| top.max(row));
+        let (to_state, to_sigma) = (
+            &mut out.state[..(top + 1) * 2],
+            &mut out.sigma[..(top + 1) * 2],
+        );
+        let to_nis = &mut out.nis[..top + 1];
         for e in 0..L {
-            let to = &mut out.state[r[e] * 2..][..2];
-            // SAFETY: `to` is two `f64`, the 16 bytes stored; AVX2 is the caller's.
-            unsafe { _mm_storeu_pd(to.as_mut_ptr(), state[e]) };
-            let to = &mut out.sigma[r[e] * 2..][..2];
-            // SAFETY: as above.
-            unsafe { _mm_storeu_pd(to.as_mut_ptr(), sd[e]) };
-            out.nis[r[e]] = nis[e];
+            // SAFETY: `r[e] ≤ top`, so row `r[e]`'s two `f64` (the 16 bytes stored) and its
+            // NIS are inside the slices just checked; AVX2 is the caller's.
+            unsafe {
+                _mm_storeu_pd(to_state.as_mut_ptr().add(r[e] * 2), state[e]);
+                _mm_storeu_pd(to_sigma.as_mut_ptr().add(r[e] * 2), sd[e]);
+                *to_nis.as_mut_ptr().add(r[e]) = nis[e];
+            }
         }
         return;
     }
