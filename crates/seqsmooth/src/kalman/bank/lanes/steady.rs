@@ -8,7 +8,7 @@
 // the lanes, vectorises).
 #![allow(clippy::needless_range_loop)]
 
-use super::super::kernel;
+use super::super::kernel::{self, Column, Square};
 use super::super::{Panel, RowsMut};
 use super::{Lanes, Step};
 use crate::model::dynamics::Dynamics;
@@ -108,18 +108,10 @@ impl<D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'_, D, N
                 keep.nis = up.nis.map(Some);
             }
             None => {
-                let sigma: [[f64; L]; N] =
-                    std::array::from_fn(|i| std::array::from_fn(|e| std_dev(self.s[i][i][e])));
-                for e in 0..L {
-                    let r = rows[e] - base;
-                    let state = &mut out.state[r * N..(r + 1) * N];
-                    let to = &mut out.sigma[r * N..(r + 1) * N];
-                    for i in 0..N {
-                        state[i] = self.x[i][e];
-                        to[i] = sigma[i][e];
-                    }
-                    out.nis[r] = up.nis[e];
-                }
+                let r = rows.map(|row| row - base);
+                // SAFETY: the lanes run only where the processor has AVX2 (`Lanes::filter`
+                // and `Lanes::smooth` check it before any step), the one feature it enables.
+                unsafe { put_rows(out, r, &self.x, &self.s, &up.nis) };
             }
         }
         for held in self.held.iter_mut() {
@@ -130,5 +122,170 @@ impl<D: Dynamics, const N: usize, const K: usize, const L: usize> Lanes<'_, D, N
             }
         }
         true
+    }
+}
+
+/// The lanes' rows `r` of `out` from their estimates `(x, s)` and NIS: the state, σ (each
+/// [`std_dev`] of the diagonal, `sqrt(max(v, +0))` with a NaN kept, four lanes an instruction:
+/// the same numbers) and the NIS. With two states (the constant-velocity model) each row's
+/// state and σ are one 16-byte store, the lanes' columns transposed into rows two lanes an
+/// instruction; otherwise entry by entry.
+///
+/// # Safety
+///
+/// The processor has AVX2 (the lanes' [`super::available`]). Inlined into the lanes' AVX2
+/// functions (`Lanes::filter_avx2`, `Lanes::smooth_avx2`), as is `steady`.
+#[inline(always)]
+unsafe fn put_rows<const N: usize, const L: usize>(
+    out: &mut RowsMut<'_>,
+    r: [usize; L],
+    x: &Column<N, L>,
+    s: &Square<N, L>,
+    nis: &[f64; L],
+) {
+    use std::arch::x86_64::{
+        __m256d, _mm256_andnot_pd, _mm256_castpd256_pd128, _mm256_cmp_pd, _mm256_extractf128_pd,
+        _mm256_loadu_pd, _mm256_setzero_pd, _mm256_sqrt_pd, _mm256_storeu_pd, _mm256_unpackhi_pd,
+        _mm256_unpacklo_pd, _mm_storeu_pd, _CMP_LE_OQ,
+    };
+    if L != 4 {
+        for e in 0..L {
+            let (state, sigma) = (
+                &mut out.state[r[e] * N..][..N],
+                &mut out.sigma[r[e] * N..][..N],
+            );
+            for i in 0..N {
+                state[i] = x[i][e];
+                sigma[i] = std_dev(s[i][i][e]);
+            }
+            out.nis[r[e]] = nis[e];
+        }
+        return;
+    }
+    // SAFETY: `L == 4`, four `f64` in each lane array; AVX2 is the caller's.
+    let load = |v: &[f64; L]| unsafe { _mm256_loadu_pd(v.as_ptr()) };
+    // `std_dev` in four lanes: `v ≤ 0` (false for a NaN) to +0, then the square root.
+    // SAFETY: AVX2 is the caller's.
+    let sigma = |i: usize| -> __m256d {
+        unsafe {
+            let v = load(&s[i][i]);
+            let nonpositive = _mm256_cmp_pd::<_CMP_LE_OQ>(v, _mm256_setzero_pd());
+            _mm256_sqrt_pd(_mm256_andnot_pd(nonpositive, v))
+        }
+    };
+    if N == 2 {
+        // Lane e's row (a[e], b[e]): lanes 0 and 2 in the interleave of the low halves of
+        // each 128 bits, lanes 1 and 3 in that of the high halves.
+        // SAFETY: AVX2 is the caller's.
+        let rows = |a: __m256d, b: __m256d| unsafe {
+            let (low, high) = (_mm256_unpacklo_pd(a, b), _mm256_unpackhi_pd(a, b));
+            [
+                _mm256_castpd256_pd128(low),
+                _mm256_castpd256_pd128(high),
+                _mm256_extractf128_pd::<1>(low),
+                _mm256_extractf128_pd::<1>(high),
+            ]
+        };
+        let state = rows(load(&x[0]), load(&x[1]));
+        let sd = rows(sigma(0), sigma(1));
+        // One bounds check for the four rows: the last of them in each buffer.
+        let top = r.iter().fold(0, |top, &row| top.max(row));
+        let (to_state, to_sigma) = (
+            &mut out.state[..(top + 1) * 2],
+            &mut out.sigma[..(top + 1) * 2],
+        );
+        let to_nis = &mut out.nis[..top + 1];
+        for e in 0..L {
+            // SAFETY: `r[e] ≤ top`, so row `r[e]`'s two `f64` (the 16 bytes stored) and its
+            // NIS are inside the slices just checked; AVX2 is the caller's.
+            unsafe {
+                _mm_storeu_pd(to_state.as_mut_ptr().add(r[e] * 2), state[e]);
+                _mm_storeu_pd(to_sigma.as_mut_ptr().add(r[e] * 2), sd[e]);
+                *to_nis.as_mut_ptr().add(r[e]) = nis[e];
+            }
+        }
+        return;
+    }
+    let mut sd = [[0.0; L]; N];
+    for i in 0..N {
+        // SAFETY: `sd[i]` is four `f64` (`L == 4`); AVX2 is the caller's.
+        unsafe { _mm256_storeu_pd(sd[i].as_mut_ptr(), sigma(i)) };
+    }
+    for e in 0..L {
+        let (state, to) = (
+            &mut out.state[r[e] * N..][..N],
+            &mut out.sigma[r[e] * N..][..N],
+        );
+        for i in 0..N {
+            state[i] = x[i][e];
+            to[i] = sd[i][e];
+        }
+        out.nis[r[e]] = nis[e];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `put_rows` writes what the entry-by-entry rows would, bit for bit: the state, σ by
+    /// [`std_dev`] (a negative or −0 variance to +0, a NaN kept, +∞ to +∞) and the NIS, each
+    /// lane into its own row, for two states (the transposing store) and three.
+    fn same_as_entry_by_entry<const N: usize>() {
+        if !super::super::available() {
+            return;
+        }
+        let diagonal = [
+            4.0,
+            -1e-18,
+            f64::NAN,
+            2.0,
+            -0.0,
+            f64::INFINITY,
+            1e-300,
+            -3.0,
+        ];
+        let mut x = [[0.0; 4]; N];
+        let mut s = [[[0.5; 4]; N]; N];
+        for i in 0..N {
+            for e in 0..4 {
+                x[i][e] = (10 * i + e) as f64 - 7.5;
+                s[i][i][e] = diagonal[(i * 4 + e) % diagonal.len()];
+            }
+        }
+        let nis = [1.5, 0.25, 3.0, 1e-3];
+        let r = [5, 0, 3, 1];
+        let (mut state, mut sigma, mut out_nis) =
+            (vec![9.0; 6 * N], vec![9.0; 6 * N], vec![9.0; 6]);
+        let mut out = RowsMut {
+            state: &mut state,
+            sigma: &mut sigma,
+            nis: &mut out_nis,
+        };
+        // SAFETY: the processor has AVX2 (checked above).
+        unsafe { put_rows(&mut out, r, &x, &s, &nis) };
+        for e in 0..4 {
+            for i in 0..N {
+                assert_eq!(state[r[e] * N + i].to_bits(), x[i][e].to_bits());
+                assert_eq!(sigma[r[e] * N + i].to_bits(), std_dev(s[i][i][e]).to_bits());
+            }
+            assert_eq!(out_nis[r[e]].to_bits(), nis[e].to_bits());
+        }
+        // The rows no lane holds are untouched.
+        for row in [2, 4] {
+            assert!(state[row * N..(row + 1) * N].iter().all(|&v| v == 9.0));
+            assert!(sigma[row * N..(row + 1) * N].iter().all(|&v| v == 9.0));
+            assert_eq!(out_nis[row], 9.0);
+        }
+    }
+
+    #[test]
+    fn rows_of_two_states() {
+        same_as_entry_by_entry::<2>();
+    }
+
+    #[test]
+    fn rows_of_three_states() {
+        same_as_entry_by_entry::<3>();
     }
 }
