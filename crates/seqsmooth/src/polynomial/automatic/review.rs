@@ -284,7 +284,7 @@ pub(super) fn interpolation_verdict(
         if n < degree + 4 {
             break;
         }
-        let worst = fit.worst_residual(&ts[..n], &ys[..n], sigma * sigma)?;
+        let worst = fit.worst_residual(sigma * sigma)?;
         if worst.0 <= k * k {
             break;
         }
