@@ -426,7 +426,7 @@ mod tests {
         let mut f = WindowFit::default();
         assert!(!f.fit(&[1.0, 2.0], &[0.0, 1.0], 2));
         assert!(f.value_and_vrf_at(1.5).is_none());
-        assert!(f.worst_residual(&[1.0, 2.0], &[0.0, 1.0], 1.0).is_none());
+        assert!(f.worst_residual(1.0).is_none());
         assert!(f.fit(&[1.0, 2.0, 3.0], &[0.0, 1.0, 4.0], 2));
         let (v, _) = f.value_and_vrf_at(4.0).unwrap();
         assert!((v - 9.0).abs() < 1e-12);
