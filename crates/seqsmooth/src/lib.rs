@@ -86,6 +86,10 @@
 //! ```
 #![warn(missing_docs)]
 
+// Before the modules: `field_clone!` is in scope in every one of them.
+#[macro_use]
+mod field_clone;
+
 pub mod basis;
 pub mod calculus;
 pub mod discount;

@@ -7,7 +7,7 @@ use std::ops::{Deref, DerefMut};
 
 /// Up to `N` values inline, more on the heap; reads and writes as a slice (crate-internal: its
 /// checks are the unit tests below).
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub(crate) struct InlineVec<T: Copy, const N: usize> {
     len: usize,
     inline: [T; N],
@@ -36,6 +36,26 @@ impl<T: Copy, const N: usize> InlineVec<T, N> {
         } else {
             self.heap.resize(len, value);
         }
+    }
+}
+
+/// A copy; `clone_from` copies only the values in use (the first `len` inline, or the heap's
+/// into its buffer): the inline slots beyond `len` are never read.
+impl<T: Copy, const N: usize> Clone for InlineVec<T, N> {
+    fn clone(&self) -> Self {
+        Self {
+            len: self.len,
+            inline: self.inline,
+            heap: self.heap.clone(),
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.len = source.len;
+        if source.len <= N {
+            self.inline[..source.len].copy_from_slice(&source.inline[..source.len]);
+        }
+        self.heap.clone_from(&source.heap);
     }
 }
 
@@ -109,5 +129,23 @@ mod tests {
         small.refill(0.5, 5); // onto the heap
         assert_eq!(small.len(), 5);
         assert!(small.iter().all(|&v| v == 0.5));
+    }
+
+    #[test]
+    fn clone_from_takes_the_values_either_way() {
+        let mut to = InlineVec::<f64, 4>::filled(9.0, 4);
+        let mut big = InlineVec::<f64, 4>::filled(2.0, 6);
+        big[5] = 3.0;
+        to.clone_from(&big); // inline → heap
+        assert_eq!(&to[..], &big[..]);
+        let mut small = InlineVec::<f64, 4>::filled(1.0, 2);
+        small[1] = 4.0;
+        to.clone_from(&small); // heap → inline: the heap emptied, the first two taken
+        assert_eq!(&to[..], &[1.0, 4.0]);
+        assert!(to.heap.is_empty());
+        to.clone_from(&big);
+        let capacity = to.heap.capacity();
+        to.clone_from(&big); // heap → heap: its buffer reused
+        assert_eq!((&to[..], to.heap.capacity()), (&big[..], capacity));
     }
 }

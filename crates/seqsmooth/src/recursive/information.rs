@@ -44,7 +44,7 @@ const RENORMALISE: f64 = 1e30;
 /// let x = f.solve().unwrap();
 /// assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] - 2.0).abs() < 1e-12);
 /// ```
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct InformationFilter {
     info: TriangularFactor,
     /// `Q` with `QᵀQ = Σ c_k w_k² h_k h_kᵀ`, when the true covariance is kept.
@@ -53,6 +53,13 @@ pub struct InformationFilter {
     /// and each new row gets the weight `c·scale²` (`Q`'s `c·scale⁴`).
     scale: f64,
 }
+
+// Field by field, `clone_from` too (the automatic filter's review keeps copies of it).
+field_clone!(InformationFilter {
+    info,
+    spread,
+    scale
+});
 
 impl InformationFilter {
     /// A filter for a `p`-dimensional state with no prior information.

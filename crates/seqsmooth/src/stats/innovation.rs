@@ -58,7 +58,7 @@ pub struct ChiSquaredOutcome {
 /// }
 /// assert_eq!(fired, Some(4));
 /// ```
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct InnovationChiSquared {
     window: usize,
     alpha: f64,
@@ -71,6 +71,16 @@ pub struct InnovationChiSquared {
     dofs: std::collections::VecDeque<usize>,
     dof_total: usize,
 }
+
+// Field by field, `clone_from` too (the automatic filter's review keeps copies of it).
+field_clone!(InnovationChiSquared {
+    window,
+    alpha,
+    thresholds,
+    recent,
+    dofs,
+    dof_total
+});
 
 impl InnovationChiSquared {
     /// A test over a window of `window ≥ 1` samples at false-alarm rate `α ∈ (0,1)` per sample.

@@ -301,7 +301,7 @@ fn divided_difference_with_factors(times: &[f64], values: &[f64], factors: &[f64
 /// let s = est.sigma().unwrap();
 /// assert!(s > 0.1 && s < 0.2); // the ramp is gone; the rest is the ±0.1 pattern
 /// ```
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct DifferenceNoise {
     order: usize,
     times: VecDeque<f64>,
@@ -320,6 +320,20 @@ pub struct DifferenceNoise {
     /// Differences left out by the screen (the screened ones and those that share their samples).
     left_out: u64,
 }
+
+// Field by field, `clone_from` too (the automatic filter's review keeps copies of it).
+field_clone!(DifferenceNoise {
+    order,
+    times,
+    values,
+    factors,
+    squares,
+    screen,
+    kept,
+    holdoff,
+    early,
+    left_out
+});
 
 /// Until the screened estimate has this many terms, the screen's reference is the mean of the
 /// smallest 80% of the squared differences seen so far, over its value for Gaussian terms

@@ -6,7 +6,7 @@ use std::collections::VecDeque;
 /// A sum over the last `window` values pushed, or over all of them with `None`. The windowed
 /// sum is updated as `(s − x_old) + x_new` and re-added from scratch every `4·window` pushes, so
 /// that its rounding cannot drift, and kept `≥ 0` (the values summed are squares).
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) struct SlidingSum {
     window: Option<usize>,
     values: VecDeque<f64>,
@@ -14,6 +14,15 @@ pub(crate) struct SlidingSum {
     count: u64,
     pushes_since_resum: usize,
 }
+
+// Field by field, `clone_from` too (the automatic filter's review keeps copies of it).
+field_clone!(SlidingSum {
+    window,
+    values,
+    sum,
+    count,
+    pushes_since_resum
+});
 
 impl SlidingSum {
     /// An empty sum over windows of `window ≥ 1` values, or over all values.

@@ -191,7 +191,7 @@ const MEMORY_RATIO: i32 = 4;
 
 /// A shorter memory of the final degree: the degree-`m` fading-memory filter of discount
 /// `θ^(4^j)` per `τ` and its degree `m + 1` companion.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 struct Shorter {
     fading: FadingMemory,
     upper: FadingMemory,
@@ -201,6 +201,13 @@ struct Shorter {
     #[serde(default)]
     stale: bool,
 }
+
+// Field by field, `clone_from` too (the review's kept copies reuse their buffers).
+field_clone!(Shorter {
+    fading,
+    upper,
+    stale
+});
 
 impl Shorter {
     /// Brings `fading` up to `upper`'s samples from `upper`'s leading block

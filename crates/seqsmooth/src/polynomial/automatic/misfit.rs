@@ -119,7 +119,7 @@ fn misfit_onset(recent: &[Kept], window: usize, m: usize) -> usize {
 /// The misfit tests and what a restart needs (Morrison §14.8): the innovation chi-squared
 /// window of the flag, the stricter one of the restart ([`MisfitResponse::Restart`]), the
 /// newest accepted samples, and the restarts so far.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Misfit {
     chi: InnovationChiSquared,
     restart_test: Option<InnovationChiSquared>,
@@ -131,6 +131,17 @@ pub(super) struct Misfit {
     restarts: u64,
     last_restart: Option<u64>,
 }
+
+// Field by field, `clone_from` too (the review's kept copies reuse their buffers).
+field_clone!(Misfit {
+    chi,
+    restart_test,
+    recent,
+    keep,
+    window,
+    restarts,
+    last_restart
+});
 
 impl Misfit {
     /// The tests of window `window` and false-alarm rate `alpha`, the restart's per

@@ -69,7 +69,7 @@ impl NoiseSource {
 
 /// A running mean over the last `window` values (or all of them), re-summed every `4·window`
 /// pushes so that the rounding of the sliding sum does not accumulate.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct WindowedMean {
     window: Option<usize>,
     values: VecDeque<f64>,
@@ -77,6 +77,15 @@ pub(super) struct WindowedMean {
     count: usize,
     pushes: usize,
 }
+
+// Field by field, `clone_from` too (the review's kept copies reuse their buffers).
+field_clone!(WindowedMean {
+    window,
+    values,
+    sum,
+    count,
+    pushes
+});
 
 impl WindowedMean {
     fn new(window: Option<usize>) -> Self {
@@ -116,11 +125,33 @@ impl WindowedMean {
 }
 
 /// The noise estimate an [`AutomaticFilter`](super::AutomaticFilter) keeps.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(super) enum NoiseState {
     Known(f64),
     Differences(DifferenceNoise, Box<Early>),
     Innovations(WindowedMean),
+}
+
+// `clone_from` into the same source reuses its buffers (the review's kept copies).
+impl Clone for NoiseState {
+    fn clone(&self) -> Self {
+        match self {
+            NoiseState::Known(s) => NoiseState::Known(*s),
+            NoiseState::Differences(d, e) => NoiseState::Differences(d.clone(), e.clone()),
+            NoiseState::Innovations(w) => NoiseState::Innovations(w.clone()),
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        match (self, source) {
+            (NoiseState::Differences(d, e), NoiseState::Differences(ds, es)) => {
+                d.clone_from(ds);
+                e.as_mut().clone_from(es);
+            }
+            (NoiseState::Innovations(w), NoiseState::Innovations(ws)) => w.clone_from(ws),
+            (to, from) => *to = from.clone(),
+        }
+    }
 }
 
 /// The accepted samples whose differences the start-up estimate screens at once ([`Early`]).
@@ -140,7 +171,7 @@ const CHI2_1_TRIMMED_MEAN: f64 = 0.437_724_6;
 /// terms are an outlier's), the kept ones divided by the truncated variance. Once the review
 /// rejects the outlier, the filter takes the samples again without it, and the running estimate
 /// is clean too.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Early {
     /// The screen `c` ([`AutoConfig::noise_screen`](super::AutoConfig::noise_screen)).
     screen: f64,
@@ -150,6 +181,14 @@ pub(super) struct Early {
     sigma: Option<f64>,
     done: bool,
 }
+
+// Field by field, `clone_from` too (the review's kept copies reuse their buffers).
+field_clone!(Early {
+    screen,
+    samples,
+    sigma,
+    done
+});
 
 impl Early {
     fn new(screen: f64) -> Self {

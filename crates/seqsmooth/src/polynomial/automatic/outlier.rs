@@ -180,11 +180,14 @@ const MARGINAL: f64 = 1.25;
 
 /// The current run of rejected samples (the gate's, not yet applied as a manoeuvre), and the
 /// count of rejections.
-#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
 pub(super) struct Run {
     pending: Vec<Kept>,
     rejected: u64,
 }
+
+// Field by field, `clone_from` too (the review's kept copies reuse their buffers).
+field_clone!(Run { pending, rejected });
 
 impl Run {
     /// Samples rejected so far (not counting runs applied as manoeuvres).

@@ -178,13 +178,7 @@ impl<S: Replay> Review<S> {
         if !self.keeps_next() {
             return None;
         }
-        Some(match self.spare.pop() {
-            Some(mut kept) => {
-                kept.as_mut().clone_from(state);
-                kept
-            }
-            None => Box::new(state.clone()),
-        })
+        Some(copy_into(&mut self.spare, state))
     }
 
     /// The newest `n` rejected samples waiting (a run just applied) are not rejected.
@@ -290,7 +284,7 @@ pub(super) fn interpolation_verdict(
         if n < degree + 4 {
             break;
         }
-        let worst = fit.worst_residual(&ts[..n], &ys[..n], sigma * sigma)?;
+        let worst = fit.worst_residual(sigma * sigma)?;
         if worst.0 <= k * k {
             break;
         }
@@ -353,6 +347,10 @@ pub(super) struct Scratch {
     /// The accepted samples after the sample decided, and the window around it.
     after: Vec<(f64, f64)>,
     around: Vec<(f64, f64)>,
+    /// The verdicts a decision going back replaces, put back if it fails
+    /// ([`Review::take_again`]): not saved.
+    #[serde(skip)]
+    undo: Vec<(bool, Option<f64>)>,
 }
 
 impl<S: Replay> Review<S> {
@@ -507,52 +505,98 @@ impl<S: Replay> Review<S> {
     /// Goes back to the nearest state kept at or before the sample `f` waiting, replays the
     /// decided samples from there with their decisions, `f` with the decision `rejected`, and
     /// the samples after it (the gate judging them anew). Returns the newest sample's output;
-    /// on an error `state` is as before the call.
+    /// on an error `state` and the review are as before the call. No state is copied but the
+    /// kept ones the replay takes again, each into the buffers of a spare one: the state
+    /// before the call is moved aside, not copied, and the verdicts and kept states the
+    /// replay replaces are put back only on an error.
     fn take_again(&mut self, state: &mut S, f: usize, rejected: bool) -> Result<AutoOutput, Error> {
-        let current = state.clone();
-        let mut entries = self.entries.clone();
-        let result = (|| {
-            let start = (0..=f)
-                .rev()
-                .find(|&j| entries[j].before.is_some())
-                .expect("the first entry keeps its state");
-            *state = entries[start].before.as_deref().expect("found").clone();
-            // Every sample before `f` is decided: none of them is part of a run.
-            state.end_run();
-            let mut out = None;
-            for j in start..entries.len() {
-                if j > start && entries[j].before.is_some() {
-                    entries[j].before = Some(Box::new(state.clone()));
-                }
-                let (t, y) = (entries[j].t, entries[j].y);
-                let force = match j.cmp(&f) {
-                    std::cmp::Ordering::Less => Some(entries[j].rejected),
-                    std::cmp::Ordering::Equal => Some(rejected),
-                    std::cmp::Ordering::Greater => None,
-                };
-                let o = state.step(t, y, force)?;
-                if j == f {
-                    entries[j].rejected = rejected;
-                    entries[j].gate_rms = None;
-                } else if j > f {
-                    reinstate(entries.range_mut(f + 1..j), o.reinstated);
-                    entries[j].rejected = o.outlier;
-                    entries[j].gate_rms = gate_rms(&o);
-                }
-                out = Some(o);
+        let start = (0..=f)
+            .rev()
+            .find(|&j| self.entries[j].before.is_some())
+            .expect("the first entry keeps its state");
+        let mut undo = std::mem::take(&mut self.scratch.undo);
+        undo.clear();
+        undo.extend(
+            self.entries
+                .range(start..)
+                .map(|e| (e.rejected, e.gate_rms)),
+        );
+        let mut replaced = Vec::new();
+        let kept = self.entries[start].before.as_deref().expect("found");
+        let mut current = copy_into(&mut self.spare, kept);
+        std::mem::swap(state, &mut current);
+        // Every sample before `f` is decided: none of them is part of a run.
+        state.end_run();
+        let mut result = Err(None);
+        for j in start..self.entries.len() {
+            if j > start && self.entries[j].before.is_some() {
+                let copy = copy_into(&mut self.spare, state);
+                let old = self.entries[j].before.replace(copy).expect("kept");
+                replaced.push((j, old));
             }
-            Ok(out.expect("the sample f was taken"))
-        })();
+            let (t, y) = (self.entries[j].t, self.entries[j].y);
+            let force = match j.cmp(&f) {
+                std::cmp::Ordering::Less => Some(self.entries[j].rejected),
+                std::cmp::Ordering::Equal => Some(rejected),
+                std::cmp::Ordering::Greater => None,
+            };
+            let o = match state.step(t, y, force) {
+                Ok(o) => o,
+                Err(e) => {
+                    result = Err(Some(e));
+                    break;
+                }
+            };
+            if j == f {
+                self.entries[j].rejected = rejected;
+                self.entries[j].gate_rms = None;
+            } else if j > f {
+                reinstate(self.entries.range_mut(f + 1..j), o.reinstated);
+                self.entries[j].rejected = o.outlier;
+                self.entries[j].gate_rms = gate_rms(&o);
+            }
+            result = Ok(o);
+        }
         match result {
             Ok(out) => {
-                self.entries = entries;
+                self.keep_spare(current);
+                for (_, old) in replaced {
+                    self.keep_spare(old);
+                }
+                self.scratch.undo = undo;
                 Ok(out)
             }
             Err(e) => {
-                *state = current;
-                Err(e)
+                std::mem::swap(state, &mut current);
+                for (entry, &(rejected, gate_rms)) in self.entries.range_mut(start..).zip(&undo) {
+                    entry.rejected = rejected;
+                    entry.gate_rms = gate_rms;
+                }
+                for (j, old) in replaced {
+                    self.entries[j].before = Some(old);
+                }
+                self.scratch.undo = undo;
+                Err(e.expect("the sample f was taken"))
             }
         }
+    }
+
+    /// Holds a kept state no longer needed for its buffers, up to [`SPARE_STATES`].
+    fn keep_spare(&mut self, kept: Box<S>) {
+        if self.spare.len() < SPARE_STATES {
+            self.spare.push(kept);
+        }
+    }
+}
+
+/// A copy of `state`, into the buffers of a spare kept state when there is one.
+fn copy_into<S: Clone>(spare: &mut Vec<Box<S>>, state: &S) -> Box<S> {
+    match spare.pop() {
+        Some(mut kept) => {
+            kept.as_mut().clone_from(state);
+            kept
+        }
+        None => Box::new(state.clone()),
     }
 }
 

@@ -12,7 +12,7 @@ use crate::polynomial::expanding::ExpandingMemory;
 use crate::polynomial::filter::PolynomialFilter;
 
 /// The ladder's filters below the final degree and the active degree.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(super) struct Ladder {
     /// Expanding-memory filters indexed by degree `< m` (`None` once passed or below `d₀`).
     filters: Vec<Option<ExpandingMemory>>,
@@ -24,6 +24,15 @@ pub(super) struct Ladder {
     stable_runs: usize,
     prev_top: Option<f64>,
 }
+
+// Field by field, `clone_from` too (the review's kept copies reuse their buffers).
+field_clone!(Ladder {
+    filters,
+    active,
+    degree,
+    stable_runs,
+    prev_top
+});
 
 impl Ladder {
     /// The ladder of `cfg`: degrees [`AutoConfig::start_degree`] to `m − 1` below the final one.

@@ -17,7 +17,7 @@
 //! fit is the same least-squares polynomial as a QR factor's; its numbers differ in the last
 //! bits (tested against nalgebra's QR below).
 
-use crate::numeric::unrolled::{unrolled_sizes, Any, Fixed, Size};
+use crate::numeric::unrolled::unrolled_sizes;
 use crate::polynomial::options::MAX_DEGREE;
 
 /// The most coefficients of a [`WindowFit`]: degree `MAX_DEGREE + 2`.
@@ -86,6 +86,11 @@ pub(super) struct WindowFit {
     determined: bool,
     /// `Σ (y_j − p(t_j))²` over the samples fitted.
     residual_sq: f64,
+    /// The samples' rows `(P_0(u_j), …, P_d(u_j))` (stride `d + 1`) and residuals
+    /// `y_j − p(t_j)` of the latest fit, for [`WindowFit::worst_residual`] (grown to the
+    /// largest window once, then reused).
+    rows: Vec<f64>,
+    residuals: Vec<f64>,
 }
 
 impl Default for WindowFit {
@@ -99,6 +104,8 @@ impl Default for WindowFit {
             degree: 0,
             determined: false,
             residual_sq: 0.0,
+            rows: Vec::new(),
+            residuals: Vec::new(),
         }
     }
 }
@@ -109,12 +116,13 @@ impl WindowFit {
     /// ([`unrolled_sizes!`]).
     pub(super) fn fit(&mut self, ts: &[f64], ys: &[f64], degree: usize) -> bool {
         let p = degree + 1;
-        unrolled_sizes!(p, N => self.fit_with(Fixed::<N>, ts, ys), p => self.fit_with(Any(p), ts, ys))
+        unrolled_sizes!(p, N => self.fit_with::<N>(N, ts, ys), p => self.fit_with::<MAX_FIT>(p, ts, ys))
     }
 
+    /// The fit of `p ≤ N` coefficients, its scratch arrays of `N` (`N = p` compiled in, or
+    /// [`MAX_FIT`]: no more zeroed per fit than the size needs).
     #[inline(always)]
-    fn fit_with(&mut self, size: impl Size, ts: &[f64], ys: &[f64]) -> bool {
-        let p = size.get();
+    fn fit_with<const N: usize>(&mut self, p: usize, ts: &[f64], ys: &[f64]) -> bool {
         let (lo, hi) = ts
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
@@ -124,7 +132,7 @@ impl WindowFit {
         self.centre = 0.5 * (lo + hi);
         self.inv_half = if half > 0.0 { 1.0 / half } else { 1.0 };
         self.degree = p - 1;
-        self.coefficients = [0.0; MAX_FIT];
+        self.coefficients[..p].fill(0.0);
         self.residual_sq = 0.0;
         // The values less their mean (added back to `a_0`, `P_0 ≡ 1`: the same fit), so the
         // normal equations' rounding scales with the values' spread over the window, not with
@@ -135,35 +143,38 @@ impl WindowFit {
             ys.iter().sum::<f64>() / ys.len() as f64
         };
         // The normal equations' upper triangle and right-hand side.
-        let mut g = [0.0; MAX_FIT * MAX_FIT];
-        let mut b = [0.0; MAX_FIT];
-        for (&t, &y) in ts.iter().zip(ys) {
-            let mut h = [0.0; MAX_FIT];
-            legendre_row((t - self.centre) * self.inv_half, &mut h[..p]);
+        let mut g = [[0.0; N]; N];
+        let mut b = [0.0; N];
+        let n = ts.len().min(ys.len());
+        self.rows.resize(n * p, 0.0);
+        self.residuals.resize(n, 0.0);
+        for ((&t, &y), row) in ts.iter().zip(ys).zip(self.rows.chunks_exact_mut(p)) {
+            let h = row;
+            legendre_row((t - self.centre) * self.inv_half, h);
             let y = y - mean;
             for i in 0..p {
                 b[i] += h[i] * y;
                 for k in i..p {
-                    g[i * p + k] += h[i] * h[k];
+                    g[i][k] += h[i] * h[k];
                 }
             }
         }
         // G = Uᵀ D U, row by row.
         let (unit, inv_d) = (&mut self.unit, &mut self.inv_d);
-        let mut d = [0.0; MAX_FIT];
+        let mut d = [0.0; N];
         let mut ok = true;
         for i in 0..p {
-            let mut di = g[i * p + i];
+            let mut di = g[i][i];
             for k in 0..i {
                 let uki = unit[k * p + i];
                 di -= uki * uki * d[k];
             }
             // NaN fails too.
-            ok &= di > DETERMINED * g[i * p + i];
+            ok &= di > DETERMINED * g[i][i];
             d[i] = di;
             inv_d[i] = 1.0 / di;
             for j in i + 1..p {
-                let mut s = g[i * p + j];
+                let mut s = g[i][j];
                 for k in 0..i {
                     s -= unit[k * p + i] * unit[k * p + j] * d[k];
                 }
@@ -191,22 +202,30 @@ impl WindowFit {
             a[i] = x;
         }
         a[0] += mean;
+        // The residuals, from the rows kept (the same numbers as `value_and_row` gives).
         let mut rss = 0.0;
-        for (&t, &y) in ts.iter().zip(ys) {
-            let mut h = [0.0; MAX_FIT];
-            let e = y - self.value_and_row(t, &mut h[..p]);
-            rss += e * e;
+        let a = &self.coefficients[..p];
+        let rows = self.rows.chunks_exact(p);
+        for ((&y, h), e) in ys.iter().zip(rows).zip(self.residuals.iter_mut()) {
+            *e = y - a.iter().zip(h.iter()).map(|(a, h)| a * h).sum::<f64>();
+            rss += *e * *e;
         }
         self.residual_sq = rss;
         true
     }
 
     /// `p(t)` and its variance for unit noise `h(t)ᵀ G⁻¹ h(t)`; `None` while not determined.
+    /// The size `d + 1` compiled in ([`unrolled_sizes!`]).
     pub(super) fn value_and_vrf_at(&self, t: f64) -> Option<(f64, f64)> {
         let p = self.degree + 1;
-        let mut h = [0.0; MAX_FIT];
+        unrolled_sizes!(p, N => self.value_and_vrf_with::<N>(N, t), p => self.value_and_vrf_with::<MAX_FIT>(p, t))
+    }
+
+    #[inline(always)]
+    fn value_and_vrf_with<const N: usize>(&self, p: usize, t: f64) -> Option<(f64, f64)> {
+        let mut h = [0.0; N];
         let value = self.value_and_row(t, &mut h[..p]);
-        Some((value, self.vrf_of(&h[..p])?))
+        Some((value, self.vrf_of::<N>(&h[..p])?))
     }
 
     /// `p(t)`, with the row `h(t) = (P_0(u), …, P_d(u))` into `h` (`p` values).
@@ -218,42 +237,39 @@ impl WindowFit {
     }
 
     /// `hᵀ G⁻¹ h = Σ_i g_i²/d_i` with `Uᵀ g = h`; `None` while not determined.
-    fn vrf_of(&self, h: &[f64]) -> Option<f64> {
+    #[inline(always)]
+    fn vrf_of<const N: usize>(&self, h: &[f64]) -> Option<f64> {
         if !self.determined {
             return None;
         }
         let p = h.len();
-        Some(quadratic_form(&self.unit[..p * p], &self.inv_d[..p], h))
+        Some(quadratic_form::<N>(
+            &self.unit[..p * p],
+            &self.inv_d[..p],
+            h,
+        ))
     }
 
     /// The largest squared studentised residual `e_j²/(σ²(1 − h_j))` (`s2 = σ²`, `h_j` the
     /// fit's VRF at `t_j`, as [`value_and_vrf_at`](Self::value_and_vrf_at) gives it) over the
-    /// samples `(ts, ys)`, and its index (the first of equals); `None` while not determined or
-    /// when one is not a number. The fit's size compiled in ([`unrolled_sizes!`]).
-    pub(super) fn worst_residual(&self, ts: &[f64], ys: &[f64], s2: f64) -> Option<(f64, usize)> {
+    /// samples of the latest fit (their rows and residuals kept by [`fit`](Self::fit)), and its
+    /// index (the first of equals); `None` while not determined or when one is not a number.
+    /// The fit's size compiled in ([`unrolled_sizes!`]).
+    pub(super) fn worst_residual(&self, s2: f64) -> Option<(f64, usize)> {
         let p = self.degree + 1;
-        unrolled_sizes!(p, N => self.worst_residual_with(Fixed::<N>, ts, ys, s2), p => self.worst_residual_with(Any(p), ts, ys, s2))
+        unrolled_sizes!(p, N => self.worst_residual_with::<N>(N, s2), p => self.worst_residual_with::<MAX_FIT>(p, s2))
     }
 
     #[inline(always)]
-    fn worst_residual_with(
-        &self,
-        size: impl Size,
-        ts: &[f64],
-        ys: &[f64],
-        s2: f64,
-    ) -> Option<(f64, usize)> {
+    fn worst_residual_with<const N: usize>(&self, p: usize, s2: f64) -> Option<(f64, usize)> {
         if !self.determined {
             return None;
         }
-        let p = size.get();
         let (u, inv_d) = (&self.unit[..p * p], &self.inv_d[..p]);
         let mut worst = (f64::NEG_INFINITY, 0);
-        for (j, (&t, &y)) in ts.iter().zip(ys).enumerate() {
-            let mut h = [0.0; MAX_FIT];
-            let value = self.value_and_row(t, &mut h[..p]);
-            let q = quadratic_form(u, inv_d, &h[..p]);
-            let e = y - value;
+        let rows = self.rows.chunks_exact(p);
+        for (j, (h, &e)) in rows.zip(&self.residuals).enumerate() {
+            let q = quadratic_form::<N>(u, inv_d, h);
             let r2 = e * e / (s2 * (1.0 - q).max(f64::EPSILON));
             if r2.is_nan() {
                 return None;
@@ -272,11 +288,11 @@ impl WindowFit {
 }
 
 /// `hᵀ G⁻¹ h = Σ_i g_i²/d_i` with `Uᵀ g = h`, for the unit triangle `u` (row-major, `p × p`,
-/// `p = h.len()`) and the pivots' reciprocals `inv_d` of `G = Uᵀ D U`.
+/// `p = h.len() ≤ N`) and the pivots' reciprocals `inv_d` of `G = Uᵀ D U`.
 #[inline(always)]
-fn quadratic_form(u: &[f64], inv_d: &[f64], h: &[f64]) -> f64 {
+fn quadratic_form<const N: usize>(u: &[f64], inv_d: &[f64], h: &[f64]) -> f64 {
     let p = h.len();
-    let mut g = [0.0; MAX_FIT];
+    let mut g = [0.0; N];
     let mut q = 0.0;
     for i in 0..p {
         let mut gi = h[i];
@@ -341,7 +357,7 @@ mod tests {
                 "case {case}: {rss} {rss0}"
             );
             // The studentised residuals: the largest one's index and value by the oracle.
-            let (w, j) = f.worst_residual(&ts, &ys, 4.0).unwrap();
+            let (w, j) = f.worst_residual(4.0).unwrap();
             let (vj, hj, _) = qr_fit(&ts, &ys, d, ts[j]);
             let want = (ys[j] - vj).powi(2) / (4.0 * (1.0 - hj).max(f64::EPSILON));
             assert!(
@@ -410,7 +426,7 @@ mod tests {
         let mut f = WindowFit::default();
         assert!(!f.fit(&[1.0, 2.0], &[0.0, 1.0], 2));
         assert!(f.value_and_vrf_at(1.5).is_none());
-        assert!(f.worst_residual(&[1.0, 2.0], &[0.0, 1.0], 1.0).is_none());
+        assert!(f.worst_residual(1.0).is_none());
         assert!(f.fit(&[1.0, 2.0, 3.0], &[0.0, 1.0, 4.0], 2));
         let (v, _) = f.value_and_vrf_at(4.0).unwrap();
         assert!((v - 9.0).abs() < 1e-12);

@@ -54,7 +54,7 @@ const fn pascal() -> [[f64; MAX_SIZE]; MAX_SIZE] {
     c
 }
 
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) struct ExactEngine {
     m: usize,
     discount: Option<Discount>,
@@ -85,6 +85,28 @@ pub(crate) struct ExactEngine {
     /// The prior's time, when the filter started from one ([`Self::set_prior`]).
     prior: Option<f64>,
 }
+
+// Field by field, `clone_from` too (the automatic filter's review keeps copies of it).
+field_clone!(ExactEngine {
+    m,
+    discount,
+    info,
+    centre,
+    unit,
+    inv_unit,
+    t_first,
+    t_last,
+    n,
+    sigma,
+    step_cached,
+    inv_root,
+    half_rate,
+    span_updates,
+    span_per_time,
+    unscale,
+    unscale_in_range,
+    prior
+});
 
 impl ExactEngine {
     pub fn new(m: usize, discount: Option<Discount>) -> Self {

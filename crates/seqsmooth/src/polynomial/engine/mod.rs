@@ -41,10 +41,29 @@ const FUSED_CHUNK: usize = 1024;
 // filter allocates nothing (the automatic filter copies its filters' state where a decision may
 // go back); boxing it would put one allocation back per copy.
 #[allow(clippy::large_enum_variant)]
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) enum EngineState {
     Exact(ExactEngine),
     Gain(GainEngine),
+}
+
+/// `clone_from` into the same engine reuses its buffers (the automatic filter's review keeps
+/// copies of its filters and takes them again).
+impl Clone for EngineState {
+    fn clone(&self) -> Self {
+        match self {
+            EngineState::Exact(e) => EngineState::Exact(e.clone()),
+            EngineState::Gain(g) => EngineState::Gain(g.clone()),
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        match (self, source) {
+            (EngineState::Exact(to), EngineState::Exact(from)) => to.clone_from(from),
+            (EngineState::Gain(to), EngineState::Gain(from)) => to.clone_from(from),
+            (to, from) => *to = from.clone(),
+        }
+    }
 }
 
 impl EngineState {

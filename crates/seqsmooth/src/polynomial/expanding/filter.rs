@@ -23,12 +23,15 @@ use crate::polynomial::prior::{check_no_prior, Prior};
 /// // the 1-step prediction Z*_{5,4} = (27/5, 4/5)
 /// assert!((f.estimate_at(5.0).unwrap().derivatives[0] - 5.4).abs() < 1e-12);
 /// ```
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct ExpandingMemory {
     m: usize,
     prior: bool,
     core: EngineState,
 }
+
+// Field by field, `clone_from` too (the automatic filter's review keeps copies of it).
+field_clone!(ExpandingMemory { m, prior, core });
 
 impl ExpandingMemory {
     /// Becomes the degree-`m` filter of `upper`'s samples (`upper` of degree `m + 1`, the same

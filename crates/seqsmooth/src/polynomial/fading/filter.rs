@@ -24,7 +24,7 @@ use crate::polynomial::prior::{check_no_prior, Prior};
 /// let s = f.estimate().unwrap();
 /// assert!((s.derivatives[0] - 251.5).abs() < 1e-9 && (s.derivatives[1] - 0.5).abs() < 1e-12);
 /// ```
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct FadingMemory {
     m: usize,
     theta: f64,
@@ -35,6 +35,18 @@ pub struct FadingMemory {
     prior: Option<Prior>,
     core: EngineState,
 }
+
+// Field by field, `clone_from` too (the automatic filter's review keeps copies of it).
+field_clone!(FadingMemory {
+    m,
+    theta,
+    tau,
+    mode,
+    rule,
+    sigma,
+    prior,
+    core
+});
 
 impl FadingMemory {
     /// Becomes the degree-`m` filter of `upper`'s samples (`upper` of degree `m + 1`, the same

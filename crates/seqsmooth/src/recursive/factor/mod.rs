@@ -53,7 +53,7 @@ const INLINE_P: usize = 5;
 /// let r = f.r(); // upper triangular with RᵀR = the Gram matrix
 /// assert!((r[(0, 0)] - 5f64.sqrt()).abs() < 1e-12 && r[(1, 0)] == 0.0);
 /// ```
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct TriangularFactor {
     /// `D`, the squares of `R`'s diagonal, each in its own 16-byte slot ([`Pivot`]).
     d: InlineVec<Pivot, INLINE_P>,
@@ -66,6 +66,16 @@ pub struct TriangularFactor {
     positive: bool,
     scratch: Vec<f64>,
 }
+
+// Field by field, `clone_from` too (the automatic filter's review keeps copies of it).
+field_clone!(TriangularFactor {
+    d,
+    u,
+    ubar,
+    residual_sq,
+    positive,
+    scratch
+});
 
 /// A pivot `d_i` alone in a 16-byte slot, so that no two pivots share a (vectorised) load or
 /// store. In the reciprocal form of [`TriangularFactor::add_row`] the next row's `1/d_i` is
