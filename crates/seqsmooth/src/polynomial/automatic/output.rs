@@ -118,28 +118,25 @@ impl AutoOutput {
 /// off the diagonal).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Reported {
-    derivatives: [f64; MAX_DEGREE + 1],
-    std_devs: [f64; MAX_DEGREE + 1],
-    len: usize,
+    pub(super) derivatives: [f64; MAX_DEGREE + 1],
+    pub(super) std_devs: [f64; MAX_DEGREE + 1],
+    pub(super) len: usize,
     /// `b₀`, NaN where [`AutoOutput::bias`] is `None`.
-    bias0: f64,
+    pub(super) bias0: f64,
+}
+
+impl Default for Reported {
+    fn default() -> Self {
+        Self {
+            derivatives: [0.0; MAX_DEGREE + 1],
+            std_devs: [0.0; MAX_DEGREE + 1],
+            len: 0,
+            bias0: f64::NAN,
+        }
+    }
 }
 
 impl Reported {
-    pub(super) fn new(
-        derivatives: [f64; MAX_DEGREE + 1],
-        std_devs: [f64; MAX_DEGREE + 1],
-        len: usize,
-        bias0: f64,
-    ) -> Self {
-        Self {
-            derivatives,
-            std_devs,
-            len,
-            bias0,
-        }
-    }
-
     /// `x, x', …` of the active degree.
     pub(crate) fn derivatives(&self) -> &[f64] {
         &self.derivatives[..self.len]

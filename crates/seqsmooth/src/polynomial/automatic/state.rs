@@ -51,7 +51,9 @@ pub(super) struct State {
 #[derive(Debug, Default)]
 struct Rows {
     on: bool,
-    reported: Option<Reported>,
+    /// The newest update reported `reported` (else it is stale).
+    valid: bool,
+    reported: Reported,
 }
 
 impl Clone for Rows {
@@ -219,7 +221,7 @@ impl State {
         force: Option<bool>,
     ) -> Result<AutoOutput, Error> {
         self.last_time = Some(t);
-        self.rows.reported = None;
+        self.rows.valid = false;
         self.memories.switch_if_due(&self.cfg, t, self.accepted)?;
         let judged = self.judge(t, y);
         let (sigma, innovation, vrf) = (judged.sigma, judged.innovation, judged.vrf);
@@ -356,11 +358,12 @@ impl State {
         let p = active.degree() + 1;
         // `estimate()` is the estimate at the newest sample's time.
         let at = if outlier { Some(t) } else { active.last_time() };
-        let (mut x, mut v) = ([0.0; P], [0.0; P]);
+        // Written in place: the derivatives into the row's own cells.
+        let mut r = Reported::default();
+        let (x, mut v) = (&mut r.derivatives, [0.0; P]);
         let (mut xu, mut vu) = ([0.0; P], [0.0; P]);
         let answered = at.is_some_and(|at| {
-            self.active_diagonal(at, &mut x, &mut v)
-                && self.companion_variances(at, &mut xu, &mut vu)
+            self.active_diagonal(at, x, &mut v) && self.companion_variances(at, &mut xu, &mut vu)
         });
         // A derivative beyond the double range: the estimate is refused as not determined
         // (`try_estimate_at`), which the full path says.
@@ -374,20 +377,19 @@ impl State {
         b[0] = at_least(b[0], self.excess.sqrt());
         let factor = self.memories.calibration_factor(self.ladder.settled());
         let s2 = sigma * sigma;
-        let mut sd = [0.0; P];
         for i in 0..p {
             let h = (v[i] * s2 + b[i] * b[i]) * factor;
             if h.is_nan() || h.abs() > LIMIT {
                 return false;
             }
-            sd[i] = std_dev(h);
+            r.std_devs[i] = std_dev(h);
         }
-        let bias0 = if b[..p].iter().all(|b| b.is_finite()) {
-            b[0]
-        } else {
-            f64::NAN
-        };
-        self.rows.reported = Some(Reported::new(x, sd, p, bias0));
+        if b[..p].iter().all(|b| b.is_finite()) {
+            r.bias0 = b[0];
+        }
+        r.len = p;
+        self.rows.reported = r;
+        self.rows.valid = true;
         true
     }
 
@@ -398,7 +400,7 @@ impl State {
 
     /// What the newest update reported on the row runner's path ([`Rows`]), if it did.
     pub(super) fn reported(&self) -> Option<&Reported> {
-        self.rows.reported.as_ref()
+        self.rows.valid.then_some(&self.rows.reported)
     }
 
     /// The active filter's estimate at `t`, its derivatives into `x` and its covariance's
