@@ -283,6 +283,26 @@ impl AnyFilter {
         }
         // The batch kernels write every cell; here a cell not written is empty.
         out.fill(f64::NAN);
+        let written = self.write_each_row(t, y, out, layout, stride);
+        // The automatic filter's rows took only what they write of its estimates
+        // (`AutomaticFilter::update_row`): its newest output is made whole for anyone after.
+        if let Inner::Automatic(f) = &mut self.inner {
+            f.complete_output();
+        }
+        written
+    }
+
+    /// [`write_rows`](Self::write_rows) a row at a time (every kind but the expanding- and
+    /// fading-memory filters' batch kernels).
+    fn write_each_row(
+        &mut self,
+        t: &[f64],
+        y: &[f64],
+        out: &mut [f64],
+        layout: RowLayout,
+        stride: usize,
+    ) -> Result<(), Error> {
+        let RowLayout { sigma, lead, .. } = layout;
         let width = (self.degree() + 1) << usize::from(sigma);
         let at = |index: usize| {
             move |e: Error| Error::InBatch {
@@ -296,7 +316,14 @@ impl AnyFilter {
             .zip(out.chunks_exact_mut(stride))
             .enumerate()
         {
-            self.update(t, y).map_err(at(index))?;
+            match &mut self.inner {
+                // Without a lead only what the rows write of the estimate.
+                Inner::Automatic(f) if lead == 0.0 => {
+                    f.update_row(t, y).map_err(at(index))?;
+                    self.rows += 1;
+                }
+                _ => self.update(t, y).map_err(at(index))?,
+            }
             let (values, extra) = row.split_at_mut(width);
             let trailing = layout.trailing;
             let estimate = match &mut self.inner {
@@ -308,12 +335,17 @@ impl AnyFilter {
                 }
                 Inner::Automatic(f) => {
                     let Some(o) = f.last_output() else { continue };
+                    let reported = f.reported();
                     if trailing {
+                        let bias0 = match reported {
+                            Some(r) => r.bias0(),
+                            None => o.bias.as_ref().map_or(f64::NAN, |b| b[0]),
+                        };
                         extra[..4].copy_from_slice(&[
                             o.noise_sigma.unwrap_or(f64::NAN),
                             f64::from(u8::from(o.outlier)),
                             f64::from(u8::from(o.misfit)),
-                            o.bias.as_ref().map_or(f64::NAN, |b| b[0]),
+                            bias0,
                         ]);
                         store_decisions(&o.decided, &mut extra[4..4 + DECISION_CELLS]);
                         extra[4 + DECISION_CELLS] = o.degree as f64;
@@ -321,7 +353,10 @@ impl AnyFilter {
                     // The estimate is at t: the update's own, or across a rejected sample the
                     // prediction; with a lead the active filter's, the same way.
                     if lead == 0.0 {
-                        store(o.estimate.as_ref(), sigma, values).map_err(at(index))?;
+                        match reported {
+                            Some(r) => store_reported(r.derivatives(), r.std_devs(), sigma, values),
+                            None => store(o.estimate.as_ref(), sigma, values).map_err(at(index))?,
+                        }
                         continue;
                     }
                     f.estimate_at(t + lead)
@@ -383,6 +418,17 @@ fn reasoned(estimate: Result<PolynomialState, Error>) -> Result<Option<Polynomia
         Ok(s) => Ok(Some(s)),
         Err(Error::TooFewSamples { .. }) => Ok(None),
         Err(e) => Err(e),
+    }
+}
+
+/// [`store`] of the automatic filter's reported derivatives `x` and their 1σ `sd`
+/// (`AutomaticFilter::update_row`): the same cells.
+fn store_reported(x: &[f64], sd: &[f64], sigma: bool, values: &mut [f64]) {
+    let width = values.len() >> usize::from(sigma);
+    let nd = x.len().min(width);
+    values[..nd].copy_from_slice(&x[..nd]);
+    if sigma {
+        values[width..width + nd].copy_from_slice(&sd[..nd]);
     }
 }
 

@@ -439,6 +439,42 @@ impl InformationFilter {
         true
     }
 
+    /// The diagonal of [`Self::covariance_of_rows`] alone (`n` values into `out`), each entry
+    /// by the same operations in the same order (bit for bit), without the products of
+    /// different rows: the rows' variances where only they are wanted (the automatic filter's
+    /// reported 1σ). `false` while not determined.
+    pub(crate) fn covariance_diagonal_of_rows(
+        &self,
+        rows: &mut [f64],
+        inv: &mut [f64],
+        out: &mut [f64],
+    ) -> bool {
+        unrolled_sizes!(self.dim(), N => self.covariance_diagonal_of_rows_with(Fixed::<N>, rows, inv, out), p => self.covariance_diagonal_of_rows_with(Any(p), rows, inv, out))
+    }
+
+    #[inline(always)]
+    fn covariance_diagonal_of_rows_with(
+        &self,
+        size: impl Size,
+        rows: &mut [f64],
+        inv: &mut [f64],
+        out: &mut [f64],
+    ) -> bool {
+        let p = size.get();
+        let solved = self.for_each_solved_row(size, rows, inv, |j, spread| match spread {
+            None => j.iter_mut().for_each(|v| *v *= self.scale),
+            Some(q) => q.unit_upper_times(size, j),
+        });
+        if !solved {
+            return false;
+        }
+        let weight = |i: usize| self.spread.as_ref().map_or(1.0, |q| q.pivot(i));
+        for (o, r) in out.iter_mut().zip(rows.chunks_exact(p)) {
+            *o = (0..p).map(|i| weight(i) * r[i] * r[i]).sum();
+        }
+        true
+    }
+
     /// Each row `j` of `rows` (`p` values) replaced by `(J R⁻¹)ᵀ` from the stored factor (`R`
     /// times the lazy scale), or with the true covariance kept by `kᵀ = R⁻¹ (J R⁻¹)ᵀ`, and
     /// handed to `f` with `Q` when it is kept; `false` (and no row touched) while not

@@ -337,6 +337,40 @@ impl AutomaticFilter {
         }
     }
 
+    /// [`update`](Self::update) for the row runner (`AnyFilter::run_rows`, the rows of
+    /// `seqsmooth filter` and of the Python package): the newest output keeps, in place of its
+    /// estimate, what the rows write of it ([`reported`](Self::reported): derivatives, 1σ,
+    /// `b₀`, the same numbers), where the filters give it without allocating; the caller
+    /// calls [`complete_output`](Self::complete_output) before anyone else reads
+    /// [`last_output`](Self::last_output).
+    pub(crate) fn update_row(&mut self, t: f64, y: f64) -> Result<(), Error> {
+        self.state.set_rows(true);
+        let result = self.update_kept(t, y);
+        self.state.set_rows(false);
+        result
+    }
+
+    /// The newest [`update_row`](Self::update_row)'s reported estimate (`None`: the output
+    /// has its full estimate, or none and the reason).
+    pub(crate) fn reported(&self) -> Option<&super::output::Reported> {
+        let out = self.last_output.as_ref()?;
+        (out.estimate.is_none() && out.withheld.is_none())
+            .then(|| self.state.reported())
+            .flatten()
+    }
+
+    /// The newest output with its full estimate and bias where
+    /// [`update_row`](Self::update_row) kept only what the rows write: computed now from the
+    /// state, unchanged since that update, by the update's own path (the same numbers).
+    pub(crate) fn complete_output(&mut self) {
+        if let Some(out) = self.last_output.as_mut() {
+            if out.estimate.is_none() && out.withheld.is_none() {
+                let (estimate, bias, withheld) = self.state.report(out.outlier, out.time);
+                (out.estimate, out.bias, out.withheld) = (estimate, bias, withheld);
+            }
+        }
+    }
+
     /// The index `j` of the memory in use: the final degree's discount is `θ^(4^j)` per `τ`
     /// (0: the configured `θ`; see the [module docs](super) and
     /// [`AutoConfig::memory_levels`]).

@@ -449,6 +449,23 @@ impl Memories {
         }
     }
 
+    /// Memory `j`'s estimate at `t`, its derivatives into `x` and its covariance's diagonal
+    /// into `var`: the numbers of its [`PolynomialFilter::estimate_at`] bit for bit, without
+    /// allocating (false where that path does not answer: the caller takes the estimate).
+    pub(super) fn estimate_diagonal(
+        &self,
+        j: usize,
+        t: f64,
+        x: &mut [f64],
+        var: &mut [f64],
+    ) -> bool {
+        match (j, &self.expanding, self.switched) {
+            (0, Some(e), false) => e.estimate_diagonal_at(t, x, var),
+            (0, _, _) => self.fading.estimate_diagonal_at(t, x, var),
+            (j, _, _) => self.shorter[j - 1].fading.estimate_diagonal_at(t, x, var),
+        }
+    }
+
     /// The position at `t` and its unit variance from memory `j`'s companion.
     pub(super) fn companion_position(&self, j: usize, t: f64) -> Option<(f64, f64)> {
         if j > 0 {

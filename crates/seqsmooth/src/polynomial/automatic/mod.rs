@@ -191,6 +191,8 @@ mod window_fit;
 
 #[cfg(test)]
 mod leading_tests;
+#[cfg(test)]
+mod rows_tests;
 
 pub use config::{AutoConfig, GATE_MAX_VRF, MAX_MEMORY_LEVELS, MAX_REVIEW_WINDOW};
 pub use filter::AutomaticFilter;

@@ -6,6 +6,7 @@ use super::phase::Phase;
 #[cfg(doc)]
 use super::{AutomaticFilter, MisfitResponse};
 use crate::model::PolynomialState;
+use crate::polynomial::options::MAX_DEGREE;
 use crate::stats::ChiSquaredOutcome;
 
 /// The result of one [`AutomaticFilter::update`], kept as [`AutomaticFilter::last_output`].
@@ -107,6 +108,48 @@ impl AutoOutput {
     /// ```
     pub fn std_devs(&self) -> Option<Vec<f64>> {
         self.estimate.as_ref().and_then(|s| s.std_devs())
+    }
+}
+
+/// What the rows of an update write of its reported estimate (the row runner's path,
+/// `AutomaticFilter::update_row`): the derivatives of [`AutoOutput::estimate`], their 1σ (the
+/// square roots of its covariance's diagonal, the same numbers bit for bit) and the first
+/// entry of [`AutoOutput::bias`], without the covariance matrix (no allocation, no products
+/// off the diagonal).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Reported {
+    pub(super) derivatives: [f64; MAX_DEGREE + 1],
+    pub(super) std_devs: [f64; MAX_DEGREE + 1],
+    pub(super) len: usize,
+    /// `b₀`, NaN where [`AutoOutput::bias`] is `None`.
+    pub(super) bias0: f64,
+}
+
+impl Default for Reported {
+    fn default() -> Self {
+        Self {
+            derivatives: [0.0; MAX_DEGREE + 1],
+            std_devs: [0.0; MAX_DEGREE + 1],
+            len: 0,
+            bias0: f64::NAN,
+        }
+    }
+}
+
+impl Reported {
+    /// `x, x', …` of the active degree.
+    pub(crate) fn derivatives(&self) -> &[f64] {
+        &self.derivatives[..self.len]
+    }
+
+    /// Their 1σ (`σ² V + b bᵀ` widened by the calibration, its diagonal's square roots).
+    pub(crate) fn std_devs(&self) -> &[f64] {
+        &self.std_devs[..self.len]
+    }
+
+    /// The position's estimated bias `b₀` (NaN: none, [`AutoOutput::bias`] `None`).
+    pub(crate) fn bias0(&self) -> f64 {
+        self.bias0
     }
 }
 

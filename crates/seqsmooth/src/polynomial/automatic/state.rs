@@ -11,12 +11,13 @@ use super::memory::Memories;
 use super::misfit::{Kept, Misfit};
 use super::noise::NoiseState;
 use super::outlier::{gate_width, Judged, Run};
-use super::output::{AutoOutput, Withheld};
+use super::output::{AutoOutput, Reported, Withheld};
 use super::phase::Phase;
 use super::review::Replay;
 use super::settle::Ladder;
 use crate::error::Error;
 use crate::model::PolynomialState;
+use crate::numeric::sigma::std_dev;
 use crate::polynomial::filter::PolynomialFilter;
 use crate::polynomial::options::MAX_DEGREE;
 use crate::stats::ChiSquaredOutcome;
@@ -35,6 +36,33 @@ pub(super) struct State {
     /// The innovations' mean square excess over their noise-only variance in the misfit
     /// window, `max(0, mean(k²) − 1)·σ²(1 + v)` (value units²), at the newest sample.
     excess: f64,
+    /// The row runner's path ([`Rows`]): not saved, not copied.
+    #[serde(skip)]
+    rows: Rows,
+}
+
+/// The row runner's path (`AutomaticFilter::update_row`): while `on`, an update reports its
+/// estimate as [`Reported`] (derivatives, 1σ, `b₀`: what the rows write) instead of the
+/// [`AutoOutput::estimate`] with its covariance matrix, where the filters answer without
+/// allocating; the output then has neither an estimate nor a reason why not, and
+/// [`State::report`] gives the full one on request (the state unchanged since). A copy of the
+/// state (the review's kept states, its replays) starts with the path off and nothing
+/// reported: the row runner sets it again before each update.
+#[derive(Debug, Default)]
+struct Rows {
+    on: bool,
+    /// The newest update reported `reported` (else it is stale).
+    valid: bool,
+    reported: Reported,
+}
+
+impl Clone for Rows {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+    fn clone_from(&mut self, _: &Self) {
+        *self = Self::default();
+    }
 }
 
 // Field by field, `clone_from` too: a kept copy of the state (the review's) is taken again
@@ -48,7 +76,8 @@ field_clone!(State {
     run,
     accepted,
     last_time,
-    excess
+    excess,
+    rows
 });
 
 impl State {
@@ -75,6 +104,7 @@ impl State {
             accepted: 0,
             last_time: None,
             excess: 0.0,
+            rows: Rows::default(),
         })
     }
 
@@ -191,6 +221,7 @@ impl State {
         force: Option<bool>,
     ) -> Result<AutoOutput, Error> {
         self.last_time = Some(t);
+        self.rows.valid = false;
         self.memories.switch_if_due(&self.cfg, t, self.accepted)?;
         let judged = self.judge(t, y);
         let (sigma, innovation, vrf) = (judged.sigma, judged.innovation, judged.vrf);
@@ -253,23 +284,10 @@ impl State {
             }
         }
         let outlier = rejected && !manoeuvre;
-        let raw = if outlier {
-            self.active_filter().estimate_at(t)
+        let (estimate, bias, withheld) = if self.rows.on && self.report_row(outlier, t) {
+            (None, None, None)
         } else {
-            self.active_filter().estimate()
-        };
-        // Right or refused: no estimate without its σ, and an estimate with a number beyond
-        // the double range is none (`try_estimate_at` names it); `withheld` says which.
-        let (estimate, bias, withheld) = match (raw, self.noise_sigma()) {
-            (_, None) => (None, None, Some(Withheld::NoiseUnknown)),
-            (None, _) => (None, None, Some(Withheld::NotDetermined)),
-            (Some(raw), Some(_)) => {
-                let (s, b) = self.honest(raw);
-                match s.checked() {
-                    Ok(s) => (Some(s), b.filter(|b| b.iter().all(|v| v.is_finite())), None),
-                    Err(_) => (None, None, Some(Withheld::OutOfRange)),
-                }
-            }
+            self.report(outlier, t)
         };
         Ok(AutoOutput {
             time: t,
@@ -290,6 +308,110 @@ impl State {
             chi_squared: chi_out,
             decided: Vec::new(),
         })
+    }
+
+    /// The reported estimate at `t` after the newest update (`outlier`: that sample was
+    /// rejected, the estimate is the prediction across it), its bias and why there is none:
+    /// the honest estimate ([`honest`](Self::honest)) of the active filter. Right or refused:
+    /// no estimate without its σ, and an estimate with a number beyond the double range is
+    /// none (`try_estimate_at` names it); `withheld` says which.
+    pub(super) fn report(
+        &self,
+        outlier: bool,
+        t: f64,
+    ) -> (Option<PolynomialState>, Option<Vec<f64>>, Option<Withheld>) {
+        let raw = if outlier {
+            self.active_filter().estimate_at(t)
+        } else {
+            self.active_filter().estimate()
+        };
+        match (raw, self.noise_sigma()) {
+            (_, None) => (None, None, Some(Withheld::NoiseUnknown)),
+            (None, _) => (None, None, Some(Withheld::NotDetermined)),
+            (Some(raw), Some(_)) => {
+                let (s, b) = self.honest(raw);
+                match s.checked() {
+                    Ok(s) => (Some(s), b.filter(|b| b.iter().all(|v| v.is_finite())), None),
+                    Err(_) => (None, None, Some(Withheld::OutOfRange)),
+                }
+            }
+        }
+    }
+
+    /// [`report`](Self::report) as the rows need it, into `self.rows.reported`: the
+    /// derivatives and the diagonal of the honest covariance `factor·(σ² V + b bᵀ)`, each
+    /// number by the same operations in the same order as there (the active filter's and its
+    /// companion's [`variances`](Memories::estimate_diagonal) without allocating, the bias of
+    /// [`bias_of`](Self::bias_of), the diagonal of [`bias::honest`]). False (nothing
+    /// reported) where that path does not answer or cannot tell the estimate within the
+    /// double range from the diagonal: no `σ` yet, a filter not determined or on the gain
+    /// engine, no companion, a number that is not finite or an honest variance above `1e300`
+    /// (below it every entry `|C_ij| ≤ √(C_ii C_jj)` is finite); the caller takes
+    /// [`report`](Self::report) then.
+    fn report_row(&mut self, outlier: bool, t: f64) -> bool {
+        const P: usize = MAX_DEGREE + 1;
+        const LIMIT: f64 = 1e300;
+        let Some(sigma) = self.noise_sigma() else {
+            return false;
+        };
+        let active = self.active_filter();
+        let p = active.degree() + 1;
+        // `estimate()` is the estimate at the newest sample's time.
+        let at = if outlier { Some(t) } else { active.last_time() };
+        // Written in place: the derivatives into the row's own cells.
+        let mut r = Reported::default();
+        let (x, mut v) = (&mut r.derivatives, [0.0; P]);
+        let (mut xu, mut vu) = ([0.0; P], [0.0; P]);
+        let answered = at.is_some_and(|at| {
+            self.active_diagonal(at, x, &mut v) && self.companion_variances(at, &mut xu, &mut vu)
+        });
+        // A derivative beyond the double range: the estimate is refused as not determined
+        // (`try_estimate_at`), which the full path says.
+        if !answered || !x[..p].iter().all(|x| x.is_finite()) {
+            return false;
+        }
+        let mut b = [0.0; P];
+        for i in 0..p {
+            b[i] = position_bias((x[i], v[i]), (xu[i], vu[i]), sigma, bias::SIGNIFICANCE);
+        }
+        b[0] = at_least(b[0], self.excess.sqrt());
+        let factor = self.memories.calibration_factor(self.ladder.settled());
+        let s2 = sigma * sigma;
+        for i in 0..p {
+            let h = (v[i] * s2 + b[i] * b[i]) * factor;
+            if h.is_nan() || h.abs() > LIMIT {
+                return false;
+            }
+            r.std_devs[i] = std_dev(h);
+        }
+        if b[..p].iter().all(|b| b.is_finite()) {
+            r.bias0 = b[0];
+        }
+        r.len = p;
+        self.rows.reported = r;
+        self.rows.valid = true;
+        true
+    }
+
+    /// The row runner's path on or off for the next update ([`Rows`]).
+    pub(super) fn set_rows(&mut self, on: bool) {
+        self.rows.on = on;
+    }
+
+    /// What the newest update reported on the row runner's path ([`Rows`]), if it did.
+    pub(super) fn reported(&self) -> Option<&Reported> {
+        self.rows.valid.then_some(&self.rows.reported)
+    }
+
+    /// The active filter's estimate at `t`, its derivatives into `x` and its covariance's
+    /// diagonal into `var`, the numbers of its `estimate_at` bit for bit, without allocating;
+    /// false where that path does not answer.
+    fn active_diagonal(&self, t: f64, x: &mut [f64], var: &mut [f64]) -> bool {
+        let d = self.ladder.active();
+        match self.ladder.filter(d).filter(|_| d < self.cfg.degree) {
+            Some(f) => f.estimate_diagonal_at(t, x, var),
+            None => (self.memories).estimate_diagonal(self.memories.in_use(), t, x, var),
+        }
     }
 
     /// Applies an accepted sample to every filter, the noise estimate and the misfit window;

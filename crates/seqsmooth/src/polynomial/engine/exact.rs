@@ -487,6 +487,55 @@ impl ExactEngine {
         Some((x, cov))
     }
 
+    /// [`Self::estimate_at`]'s derivatives into `x` and its covariance's diagonal into `var`
+    /// (`m + 1` each) without allocating: each number by the same operations in the same
+    /// order, bit for bit ([`InformationFilter::covariance_diagonal_of_rows`], then
+    /// `σ² D(s) … D(s)` entry by entry as [`Self::covariance_with`] scales them). `false` (the
+    /// slices unspecified) where `estimate_at` takes another path or has no covariance (not
+    /// determined, no tracked `σ`, a unit out of range), and where a number of the diagonal or
+    /// of the scaling exceeds `1e60`: below that every entry of the full covariance is finite
+    /// (`|C_ij| ≤ √(C_ii C_jj)`, rounding aside), so the diagonal alone answers whether the
+    /// estimate is within the double range.
+    pub fn estimate_diagonal_into(&self, t: f64, x: &mut [f64], var: &mut [f64]) -> bool {
+        const LIMIT: f64 = 1e60;
+        let Some(sigma) = self.sigma else {
+            return false;
+        };
+        let s2 = sigma * sigma;
+        if !(self.unscale_in_range && self.is_determined() && s2 <= LIMIT) {
+            return false;
+        }
+        if !self.derivatives_into(t, x) {
+            return false;
+        }
+        let v = (t - self.centre) * self.inv_unit;
+        let p = self.m + 1;
+        let mut diag = [0.0; MAX_SIZE];
+        let solved = unrolled_sizes!(p, N => self.diagonal_with(v, [[0.0; N]; N].as_flattened_mut(), &mut diag[..p]), _ => self.diagonal_with(v, &mut vec![0.0; p * p], &mut diag[..p]));
+        if !solved {
+            return false;
+        }
+        let d = &self.unscale;
+        for (i, (o, c)) in var[..p].iter_mut().zip(&diag[..p]).enumerate() {
+            if c.is_nan() || *c > LIMIT || d[i] > LIMIT {
+                return false;
+            }
+            *o = c * s2 * d[i] * d[i];
+        }
+        true
+    }
+
+    /// The diagonal of `Φ(v) C Φ(v)ᵀ` into `diag` ([`Self::covariance_with`]'s, before its
+    /// scaling); `rows` is `p²` zeroed scratch.
+    #[inline(always)]
+    fn diagonal_with(&self, v: f64, rows: &mut [f64], diag: &mut [f64]) -> bool {
+        let p = self.m + 1;
+        phi_rows(v, p, rows);
+        let mut inv = [0.0; MAX_DEGREE + 1];
+        self.info
+            .covariance_diagonal_of_rows(rows, &mut inv[..p], diag)
+    }
+
     /// The covariance of the unscaled derivatives at `v` (in the basis' units) with one
     /// allocation, its own: `σ² D(s) Φ(v) C Φ(v)ᵀ D(s)`
     /// ([`InformationFilter::covariance_of_rows`]); `rows` and `cov` are `p²` scratch values.

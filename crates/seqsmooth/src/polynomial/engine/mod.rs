@@ -307,6 +307,26 @@ impl EngineState {
         x[..p].iter().chain(&var[..p]).all(|v| v.is_finite())
     }
 
+    /// [`Self::try_estimate_at`]'s derivatives and its covariance's diagonal into `x` and `var`
+    /// (`m + 1` each), the same numbers bit for bit, without allocating: the exact engine's
+    /// [`ExactEngine::estimate_diagonal_into`]. `false` where that does not answer (the gain
+    /// engine, not determined, a number beyond its range: the caller takes the estimate).
+    pub(crate) fn estimate_diagonal_at(
+        &self,
+        m: usize,
+        t: f64,
+        x: &mut [f64],
+        var: &mut [f64],
+    ) -> bool {
+        if !self.enough_samples(m) || !t.is_finite() {
+            return false;
+        }
+        match self {
+            EngineState::Exact(e) => e.estimate_diagonal_into(t, x, var),
+            EngineState::Gain(_) => false,
+        }
+    }
+
     /// The batch σ path ([`PolynomialFilter::update_many_sigma_into`]): rows of `2(m+1)`,
     /// the derivatives and their 1σ after each sample, in chunks of [`FUSED_CHUNK`] as
     /// [`Self::update_many`]; without a covariance matrix per sample (the gain engine's

@@ -62,6 +62,14 @@ impl ExpandingMemory {
         self.core.variances_at(self.m, t, x, var)
     }
 
+    /// The estimate's derivatives at `t` and its covariance's diagonal into `x` and `var`
+    /// (`m + 1` each), the numbers of [`PolynomialFilter::estimate_at`] bit for bit, without
+    /// allocating on the exact engine; false where that path does not answer (the caller takes
+    /// the estimate).
+    pub(crate) fn estimate_diagonal_at(&self, t: f64, x: &mut [f64], var: &mut [f64]) -> bool {
+        self.core.estimate_diagonal_at(self.m, t, x, var)
+    }
+
     /// A filter of degree `m` on the given engine.
     ///
     /// ```
