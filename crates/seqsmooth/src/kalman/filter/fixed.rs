@@ -537,12 +537,15 @@ fn update<const N: usize, const K: usize, const UNIT: bool>(
     covariance.as_mut_slice()[..N * N].copy_from_slice(s_out.as_flattened());
     if prediction {
         w.x.as_mut_slice()[..N].copy_from_slice(&xp);
-        // `S_{n,n−1}` made `+0` where it is `−0` here, off the chain ([`predict_exact`]).
+        // `S_{n,n−1}` made `+0` where it is `−0` here, off the chain ([`predict_exact`]);
+        // with no step it is the covariance as it was, copied unchanged (as the generic
+        // path's `predict_work` copies it).
+        let zero = if step.is_some() { 0.0 } else { -0.0 };
         for (to, s) in w.s.as_mut_slice()[..N * N]
             .iter_mut()
             .zip(sp.as_flattened())
         {
-            *to = s + 0.0;
+            *to = s + zero;
         }
     }
     if innovation {

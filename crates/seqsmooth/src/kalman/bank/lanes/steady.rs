@@ -190,11 +190,12 @@ unsafe fn put_rows<const N: usize, const L: usize>(
         let sd = rows(sigma(0), sigma(1));
         // One bounds check for the four rows: the last of them in each buffer.
         let top = r.iter().fold(0, |top, &row| top.max(row));
+        // `..=top` first: it checks `top < len`, so `(top + 1) * 2` below cannot wrap.
+        let to_nis = &mut out.nis[..=top];
         let (to_state, to_sigma) = (
             &mut out.state[..(top + 1) * 2],
             &mut out.sigma[..(top + 1) * 2],
         );
-        let to_nis = &mut out.nis[..top + 1];
         for e in 0..L {
             // SAFETY: `r[e] ≤ top`, so row `r[e]`'s two `f64` (the 16 bytes stored) and its
             // NIS are inside the slices just checked; AVX2 is the caller's.
