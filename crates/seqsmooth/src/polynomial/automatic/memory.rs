@@ -203,11 +203,7 @@ struct Shorter {
 }
 
 // Field by field, `clone_from` too (the review's kept copies reuse their buffers).
-field_clone!(Shorter {
-    fading,
-    upper,
-    stale
-});
+field_clone! { Shorter { fading, upper, stale } }
 
 impl Shorter {
     /// Brings `fading` up to `upper`'s samples from `upper`'s leading block
@@ -307,24 +303,13 @@ pub(super) struct Memories {
 }
 
 // Field by field, `clone_from` too (the review's kept copies reuse their buffers).
-field_clone!(Memories {
-    expanding,
-    fading,
-    upper_expanding,
-    upper_fading,
-    shorter,
-    memory,
-    longer_runs,
-    compared,
-    predictions,
-    calibration,
-    switched_at,
-    switched,
-    t_first,
-    switch_constant,
-    memory_constant,
-    fresh
-});
+field_clone! {
+    Memories {
+        expanding, fading, upper_expanding, upper_fading, shorter, memory, longer_runs, compared,
+        predictions, calibration, switched_at, switched, t_first, switch_constant, memory_constant,
+        fresh,
+    }
+}
 
 impl Memories {
     /// The memories of `cfg`'s final degree, before the first sample.

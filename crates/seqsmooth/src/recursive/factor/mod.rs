@@ -68,14 +68,7 @@ pub struct TriangularFactor {
 }
 
 // Field by field, `clone_from` too (the automatic filter's review keeps copies of it).
-field_clone!(TriangularFactor {
-    d,
-    u,
-    ubar,
-    residual_sq,
-    positive,
-    scratch
-});
+field_clone! { TriangularFactor { d, u, ubar, residual_sq, positive, scratch } }
 
 /// A pivot `d_i` alone in a 16-byte slot, so that no two pivots share a (vectorised) load or
 /// store. In the reciprocal form of [`TriangularFactor::add_row`] the next row's `1/d_i` is
