@@ -406,9 +406,11 @@ impl InformationFilter {
         out: &mut [f64],
     ) -> bool {
         // As in `variances_of_rows`: the sizes compiled in, the same operations in order.
-        unrolled_sizes!(self.dim(), N => self.covariance_of_rows_with(Fixed::<N>, rows, inv, out), p => self.covariance_of_rows_with(Any(p), rows, inv, out))
+        unrolled_sizes!(self.dim(), N => self.covariance_of_rows_with(Fixed::<N>, rows, inv, out, true), p => self.covariance_of_rows_with(Any(p), rows, inv, out, true))
     }
 
+    /// Both: with `full` the whole `n × n` matrix, else its diagonal alone (`n` values),
+    /// each entry by the same operations.
     #[inline(always)]
     fn covariance_of_rows_with(
         &self,
@@ -416,6 +418,7 @@ impl InformationFilter {
         rows: &mut [f64],
         inv: &mut [f64],
         out: &mut [f64],
+        full: bool,
     ) -> bool {
         let p = size.get();
         let solved = self.for_each_solved_row(size, rows, inv, |j, spread| match spread {
@@ -429,11 +432,15 @@ impl InformationFilter {
         let n = rows.len() / p;
         let weight = |i: usize| self.spread.as_ref().map_or(1.0, |q| q.pivot(i));
         for a in 0..n {
-            for b in 0..=a {
+            for b in (if full { 0 } else { a })..=a {
                 let (ra, rb) = (&rows[a * p..(a + 1) * p], &rows[b * p..(b + 1) * p]);
                 let v = (0..p).map(|i| weight(i) * ra[i] * rb[i]).sum();
-                out[a * n + b] = v;
-                out[b * n + a] = v;
+                if full {
+                    out[a * n + b] = v;
+                    out[b * n + a] = v;
+                } else {
+                    out[a] = v;
+                }
             }
         }
         true
@@ -449,30 +456,7 @@ impl InformationFilter {
         inv: &mut [f64],
         out: &mut [f64],
     ) -> bool {
-        unrolled_sizes!(self.dim(), N => self.covariance_diagonal_of_rows_with(Fixed::<N>, rows, inv, out), p => self.covariance_diagonal_of_rows_with(Any(p), rows, inv, out))
-    }
-
-    #[inline(always)]
-    fn covariance_diagonal_of_rows_with(
-        &self,
-        size: impl Size,
-        rows: &mut [f64],
-        inv: &mut [f64],
-        out: &mut [f64],
-    ) -> bool {
-        let p = size.get();
-        let solved = self.for_each_solved_row(size, rows, inv, |j, spread| match spread {
-            None => j.iter_mut().for_each(|v| *v *= self.scale),
-            Some(q) => q.unit_upper_times(size, j),
-        });
-        if !solved {
-            return false;
-        }
-        let weight = |i: usize| self.spread.as_ref().map_or(1.0, |q| q.pivot(i));
-        for (o, r) in out.iter_mut().zip(rows.chunks_exact(p)) {
-            *o = (0..p).map(|i| weight(i) * r[i] * r[i]).sum();
-        }
-        true
+        unrolled_sizes!(self.dim(), N => self.covariance_of_rows_with(Fixed::<N>, rows, inv, out, false), p => self.covariance_of_rows_with(Any(p), rows, inv, out, false))
     }
 
     /// Each row `j` of `rows` (`p` values) replaced by `(J R⁻¹)ᵀ` from the stored factor (`R`
